@@ -1,0 +1,24 @@
+// Source readers. Each fills the neutral Tractogram (RAS mm, float32) and the SourceInfo provenance,
+// and throws vxl::Error naming the file, the byte offset and what was expected on malformed input.
+//
+//   TCK  (MRtrix):   read_tck.cpp   — Float32/64, LE/BE; NaN ends a streamline, Inf the file.
+//   TRK  (TrackVis): read_trk.cpp   — v1/v2, either endianness, voxmm -> RAS, .trk.gz.
+//   TRX:             read_trx.cpp   — zip (stored/deflated) or directory; float16/32/64; uint32/64
+//                                     offsets with or without the sentinel; groups kept.
+#pragma once
+
+#include <string>
+
+#include "tractogram.h"
+
+namespace vxl {
+
+Tractogram read_tck(const std::string& path);
+Tractogram read_trk(const std::string& path);
+Tractogram read_trx(const std::string& path);
+
+// Chooses the reader from the file name (.tck, .trk, .trk.gz, .trx or a directory ending in .trx);
+// throws an Unsupported error for anything else (e.g. .vtk, .tsf) that says what is supported.
+Tractogram read_tractogram(const std::string& path);
+
+}  // namespace vxl

@@ -1,0 +1,52 @@
+// The neutral in-memory tractogram every source reader fills and every later stage consumes.
+//
+// Coordinate convention: RAS millimetres (world space of TCK/TRX; TRK readers map voxmm to RAS).
+// Positions are float32 because every stage after reading (voxel assignment, the .vxl file, export)
+// works on exactly these values: a float32 source round-trips bit-exactly.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace vxl {
+
+struct StreamlineGroup {
+  std::string name;
+  std::vector<std::uint64_t> members;  // streamline indices, strictly increasing
+};
+
+// What the readers know of the source file, kept as provenance in the .vxl.
+struct SourceInfo {
+  std::string path;             // as given by the user
+  std::string format;           // "tck", "trk", "trx"
+  std::string dtype;            // coordinate type in the source, e.g. "Float32LE", "float16"
+  std::uint64_t bytes = 0;      // size of the source (sum of member files for a TRX directory)
+  std::string xxh3_128;         // 32 hex digits (see spec §5.8)
+  nlohmann::json header;        // the source header as JSON
+  std::optional<std::array<double, 16>> vox_to_ras;  // row-major 4x4, when the source has one
+  std::vector<std::string> warnings;  // non-fatal problems found while reading
+};
+
+struct Tractogram {
+  std::vector<float> positions;        // x,y,z interleaved, 3 * point_count() floats
+  std::vector<std::uint64_t> offsets;  // streamline i = points [offsets[i], offsets[i+1]); size N+1
+  std::vector<StreamlineGroup> groups;  // TRX groups, when the source has them
+  SourceInfo source;
+
+  Tractogram() : offsets{0} {}
+  std::uint64_t streamline_count() const { return offsets.size() - 1; }
+  std::uint64_t point_count() const { return positions.size() / 3; }
+
+  // Appends one streamline of n points (xyz interleaved).
+  void add_streamline(const float* xyz, std::size_t n) {
+    positions.insert(positions.end(), xyz, xyz + 3 * n);
+    offsets.push_back(point_count());
+  }
+};
+
+}  // namespace vxl

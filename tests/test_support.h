@@ -1,0 +1,70 @@
+// Helpers shared by the tests: where the real fixtures are, scratch directories, running the CLI.
+#pragma once
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+namespace vxl::test {
+
+// The real-world fixtures (../shared/data/real). A user's clone does not have them: tests that need
+// them call this first and are skipped with a clear message.
+inline std::filesystem::path real_data_dir() { return VOXLINES_REAL_DATA_DIR; }
+inline bool have_real_data() { return std::filesystem::is_directory(real_data_dir()); }
+#define VXL_REQUIRE_REAL_DATA()                                                                  \
+  do {                                                                                           \
+    if (!::vxl::test::have_real_data())                                                          \
+      GTEST_SKIP() << "real fixtures not found at " << ::vxl::test::real_data_dir()              \
+                   << " (they live in ../shared/data/real beside the project; CI has them)";     \
+  } while (0)
+inline std::string real(const std::string& name) { return (real_data_dir() / name).string(); }
+
+// A fresh scratch directory per test, removed at the end.
+class ScratchDir {
+ public:
+  ScratchDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = std::string(info ? info->test_suite_name() : "t") + "_" + (info ? info->name() : "x");
+    for (char& c : name)
+      if (c == '/') c = '_';
+    path_ = std::filesystem::temp_directory_path() / ("voxlines_test_" + name + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+struct CommandResult {
+  int exit_code;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs the `voxlines` CLI with the given argument string (shell syntax).
+inline CommandResult run_cli(const std::string& args) {
+  std::string cmd = std::string(VOXLINES_CLI) + " " + args + " 2>&1";
+  CommandResult r{-1, {}};
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  int status = ::pclose(p);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+}  // namespace vxl::test
