@@ -1,0 +1,71 @@
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "vxl_file.h"
+
+namespace vxl::cli {
+
+void add_info_command(CLI::App& app) {
+  struct Options {
+    std::string file;
+    bool json = false;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("info", "Summarise a .vxl file (opens and validates its tables, O(voxels))");
+  cmd->add_option("file", opt->file, ".vxl file")->required();
+  cmd->add_flag("--json", opt->json, "print JSON instead of text");
+  cmd->callback([opt] {
+    VxlFile f = VxlFile::open(opt->file);
+    const MetaSection& m = f.meta();
+    nlohmann::json j;
+    j["file"] = opt->file;
+    j["version"] = std::to_string(f.header().version_major) + "." + std::to_string(f.header().version_minor);
+    j["bytes"] = f.bytes().size();
+    j["streamlines"] = m.streamline_count;
+    j["points"] = m.point_count;
+    j["voxels"] = m.voxel_count;
+    j["segments"] = m.segment_count;
+    j["vertices"] = m.vertex_count;
+    j["voxlines"] = m.voxline_count;
+    j["synthetic_points"] = m.synthetic_point_count;
+    j["voxel_size"] = m.voxel_size;
+    j["grid_dims"] = {m.grid_dims[0], m.grid_dims[1], m.grid_dims[2]};
+    j["bounds"] = {{"min", {m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]}},
+                   {"max", {m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]}}};
+    j["stored_orders"] = m.stored_order_count;
+    nlohmann::json sections = nlohmann::json::array();
+    for (const SectionEntry& e : f.sections())
+      sections.push_back({{"id", std::string(e.id, 4)}, {"offset", e.offset}, {"bytes", e.size}});
+    j["sections"] = sections;
+    auto prov = nlohmann::json::parse(f.provenance_json(), nullptr, false);
+    if (!prov.is_discarded() && prov.contains("source")) {
+      j["source"] = {{"name", prov["source"].value("name", "")}, {"format", prov["source"].value("format", "")},
+                     {"bytes", prov["source"].value("bytes", 0)}};
+    }
+    if (opt->json) {
+      std::printf("%s\n", j.dump(2).c_str());
+      return;
+    }
+    std::printf("file          %s (.vxl %s, %llu bytes)\n", opt->file.c_str(), j["version"].get<std::string>().c_str(),
+                (unsigned long long)f.bytes().size());
+    if (j.contains("source"))
+      std::printf("source        %s (%s, %llu bytes)\n", j["source"]["name"].get<std::string>().c_str(),
+                  j["source"]["format"].get<std::string>().c_str(), (unsigned long long)j["source"]["bytes"].get<std::uint64_t>());
+    std::printf("streamlines   %llu\npoints        %llu\nvoxels        %u (grid %d x %d x %d)\n",
+                (unsigned long long)m.streamline_count, (unsigned long long)m.point_count, m.voxel_count, m.grid_dims[0],
+                m.grid_dims[1], m.grid_dims[2]);
+    std::printf("segments      %llu\nvertices      %llu (%llu points added at voxel faces)\n",
+                (unsigned long long)m.segment_count, (unsigned long long)m.vertex_count,
+                (unsigned long long)m.synthetic_point_count);
+    std::printf("voxel size    %g mm\norders        %u stored (x2 by reversal)\n", m.voxel_size, m.stored_order_count);
+    std::printf("bounds        [%.3f, %.3f, %.3f] .. [%.3f, %.3f, %.3f] mm\nsections     ", m.bounds_min[0],
+                m.bounds_min[1], m.bounds_min[2], m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]);
+    for (const SectionEntry& e : f.sections())
+      std::printf(" %.4s:%llu", e.id, (unsigned long long)e.size);
+    std::printf("\n");
+  });
+}
+
+}  // namespace vxl::cli

@@ -1,0 +1,25 @@
+#include <cstdio>
+
+#include "commands.h"
+#include "vxl_verify.h"
+
+namespace vxl::cli {
+
+void add_verify_command(CLI::App& app) {
+  auto file = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand(
+      "verify", "Check a .vxl completely: structure, every checksum, padding, orders, streamline tables.\n"
+                "Exit 0 when valid, 1 when invalid (the reason is printed).");
+  cmd->add_option("file", *file, ".vxl file")->required();
+  cmd->callback([file] {
+    VerifyResult r = verify_vxl(*file);
+    if (r.valid) {
+      std::printf("%s: valid\n", file->c_str());
+    } else {
+      std::fprintf(stderr, "%s: INVALID: %s\n", file->c_str(), r.problem.c_str());
+      g_exit_code = 1;
+    }
+  });
+}
+
+}  // namespace vxl::cli

@@ -1,0 +1,37 @@
+// `voxlines`: convert tractograms to .vxl, inspect, verify, export, and generate synthetic data.
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.h"
+#include "error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"voxlines " VOXLINES_VERSION
+               " — voxel-chunked tractograms for fast, correct-looking transparency.\n"
+               "Exit codes: 0 ok, 1 verify found the file invalid, 2 usage, 3 bad input, 4 unsupported, 5 output error."};
+  app.set_version_flag("--version", VOXLINES_VERSION);
+  app.require_subcommand(1);
+  vxl::cli::add_convert_command(app);
+  vxl::cli::add_info_command(app);
+  vxl::cli::add_verify_command(app);
+  vxl::cli::add_export_command(app);
+  vxl::cli::add_synth_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);
+    return code == 0 ? 0 : static_cast<int>(vxl::ErrorKind::Usage);
+  } catch (const vxl::Error& e) {
+    std::fprintf(stderr, "voxlines: error: %s\n", e.what());
+    return static_cast<int>(e.kind());
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "voxlines: error: out of memory\n");
+    return static_cast<int>(vxl::ErrorKind::Unsupported);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "voxlines: internal error: %s\n", e.what());
+    return 70;
+  }
+  return vxl::cli::g_exit_code;
+}

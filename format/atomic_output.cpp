@@ -1,0 +1,104 @@
+#include "atomic_output.h"
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <vector>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "error.h"
+
+namespace vxl {
+
+AtomicOutputFile::AtomicOutputFile(std::string path) : path_(std::move(path)) {
+  std::filesystem::path p(path_);
+  std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+  if (std::filesystem::is_directory(p)) fail("is a directory");
+  fd_ = ::open(dir.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    // O_TMPFILE unsupported here: fall back to a hidden temporary name beside the output.
+    std::string templ = (dir / ("." + p.filename().string() + ".partial-XXXXXX")).string();
+    std::vector<char> buf(templ.begin(), templ.end());
+    buf.push_back('\0');
+    fd_ = ::mkstemp(buf.data());
+    if (fd_ < 0) fail(std::string("cannot create a file in ") + dir.string() + ": " + std::strerror(errno));
+    temp_path_ = buf.data();
+    ::fchmod(fd_, 0644);
+  }
+}
+
+AtomicOutputFile::~AtomicOutputFile() {
+  if (fd_ >= 0) ::close(fd_);
+  if (!committed_ && !temp_path_.empty()) ::unlink(temp_path_.c_str());
+}
+
+void AtomicOutputFile::fail(const std::string& what) const { throw Error(ErrorKind::Output, path_, std::nullopt, what); }
+
+void AtomicOutputFile::write(const void* data, std::size_t size) {
+  const auto* p = static_cast<const std::uint8_t*>(data);
+  while (size > 0) {
+    ssize_t n = ::write(fd_, p, size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail(std::string("write failed: ") + std::strerror(errno));
+    }
+    p += n;
+    size -= static_cast<std::size_t>(n);
+    position_ += static_cast<std::uint64_t>(n);
+  }
+}
+
+void AtomicOutputFile::write_zeros(std::size_t size) {
+  static const std::uint8_t zeros[4096] = {};
+  while (size > 0) {
+    std::size_t n = std::min(size, sizeof zeros);
+    write(zeros, n);
+    size -= n;
+  }
+}
+
+void AtomicOutputFile::pwrite(const void* data, std::size_t size, std::uint64_t offset) {
+  const auto* p = static_cast<const std::uint8_t*>(data);
+  while (size > 0) {
+    ssize_t n = ::pwrite(fd_, p, size, static_cast<off_t>(offset));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail(std::string("write failed: ") + std::strerror(errno));
+    }
+    p += n;
+    size -= static_cast<std::size_t>(n);
+    offset += static_cast<std::uint64_t>(n);
+  }
+}
+
+void AtomicOutputFile::commit() {
+  if (temp_path_.empty()) {
+    // Link the unnamed file under a temporary name, then rename over the target (rename is atomic;
+    // linkat cannot replace an existing file).
+    std::filesystem::path p(path_);
+    std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+    std::string proc = "/proc/self/fd/" + std::to_string(fd_);
+    for (int attempt = 0;; ++attempt) {
+      std::string name = (dir / ("." + p.filename().string() + ".partial-" + std::to_string(::getpid()) + "-" +
+                                 std::to_string(attempt)))
+                             .string();
+      if (::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) == 0) {
+        temp_path_ = name;
+        break;
+      }
+      if (errno != EEXIST || attempt > 100) fail(std::string("cannot link the output: ") + std::strerror(errno));
+    }
+  }
+  if (::close(fd_) != 0) {
+    fd_ = -1;
+    fail(std::string("close failed: ") + std::strerror(errno));
+  }
+  fd_ = -1;
+  if (::rename(temp_path_.c_str(), path_.c_str()) != 0) fail(std::string("cannot rename into place: ") + std::strerror(errno));
+  committed_ = true;
+}
+
+}  // namespace vxl

@@ -1,0 +1,226 @@
+#include "vxl_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "error.h"
+
+namespace vxl {
+
+std::string section_name(std::uint32_t id) {
+  std::string s(4, ' ');
+  for (int i = 0; i < 4; ++i) {
+    char c = static_cast<char>((id >> (8 * i)) & 0xFF);
+    s[i] = (c >= 32 && c < 127) ? c : '?';
+  }
+  return s;
+}
+
+namespace {
+
+// a * b, or nullopt on overflow.
+std::optional<std::uint64_t> mul(std::uint64_t a, std::uint64_t b) {
+  std::uint64_t r;
+  if (__builtin_mul_overflow(a, b, &r)) return std::nullopt;
+  return r;
+}
+
+}  // namespace
+
+VxlFile VxlFile::open(const std::string& path) {
+  VxlFile f{MappedFile(path)};
+  f.validate();
+  return f;
+}
+
+const SectionEntry* VxlFile::find_section(std::uint32_t id) const {
+  for (const SectionEntry& e : sections_) {
+    std::uint32_t eid;
+    std::memcpy(&eid, e.id, 4);
+    if (eid == id) return &e;
+  }
+  return nullptr;
+}
+
+OrderView VxlFile::order(std::size_t voxel, std::uint32_t k) const {
+  const VoxelEntry& v = voxels_[voxel];
+  OrderView o;
+  o.wide = (v.flags & kVoxelOrdersU32) != 0;
+  o.count = v.segment_count;
+  o.data = orders_.data() + v.order_offset + std::uint64_t(k) * v.segment_count * (o.wide ? 4 : 2);
+  return o;
+}
+
+void VxlFile::validate() {
+  const std::string& p = file_.path();
+  const std::uint64_t size = file_.size();
+  const std::uint8_t* base = file_.data();
+  if (size < sizeof(FileHeader)) fail_input(p, size, "file too short for a .vxl header (64 bytes)");
+  std::memcpy(&header_, base, sizeof header_);
+  if (std::memcmp(header_.magic, kVxlMagic.data(), 8) != 0) fail_input(p, 0, "not a .vxl file (bad magic)");
+  if (header_.version_major != kVxlVersionMajor)
+    throw Error(ErrorKind::Unsupported, p, 8,
+                ".vxl major version " + std::to_string(header_.version_major) + " (this reader knows 1)");
+  if (header_.header_size != sizeof(FileHeader)) fail_input(p, 12, "header_size must be 64");
+  if (header_.file_size != size)
+    fail_input(p, 16, "file size is " + std::to_string(size) + " bytes but the header says " +
+                          std::to_string(header_.file_size) + " (truncated or extended file)");
+  if (header_.section_table_offset != sizeof(FileHeader)) fail_input(p, 24, "section table must start at byte 64");
+  if (header_.section_count == 0 || header_.section_count > kVxlMaxSections)
+    fail_input(p, 32, "section count must be 1..64");
+  if (header_.flags != 0) fail_input(p, 36, "unknown header flags");
+  const std::uint64_t table_end = sizeof(FileHeader) + std::uint64_t(header_.section_count) * sizeof(SectionEntry);
+  if (table_end > size) fail_input(p, 64, "section table runs past the end of the file");
+  sections_ = {reinterpret_cast<const SectionEntry*>(base + sizeof(FileHeader)), header_.section_count};
+
+  // Section table (§7 step 2).
+  std::uint64_t previous_end = table_end;
+  std::vector<std::uint32_t> seen;
+  for (std::size_t i = 0; i < sections_.size(); ++i) {
+    const SectionEntry& e = sections_[i];
+    const std::uint64_t at = sizeof(FileHeader) + i * sizeof(SectionEntry);
+    std::uint32_t id;
+    std::memcpy(&id, e.id, 4);
+    const std::string name = section_name(id);
+    if (e.offset % kVxlAlignment != 0) fail_input(p, at + 8, "section " + name + " offset is not a multiple of 64");
+    if (e.offset < previous_end) fail_input(p, at + 8, "section " + name + " overlaps the table or the previous section");
+    if (e.offset > size || e.size > size - e.offset)
+      fail_input(p, at + 16, "section " + name + " runs past the end of the file");
+    if ((e.flags & ~kSectionRequired) != 0) fail_input(p, at + 4, "section " + name + " has unknown flags");
+    if (std::find(seen.begin(), seen.end(), id) != seen.end()) fail_input(p, at, "section " + name + " appears twice");
+    seen.push_back(id);
+    previous_end = e.offset + e.size;
+    static const std::uint32_t known[] = {section_id("META"), section_id("DIRS"), section_id("VOXT"),
+                                          section_id("VERT"), section_id("ORDR"), section_id("VXLN"),
+                                          section_id("STRM"), section_id("PROV"), section_id("GRPS")};
+    bool is_known = std::find(std::begin(known), std::end(known), id) != std::end(known);
+    if (!is_known && (e.flags & kSectionRequired))
+      throw Error(ErrorKind::Unsupported, p, at, "required section " + name + " is unknown to this reader (newer writer?)");
+  }
+
+  auto section = [&](const char (&id)[5], bool required) -> std::span<const std::uint8_t> {
+    const SectionEntry* e = find_section(section_id(id));
+    if (!e) {
+      if (required) fail_input(p, 64, std::string("required section ") + id + " is missing");
+      return {};
+    }
+    return {base + e->offset, e->size};
+  };
+  auto offset_of = [&](const char (&id)[5]) -> std::uint64_t { return find_section(section_id(id))->offset; };
+
+  // META and counts (§7 step 3).
+  auto meta = section("META", true);
+  if (meta.size() != sizeof(MetaSection)) fail_input(p, offset_of("META"), "META must be 256 bytes");
+  std::memcpy(&meta_, meta.data(), sizeof meta_);
+  const std::uint64_t meta_at = offset_of("META");
+  const MetaSection& m = meta_;
+  if (!std::isfinite(m.voxel_size) || !(m.voxel_size > 0))
+    fail_input(p, meta_at + 56, "voxel size must be finite and positive");
+  if (m.stored_order_count < 1 || m.stored_order_count > kVxlMaxStoredOrders)
+    fail_input(p, meta_at + 52, "stored order count must be 1..64");
+  if (m.voxel_count > std::uint32_t(std::numeric_limits<std::int32_t>::max()))
+    fail_input(p, meta_at + 48, "voxel count exceeds 2^31-1");
+  for (int c = 0; c < 3; ++c) {
+    if (m.grid_dims[c] < 0) fail_input(p, meta_at + 88 + 4 * c, "negative grid dimension");
+    if (!std::isfinite(m.grid_origin[c]) || !std::isfinite(m.bounds_min[c]) || !std::isfinite(m.bounds_max[c]))
+      fail_input(p, meta_at + 64, "non-finite grid origin or bounds");
+  }
+  auto expect_size = [&](const char (&id)[5], std::optional<std::uint64_t> expected, const char* what) {
+    auto s = section(id, true);
+    if (!expected || s.size() != *expected)
+      fail_input(p, offset_of(id), std::string("section ") + id + " size " + std::to_string(s.size()) +
+                                       " does not match " + what);
+    return s;
+  };
+  auto dirs = expect_size("DIRS", mul(m.stored_order_count, sizeof(DirectionEntry)), "stored_order_count × 16");
+  auto voxt = expect_size("VOXT", mul(m.voxel_count, sizeof(VoxelEntry)), "voxel_count × 64");
+  auto vert = expect_size("VERT", mul(m.vertex_count, 12), "vertex_count × 12");
+  auto vxln = expect_size("VXLN", mul(m.voxline_count, sizeof(VoxlineEntry)), "voxline_count × 8");
+  std::optional<std::uint64_t> strm_size =
+      m.streamline_count == std::numeric_limits<std::uint64_t>::max() ? std::nullopt : mul(m.streamline_count + 1, 8);
+  auto strm = expect_size("STRM", strm_size, "(streamline_count + 1) × 8");
+  orders_ = section("ORDR", true);
+  directions_ = {reinterpret_cast<const DirectionEntry*>(dirs.data()), m.stored_order_count};
+  voxels_ = {reinterpret_cast<const VoxelEntry*>(voxt.data()), m.voxel_count};
+  vertices_ = {reinterpret_cast<const float*>(vert.data()), m.vertex_count * 3};
+  voxlines_ = {reinterpret_cast<const VoxlineEntry*>(vxln.data()), m.voxline_count};
+  strm_ = {reinterpret_cast<const std::uint64_t*>(strm.data()), m.streamline_count + 1};
+  auto prov = section("PROV", false);
+  provenance_ = {reinterpret_cast<const char*>(prov.data()), prov.size()};
+  groups_ = section("GRPS", false);
+
+  // Voxel table (§7 step 4): O(voxels).
+  const std::uint64_t voxt_at = offset_of("VOXT");
+  std::uint64_t next_vertex = 0, segments = 0, min_order_offset = 0;
+  for (std::size_t i = 0; i < voxels_.size(); ++i) {
+    const VoxelEntry& v = voxels_[i];
+    const std::uint64_t at = voxt_at + i * sizeof(VoxelEntry);
+    for (int c = 0; c < 3; ++c)
+      if (v.coord[c] < 0 || v.coord[c] >= m.grid_dims[c]) fail_input(p, at, "voxel coordinate outside the grid");
+    if (i > 0) {
+      const VoxelEntry& u = voxels_[i - 1];
+      auto key = [](const VoxelEntry& e) { return std::array<std::int32_t, 3>{e.coord[2], e.coord[1], e.coord[0]}; };
+      if (!(key(u) < key(v))) fail_input(p, at, "voxel coordinates not strictly increasing in (z, y, x)");
+    }
+    if ((v.flags & ~kVoxelOrdersU32) != 0) fail_input(p, at + 12, "unknown voxel flags");
+    if (v.vertex_count < 1) fail_input(p, at + 48, "voxel with no vertices");
+    if (v.segment_count >= v.vertex_count) fail_input(p, at + 52, "voxel has as many segments as vertices");
+    if (v.vertex_first != next_vertex) fail_input(p, at + 40, "voxel vertex blocks are not contiguous");
+    next_vertex += v.vertex_count;
+    if (next_vertex > m.vertex_count) fail_input(p, at + 48, "voxel vertex block runs past vertex_count");
+    bool wide = v.vertex_count > kU16OrderMaxVertices;
+    if (wide != ((v.flags & kVoxelOrdersU32) != 0)) fail_input(p, at + 12, "order width flag does not match vertex count");
+    if (v.order_offset % 4 != 0 || v.order_offset < min_order_offset)
+      fail_input(p, at + 56, "order offset not a multiple of 4 or decreasing");
+    std::uint64_t bytes = vxl::order_bytes(v.vertex_count, v.segment_count, m.stored_order_count);
+    if (v.order_offset > orders_.size() || bytes > orders_.size() - v.order_offset)
+      fail_input(p, at + 56, "voxel orders run past the ORDR section");
+    min_order_offset = v.order_offset + bytes;
+    segments += v.segment_count;
+  }
+  if (next_vertex != m.vertex_count) fail_input(p, voxt_at, "voxel blocks do not cover all vertices");
+  if (segments != m.segment_count) fail_input(p, voxt_at, "voxel segment counts do not add up to segment_count");
+  if (m.voxel_count == 0 && m.vertex_count != 0) fail_input(p, voxt_at, "vertices without voxels");
+}
+
+std::vector<GroupContent> VxlFile::groups() const {
+  std::vector<GroupContent> out;
+  if (groups_.empty()) return out;
+  const std::string& p = file_.path();
+  const std::uint64_t at0 = find_section(section_id("GRPS"))->offset;
+  std::uint64_t pos = 0;
+  auto need = [&](std::uint64_t n) {
+    if (n > groups_.size() - pos) fail_input(p, at0 + pos, "GRPS section truncated");
+  };
+  auto take = [&](void* dst, std::uint64_t n) {
+    need(n);
+    std::memcpy(dst, groups_.data() + pos, n);
+    pos += n;
+  };
+  std::uint32_t header[2];
+  take(header, 8);
+  for (std::uint32_t g = 0; g < header[0]; ++g) {
+    GroupContent gc;
+    std::uint32_t len;
+    take(&len, 4);
+    need(len);
+    gc.name.assign(reinterpret_cast<const char*>(groups_.data() + pos), len);
+    pos += len;
+    std::uint64_t aligned = align_up(pos, 8);
+    need(aligned - pos);
+    pos = aligned;
+    std::uint64_t count;
+    take(&count, 8);
+    if (count > (groups_.size() - pos) / 8) fail_input(p, at0 + pos, "GRPS member count runs past the section");
+    gc.members.resize(count);
+    take(gc.members.data(), count * 8);
+    for (std::uint64_t i = 0; i < count; ++i)
+      if (gc.members[i] >= meta_.streamline_count || (i > 0 && gc.members[i] <= gc.members[i - 1]))
+        fail_input(p, at0 + pos - 8 * (count - i), "GRPS member out of range or not increasing");
+    out.push_back(std::move(gc));
+  }
+  return out;
+}
+
+}  // namespace vxl

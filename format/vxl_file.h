@@ -1,0 +1,84 @@
+// Read-only, memory-mapped .vxl file.
+//
+// open() validates everything the viewer relies on — header, section table, section sizes against the
+// counts, every voxel's vertex and order ranges — in O(voxels), never O(points) (spec §7). After a
+// successful open, the per-voxel ranges can be used without further checks. Order *entries*, voxlines
+// and the streamline table are checked by whoever walks them (walk_streamlines, verify_vxl, the
+// renderer's upload), because checking them here would cost O(points).
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mapped_file.h"
+#include "vxl_layout.h"
+#include "vxl_writer.h"
+
+namespace vxl {
+
+// One stored order of one voxel: n block-local vertex indices, u16 or u32.
+struct OrderView {
+  const std::uint8_t* data = nullptr;
+  std::uint32_t count = 0;
+  bool wide = false;
+  std::uint32_t operator[](std::uint32_t i) const {
+    if (wide) {
+      std::uint32_t v;
+      std::memcpy(&v, data + 4ull * i, 4);
+      return v;
+    }
+    std::uint16_t v;
+    std::memcpy(&v, data + 2ull * i, 2);
+    return v;
+  }
+};
+
+class VxlFile {
+ public:
+  // Maps and validates; throws vxl::Error (Input, or Unsupported for a newer major version / unknown
+  // required section) naming the file and the byte offset of the problem.
+  static VxlFile open(const std::string& path);
+
+  const std::string& path() const { return file_.path(); }
+  std::span<const std::uint8_t> bytes() const { return file_.bytes(); }
+  const FileHeader& header() const { return header_; }
+  std::span<const SectionEntry> sections() const { return sections_; }
+  const SectionEntry* find_section(std::uint32_t id) const;
+
+  const MetaSection& meta() const { return meta_; }
+  std::span<const DirectionEntry> directions() const { return directions_; }
+  std::span<const VoxelEntry> voxels() const { return voxels_; }
+  std::span<const float> vertices() const { return vertices_; }  // 3 * vertex_count
+  std::span<const std::uint8_t> order_bytes() const { return orders_; }
+  OrderView order(std::size_t voxel, std::uint32_t k) const;
+  std::span<const VoxlineEntry> voxlines() const { return voxlines_; }
+  std::span<const std::uint64_t> streamline_first_voxline() const { return strm_; }
+  std::string_view provenance_json() const { return provenance_; }
+  // Parses GRPS (empty when absent); throws vxl::Error when malformed.
+  std::vector<GroupContent> groups() const;
+
+ private:
+  explicit VxlFile(MappedFile file) : file_(std::move(file)) {}
+  void validate();
+
+  MappedFile file_;
+  FileHeader header_{};
+  std::span<const SectionEntry> sections_;
+  MetaSection meta_{};
+  std::span<const DirectionEntry> directions_;
+  std::span<const VoxelEntry> voxels_;
+  std::span<const float> vertices_;
+  std::span<const std::uint8_t> orders_;
+  std::span<const VoxlineEntry> voxlines_;
+  std::span<const std::uint64_t> strm_;
+  std::string_view provenance_;
+  std::span<const std::uint8_t> groups_;
+};
+
+std::string section_name(std::uint32_t id);
+
+}  // namespace vxl

@@ -1,0 +1,121 @@
+// On-disk structures of the .vxl format, version 1.0 (spec/vxl-format-v1.md is the reference; section
+// numbers below point into it). All little-endian; every struct's layout is pinned by static_asserts so
+// a file can be used in place after mmap.
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+
+namespace vxl {
+
+static_assert(std::endian::native == std::endian::little, "the .vxl format is read in place: little-endian hosts only");
+
+inline constexpr std::array<std::uint8_t, 8> kVxlMagic = {0x89, 'V', 'X', 'L', '\r', '\n', 0x1A, '\n'};
+inline constexpr std::uint16_t kVxlVersionMajor = 1;
+inline constexpr std::uint16_t kVxlVersionMinor = 0;
+inline constexpr std::uint64_t kVxlAlignment = 64;
+inline constexpr std::uint32_t kVxlMaxSections = 64;
+inline constexpr std::uint32_t kVxlMaxStoredOrders = 64;
+inline constexpr std::uint32_t kU16OrderMaxVertices = 65536;  // u16 entries when vertex_count <= this
+
+// §3
+struct FileHeader {
+  std::uint8_t magic[8];
+  std::uint16_t version_major;
+  std::uint16_t version_minor;
+  std::uint32_t header_size;
+  std::uint64_t file_size;
+  std::uint64_t section_table_offset;
+  std::uint32_t section_count;
+  std::uint32_t flags;
+  std::uint64_t header_checksum;
+  std::uint8_t reserved[16];
+};
+static_assert(sizeof(FileHeader) == 64);
+static_assert(offsetof(FileHeader, header_checksum) == 40);
+
+// §4
+struct SectionEntry {
+  char id[4];
+  std::uint32_t flags;
+  std::uint64_t offset;
+  std::uint64_t size;
+  std::uint64_t checksum;
+};
+static_assert(sizeof(SectionEntry) == 32);
+inline constexpr std::uint32_t kSectionRequired = 1u;
+
+constexpr std::uint32_t section_id(const char (&s)[5]) {
+  return std::uint32_t(std::uint8_t(s[0])) | std::uint32_t(std::uint8_t(s[1])) << 8 |
+         std::uint32_t(std::uint8_t(s[2])) << 16 | std::uint32_t(std::uint8_t(s[3])) << 24;
+}
+
+// §5.1
+enum class OrderSet : std::uint32_t { Axis = 0, AxisDiag = 1, Random = 2 };
+
+struct MetaSection {
+  std::uint64_t streamline_count;
+  std::uint64_t point_count;
+  std::uint64_t vertex_count;
+  std::uint64_t segment_count;
+  std::uint64_t voxline_count;
+  std::uint64_t synthetic_point_count;
+  std::uint32_t voxel_count;
+  std::uint32_t stored_order_count;
+  double voxel_size;
+  double grid_origin[3];
+  std::int32_t grid_dims[3];
+  std::uint32_t order_set;
+  double bounds_min[3];
+  double bounds_max[3];
+  std::uint8_t reserved[104];
+};
+static_assert(sizeof(MetaSection) == 256);
+static_assert(offsetof(MetaSection, voxel_size) == 56);
+static_assert(offsetof(MetaSection, grid_dims) == 88);
+static_assert(offsetof(MetaSection, order_set) == 100);
+static_assert(offsetof(MetaSection, bounds_min) == 104);
+static_assert(offsetof(MetaSection, reserved) == 152);
+
+// §5.2
+struct DirectionEntry {
+  float xyz[3];
+  std::uint32_t reserved;
+};
+static_assert(sizeof(DirectionEntry) == 16);
+
+// §5.3
+struct VoxelEntry {
+  std::int32_t coord[3];
+  std::uint32_t flags;  // bit 0: order entries are u32
+  float tight_min[3];
+  float tight_max[3];
+  std::uint64_t vertex_first;
+  std::uint32_t vertex_count;
+  std::uint32_t segment_count;
+  std::uint64_t order_offset;
+};
+static_assert(sizeof(VoxelEntry) == 64);
+static_assert(offsetof(VoxelEntry, vertex_first) == 40);
+inline constexpr std::uint32_t kVoxelOrdersU32 = 1u;
+
+// §5.6
+struct VoxlineEntry {
+  std::uint32_t voxel;
+  std::uint32_t count_flags;  // bits 0-30 own point count; bit 31 first point synthetic
+};
+static_assert(sizeof(VoxlineEntry) == 8);
+inline constexpr std::uint32_t kVoxlineSyntheticFirst = 0x80000000u;
+inline constexpr std::uint32_t kVoxlineCountMask = 0x7FFFFFFFu;
+
+constexpr std::uint64_t align_up(std::uint64_t x, std::uint64_t a) { return (x + a - 1) / a * a; }
+
+// Bytes taken by one voxel's K orders of n segments, including the padding to 4 bytes (§5.5).
+constexpr std::uint64_t order_bytes(std::uint32_t vertex_count, std::uint32_t segment_count, std::uint32_t k) {
+  std::uint64_t width = vertex_count > kU16OrderMaxVertices ? 4 : 2;
+  return align_up(std::uint64_t(segment_count) * k * width, 4);
+}
+
+}  // namespace vxl

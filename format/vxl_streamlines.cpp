@@ -1,0 +1,66 @@
+#include "vxl_streamlines.h"
+
+#include <cstring>
+#include <vector>
+
+#include "error.h"
+
+namespace vxl {
+
+void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
+  const std::string& p = f.path();
+  const MetaSection& m = f.meta();
+  auto voxels = f.voxels();
+  auto voxlines = f.voxlines();
+  auto strm = f.streamline_first_voxline();
+  auto vertices = f.vertices();
+  const std::uint64_t strm_at = f.find_section(section_id("STRM"))->offset;
+  const std::uint64_t vxln_at = f.find_section(section_id("VXLN"))->offset;
+
+  if (strm[0] != 0) fail_input(p, strm_at, "streamline table must start at voxline 0");
+  if (strm[m.streamline_count] != m.voxline_count) fail_input(p, strm_at + 8 * m.streamline_count, "streamline table must end at voxline_count");
+
+  std::vector<std::uint64_t> cursor(voxels.size());
+  for (std::size_t i = 0; i < voxels.size(); ++i) cursor[i] = voxels[i].vertex_first;
+  std::vector<float> points;
+  std::uint64_t total_points = 0, synthetic = 0;
+
+  for (std::uint64_t s = 0; s < m.streamline_count; ++s) {
+    const std::uint64_t first = strm[s], last = strm[s + 1];
+    if (last < first || last > m.voxline_count) fail_input(p, strm_at + 8 * (s + 1), "streamline table not non-decreasing");
+    points.clear();
+    const float* pending_connector = nullptr;  // previous voxline's connecting vertex
+    for (std::uint64_t j = first; j < last; ++j) {
+      const VoxlineEntry& e = voxlines[j];
+      const std::uint64_t at = vxln_at + 8 * j;
+      if (e.voxel >= voxels.size()) fail_input(p, at, "voxline refers to a voxel past the table");
+      const std::uint32_t own = e.count_flags & kVoxlineCountMask;
+      const bool synthetic_first = (e.count_flags & kVoxlineSyntheticFirst) != 0;
+      const bool connected = j + 1 < last;
+      if (own == 0) fail_input(p, at, "voxline with no points");
+      const VoxelEntry& v = voxels[e.voxel];
+      const std::uint64_t end = v.vertex_first + v.vertex_count;
+      const std::uint64_t need = std::uint64_t(own) + (connected ? 1 : 0);
+      if (need > end - cursor[e.voxel]) fail_input(p, at, "voxline runs past its voxel's vertex block");
+      const float* block = vertices.data() + 3 * cursor[e.voxel];
+      if (pending_connector && std::memcmp(pending_connector, block, 12) != 0)
+        fail_input(p, at, "connecting vertex differs from the next voxline's first point");
+      if (synthetic_first && j == first) fail_input(p, at, "a streamline cannot start with a synthetic point");
+      if (cb.voxline) cb.voxline(e.voxel, cursor[e.voxel], own, connected);
+      const std::uint32_t skip = synthetic_first ? 1 : 0;
+      synthetic += skip;
+      points.insert(points.end(), block + 3 * skip, block + 3 * own);
+      pending_connector = connected ? block + 3 * own : nullptr;
+      cursor[e.voxel] += need;
+    }
+    total_points += points.size() / 3;
+    if (cb.streamline) cb.streamline(s, points);
+  }
+  for (std::size_t i = 0; i < voxels.size(); ++i)
+    if (cursor[i] != voxels[i].vertex_first + voxels[i].vertex_count)
+      fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i, "voxel block has vertices no voxline uses");
+  if (total_points != m.point_count) fail_input(p, std::nullopt, "streamlines hold " + std::to_string(total_points) + " points but META says " + std::to_string(m.point_count));
+  if (synthetic != m.synthetic_point_count) fail_input(p, std::nullopt, "synthetic point count does not match META");
+}
+
+}  // namespace vxl

@@ -1,0 +1,131 @@
+#include "vxl_verify.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "checksum.h"
+#include "error.h"
+#include "vxl_file.h"
+#include "vxl_streamlines.h"
+
+namespace vxl {
+namespace {
+
+bool all_zero(const std::uint8_t* p, std::uint64_t n) {
+  for (std::uint64_t i = 0; i < n; ++i)
+    if (p[i] != 0) return false;
+  return true;
+}
+
+void check_checksums_and_padding(const VxlFile& f) {
+  const std::string& p = f.path();
+  auto bytes = f.bytes();
+  FileHeader h = f.header();
+  h.header_checksum = 0;
+  const std::uint64_t table_end = sizeof(FileHeader) + f.sections().size_bytes();
+  std::vector<std::uint8_t> head(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(table_end));
+  std::memcpy(head.data(), &h, sizeof h);
+  if (xxh3_64(head.data(), head.size()) != f.header().header_checksum)
+    fail_input(p, 40, "header checksum mismatch (header or section table damaged)");
+  if (!all_zero(f.header().reserved, sizeof f.header().reserved)) fail_input(p, 48, "reserved header bytes are not zero");
+
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> covered = {{0, table_end}};
+  for (const SectionEntry& e : f.sections()) {
+    if (xxh3_64(bytes.data() + e.offset, e.size) != e.checksum)
+      fail_input(p, e.offset, "checksum mismatch in section " + std::string(e.id, 4));
+    covered.push_back({e.offset, e.offset + e.size});
+  }
+  std::sort(covered.begin(), covered.end());
+  std::uint64_t pos = 0;
+  for (auto [begin, end] : covered) {
+    if (begin > pos && !all_zero(bytes.data() + pos, begin - pos))
+      fail_input(p, pos, "padding bytes are not zero");
+    pos = std::max(pos, end);
+  }
+  if (pos < bytes.size() && !all_zero(bytes.data() + pos, bytes.size() - pos)) fail_input(p, pos, "padding bytes are not zero");
+}
+
+void check_meta_and_dirs(const VxlFile& f) {
+  const std::string& p = f.path();
+  const MetaSection& m = f.meta();
+  const std::uint64_t meta_at = f.find_section(section_id("META"))->offset;
+  if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 152, "META reserved bytes are not zero");
+  const std::uint64_t dirs_at = f.find_section(section_id("DIRS"))->offset;
+  for (std::size_t k = 0; k < f.directions().size(); ++k) {
+    const DirectionEntry& d = f.directions()[k];
+    double len = std::sqrt(double(d.xyz[0]) * d.xyz[0] + double(d.xyz[1]) * d.xyz[1] + double(d.xyz[2]) * d.xyz[2]);
+    if (d.reserved != 0 || !(std::abs(len - 1.0) < 1e-5)) fail_input(p, dirs_at + 16 * k, "direction is not a unit vector");
+  }
+}
+
+// Every order must be a permutation of the voxel's segments, sorted by the key of spec §6.4.
+void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_start) {
+  const std::string& p = f.path();
+  const std::uint64_t ordr_at = f.find_section(section_id("ORDR"))->offset;
+  auto voxels = f.voxels();
+  auto vertices = f.vertices();
+  std::vector<std::uint8_t> seen;
+  for (std::size_t i = 0; i < voxels.size(); ++i) {
+    const VoxelEntry& v = voxels[i];
+    const std::uint64_t at = ordr_at + v.order_offset;
+    std::uint64_t starts = 0;
+    for (std::uint32_t e = 0; e < v.vertex_count; ++e) starts += is_segment_start[v.vertex_first + e];
+    if (starts != v.segment_count)
+      fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i,
+                 "voxel " + std::to_string(i) + " segment count does not match its voxlines");
+    for (std::uint32_t k = 0; k < f.meta().stored_order_count; ++k) {
+      const DirectionEntry& dir = f.directions()[k];
+      OrderView o = f.order(i, k);
+      seen.assign(v.vertex_count, 0);
+      double previous_key = -INFINITY;
+      std::uint32_t previous_entry = 0;
+      for (std::uint32_t n = 0; n < o.count; ++n) {
+        std::uint32_t e = o[n];
+        if (e + 1ull >= v.vertex_count || !is_segment_start[v.vertex_first + e] || seen[e])
+          fail_input(p, at, "voxel " + std::to_string(i) + " order " + std::to_string(k) +
+                                " is not a permutation of its segments");
+        seen[e] = 1;
+        const float* a = vertices.data() + 3 * (v.vertex_first + e);
+        double key = 0;
+        for (int c = 0; c < 3; ++c) key += (double(a[c]) + double(a[c + 3])) * double(dir.xyz[c]);
+        if (n > 0 && (key < previous_key || (key == previous_key && e < previous_entry)))
+          fail_input(p, at, "voxel " + std::to_string(i) + " order " + std::to_string(k) + " is not sorted");
+        previous_key = key;
+        previous_entry = e;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+VerifyResult verify_vxl(const std::string& path) {
+  VerifyResult r;
+  try {
+    VxlFile f = VxlFile::open(path);
+    check_checksums_and_padding(f);
+    check_meta_and_dirs(f);
+    // The walk marks which vertices start a segment (all but each voxline's last vertex).
+    std::vector<std::uint8_t> is_segment_start(f.meta().vertex_count, 0);
+    WalkCallbacks cb;
+    cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t own, bool connected) {
+      std::uint64_t n = own + (connected ? 1 : 0);
+      for (std::uint64_t i = 0; i + 1 < n; ++i) is_segment_start[first + i] = 1;
+    };
+    walk_streamlines(f, cb);
+    check_orders(f, is_segment_start);
+    if (!f.provenance_json().empty() && !nlohmann::json::accept(f.provenance_json()))
+      fail_input(path, f.find_section(section_id("PROV"))->offset, "provenance is not valid JSON");
+    f.groups();
+    r.valid = true;
+  } catch (const Error& e) {
+    r.problem = e.what();
+  }
+  return r;
+}
+
+}  // namespace vxl
