@@ -49,6 +49,7 @@ TckHeader parse_header(const std::string& path, std::span<const std::uint8_t> by
   if (!next_line(line) || trim(line) != "mrtrix tracks")
     fail_input(path, 0, "expected the TCK magic line 'mrtrix tracks'");
   bool ended = false;
+  std::string last_key;
   while (true) {
     std::size_t line_start = pos;
     if (!next_line(line)) break;
@@ -59,9 +60,15 @@ TckHeader parse_header(const std::string& path, std::span<const std::uint8_t> by
     }
     if (t.empty()) continue;
     std::size_t colon = t.find(':');
-    if (colon == std::string_view::npos)
-      fail_input(path, line_start, "expected a 'key: value' header line or 'END'");
+    if (colon == std::string_view::npos) {
+      // A line without a colon continues the previous value (seen in real command_history fields).
+      if (last_key.empty()) fail_input(path, line_start, "expected a 'key: value' header line or 'END'");
+      auto& values = h.fields[last_key];
+      values.back() = values.back().get<std::string>() + "\n" + std::string(t);
+      continue;
+    }
     std::string key(trim(t.substr(0, colon)));
+    last_key = key;
     std::string value(trim(t.substr(colon + 1)));
     h.fields[key].push_back(value);
   }

@@ -1,0 +1,153 @@
+// Voxelisation (Algorithm 1 + face splitting, spec §6) and order building (spec §6.4) on hand-made data.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "error.h"
+#include "segment_orders.h"
+#include "voxelize.h"
+#include "test_support.h"
+
+namespace vxl {
+namespace {
+
+Tractogram make(std::initializer_list<std::vector<float>> streamlines) {
+  Tractogram t;
+  t.source.path = "hand-made";
+  for (const auto& s : streamlines) t.add_streamline(s.data(), s.size() / 3);
+  return t;
+}
+
+VoxelizedTractogram run(Tractogram t, double voxel = 10.0, unsigned threads = 1) {
+  VoxelizeSettings s;
+  s.voxel_size = voxel;
+  s.threads = threads;
+  return voxelize(std::move(t), s);
+}
+
+TEST(Voxelize, AlgorithmOneAddsOneConnectingVertexPerVoxelChange) {
+  // Points at x = 0, 4, 8 (voxel 0), 12, 16 (voxel 1), 21 (voxel 2); voxel size 10, origin x = 0.
+  auto vt = run(make({{0, 0, 0, 4, 0, 0, 8, 0, 0, 12, 0, 0, 16, 0, 0, 21, 0, 0}}));
+  ASSERT_EQ(vt.voxels.size(), 3u);
+  EXPECT_EQ(vt.voxels[0].vertex_count, 4u);  // 0, 4, 8 + connector 12
+  EXPECT_EQ(vt.voxels[1].vertex_count, 3u);  // 12, 16 + connector 21
+  EXPECT_EQ(vt.voxels[2].vertex_count, 1u);  // 21 (last point: no connector)
+  EXPECT_EQ(vt.voxels[0].segment_count, 3u);
+  EXPECT_EQ(vt.voxels[1].segment_count, 2u);
+  EXPECT_EQ(vt.voxels[2].segment_count, 0u);
+  EXPECT_EQ(vt.meta.segment_count, 5u);  // = points - streamlines: nothing lost, nothing doubled
+  EXPECT_EQ(vt.vertices[3 * 3], 12.0f);  // voxel 0's connecting vertex is the next point
+  EXPECT_EQ(vt.meta.synthetic_point_count, 0u);
+  EXPECT_EQ(vt.voxlines.size(), 3u);
+}
+
+TEST(Voxelize, PointOnAFaceBelongsToTheVoxelOnItsPositiveSide) {
+  auto vt = run(make({{0, 0, 0, 10, 0, 0, 20, 0, 0}}));
+  ASSERT_EQ(vt.voxels.size(), 3u);
+  EXPECT_EQ(vt.voxels[1].coord[0], 1);
+  EXPECT_EQ(vt.vertices[3 * vt.voxels[1].vertex_first], 10.0f);
+  EXPECT_EQ(voxel_coordinate(10.0f, 0.0, 10.0), 1);
+  EXPECT_EQ(voxel_coordinate(9.999999f, 0.0, 10.0), 0);
+}
+
+TEST(Voxelize, OnePointAndEmptyStreamlinesAreKept) {
+  auto vt = run(make({{}, {1, 2, 3}, {}, {4, 5, 6, 5, 5, 6}}));
+  EXPECT_EQ(vt.meta.streamline_count, 4u);
+  EXPECT_EQ(vt.meta.point_count, 3u);
+  EXPECT_EQ(vt.streamline_first_voxline, (std::vector<std::uint64_t>{0, 0, 1, 1, 2}));
+  EXPECT_EQ(vt.meta.segment_count, 1u);
+}
+
+TEST(Voxelize, LongStepsAreSplitAtEveryFaceTheyCross) {
+  // One step of 35 mm along x with 10 mm voxels crosses 3 faces (x = 10, 20, 30 from origin 0).
+  auto vt = run(make({{0, 0, 0, 35, 0, 0}}));
+  ASSERT_EQ(vt.voxels.size(), 4u);
+  EXPECT_EQ(vt.meta.synthetic_point_count, 3u);
+  EXPECT_EQ(vt.meta.segment_count, 4u);
+  for (int i = 0; i < 4; ++i) {
+    // every piece lies inside its voxel's cube (ends on its faces)
+    EXPECT_GE(vt.voxels[i].tight_min[0], 10.0f * i) << i;
+    EXPECT_LE(vt.voxels[i].tight_max[0], std::min(35.0f, 10.0f * (i + 1))) << i;
+  }
+  EXPECT_EQ(vt.voxlines[1].count_flags & kVoxlineSyntheticFirst, kVoxlineSyntheticFirst);
+}
+
+TEST(Voxelize, DiagonalStepThroughACornerMakesOneCrossingPoint) {
+  // From (5,5,0) to (25,25,0): passes exactly through the corner (10,10) and (20,20).
+  auto vt = run(make({{5, 5, 0, 25, 25, 0}}));
+  EXPECT_EQ(vt.meta.synthetic_point_count, 2u);
+  EXPECT_EQ(vt.voxels.size(), 3u);
+}
+
+TEST(Voxelize, StepsToANeighbourVoxelAreNotSplit) {
+  auto vt = run(make({{0, 0, 0, 9, 9, 9, 11, 11, 11}}));  // 9 -> 11 crosses to the diagonal neighbour
+  EXPECT_EQ(vt.meta.synthetic_point_count, 0u);
+  EXPECT_EQ(vt.voxels.size(), 2u);
+}
+
+TEST(Voxelize, ResultDoesNotDependOnTheThreadCount) {
+  Tractogram t;
+  for (int s = 0; s < 500; ++s) {
+    std::vector<float> pts;
+    for (int i = 0; i < 40; ++i) {
+      float a = 0.1f * i + 0.37f * s;
+      pts.insert(pts.end(), {30 * std::cos(a) + s % 7, 30 * std::sin(a), 0.5f * i - 0.01f * s});
+    }
+    t.add_streamline(pts.data(), 40);
+  }
+  Tractogram copy = t;
+  auto one = run(std::move(t), 5.0, 1);
+  auto four = run(std::move(copy), 5.0, 4);
+  EXPECT_EQ(one.vertices, four.vertices);
+  ASSERT_EQ(one.voxels.size(), four.voxels.size());
+  for (std::size_t i = 0; i < one.voxels.size(); ++i) EXPECT_EQ(0, std::memcmp(&one.voxels[i], &four.voxels[i], sizeof(VoxelEntry)));
+  EXPECT_EQ(one.streamline_first_voxline, four.streamline_first_voxline);
+}
+
+TEST(Voxelize, TooSmallAVoxelIsRefusedWithASuggestion) {
+  VoxelizeSettings s;
+  s.voxel_size = 0.001;
+  try {
+    voxelize(make({{0, 0, 0, 50, 0, 0}}), s);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+    EXPECT_NE(std::string(e.what()).find("--voxel-size"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SegmentOrders, AxisOrdersSortByMidpointWithStableTies) {
+  // Segments inside one voxel with x-midpoints 5, 1, 3 and a tie on y.
+  auto vt = run(make({{4, 1, 1, 6, 1, 1}, {0, 1, 1, 2, 1, 1}, {2, 1, 1, 4, 1, 1}}));
+  ASSERT_EQ(vt.voxels.size(), 1u);
+  BuiltOrders o = build_orders(vt, parse_order_set("axis"), 1, {});
+  ASSERT_EQ(o.directions.size(), 3u);
+  const auto* e = reinterpret_cast<const std::uint16_t*>(o.bytes.data() + vt.voxels[0].order_offset);
+  // blocks: [4,6] at 0-1, [0,2] at 2-3, [2,4] at 4-5; +X order: midpoints 1, 3, 5 -> starts 2, 4, 0
+  EXPECT_EQ(e[0], 2);
+  EXPECT_EQ(e[1], 4);
+  EXPECT_EQ(e[2], 0);
+  // +Y: all keys equal -> ascending local index
+  EXPECT_EQ(e[3], 0);
+  EXPECT_EQ(e[4], 2);
+  EXPECT_EQ(e[5], 4);
+}
+
+TEST(SegmentOrders, WideEntriesAboveU16Range) {
+  std::vector<float> pts;
+  for (int i = 0; i < 70000; ++i) pts.insert(pts.end(), {float(i % 5) * 0.1f, float((i * 7) % 9) * 0.1f, float(i % 3) * 0.1f});
+  Tractogram t;
+  t.add_streamline(pts.data(), 70000);
+  auto vt = run(std::move(t));
+  BuiltOrders o = build_orders(vt, parse_order_set("axis"), 2, {});
+  EXPECT_EQ(vt.voxels[0].flags & kVoxelOrdersU32, kVoxelOrdersU32);
+  EXPECT_EQ(o.bytes.size(), 3u * 69999u * 4u);
+}
+
+TEST(SegmentOrders, UnknownOrderSetIsAUsageError) {
+  EXPECT_THROW(parse_order_set("random"), Error);
+  EXPECT_EQ(parse_order_set("axis+diag").directions.size(), 7u);
+}
+
+}  // namespace
+}  // namespace vxl
