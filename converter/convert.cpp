@@ -1,5 +1,6 @@
 #include "convert.h"
 
+#include <chrono>
 #include <filesystem>
 
 #include "segment_orders.h"
@@ -43,8 +44,15 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   vs.voxel_size = settings.voxel_size;
   vs.threads = threads;
   vs.progress = settings.progress;
+  using Clock = std::chrono::steady_clock;
+  auto seconds_since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  ConvertSummary summary;
+  auto t0 = Clock::now();
   VoxelizedTractogram vt = voxelize(std::move(t), vs);
+  summary.voxelize_seconds = seconds_since(t0);
+  t0 = Clock::now();
   BuiltOrders orders = build_orders(vt, order_set, threads, settings.progress);
+  summary.orders_seconds = seconds_since(t0);
 
   VxlContent c;
   c.meta = vt.meta;
@@ -57,11 +65,19 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   c.provenance_json = provenance_json(source, settings, threads);
   c.groups = groups;
   if (settings.progress) settings.progress("writing", 0.0);
+  t0 = Clock::now();
   write_vxl(out_path, c);
+  summary.write_seconds = seconds_since(t0);
   if (settings.progress) settings.progress("writing", 1.0);
 
   const MetaSection& m = vt.meta;
-  return {m.streamline_count, m.point_count, m.voxel_count, m.vertex_count, m.segment_count, m.synthetic_point_count};
+  summary.streamlines = m.streamline_count;
+  summary.points = m.point_count;
+  summary.voxels = m.voxel_count;
+  summary.vertices = m.vertex_count;
+  summary.segments = m.segment_count;
+  summary.synthetic_points = m.synthetic_point_count;
+  return summary;
 }
 
 }  // namespace vxl

@@ -17,6 +17,7 @@ struct ConvertSettings {
 
 struct ConvertSummary {
   std::uint64_t streamlines = 0, points = 0, voxels = 0, vertices = 0, segments = 0, synthetic_points = 0;
+  double voxelize_seconds = 0, orders_seconds = 0, write_seconds = 0;
 };
 
 // Consumes the tractogram (its positions are released as soon as they are copied) and writes `out_path`

@@ -33,11 +33,41 @@ OrderSetSpec parse_order_set(const std::string& name) {
 
 namespace {
 
+// Order-preserving map of a double to an unsigned integer (negative numbers flip all bits).
+std::uint64_t sortable_bits(double d) {
+  std::uint64_t u;
+  std::memcpy(&u, &d, 8);
+  return (u & 0x8000000000000000ull) ? ~u : (u | 0x8000000000000000ull);
+}
+
 struct KeyedSegment {
-  double key;
+  std::uint64_t key;  // sortable_bits of the exact double key
   std::uint32_t local;
-  bool operator<(const KeyedSegment& o) const { return key < o.key || (key == o.key && local < o.local); }
 };
+
+// Stable LSD radix sort by key, 8 bits a pass. Items arrive in ascending local index, so stability gives
+// the spec's tie rule (ascending index) for free. Passes whose digit is the same for every item are
+// skipped: keys are sums of two floats, whose low mantissa bytes are zero in a double, and the keys of
+// one voxel share their high bytes, so typically only 3-4 of the 8 passes run.
+void radix_sort(std::vector<KeyedSegment>& items, std::vector<KeyedSegment>& scratch) {
+  const std::size_t n = items.size();
+  if (n < 2) return;
+  scratch.resize(n);
+  std::uint64_t all_or = 0, all_and = ~0ull;
+  for (const KeyedSegment& k : items) {
+    all_or |= k.key;
+    all_and &= k.key;
+  }
+  const std::uint64_t varying = all_or ^ all_and;
+  for (int shift = 0; shift < 64; shift += 8) {
+    if (((varying >> shift) & 0xFF) == 0) continue;
+    std::size_t count[257] = {};
+    for (const KeyedSegment& k : items) ++count[((k.key >> shift) & 0xFF) + 1];
+    for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
+    for (const KeyedSegment& k : items) scratch[count[(k.key >> shift) & 0xFF]++] = k;
+    items.swap(scratch);
+  }
+}
 
 }  // namespace
 
@@ -50,7 +80,7 @@ BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsig
 
   std::uint64_t total = 0;
   for (VoxelEntry& v : vt.voxels) {
-    v.flags = v.vertex_count > kU16OrderMaxVertices ? kVoxelOrdersU32 : 0;
+    v.flags = order_width_code(v.vertex_count);
     v.order_offset = total;
     total += order_bytes(v.vertex_count, v.segment_count, k_count);
   }
@@ -67,14 +97,14 @@ BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsig
   std::atomic<std::size_t> done{0};
   auto worker = [&](bool reports) {
     std::vector<std::uint32_t> starts;
-    std::vector<KeyedSegment> keyed;
+    std::vector<KeyedSegment> keyed, scratch;
     for (std::size_t i; (i = next++) < vt.voxels.size();) {
       const VoxelEntry& v = vt.voxels[i];
       starts.clear();
       for (std::uint32_t e = 0; e < v.vertex_count; ++e)
         if (!vt.is_voxline_end[v.vertex_first + e]) starts.push_back(e);
       const float* block = vt.vertices.data() + 3 * v.vertex_first;
-      const bool wide = (v.flags & kVoxelOrdersU32) != 0;
+      const std::uint32_t width = order_entry_width(v.vertex_count);
       std::uint8_t* dst = out.bytes.data() + v.order_offset;
       for (std::uint32_t k = 0; k < k_count; ++k) {
         keyed.resize(starts.size());
@@ -88,19 +118,10 @@ BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsig
             key = 0;
             for (int c = 0; c < 3; ++c) key += (double(a[c]) + double(a[c + 3])) * double(d[c]);
           }
-          keyed[n] = {key, starts[n]};
+          keyed[n] = {sortable_bits(key + 0.0), starts[n]};  // + 0.0 folds -0 into +0
         }
-        std::sort(keyed.begin(), keyed.end());
-        for (std::size_t n = 0; n < keyed.size(); ++n) {
-          if (wide) {
-            std::memcpy(dst, &keyed[n].local, 4);
-            dst += 4;
-          } else {
-            std::uint16_t e16 = static_cast<std::uint16_t>(keyed[n].local);
-            std::memcpy(dst, &e16, 2);
-            dst += 2;
-          }
-        }
+        radix_sort(keyed, scratch);
+        for (std::size_t n = 0; n < keyed.size(); ++n, dst += width) std::memcpy(dst, &keyed[n].local, width);
       }
       std::size_t d = ++done;
       if (reports && progress && (d & 63) == 0) progress("ordering", double(d) / double(vt.voxels.size()));

@@ -46,9 +46,9 @@ const SectionEntry* VxlFile::find_section(std::uint32_t id) const {
 OrderView VxlFile::order(std::size_t voxel, std::uint32_t k) const {
   const VoxelEntry& v = voxels_[voxel];
   OrderView o;
-  o.wide = (v.flags & kVoxelOrdersU32) != 0;
+  o.width = order_entry_width(v.vertex_count);
   o.count = v.segment_count;
-  o.data = orders_.data() + v.order_offset + std::uint64_t(k) * v.segment_count * (o.wide ? 4 : 2);
+  o.data = orders_.data() + v.order_offset + std::uint64_t(k) * v.segment_count * o.width;
   return o;
 }
 
@@ -163,14 +163,13 @@ void VxlFile::validate() {
       auto key = [](const VoxelEntry& e) { return std::array<std::int32_t, 3>{e.coord[2], e.coord[1], e.coord[0]}; };
       if (!(key(u) < key(v))) fail_input(p, at, "voxel coordinates not strictly increasing in (z, y, x)");
     }
-    if ((v.flags & ~kVoxelOrdersU32) != 0) fail_input(p, at + 12, "unknown voxel flags");
+    if (v.flags != order_width_code(v.vertex_count))
+      fail_input(p, at + 12, "voxel flags must hold the order width code for its vertex count");
     if (v.vertex_count < 1) fail_input(p, at + 48, "voxel with no vertices");
     if (v.segment_count >= v.vertex_count) fail_input(p, at + 52, "voxel has as many segments as vertices");
     if (v.vertex_first != next_vertex) fail_input(p, at + 40, "voxel vertex blocks are not contiguous");
     next_vertex += v.vertex_count;
     if (next_vertex > m.vertex_count) fail_input(p, at + 48, "voxel vertex block runs past vertex_count");
-    bool wide = v.vertex_count > kU16OrderMaxVertices;
-    if (wide != ((v.flags & kVoxelOrdersU32) != 0)) fail_input(p, at + 12, "order width flag does not match vertex count");
     if (v.order_offset % 4 != 0 || v.order_offset < min_order_offset)
       fail_input(p, at + 56, "order offset not a multiple of 4 or decreasing");
     std::uint64_t bytes = vxl::order_bytes(v.vertex_count, v.segment_count, m.stored_order_count);

@@ -20,19 +20,14 @@
 
 namespace vxl {
 
-// One stored order of one voxel: n block-local vertex indices, u16 or u32.
+// One stored order of one voxel: n block-local vertex indices of 2, 3 or 4 bytes (little-endian).
 struct OrderView {
   const std::uint8_t* data = nullptr;
   std::uint32_t count = 0;
-  bool wide = false;
+  std::uint32_t width = 2;
   std::uint32_t operator[](std::uint32_t i) const {
-    if (wide) {
-      std::uint32_t v;
-      std::memcpy(&v, data + 4ull * i, 4);
-      return v;
-    }
-    std::uint16_t v;
-    std::memcpy(&v, data + 2ull * i, 2);
+    std::uint32_t v = 0;
+    std::memcpy(&v, data + std::uint64_t(width) * i, width);
     return v;
   }
 };

@@ -18,7 +18,8 @@ inline constexpr std::uint16_t kVxlVersionMinor = 0;
 inline constexpr std::uint64_t kVxlAlignment = 64;
 inline constexpr std::uint32_t kVxlMaxSections = 64;
 inline constexpr std::uint32_t kVxlMaxStoredOrders = 64;
-inline constexpr std::uint32_t kU16OrderMaxVertices = 65536;  // u16 entries when vertex_count <= this
+inline constexpr std::uint32_t kU16OrderMaxVertices = 65536;     // u16 entries when vertex_count <= this
+inline constexpr std::uint32_t kU24OrderMaxVertices = 1u << 24;  // else u24 entries when <= this, else u32
 
 // §3
 struct FileHeader {
@@ -89,7 +90,7 @@ static_assert(sizeof(DirectionEntry) == 16);
 // §5.3
 struct VoxelEntry {
   std::int32_t coord[3];
-  std::uint32_t flags;  // bit 0: order entries are u32
+  std::uint32_t flags;  // bits 0-1: order entry width code (0: u16, 1: u24, 2: u32)
   float tight_min[3];
   float tight_max[3];
   std::uint64_t vertex_first;
@@ -99,7 +100,13 @@ struct VoxelEntry {
 };
 static_assert(sizeof(VoxelEntry) == 64);
 static_assert(offsetof(VoxelEntry, vertex_first) == 40);
-inline constexpr std::uint32_t kVoxelOrdersU32 = 1u;
+inline constexpr std::uint32_t kVoxelOrderWidthMask = 3u;
+
+// Bytes per order entry for a voxel of this many vertices (spec §5.5), and its flags code.
+constexpr std::uint32_t order_entry_width(std::uint32_t vertex_count) {
+  return vertex_count <= kU16OrderMaxVertices ? 2 : vertex_count <= kU24OrderMaxVertices ? 3 : 4;
+}
+constexpr std::uint32_t order_width_code(std::uint32_t vertex_count) { return order_entry_width(vertex_count) - 2; }
 
 // §5.6
 struct VoxlineEntry {
@@ -114,8 +121,7 @@ constexpr std::uint64_t align_up(std::uint64_t x, std::uint64_t a) { return (x +
 
 // Bytes taken by one voxel's K orders of n segments, including the padding to 4 bytes (§5.5).
 constexpr std::uint64_t order_bytes(std::uint32_t vertex_count, std::uint32_t segment_count, std::uint32_t k) {
-  std::uint64_t width = vertex_count > kU16OrderMaxVertices ? 4 : 2;
-  return align_up(std::uint64_t(segment_count) * k * width, 4);
+  return align_up(std::uint64_t(segment_count) * k * order_entry_width(vertex_count), 4);
 }
 
 }  // namespace vxl

@@ -1,3 +1,4 @@
+#include <chrono>
 #include <cstdio>
 
 #include "commands.h"
@@ -11,6 +12,7 @@ void add_convert_command(CLI::App& app) {
   struct Options {
     std::string input, output;
     ConvertSettings settings;
+    bool verbose = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("convert", "Convert a TCK / TRK (.trk.gz) / TRX tractogram to .vxl");
@@ -21,11 +23,14 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
   cmd->add_option("--orders", opt->settings.orders, "precomputed order set: axis (6 orders) or axis+diag (14)")
       ->default_val("axis")->check(CLI::IsMember({"axis", "axis+diag"}));
+  cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
   cmd->callback([opt] {
     ProgressBar bar;
     opt->settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
     bar.update("reading", 0.0);
+    auto t0 = std::chrono::steady_clock::now();
     Tractogram t = read_tractogram(opt->input);
+    double read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const std::string& w : t.source.warnings) {
       bar.done();
       std::fprintf(stderr, "voxlines: warning: %s: %s\n", opt->input.c_str(), w.c_str());
@@ -35,6 +40,9 @@ void add_convert_command(CLI::App& app) {
     std::printf("%s: %llu streamlines, %llu points -> %llu voxels, %llu segments (%llu points added at voxel faces)\n",
                 opt->output.c_str(), (unsigned long long)s.streamlines, (unsigned long long)s.points,
                 (unsigned long long)s.voxels, (unsigned long long)s.segments, (unsigned long long)s.synthetic_points);
+    if (opt->verbose)
+      std::printf("stages: read %.3f s, voxelise %.3f s, orders %.3f s, write %.3f s\n", read_seconds, s.voxelize_seconds,
+                  s.orders_seconds, s.write_seconds);
   });
 }
 
