@@ -1,0 +1,83 @@
+#include "frame_plan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+namespace vxl {
+
+ViewParams make_view_params(const glm::dvec3& eye, const glm::dvec3& forward, bool orthographic,
+                            const glm::dmat4& projection, const glm::dmat3& rotation) {
+  ViewParams v;
+  v.eye = eye;
+  v.forward = forward;
+  v.orthographic = orthographic;
+  glm::dmat4 m = projection * glm::dmat4(rotation);  // camera-relative position -> clip space
+  auto row = [&](int r) { return glm::dvec4(m[0][r], m[1][r], m[2][r], m[3][r]); };
+  v.planes = {row(3) + row(0), row(3) - row(0), row(3) + row(1), row(3) - row(1), row(3) + row(2), row(3) - row(2)};
+  return v;
+}
+
+std::pair<std::uint32_t, bool> nearest_order(const std::vector<glm::vec3>& directions, const glm::dvec3& w) {
+  // Order k drawn forwards is back to front for an eye looking along -d_k; reversed, along +d_k. We want
+  // the signed direction s maximising s . (-w): |d_k . w| largest, reversed when d_k . w > 0.
+  std::uint32_t best = 0;
+  double best_abs = -1, best_dot = 0;
+  for (std::uint32_t k = 0; k < directions.size(); ++k) {
+    double d = directions[k].x * w.x + directions[k].y * w.y + directions[k].z * w.z;
+    if (std::abs(d) > best_abs) {
+      best_abs = std::abs(d);
+      best_dot = d;
+      best = k;
+    }
+  }
+  return {best, best_dot > 0};
+}
+
+namespace {
+
+bool outside(const ViewParams& view, const VoxelDrawInfo& v) {
+  glm::dvec3 lo = glm::dvec3(v.tight_min) - view.eye, hi = glm::dvec3(v.tight_max) - view.eye;
+  for (const glm::dvec4& p : view.planes) {
+    // the box corner farthest along the plane normal
+    glm::dvec3 c(p.x >= 0 ? hi.x : lo.x, p.y >= 0 ? hi.y : lo.y, p.z >= 0 ? hi.z : lo.z);
+    if (p.x * c.x + p.y * c.y + p.z * c.z + p.w < 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder order, FramePlan& plan) {
+  plan.first.clear();
+  plan.count.clear();
+  plan.sort_keys.clear();
+  plan.voxels_drawn = plan.segments_drawn = 0;
+  const auto& voxels = layout.voxels();
+  for (std::uint32_t i = 0; i < voxels.size(); ++i) {
+    const VoxelDrawInfo& v = voxels[i];
+    if (v.segment_count == 0 || outside(view, v)) continue;
+    glm::dvec3 d = v.center - view.eye;
+    // back to front = descending distance: sort ascending on the negated key
+    float key = view.orthographic ? static_cast<float>(-glm::dot(d, view.forward)) : static_cast<float>(-glm::dot(d, d));
+    plan.sort_keys.push_back({key, i});
+  }
+  if (order != PlanOrder::Any) std::sort(plan.sort_keys.begin(), plan.sort_keys.end());
+  plan.first.reserve(plan.sort_keys.size());
+  plan.count.reserve(plan.sort_keys.size());
+  for (const auto& [key, i] : plan.sort_keys) {
+    const VoxelDrawInfo& v = voxels[i];
+    std::uint32_t slot = layout.block_slot();
+    bool reversed = false;
+    if (order == PlanOrder::Nearest) {
+      glm::dvec3 w = view.orthographic ? view.forward : glm::normalize(v.center - view.eye);
+      std::tie(slot, reversed) = nearest_order(layout.directions(), w);
+    }
+    plan.first.push_back(static_cast<std::int32_t>(layout.first_id(v, slot, reversed)));
+    plan.count.push_back(static_cast<std::int32_t>(2 * v.segment_count));
+    plan.segments_drawn += v.segment_count;
+  }
+  plan.voxels_drawn = plan.first.size();
+}
+
+}  // namespace vxl

@@ -1,0 +1,48 @@
+// The per-frame CPU work of the Voxlines method: drop voxels outside the view frustum, sort the visible
+// voxels back to front, pick each voxel's nearest precomputed order (the paper's rule), and fill the
+// first/count arrays of one glMultiDrawArrays call. No GL here.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene_layout.h"
+
+namespace vxl {
+
+struct ViewParams {
+  glm::dvec3 eye;
+  glm::dvec3 forward;                 // unit view direction (used for orthographic sorting)
+  bool orthographic = false;
+  std::array<glm::dvec4, 6> planes;   // frustum planes in camera-relative coordinates (p - eye), inside >= 0
+};
+
+// Frustum planes from a projection matrix and the world->eye rotation (Gribb & Hartmann).
+ViewParams make_view_params(const glm::dvec3& eye, const glm::dvec3& forward, bool orthographic,
+                            const glm::dmat4& projection, const glm::dmat3& rotation);
+
+enum class PlanOrder {
+  Nearest,  // sorted voxels, nearest stored order (axis)
+  Block,    // sorted voxels, dataset order inside each voxel (basic)
+  Any,      // visible voxels in table order (order-independent modes)
+};
+
+struct FramePlan {
+  std::vector<std::int32_t> first;
+  std::vector<std::int32_t> count;
+  std::uint64_t voxels_drawn = 0;
+  std::uint64_t segments_drawn = 0;
+  // scratch, kept between frames to avoid allocation
+  std::vector<std::pair<float, std::uint32_t>> sort_keys;
+};
+
+void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder order, FramePlan& plan);
+
+// The paper's rule: for a voxel centre v and eye c, the stored direction d (or its reverse) that is
+// closest to the back-to-front direction. Returns {slot, reversed}.
+std::pair<std::uint32_t, bool> nearest_order(const std::vector<glm::vec3>& directions, const glm::dvec3& view_dir);
+
+}  // namespace vxl

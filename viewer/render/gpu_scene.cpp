@@ -1,0 +1,105 @@
+#include "gpu_scene.h"
+
+#include <algorithm>
+
+#include "error.h"
+#include "vxl_streamlines.h"
+
+namespace vxl {
+
+std::uint64_t GpuScene::driver_limit() {
+  GLint texels = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &texels);
+  return texels > 0 ? static_cast<std::uint64_t>(texels) : 65536;  // 65536 is the GL 3.3 minimum
+}
+
+GpuScene::GpuScene(const VxlFile& file, std::uint64_t max_texels)
+    : file_(file), layout_(file, max_texels ? max_texels : driver_limit()) {
+  const auto voxels = file.voxels();
+  const std::uint32_t k_count = layout_.stored_orders();
+  const std::uint64_t ordr_at = file.find_section(section_id("ORDR"))->offset;
+  std::vector<std::uint32_t> entries;
+  std::vector<std::uint8_t> is_start;
+  for (const ChunkLayout& c : layout_.chunks()) {
+    GpuChunk g;
+    g.positions.create(GL_R32F, file.vertices().data() + 3 * c.vertex_first, 12 * c.vertex_count);
+    // Widen every stored order to chunk-global u32 and append the block order; the same pass checks every
+    // entry, which open() does not (it would cost O(points) there).
+    entries.assign(layout_.slots() * c.segments, 0);
+    for (std::uint32_t i = c.voxel_first; i < c.voxel_first + c.voxel_count; ++i) {
+      const VoxelEntry& v = voxels[i];
+      const VoxelDrawInfo& d = layout_.voxels()[i];
+      const std::uint32_t base = static_cast<std::uint32_t>(v.vertex_first - c.vertex_first);
+      is_start.assign(v.vertex_count, 0);
+      for (std::uint32_t k = 0; k < k_count; ++k) {
+        OrderView o = file.order(i, k);
+        std::uint32_t* out = entries.data() + k * c.segments + d.seg_first;
+        for (std::uint32_t n = 0; n < o.count; ++n) {
+          std::uint32_t e = o[n];
+          if (e + 1ull >= v.vertex_count)
+            throw Error(ErrorKind::Input, file.path(), ordr_at + v.order_offset,
+                        "order entry out of range in voxel " + std::to_string(i) + " (run `voxlines verify`)");
+          out[n] = base + e;
+          if (k == 0) is_start[e] = 1;
+        }
+      }
+      std::uint32_t* block = entries.data() + layout_.block_slot() * c.segments + d.seg_first;
+      std::uint32_t n = 0;
+      for (std::uint32_t e = 0; e < v.vertex_count && n < v.segment_count; ++e)
+        if (is_start[e]) block[n++] = base + e;
+    }
+    g.orders.create(GL_R32UI, entries.data(), entries.size() * 4);
+    g.dataset.create(GL_R32UI, nullptr, 0);
+    gpu_bytes_ += 12 * c.vertex_count + entries.size() * 4;
+    chunks_.push_back(g);
+  }
+  entries.clear();
+  entries.shrink_to_fit();
+}
+
+GpuScene::~GpuScene() {
+  for (GpuChunk& c : chunks_) {
+    c.positions.destroy();
+    c.orders.destroy();
+    c.dataset.destroy();
+  }
+}
+
+const std::vector<std::int32_t>& GpuScene::dataset_first() {
+  if (!dataset_built_) {
+    // Walk the streamlines: every voxline contributes its segments, in order, to its chunk's dataset
+    // array; consecutive segments in one chunk form one draw range.
+    std::vector<std::vector<std::uint32_t>> per_chunk(layout_.chunks().size());
+    std::int64_t run_chunk = -1;
+    WalkCallbacks cb;
+    cb.voxline = [&](std::uint32_t voxel, std::uint64_t first_vertex, std::uint32_t own, bool connected) {
+      const std::uint32_t c = layout_.voxels()[voxel].chunk;
+      const ChunkLayout& cl = layout_.chunks()[c];
+      const std::uint64_t segments = own + (connected ? 1 : 0) - 1;
+      if (segments == 0) return;
+      auto& arr = per_chunk[c];
+      if (run_chunk != c) {
+        dataset_first_.push_back(static_cast<std::int32_t>(layout_.dataset_id(c, arr.size())));
+        dataset_count_.push_back(0);
+        run_chunk = c;
+      }
+      for (std::uint64_t s = 0; s < segments; ++s) arr.push_back(static_cast<std::uint32_t>(first_vertex - cl.vertex_first + s));
+      dataset_count_.back() += static_cast<std::int32_t>(2 * segments);
+    };
+    walk_streamlines(file_, cb);
+    for (std::size_t c = 0; c < chunks_.size(); ++c) {
+      chunks_[c].dataset.destroy();
+      chunks_[c].dataset.create(GL_R32UI, per_chunk[c].data(), per_chunk[c].size() * 4);
+      gpu_bytes_ += per_chunk[c].size() * 4;
+    }
+    dataset_built_ = true;
+  }
+  return dataset_first_;
+}
+
+const std::vector<std::int32_t>& GpuScene::dataset_count() {
+  dataset_first();
+  return dataset_count_;
+}
+
+}  // namespace vxl

@@ -1,0 +1,47 @@
+// The GPU copy of a .vxl scene: per chunk (see scene_layout.h) a positions buffer (one large copy straight
+// from the memory-mapped file), an orders buffer (stored orders widened to chunk-global u32 indices, each
+// entry checked, plus the block order), and — only when first needed — a dataset-order buffer.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "gl_util.h"
+#include "scene_layout.h"
+#include "vxl_file.h"
+
+namespace vxl {
+
+struct GpuChunk {
+  gl::TextureBuffer positions;  // GL_R32F, 3 texels per vertex
+  gl::TextureBuffer orders;     // GL_R32UI, slots x S
+  gl::TextureBuffer dataset;    // GL_R32UI, S (empty until needed)
+};
+
+class GpuScene {
+ public:
+  // Needs a current GL context. max_texels 0: ask the driver (GL_MAX_TEXTURE_BUFFER_SIZE).
+  GpuScene(const VxlFile& file, std::uint64_t max_texels = 0);
+  ~GpuScene();
+  GpuScene(const GpuScene&) = delete;
+  GpuScene& operator=(const GpuScene&) = delete;
+
+  const SceneLayout& layout() const { return layout_; }
+  const std::vector<GpuChunk>& chunks() const { return chunks_; }
+  std::uint64_t gpu_bytes() const { return gpu_bytes_; }
+
+  // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)).
+  const std::vector<std::int32_t>& dataset_first();
+  const std::vector<std::int32_t>& dataset_count();
+
+ private:
+  static std::uint64_t driver_limit();
+  const VxlFile& file_;
+  SceneLayout layout_;
+  std::vector<GpuChunk> chunks_;
+  std::uint64_t gpu_bytes_ = 0;
+  bool dataset_built_ = false;
+  std::vector<std::int32_t> dataset_first_, dataset_count_;
+};
+
+}  // namespace vxl

@@ -1,0 +1,150 @@
+#include "line_shaders.h"
+
+namespace vxl::shaders {
+
+std::string line_vertex(unsigned chunk_count, const char* version) {
+  std::string n = std::to_string(chunk_count);
+  std::string s = std::string(version) + "\n#define CHUNKS " + n + "\n";
+  for (unsigned c = 0; c < chunk_count; ++c) {
+    std::string i = std::to_string(c);
+    s += "uniform samplerBuffer u_pos" + i + ";\nuniform usamplerBuffer u_ord" + i + ";\nuniform usamplerBuffer u_dat" + i + ";\n";
+  }
+  s += "vec3 fetch_pos(int c, int v) {\n";
+  for (unsigned c = 0; c < chunk_count; ++c) {
+    std::string i = std::to_string(c);
+    s += "  if (c == " + i + ") return vec3(texelFetch(u_pos" + i + ", 3 * v).r, texelFetch(u_pos" + i +
+         ", 3 * v + 1).r, texelFetch(u_pos" + i + ", 3 * v + 2).r);\n";
+  }
+  s += "  return vec3(0.0);\n}\nint fetch_order(int c, int j) {\n";
+  for (unsigned c = 0; c < chunk_count; ++c)
+    s += "  if (c == " + std::to_string(c) + ") return int(texelFetch(u_ord" + std::to_string(c) + ", j).r);\n";
+  s += "  return 0;\n}\nint fetch_dataset(int c, int j) {\n";
+  for (unsigned c = 0; c < chunk_count; ++c)
+    s += "  if (c == " + std::to_string(c) + ") return int(texelFetch(u_dat" + std::to_string(c) + ", j).r);\n";
+  s += "  return 0;\n}\n";
+  s += R"(
+uniform int u_chunk_base[CHUNKS];
+uniform int u_chunk_segments[CHUNKS];
+uniform int u_slots;
+uniform vec3 u_eye_hi;      // eye position split in two floats on the CPU (in double):
+uniform vec3 u_eye_lo;      // p - eye = (p - hi) - lo keeps the source precision far from the origin
+uniform mat3 u_rotation;    // world -> eye
+uniform mat4 u_projection;
+uniform int u_color_mode;   // 0 direction, 1 fixed
+uniform vec3 u_fixed_color;
+uniform float u_opacity;
+out vec4 v_color;
+out float v_depth;          // distance along the view axis, mm
+
+void main() {
+  int id = gl_VertexID;
+  int c = 0;
+  for (int k = 1; k < CHUNKS; ++k)
+    if (id >= u_chunk_base[k]) c = k;
+  int local = id - u_chunk_base[c];
+  int seg = local >> 1;
+  int end = local & 1;
+  int S = u_chunk_segments[c];
+  int A = u_slots * S;
+  int v;
+  if (seg < A) {
+    v = fetch_order(c, seg);
+  } else if (seg < 2 * A) {
+    int r = seg - A;
+    int slot = r / S;
+    v = fetch_order(c, slot * S + (S - 1 - (r - slot * S)));
+  } else {
+    v = fetch_dataset(c, seg - 2 * A);
+  }
+  vec3 p = fetch_pos(c, v + end);
+  vec3 q = fetch_pos(c, v + 1 - end);
+  vec3 rel = (p - u_eye_hi) - u_eye_lo;
+  vec3 e = u_rotation * rel;
+  gl_Position = u_projection * vec4(e, 1.0);
+  v_depth = -e.z;
+  vec3 d = q - p;
+  float len = length(d);
+  vec3 color = u_color_mode == 0 ? (len > 0.0 ? abs(d / len) : vec3(1.0)) : u_fixed_color;
+  v_color = vec4(color, u_opacity);
+}
+)";
+  return s;
+}
+
+const char* const kLineOverFragment = R"(#version 330 core
+in vec4 v_color;
+in float v_depth;
+out vec4 frag;
+void main() { frag = v_color; }
+)";
+
+const char* const kLineWboitAccumFragment = R"(#version 330 core
+in vec4 v_color;
+in float v_depth;
+out vec4 accum;
+void main() {
+  float a = v_color.a;
+  // Weight function (7) of McGuire & Bavoil 2013, with depth in mm scaled to their units.
+  float z = v_depth / 200.0;
+  float w = a * clamp(0.03 / (1e-5 + pow(z, 4.0)), 1e-2, 3e3);
+  accum = vec4(v_color.rgb * a * w, a * w);
+}
+)";
+
+const char* const kLineWboitRevealFragment = R"(#version 330 core
+in vec4 v_color;
+in float v_depth;
+out vec4 reveal;
+void main() { reveal = vec4(v_color.a); }
+)";
+
+const char* const kLineAdditiveFragment = R"(#version 330 core
+in vec4 v_color;
+in float v_depth;
+out vec4 frag;
+void main() { frag = vec4(v_color.rgb * v_color.a, v_color.a); }
+)";
+
+const char* const kFullscreenVertex = R"(#version 330 core
+out vec2 v_uv;
+void main() {
+  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+  v_uv = p;
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+const char* const kWboitCompositeFragment = R"(#version 330 core
+in vec2 v_uv;
+uniform sampler2D u_accum;
+uniform sampler2D u_reveal;
+out vec4 frag;
+void main() {
+  vec4 accum = texture(u_accum, v_uv);
+  float revealage = texture(u_reveal, v_uv).r;
+  if (revealage >= 1.0) discard;
+  vec3 color = accum.rgb / max(accum.a, 1e-5);
+  frag = vec4(color, 1.0 - revealage);  // blended over the background
+}
+)";
+
+const char* const kAdditiveCompositeFragment = R"(#version 330 core
+in vec2 v_uv;
+uniform sampler2D u_opaque;    // depth-tested pass, alpha 1 where a line is
+uniform sampler2D u_additive;  // sum of alpha * colour
+uniform float u_opacity;
+out vec4 frag;
+void main() {
+  vec4 o = texture(u_opaque, v_uv);
+  vec4 s = texture(u_additive, v_uv);
+  vec3 add = min(s.rgb, vec3(1.0));
+  float add_a = min(s.a, 1.0);
+  // Mix the two renders by the opacity: opaque at 1, additive as it goes to 0.
+  vec3 color = mix(add, o.rgb * o.a, u_opacity);
+  float alpha = mix(add_a, o.a, u_opacity);
+  if (alpha <= 0.0) discard;
+  frag = vec4(color / alpha, alpha);
+}
+)";
+
+}  // namespace vxl::shaders

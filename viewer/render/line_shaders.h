@@ -1,0 +1,23 @@
+// GLSL sources of the line renderer. The vertex shader is generated for the scene's chunk count (samplers
+// cannot be indexed dynamically in GLSL 3.30, so each chunk gets its own samplers and an if-chain).
+#pragma once
+
+#include <string>
+
+namespace vxl::shaders {
+
+// Vertex shader: virtual vertex id -> segment end (scene_layout.h), camera-relative position, colour.
+std::string line_vertex(unsigned chunk_count, const char* version = "#version 330 core");
+
+// Fragment shaders for the line pass.
+extern const char* const kLineOverFragment;         // colour with alpha: blended "over", or opaque
+extern const char* const kLineWboitAccumFragment;   // McGuire & Bavoil accumulation (premultiplied, weighted)
+extern const char* const kLineWboitRevealFragment;  // revealage: product of (1 - alpha)
+extern const char* const kLineAdditiveFragment;     // sum of alpha * colour
+
+// Fullscreen composites (a triangle from gl_VertexID, no buffers).
+extern const char* const kFullscreenVertex;
+extern const char* const kWboitCompositeFragment;
+extern const char* const kAdditiveCompositeFragment;
+
+}  // namespace vxl::shaders

@@ -1,0 +1,248 @@
+#include "renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "exact_renderer.h"
+#include "line_shaders.h"
+
+namespace vxl {
+
+Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels) : file_(file), scene_(file, max_texels) {
+  glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even without attributes
+  const unsigned chunks = std::max<unsigned>(1, static_cast<unsigned>(scene_.layout().chunks().size()));
+  const std::string vs = shaders::line_vertex(chunks);
+  over_program_ = gl::make_program(vs, shaders::kLineOverFragment);
+  accum_program_ = gl::make_program(vs, shaders::kLineWboitAccumFragment);
+  reveal_program_ = gl::make_program(vs, shaders::kLineWboitRevealFragment);
+  additive_program_ = gl::make_program(vs, shaders::kLineAdditiveFragment);
+  wboit_composite_ = gl::make_program(shaders::kFullscreenVertex, shaders::kWboitCompositeFragment);
+  additive_composite_ = gl::make_program(shaders::kFullscreenVertex, shaders::kAdditiveCompositeFragment);
+}
+
+Renderer::~Renderer() {
+  exact_.reset();
+  for (GLuint p : {over_program_, accum_program_, reveal_program_, additive_program_, wboit_composite_, additive_composite_})
+    if (p) glDeleteProgram(p);
+  wboit_target_.destroy();
+  opaque_target_.destroy();
+  additive_target_.destroy();
+  if (vao_) glDeleteVertexArrays(1, &vao_);
+}
+
+glm::dvec3 Renderer::bounds_min() const {
+  const MetaSection& m = file_.meta();
+  return {m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]};
+}
+glm::dvec3 Renderer::bounds_max() const {
+  const MetaSection& m = file_.meta();
+  return {m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]};
+}
+
+glm::dmat4 Renderer::projection(const Camera& camera, double aspect) const {
+  // Near and far planes hug the scene's bounding sphere, for depth precision.
+  glm::dvec3 centre = (bounds_min() + bounds_max()) * 0.5;
+  double radius = std::max(1.0, glm::length(bounds_max() - bounds_min()) * 0.5 + file_.meta().voxel_size);
+  double along = glm::dot(centre - camera.eye(), camera.forward());
+  double far_mm = along + radius;
+  double near_mm = camera.orthographic ? along - radius : std::max(far_mm * 1e-4, along - radius);
+  return glm::dmat4(Camera(camera).projection(aspect, near_mm, std::max(far_mm, near_mm + 1.0)));
+}
+
+void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out) {
+  ViewParams view = make_view_params(camera.eye(), camera.forward(), camera.orthographic, projection(camera, aspect),
+                                     glm::dmat3(camera.view_rotation()));
+  plan_frame(scene_.layout(), view, order, out);
+}
+
+void Renderer::bind_line_program(GLuint program, const Camera& camera, const RenderSettings& s, double aspect) const {
+  glUseProgram(program);
+  const SceneLayout& layout = scene_.layout();
+  const auto& chunks = layout.chunks();
+  std::vector<GLint> base, segments;
+  for (const ChunkLayout& c : chunks) {
+    base.push_back(static_cast<GLint>(c.virtual_base));
+    segments.push_back(static_cast<GLint>(std::max<std::uint64_t>(1, c.segments)));
+  }
+  if (base.empty()) base = {0}, segments = {1};
+  glUniform1iv(glGetUniformLocation(program, "u_chunk_base"), static_cast<GLsizei>(base.size()), base.data());
+  glUniform1iv(glGetUniformLocation(program, "u_chunk_segments"), static_cast<GLsizei>(segments.size()), segments.data());
+  glUniform1i(glGetUniformLocation(program, "u_slots"), static_cast<GLint>(layout.slots()));
+  for (std::size_t c = 0; c < scene_.chunks().size(); ++c) {
+    const GpuChunk& g = scene_.chunks()[c];
+    const GLuint textures[3] = {g.positions.texture, g.orders.texture, g.dataset.texture};
+    const char* names[3] = {"u_pos", "u_ord", "u_dat"};
+    for (int t = 0; t < 3; ++t) {
+      GLint unit = static_cast<GLint>(3 * c + t);
+      glActiveTexture(GL_TEXTURE0 + unit);
+      glBindTexture(GL_TEXTURE_BUFFER, textures[t]);
+      glUniform1i(glGetUniformLocation(program, (names[t] + std::to_string(c)).c_str()), unit);
+    }
+  }
+  glActiveTexture(GL_TEXTURE0);
+  const glm::dvec3 eye = camera.eye();
+  const glm::vec3 hi(eye);
+  const glm::vec3 lo(eye - glm::dvec3(hi));
+  glUniform3fv(glGetUniformLocation(program, "u_eye_hi"), 1, glm::value_ptr(hi));
+  glUniform3fv(glGetUniformLocation(program, "u_eye_lo"), 1, glm::value_ptr(lo));
+  const glm::mat3 rotation = camera.view_rotation();
+  glUniformMatrix3fv(glGetUniformLocation(program, "u_rotation"), 1, GL_FALSE, glm::value_ptr(rotation));
+  const glm::mat4 proj(projection(camera, aspect));
+  glUniformMatrix4fv(glGetUniformLocation(program, "u_projection"), 1, GL_FALSE, glm::value_ptr(proj));
+  glUniform1i(glGetUniformLocation(program, "u_color_mode"), s.color == ColorMode::Direction ? 0 : 1);
+  glUniform3fv(glGetUniformLocation(program, "u_fixed_color"), 1, glm::value_ptr(s.fixed_color));
+  glUniform1f(glGetUniformLocation(program, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
+}
+
+void Renderer::draw_plan(const std::vector<std::int32_t>& first, const std::vector<std::int32_t>& count) const {
+  if (first.empty()) return;
+  glBindVertexArray(vao_);
+  glMultiDrawArrays(GL_LINES, first.data(), count.data(), static_cast<GLsizei>(first.size()));
+}
+
+void Renderer::draw_lines(GLuint program, const Camera& camera, const RenderSettings& s, double aspect, PlanOrder order) {
+  auto t0 = std::chrono::steady_clock::now();
+  plan(camera, aspect, order, plan_);
+  stats_.plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats_.voxels_drawn = plan_.voxels_drawn;
+  stats_.segments_drawn = plan_.segments_drawn;
+  bind_line_program(program, camera, s, aspect);
+  draw_plan(plan_.first, plan_.count);
+}
+
+void Renderer::draw_dataset_order(GLuint program, const Camera& camera, const RenderSettings& s, double aspect) {
+  const auto& first = scene_.dataset_first();
+  const auto& count = scene_.dataset_count();
+  stats_.plan_ms = 0;
+  stats_.voxels_drawn = file_.meta().voxel_count;
+  stats_.segments_drawn = file_.meta().segment_count;
+  bind_line_program(program, camera, s, aspect);
+  draw_plan(first, count);
+}
+
+void Renderer::fullscreen(GLuint program) const {
+  glUseProgram(program);
+  glBindVertexArray(vao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
+  const double aspect = double(width) / std::max(1, height);
+  const glm::vec3 bg = s.background();
+  auto over_blending = [] {
+    glEnable(GL_BLEND);
+    // Premultiply colour, accumulate coverage: destination alpha reaches 1 (BRIEF §3 pitfall 5).
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  };
+  auto clear_target = [&](GLuint target, glm::vec4 colour) {
+    glBindFramebuffer(GL_FRAMEBUFFER, target);
+    glViewport(0, 0, width, height);
+    glClearColor(colour.r, colour.g, colour.b, colour.a);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  };
+  glLineWidth(std::max(1.0f, s.line_width));
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+
+  switch (s.mode) {
+    case RenderMode::Opaque:
+      clear_target(fbo, glm::vec4(bg, 1));
+      glEnable(GL_DEPTH_TEST);
+      glDepthFunc(GL_LESS);
+      draw_lines(over_program_, camera, s, aspect, PlanOrder::Any);
+      glDisable(GL_DEPTH_TEST);
+      break;
+    case RenderMode::Unsorted:
+      clear_target(fbo, glm::vec4(bg, 1));
+      over_blending();
+      draw_dataset_order(over_program_, camera, s, aspect);
+      break;
+    case RenderMode::Basic:
+      clear_target(fbo, glm::vec4(bg, 1));
+      over_blending();
+      draw_lines(over_program_, camera, s, aspect, PlanOrder::Block);
+      break;
+    case RenderMode::Axis:
+      clear_target(fbo, glm::vec4(bg, 1));
+      over_blending();
+      draw_lines(over_program_, camera, s, aspect, PlanOrder::Nearest);
+      break;
+    case RenderMode::Wboit: {
+      wboit_target_.ensure(width, height, GL_RGBA16F, GL_RGBA16F, false);
+      glBindFramebuffer(GL_FRAMEBUFFER, wboit_target_.fbo);
+      glViewport(0, 0, width, height);
+      const GLenum accum = GL_COLOR_ATTACHMENT0, reveal = GL_COLOR_ATTACHMENT1;
+      glDrawBuffers(1, &accum);
+      glClearColor(0, 0, 0, 0);
+      glClear(GL_COLOR_BUFFER_BIT);
+      glEnable(GL_BLEND);
+      glBlendFunc(GL_ONE, GL_ONE);
+      draw_lines(accum_program_, camera, s, aspect, PlanOrder::Any);
+      glDrawBuffers(1, &reveal);
+      glClearColor(1, 1, 1, 1);
+      glClear(GL_COLOR_BUFFER_BIT);
+      glBlendFunc(GL_ZERO, GL_ONE_MINUS_SRC_COLOR);
+      bind_line_program(reveal_program_, camera, s, aspect);
+      draw_plan(plan_.first, plan_.count);
+      const GLenum both[2] = {accum, reveal};
+      glDrawBuffers(2, both);
+      clear_target(fbo, glm::vec4(bg, 1));
+      over_blending();
+      glUseProgram(wboit_composite_);
+      glActiveTexture(GL_TEXTURE0);
+      glBindTexture(GL_TEXTURE_2D, wboit_target_.color[0]);
+      glActiveTexture(GL_TEXTURE1);
+      glBindTexture(GL_TEXTURE_2D, wboit_target_.color[1]);
+      glUniform1i(glGetUniformLocation(wboit_composite_, "u_accum"), 0);
+      glUniform1i(glGetUniformLocation(wboit_composite_, "u_reveal"), 1);
+      fullscreen(wboit_composite_);
+      glActiveTexture(GL_TEXTURE0);
+      break;
+    }
+    case RenderMode::Additive: {
+      opaque_target_.ensure(width, height, GL_RGBA8, 0, true);
+      additive_target_.ensure(width, height, GL_RGBA16F, 0, false);
+      clear_target(opaque_target_.fbo, glm::vec4(0));
+      glEnable(GL_DEPTH_TEST);
+      glDepthFunc(GL_LESS);
+      RenderSettings solid = s;
+      solid.opacity = 1.0f;
+      draw_lines(over_program_, camera, solid, aspect, PlanOrder::Any);
+      glDisable(GL_DEPTH_TEST);
+      glBindFramebuffer(GL_FRAMEBUFFER, additive_target_.fbo);
+      glClearColor(0, 0, 0, 0);
+      glClear(GL_COLOR_BUFFER_BIT);
+      glEnable(GL_BLEND);
+      glBlendFunc(GL_ONE, GL_ONE);
+      bind_line_program(additive_program_, camera, s, aspect);
+      draw_plan(plan_.first, plan_.count);
+      clear_target(fbo, glm::vec4(bg, 1));
+      over_blending();
+      glUseProgram(additive_composite_);
+      glActiveTexture(GL_TEXTURE0);
+      glBindTexture(GL_TEXTURE_2D, opaque_target_.color[0]);
+      glActiveTexture(GL_TEXTURE1);
+      glBindTexture(GL_TEXTURE_2D, additive_target_.color[0]);
+      glUniform1i(glGetUniformLocation(additive_composite_, "u_opaque"), 0);
+      glUniform1i(glGetUniformLocation(additive_composite_, "u_additive"), 1);
+      glUniform1f(glGetUniformLocation(additive_composite_, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
+      fullscreen(additive_composite_);
+      glActiveTexture(GL_TEXTURE0);
+      break;
+    }
+    case RenderMode::Exact:
+      if (!exact_) exact_ = std::make_unique<ExactRenderer>(*this);
+      exact_->draw(camera, s, width, height, fbo);
+      break;
+  }
+  glDisable(GL_BLEND);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+}
+
+}  // namespace vxl

@@ -1,0 +1,68 @@
+// The Voxlines renderer. Needs only a current OpenGL context (3.3 core for every mode but `exact`, which
+// needs 4.3): it is driven the same way from a GLFW window and from a headless EGL context.
+//
+//   Renderer r(file);                       // uploads the scene (few large copies)
+//   r.draw(camera, settings, w, h, fbo);    // one frame into the bound framebuffer `fbo`
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "camera.h"
+#include "frame_plan.h"
+#include "gl_util.h"
+#include "gpu_scene.h"
+#include "render_settings.h"
+
+namespace vxl {
+
+class ExactRenderer;
+
+struct FrameStats {
+  double plan_ms = 0;  // CPU work of the frame: cull + sort + order pick + command building
+  std::uint64_t voxels_drawn = 0;
+  std::uint64_t segments_drawn = 0;
+};
+
+class Renderer {
+ public:
+  explicit Renderer(const VxlFile& file, std::uint64_t max_texels = 0);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Renders one frame into framebuffer `fbo` (0: the default one) of size width x height.
+  // Throws std::runtime_error when the mode needs more than the context offers (exact on GL < 4.3).
+  void draw(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
+
+  const FrameStats& stats() const { return stats_; }
+  GpuScene& scene() { return scene_; }
+  const VxlFile& file() const { return file_; }
+  glm::dvec3 bounds_min() const;
+  glm::dvec3 bounds_max() const;
+
+  // The projection the renderer uses for `camera` (near/far planes fitted to the scene bounds).
+  glm::dmat4 projection(const Camera& camera, double aspect) const;
+
+  // Binds the line program's uniforms and textures for `camera`; used by the exact renderer too.
+  void bind_line_program(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect) const;
+  void draw_plan(const std::vector<std::int32_t>& first, const std::vector<std::int32_t>& count) const;
+  void plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out);
+
+ private:
+  void draw_lines(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect, PlanOrder order);
+  void draw_dataset_order(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect);
+  void fullscreen(GLuint program) const;
+
+  const VxlFile& file_;
+  GpuScene scene_;
+  GLuint vao_ = 0;
+  GLuint over_program_ = 0, accum_program_ = 0, reveal_program_ = 0, additive_program_ = 0;
+  GLuint wboit_composite_ = 0, additive_composite_ = 0;
+  gl::RenderTarget wboit_target_, opaque_target_, additive_target_;
+  FramePlan plan_;
+  FrameStats stats_;
+  std::unique_ptr<ExactRenderer> exact_;
+};
+
+}  // namespace vxl
