@@ -1,0 +1,55 @@
+// Shared by the render tests: one headless GL context per process, hand-made scenes converted to .vxl,
+// and rendering a frame to an image.
+#pragma once
+
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include "camera.h"
+#include "convert.h"
+#include "egl_context.h"
+#include "exact_renderer.h"
+#include "image_io.h"
+#include "offscreen_target.h"
+#include "render_settings.h"
+#include "renderer.h"
+#include "test_support.h"
+#include "vxl_file.h"
+
+namespace vxl::test {
+
+inline HeadlessGlContext& gl_context() {
+  static HeadlessGlContext context;
+  context.make_current();
+  return context;
+}
+
+// Converts `t` to a .vxl in `dir` and opens it.
+inline VxlFile make_scene(const ScratchDir& dir, Tractogram t, double voxel_size, const std::string& name = "scene.vxl") {
+  ConvertSettings s;
+  s.voxel_size = voxel_size;
+  std::string path = dir.file(name);
+  convert_tractogram(std::move(t), path, s);
+  return VxlFile::open(path);
+}
+
+inline Image render_image(Renderer& r, const Camera& camera, const RenderSettings& settings, int w, int h) {
+  OffscreenTarget target(w, h);
+  target.bind();
+  r.draw(camera, settings, w, h, target.framebuffer());
+  glFinish();
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR)) << render_mode_name(settings.mode);
+  Image img;
+  img.width = w;
+  img.height = h;
+  img.rgba = target.read_rgba();
+  // VOXLINES_TEST_IMAGES=DIR keeps every rendered image, for looking at a failure.
+  if (const char* keep = std::getenv("VOXLINES_TEST_IMAGES")) {
+    static int n = 0;
+    write_png(std::string(keep) + "/" + std::to_string(n++) + "_" + render_mode_name(settings.mode) + ".png", img);
+  }
+  return img;
+}
+
+}  // namespace vxl::test

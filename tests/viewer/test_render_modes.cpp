@@ -1,0 +1,194 @@
+// Headless render tests on Mesa llvmpipe (EGL surfaceless, no display): each transparency mode against
+// hand-made scenes whose correct picture is known.
+#include <cmath>
+
+#include "render_support.h"
+
+namespace vxl {
+namespace {
+
+using test::gl_context;
+using test::make_scene;
+using test::render_image;
+using test::ScratchDir;
+
+// Three 40 mm lines crossing at (0.5, 0.5) — the centre of pixel (32, 31) below — at z = -10, 0, +10,
+// in non-neighbouring 5 mm voxels. Streamlines are listed nearest first (as seen from above), so the
+// dataset order is the wrong one for blending.
+Tractogram crossing_lines(double offset = 0.0) {
+  Tractogram t;
+  auto add = [&](std::initializer_list<double> xyz) {
+    std::vector<float> p;
+    for (double v : xyz) p.push_back(static_cast<float>(v + offset));
+    t.add_streamline(p.data(), p.size() / 3);
+  };
+  add({-19.5, -19.5, 10, 20.5, 20.5, 10});  // diagonal, nearest
+  add({0.5, -19.5, 0, 0.5, 20.5, 0});       // along y
+  add({-19.5, 0.5, -10, 20.5, 0.5, -10});   // along x, farthest
+  t.source.path = "crossing_lines";
+  return t;
+}
+
+Camera top_view(double offset = 0.0) {
+  Camera c;
+  c.target = glm::dvec3(offset);
+  c.orthographic = true;
+  c.ortho_height = 64;  // 1 mm per pixel on a 64 x 64 image
+  c.distance = 100;
+  auto v = *parse_view("axial");
+  c.azimuth_deg = v[0];
+  c.elevation_deg = v[1];
+  return c;
+}
+
+RenderSettings settings(RenderMode mode, float opacity = 0.5f) {
+  RenderSettings s;
+  s.mode = mode;
+  s.opacity = opacity;
+  return s;
+}
+
+const std::uint8_t* centre(const Image& img) { return img.pixel(32, 31); }
+
+int lit_pixels(const Image& img) {
+  int n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) n += (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0;
+  return n;
+}
+
+class RenderModes : public ::testing::Test {
+ protected:
+  void SetUp() override { gl_context(); }
+  ScratchDir dir;
+};
+
+TEST_F(RenderModes, OpaqueShowsTheNearestLineWithItsDirectionColour) {
+  VxlFile f = make_scene(dir, crossing_lines(), 5.0);
+  Renderer r(f);
+  Image img = render_image(r, top_view(), settings(RenderMode::Opaque), 64, 64);
+  // The diagonal (colour |(1,1,0)/sqrt 2|) is nearest at the crossing.
+  EXPECT_NEAR(centre(img)[0], 180, 2);
+  EXPECT_NEAR(centre(img)[1], 180, 2);
+  EXPECT_EQ(centre(img)[2], 0);
+  // Away from the crossing: the x line (red) on its row, the y line (green) on its column, black elsewhere.
+  EXPECT_EQ(img.pixel(20, 31)[0], 255);
+  EXPECT_EQ(img.pixel(20, 31)[1], 0);
+  EXPECT_EQ(img.pixel(32, 45)[1], 255);
+  EXPECT_EQ(img.pixel(32, 45)[0], 0);
+  EXPECT_EQ(img.pixel(5, 20)[0] + img.pixel(5, 20)[1] + img.pixel(5, 20)[2], 0);
+  EXPECT_EQ(img.pixel(5, 20)[3], 255);
+}
+
+// Back-to-front "over" compositing on the CPU, in double.
+glm::dvec3 composite(std::initializer_list<glm::dvec3> far_to_near, double alpha) {
+  glm::dvec3 c(0.0);
+  for (const glm::dvec3& f : far_to_near) c = f * alpha + c * (1 - alpha);
+  return c;
+}
+
+TEST_F(RenderModes, ExactEqualsCpuCompositing) {
+  gl_context();
+  VxlFile f = make_scene(dir, crossing_lines(), 5.0);
+  Renderer r(f);
+  Image img = render_image(r, top_view(), settings(RenderMode::Exact, 0.5f), 64, 64);
+  const double k = 1 / std::sqrt(2.0);
+  glm::dvec3 expected = composite({{1, 0, 0}, {0, 1, 0}, {k, k, 0}}, 0.5);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(centre(img)[c], expected[c] * 255, 1.0) << "channel " << c;
+  // A pixel with one line only: alpha times its colour over black.
+  EXPECT_NEAR(img.pixel(20, 31)[0], 0.5 * 255, 1.0);
+}
+
+TEST_F(RenderModes, AxisAndBasicEqualExactWhereThePaperGuaranteesIt) {
+  VxlFile f = make_scene(dir, crossing_lines(), 5.0);
+  Renderer r(f);
+  Image exact = render_image(r, top_view(), settings(RenderMode::Exact), 64, 64);
+  for (RenderMode m : {RenderMode::Axis, RenderMode::Basic}) {
+    Image img = render_image(r, top_view(), settings(m), 64, 64);
+    ImageDiff d = compare_images(img, exact);
+    EXPECT_LE(d.max_error * 255, 1.01) << render_mode_name(m);
+  }
+}
+
+TEST_F(RenderModes, UnsortedDiffersFromExactOnAWrongDatasetOrder) {
+  VxlFile f = make_scene(dir, crossing_lines(), 5.0);
+  Renderer r(f);
+  Image exact = render_image(r, top_view(), settings(RenderMode::Exact), 64, 64);
+  Image unsorted = render_image(r, top_view(), settings(RenderMode::Unsorted), 64, 64);
+  // Nearest first, then the others over it: the far red line ends on top.
+  const double k = 1 / std::sqrt(2.0);
+  glm::dvec3 wrong = composite({{k, k, 0}, {0, 1, 0}, {1, 0, 0}}, 0.5);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(centre(unsorted)[c], wrong[c] * 255, 1.0) << "channel " << c;
+  int difference = 0;
+  for (int c = 0; c < 3; ++c) difference += std::abs(int(centre(unsorted)[c]) - int(centre(exact)[c]));
+  EXPECT_GT(difference, 60);
+}
+
+TEST_F(RenderModes, FarFromTheOriginRendersTheSameImage) {
+  VxlFile near_file = make_scene(dir, crossing_lines(), 5.0, "near.vxl");
+  VxlFile far_file = make_scene(dir, crossing_lines(1e5), 5.0, "far.vxl");
+  Renderer near_r(near_file), far_r(far_file);
+  for (RenderMode m : {RenderMode::Opaque, RenderMode::Axis}) {
+    Camera perspective = top_view();
+    perspective.orthographic = false;
+    for (const Camera& base : {top_view(), perspective}) {
+      Camera far_cam = base;
+      far_cam.target += glm::dvec3(1e5);
+      Image a = render_image(near_r, base, settings(m), 64, 64);
+      Image b = render_image(far_r, far_cam, settings(m), 64, 64);
+      EXPECT_EQ(compare_images(a, b).differing_pixels, 0u) << render_mode_name(m);
+      EXPECT_GT(lit_pixels(b), 100) << "the far scene must actually be drawn";
+    }
+  }
+}
+
+TEST_F(RenderModes, ExactInBandsEqualsExactInOnePass) {
+  VxlFile f = make_scene(dir, crossing_lines(), 5.0);
+  Renderer r(f);
+  Image one = render_image(r, top_view(), settings(RenderMode::Exact), 64, 64);
+  ExactRenderer small(r, 60);  // 60 nodes for ~125 fragments: forces several bands
+  OffscreenTarget target(64, 64);
+  target.bind();
+  small.draw(top_view(), settings(RenderMode::Exact), 64, 64, target.framebuffer());
+  Image banded{64, 64, target.read_rgba()};
+  EXPECT_GE(small.bands_used(), 2);
+  EXPECT_EQ(compare_images(one, banded).differing_pixels, 0u);
+}
+
+TEST_F(RenderModes, ManyChunksRenderLikeOne) {
+  // A tractogram spread over several voxels, uploaded with a tiny texture-buffer limit.
+  Tractogram t;
+  for (int s = 0; s < 40; ++s) {
+    std::vector<float> p;
+    for (int i = 0; i < 30; ++i) p.insert(p.end(), {float(-25 + 1.7 * i), float(-20 + s), float(std::sin(0.3 * i + s) * 8)});
+    t.add_streamline(p.data(), 30);
+  }
+  VxlFile f = make_scene(dir, std::move(t), 6.0);
+  Renderer one(f), many(f, 1500);
+  EXPECT_EQ(one.scene().layout().chunks().size(), 1u);
+  EXPECT_GT(many.scene().layout().chunks().size(), 3u);
+  Camera cam = top_view();
+  cam.azimuth_deg = 30;
+  cam.elevation_deg = 40;
+  for (RenderMode m : {RenderMode::Axis, RenderMode::Basic, RenderMode::Unsorted, RenderMode::Opaque}) {
+    Image a = render_image(one, cam, settings(m, 0.3f), 64, 64);
+    Image b = render_image(many, cam, settings(m, 0.3f), 64, 64);
+    EXPECT_EQ(compare_images(a, b).differing_pixels, 0u) << render_mode_name(m);
+    EXPECT_GT(lit_pixels(a), 200) << render_mode_name(m);
+  }
+}
+
+TEST_F(RenderModes, OrderIndependentModesDrawSomethingBetweenBackgroundAndOpaque) {
+  VxlFile f = make_scene(dir, crossing_lines(), 5.0);
+  Renderer r(f);
+  for (RenderMode m : {RenderMode::Wboit, RenderMode::Additive}) {
+    Image img = render_image(r, top_view(), settings(m, 0.5f), 64, 64);
+    int red = img.pixel(20, 31)[0];
+    EXPECT_GT(red, 20) << render_mode_name(m);
+    EXPECT_LT(red, 255) << render_mode_name(m);
+    EXPECT_EQ(img.pixel(5, 20)[0], 0) << render_mode_name(m);
+  }
+}
+
+}  // namespace
+}  // namespace vxl
