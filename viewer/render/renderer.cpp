@@ -54,9 +54,13 @@ glm::dmat4 Renderer::projection(const Camera& camera, double aspect) const {
 }
 
 void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out) {
+  auto t0 = std::chrono::steady_clock::now();
   ViewParams view = make_view_params(camera.eye(), camera.forward(), camera.orthographic, projection(camera, aspect),
                                      glm::dmat3(camera.view_rotation()));
   plan_frame(scene_.layout(), view, order, out);
+  stats_.plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats_.voxels_drawn = out.voxels_drawn;
+  stats_.segments_drawn = out.segments_drawn;
 }
 
 void Renderer::bind_line_program(GLuint program, const Camera& camera, const RenderSettings& s, double aspect) const {
@@ -105,11 +109,7 @@ void Renderer::draw_plan(const std::vector<std::int32_t>& first, const std::vect
 }
 
 void Renderer::draw_lines(GLuint program, const Camera& camera, const RenderSettings& s, double aspect, PlanOrder order) {
-  auto t0 = std::chrono::steady_clock::now();
   plan(camera, aspect, order, plan_);
-  stats_.plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  stats_.voxels_drawn = plan_.voxels_drawn;
-  stats_.segments_drawn = plan_.segments_drawn;
   bind_line_program(program, camera, s, aspect);
   draw_plan(plan_.first, plan_.count);
 }

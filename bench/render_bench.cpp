@@ -1,0 +1,150 @@
+// Viewer benchmark (issue: viewer and renderer). For each scene (.vxl, with its source TCK):
+//   * time from process start to the first frame read back: `voxview FILE --render` as a child process,
+//     for the .vxl and for the source TCK (converted in memory);
+//   * per-frame CPU work (cull + voxel sort + order pick + command building), median over a 72-view
+//     turntable, at the file's voxel size;
+//   * frame time per mode (glFinish-bounded), median of a few frames over the turntable.
+// Prints numbers; asserts nothing.
+//
+// Usage: render_bench --scene FILE.vxl[:SOURCE.tck] ... [--size N] [--frames N] [--modes a,b,...]
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "egl_context.h"
+#include "frame_plan.h"
+#include "offscreen_target.h"
+#include "renderer.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// Wall time of a child process, from fork to exit.
+double run_child_seconds(const std::vector<std::string>& args) {
+  auto t0 = Clock::now();
+  pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    freopen("/dev/null", "w", stdout);
+    freopen("/dev/null", "w", stderr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return -1;
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+vxl::Camera turntable_camera(const vxl::Renderer& r, int step, int steps) {
+  vxl::Camera c;
+  c.azimuth_deg = 360.0 * step / steps;
+  c.elevation_deg = 20;
+  c.frame(r.bounds_min(), r.bounds_max(), 1.0);
+  return c;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> scenes;
+  int size = 1024, frames = 5;
+  std::string modes_arg = "opaque,unsorted,additive,wboit,basic,axis,exact";
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a == "--scene" && i + 1 < argc) scenes.push_back(argv[++i]);
+    else if (a == "--size" && i + 1 < argc) size = std::stoi(argv[++i]);
+    else if (a == "--frames" && i + 1 < argc) frames = std::stoi(argv[++i]);
+    else if (a == "--modes" && i + 1 < argc) modes_arg = argv[++i];
+    else {
+      std::fprintf(stderr, "usage: render_bench --scene FILE.vxl[:SOURCE.tck]... [--size N] [--frames N] [--modes a,b]\n");
+      return 2;
+    }
+  }
+  std::vector<vxl::RenderMode> modes;
+  std::stringstream ss(modes_arg);
+  for (std::string m; std::getline(ss, m, ',');)
+    if (auto mode = vxl::parse_render_mode(m)) modes.push_back(*mode);
+
+  vxl::HeadlessGlContext context;
+  std::printf("GL: %s %s; image %dx%d\n", context.version_string().c_str(), context.renderer().c_str(), size, size);
+  for (const std::string& spec : scenes) {
+    std::string vxl_path = spec.substr(0, spec.find(':'));
+    std::string source = spec.find(':') == std::string::npos ? "" : spec.substr(spec.find(':') + 1);
+    std::string sz = std::to_string(size) + "x" + std::to_string(size);
+    std::string png = "/tmp/render_bench_" + std::to_string(getpid()) + ".png";
+    std::vector<double> first_vxl, first_src;
+    for (int r = 0; r < 3; ++r) {
+      first_vxl.push_back(run_child_seconds({VOXVIEW_CLI, vxl_path, "--render", png, "--size", sz}));
+      if (!source.empty()) first_src.push_back(run_child_seconds({VOXVIEW_CLI, source, "--render", png, "--size", sz}));
+    }
+    std::remove(png.c_str());
+
+    vxl::VxlFile file = vxl::VxlFile::open(vxl_path);
+    auto t_upload = Clock::now();
+    vxl::Renderer renderer(file);
+    double upload_s = std::chrono::duration<double>(Clock::now() - t_upload).count();
+    std::printf("\nscene %s: %llu streamlines, %llu segments, %u voxels of %g mm, GPU %.0f MiB, upload %.3f s\n",
+                vxl_path.c_str(), (unsigned long long)file.meta().streamline_count,
+                (unsigned long long)file.meta().segment_count, file.meta().voxel_count, file.meta().voxel_size,
+                renderer.scene().gpu_bytes() / 1048576.0, upload_s);
+    std::printf("  first frame read back (process start -> PNG): .vxl %.3f s", median(first_vxl));
+    if (!source.empty()) std::printf(", source %.3f s (ratio %.1fx)", median(first_src), median(first_src) / median(first_vxl));
+    std::printf("\n");
+
+    // CPU work per frame over a turntable.
+    vxl::FramePlan plan;
+    for (auto [order, name] : {std::pair{vxl::PlanOrder::Nearest, "axis (sort + nearest order)"},
+                               std::pair{vxl::PlanOrder::Block, "basic (sort only)"}}) {
+      std::vector<double> ms;
+      for (int step = 0; step < 72; ++step) {
+        vxl::Camera cam = turntable_camera(renderer, step, 72);
+        auto t0 = Clock::now();
+        renderer.plan(cam, 1.0, order, plan);
+        ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+      }
+      std::printf("  CPU per frame, %-28s median %.3f ms, max %.3f ms (%llu voxels drawn at the last view)\n", name,
+                  median(ms), *std::max_element(ms.begin(), ms.end()), (unsigned long long)plan.voxels_drawn);
+    }
+
+    vxl::OffscreenTarget target(size, size);
+    double unsorted_ms = 0;
+    for (vxl::RenderMode mode : modes) {
+      vxl::RenderSettings s;
+      s.mode = mode;
+      s.opacity = 0.05f;
+      std::vector<double> ms;
+      for (int f = 0; f <= frames; ++f) {
+        vxl::Camera cam = turntable_camera(renderer, f, frames + 1);
+        target.bind();
+        glFinish();
+        auto t0 = Clock::now();
+        renderer.draw(cam, s, size, size, target.framebuffer());
+        glFinish();
+        if (f > 0) ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());  // first: warm-up
+      }
+      double m = median(ms);
+      if (mode == vxl::RenderMode::Unsorted) unsorted_ms = m;
+      std::printf("  frame time %-9s median %9.1f ms", vxl::render_mode_name(mode), m);
+      if (unsorted_ms > 0) std::printf("  (%.2fx unsorted)", m / unsorted_ms);
+      std::printf("\n");
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,219 @@
+// The interactive `voxview FILE` window, driven by its automation options (--frames, --screenshot) under a
+// virtual X server (xvfb-run; skipped where it is not installed), and the window's voxel-grid overlay,
+// drawn headless.
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "grid_overlay.h"
+#include "image_io.h"
+#include "render_support.h"
+#include "test_support.h"
+
+namespace vxl {
+namespace {
+
+using test::CommandResult;
+using test::ScratchDir;
+
+bool have_xvfb_run() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+
+CommandResult run_shell(const std::string& command) {
+  CommandResult r{-1, {}};
+  FILE* p = ::popen((command + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int status = ::pclose(p);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+std::string shell_quoted(const std::string& s) { return "'" + s + "'"; }
+
+// voxview under a fresh virtual X server (-a: a free display number, so tests may run side by side).
+CommandResult run_voxview_in_xvfb(const std::string& args) {
+  return run_shell("xvfb-run -a -s \"-screen 0 800x600x24\" " + shell_quoted(VOXVIEW_CLI) + " " + args);
+}
+
+bool uniform(const Image& img) {
+  for (std::size_t i = 4; i < img.rgba.size(); ++i)
+    if (img.rgba[i] != img.rgba[i % 4]) return false;
+  return true;
+}
+
+int lit_pixels(const Image& img) {
+  int n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) n += (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0;
+  return n;
+}
+
+#define VXL_REQUIRE_XVFB()                                                                                   \
+  do {                                                                                                       \
+    if (!have_xvfb_run()) GTEST_SKIP() << "xvfb-run is not installed (apt install xvfb xauth): no X server"; \
+  } while (0)
+
+class Window : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_STRNE(VOXVIEW_CLI, "") << "VOXVIEW_CLI is empty: the voxview target was not known to tests/CMakeLists.txt";
+    ASSERT_TRUE(std::filesystem::exists(VOXVIEW_CLI)) << VOXVIEW_CLI << " is not built";
+  }
+
+  // A small synthetic tractogram from the project's own generator, as .tck and converted to .vxl.
+  void make_inputs() {
+    CommandResult synth = test::run_cli("synth --streamlines 300 --seed 7 " + shell_quoted(tck));
+    ASSERT_EQ(synth.exit_code, 0) << synth.output;
+    CommandResult convert = test::run_cli("convert --voxel-size 10 " + shell_quoted(tck) + " " + shell_quoted(vxl));
+    ASSERT_EQ(convert.exit_code, 0) << convert.output;
+  }
+
+  Image window_screenshot(const std::string& input) {
+    const std::string png = dir.file("shot.png");
+    std::filesystem::remove(png);
+    CommandResult r = run_voxview_in_xvfb(shell_quoted(input) + " --frames 5 --screenshot " + shell_quoted(png) + " --size 320x240");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    if (!std::filesystem::exists(png)) {
+      ADD_FAILURE() << "no screenshot: " << r.output;
+      return {};
+    }
+    Image img = read_image(png);
+    EXPECT_EQ(img.width, 320);
+    EXPECT_EQ(img.height, 240);
+    EXPECT_FALSE(uniform(img));
+    EXPECT_GT(lit_pixels(img), 320 * 240 / 100) << "the tractogram should cover more than 1% of the picture";
+    return img;
+  }
+
+  ScratchDir dir;
+  std::string tck = dir.file("synth.tck");
+  std::string vxl = dir.file("synth.vxl");
+};
+
+TEST_F(Window, ShowsAVxlFileAndSavesTheLastFrameWithoutThePanel) {
+  VXL_REQUIRE_XVFB();
+  make_inputs();
+  Image shot = window_screenshot(vxl);
+  ASSERT_EQ(shot.width, 320);
+  // The same first frame headless: the window starts with the same camera and renderer, and the automated
+  // screenshot leaves the panel out, so the pictures agree but for rasteriser details.
+  const std::string headless = dir.file("headless.png");
+  CommandResult r = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + " --render " + shell_quoted(headless) +
+                                            " --size 320x240");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ImageDiff d = compare_images(shot, read_image(headless));
+  EXPECT_LT(d.differing_pixels, 320u * 240u / 100u) << "mean error " << d.mean_error << ", max at " << d.max_x << "," << d.max_y;
+}
+
+TEST_F(Window, OpensATckDirectly) {
+  VXL_REQUIRE_XVFB();
+  make_inputs();
+  window_screenshot(tck);
+}
+
+TEST_F(Window, EveryModeRunsInTheWindow) {
+  VXL_REQUIRE_XVFB();
+  make_inputs();
+  for (const char* mode : {"opaque", "unsorted", "additive", "wboit", "basic", "axis", "exact"}) {
+    SCOPED_TRACE(mode);
+    const std::string png = dir.file(std::string(mode) + ".png");
+    CommandResult r = run_voxview_in_xvfb(shell_quoted(vxl) + " --mode " + mode + " --ortho --view axial --frames 2 --screenshot " +
+                                          shell_quoted(png) + " --size 160x120");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    Image img = read_image(png);
+    EXPECT_EQ(img.width, 160);
+    EXPECT_FALSE(uniform(img));
+  }
+}
+
+TEST_F(Window, WithoutADisplaySaysHowToRenderHeadless) {
+  make_inputs();
+  CommandResult r = run_shell("env -u DISPLAY -u WAYLAND_DISPLAY " + shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + " --frames 1");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("cannot open a window"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--render"), std::string::npos) << r.output;
+}
+
+// Two short streamlines 200 mm apart along x, in 10 mm voxels. The grid origin is the bounds' minimum,
+// (1, 1, 0) + offset, so the first lies in voxel (0, 0, 0) spanning x, y in [1, 11] and the second in (20, 0, 0).
+Tractogram two_voxels(double offset) {
+  Tractogram t;
+  auto add = [&](std::initializer_list<double> xyz) {
+    std::vector<float> p;
+    for (double v : xyz) p.push_back(static_cast<float>(v + offset));
+    t.add_streamline(p.data(), p.size() / 3);
+  };
+  add({1, 1, 0, 9, 5, 0});
+  add({201, 1, 0, 209, 5, 0});
+  t.source.path = "two_voxels";
+  return t;
+}
+
+// Looking down on the first voxel, 1 mm per pixel on 64 x 64: the cube's sides x = 1, 11 and y = 11, 1
+// fall on the centres of columns 26, 36 and rows 27, 37.
+Camera above_first_voxel(double offset) {
+  Camera c;
+  c.target = glm::dvec3(6.5, 6.5, 5.0) + offset;
+  c.orthographic = true;
+  c.ortho_height = 64;
+  c.distance = 100;
+  auto v = *parse_view("axial");
+  c.azimuth_deg = v[0];
+  c.elevation_deg = v[1];
+  return c;
+}
+
+Image overlay_image(Renderer& r, GridOverlay& grid, const Camera& camera, GridOverlay::Scope scope) {
+  OffscreenTarget target(64, 64);
+  target.bind();
+  glClearColor(0, 0, 0, 1);
+  glClear(GL_COLOR_BUFFER_BIT);
+  grid.draw(r, camera, 1.0, scope, glm::vec4(1.0f));
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+  return Image{64, 64, target.read_rgba()};
+}
+
+bool white(const Image& img, int x, int y) {
+  const std::uint8_t* p = img.pixel(x, y);
+  return p[0] == 255 && p[1] == 255 && p[2] == 255;
+}
+
+class WindowGridOverlay : public ::testing::Test {
+ protected:
+  void SetUp() override { test::gl_context(); }
+  ScratchDir dir;
+};
+
+TEST_F(WindowGridOverlay, OutlinesTheVoxelCubesWhereTheGridPutsThem) {
+  for (double offset : {0.0, 1e5}) {
+    SCOPED_TRACE(offset);
+    VxlFile f = test::make_scene(dir, two_voxels(offset), 10.0, "grid" + std::to_string(int(offset)) + ".vxl");
+    Renderer r(f);
+    GridOverlay grid(r);
+    Image img = overlay_image(r, grid, above_first_voxel(offset), GridOverlay::Scope::Drawn);
+    for (auto [x, y] : {std::pair{26, 32}, {36, 32}, {31, 27}, {31, 37}, {26, 27}, {36, 37}})
+      EXPECT_TRUE(white(img, x, y)) << "cube side at " << x << "," << y;
+    for (auto [x, y] : {std::pair{31, 32}, {25, 32}, {37, 32}, {31, 26}, {31, 38}, {10, 10}})
+      EXPECT_FALSE(white(img, x, y)) << "nothing at " << x << "," << y;
+  }
+}
+
+TEST_F(WindowGridOverlay, DrawnScopeKeepsOnlyTheVoxelsInView) {
+  VxlFile f = test::make_scene(dir, two_voxels(0.0), 10.0);
+  Renderer r(f);
+  GridOverlay grid(r);
+  overlay_image(r, grid, above_first_voxel(0.0), GridOverlay::Scope::Drawn);
+  EXPECT_EQ(grid.cubes_drawn(), 1u);
+  overlay_image(r, grid, above_first_voxel(0.0), GridOverlay::Scope::All);
+  EXPECT_EQ(grid.cubes_drawn(), 2u);
+  Camera wide = above_first_voxel(0.0);
+  wide.target.x = 105;
+  wide.ortho_height = 300;
+  overlay_image(r, grid, wide, GridOverlay::Scope::Drawn);
+  EXPECT_EQ(grid.cubes_drawn(), 2u);
+}
+
+}  // namespace
+}  // namespace vxl

@@ -1,0 +1,15 @@
+// `voxview FILE --render OUT.png`: one frame through EGL surfaceless (no X server), written with
+// OpenImageIO.
+#pragma once
+
+#include "viewer_options.h"
+
+namespace vxl::app {
+
+int run_headless(const ViewerOptions& options);
+
+// The camera voxview starts with for a scene: framed on its bounds, looking from `view` (or a default
+// oblique view from the front-left-top).
+Camera initial_camera(const glm::dvec3& lo, const glm::dvec3& hi, const ViewerOptions& options, double aspect);
+
+}  // namespace vxl::app

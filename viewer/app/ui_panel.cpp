@@ -1,0 +1,185 @@
+#include "ui_panel.h"
+
+#include <cstdio>
+
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include "camera.h"
+
+namespace vxl::app {
+
+namespace {
+
+constexpr RenderMode kModes[] = {RenderMode::Opaque, RenderMode::Unsorted, RenderMode::Additive, RenderMode::Wboit,
+                                 RenderMode::Basic,  RenderMode::Axis,     RenderMode::Exact};
+
+// "1234567" -> "1.23 M": the counts span six orders of magnitude, exact digits would not be read.
+std::string count_text(std::uint64_t n) {
+  char buf[32];
+  if (n >= 1000000)
+    std::snprintf(buf, sizeof buf, "%.2f M", n / 1e6);
+  else if (n >= 10000)
+    std::snprintf(buf, sizeof buf, "%.1f k", n / 1e3);
+  else
+    std::snprintf(buf, sizeof buf, "%llu", static_cast<unsigned long long>(n));
+  return buf;
+}
+
+void view_button(const char* label, const char* view, PanelRequests& out) {
+  if (ImGui::Button(label)) out.view = parse_view(view);
+}
+
+}  // namespace
+
+UiPanel::UiPanel(GLFWwindow* window) {
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;  // leave no imgui.ini behind in the user's directory
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+}
+
+UiPanel::~UiPanel() {
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+}
+
+bool UiPanel::takes_mouse_at(double x, double y) const {
+  if (popup_open_ || ImGui::IsAnyItemActive()) return true;
+  return x >= x0_ && x < x1_ && y >= y0_ && y < y1_;
+}
+bool UiPanel::wants_keyboard() const { return ImGui::GetIO().WantCaptureKeyboard; }
+
+PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  PanelRequests out;
+  RenderSettings& s = state.settings;
+
+  ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowBgAlpha(0.8f);
+  // "###" keeps the window's identity apart from its title; ImGui's built-in font is ASCII only.
+  const std::string title = "voxview: " + stats.title + "###panel";
+  ImGui::Begin(title.c_str(), nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  ImGui::PushItemWidth(170);
+
+  if (ImGui::BeginCombo("Mode", render_mode_name(s.mode))) {
+    for (RenderMode m : kModes) {
+      const bool selected = m == s.mode;
+      std::string label = render_mode_name(m);
+      if (m == RenderMode::Exact && !stats.exact_available) label += " (needs GL 4.3)";
+      if (ImGui::Selectable(label.c_str(), selected)) s.mode = m;
+      if (selected) ImGui::SetItemDefaultFocus();
+    }
+    ImGui::EndCombo();
+  }
+  ImGui::SliderFloat("Opacity", &s.opacity, 0.001f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
+  ImGui::SliderFloat("Line width", &s.line_width, 1.0f, stats.max_line_width, "%.1f px", ImGuiSliderFlags_AlwaysClamp);
+
+  int colour = s.color == ColorMode::Fixed ? 1 : 0;
+  ImGui::AlignTextToFramePadding();
+  ImGui::TextUnformatted("Colour");
+  ImGui::SameLine();
+  ImGui::RadioButton("direction", &colour, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("fixed", &colour, 1);
+  ImGui::SameLine();
+  // Picking a colour means the user wants it shown.
+  if (ImGui::ColorEdit3("##fixed colour", &s.fixed_color.x, ImGuiColorEditFlags_NoInputs)) colour = 1;
+  s.color = colour == 1 ? ColorMode::Fixed : ColorMode::Direction;
+
+  int background = s.white_background ? 1 : 0;
+  ImGui::AlignTextToFramePadding();
+  ImGui::TextUnformatted("Background");
+  ImGui::SameLine();
+  ImGui::RadioButton("black", &background, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("white", &background, 1);
+  s.white_background = background == 1;
+
+  ImGui::Checkbox("Voxel grid", &state.grid);
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!state.grid);
+  int grid_scope = state.grid_all ? 1 : 0;
+  ImGui::RadioButton("drawn", &grid_scope, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("all", &grid_scope, 1);
+  state.grid_all = grid_scope == 1;
+  ImGui::EndDisabled();
+
+  ImGui::Separator();
+  ImGui::AlignTextToFramePadding();
+  ImGui::TextUnformatted("View");
+  ImGui::SameLine();
+  view_button("Axial", "axial", out);
+  ImGui::SameLine();
+  view_button("Sagittal", "sagittal", out);
+  ImGui::SameLine();
+  view_button("Coronal", "coronal", out);
+  ImGui::TextUnformatted("    ");
+  ImGui::SameLine();
+  view_button("Inferior", "inferior", out);
+  ImGui::SameLine();
+  view_button("Right", "right", out);
+  ImGui::SameLine();
+  view_button("Posterior", "posterior", out);
+  int projection = state.orthographic ? 1 : 0;
+  ImGui::RadioButton("perspective", &projection, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("orthographic", &projection, 1);
+  state.orthographic = projection == 1;
+  ImGui::SameLine();
+  out.reset_camera = ImGui::Button("Reset");
+
+  out.screenshot = ImGui::Button("Screenshot");
+  ImGui::SameLine();
+  ImGui::Checkbox("with panel", &state.panel_in_screenshot);
+
+  ImGui::Separator();
+  ImGui::Text("Frame      %.2f ms", stats.frame_ms);
+  ImGui::Text("Plan (CPU) %.3f ms", stats.plan_ms);
+  ImGui::Text("Voxels     %s / %s", count_text(stats.voxels_drawn).c_str(), count_text(stats.voxels_total).c_str());
+  ImGui::Text("Segments   %s / %s", count_text(stats.segments_drawn).c_str(), count_text(stats.segments_total).c_str());
+  if (state.grid) ImGui::Text("Grid cubes %s", count_text(stats.grid_cubes).c_str());
+  ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + 330);
+  ImGui::TextDisabled("%s, GL %s", stats.gl_renderer.c_str(), stats.gl_version.c_str());
+  if (!stats.error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.35f, 1.0f), "%s", stats.error.c_str());
+  if (!stats.status.empty()) ImGui::TextUnformatted(stats.status.c_str());
+  ImGui::PopTextWrapPos();
+
+  if (ImGui::CollapsingHeader("Keys and mouse")) {
+    ImGui::TextUnformatted(
+        "left drag     orbit\n"
+        "right/middle  pan (or shift + left)\n"
+        "wheel         zoom\n"
+        "1 2 3         axial, sagittal, coronal\n"
+        "shift+1 2 3   inferior, right, posterior (or 4 5 6)\n"
+        "O             orthographic / perspective\n"
+        "M             next transparency mode\n"
+        "+ -           opacity x / : 1.5\n"
+        "S             screenshot    R  reset camera\n"
+        "Esc Q         quit");
+  }
+  ImGui::PopItemWidth();
+  const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  x0_ = pos.x;
+  y0_ = pos.y;
+  x1_ = pos.x + size.x;
+  y1_ = pos.y + size.y;
+  ImGui::End();
+  popup_open_ = ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId | ImGuiPopupFlags_AnyPopupLevel);
+  return out;
+}
+
+void UiPanel::render() {
+  ImGui::Render();
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
+}  // namespace vxl::app

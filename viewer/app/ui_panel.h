@@ -1,0 +1,72 @@
+// The Dear ImGui panel of the voxview window: the only file that knows ImGui. It edits a PanelState in
+// place, shows read-only PanelStats, and reports one-shot requests (a view preset, a screenshot, a camera
+// reset) for the window to carry out.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "render_settings.h"
+
+struct GLFWwindow;
+
+namespace vxl::app {
+
+// What the panel edits.
+struct PanelState {
+  RenderSettings settings;
+  bool orthographic = false;
+  bool grid = false;               // voxel-grid overlay
+  bool grid_all = false;           // all voxels, not only those the frame draws
+  bool panel_in_screenshot = false;
+};
+
+// What the panel only shows.
+struct PanelStats {
+  std::string title;               // the file shown
+  double frame_ms = 0;             // smoothed
+  double plan_ms = 0;              // CPU plan of the last frame
+  std::uint64_t voxels_drawn = 0, voxels_total = 0;
+  std::uint64_t segments_drawn = 0, segments_total = 0;
+  std::uint64_t grid_cubes = 0;
+  std::string gl_renderer, gl_version;
+  bool exact_available = true;     // GL >= 4.3
+  float max_line_width = 16.0f;    // the driver's wide-line limit
+  std::string error;               // shown in red until the next one replaces it
+  std::string status;              // e.g. where the last screenshot went
+};
+
+struct PanelRequests {
+  std::optional<std::array<double, 2>> view;  // azimuth, elevation
+  bool reset_camera = false;
+  bool screenshot = false;
+};
+
+class UiPanel {
+ public:
+  // Installs ImGui's GLFW callbacks after the window's own ones, which it chains to.
+  explicit UiPanel(GLFWwindow* window);
+  ~UiPanel();
+  UiPanel(const UiPanel&) = delete;
+  UiPanel& operator=(const UiPanel&) = delete;
+
+  // Starts an ImGui frame and lays out the panel. Call render() later in the same frame.
+  PanelRequests build(PanelState& state, const PanelStats& stats);
+  // Draws the panel into the bound (default) framebuffer.
+  void render();
+
+  // Whether a click or wheel at window point (x, y) belongs to the panel. Decided on the panel's last
+  // rectangle rather than ImGui's hover state, which is only as fresh as the last frame (slow frames on a
+  // software renderer would hand clicks on the scene to the panel).
+  bool takes_mouse_at(double x, double y) const;
+  // Whether the panel takes typed keys (a text field is being edited).
+  bool wants_keyboard() const;
+
+ private:
+  float x0_ = 0, y0_ = 0, x1_ = 0, y1_ = 0;  // the panel window, window units
+  bool popup_open_ = false;                   // a combo or colour picker may reach beyond the panel
+};
+
+}  // namespace vxl::app

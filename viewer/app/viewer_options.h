@@ -1,0 +1,25 @@
+// Everything `voxview` is told on its command line, shared by the headless and the window paths.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "camera.h"
+#include "render_settings.h"
+
+namespace vxl::app {
+
+struct ViewerOptions {
+  std::string input;                 // .vxl, or a .tck/.trk/.trx converted in memory
+  std::optional<std::string> render_png;  // headless: render one frame to this PNG and exit
+  RenderSettings settings;
+  std::optional<std::array<double, 2>> view;  // azimuth, elevation; default: an oblique view
+  bool orthographic = false;
+  int width = 1024, height = 1024;
+  double voxel_size = 10.0;          // for in-memory conversion
+  // Window automation (tests, scripted screenshots): quit after N frames, saving a screenshot first.
+  std::optional<int> frames;
+  std::optional<std::string> screenshot;
+};
+
+}  // namespace vxl::app

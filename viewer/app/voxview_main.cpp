@@ -1,0 +1,61 @@
+// `voxview`: look into a tractogram with correct-looking transparency, in a window or headless.
+#include <cstdio>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "error.h"
+#include "headless_render.h"
+#include "viewer_options.h"
+#include "window_app.h"
+
+int main(int argc, char** argv) {
+  using namespace vxl;
+  app::ViewerOptions o;
+  std::string mode = "axis", view, size = "1024x1024", color = "direction", background = "black";
+  CLI::App cli{"voxview " VOXLINES_VERSION
+               " — transparent tractogram viewer (Voxlines method).\n"
+               "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx is converted in memory first.\n"
+               "Window: left drag orbits, right/middle drag (or Shift+left) pans, wheel zooms. Keys: 1/2/3 axial/sagittal/coronal,\n"
+               "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, S screenshot, R reset, Esc/Q quit."};
+  cli.add_option("file", o.input, "a .vxl file, or a .tck / .trk / .trk.gz / .trx tractogram")->required();
+  cli.add_option("--render", o.render_png, "render one frame headless (EGL, no display needed) to this PNG and exit");
+  cli.add_option("--mode", mode, "opaque | unsorted | additive | wboit | basic | axis | exact")->default_val("axis")
+      ->check(CLI::IsMember({"opaque", "unsorted", "additive", "wboit", "basic", "axis", "exact"}));
+  cli.add_option("--opacity", o.settings.opacity, "line opacity, 1 down to 0.001")->default_val(0.3)
+      ->check(CLI::Range(0.001, 1.0));
+  cli.add_option("--view", view, "axial, inferior, sagittal (left), right, coronal (anterior), posterior, or AZ,EL in degrees");
+  cli.add_option("--size", size, "image or window size WxH")->default_val("1024x1024");
+  cli.add_flag("--ortho", o.orthographic, "orthographic projection (default perspective)");
+  cli.add_option("--color", color, "direction (|p1 - p0| as RGB) or fixed")->default_val("direction")
+      ->check(CLI::IsMember({"direction", "fixed"}));
+  cli.add_option("--line-width", o.settings.line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
+  cli.add_option("--background", background, "black or white")->default_val("black")->check(CLI::IsMember({"black", "white"}));
+  cli.add_option("--voxel-size", o.voxel_size, "voxel size in mm when converting a source file in memory")
+      ->default_val(10.0)->check(CLI::PositiveNumber);
+  cli.add_option("--frames", o.frames, "window: quit after this many frames (for scripts and tests)")->check(CLI::PositiveNumber);
+  cli.add_option("--screenshot", o.screenshot, "window: save the last frame to this PNG before quitting");
+  try {
+    cli.parse(argc, argv);
+    o.settings.mode = *parse_render_mode(mode);
+    o.settings.color = color == "fixed" ? ColorMode::Fixed : ColorMode::Direction;
+    o.settings.white_background = background == "white";
+    if (!view.empty()) {
+      o.view = parse_view(view);
+      if (!o.view) throw Error(ErrorKind::Usage, "", std::nullopt, "--view: unknown view '" + view + "'");
+    }
+    if (std::sscanf(size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 1 || o.height < 1 || o.width > 16384 ||
+        o.height > 16384)
+      throw Error(ErrorKind::Usage, "", std::nullopt, "--size must be WxH, each 1..16384");
+    return o.render_png ? app::run_headless(o) : app::run_window(o);
+  } catch (const CLI::ParseError& e) {
+    int code = cli.exit(e);
+    return code == 0 ? 0 : static_cast<int>(ErrorKind::Usage);
+  } catch (const Error& e) {
+    std::fprintf(stderr, "voxview: error: %s\n", e.what());
+    return static_cast<int>(e.kind());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "voxview: error: %s\n", e.what());
+    return 6;
+  }
+}

@@ -1,0 +1,382 @@
+#include "window_app.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE  // epoxy provides the GL declarations
+#include <GLFW/glfw3.h>
+
+#include "camera_controller.h"
+#include "grid_overlay.h"
+#include "headless_render.h"
+#include "image_io.h"
+#include "renderer.h"
+#include "scene_source.h"
+#include "ui_panel.h"
+
+namespace vxl::app {
+
+namespace {
+
+const char* const kHeadlessHint = "use --render OUT.png for headless rendering";
+
+std::string g_glfw_error;  // GLFW reports errors through a callback; kept for the exception's message
+void remember_glfw_error(int, const char* text) { g_glfw_error = text ? text : "unknown GLFW error"; }
+
+// glfwInit / glfwTerminate. Without an X server glfwInit fails, which is the common case (ssh, CI).
+struct GlfwLibrary {
+  GlfwLibrary() {
+    glfwSetErrorCallback(remember_glfw_error);
+    if (!glfwInit())
+      throw std::runtime_error("cannot open a window (no display?): " + g_glfw_error + "; " + kHeadlessHint);
+  }
+  ~GlfwLibrary() { glfwTerminate(); }
+  GlfwLibrary(const GlfwLibrary&) = delete;
+  GlfwLibrary& operator=(const GlfwLibrary&) = delete;
+};
+
+struct WindowDeleter {
+  void operator()(GLFWwindow* w) const { glfwDestroyWindow(w); }
+};
+using WindowPtr = std::unique_ptr<GLFWwindow, WindowDeleter>;
+
+WindowPtr open_window(const ViewerOptions& o) {
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  // Not forward-compatible: that would forbid line widths above 1.
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_FALSE);
+  glfwWindowHint(GLFW_DEPTH_BITS, 24);  // the opaque mode depth-tests in the default framebuffer
+  const std::string title = "voxview - " + std::filesystem::path(o.input).filename().string();
+  GLFWwindow* w = glfwCreateWindow(o.width, o.height, title.c_str(), nullptr, nullptr);
+  if (!w)
+    throw std::runtime_error("cannot open an OpenGL 3.3 core window: " + g_glfw_error + "; " + kHeadlessHint);
+  glfwMakeContextCurrent(w);
+  glfwSwapInterval(1);
+  return WindowPtr(w);
+}
+
+RenderMode next_mode(RenderMode m, bool exact_available) {
+  constexpr RenderMode cycle[] = {RenderMode::Opaque, RenderMode::Unsorted, RenderMode::Additive, RenderMode::Wboit,
+                                  RenderMode::Basic,  RenderMode::Axis,     RenderMode::Exact};
+  constexpr int n = sizeof cycle / sizeof cycle[0];
+  int i = static_cast<int>(std::find(cycle, cycle + n, m) - cycle);
+  do i = (i + 1) % n;
+  while (cycle[i] == RenderMode::Exact && !exact_available);
+  return cycle[i];
+}
+
+// The default framebuffer's back buffer as RGBA8 rows top to bottom (GL counts rows from the bottom).
+Image read_back_buffer(int width, int height) {
+  Image img;
+  img.width = width;
+  img.height = height;
+  img.rgba.resize(static_cast<std::size_t>(width) * height * 4);
+  std::vector<std::uint8_t> rows(img.rgba.size());
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
+  const std::size_t stride = static_cast<std::size_t>(width) * 4;
+  for (int y = 0; y < height; ++y)
+    std::copy_n(rows.data() + (height - 1 - y) * stride, stride, img.rgba.data() + y * stride);
+  // A window's picture is opaque whatever the framebuffer kept in alpha (it may have no alpha at all).
+  for (std::size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;
+  return img;
+}
+
+// voxview-YYYYMMDD-HHMMSS.png in the current directory, with a suffix when taken twice in a second.
+std::filesystem::path screenshot_name() {
+  std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &local);
+  std::filesystem::path p = std::filesystem::current_path() / (std::string("voxview-") + stamp + ".png");
+  for (int n = 2; std::filesystem::exists(p); ++n)
+    p = std::filesystem::current_path() / (std::string("voxview-") + stamp + "-" + std::to_string(n) + ".png");
+  return p;
+}
+
+// One open window on one scene: GL objects, camera, panel, input. Callbacks reach it through the GLFW
+// user pointer.
+class ViewerWindow {
+ public:
+  ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwindow* window);
+  int run();
+
+ private:
+  static ViewerWindow& of(GLFWwindow* w) { return *static_cast<ViewerWindow*>(glfwGetWindowUserPointer(w)); }
+  void on_mouse_button(int button, int action, int mods);
+  void on_cursor(double x, double y);
+  void on_scroll(double steps);
+  void on_key(int key, int action, int mods);
+  void on_char(unsigned codepoint);
+
+  Camera home_camera(double aspect, bool orthographic) const;
+  void reset_camera(double aspect);
+  double aspect() const;
+  void set_error(const std::string& message);
+  void draw_scene(int width, int height);
+  void save_screenshot(const std::string& path, int width, int height);
+
+  const ViewerOptions& options_;
+  GLFWwindow* window_;
+  Renderer renderer_;
+  GridOverlay grid_;
+  CameraController controller_;
+  std::unique_ptr<UiPanel> panel_;  // created after our callbacks, which ImGui then chains to
+  PanelState state_;
+  PanelStats stats_;
+  int drag_button_ = -1;
+  bool screenshot_requested_ = false;
+  RenderMode drawn_mode_ = RenderMode::Axis;  // the mode of the last frame, to clear a mode's error once another is chosen
+  unsigned events_ = 0;  // input events seen, to keep drawing while something happens
+};
+
+ViewerWindow::ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwindow* window)
+    : options_(o),
+      window_(window),
+      renderer_(file),
+      grid_(renderer_),
+      controller_(Camera{}, std::max(1.0, glm::length(renderer_.bounds_max() - renderer_.bounds_min()) * 0.5)) {
+  GLint major = 0, minor = 0;
+  glGetIntegerv(GL_MAJOR_VERSION, &major);
+  glGetIntegerv(GL_MINOR_VERSION, &minor);
+  GLfloat widths[2] = {1, 1};
+  glGetFloatv(GL_ALIASED_LINE_WIDTH_RANGE, widths);
+
+  state_.settings = o.settings;
+  drawn_mode_ = o.settings.mode;
+  state_.orthographic = o.orthographic;
+  stats_.title = std::filesystem::path(o.input).filename().string();
+  stats_.voxels_total = file.meta().voxel_count;
+  stats_.segments_total = file.meta().segment_count;
+  stats_.gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  stats_.gl_version = std::to_string(major) + "." + std::to_string(minor);
+  stats_.exact_available = major * 10 + minor >= 43;
+  stats_.max_line_width = std::clamp(widths[1], 1.0f, 16.0f);
+
+  controller_.set_home(home_camera(aspect(), o.orthographic));
+  controller_.reset();
+
+  glfwSetWindowUserPointer(window_, this);
+  glfwSetMouseButtonCallback(window_, [](GLFWwindow* w, int b, int a, int m) { of(w).on_mouse_button(b, a, m); });
+  glfwSetCursorPosCallback(window_, [](GLFWwindow* w, double x, double y) { of(w).on_cursor(x, y); });
+  glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double dy) { of(w).on_scroll(dy); });
+  glfwSetKeyCallback(window_, [](GLFWwindow* w, int k, int, int a, int m) { of(w).on_key(k, a, m); });
+  glfwSetCharCallback(window_, [](GLFWwindow* w, unsigned c) { of(w).on_char(c); });
+  glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* w, int, int) { of(w).events_++; });
+  glfwSetWindowRefreshCallback(window_, [](GLFWwindow* w) { of(w).events_++; });
+  panel_ = std::make_unique<UiPanel>(window_);
+}
+
+double ViewerWindow::aspect() const {
+  int w = 0, h = 0;
+  glfwGetFramebufferSize(window_, &w, &h);
+  return h > 0 && w > 0 ? double(w) / h : 1.0;
+}
+
+Camera ViewerWindow::home_camera(double aspect, bool orthographic) const {
+  ViewerOptions o = options_;
+  o.orthographic = orthographic;
+  return initial_camera(renderer_.bounds_min(), renderer_.bounds_max(), o, aspect);
+}
+
+void ViewerWindow::reset_camera(double aspect) {
+  // Re-frames for the current window shape; keeps the projection the user chose.
+  controller_.set_home(home_camera(aspect, controller_.camera().orthographic));
+  controller_.reset();
+}
+
+void ViewerWindow::set_error(const std::string& message) {
+  if (stats_.error != message) std::fprintf(stderr, "voxview: %s\n", message.c_str());
+  stats_.error = message;
+}
+
+void ViewerWindow::on_mouse_button(int button, int action, int mods) {
+  events_++;
+  if (action == GLFW_RELEASE) {
+    if (button == drag_button_) {
+      controller_.end_drag();
+      drag_button_ = -1;
+    }
+    return;
+  }
+  // A drag that starts on the panel belongs to the panel; one that started on the scene keeps going over it.
+  double x = 0, y = 0;
+  glfwGetCursorPos(window_, &x, &y);
+  if (drag_button_ != -1 || panel_->takes_mouse_at(x, y)) return;
+  DragMode mode = DragMode::None;
+  if (button == GLFW_MOUSE_BUTTON_LEFT) mode = (mods & GLFW_MOD_SHIFT) ? DragMode::Pan : DragMode::Orbit;
+  if (button == GLFW_MOUSE_BUTTON_RIGHT || button == GLFW_MOUSE_BUTTON_MIDDLE) mode = DragMode::Pan;
+  if (mode == DragMode::None) return;
+  controller_.begin_drag(mode, x, y);
+  drag_button_ = button;
+}
+
+void ViewerWindow::on_cursor(double x, double y) {
+  events_++;
+  if (controller_.dragging() != DragMode::None) controller_.drag_to(x, y);
+}
+
+void ViewerWindow::on_scroll(double steps) {
+  events_++;
+  double x = 0, y = 0;
+  glfwGetCursorPos(window_, &x, &y);
+  if (!panel_->takes_mouse_at(x, y)) controller_.zoom(steps);
+}
+
+// Keys bound to a place on the keyboard: Esc and the digit row (with Shift for the opposite view).
+void ViewerWindow::on_key(int key, int action, int mods) {
+  events_++;
+  if (action != GLFW_PRESS || panel_->wants_keyboard()) return;
+  const bool shift = mods & GLFW_MOD_SHIFT;
+  const char* view = nullptr;
+  switch (key) {
+    case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(window_, GLFW_TRUE); return;
+    case GLFW_KEY_1: view = shift ? "inferior" : "axial"; break;
+    case GLFW_KEY_2: view = shift ? "right" : "sagittal"; break;
+    case GLFW_KEY_3: view = shift ? "posterior" : "coronal"; break;
+    case GLFW_KEY_4: view = "inferior"; break;
+    case GLFW_KEY_5: view = "right"; break;
+    case GLFW_KEY_6: view = "posterior"; break;
+    default: return;
+  }
+  auto v = parse_view(view);
+  controller_.set_view((*v)[0], (*v)[1]);
+}
+
+// Keys bound to a character, so that they follow the user's keyboard layout.
+void ViewerWindow::on_char(unsigned c) {
+  events_++;
+  if (panel_->wants_keyboard()) return;
+  RenderSettings& s = state_.settings;
+  switch (c) {
+    case 'o': case 'O': controller_.set_orthographic(!controller_.camera().orthographic); break;
+    case 'm': case 'M': s.mode = next_mode(s.mode, stats_.exact_available); break;
+    case '+': case '=': s.opacity = std::clamp(s.opacity * 1.5f, 0.001f, 1.0f); break;
+    case '-': case '_': s.opacity = std::clamp(s.opacity / 1.5f, 0.001f, 1.0f); break;
+    case 's': case 'S': screenshot_requested_ = true; break;
+    case 'r': case 'R': reset_camera(aspect()); break;
+    case 'q': case 'Q': glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
+    default: break;
+  }
+}
+
+void ViewerWindow::draw_scene(int width, int height) {
+  RenderSettings& s = state_.settings;
+  if (s.mode != drawn_mode_) stats_.error.clear();  // a new choice of mode gets a fresh start
+  if (s.mode == RenderMode::Exact && !stats_.exact_available) {
+    set_error("the exact mode needs OpenGL 4.3; this context is " + stats_.gl_version + ": showing axis");
+    s.mode = RenderMode::Axis;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const Camera& camera = controller_.camera();
+  try {
+    renderer_.draw(camera, s, width, height, 0);
+  } catch (const std::exception& e) {
+    // A mode that cannot run here (e.g. exact out of node memory): say so and keep showing something.
+    set_error(std::string(render_mode_name(s.mode)) + ": " + e.what() + ": showing axis");
+    s.mode = RenderMode::Axis;
+    renderer_.draw(camera, s, width, height, 0);
+  }
+  drawn_mode_ = s.mode;
+  if (state_.grid) {
+    const glm::vec4 colour = s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
+    grid_.draw(renderer_, camera, double(width) / height, state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn,
+               colour);
+    stats_.grid_cubes = grid_.cubes_drawn();
+  }
+  glFinish();  // the frame time should include the GPU's work, not only its submission
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
+  const FrameStats& f = renderer_.stats();
+  stats_.plan_ms = f.plan_ms;
+  stats_.voxels_drawn = f.voxels_drawn;
+  stats_.segments_drawn = f.segments_drawn;
+}
+
+void ViewerWindow::save_screenshot(const std::string& path, int width, int height) {
+  write_png(path, read_back_buffer(width, height));
+  stats_.status = "saved " + path;
+  std::printf("voxview: screenshot %dx%d saved to %s\n", width, height, path.c_str());
+  std::fflush(stdout);
+}
+
+int ViewerWindow::run() {
+  const bool automated = options_.frames.has_value();
+  int settle = 2;  // frames still to draw after the last event: ImGui needs one to show hover and clicks
+  for (long frame = 1;; ++frame) {
+    const unsigned seen = events_;
+    if (automated || settle > 0) {
+      glfwPollEvents();
+    } else {
+      glfwWaitEvents();  // nothing moves by itself: sleep until the user does something
+    }
+    settle = events_ != seen ? 2 : std::max(0, settle - 1);
+    const bool closing = glfwWindowShouldClose(window_) || (automated && frame >= *options_.frames);
+
+    // Render at the framebuffer's size (HiDPI), take input in window units.
+    int fb_w = 0, fb_h = 0, win_h = 0;
+    glfwGetFramebufferSize(window_, &fb_w, &fb_h);
+    glfwGetWindowSize(window_, nullptr, &win_h);
+    if (fb_w <= 0 || fb_h <= 0) {  // minimised
+      if (closing) break;
+      continue;
+    }
+    controller_.set_window_height(win_h);
+
+    state_.orthographic = controller_.camera().orthographic;
+    const PanelRequests requests = panel_->build(state_, stats_);
+    controller_.set_orthographic(state_.orthographic);
+    if (requests.view) controller_.set_view((*requests.view)[0], (*requests.view)[1]);
+    if (requests.reset_camera) reset_camera(double(fb_w) / fb_h);
+    screenshot_requested_ |= requests.screenshot;
+
+    draw_scene(fb_w, fb_h);
+    // Screenshots show the scene alone unless the user asked for the panel too; automated ones never do.
+    if (closing && options_.screenshot) save_screenshot(*options_.screenshot, fb_w, fb_h);
+    if (screenshot_requested_ && !state_.panel_in_screenshot) {
+      try {
+        save_screenshot(screenshot_name().string(), fb_w, fb_h);
+      } catch (const std::exception& e) {
+        set_error(e.what());
+      }
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, fb_w, fb_h);
+    panel_->render();
+    if (screenshot_requested_ && state_.panel_in_screenshot) {
+      try {
+        save_screenshot(screenshot_name().string(), fb_w, fb_h);
+      } catch (const std::exception& e) {
+        set_error(e.what());
+      }
+    }
+    screenshot_requested_ = false;
+    glfwSwapBuffers(window_);
+    if (closing) break;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int run_window(const ViewerOptions& o) {
+  GlfwLibrary glfw;  // first: without a display, fail before any slow conversion
+  VxlFile file = open_scene(o.input, o.voxel_size);
+  WindowPtr window = open_window(o);
+  ViewerWindow viewer(o, file, window.get());
+  return viewer.run();
+}
+
+}  // namespace vxl::app

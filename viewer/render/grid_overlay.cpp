@@ -1,0 +1,147 @@
+#include "grid_overlay.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "camera.h"
+#include "renderer.h"
+
+namespace vxl {
+
+namespace {
+
+const char* const kVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_corner;   // unit-cube corner, each component 0 or 1
+layout(location = 1) in ivec3 a_coord;   // the voxel's integer grid coordinate (per instance)
+uniform ivec3 u_eye_cell;                // the eye in grid units: integer part ...
+uniform vec3 u_eye_frac;                 // ... and fractional part
+uniform float u_voxel_size;
+uniform mat3 u_rotation;
+uniform mat4 u_projection;
+void main() {
+  vec3 rel = (vec3(a_coord - u_eye_cell) + (a_corner - u_eye_frac)) * u_voxel_size;
+  gl_Position = u_projection * vec4(u_rotation * rel, 1.0);
+}
+)";
+
+const char* const kFragment = R"(#version 330 core
+uniform vec4 u_colour;
+out vec4 frag;
+void main() { frag = u_colour; }
+)";
+
+// The 12 edges of the unit cube as 24 line end points.
+std::vector<float> cube_edges() {
+  std::vector<float> v;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int i = 0; i < 4; ++i) {
+      // the two other axes take the four combinations of 0/1; `axis` runs 0 -> 1
+      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+      for (int end = 0; end < 2; ++end) {
+        float p[3];
+        p[axis] = static_cast<float>(end);
+        p[a] = static_cast<float>(i & 1);
+        p[b] = static_cast<float>(i >> 1);
+        v.insert(v.end(), p, p + 3);
+      }
+    }
+  return v;
+}
+
+}  // namespace
+
+GridOverlay::GridOverlay(const Renderer& renderer) {
+  program_ = gl::make_program(kVertex, kFragment);
+  glGenVertexArrays(1, &vao_);
+  glBindVertexArray(vao_);
+
+  const std::vector<float> edges = cube_edges();
+  glGenBuffers(1, &corners_);
+  glBindBuffer(GL_ARRAY_BUFFER, corners_);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(edges.size() * sizeof(float)), edges.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribDivisor(1, 1);
+
+  // Every voxel's coordinate, straight from the voxel table: uploaded once for the "all" scope.
+  std::vector<glm::ivec3> all;
+  for (const VoxelEntry& e : renderer.file().voxels()) all.emplace_back(e.coord[0], e.coord[1], e.coord[2]);
+  voxel_count_ = all.size();
+  glGenBuffers(1, &all_instances_);
+  glBindBuffer(GL_ARRAY_BUFFER, all_instances_);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(all.size() * sizeof(glm::ivec3)), all.data(), GL_STATIC_DRAW);
+  glGenBuffers(1, &drawn_instances_);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  glBindVertexArray(0);
+}
+
+GridOverlay::~GridOverlay() {
+  const GLuint buffers[3] = {corners_, all_instances_, drawn_instances_};
+  glDeleteBuffers(3, buffers);
+  if (vao_) glDeleteVertexArrays(1, &vao_);
+  if (program_) glDeleteProgram(program_);
+}
+
+void GridOverlay::draw(Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour) {
+  const VxlFile& file = renderer.file();
+  const MetaSection& m = file.meta();
+  GLuint instances = all_instances_;
+  cubes_drawn_ = voxel_count_;
+  if (scope == Scope::Drawn) {
+    // The same cull as the frame; the sort does not matter for outlines.
+    renderer.plan(camera, aspect, PlanOrder::Any, plan_);
+    const auto voxels = file.voxels();
+    drawn_coords_.clear();
+    for (const auto& [key, i] : plan_.sort_keys)
+      drawn_coords_.emplace_back(voxels[i].coord[0], voxels[i].coord[1], voxels[i].coord[2]);
+    glBindBuffer(GL_ARRAY_BUFFER, drawn_instances_);
+    // Orphan and refill: a fresh store each frame avoids waiting on the previous frame's draw.
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(drawn_coords_.size() * sizeof(glm::ivec3)),
+                 drawn_coords_.data(), GL_STREAM_DRAW);
+    instances = drawn_instances_;
+    cubes_drawn_ = drawn_coords_.size();
+  }
+  if (cubes_drawn_ == 0) return;
+
+  // The eye in grid units, split in double into an integer cell and a fraction.
+  const glm::dvec3 g = (camera.eye() - glm::dvec3(m.grid_origin[0], m.grid_origin[1], m.grid_origin[2])) / m.voxel_size;
+  const glm::dvec3 cell = glm::floor(g);
+  const glm::ivec3 eye_cell(cell);
+  const glm::vec3 eye_frac(g - cell);
+
+  // Near/far planes of our own: outlines reach up to a voxel beyond the tight bounds the renderer fits its
+  // planes to. Depth is not tested, so only clipping matters.
+  const glm::dvec3 lo = renderer.bounds_min(), hi = renderer.bounds_max();
+  const double radius = glm::length(hi - lo) * 0.5 + 2.0 * m.voxel_size;
+  const double along = glm::dot((lo + hi) * 0.5 - camera.eye(), camera.forward());
+  const double far_mm = along + radius;
+  const double near_mm = camera.orthographic ? along - radius : std::max(far_mm * 1e-4, along - radius);
+  const glm::mat4 projection = camera.projection(aspect, near_mm, std::max(far_mm, near_mm + 1.0));
+  const glm::mat3 rotation = camera.view_rotation();
+
+  glUseProgram(program_);
+  glUniform3iv(glGetUniformLocation(program_, "u_eye_cell"), 1, glm::value_ptr(eye_cell));
+  glUniform3fv(glGetUniformLocation(program_, "u_eye_frac"), 1, glm::value_ptr(eye_frac));
+  glUniform1f(glGetUniformLocation(program_, "u_voxel_size"), static_cast<float>(m.voxel_size));
+  glUniformMatrix3fv(glGetUniformLocation(program_, "u_rotation"), 1, GL_FALSE, glm::value_ptr(rotation));
+  glUniformMatrix4fv(glGetUniformLocation(program_, "u_projection"), 1, GL_FALSE, glm::value_ptr(projection));
+  glUniform4fv(glGetUniformLocation(program_, "u_colour"), 1, glm::value_ptr(colour));
+
+  glBindVertexArray(vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, instances);
+  glVertexAttribIPointer(1, 3, GL_INT, 0, nullptr);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+
+  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_BLEND);
+  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  glLineWidth(1.0f);
+  glDrawArraysInstanced(GL_LINES, 0, 24, static_cast<GLsizei>(cubes_drawn_));
+  glDisable(GL_BLEND);
+  glBindVertexArray(0);
+}
+
+}  // namespace vxl

@@ -1,0 +1,44 @@
+// Voxel-grid overlay: the cube outlines of the voxels a frame draws (those inside the view frustum, as the
+// renderer's plan culls them) or of every voxel, as GL_LINES over the picture. Shows what the Voxlines
+// method sorts. Needs only a current OpenGL 3.3 core context, like the Renderer.
+//
+// Camera-relative like the renderer, but exact in a simpler way: the shader subtracts the eye's integer
+// grid cell from each voxel's integer coordinate (exact in int) and adds the eye's fractional cell
+// position, so cubes far from the origin stay put.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "frame_plan.h"
+#include "gl_util.h"
+
+namespace vxl {
+
+class Renderer;
+struct Camera;
+
+class GridOverlay {
+ public:
+  enum class Scope { Drawn, All };
+
+  explicit GridOverlay(const Renderer& renderer);
+  ~GridOverlay();
+  GridOverlay(const GridOverlay&) = delete;
+  GridOverlay& operator=(const GridOverlay&) = delete;
+
+  // Draws into the bound framebuffer with the current viewport; blends `colour` over the picture.
+  void draw(Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour);
+
+  std::uint64_t cubes_drawn() const { return cubes_drawn_; }
+
+ private:
+  GLuint program_ = 0, vao_ = 0, corners_ = 0, all_instances_ = 0, drawn_instances_ = 0;
+  std::uint64_t voxel_count_ = 0, cubes_drawn_ = 0;
+  FramePlan plan_;                       // re-planned here: the renderer keeps its own plan private
+  std::vector<glm::ivec3> drawn_coords_;  // scratch, kept between frames
+};
+
+}  // namespace vxl
