@@ -53,9 +53,9 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs the `voxlines` CLI with the given argument string (shell syntax).
-inline CommandResult run_cli(const std::string& args) {
-  std::string cmd = std::string(VOXLINES_CLI) + " " + args + " 2>&1";
+// Runs a program with the given argument string (shell syntax), capturing stdout and stderr.
+inline CommandResult run_program(const std::string& program, const std::string& args) {
+  std::string cmd = program + " " + args + " 2>&1";
   CommandResult r{-1, {}};
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -66,5 +66,8 @@ inline CommandResult run_cli(const std::string& args) {
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return r;
 }
+
+// Runs the `voxlines` CLI.
+inline CommandResult run_cli(const std::string& args) { return run_program(VOXLINES_CLI, args); }
 
 }  // namespace vxl::test
