@@ -1,5 +1,6 @@
 #include "convert.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 
@@ -31,14 +32,24 @@ std::string provenance_json(const SourceInfo& src, const ConvertSettings& settin
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
+template <typename T>
+std::span<std::uint8_t> bytes_of(std::span<T> s) {
+  return {reinterpret_cast<std::uint8_t*>(s.data()), s.size_bytes()};
+}
+
 }  // namespace
 
 ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, const ConvertSettings& settings) {
   OrderSetSpec order_set = parse_order_set(settings.orders);
   const unsigned threads = resolve_threads(settings.threads);
-  SourceInfo source = t.source;
-  std::vector<GroupContent> groups;
-  for (const StreamlineGroup& g : t.groups) groups.push_back({g.name, g.members});
+  // PROV and GRPS are known before any work: their sizes go into the plan of the output file.
+  const std::string provenance = provenance_json(t.source, settings, threads);
+  std::vector<std::uint8_t> groups_bytes;
+  if (!t.groups.empty()) {
+    std::vector<GroupContent> groups;
+    for (const StreamlineGroup& g : t.groups) groups.push_back({g.name, g.members});
+    groups_bytes = encode_groups(groups);
+  }
 
   VoxelizeSettings vs;
   vs.voxel_size = settings.voxel_size;
@@ -48,35 +59,43 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   auto seconds_since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   ConvertSummary summary;
   auto t0 = Clock::now();
-  VoxelizedTractogram vt = voxelize(std::move(t), vs);
+
+  // Pass 1 fixes every size; the output is then mapped and filled in place (no copies of the sections).
+  VoxelPlan plan = plan_voxels(t, vs);
+  MetaSection meta = plan.meta();
+  meta.stored_order_count = static_cast<std::uint32_t>(order_set.directions.size());
+  meta.order_set = static_cast<std::uint32_t>(order_set.kind);
+  const std::uint64_t order_bytes = layout_orders(plan.voxels(), meta.stored_order_count);
+  VxlWriter out(out_path, section_sizes(meta, order_bytes, provenance.size(), groups_bytes.size()));
+  // Pass 2 writes all over these: fault them in first, in bulk (ORDR waits until the source is freed).
+  for (std::span<std::uint8_t> s : {bytes_of(out.vertices()), bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
+    prefault_for_write(s, threads);
+  VoxlineEnds ends = place_vertices(std::move(plan), std::move(t),
+                                    {out.voxels(), out.vertices(), out.voxlines(), out.streamline_first_voxline()});
   summary.voxelize_seconds = seconds_since(t0);
+
   t0 = Clock::now();
-  BuiltOrders orders = build_orders(vt, order_set, threads, settings.progress);
+  prefault_for_write(out.orders(), threads);
+  build_orders_into(out.voxels(), out.vertices(), ends, order_set, out.orders(), threads, settings.progress);
   summary.orders_seconds = seconds_since(t0);
 
-  VxlContent c;
-  c.meta = vt.meta;
-  c.directions = orders.directions;
-  c.voxels = vt.voxels;
-  c.vertices = vt.vertices;
-  c.orders = orders.bytes;
-  c.voxlines = vt.voxlines;
-  c.streamline_first_voxline = vt.streamline_first_voxline;
-  c.provenance_json = provenance_json(source, settings, threads);
-  c.groups = groups;
   if (settings.progress) settings.progress("writing", 0.0);
   t0 = Clock::now();
-  write_vxl(out_path, c);
+  out.set_meta(meta);
+  std::vector<DirectionEntry> directions = order_directions(order_set);
+  std::copy(directions.begin(), directions.end(), out.directions().begin());
+  std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
+  std::copy(groups_bytes.begin(), groups_bytes.end(), out.groups().begin());
+  out.commit(threads);
   summary.write_seconds = seconds_since(t0);
   if (settings.progress) settings.progress("writing", 1.0);
 
-  const MetaSection& m = vt.meta;
-  summary.streamlines = m.streamline_count;
-  summary.points = m.point_count;
-  summary.voxels = m.voxel_count;
-  summary.vertices = m.vertex_count;
-  summary.segments = m.segment_count;
-  summary.synthetic_points = m.synthetic_point_count;
+  summary.streamlines = meta.streamline_count;
+  summary.points = meta.point_count;
+  summary.voxels = meta.voxel_count;
+  summary.vertices = meta.vertex_count;
+  summary.segments = meta.segment_count;
+  summary.synthetic_points = meta.synthetic_point_count;
   return summary;
 }
 

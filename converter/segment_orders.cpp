@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <thread>
+#include <utility>
 
 #include "error.h"
 
@@ -33,58 +35,148 @@ OrderSetSpec parse_order_set(const std::string& name) {
 
 namespace {
 
-// Order-preserving map of a double to an unsigned integer (negative numbers flip all bits).
+// Order-preserving map of a double (not NaN) to an unsigned integer: its sign and magnitude as a two's
+// complement integer, offset by 2^63. Unlike flipping every bit of negative numbers, this keeps the zero
+// low mantissa bits of a sum of two floats zero for both signs, so that the keys of a voxel that
+// straddles 0 still vary in few enough bits for sort_segments to pack them with their index.
 std::uint64_t sortable_bits(double d) {
   std::uint64_t u;
   std::memcpy(&u, &d, 8);
-  return (u & 0x8000000000000000ull) ? ~u : (u | 0x8000000000000000ull);
+  const std::uint64_t negative = 0 - (u >> 63);  // all ones for a negative number (no branch: signs mix)
+  const std::uint64_t magnitude = u & 0x7FFFFFFFFFFFFFFFull;
+  return ((magnitude ^ negative) - negative) ^ 0x8000000000000000ull;  // -0 and +0 map alike
 }
 
-struct KeyedSegment {
-  std::uint64_t key;  // sortable_bits of the exact double key
-  std::uint32_t local;
-};
+// Stable LSD radix sort of `items` by the bits [first_bit, first_bit + bits) of key(item), in as few
+// passes of at most kDigitBits as cover them; passes whose digit is the same for every item are
+// skipped. Items arrive in ascending block-local index, so stability gives the spec's tie rule
+// (ascending index) for free.
+constexpr int kDigitBits = 11;  // 2048 buckets: the histogram stays in L1
+constexpr int kMaxPasses = (64 + kDigitBits - 1) / kDigitBits;
 
-// Stable LSD radix sort by key, 8 bits a pass. Items arrive in ascending local index, so stability gives
-// the spec's tie rule (ascending index) for free. Passes whose digit is the same for every item are
-// skipped: keys are sums of two floats, whose low mantissa bytes are zero in a double, and the keys of
-// one voxel share their high bytes, so typically only 3-4 of the 8 passes run.
-void radix_sort(std::vector<KeyedSegment>& items, std::vector<KeyedSegment>& scratch) {
-  const std::size_t n = items.size();
-  if (n < 2) return;
-  scratch.resize(n);
-  std::uint64_t all_or = 0, all_and = ~0ull;
-  for (const KeyedSegment& k : items) {
-    all_or |= k.key;
-    all_and &= k.key;
+// One read of the items fills every pass's histogram (P known at compile time, so the loop unrolls).
+template <int P, typename Item, typename Key>
+void histograms(const std::vector<Item>& items, std::uint32_t* count, Key key, int first_bit, int digit) {
+  const std::uint64_t mask = (1ull << digit) - 1;
+  for (const Item& x : items) {
+    const std::uint64_t k = key(x) >> first_bit;
+    for (int p = 0; p < P; ++p) ++count[(std::size_t(p) << digit) + ((k >> (p * digit)) & mask)];
   }
-  const std::uint64_t varying = all_or ^ all_and;
-  for (int shift = 0; shift < 64; shift += 8) {
-    if (((varying >> shift) & 0xFF) == 0) continue;
-    std::size_t count[257] = {};
-    for (const KeyedSegment& k : items) ++count[((k.key >> shift) & 0xFF) + 1];
-    for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
-    for (const KeyedSegment& k : items) scratch[count[(k.key >> shift) & 0xFF]++] = k;
+}
+
+template <typename Item, typename Key>
+void radix_sort_bits(std::vector<Item>& items, std::vector<Item>& scratch, std::vector<std::uint32_t>& count, Key key,
+                     int first_bit, int bits) {
+  const std::size_t n = items.size();
+  const int passes = (bits + kDigitBits - 1) / kDigitBits;
+  const int digit = (bits + passes - 1) / passes;
+  const std::uint64_t mask = (1ull << digit) - 1;
+  count.assign(std::size_t(passes) << digit, 0u);
+  switch (passes) {
+    case 1: histograms<1>(items, count.data(), key, first_bit, digit); break;
+    case 2: histograms<2>(items, count.data(), key, first_bit, digit); break;
+    case 3: histograms<3>(items, count.data(), key, first_bit, digit); break;
+    case 4: histograms<4>(items, count.data(), key, first_bit, digit); break;
+    case 5: histograms<5>(items, count.data(), key, first_bit, digit); break;
+    default: static_assert(kMaxPasses == 6); histograms<6>(items, count.data(), key, first_bit, digit);
+  }
+  scratch.resize(n);
+  for (int p = 0; p < passes; ++p) {
+    std::uint32_t* c = count.data() + (std::size_t(p) << digit);
+    const int shift = first_bit + p * digit;
+    if (c[(key(items[0]) >> shift) & mask] == n) continue;  // one bucket holds everything: nothing moves
+    std::uint32_t sum = 0;
+    for (std::size_t b = 0; b <= mask; ++b) sum += std::exchange(c[b], sum);
+    for (const Item& x : items) scratch[c[(key(x) >> shift) & mask]++] = x;
     items.swap(scratch);
   }
 }
 
+// Writes block-local indices as `width`-byte little-endian entries (spec §5.5).
+template <typename Local>
+std::uint8_t* put_entries(std::uint8_t* dst, std::uint32_t width, std::size_t n, Local&& local) {
+  switch (width) {
+    case 2:
+      for (std::size_t i = 0; i < n; ++i, dst += 2) {
+        std::uint16_t e = static_cast<std::uint16_t>(local(i));
+        std::memcpy(dst, &e, 2);
+      }
+      break;
+    case 3:
+      for (std::size_t i = 0; i < n; ++i, dst += 3) {
+        std::uint32_t e = local(i);
+        std::memcpy(dst, &e, 3);
+      }
+      break;
+    default:
+      for (std::size_t i = 0; i < n; ++i, dst += 4) {
+        std::uint32_t e = local(i);
+        std::memcpy(dst, &e, 4);
+      }
+  }
+  return dst;
+}
+
+// A segment whose key varies in too many bits to share 64 bits with its index.
+struct KeyedSegment {
+  std::uint64_t key;
+  std::uint32_t local;
+};
+
+struct SortScratch {
+  std::vector<std::uint64_t> keys, packed, packed_tmp;
+  std::vector<KeyedSegment> keyed, keyed_tmp;
+  std::vector<std::uint32_t> counts;
+};
+
+// Writes the order of one voxel's segments (block-local `starts`, ascending) by ascending `s.keys`
+// (which differ in the bits of `varying`), ties by ascending index, to `dst`; returns the end of what
+// it wrote.
+std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint32_t vertex_count, std::uint32_t width,
+                            std::uint64_t varying, SortScratch& s, std::uint8_t* dst) {
+  const std::size_t n = starts.size();
+  if (n < 2 || varying == 0) return put_entries(dst, width, n, [&](std::size_t i) { return starts[i]; });
+
+  // All keys share the bits above the highest varying bit and below the lowest, so the varying field
+  // alone orders them. Packed above the block-local index it makes one 8-byte item per segment, half
+  // the traffic of key + index. The field is typically 3 bytes of mantissa (sums of two floats).
+  const int low = std::countr_zero(varying), bits = 64 - std::countl_zero(varying) - low;
+  const int index_bits = std::bit_width(vertex_count - 1);  // vertex_count >= 2 here
+  if (bits + index_bits <= 64) {
+    s.packed.resize(n);
+    const std::uint64_t field = (1ull << bits) - 1;  // bits < 64 here
+    for (std::size_t i = 0; i < n; ++i) s.packed[i] = ((s.keys[i] >> low) & field) << index_bits | starts[i];
+    radix_sort_bits(s.packed, s.packed_tmp, s.counts, [](std::uint64_t x) { return x; }, index_bits, bits);
+    const std::uint64_t index_mask = (1ull << index_bits) - 1;
+    return put_entries(dst, width, n, [&](std::size_t i) { return static_cast<std::uint32_t>(s.packed[i] & index_mask); });
+  }
+  s.keyed.resize(n);
+  for (std::size_t i = 0; i < n; ++i) s.keyed[i] = {s.keys[i], starts[i]};
+  radix_sort_bits(s.keyed, s.keyed_tmp, s.counts, [](const KeyedSegment& k) { return k.key; }, low, bits);
+  return put_entries(dst, width, n, [&](std::size_t i) { return s.keyed[i].local; });
+}
+
 }  // namespace
 
-BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsigned threads, const ProgressFn& progress) {
-  BuiltOrders out;
-  const std::uint32_t k_count = static_cast<std::uint32_t>(set.directions.size());
-  for (const auto& d : set.directions) out.directions.push_back({{d[0], d[1], d[2]}, 0});
-  vt.meta.stored_order_count = k_count;
-  vt.meta.order_set = static_cast<std::uint32_t>(set.kind);
+std::vector<DirectionEntry> order_directions(const OrderSetSpec& set) {
+  std::vector<DirectionEntry> out;
+  for (const auto& d : set.directions) out.push_back({{d[0], d[1], d[2]}, 0});
+  return out;
+}
 
+std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_orders) {
   std::uint64_t total = 0;
-  for (VoxelEntry& v : vt.voxels) {
+  for (VoxelEntry& v : voxels) {
     v.flags = order_width_code(v.vertex_count);
     v.order_offset = total;
-    total += order_bytes(v.vertex_count, v.segment_count, k_count);
+    total += order_bytes(v.vertex_count, v.segment_count, stored_orders);
   }
-  out.bytes.assign(total, 0);
+  return total;
+}
+
+void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float> vertices, const VoxlineEnds& ends,
+                       const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads, const ProgressFn& progress) {
+  const std::uint32_t k_count = static_cast<std::uint32_t>(set.directions.size());
 
   // Axis directions sort by one exact component sum, as in the paper; others by a dot product.
   std::vector<int> axis_of(k_count, -1);
@@ -97,18 +189,25 @@ BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsig
   std::atomic<std::size_t> done{0};
   auto worker = [&](bool reports) {
     std::vector<std::uint32_t> starts;
-    std::vector<KeyedSegment> keyed, scratch;
-    for (std::size_t i; (i = next++) < vt.voxels.size();) {
-      const VoxelEntry& v = vt.voxels[i];
-      starts.clear();
-      for (std::uint32_t e = 0; e < v.vertex_count; ++e)
-        if (!vt.is_voxline_end[v.vertex_first + e]) starts.push_back(e);
-      const float* block = vt.vertices.data() + 3 * v.vertex_first;
+    SortScratch scratch;
+    for (std::size_t i; (i = next++) < voxels.size();) {
+      const VoxelEntry& v = voxels[i];
+      // The segments start at every vertex that does not end its voxline (branch-free: ends are
+      // scattered, a branch would mispredict often).
+      starts.resize(v.vertex_count);
+      std::size_t n_starts = 0;
+      for (std::uint32_t e = 0; e < v.vertex_count; ++e) {
+        starts[n_starts] = e;
+        n_starts += !ends.test(v.vertex_first + e);
+      }
+      starts.resize(n_starts);
+      const float* block = vertices.data() + 3 * v.vertex_first;
       const std::uint32_t width = order_entry_width(v.vertex_count);
-      std::uint8_t* dst = out.bytes.data() + v.order_offset;
+      std::uint8_t* dst = orders.data() + v.order_offset;
       for (std::uint32_t k = 0; k < k_count; ++k) {
-        keyed.resize(starts.size());
+        scratch.keys.resize(starts.size());
         const auto& d = set.directions[k];
+        std::uint64_t all_or = 0, all_and = ~0ull;
         for (std::size_t n = 0; n < starts.size(); ++n) {
           const float* a = block + 3 * starts[n];
           double key;
@@ -118,13 +217,15 @@ BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsig
             key = 0;
             for (int c = 0; c < 3; ++c) key += (double(a[c]) + double(a[c + 3])) * double(d[c]);
           }
-          keyed[n] = {sortable_bits(key + 0.0), starts[n]};  // + 0.0 folds -0 into +0
+          const std::uint64_t bits = sortable_bits(key);
+          scratch.keys[n] = bits;
+          all_or |= bits;
+          all_and &= bits;
         }
-        radix_sort(keyed, scratch);
-        for (std::size_t n = 0; n < keyed.size(); ++n, dst += width) std::memcpy(dst, &keyed[n].local, width);
+        dst = sort_segments(starts, v.vertex_count, width, all_or ^ all_and, scratch, dst);
       }
       std::size_t d = ++done;
-      if (reports && progress && (d & 63) == 0) progress("ordering", double(d) / double(vt.voxels.size()));
+      if (reports && progress && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
     }
   };
   unsigned n_threads = std::max(1u, resolve_threads(threads));
@@ -133,6 +234,15 @@ BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsig
   worker(true);
   for (auto& th : pool) th.join();
   if (progress) progress("ordering", 1.0);
+}
+
+BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsigned threads, const ProgressFn& progress) {
+  BuiltOrders out;
+  out.directions = order_directions(set);
+  vt.meta.stored_order_count = static_cast<std::uint32_t>(set.directions.size());
+  vt.meta.order_set = static_cast<std::uint32_t>(set.kind);
+  out.bytes.assign(layout_orders(vt.voxels, vt.meta.stored_order_count), 0);
+  build_orders_into(vt.voxels, vt.vertices, vt.voxline_ends, set, out.bytes, threads, progress);
   return out;
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -24,12 +25,24 @@ struct OrderSetSpec {
 // Throws vxl::Error (Usage) for anything else.
 OrderSetSpec parse_order_set(const std::string& name);
 
+// The DIRS entries of an order set.
+std::vector<DirectionEntry> order_directions(const OrderSetSpec& set);
+
+// Sets every voxel's flags (order entry width) and order_offset for K = `stored_orders`; returns the
+// size of the ORDR payload, so that it can be allocated before the orders are built.
+std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_orders);
+
+// Sorts every voxel's segments for every direction of `set` into `orders`, the ORDR payload laid out
+// by layout_orders (padding bytes are left as they are: zero in a fresh payload).
+void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float> vertices, const VoxlineEnds& ends,
+                       const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads, const ProgressFn& progress);
+
 struct BuiltOrders {
   std::vector<DirectionEntry> directions;
   std::vector<std::uint8_t> bytes;  // the ORDR payload
 };
 
-// Sorts every voxel's segments for every direction; sets each voxel's flags and order_offset.
+// All of the above in memory: sets the voxels' flags and order_offset and the meta's order fields.
 BuiltOrders build_orders(VoxelizedTractogram& voxelized, const OrderSetSpec& set, unsigned threads,
                          const ProgressFn& progress);
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <mutex>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "error.h"
@@ -90,7 +91,7 @@ struct Chunk {
   std::vector<std::uint64_t> first_voxline;  // per streamline of the chunk, chunk-local
   std::vector<float> synthetic_xyz;
   std::vector<std::uint64_t> vertices_per_voxel;  // by local id
-  std::vector<std::uint64_t> segments_per_voxel;
+  std::vector<std::uint64_t> segments_per_voxel;  // by local id
   std::vector<std::uint32_t> global_id;     // local id -> global voxel index
   std::vector<std::uint64_t> cursor;        // local id -> next vertex to write (global index)
   std::uint64_t voxline_base = 0;           // first global voxline of this chunk
@@ -100,10 +101,13 @@ struct Chunk {
 struct Grid {
   double origin[3];
   double size;
+  // voxel_coordinate() (spec §6.1) of a source point. Every point is >= the origin, so the quotient is
+  // >= 0 and below the grid size (< 2^31), where truncation is floor: this avoids a floor() library
+  // call per coordinate (the baseline x86-64 ISA has no rounding instruction).
   Coord voxel_of(const float* p) const {
-    return {static_cast<std::int32_t>(voxel_coordinate(p[0], origin[0], size)),
-            static_cast<std::int32_t>(voxel_coordinate(p[1], origin[1], size)),
-            static_cast<std::int32_t>(voxel_coordinate(p[2], origin[2], size))};
+    return {static_cast<std::int32_t>((static_cast<double>(p[0]) - origin[0]) / size),
+            static_cast<std::int32_t>((static_cast<double>(p[1]) - origin[1]) / size),
+            static_cast<std::int32_t>((static_cast<double>(p[2]) - origin[2]) / size)};
   }
 };
 
@@ -219,9 +223,56 @@ std::string format_mm(double v) {
   return s.str();
 }
 
+// Bounds, finiteness and the longest step (for the suggestion when long steps explode) of one range of
+// streamlines.
+struct BoundsPart {
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  double longest_step2 = 0;
+  std::uint64_t bad_streamline = std::numeric_limits<std::uint64_t>::max(), bad_point = 0;  // first non-finite
+};
+
+void scan_bounds(const float* pts, const std::vector<std::uint64_t>& offsets, std::uint64_t first, std::uint64_t end,
+                 BoundsPart& b) {
+  // Locals, not b's fields: the compiler cannot tell that b does not alias the points.
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  double longest_step2 = 0;
+  for (std::uint64_t k = first; k < end && b.bad_streamline == std::numeric_limits<std::uint64_t>::max(); ++k) {
+    for (std::uint64_t i = offsets[k]; i < offsets[k + 1]; ++i) {
+      const float* p = pts + 3 * i;
+      if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) {
+        b.bad_streamline = k;
+        b.bad_point = i - offsets[k];
+        break;
+      }
+      for (int c = 0; c < 3; ++c) {  // in float: converting to double afterwards gives the same bounds
+        lo[c] = std::min(lo[c], p[c]);
+        hi[c] = std::max(hi[c], p[c]);
+      }
+      if (i > offsets[k]) {
+        double d2 = 0;
+        for (int c = 0; c < 3; ++c) d2 += (double(p[c]) - p[c - 3]) * (double(p[c]) - p[c - 3]);
+        longest_step2 = std::max(longest_step2, d2);
+      }
+    }
+  }
+  std::copy(lo, lo + 3, b.lo);
+  std::copy(hi, hi + 3, b.hi);
+  b.longest_step2 = longest_step2;
+}
+
 }  // namespace
 
-VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
+struct VoxelPlan::Work {
+  unsigned threads = 1;
+  std::vector<Chunk> chunks;
+};
+
+VoxelPlan::VoxelPlan() : work_(std::make_unique<Work>()) {}
+VoxelPlan::VoxelPlan(VoxelPlan&&) noexcept = default;
+VoxelPlan& VoxelPlan::operator=(VoxelPlan&&) noexcept = default;
+VoxelPlan::~VoxelPlan() = default;
+
+VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   const std::string& path = t.source.path;
   const double s = settings.voxel_size;
   if (!std::isfinite(s) || !(s > 0)) throw Error(ErrorKind::Usage, path, std::nullopt, "voxel size must be a positive number of mm");
@@ -229,36 +280,31 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
   const std::uint64_t n_streamlines = t.streamline_count(), n_points = t.point_count();
   const float* pts = t.positions.data();
 
-  VoxelizedTractogram out;
-  MetaSection& m = out.meta;
+  VoxelPlan plan;
+  plan.work_->threads = threads;
+  MetaSection& m = plan.meta_;
   m.streamline_count = n_streamlines;
   m.point_count = n_points;
   m.voxel_size = s;
 
-  // Bounds, finiteness and the longest step (for the suggestion when long steps explode).
+  // The same streamline ranges serve the bounds scan and pass 1.
+  const std::vector<std::uint64_t> bounds = split_by_points(t.offsets, threads);
+  std::vector<BoundsPart> parts(bounds.size() - 1);
+  parallel_for_chunks(parts.size(), threads, [&](std::size_t c) { scan_bounds(pts, t.offsets, bounds[c], bounds[c + 1], parts[c]); });
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   double longest_step2 = 0;
-  for (std::uint64_t k = 0; k < n_streamlines; ++k) {
-    for (std::uint64_t i = t.offsets[k]; i < t.offsets[k + 1]; ++i) {
-      const float* p = pts + 3 * i;
-      for (int c = 0; c < 3; ++c) {
-        if (!std::isfinite(p[c]))
-          throw Error(ErrorKind::Input, path, std::nullopt,
-                      "non-finite coordinate in streamline " + std::to_string(k) + " (point " + std::to_string(i - t.offsets[k]) + ")");
-        lo[c] = std::min(lo[c], double(p[c]));
-        hi[c] = std::max(hi[c], double(p[c]));
-      }
-      if (i > t.offsets[k]) {
-        double d2 = 0;
-        for (int c = 0; c < 3; ++c) d2 += (double(p[c]) - p[c - 3]) * (double(p[c]) - p[c - 3]);
-        longest_step2 = std::max(longest_step2, d2);
-      }
+  for (const BoundsPart& b : parts) {
+    if (b.bad_streamline != std::numeric_limits<std::uint64_t>::max())  // the first one in streamline order
+      throw Error(ErrorKind::Input, path, std::nullopt,
+                  "non-finite coordinate in streamline " + std::to_string(b.bad_streamline) + " (point " +
+                      std::to_string(b.bad_point) + ")");
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], double(b.lo[c]));
+      hi[c] = std::max(hi[c], double(b.hi[c]));
     }
+    longest_step2 = std::max(longest_step2, b.longest_step2);
   }
-  if (n_points == 0) {
-    out.streamline_first_voxline.assign(n_streamlines + 1, 0);
-    return out;
-  }
+  if (n_points == 0) return plan;  // no voxels; place_vertices fills STRM with zeros
   Grid grid{{lo[0], lo[1], lo[2]}, s};
   for (int c = 0; c < 3; ++c) {
     double cells = std::floor((hi[c] - lo[c]) / s) + 1;
@@ -274,10 +320,9 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
     m.bounds_max[c] = hi[c];
   }
 
-  // Pass 1: voxlines per chunk of streamlines.
-  std::vector<std::uint64_t> bounds = split_by_points(t.offsets, threads);
-  std::vector<Chunk> chunks(bounds.size() - 1);
-  std::atomic<std::uint64_t> done_points{0};
+  // Pass 1: voxlines per chunk of streamlines, then each chunk's vertex and segment count per voxel.
+  std::vector<Chunk>& chunks = plan.work_->chunks;
+  chunks.resize(bounds.size() - 1);
   parallel_for_chunks(chunks.size(), threads, [&](std::size_t c) {
     Chunk& ch = chunks[c];
     ch.first_streamline = bounds[c];
@@ -296,7 +341,6 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
       }
     }
     ch.first_voxline.push_back(ch.voxlines.size());
-    done_points += chunk_points;
   });
   for (const Chunk& ch : chunks)
     if (ch.too_many_synthetic)
@@ -304,6 +348,22 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
                   "voxel size " + format_mm(s) + " mm is far below the longest step (" + format_mm(std::sqrt(longest_step2)) +
                       " mm): splitting steps at voxel faces would more than double the points; use --voxel-size " +
                       format_mm(std::sqrt(longest_step2)) + " or larger");
+  parallel_for_chunks(chunks.size(), threads, [&](std::size_t c) {
+    Chunk& ch = chunks[c];
+    ch.vertices_per_voxel.assign(ch.index.coords().size(), 0);
+    ch.segments_per_voxel.assign(ch.index.coords().size(), 0);
+    for (std::uint64_t k = 0; k + 1 < ch.first_voxline.size(); ++k) {
+      for (std::uint64_t j = ch.first_voxline[k]; j < ch.first_voxline[k + 1]; ++j) {
+        const TempVoxline& v = ch.voxlines[j];
+        std::uint64_t own = v.own();
+        if (own > kVoxlineCountMask)
+          throw Error(ErrorKind::Unsupported, path, std::nullopt, "a voxline of more than 2^31-1 points; use a smaller --voxel-size");
+        std::uint64_t used = own + (j + 1 < ch.first_voxline[k + 1] ? 1 : 0);  // + the connecting vertex
+        ch.vertices_per_voxel[v.voxel] += used;
+        ch.segments_per_voxel[v.voxel] += used - 1;
+      }
+    }
+  });
   if (settings.progress) settings.progress("voxelising", 1.0);
 
   // Global voxel table, sorted by (z, y, x).
@@ -320,33 +380,23 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
   for (Chunk& ch : chunks) {
     const auto& coords = ch.index.coords();
     ch.global_id.resize(coords.size());
-    for (std::size_t i = 0; i < coords.size(); ++i)
+    for (std::size_t i = 0; i < coords.size(); ++i) {
       ch.global_id[i] = static_cast<std::uint32_t>(std::lower_bound(all.begin(), all.end(), coords[i], zyx_less) - all.begin());
+      voxel_vertices[ch.global_id[i]] += ch.vertices_per_voxel[i];
+      voxel_segments[ch.global_id[i]] += ch.segments_per_voxel[i];
+    }
     ch.voxline_base = n_voxlines;
     n_voxlines += ch.voxlines.size();
     n_synthetic += ch.synthetic_xyz.size() / 3;
-    ch.vertices_per_voxel.assign(coords.size(), 0);
-    for (std::uint64_t k = 0; k + 1 < ch.first_voxline.size(); ++k) {
-      for (std::uint64_t j = ch.first_voxline[k]; j < ch.first_voxline[k + 1]; ++j) {
-        TempVoxline& v = ch.voxlines[j];
-        std::uint64_t own = v.own();
-        if (own > kVoxlineCountMask)
-          throw Error(ErrorKind::Unsupported, path, std::nullopt, "a voxline of more than 2^31-1 points; use a smaller --voxel-size");
-        bool connected = j + 1 < ch.first_voxline[k + 1];
-        ch.vertices_per_voxel[v.voxel] += own + (connected ? 1 : 0);
-        voxel_segments[ch.global_id[v.voxel]] += own + (connected ? 1 : 0) - 1;
-      }
-    }
-    for (std::size_t i = 0; i < coords.size(); ++i) voxel_vertices[ch.global_id[i]] += ch.vertices_per_voxel[i];
   }
 
-  out.voxels.resize(n_voxels);
+  plan.voxels_.resize(n_voxels);
   std::uint64_t n_vertices = 0, n_segments = 0;
   for (std::size_t i = 0; i < n_voxels; ++i) {
     if (voxel_vertices[i] > std::numeric_limits<std::uint32_t>::max())
       throw Error(ErrorKind::Unsupported, path, std::nullopt,
                   "a voxel holds more than 2^32-1 vertices; use a --voxel-size smaller than " + format_mm(s));
-    VoxelEntry& v = out.voxels[i];
+    VoxelEntry& v = plan.voxels_[i];
     v = {};
     v.coord[0] = all[i].x;
     v.coord[1] = all[i].y;
@@ -360,7 +410,7 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
   // Each chunk writes after the chunks before it inside every block: streamline order is kept.
   {
     std::vector<std::uint64_t> next(n_voxels);
-    for (std::size_t i = 0; i < n_voxels; ++i) next[i] = out.voxels[i].vertex_first;
+    for (std::size_t i = 0; i < n_voxels; ++i) next[i] = plan.voxels_[i].vertex_first;
     for (Chunk& ch : chunks) {
       ch.cursor.resize(ch.global_id.size());
       for (std::size_t i = 0; i < ch.global_id.size(); ++i) {
@@ -370,11 +420,26 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
     }
   }
 
+  m.vertex_count = n_vertices;
+  m.segment_count = n_segments;
+  m.voxline_count = n_voxlines;
+  m.synthetic_point_count = n_synthetic;
+  m.voxel_count = static_cast<std::uint32_t>(n_voxels);
+  return plan;
+}
+
+VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& out) {
+  const MetaSection& m = plan.meta_;
+  const unsigned threads = plan.work_->threads;
+  std::vector<Chunk>& chunks = plan.work_->chunks;
+  const float* pts = t.positions.data();
+  if (out.voxels.size() != m.voxel_count || out.vertices.size() != 3 * m.vertex_count ||
+      out.voxlines.size() != m.voxline_count || out.streamline_first_voxline.size() != m.streamline_count + 1)
+    throw std::logic_error("place_vertices: the output spans do not have the sizes of the plan");
+  VoxlineEnds ends(m.vertex_count);
+  std::copy(plan.voxels_.begin(), plan.voxels_.end(), out.voxels.begin());
+
   // Pass 2: place vertices, fill the voxline and streamline tables.
-  out.vertices.resize(3 * n_vertices);
-  out.is_voxline_end.assign(n_vertices, 0);
-  out.voxlines.resize(n_voxlines);
-  out.streamline_first_voxline.resize(n_streamlines + 1);
   parallel_for_chunks(chunks.size(), threads, [&](std::size_t c) {
     Chunk& ch = chunks[c];
     for (std::uint64_t k = 0; k + 1 < ch.first_voxline.size(); ++k) {
@@ -398,19 +463,20 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
           std::memcpy(dst, first, 12);
         }
         std::uint64_t used = own + (connected ? 1 : 0);
-        out.is_voxline_end[cursor + used - 1] = 1;
+        ends.set(cursor + used - 1);
         cursor += used;
         out.voxlines[ch.voxline_base + j] = {ch.global_id[v.voxel], own | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)};
       }
     }
   });
-  out.streamline_first_voxline[n_streamlines] = n_voxlines;
-  chunks.clear();
+  if (chunks.empty()) std::fill(out.streamline_first_voxline.begin(), out.streamline_first_voxline.end(), 0);
+  out.streamline_first_voxline[m.streamline_count] = m.voxline_count;
+  plan.work_.reset();
   t.positions.clear();  // the blocks now hold every point: release the source copy before orders are built
   t.positions.shrink_to_fit();
 
   // Tight bounds per voxel.
-  parallel_for_chunks(n_voxels, threads, [&](std::size_t i) {
+  parallel_for_chunks(out.voxels.size(), threads, [&](std::size_t i) {
     VoxelEntry& v = out.voxels[i];
     const float* p = out.vertices.data() + 3 * v.vertex_first;
     for (int c = 0; c < 3; ++c) v.tight_min[c] = v.tight_max[c] = p[c];
@@ -420,12 +486,19 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
         v.tight_max[c] = std::max(v.tight_max[c], p[3 * k + c]);
       }
   });
+  return ends;
+}
 
-  m.vertex_count = n_vertices;
-  m.segment_count = n_segments;
-  m.voxline_count = n_voxlines;
-  m.synthetic_point_count = n_synthetic;
-  m.voxel_count = static_cast<std::uint32_t>(n_voxels);
+VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
+  VoxelPlan plan = plan_voxels(t, settings);
+  VoxelizedTractogram out;
+  out.meta = plan.meta();
+  out.voxels.resize(out.meta.voxel_count);
+  out.vertices.resize(3 * out.meta.vertex_count);
+  out.voxlines.resize(out.meta.voxline_count);
+  out.streamline_first_voxline.resize(out.meta.streamline_count + 1);
+  out.voxline_ends = place_vertices(std::move(plan), std::move(t),
+                                    {out.voxels, out.vertices, out.voxlines, out.streamline_first_voxline});
   return out;
 }
 

@@ -3,13 +3,20 @@
 //
 //   streamlines --(voxel of each point, §6.1)--> voxlines --(grouped per voxel)--> vertex blocks
 //
+// Two passes, so that the output can be sized before it is written: plan_voxels finds the voxlines and
+// the voxel table (every count and size), place_vertices then writes the blocks and tables into spans
+// the caller provides (the mapped output file, in convert_tractogram). voxelize() runs both into vectors.
+//
 // Work is split over threads by contiguous streamline ranges; the result does not depend on the thread
 // count (voxlines keep streamline order inside each block).
 #pragma once
 
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -30,18 +37,75 @@ struct VoxelizeSettings {
   double max_synthetic_per_point = 1.0;
 };
 
-// The voxel blocks, without orders (build_orders adds those).
+// One bit per vertex, set when the vertex is the last of its voxline, so that no segment starts there
+// (spec §6.2). build_orders finds a block's segments with it. A bit, not a byte, per vertex: it is
+// read once per vertex and order, and 8 times smaller.
+class VoxlineEnds {
+ public:
+  VoxlineEnds() = default;
+  explicit VoxlineEnds(std::uint64_t vertex_count) : words_((vertex_count + 63) / 64, 0) {}
+  bool test(std::uint64_t vertex) const { return (words_[vertex >> 6] >> (vertex & 63)) & 1u; }
+  // Atomic: the blocks of two threads can meet inside one word.
+  void set(std::uint64_t vertex) {
+    std::atomic_ref<std::uint64_t>(words_[vertex >> 6]).fetch_or(1ull << (vertex & 63), std::memory_order_relaxed);
+  }
+
+ private:
+  std::vector<std::uint64_t> words_;
+};
+
+// The voxel blocks, without orders (build_orders adds those), in memory.
 struct VoxelizedTractogram {
   MetaSection meta{};
   std::vector<VoxelEntry> voxels;      // sorted by (z, y, x); order_offset/flags set by build_orders
   std::vector<float> vertices;         // 3 * vertex_count
   std::vector<VoxlineEntry> voxlines;  // streamline order
   std::vector<std::uint64_t> streamline_first_voxline;  // N + 1
-  std::vector<std::uint8_t> is_voxline_end;  // per vertex: 1 when it is the last vertex of a voxline
+  VoxlineEnds voxline_ends;
 };
 
-// Consumes the tractogram's positions (they are released once copied into the blocks, to bound peak
-// memory). Throws vxl::Error (Unsupported) when a limit of spec §9 would be exceeded, with a suggestion.
+// Where place_vertices writes; each span has exactly the size the plan's meta gives.
+struct VoxelBlocks {
+  std::span<VoxelEntry> voxels;                       // voxel_count
+  std::span<float> vertices;                          // 3 * vertex_count
+  std::span<VoxlineEntry> voxlines;                   // voxline_count
+  std::span<std::uint64_t> streamline_first_voxline;  // streamline_count + 1
+};
+
+// The result of pass 1: every streamline's voxlines and the voxel table.
+class VoxelPlan {
+ public:
+  VoxelPlan(VoxelPlan&&) noexcept;
+  VoxelPlan& operator=(VoxelPlan&&) noexcept;
+  ~VoxelPlan();
+
+  // Counts, grid and bounds; stored_order_count and order_set are left to the caller.
+  const MetaSection& meta() const { return meta_; }
+  // Sorted by (z, y, x), with coord, vertex_first, vertex_count and segment_count set. The caller may
+  // set flags and order_offset (layout_orders); place_vertices copies the entries and adds tight bounds.
+  std::span<VoxelEntry> voxels() { return voxels_; }
+
+ private:
+  struct Work;  // the per-thread voxlines (voxelize.cpp)
+  VoxelPlan();
+  friend VoxelPlan plan_voxels(const Tractogram& tractogram, const VoxelizeSettings& settings);
+  friend VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& tractogram, const VoxelBlocks& out);
+
+  std::unique_ptr<Work> work_;
+  MetaSection meta_{};
+  std::vector<VoxelEntry> voxels_;
+};
+
+// Pass 1. Throws vxl::Error: Input for a non-finite coordinate, Unsupported (with a suggestion) when a
+// limit of spec §9 would be exceeded.
+VoxelPlan plan_voxels(const Tractogram& tractogram, const VoxelizeSettings& settings);
+
+// Pass 2: writes the voxel table (with tight bounds), the vertex blocks and the voxline and streamline
+// tables into `out`, and releases the tractogram's positions (the blocks then hold every point, so peak
+// memory stays bounded). Returns the voxline ends of the blocks, for build_orders.
+VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& tractogram, const VoxelBlocks& out);
+
+// Both passes, into vectors. Consumes the tractogram's positions like place_vertices.
 VoxelizedTractogram voxelize(Tractogram&& tractogram, const VoxelizeSettings& settings);
 
 // The integer voxel coordinate of a point (spec §6.1), exposed for tests.

@@ -3,9 +3,11 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <thread>
 #include <vector>
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -17,7 +19,7 @@ AtomicOutputFile::AtomicOutputFile(std::string path) : path_(std::move(path)) {
   std::filesystem::path p(path_);
   std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
   if (std::filesystem::is_directory(p)) fail("is a directory");
-  fd_ = ::open(dir.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
+  fd_ = ::open(dir.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0644);
   if (fd_ < 0) {
     // O_TMPFILE unsupported here: fall back to a hidden temporary name beside the output.
     std::string templ = (dir / ("." + p.filename().string() + ".partial-XXXXXX")).string();
@@ -31,6 +33,7 @@ AtomicOutputFile::AtomicOutputFile(std::string path) : path_(std::move(path)) {
 }
 
 AtomicOutputFile::~AtomicOutputFile() {
+  unmap();
   if (fd_ >= 0) ::close(fd_);
   if (!committed_ && !temp_path_.empty()) ::unlink(temp_path_.c_str());
 }
@@ -38,6 +41,7 @@ AtomicOutputFile::~AtomicOutputFile() {
 void AtomicOutputFile::fail(const std::string& what) const { throw Error(ErrorKind::Output, path_, std::nullopt, what); }
 
 void AtomicOutputFile::write(const void* data, std::size_t size) {
+  if (map_ != nullptr) fail("internal error: write() on a mapped file");
   const auto* p = static_cast<const std::uint8_t*>(data);
   while (size > 0) {
     ssize_t n = ::write(fd_, p, size);
@@ -61,6 +65,7 @@ void AtomicOutputFile::write_zeros(std::size_t size) {
 }
 
 void AtomicOutputFile::pwrite(const void* data, std::size_t size, std::uint64_t offset) {
+  if (map_ != nullptr) fail("internal error: pwrite() on a mapped file");
   const auto* p = static_cast<const std::uint8_t*>(data);
   while (size > 0) {
     ssize_t n = ::pwrite(fd_, p, size, static_cast<off_t>(offset));
@@ -74,7 +79,30 @@ void AtomicOutputFile::pwrite(const void* data, std::size_t size, std::uint64_t 
   }
 }
 
+std::span<std::uint8_t> AtomicOutputFile::map(std::uint64_t size) {
+  if (map_ != nullptr || position_ != 0) fail("internal error: map() on a file already written to");
+  if (size == 0) return {};
+  // fallocate reserves the blocks (ENOSPC surfaces here); file systems without it get a sparse file.
+  if (::fallocate(fd_, 0, 0, static_cast<off_t>(size)) != 0) {
+    if (errno != EOPNOTSUPP && errno != ENOSYS) fail(std::string("cannot reserve the output size: ") + std::strerror(errno));
+    if (::ftruncate(fd_, static_cast<off_t>(size)) != 0) fail(std::string("cannot size the output: ") + std::strerror(errno));
+  }
+  void* p = ::mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_SHARED, fd_, 0);
+  if (p == MAP_FAILED) fail(std::string("cannot map the output: ") + std::strerror(errno));
+  map_ = static_cast<std::uint8_t*>(p);
+  map_size_ = size;
+  position_ = size;
+  return {map_, size};
+}
+
+void AtomicOutputFile::unmap() noexcept {
+  if (map_ != nullptr) ::munmap(map_, map_size_);
+  map_ = nullptr;
+  map_size_ = 0;
+}
+
 void AtomicOutputFile::commit() {
+  unmap();  // the data is in the page cache already; the file must not change once it has a name
   if (temp_path_.empty()) {
     // Link the unnamed file under a temporary name, then rename over the target (rename is atomic;
     // linkat cannot replace an existing file).
@@ -99,6 +127,26 @@ void AtomicOutputFile::commit() {
   fd_ = -1;
   if (::rename(temp_path_.c_str(), path_.c_str()) != 0) fail(std::string("cannot rename into place: ") + std::strerror(errno));
   committed_ = true;
+}
+
+void prefault_for_write(std::span<std::uint8_t> bytes, unsigned threads) {
+#ifdef MADV_POPULATE_WRITE
+  if (bytes.empty()) return;
+  const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+  const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(bytes.data()) / page * page;
+  const std::uintptr_t end = reinterpret_cast<std::uintptr_t>(bytes.data() + bytes.size());
+  // Whole pages per thread, and no thread for less than 8 MiB.
+  const std::uintptr_t part = std::max<std::uintptr_t>((end - begin) / std::max(1u, threads) / page * page + page, 8u << 20);
+  auto populate = [](std::uintptr_t from, std::uintptr_t to) {
+    ::madvise(reinterpret_cast<void*>(from), to - from, MADV_POPULATE_WRITE);  // a hint: errors are ignored
+  };
+  std::vector<std::thread> pool;
+  for (std::uintptr_t from = begin + part; from < end; from += part) pool.emplace_back(populate, from, std::min(end, from + part));
+  populate(begin, std::min(end, begin + part));
+  for (std::thread& t : pool) t.join();
+#else
+  (void)bytes, (void)threads;
+#endif
 }
 
 }  // namespace vxl

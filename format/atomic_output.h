@@ -4,10 +4,14 @@
 // commit(); a process killed at any moment leaves nothing behind. Where O_TMPFILE is unsupported it falls
 // back to a hidden temporary name that is removed on failure (a SIGKILL can then leave that temporary
 // file, never a partial file at the output path).
+//
+// The data is either appended with write() or, when its size is known up front, filled in place through
+// map(): the caller writes straight into the page cache, with no intermediate buffer and no copy.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 
 namespace vxl {
@@ -15,7 +19,7 @@ namespace vxl {
 class AtomicOutputFile {
  public:
   explicit AtomicOutputFile(std::string path);  // throws vxl::Error (Output) naming the path
-  ~AtomicOutputFile();                           // discards the data unless committed
+  ~AtomicOutputFile();                           // discards the data (and any mapping) unless committed
   AtomicOutputFile(const AtomicOutputFile&) = delete;
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 
@@ -23,17 +27,34 @@ class AtomicOutputFile {
   void write_zeros(std::size_t size);
   void pwrite(const void* data, std::size_t size, std::uint64_t offset);  // overwrites earlier bytes
   std::uint64_t position() const { return position_; }
-  void commit();  // replaces any existing file at the path
+
+  // Sizes the still empty file to `size` bytes and maps it read-write (MAP_SHARED). Every byte reads as
+  // zero until written. The disk space is reserved here where the file system allows it, so a full disk
+  // is an Error now rather than a SIGBUS while the mapping is filled. Call at most once, before any
+  // write(); the span stays valid until commit() or destruction.
+  std::span<std::uint8_t> map(std::uint64_t size);
+
+  void commit();  // unmaps, then replaces any existing file at the path
 
   const std::string& path() const { return path_; }
 
  private:
   [[noreturn]] void fail(const std::string& what) const;
+  void unmap() noexcept;
   std::string path_;
   std::string temp_path_;  // empty when using O_TMPFILE
   int fd_ = -1;
   std::uint64_t position_ = 0;
+  std::uint8_t* map_ = nullptr;
+  std::uint64_t map_size_ = 0;
   bool committed_ = false;
 };
+
+// Faults in the pages of `bytes` (inside a map() mapping) ready for writing, in bulk and in address
+// order (MADV_POPULATE_WRITE), split over up to `threads` threads. A caller that then writes scattered
+// over the range is spared a page fault per first touch of a page, which is far slower, not least
+// because scattered faults get small page-cache folios. Only a hint: without kernel support (before
+// Linux 5.14) or on failure, pages fault in on first touch as usual.
+void prefault_for_write(std::span<std::uint8_t> bytes, unsigned threads);
 
 }  // namespace vxl

@@ -1,5 +1,8 @@
-// Writes a complete .vxl file (spec §2–§5) from in-memory sections: payloads first, then the section
-// table and header with their checksum, into an AtomicOutputFile, so a partial file never appears.
+// Writes a complete .vxl file (spec §2–§5) in place: the section sizes are planned first, the output
+// file is sized and memory-mapped, the caller fills every payload directly in the mapping, and commit()
+// adds the checksums, the section table and the header and links the file into place (AtomicOutputFile),
+// so a partial file never appears. Writing in place avoids building the sections in memory and copying
+// them into the page cache: the output is the largest thing the converter makes.
 #pragma once
 
 #include <cstdint>
@@ -7,17 +10,67 @@
 #include <string>
 #include <vector>
 
+#include "atomic_output.h"
 #include "vxl_layout.h"
 
 namespace vxl {
+
+// Payload sizes in bytes, one per section, in file order (spec §4). They fix the whole layout.
+struct VxlSectionSizes {
+  std::uint64_t directions = 0, voxels = 0, vertices = 0, orders = 0, voxlines = 0, streamlines = 0;
+  std::uint64_t provenance = 0;
+  std::uint64_t groups = 0;  // 0: no GRPS section
+};
+
+// The sizes spec §5 gives for the counts in `meta` (stored_order_count included).
+VxlSectionSizes section_sizes(const MetaSection& meta, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
+                              std::uint64_t group_bytes);
+
+class VxlWriter {
+ public:
+  // Creates the output at `path`, sized and mapped for these payloads. Throws vxl::Error (Output).
+  VxlWriter(const std::string& path, const VxlSectionSizes& sizes);
+  VxlWriter(const VxlWriter&) = delete;
+  VxlWriter& operator=(const VxlWriter&) = delete;
+
+  // Writable payloads inside the mapping. They read as zero until written; a payload the caller does
+  // not fill completely keeps zeros, and the padding between payloads stays zero (spec §2).
+  void set_meta(const MetaSection& meta);  // zeroes the reserved bytes
+  std::span<DirectionEntry> directions() { return typed<DirectionEntry>(kDirs); }
+  std::span<VoxelEntry> voxels() { return typed<VoxelEntry>(kVoxt); }
+  std::span<float> vertices() { return typed<float>(kVert); }
+  std::span<std::uint8_t> orders() { return payload(kOrdr); }
+  std::span<VoxlineEntry> voxlines() { return typed<VoxlineEntry>(kVxln); }
+  std::span<std::uint64_t> streamline_first_voxline() { return typed<std::uint64_t>(kStrm); }
+  std::span<std::uint8_t> provenance() { return payload(kProv); }
+  std::span<std::uint8_t> groups() { return payload(kGrps); }  // empty when there is no GRPS section
+
+  // Checksums every payload (sections spread over up to `threads` threads; 0: all hardware threads),
+  // writes the section table and the header, unmaps and links the file into place. The spans above
+  // are invalid afterwards. Without commit() the destructor discards the file.
+  void commit(unsigned threads = 0);
+
+ private:
+  enum Index : std::size_t { kMeta, kDirs, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps };
+  std::span<std::uint8_t> payload(Index i);
+  template <typename T>
+  std::span<T> typed(Index i) {
+    std::span<std::uint8_t> p = payload(i);
+    return {reinterpret_cast<T*>(p.data()), p.size() / sizeof(T)};  // payloads are 64-byte aligned
+  }
+
+  AtomicOutputFile out_;
+  std::vector<SectionEntry> table_;  // in Index order; GRPS only when present
+  std::span<std::uint8_t> file_;
+};
 
 struct GroupContent {
   std::string name;
   std::vector<std::uint64_t> members;  // strictly increasing streamline indices
 };
 
-// Everything a .vxl holds. The caller fills `meta` (counts must match the spans; reserved bytes are
-// zeroed by the writer) and guarantees the invariants of spec §5 (the reader re-checks them).
+// Everything a .vxl holds, in memory. The caller fills `meta` (counts must match the spans; reserved
+// bytes are zeroed by the writer) and guarantees the invariants of spec §5 (the reader re-checks them).
 struct VxlContent {
   MetaSection meta{};
   std::span<const DirectionEntry> directions;
@@ -30,7 +83,7 @@ struct VxlContent {
   std::span<const GroupContent> groups;  // GRPS is written only when non-empty
 };
 
-// Throws vxl::Error (Output) naming the path.
+// Writes in-memory content through VxlWriter. Throws vxl::Error (Output) naming the path.
 void write_vxl(const std::string& path, const VxlContent& content);
 
 // The GRPS payload (spec §5.9), exposed for tests.
