@@ -1,3 +1,4 @@
+#include "gl_driver_pinning.h"
 #include "window_app.h"
 
 #include <algorithm>
@@ -61,6 +62,7 @@ WindowPtr open_window(const ViewerOptions& o) {
     throw std::runtime_error("cannot open an OpenGL 3.3 core window: " + g_glfw_error + "; " + kHeadlessHint);
   glfwMakeContextCurrent(w);
   glfwSwapInterval(1);
+  pin_dri_drivers();  // see gl_driver_pinning.h: Mesa's GLX path loads the same driver
   return WindowPtr(w);
 }
 

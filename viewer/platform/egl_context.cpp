@@ -1,10 +1,9 @@
 #include "egl_context.h"
+#include "gl_driver_pinning.h"
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
 
-#include <dlfcn.h>
-#include <link.h>
 
 #include <array>
 #include <cstdio>
@@ -68,26 +67,6 @@ bool has_extension(const char* list, const char* name) {
 std::mutex g_display_mutex;
 std::map<EGLDisplay, int> g_display_refs;
 bool g_any_context_created = false;
-
-// Mesa loads its DRI driver (swrast_dri.so, iris_dri.so, ...: tens of MB, with LLVM) in
-// eglInitialize and unloads it in eglTerminate. Keep every loaded DRI driver resident for the rest
-// of the process: later contexts skip the reload, and the driver's one-time allocations stay
-// reachable from its globals instead of turning into leaks of an unmapped module (which
-// LeakSanitizer can neither attribute nor suppress). No-op for drivers without *_dri.so (NVIDIA).
-void pin_dri_drivers() noexcept {
-    std::vector<std::string> names;
-    dl_iterate_phdr(
-        [](dl_phdr_info* info, size_t, void* data) {
-            const std::string name = info->dlpi_name ? info->dlpi_name : "";
-            const std::string suffix = "_dri.so";
-            if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
-                static_cast<std::vector<std::string>*>(data)->push_back(name);
-            return 0;
-        },
-        &names);
-    for (const std::string& name : names)
-        if (void* h = dlopen(name.c_str(), RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE)) dlclose(h);
-}
 
 void acquire_display(EGLDisplay dpy, const char* platform) {
     std::lock_guard lock(g_display_mutex);
