@@ -142,9 +142,17 @@ void voxelize_streamline(const Grid& grid, const float* pts, std::uint64_t first
       int axis;
       int step;
     };
-    std::vector<Crossing> crossings;
     const std::int32_t from[3] = {current.x, current.y, current.z};
     const std::int32_t to[3] = {next.x, next.y, next.z};
+    // Check the budget before allocating: one step can cross billions of faces (found by fuzzing).
+    std::uint64_t faces = 0;
+    for (int c = 0; c < 3; ++c) faces += static_cast<std::uint64_t>(std::abs(std::int64_t(to[c]) - from[c]));
+    if (ch.synthetic_xyz.size() / 3 + faces > synthetic_limit) {
+      ch.too_many_synthetic = true;
+      return;
+    }
+    std::vector<Crossing> crossings;
+    crossings.reserve(faces);
     for (int c = 0; c < 3; ++c) {
       int step = to[c] > from[c] ? 1 : -1;
       double da = static_cast<double>(a[c]), db = static_cast<double>(b[c]);

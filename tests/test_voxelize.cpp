@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstring>
 
+#include <sys/resource.h>
+
 #include "error.h"
 #include "segment_orders.h"
 #include "voxelize.h"
@@ -114,6 +116,22 @@ TEST(Voxelize, TooSmallAVoxelIsRefusedWithASuggestion) {
     EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
     EXPECT_NE(std::string(e.what()).find("--voxel-size"), std::string::npos) << e.what();
   }
+}
+
+// Regression (found by fuzz_tck): one step of 8e8 mm at 10 mm voxels would cross ~1e8 faces; the budget
+// must be checked before the crossings are generated, not after (it took 8 GB).
+TEST(Voxelize, OneHugeStepIsRefusedBeforeAllocating) {
+  struct rusage before {};
+  getrusage(RUSAGE_SELF, &before);
+  try {
+    voxelize(make({{0, 0, 0, 1, 1, 1, 8.2e8f, 2, 2}}), {});
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+  }
+  struct rusage after {};
+  getrusage(RUSAGE_SELF, &after);
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256 * 1024) << "peak memory grew by " << (after.ru_maxrss - before.ru_maxrss) << " KiB";
 }
 
 TEST(SegmentOrders, AxisOrdersSortByMidpointWithStableTies) {

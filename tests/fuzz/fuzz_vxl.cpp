@@ -1,0 +1,26 @@
+// libFuzzer target: opening, walking, exporting and verifying arbitrary bytes as a .vxl. open() must
+// never let a later read go out of bounds, whatever verify() would say.
+#include "error.h"
+#include "export_tck.h"
+#include "fuzz_input.h"
+#include "vxl_file.h"
+#include "vxl_streamlines.h"
+#include "vxl_verify.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string path = vxl::fuzz::write_input(data, size, ".vxl");
+  try {
+    vxl::VxlFile f = vxl::VxlFile::open(path);
+    for (std::size_t i = 0; i < f.voxels().size(); ++i)
+      for (std::uint32_t k = 0; k < f.meta().stored_order_count; ++k) {
+        vxl::OrderView o = f.order(i, k);
+        volatile std::uint32_t sink = 0;
+        for (std::uint32_t n = 0; n < o.count; ++n) sink = sink + o[n];
+      }
+    vxl::export_tck(f, path + ".tck");
+    f.groups();
+  } catch (const vxl::Error&) {
+  }
+  vxl::verify_vxl(path);
+  return 0;
+}
