@@ -1,6 +1,7 @@
 // The deliberate outcome of every file in ../shared/data/real, shared by the converter and viewer tests.
 #pragma once
 
+#include <cctype>
 #include <map>
 #include <string>
 
@@ -86,6 +87,14 @@ const std::map<std::string, Outcome>& expected_outcomes() {
       {"whitematteranalysis__clusters_brain_0001.vtp", Outcome::Unsupported},
   };
   return m;
+}
+
+// A fixture file name as a GoogleTest parameter name (letters, digits, underscores).
+inline std::string fixture_test_name(const std::string& file) {
+  std::string s = file;
+  for (char& c : s)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return s;
 }
 
 }  // namespace vxl::test

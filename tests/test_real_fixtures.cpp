@@ -75,12 +75,7 @@ std::vector<std::string> fixture_names() {
   return names;
 }
 
-std::string test_name(const ::testing::TestParamInfo<std::string>& info) {
-  std::string s = info.param;
-  for (char& c : s)
-    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-  return s;
-}
+std::string test_name(const ::testing::TestParamInfo<std::string>& info) { return test::fixture_test_name(info.param); }
 
 INSTANTIATE_TEST_SUITE_P(AllFiles, RealFixture, ::testing::ValuesIn(fixture_names()), test_name);
 

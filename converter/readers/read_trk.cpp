@@ -32,6 +32,7 @@
 #include "checksum.h"
 #include "error.h"
 #include "mapped_file.h"
+#include "latin1.h"
 #include "read_tractogram.h"
 
 namespace vxl {
@@ -90,19 +91,11 @@ class Bytes {
   bool swap_;
 };
 
-// Header strings are NUL-padded latin-1; JSON needs UTF-8.
+// Header strings are NUL-padded Latin-1; JSON needs UTF-8.
 std::string latin1_field(const std::uint8_t* p, std::size_t max_len) {
-  std::string out;
-  for (std::size_t i = 0; i < max_len && p[i] != 0; ++i) {
-    unsigned char c = p[i];
-    if (c < 0x80) {
-      out += static_cast<char>(c);
-    } else {
-      out += static_cast<char>(0xC0 | (c >> 6));
-      out += static_cast<char>(0x80 | (c & 0x3F));
-    }
-  }
-  return out;
+  std::size_t n = 0;
+  while (n < max_len && p[n] != 0) ++n;
+  return latin1_to_utf8({reinterpret_cast<const char*>(p), n});
 }
 
 std::string trim_right(std::string s) {

@@ -29,6 +29,7 @@
 #include "error.h"
 #include "float16.h"
 #include "mapped_file.h"
+#include "latin1.h"
 #include "read_tractogram.h"
 
 namespace vxl {
@@ -171,16 +172,7 @@ std::string json_safe(const std::string& s) {
     (void)nlohmann::json(s).dump();
     return s;
   } catch (const nlohmann::json::exception&) {
-    std::string out;
-    for (unsigned char c : s) {
-      if (c < 0x80) {
-        out += static_cast<char>(c);
-      } else {
-        out += static_cast<char>(0xC0 | (c >> 6));
-        out += static_cast<char>(0x80 | (c & 0x3F));
-      }
-    }
-    return out;
+    return latin1_to_utf8(s);
   }
 }
 

@@ -42,12 +42,7 @@ std::vector<std::string> readable_fixtures() {
   return names;
 }
 
-std::string test_name(const ::testing::TestParamInfo<std::string>& info) {
-  std::string s = info.param;
-  for (char& c : s)
-    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-  return s;
-}
+std::string test_name(const ::testing::TestParamInfo<std::string>& info) { return test::fixture_test_name(info.param); }
 
 INSTANTIATE_TEST_SUITE_P(Readable, VoxviewRealFixture, ::testing::ValuesIn(readable_fixtures()), test_name);
 

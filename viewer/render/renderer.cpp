@@ -124,10 +124,17 @@ void Renderer::draw_dataset_order(GLuint program, const Camera& camera, const Re
   draw_plan(first, count);
 }
 
-void Renderer::fullscreen(GLuint program) const {
+void Renderer::composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const {
   glUseProgram(program);
+  GLint unit = 0;
+  for (const auto& [name, texture] : textures) {
+    glActiveTexture(GL_TEXTURE0 + unit);
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glUniform1i(glGetUniformLocation(program, name), unit++);
+  }
   glBindVertexArray(vao_);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDrawArrays(GL_TRIANGLES, 0, 3);  // a fullscreen triangle
+  glActiveTexture(GL_TEXTURE0);
 }
 
 void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
@@ -194,15 +201,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       glDrawBuffers(2, both);
       clear_target(fbo, glm::vec4(bg, 1));
       over_blending();
-      glUseProgram(wboit_composite_);
-      glActiveTexture(GL_TEXTURE0);
-      glBindTexture(GL_TEXTURE_2D, wboit_target_.color[0]);
-      glActiveTexture(GL_TEXTURE1);
-      glBindTexture(GL_TEXTURE_2D, wboit_target_.color[1]);
-      glUniform1i(glGetUniformLocation(wboit_composite_, "u_accum"), 0);
-      glUniform1i(glGetUniformLocation(wboit_composite_, "u_reveal"), 1);
-      fullscreen(wboit_composite_);
-      glActiveTexture(GL_TEXTURE0);
+      composite(wboit_composite_, {{"u_accum", wboit_target_.color[0]}, {"u_reveal", wboit_target_.color[1]}});
       break;
     }
     case RenderMode::Additive: {
@@ -225,15 +224,8 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       clear_target(fbo, glm::vec4(bg, 1));
       over_blending();
       glUseProgram(additive_composite_);
-      glActiveTexture(GL_TEXTURE0);
-      glBindTexture(GL_TEXTURE_2D, opaque_target_.color[0]);
-      glActiveTexture(GL_TEXTURE1);
-      glBindTexture(GL_TEXTURE_2D, additive_target_.color[0]);
-      glUniform1i(glGetUniformLocation(additive_composite_, "u_opaque"), 0);
-      glUniform1i(glGetUniformLocation(additive_composite_, "u_additive"), 1);
       glUniform1f(glGetUniformLocation(additive_composite_, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
-      fullscreen(additive_composite_);
-      glActiveTexture(GL_TEXTURE0);
+      composite(additive_composite_, {{"u_opaque", opaque_target_.color[0]}, {"u_additive", additive_target_.color[0]}});
       break;
     }
     case RenderMode::Exact:

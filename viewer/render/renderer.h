@@ -6,7 +6,9 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
+#include <utility>
 
 #include "camera.h"
 #include "frame_plan.h"
@@ -52,7 +54,8 @@ class Renderer {
  private:
   void draw_lines(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect, PlanOrder order);
   void draw_dataset_order(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect);
-  void fullscreen(GLuint program) const;
+  // A fullscreen pass of `program` reading the named 2D textures.
+  void composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const;
 
   const VxlFile& file_;
   GpuScene scene_;
