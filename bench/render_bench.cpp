@@ -34,6 +34,7 @@ double median(std::vector<double> v) {
 
 // Wall time of a child process, from fork to exit.
 double run_child_seconds(const std::vector<std::string>& args) {
+  std::fflush(stdout);  // the child must not inherit (and print again) buffered output
   auto t0 = Clock::now();
   pid_t pid = fork();
   if (pid == 0) {
@@ -103,7 +104,7 @@ int main(int argc, char** argv) {
                 vxl_path.c_str(), (unsigned long long)file.meta().streamline_count,
                 (unsigned long long)file.meta().segment_count, file.meta().voxel_count, file.meta().voxel_size,
                 renderer.scene().gpu_bytes() / 1048576.0, upload_s);
-    std::printf("  first frame read back (process start -> PNG): .vxl %.3f s", median(first_vxl));
+    std::printf("  first frame read back (process start -> PNG written): .vxl %.3f s", median(first_vxl));
     if (!source.empty()) std::printf(", source %.3f s (ratio %.1fx)", median(first_src), median(first_src) / median(first_vxl));
     std::printf("\n");
 
