@@ -1,6 +1,10 @@
 #include "gpu_scene.h"
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
 
 #include "error.h"
 #include "vxl_streamlines.h"
@@ -13,40 +17,65 @@ std::uint64_t GpuScene::driver_limit() {
   return texels > 0 ? static_cast<std::uint64_t>(texels) : 65536;  // 65536 is the GL 3.3 minimum
 }
 
+// Widens voxel i's stored orders to chunk-global u32 and appends its block order; checks every entry,
+// which open() does not (it would cost O(points) there).
+void GpuScene::widen_voxel(const VxlFile& file, std::uint32_t i, const ChunkLayout& c, std::vector<std::uint32_t>& entries,
+                           std::vector<std::uint8_t>& is_start) const {
+  const VoxelEntry& v = file.voxels()[i];
+  const VoxelDrawInfo& d = layout_.voxels()[i];
+  const std::uint32_t base = static_cast<std::uint32_t>(v.vertex_first - c.vertex_first);
+  is_start.assign(v.vertex_count, 0);
+  for (std::uint32_t k = 0; k < layout_.stored_orders(); ++k) {
+    OrderView o = file.order(i, k);
+    std::uint32_t* out = entries.data() + k * c.segments + d.seg_first;
+    for (std::uint32_t n = 0; n < o.count; ++n) {
+      std::uint32_t e = o[n];
+      if (e + 1ull >= v.vertex_count)
+        throw Error(ErrorKind::Input, file.path(), file.find_section(section_id("ORDR"))->offset + v.order_offset,
+                    "order entry out of range in voxel " + std::to_string(i) + " (run `voxlines verify`)");
+      out[n] = base + e;
+      if (k == 0) is_start[e] = 1;
+    }
+  }
+  std::uint32_t* block = entries.data() + layout_.block_slot() * c.segments + d.seg_first;
+  std::uint32_t n = 0;
+  for (std::uint32_t e = 0; e < v.vertex_count && n < v.segment_count; ++e)
+    if (is_start[e]) block[n++] = base + e;
+  if (n != v.segment_count)  // a repeated entry in order 0: it is no permutation
+    throw Error(ErrorKind::Input, file.path(), file.find_section(section_id("ORDR"))->offset + v.order_offset,
+                "order 0 of voxel " + std::to_string(i) + " is not a permutation of its segments (run `voxlines verify`)");
+}
+
 GpuScene::GpuScene(const VxlFile& file, std::uint64_t max_texels)
     : file_(file), layout_(file, max_texels ? max_texels : driver_limit()) {
-  const auto voxels = file.voxels();
-  const std::uint32_t k_count = layout_.stored_orders();
-  const std::uint64_t ordr_at = file.find_section(section_id("ORDR"))->offset;
   std::vector<std::uint32_t> entries;
-  std::vector<std::uint8_t> is_start;
   for (const ChunkLayout& c : layout_.chunks()) {
     GpuChunk g;
     g.positions.create(GL_R32F, file.vertices().data() + 3 * c.vertex_first, 12 * c.vertex_count);
-    // Widen every stored order to chunk-global u32 and append the block order; the same pass checks every
-    // entry, which open() does not (it would cost O(points) there).
-    entries.assign(layout_.slots() * c.segments, 0);
-    for (std::uint32_t i = c.voxel_first; i < c.voxel_first + c.voxel_count; ++i) {
-      const VoxelEntry& v = voxels[i];
-      const VoxelDrawInfo& d = layout_.voxels()[i];
-      const std::uint32_t base = static_cast<std::uint32_t>(v.vertex_first - c.vertex_first);
-      is_start.assign(v.vertex_count, 0);
-      for (std::uint32_t k = 0; k < k_count; ++k) {
-        OrderView o = file.order(i, k);
-        std::uint32_t* out = entries.data() + k * c.segments + d.seg_first;
-        for (std::uint32_t n = 0; n < o.count; ++n) {
-          std::uint32_t e = o[n];
-          if (e + 1ull >= v.vertex_count)
-            throw Error(ErrorKind::Input, file.path(), ordr_at + v.order_offset,
-                        "order entry out of range in voxel " + std::to_string(i) + " (run `voxlines verify`)");
-          out[n] = base + e;
-          if (k == 0) is_start[e] = 1;
+    entries.resize(layout_.slots() * c.segments);
+    // Voxels fill disjoint ranges of every slot, so they are widened in parallel.
+    std::atomic<std::uint32_t> next{c.voxel_first};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    auto widen = [&] {
+      std::vector<std::uint8_t> is_start;
+      for (std::uint32_t i; (i = next++) < c.voxel_first + c.voxel_count;) {
+        try {
+          widen_voxel(file, i, c, entries, is_start);
+        } catch (...) {
+          std::lock_guard lock(error_mutex);
+          if (!error) error = std::current_exception();
         }
       }
-      std::uint32_t* block = entries.data() + layout_.block_slot() * c.segments + d.seg_first;
-      std::uint32_t n = 0;
-      for (std::uint32_t e = 0; e < v.vertex_count && n < v.segment_count; ++e)
-        if (is_start[e]) block[n++] = base + e;
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < std::max(1u, std::thread::hardware_concurrency()); ++t) pool.emplace_back(widen);
+    widen();
+    for (std::thread& t : pool) t.join();
+    if (error) {
+      g.positions.destroy();
+      release();
+      std::rethrow_exception(error);
     }
     g.orders.create(GL_R32UI, entries.data(), entries.size() * 4);
     g.dataset.create(GL_R32UI, nullptr, 0);
@@ -57,12 +86,15 @@ GpuScene::GpuScene(const VxlFile& file, std::uint64_t max_texels)
   entries.shrink_to_fit();
 }
 
-GpuScene::~GpuScene() {
+GpuScene::~GpuScene() { release(); }
+
+void GpuScene::release() {
   for (GpuChunk& c : chunks_) {
     c.positions.destroy();
     c.orders.destroy();
     c.dataset.destroy();
   }
+  chunks_.clear();
 }
 
 const std::vector<std::int32_t>& GpuScene::dataset_first() {

@@ -36,6 +36,9 @@ class GpuScene {
 
  private:
   static std::uint64_t driver_limit();
+  void release();
+  void widen_voxel(const VxlFile& file, std::uint32_t voxel, const ChunkLayout& chunk, std::vector<std::uint32_t>& entries,
+                   std::vector<std::uint8_t>& is_start) const;
   const VxlFile& file_;
   SceneLayout layout_;
   std::vector<GpuChunk> chunks_;
