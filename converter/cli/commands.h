@@ -11,6 +11,8 @@ void add_info_command(CLI::App& app);
 void add_verify_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
+void add_pack_command(CLI::App& app);
+void add_unpack_command(CLI::App& app);
 
 // Set by a command that wants a specific non-zero exit code without an error message (verify).
 inline int g_exit_code = 0;

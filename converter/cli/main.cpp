@@ -1,4 +1,5 @@
-// `voxlines`: convert tractograms to .vxl, inspect, verify, export, and generate synthetic data.
+// `voxlines`: convert tractograms to .vxl, inspect, verify, export, pack and unpack for sharing, and
+// generate synthetic data.
 #include <cstdio>
 #include <exception>
 
@@ -18,6 +19,8 @@ int main(int argc, char** argv) {
   vxl::cli::add_verify_command(app);
   vxl::cli::add_export_command(app);
   vxl::cli::add_synth_command(app);
+  vxl::cli::add_pack_command(app);
+  vxl::cli::add_unpack_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

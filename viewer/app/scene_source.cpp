@@ -6,6 +6,7 @@
 
 #include "convert.h"
 #include "read_tractogram.h"
+#include "unpack.h"
 
 namespace vxl::app {
 
@@ -13,6 +14,15 @@ VxlFile open_scene(const std::string& path, double voxel_size) {
   std::string lower = path;
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (lower.ends_with(".vxl")) return VxlFile::open(path);
+  if (lower.ends_with(".vxlz")) {
+    // A package is unpacked into an unlinked temporary .vxl: the mapping keeps it alive, nothing is left.
+    std::filesystem::path temp = std::filesystem::temp_directory_path() /
+                                 ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
+    unpack_vxlz(path, temp.string(), {});
+    VxlFile f = VxlFile::open(temp.string());
+    std::filesystem::remove(temp);
+    return f;
+  }
 
   Tractogram t = read_tractogram(path);
   for (const std::string& w : t.source.warnings) std::fprintf(stderr, "voxview: warning: %s: %s\n", path.c_str(), w.c_str());

@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
                "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx is converted in memory first.\n"
                "Window: left drag orbits, right/middle drag (or Shift+left) pans, wheel zooms. Keys: 1/2/3 axial/sagittal/coronal,\n"
                "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, S screenshot, R reset, Esc/Q quit."};
-  cli.add_option("file", o.input, "a .vxl file, or a .tck / .trk / .trk.gz / .trx tractogram")->required();
+  cli.add_option("file", o.input, "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx tractogram")->required();
   cli.add_option("--render", o.render_png, "render one frame headless (EGL, no display needed) to this PNG and exit");
   cli.add_option("--mode", mode, "opaque | unsorted | additive | wboit | basic | axis | exact")->default_val("axis")
       ->check(CLI::IsMember({"opaque", "unsorted", "additive", "wboit", "basic", "axis", "exact"}));

@@ -1,0 +1,36 @@
+#include <cstdio>
+
+#include "commands.h"
+#include "progress_bar.h"
+#include "unpack.h"
+
+namespace vxl::cli {
+
+void add_unpack_command(CLI::App& app) {
+  struct Options {
+    std::string input, output;
+    UnpackSettings settings;
+    bool verbose = false;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "unpack", "Turn a .vxlz package back into a .vxl (orders and bounds recomputed; verify accepts it)");
+  cmd->add_option("input", opt->input, ".vxlz package")->required();
+  cmd->add_option("output", opt->output, "output .vxl (written atomically)")->required();
+  cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
+  cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
+  cmd->callback([opt] {
+    ProgressBar bar;
+    opt->settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
+    UnpackSummary s = unpack_vxlz(opt->input, opt->output, opt->settings);
+    bar.done();
+    std::printf("%s: %llu streamlines, %llu points, %llu voxels; positions within %.6f mm of the packed file (%u bits)\n",
+                opt->output.c_str(), (unsigned long long)s.streamlines, (unsigned long long)s.points,
+                (unsigned long long)s.voxels, s.pack.error_bound, s.pack.quantization_bits);
+    if (opt->verbose)
+      std::printf("stages: decode %.3f s, orders %.3f s, write %.3f s\n", s.decode_seconds, s.orders_seconds,
+                  s.write_seconds);
+  });
+}
+
+}  // namespace vxl::cli

@@ -1,0 +1,176 @@
+#include "pack.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "error.h"
+#include "parallel_for.h"
+#include "voxelize.h"
+#include "vxl_streamlines.h"
+#include "vxlz_draco.h"
+#include "vxlz_package.h"
+#include "vxlz_quantize.h"
+#include "vxlz_tables.h"
+
+namespace vxl {
+namespace {
+
+// Where each voxline's points are: its first vertex in VERT and its first shipped point (spec §5.1).
+struct VoxlineIndex {
+  std::vector<std::uint64_t> first_vertex;  // L
+  std::vector<std::uint64_t> first_point;   // L + 1, prefix sums of own counts
+  std::vector<std::uint8_t> starts_streamline;  // L
+};
+
+VoxlineIndex index_voxlines(const VxlFile& f) {
+  VoxlineIndex x;
+  const std::uint64_t l = f.meta().voxline_count;
+  x.first_vertex.reserve(l);
+  // The walk checks the voxline and streamline tables (ranges, blocks consumed exactly, connecting
+  // vertices equal to the next first point, totals) before anything relies on them.
+  WalkCallbacks cb;
+  cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t, bool) { x.first_vertex.push_back(first); };
+  walk_streamlines(f, cb);
+  x.first_point.resize(l + 1);
+  x.first_point[0] = 0;
+  for (std::uint64_t j = 0; j < l; ++j) x.first_point[j + 1] = x.first_point[j] + (f.voxlines()[j].count_flags & kVoxlineCountMask);
+  x.starts_streamline.assign(l, 0);
+  auto strm = f.streamline_first_voxline();
+  for (std::uint64_t s = 0; s + 1 < strm.size(); ++s)
+    if (strm[s] < strm[s + 1]) x.starts_streamline[strm[s]] = 1;
+  return x;
+}
+
+// Every vertex is a shipped point or a copy of one, so the vertices' box is the shipped points' box.
+// Returns false when a coordinate is not finite (the converter never writes one; quantising it would be
+// meaningless).
+bool vertex_box(std::span<const float> vertices, unsigned threads, double lo[3], double hi[3]) {
+  const std::uint64_t n = vertices.size() / 3;
+  std::vector<std::array<float, 6>> partial(threads, {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY});
+  std::vector<std::uint8_t> finite(threads, 1);
+  const std::uint64_t pieces = threads * 4ull;
+  parallel_for(pieces, threads, [&](std::uint64_t piece, unsigned t) {
+    auto& b = partial[t];
+    bool ok = true;
+    for (std::uint64_t i = n * piece / pieces; i < n * (piece + 1) / pieces; ++i)
+      for (int c = 0; c < 3; ++c) {
+        const float v = vertices[3 * i + c];
+        ok &= std::isfinite(v);
+        b[c] = std::min(b[c], v);
+        b[c + 3] = std::max(b[c + 3], v);
+      }
+    finite[t] &= ok;
+  });
+  for (int c = 0; c < 3; ++c) {
+    lo[c] = hi[c] = 0;
+    if (n == 0) continue;
+    lo[c] = INFINITY;
+    hi[c] = -INFINITY;
+    for (const auto& b : partial) {
+      lo[c] = std::min(lo[c], double(b[c]));
+      hi[c] = std::max(hi[c], double(b[c + 3]));
+    }
+  }
+  return std::all_of(finite.begin(), finite.end(), [](std::uint8_t x) { return x != 0; });
+}
+
+}  // namespace
+
+PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSettings& settings) {
+  if (settings.bits < kVxlzMinBits || settings.bits > kVxlzMaxBits)
+    throw Error(ErrorKind::Usage, "", std::nullopt, "quantisation bits must be 11..16");
+  if (settings.chunk_points < 1 || settings.chunk_points > kVxlzMaxChunkPoints)
+    throw Error(ErrorKind::Usage, "", std::nullopt, "chunk points must be 1..2^31-1");
+  const unsigned threads = resolve_threads(settings.threads);
+  const MetaSection& m = f.meta();
+  if (m.order_set == static_cast<std::uint32_t>(OrderSet::Random))
+    fail_unsupported(f.path(), "per-voxel random order sets (.vxl VDIR) cannot be packed by package format 1.0; "
+                               "convert with --orders axis or axis+diag");
+  const VoxlineIndex index = index_voxlines(f);
+  const std::uint64_t n = index.first_point.back();
+
+  // Quantisation grid (spec §3, §5.1): one cube over all shipped points.
+  VxlzContent c;
+  PackSection& pack = c.pack;
+  pack.quantization_bits = settings.bits;
+  pack.predictor = kVxlzPredictorLinear;
+  double hi[3];
+  if (!vertex_box(f.vertices(), threads, pack.quant_origin, hi))
+    fail_input(f.path(), f.find_section(section_id("VERT"))->offset, "a vertex coordinate is not finite");
+  pack.range = std::max({hi[0] - pack.quant_origin[0], hi[1] - pack.quant_origin[1], hi[2] - pack.quant_origin[2]});
+  pack.quantum = pack.range > 0 ? pack.range / double((1u << settings.bits) - 1) : 1.0;
+  if (!std::isfinite(pack.quantum) || !(pack.quantum > 0))
+    throw Error(ErrorKind::Unsupported, f.path(), std::nullopt, "coordinate range too large to quantise");
+  pack.point_count = n;
+  pack.chunk_points = settings.chunk_points;
+  pack.chunk_count = n / settings.chunk_points + (n % settings.chunk_points != 0);
+  pack.error_bound = vxlz_error_bound(pack.quant_origin, pack.range, pack.quantum);
+
+  // Positions (spec §5): chunks are independent, so they are quantised, predicted and encoded in parallel.
+  const Quantizer quantizer(pack);
+  const float* vertices = f.vertices().data();
+  auto voxlines = f.voxlines();
+  c.chunks.resize(pack.chunk_count);
+  struct ErrorStats {
+    double max = 0, sum_squares = 0;
+  };
+  std::vector<ErrorStats> errors(threads);
+  parallel_for(pack.chunk_count, threads, [&](std::uint64_t chunk, unsigned t) {
+    const std::uint64_t start = chunk * pack.chunk_points;
+    const std::uint64_t count = std::min(pack.chunk_points, n - start);
+    std::vector<std::int32_t> residuals(3 * count);
+    std::uint64_t j = std::upper_bound(index.first_point.begin(), index.first_point.end(), start) - index.first_point.begin() - 1;
+    std::uint64_t in_voxline = start - index.first_point[j];
+    LinearPredictor predictor;
+    predictor.reset();
+    ErrorStats e;  // local: the threads' entries of `errors` share cache lines
+    for (std::uint64_t i = 0; i < count; ++i) {
+      if (in_voxline == 0 && index.starts_streamline[j]) predictor.start_streamline();
+      const float* p = vertices + 3 * (index.first_vertex[j] + in_voxline);
+      std::array<std::int64_t, 3> k;
+      for (int a = 0; a < 3; ++a) {
+        k[a] = quantizer.quantize(p[a], a);
+        residuals[3 * i + a] = static_cast<std::int32_t>(k[a] - predictor.predict(a));
+        const double error = std::abs(double(quantizer.dequantize(k[a], a)) - double(p[a]));
+        e.max = std::max(e.max, error);
+        e.sum_squares += error * error;
+      }
+      predictor.push(k);
+      if (++in_voxline == (voxlines[j].count_flags & kVoxlineCountMask)) {
+        ++j;
+        in_voxline = 0;
+      }
+    }
+    c.chunks[chunk] = encode_residual_chunk(residuals);
+    errors[t].max = std::max(errors[t].max, e.max);
+    errors[t].sum_squares += e.sum_squares;
+  });
+  double sum_squares = 0;
+  for (const ErrorStats& e : errors) {
+    pack.max_error = std::max(pack.max_error, e.max);
+    sum_squares += e.sum_squares;
+  }
+  pack.rms_error = n > 0 ? std::sqrt(sum_squares / (3.0 * double(n))) : 0.0;
+
+  // The exact part (spec §4).
+  c.meta = m;
+  c.directions.assign(f.directions().begin(), f.directions().end());
+  c.voxel_coords = encode_voxel_coords(f.voxels());
+  c.streamline_voxlines = encode_streamline_voxlines(f.streamline_first_voxline());
+  c.voxline_voxels = encode_voxline_voxels(voxlines, f.voxels());
+  c.voxline_counts = encode_voxline_counts(voxlines);
+  if (f.find_section(section_id("PROV"))) c.provenance = std::string(f.provenance_json());
+  if (f.find_section(section_id("GRPS"))) c.groups = encode_group_stream(f.groups());
+
+  PackSummary s;
+  s.bytes = write_vxlz(out_path, c, threads);
+  s.streamlines = m.streamline_count;
+  s.points = m.point_count;
+  s.shipped_points = n;
+  s.pack = pack;
+  return s;
+}
+
+}  // namespace vxl

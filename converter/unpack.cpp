@@ -1,0 +1,315 @@
+#include "unpack.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "error.h"
+#include "parallel_for.h"
+#include "segment_orders.h"
+#include "vxl_writer.h"
+#include "vxlz_draco.h"
+#include "vxlz_package.h"
+#include "vxlz_quantize.h"
+#include "vxlz_tables.h"
+
+namespace vxl {
+namespace {
+
+// The exact tables of the .vxl, rebuilt from the package's streams (spec §7 steps 2-4), and where each
+// voxline's points go.
+struct Structure {
+  std::vector<std::uint64_t> strm;              // N + 1
+  std::vector<VoxlineEntry> voxlines;           // L
+  std::vector<std::uint8_t> starts_streamline;  // L + 1 (the last entry 1): voxline j is a streamline's first
+  std::vector<VoxelEntry> voxels;               // coord, vertex and segment counts, vertex_first, order layout
+  std::uint64_t order_bytes = 0;
+  // Voxline j's first vertex is voxels[voxel].vertex_first + offset_in_voxel[j] (< 2^32: a voxel's
+  // vertex count is).
+  std::vector<std::uint32_t> offset_in_voxel;
+  // Chunk c starts at own point chunk_start_point[c] of voxline chunk_start_voxline[c].
+  std::vector<std::uint64_t> chunk_start_voxline, chunk_start_point;
+
+  bool connected(std::uint64_t j) const { return !starts_streamline[j + 1]; }
+  std::uint64_t first_vertex(std::uint64_t j) const { return voxels[voxlines[j].voxel].vertex_first + offset_in_voxel[j]; }
+};
+
+// Inflates and decodes the voxline table, the voxel and the count streams side by side.
+std::vector<VoxlineEntry> read_voxlines(const VxlzFile& f, std::span<const std::array<std::int32_t, 3>> coords) {
+  const std::uint64_t l = f.meta().voxline_count;
+  const std::uint32_t vxlv = section_id("VXLV"), vxlc = section_id("VXLC");
+  std::vector<std::uint8_t> voxel_stream, count_stream;
+  std::vector<VoxlineEntry> voxlines;
+  auto both = [&](auto&& voxel_part, auto&& count_part) {
+    std::exception_ptr error;
+    std::thread other([&] {
+      try {
+        count_part();
+      } catch (...) {
+        error = std::current_exception();
+      }
+    });
+    try {
+      voxel_part();
+    } catch (...) {
+      other.join();
+      throw;
+    }
+    other.join();
+    if (error) std::rethrow_exception(error);
+  };
+  both([&] { voxel_stream = f.inflate(vxlv); }, [&] { count_stream = f.inflate(vxlc); });
+  // Every entry takes at least a byte of each stream: refuse a count they cannot hold before allocating.
+  if (l > voxel_stream.size() || l > count_stream.size())
+    fail_input(f.path(), f.context(l > voxel_stream.size() ? vxlv : vxlc).section_offset,
+               "stream too short for META's " + std::to_string(l) + " voxlines");
+  voxlines.resize(l);
+  both([&] { decode_voxline_voxels(voxel_stream, coords, voxlines, f.context(vxlv)); },
+       [&] { decode_voxline_counts(count_stream, voxlines, f.context(vxlc)); });
+  return voxlines;
+}
+
+Structure rebuild_structure(const VxlzFile& f) {
+  const MetaSection& m = f.meta();
+  const PackSection& k = f.pack();
+  const std::string& p = f.path();
+  Structure s;
+  const auto coords = decode_voxel_coords(f.inflate(section_id("VOXC")), m.voxel_count, m.grid_dims, f.context(section_id("VOXC")));
+  s.strm = decode_streamline_voxlines(f.inflate(section_id("STRL")), m.streamline_count, m.voxline_count,
+                                      f.context(section_id("STRL")));
+  s.voxlines = read_voxlines(f, coords);
+
+  const std::uint64_t vxlc_at = f.context(section_id("VXLC")).section_offset;
+  const std::uint64_t l = m.voxline_count;
+  s.starts_streamline.assign(l + 1, 0);
+  s.starts_streamline[l] = 1;
+  for (std::uint64_t j = 0; j < m.streamline_count; ++j) {
+    if (s.strm[j] == s.strm[j + 1]) continue;
+    s.starts_streamline[s.strm[j]] = 1;
+    if (s.voxlines[s.strm[j]].count_flags & kVoxlineSyntheticFirst)
+      fail_input(p, vxlc_at, "streamline " + std::to_string(j) + " starts with a synthetic point");
+  }
+
+  // One walk: every voxline's place in its voxel, the voxels' counts, the chunk starts, the totals.
+  std::vector<std::uint64_t> vertex_count(m.voxel_count, 0), voxline_count(m.voxel_count, 0);
+  s.offset_in_voxel.resize(l);
+  s.chunk_start_voxline.reserve(k.chunk_count);
+  s.chunk_start_point.reserve(k.chunk_count);
+  std::uint64_t points = 0, synthetic = 0;
+  for (std::uint64_t j = 0; j < l; ++j) {
+    const VoxlineEntry& e = s.voxlines[j];
+    const std::uint64_t own = e.count_flags & kVoxlineCountMask;
+    std::uint64_t& count = vertex_count[e.voxel];
+    if (count + own + s.connected(j) > 0xFFFFFFFFu)
+      fail_input(p, vxlc_at, "voxel " + std::to_string(e.voxel) + " gets 2^32 or more vertices");
+    if (own > k.point_count - points)
+      fail_input(p, vxlc_at, "voxlines hold more points than PACK's point count " + std::to_string(k.point_count));
+    s.offset_in_voxel[j] = static_cast<std::uint32_t>(count);
+    count += own + s.connected(j);
+    voxline_count[e.voxel] += 1;
+    // Chunks start every chunk_points shipped points; record which voxline holds each start.
+    while (s.chunk_start_voxline.size() < k.chunk_count && s.chunk_start_voxline.size() * k.chunk_points < points + own) {
+      s.chunk_start_voxline.push_back(j);
+      s.chunk_start_point.push_back(s.chunk_start_voxline.size() * k.chunk_points - k.chunk_points - points);
+    }
+    points += own;
+    synthetic += e.count_flags >> 31;
+  }
+  std::uint64_t vertices = 0;
+  s.voxels.resize(m.voxel_count);
+  for (std::uint32_t i = 0; i < m.voxel_count; ++i) {
+    if (vertex_count[i] < 1) fail_input(p, vxlc_at, "voxel " + std::to_string(i) + " gets no vertices");
+    VoxelEntry& v = s.voxels[i];
+    v = {};
+    std::copy(coords[i].begin(), coords[i].end(), v.coord);
+    v.vertex_first = vertices;
+    v.vertex_count = static_cast<std::uint32_t>(vertex_count[i]);
+    v.segment_count = static_cast<std::uint32_t>(vertex_count[i] - voxline_count[i]);
+    vertices += vertex_count[i];
+  }
+  auto expect = [&](const char* what, std::uint64_t got, std::uint64_t meta_value) {
+    if (got != meta_value)
+      fail_input(p, vxlc_at, std::string("voxlines give ") + std::to_string(got) + " " + what + " but META says " +
+                                 std::to_string(meta_value));
+  };
+  expect("vertices", vertices, m.vertex_count);
+  expect("segments", vertices - l, m.segment_count);
+  expect("synthetic points", synthetic, m.synthetic_point_count);
+  expect("source points", points - synthetic, m.point_count);
+  expect("shipped points", points, k.point_count);
+  s.order_bytes = layout_orders(s.voxels, m.stored_order_count);
+  return s;
+}
+
+// The shipped PROV with the package's parameters added (spec §7 step 6).
+std::string provenance_with_package(const VxlzFile& f) {
+  nlohmann::json j = nlohmann::json::object();
+  if (f.has_section(section_id("PROV"))) {
+    const std::vector<std::uint8_t> raw = f.inflate(section_id("PROV"));
+    j = nlohmann::json::parse(raw.begin(), raw.end(), nullptr, false);
+    if (j.is_discarded() || !j.is_object())
+      fail_input(f.path(), f.context(section_id("PROV")).section_offset, "PROV is not a JSON object");
+  }
+  const PackSection& k = f.pack();
+  j["vxlz"] = {{"package", std::filesystem::path(f.path()).filename().string()},
+               {"bits", k.quantization_bits},
+               {"quantum_mm", k.quantum},
+               {"range_mm", k.range},
+               {"error_bound_mm", k.error_bound},
+               {"max_error_mm", k.max_error},
+               {"rms_error_mm", k.rms_error}};
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// Decodes chunk c into VERT (spec §5, §6, §7 step 4): own points at their voxline's place, and each
+// voxline's first point also as the connecting vertex of the voxline before it in the same streamline.
+// Marks the last vertex of every voxline that ends in this chunk (for the orders).
+void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, std::vector<std::int32_t>& residuals,
+                  std::span<float> vert, VoxlineEnds& ends) {
+  const Quantizer quantizer(f.pack());
+  const std::uint64_t count = f.chunk_point_count(chunk);
+  residuals.resize(3 * count);
+  decode_residual_chunk(f.chunk(chunk), residuals, f.path(), f.chunk_file_offset(chunk));
+
+  std::uint64_t j = s.chunk_start_voxline[chunk];
+  std::uint64_t in_voxline = s.chunk_start_point[chunk];
+  LinearPredictor predictor;
+  predictor.reset();
+  const std::uint64_t max_value = quantizer.max_value();
+  for (std::uint64_t i = 0; i < count;) {
+    const std::uint64_t own = s.voxlines[j].count_flags & kVoxlineCountMask;
+    const std::uint64_t run = std::min(own - in_voxline, count - i);
+    const std::uint64_t first = s.first_vertex(j);
+    if (in_voxline == 0 && s.starts_streamline[j]) predictor.start_streamline();
+    float* dst = vert.data() + 3 * (first + in_voxline);
+    const std::int32_t* residual = residuals.data() + 3 * i;
+    for (std::uint64_t r = 0; r < run; ++r, residual += 3, dst += 3) {
+      std::array<std::int64_t, 3> q;
+      for (int a = 0; a < 3; ++a) q[a] = predictor.predict(a) + residual[a];
+      // One unsigned comparison per value also catches negatives; checked per point so that a damaged
+      // chunk cannot drive the prediction into overflow.
+      if (static_cast<std::uint64_t>(q[0]) > max_value || static_cast<std::uint64_t>(q[1]) > max_value ||
+          static_cast<std::uint64_t>(q[2]) > max_value)
+        fail_input(f.path(), f.chunk_file_offset(chunk),
+                   "position chunk: point " + std::to_string(chunk * f.pack().chunk_points + i + r) +
+                       " decodes outside the quantisation grid");
+      for (int a = 0; a < 3; ++a) dst[a] = quantizer.dequantize(q[a], a);
+      predictor.push(q);
+    }
+    if (in_voxline == 0 && !s.starts_streamline[j]) {
+      // The previous voxline's connecting vertex is a copy of this first point, bit for bit.
+      const std::uint64_t previous_own = s.voxlines[j - 1].count_flags & kVoxlineCountMask;
+      std::memcpy(vert.data() + 3 * (s.first_vertex(j - 1) + previous_own), vert.data() + 3 * first, 12);
+    }
+    i += run;
+    in_voxline += run;
+    if (in_voxline == own) {
+      ends.set(first + own + s.connected(j) - 1);
+      ++j;
+      in_voxline = 0;
+    }
+  }
+}
+
+template <typename T>
+std::span<std::uint8_t> bytes_of(std::span<T> s) {
+  return {reinterpret_cast<std::uint8_t*>(s.data()), s.size_bytes()};
+}
+
+}  // namespace
+
+UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
+  using Clock = std::chrono::steady_clock;
+  auto seconds_since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  const unsigned threads = resolve_threads(settings.threads);
+  auto progress = [&](const char* stage, double fraction) {
+    if (settings.progress) settings.progress(stage, fraction);
+  };
+  UnpackSummary summary;
+  auto t0 = Clock::now();
+  progress("decoding", 0.0);
+
+  const VxlzFile f = VxlzFile::open(in_path);
+  if (f.meta().order_set == static_cast<std::uint32_t>(OrderSet::Random))
+    fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 1.0");
+  Structure s = rebuild_structure(f);
+  const std::string provenance = provenance_with_package(f);
+  std::vector<std::uint8_t> groups_bytes;
+  if (f.has_section(section_id("GRPS")))
+    groups_bytes = encode_groups(decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count,
+                                                     f.context(section_id("GRPS"))));
+
+  MetaSection meta = f.meta();
+  VxlWriter out(out_path, section_sizes(meta, s.order_bytes, provenance.size(), groups_bytes.size()));
+  prefault_for_write(bytes_of(out.vertices()), threads);
+  std::copy(s.voxels.begin(), s.voxels.end(), out.voxels().begin());
+
+  // Positions: chunks in parallel, each into its own voxlines' places.
+  std::vector<std::vector<std::int32_t>> residuals(threads);
+  std::atomic<std::uint64_t> done{0};
+  VoxlineEnds ends(meta.vertex_count);
+  parallel_for(f.chunk_count(), threads, [&](std::uint64_t chunk, unsigned t) {
+    decode_chunk(f, s, chunk, residuals[t], out.vertices(), ends);
+    if (t == 0) progress("decoding", double(++done) / double(f.chunk_count()));
+    else ++done;
+  });
+  residuals = {};
+
+  // Tight bounds per voxel and the global bounds, from the decoded vertices (spec §7 steps 1, 3).
+  std::span<VoxelEntry> voxels = out.voxels();
+  std::span<const float> vertices = out.vertices();
+  parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned) {
+    VoxelEntry& v = voxels[i];
+    const float* b = vertices.data() + 3 * v.vertex_first;
+    for (int c = 0; c < 3; ++c) v.tight_min[c] = v.tight_max[c] = b[c];
+    for (std::uint64_t e = 1; e < v.vertex_count; ++e)
+      for (int c = 0; c < 3; ++c) {
+        v.tight_min[c] = std::min(v.tight_min[c], b[3 * e + c]);
+        v.tight_max[c] = std::max(v.tight_max[c], b[3 * e + c]);
+      }
+  });
+  for (int c = 0; c < 3; ++c) {
+    meta.bounds_min[c] = meta.bounds_max[c] = 0;
+    for (std::size_t i = 0; i < voxels.size(); ++i) {
+      meta.bounds_min[c] = i == 0 ? voxels[i].tight_min[c] : std::min<double>(meta.bounds_min[c], voxels[i].tight_min[c]);
+      meta.bounds_max[c] = i == 0 ? voxels[i].tight_max[c] : std::max<double>(meta.bounds_max[c], voxels[i].tight_max[c]);
+    }
+  }
+  summary.decode_seconds = seconds_since(t0);
+
+  // Orders (spec §7 step 5), for the shipped directions.
+  t0 = Clock::now();
+  OrderSetSpec set;
+  set.kind = static_cast<OrderSet>(meta.order_set);
+  for (const DirectionEntry& d : f.directions()) set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
+  prefault_for_write(out.orders(), threads);
+  build_orders_into(out.voxels(), out.vertices(), ends, set, out.orders(), threads, settings.progress);
+  summary.orders_seconds = seconds_since(t0);
+
+  t0 = Clock::now();
+  progress("writing", 0.0);
+  out.set_meta(meta);
+  std::copy(f.directions().begin(), f.directions().end(), out.directions().begin());
+  std::copy(s.voxlines.begin(), s.voxlines.end(), out.voxlines().begin());
+  std::copy(s.strm.begin(), s.strm.end(), out.streamline_first_voxline().begin());
+  std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
+  std::copy(groups_bytes.begin(), groups_bytes.end(), out.groups().begin());
+  out.commit(threads);
+  summary.write_seconds = seconds_since(t0);
+  progress("writing", 1.0);
+
+  summary.streamlines = meta.streamline_count;
+  summary.points = meta.point_count;
+  summary.voxels = meta.voxel_count;
+  summary.pack = f.pack();
+  return summary;
+}
+
+}  // namespace vxl

@@ -1,0 +1,32 @@
+// `voxlines unpack`: a .vxlz package back to a .vxl (spec/vxlz-package-v1.md §7). The tables are taken
+// as shipped (never re-voxelised: quantisation could move a point across a voxel face), the position
+// chunks are decoded in parallel straight into the output's vertex blocks, the connecting vertices are
+// written as copies of the decoded next points, and the tight bounds and the orders are recomputed from
+// the decoded vertices. The result passes `voxlines verify`.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "voxelize.h"
+#include "vxlz_layout.h"
+
+namespace vxl {
+
+struct UnpackSettings {
+  unsigned threads = 0;  // 0: all cores
+  ProgressFn progress;   // stages "decoding", "ordering", "writing"; may be empty
+};
+
+struct UnpackSummary {
+  std::uint64_t streamlines = 0, points = 0, voxels = 0;
+  PackSection pack{};  // quantisation and the stated bound
+  double decode_seconds = 0, orders_seconds = 0, write_seconds = 0;
+};
+
+// Validates the whole package (spec §8) and writes `out_path` atomically: a refused package leaves
+// nothing at the output path. Throws vxl::Error (Input for a damaged package, naming the file, the byte
+// offset and what was expected; Unsupported for a newer version; Output).
+UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings);
+
+}  // namespace vxl

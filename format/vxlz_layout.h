@@ -1,0 +1,46 @@
+// On-disk structures of the .vxlz package, version 1.0 (spec/vxlz-package-v1.md; section numbers below
+// point into it). The header and the section table entries have the .vxl layout (FileHeader,
+// SectionEntry from vxl_layout.h) with another magic; the payloads follow each other without padding.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "vxl_layout.h"
+
+namespace vxl {
+
+inline constexpr std::array<std::uint8_t, 8> kVxlzMagic = {0x89, 'V', 'X', 'Z', '\r', '\n', 0x1A, '\n'};
+inline constexpr std::uint16_t kVxlzVersionMajor = 1;
+inline constexpr std::uint16_t kVxlzVersionMinor = 0;
+inline constexpr std::uint32_t kVxlzMaxSections = 32;
+inline constexpr std::uint32_t kVxlzMinBits = 11;
+inline constexpr std::uint32_t kVxlzMaxBits = 16;
+inline constexpr std::uint32_t kVxlzDefaultBits = 14;
+inline constexpr std::uint32_t kVxlzPredictorLinear = 1;  // §5.2
+inline constexpr std::uint64_t kVxlzDefaultChunkPoints = 1u << 18;
+inline constexpr std::uint64_t kVxlzMaxChunkPoints = (1u << 31) - 1;  // Draco point indices are 32-bit
+
+// §3
+struct PackSection {
+  std::uint32_t quantization_bits;
+  std::uint32_t predictor;
+  double quant_origin[3];
+  double quantum;
+  double range;
+  std::uint64_t point_count;  // shipped points
+  std::uint64_t chunk_points;
+  std::uint64_t chunk_count;
+  double error_bound;
+  double max_error;  // informative
+  double rms_error;  // informative
+  std::uint8_t reserved[32];
+};
+static_assert(sizeof(PackSection) == 128);
+static_assert(offsetof(PackSection, quant_origin) == 8);
+static_assert(offsetof(PackSection, point_count) == 48);
+static_assert(offsetof(PackSection, error_bound) == 72);
+static_assert(offsetof(PackSection, reserved) == 96);
+
+}  // namespace vxl

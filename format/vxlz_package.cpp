@@ -1,0 +1,287 @@
+#include "vxlz_package.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <thread>
+
+#include "atomic_output.h"
+#include "checksum.h"
+#include "error.h"
+#include "vxl_file.h"
+
+namespace vxl {
+namespace {
+
+bool all_zero(const std::uint8_t* p, std::size_t n) {
+  return std::all_of(p, p + n, [](std::uint8_t b) { return b == 0; });
+}
+
+template <typename T>
+std::vector<std::uint8_t> bytes_of(const T& value) {
+  const auto* b = reinterpret_cast<const std::uint8_t*>(&value);
+  return {b, b + sizeof value};
+}
+
+// The sections every package has (spec §2.2), and the optional ones a 1.0 reader knows.
+constexpr std::uint32_t kRequired[] = {section_id("PACK"), section_id("META"), section_id("DIRS"),
+                                       section_id("VOXC"), section_id("STRL"), section_id("VXLV"),
+                                       section_id("VXLC"), section_id("CHNK"), section_id("POSD")};
+constexpr std::uint32_t kOptional[] = {section_id("PROV"), section_id("GRPS")};
+
+}  // namespace
+
+std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, unsigned threads) {
+  struct Section {
+    const char* id;
+    bool required;
+    std::vector<std::uint8_t> payload;
+    const std::vector<std::uint8_t>* deflate_from = nullptr;  // a stream still to be deflated
+  };
+  PackSection pack = c.pack;
+  std::memset(pack.reserved, 0, sizeof pack.reserved);
+  MetaSection meta = c.meta;
+  std::memset(meta.reserved, 0, sizeof meta.reserved);
+  std::vector<std::uint8_t> provenance_raw, chunk_sizes, positions;
+  if (c.provenance) provenance_raw.assign(c.provenance->begin(), c.provenance->end());
+  std::uint64_t total_chunk_bytes = 0;
+  for (const auto& chunk : c.chunks) {
+    const std::uint64_t n = chunk.size();
+    chunk_sizes.insert(chunk_sizes.end(), reinterpret_cast<const std::uint8_t*>(&n), reinterpret_cast<const std::uint8_t*>(&n) + 8);
+    total_chunk_bytes += n;
+  }
+  positions.reserve(total_chunk_bytes);
+  for (const auto& chunk : c.chunks) positions.insert(positions.end(), chunk.begin(), chunk.end());
+
+  std::vector<Section> sections;
+  sections.push_back({"PACK", true, bytes_of(pack)});
+  sections.push_back({"META", true, bytes_of(meta)});
+  sections.push_back({"DIRS", true, {reinterpret_cast<const std::uint8_t*>(c.directions.data()),
+                                     reinterpret_cast<const std::uint8_t*>(c.directions.data() + c.directions.size())}});
+  sections.push_back({"VOXC", true, {}, &c.voxel_coords});
+  sections.push_back({"STRL", true, {}, &c.streamline_voxlines});
+  sections.push_back({"VXLV", true, {}, &c.voxline_voxels});
+  sections.push_back({"VXLC", true, {}, &c.voxline_counts});
+  if (c.provenance) sections.push_back({"PROV", false, {}, &provenance_raw});
+  if (c.groups) sections.push_back({"GRPS", false, {}, &*c.groups});
+  sections.push_back({"CHNK", true, std::move(chunk_sizes)});
+  sections.push_back({"POSD", true, std::move(positions)});
+
+  // The streams are deflated side by side: the voxline streams of a large tractogram take a while.
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t i; (i = next++) < sections.size();)
+      if (sections[i].deflate_from) sections[i].payload = deflate_section(*sections[i].deflate_from);
+  };
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  std::vector<std::thread> pool;
+  try {
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+  } catch (...) {
+    next = sections.size();
+    for (auto& t : pool) t.join();
+    throw;
+  }
+  for (auto& t : pool) t.join();
+
+  // Header, table, then the payloads back to back (spec §2).
+  const std::uint64_t table_end = sizeof(FileHeader) + sections.size() * sizeof(SectionEntry);
+  std::vector<SectionEntry> table;
+  std::uint64_t position = table_end;
+  for (const Section& s : sections) {
+    SectionEntry e{};
+    std::memcpy(e.id, s.id, 4);
+    e.flags = s.required ? kSectionRequired : 0;
+    e.offset = position;
+    e.size = s.payload.size();
+    e.checksum = xxh3_64(s.payload.data(), s.payload.size());
+    table.push_back(e);
+    position += e.size;
+  }
+  FileHeader h{};
+  std::memcpy(h.magic, kVxlzMagic.data(), 8);
+  h.version_major = kVxlzVersionMajor;
+  h.version_minor = kVxlzVersionMinor;
+  h.header_size = sizeof(FileHeader);
+  h.file_size = position;
+  h.section_table_offset = sizeof(FileHeader);
+  h.section_count = static_cast<std::uint32_t>(sections.size());
+  std::vector<std::uint8_t> head(table_end);
+  std::memcpy(head.data(), &h, sizeof h);
+  std::memcpy(head.data() + sizeof h, table.data(), table.size() * sizeof(SectionEntry));
+  h.header_checksum = xxh3_64(head.data(), head.size());
+  std::memcpy(head.data(), &h, sizeof h);
+
+  AtomicOutputFile out(path);
+  out.write(head.data(), head.size());
+  for (const Section& s : sections) out.write(s.payload.data(), s.payload.size());
+  out.commit();
+  return position;
+}
+
+VxlzFile VxlzFile::open(const std::string& path) {
+  VxlzFile f{MappedFile(path)};
+  f.validate();
+  return f;
+}
+
+const SectionEntry* VxlzFile::find(std::uint32_t id) const {
+  for (const SectionEntry& e : sections_) {
+    std::uint32_t eid;
+    std::memcpy(&eid, e.id, 4);
+    if (eid == id) return &e;
+  }
+  return nullptr;
+}
+
+void VxlzFile::validate() {
+  const std::string& p = file_.path();
+  const std::uint64_t size = file_.size();
+  const std::uint8_t* base = file_.data();
+
+  // §8 step 1: header.
+  FileHeader h;
+  if (size < sizeof h) fail_input(p, size, "file too short for a .vxlz header (64 bytes): truncated or not a package");
+  std::memcpy(&h, base, sizeof h);
+  if (std::memcmp(h.magic, kVxlzMagic.data(), 8) != 0) fail_input(p, 0, "not a .vxlz package (bad magic)");
+  if (h.version_major != kVxlzVersionMajor)
+    throw Error(ErrorKind::Unsupported, p, 8,
+                ".vxlz major version " + std::to_string(h.version_major) + " (this reader knows 1)");
+  if (h.header_size != sizeof h) fail_input(p, 12, "header_size must be 64");
+  if (h.file_size != size)
+    fail_input(p, 16, "file size is " + std::to_string(size) + " bytes but the header says " + std::to_string(h.file_size) +
+                          " (truncated or extended package)");
+  if (h.section_table_offset != sizeof h) fail_input(p, 24, "section table must start at byte 64");
+  if (h.section_count == 0 || h.section_count > kVxlzMaxSections) fail_input(p, 32, "section count must be 1..32");
+  if (h.flags != 0) fail_input(p, 36, "unknown header flags");
+  if (!all_zero(h.reserved, sizeof h.reserved)) fail_input(p, 48, "reserved header bytes are not zero");
+  const std::uint64_t table_end = sizeof h + std::uint64_t(h.section_count) * sizeof(SectionEntry);
+  if (table_end > size) fail_input(p, 64, "section table runs past the end of the file");
+  {
+    std::vector<std::uint8_t> head(base, base + table_end);
+    std::memset(head.data() + offsetof(FileHeader, header_checksum), 0, 8);
+    if (xxh3_64(head.data(), head.size()) != h.header_checksum)
+      fail_input(p, 40, "header checksum mismatch (header or section table damaged)");
+  }
+  sections_.resize(h.section_count);
+  std::memcpy(sections_.data(), base + sizeof h, sections_.size() * sizeof(SectionEntry));
+
+  // Step 2: the table. Payloads follow each other from the end of the table to the end of the file.
+  std::uint64_t expected_offset = table_end;
+  for (std::size_t i = 0; i < sections_.size(); ++i) {
+    const SectionEntry& e = sections_[i];
+    const std::uint64_t at = sizeof h + i * sizeof(SectionEntry);
+    std::uint32_t id;
+    std::memcpy(&id, e.id, 4);
+    const std::string name = section_name(id);
+    if ((e.flags & ~kSectionRequired) != 0) fail_input(p, at + 4, "section " + name + " has unknown flags");
+    if (find(id) != &e) fail_input(p, at, "section " + name + " appears twice");
+    if (e.offset != expected_offset)
+      fail_input(p, at + 8, "section " + name + " must start at byte " + std::to_string(expected_offset) +
+                                " (right after the previous one)");
+    if (e.size > size - e.offset) fail_input(p, at + 16, "section " + name + " runs past the end of the file");
+    expected_offset += e.size;
+    const bool known = std::find(std::begin(kRequired), std::end(kRequired), id) != std::end(kRequired) ||
+                       std::find(std::begin(kOptional), std::end(kOptional), id) != std::end(kOptional);
+    if (!known && (e.flags & kSectionRequired))
+      throw Error(ErrorKind::Unsupported, p, at, "required section " + name + " is unknown to this reader (newer writer?)");
+  }
+  if (expected_offset != size) fail_input(p, expected_offset, "bytes after the last section");
+  for (std::uint32_t id : kRequired)
+    if (!find(id)) fail_input(p, 64, "required section " + section_name(id) + " is missing");
+
+  // Step 3: every checksum, before anything is decoded.
+  for (const SectionEntry& e : sections_)
+    if (xxh3_64(base + e.offset, e.size) != e.checksum)
+      fail_input(p, e.offset, "checksum mismatch in section " + std::string(e.id, 4) + " (damaged package)");
+
+  // Step 4: the fixed-size sections.
+  auto fixed = [&](const char (&id)[5], std::uint64_t expected, void* dst) {
+    const SectionEntry* e = find(section_id(id));
+    if (e->size != expected)
+      fail_input(p, e->offset, std::string("section ") + id + " must be " + std::to_string(expected) + " bytes");
+    std::memcpy(dst, base + e->offset, expected);
+    return e->offset;
+  };
+  const std::uint64_t pack_at = fixed("PACK", sizeof pack_, &pack_);
+  const PackSection& k = pack_;
+  if (k.quantization_bits < kVxlzMinBits || k.quantization_bits > kVxlzMaxBits)
+    fail_input(p, pack_at, "quantization bits must be 11..16");
+  if (k.predictor != kVxlzPredictorLinear)
+    throw Error(ErrorKind::Unsupported, p, pack_at + 4, "predictor " + std::to_string(k.predictor) + " (this reader knows 1)");
+  for (int c = 0; c < 3; ++c)
+    if (!std::isfinite(k.quant_origin[c])) fail_input(p, pack_at + 8, "quantisation origin is not finite");
+  if (!std::isfinite(k.quantum) || !(k.quantum > 0)) fail_input(p, pack_at + 32, "quantum must be finite and positive");
+  // Every decoded coordinate must be a finite float32: the whole cube must lie within float range.
+  const double cube_edge = k.quantum * double((1u << k.quantization_bits) - 1);
+  for (int c = 0; c < 3; ++c)
+    if (!(std::abs(k.quant_origin[c]) <= std::numeric_limits<float>::max()) ||
+        !(std::abs(k.quant_origin[c] + cube_edge) <= std::numeric_limits<float>::max()))
+      fail_input(p, pack_at + 8, "quantisation cube reaches beyond the float32 range");
+  if (k.chunk_points < 1 || k.chunk_points > kVxlzMaxChunkPoints) fail_input(p, pack_at + 56, "chunk points must be 1..2^31-1");
+  if (k.chunk_count != k.point_count / k.chunk_points + (k.point_count % k.chunk_points != 0))
+    fail_input(p, pack_at + 64, "chunk count does not match point count / chunk points");
+  if (!all_zero(k.reserved, sizeof k.reserved)) fail_input(p, pack_at + 96, "PACK reserved bytes are not zero");
+
+  const std::uint64_t meta_at = fixed("META", sizeof meta_, &meta_);
+  const MetaSection& m = meta_;
+  if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 152, "META reserved bytes are not zero");
+  if (!std::isfinite(m.voxel_size) || !(m.voxel_size > 0)) fail_input(p, meta_at + 56, "voxel size must be finite and positive");
+  if (m.stored_order_count < 1 || m.stored_order_count > kVxlMaxStoredOrders)
+    fail_input(p, meta_at + 52, "stored order count must be 1..64");
+  if (m.voxel_count > 0x7FFFFFFFu) fail_input(p, meta_at + 48, "voxel count exceeds 2^31-1");
+  for (int c = 0; c < 3; ++c) {
+    if (m.grid_dims[c] < 0) fail_input(p, meta_at + 88, "negative grid dimension");
+    if (!std::isfinite(m.grid_origin[c])) fail_input(p, meta_at + 64, "grid origin is not finite");
+  }
+  if (m.point_count > ~std::uint64_t(0) - m.synthetic_point_count || m.point_count + m.synthetic_point_count != k.point_count)
+    fail_input(p, pack_at + 48, "shipped point count must be META's point count plus its synthetic point count");
+
+  directions_.resize(m.stored_order_count);
+  const std::uint64_t dirs_at = fixed("DIRS", std::uint64_t(m.stored_order_count) * sizeof(DirectionEntry), directions_.data());
+  for (std::size_t i = 0; i < directions_.size(); ++i) {
+    const DirectionEntry& d = directions_[i];
+    const double len = std::sqrt(double(d.xyz[0]) * d.xyz[0] + double(d.xyz[1]) * d.xyz[1] + double(d.xyz[2]) * d.xyz[2]);
+    if (d.reserved != 0 || !(std::abs(len - 1.0) < 1e-5)) fail_input(p, dirs_at + 16 * i, "direction is not a unit vector");
+  }
+
+  const SectionEntry* chnk = find(section_id("CHNK"));
+  const SectionEntry* posd = find(section_id("POSD"));
+  if (chnk->size / 8 != k.chunk_count || chnk->size % 8 != 0)
+    fail_input(p, chnk->offset, "CHNK must hold one 8-byte size per chunk (" + std::to_string(k.chunk_count) + ")");
+  chunk_offsets_.assign(1, 0);
+  for (std::uint64_t i = 0; i < k.chunk_count; ++i) {
+    std::uint64_t n;
+    std::memcpy(&n, base + chnk->offset + 8 * i, 8);
+    if (n > posd->size - chunk_offsets_.back()) fail_input(p, chnk->offset + 8 * i, "chunk runs past the end of POSD");
+    chunk_offsets_.push_back(chunk_offsets_.back() + n);
+  }
+  if (chunk_offsets_.back() != posd->size) fail_input(p, chnk->offset, "chunk sizes do not add up to the POSD size");
+  posd_offset_ = posd->offset;
+}
+
+std::vector<std::uint8_t> VxlzFile::inflate(std::uint32_t id) const {
+  const SectionEntry* e = find(id);
+  if (!e) return {};
+  return inflate_section(payload(*e), context(id));
+}
+
+StreamContext VxlzFile::context(std::uint32_t id) const {
+  const SectionEntry* e = find(id);
+  return {file_.path(), section_name(id), e ? e->offset : 0};
+}
+
+std::span<const std::uint8_t> VxlzFile::chunk(std::uint64_t i) const {
+  return file_.bytes().subspan(posd_offset_ + chunk_offsets_[i], chunk_offsets_[i + 1] - chunk_offsets_[i]);
+}
+
+std::uint64_t VxlzFile::chunk_file_offset(std::uint64_t i) const { return posd_offset_ + chunk_offsets_[i]; }
+
+std::uint64_t VxlzFile::chunk_point_count(std::uint64_t i) const {
+  return std::min(pack_.chunk_points, pack_.point_count - i * pack_.chunk_points);
+}
+
+}  // namespace vxl

@@ -1,0 +1,82 @@
+// The .vxlz package container (spec/vxlz-package-v1.md §2, §8): a writer that checksums the sections and
+// writes the file atomically, and a reader that validates the header, the section table, every checksum
+// and the fixed-size sections before anything is decoded, so that a damaged or truncated package is
+// refused with an Error naming the file, the byte offset and what was expected.
+//
+// The container knows the sections' encodings (raw, zlib) but not their meaning: vxlz_tables.h encodes
+// and decodes the exact tables, vxlz_draco.h the position chunks, converter/pack and converter/unpack
+// put them together.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "mapped_file.h"
+#include "vxl_layout.h"
+#include "vxlz_layout.h"
+#include "vxlz_streams.h"
+
+namespace vxl {
+
+// Everything a package holds, before compression. The varint streams are the raw (inflated) bytes of
+// spec §4; write_vxlz deflates them.
+struct VxlzContent {
+  PackSection pack{};  // reserved bytes are zeroed by the writer
+  MetaSection meta{};
+  std::vector<DirectionEntry> directions;
+  std::vector<std::uint8_t> voxel_coords;         // VOXC
+  std::vector<std::uint8_t> streamline_voxlines;  // STRL
+  std::vector<std::uint8_t> voxline_voxels;       // VXLV
+  std::vector<std::uint8_t> voxline_counts;       // VXLC
+  std::optional<std::string> provenance;          // PROV, when the .vxl has one
+  std::optional<std::vector<std::uint8_t>> groups;  // GRPS, when the .vxl has groups
+  std::vector<std::vector<std::uint8_t>> chunks;  // Draco buffers, one per position chunk
+};
+
+// Deflates the streams (side by side on up to `threads` threads; 0: all cores) and writes the package
+// atomically. Returns its size in bytes. Throws vxl::Error (Output) naming the path.
+std::uint64_t write_vxlz(const std::string& path, const VxlzContent& content, unsigned threads = 0);
+
+class VxlzFile {
+ public:
+  // Maps and validates spec §8 steps 1-4. Throws vxl::Error (Input; Unsupported for an unknown major
+  // version or required section).
+  static VxlzFile open(const std::string& path);
+
+  const std::string& path() const { return file_.path(); }
+  std::uint64_t size() const { return file_.size(); }
+  const PackSection& pack() const { return pack_; }
+  const MetaSection& meta() const { return meta_; }
+  std::span<const DirectionEntry> directions() const { return directions_; }
+
+  bool has_section(std::uint32_t id) const { return find(id) != nullptr; }
+  // A zlib section inflated (spec §8 step 5); empty when an optional section is absent.
+  std::vector<std::uint8_t> inflate(std::uint32_t id) const;
+  // Where errors about an inflated stream point: the section and its offset.
+  StreamContext context(std::uint32_t id) const;
+
+  std::uint64_t chunk_count() const { return chunk_offsets_.size() - 1; }
+  std::span<const std::uint8_t> chunk(std::uint64_t i) const;
+  std::uint64_t chunk_file_offset(std::uint64_t i) const;
+  // Points in chunk i (chunk_points, fewer in the last).
+  std::uint64_t chunk_point_count(std::uint64_t i) const;
+
+ private:
+  explicit VxlzFile(MappedFile file) : file_(std::move(file)) {}
+  void validate();
+  const SectionEntry* find(std::uint32_t id) const;
+  std::span<const std::uint8_t> payload(const SectionEntry& e) const { return file_.bytes().subspan(e.offset, e.size); }
+
+  MappedFile file_;
+  std::vector<SectionEntry> sections_;
+  PackSection pack_{};
+  MetaSection meta_{};
+  std::vector<DirectionEntry> directions_;
+  std::vector<std::uint64_t> chunk_offsets_{0};  // chunk_count + 1 offsets inside POSD
+  std::uint64_t posd_offset_ = 0;
+};
+
+}  // namespace vxl

@@ -1,0 +1,96 @@
+#include "vxlz_streams.h"
+
+#include <cstring>
+#include <limits>
+
+#include <zlib.h>
+
+#include "error.h"
+
+namespace vxl {
+
+std::uint64_t VarintReader::get_long() {
+  std::uint64_t v = 0;
+  for (int shift = 0;; shift += 7) {
+    if (pos_ >= bytes_.size()) fail("stream ends inside or before a value");
+    const std::uint8_t b = bytes_[pos_++];
+    if (shift == 63 && (b & 0x7E) != 0) fail("varint does not fit in 64 bits");
+    v |= std::uint64_t(b & 0x7F) << shift;
+    if ((b & 0x80) == 0) return v;
+    if (shift == 63) fail("varint longer than 10 bytes");
+  }
+}
+
+std::span<const std::uint8_t> VarintReader::get_bytes(std::uint64_t n) {
+  if (n > bytes_.size() - pos_) fail("stream ends inside a byte string of " + std::to_string(n) + " bytes");
+  std::span<const std::uint8_t> s = bytes_.subspan(pos_, n);
+  pos_ += n;
+  return s;
+}
+
+void VarintReader::expect_end() const {
+  if (pos_ != bytes_.size())
+    fail(std::to_string(bytes_.size() - pos_) + " bytes left over after the expected values");
+}
+
+void VarintReader::fail(const std::string& what) const {
+  fail_input(context_.file, context_.section_offset,
+             "section " + context_.section + ", inflated byte " + std::to_string(pos_) + ": " + what);
+}
+
+std::vector<std::uint8_t> deflate_section(std::span<const std::uint8_t> raw) {
+  uLong bound = compressBound(static_cast<uLong>(raw.size()));
+  std::vector<std::uint8_t> out(8 + bound);
+  const std::uint64_t raw_size = raw.size();
+  std::memcpy(out.data(), &raw_size, 8);
+  uLongf written = bound;
+  // Level 6 (zlib's default): level 9 makes these streams <1 % smaller and packing several times slower.
+  if (raw.size() > std::numeric_limits<uLong>::max() ||
+      compress2(out.data() + 8, &written, raw.data(), static_cast<uLong>(raw.size()), 6) != Z_OK)
+    throw Error(ErrorKind::Output, "", std::nullopt, "zlib could not compress a package stream");
+  out.resize(8 + written);
+  return out;
+}
+
+std::vector<std::uint8_t> inflate_section(std::span<const std::uint8_t> payload, const StreamContext& context) {
+  auto fail = [&](const std::string& what) {
+    fail_input(context.file, context.section_offset, "section " + context.section + ": " + what);
+  };
+  if (payload.size() < 8) fail("shorter than its 8-byte raw size");
+  std::uint64_t raw_size;
+  std::memcpy(&raw_size, payload.data(), 8);
+  const std::uint64_t compressed = payload.size() - 8;
+  if (raw_size > 1100 * compressed + 64)
+    fail("raw size " + std::to_string(raw_size) + " is more than zlib can expand " + std::to_string(compressed) + " bytes to");
+  // One spare byte: a stream that inflates to more than raw_size shows itself by filling it (and zlib
+  // wants a non-null output pointer even for an empty stream).
+  std::vector<std::uint8_t> raw(raw_size + 1);
+
+  z_stream z{};
+  if (inflateInit(&z) != Z_OK) throw Error(ErrorKind::Unsupported, context.file, std::nullopt, "zlib could not start");
+  z.next_in = const_cast<Bytef*>(payload.data() + 8);
+  z.next_out = raw.data();
+  // zlib counts in 32-bit uInt: feed and drain in pieces.
+  std::uint64_t in_left = compressed, out_left = raw.size();
+  int rc = Z_OK;
+  while (rc == Z_OK) {
+    const uInt in_piece = static_cast<uInt>(std::min<std::uint64_t>(in_left, 1u << 30));
+    const uInt out_piece = static_cast<uInt>(std::min<std::uint64_t>(out_left, 1u << 30));
+    z.avail_in = in_piece;
+    z.avail_out = out_piece;
+    rc = inflate(&z, Z_NO_FLUSH);
+    in_left -= in_piece - z.avail_in;
+    out_left -= out_piece - z.avail_out;
+    if (rc == Z_OK && in_piece == z.avail_in && out_piece == z.avail_out) rc = Z_BUF_ERROR;  // no progress
+  }
+  inflateEnd(&z);
+  const std::uint64_t produced = raw.size() - out_left;
+  if (produced > raw_size) fail("zlib stream inflates to more than its raw size " + std::to_string(raw_size));
+  if (rc != Z_STREAM_END) fail("zlib stream is damaged or ends early");
+  if (produced != raw_size) fail("zlib stream inflates to fewer bytes than its raw size " + std::to_string(raw_size));
+  if (in_left != 0) fail("bytes follow the end of the zlib stream");
+  raw.pop_back();
+  return raw;
+}
+
+}  // namespace vxl

@@ -1,0 +1,522 @@
+// The .vxlz package (spec/vxlz-package-v1.md): .vxl -> .vxlz -> .vxl keeps the structure exactly and
+// every coordinate within the stated bound at 11, 14 and 16 bits; the unpacked file passes verify;
+// Draco keeps the point order; damaged, truncated and crafted packages are refused with an Error (never
+// a crash: the ASan build runs these too).
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
+
+#include <nlohmann/json.hpp>
+
+#include "convert.h"
+#include "error.h"
+#include "pack.h"
+#include "read_tractogram.h"
+#include "synth.h"
+#include "test_support.h"
+#include "unpack.h"
+#include "checksum.h"
+#include "vxl_file.h"
+#include "vxl_streamlines.h"
+#include "vxl_verify.h"
+#include "vxlz_draco.h"
+#include "vxlz_package.h"
+#include "vxlz_tables.h"
+
+namespace vxl {
+namespace {
+
+using test::ScratchDir;
+
+// Synthetic bundles plus the awkward cases: a step over several voxels (synthetic face points), a
+// one-point and an empty streamline, and two groups.
+Tractogram test_tractogram(std::uint64_t streamlines = 1500) {
+  SynthSettings settings;
+  settings.streamlines = streamlines;
+  settings.seed = 7;
+  Tractogram t = synthesize_tractogram(settings);
+  t.source.path = "synthetic.tck";
+  t.source.format = "tck";
+  const float jump[9] = {0, 0, 0, 1, 0.5f, 0.25f, 45, 31, -17};
+  t.add_streamline(jump, 3);
+  const float one[3] = {-3, 4, 5};
+  t.add_streamline(one, 1);
+  t.add_streamline(one, 0);
+  const std::uint64_t n = t.streamline_count();
+  t.groups.push_back({"left", {0, 2, 3, 10, n - 3}});
+  t.groups.push_back({"right", {1, n - 1}});
+  return t;
+}
+
+std::string convert_to(Tractogram t, const std::string& path, double voxel_size = 10.0) {
+  ConvertSettings s;
+  s.voxel_size = voxel_size;
+  convert_tractogram(std::move(t), path, s);
+  return path;
+}
+
+std::vector<char> slurp(const std::string& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+// Written as a new file: truncating and rewriting one makes ext4 flush it on close (auto_da_alloc),
+// which made the thousands of rewrites below take seconds.
+void dump(const std::string& p, const std::vector<char>& bytes, std::size_t n) {
+  std::filesystem::remove(p);
+  std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(n));
+}
+
+template <typename T>
+std::vector<T> to_vector(std::span<const T> s) {
+  return {s.begin(), s.end()};
+}
+
+// The bound of spec §6, computed here from the .vxl's own bounds rather than taken from the package.
+double expected_bound(const MetaSection& m, std::uint32_t bits) {
+  double range = 0, magnitude = 0;
+  for (int c = 0; c < 3; ++c) range = std::max(range, m.bounds_max[c] - m.bounds_min[c]);
+  for (int c = 0; c < 3; ++c) magnitude = std::max({magnitude, std::abs(m.bounds_min[c]), std::abs(m.bounds_min[c] + range)});
+  return range / double((1u << bits) - 1) / 2 + std::ldexp(magnitude, -23);
+}
+
+// Everything the unpacked file must share with the packed one: all tables but the vertex positions, the
+// orders and the bounds.
+void expect_same_structure(const VxlFile& a, const VxlFile& b) {
+  MetaSection ma = a.meta(), mb = b.meta();
+  for (int c = 0; c < 3; ++c) {
+    ma.bounds_max[c] = mb.bounds_max[c] = 0;  // recomputed from decoded vertices
+    EXPECT_EQ(mb.bounds_min[c], mb.grid_origin[c]) << "bounds_min must stay the grid origin (spec §6)";
+  }
+  EXPECT_EQ(std::memcmp(&ma, &mb, sizeof ma), 0) << "META differs beyond the bounds";
+  ASSERT_EQ(a.voxels().size(), b.voxels().size());
+  for (std::size_t i = 0; i < a.voxels().size(); ++i) {
+    const VoxelEntry &u = a.voxels()[i], &v = b.voxels()[i];
+    ASSERT_TRUE(std::equal(u.coord, u.coord + 3, v.coord)) << i;
+    ASSERT_EQ(u.vertex_first, v.vertex_first) << i;
+    ASSERT_EQ(u.vertex_count, v.vertex_count) << i;
+    ASSERT_EQ(u.segment_count, v.segment_count) << i;
+    ASSERT_EQ(u.order_offset, v.order_offset) << i;
+    ASSERT_EQ(u.flags, v.flags) << i;
+  }
+  const auto va = a.voxlines(), vb = b.voxlines();
+  ASSERT_EQ(va.size(), vb.size());
+  if (!va.empty()) EXPECT_EQ(std::memcmp(va.data(), vb.data(), va.size_bytes()), 0);
+  EXPECT_EQ(to_vector(a.streamline_first_voxline()), to_vector(b.streamline_first_voxline()));
+  ASSERT_EQ(a.directions().size(), b.directions().size());
+  EXPECT_EQ(std::memcmp(a.directions().data(), b.directions().data(), a.directions().size_bytes()), 0);
+  const auto ga = a.groups(), gb = b.groups();
+  ASSERT_EQ(ga.size(), gb.size());
+  for (std::size_t g = 0; g < ga.size(); ++g) {
+    EXPECT_EQ(ga[g].name, gb[g].name);
+    EXPECT_EQ(ga[g].members, gb[g].members);
+  }
+}
+
+// Largest coordinate error over all vertices (they correspond one to one: the structure is the same).
+double max_vertex_error(const VxlFile& a, const VxlFile& b) {
+  const auto x = a.vertices(), y = b.vertices();
+  EXPECT_EQ(x.size(), y.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < std::min(x.size(), y.size()); ++i) worst = std::max(worst, std::abs(double(x[i]) - double(y[i])));
+  return worst;
+}
+
+struct Streamlines {
+  std::vector<std::uint64_t> sizes;
+  std::vector<float> points;
+};
+Streamlines streamlines_of(const VxlFile& f) {
+  Streamlines s;
+  walk_streamlines(f, {[&](std::uint64_t, std::span<const float> xyz) {
+                         s.sizes.push_back(xyz.size() / 3);
+                         s.points.insert(s.points.end(), xyz.begin(), xyz.end());
+                       },
+                       {}});
+  return s;
+}
+
+// Checks the whole round trip of `vxl` at `bits` and returns the unpacked file's path.
+std::string round_trip(const ScratchDir& dir, const std::string& vxl, std::uint32_t bits, const PackSettings& base = {}) {
+  const std::string packed = dir.file("p" + std::to_string(bits) + ".vxlz");
+  const std::string unpacked = dir.file("u" + std::to_string(bits) + ".vxl");
+  const VxlFile original = VxlFile::open(vxl);
+  PackSettings settings = base;
+  settings.bits = bits;
+  const PackSummary summary = pack_vxl(original, packed, settings);
+  EXPECT_EQ(summary.bytes, std::filesystem::file_size(packed));
+  const UnpackSummary back = unpack_vxlz(packed, unpacked, {});
+  EXPECT_EQ(back.pack.quantization_bits, bits);
+
+  const VerifyResult verified = verify_vxl(unpacked);
+  EXPECT_TRUE(verified.valid) << verified.problem;
+  const VxlFile copy = VxlFile::open(unpacked);
+  expect_same_structure(original, copy);
+
+  const double bound = expected_bound(original.meta(), bits);
+  EXPECT_NEAR(summary.pack.error_bound, bound, bound * 1e-12);
+  const double error = max_vertex_error(original, copy);
+  EXPECT_LE(error, bound) << bits << " bits";
+  EXPECT_LE(summary.pack.max_error, bound);
+  EXPECT_EQ(summary.pack.max_error, error) << "the stated measured error is the real one";
+
+  // Same streamlines, same point counts (the walk drops synthetic points on both sides).
+  const Streamlines a = streamlines_of(original), b = streamlines_of(copy);
+  EXPECT_EQ(a.sizes, b.sizes);
+  EXPECT_EQ(a.points.size(), b.points.size());
+
+  // The unpacked provenance states the loss.
+  const auto prov = nlohmann::json::parse(copy.provenance_json());
+  EXPECT_EQ(prov["vxlz"]["bits"], bits);
+  EXPECT_EQ(prov["vxlz"]["error_bound_mm"].get<double>(), summary.pack.error_bound);
+  EXPECT_EQ(prov["source"], nlohmann::json::parse(original.provenance_json())["source"]);
+  return unpacked;
+}
+
+class VxlzPackage : public ::testing::TestWithParam<std::uint32_t> {
+ protected:
+  ScratchDir dir;
+};
+
+TEST_P(VxlzPackage, RoundTripKeepsStructureAndStaysWithinTheBound) {
+  const std::string vxl = convert_to(test_tractogram(), dir.file("synthetic.vxl"));
+  ASSERT_GT(VxlFile::open(vxl).meta().synthetic_point_count, 0u) << "the test data must have synthetic points";
+  round_trip(dir, vxl, GetParam());
+}
+
+INSTANTIATE_TEST_SUITE_P(Bits, VxlzPackage, ::testing::Values(11u, 14u, 16u));
+
+TEST(VxlzDraco, ChunkKeepsPointOrderAndDuplicates) {
+  // Sequential encoding must keep the order, and no deduplication may merge the many repeated values.
+  std::mt19937 rng(3);
+  std::vector<std::int32_t> values(3 * 5000);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = i % 7 == 0 ? 0 : static_cast<std::int32_t>(rng() % 200001) - 100000;
+  for (std::size_t i = 300; i < 600; ++i) values[i] = 42;  // a run of identical points
+  const std::vector<std::uint8_t> buffer = encode_residual_chunk(values);
+  std::vector<std::int32_t> back(values.size());
+  decode_residual_chunk(buffer, back, "chunk", 0);
+  EXPECT_EQ(back, values);
+  std::vector<std::int32_t> wrong_count(values.size() - 3);
+  EXPECT_THROW(decode_residual_chunk(buffer, wrong_count, "chunk", 0), Error);
+}
+
+TEST(VxlzPackageOptions, ChunkSizeAndThreadsDoNotChangeTheResult) {
+  // Decoded values depend only on the quantised points, never on how they are chunked or scheduled;
+  // tiny chunks also split streamlines and voxlines across chunk boundaries.
+  ScratchDir dir;
+  const std::string vxl = convert_to(test_tractogram(300), dir.file("s.vxl"));
+  PackSettings tiny;
+  tiny.chunk_points = 7;
+  tiny.threads = 2;
+  const std::string a = round_trip(dir, vxl, 12, tiny);
+  std::filesystem::rename(a, dir.file("tiny.vxl"));
+  PackSettings one;
+  one.threads = 1;
+  const std::string b = round_trip(dir, vxl, 12, one);
+  const VxlFile fa = VxlFile::open(dir.file("tiny.vxl")), fb = VxlFile::open(b);
+  EXPECT_EQ(to_vector(fa.vertices()), to_vector(fb.vertices()));
+  EXPECT_EQ(to_vector(fa.order_bytes()), to_vector(fb.order_bytes()));
+}
+
+TEST(VxlzPackageOptions, EmptyTractogram) {
+  ScratchDir dir;
+  Tractogram t;
+  t.source.path = "empty.tck";
+  const std::string vxl = convert_to(std::move(t), dir.file("empty.vxl"));
+  round_trip(dir, vxl, 14);
+}
+
+TEST(VxlzPackageOptions, BitsOutOfRangeAreAUsageError) {
+  ScratchDir dir;
+  const std::string vxl = convert_to(test_tractogram(20), dir.file("s.vxl"));
+  for (std::uint32_t bits : {10u, 17u}) {
+    PackSettings s;
+    s.bits = bits;
+    try {
+      pack_vxl(VxlFile::open(vxl), dir.file("x.vxlz"), s);
+      ADD_FAILURE() << bits;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Usage);
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir.file("x.vxlz")));
+  }
+}
+
+// Damage -----------------------------------------------------------------------------------------
+
+class DamagedVxlz : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    Tractogram t;
+    t.source.path = "small.tck";
+    t.source.format = "tck";
+    for (int s = 0; s < 10; ++s) {
+      std::vector<float> pts;
+      for (int i = 0; i < 8; ++i) pts.insert(pts.end(), {3.0f * i + s, 2.0f * s - i, 0.5f * i * s});
+      t.add_streamline(pts.data(), 8);
+    }
+    const float jump[6] = {0, 0, 0, 40, 1, 1};
+    t.add_streamline(jump, 2);
+    t.groups.push_back({"g", {1, 4}});
+    convert_to(std::move(t), dir.file("small.vxl"), 8);
+    PackSettings s;
+    s.chunk_points = 16;  // several chunks
+    pack_vxl(VxlFile::open(dir.file("small.vxl")), good(), s);
+  }
+  std::string good() const { return dir.file("good.vxlz"); }
+  std::string out() const { return dir.file("out.vxl"); }
+
+  // Unpacking `path` must throw an Error (Input; Unsupported when a damaged byte reads as a newer
+  // version) that names the file, and leave no output.
+  void expect_refused(const std::string& path, const std::string& what) {
+    try {
+      unpack_vxlz(path, out(), {});
+      ADD_FAILURE() << what << ": accepted";
+    } catch (const Error& e) {
+      EXPECT_TRUE(e.kind() == ErrorKind::Input || e.kind() == ErrorKind::Unsupported) << what << ": " << e.what();
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << "the message names the file: " << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(out())) << what;
+  }
+
+  // The package's content as the writer takes it, for crafted packages with valid checksums.
+  VxlzContent content() const {
+    const VxlzFile f = VxlzFile::open(good());
+    VxlzContent c;
+    c.pack = f.pack();
+    c.meta = f.meta();
+    c.directions = to_vector(f.directions());
+    c.voxel_coords = f.inflate(section_id("VOXC"));
+    c.streamline_voxlines = f.inflate(section_id("STRL"));
+    c.voxline_voxels = f.inflate(section_id("VXLV"));
+    c.voxline_counts = f.inflate(section_id("VXLC"));
+    const auto prov = f.inflate(section_id("PROV"));
+    c.provenance = std::string(prov.begin(), prov.end());
+    c.groups = f.inflate(section_id("GRPS"));
+    for (std::uint64_t i = 0; i < f.chunk_count(); ++i) c.chunks.push_back(to_vector(f.chunk(i)));
+    return c;
+  }
+  void expect_crafted_refused(const VxlzContent& c, const std::string& what) {
+    const std::string path = dir.file("crafted.vxlz");
+    write_vxlz(path, c);
+    expect_refused(path, what);
+  }
+
+  ScratchDir dir;
+};
+
+TEST_F(DamagedVxlz, TheGoodPackageUnpacks) {
+  unpack_vxlz(good(), out(), {});
+  EXPECT_TRUE(verify_vxl(out()).valid);
+  EXPECT_GT(VxlzFile::open(good()).chunk_count(), 3u);
+}
+
+TEST_F(DamagedVxlz, EverySingleByteChangeIsRefused) {
+  const std::vector<char> bytes = slurp(good());
+  ASSERT_GT(bytes.size(), 500u);
+  const std::string bad = dir.file("bad.vxlz");
+  for (std::size_t pos = 0; pos < bytes.size(); ++pos) {
+    std::vector<char> b = bytes;
+    b[pos] = static_cast<char>(b[pos] ^ (1 + pos % 255));
+    dump(bad, b, b.size());
+    SCOPED_TRACE(pos);
+    expect_refused(bad, "byte " + std::to_string(pos));
+    if (HasFailure()) break;
+  }
+}
+
+TEST_F(DamagedVxlz, EveryTruncationIsRefused) {
+  const std::vector<char> bytes = slurp(good());
+  const std::string bad = dir.file("bad.vxlz");
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    dump(bad, bytes, n);
+    expect_refused(bad, "truncated to " + std::to_string(n));
+    if (HasFailure()) break;
+  }
+  std::vector<char> longer = bytes;
+  longer.push_back(0);
+  dump(bad, longer, longer.size());
+  expect_refused(bad, "one byte appended");
+}
+
+// Recomputes every section checksum and the header checksum, so that damage reaches the decoders.
+void fix_checksums(std::vector<char>& b) {
+  FileHeader h;
+  std::memcpy(&h, b.data(), sizeof h);
+  for (std::uint32_t i = 0; i < h.section_count; ++i) {
+    SectionEntry e;
+    std::memcpy(&e, b.data() + sizeof h + i * sizeof e, sizeof e);
+    e.checksum = xxh3_64(b.data() + e.offset, e.size);
+    std::memcpy(b.data() + sizeof h + i * sizeof e, &e, sizeof e);
+  }
+  h.header_checksum = 0;
+  std::memcpy(b.data(), &h, sizeof h);
+  h.header_checksum = xxh3_64(b.data(), sizeof h + h.section_count * sizeof(SectionEntry));
+  std::memcpy(b.data(), &h, sizeof h);
+}
+
+TEST_F(DamagedVxlz, DamageBehindValidChecksumsNeverCrashes) {
+  // Every payload byte changed, checksums recomputed: the zlib, varint and Draco decoders and the
+  // structure checks see the damage. Each package is refused with an Error or, where the change is
+  // still a meaningful package (a different residual, say), unpacks to a file that verify accepts.
+  const std::vector<char> bytes = slurp(good());
+  FileHeader h;
+  std::memcpy(&h, bytes.data(), sizeof h);
+  const std::size_t payloads = sizeof h + h.section_count * sizeof(SectionEntry);
+  const std::string bad = dir.file("bad.vxlz");
+  std::size_t refused = 0, accepted = 0;
+  for (std::size_t pos = payloads; pos < bytes.size(); ++pos) {
+    std::vector<char> b = bytes;
+    b[pos] = static_cast<char>(b[pos] ^ (pos % 2 ? 0x80 : 0x01));  // the lowest or the highest bit
+    fix_checksums(b);
+    dump(bad, b, b.size());
+    try {
+      unpack_vxlz(bad, out(), {});
+      const VerifyResult r = verify_vxl(out());
+      EXPECT_TRUE(r.valid) << "byte " << pos << ": " << r.problem;
+      std::filesystem::remove(out());
+      ++accepted;
+    } catch (const Error&) {
+      EXPECT_FALSE(std::filesystem::exists(out()));
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 0u);
+  EXPECT_GT(accepted, 0u);
+}
+
+TEST_F(DamagedVxlz, NewerMajorVersionIsUnsupported) {
+  std::vector<char> b = slurp(good());
+  b[8] = 2;
+  dump(dir.file("v2.vxlz"), b, b.size());
+  try {
+    unpack_vxlz(dir.file("v2.vxlz"), out(), {});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+  }
+}
+
+TEST_F(DamagedVxlz, CraftedPackagesWithValidChecksumsAreRefused) {
+  // The checksums catch damage; these packages are consistent byte-wise but wrong in meaning.
+  {
+    VxlzContent c = content();
+    c.pack.quantization_bits = 17;
+    expect_crafted_refused(c, "17 bits");
+  }
+  {
+    VxlzContent c = content();
+    c.pack.chunk_count += 1;
+    expect_crafted_refused(c, "chunk count");
+  }
+  {
+    VxlzContent c = content();
+    c.meta.voxline_count += 1;
+    expect_crafted_refused(c, "voxline count");
+  }
+  {
+    VxlzContent c = content();
+    c.meta.vertex_count += 1;
+    expect_crafted_refused(c, "vertex count");
+  }
+  {
+    VxlzContent c = content();
+    c.meta.voxline_count = std::uint64_t(1) << 60;  // must not allocate for it
+    expect_crafted_refused(c, "huge voxline count");
+  }
+  {
+    VxlzContent c = content();
+    c.voxline_voxels[0] = 0x7F;  // a voxel index far past the table
+    expect_crafted_refused(c, "voxel index");
+  }
+  {
+    VxlzContent c = content();
+    c.voxline_counts.push_back(2);  // a value after the expected ones
+    expect_crafted_refused(c, "trailing value");
+  }
+  {
+    VxlzContent c = content();
+    c.voxline_counts[0] = 1;  // own count 0
+    expect_crafted_refused(c, "empty voxline");
+  }
+  {
+    VxlzContent c = content();
+    c.voxel_coords.assign(c.voxel_coords.size(), 0);  // every voxel at (0, 0, 0): not increasing
+    expect_crafted_refused(c, "voxel order");
+  }
+  {
+    VxlzContent c = content();
+    c.chunks[0] = encode_residual_chunk(std::vector<std::int32_t>(3 * (c.pack.chunk_points - 1), 0));
+    expect_crafted_refused(c, "chunk with one point too few");
+  }
+  {
+    VxlzContent c = content();
+    std::vector<std::int32_t> huge(3 * c.pack.chunk_points, 1 << 17);  // decodes outside the grid
+    c.chunks[0] = encode_residual_chunk(huge);
+    expect_crafted_refused(c, "residuals off the grid");
+  }
+  {
+    VxlzContent c = content();
+    c.chunks[1].resize(c.chunks[1].size() / 2);  // a truncated Draco buffer
+    expect_crafted_refused(c, "truncated chunk");
+  }
+  {
+    VxlzContent c = content();
+    c.groups = encode_group_stream(std::vector<GroupContent>{{"g", {3, 2}}});  // not increasing
+    expect_crafted_refused(c, "group order");
+  }
+  {
+    VxlzContent c = content();
+    c.provenance = "[1, 2]";
+    expect_crafted_refused(c, "provenance not an object");
+  }
+}
+
+TEST_F(DamagedVxlz, CliReportsDamageWithExitCode3) {
+  std::vector<char> b = slurp(good());
+  b[b.size() / 2] ^= 0x10;
+  dump(dir.file("bad.vxlz"), b, b.size());
+  const auto r = test::run_cli("unpack '" + dir.file("bad.vxlz") + "' '" + out() + "'");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("bad.vxlz"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("checksum mismatch"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out()));
+}
+
+// The command line and real data ----------------------------------------------------------------
+
+TEST(VxlzPackCli, PackUnpackVerify) {
+  ScratchDir dir;
+  const std::string vxl = convert_to(test_tractogram(100), dir.file("s.vxl"));
+  auto r = test::run_cli("pack '" + vxl + "' '" + dir.file("s.vxlz") + "' --bits 11");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("error bound"), std::string::npos) << r.output;
+  r = test::run_cli("unpack '" + dir.file("s.vxlz") + "' '" + dir.file("u.vxl") + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_cli("verify '" + dir.file("u.vxl") + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_cli("pack '" + vxl + "' '" + dir.file("t.vxlz") + "' --bits 9");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = test::run_cli("unpack '" + vxl + "' '" + dir.file("w.vxl") + "'");  // a .vxl is not a package
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("not a .vxlz package"), std::string::npos) << r.output;
+}
+
+TEST(VxlzPackageReal, StrokeAndAfqRoundTrip) {
+  VXL_REQUIRE_REAL_DATA();
+  ScratchDir dir;
+  for (const char* name : {"TractographyFormat__stroke.tck",
+                           "niivue__sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx",
+                           "niivue__C_PHP.trk.gz", "mrtrix3__tmp.tck", "nibabel__empty.tck"}) {
+    SCOPED_TRACE(name);
+    const std::string vxl = convert_to(read_tractogram(test::real(name)), dir.file("real.vxl"));
+    for (std::uint32_t bits : {11u, 14u, 16u}) round_trip(dir, vxl, bits);
+  }
+}
+
+}  // namespace
+}  // namespace vxl
