@@ -18,34 +18,13 @@
 #include <thread>
 #include <vector>
 
+#include "child_process.h"
 #include "vxl_file.h"
 
 namespace {
 
-struct ChildRun {
-  double seconds;
-  long peak_rss_kib;
-  int exit_code;
-};
-
-ChildRun run_child(const std::vector<std::string>& args) {
-  auto start = std::chrono::steady_clock::now();
-  pid_t pid = fork();
-  if (pid == 0) {
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    int devnull = ::open("/dev/null", 1);
-    dup2(devnull, 1);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  struct rusage ru {};
-  wait4(pid, &status, 0, &ru);
-  double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return {s, ru.ru_maxrss, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
-}
+using vxl::bench::ChildRun;
+using vxl::bench::run_child;
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());

@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "child_process.h"
 #include "error.h"
 #include "vxl_file.h"
 #include "vxl_streamlines.h"
@@ -31,30 +32,8 @@
 
 namespace {
 
-struct ChildRun {
-  double seconds;
-  long peak_rss_kib;
-  int exit_code;
-};
-
-ChildRun run_child(const std::vector<std::string>& args) {
-  const auto start = std::chrono::steady_clock::now();
-  const pid_t pid = fork();
-  if (pid == 0) {
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    const int devnull = ::open("/dev/null", O_WRONLY);
-    dup2(devnull, 1);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  struct rusage ru {};
-  wait4(pid, &status, 0, &ru);
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return {s, ru.ru_maxrss, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
-}
+using vxl::bench::ChildRun;
+using vxl::bench::run_child;
 
 // Runs the command `runs` times; the median time and the largest peak RSS.
 ChildRun median_run(const std::vector<std::string>& args, int runs) {

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "child_process.h"
 #include "egl_context.h"
 #include "frame_plan.h"
 #include "offscreen_target.h"
@@ -32,24 +33,10 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Wall time of a child process, from fork to exit.
+// Wall time of a child process, from fork to exit; -1 when it failed.
 double run_child_seconds(const std::vector<std::string>& args) {
-  std::fflush(stdout);  // the child must not inherit (and print again) buffered output
-  auto t0 = Clock::now();
-  pid_t pid = fork();
-  if (pid == 0) {
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    freopen("/dev/null", "w", stdout);
-    freopen("/dev/null", "w", stderr);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return -1;
-  return std::chrono::duration<double>(Clock::now() - t0).count();
+  vxl::bench::ChildRun r = vxl::bench::run_child(args, true);
+  return r.exit_code == 0 ? r.seconds : -1;
 }
 
 vxl::Camera turntable_camera(const vxl::Renderer& r, int step, int steps) {
