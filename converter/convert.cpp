@@ -84,6 +84,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   out.set_meta(meta);
   std::vector<DirectionEntry> directions = order_directions(order_set);
   std::copy(directions.begin(), directions.end(), out.directions().begin());
+  fill_voxel_directions(order_set, out.voxels(), out.voxel_directions());
   std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
   std::copy(groups_bytes.begin(), groups_bytes.end(), out.groups().begin());
   out.commit(threads);

@@ -30,10 +30,57 @@ OrderSetSpec parse_order_set(const std::string& name) {
     set.directions.push_back({k, k, -k});
     return set;
   }
-  throw Error(ErrorKind::Usage, "", std::nullopt, "unknown order set '" + name + "' (expected axis or axis+diag)");
+  if (name.starts_with("random:")) {
+    const std::string count = name.substr(7);
+    const bool digits = !count.empty() && count.size() <= 2 && count.find_first_not_of("0123456789") == std::string::npos;
+    const unsigned n = digits ? static_cast<unsigned>(std::stoul(count)) : 0;
+    if (n >= 1 && n <= kVxlMaxStoredOrders) {
+      set.kind = OrderSet::Random;
+      set.directions.assign(n, {1, 0, 0});  // placeholders: the real directions are per voxel
+      return set;
+    }
+  }
+  throw Error(ErrorKind::Usage, "", std::nullopt,
+              "unknown order set '" + name + "' (expected axis, axis+diag or random:N with N in 1..64)");
 }
 
 namespace {
+
+// splitmix64 (Steele, Lea & Flood, "Fast splittable pseudorandom number generators", 2014): our own, so
+// that the directions do not depend on the standard library.
+struct SplitMix64 {
+  std::uint64_t state;
+  std::uint64_t next() {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  double uniform_signed() { return double(next() >> 11) * 0x1.0p-52 - 1.0; }  // [-1, 1), exactly
+};
+
+// A generator whose stream depends on (seed, coord) alone: each coordinate is folded in through a full
+// splitmix64 step, so neighbouring voxels get unrelated directions.
+SplitMix64 voxel_generator(std::uint64_t seed, const std::int32_t (&coord)[3]) {
+  SplitMix64 g{seed};
+  for (int c = 0; c < 3; ++c) {
+    g.state ^= std::uint64_t(std::uint32_t(coord[c])) << (16 * c);
+    g.state = g.next();
+  }
+  return g;
+}
+
+// A direction uniform on the unit sphere: a point uniform in the unit ball (rejection from the cube),
+// normalised. Only + * / sqrt: the same bits on every IEEE-754 platform, unlike sin/cos.
+std::array<float, 3> uniform_direction(SplitMix64& g) {
+  for (;;) {
+    const double x = g.uniform_signed(), y = g.uniform_signed(), z = g.uniform_signed();
+    const double r2 = x * x + y * y + z * z;
+    if (r2 > 1.0 || r2 < 1e-6) continue;  // outside the ball, or too short to normalise accurately
+    const double inv = 1.0 / std::sqrt(r2);
+    return {static_cast<float>(x * inv), static_cast<float>(y * inv), static_cast<float>(z * inv)};
+  }
+}
 
 // Order-preserving map of a double (not NaN) to an unsigned integer: its sign and magnitude as a two's
 // complement integer, offset by 2^63. Unlike flipping every bit of negative numbers, this keeps the zero
@@ -164,6 +211,25 @@ std::vector<DirectionEntry> order_directions(const OrderSetSpec& set) {
   return out;
 }
 
+void voxel_directions(const OrderSetSpec& set, const std::int32_t (&coord)[3], std::span<std::array<float, 3>> out) {
+  if (!set.per_voxel()) {
+    std::copy(set.directions.begin(), set.directions.end(), out.begin());
+    return;
+  }
+  SplitMix64 g = voxel_generator(set.seed, coord);
+  for (auto& d : out) d = uniform_direction(g);
+}
+
+void fill_voxel_directions(const OrderSetSpec& set, std::span<const VoxelEntry> voxels, std::span<DirectionEntry> out) {
+  if (!set.per_voxel()) return;
+  const std::size_t k_count = set.directions.size();
+  std::vector<std::array<float, 3>> dirs(k_count);
+  for (std::size_t i = 0; i < voxels.size(); ++i) {
+    voxel_directions(set, voxels[i].coord, dirs);
+    for (std::size_t k = 0; k < k_count; ++k) out[i * k_count + k] = {{dirs[k][0], dirs[k][1], dirs[k][2]}, 0};
+  }
+}
+
 std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_orders) {
   std::uint64_t total = 0;
   for (VoxelEntry& v : voxels) {
@@ -179,19 +245,27 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float
   const std::uint32_t k_count = static_cast<std::uint32_t>(set.directions.size());
 
   // Axis directions sort by one exact component sum, as in the paper; others by a dot product.
-  std::vector<int> axis_of(k_count, -1);
-  for (std::uint32_t k = 0; k < k_count; ++k)
+  auto axis_of = [](const std::array<float, 3>& d) {
     for (int c = 0; c < 3; ++c)
-      if (set.directions[k][c] == 1.0f && set.directions[k][(c + 1) % 3] == 0.0f && set.directions[k][(c + 2) % 3] == 0.0f)
-        axis_of[k] = c;
+      if (d[c] == 1.0f && d[(c + 1) % 3] == 0.0f && d[(c + 2) % 3] == 0.0f) return c;
+    return -1;
+  };
 
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
   auto worker = [&](bool reports) {
     std::vector<std::uint32_t> starts;
+    std::vector<std::array<float, 3>> directions(k_count);
+    std::vector<int> axis(k_count);
+    bool have_directions = false;  // shared directions are looked up once per worker
     SortScratch scratch;
     for (std::size_t i; (i = next++) < voxels.size();) {
       const VoxelEntry& v = voxels[i];
+      if (!have_directions || set.per_voxel()) {
+        voxel_directions(set, v.coord, directions);
+        for (std::uint32_t k = 0; k < k_count; ++k) axis[k] = axis_of(directions[k]);
+        have_directions = true;
+      }
       // The segments start at every vertex that does not end its voxline (branch-free: ends are
       // scattered, a branch would mispredict often).
       starts.resize(v.vertex_count);
@@ -206,13 +280,13 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float
       std::uint8_t* dst = orders.data() + v.order_offset;
       for (std::uint32_t k = 0; k < k_count; ++k) {
         scratch.keys.resize(starts.size());
-        const auto& d = set.directions[k];
+        const auto& d = directions[k];
         std::uint64_t all_or = 0, all_and = ~0ull;
         for (std::size_t n = 0; n < starts.size(); ++n) {
           const float* a = block + 3 * starts[n];
           double key;
-          if (axis_of[k] >= 0) {
-            key = double(a[axis_of[k]]) + double(a[axis_of[k] + 3]);
+          if (axis[k] >= 0) {
+            key = double(a[axis[k]]) + double(a[axis[k] + 3]);
           } else {
             key = 0;
             for (int c = 0; c < 3; ++c) key += (double(a[c]) + double(a[c + 3])) * double(d[c]);
@@ -242,6 +316,8 @@ BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsig
   vt.meta.stored_order_count = static_cast<std::uint32_t>(set.directions.size());
   vt.meta.order_set = static_cast<std::uint32_t>(set.kind);
   out.bytes.assign(layout_orders(vt.voxels, vt.meta.stored_order_count), 0);
+  if (set.per_voxel()) out.voxel_directions.resize(vt.voxels.size() * set.directions.size());
+  fill_voxel_directions(set, vt.voxels, out.voxel_directions);
   build_orders_into(vt.voxels, vt.vertices, vt.voxline_ends, set, out.bytes, threads, progress);
   return out;
 }

@@ -46,6 +46,13 @@ class VxlFile {
 
   const MetaSection& meta() const { return meta_; }
   std::span<const DirectionEntry> directions() const { return directions_; }
+  // VDIR (spec §5.10): voxel_count x K entries, empty when the file has one direction set for all voxels.
+  std::span<const DirectionEntry> voxel_directions() const { return voxel_directions_; }
+  // The K directions voxel `voxel`'s orders are sorted by: its VDIR entries, or DIRS.
+  std::span<const DirectionEntry> directions_of(std::size_t voxel) const {
+    if (voxel_directions_.empty()) return directions_;
+    return voxel_directions_.subspan(voxel * directions_.size(), directions_.size());
+  }
   std::span<const VoxelEntry> voxels() const { return voxels_; }
   std::span<const float> vertices() const { return vertices_; }  // 3 * vertex_count
   std::span<const std::uint8_t> order_bytes() const { return orders_; }
@@ -65,6 +72,7 @@ class VxlFile {
   std::span<const SectionEntry> sections_;
   MetaSection meta_{};
   std::span<const DirectionEntry> directions_;
+  std::span<const DirectionEntry> voxel_directions_;
   std::span<const VoxelEntry> voxels_;
   std::span<const float> vertices_;
   std::span<const std::uint8_t> orders_;

@@ -54,15 +54,21 @@ void check_meta_and_dirs(const VxlFile& f) {
   const MetaSection& m = f.meta();
   const std::uint64_t meta_at = f.find_section(section_id("META"))->offset;
   if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 152, "META reserved bytes are not zero");
-  const std::uint64_t dirs_at = f.find_section(section_id("DIRS"))->offset;
-  for (std::size_t k = 0; k < f.directions().size(); ++k) {
-    const DirectionEntry& d = f.directions()[k];
-    double len = std::sqrt(double(d.xyz[0]) * d.xyz[0] + double(d.xyz[1]) * d.xyz[1] + double(d.xyz[2]) * d.xyz[2]);
-    if (d.reserved != 0 || !(std::abs(len - 1.0) < 1e-5)) fail_input(p, dirs_at + 16 * k, "direction is not a unit vector");
-  }
+  auto check_unit = [&](std::span<const DirectionEntry> dirs, const char (&id)[5]) {
+    const std::uint64_t at = f.find_section(section_id(id))->offset;
+    for (std::size_t k = 0; k < dirs.size(); ++k) {
+      const DirectionEntry& d = dirs[k];
+      double len = std::sqrt(double(d.xyz[0]) * d.xyz[0] + double(d.xyz[1]) * d.xyz[1] + double(d.xyz[2]) * d.xyz[2]);
+      if (d.reserved != 0 || !(std::abs(len - 1.0) < 1e-5))
+        fail_input(p, at + 16 * k, std::string(id) + " direction is not a unit vector");
+    }
+  };
+  check_unit(f.directions(), "DIRS");
+  if (!f.voxel_directions().empty()) check_unit(f.voxel_directions(), "VDIR");
 }
 
-// Every order must be a permutation of the voxel's segments, sorted by the key of spec §6.4.
+// Every order must be a permutation of the voxel's segments, sorted by the key of spec §6.4 for the
+// voxel's own direction (VDIR) or the shared one (DIRS).
 void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_start) {
   const std::string& p = f.path();
   const std::uint64_t ordr_at = f.find_section(section_id("ORDR"))->offset;
@@ -78,7 +84,7 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
       fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i,
                  "voxel " + std::to_string(i) + " segment count does not match its voxlines");
     for (std::uint32_t k = 0; k < f.meta().stored_order_count; ++k) {
-      const DirectionEntry& dir = f.directions()[k];
+      const DirectionEntry& dir = f.directions_of(i)[k];
       OrderView o = f.order(i, k);
       seen.assign(v.vertex_count, 0);
       double previous_key = -INFINITY;

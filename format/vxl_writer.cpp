@@ -33,6 +33,7 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
                               std::uint64_t group_bytes) {
   VxlSectionSizes s;
   s.directions = std::uint64_t(m.stored_order_count) * sizeof(DirectionEntry);
+  if (m.order_set == static_cast<std::uint32_t>(OrderSet::Random)) s.voxel_directions = m.voxel_count * s.directions;
   s.voxels = std::uint64_t(m.voxel_count) * sizeof(VoxelEntry);
   s.vertices = m.vertex_count * 3 * sizeof(float);
   s.orders = order_bytes;
@@ -48,18 +49,31 @@ VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : ou
     const char* id;
     std::uint32_t flags;
     std::uint64_t size;
+    bool present;
   };
-  std::vector<Planned> planned = {
-      {"META", kSectionRequired, sizeof(MetaSection)}, {"DIRS", kSectionRequired, sizes.directions},
-      {"VOXT", kSectionRequired, sizes.voxels},        {"VERT", kSectionRequired, sizes.vertices},
-      {"ORDR", kSectionRequired, sizes.orders},        {"VXLN", kSectionRequired, sizes.voxlines},
-      {"STRM", kSectionRequired, sizes.streamlines},   {"PROV", 0, sizes.provenance},
+  // In Index order. VDIR is required: a reader that cannot use per-voxel directions would pick wrong
+  // orders, so it must refuse the file (spec §4, §10).
+  const Planned planned[kIndexCount] = {
+      {"META", kSectionRequired, sizeof(MetaSection), true},
+      {"DIRS", kSectionRequired, sizes.directions, true},
+      {"VDIR", kSectionRequired, sizes.voxel_directions.value_or(0), sizes.voxel_directions.has_value()},
+      {"VOXT", kSectionRequired, sizes.voxels, true},
+      {"VERT", kSectionRequired, sizes.vertices, true},
+      {"ORDR", kSectionRequired, sizes.orders, true},
+      {"VXLN", kSectionRequired, sizes.voxlines, true},
+      {"STRM", kSectionRequired, sizes.streamlines, true},
+      {"PROV", 0, sizes.provenance, true},
+      {"GRPS", 0, sizes.groups, sizes.groups > 0},
   };
-  if (sizes.groups > 0) planned.push_back({"GRPS", 0, sizes.groups});
+  std::size_t present = 0;
+  for (const Planned& p : planned) present += p.present;
 
   // Header and table first, then each payload padded to a multiple of 64 (spec §2).
-  std::uint64_t position = align_up(sizeof(FileHeader) + planned.size() * sizeof(SectionEntry), kVxlAlignment);
-  for (const Planned& p : planned) {
+  std::uint64_t position = align_up(sizeof(FileHeader) + present * sizeof(SectionEntry), kVxlAlignment);
+  for (std::size_t i = 0; i < kIndexCount; ++i) {
+    const Planned& p = planned[i];
+    position_[i] = p.present ? table_.size() : present;
+    if (!p.present) continue;
     SectionEntry e{};
     std::memcpy(e.id, p.id, 4);
     e.flags = p.flags;
@@ -72,8 +86,9 @@ VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : ou
 }
 
 std::span<std::uint8_t> VxlWriter::payload(Index i) {
-  if (i >= table_.size()) return {};
-  return file_.subspan(table_[i].offset, table_[i].size);
+  const std::size_t at = position_[i];
+  if (at >= table_.size()) return {};
+  return file_.subspan(table_[at].offset, table_[at].size);
 }
 
 void VxlWriter::set_meta(const MetaSection& meta) {
@@ -103,7 +118,8 @@ void VxlWriter::commit(unsigned threads) {
   FileHeader h{};
   std::memcpy(h.magic, kVxlMagic.data(), 8);
   h.version_major = kVxlVersionMajor;
-  h.version_minor = kVxlVersionMinor;
+  // The lowest version that holds what is written (spec §10).
+  h.version_minor = position_[kVdir] < table_.size() ? kVxlVersionMinorVoxelDirections : kVxlVersionMinor;
   h.header_size = sizeof(FileHeader);
   h.file_size = file_.size();
   h.section_table_offset = sizeof(FileHeader);
@@ -124,6 +140,7 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   if (!c.groups.empty()) groups_bytes = encode_groups(c.groups);
   VxlSectionSizes sizes;
   sizes.directions = c.directions.size_bytes();
+  if (c.meta.order_set == static_cast<std::uint32_t>(OrderSet::Random)) sizes.voxel_directions = c.voxel_directions.size_bytes();
   sizes.voxels = c.voxels.size_bytes();
   sizes.vertices = c.vertices.size_bytes();
   sizes.orders = c.orders.size_bytes();
@@ -138,6 +155,7 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   };
   w.set_meta(c.meta);
   copy(w.directions(), c.directions.data());
+  copy(w.voxel_directions(), c.voxel_directions.data());
   copy(w.voxels(), c.voxels.data());
   copy(w.vertices(), c.vertices.data());
   copy(w.orders(), c.orders.data());

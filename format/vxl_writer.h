@@ -5,7 +5,9 @@
 // them into the page cache: the output is the largest thing the converter makes.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -17,12 +19,15 @@ namespace vxl {
 
 // Payload sizes in bytes, one per section, in file order (spec §4). They fix the whole layout.
 struct VxlSectionSizes {
-  std::uint64_t directions = 0, voxels = 0, vertices = 0, orders = 0, voxlines = 0, streamlines = 0;
+  std::uint64_t directions = 0;
+  std::optional<std::uint64_t> voxel_directions;  // VDIR; only with order set random (spec §5.10)
+  std::uint64_t voxels = 0, vertices = 0, orders = 0, voxlines = 0, streamlines = 0;
   std::uint64_t provenance = 0;
   std::uint64_t groups = 0;  // 0: no GRPS section
 };
 
-// The sizes spec §5 gives for the counts in `meta` (stored_order_count included).
+// The sizes spec §5 gives for the counts in `meta` (stored_order_count included; a VDIR section when
+// order_set is random).
 VxlSectionSizes section_sizes(const MetaSection& meta, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
                               std::uint64_t group_bytes);
 
@@ -37,6 +42,8 @@ class VxlWriter {
   // not fill completely keeps zeros, and the padding between payloads stays zero (spec §2).
   void set_meta(const MetaSection& meta);  // zeroes the reserved bytes
   std::span<DirectionEntry> directions() { return typed<DirectionEntry>(kDirs); }
+  // voxel_count x K entries; empty when there is no VDIR section.
+  std::span<DirectionEntry> voxel_directions() { return typed<DirectionEntry>(kVdir); }
   std::span<VoxelEntry> voxels() { return typed<VoxelEntry>(kVoxt); }
   std::span<float> vertices() { return typed<float>(kVert); }
   std::span<std::uint8_t> orders() { return payload(kOrdr); }
@@ -51,7 +58,8 @@ class VxlWriter {
   void commit(unsigned threads = 0);
 
  private:
-  enum Index : std::size_t { kMeta, kDirs, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps };
+  // Sections in file order; VDIR and GRPS are optional.
+  enum Index : std::size_t { kMeta, kDirs, kVdir, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps, kIndexCount };
   std::span<std::uint8_t> payload(Index i);
   template <typename T>
   std::span<T> typed(Index i) {
@@ -60,7 +68,8 @@ class VxlWriter {
   }
 
   AtomicOutputFile out_;
-  std::vector<SectionEntry> table_;  // in Index order; GRPS only when present
+  std::vector<SectionEntry> table_;  // in Index order, optional sections only when present
+  std::array<std::size_t, kIndexCount> position_{};  // Index -> entry of table_ (table_.size(): absent)
   std::span<std::uint8_t> file_;
 };
 
@@ -74,6 +83,7 @@ struct GroupContent {
 struct VxlContent {
   MetaSection meta{};
   std::span<const DirectionEntry> directions;
+  std::span<const DirectionEntry> voxel_directions;  // VDIR, written when meta.order_set is random
   std::span<const VoxelEntry> voxels;
   std::span<const float> vertices;  // 3 * vertex_count
   std::span<const std::uint8_t> orders;

@@ -3,8 +3,10 @@
 
 #include "commands.h"
 #include "convert.h"
+#include "error.h"
 #include "progress_bar.h"
 #include "read_tractogram.h"
+#include "segment_orders.h"
 
 namespace vxl::cli {
 
@@ -21,8 +23,18 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--voxel-size", opt->settings.voxel_size, "voxel edge length in mm")
       ->default_val(10.0)->check(CLI::PositiveNumber);
   cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
-  cmd->add_option("--orders", opt->settings.orders, "precomputed order set: axis (6 orders) or axis+diag (14)")
-      ->default_val("axis")->check(CLI::IsMember({"axis", "axis+diag"}));
+  cmd->add_option("--orders", opt->settings.orders,
+                  "precomputed order set: axis (6 orders), axis+diag (14), or random:N (N pseudo-random directions "
+                  "per voxel, 2N orders, N in 1..64)")
+      ->default_val("axis")
+      ->check([](const std::string& name) -> std::string {
+        try {
+          parse_order_set(name);
+          return {};
+        } catch (const Error& e) {
+          return e.reason();
+        }
+      });
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
   cmd->callback([opt] {
     ProgressBar bar;

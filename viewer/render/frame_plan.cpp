@@ -18,7 +18,7 @@ ViewParams make_view_params(const glm::dvec3& eye, const glm::dvec3& forward, bo
   return v;
 }
 
-std::pair<std::uint32_t, bool> nearest_order(const std::vector<glm::vec3>& directions, const glm::dvec3& w) {
+std::pair<std::uint32_t, bool> nearest_order(std::span<const glm::vec3> directions, const glm::dvec3& w) {
   // Order k drawn forwards is back to front for an eye looking along -d_k; reversed, along +d_k. We want
   // the signed direction s maximising s . (-w): |d_k . w| largest, reversed when d_k . w > 0.
   std::uint32_t best = 0;
@@ -32,6 +32,12 @@ std::pair<std::uint32_t, bool> nearest_order(const std::vector<glm::vec3>& direc
     }
   }
   return {best, best_dot > 0};
+}
+
+double order_alignment(std::span<const glm::vec3> directions, std::uint32_t slot, bool reversed, const glm::dvec3& w) {
+  const glm::vec3& d = directions[slot];
+  const double dot = d.x * w.x + d.y * w.y + d.z * w.z;
+  return reversed ? dot : -dot;  // forwards serves w = -d, backwards w = +d
 }
 
 namespace {
@@ -63,6 +69,9 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
     plan.sort_keys.push_back({key, i});
   }
   if (order != PlanOrder::Any) std::sort(plan.sort_keys.begin(), plan.sort_keys.end());
+  const bool hysteresis = order == PlanOrder::Nearest && plan.order_hysteresis > 0;
+  if (order == PlanOrder::Nearest && !hysteresis) plan.previous_order.clear();
+  if (hysteresis && plan.previous_order.size() != voxels.size()) plan.previous_order.assign(voxels.size(), FramePlan::kNoOrder);
   plan.first.reserve(plan.sort_keys.size());
   plan.count.reserve(plan.sort_keys.size());
   for (const auto& [key, i] : plan.sort_keys) {
@@ -71,7 +80,21 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
     bool reversed = false;
     if (order == PlanOrder::Nearest) {
       glm::dvec3 w = view.orthographic ? view.forward : glm::normalize(v.center - view.eye);
-      std::tie(slot, reversed) = nearest_order(layout.directions(), w);
+      const std::span<const glm::vec3> directions = layout.directions_of(i);
+      std::tie(slot, reversed) = nearest_order(directions, w);
+      if (hysteresis) {
+        std::uint8_t& previous = plan.previous_order[i];
+        if (previous != FramePlan::kNoOrder) {
+          const std::uint32_t kept_slot = previous >> 1;
+          const bool kept_reversed = previous & 1;
+          if (order_alignment(directions, slot, reversed, w) - order_alignment(directions, kept_slot, kept_reversed, w) <=
+              plan.order_hysteresis) {
+            slot = kept_slot;
+            reversed = kept_reversed;
+          }
+        }
+        previous = static_cast<std::uint8_t>(2 * slot + (reversed ? 1 : 0));
+      }
     }
     plan.first.push_back(static_cast<std::int32_t>(layout.first_id(v, slot, reversed)));
     plan.count.push_back(static_cast<std::int32_t>(2 * v.segment_count));

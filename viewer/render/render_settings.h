@@ -31,6 +31,9 @@ struct RenderSettings {
   float opacity = 0.5f;    // 1 down to 0.001
   float line_width = 1.0f; // pixels
   bool white_background = false;
+  // `axis` mode: keep a voxel's order until another stored order is closer to its view direction by
+  // more than this cosine margin (FramePlan::order_hysteresis). 0: off, the paper's rule every frame.
+  float order_hysteresis = 0.0f;
   glm::vec3 background() const { return white_background ? glm::vec3(1.0f) : glm::vec3(0.0f); }
 };
 

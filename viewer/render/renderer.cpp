@@ -178,6 +178,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
     case RenderMode::Axis:
       clear_target(fbo, glm::vec4(bg, 1));
       over_blending();
+      plan_.order_hysteresis = s.order_hysteresis;
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Nearest);
       break;
     case RenderMode::Wboit: {

@@ -11,6 +11,8 @@ SceneLayout::SceneLayout(const VxlFile& file, std::uint64_t max_texels) {
   stored_orders_ = m.stored_order_count;
   voxel_size_ = m.voxel_size;
   for (const DirectionEntry& d : file.directions()) directions_.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
+  voxel_directions_.reserve(file.voxel_directions().size());
+  for (const DirectionEntry& d : file.voxel_directions()) voxel_directions_.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
   auto voxels = file.voxels();
   voxels_.resize(voxels.size());
 

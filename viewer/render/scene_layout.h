@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -53,7 +54,13 @@ class SceneLayout {
   std::uint32_t stored_orders() const { return stored_orders_; }     // K
   std::uint32_t slots() const { return stored_orders_ + 1; }         // K stored + block order
   std::uint32_t block_slot() const { return stored_orders_; }
-  const std::vector<glm::vec3>& directions() const { return directions_; }
+  const std::vector<glm::vec3>& directions() const { return directions_; }  // DIRS
+  // The K directions voxel `voxel`'s stored orders are sorted by: its own (VDIR, random order sets) or
+  // the shared DIRS.
+  std::span<const glm::vec3> directions_of(std::uint32_t voxel) const {
+    if (voxel_directions_.empty()) return directions_;
+    return std::span<const glm::vec3>(voxel_directions_).subspan(std::size_t(voxel) * stored_orders_, stored_orders_);
+  }
   const std::vector<VoxelDrawInfo>& voxels() const { return voxels_; }
   const std::vector<ChunkLayout>& chunks() const { return chunks_; }
   std::uint64_t virtual_ids() const { return virtual_ids_; }
@@ -75,6 +82,7 @@ class SceneLayout {
  private:
   std::uint32_t stored_orders_ = 0;
   std::vector<glm::vec3> directions_;
+  std::vector<glm::vec3> voxel_directions_;  // voxel-major, K per voxel; empty without VDIR
   std::vector<VoxelDrawInfo> voxels_;
   std::vector<ChunkLayout> chunks_;
   std::uint64_t virtual_ids_ = 0;
