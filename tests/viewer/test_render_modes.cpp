@@ -110,6 +110,22 @@ TEST_F(RenderModes, AxisAndBasicEqualExactWhereThePaperGuaranteesIt) {
   }
 }
 
+// 300 coincident green lines at opacity 0.01: 1 - 0.99^300 of full green. An 8-bit colour buffer would
+// stall near 205 (each blend rounds to 1/255 and a layer adds only 2.55 levels minus 1% of what is there).
+TEST_F(RenderModes, ManyFaintLayersAccumulateBeyondEightBitRounding) {
+  Tractogram t;
+  const float line[] = {0.5f, -19.5f, 0, 0.5f, 20.5f, 0};
+  for (int i = 0; i < 300; ++i) t.add_streamline(line, 2);
+  t.source.path = "faint_layers";
+  VxlFile f = make_scene(dir, std::move(t), 5.0);
+  Renderer r(f);
+  const double expected = 255 * (1 - std::pow(0.99, 300));  // 242.5
+  for (RenderMode m : {RenderMode::Axis, RenderMode::Basic, RenderMode::Unsorted, RenderMode::Exact}) {
+    Image img = render_image(r, top_view(), settings(m, 0.01f), 64, 64);
+    EXPECT_NEAR(img.pixel(32, 45)[1], expected, 2.0) << render_mode_name(m);
+  }
+}
+
 TEST_F(RenderModes, UnsortedDiffersFromExactOnAWrongDatasetOrder) {
   VxlFile f = make_scene(dir, crossing_lines(), 5.0);
   Renderer r(f);
