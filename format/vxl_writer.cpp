@@ -43,7 +43,7 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
   return s;
 }
 
-VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path) {
+VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
   struct Planned {
     const char* id;
     std::uint32_t flags;
@@ -57,7 +57,7 @@ VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : ou
   };
   if (sizes.groups > 0) planned.push_back({"GRPS", 0, sizes.groups});
 
-  // Header and table first, then each payload padded to a multiple of 64 (spec §2).
+  VxlLayout layout;
   std::uint64_t position = align_up(sizeof(FileHeader) + planned.size() * sizeof(SectionEntry), kVxlAlignment);
   for (const Planned& p : planned) {
     SectionEntry e{};
@@ -65,10 +65,36 @@ VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : ou
     e.flags = p.flags;
     e.offset = position;
     e.size = p.size;
-    table_.push_back(e);
+    layout.table.push_back(e);
     position = align_up(position + p.size, kVxlAlignment);
   }
-  file_ = out_.map(position);
+  layout.file_size = position;
+  return layout;
+}
+
+std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size) {
+  FileHeader h{};
+  std::memcpy(h.magic, kVxlMagic.data(), 8);
+  h.version_major = kVxlVersionMajor;
+  h.version_minor = kVxlVersionMinor;
+  h.header_size = sizeof(FileHeader);
+  h.file_size = file_size;
+  h.section_table_offset = sizeof(FileHeader);
+  h.section_count = static_cast<std::uint32_t>(table.size());
+  h.flags = 0;
+  h.header_checksum = 0;  // covered with this field zero (spec §3)
+  std::vector<std::uint8_t> bytes(sizeof h + table.size_bytes());
+  std::memcpy(bytes.data(), &h, sizeof h);
+  std::memcpy(bytes.data() + sizeof h, table.data(), table.size_bytes());
+  h.header_checksum = xxh3_64(bytes.data(), bytes.size());
+  std::memcpy(bytes.data(), &h, sizeof h);
+  return bytes;
+}
+
+VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path) {
+  VxlLayout layout = plan_vxl_layout(sizes);
+  table_ = std::move(layout.table);
+  file_ = out_.map(layout.file_size);
 }
 
 std::span<std::uint8_t> VxlWriter::payload(Index i) {
@@ -100,21 +126,8 @@ void VxlWriter::commit(unsigned threads) {
   worker();
   for (std::thread& t : pool) t.join();
 
-  FileHeader h{};
-  std::memcpy(h.magic, kVxlMagic.data(), 8);
-  h.version_major = kVxlVersionMajor;
-  h.version_minor = kVxlVersionMinor;
-  h.header_size = sizeof(FileHeader);
-  h.file_size = file_.size();
-  h.section_table_offset = sizeof(FileHeader);
-  h.section_count = static_cast<std::uint32_t>(table_.size());
-  h.flags = 0;
-  h.header_checksum = 0;  // covered with this field zero (spec §3)
-  const std::size_t table_bytes = table_.size() * sizeof(SectionEntry);
-  std::memcpy(file_.data(), &h, sizeof h);
-  std::memcpy(file_.data() + sizeof h, table_.data(), table_bytes);
-  h.header_checksum = xxh3_64(file_.data(), sizeof h + table_bytes);
-  std::memcpy(file_.data(), &h, sizeof h);
+  std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_.size());
+  std::memcpy(file_.data(), header.data(), header.size());
   file_ = {};
   out_.commit();
 }

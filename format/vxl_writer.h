@@ -26,6 +26,18 @@ struct VxlSectionSizes {
 VxlSectionSizes section_sizes(const MetaSection& meta, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
                               std::uint64_t group_bytes);
 
+// The section table (offsets and sizes; checksums left zero) and the file size for these payloads: header
+// and table first, then each payload in file order at a multiple of 64 (spec §2, §4). GRPS only when
+// sizes.groups > 0. Shared by VxlWriter and VxlStreamWriter, so that both lay out a file alike.
+struct VxlLayout {
+  std::vector<SectionEntry> table;
+  std::uint64_t file_size = 0;
+};
+VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes);
+
+// The bytes of the header and the section table (spec §3, §4), once every checksum in `table` is set.
+std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size);
+
 class VxlWriter {
  public:
   // Creates the output at `path`, sized and mapped for these payloads. Throws vxl::Error (Output).

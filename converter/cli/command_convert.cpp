@@ -3,8 +3,10 @@
 
 #include "commands.h"
 #include "convert.h"
+#include "memory_size.h"
 #include "progress_bar.h"
 #include "read_tractogram.h"
+#include "streaming_convert.h"
 
 namespace vxl::cli {
 
@@ -12,6 +14,7 @@ void add_convert_command(CLI::App& app) {
   struct Options {
     std::string input, output;
     ConvertSettings settings;
+    std::string memory_limit;
     bool verbose = false;
   };
   auto opt = std::make_shared<Options>();
@@ -23,23 +26,49 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
   cmd->add_option("--orders", opt->settings.orders, "precomputed order set: axis (6 orders) or axis+diag (14)")
       ->default_val("axis")->check(CLI::IsMember({"axis", "axis+diag"}));
+  cmd->add_option("--memory-limit", opt->memory_limit,
+                  "use at most SIZE of memory (bytes, or K/M/G for KiB/MiB/GiB: 512M, 2G) by reading the source several "
+                  "times and writing the output in parts; the output is the same as without the limit. TCK sources "
+                  "only (TRK and TRX are refused with this option); a limit too small for the data is refused with "
+                  "the limit it would need, before anything is written")
+      ->type_name("SIZE")
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            return parse_memory_size(s) ? std::string()
+                                        : "'" + s + "' is not a memory size (a number of bytes, or of KiB/MiB/GiB with K/M/G: 512M, 2G)";
+          },
+          "SIZE"));
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
   cmd->callback([opt] {
     ProgressBar bar;
     opt->settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
     bar.update("reading", 0.0);
     auto t0 = std::chrono::steady_clock::now();
-    Tractogram t = read_tractogram(opt->input);
-    double read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    for (const std::string& w : t.source.warnings) {
+    ConvertSummary s;
+    double read_seconds = 0;
+    if (!opt->memory_limit.empty()) {
+      opt->settings.memory_limit = *parse_memory_size(opt->memory_limit);
+      s = convert_streaming(opt->input, opt->output, opt->settings);
+      read_seconds = s.read_seconds;
       bar.done();
-      std::fprintf(stderr, "voxlines: warning: %s: %s\n", opt->input.c_str(), w.c_str());
+      for (const std::string& w : s.warnings) std::fprintf(stderr, "voxlines: warning: %s: %s\n", opt->input.c_str(), w.c_str());
+    } else {
+      Tractogram t = read_tractogram(opt->input);
+      read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      for (const std::string& w : t.source.warnings) {
+        bar.done();
+        std::fprintf(stderr, "voxlines: warning: %s: %s\n", opt->input.c_str(), w.c_str());
+      }
+      s = convert_tractogram(std::move(t), opt->output, opt->settings);
+      bar.done();
     }
-    ConvertSummary s = convert_tractogram(std::move(t), opt->output, opt->settings);
-    bar.done();
     std::printf("%s: %llu streamlines, %llu points -> %llu voxels, %llu segments (%llu points added at voxel faces)\n",
                 opt->output.c_str(), (unsigned long long)s.streamlines, (unsigned long long)s.points,
                 (unsigned long long)s.voxels, (unsigned long long)s.segments, (unsigned long long)s.synthetic_points);
+    if (!opt->memory_limit.empty())
+      std::printf("memory limit %s: %llu passes over the source, voxels built in %llu parts\n",
+                  format_memory_size(opt->settings.memory_limit).c_str(), (unsigned long long)s.passes,
+                  (unsigned long long)s.partitions);
     if (opt->verbose)
       std::printf("stages: read %.3f s, voxelise %.3f s, orders %.3f s, write %.3f s\n", read_seconds, s.voxelize_seconds,
                   s.orders_seconds, s.write_seconds);

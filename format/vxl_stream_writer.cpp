@@ -1,0 +1,43 @@
+#include "vxl_stream_writer.h"
+
+#include <cstring>
+#include <stdexcept>
+
+namespace vxl {
+
+VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path) {
+  VxlLayout layout = plan_vxl_layout(sizes);
+  table_ = std::move(layout.table);
+  file_size_ = layout.file_size;
+  written_.assign(table_.size(), 0);
+  for (std::size_t i = 0; i < table_.size(); ++i) checksums_.push_back(std::make_unique<Xxh3_64Stream>());
+  out_.allocate(file_size_);  // zeros everywhere: the padding between payloads is never written
+}
+
+void VxlStreamWriter::append(Section section, std::span<const std::uint8_t> bytes) {
+  if (section >= table_.size() || bytes.size() > table_[section].size - written_[section])
+    throw std::logic_error("VxlStreamWriter::append: more bytes than the section was planned for");
+  if (bytes.empty()) return;
+  out_.pwrite(bytes.data(), bytes.size(), table_[section].offset + written_[section]);
+  checksums_[section]->update(bytes.data(), bytes.size());
+  written_[section] += bytes.size();
+}
+
+void VxlStreamWriter::append_meta(const MetaSection& meta) {
+  MetaSection m = meta;
+  std::memset(m.reserved, 0, sizeof m.reserved);
+  append(kMeta, {reinterpret_cast<const std::uint8_t*>(&m), sizeof m});
+}
+
+void VxlStreamWriter::commit() {
+  for (std::size_t i = 0; i < table_.size(); ++i) {
+    if (written_[i] != table_[i].size)
+      throw std::logic_error("VxlStreamWriter::commit: section " + std::string(table_[i].id, 4) + " is incomplete");
+    table_[i].checksum = checksums_[i]->digest();
+  }
+  std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_size_);
+  out_.pwrite(header.data(), header.size(), 0);
+  out_.commit();
+}
+
+}  // namespace vxl
