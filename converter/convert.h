@@ -25,6 +25,7 @@ struct ConvertSummary {
   double read_seconds = 0;      // convert_streaming only: the first pass over the source
   std::uint64_t passes = 1;     // times the source was read
   std::uint64_t partitions = 1;  // voxel ranges whose blocks and orders were built one after another
+  std::vector<std::uint64_t> partition_starts;  // convert_streaming only: the first voxel of each range
   std::vector<std::string> warnings;  // convert_streaming only: the source's (the reader's, otherwise)
 };
 

@@ -238,9 +238,10 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float
 
 std::uint64_t order_scratch_bytes(std::uint32_t max_vertices) {
   // starts (u32) and, per segment (fewer than vertices), keys, packed and packed_tmp (u64) or keyed and
-  // keyed_tmp (16 bytes); a vector grown by resize() may hold up to twice what it was last asked for.
+  // keyed_tmp (16 bytes): a vector grown by resize() may hold up to twice what it was last asked for.
+  // The histograms are assign()ed: exactly their size.
   const std::uint64_t per_vertex = sizeof(std::uint32_t) + 3 * sizeof(std::uint64_t) + 2 * sizeof(KeyedSegment);
-  return 2 * (per_vertex * max_vertices + std::uint64_t(kMaxPasses) * (1u << kDigitBits) * sizeof(std::uint32_t));
+  return 2 * per_vertex * max_vertices + std::uint64_t(kMaxPasses) * (1u << kDigitBits) * sizeof(std::uint32_t);
 }
 
 BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsigned threads, const ProgressFn& progress) {

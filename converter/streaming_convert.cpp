@@ -1,10 +1,12 @@
 #include "streaming_convert.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <future>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -35,6 +37,9 @@ constexpr std::uint64_t kBaselineBytes = 16 * kMiB;
 // slots, with their growth: up to 40 bytes), counts per voxel (with growth: 32), sort order, global id,
 // the table itself (64) and cursor (8) — 152 bytes, and a margin.
 constexpr std::uint64_t kPlanBytesPerVoxel = 192;
+// Memory per point of a batch being read, at worst: two batches (one read while the other is processed),
+// each of whose positions may have twice the capacity in use.
+constexpr std::uint64_t kHeldBytesPerPoint = 2 * 2 * 3 * sizeof(float);
 // Voxline and streamline table entries written at once.
 constexpr std::size_t kTableBufferEntries = 1 << 16;
 
@@ -46,7 +51,8 @@ class Budget {
   Budget(std::uint64_t limit, std::string path) : limit_(limit), path_(std::move(path)) {}
   std::uint64_t used() const { return used_; }
   std::uint64_t left() const { return used_ < limit_ ? limit_ - used_ : 0; }
-  // Takes `bytes` more, or throws Unsupported naming `what`, what it needs and a limit that would do.
+  // Takes `bytes` more, or throws Unsupported naming `what` (a singular noun phrase), what it needs and a
+  // limit that would do.
   void take(std::uint64_t bytes, const std::string& what, const std::string& hint = "") {
     if (bytes > left()) fail(bytes, used_, what, hint);
     used_ += bytes;
@@ -59,17 +65,15 @@ class Budget {
     used_ += bytes - held;
     held = bytes;
   }
-
- private:
-  [[noreturn]] void fail(std::uint64_t needs, std::uint64_t others, const std::string& what, const std::string& hint) const {
+  [[noreturn]] void fail(std::uint64_t needs, std::uint64_t others, const std::string& what, const std::string& hint = "") const {
     // A quarter more than the sum, for what comes later.
     throw Error(ErrorKind::Unsupported, path_, std::nullopt,
-                "--memory-limit " + format_memory_size(limit_) + " is too small: " + what + " needs " +
-                    format_memory_size(needs) + ", and " + format_memory_size(others) +
-                    " is taken already; use --memory-limit " + memory_limit_argument((needs + others) / 4 * 5) +
-                    " or more" + hint);
+                "--memory-limit " + format_memory_size(limit_) + " is too small: " + what + " needs " + format_memory_size(needs) +
+                    (others > 0 ? " on top of " + format_memory_size(others) + " already taken" : std::string()) +
+                    "; use --memory-limit " + memory_limit_argument((needs + others) / 4 * 5) + " or more" + hint);
   }
 
+ private:
   std::uint64_t limit_;
   std::uint64_t used_ = 0;
   std::string path_;
@@ -110,9 +114,6 @@ class StreamingConversion {
   void build_range(const Range& r, std::size_t index, std::size_t count);
   void write_rest();
   [[noreturn]] void fail_changed() const;
-  std::uint64_t batch_bytes() const {
-    return batch_.positions.capacity() * sizeof(float) + batch_.offsets.capacity() * sizeof(std::uint64_t);
-  }
   // Reads the source once, calling body(batch, index of its first streamline) per batch.
   template <typename Body>
   void each_batch(const std::string& stage, Body&& body);
@@ -128,8 +129,9 @@ class StreamingConversion {
   ConvertSummary summary_;
 
   std::unique_ptr<TckStream> stream_;
-  Tractogram batch_;
-  std::uint64_t batch_items_ = 0, batch_held_ = 0;
+  Tractogram batches_[2];  // one processed while the next is read
+  std::uint64_t batch_items_ = 0, batch_held_ = 0, max_points_held_ = 0;
+  std::uint64_t longest_ = 0, longest_index_ = 0;  // the longest streamline seen (in points)
 
   // pass 1
   double lo_[3] = {INFINITY, INFINITY, INFINITY}, hi_[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -144,6 +146,9 @@ class StreamingConversion {
   std::vector<std::uint32_t> global_id_;                        // local id -> voxel index
   std::vector<VoxelEntry> voxels_;
   std::vector<std::uint64_t> cursor_;  // per voxel: the next vertex to place (global index)
+  // Per streamline: its lowest and highest voxel index (set by the first range's pass), so that later
+  // passes skip the streamlines that have no voxel in their range.
+  std::vector<std::array<std::uint32_t, 2>> spans_;
   std::uint64_t order_bytes_ = 0;
   std::unique_ptr<VxlStreamWriter> out_;
 };
@@ -164,12 +169,34 @@ void StreamingConversion::each_batch(const std::string& stage, Body&& body) {
   stream_->rewind();
   ++summary_.passes;
   report(stage, 0.0);
-  std::uint64_t first = 0;
   const double size = double(std::max<std::uint64_t>(1, stream_->file_size()));
-  while (stream_->next(batch_, batch_items_)) {
-    body(static_cast<const Tractogram&>(batch_), first);
-    first += batch_.streamline_count();
+  const bool read_ahead = threads_ > 1;
+  auto read = [&](int b) { return stream_->next(batches_[b], batch_items_, max_points_held_); };
+  std::uint64_t first = 0;
+  int current = 0;
+  bool more = read(current);
+  while (more) {
+    const int other = 1 - current;
+    std::future<bool> next;
+    if (read_ahead) next = std::async(std::launch::async, read, other);
+    body(static_cast<const Tractogram&>(batches_[current]), first);
+    first += batches_[current].streamline_count();
+    more = read_ahead ? next.get() : read(other);
+    current = other;
+    // Both batches keep their largest size; pass 1 finds it (later passes cut the same batches).
+    const std::uint64_t bytes = (batches_[0].positions.capacity() + batches_[1].positions.capacity()) * sizeof(float) +
+                                (batches_[0].offsets.capacity() + batches_[1].offsets.capacity()) * sizeof(std::uint64_t);
+    budget_.track(bytes, batch_held_, [&] {
+      return "reading two batches of streamlines, one holding streamline " + std::to_string(longest_index_) + " (" +
+             std::to_string(longest_) + " points) whole,";
+    });
     report(stage, double(stream_->position()) / size);
+  }
+  if (stream_->overflowed()) {
+    const Tractogram& b = batches_[current];
+    budget_.fail(b.point_count() * kHeldBytesPerPoint, budget_.used() - batch_held_,
+                 "streamline " + std::to_string(first + b.streamline_count()) + ", of more than " +
+                     std::to_string(b.point_count() - b.offsets.back()) + " points, held whole while reading,");
   }
   report(stage, 1.0);
 }
@@ -181,20 +208,20 @@ void StreamingConversion::open_stream() {
   budget_.take(chunk, "the read buffer");
   batch_items_ = std::clamp<std::uint64_t>(limit / 64 / 16, 1024, 1 << 20);
   stream_ = std::make_unique<TckStream>(path_, std::max<std::uint64_t>(1, budget_.left() / 4), chunk);
+  max_points_held_ = budget_.left() / kHeldBytesPerPoint;
 }
 
 // Pass 1: what plan_voxels' bounds scan finds, and the source's checksum and warnings.
 void StreamingConversion::scan() {
   float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   std::uint64_t bad_streamline = std::numeric_limits<std::uint64_t>::max(), bad_point = 0;
-  std::uint64_t longest = 0, longest_index = 0;
   std::uint64_t streamlines = 0, points = 0;
   each_batch("reading", [&](const Tractogram& b, std::uint64_t first) {
     for (std::uint64_t k = 0; k < b.streamline_count(); ++k) {
       const std::uint64_t begin = b.offsets[k], end = b.offsets[k + 1];
-      if (end - begin > longest) {
-        longest = end - begin;
-        longest_index = first + k;
+      if (end - begin > longest_) {
+        longest_ = end - begin;
+        longest_index_ = first + k;
       }
       if (bad_streamline != std::numeric_limits<std::uint64_t>::max()) continue;  // reading on for the reader's errors
       for (std::uint64_t i = begin; i < end; ++i) {
@@ -217,10 +244,6 @@ void StreamingConversion::scan() {
     }
     streamlines += b.streamline_count();
     points += b.point_count();
-    budget_.track(batch_bytes(), batch_held_, [&] {
-      return "reading streamline " + std::to_string(longest_index) + " (" + std::to_string(longest) +
-             " points) whole, with its batch,";
-    });
   });
   if (bad_streamline != std::numeric_limits<std::uint64_t>::max()) detail::fail_non_finite(path_, bad_streamline, bad_point);
   for (int c = 0; c < 3; ++c) {
@@ -239,7 +262,7 @@ void StreamingConversion::plan() {
   // plan_voxels' limit on added points, applied to the whole source (plan_voxels applies it per
   // thread's range: the two can differ only in whether a borderline source is refused).
   synthetic_limit_ = static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(meta_.point_count)) + 4096;
-  std::uint64_t voxlines = 0, synthetic = 0;
+  std::uint64_t voxlines = 0, synthetic = 0, points = 0;
   const std::string voxel_hint = ", or a larger --voxel-size";
   each_batch("voxelising", [&](const Tractogram& b, std::uint64_t) {
     const float* pts = b.positions.data();
@@ -265,10 +288,20 @@ void StreamingConversion::plan() {
       }
       voxlines += count;
       // Per streamline, so that a table outgrowing the limit is caught before it goes far past it.
-      budget_.track(n_local * kPlanBytesPerVoxel, plan_held_,
-                    [&] { return "the voxel table (" + std::to_string(n_local) + " voxels so far)"; }, voxel_hint);
-      budget_.track(sink_.bytes(), sink_held_, [] { return std::string("the voxlines of one streamline"); });
+      const std::uint64_t table = n_local * kPlanBytesPerVoxel;
+      if (table > plan_held_ && table - plan_held_ > budget_.left()) {
+        // Voxels turn up ever more slowly: extrapolating from the points read so far overestimates.
+        const std::uint64_t read = points + b.offsets[k + 1];
+        const std::uint64_t all = static_cast<std::uint64_t>(double(n_local) * double(meta_.point_count) / double(read));
+        budget_.fail(all * kPlanBytesPerVoxel, budget_.used() - plan_held_,
+                     "the voxel table (" + std::to_string(n_local) + " voxels after " + std::to_string(read) + " of " +
+                         std::to_string(meta_.point_count) + " points; about " + std::to_string(all) + " in all, extrapolated)",
+                     voxel_hint);
+      }
+      budget_.track(table, plan_held_, [] { return std::string(); });
+      budget_.track(sink_.bytes(), sink_held_, [] { return std::string("the voxline list of one streamline"); });
     }
+    points += b.point_count();
   });
   meta_.voxline_count = voxlines;
   meta_.synthetic_point_count = synthetic;
@@ -370,10 +403,14 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
     streamline_buffer.reserve(kTableBufferEntries);
   }
   std::uint64_t voxline_index = 0, streamlines = 0;
-  each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t) {
+  each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
     const float* pts = b.positions.data();
     for (std::uint64_t k = 0; k < b.streamline_count(); ++k) {
+      if (first + k >= spans_.size()) fail_changed();  // more streamlines than pass 1 saw
+      std::array<std::uint32_t, 2>& span = spans_[first + k];
+      if (!tables && (span[1] < r.first || span[0] >= r.end)) continue;  // no voxel in this range (or none at all)
       if (tables) {
+        span = {std::numeric_limits<std::uint32_t>::max(), 0};
         streamline_buffer.push_back(voxline_index);
         if (streamline_buffer.size() == kTableBufferEntries) {
           out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, streamline_buffer);
@@ -391,6 +428,7 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
         const std::uint32_t g = global_id_[v.voxel];
         const std::uint32_t own = v.own();
         if (tables) {
+          span = {std::min(span[0], g), std::max(span[1], g)};
           voxline_buffer.push_back({g, own | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)});
           if (voxline_buffer.size() == kTableBufferEntries) {
             out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, voxline_buffer);
@@ -422,7 +460,7 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
     }
     streamlines += b.streamline_count();
   });
-  if (streamlines != meta_.streamline_count || voxline_index != meta_.voxline_count) fail_changed();
+  if (streamlines != meta_.streamline_count || (tables && voxline_index != meta_.voxline_count)) fail_changed();
   for (std::size_t g = r.first; g < r.end; ++g)
     if (cursor_[g] != voxels_[g].vertex_first + voxels_[g].vertex_count) fail_changed();
   if (tables) {
@@ -489,7 +527,9 @@ ConvertSummary StreamingConversion::run() {
   plan();
   build_table();
   summary_.voxelize_seconds = seconds_since(t0);
-  budget_.take(kTableBufferEntries * (sizeof(VoxlineEntry) + sizeof(std::uint64_t)), "the table buffers");
+  budget_.take(kTableBufferEntries * (sizeof(VoxlineEntry) + sizeof(std::uint64_t)), "the buffer of the voxline and streamline tables");
+  budget_.take(meta_.streamline_count * sizeof(spans_[0]), "the voxel span of every streamline");
+  spans_.resize(meta_.streamline_count);
   std::vector<Range> ranges = cut_ranges();
 
   const std::string provenance = provenance_json(stream_->source(), settings_, threads_);
@@ -511,6 +551,7 @@ ConvertSummary StreamingConversion::run() {
   summary_.segments = meta_.segment_count;
   summary_.synthetic_points = meta_.synthetic_point_count;
   summary_.partitions = ranges.size();
+  for (const Range& r : ranges) summary_.partition_starts.push_back(r.first);
   summary_.warnings = stream_->source().warnings;
   return summary_;
 }

@@ -1,5 +1,7 @@
 #include <chrono>
 #include <cstdio>
+#include <fstream>
+#include <string>
 
 #include "commands.h"
 #include "convert.h"
@@ -9,6 +11,18 @@
 #include "streaming_convert.h"
 
 namespace vxl::cli {
+namespace {
+
+// This process's peak resident memory (VmHWM) in KiB, or -1 where /proc does not say. Unlike a parent's
+// wait4(), it does not count what the process held before exec() (a forked copy of its parent).
+long long peak_resident_kib() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.starts_with("VmHWM:")) return std::stoll(line.substr(6));
+  return -1;
+}
+
+}  // namespace
 
 void add_convert_command(CLI::App& app) {
   struct Options {
@@ -27,17 +41,16 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--orders", opt->settings.orders, "precomputed order set: axis (6 orders) or axis+diag (14)")
       ->default_val("axis")->check(CLI::IsMember({"axis", "axis+diag"}));
   cmd->add_option("--memory-limit", opt->memory_limit,
-                  "use at most SIZE of memory (bytes, or K/M/G for KiB/MiB/GiB: 512M, 2G) by reading the source several "
-                  "times and writing the output in parts; the output is the same as without the limit. TCK sources "
-                  "only (TRK and TRX are refused with this option); a limit too small for the data is refused with "
-                  "the limit it would need, before anything is written")
+                  "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): reads the source several times and writes the "
+                  "output in parts, byte-identical to a conversion without the limit. TCK sources only (TRK/TRX are "
+                  "refused); a limit too small for the data is refused, naming what needs how much")
       ->type_name("SIZE")
       ->check(CLI::Validator(
           [](std::string& s) {
             return parse_memory_size(s) ? std::string()
                                         : "'" + s + "' is not a memory size (a number of bytes, or of KiB/MiB/GiB with K/M/G: 512M, 2G)";
           },
-          "SIZE"));
+          ""));
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
   cmd->callback([opt] {
     ProgressBar bar;
@@ -69,9 +82,11 @@ void add_convert_command(CLI::App& app) {
       std::printf("memory limit %s: %llu passes over the source, voxels built in %llu parts\n",
                   format_memory_size(opt->settings.memory_limit).c_str(), (unsigned long long)s.passes,
                   (unsigned long long)s.partitions);
-    if (opt->verbose)
+    if (opt->verbose) {
       std::printf("stages: read %.3f s, voxelise %.3f s, orders %.3f s, write %.3f s\n", read_seconds, s.voxelize_seconds,
                   s.orders_seconds, s.write_seconds);
+      std::printf("peak resident memory: %lld KiB\n", peak_resident_kib());
+    }
   });
 }
 

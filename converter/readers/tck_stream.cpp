@@ -93,6 +93,7 @@ void TckStream::rewind() {
   read_end_ = header_.data_offset;
   state_ = {};
   data_ended_ = false;
+  overflowed_ = false;
   streamlines_ = 0;
   if (complete_) return;
   // The first pass hashes the whole file in order: the header here, the rest as it is read.
@@ -116,10 +117,10 @@ bool TckStream::fill_buffer() {
   return true;
 }
 
-bool TckStream::next(Tractogram& batch, std::uint64_t max_points) {
+bool TckStream::next(Tractogram& batch, std::uint64_t max_points, std::uint64_t max_points_held) {
   batch.positions.clear();
   batch.offsets.assign(1, 0);
-  if (data_ended_) return false;
+  if (data_ended_ || overflowed_) return false;
   const std::uint64_t stop = std::max<std::uint64_t>(1, max_points);
   for (;;) {
     const std::uint64_t whole = (buffer_size_ - buffer_used_) / triplet_bytes_;
@@ -138,6 +139,10 @@ bool TckStream::next(Tractogram& batch, std::uint64_t max_points) {
       if (state_.points_in_current == 0 && batch.point_count() + batch.streamline_count() >= stop) {
         streamlines_ += batch.streamline_count();
         return true;
+      }
+      if (batch.point_count() > max_points_held) {
+        overflowed_ = true;
+        return false;
       }
     }
     if (!fill_buffer()) break;

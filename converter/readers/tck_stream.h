@@ -39,9 +39,12 @@ class TckStream {
   void rewind();
 
   // Replaces batch.positions and batch.offsets with the next whole streamlines: at least one, and no more
-  // than it takes to reach `max_points` points (so at most max_points - 1 plus one streamline). Returns
-  // false, with no streamline in `batch`, at the end of the data.
-  bool next(Tractogram& batch, std::uint64_t max_points);
+  // than it takes to reach `max_points` points and streamlines (so at most max_points - 1 plus one
+  // streamline). Returns false, with no streamline in `batch`, at the end of the data. Also returns false,
+  // with overflowed() set, once `batch` holds more than `max_points_held` points (a streamline too long
+  // to hold whole; checked per read buffer, so it may hold one buffer more); rewind() to go on.
+  bool next(Tractogram& batch, std::uint64_t max_points, std::uint64_t max_points_held = ~std::uint64_t(0));
+  bool overflowed() const { return overflowed_; }
 
  private:
   bool fill_buffer();  // reads the next chunk; false at the end of the file
@@ -59,6 +62,7 @@ class TckStream {
   std::uint64_t read_end_ = 0;                        // file offset just after buffer_'s valid bytes
   tck::DecodeState state_;
   bool data_ended_ = false;
+  bool overflowed_ = false;
   std::uint64_t streamlines_ = 0;  // closed in this pass
   bool complete_ = false;
   std::unique_ptr<Xxh3_128Stream> hash_;  // while the first pass runs
