@@ -31,7 +31,7 @@ using Clock = std::chrono::steady_clock;
 
 constexpr std::uint64_t kMiB = 1ull << 20;
 // The program itself before any work: code, libraries, thread stacks, allocator slack (voxlines
-// measures about 5 MiB of resident memory at start; the rest is margin).
+// measures about 7 MiB of resident memory at start; the rest is margin).
 constexpr std::uint64_t kBaselineBytes = 16 * kMiB;
 // The voxel table while it is built and used, at its peak (build_table): hash index (coordinates and
 // slots, with their growth: up to 40 bytes), counts per voxel (with growth: 32), sort order, global id,
@@ -171,10 +171,17 @@ void StreamingConversion::each_batch(const std::string& stage, Body&& body) {
   report(stage, 0.0);
   const double size = double(std::max<std::uint64_t>(1, stream_->file_size()));
   const bool read_ahead = threads_ > 1;
-  auto read = [&](int b) { return stream_->next(batches_[b], batch_items_, max_points_held_); };
   std::uint64_t first = 0;
+  auto read = [&](int b) { return stream_->next(batches_[b], batch_items_, max_points_held_); };
+  auto check_overflow = [&](const Tractogram& b) {
+    if (stream_->overflowed())
+      budget_.fail(b.point_count() * kHeldBytesPerPoint, budget_.used() - batch_held_,
+                   "streamline " + std::to_string(first + b.streamline_count()) + ", of more than " +
+                       std::to_string(b.point_count() - b.offsets.back()) + " points, held whole while reading,");
+  };
   int current = 0;
   bool more = read(current);
+  check_overflow(batches_[current]);
   while (more) {
     const int other = 1 - current;
     std::future<bool> next;
@@ -183,6 +190,7 @@ void StreamingConversion::each_batch(const std::string& stage, Body&& body) {
     first += batches_[current].streamline_count();
     more = read_ahead ? next.get() : read(other);
     current = other;
+    check_overflow(batches_[current]);
     // Both batches keep their largest size; pass 1 finds it (later passes cut the same batches).
     const std::uint64_t bytes = (batches_[0].positions.capacity() + batches_[1].positions.capacity()) * sizeof(float) +
                                 (batches_[0].offsets.capacity() + batches_[1].offsets.capacity()) * sizeof(std::uint64_t);
@@ -191,12 +199,6 @@ void StreamingConversion::each_batch(const std::string& stage, Body&& body) {
              std::to_string(longest_) + " points) whole,";
     });
     report(stage, double(stream_->position()) / size);
-  }
-  if (stream_->overflowed()) {
-    const Tractogram& b = batches_[current];
-    budget_.fail(b.point_count() * kHeldBytesPerPoint, budget_.used() - batch_held_,
-                 "streamline " + std::to_string(first + b.streamline_count()) + ", of more than " +
-                     std::to_string(b.point_count() - b.offsets.back()) + " points, held whole while reading,");
   }
   report(stage, 1.0);
 }
