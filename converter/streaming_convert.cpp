@@ -95,6 +95,7 @@ struct Range {
   std::size_t first = 0, end = 0;  // voxels
   std::uint64_t vertex_first = 0, vertex_end = 0, order_first = 0, order_end = 0;
   std::uint32_t max_vertices = 0;
+  unsigned order_threads = 1;  // set by cut_ranges
 };
 
 class StreamingConversion {
@@ -348,12 +349,18 @@ void StreamingConversion::build_table() {
 }
 
 // Consecutive voxels, as many per range as fit in what the limit leaves: each range's vertices (12 bytes
-// each), voxline ends (1 bit each), orders, and every ordering thread's sort buffers.
+// each), voxline ends (1 bit each), orders, and its ordering threads' sort buffers. The sort buffers of
+// one thread grow with the largest voxel, so a range orders with fewer threads when they would take more
+// than a quarter of the room (the orders do not depend on the thread count).
 std::vector<Range> StreamingConversion::cut_ranges() {
   const std::uint64_t room = budget_.left();
+  auto order_threads = [&](const Range& r) {
+    const std::uint64_t per_thread = order_scratch_bytes(r.max_vertices);
+    return static_cast<unsigned>(std::clamp<std::uint64_t>(room / 4 / per_thread, 1, threads_));
+  };
   auto cost = [&](const Range& r) {
     const std::uint64_t v = r.vertex_end - r.vertex_first;
-    return 12 * v + (v / 64 + 1) * 8 + (r.order_end - r.order_first) + threads_ * order_scratch_bytes(r.max_vertices);
+    return 12 * v + (v / 64 + 1) * 8 + (r.order_end - r.order_first) + order_threads(r) * order_scratch_bytes(r.max_vertices);
   };
   auto order_end = [&](std::size_t i) { return i < voxels_.size() ? voxels_[i].order_offset : order_bytes_; };
   auto alone = [&](std::size_t i) {
@@ -362,8 +369,7 @@ std::vector<Range> StreamingConversion::cut_ranges() {
     if (cost(r) > room) {
       budget_.take(cost(r),
                    "voxel (" + std::to_string(v.coord[0]) + ", " + std::to_string(v.coord[1]) + ", " + std::to_string(v.coord[2]) +
-                       ") of " + std::to_string(v.vertex_count) + " vertices, with its orders and " + std::to_string(threads_) +
-                       " threads' sort buffers,",
+                       ") of " + std::to_string(v.vertex_count) + " vertices, with its orders and sort buffers,",
                    ", or a smaller --voxel-size");
     }
     return r;
@@ -388,6 +394,7 @@ std::vector<Range> StreamingConversion::cut_ranges() {
     }
   }
   ranges.push_back(r);
+  for (Range& each : ranges) each.order_threads = order_threads(each);
   return ranges;
 }
 
@@ -492,7 +499,7 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
     v.order_offset -= r.order_first;
   }
   const std::string stage = "ordering" + of;
-  build_orders_into(range, vertices, ends, order_set_, orders, threads_, [&](const char*, double f) { report(stage, f); });
+  build_orders_into(range, vertices, ends, order_set_, orders, r.order_threads, [&](const char*, double f) { report(stage, f); });
   for (VoxelEntry& v : range) {
     v.vertex_first += r.vertex_first;
     v.order_offset += r.order_first;

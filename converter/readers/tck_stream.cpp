@@ -36,7 +36,7 @@ TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, st
   try {
     // The header is read whole; grow the prefix until it holds the END line.
     std::vector<std::uint8_t> prefix;
-    std::uint64_t want = std::min<std::uint64_t>(source_.bytes, 1u << 16);
+    std::uint64_t want = std::min<std::uint64_t>({source_.bytes, 1u << 16, max_header_bytes});
     for (;;) {
       prefix.resize(want);
       read_at(0, prefix.data(), want);
