@@ -11,6 +11,10 @@
 #include <memory>
 #include <numeric>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include "error.h"
 #include "memory_size.h"
 #include "segment_orders.h"
@@ -543,7 +547,12 @@ ConvertSummary StreamingConversion::run() {
 
   const std::string provenance = provenance_json(stream_->source(), settings_, threads_);
   out_ = std::make_unique<VxlStreamWriter>(out_path_, section_sizes(meta_, order_bytes_, provenance.size(), 0));
-  for (std::size_t k = 0; k < ranges.size(); ++k) build_range(ranges[k], k, ranges.size());
+  for (std::size_t k = 0; k < ranges.size(); ++k) {
+    build_range(ranges[k], k, ranges.size());
+#if defined(__GLIBC__)
+    malloc_trim(0);  // give back what the range freed, lest the allocator keep it resident for the next one
+#endif
+  }
 
   report("writing", 0.0);
   t0 = Clock::now();
