@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <set>
 
 #include "convert.h"
@@ -250,6 +251,39 @@ TEST(StreamingConvert, EmptySourcesAreIdentical) {
   write_raw_tck(empties, "Float32LE", raw<float>({NAN, 0, 0, NAN, 0, 0, INFINITY, 0, 0}));
   EXPECT_EQ(expect_identical(dir, none, settings_for(10.0), 32 * kMiB).streamlines, 0u);
   EXPECT_EQ(expect_identical(dir, empties, settings_for(10.0), 32 * kMiB).streamlines, 2u);
+}
+
+// Every real TCK fixture (multi-line headers, big-endian, Float64, stale counts, no terminator, ...):
+// the same bytes, or the same error, as the in-memory conversion.
+TEST(StreamingConvert, RealTckFixturesAreIdentical) {
+  VXL_REQUIRE_REAL_DATA();
+  ScratchDir dir;
+  int compared = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(test::real_data_dir())) {
+    if (entry.path().extension() != ".tck") continue;
+    const std::string tck = entry.path().string(), whole = dir.file("whole.vxl"), limited = dir.file("limited.vxl");
+    SCOPED_TRACE(tck);
+    std::filesystem::remove(whole);
+    std::filesystem::remove(limited);
+    ConvertSettings settings = settings_for(5.0);
+    std::optional<ErrorKind> expected;
+    try {
+      convert_tractogram(read_tractogram(tck), whole, settings);
+    } catch (const Error& e) {
+      expected = e.kind();
+    }
+    settings.memory_limit = 64 * kMiB;
+    try {
+      convert_streaming(tck, limited, settings);
+      EXPECT_FALSE(expected) << "the in-memory conversion failed, the limited one did not";
+      EXPECT_TRUE(file_bytes(whole) == file_bytes(limited));
+      ++compared;
+    } catch (const Error& e) {
+      EXPECT_EQ(expected, e.kind()) << e.what();
+      EXPECT_FALSE(std::filesystem::exists(limited));
+    }
+  }
+  EXPECT_GE(compared, 10);
 }
 
 // A limit below what some part of the work needs fails before anything is written, says which part,
