@@ -6,7 +6,13 @@
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <chrono>
+#include <csignal>
 #include <set>
+#include <thread>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "convert.h"
 #include "error.h"
@@ -445,6 +451,35 @@ TEST(StreamingConvert, CliFailsCleanlyWhenTheLimitIsTooSmall) {
   EXPECT_EQ(r.exit_code, 4) << r.output;
   EXPECT_NE(r.output.find("TCK sources only"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// The output is written piece by piece over many passes: a conversion killed at any moment must still
+// leave nothing at the output path, nor a temporary file beside it.
+TEST(StreamingConvert, AConversionKilledAtAnyMomentLeavesNoOutput) {
+  ScratchDir dir;
+  const std::string tck = dir.file("in.tck"), out = dir.file("out.vxl");
+  ASSERT_EQ(test::run_cli("synth '" + tck + "' --streamlines 60000").exit_code, 0);
+  int killed_while_running = 0;
+  for (int delay_ms : {10, 50, 100, 200, 300, 450, 600, 800}) {
+    pid_t pid = fork();
+    if (pid == 0) {
+      execl(VOXLINES_CLI, VOXLINES_CLI, "convert", tck.c_str(), out.c_str(), "--memory-limit", "24M", static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (WIFSIGNALED(status)) {
+      ++killed_while_running;
+      EXPECT_FALSE(std::filesystem::exists(out)) << "killed after " << delay_ms << " ms";
+    } else {
+      std::filesystem::remove(out);  // it finished before the kill: not this test's subject
+    }
+    for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+      EXPECT_TRUE(e.path().filename() == "in.tck" || e.path().filename() == "out.vxl") << "left behind: " << e.path();
+  }
+  EXPECT_GE(killed_while_running, 3) << "the conversion finished too quickly to be killed mid-way";
 }
 
 // The point of the option: the process's peak resident memory stays under the limit for a source whose
