@@ -12,7 +12,6 @@
 #endif
 
 namespace vxl {
-namespace {
 
 std::string provenance_json(const SourceInfo& src, const ConvertSettings& settings, unsigned threads) {
   nlohmann::json j;
@@ -31,6 +30,8 @@ std::string provenance_json(const SourceInfo& src, const ConvertSettings& settin
   // Invalid UTF-8 in a source header must not make the whole file unwritable: replace it.
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
+
+namespace {
 
 template <typename T>
 std::span<std::uint8_t> bytes_of(std::span<T> s) {

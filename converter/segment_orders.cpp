@@ -170,7 +170,10 @@ struct KeyedSegment {
   std::uint32_t local;
 };
 
+// Per worker thread. Reserved for the largest voxel up front (keyed on first use), so that these never
+// grow past it: order_scratch_bytes() is a bound that callers budget with.
 struct SortScratch {
+  std::uint32_t max_vertices = 0;
   std::vector<std::uint64_t> keys, packed, packed_tmp;
   std::vector<KeyedSegment> keyed, keyed_tmp;
   std::vector<std::uint32_t> counts;
@@ -197,6 +200,8 @@ std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint3
     const std::uint64_t index_mask = (1ull << index_bits) - 1;
     return put_entries(dst, width, n, [&](std::size_t i) { return static_cast<std::uint32_t>(s.packed[i] & index_mask); });
   }
+  s.keyed.reserve(s.max_vertices);
+  s.keyed_tmp.reserve(s.max_vertices);
   s.keyed.resize(n);
   for (std::size_t i = 0; i < n; ++i) s.keyed[i] = {s.keys[i], starts[i]};
   radix_sort_bits(s.keyed, s.keyed_tmp, s.counts, [](const KeyedSegment& k) { return k.key; }, low, bits);
@@ -251,6 +256,8 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float
     return -1;
   };
 
+  std::uint32_t max_vertices = 0;
+  for (const VoxelEntry& v : voxels) max_vertices = std::max(max_vertices, v.vertex_count);
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
   auto worker = [&](bool reports) {
@@ -259,6 +266,9 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float
     std::vector<int> axis(k_count);
     bool have_directions = false;  // shared directions are looked up once per worker
     SortScratch scratch;
+    scratch.max_vertices = max_vertices;
+    for (auto* v : {&scratch.keys, &scratch.packed, &scratch.packed_tmp}) v->reserve(max_vertices);
+    starts.reserve(max_vertices);
     for (std::size_t i; (i = next++) < voxels.size();) {
       const VoxelEntry& v = voxels[i];
       if (!have_directions || set.per_voxel()) {
@@ -308,6 +318,14 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float
   worker(true);
   for (auto& th : pool) th.join();
   if (progress) progress("ordering", 1.0);
+}
+
+std::uint64_t order_scratch_bytes(std::uint32_t max_vertices) {
+  // starts (u32) and, per segment (fewer than vertices), keys, packed and packed_tmp (u64) and, for a
+  // voxel whose keys do not pack, keyed and keyed_tmp (16 bytes): all reserved once for the largest
+  // voxel (SortScratch). Plus the histograms.
+  const std::uint64_t per_vertex = sizeof(std::uint32_t) + 3 * sizeof(std::uint64_t) + 2 * sizeof(KeyedSegment);
+  return per_vertex * max_vertices + std::uint64_t(kMaxPasses) * (1u << kDigitBits) * sizeof(std::uint32_t);
 }
 
 BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsigned threads, const ProgressFn& progress) {

@@ -57,6 +57,10 @@ std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_o
 void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float> vertices, const VoxlineEnds& ends,
                        const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads, const ProgressFn& progress);
 
+// An upper bound of what build_orders_into allocates per worker thread (its sort buffers, growth
+// included) when no voxel has more than `max_vertices` vertices, for callers that budget memory.
+std::uint64_t order_scratch_bytes(std::uint32_t max_vertices);
+
 struct BuiltOrders {
   std::vector<DirectionEntry> directions;
   std::vector<DirectionEntry> voxel_directions;  // the VDIR payload; empty unless the set is random

@@ -44,16 +44,23 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
   return s;
 }
 
-VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path) {
+namespace {
+
+// Section ids in file order, indexed by VxlWriter::Index; VDIR and GRPS are optional.
+constexpr const char* kSectionIds[] = {"META", "DIRS", "VDIR", "VOXT", "VERT", "ORDR", "VXLN", "STRM", "PROV", "GRPS"};
+
+}  // namespace
+
+VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
   struct Planned {
     const char* id;
     std::uint32_t flags;
     std::uint64_t size;
     bool present;
   };
-  // In Index order. VDIR is required: a reader that cannot use per-voxel directions would pick wrong
-  // orders, so it must refuse the file (spec §4, §10).
-  const Planned planned[kIndexCount] = {
+  // VDIR is required: a reader that cannot use per-voxel directions would pick wrong orders, so it must
+  // refuse the file (spec §4, §10).
+  const Planned planned[] = {
       {"META", kSectionRequired, sizeof(MetaSection), true},
       {"DIRS", kSectionRequired, sizes.directions, true},
       {"VDIR", kSectionRequired, sizes.voxel_directions.value_or(0), sizes.voxel_directions.has_value()},
@@ -68,27 +75,53 @@ VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : ou
   std::size_t present = 0;
   for (const Planned& p : planned) present += p.present;
 
-  // Header and table first, then each payload padded to a multiple of 64 (spec §2).
+  VxlLayout layout;
   std::uint64_t position = align_up(sizeof(FileHeader) + present * sizeof(SectionEntry), kVxlAlignment);
-  for (std::size_t i = 0; i < kIndexCount; ++i) {
-    const Planned& p = planned[i];
-    position_[i] = p.present ? table_.size() : present;
+  for (const Planned& p : planned) {
     if (!p.present) continue;
     SectionEntry e{};
     std::memcpy(e.id, p.id, 4);
     e.flags = p.flags;
     e.offset = position;
     e.size = p.size;
-    table_.push_back(e);
+    layout.table.push_back(e);
     position = align_up(position + p.size, kVxlAlignment);
   }
-  file_ = out_.map(position);
+  layout.file_size = position;
+  return layout;
+}
+
+std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size) {
+  FileHeader h{};
+  std::memcpy(h.magic, kVxlMagic.data(), 8);
+  h.version_major = kVxlVersionMajor;
+  // The lowest version that holds what is written (spec §10).
+  const bool has_vdir = std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "VDIR", 4) == 0; });
+  h.version_minor = has_vdir ? kVxlVersionMinorVoxelDirections : kVxlVersionMinor;
+  h.header_size = sizeof(FileHeader);
+  h.file_size = file_size;
+  h.section_table_offset = sizeof(FileHeader);
+  h.section_count = static_cast<std::uint32_t>(table.size());
+  h.flags = 0;
+  h.header_checksum = 0;  // covered with this field zero (spec §3)
+  std::vector<std::uint8_t> bytes(sizeof h + table.size_bytes());
+  std::memcpy(bytes.data(), &h, sizeof h);
+  std::memcpy(bytes.data() + sizeof h, table.data(), table.size_bytes());
+  h.header_checksum = xxh3_64(bytes.data(), bytes.size());
+  std::memcpy(bytes.data(), &h, sizeof h);
+  return bytes;
+}
+
+VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path) {
+  VxlLayout layout = plan_vxl_layout(sizes);
+  table_ = std::move(layout.table);
+  file_ = out_.map(layout.file_size);
 }
 
 std::span<std::uint8_t> VxlWriter::payload(Index i) {
-  const std::size_t at = position_[i];
-  if (at >= table_.size()) return {};
-  return file_.subspan(table_[at].offset, table_[at].size);
+  for (const SectionEntry& e : table_)
+    if (std::memcmp(e.id, kSectionIds[i], 4) == 0) return file_.subspan(e.offset, e.size);
+  return {};  // an optional section that is not there
 }
 
 void VxlWriter::set_meta(const MetaSection& meta) {
@@ -115,22 +148,8 @@ void VxlWriter::commit(unsigned threads) {
   worker();
   for (std::thread& t : pool) t.join();
 
-  FileHeader h{};
-  std::memcpy(h.magic, kVxlMagic.data(), 8);
-  h.version_major = kVxlVersionMajor;
-  // The lowest version that holds what is written (spec §10).
-  h.version_minor = position_[kVdir] < table_.size() ? kVxlVersionMinorVoxelDirections : kVxlVersionMinor;
-  h.header_size = sizeof(FileHeader);
-  h.file_size = file_.size();
-  h.section_table_offset = sizeof(FileHeader);
-  h.section_count = static_cast<std::uint32_t>(table_.size());
-  h.flags = 0;
-  h.header_checksum = 0;  // covered with this field zero (spec §3)
-  const std::size_t table_bytes = table_.size() * sizeof(SectionEntry);
-  std::memcpy(file_.data(), &h, sizeof h);
-  std::memcpy(file_.data() + sizeof h, table_.data(), table_bytes);
-  h.header_checksum = xxh3_64(file_.data(), sizeof h + table_bytes);
-  std::memcpy(file_.data(), &h, sizeof h);
+  std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_.size());
+  std::memcpy(file_.data(), header.data(), header.size());
   file_ = {};
   out_.commit();
 }

@@ -5,7 +5,6 @@
 // them into the page cache: the output is the largest thing the converter makes.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -30,6 +29,19 @@ struct VxlSectionSizes {
 // order_set is random).
 VxlSectionSizes section_sizes(const MetaSection& meta, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
                               std::uint64_t group_bytes);
+
+// The section table (offsets and sizes; checksums left zero) and the file size for these payloads: header
+// and table first, then each payload in file order at a multiple of 64 (spec §2, §4). VDIR only when
+// sizes.voxel_directions is set, GRPS only when sizes.groups > 0. Shared by VxlWriter and VxlStreamWriter, so that both lay out a file alike.
+struct VxlLayout {
+  std::vector<SectionEntry> table;
+  std::uint64_t file_size = 0;
+};
+VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes);
+
+// The bytes of the header and the section table (spec §3, §4), once every checksum in `table` is set.
+// The version is 1.1 when the table has VDIR, else 1.0 (spec §10).
+std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size);
 
 class VxlWriter {
  public:
@@ -59,7 +71,7 @@ class VxlWriter {
 
  private:
   // Sections in file order; VDIR and GRPS are optional.
-  enum Index : std::size_t { kMeta, kDirs, kVdir, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps, kIndexCount };
+  enum Index : std::size_t { kMeta, kDirs, kVdir, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps };
   std::span<std::uint8_t> payload(Index i);
   template <typename T>
   std::span<T> typed(Index i) {
@@ -69,7 +81,6 @@ class VxlWriter {
 
   AtomicOutputFile out_;
   std::vector<SectionEntry> table_;  // in Index order, optional sections only when present
-  std::array<std::size_t, kIndexCount> position_{};  // Index -> entry of table_ (table_.size(): absent)
   std::span<std::uint8_t> file_;
 };
 
