@@ -83,7 +83,7 @@ struct Options {
   std::string manifest, out, name = "dataset";
   int size = 384, flicker_size = 256, flicker_frames = 72;
   double reference_voxel_mm = 10, flicker_opacity = 0.5;
-  std::vector<double> hysteresis = {0.05, 0.15};
+  std::vector<double> hysteresis = {0.1};
   bool sweep = true, flicker = true;
 };
 
