@@ -31,6 +31,64 @@ void view_button(const char* label, const char* view, PanelRequests& out) {
   if (ImGui::Button(label)) out.view = parse_view(view);
 }
 
+// Slab (thickness, move) and up to three clip planes (on/off, side and axis, position within the bounds).
+void clipping_controls(PanelState& state, const PanelStats& stats, PanelRequests& out) {
+  Clipping& c = state.settings.clipping;
+  ImGui::Separator();
+  bool slab = c.slab_mm > 0;
+  if (ImGui::Checkbox("Slab", &slab)) c.slab_mm = slab ? state.slab_thickness : 0.0;
+  ImGui::SameLine();
+  ImGui::PushItemWidth(110);
+  float thickness = static_cast<float>(state.slab_thickness);
+  if (ImGui::DragFloat("mm##slab", &thickness, 0.1f, 0.1f, 1000.0f, "%.1f", ImGuiSliderFlags_AlwaysClamp)) {
+    state.slab_thickness = thickness;
+    if (c.slab_mm > 0) c.slab_mm = thickness;
+  }
+  ImGui::PopItemWidth();
+  ImGui::SameLine();
+  ImGui::BeginDisabled(c.slab_mm <= 0);
+  if (ImGui::ArrowButton("##nearer", ImGuiDir_Left)) out.move_focus = -1.0;
+  ImGui::SameLine();
+  if (ImGui::ArrowButton("##farther", ImGuiDir_Right)) out.move_focus = 1.0;
+  ImGui::SameLine();
+  ImGui::TextUnformatted("move");
+  ImGui::EndDisabled();
+
+  static const char* const kSides[] = {"x >=", "y >=", "z >=", "x <=", "y <=", "z <="};
+  for (std::size_t i = 0; i < c.planes.size(); ++i) {
+    AxisClip& p = c.planes[i];
+    ImGui::PushID(static_cast<int>(i));
+    ImGui::Checkbox("##on", &p.enabled);
+    ImGui::SameLine();
+    ImGui::PushItemWidth(60);
+    int side = p.axis + (p.keep_above ? 0 : 3);
+    if (ImGui::Combo("##side", &side, kSides, 6)) {
+      p.axis = side % 3;
+      p.keep_above = side < 3;
+    }
+    ImGui::PopItemWidth();
+    ImGui::SameLine();
+    ImGui::PushItemWidth(150);
+    float pos = static_cast<float>(p.position);
+    const float lo = static_cast<float>(stats.bounds_min[p.axis]), hi = static_cast<float>(stats.bounds_max[p.axis]);
+    if (ImGui::SliderFloat("mm##pos", &pos, lo, hi, "%.1f")) p.position = pos;
+    ImGui::PopItemWidth();
+    ImGui::SameLine();
+    const bool remove = ImGui::SmallButton("x");
+    ImGui::PopID();
+    if (remove) {
+      c.planes.erase(c.planes.begin() + static_cast<std::ptrdiff_t>(i));
+      break;
+    }
+  }
+  if (c.planes.size() < Clipping::kMaxPlanes && ImGui::Button("Add clip plane")) {
+    AxisClip p;
+    p.axis = static_cast<int>(c.planes.size());  // x, then y, then z, through the scene's centre
+    p.position = (stats.bounds_min[p.axis] + stats.bounds_max[p.axis]) / 2;
+    c.planes.push_back(p);
+  }
+}
+
 }  // namespace
 
 UiPanel::UiPanel(GLFWwindow* window) {
@@ -113,6 +171,8 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   state.grid_all = grid_scope == 1;
   ImGui::EndDisabled();
 
+  clipping_controls(state, stats, out);
+
   ImGui::Separator();
   ImGui::AlignTextToFramePadding();
   ImGui::TextUnformatted("View");
@@ -164,6 +224,11 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
         "M             next transparency mode\n"
         "+ -           opacity x / : 1.5\n"
         "S             screenshot    R  reset camera\n"
+        "C             slab on / off\n"
+        "[ ]           slab thinner / thicker\n"
+        "PgUp PgDn     move the slab (shift: x10; or ctrl + wheel)\n"
+        "F1 F2 F3      toggle clip plane 1 2 3 (adds one through\n"
+        "              the focus on x, y, z if missing)\n"
         "Esc Q         quit");
   }
   ImGui::PopItemWidth();

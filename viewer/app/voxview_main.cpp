@@ -1,6 +1,7 @@
 // `voxview`: look into a tractogram with correct-looking transparency, in a window or headless.
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -17,7 +18,9 @@ int main(int argc, char** argv) {
                " — transparent tractogram viewer (Voxlines method).\n"
                "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx is converted in memory first.\n"
                "Window: left drag orbits, right/middle drag (or Shift+left) pans, wheel zooms. Keys: 1/2/3 axial/sagittal/coronal,\n"
-               "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, S screenshot, R reset, Esc/Q quit."};
+               "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, S screenshot, R reset, Esc/Q quit.\n"
+               "Slab and clip planes: C slab on/off, [ ] thinner/thicker, PageUp/PageDown or Ctrl+wheel move the slab\n"
+               "(the focus) along the view direction (Shift: 10x), F1/F2/F3 toggle clip planes 1/2/3."};
   cli.add_option("file", o.input, "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx tractogram")->required();
   cli.add_option("--render", o.render_png, "render one frame headless (EGL, no display needed) to this PNG and exit");
   cli.add_option("--mode", mode, "opaque | unsorted | additive | wboit | basic | axis | exact")->default_val("axis")
@@ -31,15 +34,44 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"direction", "fixed"}));
   cli.add_option("--line-width", o.settings.line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
   cli.add_option("--background", background, "black or white")->default_val("black")->check(CLI::IsMember({"black", "white"}));
+  std::vector<std::string> clips;
+  cli.add_option("--slab", o.settings.clipping.slab_mm,
+                 "crop to a slab MM thick, centred on the focus point (the view's centre), perpendicular to the view "
+                 "direction (mrview's crop to slab)")
+      ->check(CLI::PositiveNumber);
+  cli.add_option("--clip", clips,
+                 "clip plane AXIS,POS in RAS mm, up to 3: x,10 keeps x >= 10, -x,10 keeps x <= 10 (axes x y z, -x -y -z)")
+      ->expected(1)->take_all();
   cli.add_option("--voxel-size", o.voxel_size, "voxel size in mm when converting a source file in memory")
       ->default_val(10.0)->check(CLI::PositiveNumber);
   cli.add_option("--frames", o.frames, "window: quit after this many frames (for scripts and tests)")->check(CLI::PositiveNumber);
   cli.add_option("--screenshot", o.screenshot, "window: save the last frame to this PNG before quitting");
   try {
-    cli.parse(argc, argv);
+    // "--clip -x,10": CLI11 would take "-x,10" for an option; pass it as "--clip=-x,10".
+    std::vector<std::string> args;
+    for (int i = argc - 1; i >= 1; --i) {
+      const std::string a = argv[i];
+      if (i >= 2 && std::string(argv[i - 1]) == "--clip" && a.size() > 1 && a[0] == '-' && a[1] != '-') {
+        args.push_back("--clip=" + a);
+        --i;
+      } else {
+        args.push_back(a);
+      }
+    }
+    cli.name("voxview");
+    cli.parse(args);
     o.settings.mode = *parse_render_mode(mode);
     o.settings.color = color == "fixed" ? ColorMode::Fixed : ColorMode::Direction;
     o.settings.white_background = background == "white";
+    if (clips.size() > Clipping::kMaxPlanes)
+      throw Error(ErrorKind::Usage, "", std::nullopt, "--clip: at most 3 clip planes (got " + std::to_string(clips.size()) + ")");
+    for (const std::string& c : clips) {
+      auto plane = parse_axis_clip(c);
+      if (!plane)
+        throw Error(ErrorKind::Usage, "", std::nullopt,
+                    "--clip: expected AXIS,POS with AXIS one of x y z -x -y -z and POS in mm (e.g. -z,12.5); got '" + c + "'");
+      o.settings.clipping.planes.push_back(*plane);
+    }
     if (!view.empty()) {
       o.view = parse_view(view);
       if (!o.view) throw Error(ErrorKind::Usage, "", std::nullopt, "--view: unknown view '" + view + "'");

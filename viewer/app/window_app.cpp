@@ -122,6 +122,7 @@ class ViewerWindow {
   void on_scroll(double steps);
   void on_key(int key, int action, int mods);
   void on_char(unsigned codepoint);
+  void toggle_clip_plane(std::size_t i);
 
   Camera home_camera(double aspect, bool orthographic) const;
   void reset_camera(double aspect);
@@ -166,6 +167,11 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwind
   stats_.gl_version = std::to_string(major) + "." + std::to_string(minor);
   stats_.exact_available = major * 10 + minor >= 43;
   stats_.max_line_width = std::clamp(widths[1], 1.0f, 16.0f);
+  for (int c = 0; c < 3; ++c) {
+    stats_.bounds_min[c] = renderer_.bounds_min()[c];
+    stats_.bounds_max[c] = renderer_.bounds_max()[c];
+  }
+  if (o.settings.clipping.slab_mm > 0) state_.slab_thickness = o.settings.clipping.slab_mm;
 
   controller_.set_home(home_camera(aspect(), o.orthographic));
   controller_.reset();
@@ -234,17 +240,45 @@ void ViewerWindow::on_scroll(double steps) {
   events_++;
   double x = 0, y = 0;
   glfwGetCursorPos(window_, &x, &y);
-  if (!panel_->takes_mouse_at(x, y)) controller_.zoom(steps);
+  if (panel_->takes_mouse_at(x, y)) return;
+  // Ctrl + wheel moves the slab through the scene (as in mrview); the plain wheel zooms.
+  if (glfwGetKey(window_, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(window_, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
+    controller_.move_focus(-steps);
+  else
+    controller_.zoom(steps);
+}
+
+// Clip plane i on or off; a missing one is added through the focus point, on axis i, keeping the + side.
+void ViewerWindow::toggle_clip_plane(std::size_t i) {
+  std::vector<AxisClip>& planes = state_.settings.clipping.planes;
+  if (i < planes.size()) {
+    planes[i].enabled = !planes[i].enabled;
+    return;
+  }
+  if (planes.size() >= Clipping::kMaxPlanes) return;
+  AxisClip p;
+  p.axis = static_cast<int>(i);
+  p.position = controller_.camera().target[p.axis];
+  planes.push_back(p);
 }
 
 // Keys bound to a place on the keyboard: Esc and the digit row (with Shift for the opposite view).
 void ViewerWindow::on_key(int key, int action, int mods) {
   events_++;
-  if (action != GLFW_PRESS || panel_->wants_keyboard()) return;
+  if ((action != GLFW_PRESS && action != GLFW_REPEAT) || panel_->wants_keyboard()) return;
   const bool shift = mods & GLFW_MOD_SHIFT;
+  // Held keys repeat only for moving the slab.
+  if (key == GLFW_KEY_PAGE_UP || key == GLFW_KEY_PAGE_DOWN) {
+    controller_.move_focus((key == GLFW_KEY_PAGE_UP ? -1.0 : 1.0) * (shift ? 10.0 : 1.0));
+    return;
+  }
+  if (action != GLFW_PRESS) return;
   const char* view = nullptr;
   switch (key) {
     case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(window_, GLFW_TRUE); return;
+    case GLFW_KEY_F1: toggle_clip_plane(0); return;
+    case GLFW_KEY_F2: toggle_clip_plane(1); return;
+    case GLFW_KEY_F3: toggle_clip_plane(2); return;
     case GLFW_KEY_1: view = shift ? "inferior" : "axial"; break;
     case GLFW_KEY_2: view = shift ? "right" : "sagittal"; break;
     case GLFW_KEY_3: view = shift ? "posterior" : "coronal"; break;
@@ -270,6 +304,16 @@ void ViewerWindow::on_char(unsigned c) {
     case 's': case 'S': screenshot_requested_ = true; break;
     case 'r': case 'R': reset_camera(aspect()); break;
     case 'q': case 'Q': glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
+    case 'c': case 'C': {
+      double& slab = s.clipping.slab_mm;
+      slab = slab > 0 ? 0.0 : state_.slab_thickness;
+      break;
+    }
+    case '[': case ']': {
+      state_.slab_thickness = std::clamp(state_.slab_thickness * (c == ']' ? 1.25 : 0.8), 0.1, 1000.0);
+      if (s.clipping.slab_mm > 0) s.clipping.slab_mm = state_.slab_thickness;
+      break;
+    }
     default: break;
   }
 }
@@ -295,7 +339,7 @@ void ViewerWindow::draw_scene(int width, int height) {
   if (state_.grid) {
     const glm::vec4 colour = s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
     grid_.draw(renderer_, camera, double(width) / height, state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn,
-               colour);
+               colour, s.clipping);
     stats_.grid_cubes = grid_.cubes_drawn();
   }
   glFinish();  // the frame time should include the GPU's work, not only its submission
@@ -342,6 +386,7 @@ int ViewerWindow::run() {
     controller_.set_orthographic(state_.orthographic);
     if (requests.view) controller_.set_view((*requests.view)[0], (*requests.view)[1]);
     if (requests.reset_camera) reset_camera(double(fb_w) / fb_h);
+    if (requests.move_focus != 0) controller_.move_focus(requests.move_focus);
     screenshot_requested_ |= requests.screenshot;
 
     draw_scene(fb_w, fb_h);

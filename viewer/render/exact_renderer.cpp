@@ -111,7 +111,7 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
   }
   const double aspect = double(width) / std::max(1, height);
   FramePlan plan;
-  lines_.plan(camera, aspect, PlanOrder::Any, plan);
+  lines_.plan(camera, aspect, PlanOrder::Any, plan, s.clipping);
   const glm::vec3 bg = s.background();
 
   // Bands of rows; a band whose fragments overflow the node buffer is split in two and redone.
@@ -156,6 +156,7 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
     fragments_ += stored;
     resolve_band(y0, y1, stored, bg);
   }
+  Renderer::enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, width, height);
   glUseProgram(blit_program_);

@@ -85,14 +85,15 @@ GridOverlay::~GridOverlay() {
   if (program_) glDeleteProgram(program_);
 }
 
-void GridOverlay::draw(Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour) {
+void GridOverlay::draw(Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour,
+                       const Clipping& clipping) {
   const VxlFile& file = renderer.file();
   const MetaSection& m = file.meta();
   GLuint instances = all_instances_;
   cubes_drawn_ = voxel_count_;
   if (scope == Scope::Drawn) {
     // The same cull as the frame; the sort does not matter for outlines.
-    renderer.plan(camera, aspect, PlanOrder::Any, plan_);
+    renderer.plan(camera, aspect, PlanOrder::Any, plan_, clipping);
     const auto voxels = file.voxels();
     drawn_coords_.clear();
     for (const auto& [key, i] : plan_.sort_keys)

@@ -1,10 +1,12 @@
 #include "line_shaders.h"
 
+#include "clip_planes.h"
+
 namespace vxl::shaders {
 
 std::string line_vertex(unsigned chunk_count, const char* version) {
   std::string n = std::to_string(chunk_count);
-  std::string s = std::string(version) + "\n#define CHUNKS " + n + "\n";
+  std::string s = std::string(version) + "\n#define CHUNKS " + n + "\n#define CLIPS " + std::to_string(kMaxClipDistances) + "\n";
   for (unsigned c = 0; c < chunk_count; ++c) {
     std::string i = std::to_string(c);
     s += "uniform samplerBuffer u_pos" + i + ";\nuniform usamplerBuffer u_ord" + i + ";\nuniform usamplerBuffer u_dat" + i + ";\n";
@@ -33,6 +35,9 @@ uniform mat4 u_projection;
 uniform int u_color_mode;   // 0 direction, 1 fixed
 uniform vec3 u_fixed_color;
 uniform float u_opacity;
+uniform vec4 u_clip[CLIPS];  // slab and clip half-spaces, camera-relative: dot(n, p - eye) + d >= 0 is kept
+uniform int u_clip_count;
+out float gl_ClipDistance[CLIPS];
 out vec4 v_color;
 out float v_depth;          // distance along the view axis, mm
 
@@ -61,6 +66,7 @@ void main() {
   vec3 rel = (p - u_eye_hi) - u_eye_lo;
   vec3 e = u_rotation * rel;
   gl_Position = u_projection * vec4(e, 1.0);
+  for (int i = 0; i < CLIPS; ++i) gl_ClipDistance[i] = i < u_clip_count ? dot(u_clip[i].xyz, rel) + u_clip[i].w : 1.0;
   v_depth = -e.z;
   vec3 d = q - p;
   float len = length(d);

@@ -1,10 +1,13 @@
-// What the user chooses about a picture: transparency mode, colouring, opacity, line width, background.
+// What the user chooses about a picture: transparency mode, colouring, opacity, line width, background,
+// slab and clip planes.
 #pragma once
 
 #include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
+
+#include "clip_planes.h"
 
 namespace vxl {
 
@@ -34,6 +37,7 @@ struct RenderSettings {
   // `axis` mode: keep a voxel's order until another stored order is closer to its view direction by
   // more than this cosine margin (FramePlan::order_hysteresis). 0: off, the paper's rule every frame.
   float order_hysteresis = 0.0f;
+  Clipping clipping;       // slab and clip planes (clip_planes.h)
   glm::vec3 background() const { return white_background ? glm::vec3(1.0f) : glm::vec3(0.0f); }
 };
 

@@ -53,10 +53,11 @@ glm::dmat4 Renderer::projection(const Camera& camera, double aspect) const {
   return glm::dmat4(Camera(camera).projection(aspect, near_mm, std::max(far_mm, near_mm + 1.0)));
 }
 
-void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out) {
+void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping) {
   auto t0 = std::chrono::steady_clock::now();
   ViewParams view = make_view_params(camera.eye(), camera.forward(), camera.orthographic, projection(camera, aspect),
                                      glm::dmat3(camera.view_rotation()));
+  for (const glm::dvec4& h : clip_half_spaces(clipping, camera)) view.clip.push_back(relative_to(h, view.eye));
   plan_frame(scene_.layout(), view, order, out);
   stats_.plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.voxels_drawn = out.voxels_drawn;
@@ -100,6 +101,19 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   glUniform1i(glGetUniformLocation(program, "u_color_mode"), s.color == ColorMode::Direction ? 0 : 1);
   glUniform3fv(glGetUniformLocation(program, "u_fixed_color"), 1, glm::value_ptr(s.fixed_color));
   glUniform1f(glGetUniformLocation(program, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
+  std::vector<glm::vec4> clip;
+  for (const glm::dvec4& h : clip_half_spaces(s.clipping, camera)) clip.push_back(glm::vec4(relative_to(h, eye)));
+  const int clips = static_cast<int>(std::min<std::size_t>(clip.size(), kMaxClipDistances));
+  if (clips > 0) glUniform4fv(glGetUniformLocation(program, "u_clip"), clips, glm::value_ptr(clip[0]));
+  glUniform1i(glGetUniformLocation(program, "u_clip_count"), clips);
+  enable_clip_distances(clips);
+}
+
+void Renderer::enable_clip_distances(int n) {
+  for (int i = 0; i < kMaxClipDistances; ++i) {
+    if (i < n) glEnable(GL_CLIP_DISTANCE0 + i);
+    else glDisable(GL_CLIP_DISTANCE0 + i);
+  }
 }
 
 void Renderer::draw_plan(const std::vector<std::int32_t>& first, const std::vector<std::int32_t>& count) const {
@@ -109,7 +123,7 @@ void Renderer::draw_plan(const std::vector<std::int32_t>& first, const std::vect
 }
 
 void Renderer::draw_lines(GLuint program, const Camera& camera, const RenderSettings& s, double aspect, PlanOrder order) {
-  plan(camera, aspect, order, plan_);
+  plan(camera, aspect, order, plan_, s.clipping);
   bind_line_program(program, camera, s, aspect);
   draw_plan(plan_.first, plan_.count);
 }
@@ -125,6 +139,7 @@ void Renderer::draw_dataset_order(GLuint program, const Camera& camera, const Re
 }
 
 void Renderer::composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const {
+  enable_clip_distances(0);
   glUseProgram(program);
   GLint unit = 0;
   for (const auto& [name, texture] : textures) {
@@ -235,6 +250,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       break;
   }
   glDisable(GL_BLEND);
+  enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
 }
 

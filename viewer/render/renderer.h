@@ -49,7 +49,11 @@ class Renderer {
   // Binds the line program's uniforms and textures for `camera`; used by the exact renderer too.
   void bind_line_program(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect) const;
   void draw_plan(const std::vector<std::int32_t>& first, const std::vector<std::int32_t>& count) const;
-  void plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out);
+  // The frame plan for `camera`: voxels outside the frustum or the slab / clip planes of `clipping` culled.
+  void plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping = {});
+  // Enables the first n of the line shader's clip distances and disables the others (passes without
+  // gl_ClipDistance must run with none enabled).
+  static void enable_clip_distances(int n);
 
  private:
   void draw_lines(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect, PlanOrder order);
