@@ -151,6 +151,7 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   // Picking a colour means the user wants it shown.
   if (ImGui::ColorEdit3("##fixed colour", &s.fixed_color.x, ImGuiColorEditFlags_NoInputs)) colour = 1;
   s.color = colour == 1 ? ColorMode::Fixed : ColorMode::Direction;
+  ImGui::Checkbox("Lighting", &s.lighting);
 
   int background = s.white_background ? 1 : 0;
   ImGui::AlignTextToFramePadding();
@@ -223,6 +224,7 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
         "O             orthographic / perspective\n"
         "M             next transparency mode\n"
         "+ -           opacity x / : 1.5\n"
+        "L             lighting on / off\n"
         "S             screenshot    R  reset camera\n"
         "C             slab on / off\n"
         "[ ]           slab thinner / thicker\n"

@@ -18,7 +18,8 @@ int main(int argc, char** argv) {
                " — transparent tractogram viewer (Voxlines method).\n"
                "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx is converted in memory first.\n"
                "Window: left drag orbits, right/middle drag (or Shift+left) pans, wheel zooms. Keys: 1/2/3 axial/sagittal/coronal,\n"
-               "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, S screenshot, R reset, Esc/Q quit.\n"
+               "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, L lighting, S screenshot, R reset,\n"
+               "Esc/Q quit.\n"
                "Slab and clip planes: C slab on/off, [ ] thinner/thicker, PageUp/PageDown or Ctrl+wheel move the slab\n"
                "(the focus) along the view direction (Shift: 10x), F1/F2/F3 toggle clip planes 1/2/3."};
   cli.add_option("file", o.input, "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx tractogram")->required();
@@ -32,6 +33,9 @@ int main(int argc, char** argv) {
   cli.add_flag("--ortho", o.orthographic, "orthographic projection (default perspective)");
   cli.add_option("--color", color, "direction (|p1 - p0| as RGB) or fixed")->default_val("direction")
       ->check(CLI::IsMember({"direction", "fixed"}));
+  cli.add_flag("--lighting", o.settings.lighting,
+               "light the lines (illuminated lines: a line along the light, which comes from the viewer's upper left, is "
+               "dark, one across it bright)");
   cli.add_option("--line-width", o.settings.line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
   cli.add_option("--background", background, "black or white")->default_val("black")->check(CLI::IsMember({"black", "white"}));
   std::vector<std::string> clips;

@@ -302,6 +302,7 @@ void ViewerWindow::on_char(unsigned c) {
     case '+': case '=': s.opacity = std::clamp(s.opacity * 1.5f, 0.001f, 1.0f); break;
     case '-': case '_': s.opacity = std::clamp(s.opacity / 1.5f, 0.001f, 1.0f); break;
     case 's': case 'S': screenshot_requested_ = true; break;
+    case 'l': case 'L': s.lighting = !s.lighting; break;
     case 'r': case 'R': reset_camera(aspect()); break;
     case 'q': case 'Q': glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
     case 'c': case 'C': {

@@ -37,6 +37,10 @@ uniform vec3 u_fixed_color;
 uniform float u_opacity;
 uniform vec4 u_clip[CLIPS];  // slab and clip half-spaces, camera-relative: dot(n, p - eye) + d >= 0 is kept
 uniform int u_clip_count;
+uniform int u_lighting;     // 0 off, 1 illuminated lines
+uniform vec3 u_light;       // towards the light, eye space
+uniform vec4 u_light_terms; // ambient, diffuse, specular, shininess
+uniform int u_orthographic;
 out float gl_ClipDistance[CLIPS];
 out vec4 v_color;
 out float v_depth;          // distance along the view axis, mm
@@ -71,6 +75,16 @@ void main() {
   vec3 d = q - p;
   float len = length(d);
   vec3 color = u_color_mode == 0 ? (len > 0.0 ? abs(d / len) : vec3(1.0)) : u_fixed_color;
+  if (u_lighting != 0 && len > 0.0) {
+    // Illuminated lines (line_lighting.h), in eye space. Both ends use the same tangent sign, so the
+    // interpolated tangent never passes through zero.
+    vec3 t = normalize(u_rotation * (end == 0 ? d : -d));
+    vec3 view = u_orthographic != 0 ? vec3(0.0, 0.0, 1.0) : normalize(-e);
+    float lt = dot(u_light, t), vt = dot(view, t);
+    float diffuse = sqrt(max(0.0, 1.0 - lt * lt));
+    float specular = pow(max(0.0, diffuse * sqrt(max(0.0, 1.0 - vt * vt)) - lt * vt), u_light_terms.w);
+    color = color * (u_light_terms.x + u_light_terms.y * diffuse) + vec3(u_light_terms.z * specular);
+  }
   v_color = vec4(color, u_opacity);
 }
 )";

@@ -1,5 +1,5 @@
-// What the user chooses about a picture: transparency mode, colouring, opacity, line width, background,
-// slab and clip planes.
+// What the user chooses about a picture: transparency mode, colouring, lighting, opacity, line width,
+// background, slab and clip planes.
 #pragma once
 
 #include <optional>
@@ -38,6 +38,7 @@ struct RenderSettings {
   // more than this cosine margin (FramePlan::order_hysteresis). 0: off, the paper's rule every frame.
   float order_hysteresis = 0.0f;
   Clipping clipping;       // slab and clip planes (clip_planes.h)
+  bool lighting = false;   // illuminated lines (line_lighting.h)
   glm::vec3 background() const { return white_background ? glm::vec3(1.0f) : glm::vec3(0.0f); }
 };
 

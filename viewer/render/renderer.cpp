@@ -8,6 +8,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "exact_renderer.h"
+#include "line_lighting.h"
 #include "line_shaders.h"
 
 namespace vxl {
@@ -101,6 +102,12 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   glUniform1i(glGetUniformLocation(program, "u_color_mode"), s.color == ColorMode::Direction ? 0 : 1);
   glUniform3fv(glGetUniformLocation(program, "u_fixed_color"), 1, glm::value_ptr(s.fixed_color));
   glUniform1f(glGetUniformLocation(program, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
+  glUniform1i(glGetUniformLocation(program, "u_lighting"), s.lighting ? 1 : 0);
+  const glm::vec3 light = lighting::light_direction_eye();
+  glUniform3fv(glGetUniformLocation(program, "u_light"), 1, glm::value_ptr(light));
+  glUniform4f(glGetUniformLocation(program, "u_light_terms"), lighting::kAmbient, lighting::kDiffuse, lighting::kSpecular,
+              lighting::kShininess);
+  glUniform1i(glGetUniformLocation(program, "u_orthographic"), camera.orthographic ? 1 : 0);
   std::vector<glm::vec4> clip;
   for (const glm::dvec4& h : clip_half_spaces(s.clipping, camera)) clip.push_back(glm::vec4(relative_to(h, eye)));
   const int clips = static_cast<int>(std::min<std::size_t>(clip.size(), kMaxClipDistances));
