@@ -107,6 +107,26 @@ TEST_F(Window, ShowsAVxlFileAndSavesTheLastFrameWithoutThePanel) {
   EXPECT_LT(d.differing_pixels, 320u * 240u / 100u) << "mean error " << d.mean_error << ", max at " << d.max_x << "," << d.max_y;
 }
 
+TEST_F(Window, AViewSavedInTheWindowReplaysHeadless) {
+  VXL_REQUIRE_XVFB();
+  make_inputs();
+  const std::string view = dir.file("view.json"), shot = dir.file("window.png"), replay = dir.file("replay.png");
+  CommandResult w = run_voxview_in_xvfb(shell_quoted(vxl) + " --frames 3 --size 200x150 --view 40,15 --lighting --slab 60 --opacity 0.6"
+                                        " --save-camera " + shell_quoted(view) + " --screenshot " + shell_quoted(shot));
+  ASSERT_EQ(w.exit_code, 0) << w.output;
+  ASSERT_TRUE(std::filesystem::exists(view)) << w.output;
+  CommandResult h = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + " --camera " + shell_quoted(view) +
+                              " --render " + shell_quoted(replay));
+  ASSERT_EQ(h.exit_code, 0) << h.output;
+  const Image a = read_image(shot), b = read_image(replay);
+  ASSERT_EQ(b.width, 200);
+  ASSERT_EQ(b.height, 150);
+  // Same camera, settings and size; window (GLX) and headless (EGL) rasterise alike but for details.
+  ImageDiff d = compare_images(a, b);
+  EXPECT_LT(d.differing_pixels, 200u * 150u / 100u) << "mean error " << d.mean_error;
+  EXPECT_GT(lit_pixels(b), 200 * 150 / 200);
+}
+
 TEST_F(Window, OpensATckDirectly) {
   VXL_REQUIRE_XVFB();
   make_inputs();

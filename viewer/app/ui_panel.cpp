@@ -201,6 +201,8 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   out.screenshot = ImGui::Button("Screenshot");
   ImGui::SameLine();
   ImGui::Checkbox("with panel", &state.panel_in_screenshot);
+  ImGui::SameLine();
+  out.save_view = ImGui::Button("Save view");
 
   ImGui::Separator();
   ImGui::Text("Frame      %.2f ms", stats.frame_ms);
@@ -226,6 +228,7 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
         "+ -           opacity x / : 1.5\n"
         "L             lighting on / off\n"
         "S             screenshot    R  reset camera\n"
+        "V             save the view (for --camera)\n"
         "C             slab on / off\n"
         "[ ]           slab thinner / thicker\n"
         "PgUp PgDn     move the slab (shift: x10; or ctrl + wheel)\n"

@@ -44,6 +44,7 @@ struct PanelRequests {
   std::optional<std::array<double, 2>> view;  // azimuth, elevation
   bool reset_camera = false;
   bool screenshot = false;
+  bool save_view = false;  // write the view (camera and settings) for --camera
   double move_focus = 0;  // mm along the view direction (moves the slab)
 };
 

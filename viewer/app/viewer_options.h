@@ -14,6 +14,9 @@ struct ViewerOptions {
   std::optional<std::string> render_png;  // headless: render one frame to this PNG and exit
   RenderSettings settings;
   std::optional<std::array<double, 2>> view;  // azimuth, elevation; default: an oblique view
+  std::optional<Camera> camera;      // a saved view's camera (--camera); --view and --ortho still apply
+  int turntable = 0;                 // headless: frames around the vertical axis (0: one plain frame)
+  std::optional<std::string> save_camera;  // write the view here (headless: after rendering)
   bool orthographic = false;
   int width = 1024, height = 1024;
   double voxel_size = 10.0;          // for in-memory conversion

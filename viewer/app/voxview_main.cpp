@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "camera_file.h"
 #include "error.h"
 #include "headless_render.h"
 #include "viewer_options.h"
@@ -13,7 +14,10 @@
 int main(int argc, char** argv) {
   using namespace vxl;
   app::ViewerOptions o;
-  std::string mode = "axis", view, size = "1024x1024", color = "direction", background = "black";
+  std::string mode = "axis", view, size = "1024x1024", color = "direction", background = "black", camera_file;
+  float opacity = 0.3f, line_width = 1.0f;
+  double slab = 0;
+  bool lighting = false;
   CLI::App cli{"voxview " VOXLINES_VERSION
                " — transparent tractogram viewer (Voxlines method).\n"
                "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx is converted in memory first.\n"
@@ -21,25 +25,35 @@ int main(int argc, char** argv) {
                "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, L lighting, S screenshot, R reset,\n"
                "Esc/Q quit.\n"
                "Slab and clip planes: C slab on/off, [ ] thinner/thicker, PageUp/PageDown or Ctrl+wheel move the slab\n"
-               "(the focus) along the view direction (Shift: 10x), F1/F2/F3 toggle clip planes 1/2/3."};
+               "(the focus) along the view direction (Shift: 10x), F1/F2/F3 toggle clip planes 1/2/3. V saves the view (see\n"
+               "--save-camera) for replaying headless with --camera."};
   cli.add_option("file", o.input, "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx tractogram")->required();
-  cli.add_option("--render", o.render_png, "render one frame headless (EGL, no display needed) to this PNG and exit");
+  cli.add_option("--render", o.render_png, "render headless (EGL, no display needed) to this PNG and exit");
+  cli.add_option("--turntable", o.turntable,
+                 "with --render: N frames turning once around the vertical (superior) axis, written as OUT_000.png, "
+                 "OUT_001.png, ... (frame i at azimuth + 360 i / N degrees; frame 0 is the plain --render view)")
+      ->check(CLI::Range(1, 100000));
+  cli.add_option("--camera", camera_file,
+                 "start from a saved view (camera and settings; JSON, see --save-camera); options given as well "
+                 "override it");
+  cli.add_option("--save-camera", o.save_camera,
+                 "write the view (camera and settings) to this JSON file: headless after rendering, in the window on "
+                 "V, the panel's Save view button, or on quitting after --frames");
   cli.add_option("--mode", mode, "opaque | unsorted | additive | wboit | basic | axis | exact")->default_val("axis")
       ->check(CLI::IsMember({"opaque", "unsorted", "additive", "wboit", "basic", "axis", "exact"}));
-  cli.add_option("--opacity", o.settings.opacity, "line opacity, 1 down to 0.001")->default_val(0.3)
-      ->check(CLI::Range(0.001, 1.0));
+  cli.add_option("--opacity", opacity, "line opacity, 1 down to 0.001")->default_val(0.3)->check(CLI::Range(0.001, 1.0));
   cli.add_option("--view", view, "axial, inferior, sagittal (left), right, coronal (anterior), posterior, or AZ,EL in degrees");
   cli.add_option("--size", size, "image or window size WxH")->default_val("1024x1024");
   cli.add_flag("--ortho", o.orthographic, "orthographic projection (default perspective)");
   cli.add_option("--color", color, "direction (|p1 - p0| as RGB) or fixed")->default_val("direction")
       ->check(CLI::IsMember({"direction", "fixed"}));
-  cli.add_flag("--lighting", o.settings.lighting,
+  cli.add_flag("--lighting", lighting,
                "light the lines (illuminated lines: a line along the light, which comes from the viewer's upper left, is "
                "dark, one across it bright)");
-  cli.add_option("--line-width", o.settings.line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
+  cli.add_option("--line-width", line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
   cli.add_option("--background", background, "black or white")->default_val("black")->check(CLI::IsMember({"black", "white"}));
   std::vector<std::string> clips;
-  cli.add_option("--slab", o.settings.clipping.slab_mm,
+  cli.add_option("--slab", slab,
                  "crop to a slab MM thick, centred on the focus point (the view's centre), perpendicular to the view "
                  "direction (mrview's crop to slab)")
       ->check(CLI::PositiveNumber);
@@ -64,17 +78,38 @@ int main(int argc, char** argv) {
     }
     cli.name("voxview");
     cli.parse(args);
-    o.settings.mode = *parse_render_mode(mode);
-    o.settings.color = color == "fixed" ? ColorMode::Fixed : ColorMode::Direction;
-    o.settings.white_background = background == "white";
+    auto given = [&](const char* name) { return cli.get_option(name)->count() > 0; };
+    if (o.turntable && !o.render_png)
+      throw Error(ErrorKind::Usage, "", std::nullopt, "--turntable needs --render OUT.png (it writes OUT_000.png, ...)");
+
+    // Settings: the defaults, then a saved view, then what the command line gives explicitly.
+    RenderSettings& s = o.settings;
+    s.opacity = opacity;
+    if (!camera_file.empty()) {
+      app::SavedView defaults;
+      defaults.settings = s;
+      app::SavedView saved = app::read_view(camera_file, defaults);
+      s = saved.settings;
+      o.camera = saved.camera;
+      if (saved.size && !given("--size")) size = std::to_string((*saved.size)[0]) + "x" + std::to_string((*saved.size)[1]);
+    }
+    const bool from_file = o.camera.has_value();
+    if (!from_file || given("--mode")) s.mode = *parse_render_mode(mode);
+    if (!from_file || given("--opacity")) s.opacity = opacity;
+    if (!from_file || given("--color")) s.color = color == "fixed" ? ColorMode::Fixed : ColorMode::Direction;
+    if (!from_file || given("--background")) s.white_background = background == "white";
+    if (!from_file || given("--line-width")) s.line_width = line_width;
+    if (lighting) s.lighting = true;
+    if (given("--slab")) s.clipping.slab_mm = slab;
     if (clips.size() > Clipping::kMaxPlanes)
       throw Error(ErrorKind::Usage, "", std::nullopt, "--clip: at most 3 clip planes (got " + std::to_string(clips.size()) + ")");
+    if (!clips.empty()) s.clipping.planes.clear();
     for (const std::string& c : clips) {
       auto plane = parse_axis_clip(c);
       if (!plane)
         throw Error(ErrorKind::Usage, "", std::nullopt,
                     "--clip: expected AXIS,POS with AXIS one of x y z -x -y -z and POS in mm (e.g. -z,12.5); got '" + c + "'");
-      o.settings.clipping.planes.push_back(*plane);
+      s.clipping.planes.push_back(*plane);
     }
     if (!view.empty()) {
       o.view = parse_view(view);

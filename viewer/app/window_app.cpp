@@ -16,6 +16,7 @@
 #include <GLFW/glfw3.h>
 
 #include "camera_controller.h"
+#include "camera_file.h"
 #include "grid_overlay.h"
 #include "headless_render.h"
 #include "image_io.h"
@@ -95,16 +96,17 @@ Image read_back_buffer(int width, int height) {
   return img;
 }
 
-// voxview-YYYYMMDD-HHMMSS.png in the current directory, with a suffix when taken twice in a second.
-std::filesystem::path screenshot_name() {
+// voxview-YYYYMMDD-HHMMSS.png (or .json, ...) in the current directory, with a suffix when taken twice in
+// a second.
+std::filesystem::path stamped_name(const std::string& prefix, const std::string& extension) {
   std::time_t now = std::time(nullptr);
   std::tm local{};
   localtime_r(&now, &local);
   char stamp[32];
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &local);
-  std::filesystem::path p = std::filesystem::current_path() / (std::string("voxview-") + stamp + ".png");
+  std::filesystem::path p = std::filesystem::current_path() / (prefix + stamp + extension);
   for (int n = 2; std::filesystem::exists(p); ++n)
-    p = std::filesystem::current_path() / (std::string("voxview-") + stamp + "-" + std::to_string(n) + ".png");
+    p = std::filesystem::current_path() / (prefix + stamp + "-" + std::to_string(n) + extension);
   return p;
 }
 
@@ -130,6 +132,8 @@ class ViewerWindow {
   void set_error(const std::string& message);
   void draw_scene(int width, int height);
   void save_screenshot(const std::string& path, int width, int height);
+  // Writes the current view (camera, settings, size) to --save-camera's path or a stamped name.
+  void save_view(int width, int height);
 
   const ViewerOptions& options_;
   GLFWwindow* window_;
@@ -141,6 +145,7 @@ class ViewerWindow {
   PanelStats stats_;
   int drag_button_ = -1;
   bool screenshot_requested_ = false;
+  bool save_view_requested_ = false;
   RenderMode drawn_mode_ = RenderMode::Axis;  // the mode of the last frame, to clear a mode's error once another is chosen
   unsigned events_ = 0;  // input events seen, to keep drawing while something happens
 };
@@ -303,6 +308,7 @@ void ViewerWindow::on_char(unsigned c) {
     case '-': case '_': s.opacity = std::clamp(s.opacity / 1.5f, 0.001f, 1.0f); break;
     case 's': case 'S': screenshot_requested_ = true; break;
     case 'l': case 'L': s.lighting = !s.lighting; break;
+    case 'v': case 'V': save_view_requested_ = true; break;
     case 'r': case 'R': reset_camera(aspect()); break;
     case 'q': case 'Q': glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
     case 'c': case 'C': {
@@ -359,6 +365,19 @@ void ViewerWindow::save_screenshot(const std::string& path, int width, int heigh
   std::fflush(stdout);
 }
 
+void ViewerWindow::save_view(int width, int height) {
+  const std::string path = options_.save_camera.value_or(stamped_name("voxview-view-", ".json").string());
+  try {
+    write_view(path, SavedView{controller_.camera(), state_.settings, std::array<int, 2>{width, height}});
+    stats_.status = "view saved to " + path;
+    std::printf("voxview: view saved to %s (replay: voxview FILE --camera '%s' --render OUT.png)\n", path.c_str(),
+                path.c_str());
+    std::fflush(stdout);
+  } catch (const std::exception& e) {
+    set_error(e.what());
+  }
+}
+
 int ViewerWindow::run() {
   const bool automated = options_.frames.has_value();
   int settle = 2;  // frames still to draw after the last event: ImGui needs one to show hover and clicks
@@ -389,13 +408,17 @@ int ViewerWindow::run() {
     if (requests.reset_camera) reset_camera(double(fb_w) / fb_h);
     if (requests.move_focus != 0) controller_.move_focus(requests.move_focus);
     screenshot_requested_ |= requests.screenshot;
+    save_view_requested_ |= requests.save_view;
 
     draw_scene(fb_w, fb_h);
     // Screenshots show the scene alone unless the user asked for the panel too; automated ones never do.
     if (closing && options_.screenshot) save_screenshot(*options_.screenshot, fb_w, fb_h);
+    // The view of the frame just drawn; scripts get it on quitting after --frames.
+    if (save_view_requested_ || (closing && automated && options_.save_camera)) save_view(fb_w, fb_h);
+    save_view_requested_ = false;
     if (screenshot_requested_ && !state_.panel_in_screenshot) {
       try {
-        save_screenshot(screenshot_name().string(), fb_w, fb_h);
+        save_screenshot(stamped_name("voxview-", ".png").string(), fb_w, fb_h);
       } catch (const std::exception& e) {
         set_error(e.what());
       }
@@ -405,7 +428,7 @@ int ViewerWindow::run() {
     panel_->render();
     if (screenshot_requested_ && state_.panel_in_screenshot) {
       try {
-        save_screenshot(screenshot_name().string(), fb_w, fb_h);
+        save_screenshot(stamped_name("voxview-", ".png").string(), fb_w, fb_h);
       } catch (const std::exception& e) {
         set_error(e.what());
       }
