@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "checksum.h"
+#include "vxl_value_sets.h"
 
 namespace vxl {
 
@@ -30,7 +31,8 @@ std::vector<std::uint8_t> encode_groups(std::span<const GroupContent> groups) {
 }
 
 VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
-                              std::uint64_t group_bytes) {
+                              std::uint64_t group_bytes, std::uint32_t vertex_value_sets,
+                              std::uint32_t streamline_value_sets) {
   VxlSectionSizes s;
   s.directions = std::uint64_t(m.stored_order_count) * sizeof(DirectionEntry);
   if (m.order_set == static_cast<std::uint32_t>(OrderSet::Random)) s.voxel_directions = m.voxel_count * s.directions;
@@ -41,6 +43,8 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
   s.streamlines = (m.streamline_count + 1) * sizeof(std::uint64_t);
   s.provenance = provenance_bytes;
   s.groups = group_bytes;
+  s.vertex_values = value_sets_bytes(vertex_value_sets, m.vertex_count);
+  s.streamline_values = value_sets_bytes(streamline_value_sets, m.streamline_count);
   return s;
 }
 
@@ -64,6 +68,9 @@ VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : ou
       {"STRM", kSectionRequired, sizes.streamlines, true},
       {"PROV", 0, sizes.provenance, true},
       {"GRPS", 0, sizes.groups, sizes.groups > 0},
+      // Optional: a reader that does not know them still draws the picture, in the other colour modes.
+      {"VVAL", 0, sizes.vertex_values, sizes.vertex_values > 0},
+      {"SVAL", 0, sizes.streamline_values, sizes.streamline_values > 0},
   };
   std::size_t present = 0;
   for (const Planned& p : planned) present += p.present;
@@ -119,7 +126,10 @@ void VxlWriter::commit(unsigned threads) {
   std::memcpy(h.magic, kVxlMagic.data(), 8);
   h.version_major = kVxlVersionMajor;
   // The lowest version that holds what is written (spec §10).
-  h.version_minor = position_[kVdir] < table_.size() ? kVxlVersionMinorVoxelDirections : kVxlVersionMinor;
+  const auto present = [&](Index i) { return position_[i] < table_.size(); };
+  h.version_minor = present(kVval) || present(kSval) ? kVxlVersionMinorValueSets
+                    : present(kVdir)                 ? kVxlVersionMinorVoxelDirections
+                                                     : kVxlVersionMinor;
   h.header_size = sizeof(FileHeader);
   h.file_size = file_.size();
   h.section_table_offset = sizeof(FileHeader);

@@ -6,6 +6,7 @@
 #include "error.h"
 #include "progress_bar.h"
 #include "read_tractogram.h"
+#include "read_tsf.h"
 #include "segment_orders.h"
 
 namespace vxl::cli {
@@ -15,6 +16,7 @@ void add_convert_command(CLI::App& app) {
     std::string input, output;
     ConvertSettings settings;
     bool verbose = false;
+    std::vector<std::string> tsf;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("convert", "Convert a TCK / TRK (.trk.gz) / TRX tractogram to .vxl");
@@ -35,6 +37,10 @@ void add_convert_command(CLI::App& app) {
           return e.reason();
         }
       });
+  cmd->add_option("--tsf", opt->tsf,
+                  "MRtrix track scalar file with one value per point of the input (repeatable); stored so that voxview "
+                  "can colour by it (--color scalar)")
+      ->expected(1)->take_all();
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
   cmd->callback([opt] {
     ProgressBar bar;
@@ -42,6 +48,7 @@ void add_convert_command(CLI::App& app) {
     bar.update("reading", 0.0);
     auto t0 = std::chrono::steady_clock::now();
     Tractogram t = read_tractogram(opt->input);
+    for (const std::string& tsf : opt->tsf) attach_tsf(t, tsf);
     double read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const std::string& w : t.source.warnings) {
       bar.done();

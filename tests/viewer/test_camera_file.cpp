@@ -27,8 +27,12 @@ SavedView unusual_view() {
   RenderSettings& s = v.settings;
   s.mode = RenderMode::Wboit;
   s.opacity = 0.123f;
-  s.color = ColorMode::Fixed;
+  s.color = ColorMode::Scalar;
   s.fixed_color = {0.1f, 0.2f, 0.3f};
+  s.colormap = Colormap::Hot;
+  s.scalar = "fa";
+  s.range = std::array<float, 2>{0.1f, 0.9f};
+  s.group_styles = {{"ARC_L", glm::vec3(1, 0, 0), 0.25f}, {"ARC_R", std::nullopt, 0.0f}};
   s.line_width = 2.5f;
   s.white_background = true;
   s.lighting = true;
@@ -55,6 +59,15 @@ TEST(CameraFile, RoundTripsEveryFieldExactly) {
   EXPECT_EQ(t.opacity, s.opacity);
   EXPECT_EQ(t.color, s.color);
   EXPECT_EQ(t.fixed_color, s.fixed_color);
+  EXPECT_EQ(t.colormap, s.colormap);
+  EXPECT_EQ(t.scalar, s.scalar);
+  EXPECT_EQ(t.range, s.range);
+  ASSERT_EQ(t.group_styles.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(t.group_styles[i].name, s.group_styles[i].name);
+    EXPECT_EQ(t.group_styles[i].color, s.group_styles[i].color);
+    EXPECT_EQ(t.group_styles[i].opacity, s.group_styles[i].opacity);
+  }
   EXPECT_EQ(t.line_width, s.line_width);
   EXPECT_EQ(t.white_background, s.white_background);
   EXPECT_EQ(t.lighting, s.lighting);
@@ -97,6 +110,11 @@ TEST(CameraFile, MissingKeysKeepDefaultsAndBadOnesNameFileAndKey) {
   EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"clip": [{"plane": "w,1"}]}})").find("settings.clip[0].plane"),
             std::string::npos);
   EXPECT_NE(error_of(R"({"voxview_view": 1, "size": [0, 10]})").find("size"), std::string::npos);
+  EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"range": [2, 1]}})").find("settings.range"), std::string::npos);
+  EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"groups": [{"name": "A", "color": "red"}]}})")
+                .find("settings.groups[0].color"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"colormap": "jet"}})").find("settings.colormap"), std::string::npos);
 
   ScratchDir dir;
   try {

@@ -115,11 +115,47 @@ void read_settings(const Reader& r, RenderSettings& s) {
   r.number("opacity", s.opacity);
   if (!(s.opacity >= 0.001f && s.opacity <= 1.0f)) r.fail("opacity", "a number in [0.001, 1]");
   if (const std::string* color = r.text("color")) {
-    if (*color == "direction") s.color = ColorMode::Direction;
-    else if (*color == "fixed") s.color = ColorMode::Fixed;
-    else r.fail("color", "direction or fixed");
+    auto c = parse_color_mode(*color);
+    if (!c) r.fail("color", "direction, fixed, scalar or group");
+    s.color = *c;
   }
   r.triple("fixed_color", s.fixed_color);
+  if (const std::string* map = r.text("colormap")) {
+    auto m = parse_colormap(*map);
+    if (!m) r.fail("colormap", "grey, hot or viridis");
+    s.colormap = *m;
+  }
+  if (const std::string* scalar = r.text("scalar")) s.scalar = *scalar;
+  if (const json* range = r.find("range")) {
+    if (range->is_null()) {
+      s.range.reset();
+    } else {
+      if (!range->is_array() || range->size() != 2 || !(*range)[0].is_number() || !(*range)[1].is_number() ||
+          !((*range)[0].get<double>() < (*range)[1].get<double>()))
+        r.fail("range", "[min, max] with min < max, or null (the values' own range)");
+      s.range = std::array<float, 2>{(*range)[0].get<float>(), (*range)[1].get<float>()};
+    }
+  }
+  if (const json* groups = r.find("groups")) {
+    if (!groups->is_array()) r.fail("groups", "an array of {\"name\", \"color\", \"opacity\"}");
+    s.group_styles.clear();
+    for (std::size_t i = 0; i < groups->size(); ++i) {
+      const std::string key = "groups[" + std::to_string(i) + "]";
+      if (!(*groups)[i].is_object()) r.fail(key, "an object {\"name\", \"color\", \"opacity\"}");
+      Reader g((*groups)[i], r.path(), r.prefix() + key + ".");
+      GroupStyle style;
+      const std::string* name = g.text("name");
+      if (!name) g.fail("name", "the group's name");
+      style.name = *name;
+      if (const std::string* color = g.text("color")) {
+        style.color = parse_hex_color(*color);
+        if (!style.color) g.fail("color", "#RRGGBB");
+      }
+      g.number("opacity", style.opacity);
+      if (!(style.opacity >= 0.0f && style.opacity <= 1.0f)) g.fail("opacity", "a factor in [0, 1]");
+      s.group_styles.push_back(style);
+    }
+  }
   r.number("line_width", s.line_width);
   if (!(s.line_width >= 1.0f && s.line_width <= 16.0f)) r.fail("line_width", "pixels in [1, 16]");
   if (const std::string* bg = r.text("background")) {
@@ -160,10 +196,20 @@ std::string view_json(const SavedView& v) {
                  {"ortho_height", c.ortho_height}};
   json clip = json::array();
   for (const AxisClip& p : s.clipping.planes) clip.push_back({{"plane", axis_clip_text(p)}, {"enabled", p.enabled}});
+  json groups = json::array();
+  for (const GroupStyle& g : s.group_styles) {
+    json entry = {{"name", g.name}, {"opacity", shortest(g.opacity)}};
+    if (g.color) entry["color"] = hex_color(*g.color);
+    groups.push_back(entry);
+  }
   j["settings"] = {{"mode", render_mode_name(s.mode)},
                    {"opacity", shortest(s.opacity)},
-                   {"color", s.color == ColorMode::Fixed ? "fixed" : "direction"},
+                   {"color", color_mode_name(s.color)},
                    {"fixed_color", vec(s.fixed_color)},
+                   {"colormap", colormap_name(s.colormap)},
+                   {"scalar", s.scalar},
+                   {"range", s.range ? json::array({shortest((*s.range)[0]), shortest((*s.range)[1])}) : json(nullptr)},
+                   {"groups", groups},
                    {"line_width", shortest(s.line_width)},
                    {"background", s.white_background ? "white" : "black"},
                    {"lighting", s.lighting},

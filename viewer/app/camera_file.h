@@ -1,6 +1,7 @@
 // Saved views (`voxview --camera FILE.json`, `--save-camera FILE.json`, the window's V key): everything
-// that decides a picture apart from the data — the camera, the render settings (mode, opacity, colour,
-// line width, background, lighting, slab and clip planes) and the image size — as a small JSON file, so
+// that decides a picture apart from the data — the camera, the render settings (mode, opacity, colour mode,
+// colour map, range, group colours, line width, background, lighting, slab and clip planes) and the image
+// size — as a small JSON file, so
 // that a view found in the window can be rendered again headless, identically, for a figure.
 //
 //   {
@@ -9,6 +10,8 @@
 //     "camera": {"target": [x, y, z], "distance": 300, "azimuth_deg": -35, "elevation_deg": 25,
 //                "fov_y_deg": 30, "orthographic": false, "ortho_height": 200},
 //     "settings": {"mode": "axis", "opacity": 0.3, "color": "direction", "fixed_color": [1, 0.85, 0.3],
+//                  "colormap": "viridis", "scalar": "", "range": null,
+//                  "groups": [{"name": "ARC_L", "color": "#e41a1c", "opacity": 1}],
 //                  "line_width": 1, "background": "black", "lighting": false, "order_hysteresis": 0,
 //                  "slab_mm": 0, "clip": [{"plane": "-x,10", "enabled": true}]}
 //   }

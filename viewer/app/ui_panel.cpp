@@ -1,5 +1,6 @@
 #include "ui_panel.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include <imgui.h>
@@ -29,6 +30,73 @@ std::string count_text(std::uint64_t n) {
 
 void view_button(const char* label, const char* view, PanelRequests& out) {
   if (ImGui::Button(label)) out.view = parse_view(view);
+}
+
+// Colour mode, fixed colour, value set, colour map and range, and each group's colour and opacity.
+void colour_controls(PanelState& state, const PanelStats& stats) {
+  RenderSettings& s = state.settings;
+  int colour = static_cast<int>(s.color);
+  ImGui::AlignTextToFramePadding();
+  ImGui::TextUnformatted("Colour");
+  ImGui::SameLine();
+  ImGui::RadioButton("direction", &colour, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("fixed", &colour, 1);
+  ImGui::SameLine();
+  // Picking a colour means the user wants it shown.
+  if (ImGui::ColorEdit3("##fixed colour", &s.fixed_color.x, ImGuiColorEditFlags_NoInputs)) colour = 1;
+  ImGui::TextUnformatted("      ");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(stats.value_sets.empty());
+  ImGui::RadioButton("scalar", &colour, 2);
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  ImGui::RadioButton("group", &colour, 3);
+  s.color = static_cast<ColorMode>(colour);
+
+  if (s.color == ColorMode::Scalar && !stats.value_sets.empty()) {
+    const std::string current = s.scalar.empty() ? stats.value_sets.front() : s.scalar;
+    if (ImGui::BeginCombo("Values", current.c_str())) {
+      for (const std::string& name : stats.value_sets)
+        if (ImGui::Selectable(name.c_str(), name == current)) s.scalar = name;
+      ImGui::EndCombo();
+    }
+    if (ImGui::BeginCombo("Colour map", colormap_name(s.colormap))) {
+      for (Colormap m : {Colormap::Grey, Colormap::Hot, Colormap::Viridis})
+        if (ImGui::Selectable(colormap_name(m), m == s.colormap)) s.colormap = m;
+      ImGui::EndCombo();
+    }
+    bool automatic = !s.range.has_value();
+    if (ImGui::Checkbox("auto range", &automatic)) {
+      if (automatic) s.range.reset();
+      else s.range = stats.scalar_range;
+    }
+    ImGui::SameLine();
+    ImGui::BeginDisabled(automatic);
+    std::array<float, 2> r = s.range.value_or(stats.scalar_range);
+    const float speed = std::max(1e-6f, (r[1] - r[0]) / 200.0f);
+    ImGui::PushItemWidth(110);
+    if (ImGui::DragFloatRange2("##range", &r[0], &r[1], speed, 0.0f, 0.0f, "%.4g", "%.4g") && r[1] > r[0]) s.range = r;
+    ImGui::PopItemWidth();
+    ImGui::EndDisabled();
+  }
+  if (stats.groups.size() > 1 || s.color == ColorMode::Group) {
+    if (ImGui::CollapsingHeader("Groups", ImGuiTreeNodeFlags_DefaultOpen)) {
+      for (std::size_t g = 0; g < stats.groups.size(); ++g) {
+        const auto& [name, count] = stats.groups[g];
+        ImGui::PushID(static_cast<int>(g));
+        glm::vec4 c = s.group_color(name, g);
+        if (ImGui::ColorEdit3("##colour", &c.x, ImGuiColorEditFlags_NoInputs)) s.style_of(name).color = glm::vec3(c);
+        ImGui::SameLine();
+        ImGui::PushItemWidth(90);
+        if (ImGui::SliderFloat("##opacity", &c.w, 0.0f, 1.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp)) s.style_of(name).opacity = c.w;
+        ImGui::PopItemWidth();
+        ImGui::SameLine();
+        ImGui::Text("%s (%s)", name.c_str(), count_text(count).c_str());
+        ImGui::PopID();
+      }
+    }
+  }
 }
 
 // Slab (thickness, move) and up to three clip planes (on/off, side and axis, position within the bounds).
@@ -140,17 +208,7 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   ImGui::SliderFloat("Opacity", &s.opacity, 0.001f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
   ImGui::SliderFloat("Line width", &s.line_width, 1.0f, stats.max_line_width, "%.1f px", ImGuiSliderFlags_AlwaysClamp);
 
-  int colour = s.color == ColorMode::Fixed ? 1 : 0;
-  ImGui::AlignTextToFramePadding();
-  ImGui::TextUnformatted("Colour");
-  ImGui::SameLine();
-  ImGui::RadioButton("direction", &colour, 0);
-  ImGui::SameLine();
-  ImGui::RadioButton("fixed", &colour, 1);
-  ImGui::SameLine();
-  // Picking a colour means the user wants it shown.
-  if (ImGui::ColorEdit3("##fixed colour", &s.fixed_color.x, ImGuiColorEditFlags_NoInputs)) colour = 1;
-  s.color = colour == 1 ? ColorMode::Fixed : ColorMode::Direction;
+  colour_controls(state, stats);
   ImGui::Checkbox("Lighting", &s.lighting);
 
   int background = s.white_background ? 1 : 0;

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "render_settings.h"
 
@@ -38,6 +40,9 @@ struct PanelStats {
   std::string error;               // shown in red until the next one replaces it
   std::string status;              // e.g. where the last screenshot went
   double bounds_min[3] = {0, 0, 0}, bounds_max[3] = {0, 0, 0};  // scene bounds, for the clip-plane sliders
+  std::vector<std::string> value_sets;                          // what --color scalar can show
+  std::vector<std::pair<std::string, std::uint64_t>> groups;    // name, streamlines
+  std::array<float, 2> scalar_range = {0, 1};                   // the range in use
 };
 
 struct PanelRequests {

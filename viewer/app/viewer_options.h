@@ -3,6 +3,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "camera.h"
 #include "render_settings.h"
@@ -20,6 +21,7 @@ struct ViewerOptions {
   bool orthographic = false;
   int width = 1024, height = 1024;
   double voxel_size = 10.0;          // for in-memory conversion
+  std::vector<std::string> tsf;      // per-point values for a .tck converted in memory
   // Window automation (tests, scripted screenshots): quit after N frames, saving a screenshot first.
   std::optional<int> frames;
   std::optional<std::string> screenshot;

@@ -1,4 +1,5 @@
 // `voxview`: look into a tractogram with correct-looking transparency, in a window or headless.
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -15,6 +16,8 @@ int main(int argc, char** argv) {
   using namespace vxl;
   app::ViewerOptions o;
   std::string mode = "axis", view, size = "1024x1024", color = "direction", background = "black", camera_file;
+  std::string fixed_color, scalar, colormap = "viridis", range;
+  std::vector<std::string> groups;
   float opacity = 0.3f, line_width = 1.0f;
   double slab = 0;
   bool lighting = false;
@@ -45,8 +48,25 @@ int main(int argc, char** argv) {
   cli.add_option("--view", view, "axial, inferior, sagittal (left), right, coronal (anterior), posterior, or AZ,EL in degrees");
   cli.add_option("--size", size, "image or window size WxH")->default_val("1024x1024");
   cli.add_flag("--ortho", o.orthographic, "orthographic projection (default perspective)");
-  cli.add_option("--color", color, "direction (|p1 - p0| as RGB) or fixed")->default_val("direction")
-      ->check(CLI::IsMember({"direction", "fixed"}));
+  cli.add_option("--color", color,
+                 "direction (|p1 - p0| as RGB), fixed (--fixed-color), scalar (a value set through --colormap) or group "
+                 "(one colour per TRX group, or per file when several are shown)")
+      ->default_val("direction")->check(CLI::IsMember({"direction", "fixed", "scalar", "group"}));
+  cli.add_option("--fixed-color", fixed_color, "the fixed colour, #RRGGBB (also for points without a value)")
+      ->check([](const std::string& v) { return parse_hex_color(v) ? std::string() : "expected #RRGGBB, got '" + v + "'"; });
+  cli.add_option("--scalar", scalar,
+                 "the value set to colour by (a TSF's file name, a TRK scalar or property, a TRX dpv or dps name); "
+                 "default: the first")
+      ;
+  cli.add_option("--colormap", colormap, "grey, hot or viridis, for --color scalar")->default_val("viridis")
+      ->check(CLI::IsMember({"grey", "gray", "hot", "viridis"}));
+  cli.add_option("--range", range, "MIN,MAX: the values at the colour map's ends (default: the set's minimum and maximum)");
+  cli.add_option("--group", groups,
+                 "NAME=#RRGGBB[:OPACITY] or NAME=:OPACITY: a group's colour and opacity (a factor on --opacity; 0 hides "
+                 "it), repeatable")
+      ->expected(1)->take_all();
+  cli.add_option("--tsf", o.tsf, "a TSF file of per-point values for a .tck given as input (converted in memory), repeatable")
+      ->expected(1)->take_all();
   cli.add_flag("--lighting", lighting,
                "light the lines (illuminated lines: a line along the light, which comes from the viewer's upper left, is "
                "dark, one across it bright)");
@@ -96,7 +116,26 @@ int main(int argc, char** argv) {
     const bool from_file = o.camera.has_value();
     if (!from_file || given("--mode")) s.mode = *parse_render_mode(mode);
     if (!from_file || given("--opacity")) s.opacity = opacity;
-    if (!from_file || given("--color")) s.color = color == "fixed" ? ColorMode::Fixed : ColorMode::Direction;
+    if (!from_file || given("--color")) s.color = *parse_color_mode(color);
+    if (given("--fixed-color")) s.fixed_color = *parse_hex_color(fixed_color);
+    if (given("--scalar")) s.scalar = scalar;
+    if (!from_file || given("--colormap")) s.colormap = *parse_colormap(colormap);
+    if (given("--range")) {
+      float lo = 0, hi = 0;
+      char end = 0;
+      if (std::sscanf(range.c_str(), "%f,%f%c", &lo, &hi, &end) != 2 || !std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo))
+        throw Error(ErrorKind::Usage, "", std::nullopt, "--range: expected MIN,MAX with MIN < MAX (e.g. 0,0.5); got '" + range + "'");
+      s.range = std::array<float, 2>{lo, hi};
+    }
+    for (const std::string& g : groups) {
+      auto style = parse_group_style(g);
+      if (!style)
+        throw Error(ErrorKind::Usage, "", std::nullopt,
+                    "--group: expected NAME=#RRGGBB, NAME=#RRGGBB:OPACITY or NAME=:OPACITY (opacity 0..1); got '" + g + "'");
+      GroupStyle& existing = s.style_of(style->name);
+      if (style->color) existing.color = style->color;
+      existing.opacity = style->opacity;
+    }
     if (!from_file || given("--background")) s.white_background = background == "white";
     if (!from_file || given("--line-width")) s.line_width = line_width;
     if (lighting) s.lighting = true;

@@ -156,6 +156,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwind
       renderer_(file),
       grid_(renderer_),
       controller_(Camera{}, std::max(1.0, glm::length(renderer_.bounds_max() - renderer_.bounds_min()) * 0.5)) {
+  check_color_options(o.input, renderer_, o.settings);
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
   glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -172,6 +173,8 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwind
   stats_.gl_version = std::to_string(major) + "." + std::to_string(minor);
   stats_.exact_available = major * 10 + minor >= 43;
   stats_.max_line_width = std::clamp(widths[1], 1.0f, 16.0f);
+  stats_.value_sets = renderer_.value_set_names();
+  for (const SceneGroup& g : renderer_.groups().groups()) stats_.groups.emplace_back(g.name, g.streamlines);
   for (int c = 0; c < 3; ++c) {
     stats_.bounds_min[c] = renderer_.bounds_min()[c];
     stats_.bounds_max[c] = renderer_.bounds_max()[c];
@@ -353,6 +356,7 @@ void ViewerWindow::draw_scene(int width, int height) {
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
   const FrameStats& f = renderer_.stats();
+  stats_.scalar_range = renderer_.scalar_range(s);
   stats_.plan_ms = f.plan_ms;
   stats_.voxels_drawn = f.voxels_drawn;
   stats_.segments_drawn = f.segments_drawn;
@@ -444,7 +448,7 @@ int ViewerWindow::run() {
 
 int run_window(const ViewerOptions& o) {
   GlfwLibrary glfw;  // first: without a display, fail before any slow conversion
-  VxlFile file = open_scene(o.input, o.voxel_size);
+  VxlFile file = open_scene(o.input, o.voxel_size, o.tsf);
   WindowPtr window = open_window(o);
   ViewerWindow viewer(o, file, window.get());
   return viewer.run();

@@ -79,6 +79,7 @@ GpuScene::GpuScene(const VxlFile& file, std::uint64_t max_texels)
     }
     g.orders.create(GL_R32UI, entries.data(), entries.size() * 4);
     g.dataset.create(GL_R32UI, nullptr, 0);
+    g.attributes.create(GL_RG32F, nullptr, 0);
     gpu_bytes_ += 12 * c.vertex_count + entries.size() * 4;
     chunks_.push_back(g);
   }
@@ -93,8 +94,19 @@ void GpuScene::release() {
     c.positions.destroy();
     c.orders.destroy();
     c.dataset.destroy();
+    c.attributes.destroy();
   }
   chunks_.clear();
+}
+
+void GpuScene::upload_attributes(const std::vector<float>& per_vertex) {
+  for (std::size_t i = 0; i < chunks_.size(); ++i) {
+    const ChunkLayout& c = layout_.chunks()[i];
+    GpuChunk& g = chunks_[i];
+    g.attributes.destroy();
+    if (per_vertex.empty()) g.attributes.create(GL_RG32F, nullptr, 0);
+    else g.attributes.create(GL_RG32F, per_vertex.data() + 2 * c.vertex_first, 8 * c.vertex_count);
+  }
 }
 
 const std::vector<std::int32_t>& GpuScene::dataset_first() {

@@ -16,6 +16,7 @@ struct GpuChunk {
   gl::TextureBuffer positions;  // GL_R32F, 3 texels per vertex
   gl::TextureBuffer orders;     // GL_R32UI, slots x S
   gl::TextureBuffer dataset;    // GL_R32UI, S (empty until needed)
+  gl::TextureBuffer attributes; // GL_RG32F, (value, group) per vertex (empty until a colour mode needs it)
 };
 
 class GpuScene {
@@ -29,6 +30,10 @@ class GpuScene {
   const SceneLayout& layout() const { return layout_; }
   const std::vector<GpuChunk>& chunks() const { return chunks_; }
   std::uint64_t gpu_bytes() const { return gpu_bytes_; }
+
+  // Replaces every chunk's attribute buffer with its vertices' share of `per_vertex` (2 floats per vertex
+  // of the file, vertex_attributes.h); an empty vector empties them.
+  void upload_attributes(const std::vector<float>& per_vertex);
 
   // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)).
   const std::vector<std::int32_t>& dataset_first();

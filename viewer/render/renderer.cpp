@@ -7,20 +7,34 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "error.h"
 #include "exact_renderer.h"
 #include "line_lighting.h"
 #include "line_shaders.h"
+#include "vertex_attributes.h"
 
 namespace vxl {
 
 Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels) : file_(file), scene_(file, max_texels) {
-  glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even without attributes
+  const VxlFile* files[1] = {&file};
+  groups_ = SceneGroups(files);
+  for (const ValueSets* sets : {&file.vertex_values(), &file.streamline_values()})
+    for (std::uint32_t k = 0; k < sets->size(); ++k)
+      if (std::find(value_set_names_.begin(), value_set_names_.end(), sets->name(k)) == value_set_names_.end())
+        value_set_names_.push_back(sets->name(k));
   const unsigned chunks = std::max<unsigned>(1, static_cast<unsigned>(scene_.layout().chunks().size()));
+  GLint units = 0;
+  glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
+  if (static_cast<GLint>(kSamplersPerChunk * chunks) > units)
+    throw Error(ErrorKind::Unsupported, file.path(), std::nullopt,
+                "the scene needs " + std::to_string(kSamplersPerChunk * chunks) + " vertex-shader textures (" +
+                    std::to_string(chunks) + " GPU chunks) but this GPU offers " + std::to_string(units));
+  glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even without attributes
   const std::string vs = shaders::line_vertex(chunks);
-  over_program_ = gl::make_program(vs, shaders::kLineOverFragment);
-  accum_program_ = gl::make_program(vs, shaders::kLineWboitAccumFragment);
-  reveal_program_ = gl::make_program(vs, shaders::kLineWboitRevealFragment);
-  additive_program_ = gl::make_program(vs, shaders::kLineAdditiveFragment);
+  over_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineOverFragment));
+  accum_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitAccumFragment));
+  reveal_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitRevealFragment));
+  additive_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineAdditiveFragment));
   wboit_composite_ = gl::make_program(shaders::kFullscreenVertex, shaders::kWboitCompositeFragment);
   additive_composite_ = gl::make_program(shaders::kFullscreenVertex, shaders::kAdditiveCompositeFragment);
 }
@@ -80,10 +94,11 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   glUniform1i(glGetUniformLocation(program, "u_slots"), static_cast<GLint>(layout.slots()));
   for (std::size_t c = 0; c < scene_.chunks().size(); ++c) {
     const GpuChunk& g = scene_.chunks()[c];
-    const GLuint textures[3] = {g.positions.texture, g.orders.texture, g.dataset.texture};
-    const char* names[3] = {"u_pos", "u_ord", "u_dat"};
-    for (int t = 0; t < 3; ++t) {
-      GLint unit = static_cast<GLint>(3 * c + t);
+    const GLuint textures[kSamplersPerChunk] = {g.positions.texture, g.orders.texture, g.dataset.texture,
+                                                g.attributes.texture};
+    const char* names[kSamplersPerChunk] = {"u_pos", "u_ord", "u_dat", "u_att"};
+    for (int t = 0; t < kSamplersPerChunk; ++t) {
+      GLint unit = static_cast<GLint>(kSamplersPerChunk * c + t);
       glActiveTexture(GL_TEXTURE0 + unit);
       glBindTexture(GL_TEXTURE_BUFFER, textures[t]);
       glUniform1i(glGetUniformLocation(program, (names[t] + std::to_string(c)).c_str()), unit);
@@ -99,8 +114,16 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   glUniformMatrix3fv(glGetUniformLocation(program, "u_rotation"), 1, GL_FALSE, glm::value_ptr(rotation));
   const glm::mat4 proj(projection(camera, aspect));
   glUniformMatrix4fv(glGetUniformLocation(program, "u_projection"), 1, GL_FALSE, glm::value_ptr(proj));
-  glUniform1i(glGetUniformLocation(program, "u_color_mode"), s.color == ColorMode::Direction ? 0 : 1);
+  glUniform1i(glGetUniformLocation(program, "u_color_mode"), static_cast<int>(s.color));
   glUniform3fv(glGetUniformLocation(program, "u_fixed_color"), 1, glm::value_ptr(s.fixed_color));
+  glUniform1i(glGetUniformLocation(program, "u_attributes"), attributes_key_.empty() ? 0 : 1);
+  glUniform3fv(glGetUniformLocation(program, "u_colormap"), kColormapSamples, glm::value_ptr(colormap_samples(s.colormap)[0]));
+  const std::array<float, 2> range = scalar_range(s);
+  glUniform2f(glGetUniformLocation(program, "u_range"), range[0], range[1]);
+  std::vector<glm::vec4> group(shaders::kShaderGroups, glm::vec4(1.0f));
+  const auto& groups = groups_.groups();
+  for (std::size_t g = 0; g < groups.size() && g < group.size(); ++g) group[g] = s.group_color(groups[g].name, g);
+  glUniform4fv(glGetUniformLocation(program, "u_group"), shaders::kShaderGroups, glm::value_ptr(group[0]));
   glUniform1f(glGetUniformLocation(program, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
   glUniform1i(glGetUniformLocation(program, "u_lighting"), s.lighting ? 1 : 0);
   const glm::vec3 light = lighting::light_direction_eye();
@@ -121,6 +144,50 @@ void Renderer::enable_clip_distances(int n) {
     if (i < n) glEnable(GL_CLIP_DISTANCE0 + i);
     else glDisable(GL_CLIP_DISTANCE0 + i);
   }
+}
+
+std::string Renderer::scalar_name(const RenderSettings& s) const {
+  if (!s.scalar.empty()) return s.scalar;
+  return value_set_names_.empty() ? std::string() : value_set_names_.front();
+}
+
+std::array<float, 2> Renderer::scalar_range(const RenderSettings& s) const {
+  float lo = 0, hi = 1;
+  if (s.range) {
+    lo = (*s.range)[0];
+    hi = (*s.range)[1];
+  } else if (const std::string name = scalar_name(s); !name.empty()) {
+    // The stored extremes of the set (NaN when it has no finite value).
+    const ValueSource v = find_value_set(file_, name);
+    const ValueSets* sets = v.kind == ValueSource::Kind::Vertex       ? &file_.vertex_values()
+                            : v.kind == ValueSource::Kind::Streamline ? &file_.streamline_values()
+                                                                      : nullptr;
+    if (sets && std::isfinite(sets->min(v.set)) && std::isfinite(sets->max(v.set))) {
+      lo = sets->min(v.set);
+      hi = sets->max(v.set);
+    }
+  }
+  if (!(hi > lo)) {  // one value only: show it mid-map
+    const float mid = std::isfinite(lo) ? lo : 0.0f;
+    lo = mid - 0.5f;
+    hi = mid + 0.5f;
+  }
+  return {lo, hi};
+}
+
+void Renderer::prepare_attributes(const RenderSettings& s) {
+  const std::string name = s.color == ColorMode::Scalar ? scalar_name(s) : std::string();
+  bool want_groups = s.color == ColorMode::Group;
+  const auto& groups = groups_.groups();
+  for (std::size_t g = 0; g < groups.size(); ++g) want_groups |= s.group_color(groups[g].name, g).a != 1.0f;
+  const std::string key = (name.empty() ? "" : "value:" + name) + (want_groups ? "|groups" : "");
+  if (key == attributes_key_) return;
+  attributes_key_.clear();
+  scene_.upload_attributes({});
+  if (key.empty()) return;
+  scene_.upload_attributes(vertex_attributes(file_, 0, name.empty() ? ValueSource{} : find_value_set(file_, name),
+                                             want_groups ? &groups_ : nullptr));
+  attributes_key_ = key;
 }
 
 void Renderer::draw_plan(const std::vector<std::int32_t>& first, const std::vector<std::int32_t>& count) const {
@@ -174,6 +241,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
     glClearDepth(1.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   };
+  prepare_attributes(s);
   glLineWidth(std::max(1.0f, s.line_width));
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);

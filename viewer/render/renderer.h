@@ -5,7 +5,10 @@
 //   r.draw(camera, settings, w, h, fbo);    // one frame into the bound framebuffer `fbo`
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <string>
+#include <vector>
 #include <initializer_list>
 #include <memory>
 #include <utility>
@@ -15,6 +18,7 @@
 #include "gl_util.h"
 #include "gpu_scene.h"
 #include "render_settings.h"
+#include "scene_groups.h"
 
 namespace vxl {
 
@@ -28,6 +32,7 @@ struct FrameStats {
 
 class Renderer {
  public:
+  static constexpr int kSamplersPerChunk = 4;  // positions, orders, dataset order, attributes
   explicit Renderer(const VxlFile& file, std::uint64_t max_texels = 0);
   ~Renderer();
   Renderer(const Renderer&) = delete;
@@ -38,6 +43,13 @@ class Renderer {
   void draw(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
 
   const FrameStats& stats() const { return stats_; }
+  // The scene's groups (scene_groups.h) and value sets (per-vertex sets first, then per-streamline ones).
+  const SceneGroups& groups() const { return groups_; }
+  const std::vector<std::string>& value_set_names() const { return value_set_names_; }
+  // The value set ColorMode::Scalar shows for `settings` (its `scalar`, else the first; empty when none),
+  // and the range it maps (settings.range, else the set's stored min and max).
+  std::string scalar_name(const RenderSettings& settings) const;
+  std::array<float, 2> scalar_range(const RenderSettings& settings) const;
   GpuScene& scene() { return scene_; }
   const VxlFile& file() const { return file_; }
   glm::dvec3 bounds_min() const;
@@ -56,6 +68,8 @@ class Renderer {
   static void enable_clip_distances(int n);
 
  private:
+  // Uploads the per-vertex (value, group) attributes that `settings` needs, when they changed.
+  void prepare_attributes(const RenderSettings& settings);
   void draw_lines(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect, PlanOrder order);
   void draw_dataset_order(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect);
   // A fullscreen pass of `program` reading the named 2D textures.
@@ -70,6 +84,9 @@ class Renderer {
   FramePlan plan_;
   FrameStats stats_;
   std::unique_ptr<ExactRenderer> exact_;
+  SceneGroups groups_;
+  std::vector<std::string> value_set_names_;
+  std::string attributes_key_;  // what the attribute buffers hold ("" : nothing)
 };
 
 }  // namespace vxl
