@@ -36,10 +36,10 @@ Camera initial_camera(const glm::dvec3& lo, const glm::dvec3& hi, const ViewerOp
 
 int run_headless(const ViewerOptions& o) {
   auto t0 = std::chrono::steady_clock::now();
-  VxlFile file = open_scene(o.input, o.voxel_size, o.tsf);
+  const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf);
   HeadlessGlContext context;
-  Renderer renderer(file);
-  check_color_options(o.input, renderer, o.settings);
+  Renderer renderer(pointers(files));
+  check_color_options(o.inputs_name(), renderer, o.settings);
   OffscreenTarget target(o.width, o.height);
   target.bind();
   const double aspect = double(o.width) / o.height;

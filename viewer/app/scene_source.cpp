@@ -51,6 +51,22 @@ VxlFile open_scene(const std::string& path, double voxel_size, const std::vector
   return f;
 }
 
+std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double voxel_size, const std::vector<std::string>& tsf) {
+  if (!tsf.empty() && paths.size() != 1)
+    throw Error(ErrorKind::Usage, "", std::nullopt,
+                "--tsf needs a single input tractogram (it has one value per point of that file); convert each with "
+                "voxlines convert IN.tck OUT.vxl --tsf FILE.tsf and open the .vxl files together");
+  std::vector<VxlFile> files;
+  for (const std::string& p : paths) files.push_back(open_scene(p, voxel_size, tsf));
+  return files;
+}
+
+std::vector<const VxlFile*> pointers(const std::vector<VxlFile>& files) {
+  std::vector<const VxlFile*> out;
+  for (const VxlFile& f : files) out.push_back(&f);
+  return out;
+}
+
 void check_color_options(const std::string& path, const Renderer& r, const RenderSettings& s) {
   const auto& names = r.value_set_names();
   std::string available;

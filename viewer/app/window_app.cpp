@@ -57,7 +57,8 @@ WindowPtr open_window(const ViewerOptions& o) {
   // Not forward-compatible: that would forbid line widths above 1.
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_FALSE);
   glfwWindowHint(GLFW_DEPTH_BITS, 24);  // the opaque mode depth-tests in the default framebuffer
-  const std::string title = "voxview - " + std::filesystem::path(o.input).filename().string();
+  std::string title = "voxview -";
+  for (const std::string& in : o.inputs) title += " " + std::filesystem::path(in).filename().string();
   GLFWwindow* w = glfwCreateWindow(o.width, o.height, title.c_str(), nullptr, nullptr);
   if (!w)
     throw std::runtime_error("cannot open an OpenGL 3.3 core window: " + g_glfw_error + "; " + kHeadlessHint);
@@ -114,7 +115,7 @@ std::filesystem::path stamped_name(const std::string& prefix, const std::string&
 // user pointer.
 class ViewerWindow {
  public:
-  ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwindow* window);
+  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, GLFWwindow* window);
   int run();
 
  private:
@@ -150,13 +151,13 @@ class ViewerWindow {
   unsigned events_ = 0;  // input events seen, to keep drawing while something happens
 };
 
-ViewerWindow::ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwindow* window)
+ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, GLFWwindow* window)
     : options_(o),
       window_(window),
-      renderer_(file),
+      renderer_(pointers(files)),
       grid_(renderer_),
       controller_(Camera{}, std::max(1.0, glm::length(renderer_.bounds_max() - renderer_.bounds_min()) * 0.5)) {
-  check_color_options(o.input, renderer_, o.settings);
+  check_color_options(o.inputs_name(), renderer_, o.settings);
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
   glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -166,9 +167,12 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwind
   state_.settings = o.settings;
   drawn_mode_ = o.settings.mode;
   state_.orthographic = o.orthographic;
-  stats_.title = std::filesystem::path(o.input).filename().string();
-  stats_.voxels_total = file.meta().voxel_count;
-  stats_.segments_total = file.meta().segment_count;
+  stats_.title = std::filesystem::path(o.inputs.front()).filename().string();
+  if (files.size() > 1) stats_.title += " + " + std::to_string(files.size() - 1) + " more";
+  for (const VxlFile& f : files) {
+    stats_.voxels_total += f.meta().voxel_count;
+    stats_.segments_total += f.meta().segment_count;
+  }
   stats_.gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   stats_.gl_version = std::to_string(major) + "." + std::to_string(minor);
   stats_.exact_available = major * 10 + minor >= 43;
@@ -448,9 +452,9 @@ int ViewerWindow::run() {
 
 int run_window(const ViewerOptions& o) {
   GlfwLibrary glfw;  // first: without a display, fail before any slow conversion
-  VxlFile file = open_scene(o.input, o.voxel_size, o.tsf);
+  const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf);
   WindowPtr window = open_window(o);
-  ViewerWindow viewer(o, file, window.get());
+  ViewerWindow viewer(o, files, window.get());
   return viewer.run();
 }
 

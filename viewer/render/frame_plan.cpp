@@ -82,7 +82,7 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
   plan.count.reserve(plan.sort_keys.size());
   for (const auto& [key, i] : plan.sort_keys) {
     const VoxelDrawInfo& v = voxels[i];
-    std::uint32_t slot = layout.block_slot();
+    std::uint32_t slot = layout.block_slot(v);
     bool reversed = false;
     if (order == PlanOrder::Nearest) {
       glm::dvec3 w = view.orthographic ? view.forward : glm::normalize(v.center - view.eye);

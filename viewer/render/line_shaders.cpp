@@ -34,7 +34,7 @@ std::string line_vertex(unsigned chunk_count, const char* version) {
   s += R"(
 uniform int u_chunk_base[CHUNKS];
 uniform int u_chunk_segments[CHUNKS];
-uniform int u_slots;
+uniform int u_chunk_slots[CHUNKS];  // its file's stored orders + 1
 uniform vec3 u_eye_hi;      // eye position split in two floats on the CPU (in double):
 uniform vec3 u_eye_lo;      // p - eye = (p - hi) - lo keeps the source precision far from the origin
 uniform mat3 u_rotation;    // world -> eye
@@ -67,7 +67,7 @@ void main() {
   int seg = local >> 1;
   int end = local & 1;
   int S = u_chunk_segments[c];
-  int A = u_slots * S;
+  int A = u_chunk_slots[c] * S;
   int v;
   if (seg < A) {
     v = fetch_order(c, seg);

@@ -15,13 +15,18 @@
 
 namespace vxl {
 
-Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels) : file_(file), scene_(file, max_texels) {
-  const VxlFile* files[1] = {&file};
-  groups_ = SceneGroups(files);
-  for (const ValueSets* sets : {&file.vertex_values(), &file.streamline_values()})
-    for (std::uint32_t k = 0; k < sets->size(); ++k)
-      if (std::find(value_set_names_.begin(), value_set_names_.end(), sets->name(k)) == value_set_names_.end())
-        value_set_names_.push_back(sets->name(k));
+Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels) : Renderer(std::vector<const VxlFile*>{&file}, max_texels) {}
+
+Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels)
+    : files_(files.empty() ? throw std::invalid_argument("Renderer: no files") : files),
+      scene_(files_, max_texels),
+      groups_(files_) {
+  const VxlFile& file = *files_.front();
+  for (const VxlFile* f : files_)
+    for (const ValueSets* sets : {&f->vertex_values(), &f->streamline_values()})
+      for (std::uint32_t k = 0; k < sets->size(); ++k)
+        if (std::find(value_set_names_.begin(), value_set_names_.end(), sets->name(k)) == value_set_names_.end())
+          value_set_names_.push_back(sets->name(k));
   const unsigned chunks = std::max<unsigned>(1, static_cast<unsigned>(scene_.layout().chunks().size()));
   GLint units = 0;
   glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
@@ -49,19 +54,36 @@ Renderer::~Renderer() {
   if (vao_) glDeleteVertexArrays(1, &vao_);
 }
 
+// The union of the files' bounds (a file without points does not count).
 glm::dvec3 Renderer::bounds_min() const {
-  const MetaSection& m = file_.meta();
-  return {m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]};
+  glm::dvec3 lo(0.0);
+  bool any = false;
+  for (const VxlFile* f : files_) {
+    const MetaSection& m = f->meta();
+    if (m.point_count == 0) continue;
+    const glm::dvec3 b(m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]);
+    lo = any ? glm::min(lo, b) : b;
+    any = true;
+  }
+  return lo;
 }
 glm::dvec3 Renderer::bounds_max() const {
-  const MetaSection& m = file_.meta();
-  return {m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]};
+  glm::dvec3 hi(0.0);
+  bool any = false;
+  for (const VxlFile* f : files_) {
+    const MetaSection& m = f->meta();
+    if (m.point_count == 0) continue;
+    const glm::dvec3 b(m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]);
+    hi = any ? glm::max(hi, b) : b;
+    any = true;
+  }
+  return hi;
 }
 
 glm::dmat4 Renderer::projection(const Camera& camera, double aspect) const {
   // Near and far planes hug the scene's bounding sphere, for depth precision.
   glm::dvec3 centre = (bounds_min() + bounds_max()) * 0.5;
-  double radius = std::max(1.0, glm::length(bounds_max() - bounds_min()) * 0.5 + file_.meta().voxel_size);
+  double radius = std::max(1.0, glm::length(bounds_max() - bounds_min()) * 0.5 + scene_.layout().voxel_size());
   double along = glm::dot(centre - camera.eye(), camera.forward());
   double far_mm = along + radius;
   double near_mm = camera.orthographic ? along - radius : std::max(far_mm * 1e-4, along - radius);
@@ -83,15 +105,16 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   glUseProgram(program);
   const SceneLayout& layout = scene_.layout();
   const auto& chunks = layout.chunks();
-  std::vector<GLint> base, segments;
+  std::vector<GLint> base, segments, slots;
   for (const ChunkLayout& c : chunks) {
     base.push_back(static_cast<GLint>(c.virtual_base));
     segments.push_back(static_cast<GLint>(std::max<std::uint64_t>(1, c.segments)));
+    slots.push_back(static_cast<GLint>(c.slots));
   }
-  if (base.empty()) base = {0}, segments = {1};
+  if (base.empty()) base = {0}, segments = {1}, slots = {1};
   glUniform1iv(glGetUniformLocation(program, "u_chunk_base"), static_cast<GLsizei>(base.size()), base.data());
   glUniform1iv(glGetUniformLocation(program, "u_chunk_segments"), static_cast<GLsizei>(segments.size()), segments.data());
-  glUniform1i(glGetUniformLocation(program, "u_slots"), static_cast<GLint>(layout.slots()));
+  glUniform1iv(glGetUniformLocation(program, "u_chunk_slots"), static_cast<GLsizei>(slots.size()), slots.data());
   for (std::size_t c = 0; c < scene_.chunks().size(); ++c) {
     const GpuChunk& g = scene_.chunks()[c];
     const GLuint textures[kSamplersPerChunk] = {g.positions.texture, g.orders.texture, g.dataset.texture,
@@ -157,14 +180,17 @@ std::array<float, 2> Renderer::scalar_range(const RenderSettings& s) const {
     lo = (*s.range)[0];
     hi = (*s.range)[1];
   } else if (const std::string name = scalar_name(s); !name.empty()) {
-    // The stored extremes of the set (NaN when it has no finite value).
-    const ValueSource v = find_value_set(file_, name);
-    const ValueSets* sets = v.kind == ValueSource::Kind::Vertex       ? &file_.vertex_values()
-                            : v.kind == ValueSource::Kind::Streamline ? &file_.streamline_values()
-                                                                      : nullptr;
-    if (sets && std::isfinite(sets->min(v.set)) && std::isfinite(sets->max(v.set))) {
-      lo = sets->min(v.set);
-      hi = sets->max(v.set);
+    // The stored extremes of the set over the files that have it (NaN when one has no finite value).
+    bool any = false;
+    for (const VxlFile* f : files_) {
+      const ValueSource v = find_value_set(*f, name);
+      const ValueSets* sets = v.kind == ValueSource::Kind::Vertex       ? &f->vertex_values()
+                              : v.kind == ValueSource::Kind::Streamline ? &f->streamline_values()
+                                                                        : nullptr;
+      if (!sets || !std::isfinite(sets->min(v.set)) || !std::isfinite(sets->max(v.set))) continue;
+      lo = any ? std::min(lo, sets->min(v.set)) : sets->min(v.set);
+      hi = any ? std::max(hi, sets->max(v.set)) : sets->max(v.set);
+      any = true;
     }
   }
   if (!(hi > lo)) {  // one value only: show it mid-map
@@ -185,8 +211,11 @@ void Renderer::prepare_attributes(const RenderSettings& s) {
   attributes_key_.clear();
   scene_.upload_attributes({});
   if (key.empty()) return;
-  scene_.upload_attributes(vertex_attributes(file_, 0, name.empty() ? ValueSource{} : find_value_set(file_, name),
-                                             want_groups ? &groups_ : nullptr));
+  std::vector<std::vector<float>> per_file;
+  for (std::size_t i = 0; i < files_.size(); ++i)
+    per_file.push_back(vertex_attributes(*files_[i], i, name.empty() ? ValueSource{} : find_value_set(*files_[i], name),
+                                         want_groups ? &groups_ : nullptr));
+  scene_.upload_attributes(per_file);
   attributes_key_ = key;
 }
 
@@ -206,8 +235,11 @@ void Renderer::draw_dataset_order(GLuint program, const Camera& camera, const Re
   const auto& first = scene_.dataset_first();
   const auto& count = scene_.dataset_count();
   stats_.plan_ms = 0;
-  stats_.voxels_drawn = file_.meta().voxel_count;
-  stats_.segments_drawn = file_.meta().segment_count;
+  stats_.voxels_drawn = stats_.segments_drawn = 0;
+  for (const VxlFile* f : files_) {
+    stats_.voxels_drawn += f->meta().voxel_count;
+    stats_.segments_drawn += f->meta().segment_count;
+  }
   bind_line_program(program, camera, s, aspect);
   draw_plan(first, count);
 }
@@ -252,6 +284,10 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       clear_target(fbo, glm::vec4(bg, 1));
       glEnable(GL_DEPTH_TEST);
       glDepthFunc(GL_LESS);
+      // The colour replaces, the alpha stays the clear's 1: an opaque picture (a PNG would otherwise keep
+      // the lines' opacity as their alpha).
+      glEnable(GL_BLEND);
+      glBlendFuncSeparate(GL_ONE, GL_ZERO, GL_ZERO, GL_ONE);
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Any);
       glDisable(GL_DEPTH_TEST);
       break;

@@ -2,6 +2,7 @@
 // needs 4.3): it is driven the same way from a GLFW window and from a headless EGL context.
 //
 //   Renderer r(file);                       // uploads the scene (few large copies)
+//   Renderer r({&a, &b});                   // several files, their voxels sorted together every frame
 //   r.draw(camera, settings, w, h, fbo);    // one frame into the bound framebuffer `fbo`
 #pragma once
 
@@ -34,6 +35,9 @@ class Renderer {
  public:
   static constexpr int kSamplersPerChunk = 4;  // positions, orders, dataset order, attributes
   explicit Renderer(const VxlFile& file, std::uint64_t max_texels = 0);
+  // Several files drawn as one scene: one sort over all their voxels, one group per file. The files must
+  // outlive the renderer.
+  explicit Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -51,7 +55,8 @@ class Renderer {
   std::string scalar_name(const RenderSettings& settings) const;
   std::array<float, 2> scalar_range(const RenderSettings& settings) const;
   GpuScene& scene() { return scene_; }
-  const VxlFile& file() const { return file_; }
+  const VxlFile& file() const { return *files_.front(); }  // the first
+  const std::vector<const VxlFile*>& files() const { return files_; }
   glm::dvec3 bounds_min() const;
   glm::dvec3 bounds_max() const;
 
@@ -75,7 +80,7 @@ class Renderer {
   // A fullscreen pass of `program` reading the named 2D textures.
   void composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const;
 
-  const VxlFile& file_;
+  std::vector<const VxlFile*> files_;
   GpuScene scene_;
   GLuint vao_ = 0;
   GLuint over_program_ = 0, accum_program_ = 0, reveal_program_ = 0, additive_program_ = 0;
