@@ -60,8 +60,7 @@ int main(int argc, char** argv) {
       ->check([](const std::string& v) { return parse_hex_color(v) ? std::string() : "expected #RRGGBB, got '" + v + "'"; });
   cli.add_option("--scalar", scalar,
                  "the value set to colour by (a TSF's file name, a TRK scalar or property, a TRX dpv or dps name); "
-                 "default: the first")
-      ;
+                 "default: the first");
   cli.add_option("--colormap", colormap, "grey, hot or viridis, for --color scalar")->default_val("viridis")
       ->check(CLI::IsMember({"grey", "gray", "hot", "viridis"}));
   cli.add_option("--range", range, "MIN,MAX: the values at the colour map's ends (default: the set's minimum and maximum)");
