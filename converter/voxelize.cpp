@@ -38,6 +38,7 @@ struct Chunk {
   std::vector<TempVoxline> voxlines;
   std::vector<std::uint64_t> first_voxline;  // per streamline of the chunk, chunk-local
   std::vector<float> synthetic_xyz;
+  std::vector<double> synthetic_t;  // per synthetic point: where it lies on its step, for value interpolation
   std::vector<std::uint64_t> vertices_per_voxel;  // by local id
   std::vector<std::uint64_t> segments_per_voxel;  // by local id
   std::vector<std::uint32_t> global_id;     // local id -> global voxel index
@@ -340,6 +341,12 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
   VoxlineEnds ends(m.vertex_count);
   std::copy(plan.voxels_.begin(), plan.voxels_.end(), out.voxels.begin());
 
+  if (out.vertex_values.size() != t.point_values.size())
+    throw std::logic_error("place_vertices: one vertex value array per point value set expected");
+  for (std::size_t k = 0; k < out.vertex_values.size(); ++k)
+    if (out.vertex_values[k].size() != m.vertex_count || t.point_values[k].values.size() != m.point_count)
+      throw std::logic_error("place_vertices: value arrays do not have the sizes of the plan");
+
   // Pass 2: place vertices, fill the voxline and streamline tables.
   parallel_for_chunks(chunks.size(), threads, [&](std::size_t c) {
     Chunk& ch = chunks[c];
@@ -363,6 +370,20 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
           const float* first = w.synthetic != kNoSynthetic ? ch.synthetic_xyz.data() + 3 * w.synthetic : pts + 3 * w.src_first;
           std::memcpy(dst, first, 12);
         }
+        // Values travel with their points: a synthetic point's is interpolated where it lies on its step
+        // (from source point src_first - 1 to src_first), a connecting vertex copies the next voxline's first.
+        for (std::size_t k = 0; k < out.vertex_values.size(); ++k) {
+          const float* src = t.point_values[k].values.data();
+          auto first_value = [&](const TempVoxline& x) {
+            if (x.synthetic == kNoSynthetic) return src[x.src_first];
+            const double a = src[x.src_first - 1], b = src[x.src_first], at = ch.synthetic_t[x.synthetic];
+            return static_cast<float>(a + at * (b - a));
+          };
+          float* dv = out.vertex_values[k].data() + cursor;
+          if (v.synthetic != kNoSynthetic) *dv++ = first_value(v);
+          std::copy(src + v.src_first, src + v.src_first + v.src_count, dv);
+          if (connected) dv[v.src_count] = first_value(ch.voxlines[j + 1]);
+        }
         std::uint64_t used = own + (connected ? 1 : 0);
         ends.set(cursor + used - 1);
         cursor += used;
@@ -375,6 +396,8 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
   plan.work_.reset();
   t.positions.clear();  // the blocks now hold every point: release the source copy before orders are built
   t.positions.shrink_to_fit();
+  t.point_values.clear();  // likewise their values
+  t.point_values.shrink_to_fit();
 
   // Tight bounds per voxel.
   parallel_for_chunks(out.voxels.size(), threads, [&](std::size_t i) {
@@ -391,6 +414,7 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
 }
 
 VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
+  t.point_values.clear();  // the in-memory result has no value arrays
   VoxelPlan plan = plan_voxels(t, settings);
   VoxelizedTractogram out;
   out.meta = plan.meta();
@@ -399,7 +423,7 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
   out.voxlines.resize(out.meta.voxline_count);
   out.streamline_first_voxline.resize(out.meta.streamline_count + 1);
   out.voxline_ends = place_vertices(std::move(plan), std::move(t),
-                                    {out.voxels, out.vertices, out.voxlines, out.streamline_first_voxline});
+                                    {out.voxels, out.vertices, out.voxlines, out.streamline_first_voxline, {}});
   return out;
 }
 

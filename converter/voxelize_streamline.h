@@ -157,6 +157,8 @@ void voxelize_streamline(const Grid& grid, const float* pts, std::uint64_t first
         double da = static_cast<double>(a[c]), db = static_cast<double>(b[c]);
         ch.synthetic_xyz.push_back(static_cast<float>(da + t * (db - da)));
       }
+      // Where the point lies on its step, for interpolating per-point values (in-memory conversion only).
+      if constexpr (requires { ch.synthetic_t; }) ch.synthetic_t.push_back(t);
       open = {ch.index.find_or_insert({at[0], at[1], at[2]}), 0, i, s};
     }
     if (ch.synthetic_xyz.size() / 3 > synthetic_limit) {

@@ -94,7 +94,7 @@ void VxlFile::validate() {
     static const std::uint32_t known[] = {section_id("META"), section_id("DIRS"), section_id("VOXT"),
                                           section_id("VERT"), section_id("ORDR"), section_id("VXLN"),
                                           section_id("STRM"), section_id("PROV"), section_id("GRPS"),
-                                          section_id("VDIR")};
+                                          section_id("VDIR"), section_id("VVAL"), section_id("SVAL")};
     bool is_known = std::find(std::begin(known), std::end(known), id) != std::end(known);
     if (!is_known && (e.flags & kSectionRequired))
       throw Error(ErrorKind::Unsupported, p, at, "required section " + name + " is unknown to this reader (newer writer?)");
@@ -158,6 +158,10 @@ void VxlFile::validate() {
   auto prov = section("PROV", false);
   provenance_ = {reinterpret_cast<const char*>(prov.data()), prov.size()};
   groups_ = section("GRPS", false);
+  if (find_section(section_id("VVAL")))
+    vertex_values_ = ValueSets(section("VVAL", true), m.vertex_count, p, offset_of("VVAL"));
+  if (find_section(section_id("SVAL")))
+    streamline_values_ = ValueSets(section("SVAL", true), m.streamline_count, p, offset_of("SVAL"));
 
   // Voxel table (§7 step 4): O(voxels).
   const std::uint64_t voxt_at = offset_of("VOXT");

@@ -16,6 +16,7 @@
 
 #include "mapped_file.h"
 #include "vxl_layout.h"
+#include "vxl_value_sets.h"
 #include "vxl_writer.h"
 
 namespace vxl {
@@ -62,6 +63,9 @@ class VxlFile {
   std::string_view provenance_json() const { return provenance_; }
   // Parses GRPS (empty when absent); throws vxl::Error when malformed.
   std::vector<GroupContent> groups() const;
+  // VVAL: per-vertex value sets (vertex_count values each); SVAL: per-streamline ones. Empty when absent.
+  const ValueSets& vertex_values() const { return vertex_values_; }
+  const ValueSets& streamline_values() const { return streamline_values_; }
 
  private:
   explicit VxlFile(MappedFile file) : file_(std::move(file)) {}
@@ -80,6 +84,7 @@ class VxlFile {
   std::span<const std::uint64_t> strm_;
   std::string_view provenance_;
   std::span<const std::uint8_t> groups_;
+  ValueSets vertex_values_, streamline_values_;
 };
 
 std::string section_name(std::uint32_t id);

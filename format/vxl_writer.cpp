@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "checksum.h"
+#include "vxl_value_sets.h"
 
 namespace vxl {
 
@@ -30,7 +31,8 @@ std::vector<std::uint8_t> encode_groups(std::span<const GroupContent> groups) {
 }
 
 VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
-                              std::uint64_t group_bytes) {
+                              std::uint64_t group_bytes, std::uint32_t vertex_value_sets,
+                              std::uint32_t streamline_value_sets) {
   VxlSectionSizes s;
   s.directions = std::uint64_t(m.stored_order_count) * sizeof(DirectionEntry);
   if (m.order_set == static_cast<std::uint32_t>(OrderSet::Random)) s.voxel_directions = m.voxel_count * s.directions;
@@ -41,13 +43,15 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
   s.streamlines = (m.streamline_count + 1) * sizeof(std::uint64_t);
   s.provenance = provenance_bytes;
   s.groups = group_bytes;
+  s.vertex_values = value_sets_bytes(vertex_value_sets, m.vertex_count);
+  s.streamline_values = value_sets_bytes(streamline_value_sets, m.streamline_count);
   return s;
 }
 
 namespace {
 
 // Section ids in file order, indexed by VxlWriter::Index; VDIR and GRPS are optional.
-constexpr const char* kSectionIds[] = {"META", "DIRS", "VDIR", "VOXT", "VERT", "ORDR", "VXLN", "STRM", "PROV", "GRPS"};
+constexpr const char* kSectionIds[] = {"META", "DIRS", "VDIR", "VOXT", "VERT", "ORDR", "VXLN", "STRM", "PROV", "GRPS", "VVAL", "SVAL"};
 
 }  // namespace
 
@@ -71,6 +75,9 @@ VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
       {"STRM", kSectionRequired, sizes.streamlines, true},
       {"PROV", 0, sizes.provenance, true},
       {"GRPS", 0, sizes.groups, sizes.groups > 0},
+      // Optional: a reader that does not know them still draws the picture, in the other colour modes.
+      {"VVAL", 0, sizes.vertex_values, sizes.vertex_values > 0},
+      {"SVAL", 0, sizes.streamline_values, sizes.streamline_values > 0},
   };
   std::size_t present = 0;
   for (const Planned& p : planned) present += p.present;
@@ -97,7 +104,10 @@ std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, 
   h.version_major = kVxlVersionMajor;
   // The lowest version that holds what is written (spec §10).
   const bool has_vdir = std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "VDIR", 4) == 0; });
-  h.version_minor = has_vdir ? kVxlVersionMinorVoxelDirections : kVxlVersionMinor;
+  const bool has_values = std::any_of(table.begin(), table.end(), [](const SectionEntry& e) {
+    return std::memcmp(e.id, "VVAL", 4) == 0 || std::memcmp(e.id, "SVAL", 4) == 0;
+  });
+  h.version_minor = has_values ? kVxlVersionMinorValueSets : has_vdir ? kVxlVersionMinorVoxelDirections : kVxlVersionMinor;
   h.header_size = sizeof(FileHeader);
   h.file_size = file_size;
   h.section_table_offset = sizeof(FileHeader);

@@ -23,12 +23,14 @@ struct VxlSectionSizes {
   std::uint64_t voxels = 0, vertices = 0, orders = 0, voxlines = 0, streamlines = 0;
   std::uint64_t provenance = 0;
   std::uint64_t groups = 0;  // 0: no GRPS section
+  std::uint64_t vertex_values = 0, streamline_values = 0;  // VVAL, SVAL (spec §5.11); 0: absent
 };
 
 // The sizes spec §5 gives for the counts in `meta` (stored_order_count included; a VDIR section when
-// order_set is random).
+// order_set is random; VVAL / SVAL sections holding that many value sets, none when 0).
 VxlSectionSizes section_sizes(const MetaSection& meta, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
-                              std::uint64_t group_bytes);
+                              std::uint64_t group_bytes, std::uint32_t vertex_value_sets = 0,
+                              std::uint32_t streamline_value_sets = 0);
 
 // The section table (offsets and sizes; checksums left zero) and the file size for these payloads: header
 // and table first, then each payload in file order at a multiple of 64 (spec §2, §4). VDIR only when
@@ -63,6 +65,9 @@ class VxlWriter {
   std::span<std::uint64_t> streamline_first_voxline() { return typed<std::uint64_t>(kStrm); }
   std::span<std::uint8_t> provenance() { return payload(kProv); }
   std::span<std::uint8_t> groups() { return payload(kGrps); }  // empty when there is no GRPS section
+  // VVAL and SVAL payloads (vxl_value_sets.h: layout_value_sets, finish_value_sets); empty when absent.
+  std::span<std::uint8_t> vertex_values() { return payload(kVval); }
+  std::span<std::uint8_t> streamline_values() { return payload(kSval); }
 
   // Checksums every payload (sections spread over up to `threads` threads; 0: all hardware threads),
   // writes the section table and the header, unmaps and links the file into place. The spans above
@@ -70,8 +75,8 @@ class VxlWriter {
   void commit(unsigned threads = 0);
 
  private:
-  // Sections in file order; VDIR and GRPS are optional.
-  enum Index : std::size_t { kMeta, kDirs, kVdir, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps };
+  // Sections in file order; VDIR, GRPS, VVAL and SVAL are optional.
+  enum Index : std::size_t { kMeta, kDirs, kVdir, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps, kVval, kSval };
   std::span<std::uint8_t> payload(Index i);
   template <typename T>
   std::span<T> typed(Index i) {

@@ -9,6 +9,7 @@
 #include "memory_size.h"
 #include "progress_bar.h"
 #include "read_tractogram.h"
+#include "read_tsf.h"
 #include "segment_orders.h"
 #include "streaming_convert.h"
 
@@ -32,6 +33,7 @@ void add_convert_command(CLI::App& app) {
     ConvertSettings settings;
     std::string memory_limit;
     bool verbose = false;
+    std::vector<std::string> tsf;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("convert", "Convert a TCK / TRK (.trk.gz) / TRX tractogram to .vxl");
@@ -63,6 +65,10 @@ void add_convert_command(CLI::App& app) {
                                         : "'" + s + "' is not a memory size (a number of bytes, or of KiB/MiB/GiB with K/M/G: 512M, 2G)";
           },
           ""));
+  cmd->add_option("--tsf", opt->tsf,
+                  "MRtrix track scalar file with one value per point of the input (repeatable); stored so that voxview "
+                  "can colour by it (--color scalar)")
+      ->expected(1)->take_all();
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
   cmd->callback([opt] {
     ProgressBar bar;
@@ -72,6 +78,9 @@ void add_convert_command(CLI::App& app) {
     ConvertSummary s;
     double read_seconds = 0;
     if (!opt->memory_limit.empty()) {
+      if (!opt->tsf.empty())
+        throw Error(ErrorKind::Unsupported, opt->input, std::nullopt,
+                    "--memory-limit does not carry --tsf values yet; convert without the limit");
       opt->settings.memory_limit = *parse_memory_size(opt->memory_limit);
       s = convert_streaming(opt->input, opt->output, opt->settings);
       read_seconds = s.read_seconds;
@@ -79,6 +88,7 @@ void add_convert_command(CLI::App& app) {
       for (const std::string& w : s.warnings) std::fprintf(stderr, "voxlines: warning: %s: %s\n", opt->input.c_str(), w.c_str());
     } else {
       Tractogram t = read_tractogram(opt->input);
+      for (const std::string& tsf : opt->tsf) attach_tsf(t, tsf);
       read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       for (const std::string& w : t.source.warnings) {
         bar.done();

@@ -71,6 +71,7 @@ TEST_F(RenderModes, OpaqueShowsTheNearestLineWithItsDirectionColour) {
   EXPECT_NEAR(centre(img)[0], 180, 2);
   EXPECT_NEAR(centre(img)[1], 180, 2);
   EXPECT_EQ(centre(img)[2], 0);
+  EXPECT_EQ(centre(img)[3], 255) << "an opaque picture: the line's opacity is not its alpha";
   // Away from the crossing: the x line (red) on its row, the y line (green) on its column, black elsewhere.
   EXPECT_EQ(img.pixel(20, 31)[0], 255);
   EXPECT_EQ(img.pixel(20, 31)[1], 0);

@@ -13,21 +13,20 @@
 namespace vxl {
 namespace {
 
-const char* const kListFragment = R"(#version 430 core
+const char* const kListFragment = R"(
 layout(binding = 0, r32ui) uniform coherent uimage2D u_heads;
 layout(binding = 0, offset = 0) uniform atomic_uint u_counter;
 layout(std430, binding = 1) buffer Nodes { uvec4 nodes[]; };
 uniform uint u_capacity;
 uniform ivec4 u_band;  // x0, y0, x1, y1: only fragments inside are stored this pass
-in vec4 v_color;
-in float v_depth;
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   if (p.x < u_band.x || p.y < u_band.y || p.x >= u_band.z || p.y >= u_band.w) discard;
   uint i = atomicCounterIncrement(u_counter);
   if (i < u_capacity) {
     uint previous = imageAtomicExchange(u_heads, p, i);
-    nodes[i] = uvec4(packHalf2x16(v_color.rg), packHalf2x16(v_color.ba), floatBitsToUint(gl_FragCoord.z), previous);
+    vec4 c = line_color();
+    nodes[i] = uvec4(packHalf2x16(c.rg), packHalf2x16(c.ba), floatBitsToUint(gl_FragCoord.z), previous);
   }
   discard;  // nothing is written to the colour buffer in this pass
 }
@@ -74,7 +73,8 @@ ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity) : lin
   std::uint64_t bytes = std::min<std::uint64_t>(static_cast<std::uint32_t>(max_block), 256ull << 20);
   capacity_ = node_capacity ? node_capacity : bytes / 16;
   const unsigned chunks = std::max<unsigned>(1, static_cast<unsigned>(lines.scene().layout().chunks().size()));
-  list_program_ = gl::make_program(shaders::line_vertex(chunks, "#version 430 core"), kListFragment);
+  list_program_ = gl::make_program(shaders::line_vertex(chunks, "#version 430 core"),
+                                   shaders::line_fragment(kListFragment, "#version 430 core"));
   clear_program_ = gl::make_compute_program(kClearCompute);
   blit_program_ = gl::make_program(shaders::kFullscreenVertex, kBlitFragment);
   glGenBuffers(1, &nodes_);
@@ -111,7 +111,7 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
   }
   const double aspect = double(width) / std::max(1, height);
   FramePlan plan;
-  lines_.plan(camera, aspect, PlanOrder::Any, plan);
+  lines_.plan(camera, aspect, PlanOrder::Any, plan, s.clipping);
   const glm::vec3 bg = s.background();
 
   // Bands of rows; a band whose fragments overflow the node buffer is split in two and redone.
@@ -156,6 +156,7 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
     fragments_ += stored;
     resolve_band(y0, y1, stored, bg);
   }
+  Renderer::enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, width, height);
   glUseProgram(blit_program_);

@@ -42,13 +42,19 @@ double order_alignment(std::span<const glm::vec3> directions, std::uint32_t slot
 
 namespace {
 
+// Whether the box [lo, hi] lies wholly on the negative side of plane p: its corner farthest along the
+// normal is outside.
+bool box_outside(const glm::dvec4& p, const glm::dvec3& lo, const glm::dvec3& hi) {
+  glm::dvec3 c(p.x >= 0 ? hi.x : lo.x, p.y >= 0 ? hi.y : lo.y, p.z >= 0 ? hi.z : lo.z);
+  return p.x * c.x + p.y * c.y + p.z * c.z + p.w < 0;
+}
+
 bool outside(const ViewParams& view, const VoxelDrawInfo& v) {
   glm::dvec3 lo = glm::dvec3(v.tight_min) - view.eye, hi = glm::dvec3(v.tight_max) - view.eye;
-  for (const glm::dvec4& p : view.planes) {
-    // the box corner farthest along the plane normal
-    glm::dvec3 c(p.x >= 0 ? hi.x : lo.x, p.y >= 0 ? hi.y : lo.y, p.z >= 0 ? hi.z : lo.z);
-    if (p.x * c.x + p.y * c.y + p.z * c.z + p.w < 0) return true;
-  }
+  for (const glm::dvec4& p : view.planes)
+    if (box_outside(p, lo, hi)) return true;
+  for (const glm::dvec4& p : view.clip)
+    if (box_outside(p, lo, hi)) return true;
   return false;
 }
 
@@ -76,7 +82,7 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
   plan.count.reserve(plan.sort_keys.size());
   for (const auto& [key, i] : plan.sort_keys) {
     const VoxelDrawInfo& v = voxels[i];
-    std::uint32_t slot = layout.block_slot();
+    std::uint32_t slot = layout.block_slot(v);
     bool reversed = false;
     if (order == PlanOrder::Nearest) {
       glm::dvec3 w = view.orthographic ? view.forward : glm::normalize(v.center - view.eye);

@@ -1,4 +1,5 @@
-// The per-frame CPU work of the Voxlines method: drop voxels outside the view frustum, sort the visible
+// The per-frame CPU work of the Voxlines method: drop voxels outside the view frustum (and outside the
+// slab and clip planes), sort the visible
 // voxels back to front, pick each voxel's nearest precomputed order (the paper's rule), and fill the
 // first/count arrays of one glMultiDrawArrays call. No GL here.
 #pragma once
@@ -19,6 +20,7 @@ struct ViewParams {
   glm::dvec3 forward;                 // unit view direction (used for orthographic sorting)
   bool orthographic = false;
   std::array<glm::dvec4, 6> planes;   // frustum planes in camera-relative coordinates (p - eye), inside >= 0
+  std::vector<glm::dvec4> clip;       // slab and clip half-spaces, camera-relative likewise (clip_planes.h)
 };
 
 // Frustum planes from a projection matrix and the world->eye rotation (Gribb & Hartmann).
