@@ -7,6 +7,7 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "grid_overlay.h"
 #include "headless_render.h"
 #include "image_io.h"
+#include "offscreen_target.h"
 #include "renderer.h"
 #include "scene_source.h"
 #include "ui_panel.h"
@@ -140,6 +142,9 @@ class ViewerWindow {
   GLFWwindow* window_;
   Renderer renderer_;
   GridOverlay grid_;
+  // The scene is drawn here and blitted to the window: it blends in float like headless rendering, so
+  // faint layers add up beyond 8-bit rounding and the window shows what --render writes.
+  std::optional<OffscreenTarget> scene_target_;
   CameraController controller_;
   std::unique_ptr<UiPanel> panel_;  // created after our callbacks, which ImGui then chains to
   PanelState state_;
@@ -341,14 +346,18 @@ void ViewerWindow::draw_scene(int width, int height) {
   }
   const auto t0 = std::chrono::steady_clock::now();
   const Camera& camera = controller_.camera();
+  if (!scene_target_) scene_target_.emplace(width, height);
+  if (scene_target_->width() != width || scene_target_->height() != height) scene_target_->resize(width, height);
+  const GLuint target = scene_target_->framebuffer();
   try {
-    renderer_.draw(camera, s, width, height, 0);
+    renderer_.draw(camera, s, width, height, target);
   } catch (const std::exception& e) {
     // A mode that cannot run here (e.g. exact out of node memory): say so and keep showing something.
     set_error(std::string(render_mode_name(s.mode)) + ": " + e.what() + ": showing axis");
     s.mode = RenderMode::Axis;
-    renderer_.draw(camera, s, width, height, 0);
+    renderer_.draw(camera, s, width, height, target);
   }
+  scene_target_->bind();
   drawn_mode_ = s.mode;
   if (state_.grid) {
     const glm::vec4 colour = s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
@@ -356,6 +365,10 @@ void ViewerWindow::draw_scene(int width, int height) {
                colour, s.clipping);
     stats_.grid_cubes = grid_.cubes_drawn();
   }
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, target);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glFinish();  // the frame time should include the GPU's work, not only its submission
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
