@@ -31,17 +31,30 @@ std::optional<Header> parse_header(const std::string& path, std::span<const std:
   Header h;
   std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   std::size_t pos = 0;
+  // With only the first bytes of a longer file, a line that runs to their end may be cut: it is not
+  // judged (nor the magic line) until more is read, so a streamed header fails exactly where a whole one does.
+  const bool partial = bytes.size() < file_size;
+  bool cut = false;
   auto next_line = [&](std::string_view& line) {
     if (pos >= text.size()) return false;
     std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
+    if (end == std::string_view::npos) {
+      if (partial) {
+        cut = true;
+        return false;
+      }
+      end = text.size();
+    }
     line = text.substr(pos, end - pos);
     pos = end + 1;
     return true;
   };
   std::string_view line;
-  if (!next_line(line) || trim(line) != "mrtrix tracks")
+  if (!next_line(line)) {
+    if (cut) return std::nullopt;
     fail_input(path, 0, "expected the TCK magic line 'mrtrix tracks'");
+  }
+  if (trim(line) != "mrtrix tracks") fail_input(path, 0, "expected the TCK magic line 'mrtrix tracks'");
   bool ended = false;
   std::string last_key;
   while (true) {
