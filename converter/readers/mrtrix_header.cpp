@@ -15,20 +15,36 @@ std::string_view trim(std::string_view s) {
 
 }  // namespace
 
-MrtrixHeader parse_mrtrix_header(const std::string& path, std::span<const std::uint8_t> bytes, const char* magic) {
+std::optional<MrtrixHeader> parse_mrtrix_header(const std::string& path, std::span<const std::uint8_t> bytes,
+                                                std::uint64_t file_size, const MrtrixFileKind& kind) {
+  const std::string name = kind.name;
   MrtrixHeader h;
   std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   std::size_t pos = 0;
+  // With only the first bytes of a longer file, a line that runs to their end may be cut: it is not
+  // judged (nor the magic line) until more is read, so a streamed header fails exactly where a whole one does.
+  const bool partial = bytes.size() < file_size;
+  bool cut = false;
   auto next_line = [&](std::string_view& line) {
     if (pos >= text.size()) return false;
     std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
+    if (end == std::string_view::npos) {
+      if (partial) {
+        cut = true;
+        return false;
+      }
+      end = text.size();
+    }
     line = text.substr(pos, end - pos);
     pos = end + 1;
     return true;
   };
   std::string_view line;
-  if (!next_line(line) || trim(line) != magic) fail_input(path, 0, std::string("expected the magic line '") + magic + "'");
+  if (!next_line(line)) {
+    if (cut) return std::nullopt;
+    fail_input(path, 0, "expected the " + name + " magic line '" + kind.magic + "'");
+  }
+  if (trim(line) != kind.magic) fail_input(path, 0, "expected the " + name + " magic line '" + kind.magic + "'");
   bool ended = false;
   std::string last_key;
   while (true) {
@@ -53,27 +69,30 @@ MrtrixHeader parse_mrtrix_header(const std::string& path, std::span<const std::u
     std::string value(trim(t.substr(colon + 1)));
     h.fields[key].push_back(value);
   }
-  if (!ended) fail_input(path, bytes.size(), "header has no 'END' line");
+  if (!ended) {
+    if (bytes.size() < file_size) return std::nullopt;
+    fail_input(path, bytes.size(), name + " header has no 'END' line");
+  }
 
   auto single = [&](const char* key) -> std::string {
-    if (!h.fields.contains(key)) fail_input(path, std::nullopt, std::string("header lacks '") + key + ":'");
+    if (!h.fields.contains(key)) fail_input(path, std::nullopt, name + " header lacks '" + key + ":'");
     return h.fields[key].back().get<std::string>();
   };
   h.datatype = single("datatype");
   std::string file = single("file");
   if (file.size() < 2 || file[0] != '.' || file[1] != ' ')
-    fail_unsupported(path, "'file:' must be '. OFFSET' (data in the same file); got '" + file + "'");
+    fail_unsupported(path, name + " 'file:' must be '. OFFSET' (data in the same file); got '" + file + "'");
   try {
     std::size_t used = 0;
     long long off = std::stoll(file.substr(2), &used);
     if (off < 0) throw std::out_of_range("negative");
     h.data_offset = static_cast<std::uint64_t>(off);
   } catch (const std::exception&) {
-    fail_input(path, std::nullopt, "'file:' offset is not a number: '" + file + "'");
+    fail_input(path, std::nullopt, name + " 'file:' offset is not a number: '" + file + "'");
   }
-  if (h.data_offset < pos) fail_input(path, h.data_offset, "data offset points inside the header");
-  if (h.data_offset > bytes.size())
-    fail_input(path, h.data_offset, "data offset is past the end of the file (" + std::to_string(bytes.size()) + " bytes)");
+  if (h.data_offset < pos) fail_input(path, h.data_offset, name + " data offset points inside the header");
+  if (h.data_offset > file_size)
+    fail_input(path, h.data_offset, name + " data offset is past the end of the file (" + std::to_string(file_size) + " bytes)");
   if (h.fields.contains("count")) {
     try {
       h.count = std::stoull(h.fields["count"].back().get<std::string>());
@@ -83,7 +102,6 @@ MrtrixHeader parse_mrtrix_header(const std::string& path, std::span<const std::u
   }
   return h;
 }
-
 
 std::optional<std::string> MrtrixHeader::last(const char* key) const {
   auto it = fields.find(key);

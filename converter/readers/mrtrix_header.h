@@ -1,7 +1,7 @@
 // The text header MRtrix puts in front of its track files (TCK, "mrtrix tracks") and track scalar
 // files (TSF, "mrtrix track scalars"): a magic line, "key: value" lines (keys may repeat; a line without
 // a colon continues the previous value), "END". Required: "datatype" and "file: . OFFSET" (data in the
-// same file, after the header).
+// same file, after the header). One parser for both, and for a whole file as for its first bytes.
 #pragma once
 
 #include <cstdint>
@@ -22,7 +22,24 @@ struct MrtrixHeader {
   std::optional<std::string> last(const char* key) const;
 };
 
-// Throws vxl::Error (Input / Unsupported) naming `path` and the byte offset where known.
-MrtrixHeader parse_mrtrix_header(const std::string& path, std::span<const std::uint8_t> bytes, const char* magic);
+// What is being parsed: the magic line, and the name used in messages ("TCK", "TSF").
+struct MrtrixFileKind {
+  const char* magic;
+  const char* name;
+};
+inline constexpr MrtrixFileKind kTckFile{"mrtrix tracks", "TCK"};
+inline constexpr MrtrixFileKind kTsfFile{"mrtrix track scalars", "TSF"};
+
+// Parses the header at the start of `bytes`, the first bytes of a file of `file_size` bytes. Returns
+// nullopt when `bytes` is shorter than the file and holds no END line yet (read more and call again);
+// throws vxl::Error (Input / Unsupported) naming `path` and the byte offset where known.
+std::optional<MrtrixHeader> parse_mrtrix_header(const std::string& path, std::span<const std::uint8_t> bytes,
+                                                std::uint64_t file_size, const MrtrixFileKind& kind);
+
+// The same for a whole file in memory (never nullopt).
+inline MrtrixHeader parse_mrtrix_header(const std::string& path, std::span<const std::uint8_t> whole_file,
+                                        const MrtrixFileKind& kind) {
+  return *parse_mrtrix_header(path, whole_file, whole_file.size(), kind);
+}
 
 }  // namespace vxl

@@ -60,7 +60,7 @@ void read_values(std::span<const std::uint8_t> bytes, std::uint64_t offset, Trac
 
 TrackScalars read_tsf(const std::string& path) {
   MappedFile file(path);
-  const MrtrixHeader h = parse_mrtrix_header(path, file.bytes(), "mrtrix track scalars");
+  const MrtrixHeader h = parse_mrtrix_header(path, file.bytes(), kTsfFile);
   TrackScalars s;
   s.offsets = {0};
   s.timestamp = h.last("timestamp");

@@ -14,21 +14,10 @@
 #include <vector>
 
 #include "error.h"
+#include "mrtrix_header.h"
 #include "tractogram.h"
 
 namespace vxl::tck {
-
-struct Header {
-  nlohmann::json fields = nlohmann::json::object();  // key -> array of values (keys may repeat)
-  std::string datatype;
-  std::uint64_t data_offset = 0;
-  std::optional<std::uint64_t> count;
-};
-
-// Parses the header at the start of `bytes`, the first bytes of a file of `file_size` bytes. Returns
-// nullopt when `bytes` is shorter than the file and holds no END line yet (read more and call again);
-// throws vxl::Error (Input / Unsupported) for a malformed header.
-std::optional<Header> parse_header(const std::string& path, std::span<const std::uint8_t> bytes, std::uint64_t file_size);
 
 template <typename Real, bool kBigEndian>
 Real load(const std::uint8_t* p) {
@@ -85,6 +74,6 @@ std::uint64_t decode(const std::string& path, const std::uint8_t* p, std::uint64
 void finish(const DecodeState& s, std::uint64_t trailing, Tractogram& t, std::vector<std::string>& warnings);
 
 // The warnings about the header that need the whole data (appended after finish()'s).
-void header_warnings(const Header& h, std::uint64_t streamlines, std::vector<std::string>& warnings);
+void header_warnings(const MrtrixHeader& h, std::uint64_t streamlines, std::vector<std::string>& warnings);
 
 }  // namespace vxl::tck

@@ -40,7 +40,7 @@ TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, st
     for (;;) {
       prefix.resize(want);
       read_at(0, prefix.data(), want);
-      if (std::optional<tck::Header> h = tck::parse_header(path, prefix, source_.bytes)) {
+      if (std::optional<MrtrixHeader> h = parse_mrtrix_header(path, prefix, source_.bytes, kTckFile)) {
         header_ = std::move(*h);
         break;
       }

@@ -53,7 +53,7 @@ class TckStream {
 
   std::string path_;
   int fd_ = -1;
-  tck::Header header_;
+  MrtrixHeader header_;
   SourceInfo source_;
   std::uint32_t triplet_bytes_ = 12;
   std::int64_t mtime_ns_ = 0;
