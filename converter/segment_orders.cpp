@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <thread>
 #include <utility>
 
@@ -174,56 +175,68 @@ std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_o
   return total;
 }
 
+struct VoxelOrderWriter::Scratch {
+  std::vector<std::uint32_t> starts;
+  SortScratch sort;
+};
+
+VoxelOrderWriter::VoxelOrderWriter(const OrderSetSpec& set)
+    : directions_(set.directions), axis_of_(set.directions.size(), -1), scratch_(std::make_unique<Scratch>()) {
+  // Axis directions sort by one exact component sum, as in the paper; others by a dot product.
+  for (std::size_t k = 0; k < directions_.size(); ++k)
+    for (int c = 0; c < 3; ++c)
+      if (directions_[k][c] == 1.0f && directions_[k][(c + 1) % 3] == 0.0f && directions_[k][(c + 2) % 3] == 0.0f)
+        axis_of_[k] = c;
+}
+
+VoxelOrderWriter::~VoxelOrderWriter() = default;
+VoxelOrderWriter::VoxelOrderWriter(VoxelOrderWriter&&) noexcept = default;
+
+void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const float> vertices, const VoxlineEnds& ends,
+                             std::uint8_t* dst) {
+  std::vector<std::uint32_t>& starts = scratch_->starts;
+  SortScratch& scratch = scratch_->sort;
+  // The segments start at every vertex that does not end its voxline (branch-free: ends are
+  // scattered, a branch would mispredict often).
+  starts.resize(v.vertex_count);
+  std::size_t n_starts = 0;
+  for (std::uint32_t e = 0; e < v.vertex_count; ++e) {
+    starts[n_starts] = e;
+    n_starts += !ends.test(v.vertex_first + e);
+  }
+  starts.resize(n_starts);
+  const float* block = vertices.data() + 3 * v.vertex_first;
+  const std::uint32_t width = order_entry_width(v.vertex_count);
+  for (std::size_t k = 0; k < directions_.size(); ++k) {
+    scratch.keys.resize(starts.size());
+    const auto& d = directions_[k];
+    std::uint64_t all_or = 0, all_and = ~0ull;
+    for (std::size_t n = 0; n < starts.size(); ++n) {
+      const float* a = block + 3 * starts[n];
+      double key;
+      if (axis_of_[k] >= 0) {
+        key = double(a[axis_of_[k]]) + double(a[axis_of_[k] + 3]);
+      } else {
+        key = 0;
+        for (int c = 0; c < 3; ++c) key += (double(a[c]) + double(a[c + 3])) * double(d[c]);
+      }
+      const std::uint64_t bits = sortable_bits(key);
+      scratch.keys[n] = bits;
+      all_or |= bits;
+      all_and &= bits;
+    }
+    dst = sort_segments(starts, v.vertex_count, width, all_or ^ all_and, scratch, dst);
+  }
+}
+
 void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float> vertices, const VoxlineEnds& ends,
                        const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads, const ProgressFn& progress) {
-  const std::uint32_t k_count = static_cast<std::uint32_t>(set.directions.size());
-
-  // Axis directions sort by one exact component sum, as in the paper; others by a dot product.
-  std::vector<int> axis_of(k_count, -1);
-  for (std::uint32_t k = 0; k < k_count; ++k)
-    for (int c = 0; c < 3; ++c)
-      if (set.directions[k][c] == 1.0f && set.directions[k][(c + 1) % 3] == 0.0f && set.directions[k][(c + 2) % 3] == 0.0f)
-        axis_of[k] = c;
-
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
   auto worker = [&](bool reports) {
-    std::vector<std::uint32_t> starts;
-    SortScratch scratch;
+    VoxelOrderWriter writer(set);
     for (std::size_t i; (i = next++) < voxels.size();) {
-      const VoxelEntry& v = voxels[i];
-      // The segments start at every vertex that does not end its voxline (branch-free: ends are
-      // scattered, a branch would mispredict often).
-      starts.resize(v.vertex_count);
-      std::size_t n_starts = 0;
-      for (std::uint32_t e = 0; e < v.vertex_count; ++e) {
-        starts[n_starts] = e;
-        n_starts += !ends.test(v.vertex_first + e);
-      }
-      starts.resize(n_starts);
-      const float* block = vertices.data() + 3 * v.vertex_first;
-      const std::uint32_t width = order_entry_width(v.vertex_count);
-      std::uint8_t* dst = orders.data() + v.order_offset;
-      for (std::uint32_t k = 0; k < k_count; ++k) {
-        scratch.keys.resize(starts.size());
-        const auto& d = set.directions[k];
-        std::uint64_t all_or = 0, all_and = ~0ull;
-        for (std::size_t n = 0; n < starts.size(); ++n) {
-          const float* a = block + 3 * starts[n];
-          double key;
-          if (axis_of[k] >= 0) {
-            key = double(a[axis_of[k]]) + double(a[axis_of[k] + 3]);
-          } else {
-            key = 0;
-            for (int c = 0; c < 3; ++c) key += (double(a[c]) + double(a[c + 3])) * double(d[c]);
-          }
-          const std::uint64_t bits = sortable_bits(key);
-          scratch.keys[n] = bits;
-          all_or |= bits;
-          all_and &= bits;
-        }
-        dst = sort_segments(starts, v.vertex_count, width, all_or ^ all_and, scratch, dst);
-      }
+      writer.write(voxels[i], vertices, ends, orders.data() + voxels[i].order_offset);
       std::size_t d = ++done;
       if (reports && progress && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
     }

@@ -262,10 +262,21 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   });
   residuals = {};
 
-  // Tight bounds per voxel and the global bounds, from the decoded vertices (spec §7 steps 1, 3).
+  summary.decode_seconds = seconds_since(t0);
+
+  // Per voxel, while its block is in cache: its tight bounds from the decoded vertices (spec §7 step 3),
+  // then its orders for the shipped directions (step 5).
+  t0 = Clock::now();
+  OrderSetSpec set;
+  set.kind = static_cast<OrderSet>(meta.order_set);
+  for (const DirectionEntry& d : f.directions()) set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
+  prefault_for_write(out.orders(), threads);
   std::span<VoxelEntry> voxels = out.voxels();
   std::span<const float> vertices = out.vertices();
-  parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned) {
+  std::vector<VoxelOrderWriter> writers;
+  for (unsigned t = 0; t < threads; ++t) writers.emplace_back(set);
+  std::atomic<std::uint64_t> ordered{0};
+  parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned t) {
     VoxelEntry& v = voxels[i];
     const float* b = vertices.data() + 3 * v.vertex_first;
     for (int c = 0; c < 3; ++c) v.tight_min[c] = v.tight_max[c] = b[c];
@@ -274,7 +285,12 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
         v.tight_min[c] = std::min(v.tight_min[c], b[3 * e + c]);
         v.tight_max[c] = std::max(v.tight_max[c], b[3 * e + c]);
       }
+    writers[t].write(v, vertices, ends, out.orders().data() + v.order_offset);
+    const std::uint64_t d = ++ordered;
+    if (t == 0 && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
   });
+  progress("ordering", 1.0);
+  // The global bounds (step 1).
   for (int c = 0; c < 3; ++c) {
     meta.bounds_min[c] = meta.bounds_max[c] = 0;
     for (std::size_t i = 0; i < voxels.size(); ++i) {
@@ -282,15 +298,6 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
       meta.bounds_max[c] = i == 0 ? voxels[i].tight_max[c] : std::max<double>(meta.bounds_max[c], voxels[i].tight_max[c]);
     }
   }
-  summary.decode_seconds = seconds_since(t0);
-
-  // Orders (spec §7 step 5), for the shipped directions.
-  t0 = Clock::now();
-  OrderSetSpec set;
-  set.kind = static_cast<OrderSet>(meta.order_set);
-  for (const DirectionEntry& d : f.directions()) set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
-  prefault_for_write(out.orders(), threads);
-  build_orders_into(out.voxels(), out.vertices(), ends, set, out.orders(), threads, settings.progress);
   summary.orders_seconds = seconds_since(t0);
 
   t0 = Clock::now();
