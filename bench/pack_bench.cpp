@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
         }
         const vxl::VxlzFile z = vxl::VxlzFile::open(package);
         double position_bytes = 0;
-        for (std::uint64_t c = 0; c < z.chunk_count(); ++c) position_bytes += double(z.chunk(c).size());
+        for (std::uint64_t c = 0; c < z.chunk_count(); ++c) position_bytes += double(z.chunk(c).symbols.size() + z.chunk(c).escapes.size());
         const std::vector<float> got = source_points(vxl::VxlFile::open(unpacked));
         double max_error = 0, sum_squares = 0;
         for (std::size_t i = 0; i < std::min(got.size(), expected.size()); ++i) {

@@ -176,7 +176,8 @@ void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, st
   const Quantizer quantizer(f.pack());
   const std::uint64_t count = f.chunk_point_count(chunk);
   residuals.resize(3 * count);
-  decode_residual_chunk(f.chunk(chunk), residuals, f.path(), f.chunk_file_offset(chunk));
+  const ChunkBytes bytes = f.chunk(chunk);
+  decode_residual_chunk(bytes, f.pack().joint_bits, residuals, f.path());
 
   std::uint64_t j = s.chunk_start_voxline[chunk];
   std::uint64_t in_voxline = s.chunk_start_point[chunk];
@@ -197,7 +198,7 @@ void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, st
       // chunk cannot drive the prediction into overflow.
       if (static_cast<std::uint64_t>(q[0]) > max_value || static_cast<std::uint64_t>(q[1]) > max_value ||
           static_cast<std::uint64_t>(q[2]) > max_value)
-        fail_input(f.path(), f.chunk_file_offset(chunk),
+        fail_input(f.path(), bytes.symbols_offset,
                    "position chunk: point " + std::to_string(chunk * f.pack().chunk_points + i + r) +
                        " decodes outside the quantisation grid");
       for (int a = 0; a < 3; ++a) dst[a] = quantizer.dequantize(q[a], a);
@@ -238,7 +239,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
 
   const VxlzFile f = VxlzFile::open(in_path);
   if (f.meta().order_set == static_cast<std::uint32_t>(OrderSet::Random))
-    fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 1.0");
+    fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");
   Structure s = rebuild_structure(f);
   const std::string provenance = provenance_with_package(f);
   std::vector<std::uint8_t> groups_bytes;

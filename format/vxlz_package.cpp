@@ -25,7 +25,7 @@ std::vector<std::uint8_t> bytes_of(const T& value) {
   return {b, b + sizeof value};
 }
 
-// The sections every package has (spec §2.2), and the optional ones a 1.0 reader knows.
+// The sections every package has (spec §2.2), and the optional ones a 2.0 reader knows.
 constexpr std::uint32_t kRequired[] = {section_id("PACK"), section_id("META"), section_id("DIRS"),
                                        section_id("VOXC"), section_id("STRL"), section_id("VXLV"),
                                        section_id("VXLC"), section_id("CHNK"), section_id("POSD")};
@@ -47,13 +47,17 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, unsigned
   std::vector<std::uint8_t> provenance_raw, chunk_sizes, positions;
   if (c.provenance) provenance_raw.assign(c.provenance->begin(), c.provenance->end());
   std::uint64_t total_chunk_bytes = 0;
-  for (const auto& chunk : c.chunks) {
-    const std::uint64_t n = chunk.size();
-    chunk_sizes.insert(chunk_sizes.end(), reinterpret_cast<const std::uint8_t*>(&n), reinterpret_cast<const std::uint8_t*>(&n) + 8);
-    total_chunk_bytes += n;
-  }
+  for (const EncodedChunk& chunk : c.chunks)
+    for (const std::vector<std::uint8_t>* buffer : {&chunk.symbols, &chunk.escapes}) {
+      const std::uint64_t n = buffer->size();
+      chunk_sizes.insert(chunk_sizes.end(), reinterpret_cast<const std::uint8_t*>(&n), reinterpret_cast<const std::uint8_t*>(&n) + 8);
+      total_chunk_bytes += n;
+    }
   positions.reserve(total_chunk_bytes);
-  for (const auto& chunk : c.chunks) positions.insert(positions.end(), chunk.begin(), chunk.end());
+  for (const EncodedChunk& chunk : c.chunks) {
+    positions.insert(positions.end(), chunk.symbols.begin(), chunk.symbols.end());
+    positions.insert(positions.end(), chunk.escapes.begin(), chunk.escapes.end());
+  }
 
   std::vector<Section> sections;
   sections.push_back({"PACK", true, bytes_of(pack)});
@@ -149,7 +153,9 @@ void VxlzFile::validate() {
   if (std::memcmp(h.magic, kVxlzMagic.data(), 8) != 0) fail_input(p, 0, "not a .vxlz package (bad magic)");
   if (h.version_major != kVxlzVersionMajor)
     throw Error(ErrorKind::Unsupported, p, 8,
-                ".vxlz major version " + std::to_string(h.version_major) + " (this reader knows 1)");
+                ".vxlz major version " + std::to_string(h.version_major) + " (this reader knows " +
+                    std::to_string(kVxlzVersionMajor) + " only" +
+                    (h.version_major < kVxlzVersionMajor ? "; pack the .vxl again with this version)" : ")"));
   if (h.header_size != sizeof h) fail_input(p, 12, "header_size must be 64");
   if (h.file_size != size)
     fail_input(p, 16, "file size is " + std::to_string(size) + " bytes but the header says " + std::to_string(h.file_size) +
@@ -224,7 +230,9 @@ void VxlzFile::validate() {
   if (k.chunk_points < 1 || k.chunk_points > kVxlzMaxChunkPoints) fail_input(p, pack_at + 56, "chunk points must be 1..2^31-1");
   if (k.chunk_count != k.point_count / k.chunk_points + (k.point_count % k.chunk_points != 0))
     fail_input(p, pack_at + 64, "chunk count does not match point count / chunk points");
-  if (!all_zero(k.reserved, sizeof k.reserved)) fail_input(p, pack_at + 96, "PACK reserved bytes are not zero");
+  if (k.joint_bits < kVxlzMinJointBits || k.joint_bits > kVxlzMaxJointBits)
+    fail_input(p, pack_at + 96, "joint symbol bits must be 1..5");
+  if (!all_zero(k.reserved, sizeof k.reserved)) fail_input(p, pack_at + 100, "PACK reserved bytes are not zero");
 
   const std::uint64_t meta_at = fixed("META", sizeof meta_, &meta_);
   const MetaSection& m = meta_;
@@ -250,10 +258,10 @@ void VxlzFile::validate() {
 
   const SectionEntry* chnk = find(section_id("CHNK"));
   const SectionEntry* posd = find(section_id("POSD"));
-  if (chnk->size / 8 != k.chunk_count || chnk->size % 8 != 0)
-    fail_input(p, chnk->offset, "CHNK must hold one 8-byte size per chunk (" + std::to_string(k.chunk_count) + ")");
+  if (chnk->size / 16 != k.chunk_count || chnk->size % 16 != 0)
+    fail_input(p, chnk->offset, "CHNK must hold two 8-byte sizes per chunk (" + std::to_string(k.chunk_count) + " chunks)");
   chunk_offsets_.assign(1, 0);
-  for (std::uint64_t i = 0; i < k.chunk_count; ++i) {
+  for (std::uint64_t i = 0; i < 2 * k.chunk_count; ++i) {
     std::uint64_t n;
     std::memcpy(&n, base + chnk->offset + 8 * i, 8);
     if (n > posd->size - chunk_offsets_.back()) fail_input(p, chnk->offset + 8 * i, "chunk runs past the end of POSD");
@@ -274,11 +282,15 @@ StreamContext VxlzFile::context(std::uint32_t id) const {
   return {file_.path(), section_name(id), e ? e->offset : 0};
 }
 
-std::span<const std::uint8_t> VxlzFile::chunk(std::uint64_t i) const {
-  return file_.bytes().subspan(posd_offset_ + chunk_offsets_[i], chunk_offsets_[i + 1] - chunk_offsets_[i]);
+ChunkBytes VxlzFile::chunk(std::uint64_t i) const {
+  const std::uint64_t* o = chunk_offsets_.data() + 2 * i;
+  ChunkBytes c;
+  c.symbols = file_.bytes().subspan(posd_offset_ + o[0], o[1] - o[0]);
+  c.escapes = file_.bytes().subspan(posd_offset_ + o[1], o[2] - o[1]);
+  c.symbols_offset = posd_offset_ + o[0];
+  c.escapes_offset = posd_offset_ + o[1];
+  return c;
 }
-
-std::uint64_t VxlzFile::chunk_file_offset(std::uint64_t i) const { return posd_offset_ + chunk_offsets_[i]; }
 
 std::uint64_t VxlzFile::chunk_point_count(std::uint64_t i) const {
   return std::min(pack_.chunk_points, pack_.point_count - i * pack_.chunk_points);
