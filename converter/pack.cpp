@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -132,6 +134,33 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   pack.chunk_count = n / settings.chunk_points + (n % settings.chunk_points != 0);
   pack.error_bound = vxlz_error_bound(pack.quant_origin, pack.range, pack.quantum);
 
+  // The exact part (spec §4), deflated on a thread of its own while the positions are encoded: the
+  // voxline voxels take seconds to deflate on a large tractogram, and would otherwise run alone at the end.
+  c.meta = m;
+  c.directions.assign(f.directions().begin(), f.directions().end());
+  c.voxel_coords = encode_voxel_coords(f.voxels());
+  c.streamline_voxlines = encode_streamline_voxlines(f.streamline_first_voxline());
+  c.voxline_voxels = encode_voxline_voxels(f.voxlines(), f.voxels());
+  c.voxline_counts = encode_voxline_counts(f.voxlines());
+  if (f.find_section(section_id("PROV"))) c.provenance = std::string(f.provenance_json());
+  if (f.find_section(section_id("GRPS"))) c.groups = encode_group_stream(f.groups());
+  DeflatedTables tables;
+  std::exception_ptr tables_error;
+  std::thread tables_thread([&] {
+    try {
+      tables = deflate_tables(c, 1);
+    } catch (...) {
+      tables_error = std::current_exception();
+    }
+  });
+  // Joined on every path out of here: a failure below must not leave the thread running.
+  struct Join {
+    std::thread& t;
+    ~Join() {
+      if (t.joinable()) t.join();
+    }
+  } join_tables{tables_thread};
+
   // Positions (spec §5): chunks are independent, so they are quantised, predicted and encoded in parallel.
   const Quantizer quantizer(pack);
   const float* vertices = f.vertices().data();
@@ -172,13 +201,14 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
     chunk_residuals(0, sample, ignored);
   });
   c.chunks.resize(pack.chunk_count);
-  std::vector<ErrorStats> errors(threads);
+  // Per chunk, summed in chunk order below: summed per thread, the RMS error's last bits (stored in PACK
+  // and in the unpacked file's provenance) depended on which thread took which chunk.
+  std::vector<ErrorStats> errors(pack.chunk_count);
   parallel_for(pack.chunk_count, threads, [&](std::uint64_t chunk, unsigned t) {
-    ErrorStats e;  // local: the threads' entries of `errors` share cache lines
+    ErrorStats e;  // local: neighbouring entries of `errors` share cache lines
     chunk_residuals(chunk, residuals[t], e);
     c.chunks[chunk] = encode_residual_chunk(residuals[t], pack.joint_bits);
-    errors[t].max = std::max(errors[t].max, e.max);
-    errors[t].sum_squares += e.sum_squares;
+    errors[chunk] = e;
   });
   double sum_squares = 0;
   for (const ErrorStats& e : errors) {
@@ -187,18 +217,11 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   }
   pack.rms_error = n > 0 ? std::sqrt(sum_squares / (3.0 * double(n))) : 0.0;
 
-  // The exact part (spec §4).
-  c.meta = m;
-  c.directions.assign(f.directions().begin(), f.directions().end());
-  c.voxel_coords = encode_voxel_coords(f.voxels());
-  c.streamline_voxlines = encode_streamline_voxlines(f.streamline_first_voxline());
-  c.voxline_voxels = encode_voxline_voxels(voxlines, f.voxels());
-  c.voxline_counts = encode_voxline_counts(voxlines);
-  if (f.find_section(section_id("PROV"))) c.provenance = std::string(f.provenance_json());
-  if (f.find_section(section_id("GRPS"))) c.groups = encode_group_stream(f.groups());
+  tables_thread.join();
+  if (tables_error) std::rethrow_exception(tables_error);
 
   PackSummary s;
-  s.bytes = write_vxlz(out_path, c, threads);
+  s.bytes = write_vxlz(out_path, c, tables);
   s.streamlines = m.streamline_count;
   s.points = m.point_count;
   s.shipped_points = n;

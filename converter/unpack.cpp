@@ -280,12 +280,16 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned t) {
     VoxelEntry& v = voxels[i];
     const float* b = vertices.data() + 3 * v.vertex_first;
-    for (int c = 0; c < 3; ++c) v.tight_min[c] = v.tight_max[c] = b[c];
+    // In locals: the entry lives in the same mapping as the vertices, so the compiler would otherwise
+    // store it back after every vertex.
+    float lo[3] = {b[0], b[1], b[2]}, hi[3] = {b[0], b[1], b[2]};
     for (std::uint64_t e = 1; e < v.vertex_count; ++e)
       for (int c = 0; c < 3; ++c) {
-        v.tight_min[c] = std::min(v.tight_min[c], b[3 * e + c]);
-        v.tight_max[c] = std::max(v.tight_max[c], b[3 * e + c]);
+        lo[c] = std::min(lo[c], b[3 * e + c]);
+        hi[c] = std::max(hi[c], b[3 * e + c]);
       }
+    std::copy(lo, lo + 3, v.tight_min);
+    std::copy(hi, hi + 3, v.tight_max);
     writers[t].write(v, vertices, ends, out.orders().data() + v.order_offset);
     const std::uint64_t d = ++ordered;
     if (t == 0 && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));

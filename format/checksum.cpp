@@ -8,6 +8,13 @@ namespace vxl {
 
 std::uint64_t xxh3_64(const void* data, std::size_t size) { return XXH3_64bits(data, size); }
 
+Xxh3_64Stream::Xxh3_64Stream() : state_(XXH3_createState()) { XXH3_64bits_reset(static_cast<XXH3_state_t*>(state_)); }
+Xxh3_64Stream::~Xxh3_64Stream() { XXH3_freeState(static_cast<XXH3_state_t*>(state_)); }
+void Xxh3_64Stream::update(const void* data, std::size_t size) {
+  XXH3_64bits_update(static_cast<XXH3_state_t*>(state_), data, size);
+}
+std::uint64_t Xxh3_64Stream::digest() const { return XXH3_64bits_digest(static_cast<XXH3_state_t*>(state_)); }
+
 Xxh3_128Stream::Xxh3_128Stream() : state_(XXH3_createState()) {
   XXH3_128bits_reset(static_cast<XXH3_state_t*>(state_));
 }

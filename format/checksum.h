@@ -9,6 +9,20 @@ namespace vxl {
 
 std::uint64_t xxh3_64(const void* data, std::size_t size);
 
+// Incremental XXH3-64: the same value as xxh3_64 over the concatenation of the pieces.
+class Xxh3_64Stream {
+ public:
+  Xxh3_64Stream();
+  ~Xxh3_64Stream();
+  Xxh3_64Stream(const Xxh3_64Stream&) = delete;
+  Xxh3_64Stream& operator=(const Xxh3_64Stream&) = delete;
+  void update(const void* data, std::size_t size);
+  std::uint64_t digest() const;
+
+ private:
+  void* state_;
+};
+
 // Incremental XXH3-128, for hashing a source file (or a TRX directory's members) piece by piece.
 class Xxh3_128Stream {
  public:

@@ -37,8 +37,19 @@ struct VxlzContent {
   std::vector<EncodedChunk> chunks;               // Draco buffers, one pair per position chunk
 };
 
-// Deflates the streams (side by side on up to `threads` threads; 0: all cores) and writes the package
-// atomically. Returns its size in bytes. Throws vxl::Error (Output) naming the path.
+// The zlib payloads of the table sections (spec §4), deflated side by side on up to `threads` threads
+// (0: all cores). Separate from write_vxlz so that a packer can deflate them while it encodes the
+// positions. Throws vxl::Error (Output).
+struct DeflatedTables {
+  std::vector<std::uint8_t> voxel_coords, streamline_voxlines, voxline_voxels, voxline_counts;
+  std::optional<std::vector<std::uint8_t>> provenance, groups;  // when the content has them
+};
+DeflatedTables deflate_tables(const VxlzContent& content, unsigned threads = 0);
+
+// Writes the package atomically, its table sections from `tables` (deflated from `content`); the
+// second form deflates them first. Returns the package's size in bytes. Throws vxl::Error (Output)
+// naming the path.
+std::uint64_t write_vxlz(const std::string& path, const VxlzContent& content, const DeflatedTables& tables);
 std::uint64_t write_vxlz(const std::string& path, const VxlzContent& content, unsigned threads = 0);
 
 class VxlzFile {

@@ -245,6 +245,19 @@ TEST(VxlzPackageOptions, ChunkSizeAndThreadsDoNotChangeTheResult) {
   EXPECT_EQ(to_vector(fa.order_bytes()), to_vector(fb.order_bytes()));
 }
 
+TEST(VxlzPackageOptions, PackageBytesDoNotDependOnThreads) {
+  // The measured errors in PACK are summed in chunk order, whichever thread encoded which chunk.
+  ScratchDir dir;
+  const VxlFile f = VxlFile::open(convert_to(test_tractogram(300), dir.file("s.vxl")));
+  PackSettings s;
+  s.chunk_points = 64;
+  s.threads = 1;
+  pack_vxl(f, dir.file("one.vxlz"), s);
+  s.threads = 3;
+  pack_vxl(f, dir.file("three.vxlz"), s);
+  EXPECT_EQ(slurp(dir.file("one.vxlz")), slurp(dir.file("three.vxlz")));
+}
+
 TEST(VxlzPackageOptions, EmptyTractogram) {
   ScratchDir dir;
   Tractogram t;
