@@ -112,9 +112,16 @@ std::uint8_t* put_entries(std::uint8_t* dst, std::uint32_t width, std::size_t n,
       }
       break;
     case 3:
-      for (std::size_t i = 0; i < n; ++i, dst += 3) {
+      // Four bytes at a time, each store's top byte overwritten by the next entry; the last entry
+      // stores its three bytes alone, so nothing past the array is touched.
+      for (std::size_t i = 0; i + 1 < n; ++i, dst += 3) {
         std::uint32_t e = local(i);
+        std::memcpy(dst, &e, 4);
+      }
+      if (n > 0) {
+        std::uint32_t e = local(n - 1);
         std::memcpy(dst, &e, 3);
+        dst += 3;
       }
       break;
     default:

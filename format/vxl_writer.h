@@ -44,6 +44,8 @@ class VxlWriter {
   std::span<std::uint64_t> streamline_first_voxline() { return typed<std::uint64_t>(kStrm); }
   std::span<std::uint8_t> provenance() { return payload(kProv); }
   std::span<std::uint8_t> groups() { return payload(kGrps); }  // empty when there is no GRPS section
+  // The whole mapped file (header and table still unwritten), for prefaulting several payloads at once.
+  std::span<std::uint8_t> file() { return file_; }
 
   // Checksums every payload (sections spread over up to `threads` threads; 0: all hardware threads),
   // writes the section table and the header, unmaps and links the file into place. The spans above
