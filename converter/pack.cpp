@@ -134,8 +134,9 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   pack.chunk_count = n / settings.chunk_points + (n % settings.chunk_points != 0);
   pack.error_bound = vxlz_error_bound(pack.quant_origin, pack.range, pack.quantum);
 
-  // The exact part (spec §4), deflated on a thread of its own while the positions are encoded: the
-  // voxline voxels take seconds to deflate on a large tractogram, and would otherwise run alone at the end.
+  // The exact part (spec §4), deflated on a thread of its own while the positions are encoded (unless
+  // one thread was asked for): the voxline voxels take seconds to deflate on a large tractogram, and
+  // would otherwise run alone at the end.
   c.meta = m;
   c.directions.assign(f.directions().begin(), f.directions().end());
   c.voxel_coords = encode_voxel_coords(f.voxels());
@@ -146,13 +147,15 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   if (f.find_section(section_id("GRPS"))) c.groups = encode_group_stream(f.groups());
   DeflatedTables tables;
   std::exception_ptr tables_error;
-  std::thread tables_thread([&] {
+  auto deflate = [&] {
     try {
       tables = deflate_tables(c, 1);
     } catch (...) {
       tables_error = std::current_exception();
     }
-  });
+  };
+  std::thread tables_thread;
+  if (threads > 1) tables_thread = std::thread(deflate);
   // Joined on every path out of here: a failure below must not leave the thread running.
   struct Join {
     std::thread& t;
@@ -217,7 +220,8 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   }
   pack.rms_error = n > 0 ? std::sqrt(sum_squares / (3.0 * double(n))) : 0.0;
 
-  tables_thread.join();
+  if (tables_thread.joinable()) tables_thread.join();
+  else deflate();
   if (tables_error) std::rethrow_exception(tables_error);
 
   PackSummary s;
