@@ -53,6 +53,17 @@ ChildRun median_run(const std::vector<std::string>& args, const std::string& out
   return worst;
 }
 
+// The 1, 5 and 15 minute load averages: timings on a shared machine mean little without them.
+std::string load_average() {
+  std::FILE* f = std::fopen("/proc/loadavg", "r");
+  double a = 0, b = 0, c = 0;
+  const bool ok = f && std::fscanf(f, "%lf %lf %lf", &a, &b, &c) == 3;
+  if (f) std::fclose(f);
+  char text[64];
+  std::snprintf(text, sizeof text, ok ? "%.2f %.2f %.2f" : "unknown", a, b, c);
+  return text;
+}
+
 std::vector<float> source_points(const vxl::VxlFile& f) {
   std::vector<float> points;
   points.reserve(3 * f.meta().point_count);
@@ -98,8 +109,8 @@ int main(int argc, char** argv) {
                                                  : std::filesystem::path(keep);
   std::filesystem::create_directories(dir);
 
-  std::printf("machine: %u hardware threads; pack/unpack threads: %s; times are medians of %d runs\n\n",
-              std::thread::hardware_concurrency(), threads.c_str(), runs);
+  std::printf("machine: %u hardware threads; pack/unpack threads: %s; times are medians of %d runs; load %s\n\n",
+              std::thread::hardware_concurrency(), threads.c_str(), runs, load_average().c_str());
   std::printf("| data | points | bits | package MiB | bytes/point | × TCK | positions B/pt | Draco-native B/pt | max error mm | "
               "RMS error mm | bound mm | pack s | unpack s | unpack peak MiB |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -150,5 +161,6 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (keep.empty()) std::filesystem::remove_all(dir);
+  std::printf("\nload at the end: %s\n", load_average().c_str());
   return 0;
 }
