@@ -279,8 +279,11 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   std::vector<VoxelOrderWriter> writers;
   for (unsigned t = 0; t < threads; ++t) writers.emplace_back(set);
   std::atomic<std::uint64_t> ordered{0};
-  parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned t) {
-    VoxelEntry& v = voxels[i];
+  // One more item before the voxels: the vertices are final, so their checksum is taken here, beside
+  // the orders, rather than alone at the end.
+  parallel_for(voxels.size() + 1, threads, [&](std::uint64_t item, unsigned t) {
+    if (item == 0) return out.checksum_vertices_now();
+    VoxelEntry& v = voxels[item - 1];
     const float* b = vertices.data() + 3 * v.vertex_first;
     // In locals: the entry lives in the same mapping as the vertices, so the compiler would otherwise
     // store it back after every vertex.

@@ -82,10 +82,16 @@ void VxlWriter::set_meta(const MetaSection& meta) {
   std::memcpy(payload(kMeta).data(), &m, sizeof m);
 }
 
+void VxlWriter::checksum_vertices_now() {
+  table_[kVert].checksum = xxh3_64(file_.data() + table_[kVert].offset, table_[kVert].size);
+  vertices_checksummed_ = true;
+}
+
 void VxlWriter::commit(unsigned threads) {
   // Largest payloads first, so that the big ones (VERT, ORDR) run side by side.
-  std::vector<std::size_t> by_size(table_.size());
-  for (std::size_t i = 0; i < by_size.size(); ++i) by_size[i] = i;
+  std::vector<std::size_t> by_size;
+  for (std::size_t i = 0; i < table_.size(); ++i)
+    if (!(i == kVert && vertices_checksummed_)) by_size.push_back(i);
   std::stable_sort(by_size.begin(), by_size.end(), [&](std::size_t a, std::size_t b) { return table_[a].size > table_[b].size; });
   std::atomic<std::size_t> next{0};
   auto worker = [&] {

@@ -47,6 +47,11 @@ class VxlWriter {
   // The whole mapped file (header and table still unwritten), for prefaulting several payloads at once.
   std::span<std::uint8_t> file() { return file_; }
 
+  // Checksums VERT now, for a caller whose vertices are final before it fills the rest (the unpacker
+  // hashes them beside its order building instead of at the end). The vertices must not change
+  // afterwards; commit() then leaves VERT's checksum as it is.
+  void checksum_vertices_now();
+
   // Checksums every payload (sections spread over up to `threads` threads; 0: all hardware threads),
   // writes the section table and the header, unmaps and links the file into place. The spans above
   // are invalid afterwards. Without commit() the destructor discards the file.
@@ -63,6 +68,7 @@ class VxlWriter {
 
   AtomicOutputFile out_;
   std::vector<SectionEntry> table_;  // in Index order; GRPS only when present
+  bool vertices_checksummed_ = false;
   std::span<std::uint8_t> file_;
 };
 

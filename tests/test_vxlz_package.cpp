@@ -438,7 +438,9 @@ TEST_F(DamagedVxlz, OtherMajorVersionsAreUnsupported) {
     } catch (const Error& e) {
       EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
       EXPECT_NE(std::string(e.what()).find("major version " + std::to_string(version)), std::string::npos) << e.what();
-      if (version == 1) EXPECT_NE(std::string(e.what()).find("pack the .vxl again"), std::string::npos) << e.what();
+      if (version == 1) {
+        EXPECT_NE(std::string(e.what()).find("pack the .vxl again"), std::string::npos) << e.what();
+      }
     }
     EXPECT_FALSE(std::filesystem::exists(out()));
   }
