@@ -171,13 +171,11 @@ std::string provenance_with_package(const VxlzFile& f) {
 // Decodes chunk c into VERT (spec §5, §6, §7 step 4): own points at their voxline's place, and each
 // voxline's first point also as the connecting vertex of the voxline before it in the same streamline.
 // Marks the last vertex of every voxline that ends in this chunk (for the orders).
-void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, std::vector<std::int32_t>& residuals,
-                  std::span<float> vert, VoxlineEnds& ends) {
+void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, std::span<float> vert, VoxlineEnds& ends) {
   const Quantizer quantizer(f.pack());
   const std::uint64_t count = f.chunk_point_count(chunk);
-  residuals.resize(3 * count);
   const ChunkBytes bytes = f.chunk(chunk);
-  decode_residual_chunk(bytes, f.pack().joint_bits, residuals, f.path());
+  ResidualChunk residuals(bytes, f.pack().joint_bits, count, f.path());
 
   std::uint64_t j = s.chunk_start_voxline[chunk];
   std::uint64_t in_voxline = s.chunk_start_point[chunk];
@@ -190,8 +188,9 @@ void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, st
     const std::uint64_t first = s.first_vertex(j);
     if (in_voxline == 0 && s.starts_streamline[j]) predictor.start_streamline();
     float* dst = vert.data() + 3 * (first + in_voxline);
-    const std::int32_t* residual = residuals.data() + 3 * i;
-    for (std::uint64_t r = 0; r < run; ++r, residual += 3, dst += 3) {
+    for (std::uint64_t r = 0; r < run; ++r, dst += 3) {
+      std::int32_t residual[3];
+      residuals.next(residual);
       std::array<std::int64_t, 3> q;
       for (int a = 0; a < 3; ++a) q[a] = predictor.predict(a) + residual[a];
       // One unsigned comparison per value also catches negatives; checked per point so that a damaged
@@ -253,15 +252,13 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   std::copy(s.voxels.begin(), s.voxels.end(), out.voxels().begin());
 
   // Positions: chunks in parallel, each into its own voxlines' places.
-  std::vector<std::vector<std::int32_t>> residuals(threads);
   std::atomic<std::uint64_t> done{0};
   VoxlineEnds ends(meta.vertex_count);
   parallel_for(f.chunk_count(), threads, [&](std::uint64_t chunk, unsigned t) {
-    decode_chunk(f, s, chunk, residuals[t], out.vertices(), ends);
+    decode_chunk(f, s, chunk, out.vertices(), ends);
     if (t == 0) progress("decoding", double(++done) / double(f.chunk_count()));
     else ++done;
   });
-  residuals = {};
 
   summary.decode_seconds = seconds_since(t0);
 

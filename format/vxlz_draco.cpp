@@ -16,7 +16,6 @@ namespace {
 std::uint32_t zigzag(std::int32_t r) {
   return (static_cast<std::uint32_t>(r) << 1) ^ static_cast<std::uint32_t>(r >> 31);
 }
-std::int32_t unzigzag(std::uint32_t z) { return static_cast<std::int32_t>((z >> 1) ^ (0u - (z & 1))); }
 
 // n points with one GENERIC int32 attribute of `components` components, sequentially encoded.
 std::vector<std::uint8_t> encode_cloud(const std::int32_t* values, std::size_t n, int components) {
@@ -110,42 +109,39 @@ EncodedChunk encode_residual_chunk(std::span<const std::int32_t> xyz, std::uint3
   return out;
 }
 
-void decode_residual_chunk(const ChunkBytes& chunk, std::uint32_t joint_bits, std::span<std::int32_t> xyz,
-                           const std::string& file) {
-  const std::size_t n = xyz.size() / 3;
-  const DecodedCloud symbols(chunk.symbols, n, 1, "position chunk symbols", file, chunk.symbols_offset);
+struct ResidualChunk::Clouds {
+  std::optional<DecodedCloud> symbols, escapes;
+};
+
+ResidualChunk::ResidualChunk(const ChunkBytes& chunk, std::uint32_t joint_bits, std::uint64_t points,
+                             const std::string& file)
+    : clouds_(std::make_unique<Clouds>()), bits_(joint_bits), mask_((1u << joint_bits) - 1) {
+  const std::size_t n = points;
+  symbol_ = clouds_->symbols.emplace(chunk.symbols, n, 1, "position chunk symbols", file, chunk.symbols_offset).values();
   if (n == 0) return;
   // Symbols above 2^3t name no triplet; 0 takes the next escape.
   const std::uint32_t largest = 1u << 3 * joint_bits;
-  const std::int32_t* s = symbols.values();
   std::size_t escaped = 0;
   bool in_range = true;
   for (std::size_t i = 0; i < n; ++i) {
-    escaped += s[i] == 0;
-    in_range &= static_cast<std::uint32_t>(s[i]) <= largest;
+    escaped += symbol_[i] == 0;
+    in_range &= static_cast<std::uint32_t>(symbol_[i]) <= largest;
   }
   if (!in_range) fail_input(file, chunk.symbols_offset, "position chunk symbols: a symbol lies outside [0, 2^3t]");
   if (escaped == 0 && !chunk.escapes.empty())
     fail_input(file, chunk.escapes_offset, "position chunk escapes: present although no point escapes");
   if (escaped > 0 && chunk.escapes.empty())
     fail_input(file, chunk.escapes_offset, "position chunk escapes: missing for " + std::to_string(escaped) + " escaped points");
-  std::optional<DecodedCloud> escapes;
-  if (escaped > 0) escapes.emplace(chunk.escapes, escaped, 3, "position chunk escapes", file, chunk.escapes_offset);
+  if (escaped > 0)
+    escape_ = clouds_->escapes.emplace(chunk.escapes, escaped, 3, "position chunk escapes", file, chunk.escapes_offset).values();
+}
 
-  const std::uint32_t mask = (1u << joint_bits) - 1;
-  const std::int32_t* e = escapes ? escapes->values() : nullptr;
-  std::int32_t* out = xyz.data();
-  for (std::size_t i = 0; i < n; ++i, out += 3) {
-    if (s[i] == 0) {
-      std::memcpy(out, e, 3 * sizeof(std::int32_t));
-      e += 3;
-      continue;
-    }
-    const std::uint32_t u = static_cast<std::uint32_t>(s[i]) - 1;
-    out[0] = unzigzag(u & mask);
-    out[1] = unzigzag((u >> joint_bits) & mask);
-    out[2] = unzigzag(u >> 2 * joint_bits);
-  }
+ResidualChunk::~ResidualChunk() = default;
+
+void decode_residual_chunk(const ChunkBytes& chunk, std::uint32_t joint_bits, std::span<std::int32_t> xyz,
+                           const std::string& file) {
+  ResidualChunk residuals(chunk, joint_bits, xyz.size() / 3, file);
+  for (std::size_t i = 0; i + 3 <= xyz.size(); i += 3) residuals.next(xyz.data() + i);
 }
 
 std::size_t draco_native_size(std::span<const float> xyz, std::uint32_t bits, const float origin[3], float range) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -33,11 +34,44 @@ std::uint32_t joint_symbol(const std::int32_t r[3], std::uint32_t joint_bits);
 // kVxlzMaxJointBits]. Throws vxl::Error (Output) if Draco fails.
 EncodedChunk encode_residual_chunk(std::span<const std::int32_t> xyz, std::uint32_t joint_bits);
 
-// Decodes one chunk into `xyz` (3 * n values for the n points the chunk must hold). Throws vxl::Error
-// (Input) naming `file` and the offset of the offending buffer unless the symbol buffer is a Draco point
-// cloud of exactly n points with one 1-component int32 attribute whose values lie in [0, 2^3t], and the
+// One decoded chunk, read point by point, so that a caller places the points without a buffer of
+// residuals in between. The constructor decodes and checks both clouds: it throws vxl::Error (Input)
+// naming `file` and the offset of the offending buffer unless the symbol buffer is a Draco point cloud of
+// exactly `points` points with one 1-component int32 attribute whose values lie in [0, 2^3t], and the
 // escape buffer is empty when no symbol is 0 and otherwise a cloud of exactly that many points with one
-// 3-component int32 attribute. Safe for untrusted bytes.
+// 3-component int32 attribute. Safe for untrusted bytes; after it, next() needs no checks.
+class ResidualChunk {
+ public:
+  ResidualChunk(const ChunkBytes& chunk, std::uint32_t joint_bits, std::uint64_t points, const std::string& file);
+  ~ResidualChunk();
+  ResidualChunk(const ResidualChunk&) = delete;
+  ResidualChunk& operator=(const ResidualChunk&) = delete;
+
+  // The next point's residual triplet; call it once per point, in order.
+  void next(std::int32_t r[3]) {
+    const std::uint32_t s = static_cast<std::uint32_t>(*symbol_++);
+    if (s == 0) {
+      r[0] = escape_[0], r[1] = escape_[1], r[2] = escape_[2];
+      escape_ += 3;
+      return;
+    }
+    const std::uint32_t u = s - 1;
+    r[0] = unzigzag(u & mask_);
+    r[1] = unzigzag((u >> bits_) & mask_);
+    r[2] = unzigzag(u >> 2 * bits_);
+  }
+
+ private:
+  static std::int32_t unzigzag(std::uint32_t z) { return static_cast<std::int32_t>((z >> 1) ^ (0u - (z & 1))); }
+  struct Clouds;  // the decoded Draco point clouds, which own the values read below
+  std::unique_ptr<Clouds> clouds_;
+  const std::int32_t* symbol_ = nullptr;
+  const std::int32_t* escape_ = nullptr;
+  std::uint32_t bits_ = 0, mask_ = 0;
+};
+
+// Decodes one chunk into `xyz` (3 * n values for the n points the chunk must hold), with the checks of
+// ResidualChunk.
 void decode_residual_chunk(const ChunkBytes& chunk, std::uint32_t joint_bits, std::span<std::int32_t> xyz,
                            const std::string& file);
 
