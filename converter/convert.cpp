@@ -4,7 +4,9 @@
 #include <chrono>
 #include <filesystem>
 
+#include "error.h"
 #include "segment_orders.h"
+#include "vxl_value_sets.h"
 #include "vxl_writer.h"
 
 #ifndef VOXLINES_VERSION
@@ -12,7 +14,6 @@
 #endif
 
 namespace vxl {
-namespace {
 
 std::string provenance_json(const SourceInfo& src, const ConvertSettings& settings, unsigned threads) {
   nlohmann::json j;
@@ -28,9 +29,12 @@ std::string provenance_json(const SourceInfo& src, const ConvertSettings& settin
   j["converter"] = {{"name", "voxlines"}, {"version", VOXLINES_VERSION}, {"voxel_size", settings.voxel_size},
                     {"orders", settings.orders}, {"threads", threads}};
   j["warnings"] = src.warnings;
+  if (!src.value_files.empty()) j["value_files"] = src.value_files;
   // Invalid UTF-8 in a source header must not make the whole file unwritable: replace it.
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
+
+namespace {
 
 template <typename T>
 std::span<std::uint8_t> bytes_of(std::span<T> s) {
@@ -42,6 +46,20 @@ std::span<std::uint8_t> bytes_of(std::span<T> s) {
 ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, const ConvertSettings& settings) {
   OrderSetSpec order_set = parse_order_set(settings.orders);
   const unsigned threads = resolve_threads(settings.threads);
+  for (const ValueSet& v : t.point_values)
+    if (v.values.size() != t.point_count())
+      throw Error(ErrorKind::Input, t.source.path, std::nullopt, "value set '" + v.name + "' has " +
+                  std::to_string(v.values.size()) + " values for " + std::to_string(t.point_count()) + " points");
+  for (const ValueSet& v : t.streamline_values)
+    if (v.values.size() != t.streamline_count())
+      throw Error(ErrorKind::Input, t.source.path, std::nullopt, "value set '" + v.name + "' has " +
+                  std::to_string(v.values.size()) + " values for " + std::to_string(t.streamline_count()) + " streamlines");
+  for (auto* sets : {&t.point_values, &t.streamline_values})
+    if (sets->size() > kMaxValueSets) {
+      t.source.warnings.push_back("only the first " + std::to_string(kMaxValueSets) + " of " + std::to_string(sets->size()) +
+                                  (sets == &t.point_values ? " per-point" : " per-streamline") + " value sets are kept");
+      sets->resize(kMaxValueSets);
+    }
   // PROV and GRPS are known before any work: their sizes go into the plan of the output file.
   const std::string provenance = provenance_json(t.source, settings, threads);
   std::vector<std::uint8_t> groups_bytes;
@@ -66,12 +84,25 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   meta.stored_order_count = static_cast<std::uint32_t>(order_set.directions.size());
   meta.order_set = static_cast<std::uint32_t>(order_set.kind);
   const std::uint64_t order_bytes = layout_orders(plan.voxels(), meta.stored_order_count);
-  VxlWriter out(out_path, section_sizes(meta, order_bytes, provenance.size(), groups_bytes.size()));
+  std::vector<std::string> point_set_names, streamline_set_names;
+  for (const ValueSet& v : t.point_values) point_set_names.push_back(v.name);
+  for (const ValueSet& v : t.streamline_values) streamline_set_names.push_back(v.name);
+  VxlWriter out(out_path, section_sizes(meta, order_bytes, provenance.size(), groups_bytes.size(),
+                                        static_cast<std::uint32_t>(point_set_names.size()),
+                                        static_cast<std::uint32_t>(streamline_set_names.size())));
+  // Per-streamline values are copied as they are; per-point ones are spread over the vertices below.
+  const auto streamline_arrays = layout_value_sets(out.streamline_values(), streamline_set_names, meta.streamline_count);
+  for (std::size_t k = 0; k < streamline_arrays.size(); ++k)
+    std::copy(t.streamline_values[k].values.begin(), t.streamline_values[k].values.end(), streamline_arrays[k].begin());
+  t.streamline_values.clear();
+  finish_value_sets(out.streamline_values());
   // Pass 2 writes all over these: fault them in first, in bulk (ORDR waits until the source is freed).
   for (std::span<std::uint8_t> s : {bytes_of(out.vertices()), bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
     prefault_for_write(s, threads);
-  VoxlineEnds ends = place_vertices(std::move(plan), std::move(t),
-                                    {out.voxels(), out.vertices(), out.voxlines(), out.streamline_first_voxline()});
+  VoxelBlocks blocks{out.voxels(), out.vertices(), out.voxlines(), out.streamline_first_voxline(), {}};
+  blocks.vertex_values = layout_value_sets(out.vertex_values(), point_set_names, meta.vertex_count);
+  VoxlineEnds ends = place_vertices(std::move(plan), std::move(t), blocks);
+  finish_value_sets(out.vertex_values());
   summary.voxelize_seconds = seconds_since(t0);
 
   t0 = Clock::now();
@@ -84,6 +115,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   out.set_meta(meta);
   std::vector<DirectionEntry> directions = order_directions(order_set);
   std::copy(directions.begin(), directions.end(), out.directions().begin());
+  fill_voxel_directions(order_set, out.voxels(), out.voxel_directions());
   std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
   std::copy(groups_bytes.begin(), groups_bytes.end(), out.groups().begin());
   out.commit(threads);

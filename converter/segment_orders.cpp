@@ -31,10 +31,57 @@ OrderSetSpec parse_order_set(const std::string& name) {
     set.directions.push_back({k, k, -k});
     return set;
   }
-  throw Error(ErrorKind::Usage, "", std::nullopt, "unknown order set '" + name + "' (expected axis or axis+diag)");
+  if (name.starts_with("random:")) {
+    const std::string count = name.substr(7);
+    const bool digits = !count.empty() && count.size() <= 2 && count.find_first_not_of("0123456789") == std::string::npos;
+    const unsigned n = digits ? static_cast<unsigned>(std::stoul(count)) : 0;
+    if (n >= 1 && n <= kVxlMaxStoredOrders) {
+      set.kind = OrderSet::Random;
+      set.directions.assign(n, {1, 0, 0});  // placeholders: the real directions are per voxel
+      return set;
+    }
+  }
+  throw Error(ErrorKind::Usage, "", std::nullopt,
+              "unknown order set '" + name + "' (expected axis, axis+diag or random:N with N in 1..64)");
 }
 
 namespace {
+
+// splitmix64 (Steele, Lea & Flood, "Fast splittable pseudorandom number generators", 2014): our own, so
+// that the directions do not depend on the standard library.
+struct SplitMix64 {
+  std::uint64_t state;
+  std::uint64_t next() {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  double uniform_signed() { return double(next() >> 11) * 0x1.0p-52 - 1.0; }  // [-1, 1), exactly
+};
+
+// A generator whose stream depends on (seed, coord) alone: each coordinate is folded in through a full
+// splitmix64 step, so neighbouring voxels get unrelated directions.
+SplitMix64 voxel_generator(std::uint64_t seed, const std::int32_t (&coord)[3]) {
+  SplitMix64 g{seed};
+  for (int c = 0; c < 3; ++c) {
+    g.state ^= std::uint64_t(std::uint32_t(coord[c])) << (16 * c);
+    g.state = g.next();
+  }
+  return g;
+}
+
+// A direction uniform on the unit sphere: a point uniform in the unit ball (rejection from the cube),
+// normalised. Only + * / sqrt: the same bits on every IEEE-754 platform, unlike sin/cos.
+std::array<float, 3> uniform_direction(SplitMix64& g) {
+  for (;;) {
+    const double x = g.uniform_signed(), y = g.uniform_signed(), z = g.uniform_signed();
+    const double r2 = x * x + y * y + z * z;
+    if (r2 > 1.0 || r2 < 1e-6) continue;  // outside the ball, or too short to normalise accurately
+    const double inv = 1.0 / std::sqrt(r2);
+    return {static_cast<float>(x * inv), static_cast<float>(y * inv), static_cast<float>(z * inv)};
+  }
+}
 
 // Order-preserving map of a double (not NaN) to an unsigned integer: its sign and magnitude as a two's
 // complement integer, offset by 2^63. Unlike flipping every bit of negative numbers, this keeps the zero
@@ -139,7 +186,10 @@ struct KeyedSegment {
   std::uint32_t local;
 };
 
+// Per worker thread. Reserved for the largest voxel up front (keyed on first use), so that these never
+// grow past it: order_scratch_bytes() is a bound that callers budget with.
 struct SortScratch {
+  std::uint32_t max_vertices = 0;
   std::vector<std::uint64_t> keys, packed, packed_tmp;
   std::vector<KeyedSegment> keyed, keyed_tmp;
   std::vector<std::uint32_t> counts;
@@ -166,6 +216,8 @@ std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint3
     const std::uint64_t index_mask = (1ull << index_bits) - 1;
     return put_entries(dst, width, n, [&](std::size_t i) { return static_cast<std::uint32_t>(s.packed[i] & index_mask); });
   }
+  s.keyed.reserve(s.max_vertices);
+  s.keyed_tmp.reserve(s.max_vertices);
   s.keyed.resize(n);
   for (std::size_t i = 0; i < n; ++i) s.keyed[i] = {s.keys[i], starts[i]};
   radix_sort_bits(s.keyed, s.keyed_tmp, s.counts, [](const KeyedSegment& k) { return k.key; }, low, bits);
@@ -178,6 +230,25 @@ std::vector<DirectionEntry> order_directions(const OrderSetSpec& set) {
   std::vector<DirectionEntry> out;
   for (const auto& d : set.directions) out.push_back({{d[0], d[1], d[2]}, 0});
   return out;
+}
+
+void voxel_directions(const OrderSetSpec& set, const std::int32_t (&coord)[3], std::span<std::array<float, 3>> out) {
+  if (!set.per_voxel()) {
+    std::copy(set.directions.begin(), set.directions.end(), out.begin());
+    return;
+  }
+  SplitMix64 g = voxel_generator(set.seed, coord);
+  for (auto& d : out) d = uniform_direction(g);
+}
+
+void fill_voxel_directions(const OrderSetSpec& set, std::span<const VoxelEntry> voxels, std::span<DirectionEntry> out) {
+  if (!set.per_voxel()) return;
+  const std::size_t k_count = set.directions.size();
+  std::vector<std::array<float, 3>> dirs(k_count);
+  for (std::size_t i = 0; i < voxels.size(); ++i) {
+    voxel_directions(set, voxels[i].coord, dirs);
+    for (std::size_t k = 0; k < k_count; ++k) out[i * k_count + k] = {{dirs[k][0], dirs[k][1], dirs[k][2]}, 0};
+  }
 }
 
 std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_orders) {
@@ -195,13 +266,26 @@ struct VoxelOrderWriter::Scratch {
   SortScratch sort;
 };
 
-VoxelOrderWriter::VoxelOrderWriter(const OrderSetSpec& set)
-    : directions_(set.directions), axis_of_(set.directions.size(), -1), scratch_(std::make_unique<Scratch>()) {
+VoxelOrderWriter::VoxelOrderWriter(const OrderSetSpec& set, std::uint32_t max_vertices)
+    : set_(&set), directions_(set.directions.size()), axis_of_(set.directions.size(), -1),
+      scratch_(std::make_unique<Scratch>()) {
+  SortScratch& s = scratch_->sort;
+  s.max_vertices = max_vertices;
+  for (auto* v : {&s.keys, &s.packed, &s.packed_tmp}) v->reserve(max_vertices);
+  scratch_->starts.reserve(max_vertices);
+}
+
+void VoxelOrderWriter::use_directions_of(const VoxelEntry& v) {
+  if (have_directions_ && !set_->per_voxel()) return;
+  voxel_directions(*set_, v.coord, directions_);
   // Axis directions sort by one exact component sum, as in the paper; others by a dot product.
-  for (std::size_t k = 0; k < directions_.size(); ++k)
+  for (std::size_t k = 0; k < directions_.size(); ++k) {
+    axis_of_[k] = -1;
     for (int c = 0; c < 3; ++c)
       if (directions_[k][c] == 1.0f && directions_[k][(c + 1) % 3] == 0.0f && directions_[k][(c + 2) % 3] == 0.0f)
         axis_of_[k] = c;
+  }
+  have_directions_ = true;
 }
 
 VoxelOrderWriter::~VoxelOrderWriter() = default;
@@ -209,6 +293,7 @@ VoxelOrderWriter::VoxelOrderWriter(VoxelOrderWriter&&) noexcept = default;
 
 void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const float> vertices, const VoxlineEnds& ends,
                              std::uint8_t* dst) {
+  use_directions_of(v);
   std::vector<std::uint32_t>& starts = scratch_->starts;
   SortScratch& scratch = scratch_->sort;
   // The segments start at every vertex that does not end its voxline (branch-free: ends are
@@ -246,10 +331,12 @@ void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const float> vertice
 
 void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float> vertices, const VoxlineEnds& ends,
                        const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads, const ProgressFn& progress) {
+  std::uint32_t max_vertices = 0;
+  for (const VoxelEntry& v : voxels) max_vertices = std::max(max_vertices, v.vertex_count);
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
   auto worker = [&](bool reports) {
-    VoxelOrderWriter writer(set);
+    VoxelOrderWriter writer(set, max_vertices);
     for (std::size_t i; (i = next++) < voxels.size();) {
       writer.write(voxels[i], vertices, ends, orders.data() + voxels[i].order_offset);
       std::size_t d = ++done;
@@ -264,12 +351,22 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float
   if (progress) progress("ordering", 1.0);
 }
 
+std::uint64_t order_scratch_bytes(std::uint32_t max_vertices) {
+  // starts (u32) and, per segment (fewer than vertices), keys, packed and packed_tmp (u64) and, for a
+  // voxel whose keys do not pack, keyed and keyed_tmp (16 bytes): all reserved once for the largest
+  // voxel (SortScratch). Plus the histograms.
+  const std::uint64_t per_vertex = sizeof(std::uint32_t) + 3 * sizeof(std::uint64_t) + 2 * sizeof(KeyedSegment);
+  return per_vertex * max_vertices + std::uint64_t(kMaxPasses) * (1u << kMaxDigitBits) * sizeof(std::uint32_t);
+}
+
 BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsigned threads, const ProgressFn& progress) {
   BuiltOrders out;
   out.directions = order_directions(set);
   vt.meta.stored_order_count = static_cast<std::uint32_t>(set.directions.size());
   vt.meta.order_set = static_cast<std::uint32_t>(set.kind);
   out.bytes.assign(layout_orders(vt.voxels, vt.meta.stored_order_count), 0);
+  if (set.per_voxel()) out.voxel_directions.resize(vt.voxels.size() * set.directions.size());
+  fill_voxel_directions(set, vt.voxels, out.voxel_directions);
   build_orders_into(vt.voxels, vt.vertices, vt.voxline_ends, set, out.bytes, threads, progress);
   return out;
 }

@@ -3,6 +3,10 @@
 // For each stored direction d, a voxel's segments (a, b) are sorted by dot(a + b, d) ascending, ties by
 // block-local index, so the file is deterministic. Only one of d / −d is stored: the renderer reads the
 // order backwards for −d.
+//
+// Order sets: `axis` and `axis+diag` share one direction set between all voxels (DIRS); `random:N`
+// (paper §"Different sorting orders") gives every voxel its own N pseudo-random directions, uniform on the
+// sphere and derived from (seed, voxel coordinate) alone, stored per voxel in VDIR (spec §5.10).
 #pragma once
 
 #include <array>
@@ -16,18 +20,34 @@
 
 namespace vxl {
 
+// The seed of `random:N` sets made by `voxlines convert`. Any seed gives a valid file (the directions
+// are stored); a fixed one makes conversions reproducible.
+inline constexpr std::uint64_t kRandomOrderSeed = 0x566F786C696E6573ull;  // "Voxlines"
+
 struct OrderSetSpec {
   OrderSet kind = OrderSet::Axis;
   std::string name = "axis";
-  std::vector<std::array<float, 3>> directions;  // stored directions (unit vectors)
+  // The DIRS entries (unit vectors), K of them. A random set has no shared directions: it stores K
+  // placeholders (1, 0, 0) there (spec §5.2) and each voxel's own in VDIR (voxel_directions below).
+  std::vector<std::array<float, 3>> directions;
+  std::uint64_t seed = kRandomOrderSeed;  // random sets only
+  bool per_voxel() const { return kind == OrderSet::Random; }
 };
 
-// "axis" (K = 3: ±X, ±Y, ±Z) or "axis+diag" (K = 7: also the 8 cube diagonals).
-// Throws vxl::Error (Usage) for anything else.
+// "axis" (K = 3: ±X, ±Y, ±Z), "axis+diag" (K = 7: also the 8 cube diagonals) or "random:N" (K = N,
+// 1 <= N <= 64, per voxel). Throws vxl::Error (Usage) for anything else.
 OrderSetSpec parse_order_set(const std::string& name);
 
 // The DIRS entries of an order set.
 std::vector<DirectionEntry> order_directions(const OrderSetSpec& set);
+
+// The K directions voxel `coord` sorts by: the shared ones, or for a random set its own, a function of
+// (set.seed, coord) only. `out` has K entries.
+void voxel_directions(const OrderSetSpec& set, const std::int32_t (&coord)[3], std::span<std::array<float, 3>> out);
+
+// The VDIR payload (voxels.size() x K entries, voxel-major) of a random set; nothing for other sets
+// (`out` is then empty).
+void fill_voxel_directions(const OrderSetSpec& set, std::span<const VoxelEntry> voxels, std::span<DirectionEntry> out);
 
 // Sets every voxel's flags (order entry width) and order_offset for K = `stored_orders`; returns the
 // size of the ORDR payload, so that it can be allocated before the orders are built.
@@ -38,7 +58,9 @@ std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_o
 // buffers between voxels: use one per thread.
 class VoxelOrderWriter {
  public:
-  explicit VoxelOrderWriter(const OrderSetSpec& set);
+  // `max_vertices`: the largest voxel this writer will see, so that its buffers are reserved once and
+  // never grow past order_scratch_bytes(max_vertices); 0 lets them grow as needed.
+  explicit VoxelOrderWriter(const OrderSetSpec& set, std::uint32_t max_vertices = 0);
   ~VoxelOrderWriter();
   VoxelOrderWriter(VoxelOrderWriter&&) noexcept;
 
@@ -48,7 +70,11 @@ class VoxelOrderWriter {
   void write(const VoxelEntry& v, std::span<const float> vertices, const VoxlineEnds& ends, std::uint8_t* dst);
 
  private:
+  void use_directions_of(const VoxelEntry& v);
+
   struct Scratch;
+  const OrderSetSpec* set_;
+  bool have_directions_ = false;  // a shared set is looked up once; a per-voxel set for every voxel
   std::vector<std::array<float, 3>> directions_;
   std::vector<int> axis_of_;  // the component of an axis direction, -1 for any other
   std::unique_ptr<Scratch> scratch_;
@@ -59,8 +85,13 @@ class VoxelOrderWriter {
 void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float> vertices, const VoxlineEnds& ends,
                        const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads, const ProgressFn& progress);
 
+// An upper bound of what build_orders_into allocates per worker thread (its sort buffers, growth
+// included) when no voxel has more than `max_vertices` vertices, for callers that budget memory.
+std::uint64_t order_scratch_bytes(std::uint32_t max_vertices);
+
 struct BuiltOrders {
   std::vector<DirectionEntry> directions;
+  std::vector<DirectionEntry> voxel_directions;  // the VDIR payload; empty unless the set is random
   std::vector<std::uint8_t> bytes;  // the ORDR payload
 };
 

@@ -30,12 +30,23 @@ struct SourceInfo {
   nlohmann::json header;        // the source header as JSON
   std::optional<std::array<double, 16>> vox_to_ras;  // row-major 4x4, when the source has one
   std::vector<std::string> warnings;  // non-fatal problems found while reading
+  // Files that added values (TSF): {"name", "bytes", "xxh3_128", "header"} each, for provenance.
+  nlohmann::json value_files = nlohmann::json::array();
+};
+
+// Values a source carries besides positions (a TSF file, TRK scalars and properties, TRX dpv and dps),
+// kept so that the viewer can colour by them.
+struct ValueSet {
+  std::string name;
+  std::vector<float> values;
 };
 
 struct Tractogram {
   std::vector<float> positions;        // x,y,z interleaved, 3 * point_count() floats
   std::vector<std::uint64_t> offsets;  // streamline i = points [offsets[i], offsets[i+1]); size N+1
   std::vector<StreamlineGroup> groups;  // TRX groups, when the source has them
+  std::vector<ValueSet> point_values;       // each point_count() values, in point order
+  std::vector<ValueSet> streamline_values;  // each streamline_count() values
   SourceInfo source;
 
   Tractogram() : offsets{0} {}

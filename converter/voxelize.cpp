@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "error.h"
+#include "voxelize_streamline.h"
 
 namespace vxl {
 
@@ -22,66 +23,13 @@ unsigned resolve_threads(unsigned requested) {
 
 namespace {
 
-constexpr std::uint64_t kNoSynthetic = std::numeric_limits<std::uint64_t>::max();
-
-struct Coord {
-  std::int32_t x, y, z;
-  bool operator==(const Coord&) const = default;
-};
-bool zyx_less(const Coord& a, const Coord& b) {
-  if (a.z != b.z) return a.z < b.z;
-  if (a.y != b.y) return a.y < b.y;
-  return a.x < b.x;
-}
-
-// Open-addressing hash map from voxel coordinate to a dense local id. Only consulted when a streamline
-// changes voxel (about one point in seven at 10 mm), so simplicity beats cleverness here.
-class VoxelIndex {
- public:
-  std::uint32_t find_or_insert(const Coord& c) {
-    if ((coords_.size() + 1) * 2 > slots_.size()) grow();
-    std::size_t mask = slots_.size() - 1;
-    for (std::size_t i = hash(c) & mask;; i = (i + 1) & mask) {
-      std::uint32_t id = slots_[i];
-      if (id == kEmpty) {
-        slots_[i] = static_cast<std::uint32_t>(coords_.size());
-        coords_.push_back(c);
-        return slots_[i];
-      }
-      if (coords_[id] == c) return id;
-    }
-  }
-  const std::vector<Coord>& coords() const { return coords_; }
-
- private:
-  static constexpr std::uint32_t kEmpty = std::numeric_limits<std::uint32_t>::max();
-  static std::size_t hash(const Coord& c) {
-    std::uint64_t h = std::uint64_t(std::uint32_t(c.x)) * 0x9E3779B97F4A7C15ull;
-    h ^= std::uint64_t(std::uint32_t(c.y)) * 0xC2B2AE3D27D4EB4Full;
-    h ^= std::uint64_t(std::uint32_t(c.z)) * 0x165667B19E3779F9ull;
-    return static_cast<std::size_t>(h ^ (h >> 29));
-  }
-  void grow() {
-    slots_.assign(std::max<std::size_t>(64, slots_.size() * 2), kEmpty);
-    std::size_t mask = slots_.size() - 1;
-    for (std::uint32_t id = 0; id < coords_.size(); ++id) {
-      std::size_t i = hash(coords_[id]) & mask;
-      while (slots_[i] != kEmpty) i = (i + 1) & mask;
-      slots_[i] = id;
-    }
-  }
-  std::vector<std::uint32_t> slots_;
-  std::vector<Coord> coords_;
-};
-
-// A voxline before its vertices are placed: an optional synthetic first point, then source points.
-struct TempVoxline {
-  std::uint32_t voxel;      // chunk-local voxel id
-  std::uint32_t src_count;  // source points after the optional synthetic point
-  std::uint64_t src_first;  // first source point index
-  std::uint64_t synthetic;  // index into Chunk::synthetic_xyz, or kNoSynthetic
-  std::uint32_t own() const { return src_count + (synthetic != kNoSynthetic ? 1u : 0u); }
-};
+using detail::Coord;
+using detail::Grid;
+using detail::kNoSynthetic;
+using detail::TempVoxline;
+using detail::VoxelIndex;
+using detail::voxelize_streamline;
+using detail::zyx_less;
 
 // One thread's contiguous range of streamlines.
 struct Chunk {
@@ -90,6 +38,7 @@ struct Chunk {
   std::vector<TempVoxline> voxlines;
   std::vector<std::uint64_t> first_voxline;  // per streamline of the chunk, chunk-local
   std::vector<float> synthetic_xyz;
+  std::vector<double> synthetic_t;  // per synthetic point: where it lies on its step, for value interpolation
   std::vector<std::uint64_t> vertices_per_voxel;  // by local id
   std::vector<std::uint64_t> segments_per_voxel;  // by local id
   std::vector<std::uint32_t> global_id;     // local id -> global voxel index
@@ -97,93 +46,6 @@ struct Chunk {
   std::uint64_t voxline_base = 0;           // first global voxline of this chunk
   bool too_many_synthetic = false;
 };
-
-struct Grid {
-  double origin[3];
-  double size;
-  // voxel_coordinate() (spec §6.1) of a source point. Every point is >= the origin, so the quotient is
-  // >= 0 and below the grid size (< 2^31), where truncation is floor: this avoids a floor() library
-  // call per coordinate (the baseline x86-64 ISA has no rounding instruction).
-  Coord voxel_of(const float* p) const {
-    return {static_cast<std::int32_t>((static_cast<double>(p[0]) - origin[0]) / size),
-            static_cast<std::int32_t>((static_cast<double>(p[1]) - origin[1]) / size),
-            static_cast<std::int32_t>((static_cast<double>(p[2]) - origin[2]) / size)};
-  }
-};
-
-int chebyshev(const Coord& a, const Coord& b) {
-  return std::max({std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.z - b.z)});
-}
-
-// Appends the voxlines of one streamline (Algorithm 1, with face splitting of long steps: spec §6.3).
-void voxelize_streamline(const Grid& grid, const float* pts, std::uint64_t first, std::uint64_t n, Chunk& ch,
-                         std::uint64_t synthetic_limit) {
-  if (n == 0) return;
-  Coord current = grid.voxel_of(pts + 3 * first);
-  TempVoxline open{ch.index.find_or_insert(current), 0, first, kNoSynthetic};
-  auto close = [&](std::uint64_t end_point) {
-    open.src_count = static_cast<std::uint32_t>(end_point - open.src_first);
-    ch.voxlines.push_back(open);
-  };
-  for (std::uint64_t i = first + 1; i < first + n; ++i) {
-    Coord next = grid.voxel_of(pts + 3 * i);
-    if (next == current) continue;
-    if (chebyshev(current, next) <= 1) {
-      close(i);
-      current = next;
-      open = {ch.index.find_or_insert(current), 0, i, kNoSynthetic};
-      continue;
-    }
-    // Long step a -> b: cross the faces in order of the line parameter t.
-    const float* a = pts + 3 * (i - 1);
-    const float* b = pts + 3 * i;
-    struct Crossing {
-      double t;
-      int axis;
-      int step;
-    };
-    const std::int32_t from[3] = {current.x, current.y, current.z};
-    const std::int32_t to[3] = {next.x, next.y, next.z};
-    // Check the budget before allocating: one step can cross billions of faces (found by fuzzing).
-    std::uint64_t faces = 0;
-    for (int c = 0; c < 3; ++c) faces += static_cast<std::uint64_t>(std::abs(std::int64_t(to[c]) - from[c]));
-    if (ch.synthetic_xyz.size() / 3 + faces > synthetic_limit) {
-      ch.too_many_synthetic = true;
-      return;
-    }
-    std::vector<Crossing> crossings;
-    crossings.reserve(faces);
-    for (int c = 0; c < 3; ++c) {
-      int step = to[c] > from[c] ? 1 : -1;
-      double da = static_cast<double>(a[c]), db = static_cast<double>(b[c]);
-      for (std::int32_t k = from[c]; k != to[c]; k += step) {
-        // the face between voxel k and k + step
-        double plane = grid.origin[c] + grid.size * static_cast<double>(step > 0 ? k + 1 : k);
-        double t = (plane - da) / (db - da);
-        crossings.push_back({std::clamp(t, 0.0, 1.0), c, step});
-      }
-    }
-    std::stable_sort(crossings.begin(), crossings.end(), [](const Crossing& x, const Crossing& y) { return x.t < y.t; });
-    std::int32_t at[3] = {from[0], from[1], from[2]};
-    for (std::size_t k = 0; k < crossings.size();) {
-      double t = crossings[k].t;
-      for (; k < crossings.size() && crossings[k].t == t; ++k) at[crossings[k].axis] += crossings[k].step;
-      close(i);
-      std::uint64_t s = ch.synthetic_xyz.size() / 3;
-      for (int c = 0; c < 3; ++c) {
-        double da = static_cast<double>(a[c]), db = static_cast<double>(b[c]);
-        ch.synthetic_xyz.push_back(static_cast<float>(da + t * (db - da)));
-      }
-      open = {ch.index.find_or_insert({at[0], at[1], at[2]}), 0, i, s};
-    }
-    if (ch.synthetic_xyz.size() / 3 > synthetic_limit) {
-      ch.too_many_synthetic = true;
-      return;
-    }
-    current = next;
-  }
-  close(first + n);
-}
 
 // Splits [0, N) into `parts` contiguous ranges of about equal point counts.
 std::vector<std::uint64_t> split_by_points(const std::vector<std::uint64_t>& offsets, unsigned parts) {
@@ -270,6 +132,59 @@ void scan_bounds(const float* pts, const std::vector<std::uint64_t>& offsets, st
 
 }  // namespace
 
+namespace detail {
+
+void check_voxel_size(double s, const std::string& path) {
+  if (!std::isfinite(s) || !(s > 0)) throw Error(ErrorKind::Usage, path, std::nullopt, "voxel size must be a positive number of mm");
+}
+
+void fail_non_finite(const std::string& path, std::uint64_t streamline, std::uint64_t point) {
+  throw Error(ErrorKind::Input, path, std::nullopt,
+              "non-finite coordinate in streamline " + std::to_string(streamline) + " (point " + std::to_string(point) + ")");
+}
+
+Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std::string& path) {
+  const double s = m.voxel_size;
+  for (int c = 0; c < 3; ++c) {
+    double cells = std::floor((hi[c] - lo[c]) / s) + 1;
+    if (!(cells < double(std::numeric_limits<std::int32_t>::max()))) {
+      double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+      throw Error(ErrorKind::Unsupported, path, std::nullopt,
+                  "a voxel size of " + format_mm(s) + " mm makes a grid of more than 2^31 voxels along an axis (extent " +
+                      format_mm(extent) + " mm); use --voxel-size " + format_mm(extent / 1e9) + " or larger");
+    }
+    m.grid_dims[c] = static_cast<std::int32_t>(cells);
+    m.grid_origin[c] = lo[c];
+    m.bounds_min[c] = lo[c];
+    m.bounds_max[c] = hi[c];
+  }
+  return Grid{{lo[0], lo[1], lo[2]}, s};
+}
+
+void fail_too_many_synthetic(const std::string& path, double s, double longest_step2) {
+  throw Error(ErrorKind::Unsupported, path, std::nullopt,
+              "voxel size " + format_mm(s) + " mm is far below the longest step (" + format_mm(std::sqrt(longest_step2)) +
+                  " mm): splitting steps at voxel faces would more than double the points; use --voxel-size " +
+                  format_mm(std::sqrt(longest_step2)) + " or larger");
+}
+
+void fail_long_voxline(const std::string& path) {
+  throw Error(ErrorKind::Unsupported, path, std::nullopt, "a voxline of more than 2^31-1 points; use a smaller --voxel-size");
+}
+
+void check_voxel_total(std::uint64_t n_voxels, double s, const std::string& path) {
+  if (n_voxels >= std::uint64_t(std::numeric_limits<std::int32_t>::max()))
+    throw Error(ErrorKind::Unsupported, path, std::nullopt,
+                "more than 2^31 non-empty voxels; use a larger --voxel-size than " + format_mm(s));
+}
+
+void fail_full_voxel(const std::string& path, double s) {
+  throw Error(ErrorKind::Unsupported, path, std::nullopt,
+              "a voxel holds more than 2^32-1 vertices; use a --voxel-size smaller than " + format_mm(s));
+}
+
+}  // namespace detail
+
 struct VoxelPlan::Work {
   unsigned threads = 1;
   std::vector<Chunk> chunks;
@@ -283,7 +198,7 @@ VoxelPlan::~VoxelPlan() = default;
 VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   const std::string& path = t.source.path;
   const double s = settings.voxel_size;
-  if (!std::isfinite(s) || !(s > 0)) throw Error(ErrorKind::Usage, path, std::nullopt, "voxel size must be a positive number of mm");
+  detail::check_voxel_size(s, path);
   const unsigned threads = resolve_threads(settings.threads);
   const std::uint64_t n_streamlines = t.streamline_count(), n_points = t.point_count();
   const float* pts = t.positions.data();
@@ -303,9 +218,7 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   double longest_step2 = 0;
   for (const BoundsPart& b : parts) {
     if (b.bad_streamline != std::numeric_limits<std::uint64_t>::max())  // the first one in streamline order
-      throw Error(ErrorKind::Input, path, std::nullopt,
-                  "non-finite coordinate in streamline " + std::to_string(b.bad_streamline) + " (point " +
-                      std::to_string(b.bad_point) + ")");
+      detail::fail_non_finite(path, b.bad_streamline, b.bad_point);
     for (int c = 0; c < 3; ++c) {
       lo[c] = std::min(lo[c], double(b.lo[c]));
       hi[c] = std::max(hi[c], double(b.hi[c]));
@@ -313,20 +226,7 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
     longest_step2 = std::max(longest_step2, b.longest_step2);
   }
   if (n_points == 0) return plan;  // no voxels; place_vertices fills STRM with zeros
-  Grid grid{{lo[0], lo[1], lo[2]}, s};
-  for (int c = 0; c < 3; ++c) {
-    double cells = std::floor((hi[c] - lo[c]) / s) + 1;
-    if (!(cells < double(std::numeric_limits<std::int32_t>::max()))) {
-      double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-      throw Error(ErrorKind::Unsupported, path, std::nullopt,
-                  "a voxel size of " + format_mm(s) + " mm makes a grid of more than 2^31 voxels along an axis (extent " +
-                      format_mm(extent) + " mm); use --voxel-size " + format_mm(extent / 1e9) + " or larger");
-    }
-    m.grid_dims[c] = static_cast<std::int32_t>(cells);
-    m.grid_origin[c] = lo[c];
-    m.bounds_min[c] = lo[c];
-    m.bounds_max[c] = hi[c];
-  }
+  const Grid grid = detail::set_grid(m, lo, hi, path);
 
   // Pass 1: voxlines per chunk of streamlines, then each chunk's vertex and segment count per voxel.
   std::vector<Chunk>& chunks = plan.work_->chunks;
@@ -352,10 +252,7 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   });
   for (const Chunk& ch : chunks)
     if (ch.too_many_synthetic)
-      throw Error(ErrorKind::Unsupported, path, std::nullopt,
-                  "voxel size " + format_mm(s) + " mm is far below the longest step (" + format_mm(std::sqrt(longest_step2)) +
-                      " mm): splitting steps at voxel faces would more than double the points; use --voxel-size " +
-                      format_mm(std::sqrt(longest_step2)) + " or larger");
+      detail::fail_too_many_synthetic(path, s, longest_step2);
   parallel_for_chunks(chunks.size(), threads, [&](std::size_t c) {
     Chunk& ch = chunks[c];
     ch.vertices_per_voxel.assign(ch.index.coords().size(), 0);
@@ -365,7 +262,7 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
         const TempVoxline& v = ch.voxlines[j];
         std::uint64_t own = v.own();
         if (own > kVoxlineCountMask)
-          throw Error(ErrorKind::Unsupported, path, std::nullopt, "a voxline of more than 2^31-1 points; use a smaller --voxel-size");
+          detail::fail_long_voxline(path);
         std::uint64_t used = own + (j + 1 < ch.first_voxline[k + 1] ? 1 : 0);  // + the connecting vertex
         ch.vertices_per_voxel[v.voxel] += used;
         ch.segments_per_voxel[v.voxel] += used - 1;
@@ -379,9 +276,7 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   for (const Chunk& ch : chunks) all.insert(all.end(), ch.index.coords().begin(), ch.index.coords().end());
   std::sort(all.begin(), all.end(), zyx_less);
   all.erase(std::unique(all.begin(), all.end()), all.end());
-  if (all.size() >= std::uint64_t(std::numeric_limits<std::int32_t>::max()))
-    throw Error(ErrorKind::Unsupported, path, std::nullopt,
-                "more than 2^31 non-empty voxels; use a larger --voxel-size than " + format_mm(s));
+  detail::check_voxel_total(all.size(), s, path);
   const std::size_t n_voxels = all.size();
   std::vector<std::uint64_t> voxel_vertices(n_voxels, 0), voxel_segments(n_voxels, 0);
   std::uint64_t n_voxlines = 0, n_synthetic = 0;
@@ -402,8 +297,7 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   std::uint64_t n_vertices = 0, n_segments = 0;
   for (std::size_t i = 0; i < n_voxels; ++i) {
     if (voxel_vertices[i] > std::numeric_limits<std::uint32_t>::max())
-      throw Error(ErrorKind::Unsupported, path, std::nullopt,
-                  "a voxel holds more than 2^32-1 vertices; use a --voxel-size smaller than " + format_mm(s));
+      detail::fail_full_voxel(path, s);
     VoxelEntry& v = plan.voxels_[i];
     v = {};
     v.coord[0] = all[i].x;
@@ -447,6 +341,12 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
   VoxlineEnds ends(m.vertex_count);
   std::copy(plan.voxels_.begin(), plan.voxels_.end(), out.voxels.begin());
 
+  if (out.vertex_values.size() != t.point_values.size())
+    throw std::logic_error("place_vertices: one vertex value array per point value set expected");
+  for (std::size_t k = 0; k < out.vertex_values.size(); ++k)
+    if (out.vertex_values[k].size() != m.vertex_count || t.point_values[k].values.size() != m.point_count)
+      throw std::logic_error("place_vertices: value arrays do not have the sizes of the plan");
+
   // Pass 2: place vertices, fill the voxline and streamline tables.
   parallel_for_chunks(chunks.size(), threads, [&](std::size_t c) {
     Chunk& ch = chunks[c];
@@ -470,6 +370,20 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
           const float* first = w.synthetic != kNoSynthetic ? ch.synthetic_xyz.data() + 3 * w.synthetic : pts + 3 * w.src_first;
           std::memcpy(dst, first, 12);
         }
+        // Values travel with their points: a synthetic point's is interpolated where it lies on its step
+        // (from source point src_first - 1 to src_first), a connecting vertex copies the next voxline's first.
+        for (std::size_t k = 0; k < out.vertex_values.size(); ++k) {
+          const float* src = t.point_values[k].values.data();
+          auto first_value = [&](const TempVoxline& x) {
+            if (x.synthetic == kNoSynthetic) return src[x.src_first];
+            const double a = src[x.src_first - 1], b = src[x.src_first], at = ch.synthetic_t[x.synthetic];
+            return static_cast<float>(a + at * (b - a));
+          };
+          float* dv = out.vertex_values[k].data() + cursor;
+          if (v.synthetic != kNoSynthetic) *dv++ = first_value(v);
+          std::copy(src + v.src_first, src + v.src_first + v.src_count, dv);
+          if (connected) dv[v.src_count] = first_value(ch.voxlines[j + 1]);
+        }
         std::uint64_t used = own + (connected ? 1 : 0);
         ends.set(cursor + used - 1);
         cursor += used;
@@ -482,6 +396,8 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
   plan.work_.reset();
   t.positions.clear();  // the blocks now hold every point: release the source copy before orders are built
   t.positions.shrink_to_fit();
+  t.point_values.clear();  // likewise their values
+  t.point_values.shrink_to_fit();
 
   // Tight bounds per voxel.
   parallel_for_chunks(out.voxels.size(), threads, [&](std::size_t i) {
@@ -498,6 +414,7 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
 }
 
 VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
+  t.point_values.clear();  // the in-memory result has no value arrays
   VoxelPlan plan = plan_voxels(t, settings);
   VoxelizedTractogram out;
   out.meta = plan.meta();
@@ -506,7 +423,7 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
   out.voxlines.resize(out.meta.voxline_count);
   out.streamline_first_voxline.resize(out.meta.streamline_count + 1);
   out.voxline_ends = place_vertices(std::move(plan), std::move(t),
-                                    {out.voxels, out.vertices, out.voxlines, out.streamline_first_voxline});
+                                    {out.voxels, out.vertices, out.voxlines, out.streamline_first_voxline, {}});
   return out;
 }
 

@@ -70,6 +70,9 @@ struct VoxelBlocks {
   std::span<float> vertices;                          // 3 * vertex_count
   std::span<VoxlineEntry> voxlines;                   // voxline_count
   std::span<std::uint64_t> streamline_first_voxline;  // streamline_count + 1
+  // One per point value set of the tractogram, vertex_count each: the values spread like the positions
+  // (spec §5.11). Empty when the tractogram has none.
+  std::vector<std::span<float>> vertex_values;
 };
 
 // The result of pass 1: every streamline's voxlines and the voxel table.
@@ -100,8 +103,8 @@ class VoxelPlan {
 // limit of spec §9 would be exceeded.
 VoxelPlan plan_voxels(const Tractogram& tractogram, const VoxelizeSettings& settings);
 
-// Pass 2: writes the voxel table (with tight bounds), the vertex blocks and the voxline and streamline
-// tables into `out`, and releases the tractogram's positions (the blocks then hold every point, so peak
+// Pass 2: writes the voxel table (with tight bounds), the vertex blocks, their values and the voxline and
+// streamline tables into `out`, and releases the tractogram's positions and point values (the blocks then hold every point, so peak
 // memory stays bounded). Returns the voxline ends of the blocks, for build_orders.
 VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& tractogram, const VoxelBlocks& out);
 

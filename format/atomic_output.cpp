@@ -79,19 +79,25 @@ void AtomicOutputFile::pwrite(const void* data, std::size_t size, std::uint64_t 
   }
 }
 
-std::span<std::uint8_t> AtomicOutputFile::map(std::uint64_t size) {
-  if (map_ != nullptr || position_ != 0) fail("internal error: map() on a file already written to");
-  if (size == 0) return {};
+void AtomicOutputFile::allocate(std::uint64_t size) {
+  if (map_ != nullptr || position_ != 0) fail("internal error: allocate() on a file already written to");
+  if (size == 0) return;
   // fallocate reserves the blocks (ENOSPC surfaces here); file systems without it get a sparse file.
   if (::fallocate(fd_, 0, 0, static_cast<off_t>(size)) != 0) {
     if (errno != EOPNOTSUPP && errno != ENOSYS) fail(std::string("cannot reserve the output size: ") + std::strerror(errno));
     if (::ftruncate(fd_, static_cast<off_t>(size)) != 0) fail(std::string("cannot size the output: ") + std::strerror(errno));
   }
+  position_ = size;
+}
+
+std::span<std::uint8_t> AtomicOutputFile::map(std::uint64_t size) {
+  if (map_ != nullptr || position_ != 0) fail("internal error: map() on a file already written to");
+  if (size == 0) return {};
+  allocate(size);
   void* p = ::mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_SHARED, fd_, 0);
   if (p == MAP_FAILED) fail(std::string("cannot map the output: ") + std::strerror(errno));
   map_ = static_cast<std::uint8_t*>(p);
   map_size_ = size;
-  position_ = size;
   return {map_, size};
 }
 

@@ -34,6 +34,10 @@ class AtomicOutputFile {
   // write(); the span stays valid until commit() or destruction.
   std::span<std::uint8_t> map(std::uint64_t size);
 
+  // Sizes the still empty file to `size` bytes like map(), without mapping it: the caller then fills it
+  // with pwrite(), which keeps the written pages out of this process's resident memory.
+  void allocate(std::uint64_t size);
+
   void commit();  // unmaps, then replaces any existing file at the path
 
   const std::string& path() const { return path_; }

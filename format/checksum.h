@@ -9,7 +9,7 @@ namespace vxl {
 
 std::uint64_t xxh3_64(const void* data, std::size_t size);
 
-// Incremental XXH3-64: the same value as xxh3_64 over the concatenation of the pieces.
+// Incremental XXH3-64: the same value as xxh3_64() over the concatenation of the updates.
 class Xxh3_64Stream {
  public:
   Xxh3_64Stream();

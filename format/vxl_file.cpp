@@ -93,7 +93,8 @@ void VxlFile::validate() {
     previous_end = e.offset + e.size;
     static const std::uint32_t known[] = {section_id("META"), section_id("DIRS"), section_id("VOXT"),
                                           section_id("VERT"), section_id("ORDR"), section_id("VXLN"),
-                                          section_id("STRM"), section_id("PROV"), section_id("GRPS")};
+                                          section_id("STRM"), section_id("PROV"), section_id("GRPS"),
+                                          section_id("VDIR"), section_id("VVAL"), section_id("SVAL")};
     bool is_known = std::find(std::begin(known), std::end(known), id) != std::end(known);
     if (!is_known && (e.flags & kSectionRequired))
       throw Error(ErrorKind::Unsupported, p, at, "required section " + name + " is unknown to this reader (newer writer?)");
@@ -141,6 +142,14 @@ void VxlFile::validate() {
       m.streamline_count == std::numeric_limits<std::uint64_t>::max() ? std::nullopt : mul(m.streamline_count + 1, 8);
   auto strm = expect_size("STRM", strm_size, "(streamline_count + 1) × 8");
   orders_ = section("ORDR", true);
+  // Per-voxel directions: present exactly when the order set is random (§5.10).
+  const bool random_set = m.order_set == static_cast<std::uint32_t>(OrderSet::Random);
+  if (random_set != (find_section(section_id("VDIR")) != nullptr))
+    fail_input(p, meta_at + 100, random_set ? "order set random needs a VDIR section" : "VDIR section without order set random");
+  if (random_set) {
+    auto vdir = expect_size("VDIR", mul(m.voxel_count, dirs.size()), "voxel_count × stored_order_count × 16");
+    voxel_directions_ = {reinterpret_cast<const DirectionEntry*>(vdir.data()), vdir.size() / sizeof(DirectionEntry)};
+  }
   directions_ = {reinterpret_cast<const DirectionEntry*>(dirs.data()), m.stored_order_count};
   voxels_ = {reinterpret_cast<const VoxelEntry*>(voxt.data()), m.voxel_count};
   vertices_ = {reinterpret_cast<const float*>(vert.data()), m.vertex_count * 3};
@@ -149,6 +158,10 @@ void VxlFile::validate() {
   auto prov = section("PROV", false);
   provenance_ = {reinterpret_cast<const char*>(prov.data()), prov.size()};
   groups_ = section("GRPS", false);
+  if (find_section(section_id("VVAL")))
+    vertex_values_ = ValueSets(section("VVAL", true), m.vertex_count, p, offset_of("VVAL"));
+  if (find_section(section_id("SVAL")))
+    streamline_values_ = ValueSets(section("SVAL", true), m.streamline_count, p, offset_of("SVAL"));
 
   // Voxel table (§7 step 4): O(voxels).
   const std::uint64_t voxt_at = offset_of("VOXT");

@@ -16,6 +16,7 @@
 
 #include "mapped_file.h"
 #include "vxl_layout.h"
+#include "vxl_value_sets.h"
 #include "vxl_writer.h"
 
 namespace vxl {
@@ -46,6 +47,13 @@ class VxlFile {
 
   const MetaSection& meta() const { return meta_; }
   std::span<const DirectionEntry> directions() const { return directions_; }
+  // VDIR (spec §5.10): voxel_count x K entries, empty when the file has one direction set for all voxels.
+  std::span<const DirectionEntry> voxel_directions() const { return voxel_directions_; }
+  // The K directions voxel `voxel`'s orders are sorted by: its VDIR entries, or DIRS.
+  std::span<const DirectionEntry> directions_of(std::size_t voxel) const {
+    if (voxel_directions_.empty()) return directions_;
+    return voxel_directions_.subspan(voxel * directions_.size(), directions_.size());
+  }
   std::span<const VoxelEntry> voxels() const { return voxels_; }
   std::span<const float> vertices() const { return vertices_; }  // 3 * vertex_count
   std::span<const std::uint8_t> order_bytes() const { return orders_; }
@@ -55,6 +63,9 @@ class VxlFile {
   std::string_view provenance_json() const { return provenance_; }
   // Parses GRPS (empty when absent); throws vxl::Error when malformed.
   std::vector<GroupContent> groups() const;
+  // VVAL: per-vertex value sets (vertex_count values each); SVAL: per-streamline ones. Empty when absent.
+  const ValueSets& vertex_values() const { return vertex_values_; }
+  const ValueSets& streamline_values() const { return streamline_values_; }
 
  private:
   explicit VxlFile(MappedFile file) : file_(std::move(file)) {}
@@ -65,6 +76,7 @@ class VxlFile {
   std::span<const SectionEntry> sections_;
   MetaSection meta_{};
   std::span<const DirectionEntry> directions_;
+  std::span<const DirectionEntry> voxel_directions_;
   std::span<const VoxelEntry> voxels_;
   std::span<const float> vertices_;
   std::span<const std::uint8_t> orders_;
@@ -72,6 +84,7 @@ class VxlFile {
   std::span<const std::uint64_t> strm_;
   std::string_view provenance_;
   std::span<const std::uint8_t> groups_;
+  ValueSets vertex_values_, streamline_values_;
 };
 
 std::string section_name(std::uint32_t id);

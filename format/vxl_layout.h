@@ -15,6 +15,10 @@ static_assert(std::endian::native == std::endian::little, "the .vxl format is re
 inline constexpr std::array<std::uint8_t, 8> kVxlMagic = {0x89, 'V', 'X', 'L', '\r', '\n', 0x1A, '\n'};
 inline constexpr std::uint16_t kVxlVersionMajor = 1;
 inline constexpr std::uint16_t kVxlVersionMinor = 0;
+// Files with per-voxel directions (VDIR, spec §5.10) are version 1.1; files with value sets (VVAL, SVAL,
+// spec §5.11) are 1.2; all others stay 1.0 (spec §10).
+inline constexpr std::uint16_t kVxlVersionMinorVoxelDirections = 1;
+inline constexpr std::uint16_t kVxlVersionMinorValueSets = 2;
 inline constexpr std::uint64_t kVxlAlignment = 64;
 inline constexpr std::uint32_t kVxlMaxSections = 64;
 inline constexpr std::uint32_t kVxlMaxStoredOrders = 64;

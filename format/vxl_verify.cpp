@@ -54,15 +54,21 @@ void check_meta_and_dirs(const VxlFile& f) {
   const MetaSection& m = f.meta();
   const std::uint64_t meta_at = f.find_section(section_id("META"))->offset;
   if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 152, "META reserved bytes are not zero");
-  const std::uint64_t dirs_at = f.find_section(section_id("DIRS"))->offset;
-  for (std::size_t k = 0; k < f.directions().size(); ++k) {
-    const DirectionEntry& d = f.directions()[k];
-    double len = std::sqrt(double(d.xyz[0]) * d.xyz[0] + double(d.xyz[1]) * d.xyz[1] + double(d.xyz[2]) * d.xyz[2]);
-    if (d.reserved != 0 || !(std::abs(len - 1.0) < 1e-5)) fail_input(p, dirs_at + 16 * k, "direction is not a unit vector");
-  }
+  auto check_unit = [&](std::span<const DirectionEntry> dirs, const char (&id)[5]) {
+    const std::uint64_t at = f.find_section(section_id(id))->offset;
+    for (std::size_t k = 0; k < dirs.size(); ++k) {
+      const DirectionEntry& d = dirs[k];
+      double len = std::sqrt(double(d.xyz[0]) * d.xyz[0] + double(d.xyz[1]) * d.xyz[1] + double(d.xyz[2]) * d.xyz[2]);
+      if (d.reserved != 0 || !(std::abs(len - 1.0) < 1e-5))
+        fail_input(p, at + 16 * k, std::string(id) + " direction is not a unit vector");
+    }
+  };
+  check_unit(f.directions(), "DIRS");
+  if (!f.voxel_directions().empty()) check_unit(f.voxel_directions(), "VDIR");
 }
 
-// Every order must be a permutation of the voxel's segments, sorted by the key of spec §6.4.
+// Every order must be a permutation of the voxel's segments, sorted by the key of spec §6.4 for the
+// voxel's own direction (VDIR) or the shared one (DIRS).
 void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_start) {
   const std::string& p = f.path();
   const std::uint64_t ordr_at = f.find_section(section_id("ORDR"))->offset;
@@ -78,7 +84,7 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
       fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i,
                  "voxel " + std::to_string(i) + " segment count does not match its voxlines");
     for (std::uint32_t k = 0; k < f.meta().stored_order_count; ++k) {
-      const DirectionEntry& dir = f.directions()[k];
+      const DirectionEntry& dir = f.directions_of(i)[k];
       OrderView o = f.order(i, k);
       seen.assign(v.vertex_count, 0);
       double previous_key = -INFINITY;
@@ -101,6 +107,40 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
   }
 }
 
+// VVAL / SVAL (spec §5.11): reserved fields and every padding byte zero (names, between the entries and
+// the arrays, after each array), min and max equal to the arrays' finite extremes.
+void check_value_sets(const VxlFile& f, const ValueSets& sets, const char (&id)[5]) {
+  if (sets.empty()) return;
+  const std::string& p = f.path();
+  const std::uint64_t at = f.find_section(section_id(id))->offset;
+  const auto bytes = sets.payload();
+  ValueSetsHeader h;
+  std::memcpy(&h, bytes.data(), sizeof h);
+  if (h.reserved != 0) fail_input(p, at + 4, std::string(id) + " reserved field is not zero");
+  const std::uint64_t data = value_sets_data_offset(h.set_count), stride = value_array_stride(h.value_count);
+  for (std::uint32_t k = 0; k < h.set_count; ++k) {
+    const std::uint64_t e_at = sizeof h + k * sizeof(ValueSetEntry);
+    ValueSetEntry e;
+    std::memcpy(&e, bytes.data() + e_at, sizeof e);
+    const std::size_t len = std::strlen(e.name);
+    if (!all_zero(reinterpret_cast<const std::uint8_t*>(e.name) + len, sizeof e.name - len) || e.reserved != 0)
+      fail_input(p, at + e_at, std::string(id) + " set " + std::to_string(k) + ": name padding or reserved bytes not zero");
+    float lo = INFINITY, hi = -INFINITY;
+    for (float v : sets.values(k))
+      if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    const bool none = lo > hi;
+    if (none ? !(std::isnan(e.min) && std::isnan(e.max)) : (e.min != lo || e.max != hi))
+      fail_input(p, at + e_at + 48, std::string(id) + " set " + std::to_string(k) + " (" + sets.name(k) +
+                                        "): min/max do not match its values");
+    const std::uint64_t end = data + k * stride + 4 * h.value_count;
+    if (!all_zero(bytes.data() + end, data + (k + 1) * stride - end))
+      fail_input(p, at + end, std::string(id) + " padding after set " + std::to_string(k) + " is not zero");
+  }
+  const std::uint64_t entries_end = sizeof h + std::uint64_t(h.set_count) * sizeof(ValueSetEntry);
+  if (!all_zero(bytes.data() + entries_end, data - entries_end))
+    fail_input(p, at + entries_end, std::string(id) + " padding before the arrays is not zero");
+}
+
 }  // namespace
 
 VerifyResult verify_vxl(const std::string& path) {
@@ -121,6 +161,8 @@ VerifyResult verify_vxl(const std::string& path) {
     if (!f.provenance_json().empty() && !nlohmann::json::accept(f.provenance_json()))
       fail_input(path, f.find_section(section_id("PROV"))->offset, "provenance is not valid JSON");
     f.groups();
+    check_value_sets(f, f.vertex_values(), "VVAL");
+    check_value_sets(f, f.streamline_values(), "SVAL");
     r.valid = true;
   } catch (const Error& e) {
     r.problem = e.what();

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "checksum.h"
+#include "vxl_value_sets.h"
 
 namespace vxl {
 
@@ -30,9 +31,11 @@ std::vector<std::uint8_t> encode_groups(std::span<const GroupContent> groups) {
 }
 
 VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
-                              std::uint64_t group_bytes) {
+                              std::uint64_t group_bytes, std::uint32_t vertex_value_sets,
+                              std::uint32_t streamline_value_sets) {
   VxlSectionSizes s;
   s.directions = std::uint64_t(m.stored_order_count) * sizeof(DirectionEntry);
+  if (m.order_set == static_cast<std::uint32_t>(OrderSet::Random)) s.voxel_directions = m.voxel_count * s.directions;
   s.voxels = std::uint64_t(m.voxel_count) * sizeof(VoxelEntry);
   s.vertices = m.vertex_count * 3 * sizeof(float);
   s.orders = order_bytes;
@@ -40,40 +43,100 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
   s.streamlines = (m.streamline_count + 1) * sizeof(std::uint64_t);
   s.provenance = provenance_bytes;
   s.groups = group_bytes;
+  s.vertex_values = value_sets_bytes(vertex_value_sets, m.vertex_count);
+  s.streamline_values = value_sets_bytes(streamline_value_sets, m.streamline_count);
   return s;
 }
 
-VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path) {
+namespace {
+
+// Section ids in file order, indexed by VxlWriter::Index; VDIR and GRPS are optional.
+constexpr const char* kSectionIds[] = {"META", "DIRS", "VDIR", "VOXT", "VERT", "ORDR", "VXLN", "STRM", "PROV", "GRPS", "VVAL", "SVAL"};
+
+}  // namespace
+
+VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
   struct Planned {
     const char* id;
     std::uint32_t flags;
     std::uint64_t size;
+    bool present;
   };
-  std::vector<Planned> planned = {
-      {"META", kSectionRequired, sizeof(MetaSection)}, {"DIRS", kSectionRequired, sizes.directions},
-      {"VOXT", kSectionRequired, sizes.voxels},        {"VERT", kSectionRequired, sizes.vertices},
-      {"ORDR", kSectionRequired, sizes.orders},        {"VXLN", kSectionRequired, sizes.voxlines},
-      {"STRM", kSectionRequired, sizes.streamlines},   {"PROV", 0, sizes.provenance},
+  // VDIR is required: a reader that cannot use per-voxel directions would pick wrong orders, so it must
+  // refuse the file (spec §4, §10).
+  const Planned planned[] = {
+      {"META", kSectionRequired, sizeof(MetaSection), true},
+      {"DIRS", kSectionRequired, sizes.directions, true},
+      {"VDIR", kSectionRequired, sizes.voxel_directions.value_or(0), sizes.voxel_directions.has_value()},
+      {"VOXT", kSectionRequired, sizes.voxels, true},
+      {"VERT", kSectionRequired, sizes.vertices, true},
+      {"ORDR", kSectionRequired, sizes.orders, true},
+      {"VXLN", kSectionRequired, sizes.voxlines, true},
+      {"STRM", kSectionRequired, sizes.streamlines, true},
+      {"PROV", 0, sizes.provenance, true},
+      {"GRPS", 0, sizes.groups, sizes.groups > 0},
+      // Optional: a reader that does not know them still draws the picture, in the other colour modes.
+      {"VVAL", 0, sizes.vertex_values, sizes.vertex_values > 0},
+      {"SVAL", 0, sizes.streamline_values, sizes.streamline_values > 0},
   };
-  if (sizes.groups > 0) planned.push_back({"GRPS", 0, sizes.groups});
+  std::size_t present = 0;
+  for (const Planned& p : planned) present += p.present;
 
-  // Header and table first, then each payload padded to a multiple of 64 (spec §2).
-  std::uint64_t position = align_up(sizeof(FileHeader) + planned.size() * sizeof(SectionEntry), kVxlAlignment);
+  VxlLayout layout;
+  std::uint64_t position = align_up(sizeof(FileHeader) + present * sizeof(SectionEntry), kVxlAlignment);
   for (const Planned& p : planned) {
+    if (!p.present) continue;
     SectionEntry e{};
     std::memcpy(e.id, p.id, 4);
     e.flags = p.flags;
     e.offset = position;
     e.size = p.size;
-    table_.push_back(e);
+    layout.table.push_back(e);
     position = align_up(position + p.size, kVxlAlignment);
   }
-  file_ = out_.map(position);
+  layout.file_size = position;
+  return layout;
+}
+
+std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size) {
+  FileHeader h{};
+  std::memcpy(h.magic, kVxlMagic.data(), 8);
+  h.version_major = kVxlVersionMajor;
+  // The lowest version that holds what is written (spec §10).
+  const bool has_vdir = std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "VDIR", 4) == 0; });
+  const bool has_values = std::any_of(table.begin(), table.end(), [](const SectionEntry& e) {
+    return std::memcmp(e.id, "VVAL", 4) == 0 || std::memcmp(e.id, "SVAL", 4) == 0;
+  });
+  h.version_minor = has_values ? kVxlVersionMinorValueSets : has_vdir ? kVxlVersionMinorVoxelDirections : kVxlVersionMinor;
+  h.header_size = sizeof(FileHeader);
+  h.file_size = file_size;
+  h.section_table_offset = sizeof(FileHeader);
+  h.section_count = static_cast<std::uint32_t>(table.size());
+  h.flags = 0;
+  h.header_checksum = 0;  // covered with this field zero (spec §3)
+  std::vector<std::uint8_t> bytes(sizeof h + table.size_bytes());
+  std::memcpy(bytes.data(), &h, sizeof h);
+  std::memcpy(bytes.data() + sizeof h, table.data(), table.size_bytes());
+  h.header_checksum = xxh3_64(bytes.data(), bytes.size());
+  std::memcpy(bytes.data(), &h, sizeof h);
+  return bytes;
+}
+
+VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path) {
+  VxlLayout layout = plan_vxl_layout(sizes);
+  table_ = std::move(layout.table);
+  file_ = out_.map(layout.file_size);
+}
+
+SectionEntry* VxlWriter::entry(Index i) {
+  for (SectionEntry& e : table_)
+    if (std::memcmp(e.id, kSectionIds[i], 4) == 0) return &e;
+  return nullptr;  // an optional section that is not there
 }
 
 std::span<std::uint8_t> VxlWriter::payload(Index i) {
-  if (i >= table_.size()) return {};
-  return file_.subspan(table_[i].offset, table_[i].size);
+  const SectionEntry* e = entry(i);
+  return e ? file_.subspan(e->offset, e->size) : std::span<std::uint8_t>{};
 }
 
 void VxlWriter::set_meta(const MetaSection& meta) {
@@ -83,15 +146,17 @@ void VxlWriter::set_meta(const MetaSection& meta) {
 }
 
 void VxlWriter::checksum_vertices_now() {
-  table_[kVert].checksum = xxh3_64(file_.data() + table_[kVert].offset, table_[kVert].size);
+  SectionEntry& vert = *entry(kVert);  // required: always in the table
+  vert.checksum = xxh3_64(file_.data() + vert.offset, vert.size);
   vertices_checksummed_ = true;
 }
 
 void VxlWriter::commit(unsigned threads) {
   // Largest payloads first, so that the big ones (VERT, ORDR) run side by side.
   std::vector<std::size_t> by_size;
+  const SectionEntry* vert = entry(kVert);
   for (std::size_t i = 0; i < table_.size(); ++i)
-    if (!(i == kVert && vertices_checksummed_)) by_size.push_back(i);
+    if (!(&table_[i] == vert && vertices_checksummed_)) by_size.push_back(i);
   std::stable_sort(by_size.begin(), by_size.end(), [&](std::size_t a, std::size_t b) { return table_[a].size > table_[b].size; });
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
@@ -106,21 +171,8 @@ void VxlWriter::commit(unsigned threads) {
   worker();
   for (std::thread& t : pool) t.join();
 
-  FileHeader h{};
-  std::memcpy(h.magic, kVxlMagic.data(), 8);
-  h.version_major = kVxlVersionMajor;
-  h.version_minor = kVxlVersionMinor;
-  h.header_size = sizeof(FileHeader);
-  h.file_size = file_.size();
-  h.section_table_offset = sizeof(FileHeader);
-  h.section_count = static_cast<std::uint32_t>(table_.size());
-  h.flags = 0;
-  h.header_checksum = 0;  // covered with this field zero (spec §3)
-  const std::size_t table_bytes = table_.size() * sizeof(SectionEntry);
-  std::memcpy(file_.data(), &h, sizeof h);
-  std::memcpy(file_.data() + sizeof h, table_.data(), table_bytes);
-  h.header_checksum = xxh3_64(file_.data(), sizeof h + table_bytes);
-  std::memcpy(file_.data(), &h, sizeof h);
+  std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_.size());
+  std::memcpy(file_.data(), header.data(), header.size());
   file_ = {};
   out_.commit();
 }
@@ -130,6 +182,7 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   if (!c.groups.empty()) groups_bytes = encode_groups(c.groups);
   VxlSectionSizes sizes;
   sizes.directions = c.directions.size_bytes();
+  if (c.meta.order_set == static_cast<std::uint32_t>(OrderSet::Random)) sizes.voxel_directions = c.voxel_directions.size_bytes();
   sizes.voxels = c.voxels.size_bytes();
   sizes.vertices = c.vertices.size_bytes();
   sizes.orders = c.orders.size_bytes();
@@ -144,6 +197,7 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   };
   w.set_meta(c.meta);
   copy(w.directions(), c.directions.data());
+  copy(w.voxel_directions(), c.voxel_directions.data());
   copy(w.voxels(), c.voxels.data());
   copy(w.vertices(), c.vertices.data());
   copy(w.orders(), c.orders.data());

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -17,14 +18,32 @@ namespace vxl {
 
 // Payload sizes in bytes, one per section, in file order (spec §4). They fix the whole layout.
 struct VxlSectionSizes {
-  std::uint64_t directions = 0, voxels = 0, vertices = 0, orders = 0, voxlines = 0, streamlines = 0;
+  std::uint64_t directions = 0;
+  std::optional<std::uint64_t> voxel_directions;  // VDIR; only with order set random (spec §5.10)
+  std::uint64_t voxels = 0, vertices = 0, orders = 0, voxlines = 0, streamlines = 0;
   std::uint64_t provenance = 0;
   std::uint64_t groups = 0;  // 0: no GRPS section
+  std::uint64_t vertex_values = 0, streamline_values = 0;  // VVAL, SVAL (spec §5.11); 0: absent
 };
 
-// The sizes spec §5 gives for the counts in `meta` (stored_order_count included).
+// The sizes spec §5 gives for the counts in `meta` (stored_order_count included; a VDIR section when
+// order_set is random; VVAL / SVAL sections holding that many value sets, none when 0).
 VxlSectionSizes section_sizes(const MetaSection& meta, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
-                              std::uint64_t group_bytes);
+                              std::uint64_t group_bytes, std::uint32_t vertex_value_sets = 0,
+                              std::uint32_t streamline_value_sets = 0);
+
+// The section table (offsets and sizes; checksums left zero) and the file size for these payloads: header
+// and table first, then each payload in file order at a multiple of 64 (spec §2, §4). VDIR only when
+// sizes.voxel_directions is set, GRPS only when sizes.groups > 0. Shared by VxlWriter and VxlStreamWriter, so that both lay out a file alike.
+struct VxlLayout {
+  std::vector<SectionEntry> table;
+  std::uint64_t file_size = 0;
+};
+VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes);
+
+// The bytes of the header and the section table (spec §3, §4), once every checksum in `table` is set.
+// The version is 1.1 when the table has VDIR, else 1.0 (spec §10).
+std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size);
 
 class VxlWriter {
  public:
@@ -37,6 +56,8 @@ class VxlWriter {
   // not fill completely keeps zeros, and the padding between payloads stays zero (spec §2).
   void set_meta(const MetaSection& meta);  // zeroes the reserved bytes
   std::span<DirectionEntry> directions() { return typed<DirectionEntry>(kDirs); }
+  // voxel_count x K entries; empty when there is no VDIR section.
+  std::span<DirectionEntry> voxel_directions() { return typed<DirectionEntry>(kVdir); }
   std::span<VoxelEntry> voxels() { return typed<VoxelEntry>(kVoxt); }
   std::span<float> vertices() { return typed<float>(kVert); }
   std::span<std::uint8_t> orders() { return payload(kOrdr); }
@@ -51,6 +72,9 @@ class VxlWriter {
   // hashes them beside its order building instead of at the end). The vertices must not change
   // afterwards; commit() then leaves VERT's checksum as it is.
   void checksum_vertices_now();
+  // VVAL and SVAL payloads (vxl_value_sets.h: layout_value_sets, finish_value_sets); empty when absent.
+  std::span<std::uint8_t> vertex_values() { return payload(kVval); }
+  std::span<std::uint8_t> streamline_values() { return payload(kSval); }
 
   // Checksums every payload (sections spread over up to `threads` threads; 0: all hardware threads),
   // writes the section table and the header, unmaps and links the file into place. The spans above
@@ -58,7 +82,9 @@ class VxlWriter {
   void commit(unsigned threads = 0);
 
  private:
-  enum Index : std::size_t { kMeta, kDirs, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps };
+  // Sections in file order; VDIR, GRPS, VVAL and SVAL are optional.
+  enum Index : std::size_t { kMeta, kDirs, kVdir, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps, kVval, kSval };
+  SectionEntry* entry(Index i);  // null for an optional section that is absent
   std::span<std::uint8_t> payload(Index i);
   template <typename T>
   std::span<T> typed(Index i) {
@@ -67,7 +93,7 @@ class VxlWriter {
   }
 
   AtomicOutputFile out_;
-  std::vector<SectionEntry> table_;  // in Index order; GRPS only when present
+  std::vector<SectionEntry> table_;  // in Index order, optional sections only when present
   bool vertices_checksummed_ = false;
   std::span<std::uint8_t> file_;
 };
@@ -82,6 +108,7 @@ struct GroupContent {
 struct VxlContent {
   MetaSection meta{};
   std::span<const DirectionEntry> directions;
+  std::span<const DirectionEntry> voxel_directions;  // VDIR, written when meta.order_set is random
   std::span<const VoxelEntry> voxels;
   std::span<const float> vertices;  // 3 * vertex_count
   std::span<const std::uint8_t> orders;

@@ -52,9 +52,10 @@ Tractogram test_tractogram(std::uint64_t streamlines = 1500) {
   return t;
 }
 
-std::string convert_to(Tractogram t, const std::string& path, double voxel_size = 10.0) {
+std::string convert_to(Tractogram t, const std::string& path, double voxel_size = 10.0, const char* orders = "axis") {
   ConvertSettings s;
   s.voxel_size = voxel_size;
+  s.orders = orders;
   convert_tractogram(std::move(t), path, s);
   return path;
 }
@@ -264,6 +265,30 @@ TEST(VxlzPackageOptions, EmptyTractogram) {
   t.source.path = "empty.tck";
   const std::string vxl = convert_to(std::move(t), dir.file("empty.vxl"));
   round_trip(dir, vxl, 14);
+}
+
+// Unpack rebuilds the orders of any shared direction set: the diagonals sort by a dot product, not by one
+// component as the axes do (verify checks every order's sortedness against the decoded vertices).
+TEST(VxlzPackageOptions, AxisDiagOrdersAreRebuiltForTheDecodedPositions) {
+  ScratchDir dir;
+  const std::string vxl = convert_to(test_tractogram(300), dir.file("diag.vxl"), 5.0, "axis+diag");
+  ASSERT_EQ(VxlFile::open(vxl).meta().stored_order_count, 7u);
+  const VxlFile copy = VxlFile::open(round_trip(dir, vxl, 14));
+  EXPECT_EQ(copy.meta().order_set, static_cast<std::uint32_t>(OrderSet::AxisDiag));
+}
+
+// Per-voxel random directions (VDIR) are not part of the package format: refused before any output.
+TEST(VxlzPackageOptions, RandomOrderSetsAreRefusedWithoutOutput) {
+  ScratchDir dir;
+  const std::string vxl = convert_to(test_tractogram(50), dir.file("random.vxl"), 10.0, "random:4");
+  try {
+    pack_vxl(VxlFile::open(vxl), dir.file("r.vxlz"), {});
+    ADD_FAILURE() << "packing a random:4 file must fail";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--orders axis"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("r.vxlz")));
 }
 
 TEST(VxlzPackageOptions, BitsOutOfRangeAreAUsageError) {

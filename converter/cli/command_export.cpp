@@ -26,6 +26,9 @@ void add_export_command(CLI::App& app) {
     const bool tck = lower.ends_with(".tck"), trx = lower.ends_with(".trx");
     if (!tck && !trx) throw Error(ErrorKind::Usage, opt->output, std::nullopt, "export writes .tck or .trx files");
     VxlFile f = VxlFile::open(opt->input);
+    if (!f.vertex_values().empty() || !f.streamline_values().empty())
+      std::fprintf(stderr, "voxlines: warning: %s: its values per vertex / streamline (VVAL, SVAL) are not exported\n",
+                   opt->input.c_str());
     if (tck) export_tck(f, opt->output);
     else export_trx(f, opt->output);
     std::printf("%s: %llu streamlines, %llu points\n", opt->output.c_str(),

@@ -1,3 +1,4 @@
+#include <cmath>
 #include <cstdio>
 
 #include <nlohmann/json.hpp>
@@ -39,6 +40,16 @@ void add_info_command(CLI::App& app) {
     for (const SectionEntry& e : f.sections())
       sections.push_back({{"id", std::string(e.id, 4)}, {"offset", e.offset}, {"bytes", e.size}});
     j["sections"] = sections;
+    auto sets = [](const ValueSets& v) {
+      nlohmann::json a = nlohmann::json::array();
+      for (std::uint32_t k = 0; k < v.size(); ++k) a.push_back({{"name", v.name(k)}, {"min", v.min(k)}, {"max", v.max(k)}});
+      return a;
+    };
+    j["vertex_values"] = sets(f.vertex_values());
+    j["streamline_values"] = sets(f.streamline_values());
+    nlohmann::json groups = nlohmann::json::array();
+    for (const GroupContent& g : f.groups()) groups.push_back({{"name", g.name}, {"streamlines", g.members.size()}});
+    j["groups"] = groups;
     auto prov = nlohmann::json::parse(f.provenance_json(), nullptr, false);
     if (!prov.is_discarded() && prov.contains("source")) {
       j["source"] = {{"name", prov["source"].value("name", "")}, {"format", prov["source"].value("format", "")},
@@ -65,6 +76,14 @@ void add_info_command(CLI::App& app) {
     for (const SectionEntry& e : f.sections())
       std::printf(" %.4s:%llu", e.id, (unsigned long long)e.size);
     std::printf("\n");
+    for (const char* kind : {"vertex_values", "streamline_values"})
+      for (const auto& v : j[kind])
+        std::printf("%-13s %s [%g, %g]\n", kind == std::string("vertex_values") ? "point values" : "streamline values",
+                    v["name"].get<std::string>().c_str(), v["min"].is_number() ? v["min"].get<double>() : NAN,
+                    v["max"].is_number() ? v["max"].get<double>() : NAN);
+    for (const auto& g : j["groups"])
+      std::printf("group         %s (%llu streamlines)\n", g["name"].get<std::string>().c_str(),
+                  (unsigned long long)g["streamlines"].get<std::uint64_t>());
   });
 }
 

@@ -22,6 +22,9 @@ void add_pack_command(CLI::App& app) {
   cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
   cmd->callback([opt] {
     VxlFile f = VxlFile::open(opt->input);
+    if (!f.vertex_values().empty() || !f.streamline_values().empty())
+      std::fprintf(stderr, "voxlines: warning: %s: its values per vertex / streamline (VVAL, SVAL) are not packed; "
+                           "the package shows the streamlines only\n", opt->input.c_str());
     PackSummary s = pack_vxl(f, opt->output, opt->settings);
     const double per_point = s.points > 0 ? double(s.bytes) / double(s.points) : 0.0;
     std::printf("%s: %llu streamlines, %llu points -> %llu bytes (%.3f bytes per point, %.3fx the .vxl)\n",

@@ -7,17 +7,16 @@
 // the byte offset in "file: . OFFSET". Data: xyz triplets; a triplet whose x is NaN ends a streamline, one
 // whose x is Inf ends the file. Like MRtrix we tolerate a missing Inf terminator at EOF, and trust the data
 // over a stale "count".
-#include <bit>
-#include <cmath>
-#include <cstring>
 #include <string_view>
 
 #include "checksum.h"
 #include "error.h"
 #include "mapped_file.h"
 #include "read_tractogram.h"
+#include "tck_format.h"
 
 namespace vxl {
+namespace tck {
 namespace {
 
 std::string_view trim(std::string_view s) {
@@ -26,28 +25,36 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-struct TckHeader {
-  nlohmann::json fields = nlohmann::json::object();  // key -> array of values (keys may repeat)
-  std::string datatype;
-  std::uint64_t data_offset = 0;
-  std::optional<std::uint64_t> count;
-};
+}  // namespace
 
-TckHeader parse_header(const std::string& path, std::span<const std::uint8_t> bytes) {
-  TckHeader h;
+std::optional<Header> parse_header(const std::string& path, std::span<const std::uint8_t> bytes, std::uint64_t file_size) {
+  Header h;
   std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   std::size_t pos = 0;
+  // With only the first bytes of a longer file, a line that runs to their end may be cut: it is not
+  // judged (nor the magic line) until more is read, so a streamed header fails exactly where a whole one does.
+  const bool partial = bytes.size() < file_size;
+  bool cut = false;
   auto next_line = [&](std::string_view& line) {
     if (pos >= text.size()) return false;
     std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
+    if (end == std::string_view::npos) {
+      if (partial) {
+        cut = true;
+        return false;
+      }
+      end = text.size();
+    }
     line = text.substr(pos, end - pos);
     pos = end + 1;
     return true;
   };
   std::string_view line;
-  if (!next_line(line) || trim(line) != "mrtrix tracks")
+  if (!next_line(line)) {
+    if (cut) return std::nullopt;
     fail_input(path, 0, "expected the TCK magic line 'mrtrix tracks'");
+  }
+  if (trim(line) != "mrtrix tracks") fail_input(path, 0, "expected the TCK magic line 'mrtrix tracks'");
   bool ended = false;
   std::string last_key;
   while (true) {
@@ -72,7 +79,10 @@ TckHeader parse_header(const std::string& path, std::span<const std::uint8_t> by
     std::string value(trim(t.substr(colon + 1)));
     h.fields[key].push_back(value);
   }
-  if (!ended) fail_input(path, bytes.size(), "TCK header has no 'END' line");
+  if (!ended) {
+    if (bytes.size() < file_size) return std::nullopt;
+    fail_input(path, bytes.size(), "TCK header has no 'END' line");
+  }
 
   auto single = [&](const char* key) -> std::string {
     if (!h.fields.contains(key)) fail_input(path, std::nullopt, std::string("TCK header lacks '") + key + ":'");
@@ -91,8 +101,8 @@ TckHeader parse_header(const std::string& path, std::span<const std::uint8_t> by
     fail_input(path, std::nullopt, "TCK 'file:' offset is not a number: '" + file + "'");
   }
   if (h.data_offset < pos) fail_input(path, h.data_offset, "TCK data offset points inside the header");
-  if (h.data_offset > bytes.size())
-    fail_input(path, h.data_offset, "TCK data offset is past the end of the file (" + std::to_string(bytes.size()) + " bytes)");
+  if (h.data_offset > file_size)
+    fail_input(path, h.data_offset, "TCK data offset is past the end of the file (" + std::to_string(file_size) + " bytes)");
   if (h.fields.contains("count")) {
     try {
       h.count = std::stoull(h.fields["count"].back().get<std::string>());
@@ -103,67 +113,48 @@ TckHeader parse_header(const std::string& path, std::span<const std::uint8_t> by
   return h;
 }
 
-template <typename Real, bool kBigEndian>
-Real load(const std::uint8_t* p) {
-  using Bits = std::conditional_t<sizeof(Real) == 4, std::uint32_t, std::uint64_t>;
-  Bits bits;
-  std::memcpy(&bits, p, sizeof bits);
-  if constexpr (kBigEndian) {
-    if constexpr (sizeof(Bits) == 4) bits = __builtin_bswap32(bits);
-    else bits = __builtin_bswap64(bits);
+void finish(const DecodeState& s, std::uint64_t trailing, Tractogram& t, std::vector<std::string>& warnings) {
+  if (!s.terminated) {
+    std::string w = "no Inf terminator before end of file (tolerated, as MRtrix does)";
+    if (trailing != 0) w += "; " + std::to_string(trailing) + " trailing bytes ignored";
+    warnings.push_back(w);
+    if (s.points_in_current > 0) {
+      t.offsets.push_back(t.point_count());
+      warnings.push_back("last streamline (" + std::to_string(s.points_in_current) + " points) has no NaN delimiter: kept");
+    }
+  } else if (s.points_in_current > 0) {
+    // MRtrix writes a NaN before the Inf; without it the points still form a streamline.
+    t.offsets.push_back(t.point_count());
   }
-  return std::bit_cast<Real>(bits);
 }
 
-// Walks the data triplets, filling t. Returns the number of bytes consumed.
+void header_warnings(const Header& h, std::uint64_t streamlines, std::vector<std::string>& warnings) {
+  if (h.datatype.starts_with("Float64")) warnings.push_back("Float64 coordinates rounded to float32 (spec §8)");
+  if (h.count && *h.count != streamlines)
+    warnings.push_back("header count " + std::to_string(*h.count) + " disagrees with the data (" +
+                       std::to_string(streamlines) + " streamlines): the data is trusted");
+}
+
+}  // namespace tck
+
+namespace {
+
+// Walks all data triplets into t.
 template <typename Real, bool kBigEndian>
 void read_points(const std::string& path, std::span<const std::uint8_t> bytes, std::uint64_t offset, Tractogram& t) {
   constexpr std::size_t kTriplet = 3 * sizeof(Real);
   const std::uint64_t available = (bytes.size() - offset) / kTriplet;
   t.positions.reserve(3 * available);
-  const std::uint8_t* p = bytes.data() + offset;
-  bool terminated = false;
-  std::uint64_t points_in_current = 0;
-  for (std::uint64_t i = 0; i < available; ++i, p += kTriplet) {
-    Real x = load<Real, kBigEndian>(p), y = load<Real, kBigEndian>(p + sizeof(Real)),
-         z = load<Real, kBigEndian>(p + 2 * sizeof(Real));
-    if (std::isnan(x)) {  // end of streamline
-      t.offsets.push_back(t.point_count());
-      points_in_current = 0;
-      continue;
-    }
-    if (std::isinf(x)) {  // end of file
-      terminated = true;
-      break;
-    }
-    if (!std::isfinite(y) || !std::isfinite(z))
-      fail_input(path, offset + i * kTriplet, "non-finite coordinate inside a streamline (only x marks NaN/Inf delimiters)");
-    t.positions.push_back(static_cast<float>(x));
-    t.positions.push_back(static_cast<float>(y));
-    t.positions.push_back(static_cast<float>(z));
-    ++points_in_current;
-  }
-  if (!terminated) {
-    std::uint64_t trailing = (bytes.size() - offset) % kTriplet;
-    std::string w = "no Inf terminator before end of file (tolerated, as MRtrix does)";
-    if (trailing != 0) w += "; " + std::to_string(trailing) + " trailing bytes ignored";
-    t.source.warnings.push_back(w);
-    if (points_in_current > 0) {
-      t.offsets.push_back(t.point_count());
-      t.source.warnings.push_back("last streamline (" + std::to_string(points_in_current) +
-                                  " points) has no NaN delimiter: kept");
-    }
-  } else if (points_in_current > 0) {
-    // MRtrix writes a NaN before the Inf; without it the points still form a streamline.
-    t.offsets.push_back(t.point_count());
-  }
+  tck::DecodeState s;
+  tck::decode<Real, kBigEndian>(path, bytes.data() + offset, available, offset, t, s, ~std::uint64_t(0));
+  tck::finish(s, (bytes.size() - offset) % kTriplet, t, t.source.warnings);
 }
 
 }  // namespace
 
 Tractogram read_tck(const std::string& path) {
   MappedFile file(path);
-  TckHeader h = parse_header(path, file.bytes());
+  tck::Header h = *tck::parse_header(path, file.bytes(), file.size());
   Tractogram t;
   t.source.path = path;
   t.source.format = "tck";
@@ -179,11 +170,7 @@ Tractogram read_tck(const std::string& path) {
   else if (dt == "Float64BE") read_points<double, true>(path, file.bytes(), h.data_offset, t);
   else fail_unsupported(path, "TCK datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
 
-  if (dt.starts_with("Float64"))
-    t.source.warnings.push_back("Float64 coordinates rounded to float32 (spec §8)");
-  if (h.count && *h.count != t.streamline_count())
-    t.source.warnings.push_back("header count " + std::to_string(*h.count) + " disagrees with the data (" +
-                                std::to_string(t.streamline_count()) + " streamlines): the data is trusted");
+  tck::header_warnings(h, t.streamline_count(), t.source.warnings);
   return t;
 }
 

@@ -15,8 +15,9 @@
 //
 // Layout: 1000-byte header; then per streamline: int32 n, n * (3 + n_scalars) float32,
 // n_properties float32. hdr_size (int32 at byte 996) is 1000 in the file's byte order, which is how
-// a big-endian file is recognised. Scalars and properties are skipped (their names are kept in the
-// header JSON).
+// a big-endian file is recognised. Scalars become per-point value sets and properties per-streamline value
+// sets, named from the header's name slots (a slot "name\0N", nibabel's way of naming N values, gives
+// name[0] ... name[N-1]).
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -111,6 +112,35 @@ nlohmann::json slot_names(const std::uint8_t* p) {
     std::string name = trim_right(latin1_field(p + 20 * i, 20));
     if (!name.empty()) names.push_back(name);
   }
+  return names;
+}
+
+// One name per value: the slots' names expanded by their counts ("colors\03" -> colors[0..2]), padded
+// with "<fallback>_k" or cut to `count` (with a warning) when the slots disagree with n_scalars/n_properties.
+std::vector<std::string> value_names(const std::uint8_t* slots, int count, const char* fallback,
+                                     std::vector<std::string>& warnings) {
+  std::vector<std::string> names;
+  for (int i = 0; i < 10 && static_cast<int>(names.size()) < count; ++i) {
+    const std::uint8_t* p = slots + 20 * i;
+    std::size_t n = 0;
+    while (n < 20 && p[n] != 0) ++n;
+    const std::string name = trim_right(latin1_to_utf8({reinterpret_cast<const char*>(p), n}));
+    if (name.empty()) continue;
+    int multiple = 1;
+    if (n + 1 < 20 && p[n + 1] >= '1' && p[n + 1] <= '9') {
+      multiple = 0;
+      for (std::size_t k = n + 1; k < 20 && p[k] >= '0' && p[k] <= '9'; ++k) multiple = multiple * 10 + (p[k] - '0');
+    }
+    if (multiple == 1) names.push_back(name);
+    else
+      for (int k = 0; k < multiple; ++k) names.push_back(name + "[" + std::to_string(k) + "]");
+  }
+  if (static_cast<int>(names.size()) != count)
+    warnings.push_back(std::string("the header names ") + std::to_string(names.size()) + " " + fallback + " values but holds " +
+                       std::to_string(count) + "; unnamed ones are called " + fallback + "_<k>");
+  names.resize(count);
+  for (int k = 0; k < count; ++k)
+    if (names[k].empty()) names[k] = std::string(fallback) + "_" + std::to_string(k);
   return names;
 }
 
@@ -420,6 +450,10 @@ Tractogram read_trk(const std::string& path) {
   const std::uint64_t point_bytes = 4 * floats_per_point;
   const std::uint64_t property_bytes = 4 * static_cast<std::uint64_t>(n_properties);
   t.positions.reserve(3 * ((size - kHeaderSize) / point_bytes));  // an upper bound: no reallocation
+  for (const std::string& name : value_names(data + kOffScalarNames, n_scalars, "scalar", warnings))
+    t.point_values.push_back({name, {}});
+  for (const std::string& name : value_names(data + kOffPropertyNames, n_properties, "property", warnings))
+    t.streamline_values.push_back({name, {}});
   const Mat4& a = voxmm_to_ras;
   std::uint64_t off = kHeaderSize;
   std::uint64_t count = 0;
@@ -446,7 +480,9 @@ Tractogram read_trk(const std::string& path) {
                          " is not finite after mapping to RAS mm");
         t.positions.push_back(v);
       }
+      for (int k = 0; k < n_scalars; ++k) t.point_values[k].values.push_back(in.f32(p + 12 + 4 * k));
     }
+    for (int k = 0; k < n_properties; ++k) t.streamline_values[k].values.push_back(in.f32(p + 4 * k));
     t.offsets.push_back(t.point_count());
     off += 4 + need;
     ++count;

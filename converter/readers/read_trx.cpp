@@ -7,8 +7,9 @@
 //
 // Members used: header.json (NB_STREAMLINES, NB_VERTICES, VOXEL_TO_RASMM, DIMENSIONS),
 // positions.3.<float16|float32|float64>, offsets.<uint32|uint64> and groups/<name>.<integer dtype>;
-// all little-endian. dps/, dpv/ and dpg/ are not read (their names are listed in the header JSON under
-// "_members"). Offsets come in two conventions: N + 1 entries ending with the NB_VERTICES sentinel
+// all little-endian. dpv/<name>[.<n>].<dtype> and dps/<name>[.<n>].<dtype> (any float or integer dtype)
+// become per-point and per-streamline value sets (one per component: name[0] ... name[n-1]); dpg/ is not
+// read. All member names are listed in the header JSON under "_members". Offsets come in two conventions: N + 1 entries ending with the NB_VERTICES sentinel
 // (current trx-python), or N entries without it (older files); both are accepted.
 #include <algorithm>
 #include <array>
@@ -346,6 +347,69 @@ void read_groups(const std::string& path, const Members& members, Tractogram& t)
   }
 }
 
+// A float or integer dtype's element size, 0 when unknown.
+std::size_t value_dtype_size(const std::string& dtype) {
+  bool is_signed = false;
+  if (dtype == "float16") return 2;
+  if (dtype == "float32") return 4;
+  if (dtype == "float64") return 8;
+  return integer_dtype_size(dtype, is_signed);
+}
+
+float load_value(const std::uint8_t* p, const std::string& dtype) {
+  if (dtype == "float16") return half_to_float(load_le<std::uint16_t>(p));
+  if (dtype == "float32") return load_le<float>(p);
+  if (dtype == "float64") return static_cast<float>(load_le<double>(p));
+  if (dtype == "uint8") return load_le<std::uint8_t>(p);
+  if (dtype == "uint16") return load_le<std::uint16_t>(p);
+  if (dtype == "uint32") return static_cast<float>(load_le<std::uint32_t>(p));
+  if (dtype == "uint64") return static_cast<float>(load_le<std::uint64_t>(p));
+  if (dtype == "int8") return load_le<std::int8_t>(p);
+  if (dtype == "int16") return load_le<std::int16_t>(p);
+  if (dtype == "int32") return static_cast<float>(load_le<std::int32_t>(p));
+  return static_cast<float>(load_le<std::int64_t>(p));
+}
+
+// dpv/ or dps/ members -> value sets of `count` entries each. A member that cannot be read as such (no
+// dtype, a size that does not match) is skipped with a warning: the streamlines are still good.
+void read_value_sets(const Members& members, const std::string& folder, std::uint64_t count, Tractogram& t,
+                     std::vector<ValueSet>& out) {
+  for (const auto& [name, index] : members.names()) {
+    if (!name.starts_with(folder)) continue;
+    const std::string rest = name.substr(folder.size());
+    const std::size_t dot = rest.rfind('.');
+    const std::string dtype = dot == std::string::npos ? "" : rest.substr(dot + 1);
+    const std::size_t elem = value_dtype_size(dtype);
+    if (rest.find('/') != std::string::npos || dot == std::string::npos || dot == 0 || elem == 0) {
+      t.source.warnings.push_back(json_safe(name) + ": not " + folder + "<name>[.<components>].<dtype>; ignored");
+      continue;
+    }
+    std::string base = rest.substr(0, dot);
+    std::uint64_t components = 1;
+    if (const std::size_t d2 = base.rfind('.'); d2 != std::string::npos && d2 > 0 && d2 + 1 < base.size() &&
+                                                base.find_first_not_of("0123456789", d2 + 1) == std::string::npos) {
+      components = std::stoull(base.substr(d2 + 1));
+      base = base.substr(0, d2);
+    }
+    const Blob blob = members.read(name);
+    const auto bytes = blob.bytes();
+    if (components == 0 || components > 64 || bytes.size() != count * components * elem) {
+      t.source.warnings.push_back(json_safe(name) + ": holds " + std::to_string(bytes.size()) + " bytes, expected " +
+                                  std::to_string(count) + " x " + std::to_string(components) + " x " +
+                                  std::to_string(elem) + "; ignored");
+      continue;
+    }
+    while (!base.empty() && base.back() == ' ') base.pop_back();  // seen in niivue's colby.trx: "effect   .float32"
+    for (std::uint64_t c = 0; c < components; ++c) {
+      ValueSet v;
+      v.name = json_safe(base) + (components > 1 ? "[" + std::to_string(c) + "]" : "");
+      v.values.resize(count);
+      for (std::uint64_t i = 0; i < count; ++i) v.values[i] = load_value(bytes.data() + (i * components + c) * elem, dtype);
+      out.push_back(std::move(v));
+    }
+  }
+}
+
 }  // namespace
 
 Tractogram read_trx(const std::string& path) {
@@ -434,6 +498,8 @@ Tractogram read_trx(const std::string& path) {
     read_positions(path, *positions, pos_dtype, blob.bytes(), nb_vertices, t);
   }
   read_groups(path, *members, t);
+  read_value_sets(*members, "dpv/", t.point_count(), t, t.point_values);
+  read_value_sets(*members, "dps/", t.streamline_count(), t, t.streamline_values);
 
   nlohmann::json names = nlohmann::json::array();
   for (const auto& [name, index] : members->names()) names.push_back(json_safe(name));

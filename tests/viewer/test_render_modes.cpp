@@ -71,6 +71,7 @@ TEST_F(RenderModes, OpaqueShowsTheNearestLineWithItsDirectionColour) {
   EXPECT_NEAR(centre(img)[0], 180, 2);
   EXPECT_NEAR(centre(img)[1], 180, 2);
   EXPECT_EQ(centre(img)[2], 0);
+  EXPECT_EQ(centre(img)[3], 255) << "an opaque picture: the line's opacity is not its alpha";
   // Away from the crossing: the x line (red) on its row, the y line (green) on its column, black elsewhere.
   EXPECT_EQ(img.pixel(20, 31)[0], 255);
   EXPECT_EQ(img.pixel(20, 31)[1], 0);
@@ -107,6 +108,22 @@ TEST_F(RenderModes, AxisAndBasicEqualExactWhereThePaperGuaranteesIt) {
     Image img = render_image(r, top_view(), settings(m), 64, 64);
     ImageDiff d = compare_images(img, exact);
     EXPECT_LE(d.max_error * 255, 1.01) << render_mode_name(m);
+  }
+}
+
+// 300 coincident green lines at opacity 0.01: 1 - 0.99^300 of full green. An 8-bit colour buffer would
+// stall near 205 (each blend rounds to 1/255 and a layer adds only 2.55 levels minus 1% of what is there).
+TEST_F(RenderModes, ManyFaintLayersAccumulateBeyondEightBitRounding) {
+  Tractogram t;
+  const float line[] = {0.5f, -19.5f, 0, 0.5f, 20.5f, 0};
+  for (int i = 0; i < 300; ++i) t.add_streamline(line, 2);
+  t.source.path = "faint_layers";
+  VxlFile f = make_scene(dir, std::move(t), 5.0);
+  Renderer r(f);
+  const double expected = 255 * (1 - std::pow(0.99, 300));  // 242.5
+  for (RenderMode m : {RenderMode::Axis, RenderMode::Basic, RenderMode::Unsorted, RenderMode::Exact}) {
+    Image img = render_image(r, top_view(), settings(m, 0.01f), 64, 64);
+    EXPECT_NEAR(img.pixel(32, 45)[1], expected, 2.0) << render_mode_name(m);
   }
 }
 

@@ -103,8 +103,34 @@ TEST_F(Window, ShowsAVxlFileAndSavesTheLastFrameWithoutThePanel) {
   CommandResult r = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + " --render " + shell_quoted(headless) +
                                             " --size 320x240");
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  // Measured on llvmpipe 15: 2 pixels differed with the line shader of before colour-by-value, 1264 (1.65%)
+  // with it (the same lines, some moved by a pixel: the colour branch changes the vertex shader's code, and
+  // the GLX and EGL paths round positions differently). The mean error separates that from a wrong picture:
+  // 2.7e-5 here, 1.2e-4 for `basic` instead of `axis`, 1.5e-3 for opacity 0.25 instead of 0.3, 5e-3 for the
+  // azimuth 1 degree off.
   ImageDiff d = compare_images(shot, read_image(headless));
-  EXPECT_LT(d.differing_pixels, 320u * 240u / 100u) << "mean error " << d.mean_error << ", max at " << d.max_x << "," << d.max_y;
+  EXPECT_LT(d.differing_pixels, 320u * 240u * 25u / 1000u) << "mean error " << d.mean_error << ", max at " << d.max_x << "," << d.max_y;
+  EXPECT_LT(d.mean_error, 6e-5);
+}
+
+TEST_F(Window, AViewSavedInTheWindowReplaysHeadless) {
+  VXL_REQUIRE_XVFB();
+  make_inputs();
+  const std::string view = dir.file("view.json"), shot = dir.file("window.png"), replay = dir.file("replay.png");
+  CommandResult w = run_voxview_in_xvfb(shell_quoted(vxl) + " --frames 3 --size 200x150 --view 40,15 --lighting --slab 60 --opacity 0.6"
+                                        " --save-camera " + shell_quoted(view) + " --screenshot " + shell_quoted(shot));
+  ASSERT_EQ(w.exit_code, 0) << w.output;
+  ASSERT_TRUE(std::filesystem::exists(view)) << w.output;
+  CommandResult h = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + " --camera " + shell_quoted(view) +
+                              " --render " + shell_quoted(replay));
+  ASSERT_EQ(h.exit_code, 0) << h.output;
+  const Image a = read_image(shot), b = read_image(replay);
+  ASSERT_EQ(b.width, 200);
+  ASSERT_EQ(b.height, 150);
+  // Same camera, settings and size; window (GLX) and headless (EGL) rasterise alike but for details.
+  ImageDiff d = compare_images(a, b);
+  EXPECT_LT(d.differing_pixels, 200u * 150u / 100u) << "mean error " << d.mean_error;
+  EXPECT_GT(lit_pixels(b), 200 * 150 / 200);
 }
 
 TEST_F(Window, OpensATckDirectly) {

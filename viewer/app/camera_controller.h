@@ -39,6 +39,9 @@ class CameraController {
   DragMode dragging() const { return drag_; }
 
   void zoom(double steps);
+  // Moves the focus point (the target, where a slab is centred) along the view direction; + is away
+  // from the viewer. The eye moves with it, so the picture's scale stays.
+  void move_focus(double mm) { camera_.target += camera_.forward() * mm; }
   void set_view(double azimuth_deg, double elevation_deg);
   // Keeps the picture's scale at the target when switching projection.
   void set_orthographic(bool orthographic);

@@ -1,17 +1,30 @@
 #include "headless_render.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
+#include "camera_file.h"
 #include "egl_context.h"
 #include "image_io.h"
 #include "offscreen_target.h"
 #include "renderer.h"
 #include "scene_source.h"
+#include "turntable.h"
 
 namespace vxl::app {
 
 Camera initial_camera(const glm::dvec3& lo, const glm::dvec3& hi, const ViewerOptions& options, double aspect) {
+  if (options.camera) {
+    // A saved view is used as saved; --view and --ortho given as well still turn it.
+    Camera c = *options.camera;
+    if (options.orthographic) c.orthographic = true;
+    if (options.view) {
+      c.azimuth_deg = (*options.view)[0];
+      c.elevation_deg = (*options.view)[1];
+    }
+    return c;
+  }
   Camera c;
   c.orthographic = options.orthographic;
   auto view = options.view.value_or(std::array<double, 2>{-35.0, 25.0});
@@ -23,22 +36,28 @@ Camera initial_camera(const glm::dvec3& lo, const glm::dvec3& hi, const ViewerOp
 
 int run_headless(const ViewerOptions& o) {
   auto t0 = std::chrono::steady_clock::now();
-  VxlFile file = open_scene(o.input, o.voxel_size);
+  const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf);
   HeadlessGlContext context;
-  Renderer renderer(file);
+  Renderer renderer(pointers(files));
+  check_color_options(o.inputs_name(), renderer, o.settings);
   OffscreenTarget target(o.width, o.height);
   target.bind();
   const double aspect = double(o.width) / o.height;
-  Camera camera = initial_camera(renderer.bounds_min(), renderer.bounds_max(), o, aspect);
-  renderer.draw(camera, o.settings, o.width, o.height, target.framebuffer());
-  std::vector<std::uint8_t> rgba = target.read_rgba();
-  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_png(*o.render_png, o.width, o.height, rgba);
-  const FrameStats& s = renderer.stats();
-  std::printf("%s: %dx%d %s, %llu voxels and %llu segments drawn, first frame after %.3f s (%s)\n",
-              o.render_png->c_str(), o.width, o.height, render_mode_name(o.settings.mode),
-              (unsigned long long)s.voxels_drawn, (unsigned long long)s.segments_drawn, seconds,
-              context.renderer().c_str());
+  const Camera camera = initial_camera(renderer.bounds_min(), renderer.bounds_max(), o, aspect);
+  if (o.save_camera) write_view(*o.save_camera, SavedView{camera, o.settings, std::array<int, 2>{o.width, o.height}});
+  const int frames = std::max(1, o.turntable);
+  for (int i = 0; i < frames; ++i) {
+    renderer.draw(turntable_camera(camera, i, frames), o.settings, o.width, o.height, target.framebuffer());
+    std::vector<std::uint8_t> rgba = target.read_rgba();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const std::string png = o.turntable ? turntable_frame_path(*o.render_png, i, frames) : *o.render_png;
+    write_png(png, o.width, o.height, rgba);
+    const FrameStats& s = renderer.stats();
+    std::printf("%s: %dx%d %s, %llu voxels and %llu segments drawn, %s after %.3f s (%s)\n", png.c_str(), o.width,
+                o.height, render_mode_name(o.settings.mode), (unsigned long long)s.voxels_drawn,
+                (unsigned long long)s.segments_drawn, i == 0 ? "first frame" : "frame", seconds, context.renderer().c_str());
+  }
+  if (o.save_camera) std::printf("view saved to %s\n", o.save_camera->c_str());
   return 0;
 }
 

@@ -1,18 +1,26 @@
 #include "scene_source.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <unistd.h>
 
 #include "convert.h"
+#include "error.h"
+#include "read_tsf.h"
+#include "renderer.h"
 #include "read_tractogram.h"
 #include "unpack.h"
 
 namespace vxl::app {
 
-VxlFile open_scene(const std::string& path, double voxel_size) {
+VxlFile open_scene(const std::string& path, double voxel_size, const std::vector<std::string>& tsf) {
   std::string lower = path;
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (!tsf.empty() && (lower.ends_with(".vxl") || lower.ends_with(".vxlz")))
+    throw Error(ErrorKind::Usage, path, std::nullopt,
+                "--tsf adds values to a source tractogram converted in memory; a .vxl keeps the values it was converted "
+                "with (voxlines convert IN.tck OUT.vxl --tsf FILE.tsf)");
   if (lower.ends_with(".vxl")) return VxlFile::open(path);
   if (lower.ends_with(".vxlz")) {
     // A package is unpacked into an unlinked temporary .vxl: the mapping keeps it alive, nothing is left.
@@ -25,6 +33,7 @@ VxlFile open_scene(const std::string& path, double voxel_size) {
   }
 
   Tractogram t = read_tractogram(path);
+  for (const std::string& f : tsf) attach_tsf(t, f);
   for (const std::string& w : t.source.warnings) std::fprintf(stderr, "voxview: warning: %s: %s\n", path.c_str(), w.c_str());
   std::filesystem::path temp = std::filesystem::temp_directory_path() /
                                ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
@@ -33,11 +42,48 @@ VxlFile open_scene(const std::string& path, double voxel_size) {
   convert_tractogram(std::move(t), temp.string(), settings);
   VxlFile f = VxlFile::open(temp.string());
   std::filesystem::remove(temp);  // the mapping keeps the data; nothing is left behind
+  std::string tsf_options;
+  for (const std::string& f : tsf) tsf_options += " --tsf '" + f + "'";
   std::fprintf(stderr,
                "voxview: converted %s in memory. To reopen it instantly, convert once:\n"
-               "  voxlines convert '%s' '%s.vxl'\n",
-               path.c_str(), path.c_str(), std::filesystem::path(path).stem().string().c_str());
+               "  voxlines convert '%s' '%s.vxl'%s\n",
+               path.c_str(), path.c_str(), std::filesystem::path(path).stem().string().c_str(), tsf_options.c_str());
   return f;
+}
+
+std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double voxel_size, const std::vector<std::string>& tsf) {
+  if (!tsf.empty() && paths.size() != 1)
+    throw Error(ErrorKind::Usage, "", std::nullopt,
+                "--tsf needs a single input tractogram (it has one value per point of that file); convert each with "
+                "voxlines convert IN.tck OUT.vxl --tsf FILE.tsf and open the .vxl files together");
+  std::vector<VxlFile> files;
+  for (const std::string& p : paths) files.push_back(open_scene(p, voxel_size, tsf));
+  return files;
+}
+
+std::vector<const VxlFile*> pointers(const std::vector<VxlFile>& files) {
+  std::vector<const VxlFile*> out;
+  for (const VxlFile& f : files) out.push_back(&f);
+  return out;
+}
+
+void check_color_options(const std::string& path, const Renderer& r, const RenderSettings& s) {
+  const auto& names = r.value_set_names();
+  std::string available;
+  for (const std::string& n : names) available += (available.empty() ? "" : ", ") + n;
+  if (s.color == ColorMode::Scalar && names.empty())
+    throw Error(ErrorKind::Usage, path, std::nullopt,
+                "--color scalar: this tractogram has no per-point or per-streamline values (add a TSF with --tsf, or "
+                "use a TRK with scalars or properties, a TRX with dpv or dps)");
+  if (!s.scalar.empty() && std::find(names.begin(), names.end(), s.scalar) == names.end())
+    throw Error(ErrorKind::Usage, path, std::nullopt,
+                "--scalar: no value set '" + s.scalar + "'" + (names.empty() ? " (it has none)" : " (it has: " + available + ")"));
+  for (const GroupStyle& g : s.group_styles)
+    if (r.groups().find(g.name) < 0) {
+      std::string groups;
+      for (const SceneGroup& sg : r.groups().groups()) groups += (groups.empty() ? "" : ", ") + sg.name;
+      throw Error(ErrorKind::Usage, path, std::nullopt, "--group: no group '" + g.name + "' (groups: " + groups + ")");
+    }
 }
 
 }  // namespace vxl::app

@@ -4,11 +4,28 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "vxl_file.h"
 
+namespace vxl {
+class Renderer;
+struct RenderSettings;
+}  // namespace vxl
+
 namespace vxl::app {
 
-VxlFile open_scene(const std::string& path, double voxel_size_for_sources);
+// `tsf`: MRtrix track scalar files to attach to a source tractogram (refused for a .vxl / .vxlz, whose values
+// were fixed at conversion).
+VxlFile open_scene(const std::string& path, double voxel_size_for_sources, const std::vector<std::string>& tsf = {});
+
+// Opens every input of a scene (open_scene each; --tsf only with a single source input). Throws vxl::Error.
+std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double voxel_size_for_sources,
+                                 const std::vector<std::string>& tsf);
+std::vector<const VxlFile*> pointers(const std::vector<VxlFile>& files);
+
+// Refuses colour options the scene cannot honour, naming the file and what it has: --color scalar without
+// values, an unknown --scalar, a --group that is no group of the scene.
+void check_color_options(const std::string& path, const Renderer& renderer, const RenderSettings& settings);
 
 }  // namespace vxl::app

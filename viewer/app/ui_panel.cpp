@@ -1,5 +1,6 @@
 #include "ui_panel.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include <imgui.h>
@@ -29,6 +30,131 @@ std::string count_text(std::uint64_t n) {
 
 void view_button(const char* label, const char* view, PanelRequests& out) {
   if (ImGui::Button(label)) out.view = parse_view(view);
+}
+
+// Colour mode, fixed colour, value set, colour map and range, and each group's colour and opacity.
+void colour_controls(PanelState& state, const PanelStats& stats) {
+  RenderSettings& s = state.settings;
+  int colour = static_cast<int>(s.color);
+  ImGui::AlignTextToFramePadding();
+  ImGui::TextUnformatted("Colour");
+  ImGui::SameLine();
+  ImGui::RadioButton("direction", &colour, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("fixed", &colour, 1);
+  ImGui::SameLine();
+  // Picking a colour means the user wants it shown.
+  if (ImGui::ColorEdit3("##fixed colour", &s.fixed_color.x, ImGuiColorEditFlags_NoInputs)) colour = 1;
+  ImGui::TextUnformatted("      ");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(stats.value_sets.empty());
+  ImGui::RadioButton("scalar", &colour, 2);
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  ImGui::RadioButton("group", &colour, 3);
+  s.color = static_cast<ColorMode>(colour);
+
+  if (s.color == ColorMode::Scalar && !stats.value_sets.empty()) {
+    const std::string current = s.scalar.empty() ? stats.value_sets.front() : s.scalar;
+    if (ImGui::BeginCombo("Values", current.c_str())) {
+      for (const std::string& name : stats.value_sets)
+        if (ImGui::Selectable(name.c_str(), name == current)) s.scalar = name;
+      ImGui::EndCombo();
+    }
+    if (ImGui::BeginCombo("Colour map", colormap_name(s.colormap))) {
+      for (Colormap m : {Colormap::Grey, Colormap::Hot, Colormap::Viridis})
+        if (ImGui::Selectable(colormap_name(m), m == s.colormap)) s.colormap = m;
+      ImGui::EndCombo();
+    }
+    bool automatic = !s.range.has_value();
+    if (ImGui::Checkbox("auto range", &automatic)) {
+      if (automatic) s.range.reset();
+      else s.range = stats.scalar_range;
+    }
+    ImGui::SameLine();
+    ImGui::BeginDisabled(automatic);
+    std::array<float, 2> r = s.range.value_or(stats.scalar_range);
+    const float speed = std::max(1e-6f, (r[1] - r[0]) / 200.0f);
+    ImGui::PushItemWidth(110);
+    if (ImGui::DragFloatRange2("##range", &r[0], &r[1], speed, 0.0f, 0.0f, "%.4g", "%.4g") && r[1] > r[0]) s.range = r;
+    ImGui::PopItemWidth();
+    ImGui::EndDisabled();
+  }
+  if (stats.groups.size() > 1 || s.color == ColorMode::Group) {
+    if (ImGui::CollapsingHeader("Groups", ImGuiTreeNodeFlags_DefaultOpen)) {
+      for (std::size_t g = 0; g < stats.groups.size(); ++g) {
+        const auto& [name, count] = stats.groups[g];
+        ImGui::PushID(static_cast<int>(g));
+        glm::vec4 c = s.group_color(name, g);
+        if (ImGui::ColorEdit3("##colour", &c.x, ImGuiColorEditFlags_NoInputs)) s.style_of(name).color = glm::vec3(c);
+        ImGui::SameLine();
+        ImGui::PushItemWidth(90);
+        if (ImGui::SliderFloat("##opacity", &c.w, 0.0f, 1.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp)) s.style_of(name).opacity = c.w;
+        ImGui::PopItemWidth();
+        ImGui::SameLine();
+        ImGui::Text("%s (%s)", name.c_str(), count_text(count).c_str());
+        ImGui::PopID();
+      }
+    }
+  }
+}
+
+// Slab (thickness, move) and up to three clip planes (on/off, side and axis, position within the bounds).
+void clipping_controls(PanelState& state, const PanelStats& stats, PanelRequests& out) {
+  Clipping& c = state.settings.clipping;
+  ImGui::Separator();
+  bool slab = c.slab_mm > 0;
+  if (ImGui::Checkbox("Slab", &slab)) c.slab_mm = slab ? state.slab_thickness : 0.0;
+  ImGui::SameLine();
+  ImGui::PushItemWidth(110);
+  float thickness = static_cast<float>(state.slab_thickness);
+  if (ImGui::DragFloat("mm##slab", &thickness, 0.1f, 0.1f, 1000.0f, "%.1f", ImGuiSliderFlags_AlwaysClamp)) {
+    state.slab_thickness = thickness;
+    if (c.slab_mm > 0) c.slab_mm = thickness;
+  }
+  ImGui::PopItemWidth();
+  ImGui::SameLine();
+  ImGui::BeginDisabled(c.slab_mm <= 0);
+  if (ImGui::ArrowButton("##nearer", ImGuiDir_Left)) out.move_focus = -1.0;
+  ImGui::SameLine();
+  if (ImGui::ArrowButton("##farther", ImGuiDir_Right)) out.move_focus = 1.0;
+  ImGui::SameLine();
+  ImGui::TextUnformatted("move");
+  ImGui::EndDisabled();
+
+  static const char* const kSides[] = {"x >=", "y >=", "z >=", "x <=", "y <=", "z <="};
+  for (std::size_t i = 0; i < c.planes.size(); ++i) {
+    AxisClip& p = c.planes[i];
+    ImGui::PushID(static_cast<int>(i));
+    ImGui::Checkbox("##on", &p.enabled);
+    ImGui::SameLine();
+    ImGui::PushItemWidth(60);
+    int side = p.axis + (p.keep_above ? 0 : 3);
+    if (ImGui::Combo("##side", &side, kSides, 6)) {
+      p.axis = side % 3;
+      p.keep_above = side < 3;
+    }
+    ImGui::PopItemWidth();
+    ImGui::SameLine();
+    ImGui::PushItemWidth(150);
+    float pos = static_cast<float>(p.position);
+    const float lo = static_cast<float>(stats.bounds_min[p.axis]), hi = static_cast<float>(stats.bounds_max[p.axis]);
+    if (ImGui::SliderFloat("mm##pos", &pos, lo, hi, "%.1f")) p.position = pos;
+    ImGui::PopItemWidth();
+    ImGui::SameLine();
+    const bool remove = ImGui::SmallButton("x");
+    ImGui::PopID();
+    if (remove) {
+      c.planes.erase(c.planes.begin() + static_cast<std::ptrdiff_t>(i));
+      break;
+    }
+  }
+  if (c.planes.size() < Clipping::kMaxPlanes && ImGui::Button("Add clip plane")) {
+    AxisClip p;
+    p.axis = static_cast<int>(c.planes.size());  // x, then y, then z, through the scene's centre
+    p.position = (stats.bounds_min[p.axis] + stats.bounds_max[p.axis]) / 2;
+    c.planes.push_back(p);
+  }
 }
 
 }  // namespace
@@ -82,17 +208,8 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   ImGui::SliderFloat("Opacity", &s.opacity, 0.001f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
   ImGui::SliderFloat("Line width", &s.line_width, 1.0f, stats.max_line_width, "%.1f px", ImGuiSliderFlags_AlwaysClamp);
 
-  int colour = s.color == ColorMode::Fixed ? 1 : 0;
-  ImGui::AlignTextToFramePadding();
-  ImGui::TextUnformatted("Colour");
-  ImGui::SameLine();
-  ImGui::RadioButton("direction", &colour, 0);
-  ImGui::SameLine();
-  ImGui::RadioButton("fixed", &colour, 1);
-  ImGui::SameLine();
-  // Picking a colour means the user wants it shown.
-  if (ImGui::ColorEdit3("##fixed colour", &s.fixed_color.x, ImGuiColorEditFlags_NoInputs)) colour = 1;
-  s.color = colour == 1 ? ColorMode::Fixed : ColorMode::Direction;
+  colour_controls(state, stats);
+  ImGui::Checkbox("Lighting", &s.lighting);
 
   int background = s.white_background ? 1 : 0;
   ImGui::AlignTextToFramePadding();
@@ -112,6 +229,8 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   ImGui::RadioButton("all", &grid_scope, 1);
   state.grid_all = grid_scope == 1;
   ImGui::EndDisabled();
+
+  clipping_controls(state, stats, out);
 
   ImGui::Separator();
   ImGui::AlignTextToFramePadding();
@@ -140,6 +259,8 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   out.screenshot = ImGui::Button("Screenshot");
   ImGui::SameLine();
   ImGui::Checkbox("with panel", &state.panel_in_screenshot);
+  ImGui::SameLine();
+  out.save_view = ImGui::Button("Save view");
 
   ImGui::Separator();
   ImGui::Text("Frame      %.2f ms", stats.frame_ms);
@@ -163,7 +284,14 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
         "O             orthographic / perspective\n"
         "M             next transparency mode\n"
         "+ -           opacity x / : 1.5\n"
+        "L             lighting on / off\n"
         "S             screenshot    R  reset camera\n"
+        "V             save the view (for --camera)\n"
+        "C             slab on / off\n"
+        "[ ]           slab thinner / thicker\n"
+        "PgUp PgDn     move the slab (shift: x10; or ctrl + wheel)\n"
+        "F1 F2 F3      toggle clip plane 1 2 3 (adds one through\n"
+        "              the focus on x, y, z if missing)\n"
         "Esc Q         quit");
   }
   ImGui::PopItemWidth();

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "render_settings.h"
 
@@ -21,6 +23,7 @@ struct PanelState {
   bool grid = false;               // voxel-grid overlay
   bool grid_all = false;           // all voxels, not only those the frame draws
   bool panel_in_screenshot = false;
+  double slab_thickness = 10.0;    // mm, kept while the slab is off (settings.clipping.slab_mm is 0 then)
 };
 
 // What the panel only shows.
@@ -36,12 +39,18 @@ struct PanelStats {
   float max_line_width = 16.0f;    // the driver's wide-line limit
   std::string error;               // shown in red until the next one replaces it
   std::string status;              // e.g. where the last screenshot went
+  double bounds_min[3] = {0, 0, 0}, bounds_max[3] = {0, 0, 0};  // scene bounds, for the clip-plane sliders
+  std::vector<std::string> value_sets;                          // what --color scalar can show
+  std::vector<std::pair<std::string, std::uint64_t>> groups;    // name, streamlines
+  std::array<float, 2> scalar_range = {0, 1};                   // the range in use
 };
 
 struct PanelRequests {
   std::optional<std::array<double, 2>> view;  // azimuth, elevation
   bool reset_camera = false;
   bool screenshot = false;
+  bool save_view = false;  // write the view (camera and settings) for --camera
+  double move_focus = 0;  // mm along the view direction (moves the slab)
 };
 
 class UiPanel {

@@ -1,9 +1,12 @@
 // `voxview`: look into a tractogram with correct-looking transparency, in a window or headless.
+#include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "camera_file.h"
 #include "error.h"
 #include "headless_render.h"
 #include "viewer_options.h"
@@ -12,34 +15,144 @@
 int main(int argc, char** argv) {
   using namespace vxl;
   app::ViewerOptions o;
-  std::string mode = "axis", view, size = "1024x1024", color = "direction", background = "black";
+  std::string mode = "axis", view, size = "1024x1024", color = "direction", background = "black", camera_file;
+  std::string fixed_color, scalar, colormap = "viridis", range;
+  std::vector<std::string> groups;
+  float opacity = 0.3f, line_width = 1.0f;
+  double slab = 0;
+  bool lighting = false;
   CLI::App cli{"voxview " VOXLINES_VERSION
                " — transparent tractogram viewer (Voxlines method).\n"
+               "voxview FILE... [--render OUT.png]: a window, or headless to PNG with --render.\n"
                "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx is converted in memory first.\n"
                "Window: left drag orbits, right/middle drag (or Shift+left) pans, wheel zooms. Keys: 1/2/3 axial/sagittal/coronal,\n"
-               "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, S screenshot, R reset, Esc/Q quit."};
-  cli.add_option("file", o.input, "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx tractogram")->required();
-  cli.add_option("--render", o.render_png, "render one frame headless (EGL, no display needed) to this PNG and exit");
+               "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, L lighting, S screenshot, R reset,\n"
+               "Esc/Q quit.\n"
+               "Slab and clip planes: C slab on/off, [ ] thinner/thicker, PageUp/PageDown or Ctrl+wheel move the slab\n"
+               "(the focus) along the view direction (Shift: 10x), F1/F2/F3 toggle clip planes 1/2/3. V saves the view (see\n"
+               "--save-camera) for replaying headless with --camera."};
+  cli.add_option("files", o.inputs,
+                 "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx tractogram; several are shown together "
+                 "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
+      ->required();
+  cli.add_option("--render", o.render_png, "render headless (EGL, no display needed) to this PNG and exit");
+  cli.add_option("--turntable", o.turntable,
+                 "with --render: N frames turning once around the vertical (superior) axis, written as OUT_000.png, "
+                 "OUT_001.png, ... (frame i at azimuth + 360 i / N degrees; frame 0 is the plain --render view)")
+      ->check(CLI::Range(1, 100000));
+  cli.add_option("--camera", camera_file,
+                 "start from a saved view (camera and settings; JSON, see --save-camera); options given as well "
+                 "override it");
+  cli.add_option("--save-camera", o.save_camera,
+                 "write the view (camera and settings) to this JSON file: headless after rendering, in the window on "
+                 "V, the panel's Save view button, or on quitting after --frames");
   cli.add_option("--mode", mode, "opaque | unsorted | additive | wboit | basic | axis | exact")->default_val("axis")
       ->check(CLI::IsMember({"opaque", "unsorted", "additive", "wboit", "basic", "axis", "exact"}));
-  cli.add_option("--opacity", o.settings.opacity, "line opacity, 1 down to 0.001")->default_val(0.3)
-      ->check(CLI::Range(0.001, 1.0));
+  cli.add_option("--opacity", opacity, "line opacity, 1 down to 0.001")->default_val(0.3)->check(CLI::Range(0.001, 1.0));
   cli.add_option("--view", view, "axial, inferior, sagittal (left), right, coronal (anterior), posterior, or AZ,EL in degrees");
   cli.add_option("--size", size, "image or window size WxH")->default_val("1024x1024");
   cli.add_flag("--ortho", o.orthographic, "orthographic projection (default perspective)");
-  cli.add_option("--color", color, "direction (|p1 - p0| as RGB) or fixed")->default_val("direction")
-      ->check(CLI::IsMember({"direction", "fixed"}));
-  cli.add_option("--line-width", o.settings.line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
+  cli.add_option("--color", color,
+                 "direction (|p1 - p0| as RGB), fixed (--fixed-color), scalar (a value set through --colormap) or group "
+                 "(one colour per TRX group, or per file when several are shown)")
+      ->default_val("direction")->check(CLI::IsMember({"direction", "fixed", "scalar", "group"}));
+  cli.add_option("--fixed-color", fixed_color, "the fixed colour, #RRGGBB (also for points without a value)")
+      ->check([](const std::string& v) { return parse_hex_color(v) ? std::string() : "expected #RRGGBB, got '" + v + "'"; });
+  cli.add_option("--scalar", scalar,
+                 "the value set to colour by (a TSF's file name, a TRK scalar or property, a TRX dpv or dps name); "
+                 "default: the first");
+  cli.add_option("--colormap", colormap, "grey, hot or viridis, for --color scalar")->default_val("viridis")
+      ->check(CLI::IsMember({"grey", "gray", "hot", "viridis"}));
+  cli.add_option("--range", range, "MIN,MAX: the values at the colour map's ends (default: the set's minimum and maximum)");
+  cli.add_option("--group", groups,
+                 "NAME=#RRGGBB[:OPACITY] or NAME=:OPACITY: a group's colour and opacity (a factor on --opacity; 0 hides "
+                 "it), repeatable")
+      ->expected(1)->take_all();
+  cli.add_option("--tsf", o.tsf, "a TSF file of per-point values for a .tck given as input (converted in memory), repeatable")
+      ->expected(1)->take_all();
+  cli.add_flag("--lighting", lighting,
+               "light the lines (illuminated lines: a line along the light, which comes from the viewer's upper left, is "
+               "dark, one across it bright)");
+  cli.add_option("--line-width", line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
   cli.add_option("--background", background, "black or white")->default_val("black")->check(CLI::IsMember({"black", "white"}));
+  std::vector<std::string> clips;
+  cli.add_option("--slab", slab,
+                 "crop to a slab MM thick, centred on the focus point (the view's centre), perpendicular to the view "
+                 "direction (mrview's crop to slab)")
+      ->check(CLI::PositiveNumber);
+  cli.add_option("--clip", clips,
+                 "clip plane AXIS,POS in RAS mm, up to 3: x,10 keeps x >= 10, -x,10 keeps x <= 10 (axes x y z, -x -y -z)")
+      ->expected(1)->take_all();
   cli.add_option("--voxel-size", o.voxel_size, "voxel size in mm when converting a source file in memory")
       ->default_val(10.0)->check(CLI::PositiveNumber);
   cli.add_option("--frames", o.frames, "window: quit after this many frames (for scripts and tests)")->check(CLI::PositiveNumber);
   cli.add_option("--screenshot", o.screenshot, "window: save the last frame to this PNG before quitting");
   try {
-    cli.parse(argc, argv);
-    o.settings.mode = *parse_render_mode(mode);
-    o.settings.color = color == "fixed" ? ColorMode::Fixed : ColorMode::Direction;
-    o.settings.white_background = background == "white";
+    // "--clip -x,10": CLI11 would take "-x,10" for an option; pass it as "--clip=-x,10".
+    std::vector<std::string> args;
+    for (int i = argc - 1; i >= 1; --i) {
+      const std::string a = argv[i];
+      if (i >= 2 && std::string(argv[i - 1]) == "--clip" && a.size() > 1 && a[0] == '-' && a[1] != '-') {
+        args.push_back("--clip=" + a);
+        --i;
+      } else {
+        args.push_back(a);
+      }
+    }
+    cli.name("voxview");
+    cli.parse(args);
+    auto given = [&](const char* name) { return cli.get_option(name)->count() > 0; };
+    if (o.turntable && !o.render_png)
+      throw Error(ErrorKind::Usage, "", std::nullopt, "--turntable needs --render OUT.png (it writes OUT_000.png, ...)");
+
+    // Settings: the defaults, then a saved view, then what the command line gives explicitly.
+    RenderSettings& s = o.settings;
+    s.opacity = opacity;
+    if (!camera_file.empty()) {
+      app::SavedView defaults;
+      defaults.settings = s;
+      app::SavedView saved = app::read_view(camera_file, defaults);
+      s = saved.settings;
+      o.camera = saved.camera;
+      if (saved.size && !given("--size")) size = std::to_string((*saved.size)[0]) + "x" + std::to_string((*saved.size)[1]);
+    }
+    const bool from_file = o.camera.has_value();
+    if (!from_file || given("--mode")) s.mode = *parse_render_mode(mode);
+    if (!from_file || given("--opacity")) s.opacity = opacity;
+    if (!from_file || given("--color")) s.color = *parse_color_mode(color);
+    if (given("--fixed-color")) s.fixed_color = *parse_hex_color(fixed_color);
+    if (given("--scalar")) s.scalar = scalar;
+    if (!from_file || given("--colormap")) s.colormap = *parse_colormap(colormap);
+    if (given("--range")) {
+      float lo = 0, hi = 0;
+      char end = 0;
+      if (std::sscanf(range.c_str(), "%f,%f%c", &lo, &hi, &end) != 2 || !std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo))
+        throw Error(ErrorKind::Usage, "", std::nullopt, "--range: expected MIN,MAX with MIN < MAX (e.g. 0,0.5); got '" + range + "'");
+      s.range = std::array<float, 2>{lo, hi};
+    }
+    for (const std::string& g : groups) {
+      auto style = parse_group_style(g);
+      if (!style)
+        throw Error(ErrorKind::Usage, "", std::nullopt,
+                    "--group: expected NAME=#RRGGBB, NAME=#RRGGBB:OPACITY or NAME=:OPACITY (opacity 0..1); got '" + g + "'");
+      GroupStyle& existing = s.style_of(style->name);
+      if (style->color) existing.color = style->color;
+      existing.opacity = style->opacity;
+    }
+    if (!from_file || given("--background")) s.white_background = background == "white";
+    if (!from_file || given("--line-width")) s.line_width = line_width;
+    if (lighting) s.lighting = true;
+    if (given("--slab")) s.clipping.slab_mm = slab;
+    if (clips.size() > Clipping::kMaxPlanes)
+      throw Error(ErrorKind::Usage, "", std::nullopt, "--clip: at most 3 clip planes (got " + std::to_string(clips.size()) + ")");
+    if (!clips.empty()) s.clipping.planes.clear();
+    for (const std::string& c : clips) {
+      auto plane = parse_axis_clip(c);
+      if (!plane)
+        throw Error(ErrorKind::Usage, "", std::nullopt,
+                    "--clip: expected AXIS,POS with AXIS one of x y z -x -y -z and POS in mm (e.g. -z,12.5); got '" + c + "'");
+      s.clipping.planes.push_back(*plane);
+    }
     if (!view.empty()) {
       o.view = parse_view(view);
       if (!o.view) throw Error(ErrorKind::Usage, "", std::nullopt, "--view: unknown view '" + view + "'");

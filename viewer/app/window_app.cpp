@@ -7,6 +7,7 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -16,9 +17,11 @@
 #include <GLFW/glfw3.h>
 
 #include "camera_controller.h"
+#include "camera_file.h"
 #include "grid_overlay.h"
 #include "headless_render.h"
 #include "image_io.h"
+#include "offscreen_target.h"
 #include "renderer.h"
 #include "scene_source.h"
 #include "ui_panel.h"
@@ -56,7 +59,8 @@ WindowPtr open_window(const ViewerOptions& o) {
   // Not forward-compatible: that would forbid line widths above 1.
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_FALSE);
   glfwWindowHint(GLFW_DEPTH_BITS, 24);  // the opaque mode depth-tests in the default framebuffer
-  const std::string title = "voxview - " + std::filesystem::path(o.input).filename().string();
+  std::string title = "voxview -";
+  for (const std::string& in : o.inputs) title += " " + std::filesystem::path(in).filename().string();
   GLFWwindow* w = glfwCreateWindow(o.width, o.height, title.c_str(), nullptr, nullptr);
   if (!w)
     throw std::runtime_error("cannot open an OpenGL 3.3 core window: " + g_glfw_error + "; " + kHeadlessHint);
@@ -95,16 +99,17 @@ Image read_back_buffer(int width, int height) {
   return img;
 }
 
-// voxview-YYYYMMDD-HHMMSS.png in the current directory, with a suffix when taken twice in a second.
-std::filesystem::path screenshot_name() {
+// voxview-YYYYMMDD-HHMMSS.png (or .json, ...) in the current directory, with a suffix when taken twice in
+// a second.
+std::filesystem::path stamped_name(const std::string& prefix, const std::string& extension) {
   std::time_t now = std::time(nullptr);
   std::tm local{};
   localtime_r(&now, &local);
   char stamp[32];
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &local);
-  std::filesystem::path p = std::filesystem::current_path() / (std::string("voxview-") + stamp + ".png");
+  std::filesystem::path p = std::filesystem::current_path() / (prefix + stamp + extension);
   for (int n = 2; std::filesystem::exists(p); ++n)
-    p = std::filesystem::current_path() / (std::string("voxview-") + stamp + "-" + std::to_string(n) + ".png");
+    p = std::filesystem::current_path() / (prefix + stamp + "-" + std::to_string(n) + extension);
   return p;
 }
 
@@ -112,7 +117,7 @@ std::filesystem::path screenshot_name() {
 // user pointer.
 class ViewerWindow {
  public:
-  ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwindow* window);
+  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, GLFWwindow* window);
   int run();
 
  private:
@@ -122,6 +127,7 @@ class ViewerWindow {
   void on_scroll(double steps);
   void on_key(int key, int action, int mods);
   void on_char(unsigned codepoint);
+  void toggle_clip_plane(std::size_t i);
 
   Camera home_camera(double aspect, bool orthographic) const;
   void reset_camera(double aspect);
@@ -129,27 +135,34 @@ class ViewerWindow {
   void set_error(const std::string& message);
   void draw_scene(int width, int height);
   void save_screenshot(const std::string& path, int width, int height);
+  // Writes the current view (camera, settings, size) to --save-camera's path or a stamped name.
+  void save_view(int width, int height);
 
   const ViewerOptions& options_;
   GLFWwindow* window_;
   Renderer renderer_;
   GridOverlay grid_;
+  // The scene is drawn here and blitted to the window: it blends in float like headless rendering, so
+  // faint layers add up beyond 8-bit rounding and the window shows what --render writes.
+  std::optional<OffscreenTarget> scene_target_;
   CameraController controller_;
   std::unique_ptr<UiPanel> panel_;  // created after our callbacks, which ImGui then chains to
   PanelState state_;
   PanelStats stats_;
   int drag_button_ = -1;
   bool screenshot_requested_ = false;
+  bool save_view_requested_ = false;
   RenderMode drawn_mode_ = RenderMode::Axis;  // the mode of the last frame, to clear a mode's error once another is chosen
   unsigned events_ = 0;  // input events seen, to keep drawing while something happens
 };
 
-ViewerWindow::ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwindow* window)
+ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, GLFWwindow* window)
     : options_(o),
       window_(window),
-      renderer_(file),
+      renderer_(pointers(files)),
       grid_(renderer_),
       controller_(Camera{}, std::max(1.0, glm::length(renderer_.bounds_max() - renderer_.bounds_min()) * 0.5)) {
+  check_color_options(o.inputs_name(), renderer_, o.settings);
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
   glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -159,13 +172,23 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const VxlFile& file, GLFWwind
   state_.settings = o.settings;
   drawn_mode_ = o.settings.mode;
   state_.orthographic = o.orthographic;
-  stats_.title = std::filesystem::path(o.input).filename().string();
-  stats_.voxels_total = file.meta().voxel_count;
-  stats_.segments_total = file.meta().segment_count;
+  stats_.title = std::filesystem::path(o.inputs.front()).filename().string();
+  if (files.size() > 1) stats_.title += " + " + std::to_string(files.size() - 1) + " more";
+  for (const VxlFile& f : files) {
+    stats_.voxels_total += f.meta().voxel_count;
+    stats_.segments_total += f.meta().segment_count;
+  }
   stats_.gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   stats_.gl_version = std::to_string(major) + "." + std::to_string(minor);
   stats_.exact_available = major * 10 + minor >= 43;
   stats_.max_line_width = std::clamp(widths[1], 1.0f, 16.0f);
+  stats_.value_sets = renderer_.value_set_names();
+  for (const SceneGroup& g : renderer_.groups().groups()) stats_.groups.emplace_back(g.name, g.streamlines);
+  for (int c = 0; c < 3; ++c) {
+    stats_.bounds_min[c] = renderer_.bounds_min()[c];
+    stats_.bounds_max[c] = renderer_.bounds_max()[c];
+  }
+  if (o.settings.clipping.slab_mm > 0) state_.slab_thickness = o.settings.clipping.slab_mm;
 
   controller_.set_home(home_camera(aspect(), o.orthographic));
   controller_.reset();
@@ -234,17 +257,45 @@ void ViewerWindow::on_scroll(double steps) {
   events_++;
   double x = 0, y = 0;
   glfwGetCursorPos(window_, &x, &y);
-  if (!panel_->takes_mouse_at(x, y)) controller_.zoom(steps);
+  if (panel_->takes_mouse_at(x, y)) return;
+  // Ctrl + wheel moves the slab through the scene (as in mrview); the plain wheel zooms.
+  if (glfwGetKey(window_, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(window_, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
+    controller_.move_focus(-steps);
+  else
+    controller_.zoom(steps);
+}
+
+// Clip plane i on or off; a missing one is added through the focus point, on axis i, keeping the + side.
+void ViewerWindow::toggle_clip_plane(std::size_t i) {
+  std::vector<AxisClip>& planes = state_.settings.clipping.planes;
+  if (i < planes.size()) {
+    planes[i].enabled = !planes[i].enabled;
+    return;
+  }
+  if (planes.size() >= Clipping::kMaxPlanes) return;
+  AxisClip p;
+  p.axis = static_cast<int>(i);
+  p.position = controller_.camera().target[p.axis];
+  planes.push_back(p);
 }
 
 // Keys bound to a place on the keyboard: Esc and the digit row (with Shift for the opposite view).
 void ViewerWindow::on_key(int key, int action, int mods) {
   events_++;
-  if (action != GLFW_PRESS || panel_->wants_keyboard()) return;
+  if ((action != GLFW_PRESS && action != GLFW_REPEAT) || panel_->wants_keyboard()) return;
   const bool shift = mods & GLFW_MOD_SHIFT;
+  // Held keys repeat only for moving the slab.
+  if (key == GLFW_KEY_PAGE_UP || key == GLFW_KEY_PAGE_DOWN) {
+    controller_.move_focus((key == GLFW_KEY_PAGE_UP ? -1.0 : 1.0) * (shift ? 10.0 : 1.0));
+    return;
+  }
+  if (action != GLFW_PRESS) return;
   const char* view = nullptr;
   switch (key) {
     case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(window_, GLFW_TRUE); return;
+    case GLFW_KEY_F1: toggle_clip_plane(0); return;
+    case GLFW_KEY_F2: toggle_clip_plane(1); return;
+    case GLFW_KEY_F3: toggle_clip_plane(2); return;
     case GLFW_KEY_1: view = shift ? "inferior" : "axial"; break;
     case GLFW_KEY_2: view = shift ? "right" : "sagittal"; break;
     case GLFW_KEY_3: view = shift ? "posterior" : "coronal"; break;
@@ -268,8 +319,20 @@ void ViewerWindow::on_char(unsigned c) {
     case '+': case '=': s.opacity = std::clamp(s.opacity * 1.5f, 0.001f, 1.0f); break;
     case '-': case '_': s.opacity = std::clamp(s.opacity / 1.5f, 0.001f, 1.0f); break;
     case 's': case 'S': screenshot_requested_ = true; break;
+    case 'l': case 'L': s.lighting = !s.lighting; break;
+    case 'v': case 'V': save_view_requested_ = true; break;
     case 'r': case 'R': reset_camera(aspect()); break;
     case 'q': case 'Q': glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
+    case 'c': case 'C': {
+      double& slab = s.clipping.slab_mm;
+      slab = slab > 0 ? 0.0 : state_.slab_thickness;
+      break;
+    }
+    case '[': case ']': {
+      state_.slab_thickness = std::clamp(state_.slab_thickness * (c == ']' ? 1.25 : 0.8), 0.1, 1000.0);
+      if (s.clipping.slab_mm > 0) s.clipping.slab_mm = state_.slab_thickness;
+      break;
+    }
     default: break;
   }
 }
@@ -283,25 +346,34 @@ void ViewerWindow::draw_scene(int width, int height) {
   }
   const auto t0 = std::chrono::steady_clock::now();
   const Camera& camera = controller_.camera();
+  if (!scene_target_) scene_target_.emplace(width, height);
+  if (scene_target_->width() != width || scene_target_->height() != height) scene_target_->resize(width, height);
+  const GLuint target = scene_target_->framebuffer();
   try {
-    renderer_.draw(camera, s, width, height, 0);
+    renderer_.draw(camera, s, width, height, target);
   } catch (const std::exception& e) {
     // A mode that cannot run here (e.g. exact out of node memory): say so and keep showing something.
     set_error(std::string(render_mode_name(s.mode)) + ": " + e.what() + ": showing axis");
     s.mode = RenderMode::Axis;
-    renderer_.draw(camera, s, width, height, 0);
+    renderer_.draw(camera, s, width, height, target);
   }
+  scene_target_->bind();
   drawn_mode_ = s.mode;
   if (state_.grid) {
     const glm::vec4 colour = s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
     grid_.draw(renderer_, camera, double(width) / height, state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn,
-               colour);
+               colour, s.clipping);
     stats_.grid_cubes = grid_.cubes_drawn();
   }
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, target);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glFinish();  // the frame time should include the GPU's work, not only its submission
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
   const FrameStats& f = renderer_.stats();
+  stats_.scalar_range = renderer_.scalar_range(s);
   stats_.plan_ms = f.plan_ms;
   stats_.voxels_drawn = f.voxels_drawn;
   stats_.segments_drawn = f.segments_drawn;
@@ -312,6 +384,19 @@ void ViewerWindow::save_screenshot(const std::string& path, int width, int heigh
   stats_.status = "saved " + path;
   std::printf("voxview: screenshot %dx%d saved to %s\n", width, height, path.c_str());
   std::fflush(stdout);
+}
+
+void ViewerWindow::save_view(int width, int height) {
+  const std::string path = options_.save_camera.value_or(stamped_name("voxview-view-", ".json").string());
+  try {
+    write_view(path, SavedView{controller_.camera(), state_.settings, std::array<int, 2>{width, height}});
+    stats_.status = "view saved to " + path;
+    std::printf("voxview: view saved to %s (replay: voxview FILE --camera '%s' --render OUT.png)\n", path.c_str(),
+                path.c_str());
+    std::fflush(stdout);
+  } catch (const std::exception& e) {
+    set_error(e.what());
+  }
 }
 
 int ViewerWindow::run() {
@@ -342,14 +427,19 @@ int ViewerWindow::run() {
     controller_.set_orthographic(state_.orthographic);
     if (requests.view) controller_.set_view((*requests.view)[0], (*requests.view)[1]);
     if (requests.reset_camera) reset_camera(double(fb_w) / fb_h);
+    if (requests.move_focus != 0) controller_.move_focus(requests.move_focus);
     screenshot_requested_ |= requests.screenshot;
+    save_view_requested_ |= requests.save_view;
 
     draw_scene(fb_w, fb_h);
     // Screenshots show the scene alone unless the user asked for the panel too; automated ones never do.
     if (closing && options_.screenshot) save_screenshot(*options_.screenshot, fb_w, fb_h);
+    // The view of the frame just drawn; scripts get it on quitting after --frames.
+    if (save_view_requested_ || (closing && automated && options_.save_camera)) save_view(fb_w, fb_h);
+    save_view_requested_ = false;
     if (screenshot_requested_ && !state_.panel_in_screenshot) {
       try {
-        save_screenshot(screenshot_name().string(), fb_w, fb_h);
+        save_screenshot(stamped_name("voxview-", ".png").string(), fb_w, fb_h);
       } catch (const std::exception& e) {
         set_error(e.what());
       }
@@ -359,7 +449,7 @@ int ViewerWindow::run() {
     panel_->render();
     if (screenshot_requested_ && state_.panel_in_screenshot) {
       try {
-        save_screenshot(screenshot_name().string(), fb_w, fb_h);
+        save_screenshot(stamped_name("voxview-", ".png").string(), fb_w, fb_h);
       } catch (const std::exception& e) {
         set_error(e.what());
       }
@@ -375,9 +465,9 @@ int ViewerWindow::run() {
 
 int run_window(const ViewerOptions& o) {
   GlfwLibrary glfw;  // first: without a display, fail before any slow conversion
-  VxlFile file = open_scene(o.input, o.voxel_size);
+  const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf);
   WindowPtr window = open_window(o);
-  ViewerWindow viewer(o, file, window.get());
+  ViewerWindow viewer(o, files, window.get());
   return viewer.run();
 }
 

@@ -106,7 +106,7 @@ void OffscreenTarget::allocate() {
     try {
         glGenTextures(1, &color_tex_);
         glBindTexture(GL_TEXTURE_2D, color_tex_);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width_, height_, 0, GL_RGBA, GL_FLOAT, nullptr);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -123,7 +123,7 @@ void OffscreenTarget::allocate() {
         if (samples_ > 0) {
             glGenRenderbuffers(1, &color_rb_);
             glBindRenderbuffer(GL_RENDERBUFFER, color_rb_);
-            glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_RGBA8, width_, height_);
+            glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_RGBA32F, width_, height_);
 
             glGenFramebuffers(1, &fbo_);
             glBindFramebuffer(GL_FRAMEBUFFER, fbo_);

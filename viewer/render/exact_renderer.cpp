@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -11,21 +13,20 @@
 namespace vxl {
 namespace {
 
-const char* const kListFragment = R"(#version 430 core
+const char* const kListFragment = R"(
 layout(binding = 0, r32ui) uniform coherent uimage2D u_heads;
 layout(binding = 0, offset = 0) uniform atomic_uint u_counter;
 layout(std430, binding = 1) buffer Nodes { uvec4 nodes[]; };
 uniform uint u_capacity;
 uniform ivec4 u_band;  // x0, y0, x1, y1: only fragments inside are stored this pass
-in vec4 v_color;
-in float v_depth;
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   if (p.x < u_band.x || p.y < u_band.y || p.x >= u_band.z || p.y >= u_band.w) discard;
   uint i = atomicCounterIncrement(u_counter);
   if (i < u_capacity) {
     uint previous = imageAtomicExchange(u_heads, p, i);
-    nodes[i] = uvec4(packHalf2x16(v_color.rg), packHalf2x16(v_color.ba), floatBitsToUint(gl_FragCoord.z), previous);
+    vec4 c = line_color();
+    nodes[i] = uvec4(packHalf2x16(c.rg), packHalf2x16(c.ba), floatBitsToUint(gl_FragCoord.z), previous);
   }
   discard;  // nothing is written to the colour buffer in this pass
 }
@@ -37,76 +38,6 @@ layout(binding = 0, r32ui) uniform writeonly uimage2D u_heads;
 void main() { imageStore(u_heads, ivec2(gl_GlobalInvocationID.xy), uvec4(0xFFFFFFFFu)); }
 )";
 
-const char* const kResolveCompute = R"(#version 430 core
-layout(local_size_x = 8, local_size_y = 8) in;
-layout(binding = 0, r32ui) uniform readonly uimage2D u_heads;
-layout(binding = 1, rgba32f) uniform image2D u_result;
-layout(std430, binding = 1) readonly buffer Nodes { uvec4 nodes[]; };
-uniform ivec4 u_band;
-uniform vec3 u_background;
-const int B = 64;
-float key_depth[B];
-uint key_node[B];
-// Fragments are ordered by (depth, node index): a strict order, so equal depths are never lost.
-bool less_key(float da, uint ia, float db, uint ib) { return da < db || (da == db && ia < ib); }
-void sift_down(int root, int n) {
-  while (true) {
-    int child = 2 * root + 1;
-    if (child >= n) return;
-    if (child + 1 < n && less_key(key_depth[child + 1], key_node[child + 1], key_depth[child], key_node[child])) child++;
-    if (!less_key(key_depth[child], key_node[child], key_depth[root], key_node[root])) return;
-    float d = key_depth[root]; key_depth[root] = key_depth[child]; key_depth[child] = d;
-    uint k = key_node[root]; key_node[root] = key_node[child]; key_node[child] = k;
-    root = child;
-  }
-}
-void main() {
-  ivec2 p = ivec2(gl_GlobalInvocationID.xy) + u_band.xy;
-  if (p.x >= u_band.z || p.y >= u_band.w) return;
-  vec3 color = u_background;
-  float limit_depth = 3.0e38;   // only fragments nearer than the last batch's nearest remain
-  uint limit_node = 0xFFFFFFFFu;
-  uint head = imageLoad(u_heads, p).r;
-  while (true) {
-    // Batch: the B farthest fragments below the limit, kept in a min-heap (root = nearest kept).
-    int n = 0;
-    for (uint i = head; i != 0xFFFFFFFFu; i = nodes[i].w) {
-      float d = uintBitsToFloat(nodes[i].z);
-      if (!less_key(d, i, limit_depth, limit_node)) continue;
-      if (n < B) {
-        int c = n++;
-        key_depth[c] = d; key_node[c] = i;
-        while (c > 0) {  // sift up
-          int parent = (c - 1) / 2;
-          if (!less_key(key_depth[c], key_node[c], key_depth[parent], key_node[parent])) break;
-          float t = key_depth[c]; key_depth[c] = key_depth[parent]; key_depth[parent] = t;
-          uint u = key_node[c]; key_node[c] = key_node[parent]; key_node[parent] = u;
-          c = parent;
-        }
-      } else if (less_key(key_depth[0], key_node[0], d, i)) {
-        key_depth[0] = d; key_node[0] = i;
-        sift_down(0, n);
-      }
-    }
-    if (n == 0) break;
-    // Heap sort with a min-heap leaves the batch in descending order: farthest first.
-    for (int end = n - 1; end > 0; --end) {
-      float t = key_depth[0]; key_depth[0] = key_depth[end]; key_depth[end] = t;
-      uint u = key_node[0]; key_node[0] = key_node[end]; key_node[end] = u;
-      sift_down(0, end);
-    }
-    for (int k = 0; k < n; ++k) {
-      uvec4 node = nodes[key_node[k]];
-      vec4 c = vec4(unpackHalf2x16(node.x), unpackHalf2x16(node.y));
-      color = c.rgb * c.a + color * (1.0 - c.a);
-    }
-    limit_depth = key_depth[n - 1];
-    limit_node = key_node[n - 1];
-    if (n < B) break;
-  }
-  imageStore(u_result, p, vec4(color, 1.0));
-}
-)";
 
 const char* const kBlitFragment = R"(#version 330 core
 in vec2 v_uv;
@@ -114,6 +45,19 @@ uniform sampler2D u_result;
 out vec4 frag;
 void main() { frag = vec4(texture(u_result, v_uv).rgb, 1.0); }
 )";
+
+// IEEE binary16 -> binary32 (the colours are stored with GLSL's packHalf2x16).
+float half_to_float(std::uint16_t h) {
+  const std::uint32_t sign = std::uint32_t(h & 0x8000u) << 16, exponent = (h >> 10) & 0x1Fu, mantissa = h & 0x3FFu;
+  if (exponent == 0) {  // zero or subnormal: mantissa * 2^-24
+    const float f = std::ldexp(static_cast<float>(mantissa), -24);
+    return sign ? -f : f;
+  }
+  const std::uint32_t bits = sign | (exponent == 0x1F ? 0x7F800000u : (exponent + 112) << 23) | mantissa << 13;
+  float f;
+  std::memcpy(&f, &bits, 4);
+  return f;
+}
 
 }  // namespace
 
@@ -129,9 +73,9 @@ ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity) : lin
   std::uint64_t bytes = std::min<std::uint64_t>(static_cast<std::uint32_t>(max_block), 256ull << 20);
   capacity_ = node_capacity ? node_capacity : bytes / 16;
   const unsigned chunks = std::max<unsigned>(1, static_cast<unsigned>(lines.scene().layout().chunks().size()));
-  list_program_ = gl::make_program(shaders::line_vertex(chunks, "#version 430 core"), kListFragment);
+  list_program_ = gl::make_program(shaders::line_vertex(chunks, "#version 430 core"),
+                                   shaders::line_fragment(kListFragment, "#version 430 core"));
   clear_program_ = gl::make_compute_program(kClearCompute);
-  resolve_program_ = gl::make_compute_program(kResolveCompute);
   blit_program_ = gl::make_program(shaders::kFullscreenVertex, kBlitFragment);
   glGenBuffers(1, &nodes_);
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, nodes_);
@@ -142,7 +86,7 @@ ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity) : lin
 }
 
 ExactRenderer::~ExactRenderer() {
-  for (GLuint p : {list_program_, clear_program_, resolve_program_, blit_program_})
+  for (GLuint p : {list_program_, clear_program_, blit_program_})
     if (p) glDeleteProgram(p);
   if (nodes_) glDeleteBuffers(1, &nodes_);
   if (counter_) glDeleteBuffers(1, &counter_);
@@ -167,7 +111,7 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
   }
   const double aspect = double(width) / std::max(1, height);
   FramePlan plan;
-  lines_.plan(camera, aspect, PlanOrder::Any, plan);
+  lines_.plan(camera, aspect, PlanOrder::Any, plan, s.clipping);
   const glm::vec3 bg = s.background();
 
   // Bands of rows; a band whose fragments overflow the node buffer is split in two and redone.
@@ -210,15 +154,9 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
     }
     ++bands_used_;
     fragments_ += stored;
-    glUseProgram(resolve_program_);
-    glBindImageTexture(0, heads_, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
-    glBindImageTexture(1, result_, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_);
-    glUniform4i(glGetUniformLocation(resolve_program_, "u_band"), 0, y0, width, y1);
-    glUniform3f(glGetUniformLocation(resolve_program_, "u_background"), bg.r, bg.g, bg.b);
-    glDispatchCompute((width + 7) / 8, (y1 - y0 + 7) / 8, 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    resolve_band(y0, y1, stored, bg);
   }
+  Renderer::enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, width, height);
   glUseProgram(blit_program_);
@@ -230,6 +168,45 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
   glBindVertexArray(vao);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glDeleteVertexArrays(1, &vao);
+}
+
+void ExactRenderer::resolve_band(int y0, int y1, std::uint32_t stored, const glm::vec3& background) {
+  // The shaders' writes must be visible to the read-backs.
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  heads_copy_.resize(std::size_t(width_) * height_);
+  glBindTexture(GL_TEXTURE_2D, heads_);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glGetTexImage(GL_TEXTURE_2D, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, heads_copy_.data());
+  nodes_copy_.resize(stored);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, nodes_);
+  glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(stored) * 16, nodes_copy_.data());
+
+  rows_.resize(std::size_t(width_) * (y1 - y0) * 4);
+  std::vector<std::pair<float, std::uint32_t>> list;  // (depth, node)
+  for (int y = y0; y < y1; ++y)
+    for (int x = 0; x < width_; ++x) {
+      list.clear();
+      for (std::uint32_t i = heads_copy_[std::size_t(y) * width_ + x]; i != 0xFFFFFFFFu; i = nodes_copy_[i][3]) {
+        if (i >= stored || list.size() >= stored) throw std::runtime_error("exact mode: corrupt fragment list");
+        float depth;
+        std::memcpy(&depth, &nodes_copy_[i][2], 4);
+        list.push_back({depth, i});
+      }
+      // Farthest first; equal depths in a fixed (node) order, so no fragment is lost or doubled.
+      std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a > b; });
+      glm::vec3 color = background;
+      for (const auto& [depth, i] : list) {
+        const std::array<std::uint32_t, 4>& n = nodes_copy_[i];
+        const glm::vec3 c(half_to_float(n[0] & 0xFFFF), half_to_float(n[0] >> 16), half_to_float(n[1] & 0xFFFF));
+        const float a = half_to_float(n[1] >> 16);
+        color = c * a + color * (1.0f - a);
+      }
+      float* out = rows_.data() + (std::size_t(y - y0) * width_ + x) * 4;
+      out[0] = color.r, out[1] = color.g, out[2] = color.b, out[3] = 1.0f;
+    }
+  glBindTexture(GL_TEXTURE_2D, result_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, y0, width_, y1 - y0, GL_RGBA, GL_FLOAT, rows_.data());
 }
 
 }  // namespace vxl

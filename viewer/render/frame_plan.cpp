@@ -18,7 +18,7 @@ ViewParams make_view_params(const glm::dvec3& eye, const glm::dvec3& forward, bo
   return v;
 }
 
-std::pair<std::uint32_t, bool> nearest_order(const std::vector<glm::vec3>& directions, const glm::dvec3& w) {
+std::pair<std::uint32_t, bool> nearest_order(std::span<const glm::vec3> directions, const glm::dvec3& w) {
   // Order k drawn forwards is back to front for an eye looking along -d_k; reversed, along +d_k. We want
   // the signed direction s maximising s . (-w): |d_k . w| largest, reversed when d_k . w > 0.
   std::uint32_t best = 0;
@@ -34,15 +34,27 @@ std::pair<std::uint32_t, bool> nearest_order(const std::vector<glm::vec3>& direc
   return {best, best_dot > 0};
 }
 
+double order_alignment(std::span<const glm::vec3> directions, std::uint32_t slot, bool reversed, const glm::dvec3& w) {
+  const glm::vec3& d = directions[slot];
+  const double dot = d.x * w.x + d.y * w.y + d.z * w.z;
+  return reversed ? dot : -dot;  // forwards serves w = -d, backwards w = +d
+}
+
 namespace {
+
+// Whether the box [lo, hi] lies wholly on the negative side of plane p: its corner farthest along the
+// normal is outside.
+bool box_outside(const glm::dvec4& p, const glm::dvec3& lo, const glm::dvec3& hi) {
+  glm::dvec3 c(p.x >= 0 ? hi.x : lo.x, p.y >= 0 ? hi.y : lo.y, p.z >= 0 ? hi.z : lo.z);
+  return p.x * c.x + p.y * c.y + p.z * c.z + p.w < 0;
+}
 
 bool outside(const ViewParams& view, const VoxelDrawInfo& v) {
   glm::dvec3 lo = glm::dvec3(v.tight_min) - view.eye, hi = glm::dvec3(v.tight_max) - view.eye;
-  for (const glm::dvec4& p : view.planes) {
-    // the box corner farthest along the plane normal
-    glm::dvec3 c(p.x >= 0 ? hi.x : lo.x, p.y >= 0 ? hi.y : lo.y, p.z >= 0 ? hi.z : lo.z);
-    if (p.x * c.x + p.y * c.y + p.z * c.z + p.w < 0) return true;
-  }
+  for (const glm::dvec4& p : view.planes)
+    if (box_outside(p, lo, hi)) return true;
+  for (const glm::dvec4& p : view.clip)
+    if (box_outside(p, lo, hi)) return true;
   return false;
 }
 
@@ -63,15 +75,32 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
     plan.sort_keys.push_back({key, i});
   }
   if (order != PlanOrder::Any) std::sort(plan.sort_keys.begin(), plan.sort_keys.end());
+  const bool hysteresis = order == PlanOrder::Nearest && plan.order_hysteresis > 0;
+  if (order == PlanOrder::Nearest && !hysteresis) plan.previous_order.clear();
+  if (hysteresis && plan.previous_order.size() != voxels.size()) plan.previous_order.assign(voxels.size(), FramePlan::kNoOrder);
   plan.first.reserve(plan.sort_keys.size());
   plan.count.reserve(plan.sort_keys.size());
   for (const auto& [key, i] : plan.sort_keys) {
     const VoxelDrawInfo& v = voxels[i];
-    std::uint32_t slot = layout.block_slot();
+    std::uint32_t slot = layout.block_slot(v);
     bool reversed = false;
     if (order == PlanOrder::Nearest) {
       glm::dvec3 w = view.orthographic ? view.forward : glm::normalize(v.center - view.eye);
-      std::tie(slot, reversed) = nearest_order(layout.directions(), w);
+      const std::span<const glm::vec3> directions = layout.directions_of(i);
+      std::tie(slot, reversed) = nearest_order(directions, w);
+      if (hysteresis) {
+        std::uint8_t& previous = plan.previous_order[i];
+        if (previous != FramePlan::kNoOrder) {
+          const std::uint32_t kept_slot = previous >> 1;
+          const bool kept_reversed = previous & 1;
+          if (order_alignment(directions, slot, reversed, w) - order_alignment(directions, kept_slot, kept_reversed, w) <=
+              plan.order_hysteresis) {
+            slot = kept_slot;
+            reversed = kept_reversed;
+          }
+        }
+        previous = static_cast<std::uint8_t>(2 * slot + (reversed ? 1 : 0));
+      }
     }
     plan.first.push_back(static_cast<std::int32_t>(layout.first_id(v, slot, reversed)));
     plan.count.push_back(static_cast<std::int32_t>(2 * v.segment_count));

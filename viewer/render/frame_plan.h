@@ -1,10 +1,12 @@
-// The per-frame CPU work of the Voxlines method: drop voxels outside the view frustum, sort the visible
+// The per-frame CPU work of the Voxlines method: drop voxels outside the view frustum (and outside the
+// slab and clip planes), sort the visible
 // voxels back to front, pick each voxel's nearest precomputed order (the paper's rule), and fill the
 // first/count arrays of one glMultiDrawArrays call. No GL here.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -18,6 +20,7 @@ struct ViewParams {
   glm::dvec3 forward;                 // unit view direction (used for orthographic sorting)
   bool orthographic = false;
   std::array<glm::dvec4, 6> planes;   // frustum planes in camera-relative coordinates (p - eye), inside >= 0
+  std::vector<glm::dvec4> clip;       // slab and clip half-spaces, camera-relative likewise (clip_planes.h)
 };
 
 // Frustum planes from a projection matrix and the world->eye rotation (Gribb & Hartmann).
@@ -35,6 +38,17 @@ struct FramePlan {
   std::vector<std::int32_t> count;
   std::uint64_t voxels_drawn = 0;
   std::uint64_t segments_drawn = 0;
+
+  // Order hysteresis for PlanOrder::Nearest (off when <= 0). A voxel keeps the order it had in the
+  // previous Nearest frame unless the nearest order is closer to its view direction by more than this
+  // margin (a difference of cosines). Meant against the jitter of voxels whose view direction hovers at
+  // the boundary between two stored directions (paper, "Different sorting orders").
+  double order_hysteresis = 0;
+  // Per voxel: 2 * slot + reversed of its last Nearest order, kNoOrder when unknown. Kept only while the
+  // hysteresis is on; a Nearest frame without it forgets them.
+  static constexpr std::uint8_t kNoOrder = 0xFF;
+  std::vector<std::uint8_t> previous_order;
+
   // scratch, kept between frames to avoid allocation
   std::vector<std::pair<float, std::uint32_t>> sort_keys;
 };
@@ -42,7 +56,11 @@ struct FramePlan {
 void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder order, FramePlan& plan);
 
 // The paper's rule: for a voxel centre v and eye c, the stored direction d (or its reverse) that is
-// closest to the back-to-front direction. Returns {slot, reversed}.
-std::pair<std::uint32_t, bool> nearest_order(const std::vector<glm::vec3>& directions, const glm::dvec3& view_dir);
+// closest to the back-to-front direction w = (v - c) / |v - c|. Returns {slot, reversed}.
+std::pair<std::uint32_t, bool> nearest_order(std::span<const glm::vec3> directions, const glm::dvec3& view_dir);
+
+// How close stored order {slot, reversed} is to view direction w: the cosine between the direction it
+// serves and w (nearest_order maximises it).
+double order_alignment(std::span<const glm::vec3> directions, std::uint32_t slot, bool reversed, const glm::dvec3& view_dir);
 
 }  // namespace vxl

@@ -19,40 +19,42 @@ std::uint64_t GpuScene::driver_limit() {
 
 // Widens voxel i's stored orders to chunk-global u32 and appends its block order; checks every entry,
 // which open() does not (it would cost O(points) there).
-void GpuScene::widen_voxel(const VxlFile& file, std::uint32_t i, const ChunkLayout& c, std::vector<std::uint32_t>& entries,
-                           std::vector<std::uint8_t>& is_start) const {
-  const VoxelEntry& v = file.voxels()[i];
+void GpuScene::widen_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t li, const ChunkLayout& c,
+                           std::vector<std::uint32_t>& entries, std::vector<std::uint8_t>& is_start) const {
+  const VoxelEntry& v = file.voxels()[li];
   const VoxelDrawInfo& d = layout_.voxels()[i];
   const std::uint32_t base = static_cast<std::uint32_t>(v.vertex_first - c.vertex_first);
   is_start.assign(v.vertex_count, 0);
-  for (std::uint32_t k = 0; k < layout_.stored_orders(); ++k) {
-    OrderView o = file.order(i, k);
+  for (std::uint32_t k = 0; k + 1 < c.slots; ++k) {
+    OrderView o = file.order(li, k);
     std::uint32_t* out = entries.data() + k * c.segments + d.seg_first;
     for (std::uint32_t n = 0; n < o.count; ++n) {
       std::uint32_t e = o[n];
       if (e + 1ull >= v.vertex_count)
         throw Error(ErrorKind::Input, file.path(), file.find_section(section_id("ORDR"))->offset + v.order_offset,
-                    "order entry out of range in voxel " + std::to_string(i) + " (run `voxlines verify`)");
+                    "order entry out of range in voxel " + std::to_string(li) + " (run `voxlines verify`)");
       out[n] = base + e;
       if (k == 0) is_start[e] = 1;
     }
   }
-  std::uint32_t* block = entries.data() + layout_.block_slot() * c.segments + d.seg_first;
+  std::uint32_t* block = entries.data() + layout_.block_slot(d) * c.segments + d.seg_first;
   std::uint32_t n = 0;
   for (std::uint32_t e = 0; e < v.vertex_count && n < v.segment_count; ++e)
     if (is_start[e]) block[n++] = base + e;
   if (n != v.segment_count)  // a repeated entry in order 0: it is no permutation
     throw Error(ErrorKind::Input, file.path(), file.find_section(section_id("ORDR"))->offset + v.order_offset,
-                "order 0 of voxel " + std::to_string(i) + " is not a permutation of its segments (run `voxlines verify`)");
+                "order 0 of voxel " + std::to_string(li) + " is not a permutation of its segments (run `voxlines verify`)");
 }
 
-GpuScene::GpuScene(const VxlFile& file, std::uint64_t max_texels)
-    : file_(file), layout_(file, max_texels ? max_texels : driver_limit()) {
+GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels)
+    : files_(std::move(files)), layout_(files_, max_texels ? max_texels : driver_limit()) {
   std::vector<std::uint32_t> entries;
   for (const ChunkLayout& c : layout_.chunks()) {
+    const VxlFile& file = *files_[c.file];
+    const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
     GpuChunk g;
     g.positions.create(GL_R32F, file.vertices().data() + 3 * c.vertex_first, 12 * c.vertex_count);
-    entries.resize(layout_.slots() * c.segments);
+    entries.resize(std::uint64_t(c.slots) * c.segments);
     // Voxels fill disjoint ranges of every slot, so they are widened in parallel.
     std::atomic<std::uint32_t> next{c.voxel_first};
     std::exception_ptr error;
@@ -61,7 +63,7 @@ GpuScene::GpuScene(const VxlFile& file, std::uint64_t max_texels)
       std::vector<std::uint8_t> is_start;
       for (std::uint32_t i; (i = next++) < c.voxel_first + c.voxel_count;) {
         try {
-          widen_voxel(file, i, c, entries, is_start);
+          widen_voxel(file, i, i - file_first, c, entries, is_start);
         } catch (...) {
           std::lock_guard lock(error_mutex);
           if (!error) error = std::current_exception();
@@ -79,6 +81,7 @@ GpuScene::GpuScene(const VxlFile& file, std::uint64_t max_texels)
     }
     g.orders.create(GL_R32UI, entries.data(), entries.size() * 4);
     g.dataset.create(GL_R32UI, nullptr, 0);
+    g.attributes.create(GL_RG32F, nullptr, 0);
     gpu_bytes_ += 12 * c.vertex_count + entries.size() * 4;
     chunks_.push_back(g);
   }
@@ -93,32 +96,47 @@ void GpuScene::release() {
     c.positions.destroy();
     c.orders.destroy();
     c.dataset.destroy();
+    c.attributes.destroy();
   }
   chunks_.clear();
 }
 
+void GpuScene::upload_attributes(const std::vector<std::vector<float>>& per_file) {
+  for (std::size_t i = 0; i < chunks_.size(); ++i) {
+    const ChunkLayout& c = layout_.chunks()[i];
+    GpuChunk& g = chunks_[i];
+    g.attributes.destroy();
+    const std::vector<float>* values = c.file < per_file.size() ? &per_file[c.file] : nullptr;
+    if (values == nullptr || values->empty()) g.attributes.create(GL_RG32F, nullptr, 0);
+    else g.attributes.create(GL_RG32F, values->data() + 2 * c.vertex_first, 8 * c.vertex_count);
+  }
+}
+
 const std::vector<std::int32_t>& GpuScene::dataset_first() {
   if (!dataset_built_) {
-    // Walk the streamlines: every voxline contributes its segments, in order, to its chunk's dataset
-    // array; consecutive segments in one chunk form one draw range.
+    // Walk the streamlines, file after file: every voxline contributes its segments, in order, to its
+    // chunk's dataset array; consecutive segments in one chunk form one draw range.
     std::vector<std::vector<std::uint32_t>> per_chunk(layout_.chunks().size());
     std::int64_t run_chunk = -1;
-    WalkCallbacks cb;
-    cb.voxline = [&](std::uint32_t voxel, std::uint64_t first_vertex, std::uint32_t own, bool connected) {
-      const std::uint32_t c = layout_.voxels()[voxel].chunk;
-      const ChunkLayout& cl = layout_.chunks()[c];
-      const std::uint64_t segments = own + (connected ? 1 : 0) - 1;
-      if (segments == 0) return;
-      auto& arr = per_chunk[c];
-      if (run_chunk != c) {
-        dataset_first_.push_back(static_cast<std::int32_t>(layout_.dataset_id(c, arr.size())));
-        dataset_count_.push_back(0);
-        run_chunk = c;
-      }
-      for (std::uint64_t s = 0; s < segments; ++s) arr.push_back(static_cast<std::uint32_t>(first_vertex - cl.vertex_first + s));
-      dataset_count_.back() += static_cast<std::int32_t>(2 * segments);
-    };
-    walk_streamlines(file_, cb);
+    for (std::uint32_t fi = 0; fi < files_.size(); ++fi) {
+      const std::uint32_t file_first = layout_.files()[fi].voxel_first;
+      WalkCallbacks cb;
+      cb.voxline = [&](std::uint32_t voxel, std::uint64_t first_vertex, std::uint32_t own, bool connected) {
+        const std::uint32_t c = layout_.voxels()[file_first + voxel].chunk;
+        const ChunkLayout& cl = layout_.chunks()[c];
+        const std::uint64_t segments = own + (connected ? 1 : 0) - 1;
+        if (segments == 0) return;
+        auto& arr = per_chunk[c];
+        if (run_chunk != c) {
+          dataset_first_.push_back(static_cast<std::int32_t>(layout_.dataset_id(c, arr.size())));
+          dataset_count_.push_back(0);
+          run_chunk = c;
+        }
+        for (std::uint64_t s = 0; s < segments; ++s) arr.push_back(static_cast<std::uint32_t>(first_vertex - cl.vertex_first + s));
+        dataset_count_.back() += static_cast<std::int32_t>(2 * segments);
+      };
+      walk_streamlines(*files_[fi], cb);
+    }
     for (std::size_t c = 0; c < chunks_.size(); ++c) {
       chunks_[c].dataset.destroy();
       chunks_[c].dataset.create(GL_R32UI, per_chunk[c].data(), per_chunk[c].size() * 4);

@@ -1,5 +1,5 @@
-// The GPU copy of a .vxl scene: per chunk (see scene_layout.h) a positions buffer (one large copy straight
-// from the memory-mapped file), an orders buffer (stored orders widened to chunk-global u32 indices, each
+// The GPU copy of a scene of one or more .vxl files: per chunk (see scene_layout.h) a positions buffer (one
+// large copy straight from the memory-mapped file), an orders buffer (stored orders widened to chunk-global u32 indices, each
 // entry checked, plus the block order), and — only when first needed — a dataset-order buffer.
 #pragma once
 
@@ -16,12 +16,15 @@ struct GpuChunk {
   gl::TextureBuffer positions;  // GL_R32F, 3 texels per vertex
   gl::TextureBuffer orders;     // GL_R32UI, slots x S
   gl::TextureBuffer dataset;    // GL_R32UI, S (empty until needed)
+  gl::TextureBuffer attributes; // GL_RG32F, (value, group) per vertex (empty until a colour mode needs it)
 };
 
 class GpuScene {
  public:
-  // Needs a current GL context. max_texels 0: ask the driver (GL_MAX_TEXTURE_BUFFER_SIZE).
-  GpuScene(const VxlFile& file, std::uint64_t max_texels = 0);
+  // Needs a current GL context. max_texels 0: ask the driver (GL_MAX_TEXTURE_BUFFER_SIZE). The files must
+  // outlive the scene.
+  GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0);
+  GpuScene(const VxlFile& file, std::uint64_t max_texels = 0) : GpuScene(std::vector<const VxlFile*>{&file}, max_texels) {}
   ~GpuScene();
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;
@@ -30,6 +33,10 @@ class GpuScene {
   const std::vector<GpuChunk>& chunks() const { return chunks_; }
   std::uint64_t gpu_bytes() const { return gpu_bytes_; }
 
+  // Replaces every chunk's attribute buffer with its vertices' share of its file's `per_file` entry (2 floats
+  // per vertex of that file, vertex_attributes.h); an empty vector empties them.
+  void upload_attributes(const std::vector<std::vector<float>>& per_file);
+
   // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)).
   const std::vector<std::int32_t>& dataset_first();
   const std::vector<std::int32_t>& dataset_count();
@@ -37,9 +44,10 @@ class GpuScene {
  private:
   static std::uint64_t driver_limit();
   void release();
-  void widen_voxel(const VxlFile& file, std::uint32_t voxel, const ChunkLayout& chunk, std::vector<std::uint32_t>& entries,
-                   std::vector<std::uint8_t>& is_start) const;
-  const VxlFile& file_;
+  // Voxel `voxel` of the scene (`local` in its file).
+  void widen_voxel(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, const ChunkLayout& chunk,
+                   std::vector<std::uint32_t>& entries, std::vector<std::uint8_t>& is_start) const;
+  std::vector<const VxlFile*> files_;
   SceneLayout layout_;
   std::vector<GpuChunk> chunks_;
   std::uint64_t gpu_bytes_ = 0;

@@ -66,9 +66,11 @@ GridOverlay::GridOverlay(const Renderer& renderer) {
   glEnableVertexAttribArray(1);
   glVertexAttribDivisor(1, 1);
 
-  // Every voxel's coordinate, straight from the voxel table: uploaded once for the "all" scope.
+  // Every voxel's coordinate, straight from the voxel tables (file after file, as in the scene): uploaded
+  // once for the "all" scope.
   std::vector<glm::ivec3> all;
-  for (const VoxelEntry& e : renderer.file().voxels()) all.emplace_back(e.coord[0], e.coord[1], e.coord[2]);
+  for (const VxlFile* f : renderer.files())
+    for (const VoxelEntry& e : f->voxels()) all.emplace_back(e.coord[0], e.coord[1], e.coord[2]);
   voxel_count_ = all.size();
   glGenBuffers(1, &all_instances_);
   glBindBuffer(GL_ARRAY_BUFFER, all_instances_);
@@ -85,37 +87,43 @@ GridOverlay::~GridOverlay() {
   if (program_) glDeleteProgram(program_);
 }
 
-void GridOverlay::draw(Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour) {
-  const VxlFile& file = renderer.file();
-  const MetaSection& m = file.meta();
+void GridOverlay::draw(Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour,
+                       const Clipping& clipping) {
+  const SceneLayout& layout = renderer.scene().layout();
+  const auto& files = layout.files();
+  // Per file: the first instance and the count in the instance buffer (each file has its own grid).
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges;
   GLuint instances = all_instances_;
   cubes_drawn_ = voxel_count_;
   if (scope == Scope::Drawn) {
-    // The same cull as the frame; the sort does not matter for outlines.
-    renderer.plan(camera, aspect, PlanOrder::Any, plan_);
-    const auto voxels = file.voxels();
+    // The same cull as the frame; the sort does not matter for outlines. Grouped by file.
+    renderer.plan(camera, aspect, PlanOrder::Any, plan_, clipping);
     drawn_coords_.clear();
-    for (const auto& [key, i] : plan_.sort_keys)
-      drawn_coords_.emplace_back(voxels[i].coord[0], voxels[i].coord[1], voxels[i].coord[2]);
+    for (std::uint32_t fi = 0; fi < files.size(); ++fi) {
+      const std::uint64_t first = drawn_coords_.size();
+      const auto voxels = renderer.files()[fi]->voxels();
+      for (const auto& [key, i] : plan_.sort_keys)
+        if (layout.file_of(i) == fi) {
+          const VoxelEntry& e = voxels[layout.local_voxel(i)];
+          drawn_coords_.emplace_back(e.coord[0], e.coord[1], e.coord[2]);
+        }
+      ranges.emplace_back(first, drawn_coords_.size() - first);
+    }
     glBindBuffer(GL_ARRAY_BUFFER, drawn_instances_);
     // Orphan and refill: a fresh store each frame avoids waiting on the previous frame's draw.
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(drawn_coords_.size() * sizeof(glm::ivec3)),
                  drawn_coords_.data(), GL_STREAM_DRAW);
     instances = drawn_instances_;
     cubes_drawn_ = drawn_coords_.size();
+  } else {
+    for (const FileLayout& f : files) ranges.emplace_back(f.voxel_first, f.voxel_count);
   }
   if (cubes_drawn_ == 0) return;
-
-  // The eye in grid units, split in double into an integer cell and a fraction.
-  const glm::dvec3 g = (camera.eye() - glm::dvec3(m.grid_origin[0], m.grid_origin[1], m.grid_origin[2])) / m.voxel_size;
-  const glm::dvec3 cell = glm::floor(g);
-  const glm::ivec3 eye_cell(cell);
-  const glm::vec3 eye_frac(g - cell);
 
   // Near/far planes of our own: outlines reach up to a voxel beyond the tight bounds the renderer fits its
   // planes to. Depth is not tested, so only clipping matters.
   const glm::dvec3 lo = renderer.bounds_min(), hi = renderer.bounds_max();
-  const double radius = glm::length(hi - lo) * 0.5 + 2.0 * m.voxel_size;
+  const double radius = glm::length(hi - lo) * 0.5 + 2.0 * layout.voxel_size();
   const double along = glm::dot((lo + hi) * 0.5 - camera.eye(), camera.forward());
   const double far_mm = along + radius;
   const double near_mm = camera.orthographic ? along - radius : std::max(far_mm * 1e-4, along - radius);
@@ -123,23 +131,31 @@ void GridOverlay::draw(Renderer& renderer, const Camera& camera, double aspect, 
   const glm::mat3 rotation = camera.view_rotation();
 
   glUseProgram(program_);
-  glUniform3iv(glGetUniformLocation(program_, "u_eye_cell"), 1, glm::value_ptr(eye_cell));
-  glUniform3fv(glGetUniformLocation(program_, "u_eye_frac"), 1, glm::value_ptr(eye_frac));
-  glUniform1f(glGetUniformLocation(program_, "u_voxel_size"), static_cast<float>(m.voxel_size));
   glUniformMatrix3fv(glGetUniformLocation(program_, "u_rotation"), 1, GL_FALSE, glm::value_ptr(rotation));
   glUniformMatrix4fv(glGetUniformLocation(program_, "u_projection"), 1, GL_FALSE, glm::value_ptr(projection));
   glUniform4fv(glGetUniformLocation(program_, "u_colour"), 1, glm::value_ptr(colour));
-
   glBindVertexArray(vao_);
-  glBindBuffer(GL_ARRAY_BUFFER, instances);
-  glVertexAttribIPointer(1, 3, GL_INT, 0, nullptr);
-  glBindBuffer(GL_ARRAY_BUFFER, 0);
-
   glDisable(GL_DEPTH_TEST);
   glEnable(GL_BLEND);
   glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   glLineWidth(1.0f);
-  glDrawArraysInstanced(GL_LINES, 0, 24, static_cast<GLsizei>(cubes_drawn_));
+  for (std::size_t fi = 0; fi < ranges.size(); ++fi) {
+    const auto [first, count] = ranges[fi];
+    if (count == 0) continue;
+    const MetaSection& m = renderer.files()[fi]->meta();
+    // The eye in this file's grid units, split in double into an integer cell and a fraction.
+    const glm::dvec3 g = (camera.eye() - glm::dvec3(m.grid_origin[0], m.grid_origin[1], m.grid_origin[2])) / m.voxel_size;
+    const glm::dvec3 cell = glm::floor(g);
+    const glm::ivec3 eye_cell(cell);
+    const glm::vec3 eye_frac(g - cell);
+    glUniform3iv(glGetUniformLocation(program_, "u_eye_cell"), 1, glm::value_ptr(eye_cell));
+    glUniform3fv(glGetUniformLocation(program_, "u_eye_frac"), 1, glm::value_ptr(eye_frac));
+    glUniform1f(glGetUniformLocation(program_, "u_voxel_size"), static_cast<float>(m.voxel_size));
+    glBindBuffer(GL_ARRAY_BUFFER, instances);
+    glVertexAttribIPointer(1, 3, GL_INT, 0, reinterpret_cast<const void*>(first * sizeof(glm::ivec3)));
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glDrawArraysInstanced(GL_LINES, 0, 24, static_cast<GLsizei>(count));
+  }
   glDisable(GL_BLEND);
   glBindVertexArray(0);
 }

@@ -12,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "clip_planes.h"
 #include "frame_plan.h"
 #include "gl_util.h"
 
@@ -30,7 +31,9 @@ class GridOverlay {
   GridOverlay& operator=(const GridOverlay&) = delete;
 
   // Draws into the bound framebuffer with the current viewport; blends `colour` over the picture.
-  void draw(Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour);
+  // Scope::Drawn outlines the voxels the frame draws with `clipping` (the slab and clip planes cull too).
+  void draw(Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour,
+            const Clipping& clipping = {});
 
   std::uint64_t cubes_drawn() const { return cubes_drawn_; }
 

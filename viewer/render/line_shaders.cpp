@@ -1,13 +1,19 @@
 #include "line_shaders.h"
 
+#include "clip_planes.h"
+#include "colormap.h"
+
 namespace vxl::shaders {
 
 std::string line_vertex(unsigned chunk_count, const char* version) {
   std::string n = std::to_string(chunk_count);
-  std::string s = std::string(version) + "\n#define CHUNKS " + n + "\n";
+  std::string s = std::string(version) + "\n#define CHUNKS " + n + "\n#define CLIPS " + std::to_string(kMaxClipDistances) +
+                  "\n#define GROUPS " + std::to_string(kShaderGroups) + "\n#define SAMPLES " +
+                  std::to_string(kColormapSamples) + "\n";
   for (unsigned c = 0; c < chunk_count; ++c) {
     std::string i = std::to_string(c);
-    s += "uniform samplerBuffer u_pos" + i + ";\nuniform usamplerBuffer u_ord" + i + ";\nuniform usamplerBuffer u_dat" + i + ";\n";
+    s += "uniform samplerBuffer u_pos" + i + ";\nuniform usamplerBuffer u_ord" + i + ";\nuniform usamplerBuffer u_dat" + i +
+         ";\nuniform samplerBuffer u_att" + i + ";\n";
   }
   s += "vec3 fetch_pos(int c, int v) {\n";
   for (unsigned c = 0; c < chunk_count; ++c) {
@@ -21,19 +27,35 @@ std::string line_vertex(unsigned chunk_count, const char* version) {
   s += "  return 0;\n}\nint fetch_dataset(int c, int j) {\n";
   for (unsigned c = 0; c < chunk_count; ++c)
     s += "  if (c == " + std::to_string(c) + ") return int(texelFetch(u_dat" + std::to_string(c) + ", j).r);\n";
-  s += "  return 0;\n}\n";
+  s += "  return 0;\n}\nvec2 fetch_attributes(int c, int v) {\n";
+  for (unsigned c = 0; c < chunk_count; ++c)
+    s += "  if (c == " + std::to_string(c) + ") return texelFetch(u_att" + std::to_string(c) + ", v).rg;\n";
+  s += "  return vec2(0.0);\n}\n";
   s += R"(
 uniform int u_chunk_base[CHUNKS];
 uniform int u_chunk_segments[CHUNKS];
-uniform int u_slots;
+uniform int u_chunk_slots[CHUNKS];  // its file's stored orders + 1
 uniform vec3 u_eye_hi;      // eye position split in two floats on the CPU (in double):
 uniform vec3 u_eye_lo;      // p - eye = (p - hi) - lo keeps the source precision far from the origin
 uniform mat3 u_rotation;    // world -> eye
 uniform mat4 u_projection;
-uniform int u_color_mode;   // 0 direction, 1 fixed
+uniform int u_color_mode;   // 0 direction, 1 fixed, 2 scalar, 3 group
 uniform vec3 u_fixed_color;
+uniform int u_attributes;   // 1: read (value, group) per vertex (vertex_attributes.h)
+uniform vec2 u_range;       // value -> t = (value - x) / (y - x)
+uniform vec4 u_group[GROUPS];  // per group (index mod GROUPS): colour, opacity factor
 uniform float u_opacity;
-out vec4 v_color;
+uniform vec4 u_clip[CLIPS];  // slab and clip half-spaces, camera-relative: dot(n, p - eye) + d >= 0 is kept
+uniform int u_clip_count;
+uniform int u_lighting;     // 0 off, 1 illuminated lines
+uniform vec3 u_light;       // towards the light, eye space
+uniform vec4 u_light_terms; // ambient, diffuse, specular, shininess
+uniform int u_orthographic;
+out float gl_ClipDistance[CLIPS];
+out vec4 v_color;           // colour (unless mapped) and alpha
+out vec2 v_light;           // lighting: colour * x + y (1, 0 when off)
+out float v_value;          // colour-map position, unclamped: mapped per fragment, so long segments are exact
+out float v_mapped;         // 1: colour from the map at v_value
 out float v_depth;          // distance along the view axis, mm
 
 void main() {
@@ -45,7 +67,7 @@ void main() {
   int seg = local >> 1;
   int end = local & 1;
   int S = u_chunk_segments[c];
-  int A = u_slots * S;
+  int A = u_chunk_slots[c] * S;
   int v;
   if (seg < A) {
     v = fetch_order(c, seg);
@@ -60,49 +82,95 @@ void main() {
   vec3 q = fetch_pos(c, v + 1 - end);
   vec3 rel = (p - u_eye_hi) - u_eye_lo;
   vec3 e = u_rotation * rel;
-  gl_Position = u_projection * vec4(e, 1.0);
+  for (int i = 0; i < CLIPS; ++i) gl_ClipDistance[i] = i < u_clip_count ? dot(u_clip[i].xyz, rel) + u_clip[i].w : 1.0;
   v_depth = -e.z;
   vec3 d = q - p;
   float len = length(d);
   vec3 color = u_color_mode == 0 ? (len > 0.0 ? abs(d / len) : vec3(1.0)) : u_fixed_color;
-  v_color = vec4(color, u_opacity);
+  float alpha = u_opacity;
+  v_mapped = 0.0;
+  v_value = 0.0;
+  bool hidden = false;
+  if (u_attributes != 0) {
+    vec2 a = fetch_attributes(c, v + end);
+    vec4 group = u_group[int(a.y) % GROUPS];
+    alpha *= group.a;
+    // A missing or non-finite value keeps the fixed colour.
+    if (u_color_mode == 2 && !isnan(a.x) && !isinf(a.x)) {
+      v_mapped = 1.0;
+      v_value = (a.x - u_range.x) / (u_range.y - u_range.x);
+    }
+    if (u_color_mode == 3) color = group.rgb;
+    hidden = group.a <= 0.0;
+  }
+  v_light = vec2(1.0, 0.0);
+  if (u_lighting != 0 && len > 0.0) {
+    // Illuminated lines (line_lighting.h), in eye space. Both ends use the same tangent sign, so the
+    // interpolated tangent never passes through zero.
+    vec3 t = normalize(u_rotation * (end == 0 ? d : -d));
+    vec3 view = u_orthographic != 0 ? vec3(0.0, 0.0, 1.0) : normalize(-e);
+    float lt = dot(u_light, t), vt = dot(view, t);
+    float diffuse = sqrt(max(0.0, 1.0 - lt * lt));
+    float specular = pow(max(0.0, diffuse * sqrt(max(0.0, 1.0 - vt * vt)) - lt * vt), u_light_terms.w);
+    v_light = vec2(u_light_terms.x + u_light_terms.y * diffuse, u_light_terms.z * specular);
+  }
+  v_color = vec4(color, alpha);
+  // A hidden group (opacity 0): both ends outside the clip volume, so no line, in every mode.
+  gl_Position = hidden ? vec4(2.0, 2.0, 2.0, 1.0) : u_projection * vec4(e, 1.0);
 }
 )";
   return s;
 }
 
-const char* const kLineOverFragment = R"(#version 330 core
+std::string line_fragment(const char* body, const char* version) {
+  // The line's colour: from the colour map per fragment, or the vertex colour; then the lighting terms.
+  return std::string(version) + "\n#define SAMPLES " + std::to_string(kColormapSamples) + R"(
 in vec4 v_color;
+in vec2 v_light;
+in float v_value;
+in float v_mapped;
 in float v_depth;
+uniform vec3 u_colormap[SAMPLES];  // colormap.h: samples at t = k / (SAMPLES - 1), linear in between
+vec3 colormap(float t) {
+  float x = clamp(t, 0.0, 1.0) * float(SAMPLES - 1);
+  int i = min(int(x), SAMPLES - 2);
+  return mix(u_colormap[i], u_colormap[i + 1], x - float(i));
+}
+vec4 line_color() {
+  vec3 base = v_mapped > 0.5 ? colormap(v_value) : v_color.rgb;
+  return vec4(base * v_light.x + vec3(v_light.y), v_color.a);
+}
+)" + body;
+}
+
+const char* const kLineOverFragment = R"(
 out vec4 frag;
-void main() { frag = v_color; }
+void main() { frag = line_color(); }
 )";
 
-const char* const kLineWboitAccumFragment = R"(#version 330 core
-in vec4 v_color;
-in float v_depth;
+const char* const kLineWboitAccumFragment = R"(
 out vec4 accum;
 void main() {
-  float a = v_color.a;
+  vec4 c = line_color();
+  float a = c.a;
   // Weight function (7) of McGuire & Bavoil 2013, with depth in mm scaled to their units.
   float z = v_depth / 200.0;
   float w = a * clamp(0.03 / (1e-5 + pow(z, 4.0)), 1e-2, 3e3);
-  accum = vec4(v_color.rgb * a * w, a * w);
+  accum = vec4(c.rgb * a * w, a * w);
 }
 )";
 
-const char* const kLineWboitRevealFragment = R"(#version 330 core
-in vec4 v_color;
-in float v_depth;
+const char* const kLineWboitRevealFragment = R"(
 out vec4 reveal;
 void main() { reveal = vec4(v_color.a); }
 )";
 
-const char* const kLineAdditiveFragment = R"(#version 330 core
-in vec4 v_color;
-in float v_depth;
+const char* const kLineAdditiveFragment = R"(
 out vec4 frag;
-void main() { frag = vec4(v_color.rgb * v_color.a, v_color.a); }
+void main() {
+  vec4 c = line_color();
+  frag = vec4(c.rgb * c.a, c.a);
+}
 )";
 
 const char* const kFullscreenVertex = R"(#version 330 core

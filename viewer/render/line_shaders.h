@@ -6,10 +6,17 @@
 
 namespace vxl::shaders {
 
+// Groups with their own colour and opacity in the shader's table; group g uses entry g mod kShaderGroups.
+inline constexpr int kShaderGroups = 64;
+
 // Vertex shader: virtual vertex id -> segment end (scene_layout.h), camera-relative position, colour.
 std::string line_vertex(unsigned chunk_count, const char* version = "#version 330 core");
 
-// Fragment shaders for the line pass.
+// A fragment shader for the line pass: `body` (with its main) after the line inputs and line_color(),
+// which gives the fragment's colour and alpha (colour map per fragment, lighting).
+std::string line_fragment(const char* body, const char* version = "#version 330 core");
+
+// Bodies for line_fragment.
 extern const char* const kLineOverFragment;         // colour with alpha: blended "over", or opaque
 extern const char* const kLineWboitAccumFragment;   // McGuire & Bavoil accumulation (premultiplied, weighted)
 extern const char* const kLineWboitRevealFragment;  // revealage: product of (1 - alpha)

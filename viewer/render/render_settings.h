@@ -1,10 +1,16 @@
-// What the user chooses about a picture: transparency mode, colouring, opacity, line width, background.
+// What the user chooses about a picture: transparency mode, colouring, lighting, opacity, line width,
+// background, slab and clip planes.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
+
+#include "clip_planes.h"
+#include "colormap.h"
 
 namespace vxl {
 
@@ -22,7 +28,28 @@ enum class RenderMode {
 std::optional<RenderMode> parse_render_mode(const std::string& name);
 const char* render_mode_name(RenderMode mode);
 
-enum class ColorMode { Direction, Fixed };
+enum class ColorMode {
+  Direction,  // |p1 - p0| as RGB, the convention of every tractography viewer
+  Fixed,      // one colour
+  Scalar,     // a value set of the file (per point or per streamline) through a colour map
+  Group,      // one colour per group (scene_groups.h)
+};
+std::optional<ColorMode> parse_color_mode(const std::string& name);
+const char* color_mode_name(ColorMode mode);
+
+// What the user changed about one group: its colour (else the palette's) and its opacity, a factor on
+// RenderSettings::opacity (0 hides the group).
+struct GroupStyle {
+  std::string name;
+  std::optional<glm::vec3> color;
+  float opacity = 1.0f;
+};
+
+// "#RRGGBB" -> colour in [0, 1].
+std::optional<glm::vec3> parse_hex_color(const std::string& text);
+std::string hex_color(const glm::vec3& color);
+// "NAME=#RRGGBB", "NAME=#RRGGBB:0.5", "NAME=:0" (opacity only); nullopt when malformed.
+std::optional<GroupStyle> parse_group_style(const std::string& text);
 
 struct RenderSettings {
   RenderMode mode = RenderMode::Axis;
@@ -31,7 +58,19 @@ struct RenderSettings {
   float opacity = 0.5f;    // 1 down to 0.001
   float line_width = 1.0f; // pixels
   bool white_background = false;
+  // `axis` mode: keep a voxel's order until another stored order is closer to its view direction by
+  // more than this cosine margin (FramePlan::order_hysteresis). 0: off, the paper's rule every frame.
+  float order_hysteresis = 0.0f;
+  Colormap colormap = Colormap::Viridis;  // for ColorMode::Scalar
+  std::string scalar;                     // the value set to colour by; empty: the first the scene has
+  std::optional<std::array<float, 2>> range;  // values mapped to the colour map's ends; none: the set's min, max
+  std::vector<GroupStyle> group_styles;   // only the groups the user changed
+  Clipping clipping;       // slab and clip planes (clip_planes.h)
+  bool lighting = false;   // illuminated lines (line_lighting.h)
   glm::vec3 background() const { return white_background ? glm::vec3(1.0f) : glm::vec3(0.0f); }
+  // The colour and opacity factor of group `index` called `name`.
+  glm::vec4 group_color(const std::string& name, std::size_t index) const;
+  GroupStyle& style_of(const std::string& name);  // the user's entry for `name`, added when missing
 };
 
 }  // namespace vxl

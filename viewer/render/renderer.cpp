@@ -7,19 +7,39 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "error.h"
 #include "exact_renderer.h"
+#include "line_lighting.h"
 #include "line_shaders.h"
+#include "vertex_attributes.h"
 
 namespace vxl {
 
-Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels) : file_(file), scene_(file, max_texels) {
-  glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even without attributes
+Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels) : Renderer(std::vector<const VxlFile*>{&file}, max_texels) {}
+
+Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels)
+    : files_(files.empty() ? throw std::invalid_argument("Renderer: no files") : files),
+      scene_(files_, max_texels),
+      groups_(files_) {
+  const VxlFile& file = *files_.front();
+  for (const VxlFile* f : files_)
+    for (const ValueSets* sets : {&f->vertex_values(), &f->streamline_values()})
+      for (std::uint32_t k = 0; k < sets->size(); ++k)
+        if (std::find(value_set_names_.begin(), value_set_names_.end(), sets->name(k)) == value_set_names_.end())
+          value_set_names_.push_back(sets->name(k));
   const unsigned chunks = std::max<unsigned>(1, static_cast<unsigned>(scene_.layout().chunks().size()));
+  GLint units = 0;
+  glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
+  if (static_cast<GLint>(kSamplersPerChunk * chunks) > units)
+    throw Error(ErrorKind::Unsupported, file.path(), std::nullopt,
+                "the scene needs " + std::to_string(kSamplersPerChunk * chunks) + " vertex-shader textures (" +
+                    std::to_string(chunks) + " GPU chunks) but this GPU offers " + std::to_string(units));
+  glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even without attributes
   const std::string vs = shaders::line_vertex(chunks);
-  over_program_ = gl::make_program(vs, shaders::kLineOverFragment);
-  accum_program_ = gl::make_program(vs, shaders::kLineWboitAccumFragment);
-  reveal_program_ = gl::make_program(vs, shaders::kLineWboitRevealFragment);
-  additive_program_ = gl::make_program(vs, shaders::kLineAdditiveFragment);
+  over_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineOverFragment));
+  accum_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitAccumFragment));
+  reveal_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitRevealFragment));
+  additive_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineAdditiveFragment));
   wboit_composite_ = gl::make_program(shaders::kFullscreenVertex, shaders::kWboitCompositeFragment);
   additive_composite_ = gl::make_program(shaders::kFullscreenVertex, shaders::kAdditiveCompositeFragment);
 }
@@ -34,29 +54,47 @@ Renderer::~Renderer() {
   if (vao_) glDeleteVertexArrays(1, &vao_);
 }
 
+// The union of the files' bounds (a file without points does not count).
 glm::dvec3 Renderer::bounds_min() const {
-  const MetaSection& m = file_.meta();
-  return {m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]};
+  glm::dvec3 lo(0.0);
+  bool any = false;
+  for (const VxlFile* f : files_) {
+    const MetaSection& m = f->meta();
+    if (m.point_count == 0) continue;
+    const glm::dvec3 b(m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]);
+    lo = any ? glm::min(lo, b) : b;
+    any = true;
+  }
+  return lo;
 }
 glm::dvec3 Renderer::bounds_max() const {
-  const MetaSection& m = file_.meta();
-  return {m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]};
+  glm::dvec3 hi(0.0);
+  bool any = false;
+  for (const VxlFile* f : files_) {
+    const MetaSection& m = f->meta();
+    if (m.point_count == 0) continue;
+    const glm::dvec3 b(m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]);
+    hi = any ? glm::max(hi, b) : b;
+    any = true;
+  }
+  return hi;
 }
 
 glm::dmat4 Renderer::projection(const Camera& camera, double aspect) const {
   // Near and far planes hug the scene's bounding sphere, for depth precision.
   glm::dvec3 centre = (bounds_min() + bounds_max()) * 0.5;
-  double radius = std::max(1.0, glm::length(bounds_max() - bounds_min()) * 0.5 + file_.meta().voxel_size);
+  double radius = std::max(1.0, glm::length(bounds_max() - bounds_min()) * 0.5 + scene_.layout().voxel_size());
   double along = glm::dot(centre - camera.eye(), camera.forward());
   double far_mm = along + radius;
   double near_mm = camera.orthographic ? along - radius : std::max(far_mm * 1e-4, along - radius);
   return glm::dmat4(Camera(camera).projection(aspect, near_mm, std::max(far_mm, near_mm + 1.0)));
 }
 
-void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out) {
+void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping) {
   auto t0 = std::chrono::steady_clock::now();
   ViewParams view = make_view_params(camera.eye(), camera.forward(), camera.orthographic, projection(camera, aspect),
                                      glm::dmat3(camera.view_rotation()));
+  for (const glm::dvec4& h : clip_half_spaces(clipping, camera)) view.clip.push_back(relative_to(h, view.eye));
   plan_frame(scene_.layout(), view, order, out);
   stats_.plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.voxels_drawn = out.voxels_drawn;
@@ -67,21 +105,23 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   glUseProgram(program);
   const SceneLayout& layout = scene_.layout();
   const auto& chunks = layout.chunks();
-  std::vector<GLint> base, segments;
+  std::vector<GLint> base, segments, slots;
   for (const ChunkLayout& c : chunks) {
     base.push_back(static_cast<GLint>(c.virtual_base));
     segments.push_back(static_cast<GLint>(std::max<std::uint64_t>(1, c.segments)));
+    slots.push_back(static_cast<GLint>(c.slots));
   }
-  if (base.empty()) base = {0}, segments = {1};
+  if (base.empty()) base = {0}, segments = {1}, slots = {1};
   glUniform1iv(glGetUniformLocation(program, "u_chunk_base"), static_cast<GLsizei>(base.size()), base.data());
   glUniform1iv(glGetUniformLocation(program, "u_chunk_segments"), static_cast<GLsizei>(segments.size()), segments.data());
-  glUniform1i(glGetUniformLocation(program, "u_slots"), static_cast<GLint>(layout.slots()));
+  glUniform1iv(glGetUniformLocation(program, "u_chunk_slots"), static_cast<GLsizei>(slots.size()), slots.data());
   for (std::size_t c = 0; c < scene_.chunks().size(); ++c) {
     const GpuChunk& g = scene_.chunks()[c];
-    const GLuint textures[3] = {g.positions.texture, g.orders.texture, g.dataset.texture};
-    const char* names[3] = {"u_pos", "u_ord", "u_dat"};
-    for (int t = 0; t < 3; ++t) {
-      GLint unit = static_cast<GLint>(3 * c + t);
+    const GLuint textures[kSamplersPerChunk] = {g.positions.texture, g.orders.texture, g.dataset.texture,
+                                                g.attributes.texture};
+    const char* names[kSamplersPerChunk] = {"u_pos", "u_ord", "u_dat", "u_att"};
+    for (int t = 0; t < kSamplersPerChunk; ++t) {
+      GLint unit = static_cast<GLint>(kSamplersPerChunk * c + t);
       glActiveTexture(GL_TEXTURE0 + unit);
       glBindTexture(GL_TEXTURE_BUFFER, textures[t]);
       glUniform1i(glGetUniformLocation(program, (names[t] + std::to_string(c)).c_str()), unit);
@@ -97,9 +137,86 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   glUniformMatrix3fv(glGetUniformLocation(program, "u_rotation"), 1, GL_FALSE, glm::value_ptr(rotation));
   const glm::mat4 proj(projection(camera, aspect));
   glUniformMatrix4fv(glGetUniformLocation(program, "u_projection"), 1, GL_FALSE, glm::value_ptr(proj));
-  glUniform1i(glGetUniformLocation(program, "u_color_mode"), s.color == ColorMode::Direction ? 0 : 1);
+  glUniform1i(glGetUniformLocation(program, "u_color_mode"), static_cast<int>(s.color));
   glUniform3fv(glGetUniformLocation(program, "u_fixed_color"), 1, glm::value_ptr(s.fixed_color));
+  glUniform1i(glGetUniformLocation(program, "u_attributes"), attributes_key_.empty() ? 0 : 1);
+  glUniform3fv(glGetUniformLocation(program, "u_colormap"), kColormapSamples, glm::value_ptr(colormap_samples(s.colormap)[0]));
+  const std::array<float, 2> range = scalar_range(s);
+  glUniform2f(glGetUniformLocation(program, "u_range"), range[0], range[1]);
+  std::vector<glm::vec4> group(shaders::kShaderGroups, glm::vec4(1.0f));
+  const auto& groups = groups_.groups();
+  for (std::size_t g = 0; g < groups.size() && g < group.size(); ++g) group[g] = s.group_color(groups[g].name, g);
+  glUniform4fv(glGetUniformLocation(program, "u_group"), shaders::kShaderGroups, glm::value_ptr(group[0]));
   glUniform1f(glGetUniformLocation(program, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
+  glUniform1i(glGetUniformLocation(program, "u_lighting"), s.lighting ? 1 : 0);
+  const glm::vec3 light = lighting::light_direction_eye();
+  glUniform3fv(glGetUniformLocation(program, "u_light"), 1, glm::value_ptr(light));
+  glUniform4f(glGetUniformLocation(program, "u_light_terms"), lighting::kAmbient, lighting::kDiffuse, lighting::kSpecular,
+              lighting::kShininess);
+  glUniform1i(glGetUniformLocation(program, "u_orthographic"), camera.orthographic ? 1 : 0);
+  std::vector<glm::vec4> clip;
+  for (const glm::dvec4& h : clip_half_spaces(s.clipping, camera)) clip.push_back(glm::vec4(relative_to(h, eye)));
+  const int clips = static_cast<int>(std::min<std::size_t>(clip.size(), kMaxClipDistances));
+  if (clips > 0) glUniform4fv(glGetUniformLocation(program, "u_clip"), clips, glm::value_ptr(clip[0]));
+  glUniform1i(glGetUniformLocation(program, "u_clip_count"), clips);
+  enable_clip_distances(clips);
+}
+
+void Renderer::enable_clip_distances(int n) {
+  for (int i = 0; i < kMaxClipDistances; ++i) {
+    if (i < n) glEnable(GL_CLIP_DISTANCE0 + i);
+    else glDisable(GL_CLIP_DISTANCE0 + i);
+  }
+}
+
+std::string Renderer::scalar_name(const RenderSettings& s) const {
+  if (!s.scalar.empty()) return s.scalar;
+  return value_set_names_.empty() ? std::string() : value_set_names_.front();
+}
+
+std::array<float, 2> Renderer::scalar_range(const RenderSettings& s) const {
+  float lo = 0, hi = 1;
+  if (s.range) {
+    lo = (*s.range)[0];
+    hi = (*s.range)[1];
+  } else if (const std::string name = scalar_name(s); !name.empty()) {
+    // The stored extremes of the set over the files that have it (NaN when one has no finite value).
+    bool any = false;
+    for (const VxlFile* f : files_) {
+      const ValueSource v = find_value_set(*f, name);
+      const ValueSets* sets = v.kind == ValueSource::Kind::Vertex       ? &f->vertex_values()
+                              : v.kind == ValueSource::Kind::Streamline ? &f->streamline_values()
+                                                                        : nullptr;
+      if (!sets || !std::isfinite(sets->min(v.set)) || !std::isfinite(sets->max(v.set))) continue;
+      lo = any ? std::min(lo, sets->min(v.set)) : sets->min(v.set);
+      hi = any ? std::max(hi, sets->max(v.set)) : sets->max(v.set);
+      any = true;
+    }
+  }
+  if (!(hi > lo)) {  // one value only: show it mid-map
+    const float mid = std::isfinite(lo) ? lo : 0.0f;
+    lo = mid - 0.5f;
+    hi = mid + 0.5f;
+  }
+  return {lo, hi};
+}
+
+void Renderer::prepare_attributes(const RenderSettings& s) {
+  const std::string name = s.color == ColorMode::Scalar ? scalar_name(s) : std::string();
+  bool want_groups = s.color == ColorMode::Group;
+  const auto& groups = groups_.groups();
+  for (std::size_t g = 0; g < groups.size(); ++g) want_groups |= s.group_color(groups[g].name, g).a != 1.0f;
+  const std::string key = (name.empty() ? "" : "value:" + name) + (want_groups ? "|groups" : "");
+  if (key == attributes_key_) return;
+  attributes_key_.clear();
+  scene_.upload_attributes({});
+  if (key.empty()) return;
+  std::vector<std::vector<float>> per_file;
+  for (std::size_t i = 0; i < files_.size(); ++i)
+    per_file.push_back(vertex_attributes(*files_[i], i, name.empty() ? ValueSource{} : find_value_set(*files_[i], name),
+                                         want_groups ? &groups_ : nullptr));
+  scene_.upload_attributes(per_file);
+  attributes_key_ = key;
 }
 
 void Renderer::draw_plan(const std::vector<std::int32_t>& first, const std::vector<std::int32_t>& count) const {
@@ -109,7 +226,7 @@ void Renderer::draw_plan(const std::vector<std::int32_t>& first, const std::vect
 }
 
 void Renderer::draw_lines(GLuint program, const Camera& camera, const RenderSettings& s, double aspect, PlanOrder order) {
-  plan(camera, aspect, order, plan_);
+  plan(camera, aspect, order, plan_, s.clipping);
   bind_line_program(program, camera, s, aspect);
   draw_plan(plan_.first, plan_.count);
 }
@@ -118,13 +235,17 @@ void Renderer::draw_dataset_order(GLuint program, const Camera& camera, const Re
   const auto& first = scene_.dataset_first();
   const auto& count = scene_.dataset_count();
   stats_.plan_ms = 0;
-  stats_.voxels_drawn = file_.meta().voxel_count;
-  stats_.segments_drawn = file_.meta().segment_count;
+  stats_.voxels_drawn = stats_.segments_drawn = 0;
+  for (const VxlFile* f : files_) {
+    stats_.voxels_drawn += f->meta().voxel_count;
+    stats_.segments_drawn += f->meta().segment_count;
+  }
   bind_line_program(program, camera, s, aspect);
   draw_plan(first, count);
 }
 
 void Renderer::composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const {
+  enable_clip_distances(0);
   glUseProgram(program);
   GLint unit = 0;
   for (const auto& [name, texture] : textures) {
@@ -152,6 +273,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
     glClearDepth(1.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   };
+  prepare_attributes(s);
   glLineWidth(std::max(1.0f, s.line_width));
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
@@ -162,6 +284,10 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       clear_target(fbo, glm::vec4(bg, 1));
       glEnable(GL_DEPTH_TEST);
       glDepthFunc(GL_LESS);
+      // The colour replaces, the alpha stays the clear's 1: an opaque picture (a PNG would otherwise keep
+      // the lines' opacity as their alpha).
+      glEnable(GL_BLEND);
+      glBlendFuncSeparate(GL_ONE, GL_ZERO, GL_ZERO, GL_ONE);
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Any);
       glDisable(GL_DEPTH_TEST);
       break;
@@ -178,6 +304,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
     case RenderMode::Axis:
       clear_target(fbo, glm::vec4(bg, 1));
       over_blending();
+      plan_.order_hysteresis = s.order_hysteresis;
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Nearest);
       break;
     case RenderMode::Wboit: {
@@ -234,6 +361,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       break;
   }
   glDisable(GL_BLEND);
+  enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
 }
 

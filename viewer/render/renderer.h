@@ -2,10 +2,14 @@
 // needs 4.3): it is driven the same way from a GLFW window and from a headless EGL context.
 //
 //   Renderer r(file);                       // uploads the scene (few large copies)
+//   Renderer r({&a, &b});                   // several files, their voxels sorted together every frame
 //   r.draw(camera, settings, w, h, fbo);    // one frame into the bound framebuffer `fbo`
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <string>
+#include <vector>
 #include <initializer_list>
 #include <memory>
 #include <utility>
@@ -15,6 +19,7 @@
 #include "gl_util.h"
 #include "gpu_scene.h"
 #include "render_settings.h"
+#include "scene_groups.h"
 
 namespace vxl {
 
@@ -28,7 +33,11 @@ struct FrameStats {
 
 class Renderer {
  public:
+  static constexpr int kSamplersPerChunk = 4;  // positions, orders, dataset order, attributes
   explicit Renderer(const VxlFile& file, std::uint64_t max_texels = 0);
+  // Several files drawn as one scene: one sort over all their voxels, one group per file. The files must
+  // outlive the renderer.
+  explicit Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -38,8 +47,16 @@ class Renderer {
   void draw(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
 
   const FrameStats& stats() const { return stats_; }
+  // The scene's groups (scene_groups.h) and value sets (per-vertex sets first, then per-streamline ones).
+  const SceneGroups& groups() const { return groups_; }
+  const std::vector<std::string>& value_set_names() const { return value_set_names_; }
+  // The value set ColorMode::Scalar shows for `settings` (its `scalar`, else the first; empty when none),
+  // and the range it maps (settings.range, else the set's stored min and max).
+  std::string scalar_name(const RenderSettings& settings) const;
+  std::array<float, 2> scalar_range(const RenderSettings& settings) const;
   GpuScene& scene() { return scene_; }
-  const VxlFile& file() const { return file_; }
+  const VxlFile& file() const { return *files_.front(); }  // the first
+  const std::vector<const VxlFile*>& files() const { return files_; }
   glm::dvec3 bounds_min() const;
   glm::dvec3 bounds_max() const;
 
@@ -49,15 +66,21 @@ class Renderer {
   // Binds the line program's uniforms and textures for `camera`; used by the exact renderer too.
   void bind_line_program(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect) const;
   void draw_plan(const std::vector<std::int32_t>& first, const std::vector<std::int32_t>& count) const;
-  void plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out);
+  // The frame plan for `camera`: voxels outside the frustum or the slab / clip planes of `clipping` culled.
+  void plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping = {});
+  // Enables the first n of the line shader's clip distances and disables the others (passes without
+  // gl_ClipDistance must run with none enabled).
+  static void enable_clip_distances(int n);
 
  private:
+  // Uploads the per-vertex (value, group) attributes that `settings` needs, when they changed.
+  void prepare_attributes(const RenderSettings& settings);
   void draw_lines(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect, PlanOrder order);
   void draw_dataset_order(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect);
   // A fullscreen pass of `program` reading the named 2D textures.
   void composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const;
 
-  const VxlFile& file_;
+  std::vector<const VxlFile*> files_;
   GpuScene scene_;
   GLuint vao_ = 0;
   GLuint over_program_ = 0, accum_program_ = 0, reveal_program_ = 0, additive_program_ = 0;
@@ -66,6 +89,9 @@ class Renderer {
   FramePlan plan_;
   FrameStats stats_;
   std::unique_ptr<ExactRenderer> exact_;
+  SceneGroups groups_;
+  std::vector<std::string> value_set_names_;
+  std::string attributes_key_;  // what the attribute buffers hold ("" : nothing)
 };
 
 }  // namespace vxl

@@ -1,10 +1,13 @@
-// How a .vxl scene is laid out on the GPU, computed on the CPU in O(voxels) (no GL here, so the per-frame
-// planning can be tested and benchmarked without a context).
+// How a scene of one or more .vxl files is laid out on the GPU, computed on the CPU in O(voxels) (no GL
+// here, so the per-frame planning can be tested and benchmarked without a context).
 //
-// Voxels are grouped into chunks (contiguous voxel ranges) small enough for the driver's texture-buffer
-// limit. Each chunk holds, in texture buffers:
+// The voxels of all files form one table (file 0's, then file 1's, ...), so that one frame plan sorts them
+// all together, back to front, interleaved across files. Voxels are grouped into chunks (contiguous voxel
+// ranges of one file) small enough for the driver's texture-buffer limit. Each chunk holds, in texture
+// buffers:
 //   positions: 3 floats per vertex;
-//   orders:    (K + 1) "slots" of S entries each (S = the chunk's segments): the K stored orders widened to
+//   orders:    (K + 1) "slots" of S entries each (S = the chunk's segments; K its file's stored orders): the K
+//              stored orders widened to
 //              chunk-global vertex indices, then the block (dataset) order inside each voxel. A voxel owns the
 //              same range [seg_first, seg_first + n) in every slot;
 //   dataset:   S entries in streamline order (built only when the `unsorted` mode is first used).
@@ -18,6 +21,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -35,46 +39,70 @@ struct VoxelDrawInfo {
 };
 
 struct ChunkLayout {
-  std::uint32_t voxel_first = 0, voxel_count = 0;
-  std::uint64_t vertex_first = 0, vertex_count = 0;  // global vertex range
+  std::uint32_t file = 0;                            // the file its voxels come from
+  std::uint32_t slots = 1;                           // its file's K + 1
+  std::uint32_t voxel_first = 0, voxel_count = 0;    // scene voxel range
+  std::uint64_t vertex_first = 0, vertex_count = 0;  // vertex range within its file
   std::uint64_t segments = 0;                        // S
   std::uint64_t virtual_base = 0;                    // first virtual vertex id
-  std::uint64_t slot_entries(std::uint32_t slots) const { return slots * segments; }
+};
+
+// Where one file's voxels are in the scene, and its sorting directions.
+struct FileLayout {
+  std::uint32_t voxel_first = 0, voxel_count = 0;
+  std::uint32_t stored_orders = 0;              // K
+  std::vector<glm::vec3> directions;            // DIRS
+  std::vector<glm::vec3> voxel_directions;      // VDIR, voxel-major, K per voxel; empty without
 };
 
 class SceneLayout {
  public:
   // max_texels: the driver's GL_MAX_TEXTURE_BUFFER_SIZE (tests pass small values to force many chunks).
   // Throws vxl::Error (Unsupported) when the scene needs more than kMaxChunks chunks or 2^31 virtual ids.
+  SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels);
   SceneLayout(const VxlFile& file, std::uint64_t max_texels);
 
-  static constexpr std::uint32_t kMaxChunks = 8;  // each chunk needs 3 samplers in the vertex shader
+  static constexpr std::uint32_t kMaxChunks = 8;  // each chunk needs 4 samplers in the vertex shader
 
-  std::uint32_t stored_orders() const { return stored_orders_; }     // K
-  std::uint32_t slots() const { return stored_orders_ + 1; }         // K stored + block order
-  std::uint32_t block_slot() const { return stored_orders_; }
-  const std::vector<glm::vec3>& directions() const { return directions_; }
+  // Of the first file (all of a single-file scene): K, K + 1 slots, the block order's slot, DIRS.
+  std::uint32_t stored_orders() const { return files_[0].stored_orders; }
+  std::uint32_t slots() const { return stored_orders() + 1; }
+  std::uint32_t block_slot() const { return stored_orders(); }
+  const std::vector<glm::vec3>& directions() const { return files_[0].directions; }
+  // The slot of a voxel's block (dataset) order: its file's K.
+  std::uint32_t block_slot(const VoxelDrawInfo& v) const { return chunks_[v.chunk].slots - 1; }
+  // The K directions voxel `voxel`'s stored orders are sorted by: its own (VDIR, random order sets) or
+  // its file's DIRS.
+  std::span<const glm::vec3> directions_of(std::uint32_t voxel) const {
+    const FileLayout& f = files_[chunks_[voxels_[voxel].chunk].file];
+    if (f.voxel_directions.empty()) return f.directions;
+    return std::span<const glm::vec3>(f.voxel_directions)
+        .subspan(std::size_t(voxel - f.voxel_first) * f.stored_orders, f.stored_orders);
+  }
   const std::vector<VoxelDrawInfo>& voxels() const { return voxels_; }
   const std::vector<ChunkLayout>& chunks() const { return chunks_; }
+  const std::vector<FileLayout>& files() const { return files_; }
+  // The file a scene voxel belongs to, and its index in that file's voxel table.
+  std::uint32_t file_of(std::uint32_t voxel) const { return chunks_[voxels_[voxel].chunk].file; }
+  std::uint32_t local_voxel(std::uint32_t voxel) const { return voxel - files_[file_of(voxel)].voxel_first; }
   std::uint64_t virtual_ids() const { return virtual_ids_; }
-  double voxel_size() const { return voxel_size_; }
+  double voxel_size() const { return voxel_size_; }  // the largest of the files'
 
   // First virtual vertex id of voxel v's range in `slot`, forwards or reversed.
   std::int64_t first_id(const VoxelDrawInfo& v, std::uint32_t slot, bool reversed) const {
     const ChunkLayout& c = chunks_[v.chunk];
-    const std::uint64_t s = c.segments, a = slots() * s;
+    const std::uint64_t s = c.segments, a = std::uint64_t(c.slots) * s;
     std::uint64_t seg = reversed ? a + slot * s + (s - v.seg_first - v.segment_count) : slot * s + v.seg_first;
     return static_cast<std::int64_t>(c.virtual_base + 2 * seg);
   }
   // First virtual id of entry j of a chunk's dataset-order array.
   std::int64_t dataset_id(std::uint32_t chunk, std::uint64_t j) const {
     const ChunkLayout& c = chunks_[chunk];
-    return static_cast<std::int64_t>(c.virtual_base + 2 * (2 * slots() * c.segments + j));
+    return static_cast<std::int64_t>(c.virtual_base + 2 * (2 * std::uint64_t(c.slots) * c.segments + j));
   }
 
  private:
-  std::uint32_t stored_orders_ = 0;
-  std::vector<glm::vec3> directions_;
+  std::vector<FileLayout> files_;
   std::vector<VoxelDrawInfo> voxels_;
   std::vector<ChunkLayout> chunks_;
   std::uint64_t virtual_ids_ = 0;

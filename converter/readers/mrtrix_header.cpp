@@ -1,0 +1,94 @@
+#include "mrtrix_header.h"
+
+#include <string_view>
+
+#include "error.h"
+
+namespace vxl {
+namespace {
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  return s;
+}
+
+}  // namespace
+
+MrtrixHeader parse_mrtrix_header(const std::string& path, std::span<const std::uint8_t> bytes, const char* magic) {
+  MrtrixHeader h;
+  std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  std::size_t pos = 0;
+  auto next_line = [&](std::string_view& line) {
+    if (pos >= text.size()) return false;
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    line = text.substr(pos, end - pos);
+    pos = end + 1;
+    return true;
+  };
+  std::string_view line;
+  if (!next_line(line) || trim(line) != magic) fail_input(path, 0, std::string("expected the magic line '") + magic + "'");
+  bool ended = false;
+  std::string last_key;
+  while (true) {
+    std::size_t line_start = pos;
+    if (!next_line(line)) break;
+    std::string_view t = trim(line);
+    if (t == "END") {
+      ended = true;
+      break;
+    }
+    if (t.empty()) continue;
+    std::size_t colon = t.find(':');
+    if (colon == std::string_view::npos) {
+      // A line without a colon continues the previous value (seen in real command_history fields).
+      if (last_key.empty()) fail_input(path, line_start, "expected a 'key: value' header line or 'END'");
+      auto& values = h.fields[last_key];
+      values.back() = values.back().get<std::string>() + "\n" + std::string(t);
+      continue;
+    }
+    std::string key(trim(t.substr(0, colon)));
+    last_key = key;
+    std::string value(trim(t.substr(colon + 1)));
+    h.fields[key].push_back(value);
+  }
+  if (!ended) fail_input(path, bytes.size(), "header has no 'END' line");
+
+  auto single = [&](const char* key) -> std::string {
+    if (!h.fields.contains(key)) fail_input(path, std::nullopt, std::string("header lacks '") + key + ":'");
+    return h.fields[key].back().get<std::string>();
+  };
+  h.datatype = single("datatype");
+  std::string file = single("file");
+  if (file.size() < 2 || file[0] != '.' || file[1] != ' ')
+    fail_unsupported(path, "'file:' must be '. OFFSET' (data in the same file); got '" + file + "'");
+  try {
+    std::size_t used = 0;
+    long long off = std::stoll(file.substr(2), &used);
+    if (off < 0) throw std::out_of_range("negative");
+    h.data_offset = static_cast<std::uint64_t>(off);
+  } catch (const std::exception&) {
+    fail_input(path, std::nullopt, "'file:' offset is not a number: '" + file + "'");
+  }
+  if (h.data_offset < pos) fail_input(path, h.data_offset, "data offset points inside the header");
+  if (h.data_offset > bytes.size())
+    fail_input(path, h.data_offset, "data offset is past the end of the file (" + std::to_string(bytes.size()) + " bytes)");
+  if (h.fields.contains("count")) {
+    try {
+      h.count = std::stoull(h.fields["count"].back().get<std::string>());
+    } catch (const std::exception&) {
+      // a malformed count is as good as a stale one: we trust the data
+    }
+  }
+  return h;
+}
+
+
+std::optional<std::string> MrtrixHeader::last(const char* key) const {
+  auto it = fields.find(key);
+  if (it == fields.end() || it->empty()) return std::nullopt;
+  return it->back().get<std::string>();
+}
+
+}  // namespace vxl

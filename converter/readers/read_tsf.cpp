@@ -1,0 +1,107 @@
+#include "read_tsf.h"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+
+#include "checksum.h"
+#include "error.h"
+#include "mapped_file.h"
+#include "mrtrix_header.h"
+
+namespace vxl {
+namespace {
+
+template <typename Real, bool kBigEndian>
+Real load(const std::uint8_t* p) {
+  using Bits = std::conditional_t<sizeof(Real) == 4, std::uint32_t, std::uint64_t>;
+  Bits bits;
+  std::memcpy(&bits, p, sizeof bits);
+  if constexpr (kBigEndian) {
+    if constexpr (sizeof(Bits) == 4) bits = __builtin_bswap32(bits);
+    else bits = __builtin_bswap64(bits);
+  }
+  return std::bit_cast<Real>(bits);
+}
+
+template <typename Real, bool kBigEndian>
+void read_values(std::span<const std::uint8_t> bytes, std::uint64_t offset, TrackScalars& s) {
+  const std::uint64_t available = (bytes.size() - offset) / sizeof(Real);
+  s.values.reserve(available);
+  const std::uint8_t* p = bytes.data() + offset;
+  bool terminated = false;
+  std::uint64_t in_current = 0;
+  for (std::uint64_t i = 0; i < available; ++i, p += sizeof(Real)) {
+    const Real v = load<Real, kBigEndian>(p);
+    if (std::isnan(v)) {  // end of streamline
+      s.offsets.push_back(s.values.size());
+      in_current = 0;
+      continue;
+    }
+    if (std::isinf(v)) {  // end of file
+      terminated = true;
+      break;
+    }
+    s.values.push_back(static_cast<float>(v));
+    ++in_current;
+  }
+  // Real TSF files (MRtrix's test data, NiiVue's demos) end with a streamline's NaN and no Inf: that is no
+  // reason to warn. A last streamline without its NaN, or a partial value, is.
+  const std::uint64_t trailing = (bytes.size() - offset) % sizeof(Real);
+  if (!terminated && in_current > 0)
+    s.warnings.push_back("file ends inside a streamline (no NaN, no Inf): its " + std::to_string(in_current) +
+                         " values are kept, as MRtrix does");
+  if (!terminated && trailing != 0) s.warnings.push_back(std::to_string(trailing) + " trailing bytes ignored");
+  if (in_current > 0) s.offsets.push_back(s.values.size());  // a last streamline without its NaN
+}
+
+}  // namespace
+
+TrackScalars read_tsf(const std::string& path) {
+  MappedFile file(path);
+  const MrtrixHeader h = parse_mrtrix_header(path, file.bytes(), "mrtrix track scalars");
+  TrackScalars s;
+  s.offsets = {0};
+  s.timestamp = h.last("timestamp");
+  s.provenance = {{"name", std::filesystem::path(path).filename().string()},
+                  {"bytes", file.size()},
+                  {"xxh3_128", xxh3_128_hex(file.data(), file.size())},
+                  {"header", h.fields}};
+  const std::string& dt = h.datatype;
+  if (dt == "Float32LE") read_values<float, false>(file.bytes(), h.data_offset, s);
+  else if (dt == "Float32BE") read_values<float, true>(file.bytes(), h.data_offset, s);
+  else if (dt == "Float64LE") read_values<double, false>(file.bytes(), h.data_offset, s);
+  else if (dt == "Float64BE") read_values<double, true>(file.bytes(), h.data_offset, s);
+  else fail_unsupported(path, "TSF datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+  return s;
+}
+
+void attach_tsf(Tractogram& t, const std::string& tsf_path) {
+  TrackScalars s = read_tsf(tsf_path);
+  const std::uint64_t n = s.offsets.size() - 1;
+  const std::string counts = std::to_string(n) + " streamlines and " + std::to_string(s.values.size()) + " values";
+  const std::string expected = std::to_string(t.streamline_count()) + " streamlines and " +
+                               std::to_string(t.point_count()) + " points";
+  const std::string source = t.source.path.empty() ? "the tractogram" : t.source.path;
+  if (n != t.streamline_count() || s.values.size() != t.point_count())
+    fail_input(tsf_path, std::nullopt,
+               "holds " + counts + " but " + source + " has " + expected + ": a TSF must have one value per point");
+  for (std::uint64_t i = 0; i < n; ++i)
+    if (s.offsets[i + 1] - s.offsets[i] != t.offsets[i + 1] - t.offsets[i])
+      fail_input(tsf_path, std::nullopt,
+                 "streamline " + std::to_string(i) + " has " + std::to_string(s.offsets[i + 1] - s.offsets[i]) +
+                     " values but " + std::to_string(t.offsets[i + 1] - t.offsets[i]) + " points in " + source);
+  const std::string name = std::filesystem::path(tsf_path).stem().string();
+  for (const std::string& w : s.warnings) t.source.warnings.push_back(name + ".tsf: " + w);
+  if (s.timestamp && t.source.header.is_object() && t.source.header.contains("timestamp")) {
+    const auto& ts = t.source.header["timestamp"];
+    if (ts.is_array() && !ts.empty() && ts.back().is_string() && ts.back().get<std::string>() != *s.timestamp)
+      t.source.warnings.push_back(name + ".tsf: its timestamp differs from the tractogram's (the counts agree, so it "
+                                         "is used)");
+  }
+  t.point_values.push_back({name, std::move(s.values)});
+  t.source.value_files.push_back(std::move(s.provenance));
+}
+
+}  // namespace vxl

@@ -1,0 +1,90 @@
+// Pieces of the TCK reader shared by read_tck (whole file in memory) and TckStream (bounded memory), so
+// that both read a file identically: header, triplet decoding, and the warnings about the data's end.
+// See read_tck.cpp for the format.
+#pragma once
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <optional>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "error.h"
+#include "tractogram.h"
+
+namespace vxl::tck {
+
+struct Header {
+  nlohmann::json fields = nlohmann::json::object();  // key -> array of values (keys may repeat)
+  std::string datatype;
+  std::uint64_t data_offset = 0;
+  std::optional<std::uint64_t> count;
+};
+
+// Parses the header at the start of `bytes`, the first bytes of a file of `file_size` bytes. Returns
+// nullopt when `bytes` is shorter than the file and holds no END line yet (read more and call again);
+// throws vxl::Error (Input / Unsupported) for a malformed header.
+std::optional<Header> parse_header(const std::string& path, std::span<const std::uint8_t> bytes, std::uint64_t file_size);
+
+template <typename Real, bool kBigEndian>
+Real load(const std::uint8_t* p) {
+  using Bits = std::conditional_t<sizeof(Real) == 4, std::uint32_t, std::uint64_t>;
+  Bits bits;
+  std::memcpy(&bits, p, sizeof bits);
+  if constexpr (kBigEndian) {
+    if constexpr (sizeof(Bits) == 4) bits = __builtin_bswap32(bits);
+    else bits = __builtin_bswap64(bits);
+  }
+  return std::bit_cast<Real>(bits);
+}
+
+// Where decoding stands between calls.
+struct DecodeState {
+  std::uint64_t points_in_current = 0;  // points of the streamline not yet closed by a NaN
+  bool terminated = false;              // an Inf triplet was seen: the data has ended
+};
+
+// Decodes up to `n` triplets at `p` (the first at byte `offset` of the file) into `t`: points are
+// appended, a NaN delimiter closes a streamline (t.offsets), an Inf one ends the data. Returns early,
+// right after a streamline is closed, once `t` holds `stop_items` points and streamlines together (the
+// streamlines count too: a file of delimiters alone is a file of empty streamlines). Returns the number
+// of triplets consumed (the terminator included).
+template <typename Real, bool kBigEndian>
+std::uint64_t decode(const std::string& path, const std::uint8_t* p, std::uint64_t n, std::uint64_t offset, Tractogram& t,
+                     DecodeState& s, std::uint64_t stop_items) {
+  constexpr std::size_t kTriplet = 3 * sizeof(Real);
+  for (std::uint64_t i = 0; i < n; ++i, p += kTriplet) {
+    Real x = load<Real, kBigEndian>(p), y = load<Real, kBigEndian>(p + sizeof(Real)),
+         z = load<Real, kBigEndian>(p + 2 * sizeof(Real));
+    if (std::isnan(x)) {  // end of streamline
+      t.offsets.push_back(t.point_count());
+      s.points_in_current = 0;
+      if (t.point_count() + t.streamline_count() >= stop_items) return i + 1;
+      continue;
+    }
+    if (std::isinf(x)) {  // end of file
+      s.terminated = true;
+      return i + 1;
+    }
+    if (!std::isfinite(y) || !std::isfinite(z))
+      fail_input(path, offset + i * kTriplet, "non-finite coordinate inside a streamline (only x marks NaN/Inf delimiters)");
+    t.positions.push_back(static_cast<float>(x));
+    t.positions.push_back(static_cast<float>(y));
+    t.positions.push_back(static_cast<float>(z));
+    ++s.points_in_current;
+  }
+  return n;
+}
+
+// After the last triplet: closes a streamline left open (adding it to `t`) and appends the warnings
+// about the end of the data. `trailing` is the number of bytes after the last whole triplet.
+void finish(const DecodeState& s, std::uint64_t trailing, Tractogram& t, std::vector<std::string>& warnings);
+
+// The warnings about the header that need the whole data (appended after finish()'s).
+void header_warnings(const Header& h, std::uint64_t streamlines, std::vector<std::string>& warnings);
+
+}  // namespace vxl::tck

@@ -1,0 +1,594 @@
+#include "streaming_convert.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <future>
+#include <limits>
+#include <memory>
+#include <numeric>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+#include "error.h"
+#include "memory_size.h"
+#include "segment_orders.h"
+#include "tck_stream.h"
+#include "voxelize.h"
+#include "voxelize_streamline.h"
+#include "vxl_stream_writer.h"
+
+namespace vxl {
+namespace {
+
+using detail::Coord;
+using detail::Grid;
+using detail::kNoSynthetic;
+using detail::TempVoxline;
+using detail::VoxelIndex;
+using Clock = std::chrono::steady_clock;
+
+constexpr std::uint64_t kMiB = 1ull << 20;
+// The program itself before any work: code, libraries, thread stacks, allocator slack (voxlines
+// measures about 7 MiB of resident memory at start; the rest is margin).
+constexpr std::uint64_t kBaselineBytes = 16 * kMiB;
+// The voxel table while it is built and used, at its peak (build_table): hash index (coordinates and
+// slots, with their growth: up to 40 bytes), counts per voxel (with growth: 32), sort order, global id,
+// the table itself (64) and cursor (8) — 152 bytes, and a margin.
+constexpr std::uint64_t kPlanBytesPerVoxel = 192;
+// Memory per point of a batch being read, at worst: two batches (one read while the other is processed),
+// each of whose positions may have twice the capacity in use.
+constexpr std::uint64_t kHeldBytesPerPoint = 2 * 2 * 3 * sizeof(float);
+// Voxline and streamline table entries written at once.
+constexpr std::size_t kTableBufferEntries = 1 << 16;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// The memory the conversion holds, held against the limit.
+class Budget {
+ public:
+  Budget(std::uint64_t limit, std::string path) : limit_(limit), path_(std::move(path)) {}
+  std::uint64_t used() const { return used_; }
+  std::uint64_t left() const { return used_ < limit_ ? limit_ - used_ : 0; }
+  // Takes `bytes` more, or throws Unsupported naming `what` (a singular noun phrase), what it needs and a
+  // limit that would do.
+  void take(std::uint64_t bytes, const std::string& what, const std::string& hint = "") {
+    if (bytes > left()) fail(bytes, used_, what, hint);
+    used_ += bytes;
+  }
+  // Follows a buffer that grows to `bytes`: takes its growth since `held`, which it updates. what() names it.
+  template <typename What>
+  void track(std::uint64_t bytes, std::uint64_t& held, What&& what, const std::string& hint = "") {
+    if (bytes <= held) return;
+    if (bytes - held > left()) fail(bytes, used_ - held, what(), hint);
+    used_ += bytes - held;
+    held = bytes;
+  }
+  [[noreturn]] void fail(std::uint64_t needs, std::uint64_t others, const std::string& what, const std::string& hint = "") const {
+    // A quarter more than the sum, for what comes later.
+    throw Error(ErrorKind::Unsupported, path_, std::nullopt,
+                "--memory-limit " + format_memory_size(limit_) + " is too small: " + what + " needs " + format_memory_size(needs) +
+                    (others > 0 ? " on top of " + format_memory_size(others) + " already taken" : std::string()) +
+                    "; use --memory-limit " + memory_limit_argument((needs + others) / 4 * 5) + " or more" + hint);
+  }
+
+ private:
+  std::uint64_t limit_;
+  std::uint64_t used_ = 0;
+  std::string path_;
+};
+
+// Where voxelize_streamline puts one streamline's voxlines.
+struct Sink {
+  VoxelIndex index;
+  std::vector<TempVoxline> voxlines;
+  std::vector<float> synthetic_xyz;
+  bool too_many_synthetic = false;
+  std::uint64_t bytes() const {
+    return voxlines.capacity() * sizeof(TempVoxline) + synthetic_xyz.capacity() * sizeof(float);
+  }
+};
+
+// A range of the voxel table, built in one pass.
+struct Range {
+  std::size_t first = 0, end = 0;  // voxels
+  std::uint64_t vertex_first = 0, vertex_end = 0, order_first = 0, order_end = 0;
+  std::uint32_t max_vertices = 0;
+  unsigned order_threads = 1;  // set by cut_ranges
+};
+
+class StreamingConversion {
+ public:
+  StreamingConversion(const std::string& source, const std::string& out, const ConvertSettings& settings)
+      : path_(source), out_path_(out), settings_(settings), budget_(settings.memory_limit, source) {}
+
+  ConvertSummary run();
+
+ private:
+  void check_source_type() const;
+  void open_stream();
+  void scan();
+  void plan();
+  void build_table();
+  std::vector<Range> cut_ranges();
+  void build_range(const Range& r, std::size_t index, std::size_t count);
+  void write_rest();
+  [[noreturn]] void fail_changed() const;
+  // Reads the source once, calling body(batch, index of its first streamline) per batch.
+  template <typename Body>
+  void each_batch(const std::string& stage, Body&& body);
+  void report(const std::string& stage, double fraction) const {
+    if (settings_.progress) settings_.progress(stage.c_str(), fraction);
+  }
+
+  std::string path_, out_path_;
+  ConvertSettings settings_;
+  Budget budget_;
+  OrderSetSpec order_set_;
+  unsigned threads_ = 1;
+  ConvertSummary summary_;
+
+  std::unique_ptr<TckStream> stream_;
+  Tractogram batches_[2];  // one processed while the next is read
+  std::uint64_t batch_items_ = 0, batch_held_ = 0, max_points_held_ = 0;
+  std::uint64_t longest_ = 0, longest_index_ = 0;  // the longest streamline seen (in points)
+
+  // pass 1
+  double lo_[3] = {INFINITY, INFINITY, INFINITY}, hi_[3] = {-INFINITY, -INFINITY, -INFINITY};
+  double longest_step2_ = 0;
+  // pass 2 and the table
+  MetaSection meta_{};
+  Grid grid_{};
+  std::uint64_t synthetic_limit_ = 0;
+  Sink sink_;
+  std::uint64_t sink_held_ = 0, plan_held_ = 0;
+  std::vector<std::uint64_t> local_vertices_, local_segments_;  // by local id, while planning
+  std::vector<std::uint32_t> global_id_;                        // local id -> voxel index
+  std::vector<VoxelEntry> voxels_;
+  std::vector<std::uint64_t> cursor_;  // per voxel: the next vertex to place (global index)
+  // Per streamline: its lowest and highest voxel index (set by the first range's pass), so that later
+  // passes skip the streamlines that have no voxel in their range.
+  std::vector<std::array<std::uint32_t, 2>> spans_;
+  std::uint64_t order_bytes_ = 0;
+  std::unique_ptr<VxlStreamWriter> out_;
+};
+
+void StreamingConversion::fail_changed() const {
+  fail_input(path_, std::nullopt, "the file changed while it was being converted (--memory-limit reads it several times)");
+}
+
+void StreamingConversion::check_source_type() const {
+  std::string lower = path_;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (!lower.ends_with(".tck"))
+    fail_unsupported(path_, "--memory-limit streams TCK sources only (.tck); convert TRK and TRX sources without it");
+}
+
+template <typename Body>
+void StreamingConversion::each_batch(const std::string& stage, Body&& body) {
+  stream_->rewind();
+  ++summary_.passes;
+  report(stage, 0.0);
+  const double size = double(std::max<std::uint64_t>(1, stream_->file_size()));
+  const bool read_ahead = threads_ > 1;
+  std::uint64_t first = 0;
+  auto read = [&](int b) { return stream_->next(batches_[b], batch_items_, max_points_held_); };
+  auto check_overflow = [&](const Tractogram& b) {
+    if (stream_->overflowed())
+      budget_.fail(b.point_count() * kHeldBytesPerPoint, budget_.used() - batch_held_,
+                   "streamline " + std::to_string(first + b.streamline_count()) + ", of more than " +
+                       std::to_string(b.point_count() - b.offsets.back()) + " points, held whole while reading,");
+  };
+  int current = 0;
+  bool more = read(current);
+  check_overflow(batches_[current]);
+  while (more) {
+    const int other = 1 - current;
+    std::future<bool> next;
+    if (read_ahead) next = std::async(std::launch::async, read, other);
+    body(static_cast<const Tractogram&>(batches_[current]), first);
+    first += batches_[current].streamline_count();
+    more = read_ahead ? next.get() : read(other);
+    current = other;
+    check_overflow(batches_[current]);
+    // Both batches keep their largest size; pass 1 finds it (later passes cut the same batches).
+    const std::uint64_t bytes = (batches_[0].positions.capacity() + batches_[1].positions.capacity()) * sizeof(float) +
+                                (batches_[0].offsets.capacity() + batches_[1].offsets.capacity()) * sizeof(std::uint64_t);
+    budget_.track(bytes, batch_held_, [&] {
+      return "reading two batches of streamlines, one holding streamline " + std::to_string(longest_index_) + " (" +
+             std::to_string(longest_) + " points) whole,";
+    });
+    report(stage, double(stream_->position()) / size);
+  }
+  report(stage, 1.0);
+}
+
+void StreamingConversion::open_stream() {
+  const std::uint64_t limit = settings_.memory_limit;
+  budget_.take(kBaselineBytes, "the program itself");
+  const std::uint64_t chunk = std::clamp<std::uint64_t>(limit / 64, 64 << 10, 4 * kMiB);
+  budget_.take(chunk, "the read buffer");
+  batch_items_ = std::clamp<std::uint64_t>(limit / 64 / 16, 1024, 1 << 20);
+  stream_ = std::make_unique<TckStream>(path_, std::max<std::uint64_t>(1, budget_.left() / 4), chunk);
+  max_points_held_ = budget_.left() / kHeldBytesPerPoint;
+}
+
+// Pass 1: what plan_voxels' bounds scan finds, and the source's checksum and warnings.
+void StreamingConversion::scan() {
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  std::uint64_t bad_streamline = std::numeric_limits<std::uint64_t>::max(), bad_point = 0;
+  std::uint64_t streamlines = 0, points = 0;
+  each_batch("reading", [&](const Tractogram& b, std::uint64_t first) {
+    for (std::uint64_t k = 0; k < b.streamline_count(); ++k) {
+      const std::uint64_t begin = b.offsets[k], end = b.offsets[k + 1];
+      if (end - begin > longest_) {
+        longest_ = end - begin;
+        longest_index_ = first + k;
+      }
+      if (bad_streamline != std::numeric_limits<std::uint64_t>::max()) continue;  // reading on for the reader's errors
+      for (std::uint64_t i = begin; i < end; ++i) {
+        const float* p = b.positions.data() + 3 * i;
+        if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) {
+          bad_streamline = first + k;
+          bad_point = i - begin;
+          break;
+        }
+        for (int c = 0; c < 3; ++c) {
+          lo[c] = std::min(lo[c], p[c]);
+          hi[c] = std::max(hi[c], p[c]);
+        }
+        if (i > begin) {
+          double d2 = 0;
+          for (int c = 0; c < 3; ++c) d2 += (double(p[c]) - p[c - 3]) * (double(p[c]) - p[c - 3]);
+          longest_step2_ = std::max(longest_step2_, d2);
+        }
+      }
+    }
+    streamlines += b.streamline_count();
+    points += b.point_count();
+  });
+  if (bad_streamline != std::numeric_limits<std::uint64_t>::max()) detail::fail_non_finite(path_, bad_streamline, bad_point);
+  for (int c = 0; c < 3; ++c) {
+    lo_[c] = lo[c];
+    hi_[c] = hi[c];
+  }
+  meta_.streamline_count = streamlines;
+  meta_.point_count = points;
+  meta_.voxel_size = settings_.voxel_size;
+}
+
+// Pass 2: the vertex and segment counts per voxel (plan_voxels' pass 1), kept per voxel only.
+void StreamingConversion::plan() {
+  if (meta_.point_count == 0) return;  // no voxels (plan_voxels returns early too)
+  grid_ = detail::set_grid(meta_, lo_, hi_, path_);
+  // plan_voxels' limit on added points, applied to the whole source (plan_voxels applies it per
+  // thread's range: the two can differ only in whether a borderline source is refused).
+  synthetic_limit_ = static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(meta_.point_count)) + 4096;
+  std::uint64_t voxlines = 0, synthetic = 0, points = 0;
+  const std::string voxel_hint = ", or a larger --voxel-size";
+  each_batch("voxelising", [&](const Tractogram& b, std::uint64_t) {
+    const float* pts = b.positions.data();
+    for (std::uint64_t k = 0; k < b.streamline_count(); ++k) {
+      sink_.voxlines.clear();
+      sink_.synthetic_xyz.clear();
+      detail::voxelize_streamline(grid_, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], sink_, synthetic_limit_ - synthetic);
+      if (sink_.too_many_synthetic) detail::fail_too_many_synthetic(path_, meta_.voxel_size, longest_step2_);
+      synthetic += sink_.synthetic_xyz.size() / 3;
+      const std::size_t n_local = sink_.index.coords().size();
+      if (local_vertices_.size() < n_local) {
+        local_vertices_.resize(n_local, 0);
+        local_segments_.resize(n_local, 0);
+      }
+      const std::size_t count = sink_.voxlines.size();
+      for (std::size_t j = 0; j < count; ++j) {
+        const TempVoxline& v = sink_.voxlines[j];
+        const std::uint64_t own = v.own();
+        if (own > kVoxlineCountMask) detail::fail_long_voxline(path_);
+        const std::uint64_t used = own + (j + 1 < count ? 1 : 0);  // + the connecting vertex
+        local_vertices_[v.voxel] += used;
+        local_segments_[v.voxel] += used - 1;
+      }
+      voxlines += count;
+      // Per streamline, so that a table outgrowing the limit is caught before it goes far past it.
+      const std::uint64_t table = n_local * kPlanBytesPerVoxel;
+      if (table > plan_held_ && table - plan_held_ > budget_.left()) {
+        // Voxels turn up ever more slowly: extrapolating from the points read so far overestimates.
+        const std::uint64_t read = points + b.offsets[k + 1];
+        const std::uint64_t all = static_cast<std::uint64_t>(double(n_local) * double(meta_.point_count) / double(read));
+        budget_.fail(all * kPlanBytesPerVoxel, budget_.used() - plan_held_,
+                     "the voxel table (" + std::to_string(n_local) + " voxels after " + std::to_string(read) + " of " +
+                         std::to_string(meta_.point_count) + " points; about " + std::to_string(all) + " in all, extrapolated)",
+                     voxel_hint);
+      }
+      budget_.track(table, plan_held_, [] { return std::string(); });
+      budget_.track(sink_.bytes(), sink_held_, [] { return std::string("the voxline list of one streamline"); });
+    }
+    points += b.point_count();
+  });
+  meta_.voxline_count = voxlines;
+  meta_.synthetic_point_count = synthetic;
+}
+
+// The voxel table sorted by (z, y, x), as plan_voxels and layout_orders make it.
+void StreamingConversion::build_table() {
+  const std::vector<Coord>& coords = sink_.index.coords();
+  const std::size_t n = coords.size();
+  detail::check_voxel_total(n, meta_.voxel_size, path_);
+  std::vector<std::uint32_t> by_coord(n);
+  std::iota(by_coord.begin(), by_coord.end(), 0u);
+  std::sort(by_coord.begin(), by_coord.end(), [&](std::uint32_t a, std::uint32_t b) { return detail::zyx_less(coords[a], coords[b]); });
+  global_id_.resize(n);
+  voxels_.resize(n);
+  cursor_.resize(n);
+  std::uint64_t vertices = 0, segments = 0;
+  for (std::size_t g = 0; g < n; ++g) {
+    const std::uint32_t local = by_coord[g];
+    global_id_[local] = static_cast<std::uint32_t>(g);
+    if (local_vertices_[local] > std::numeric_limits<std::uint32_t>::max()) detail::fail_full_voxel(path_, meta_.voxel_size);
+    VoxelEntry& v = voxels_[g];
+    v = {};
+    v.coord[0] = coords[local].x;
+    v.coord[1] = coords[local].y;
+    v.coord[2] = coords[local].z;
+    v.vertex_first = vertices;
+    v.vertex_count = static_cast<std::uint32_t>(local_vertices_[local]);
+    v.segment_count = static_cast<std::uint32_t>(local_segments_[local]);
+    cursor_[g] = vertices;
+    vertices += local_vertices_[local];
+    segments += local_segments_[local];
+  }
+  local_vertices_ = {};
+  local_segments_ = {};
+  meta_.vertex_count = vertices;
+  meta_.segment_count = segments;
+  meta_.voxel_count = static_cast<std::uint32_t>(n);
+  meta_.stored_order_count = static_cast<std::uint32_t>(order_set_.directions.size());
+  meta_.order_set = static_cast<std::uint32_t>(order_set_.kind);
+  order_bytes_ = layout_orders(voxels_, meta_.stored_order_count);
+}
+
+// Consecutive voxels, as many per range as fit in what the limit leaves: each range's vertices (12 bytes
+// each), voxline ends (1 bit each), orders, and its ordering threads' sort buffers. The sort buffers of
+// one thread grow with the largest voxel, so a range orders with fewer threads when they would take more
+// than a quarter of the room (the orders do not depend on the thread count).
+std::vector<Range> StreamingConversion::cut_ranges() {
+  const std::uint64_t room = budget_.left();
+  auto order_threads = [&](const Range& r) {
+    const std::uint64_t per_thread = order_scratch_bytes(r.max_vertices);
+    return static_cast<unsigned>(std::clamp<std::uint64_t>(room / 4 / per_thread, 1, threads_));
+  };
+  auto cost = [&](const Range& r) {
+    const std::uint64_t v = r.vertex_end - r.vertex_first;
+    return 12 * v + (v / 64 + 1) * 8 + (r.order_end - r.order_first) + order_threads(r) * order_scratch_bytes(r.max_vertices);
+  };
+  auto order_end = [&](std::size_t i) { return i < voxels_.size() ? voxels_[i].order_offset : order_bytes_; };
+  auto alone = [&](std::size_t i) {
+    const VoxelEntry& v = voxels_[i];
+    Range r{i, i + 1, v.vertex_first, v.vertex_first + v.vertex_count, v.order_offset, order_end(i + 1), v.vertex_count};
+    if (cost(r) > room) {
+      budget_.take(cost(r),
+                   "voxel (" + std::to_string(v.coord[0]) + ", " + std::to_string(v.coord[1]) + ", " + std::to_string(v.coord[2]) +
+                       ") of " + std::to_string(v.vertex_count) + " vertices, with its orders and sort buffers,",
+                   ", or a smaller --voxel-size");
+    }
+    return r;
+  };
+  std::vector<Range> ranges;
+  Range r;  // empty: the last one when there are no voxels (its pass still writes the tables)
+  for (std::size_t i = 0; i < voxels_.size(); ++i) {
+    if (r.first == r.end) {
+      r = alone(i);
+      continue;
+    }
+    Range grown = r;
+    grown.end = i + 1;
+    grown.vertex_end = voxels_[i].vertex_first + voxels_[i].vertex_count;
+    grown.order_end = order_end(i + 1);
+    grown.max_vertices = std::max(grown.max_vertices, voxels_[i].vertex_count);
+    if (cost(grown) <= room) {
+      r = grown;
+    } else {
+      ranges.push_back(r);
+      r = alone(i);
+    }
+  }
+  ranges.push_back(r);
+  for (Range& each : ranges) each.order_threads = order_threads(each);
+  return ranges;
+}
+
+// Pass 2 + k: the blocks and orders of one range; the first also writes the voxline and streamline tables.
+void StreamingConversion::build_range(const Range& r, std::size_t index, std::size_t count) {
+  const std::string of = " " + std::to_string(index + 1) + "/" + std::to_string(count);
+  const bool tables = index == 0;
+  auto t0 = Clock::now();
+  std::vector<float> vertices(3 * (r.vertex_end - r.vertex_first));
+  VoxlineEnds ends(r.vertex_end - r.vertex_first);
+  std::vector<VoxlineEntry> voxline_buffer;
+  std::vector<std::uint64_t> streamline_buffer;
+  if (tables) {
+    voxline_buffer.reserve(kTableBufferEntries);
+    streamline_buffer.reserve(kTableBufferEntries);
+  }
+  std::uint64_t voxline_index = 0, streamlines = 0;
+  each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
+    const float* pts = b.positions.data();
+    for (std::uint64_t k = 0; k < b.streamline_count(); ++k) {
+      if (first + k >= spans_.size()) fail_changed();  // more streamlines than pass 1 saw
+      std::array<std::uint32_t, 2>& span = spans_[first + k];
+      if (!tables && (span[1] < r.first || span[0] >= r.end)) continue;  // no voxel in this range (or none at all)
+      if (tables) {
+        span = {std::numeric_limits<std::uint32_t>::max(), 0};
+        streamline_buffer.push_back(voxline_index);
+        if (streamline_buffer.size() == kTableBufferEntries) {
+          out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, streamline_buffer);
+          streamline_buffer.clear();
+        }
+      }
+      sink_.voxlines.clear();
+      sink_.synthetic_xyz.clear();
+      detail::voxelize_streamline(grid_, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], sink_, synthetic_limit_);
+      if (sink_.too_many_synthetic) fail_changed();
+      const std::size_t n = sink_.voxlines.size();
+      for (std::size_t j = 0; j < n; ++j) {
+        const TempVoxline& v = sink_.voxlines[j];
+        if (v.voxel >= global_id_.size()) fail_changed();  // a voxel pass 2 did not see
+        const std::uint32_t g = global_id_[v.voxel];
+        const std::uint32_t own = v.own();
+        if (tables) {
+          span = {std::min(span[0], g), std::max(span[1], g)};
+          voxline_buffer.push_back({g, own | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)});
+          if (voxline_buffer.size() == kTableBufferEntries) {
+            out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, voxline_buffer);
+            voxline_buffer.clear();
+          }
+        }
+        if (g < r.first || g >= r.end) continue;
+        // As place_vertices: the optional synthetic first point, the own points, the connecting vertex.
+        const bool connected = j + 1 < n;
+        const std::uint64_t used = own + (connected ? 1 : 0);
+        const std::uint64_t cursor = cursor_[g];
+        if (used > voxels_[g].vertex_first + voxels_[g].vertex_count - cursor) fail_changed();
+        float* dst = vertices.data() + 3 * (cursor - r.vertex_first);
+        if (v.synthetic != kNoSynthetic) {
+          std::memcpy(dst, sink_.synthetic_xyz.data() + 3 * v.synthetic, 12);
+          dst += 3;
+        }
+        std::memcpy(dst, pts + 3 * v.src_first, 12ull * v.src_count);
+        dst += 3 * v.src_count;
+        if (connected) {
+          const TempVoxline& w = sink_.voxlines[j + 1];
+          const float* next = w.synthetic != kNoSynthetic ? sink_.synthetic_xyz.data() + 3 * w.synthetic : pts + 3 * w.src_first;
+          std::memcpy(dst, next, 12);
+        }
+        ends.set(cursor - r.vertex_first + used - 1);
+        cursor_[g] = cursor + used;
+      }
+      voxline_index += n;
+    }
+    streamlines += b.streamline_count();
+  });
+  if (streamlines != meta_.streamline_count || (tables && voxline_index != meta_.voxline_count)) fail_changed();
+  for (std::size_t g = r.first; g < r.end; ++g)
+    if (cursor_[g] != voxels_[g].vertex_first + voxels_[g].vertex_count) fail_changed();
+  if (tables) {
+    streamline_buffer.push_back(voxline_index);
+    out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, streamline_buffer);
+    out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, voxline_buffer);
+  }
+
+  // Tight bounds, as place_vertices computes them.
+  const std::span<VoxelEntry> range(voxels_.data() + r.first, r.end - r.first);
+  for (VoxelEntry& v : range) {
+    const float* p = vertices.data() + 3 * (v.vertex_first - r.vertex_first);
+    for (int c = 0; c < 3; ++c) v.tight_min[c] = v.tight_max[c] = p[c];
+    for (std::uint64_t k = 1; k < v.vertex_count; ++k)
+      for (int c = 0; c < 3; ++c) {
+        v.tight_min[c] = std::min(v.tight_min[c], p[3 * k + c]);
+        v.tight_max[c] = std::max(v.tight_max[c], p[3 * k + c]);
+      }
+  }
+  summary_.voxelize_seconds += seconds_since(t0);
+
+  // The orders, with the range's entries rebased to its own vertices and orders for the while.
+  t0 = Clock::now();
+  std::vector<std::uint8_t> orders(r.order_end - r.order_first, 0);
+  for (VoxelEntry& v : range) {
+    v.vertex_first -= r.vertex_first;
+    v.order_offset -= r.order_first;
+  }
+  const std::string stage = "ordering" + of;
+  build_orders_into(range, vertices, ends, order_set_, orders, r.order_threads, [&](const char*, double f) { report(stage, f); });
+  for (VoxelEntry& v : range) {
+    v.vertex_first += r.vertex_first;
+    v.order_offset += r.order_first;
+  }
+  summary_.orders_seconds += seconds_since(t0);
+
+  t0 = Clock::now();
+  out_->append_items<float>(VxlStreamWriter::kVert, vertices);
+  out_->append(VxlStreamWriter::kOrdr, orders);
+  summary_.write_seconds += seconds_since(t0);
+}
+
+void StreamingConversion::write_rest() {
+  out_->append_meta(meta_);
+  std::vector<DirectionEntry> directions = order_directions(order_set_);
+  out_->append_items<DirectionEntry>(VxlStreamWriter::kDirs, directions);
+  if (order_set_.per_voxel()) {  // VDIR, a function of (seed, voxel coordinate): made in bounded slices
+    const std::size_t slice = 4096;
+    std::vector<DirectionEntry> voxel_directions;
+    for (std::size_t first = 0; first < voxels_.size(); first += slice) {
+      const std::span<const VoxelEntry> part = std::span<const VoxelEntry>(voxels_).subspan(first, std::min(slice, voxels_.size() - first));
+      voxel_directions.resize(part.size() * directions.size());
+      fill_voxel_directions(order_set_, part, voxel_directions);
+      out_->append_items<DirectionEntry>(VxlStreamWriter::kVdir, voxel_directions);
+    }
+  }
+  out_->append_items<VoxelEntry>(VxlStreamWriter::kVoxt, voxels_);
+}
+
+ConvertSummary StreamingConversion::run() {
+  if (settings_.memory_limit == 0) throw std::logic_error("convert_streaming: memory_limit must be > 0");
+  check_source_type();
+  order_set_ = parse_order_set(settings_.orders);
+  threads_ = resolve_threads(settings_.threads);
+  detail::check_voxel_size(settings_.voxel_size, path_);
+  summary_.passes = 0;
+
+  auto t0 = Clock::now();
+  open_stream();
+  scan();
+  summary_.read_seconds = seconds_since(t0);
+
+  t0 = Clock::now();
+  plan();
+  build_table();
+  summary_.voxelize_seconds = seconds_since(t0);
+  budget_.take(kTableBufferEntries * (sizeof(VoxlineEntry) + sizeof(std::uint64_t)), "the buffer of the voxline and streamline tables");
+  budget_.take(meta_.streamline_count * sizeof(spans_[0]), "the voxel span of every streamline");
+  spans_.resize(meta_.streamline_count);
+  std::vector<Range> ranges = cut_ranges();
+
+  const std::string provenance = provenance_json(stream_->source(), settings_, threads_);
+  out_ = std::make_unique<VxlStreamWriter>(out_path_, section_sizes(meta_, order_bytes_, provenance.size(), 0));
+  for (std::size_t k = 0; k < ranges.size(); ++k) {
+    build_range(ranges[k], k, ranges.size());
+#if defined(__GLIBC__)
+    malloc_trim(0);  // give back what the range freed, lest the allocator keep it resident for the next one
+#endif
+  }
+
+  report("writing", 0.0);
+  t0 = Clock::now();
+  write_rest();
+  out_->append(VxlStreamWriter::kProv, {reinterpret_cast<const std::uint8_t*>(provenance.data()), provenance.size()});
+  out_->commit();
+  summary_.write_seconds += seconds_since(t0);
+  report("writing", 1.0);
+
+  summary_.streamlines = meta_.streamline_count;
+  summary_.points = meta_.point_count;
+  summary_.voxels = meta_.voxel_count;
+  summary_.vertices = meta_.vertex_count;
+  summary_.segments = meta_.segment_count;
+  summary_.synthetic_points = meta_.synthetic_point_count;
+  summary_.partitions = ranges.size();
+  for (const Range& r : ranges) summary_.partition_starts.push_back(r.first);
+  summary_.warnings = stream_->source().warnings;
+  return summary_;
+}
+
+}  // namespace
+
+ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path, const ConvertSettings& settings) {
+  StreamingConversion conversion(source_path, out_path, settings);
+  return conversion.run();
+}
+
+}  // namespace vxl

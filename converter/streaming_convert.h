@@ -1,0 +1,29 @@
+// Conversion in bounded memory (voxlines convert --memory-limit SIZE), for tractograms larger than the
+// memory at hand. It writes exactly the bytes convert_tractogram writes for the same source and settings
+// (the limit is not recorded), reading the source several times instead of holding it:
+//
+//   pass 1    bounds, checksum, warnings and the longest streamline                 (TckStream)
+//   pass 2    voxelise every streamline, keeping only the counts per voxel          -> voxel table, layout
+//   then      cut the voxel table into ranges whose vertex blocks and orders fit in what the limit leaves
+//   pass 2+k  voxelise again, place the vertices that fall in range k, build their orders, and write both
+//             at their final offsets (VxlStreamWriter); pass 3 also writes the voxline and streamline tables
+//
+// What stays in memory: the voxel table (about 256 bytes per voxel), one read buffer and one batch of
+// whole streamlines, and one range's blocks, orders and sort buffers. The source and the output are read
+// and written with pread / pwrite, so neither enters the resident memory. Only TCK sources stream.
+#pragma once
+
+#include <string>
+
+#include "convert.h"
+
+namespace vxl {
+
+// Converts the TCK file `source_path` to `out_path` (atomically) using at most settings.memory_limit
+// bytes (> 0). Throws vxl::Error: Unsupported for a source other than TCK, and when the limit is too
+// small for some part of the work — naming the part, what it needs and a limit that would do — before
+// anything is written; Input when the source changes between passes; as convert_tractogram otherwise.
+// The summary's passes and partitions say how the work was split; its warnings are the source's.
+ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path, const ConvertSettings& settings);
+
+}  // namespace vxl

@@ -1,0 +1,50 @@
+#include "vxl_stream_writer.h"
+
+#include <cstring>
+#include <stdexcept>
+
+namespace vxl {
+
+VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path) {
+  VxlLayout layout = plan_vxl_layout(sizes);
+  table_ = std::move(layout.table);
+  file_size_ = layout.file_size;
+  written_.assign(table_.size(), 0);
+  for (std::size_t i = 0; i < table_.size(); ++i) checksums_.push_back(std::make_unique<Xxh3_64Stream>());
+  static const char* const ids[kSectionCount] = {"META", "DIRS", "VDIR", "VOXT", "VERT", "ORDR", "VXLN", "STRM", "PROV", "GRPS"};
+  for (std::size_t s = 0; s < kSectionCount; ++s) {
+    entry_[s] = table_.size();
+    for (std::size_t i = 0; i < table_.size(); ++i)
+      if (std::memcmp(table_[i].id, ids[s], 4) == 0) entry_[s] = i;
+  }
+  out_.allocate(file_size_);  // zeros everywhere: the padding between payloads is never written
+}
+
+void VxlStreamWriter::append(Section section, std::span<const std::uint8_t> bytes) {
+  const std::size_t i = entry_[section];
+  if (i >= table_.size() || bytes.size() > table_[i].size - written_[i])
+    throw std::logic_error("VxlStreamWriter::append: more bytes than the section was planned for");
+  if (bytes.empty()) return;
+  out_.pwrite(bytes.data(), bytes.size(), table_[i].offset + written_[i]);
+  checksums_[i]->update(bytes.data(), bytes.size());
+  written_[i] += bytes.size();
+}
+
+void VxlStreamWriter::append_meta(const MetaSection& meta) {
+  MetaSection m = meta;
+  std::memset(m.reserved, 0, sizeof m.reserved);
+  append(kMeta, {reinterpret_cast<const std::uint8_t*>(&m), sizeof m});
+}
+
+void VxlStreamWriter::commit() {
+  for (std::size_t i = 0; i < table_.size(); ++i) {
+    if (written_[i] != table_[i].size)
+      throw std::logic_error("VxlStreamWriter::commit: section " + std::string(table_[i].id, 4) + " is incomplete");
+    table_[i].checksum = checksums_[i]->digest();
+  }
+  std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_size_);
+  out_.pwrite(header.data(), header.size(), 0);
+  out_.commit();
+}
+
+}  // namespace vxl

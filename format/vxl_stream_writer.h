@@ -1,0 +1,56 @@
+// Writes a .vxl file (spec §2–§5) whose payloads are produced piece by piece, in bounded memory: each
+// section's bytes are appended in order (sections may be interleaved) and written with pwrite at their
+// final offsets, so nothing of the output stays in this process's memory. Each section is checksummed
+// as it is appended; commit() checks that every payload is complete, writes the section table and the
+// header, and links the file into place (AtomicOutputFile), so a partial file never appears.
+//
+// The layout is VxlWriter's (plan_vxl_layout): the same content gives the same bytes either way.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "atomic_output.h"
+#include "checksum.h"
+#include "vxl_layout.h"
+#include "vxl_writer.h"
+
+namespace vxl {
+
+class VxlStreamWriter {
+ public:
+  enum Section : std::size_t { kMeta, kDirs, kVdir, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps, kSectionCount };
+
+  // Creates the output at `path`, sized for these payloads (which read as zero until written).
+  // Throws vxl::Error (Output).
+  VxlStreamWriter(const std::string& path, const VxlSectionSizes& sizes);
+  VxlStreamWriter(const VxlStreamWriter&) = delete;
+  VxlStreamWriter& operator=(const VxlStreamWriter&) = delete;
+
+  // Appends to a payload. Throws std::logic_error past the payload's planned size (or for kGrps when
+  // there is no GRPS section), vxl::Error (Output) when the write fails.
+  void append(Section section, std::span<const std::uint8_t> bytes);
+  template <typename T>
+  void append_items(Section section, std::span<const T> items) {
+    append(section, {reinterpret_cast<const std::uint8_t*>(items.data()), items.size_bytes()});
+  }
+  void append_meta(const MetaSection& meta);  // zeroes the reserved bytes
+  std::uint64_t written(Section section) const { return entry_[section] < table_.size() ? written_[entry_[section]] : 0; }
+
+  // Throws std::logic_error unless every payload has been appended in full; then writes the table and
+  // the header and links the file into place. Without commit() the destructor discards the file.
+  void commit();
+
+ private:
+  AtomicOutputFile out_;
+  std::vector<SectionEntry> table_;  // in Section order, optional sections (VDIR, GRPS) only when present
+  std::size_t entry_[kSectionCount];   // Section -> index in table_ (table_.size(): absent)
+  std::uint64_t file_size_ = 0;
+  std::vector<std::uint64_t> written_;
+  std::vector<std::unique_ptr<Xxh3_64Stream>> checksums_;
+};
+
+}  // namespace vxl

@@ -1,0 +1,57 @@
+#include "scene_groups.h"
+
+#include <filesystem>
+#include <limits>
+
+namespace vxl {
+
+SceneGroups::SceneGroups(std::span<const VxlFile* const> files) {
+  files_.resize(files.size());
+  const auto file_name = [](const VxlFile& f) { return std::filesystem::path(f.path()).filename().string(); };
+  if (files.size() != 1) {
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      files_[i].constant = static_cast<std::uint32_t>(i);
+      groups_.push_back({file_name(*files[i]), files[i]->meta().streamline_count});
+    }
+    return;
+  }
+  const VxlFile& f = *files[0];
+  const std::vector<GroupContent> stored = f.groups();
+  const std::uint64_t n = f.meta().streamline_count;
+  if (stored.empty()) {
+    groups_.push_back({file_name(f), n});
+    return;
+  }
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t>& of = files_[0].of_streamline;
+  of.assign(n, kNone);
+  for (std::size_t g = 0; g < stored.size(); ++g) {
+    groups_.push_back({stored[g].name, 0});
+    for (std::uint64_t s : stored[g].members)
+      if (of[s] == kNone) {
+        of[s] = static_cast<std::uint32_t>(g);
+        groups_[g].streamlines++;
+      }
+  }
+  std::uint64_t ungrouped = 0;
+  for (std::uint32_t& g : of)
+    if (g == kNone) {
+      g = static_cast<std::uint32_t>(stored.size());
+      ++ungrouped;
+    }
+  if (ungrouped > 0) groups_.push_back({"(ungrouped)", ungrouped});
+}
+
+int SceneGroups::find(const std::string& name) const {
+  for (std::size_t g = 0; g < groups_.size(); ++g)
+    if (groups_[g].name == name) return static_cast<int>(g);
+  return -1;
+}
+
+glm::vec3 group_palette(std::size_t g) {
+  static const glm::vec3 kTab10[] = {{31, 119, 180},  {255, 127, 14}, {44, 160, 44},  {214, 39, 40},  {148, 103, 189},
+                                     {140, 86, 75},   {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207}};
+  return kTab10[g % 10] / 255.0f;
+}
+
+}  // namespace vxl

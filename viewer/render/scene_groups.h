@@ -1,0 +1,54 @@
+// Which group each streamline belongs to, for colour and opacity per group (--color group, --group):
+//
+//   several files shown together  one group per file, named after the file;
+//   one file with groups (GRPS)    its groups (TRX bundles); a streamline listed in several takes the
+//                                  first that lists it; those in none form a last group, "(ungrouped)";
+//   one file without groups        one group, named after the file.
+//
+// Group g gets palette colour g (matplotlib's tab10, repeating) unless the user chose one.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "vxl_file.h"
+
+namespace vxl {
+
+struct SceneGroup {
+  std::string name;
+  std::uint64_t streamlines = 0;
+};
+
+class SceneGroups {
+ public:
+  SceneGroups() = default;
+  // Reads GRPS (throws vxl::Error naming the file when it is malformed).
+  explicit SceneGroups(std::span<const VxlFile* const> files);
+
+  const std::vector<SceneGroup>& groups() const { return groups_; }
+  std::uint32_t group_of(std::size_t file, std::uint64_t streamline) const {
+    const PerFile& f = files_[file];
+    return f.of_streamline.empty() ? f.constant : f.of_streamline[streamline];
+  }
+  // Whether every streamline of `file` is in one group (no per-streamline lookup needed).
+  bool uniform(std::size_t file) const { return files_[file].of_streamline.empty(); }
+  int find(const std::string& name) const;
+
+ private:
+  struct PerFile {
+    std::uint32_t constant = 0;
+    std::vector<std::uint32_t> of_streamline;  // empty: all in `constant`
+  };
+  std::vector<SceneGroup> groups_;
+  std::vector<PerFile> files_;
+};
+
+// Palette colour of group g.
+glm::vec3 group_palette(std::size_t g);
+
+}  // namespace vxl

@@ -1,0 +1,50 @@
+#include "vertex_attributes.h"
+
+#include <limits>
+
+#include "vxl_streamlines.h"
+
+namespace vxl {
+
+ValueSource find_value_set(const VxlFile& file, const std::string& name) {
+  if (int k = file.vertex_values().find(name); k >= 0) return {ValueSource::Kind::Vertex, static_cast<std::uint32_t>(k)};
+  if (int k = file.streamline_values().find(name); k >= 0)
+    return {ValueSource::Kind::Streamline, static_cast<std::uint32_t>(k)};
+  return {};
+}
+
+std::vector<float> vertex_attributes(const VxlFile& file, std::size_t file_index, const ValueSource& source,
+                                     const SceneGroups* groups) {
+  const std::uint64_t v = file.meta().vertex_count;
+  std::vector<float> out(2 * v);
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  const bool uniform_group = groups == nullptr || groups->uniform(file_index);
+  const float constant_group = groups == nullptr ? 0.0f : static_cast<float>(groups->group_of(file_index, 0));
+  if (source.kind == ValueSource::Kind::Vertex) {
+    const std::span<const float> values = file.vertex_values().values(source.set);
+    for (std::uint64_t i = 0; i < v; ++i) out[2 * i] = values[i];
+  } else {
+    for (std::uint64_t i = 0; i < v; ++i) out[2 * i] = none;
+  }
+  for (std::uint64_t i = 0; i < v; ++i) out[2 * i + 1] = constant_group;
+  if (source.kind != ValueSource::Kind::Streamline && uniform_group) return out;
+
+  // Per-streamline values or groups: every vertex of a voxline belongs to the streamline being walked.
+  const std::span<const float> per_streamline =
+      source.kind == ValueSource::Kind::Streamline ? file.streamline_values().values(source.set) : std::span<const float>{};
+  std::uint64_t streamline = 0;
+  WalkCallbacks cb;
+  cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t own, bool connected) {
+    const std::uint64_t end = first + own + (connected ? 1 : 0);
+    const float group = uniform_group ? constant_group : static_cast<float>(groups->group_of(file_index, streamline));
+    for (std::uint64_t i = first; i < end; ++i) {
+      if (!per_streamline.empty()) out[2 * i] = per_streamline[streamline];
+      out[2 * i + 1] = group;
+    }
+  };
+  cb.streamline = [&](std::uint64_t, std::span<const float>) { ++streamline; };
+  walk_streamlines(file, cb);
+  return out;
+}
+
+}  // namespace vxl
