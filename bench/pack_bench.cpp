@@ -35,11 +35,14 @@ namespace {
 using vxl::bench::ChildRun;
 using vxl::bench::run_child;
 
-// Runs the command `runs` times; the median time and the largest peak RSS.
-ChildRun median_run(const std::vector<std::string>& args, int runs) {
+// Runs the command `runs` times; the median time and the largest peak RSS. `output` is removed before
+// every run, so that each writes a new file as a user would, rather than also paying for dropping the
+// previous run's file from the page cache when it replaces it.
+ChildRun median_run(const std::vector<std::string>& args, const std::string& output, int runs) {
   std::vector<double> seconds;
   ChildRun worst{0, 0, 0};
   for (int r = 0; r < runs; ++r) {
+    std::filesystem::remove(output);
     const ChildRun c = run_child(args);
     if (c.exit_code != 0) return c;
     seconds.push_back(c.seconds);
@@ -48,6 +51,17 @@ ChildRun median_run(const std::vector<std::string>& args, int runs) {
   std::sort(seconds.begin(), seconds.end());
   worst.seconds = seconds[seconds.size() / 2];
   return worst;
+}
+
+// The 1, 5 and 15 minute load averages: timings on a shared machine mean little without them.
+std::string load_average() {
+  std::FILE* f = std::fopen("/proc/loadavg", "r");
+  double a = 0, b = 0, c = 0;
+  const bool ok = f && std::fscanf(f, "%lf %lf %lf", &a, &b, &c) == 3;
+  if (f) std::fclose(f);
+  char text[64];
+  std::snprintf(text, sizeof text, ok ? "%.2f %.2f %.2f" : "unknown", a, b, c);
+  return text;
 }
 
 std::vector<float> source_points(const vxl::VxlFile& f) {
@@ -95,8 +109,8 @@ int main(int argc, char** argv) {
                                                  : std::filesystem::path(keep);
   std::filesystem::create_directories(dir);
 
-  std::printf("machine: %u hardware threads; pack/unpack threads: %s; times are medians of %d runs\n\n",
-              std::thread::hardware_concurrency(), threads.c_str(), runs);
+  std::printf("machine: %u hardware threads; pack/unpack threads: %s; times are medians of %d runs; load %s\n\n",
+              std::thread::hardware_concurrency(), threads.c_str(), runs, load_average().c_str());
   std::printf("| data | points | bits | package MiB | bytes/point | × TCK | positions B/pt | Draco-native B/pt | max error mm | "
               "RMS error mm | bound mm | pack s | unpack s | unpack peak MiB |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -111,8 +125,8 @@ int main(int argc, char** argv) {
       for (std::uint32_t b : bits) {
         const std::string package = (dir / (name + "_" + std::to_string(b) + ".vxlz")).string();
         const std::string unpacked = (dir / (name + "_" + std::to_string(b) + ".vxl")).string();
-        const ChildRun pack = median_run({cli, "pack", vxl, package, "--bits", std::to_string(b), "--threads", threads}, runs);
-        const ChildRun unpack = median_run({cli, "unpack", package, unpacked, "--threads", threads}, runs);
+        const ChildRun pack = median_run({cli, "pack", vxl, package, "--bits", std::to_string(b), "--threads", threads}, package, runs);
+        const ChildRun unpack = median_run({cli, "unpack", package, unpacked, "--threads", threads}, unpacked, runs);
         if (pack.exit_code != 0 || unpack.exit_code != 0) {
           std::fprintf(stderr, "pack_bench: voxlines failed on %s at %u bits (exit %d / %d)\n", vxl.c_str(), b,
                        pack.exit_code, unpack.exit_code);
@@ -120,7 +134,7 @@ int main(int argc, char** argv) {
         }
         const vxl::VxlzFile z = vxl::VxlzFile::open(package);
         double position_bytes = 0;
-        for (std::uint64_t c = 0; c < z.chunk_count(); ++c) position_bytes += double(z.chunk(c).size());
+        for (std::uint64_t c = 0; c < z.chunk_count(); ++c) position_bytes += double(z.chunk(c).symbols.size() + z.chunk(c).escapes.size());
         const std::vector<float> got = source_points(vxl::VxlFile::open(unpacked));
         double max_error = 0, sum_squares = 0;
         for (std::size_t i = 0; i < std::min(got.size(), expected.size()); ++i) {
@@ -147,5 +161,6 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (keep.empty()) std::filesystem::remove_all(dir);
+  std::printf("\nload at the end: %s\n", load_average().c_str());
   return 0;
 }

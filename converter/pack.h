@@ -1,4 +1,4 @@
-// `voxlines pack`: a .vxl to a .vxlz package (spec/vxlz-package-v1.md). The tables travel exactly; the
+// `voxlines pack`: a .vxl to a .vxlz package (spec/vxlz-package-v2.md). The tables travel exactly; the
 // vertex positions are quantised on one grid over the data's bounding cube, predicted along the
 // streamlines and Draco-coded in chunks; the orders, connecting vertices and bounds are left out
 // (the unpacker recomputes them, see unpack.h).

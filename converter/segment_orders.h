@@ -10,6 +10,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -51,6 +52,33 @@ void fill_voxel_directions(const OrderSetSpec& set, std::span<const VoxelEntry> 
 // Sets every voxel's flags (order entry width) and order_offset for K = `stored_orders`; returns the
 // size of the ORDR payload, so that it can be allocated before the orders are built.
 std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_orders);
+
+// Writes one voxel's orders at a time, for callers that do other per-voxel work in the same pass (the
+// unpacker computes the voxel's tight bounds while its vertices are in cache). It keeps its sort
+// buffers between voxels: use one per thread.
+class VoxelOrderWriter {
+ public:
+  // `max_vertices`: the largest voxel this writer will see, so that its buffers are reserved once and
+  // never grow past order_scratch_bytes(max_vertices); 0 lets them grow as needed.
+  explicit VoxelOrderWriter(const OrderSetSpec& set, std::uint32_t max_vertices = 0);
+  ~VoxelOrderWriter();
+  VoxelOrderWriter(VoxelOrderWriter&&) noexcept;
+
+  // Sorts voxel `v`'s segments (the vertices of its block that do not end a voxline in `ends`) for every
+  // direction of the set and writes its K orders at `dst` (the ORDR payload plus v.order_offset; the
+  // voxel's flags and order_offset as layout_orders set them). Padding bytes are left as they are.
+  void write(const VoxelEntry& v, std::span<const float> vertices, const VoxlineEnds& ends, std::uint8_t* dst);
+
+ private:
+  void use_directions_of(const VoxelEntry& v);
+
+  struct Scratch;
+  const OrderSetSpec* set_;
+  bool have_directions_ = false;  // a shared set is looked up once; a per-voxel set for every voxel
+  std::vector<std::array<float, 3>> directions_;
+  std::vector<int> axis_of_;  // the component of an axis direction, -1 for any other
+  std::unique_ptr<Scratch> scratch_;
+};
 
 // Sorts every voxel's segments for every direction of `set` into `orders`, the ORDR payload laid out
 // by layout_orders (padding bytes are left as they are: zero in a fresh payload).

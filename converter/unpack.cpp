@@ -171,12 +171,11 @@ std::string provenance_with_package(const VxlzFile& f) {
 // Decodes chunk c into VERT (spec §5, §6, §7 step 4): own points at their voxline's place, and each
 // voxline's first point also as the connecting vertex of the voxline before it in the same streamline.
 // Marks the last vertex of every voxline that ends in this chunk (for the orders).
-void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, std::vector<std::int32_t>& residuals,
-                  std::span<float> vert, VoxlineEnds& ends) {
+void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, std::span<float> vert, VoxlineEnds& ends) {
   const Quantizer quantizer(f.pack());
   const std::uint64_t count = f.chunk_point_count(chunk);
-  residuals.resize(3 * count);
-  decode_residual_chunk(f.chunk(chunk), residuals, f.path(), f.chunk_file_offset(chunk));
+  const ChunkBytes bytes = f.chunk(chunk);
+  ResidualChunk residuals(bytes, f.pack().joint_bits, count, f.path());
 
   std::uint64_t j = s.chunk_start_voxline[chunk];
   std::uint64_t in_voxline = s.chunk_start_point[chunk];
@@ -189,15 +188,16 @@ void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, st
     const std::uint64_t first = s.first_vertex(j);
     if (in_voxline == 0 && s.starts_streamline[j]) predictor.start_streamline();
     float* dst = vert.data() + 3 * (first + in_voxline);
-    const std::int32_t* residual = residuals.data() + 3 * i;
-    for (std::uint64_t r = 0; r < run; ++r, residual += 3, dst += 3) {
+    for (std::uint64_t r = 0; r < run; ++r, dst += 3) {
+      std::int32_t residual[3];
+      residuals.next(residual);
       std::array<std::int64_t, 3> q;
       for (int a = 0; a < 3; ++a) q[a] = predictor.predict(a) + residual[a];
       // One unsigned comparison per value also catches negatives; checked per point so that a damaged
       // chunk cannot drive the prediction into overflow.
       if (static_cast<std::uint64_t>(q[0]) > max_value || static_cast<std::uint64_t>(q[1]) > max_value ||
           static_cast<std::uint64_t>(q[2]) > max_value)
-        fail_input(f.path(), f.chunk_file_offset(chunk),
+        fail_input(f.path(), bytes.symbols_offset,
                    "position chunk: point " + std::to_string(chunk * f.pack().chunk_points + i + r) +
                        " decodes outside the quantisation grid");
       for (int a = 0; a < 3; ++a) dst[a] = quantizer.dequantize(q[a], a);
@@ -238,7 +238,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
 
   const VxlzFile f = VxlzFile::open(in_path);
   if (f.meta().order_set == static_cast<std::uint32_t>(OrderSet::Random))
-    fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 1.0");
+    fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");
   Structure s = rebuild_structure(f);
   const std::string provenance = provenance_with_package(f);
   std::vector<std::uint8_t> groups_bytes;
@@ -252,29 +252,52 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   std::copy(s.voxels.begin(), s.voxels.end(), out.voxels().begin());
 
   // Positions: chunks in parallel, each into its own voxlines' places.
-  std::vector<std::vector<std::int32_t>> residuals(threads);
   std::atomic<std::uint64_t> done{0};
   VoxlineEnds ends(meta.vertex_count);
   parallel_for(f.chunk_count(), threads, [&](std::uint64_t chunk, unsigned t) {
-    decode_chunk(f, s, chunk, residuals[t], out.vertices(), ends);
+    decode_chunk(f, s, chunk, out.vertices(), ends);
     if (t == 0) progress("decoding", double(++done) / double(f.chunk_count()));
     else ++done;
   });
-  residuals = {};
 
-  // Tight bounds per voxel and the global bounds, from the decoded vertices (spec §7 steps 1, 3).
+  summary.decode_seconds = seconds_since(t0);
+
+  // Per voxel, while its block is in cache: its tight bounds from the decoded vertices (spec §7 step 3),
+  // then its orders for the shipped directions (step 5).
+  t0 = Clock::now();
+  OrderSetSpec set;
+  set.kind = static_cast<OrderSet>(meta.order_set);
+  for (const DirectionEntry& d : f.directions()) set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
+  // ORDR and the sections after it (VXLN, STRM, PROV, GRPS), which are filled after the orders: one
+  // populate for all, instead of a fault per page for the voxline table's 8 bytes per voxline.
+  prefault_for_write(out.file().subspan(static_cast<std::size_t>(out.orders().data() - out.file().data())), threads);
   std::span<VoxelEntry> voxels = out.voxels();
   std::span<const float> vertices = out.vertices();
-  parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned) {
-    VoxelEntry& v = voxels[i];
+  std::vector<VoxelOrderWriter> writers;
+  for (unsigned t = 0; t < threads; ++t) writers.emplace_back(set);
+  std::atomic<std::uint64_t> ordered{0};
+  // One more item before the voxels: the vertices are final, so their checksum is taken here, beside
+  // the orders, rather than alone at the end.
+  parallel_for(voxels.size() + 1, threads, [&](std::uint64_t item, unsigned t) {
+    if (item == 0) return out.checksum_vertices_now();
+    VoxelEntry& v = voxels[item - 1];
     const float* b = vertices.data() + 3 * v.vertex_first;
-    for (int c = 0; c < 3; ++c) v.tight_min[c] = v.tight_max[c] = b[c];
+    // In locals: the entry lives in the same mapping as the vertices, so the compiler would otherwise
+    // store it back after every vertex.
+    float lo[3] = {b[0], b[1], b[2]}, hi[3] = {b[0], b[1], b[2]};
     for (std::uint64_t e = 1; e < v.vertex_count; ++e)
       for (int c = 0; c < 3; ++c) {
-        v.tight_min[c] = std::min(v.tight_min[c], b[3 * e + c]);
-        v.tight_max[c] = std::max(v.tight_max[c], b[3 * e + c]);
+        lo[c] = std::min(lo[c], b[3 * e + c]);
+        hi[c] = std::max(hi[c], b[3 * e + c]);
       }
+    std::copy(lo, lo + 3, v.tight_min);
+    std::copy(hi, hi + 3, v.tight_max);
+    writers[t].write(v, vertices, ends, out.orders().data() + v.order_offset);
+    const std::uint64_t d = ++ordered;
+    if (t == 0 && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
   });
+  progress("ordering", 1.0);
+  // The global bounds (step 1).
   for (int c = 0; c < 3; ++c) {
     meta.bounds_min[c] = meta.bounds_max[c] = 0;
     for (std::size_t i = 0; i < voxels.size(); ++i) {
@@ -282,15 +305,6 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
       meta.bounds_max[c] = i == 0 ? voxels[i].tight_max[c] : std::max<double>(meta.bounds_max[c], voxels[i].tight_max[c]);
     }
   }
-  summary.decode_seconds = seconds_since(t0);
-
-  // Orders (spec §7 step 5), for the shipped directions.
-  t0 = Clock::now();
-  OrderSetSpec set;
-  set.kind = static_cast<OrderSet>(meta.order_set);
-  for (const DirectionEntry& d : f.directions()) set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
-  prefault_for_write(out.orders(), threads);
-  build_orders_into(out.voxels(), out.vertices(), ends, set, out.orders(), threads, settings.progress);
   summary.orders_seconds = seconds_since(t0);
 
   t0 = Clock::now();

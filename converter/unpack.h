@@ -1,4 +1,4 @@
-// `voxlines unpack`: a .vxlz package back to a .vxl (spec/vxlz-package-v1.md §7). The tables are taken
+// `voxlines unpack`: a .vxlz package back to a .vxl (spec/vxlz-package-v2.md §7). The tables are taken
 // as shipped (never re-voxelised: quantisation could move a point across a voxel face), the position
 // chunks are decoded in parallel straight into the output's vertex blocks, the connecting vertices are
 // written as copies of the decoded next points, and the tight bounds and the orders are recomputed from

@@ -55,10 +55,10 @@ class AtomicOutputFile {
 };
 
 // Faults in the pages of `bytes` (inside a map() mapping) ready for writing, in bulk and in address
-// order (MADV_POPULATE_WRITE), split over up to `threads` threads. A caller that then writes scattered
-// over the range is spared a page fault per first touch of a page, which is far slower, not least
-// because scattered faults get small page-cache folios. Only a hint: without kernel support (before
-// Linux 5.14) or on failure, pages fault in on first touch as usual.
+// order (MADV_POPULATE_WRITE), split over up to `threads` threads, as single-page folios (MADV_RANDOM;
+// see the .cpp for why). A caller that then writes scattered over the range is spared a page fault per
+// first touch of a page, which is far slower. Only a hint: without kernel support (before Linux 5.14)
+// or on failure, pages fault in on first touch as usual.
 void prefault_for_write(std::span<std::uint8_t> bytes, unsigned threads);
 
 }  // namespace vxl

@@ -128,10 +128,15 @@ VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : ou
   file_ = out_.map(layout.file_size);
 }
 
+SectionEntry* VxlWriter::entry(Index i) {
+  for (SectionEntry& e : table_)
+    if (std::memcmp(e.id, kSectionIds[i], 4) == 0) return &e;
+  return nullptr;  // an optional section that is not there
+}
+
 std::span<std::uint8_t> VxlWriter::payload(Index i) {
-  for (const SectionEntry& e : table_)
-    if (std::memcmp(e.id, kSectionIds[i], 4) == 0) return file_.subspan(e.offset, e.size);
-  return {};  // an optional section that is not there
+  const SectionEntry* e = entry(i);
+  return e ? file_.subspan(e->offset, e->size) : std::span<std::uint8_t>{};
 }
 
 void VxlWriter::set_meta(const MetaSection& meta) {
@@ -140,10 +145,18 @@ void VxlWriter::set_meta(const MetaSection& meta) {
   std::memcpy(payload(kMeta).data(), &m, sizeof m);
 }
 
+void VxlWriter::checksum_vertices_now() {
+  SectionEntry& vert = *entry(kVert);  // required: always in the table
+  vert.checksum = xxh3_64(file_.data() + vert.offset, vert.size);
+  vertices_checksummed_ = true;
+}
+
 void VxlWriter::commit(unsigned threads) {
   // Largest payloads first, so that the big ones (VERT, ORDR) run side by side.
-  std::vector<std::size_t> by_size(table_.size());
-  for (std::size_t i = 0; i < by_size.size(); ++i) by_size[i] = i;
+  std::vector<std::size_t> by_size;
+  const SectionEntry* vert = entry(kVert);
+  for (std::size_t i = 0; i < table_.size(); ++i)
+    if (!(&table_[i] == vert && vertices_checksummed_)) by_size.push_back(i);
   std::stable_sort(by_size.begin(), by_size.end(), [&](std::size_t a, std::size_t b) { return table_[a].size > table_[b].size; });
   std::atomic<std::size_t> next{0};
   auto worker = [&] {

@@ -65,6 +65,13 @@ class VxlWriter {
   std::span<std::uint64_t> streamline_first_voxline() { return typed<std::uint64_t>(kStrm); }
   std::span<std::uint8_t> provenance() { return payload(kProv); }
   std::span<std::uint8_t> groups() { return payload(kGrps); }  // empty when there is no GRPS section
+  // The whole mapped file (header and table still unwritten), for prefaulting several payloads at once.
+  std::span<std::uint8_t> file() { return file_; }
+
+  // Checksums VERT now, for a caller whose vertices are final before it fills the rest (the unpacker
+  // hashes them beside its order building instead of at the end). The vertices must not change
+  // afterwards; commit() then leaves VERT's checksum as it is.
+  void checksum_vertices_now();
   // VVAL and SVAL payloads (vxl_value_sets.h: layout_value_sets, finish_value_sets); empty when absent.
   std::span<std::uint8_t> vertex_values() { return payload(kVval); }
   std::span<std::uint8_t> streamline_values() { return payload(kSval); }
@@ -77,6 +84,7 @@ class VxlWriter {
  private:
   // Sections in file order; VDIR, GRPS, VVAL and SVAL are optional.
   enum Index : std::size_t { kMeta, kDirs, kVdir, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps, kVval, kSval };
+  SectionEntry* entry(Index i);  // null for an optional section that is absent
   std::span<std::uint8_t> payload(Index i);
   template <typename T>
   std::span<T> typed(Index i) {
@@ -86,6 +94,7 @@ class VxlWriter {
 
   AtomicOutputFile out_;
   std::vector<SectionEntry> table_;  // in Index order, optional sections only when present
+  bool vertices_checksummed_ = false;
   std::span<std::uint8_t> file_;
 };
 

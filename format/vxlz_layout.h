@@ -1,4 +1,4 @@
-// On-disk structures of the .vxlz package, version 1.0 (spec/vxlz-package-v1.md; section numbers below
+// On-disk structures of the .vxlz package, version 2.0 (spec/vxlz-package-v2.md; section numbers below
 // point into it). The header and the section table entries have the .vxl layout (FileHeader,
 // SectionEntry from vxl_layout.h) with another magic; the payloads follow each other without padding.
 #pragma once
@@ -12,7 +12,7 @@
 namespace vxl {
 
 inline constexpr std::array<std::uint8_t, 8> kVxlzMagic = {0x89, 'V', 'X', 'Z', '\r', '\n', 0x1A, '\n'};
-inline constexpr std::uint16_t kVxlzVersionMajor = 1;
+inline constexpr std::uint16_t kVxlzVersionMajor = 2;  // 1.0 coded residual triplets with no joint symbols
 inline constexpr std::uint16_t kVxlzVersionMinor = 0;
 inline constexpr std::uint32_t kVxlzMaxSections = 32;
 inline constexpr std::uint32_t kVxlzMinBits = 11;
@@ -21,6 +21,8 @@ inline constexpr std::uint32_t kVxlzDefaultBits = 14;
 inline constexpr std::uint32_t kVxlzPredictorLinear = 1;  // §5.2
 inline constexpr std::uint64_t kVxlzDefaultChunkPoints = 1u << 18;
 inline constexpr std::uint64_t kVxlzMaxChunkPoints = (1u << 31) - 1;  // Draco point indices are 32-bit
+inline constexpr std::uint32_t kVxlzMinJointBits = 1;  // §5.3: zigzagged residuals of up to t bits per
+inline constexpr std::uint32_t kVxlzMaxJointBits = 5;  // component share one symbol (at most 2^15)
 
 // §3
 struct PackSection {
@@ -35,12 +37,14 @@ struct PackSection {
   double error_bound;
   double max_error;  // informative
   double rms_error;  // informative
-  std::uint8_t reserved[32];
+  std::uint32_t joint_bits;  // t of the joint symbols (§5.3)
+  std::uint8_t reserved[28];
 };
 static_assert(sizeof(PackSection) == 128);
 static_assert(offsetof(PackSection, quant_origin) == 8);
 static_assert(offsetof(PackSection, point_count) == 48);
 static_assert(offsetof(PackSection, error_bound) == 72);
-static_assert(offsetof(PackSection, reserved) == 96);
+static_assert(offsetof(PackSection, joint_bits) == 96);
+static_assert(offsetof(PackSection, reserved) == 100);
 
 }  // namespace vxl

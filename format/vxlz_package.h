@@ -1,4 +1,4 @@
-// The .vxlz package container (spec/vxlz-package-v1.md §2, §8): a writer that checksums the sections and
+// The .vxlz package container (spec/vxlz-package-v2.md §2, §8): a writer that checksums the sections and
 // writes the file atomically, and a reader that validates the header, the section table, every checksum
 // and the fixed-size sections before anything is decoded, so that a damaged or truncated package is
 // refused with an Error naming the file, the byte offset and what was expected.
@@ -16,6 +16,7 @@
 
 #include "mapped_file.h"
 #include "vxl_layout.h"
+#include "vxlz_draco.h"
 #include "vxlz_layout.h"
 #include "vxlz_streams.h"
 
@@ -33,11 +34,22 @@ struct VxlzContent {
   std::vector<std::uint8_t> voxline_counts;       // VXLC
   std::optional<std::string> provenance;          // PROV, when the .vxl has one
   std::optional<std::vector<std::uint8_t>> groups;  // GRPS, when the .vxl has groups
-  std::vector<std::vector<std::uint8_t>> chunks;  // Draco buffers, one per position chunk
+  std::vector<EncodedChunk> chunks;               // Draco buffers, one pair per position chunk
 };
 
-// Deflates the streams (side by side on up to `threads` threads; 0: all cores) and writes the package
-// atomically. Returns its size in bytes. Throws vxl::Error (Output) naming the path.
+// The zlib payloads of the table sections (spec §4), deflated side by side on up to `threads` threads
+// (0: all cores). Separate from write_vxlz so that a packer can deflate them while it encodes the
+// positions. Throws vxl::Error (Output).
+struct DeflatedTables {
+  std::vector<std::uint8_t> voxel_coords, streamline_voxlines, voxline_voxels, voxline_counts;
+  std::optional<std::vector<std::uint8_t>> provenance, groups;  // when the content has them
+};
+DeflatedTables deflate_tables(const VxlzContent& content, unsigned threads = 0);
+
+// Writes the package atomically, its table sections from `tables` (deflated from `content`); the
+// second form deflates them first. Returns the package's size in bytes. Throws vxl::Error (Output)
+// naming the path.
+std::uint64_t write_vxlz(const std::string& path, const VxlzContent& content, const DeflatedTables& tables);
 std::uint64_t write_vxlz(const std::string& path, const VxlzContent& content, unsigned threads = 0);
 
 class VxlzFile {
@@ -58,9 +70,9 @@ class VxlzFile {
   // Where errors about an inflated stream point: the section and its offset.
   StreamContext context(std::uint32_t id) const;
 
-  std::uint64_t chunk_count() const { return chunk_offsets_.size() - 1; }
-  std::span<const std::uint8_t> chunk(std::uint64_t i) const;
-  std::uint64_t chunk_file_offset(std::uint64_t i) const;
+  std::uint64_t chunk_count() const { return (chunk_offsets_.size() - 1) / 2; }
+  // Chunk i's symbol and escape buffers and where they lie in the file.
+  ChunkBytes chunk(std::uint64_t i) const;
   // Points in chunk i (chunk_points, fewer in the last).
   std::uint64_t chunk_point_count(std::uint64_t i) const;
 
@@ -75,7 +87,8 @@ class VxlzFile {
   PackSection pack_{};
   MetaSection meta_{};
   std::vector<DirectionEntry> directions_;
-  std::vector<std::uint64_t> chunk_offsets_{0};  // chunk_count + 1 offsets inside POSD
+  // 2 chunk_count + 1 offsets inside POSD: chunk i's symbols start at [2i], its escapes at [2i + 1].
+  std::vector<std::uint64_t> chunk_offsets_{0};
   std::uint64_t posd_offset_ = 0;
 };
 

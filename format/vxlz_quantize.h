@@ -1,5 +1,5 @@
 // Quantisation of positions on the package's grid and the linear predictor along streamlines
-// (spec/vxlz-package-v1.md §5.1, §5.2, §6). Shared by the packer and the unpacker, which must agree on
+// (spec/vxlz-package-v2.md §5.1, §5.2, §6). Shared by the packer and the unpacker, which must agree on
 // every bit.
 #pragma once
 

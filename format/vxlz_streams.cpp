@@ -1,5 +1,6 @@
 #include "vxlz_streams.h"
 
+#include <algorithm>
 #include <cstring>
 #include <limits>
 
@@ -38,17 +39,33 @@ void VarintReader::fail(const std::string& what) const {
              "section " + context_.section + ", inflated byte " + std::to_string(pos_) + ": " + what);
 }
 
-std::vector<std::uint8_t> deflate_section(std::span<const std::uint8_t> raw) {
-  uLong bound = compressBound(static_cast<uLong>(raw.size()));
-  std::vector<std::uint8_t> out(8 + bound);
+std::vector<std::uint8_t> deflate_section(std::span<const std::uint8_t> raw, DeflateMode mode) {
+  auto fail = [] { throw Error(ErrorKind::Output, "", std::nullopt, "zlib could not compress a package stream"); };
+  z_stream z{};
+  // Level 6 (zlib's default): level 9 makes these streams <1 % smaller and packing several times slower.
+  if (deflateInit2(&z, 6, Z_DEFLATED, 15, 8, mode == DeflateMode::HuffmanOnly ? Z_HUFFMAN_ONLY : Z_DEFAULT_STRATEGY) != Z_OK)
+    fail();
+  std::vector<std::uint8_t> out(8 + deflateBound(&z, static_cast<uLong>(raw.size())));
   const std::uint64_t raw_size = raw.size();
   std::memcpy(out.data(), &raw_size, 8);
-  uLongf written = bound;
-  // Level 6 (zlib's default): level 9 makes these streams <1 % smaller and packing several times slower.
-  if (raw.size() > std::numeric_limits<uLong>::max() ||
-      compress2(out.data() + 8, &written, raw.data(), static_cast<uLong>(raw.size()), 6) != Z_OK)
-    throw Error(ErrorKind::Output, "", std::nullopt, "zlib could not compress a package stream");
-  out.resize(8 + written);
+  // zlib counts in 32-bit uInt: feed and drain in pieces.
+  z.next_in = const_cast<Bytef*>(raw.data());
+  z.next_out = out.data() + 8;
+  std::uint64_t in_left = raw.size(), out_left = out.size() - 8;
+  int rc = Z_OK;
+  while (rc == Z_OK) {
+    const uInt in_piece = static_cast<uInt>(std::min<std::uint64_t>(in_left, 1u << 30));
+    const uInt out_piece = static_cast<uInt>(std::min<std::uint64_t>(out_left, 1u << 30));
+    z.avail_in = in_piece;
+    z.avail_out = out_piece;
+    rc = deflate(&z, in_piece == in_left ? Z_FINISH : Z_NO_FLUSH);
+    if (rc == Z_OK && in_piece == z.avail_in && out_piece == z.avail_out) rc = Z_BUF_ERROR;  // no progress
+    in_left -= in_piece - z.avail_in;
+    out_left -= out_piece - z.avail_out;
+  }
+  deflateEnd(&z);
+  if (rc != Z_STREAM_END) fail();
+  out.resize(out.size() - out_left);
   return out;
 }
 

@@ -61,8 +61,15 @@ class VarintReader {
   StreamContext context_;
 };
 
+// How a stream is deflated; readers need not know (any zlib stream is valid, spec §1).
+enum class DeflateMode {
+  Matching,     // zlib level 6: string matching, for streams with repeated runs (the voxline voxels)
+  HuffmanOnly,  // entropy coding only (Z_HUFFMAN_ONLY): for streams of numbers that seldom repeat in
+                // sequence (counts), smaller than level 6 and an order of magnitude faster
+};
+
 // The payload of a zlib section: u64 raw size, then `raw` deflated. Throws vxl::Error (Output) when zlib fails.
-std::vector<std::uint8_t> deflate_section(std::span<const std::uint8_t> raw);
+std::vector<std::uint8_t> deflate_section(std::span<const std::uint8_t> raw, DeflateMode mode = DeflateMode::Matching);
 
 // Inflates a zlib section payload; throws vxl::Error (Input) naming the section unless it inflates to
 // exactly its stated raw size and the stream ends exactly at the end of the payload. The raw size is

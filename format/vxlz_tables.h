@@ -1,4 +1,4 @@
-// The exact part of a .vxlz package (spec/vxlz-package-v1.md §4): the voxel coordinates, the streamline
+// The exact part of a .vxlz package (spec/vxlz-package-v2.md §4): the voxel coordinates, the streamline
 // and voxline tables and the groups as varint streams, and back. Decoding checks what each stream alone
 // can tell (counts, ranges, order); the unpacker checks the rest against META (spec §8 step 6).
 #pragma once

@@ -1,4 +1,4 @@
-// The .vxlz package (spec/vxlz-package-v1.md): .vxl -> .vxlz -> .vxl keeps the structure exactly and
+// The .vxlz package (spec/vxlz-package-v2.md): .vxl -> .vxlz -> .vxl keeps the structure exactly and
 // every coordinate within the stated bound at 11, 14 and 16 bits; the unpacked file passes verify;
 // Draco keeps the point order; damaged, truncated and crafted packages are refused with an Error (never
 // a crash: the ASan build runs these too).
@@ -52,9 +52,10 @@ Tractogram test_tractogram(std::uint64_t streamlines = 1500) {
   return t;
 }
 
-std::string convert_to(Tractogram t, const std::string& path, double voxel_size = 10.0) {
+std::string convert_to(Tractogram t, const std::string& path, double voxel_size = 10.0, const char* orders = "axis") {
   ConvertSettings s;
   s.voxel_size = voxel_size;
+  s.orders = orders;
   convert_tractogram(std::move(t), path, s);
   return path;
 }
@@ -190,18 +191,41 @@ TEST_P(VxlzPackage, RoundTripKeepsStructureAndStaysWithinTheBound) {
 INSTANTIATE_TEST_SUITE_P(Bits, VxlzPackage, ::testing::Values(11u, 14u, 16u));
 
 TEST(VxlzDraco, ChunkKeepsPointOrderAndDuplicates) {
-  // Sequential encoding must keep the order, and no deduplication may merge the many repeated values.
+  // Sequential encoding must keep the order, and no deduplication may merge the many repeated values;
+  // small residuals go through joint symbols, large ones through the escape cloud, for every width t.
   std::mt19937 rng(3);
   std::vector<std::int32_t> values(3 * 5000);
   for (std::size_t i = 0; i < values.size(); ++i)
-    values[i] = i % 7 == 0 ? 0 : static_cast<std::int32_t>(rng() % 200001) - 100000;
+    values[i] = i % 7 == 0 ? 0 : i % 5 == 0 ? static_cast<std::int32_t>(rng() % 200001) - 100000
+                                            : static_cast<std::int32_t>(rng() % 9) - 4;
   for (std::size_t i = 300; i < 600; ++i) values[i] = 42;  // a run of identical points
-  const std::vector<std::uint8_t> buffer = encode_residual_chunk(values);
-  std::vector<std::int32_t> back(values.size());
-  decode_residual_chunk(buffer, back, "chunk", 0);
-  EXPECT_EQ(back, values);
-  std::vector<std::int32_t> wrong_count(values.size() - 3);
-  EXPECT_THROW(decode_residual_chunk(buffer, wrong_count, "chunk", 0), Error);
+  for (std::uint32_t t = kVxlzMinJointBits; t <= kVxlzMaxJointBits; ++t) {
+    SCOPED_TRACE(t);
+    const EncodedChunk chunk = encode_residual_chunk(values, t);
+    EXPECT_FALSE(chunk.escapes.empty());
+    const ChunkBytes bytes{chunk.symbols, chunk.escapes, 0, 0};
+    std::vector<std::int32_t> back(values.size());
+    decode_residual_chunk(bytes, t, back, "chunk");
+    EXPECT_EQ(back, values);
+    std::vector<std::int32_t> wrong_count(values.size() - 3);
+    EXPECT_THROW(decode_residual_chunk(bytes, t, wrong_count, "chunk"), Error);
+  }
+  // No escapes at all: the escape buffer is empty.
+  const std::vector<std::int32_t> small(3 * 100, -1);
+  const EncodedChunk chunk = encode_residual_chunk(small, 3);
+  EXPECT_TRUE(chunk.escapes.empty());
+  std::vector<std::int32_t> back(small.size());
+  decode_residual_chunk({chunk.symbols, chunk.escapes, 0, 0}, 3, back, "chunk");
+  EXPECT_EQ(back, small);
+}
+
+TEST(VxlzDraco, JointSymbols) {
+  const std::int32_t zero[3] = {0, 0, 0}, mixed[3] = {-1, 1, 0}, edge[3] = {-4, 3, -4}, wide[3] = {4, 0, 0};
+  EXPECT_EQ(joint_symbol(zero, 3), 1u);
+  EXPECT_EQ(joint_symbol(mixed, 3), 1u + 1u + (2u << 3));  // zigzag: -1 -> 1, 1 -> 2
+  EXPECT_EQ(joint_symbol(edge, 3), 1u + 7u + (6u << 3) + (7u << 6));  // the largest symbol is 2^9
+  EXPECT_EQ(joint_symbol(wide, 3), 0u) << "zigzag(4) = 8 needs 4 bits: escape";
+  EXPECT_EQ(joint_symbol(wide, 4), 1u + 8u);
 }
 
 TEST(VxlzPackageOptions, ChunkSizeAndThreadsDoNotChangeTheResult) {
@@ -222,12 +246,49 @@ TEST(VxlzPackageOptions, ChunkSizeAndThreadsDoNotChangeTheResult) {
   EXPECT_EQ(to_vector(fa.order_bytes()), to_vector(fb.order_bytes()));
 }
 
+TEST(VxlzPackageOptions, PackageBytesDoNotDependOnThreads) {
+  // The measured errors in PACK are summed in chunk order, whichever thread encoded which chunk.
+  ScratchDir dir;
+  const VxlFile f = VxlFile::open(convert_to(test_tractogram(300), dir.file("s.vxl")));
+  PackSettings s;
+  s.chunk_points = 64;
+  s.threads = 1;
+  pack_vxl(f, dir.file("one.vxlz"), s);
+  s.threads = 3;
+  pack_vxl(f, dir.file("three.vxlz"), s);
+  EXPECT_EQ(slurp(dir.file("one.vxlz")), slurp(dir.file("three.vxlz")));
+}
+
 TEST(VxlzPackageOptions, EmptyTractogram) {
   ScratchDir dir;
   Tractogram t;
   t.source.path = "empty.tck";
   const std::string vxl = convert_to(std::move(t), dir.file("empty.vxl"));
   round_trip(dir, vxl, 14);
+}
+
+// Unpack rebuilds the orders of any shared direction set: the diagonals sort by a dot product, not by one
+// component as the axes do (verify checks every order's sortedness against the decoded vertices).
+TEST(VxlzPackageOptions, AxisDiagOrdersAreRebuiltForTheDecodedPositions) {
+  ScratchDir dir;
+  const std::string vxl = convert_to(test_tractogram(300), dir.file("diag.vxl"), 5.0, "axis+diag");
+  ASSERT_EQ(VxlFile::open(vxl).meta().stored_order_count, 7u);
+  const VxlFile copy = VxlFile::open(round_trip(dir, vxl, 14));
+  EXPECT_EQ(copy.meta().order_set, static_cast<std::uint32_t>(OrderSet::AxisDiag));
+}
+
+// Per-voxel random directions (VDIR) are not part of the package format: refused before any output.
+TEST(VxlzPackageOptions, RandomOrderSetsAreRefusedWithoutOutput) {
+  ScratchDir dir;
+  const std::string vxl = convert_to(test_tractogram(50), dir.file("random.vxl"), 10.0, "random:4");
+  try {
+    pack_vxl(VxlFile::open(vxl), dir.file("r.vxlz"), {});
+    ADD_FAILURE() << "packing a random:4 file must fail";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--orders axis"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("r.vxlz")));
 }
 
 TEST(VxlzPackageOptions, BitsOutOfRangeAreAUsageError) {
@@ -297,7 +358,8 @@ class DamagedVxlz : public ::testing::Test {
     const auto prov = f.inflate(section_id("PROV"));
     c.provenance = std::string(prov.begin(), prov.end());
     c.groups = f.inflate(section_id("GRPS"));
-    for (std::uint64_t i = 0; i < f.chunk_count(); ++i) c.chunks.push_back(to_vector(f.chunk(i)));
+    for (std::uint64_t i = 0; i < f.chunk_count(); ++i)
+      c.chunks.push_back({to_vector(f.chunk(i).symbols), to_vector(f.chunk(i).escapes)});
     return c;
   }
   void expect_crafted_refused(const VxlzContent& c, const std::string& what) {
@@ -389,15 +451,23 @@ TEST_F(DamagedVxlz, DamageBehindValidChecksumsNeverCrashes) {
   EXPECT_GT(accepted, 0u);
 }
 
-TEST_F(DamagedVxlz, NewerMajorVersionIsUnsupported) {
-  std::vector<char> b = slurp(good());
-  b[8] = 2;
-  dump(dir.file("v2.vxlz"), b, b.size());
-  try {
-    unpack_vxlz(dir.file("v2.vxlz"), out(), {});
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+TEST_F(DamagedVxlz, OtherMajorVersionsAreUnsupported) {
+  // 1.0 coded positions differently (no joint symbols): its packages are refused with a hint, never misread.
+  for (const std::uint8_t version : {1, 3}) {
+    std::vector<char> b = slurp(good());
+    b[8] = static_cast<char>(version);
+    dump(dir.file("other.vxlz"), b, b.size());
+    try {
+      unpack_vxlz(dir.file("other.vxlz"), out(), {});
+      ADD_FAILURE() << int(version);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+      EXPECT_NE(std::string(e.what()).find("major version " + std::to_string(version)), std::string::npos) << e.what();
+      if (version == 1) {
+        EXPECT_NE(std::string(e.what()).find("pack the .vxl again"), std::string::npos) << e.what();
+      }
+    }
+    EXPECT_FALSE(std::filesystem::exists(out()));
   }
 }
 
@@ -450,19 +520,51 @@ TEST_F(DamagedVxlz, CraftedPackagesWithValidChecksumsAreRefused) {
   }
   {
     VxlzContent c = content();
-    c.chunks[0] = encode_residual_chunk(std::vector<std::int32_t>(3 * (c.pack.chunk_points - 1), 0));
+    c.chunks[0] = encode_residual_chunk(std::vector<std::int32_t>(3 * (c.pack.chunk_points - 1), 0), c.pack.joint_bits);
     expect_crafted_refused(c, "chunk with one point too few");
   }
   {
     VxlzContent c = content();
     std::vector<std::int32_t> huge(3 * c.pack.chunk_points, 1 << 17);  // decodes outside the grid
-    c.chunks[0] = encode_residual_chunk(huge);
+    c.chunks[0] = encode_residual_chunk(huge, c.pack.joint_bits);
     expect_crafted_refused(c, "residuals off the grid");
   }
   {
     VxlzContent c = content();
-    c.chunks[1].resize(c.chunks[1].size() / 2);  // a truncated Draco buffer
+    c.chunks[1].symbols.resize(c.chunks[1].symbols.size() / 2);  // a truncated Draco buffer
     expect_crafted_refused(c, "truncated chunk");
+  }
+  for (std::uint32_t t : {0u, 6u}) {
+    VxlzContent c = content();
+    c.pack.joint_bits = t;
+    expect_crafted_refused(c, "joint bits " + std::to_string(t));
+  }
+  {
+    // Symbols of a wider t than PACK states name no triplet.
+    VxlzContent c = content();
+    std::vector<std::int32_t> wide(3 * c.pack.chunk_points, 7);
+    c.chunks[0] = encode_residual_chunk(wide, kVxlzMaxJointBits);
+    c.pack.joint_bits = 2;
+    expect_crafted_refused(c, "symbol out of range");
+  }
+  {
+    VxlzContent c = content();
+    std::vector<std::int32_t> escaping(3 * c.pack.chunk_points, 1000);
+    const EncodedChunk e = encode_residual_chunk(escaping, c.pack.joint_bits);
+    ASSERT_FALSE(e.escapes.empty());
+    c.chunks[0].symbols = e.symbols;  // escapes missing
+    c.chunks[0].escapes.clear();
+    expect_crafted_refused(c, "escapes missing");
+    c.chunks[0].escapes = encode_residual_chunk(std::vector<std::int32_t>(3 * (c.pack.chunk_points - 1), 1000),
+                                                c.pack.joint_bits).escapes;  // one escape too few
+    expect_crafted_refused(c, "escapes short");
+  }
+  {
+    VxlzContent c = content();
+    const std::vector<std::int32_t> small(3 * c.pack.chunk_points, 0);
+    c.chunks[0] = encode_residual_chunk(small, c.pack.joint_bits);
+    c.chunks[0].escapes = encode_residual_chunk(std::vector<std::int32_t>(3, 1000), c.pack.joint_bits).escapes;
+    expect_crafted_refused(c, "escapes without escaped points");
   }
   {
     VxlzContent c = content();

@@ -14,7 +14,7 @@ void add_pack_command(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "pack", "Compress a .vxl into a .vxlz package for sharing: tables exact, positions quantised\n"
-              "(error at most half a quantum of range / (2^bits - 1)) and Draco-coded (spec/vxlz-package-v1.md)");
+              "(error at most half a quantum of range / (2^bits - 1)) and Draco-coded (spec/vxlz-package-v2.md)");
   cmd->add_option("input", opt->input, ".vxl file")->required();
   cmd->add_option("output", opt->output, "output .vxlz package (written atomically)")->required();
   cmd->add_option("--bits", opt->settings.bits, "quantisation bits per coordinate over the data's bounding cube")
