@@ -4,10 +4,13 @@
 // same file, after the header). One parser for both, and for a whole file as for its first bytes.
 #pragma once
 
+#include <bit>
 #include <cstdint>
+#include <cstring>
 #include <optional>
 #include <span>
 #include <string>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
@@ -40,6 +43,20 @@ std::optional<MrtrixHeader> parse_mrtrix_header(const std::string& path, std::sp
 inline MrtrixHeader parse_mrtrix_header(const std::string& path, std::span<const std::uint8_t> whole_file,
                                         const MrtrixFileKind& kind) {
   return *parse_mrtrix_header(path, whole_file, whole_file.size(), kind);
+}
+
+// One value of the data that follows the header: Float32/Float64, little- or big-endian (the datatype's
+// LE/BE suffix), at any alignment.
+template <typename Real, bool kBigEndian>
+Real load_mrtrix_value(const std::uint8_t* p) {
+  using Bits = std::conditional_t<sizeof(Real) == 4, std::uint32_t, std::uint64_t>;
+  Bits bits;
+  std::memcpy(&bits, p, sizeof bits);
+  if constexpr (kBigEndian) {
+    if constexpr (sizeof(Bits) == 4) bits = __builtin_bswap32(bits);
+    else bits = __builtin_bswap64(bits);
+  }
+  return std::bit_cast<Real>(bits);
 }
 
 }  // namespace vxl

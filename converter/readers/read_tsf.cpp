@@ -14,18 +14,6 @@ namespace vxl {
 namespace {
 
 template <typename Real, bool kBigEndian>
-Real load(const std::uint8_t* p) {
-  using Bits = std::conditional_t<sizeof(Real) == 4, std::uint32_t, std::uint64_t>;
-  Bits bits;
-  std::memcpy(&bits, p, sizeof bits);
-  if constexpr (kBigEndian) {
-    if constexpr (sizeof(Bits) == 4) bits = __builtin_bswap32(bits);
-    else bits = __builtin_bswap64(bits);
-  }
-  return std::bit_cast<Real>(bits);
-}
-
-template <typename Real, bool kBigEndian>
 void read_values(std::span<const std::uint8_t> bytes, std::uint64_t offset, TrackScalars& s) {
   const std::uint64_t available = (bytes.size() - offset) / sizeof(Real);
   s.values.reserve(available);
@@ -33,7 +21,7 @@ void read_values(std::span<const std::uint8_t> bytes, std::uint64_t offset, Trac
   bool terminated = false;
   std::uint64_t in_current = 0;
   for (std::uint64_t i = 0; i < available; ++i, p += sizeof(Real)) {
-    const Real v = load<Real, kBigEndian>(p);
+    const Real v = load_mrtrix_value<Real, kBigEndian>(p);
     if (std::isnan(v)) {  // end of streamline
       s.offsets.push_back(s.values.size());
       in_current = 0;

@@ -19,18 +19,6 @@
 
 namespace vxl::tck {
 
-template <typename Real, bool kBigEndian>
-Real load(const std::uint8_t* p) {
-  using Bits = std::conditional_t<sizeof(Real) == 4, std::uint32_t, std::uint64_t>;
-  Bits bits;
-  std::memcpy(&bits, p, sizeof bits);
-  if constexpr (kBigEndian) {
-    if constexpr (sizeof(Bits) == 4) bits = __builtin_bswap32(bits);
-    else bits = __builtin_bswap64(bits);
-  }
-  return std::bit_cast<Real>(bits);
-}
-
 // Where decoding stands between calls.
 struct DecodeState {
   std::uint64_t points_in_current = 0;  // points of the streamline not yet closed by a NaN
@@ -47,8 +35,8 @@ std::uint64_t decode(const std::string& path, const std::uint8_t* p, std::uint64
                      DecodeState& s, std::uint64_t stop_items) {
   constexpr std::size_t kTriplet = 3 * sizeof(Real);
   for (std::uint64_t i = 0; i < n; ++i, p += kTriplet) {
-    Real x = load<Real, kBigEndian>(p), y = load<Real, kBigEndian>(p + sizeof(Real)),
-         z = load<Real, kBigEndian>(p + 2 * sizeof(Real));
+    Real x = load_mrtrix_value<Real, kBigEndian>(p), y = load_mrtrix_value<Real, kBigEndian>(p + sizeof(Real)),
+         z = load_mrtrix_value<Real, kBigEndian>(p + 2 * sizeof(Real));
     if (std::isnan(x)) {  // end of streamline
       t.offsets.push_back(t.point_count());
       s.points_in_current = 0;
