@@ -16,6 +16,7 @@
 #include "error.h"
 #include "pack.h"
 #include "read_tractogram.h"
+#include "reseal_checksums.h"
 #include "synth.h"
 #include "test_support.h"
 #include "unpack.h"
@@ -405,22 +406,6 @@ TEST_F(DamagedVxlz, EveryTruncationIsRefused) {
   expect_refused(bad, "one byte appended");
 }
 
-// Recomputes every section checksum and the header checksum, so that damage reaches the decoders.
-void fix_checksums(std::vector<char>& b) {
-  FileHeader h;
-  std::memcpy(&h, b.data(), sizeof h);
-  for (std::uint32_t i = 0; i < h.section_count; ++i) {
-    SectionEntry e;
-    std::memcpy(&e, b.data() + sizeof h + i * sizeof e, sizeof e);
-    e.checksum = xxh3_64(b.data() + e.offset, e.size);
-    std::memcpy(b.data() + sizeof h + i * sizeof e, &e, sizeof e);
-  }
-  h.header_checksum = 0;
-  std::memcpy(b.data(), &h, sizeof h);
-  h.header_checksum = xxh3_64(b.data(), sizeof h + h.section_count * sizeof(SectionEntry));
-  std::memcpy(b.data(), &h, sizeof h);
-}
-
 TEST_F(DamagedVxlz, DamageBehindValidChecksumsNeverCrashes) {
   // Every payload byte changed, checksums recomputed: the zlib, varint and Draco decoders and the
   // structure checks see the damage. Each package is refused with an Error or, where the change is
@@ -434,7 +419,7 @@ TEST_F(DamagedVxlz, DamageBehindValidChecksumsNeverCrashes) {
   for (std::size_t pos = payloads; pos < bytes.size(); ++pos) {
     std::vector<char> b = bytes;
     b[pos] = static_cast<char>(b[pos] ^ (pos % 2 ? 0x80 : 0x01));  // the lowest or the highest bit
-    fix_checksums(b);
+    test::reseal_checksums(b.data(), b.size());
     dump(bad, b, b.size());
     try {
       unpack_vxlz(bad, out(), {});
