@@ -6,6 +6,7 @@
 
 #include <draco/compression/decode.h>
 #include <draco/compression/expert_encode.h>
+#include <draco/compression/point_cloud/point_cloud_decoder.h>
 #include <draco/point_cloud/point_cloud_builder.h>
 
 #include "error.h"
@@ -48,6 +49,22 @@ class DecodedCloud {
   DecodedCloud(std::span<const std::uint8_t> bytes, std::size_t n, int components, const char* what,
                const std::string& file, std::uint64_t offset) {
     auto fail = [&](const std::string& message) { fail_input(file, offset, std::string(what) + ": " + message); };
+    // Draco sizes its buffers by the point count the stream states: check it against ours before Draco
+    // allocates anything (a stream with valid package checksums but a damaged count asked for 6 GB).
+    // What we write: a sequentially encoded point cloud without metadata, whose geometry data is the
+    // point count as an int32 right after the header.
+    draco::DecoderBuffer probe;
+    probe.Init(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    draco::DracoHeader header;
+    if (!draco::PointCloudDecoder::DecodeHeader(&probe, &header).ok()) fail("not a Draco point cloud (bad header)");
+    if (header.encoder_type != draco::POINT_CLOUD || header.encoder_method != draco::POINT_CLOUD_SEQUENTIAL_ENCODING ||
+        (header.flags & METADATA_FLAG_MASK) != 0)
+      fail("expected a sequentially encoded Draco point cloud without metadata");
+    std::int32_t stated_points = 0;
+    if (!probe.Decode(&stated_points)) fail("Draco point cloud ends before its point count");
+    if (stated_points < 0 || static_cast<std::uint64_t>(stated_points) != n)
+      fail("Draco point cloud states " + std::to_string(stated_points) + " points, expected " + std::to_string(n));
+
     draco::DecoderBuffer buffer;
     buffer.Init(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     draco::Decoder decoder;

@@ -436,6 +436,32 @@ TEST_F(DamagedVxlz, DamageBehindValidChecksumsNeverCrashes) {
   EXPECT_GT(accepted, 0u);
 }
 
+// Found by fuzz_vxlz: a Draco stream whose point count is damaged behind valid checksums made Draco
+// allocate 6 GB before our count check ran. Now refused before Draco decodes anything.
+TEST_F(DamagedVxlz, ADracoPointCountBeyondTheChunkIsRefusedBeforeDecoding) {
+  std::vector<char> bytes = slurp(good());
+  const std::string magic = "DRACO";
+  std::size_t clouds = 0;
+  for (auto at = std::search(bytes.begin(), bytes.end(), magic.begin(), magic.end()); at != bytes.end();
+       at = std::search(at + 1, bytes.end(), magic.begin(), magic.end())) {
+    // The sequential point cloud's int32 point count follows the 11-byte header (magic, version,
+    // encoder type and method, flags).
+    std::vector<char> b = bytes;
+    const std::int32_t huge = 1 << 29;
+    std::memcpy(b.data() + (at - bytes.begin()) + 11, &huge, sizeof huge);
+    test::reseal_checksums(b.data(), b.size());
+    dump(dir.file("count.vxlz"), b, b.size());
+    expect_refused(dir.file("count.vxlz"), "Draco point count at byte " + std::to_string(at - bytes.begin()));
+    try {
+      unpack_vxlz(dir.file("count.vxlz"), out(), {});
+    } catch (const Error& e) {  // refused by the check before decoding, not by Draco or after it
+      EXPECT_NE(std::string(e.what()).find("states 536870912 points"), std::string::npos) << e.what();
+    }
+    ++clouds;
+  }
+  EXPECT_GT(clouds, 1u) << "the package must hold several Draco clouds";
+}
+
 TEST_F(DamagedVxlz, OtherMajorVersionsAreUnsupported) {
   // 1.0 coded positions differently (no joint symbols): its packages are refused with a hint, never misread.
   for (const std::uint8_t version : {1, 3}) {
