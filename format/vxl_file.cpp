@@ -207,6 +207,7 @@ std::vector<GroupContent> VxlFile::groups() const {
   };
   auto take = [&](void* dst, std::uint64_t n) {
     need(n);
+    if (n == 0) return;  // an empty group: dst may be null, which memcpy must not see
     std::memcpy(dst, groups_.data() + pos, n);
     pos += n;
   };

@@ -56,6 +56,23 @@ class VxlFormat : public ::testing::Test {
   ScratchDir dir;
 };
 
+// Found by fuzz_vxl (UBSan: memcpy with a null destination): a group without members, which a TRX may
+// hold, is kept and read back without undefined behaviour.
+TEST(VxlGroups, AGroupWithoutMembersIsKept) {
+  ScratchDir dir;
+  Tractogram t = small_tractogram();
+  t.groups.push_back({"empty", {}});
+  ConvertSettings s;
+  s.voxel_size = 8;
+  convert_tractogram(std::move(t), dir.file("g.vxl"), s);
+  const std::vector<GroupContent> groups = VxlFile::open(dir.file("g.vxl")).groups();
+  ASSERT_EQ(groups.size(), 2u);
+  EXPECT_EQ(groups[0].members, (std::vector<std::uint64_t>{0, 3, 14}));
+  EXPECT_EQ(groups[1].name, "empty");
+  EXPECT_TRUE(groups[1].members.empty());
+  EXPECT_TRUE(verify_vxl(dir.file("g.vxl")).valid);
+}
+
 TEST_F(VxlFormat, RoundTripThroughTheWalk) {
   VerifyResult r = verify_vxl(path());
   ASSERT_TRUE(r.valid) << r.problem;
