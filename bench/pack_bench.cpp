@@ -85,7 +85,7 @@ double draco_native_bytes(const std::vector<float>& points, std::uint32_t bits, 
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   std::vector<std::uint32_t> bits;
   std::vector<std::string> files;
   std::string threads = "0", keep;
@@ -163,4 +163,14 @@ int main(int argc, char** argv) {
   if (keep.empty()) std::filesystem::remove_all(dir);
   std::printf("\nload at the end: %s\n", load_average().c_str());
   return 0;
+}
+
+// A file that cannot be read is reported, not left to std::terminate.
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", "pack_bench", e.what());
+    return 1;
+  }
 }

@@ -49,7 +49,7 @@ vxl::Camera turntable_camera(const vxl::Renderer& r, int step, int steps) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   std::vector<std::string> scenes;
   int size = 1024, frames = 5;
   std::string modes_arg = "opaque,unsorted,additive,wboit,basic,axis,exact";
@@ -135,4 +135,14 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+// A file that cannot be read is reported, not left to std::terminate.
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", "render_bench", e.what());
+    return 1;
+  }
 }
