@@ -58,8 +58,9 @@ std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_o
 // buffers between voxels: use one per thread.
 class VoxelOrderWriter {
  public:
-  // `max_vertices`: the largest voxel this writer will see, so that its buffers are reserved once and
-  // never grow past order_scratch_bytes(max_vertices); 0 lets them grow as needed.
+  // `set` must outlive the writer (it is not copied). `max_vertices`: the largest voxel this writer will
+  // see, so that its buffers are reserved once and never grow past order_scratch_bytes(max_vertices); 0
+  // lets them grow as needed.
   explicit VoxelOrderWriter(const OrderSetSpec& set, std::uint32_t max_vertices = 0);
   ~VoxelOrderWriter();
   VoxelOrderWriter(VoxelOrderWriter&&) noexcept;
