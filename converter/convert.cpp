@@ -122,12 +122,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   summary.write_seconds = seconds_since(t0);
   if (settings.progress) settings.progress("writing", 1.0);
 
-  summary.streamlines = meta.streamline_count;
-  summary.points = meta.point_count;
-  summary.voxels = meta.voxel_count;
-  summary.vertices = meta.vertex_count;
-  summary.segments = meta.segment_count;
-  summary.synthetic_points = meta.synthetic_point_count;
+  summary.take_counts(meta);
   return summary;
 }
 

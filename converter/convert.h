@@ -27,6 +27,16 @@ struct ConvertSummary {
   std::uint64_t partitions = 1;  // voxel ranges whose blocks and orders were built one after another
   std::vector<std::uint64_t> partition_starts;  // convert_streaming only: the first voxel of each range
   std::vector<std::string> warnings;  // convert_streaming only: the source's (the reader's, otherwise)
+
+  // The counts, as written in the file's META.
+  void take_counts(const MetaSection& meta) {
+    streamlines = meta.streamline_count;
+    points = meta.point_count;
+    voxels = meta.voxel_count;
+    vertices = meta.vertex_count;
+    segments = meta.segment_count;
+    synthetic_points = meta.synthetic_point_count;
+  }
 };
 
 // Consumes the tractogram (its positions are released as soon as they are copied) and writes `out_path`

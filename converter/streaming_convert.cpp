@@ -572,12 +572,7 @@ ConvertSummary StreamingConversion::run() {
   summary_.write_seconds += seconds_since(t0);
   report("writing", 1.0);
 
-  summary_.streamlines = meta_.streamline_count;
-  summary_.points = meta_.point_count;
-  summary_.voxels = meta_.voxel_count;
-  summary_.vertices = meta_.vertex_count;
-  summary_.segments = meta_.segment_count;
-  summary_.synthetic_points = meta_.synthetic_point_count;
+  summary_.take_counts(meta_);
   summary_.partitions = ranges.size();
   for (const Range& r : ranges) summary_.partition_starts.push_back(r.first);
   summary_.warnings = stream_->source().warnings;

@@ -248,26 +248,7 @@ TEST(Extremes, AConversionKilledAtAnyMomentLeavesNoOutput) {
     w.finish();
   }
   const std::string out = dir.file("out.vxl");
-  int killed_while_running = 0;
-  for (int delay_ms : {5, 20, 50, 100, 150, 200, 300, 400, 600, 800}) {
-    pid_t pid = fork();
-    if (pid == 0) {
-      execl(VOXLINES_CLI, VOXLINES_CLI, "convert", tck.c_str(), out.c_str(), static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
-    kill(pid, SIGKILL);
-    int status = 0;
-    waitpid(pid, &status, 0);
-    if (WIFSIGNALED(status)) {
-      ++killed_while_running;
-      EXPECT_FALSE(std::filesystem::exists(out)) << "killed after " << delay_ms << " ms";
-    } else {
-      std::filesystem::remove(out);  // it finished before the kill: not this test's subject
-    }
-    for (const auto& e : std::filesystem::directory_iterator(dir.path()))
-      EXPECT_TRUE(e.path().filename() == "in.tck" || e.path().filename() == "out.vxl") << "left behind: " << e.path();
-  }
+  const int killed_while_running = test::kill_conversions(dir, {tck, out}, out, {5, 20, 50, 100, 150, 200, 300, 400, 600, 800});
   EXPECT_GE(killed_while_running, 3) << "the conversion finished too quickly to be killed mid-way";
 }
 

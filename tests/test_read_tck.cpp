@@ -6,34 +6,19 @@
 
 #include "error.h"
 #include "read_tractogram.h"
+#include "mrtrix_test_files.h"
 #include "test_support.h"
 
 namespace vxl {
 namespace {
 
 using test::real;
+using test::raw;
 using test::ScratchDir;
 
 // Writes a TCK with the given datatype from raw data bytes.
 void write_tck(const std::string& path, const std::string& datatype, const std::string& data, const std::string& extra = "") {
-  std::string head = "mrtrix tracks\ndatatype: " + datatype + "\n" + extra + "file: . ";
-  std::string tail = "\nEND\n";
-  std::size_t offset = head.size() + 4 + tail.size();
-  char num[8];
-  std::snprintf(num, sizeof num, "%4zu", offset);
-  std::ofstream(path, std::ios::binary) << head << num << tail << data;
-}
-
-template <typename T>
-std::string raw(std::initializer_list<T> values, bool big_endian = false) {
-  std::string s;
-  for (T v : values) {
-    char b[sizeof(T)];
-    std::memcpy(b, &v, sizeof(T));
-    if (big_endian) std::reverse(b, b + sizeof(T));
-    s.append(b, sizeof(T));
-  }
-  return s;
+  test::write_mrtrix_file(path, "mrtrix tracks", datatype, data, extra);
 }
 
 const float kNaN = NAN, kInf = INFINITY;

@@ -24,11 +24,13 @@
 #include "tck_writer.h"
 #include "vxl_file.h"
 #include "vxl_verify.h"
+#include "mrtrix_test_files.h"
 #include "test_support.h"
 
 namespace vxl {
 namespace {
 
+using test::raw;
 using test::ScratchDir;
 
 constexpr std::uint64_t kMiB = 1ull << 20;
@@ -43,23 +45,7 @@ void write_synth_tck(const std::string& path, std::uint64_t streamlines, std::ui
 
 // A TCK with the given datatype and raw data bytes (as in test_read_tck.cpp).
 void write_raw_tck(const std::string& path, const std::string& datatype, const std::string& data, const std::string& extra = "") {
-  std::string head = "mrtrix tracks\ndatatype: " + datatype + "\n" + extra + "file: . ";
-  std::string tail = "\nEND\n";
-  char num[8];
-  std::snprintf(num, sizeof num, "%4zu", head.size() + 4 + tail.size());
-  std::ofstream(path, std::ios::binary) << head << num << tail << data;
-}
-
-template <typename T>
-std::string raw(std::initializer_list<T> values, bool big_endian = false) {
-  std::string s;
-  for (T v : values) {
-    char b[sizeof(T)];
-    std::memcpy(b, &v, sizeof(T));
-    if (big_endian) std::reverse(b, b + sizeof(T));
-    s.append(b, sizeof(T));
-  }
-  return s;
+  test::write_mrtrix_file(path, "mrtrix tracks", datatype, data, extra);
 }
 
 std::vector<char> file_bytes(const std::string& path) {
@@ -462,26 +448,7 @@ TEST(StreamingConvert, AConversionKilledAtAnyMomentLeavesNoOutput) {
   ScratchDir dir;
   const std::string tck = dir.file("in.tck"), out = dir.file("out.vxl");
   ASSERT_EQ(test::run_cli("synth '" + tck + "' --streamlines 60000").exit_code, 0);
-  int killed_while_running = 0;
-  for (int delay_ms : {10, 50, 100, 200, 300, 450, 600, 800}) {
-    pid_t pid = fork();
-    if (pid == 0) {
-      execl(VOXLINES_CLI, VOXLINES_CLI, "convert", tck.c_str(), out.c_str(), "--memory-limit", "24M", static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
-    kill(pid, SIGKILL);
-    int status = 0;
-    waitpid(pid, &status, 0);
-    if (WIFSIGNALED(status)) {
-      ++killed_while_running;
-      EXPECT_FALSE(std::filesystem::exists(out)) << "killed after " << delay_ms << " ms";
-    } else {
-      std::filesystem::remove(out);  // it finished before the kill: not this test's subject
-    }
-    for (const auto& e : std::filesystem::directory_iterator(dir.path()))
-      EXPECT_TRUE(e.path().filename() == "in.tck" || e.path().filename() == "out.vxl") << "left behind: " << e.path();
-  }
+  const int killed_while_running = test::kill_conversions(dir, {tck, out, "--memory-limit", "24M"}, out, {10, 50, 100, 200, 300, 450, 600, 800});
   EXPECT_GE(killed_while_running, 3) << "the conversion finished too quickly to be killed mid-way";
 }
 

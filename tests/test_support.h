@@ -1,10 +1,14 @@
 // Helpers shared by the tests: where the real fixtures are, scratch directories, running the CLI.
 #pragma once
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -69,5 +73,38 @@ inline CommandResult run_program(const std::string& program, const std::string& 
 
 // Runs the `voxlines` CLI.
 inline CommandResult run_cli(const std::string& args) { return run_program(VOXLINES_CLI, args); }
+
+// Starts `voxlines convert ARGS...` and SIGKILLs it after each delay in turn: every run killed while
+// running must leave nothing at `out`, and the directory nothing but `in.tck` and `out.vxl` (no temporary
+// file). Returns how many runs were killed while running (the others had finished: not the subject).
+inline int kill_conversions(const ScratchDir& dir, const std::vector<std::string>& convert_args, const std::string& out,
+                            std::initializer_list<int> delays_ms) {
+  std::vector<std::string> args = {VOXLINES_CLI, "convert"};
+  args.insert(args.end(), convert_args.begin(), convert_args.end());
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  int killed_while_running = 0;
+  for (int delay_ms : delays_ms) {
+    pid_t pid = fork();
+    if (pid == 0) {
+      execv(VOXLINES_CLI, argv.data());
+      _exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (WIFSIGNALED(status)) {
+      ++killed_while_running;
+      EXPECT_FALSE(std::filesystem::exists(out)) << "killed after " << delay_ms << " ms";
+    } else {
+      std::filesystem::remove(out);
+    }
+    for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+      EXPECT_TRUE(e.path().filename() == "in.tck" || e.path().filename() == "out.vxl") << "left behind: " << e.path();
+  }
+  return killed_while_running;
+}
 
 }  // namespace vxl::test

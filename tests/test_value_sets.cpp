@@ -12,6 +12,7 @@
 #include "error.h"
 #include "read_tractogram.h"
 #include "read_tsf.h"
+#include "mrtrix_test_files.h"
 #include "test_support.h"
 #include "vxl_file.h"
 #include "vxl_verify.h"
@@ -20,27 +21,12 @@ namespace vxl {
 namespace {
 
 using test::real;
+using test::raw;
 using test::ScratchDir;
 
 // A TSF with the given datatype and raw data bytes (header padded so that the offset has 4 digits).
 void write_tsf(const std::string& path, const std::string& datatype, const std::string& data, const std::string& extra = "") {
-  std::string head = "mrtrix track scalars\ndatatype: " + datatype + "\n" + extra + "file: . ";
-  std::string tail = "\nEND\n";
-  char num[8];
-  std::snprintf(num, sizeof num, "%4zu", head.size() + 4 + tail.size());
-  std::ofstream(path, std::ios::binary) << head << num << tail << data;
-}
-
-template <typename T>
-std::string raw(std::initializer_list<T> values, bool big_endian = false) {
-  std::string s;
-  for (T v : values) {
-    char b[sizeof(T)];
-    std::memcpy(b, &v, sizeof(T));
-    if (big_endian) std::reverse(b, b + sizeof(T));
-    s.append(b, sizeof(T));
-  }
-  return s;
+  test::write_mrtrix_file(path, "mrtrix track scalars", datatype, data, extra);
 }
 
 const float kNaN = NAN, kInf = INFINITY;
