@@ -3,12 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <exception>
-#include <thread>
 #include <vector>
 
 #include "error.h"
-#include "parallel_for.h"
+#include "parallel.h"
 #include "voxelize.h"
 #include "vxl_streamlines.h"
 #include "vxlz_draco.h"
@@ -158,9 +156,7 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   pack.chunk_count = n / settings.chunk_points + (n % settings.chunk_points != 0);
   pack.error_bound = vxlz_error_bound(pack.quant_origin, pack.range, pack.quantum);
 
-  // The exact part (spec §4), deflated on a thread of its own while the positions are encoded (unless
-  // one thread was asked for): the voxline voxels take seconds to deflate on a large tractogram, and
-  // would otherwise run alone at the end.
+  // The exact part (spec §4).
   c.meta = m;
   c.directions.assign(f.directions().begin(), f.directions().end());
   c.voxel_coords = encode_voxel_coords(f.voxels());
@@ -169,84 +165,69 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   c.voxline_counts = encode_voxline_counts(f.voxlines());
   if (f.find_section(section_id("PROV"))) c.provenance = std::string(f.provenance_json());
   if (f.find_section(section_id("GRPS"))) c.groups = encode_group_stream(f.groups());
-  DeflatedTables tables;
-  std::exception_ptr tables_error;
-  auto deflate = [&] {
-    try {
-      tables = deflate_tables(c, 1);
-    } catch (...) {
-      tables_error = std::current_exception();
-    }
-  };
-  std::thread tables_thread;
-  if (threads > 1) tables_thread = std::thread(deflate);
-  // Joined on every path out of here: a failure below must not leave the thread running.
-  struct Join {
-    std::thread& t;
-    ~Join() {
-      if (t.joinable()) t.join();
-    }
-  } join_tables{tables_thread};
 
   // Positions (spec §5): chunks are independent, so they are quantised, predicted and encoded in parallel.
-  const Quantizer quantizer(pack);
-  const float* vertices = f.vertices().data();
-  auto voxlines = f.voxlines();
-  struct ErrorStats {
-    double max = 0, sum_squares = 0;
-  };
-  // Chunk `chunk`'s residuals (spec §5.2) into `residuals`, its quantisation errors into `e`.
-  auto chunk_residuals = [&](std::uint64_t chunk, std::vector<std::int32_t>& residuals, ErrorStats& e) {
-    const std::uint64_t start = chunk * pack.chunk_points;
-    const std::uint64_t count = std::min(pack.chunk_points, n - start);
-    residuals.resize(3 * count);
-    std::uint64_t j = std::upper_bound(index.first_point.begin(), index.first_point.end(), start) - index.first_point.begin() - 1;
-    std::uint64_t in_voxline = start - index.first_point[j];
-    LinearPredictor predictor;
-    predictor.reset();
-    for (std::uint64_t i = 0; i < count; ++i) {
-      if (in_voxline == 0 && index.starts_streamline[j]) predictor.start_streamline();
-      const float* p = vertices + 3 * (index.first_vertex[j] + in_voxline);
-      std::array<std::int64_t, 3> k;
-      for (int a = 0; a < 3; ++a) {
-        k[a] = quantizer.quantize(p[a], a);
-        residuals[3 * i + a] = static_cast<std::int32_t>(k[a] - predictor.predict(a));
-        const double error = std::abs(double(quantizer.dequantize(k[a], a)) - double(p[a]));
-        e.max = std::max(e.max, error);
-        e.sum_squares += error * error;
+  auto encode_positions = [&] {
+    const Quantizer quantizer(pack);
+    const float* vertices = f.vertices().data();
+    auto voxlines = f.voxlines();
+    struct ErrorStats {
+      double max = 0, sum_squares = 0;
+    };
+    // Chunk `chunk`'s residuals (spec §5.2) into `residuals`, its quantisation errors into `e`.
+    auto chunk_residuals = [&](std::uint64_t chunk, std::vector<std::int32_t>& residuals, ErrorStats& e) {
+      const std::uint64_t start = chunk * pack.chunk_points;
+      const std::uint64_t count = std::min(pack.chunk_points, n - start);
+      residuals.resize(3 * count);
+      std::uint64_t j = std::upper_bound(index.first_point.begin(), index.first_point.end(), start) - index.first_point.begin() - 1;
+      std::uint64_t in_voxline = start - index.first_point[j];
+      LinearPredictor predictor;
+      predictor.reset();
+      for (std::uint64_t i = 0; i < count; ++i) {
+        if (in_voxline == 0 && index.starts_streamline[j]) predictor.start_streamline();
+        const float* p = vertices + 3 * (index.first_vertex[j] + in_voxline);
+        std::array<std::int64_t, 3> k;
+        for (int a = 0; a < 3; ++a) {
+          k[a] = quantizer.quantize(p[a], a);
+          residuals[3 * i + a] = static_cast<std::int32_t>(k[a] - predictor.predict(a));
+          const double error = std::abs(double(quantizer.dequantize(k[a], a)) - double(p[a]));
+          e.max = std::max(e.max, error);
+          e.sum_squares += error * error;
+        }
+        predictor.push(k);
+        if (++in_voxline == (voxlines[j].count_flags & kVoxlineCountMask)) {
+          ++j;
+          in_voxline = 0;
+        }
       }
-      predictor.push(k);
-      if (++in_voxline == (voxlines[j].count_flags & kVoxlineCountMask)) {
-        ++j;
-        in_voxline = 0;
-      }
+    };
+    std::vector<std::vector<std::int32_t>> residuals(threads);  // one per thread, reused across chunks
+    pack.joint_bits = pick_joint_bits(pack.chunk_count > 0, [&](std::vector<std::int32_t>& sample) {
+      ErrorStats ignored;
+      chunk_residuals(0, sample, ignored);
+    });
+    c.chunks.resize(pack.chunk_count);
+    // Per chunk, summed in chunk order below: summed per thread, the RMS error's last bits (stored in PACK
+    // and in the unpacked file's provenance) depended on which thread took which chunk.
+    std::vector<ErrorStats> errors(pack.chunk_count);
+    parallel_for(pack.chunk_count, threads, [&](std::uint64_t chunk, unsigned t) {
+      ErrorStats e;  // local: neighbouring entries of `errors` share cache lines
+      chunk_residuals(chunk, residuals[t], e);
+      c.chunks[chunk] = encode_residual_chunk(residuals[t], pack.joint_bits);
+      errors[chunk] = e;
+    });
+    double sum_squares = 0;
+    for (const ErrorStats& e : errors) {
+      pack.max_error = std::max(pack.max_error, e.max);
+      sum_squares += e.sum_squares;
     }
+    pack.rms_error = n > 0 ? std::sqrt(sum_squares / (3.0 * double(n))) : 0.0;
   };
-  std::vector<std::vector<std::int32_t>> residuals(threads);  // one per thread, reused across chunks
-  pack.joint_bits = pick_joint_bits(pack.chunk_count > 0, [&](std::vector<std::int32_t>& sample) {
-    ErrorStats ignored;
-    chunk_residuals(0, sample, ignored);
-  });
-  c.chunks.resize(pack.chunk_count);
-  // Per chunk, summed in chunk order below: summed per thread, the RMS error's last bits (stored in PACK
-  // and in the unpacked file's provenance) depended on which thread took which chunk.
-  std::vector<ErrorStats> errors(pack.chunk_count);
-  parallel_for(pack.chunk_count, threads, [&](std::uint64_t chunk, unsigned t) {
-    ErrorStats e;  // local: neighbouring entries of `errors` share cache lines
-    chunk_residuals(chunk, residuals[t], e);
-    c.chunks[chunk] = encode_residual_chunk(residuals[t], pack.joint_bits);
-    errors[chunk] = e;
-  });
-  double sum_squares = 0;
-  for (const ErrorStats& e : errors) {
-    pack.max_error = std::max(pack.max_error, e.max);
-    sum_squares += e.sum_squares;
-  }
-  pack.rms_error = n > 0 ? std::sqrt(sum_squares / (3.0 * double(n))) : 0.0;
-
-  if (tables_thread.joinable()) tables_thread.join();
-  else deflate();
-  if (tables_error) std::rethrow_exception(tables_error);
+  // The exact part is deflated on a thread of its own while the positions are encoded (unless one thread
+  // was asked for): the voxline voxels take seconds to deflate on a large tractogram, and would otherwise
+  // run alone at the end.
+  DeflatedTables tables;
+  parallel_invoke(threads > 1, [&] { tables = deflate_tables(c, 1); }, encode_positions);
 
   PackSummary s;
   s.bytes = write_vxlz(out_path, c, tables);

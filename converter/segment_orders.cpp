@@ -6,10 +6,11 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
-#include <thread>
+#include <optional>
 #include <utility>
 
 #include "error.h"
+#include "parallel.h"
 
 namespace vxl {
 
@@ -333,21 +334,15 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float
                        const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads, const ProgressFn& progress) {
   std::uint32_t max_vertices = 0;
   for (const VoxelEntry& v : voxels) max_vertices = std::max(max_vertices, v.vertex_count);
-  std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
-  auto worker = [&](bool reports) {
-    VoxelOrderWriter writer(set, max_vertices);
-    for (std::size_t i; (i = next++) < voxels.size();) {
-      writer.write(voxels[i], vertices, ends, orders.data() + voxels[i].order_offset);
-      std::size_t d = ++done;
-      if (reports && progress && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
-    }
-  };
-  unsigned n_threads = std::max(1u, resolve_threads(threads));
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < n_threads; ++t) pool.emplace_back(worker, false);
-  worker(true);
-  for (auto& th : pool) th.join();
+  // One writer (sort scratch for the largest voxel) per thread, made by the thread that uses it.
+  std::vector<std::optional<VoxelOrderWriter>> writers(resolve_threads(threads));
+  parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned t) {
+    if (!writers[t]) writers[t].emplace(set, max_vertices);
+    writers[t]->write(voxels[i], vertices, ends, orders.data() + voxels[i].order_offset);
+    const std::size_t d = ++done;
+    if (t == 0 && progress && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
+  });
   if (progress) progress("ordering", 1.0);
 }
 

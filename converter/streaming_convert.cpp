@@ -5,11 +5,8 @@
 #include <chrono>
 #include <cctype>
 #include <cmath>
-#include <cstring>
-#include <future>
 #include <limits>
 #include <memory>
-#include <numeric>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -17,16 +14,16 @@
 
 #include "error.h"
 #include "memory_size.h"
+#include "parallel.h"
 #include "segment_orders.h"
 #include "tck_stream.h"
 #include "voxelize.h"
-#include "voxelize_streamline.h"
+#include "voxel_table.h"
 #include "vxl_stream_writer.h"
 
 namespace vxl {
 namespace {
 
-using detail::Coord;
 using detail::Grid;
 using detail::kNoSynthetic;
 using detail::TempVoxline;
@@ -147,10 +144,10 @@ class StreamingConversion {
   std::uint64_t synthetic_limit_ = 0;
   Sink sink_;
   std::uint64_t sink_held_ = 0, plan_held_ = 0;
-  std::vector<std::uint64_t> local_vertices_, local_segments_;  // by local id, while planning
-  std::vector<std::uint32_t> global_id_;                        // local id -> voxel index
+  detail::VoxelUse use_;                   // by local id, while planning
+  std::vector<std::uint32_t> global_id_;  // local id -> voxel index
   std::vector<VoxelEntry> voxels_;
-  std::vector<std::uint64_t> cursor_;  // per voxel: the next vertex to place (global index)
+  std::vector<std::uint64_t> cursor_;  // by local id: the next vertex of its voxel to place (global index)
   // Per streamline: its lowest and highest voxel index (set by the first range's pass), so that later
   // passes skip the streamlines that have no voxel in their range.
   std::vector<std::array<std::uint32_t, 2>> spans_;
@@ -189,11 +186,9 @@ void StreamingConversion::each_batch(const std::string& stage, Body&& body) {
   check_overflow(batches_[current]);
   while (more) {
     const int other = 1 - current;
-    std::future<bool> next;
-    if (read_ahead) next = std::async(std::launch::async, read, other);
-    body(static_cast<const Tractogram&>(batches_[current]), first);
+    parallel_invoke(read_ahead, [&] { body(static_cast<const Tractogram&>(batches_[current]), first); },
+                    [&] { more = read(other); });
     first += batches_[current].streamline_count();
-    more = read_ahead ? next.get() : read(other);
     current = other;
     check_overflow(batches_[current]);
     // Both batches keep their largest size; pass 1 finds it (later passes cut the same batches).
@@ -220,43 +215,24 @@ void StreamingConversion::open_stream() {
 
 // Pass 1: what plan_voxels' bounds scan finds, and the source's checksum and warnings.
 void StreamingConversion::scan() {
-  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  std::uint64_t bad_streamline = std::numeric_limits<std::uint64_t>::max(), bad_point = 0;
+  detail::BoundsScan bounds;
   std::uint64_t streamlines = 0, points = 0;
   each_batch("reading", [&](const Tractogram& b, std::uint64_t first) {
-    for (std::uint64_t k = 0; k < b.streamline_count(); ++k) {
-      const std::uint64_t begin = b.offsets[k], end = b.offsets[k + 1];
-      if (end - begin > longest_) {
-        longest_ = end - begin;
+    for (std::uint64_t k = 0; k < b.streamline_count(); ++k)
+      if (b.offsets[k + 1] - b.offsets[k] > longest_) {
+        longest_ = b.offsets[k + 1] - b.offsets[k];
         longest_index_ = first + k;
       }
-      if (bad_streamline != std::numeric_limits<std::uint64_t>::max()) continue;  // reading on for the reader's errors
-      for (std::uint64_t i = begin; i < end; ++i) {
-        const float* p = b.positions.data() + 3 * i;
-        if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) {
-          bad_streamline = first + k;
-          bad_point = i - begin;
-          break;
-        }
-        for (int c = 0; c < 3; ++c) {
-          lo[c] = std::min(lo[c], p[c]);
-          hi[c] = std::max(hi[c], p[c]);
-        }
-        if (i > begin) {
-          double d2 = 0;
-          for (int c = 0; c < 3; ++c) d2 += (double(p[c]) - p[c - 3]) * (double(p[c]) - p[c - 3]);
-          longest_step2_ = std::max(longest_step2_, d2);
-        }
-      }
-    }
+    bounds.add(b.positions.data(), b.offsets.data(), 0, b.streamline_count(), first);  // stops at a bad point; reading goes on for the reader's errors
     streamlines += b.streamline_count();
     points += b.point_count();
   });
-  if (bad_streamline != std::numeric_limits<std::uint64_t>::max()) detail::fail_non_finite(path_, bad_streamline, bad_point);
+  bounds.check(path_);
   for (int c = 0; c < 3; ++c) {
-    lo_[c] = lo[c];
-    hi_[c] = hi[c];
+    lo_[c] = bounds.lo[c];
+    hi_[c] = bounds.hi[c];
   }
+  longest_step2_ = bounds.longest_step2;
   meta_.streamline_count = streamlines;
   meta_.point_count = points;
   meta_.voxel_size = settings_.voxel_size;
@@ -280,20 +256,9 @@ void StreamingConversion::plan() {
       if (sink_.too_many_synthetic) detail::fail_too_many_synthetic(path_, meta_.voxel_size, longest_step2_);
       synthetic += sink_.synthetic_xyz.size() / 3;
       const std::size_t n_local = sink_.index.coords().size();
-      if (local_vertices_.size() < n_local) {
-        local_vertices_.resize(n_local, 0);
-        local_segments_.resize(n_local, 0);
-      }
-      const std::size_t count = sink_.voxlines.size();
-      for (std::size_t j = 0; j < count; ++j) {
-        const TempVoxline& v = sink_.voxlines[j];
-        const std::uint64_t own = v.own();
-        if (own > kVoxlineCountMask) detail::fail_long_voxline(path_);
-        const std::uint64_t used = own + (j + 1 < count ? 1 : 0);  // + the connecting vertex
-        local_vertices_[v.voxel] += used;
-        local_segments_[v.voxel] += used - 1;
-      }
-      voxlines += count;
+      use_.grow_to(n_local);
+      detail::count_voxel_use(sink_.voxlines, use_, path_);
+      voxlines += sink_.voxlines.size();
       // Per streamline, so that a table outgrowing the limit is caught before it goes far past it.
       const std::uint64_t table = n_local * kPlanBytesPerVoxel;
       if (table > plan_held_ && table - plan_held_ > budget_.left()) {
@@ -316,37 +281,11 @@ void StreamingConversion::plan() {
 
 // The voxel table sorted by (z, y, x), as plan_voxels and layout_orders make it.
 void StreamingConversion::build_table() {
-  const std::vector<Coord>& coords = sink_.index.coords();
-  const std::size_t n = coords.size();
-  detail::check_voxel_total(n, meta_.voxel_size, path_);
-  std::vector<std::uint32_t> by_coord(n);
-  std::iota(by_coord.begin(), by_coord.end(), 0u);
-  std::sort(by_coord.begin(), by_coord.end(), [&](std::uint32_t a, std::uint32_t b) { return detail::zyx_less(coords[a], coords[b]); });
-  global_id_.resize(n);
-  voxels_.resize(n);
-  cursor_.resize(n);
-  std::uint64_t vertices = 0, segments = 0;
-  for (std::size_t g = 0; g < n; ++g) {
-    const std::uint32_t local = by_coord[g];
-    global_id_[local] = static_cast<std::uint32_t>(g);
-    if (local_vertices_[local] > std::numeric_limits<std::uint32_t>::max()) detail::fail_full_voxel(path_, meta_.voxel_size);
-    VoxelEntry& v = voxels_[g];
-    v = {};
-    v.coord[0] = coords[local].x;
-    v.coord[1] = coords[local].y;
-    v.coord[2] = coords[local].z;
-    v.vertex_first = vertices;
-    v.vertex_count = static_cast<std::uint32_t>(local_vertices_[local]);
-    v.segment_count = static_cast<std::uint32_t>(local_segments_[local]);
-    cursor_[g] = vertices;
-    vertices += local_vertices_[local];
-    segments += local_segments_[local];
-  }
-  local_vertices_ = {};
-  local_segments_ = {};
-  meta_.vertex_count = vertices;
-  meta_.segment_count = segments;
-  meta_.voxel_count = static_cast<std::uint32_t>(n);
+  detail::LocalVoxels table{&sink_.index.coords(), &use_, {}, {}};
+  voxels_ = detail::build_voxel_table({&table, 1}, meta_, path_);
+  use_ = {};
+  global_id_ = std::move(table.global_id);
+  cursor_ = std::move(table.cursor);
   meta_.stored_order_count = static_cast<std::uint32_t>(order_set_.directions.size());
   meta_.order_set = static_cast<std::uint32_t>(order_set_.kind);
   order_bytes_ = layout_orders(voxels_, meta_.stored_order_count);
@@ -449,50 +388,30 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
           }
         }
         if (g < r.first || g >= r.end) continue;
-        // As place_vertices: the optional synthetic first point, the own points, the connecting vertex.
-        const bool connected = j + 1 < n;
-        const std::uint64_t used = own + (connected ? 1 : 0);
-        const std::uint64_t cursor = cursor_[g];
+        const std::uint64_t used = own + (j + 1 < n ? 1 : 0);
+        std::uint64_t& cursor = cursor_[v.voxel];
         if (used > voxels_[g].vertex_first + voxels_[g].vertex_count - cursor) fail_changed();
-        float* dst = vertices.data() + 3 * (cursor - r.vertex_first);
-        if (v.synthetic != kNoSynthetic) {
-          std::memcpy(dst, sink_.synthetic_xyz.data() + 3 * v.synthetic, 12);
-          dst += 3;
-        }
-        std::memcpy(dst, pts + 3 * v.src_first, 12ull * v.src_count);
-        dst += 3 * v.src_count;
-        if (connected) {
-          const TempVoxline& w = sink_.voxlines[j + 1];
-          const float* next = w.synthetic != kNoSynthetic ? sink_.synthetic_xyz.data() + 3 * w.synthetic : pts + 3 * w.src_first;
-          std::memcpy(dst, next, 12);
-        }
+        detail::place_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data(), vertices.data() + 3 * (cursor - r.vertex_first));
         ends.set(cursor - r.vertex_first + used - 1);
-        cursor_[g] = cursor + used;
+        cursor += used;
       }
       voxline_index += n;
     }
     streamlines += b.streamline_count();
   });
   if (streamlines != meta_.streamline_count || (tables && voxline_index != meta_.voxline_count)) fail_changed();
-  for (std::size_t g = r.first; g < r.end; ++g)
-    if (cursor_[g] != voxels_[g].vertex_first + voxels_[g].vertex_count) fail_changed();
+  for (std::size_t local = 0; local < cursor_.size(); ++local) {
+    const std::uint32_t g = global_id_[local];
+    if (g >= r.first && g < r.end && cursor_[local] != voxels_[g].vertex_first + voxels_[g].vertex_count) fail_changed();
+  }
   if (tables) {
     streamline_buffer.push_back(voxline_index);
     out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, streamline_buffer);
     out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, voxline_buffer);
   }
 
-  // Tight bounds, as place_vertices computes them.
   const std::span<VoxelEntry> range(voxels_.data() + r.first, r.end - r.first);
-  for (VoxelEntry& v : range) {
-    const float* p = vertices.data() + 3 * (v.vertex_first - r.vertex_first);
-    for (int c = 0; c < 3; ++c) v.tight_min[c] = v.tight_max[c] = p[c];
-    for (std::uint64_t k = 1; k < v.vertex_count; ++k)
-      for (int c = 0; c < 3; ++c) {
-        v.tight_min[c] = std::min(v.tight_min[c], p[3 * k + c]);
-        v.tight_max[c] = std::max(v.tight_max[c], p[3 * k + c]);
-      }
-  }
+  detail::set_tight_bounds(range, vertices.data(), r.vertex_first);
   summary_.voxelize_seconds += seconds_since(t0);
 
   // The orders, with the range's entries rebased to its own vertices and orders for the while.

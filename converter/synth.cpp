@@ -1,13 +1,13 @@
 #include "synth.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
+
+#include "parallel.h"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -574,37 +574,19 @@ void generate_streamline(const Layout& layout, const Smoothstep& smooth, const P
   }
 }
 
-// Runs body(begin, end) over [0, n) in chunks on `threads` threads.
+// Runs body(begin, end) over [0, n) in batches of streamlines on `threads` threads.
 template <typename Body>
-void parallel_chunks(std::uint64_t n, unsigned threads, Body body) {
-  constexpr std::uint64_t kChunk = 4096;
-  const std::uint64_t chunks = (n + kChunk - 1) / kChunk;
-  std::atomic<std::uint64_t> next{0};
-  auto worker = [&] {
-    for (;;) {
-      const std::uint64_t c = next.fetch_add(1, std::memory_order_relaxed);
-      if (c >= chunks) return;
-      body(c * kChunk, std::min(n, (c + 1) * kChunk));
-    }
-  };
-  const auto t = static_cast<unsigned>(std::min<std::uint64_t>(threads, chunks));
-  if (t <= 1) {
-    worker();
-    return;
-  }
-  std::vector<std::thread> pool;
-  pool.reserve(t - 1);
-  for (unsigned i = 0; i + 1 < t; ++i) pool.emplace_back(worker);
-  worker();
-  for (auto& th : pool) th.join();
+void parallel_batches(std::uint64_t n, unsigned threads, Body body) {
+  constexpr std::uint64_t kBatch = 4096;
+  parallel_for((n + kBatch - 1) / kBatch, threads,
+               [&](std::uint64_t b, unsigned) { body(b * kBatch, std::min(n, (b + 1) * kBatch)); });
 }
 
 }  // namespace
 
 Tractogram synthesize_tractogram(const SynthSettings& settings) {
   const std::uint64_t n = settings.streamlines;
-  unsigned threads = settings.threads ? settings.threads : std::thread::hardware_concurrency();
-  if (threads == 0) threads = 1;
+  const unsigned threads = resolve_threads(settings.threads);
 
   const Layout layout = build_layout(settings.seed);
   const std::uint64_t key = mix64(settings.seed ^ 0x73747265616D2131ULL);  // "stream!1"
@@ -624,7 +606,7 @@ Tractogram synthesize_tractogram(const SynthSettings& settings) {
 
   // Pass 1: every streamline's point count (its plan is cheap to redraw), then exact offsets.
   t.offsets.assign(n + 1, 0);
-  parallel_chunks(n, threads, [&](std::uint64_t begin, std::uint64_t end) {
+  parallel_batches(n, threads, [&](std::uint64_t begin, std::uint64_t end) {
     for (std::uint64_t i = begin; i < end; ++i) {
       Rng rng = streamline_rng(key, i);
       t.offsets[i + 1] = plan_streamline(layout, rng).points;
@@ -648,7 +630,7 @@ Tractogram synthesize_tractogram(const SynthSettings& settings) {
 #endif
   t.positions.resize(floats);
   const Smoothstep smooth;
-  parallel_chunks(n, threads, [&](std::uint64_t begin, std::uint64_t end) {
+  parallel_batches(n, threads, [&](std::uint64_t begin, std::uint64_t end) {
     for (std::uint64_t i = begin; i < end; ++i) {
       Rng rng = streamline_rng(key, i);
       const Plan plan = plan_streamline(layout, rng);

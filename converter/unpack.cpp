@@ -4,16 +4,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <exception>
 #include <filesystem>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "error.h"
-#include "parallel_for.h"
+#include "parallel.h"
 #include "segment_orders.h"
+#include "voxel_table.h"
 #include "vxl_writer.h"
 #include "vxlz_draco.h"
 #include "vxlz_package.h"
@@ -47,24 +46,7 @@ std::vector<VoxlineEntry> read_voxlines(const VxlzFile& f, std::span<const std::
   const std::uint32_t vxlv = section_id("VXLV"), vxlc = section_id("VXLC");
   std::vector<std::uint8_t> voxel_stream, count_stream;
   std::vector<VoxlineEntry> voxlines;
-  auto both = [&](auto&& voxel_part, auto&& count_part) {
-    std::exception_ptr error;
-    std::thread other([&] {
-      try {
-        count_part();
-      } catch (...) {
-        error = std::current_exception();
-      }
-    });
-    try {
-      voxel_part();
-    } catch (...) {
-      other.join();
-      throw;
-    }
-    other.join();
-    if (error) std::rethrow_exception(error);
-  };
+  auto both = [](auto&& voxel_part, auto&& count_part) { parallel_invoke(true, voxel_part, count_part); };
   both([&] { voxel_stream = f.inflate(vxlv); }, [&] { count_stream = f.inflate(vxlc); });
   // Every entry takes at least a byte of each stream: refuse a count they cannot hold before allocating.
   if (l > voxel_stream.size() || l > count_stream.size())
@@ -281,17 +263,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   parallel_for(voxels.size() + 1, threads, [&](std::uint64_t item, unsigned t) {
     if (item == 0) return out.checksum_vertices_now();
     VoxelEntry& v = voxels[item - 1];
-    const float* b = vertices.data() + 3 * v.vertex_first;
-    // In locals: the entry lives in the same mapping as the vertices, so the compiler would otherwise
-    // store it back after every vertex.
-    float lo[3] = {b[0], b[1], b[2]}, hi[3] = {b[0], b[1], b[2]};
-    for (std::uint64_t e = 1; e < v.vertex_count; ++e)
-      for (int c = 0; c < 3; ++c) {
-        lo[c] = std::min(lo[c], b[3 * e + c]);
-        hi[c] = std::max(hi[c], b[3 * e + c]);
-      }
-    std::copy(lo, lo + 3, v.tight_min);
-    std::copy(hi, hi + 3, v.tight_max);
+    detail::set_tight_bounds({&v, 1}, vertices.data(), 0);
     writers[t].write(v, vertices, ends, out.orders().data() + v.order_offset);
     const std::uint64_t d = ++ordered;
     if (t == 0 && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));

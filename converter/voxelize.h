@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "parallel.h"  // resolve_threads: the meaning of VoxelizeSettings::threads
 #include "tractogram.h"
 #include "vxl_layout.h"
 
@@ -115,7 +116,5 @@ VoxelizedTractogram voxelize(Tractogram&& tractogram, const VoxelizeSettings& se
 inline std::int64_t voxel_coordinate(float p, double origin, double voxel_size) {
   return static_cast<std::int64_t>(std::floor((static_cast<double>(p) - origin) / voxel_size));
 }
-
-unsigned resolve_threads(unsigned requested);
 
 }  // namespace vxl

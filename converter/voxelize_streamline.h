@@ -9,7 +9,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
-#include <string>
 #include <vector>
 
 #include "vxl_layout.h"
@@ -169,17 +168,5 @@ void voxelize_streamline(const Grid& grid, const float* pts, std::uint64_t first
   }
   close(first + n);
 }
-
-// The checks of plan_voxels, shared so that both paths refuse the same input with the same message
-// (defined in voxelize.cpp). All throw vxl::Error.
-void check_voxel_size(double voxel_size, const std::string& path);  // Usage unless finite and > 0
-[[noreturn]] void fail_non_finite(const std::string& path, std::uint64_t streamline, std::uint64_t point);
-// Sets the grid and bounds of `m` (voxel_size already set) for points inside [lo, hi]; Unsupported when
-// an axis would have 2^31 cells or more.
-Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std::string& path);
-[[noreturn]] void fail_too_many_synthetic(const std::string& path, double voxel_size, double longest_step2);
-[[noreturn]] void fail_long_voxline(const std::string& path);
-void check_voxel_total(std::uint64_t voxels, double voxel_size, const std::string& path);
-[[noreturn]] void fail_full_voxel(const std::string& path, double voxel_size);
 
 }  // namespace vxl::detail

@@ -3,7 +3,6 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <thread>
 #include <vector>
 
 #include <fcntl.h>
@@ -12,6 +11,7 @@
 #include <unistd.h>
 
 #include "error.h"
+#include "parallel.h"
 
 namespace vxl {
 
@@ -142,7 +142,7 @@ void prefault_for_write(std::span<std::uint8_t> bytes, unsigned threads) {
   const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(bytes.data()) / page * page;
   const std::uintptr_t end = reinterpret_cast<std::uintptr_t>(bytes.data() + bytes.size());
   // Whole pages per thread, and no thread for less than 8 MiB.
-  const std::uintptr_t part = std::max<std::uintptr_t>((end - begin) / std::max(1u, threads) / page * page + page, 8u << 20);
+  const std::uintptr_t part = std::max<std::uintptr_t>((end - begin) / resolve_threads(threads) / page * page + page, 8u << 20);
   auto populate = [](std::uintptr_t from, std::uintptr_t to) {
     // MADV_RANDOM first: without readahead the pages come as single-page folios. With it the kernel
     // builds large folios from free 2 MiB blocks and zeroes them, and in a VM whose host has taken those
@@ -153,10 +153,10 @@ void prefault_for_write(std::span<std::uint8_t> bytes, unsigned threads) {
     ::madvise(reinterpret_cast<void*>(from), to - from, MADV_RANDOM);
     ::madvise(reinterpret_cast<void*>(from), to - from, MADV_POPULATE_WRITE);  // hints: errors are ignored
   };
-  std::vector<std::thread> pool;
-  for (std::uintptr_t from = begin + part; from < end; from += part) pool.emplace_back(populate, from, std::min(end, from + part));
-  populate(begin, std::min(end, begin + part));
-  for (std::thread& t : pool) t.join();
+  parallel_for((end - begin + part - 1) / part, threads, [&](std::uint64_t k, unsigned) {
+    const std::uintptr_t from = begin + k * part;
+    populate(from, std::min(end, from + part));
+  });
 #else
   (void)bytes, (void)threads;
 #endif

@@ -1,11 +1,10 @@
 #include "vxl_writer.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cstring>
-#include <thread>
 
 #include "checksum.h"
+#include "parallel.h"
 #include "vxl_value_sets.h"
 
 namespace vxl {
@@ -158,18 +157,10 @@ void VxlWriter::commit(unsigned threads) {
   for (std::size_t i = 0; i < table_.size(); ++i)
     if (!(&table_[i] == vert && vertices_checksummed_)) by_size.push_back(i);
   std::stable_sort(by_size.begin(), by_size.end(), [&](std::size_t a, std::size_t b) { return table_[a].size > table_[b].size; });
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    for (std::size_t k; (k = next++) < by_size.size();) {
-      SectionEntry& e = table_[by_size[k]];
-      e.checksum = xxh3_64(file_.data() + e.offset, e.size);
-    }
-  };
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < std::min<std::size_t>(threads, table_.size()); ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
+  parallel_for(by_size.size(), threads, [&](std::uint64_t k, unsigned) {
+    SectionEntry& e = table_[by_size[k]];
+    e.checksum = xxh3_64(file_.data() + e.offset, e.size);
+  });
 
   std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_.size());
   std::memcpy(file_.data(), header.data(), header.size());

@@ -1,15 +1,14 @@
 #include "vxlz_package.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <thread>
 
 #include "atomic_output.h"
 #include "checksum.h"
 #include "error.h"
+#include "parallel.h"
 #include "vxl_file.h"
 
 namespace vxl {
@@ -54,21 +53,7 @@ DeflatedTables deflate_tables(const VxlzContent& c, unsigned threads) {
     jobs.push_back({{reinterpret_cast<const std::uint8_t*>(c.provenance->data()), c.provenance->size()}, DeflateMode::Matching,
                     &*d.provenance});
   if (c.groups) jobs.push_back({*c.groups, DeflateMode::Matching, &*d.groups});
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    for (std::size_t i; (i = next++) < jobs.size();) *jobs[i].out = deflate_section(jobs[i].raw, jobs[i].mode);
-  };
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  std::vector<std::thread> pool;
-  try {
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-  } catch (...) {
-    next = jobs.size();
-    for (auto& t : pool) t.join();
-    throw;
-  }
-  for (auto& t : pool) t.join();
+  parallel_for(jobs.size(), threads, [&](std::uint64_t i, unsigned) { *jobs[i].out = deflate_section(jobs[i].raw, jobs[i].mode); });
   return d;
 }
 

@@ -1,12 +1,9 @@
 #include "gpu_scene.h"
 
 #include <algorithm>
-#include <atomic>
-#include <exception>
-#include <mutex>
-#include <thread>
 
 #include "error.h"
+#include "parallel.h"
 #include "vxl_streamlines.h"
 
 namespace vxl {
@@ -56,28 +53,16 @@ GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels)
     g.positions.create(GL_R32F, file.vertices().data() + 3 * c.vertex_first, 12 * c.vertex_count);
     entries.resize(std::uint64_t(c.slots) * c.segments);
     // Voxels fill disjoint ranges of every slot, so they are widened in parallel.
-    std::atomic<std::uint32_t> next{c.voxel_first};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    auto widen = [&] {
-      std::vector<std::uint8_t> is_start;
-      for (std::uint32_t i; (i = next++) < c.voxel_first + c.voxel_count;) {
-        try {
-          widen_voxel(file, i, i - file_first, c, entries, is_start);
-        } catch (...) {
-          std::lock_guard lock(error_mutex);
-          if (!error) error = std::current_exception();
-        }
-      }
-    };
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < std::max(1u, std::thread::hardware_concurrency()); ++t) pool.emplace_back(widen);
-    widen();
-    for (std::thread& t : pool) t.join();
-    if (error) {
+    std::vector<std::vector<std::uint8_t>> is_start(resolve_threads(0));  // scratch per thread
+    try {
+      parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
+        const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
+        widen_voxel(file, i, i - file_first, c, entries, is_start[t]);
+      });
+    } catch (...) {
       g.positions.destroy();
       release();
-      std::rethrow_exception(error);
+      throw;
     }
     g.orders.create(GL_R32UI, entries.data(), entries.size() * 4);
     g.dataset.create(GL_R32UI, nullptr, 0);

@@ -1,0 +1,185 @@
+#include "voxel_table.h"
+
+#include <algorithm>
+#include <sstream>
+
+#include "error.h"
+
+namespace vxl::detail {
+namespace {
+
+std::string format_mm(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+
+[[noreturn]] void fail_non_finite(const std::string& path, std::uint64_t streamline, std::uint64_t point) {
+  throw Error(ErrorKind::Input, path, std::nullopt,
+              "non-finite coordinate in streamline " + std::to_string(streamline) + " (point " + std::to_string(point) + ")");
+}
+
+[[noreturn]] void fail_long_voxline(const std::string& path) {
+  throw Error(ErrorKind::Unsupported, path, std::nullopt, "a voxline of more than 2^31-1 points; use a smaller --voxel-size");
+}
+
+}  // namespace
+
+void BoundsScan::add(const float* pts, const std::uint64_t* offsets, std::uint64_t first, std::uint64_t end,
+                     std::uint64_t index_base) {
+  // Locals, not the fields: the compiler cannot tell that `this` does not alias the points.
+  float l[3] = {lo[0], lo[1], lo[2]}, h[3] = {hi[0], hi[1], hi[2]};
+  double step2 = longest_step2;
+  for (std::uint64_t k = first; k < end && bad_streamline == kNone; ++k) {
+    for (std::uint64_t i = offsets[k]; i < offsets[k + 1]; ++i) {
+      const float* p = pts + 3 * i;
+      if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) {
+        bad_streamline = index_base + k;
+        bad_point = i - offsets[k];
+        break;
+      }
+      for (int c = 0; c < 3; ++c) {  // in float: converting to double afterwards gives the same bounds
+        l[c] = std::min(l[c], p[c]);
+        h[c] = std::max(h[c], p[c]);
+      }
+      if (i > offsets[k]) {
+        double d2 = 0;
+        for (int c = 0; c < 3; ++c) d2 += (double(p[c]) - p[c - 3]) * (double(p[c]) - p[c - 3]);
+        step2 = std::max(step2, d2);
+      }
+    }
+  }
+  std::copy(l, l + 3, lo);
+  std::copy(h, h + 3, hi);
+  longest_step2 = step2;
+}
+
+void BoundsScan::merge(const BoundsScan& later) {
+  for (int c = 0; c < 3; ++c) {
+    lo[c] = std::min(lo[c], later.lo[c]);
+    hi[c] = std::max(hi[c], later.hi[c]);
+  }
+  longest_step2 = std::max(longest_step2, later.longest_step2);
+  if (bad_streamline == kNone) {
+    bad_streamline = later.bad_streamline;
+    bad_point = later.bad_point;
+  }
+}
+
+void BoundsScan::check(const std::string& path) const {
+  if (bad_streamline != kNone) fail_non_finite(path, bad_streamline, bad_point);
+}
+
+void check_voxel_size(double s, const std::string& path) {
+  if (!std::isfinite(s) || !(s > 0)) throw Error(ErrorKind::Usage, path, std::nullopt, "voxel size must be a positive number of mm");
+}
+
+Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std::string& path) {
+  const double s = m.voxel_size;
+  for (int c = 0; c < 3; ++c) {
+    double cells = std::floor((hi[c] - lo[c]) / s) + 1;
+    if (!(cells < double(std::numeric_limits<std::int32_t>::max()))) {
+      double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+      throw Error(ErrorKind::Unsupported, path, std::nullopt,
+                  "a voxel size of " + format_mm(s) + " mm makes a grid of more than 2^31 voxels along an axis (extent " +
+                      format_mm(extent) + " mm); use --voxel-size " + format_mm(extent / 1e9) + " or larger");
+    }
+    m.grid_dims[c] = static_cast<std::int32_t>(cells);
+    m.grid_origin[c] = lo[c];
+    m.bounds_min[c] = lo[c];
+    m.bounds_max[c] = hi[c];
+  }
+  return Grid{{lo[0], lo[1], lo[2]}, s};
+}
+
+void fail_too_many_synthetic(const std::string& path, double s, double longest_step2) {
+  throw Error(ErrorKind::Unsupported, path, std::nullopt,
+              "voxel size " + format_mm(s) + " mm is far below the longest step (" + format_mm(std::sqrt(longest_step2)) +
+                  " mm): splitting steps at voxel faces would more than double the points; use --voxel-size " +
+                  format_mm(std::sqrt(longest_step2)) + " or larger");
+}
+
+void count_voxel_use(std::span<const TempVoxline> streamline, VoxelUse& use, const std::string& path) {
+  for (std::size_t j = 0; j < streamline.size(); ++j) {
+    const TempVoxline& v = streamline[j];
+    const std::uint64_t own = v.own();
+    if (own > kVoxlineCountMask) fail_long_voxline(path);
+    const std::uint64_t used = own + (j + 1 < streamline.size() ? 1 : 0);  // + the connecting vertex
+    use.vertices[v.voxel] += used;
+    use.segments[v.voxel] += used - 1;
+  }
+}
+
+std::vector<VoxelEntry> build_voxel_table(std::span<LocalVoxels> indexes, MetaSection& m, const std::string& path) {
+  std::vector<Coord> all;
+  for (const LocalVoxels& x : indexes) all.insert(all.end(), x.coords->begin(), x.coords->end());
+  std::sort(all.begin(), all.end(), zyx_less);
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  const std::size_t n = all.size();
+  if (n >= std::uint64_t(std::numeric_limits<std::int32_t>::max()))
+    throw Error(ErrorKind::Unsupported, path, std::nullopt,
+                "more than 2^31 non-empty voxels; use a larger --voxel-size than " + format_mm(m.voxel_size));
+
+  std::vector<std::uint64_t> vertices(n, 0), segments(n, 0);
+  for (LocalVoxels& x : indexes) {
+    const std::vector<Coord>& coords = *x.coords;
+    x.global_id.resize(coords.size());
+    for (std::size_t i = 0; i < coords.size(); ++i) {
+      const auto g = static_cast<std::uint32_t>(std::lower_bound(all.begin(), all.end(), coords[i], zyx_less) - all.begin());
+      x.global_id[i] = g;
+      vertices[g] += x.use->vertices[i];
+      segments[g] += x.use->segments[i];
+    }
+  }
+
+  std::vector<VoxelEntry> voxels(n);
+  std::uint64_t vertex_total = 0, segment_total = 0;
+  for (std::size_t g = 0; g < n; ++g) {
+    if (vertices[g] > std::numeric_limits<std::uint32_t>::max())
+      throw Error(ErrorKind::Unsupported, path, std::nullopt,
+                  "a voxel holds more than 2^32-1 vertices; use a --voxel-size smaller than " + format_mm(m.voxel_size));
+    VoxelEntry& v = voxels[g];
+    v = {};
+    v.coord[0] = all[g].x;
+    v.coord[1] = all[g].y;
+    v.coord[2] = all[g].z;
+    v.vertex_first = vertex_total;
+    v.vertex_count = static_cast<std::uint32_t>(vertices[g]);
+    v.segment_count = static_cast<std::uint32_t>(segments[g]);
+    vertex_total += vertices[g];
+    segment_total += segments[g];
+  }
+  // Each index writes after the indexes before it inside every block: streamline order is kept.
+  std::vector<std::uint64_t>& next = vertices;  // reused: the counts are no longer needed
+  for (std::size_t g = 0; g < n; ++g) next[g] = voxels[g].vertex_first;
+  for (LocalVoxels& x : indexes) {
+    x.cursor.resize(x.global_id.size());
+    for (std::size_t i = 0; i < x.global_id.size(); ++i) {
+      x.cursor[i] = next[x.global_id[i]];
+      next[x.global_id[i]] += x.use->vertices[i];
+    }
+  }
+  m.voxel_count = static_cast<std::uint32_t>(n);
+  m.vertex_count = vertex_total;
+  m.segment_count = segment_total;
+  return voxels;
+}
+
+void set_tight_bounds(std::span<VoxelEntry> voxels, const float* vertices, std::uint64_t vertex_base) {
+  for (VoxelEntry& v : voxels) {
+    const float* p = vertices + 3 * (v.vertex_first - vertex_base);
+    // In locals: the entry may live in the same mapping as the vertices (unpack), and the compiler would
+    // otherwise store it back after every vertex.
+    float lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
+    for (std::uint64_t k = 1; k < v.vertex_count; ++k)
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = std::min(lo[c], p[3 * k + c]);
+        hi[c] = std::max(hi[c], p[3 * k + c]);
+      }
+    std::copy(lo, lo + 3, v.tight_min);
+    std::copy(hi, hi + 3, v.tight_max);
+  }
+}
+
+}  // namespace vxl::detail

@@ -1,0 +1,105 @@
+// The stages of voxelisation that both conversion paths run — voxelize.cpp over a tractogram in memory
+// (split over threads by streamline range) and streaming_convert.cpp over batches read from a file in
+// bounded memory — so that both make exactly the same bytes:
+//
+//   BoundsScan          bounds, finiteness and longest step of the points         (before the grid is set)
+//   set_grid            the grid of spec §6.1 over those bounds
+//   voxelize_streamline the voxlines of one streamline (voxelize_streamline.h)
+//   count_voxel_use     the vertices and segments those voxlines add to their voxels
+//   build_voxel_table   the voxel table sorted by (z, y, x), from one or more local voxel indexes
+//   place_voxline       a voxline's vertices into its block
+//   set_tight_bounds    each voxel's bounds from its block
+//
+// Internal to the converter: the public interfaces are voxelize.h and streaming_convert.h.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "voxelize_streamline.h"
+#include "vxl_layout.h"
+
+namespace vxl::detail {
+
+// Bounds, the first non-finite point and the longest step of the streamlines seen so far. Scans stop at
+// the first non-finite point (the conversion then fails on it); merging keeps the earliest.
+struct BoundsScan {
+  static constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  double longest_step2 = 0;
+  std::uint64_t bad_streamline = kNone, bad_point = 0;  // the first non-finite point
+
+  // Streamlines [first, end) of `offsets` (points xyz in `pts`), numbered from `index_base` in messages.
+  void add(const float* pts, const std::uint64_t* offsets, std::uint64_t first, std::uint64_t end, std::uint64_t index_base);
+  // Folds in a scan of later streamlines.
+  void merge(const BoundsScan& later);
+  // Throws Input for the first non-finite point, if any.
+  void check(const std::string& path) const;
+};
+
+// Vertex and segment counts per voxel of one local voxel index.
+struct VoxelUse {
+  std::vector<std::uint64_t> vertices, segments;
+  void grow_to(std::size_t voxels) {
+    if (vertices.size() < voxels) {
+      vertices.resize(voxels, 0);
+      segments.resize(voxels, 0);
+    }
+  }
+};
+
+// Adds one streamline's voxlines (all of them, in order) to `use`: each voxline's own points plus, but
+// for the last, the connecting vertex. Throws Unsupported for a voxline longer than spec §9 allows.
+void count_voxel_use(std::span<const TempVoxline> streamline, VoxelUse& use, const std::string& path);
+
+// One local voxel index (a thread's or the whole source's) and what build_voxel_table gives back for it.
+struct LocalVoxels {
+  const std::vector<Coord>* coords = nullptr;  // by local id
+  const VoxelUse* use = nullptr;               // by local id
+  std::vector<std::uint32_t> global_id;        // out: local id -> voxel index
+  // out: local id -> the first vertex of its block this index places (after the indexes before it)
+  std::vector<std::uint64_t> cursor;
+};
+
+// The voxel table of spec §5.3, sorted by (z, y, x), with coord, vertex_first, vertex_count and
+// segment_count set; inside each block the indexes place their vertices in the order given (so that
+// streamline order is kept). Sets m's voxel_count, vertex_count and segment_count. Throws Unsupported
+// beyond the limits of spec §9.
+std::vector<VoxelEntry> build_voxel_table(std::span<LocalVoxels> indexes, MetaSection& m, const std::string& path);
+
+// Writes voxline j of one streamline's list (its optional synthetic first point, its own points and, but
+// for the streamline's last voxline, the next voxline's first point) at `dst`; returns the vertices written.
+inline std::uint64_t place_voxline(std::span<const TempVoxline> streamline, std::size_t j, const float* pts,
+                                   const float* synthetic_xyz, float* dst) {
+  const TempVoxline& v = streamline[j];
+  auto first_point = [&](const TempVoxline& x) {
+    return x.synthetic != kNoSynthetic ? synthetic_xyz + 3 * x.synthetic : pts + 3 * x.src_first;
+  };
+  float* out = dst;
+  if (v.synthetic != kNoSynthetic) {
+    std::copy_n(first_point(v), 3, out);
+    out += 3;
+  }
+  std::copy_n(pts + 3 * v.src_first, 3 * std::size_t(v.src_count), out);
+  out += 3 * std::size_t(v.src_count);
+  const bool connected = j + 1 < streamline.size();
+  if (connected) std::copy_n(first_point(streamline[j + 1]), 3, out);
+  return v.own() + (connected ? 1 : 0);
+}
+
+// The checks, shared so that both paths refuse the same input with the same message. All throw vxl::Error.
+void check_voxel_size(double voxel_size, const std::string& path);  // Usage unless finite and > 0
+// Sets the grid and bounds of `m` (voxel_size already set) for points inside [lo, hi]; Unsupported when
+// an axis would have 2^31 cells or more.
+Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std::string& path);
+[[noreturn]] void fail_too_many_synthetic(const std::string& path, double voxel_size, double longest_step2);
+
+// Each voxel's tight bounds from its block; `vertices` holds the blocks from vertex `vertex_base` on.
+void set_tight_bounds(std::span<VoxelEntry> voxels, const float* vertices, std::uint64_t vertex_base);
+
+}  // namespace vxl::detail

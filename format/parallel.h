@@ -1,0 +1,69 @@
+// The project's one way to run work on several threads. Every parallel loop of the converter, the
+// package codec, the writer and the viewer's upload goes through parallel_for, so that they share one
+// rule for the thread count (0 = all hardware threads) and one exception policy: the first exception
+// thrown by any item stops the hand-out of further items and is rethrown on the caller's thread once
+// every thread has joined (items already running finish; later exceptions are dropped).
+//
+// Threads are started per call, not kept in a pool: every call here runs for milliseconds to seconds,
+// so the start-up (tens of microseconds) does not show, and nothing outlives the call.
+// Lives in format/, the library every other one links, so that all of them can use it.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace vxl {
+
+// The number of worker threads for a requested count: `requested` itself, or all hardware threads for 0.
+inline unsigned resolve_threads(unsigned requested) {
+  if (requested > 0) return requested;
+  const unsigned n = std::thread::hardware_concurrency();
+  return n == 0 ? 1 : n;
+}
+
+// Calls fn(item, thread) for every item in [0, count), handing items out one at a time to
+// min(resolve_threads(threads), count) threads; `thread` is in [0, that number) and names the worker, so
+// that fn can keep per-thread scratch in a vector indexed by it. Thread 0 is the calling thread.
+template <typename Fn>
+void parallel_for(std::uint64_t count, unsigned threads, Fn&& fn) {
+  const unsigned workers = static_cast<unsigned>(std::min<std::uint64_t>(resolve_threads(threads), count));
+  if (workers <= 1) {
+    for (std::uint64_t i = 0; i < count; ++i) fn(i, 0u);
+    return;
+  }
+  std::atomic<std::uint64_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto worker = [&](unsigned t) {
+    try {
+      for (std::uint64_t i; (i = next.fetch_add(1, std::memory_order_relaxed)) < count;) fn(i, t);
+    } catch (...) {
+      std::lock_guard lock(error_mutex);
+      if (!error) error = std::current_exception();
+      next = count;
+    }
+  };
+  std::vector<std::thread> pool;
+  pool.reserve(workers - 1);
+  for (unsigned t = 1; t < workers; ++t) pool.emplace_back(worker, t);
+  worker(0);
+  for (std::thread& th : pool) th.join();
+  if (error) std::rethrow_exception(error);
+}
+
+// Runs a() and b() side by side (b on the calling thread), or one after the other when `concurrent` is
+// false; the exception policy is parallel_for's.
+template <typename A, typename B>
+void parallel_invoke(bool concurrent, A&& a, B&& b) {
+  parallel_for(2, concurrent ? 2u : 1u, [&](std::uint64_t item, unsigned) {
+    if (item == 0) a();
+    else b();
+  });
+}
+
+}  // namespace vxl
