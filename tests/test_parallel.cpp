@@ -1,0 +1,75 @@
+// format/parallel.h: every item runs once, on a named worker, and the first error reaches the caller.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <set>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "parallel.h"
+
+namespace vxl {
+namespace {
+
+TEST(Parallel, ZeroThreadsMeansAllHardwareThreads) {
+  EXPECT_EQ(resolve_threads(3), 3u);
+  EXPECT_EQ(resolve_threads(0), std::max(1u, std::thread::hardware_concurrency()));
+}
+
+TEST(Parallel, EveryItemRunsExactlyOnceOnAWorkerBelowTheThreadCount) {
+  const std::uint64_t count = 10000;
+  std::vector<std::atomic<int>> runs(count);
+  std::atomic<unsigned> highest_worker{0};
+  parallel_for(count, 4, [&](std::uint64_t i, unsigned t) {
+    ++runs[i];
+    unsigned seen = highest_worker.load();
+    while (t > seen && !highest_worker.compare_exchange_weak(seen, t)) {
+    }
+  });
+  for (std::uint64_t i = 0; i < count; ++i) ASSERT_EQ(runs[i].load(), 1) << "item " << i;
+  EXPECT_LT(highest_worker.load(), 4u);
+}
+
+TEST(Parallel, NoMoreWorkersThanItems) {
+  std::set<unsigned> workers;
+  std::mutex m;
+  parallel_for(2, 16, [&](std::uint64_t, unsigned t) {
+    std::lock_guard lock(m);
+    workers.insert(t);
+  });
+  EXPECT_LE(*workers.rbegin(), 1u);
+}
+
+TEST(Parallel, TheFirstErrorIsRethrownOnTheCallerAndStopsTheHandOut) {
+  for (unsigned threads : {1u, 2u, 4u}) {
+    const std::uint64_t count = 200;
+    std::atomic<std::uint64_t> ran{0};
+    try {
+      parallel_for(count, threads, [&](std::uint64_t i, unsigned) {
+        ++ran;
+        if (i == 0) throw std::runtime_error("item 0");
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the others take a while
+      });
+      FAIL() << "no exception with " << threads << " threads";
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "item 0");
+    }
+    // Items already handed out finish; the rest never start.
+    EXPECT_LT(ran.load(), count) << threads << " threads";
+  }
+}
+
+TEST(Parallel, InvokeRunsBothAndRethrows) {
+  for (bool concurrent : {false, true}) {
+    int a = 0, b = 0;
+    parallel_invoke(concurrent, [&] { a = 1; }, [&] { b = 2; });
+    EXPECT_EQ(a + b, 3);
+    EXPECT_THROW(parallel_invoke(concurrent, [] {}, [] { throw std::logic_error("b"); }), std::logic_error);
+  }
+}
+
+}  // namespace
+}  // namespace vxl
