@@ -42,7 +42,8 @@ struct VxlLayout {
 VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes);
 
 // The bytes of the header and the section table (spec §3, §4), once every checksum in `table` is set.
-// The version is 1.1 when the table has VDIR, else 1.0 (spec §10).
+// The version is the lowest that holds the table (spec §10): 1.2 with VVAL or SVAL, else 1.1 with VDIR,
+// else 1.0.
 std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size);
 
 class VxlWriter {

@@ -6,7 +6,7 @@
 // node buffer would overflow, the image is rendered in horizontal bands. Needs OpenGL 4.3.
 //
 // Why the CPU: the reference must not depend on a shader compiler. On llvmpipe 22.3 a fragment-shader
-// resolve gave wrong pixels (BRIEF §3, pitfall 4), and so did a compute-shader resolve once a pixel held
+// resolve gave wrong pixels (docs/rendering.md, pitfall 2), and so did a compute-shader resolve once a pixel held
 // more fragments than one batch of its bounded heap: on the 144k synthetic set its image changed with the
 // batch size (RMSE 14 levels between 64 and 2048), although the algorithm is exact for any batch size.
 #pragma once

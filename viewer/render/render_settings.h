@@ -14,7 +14,7 @@
 
 namespace vxl {
 
-// Transparency modes (BRIEF §6). All draw the same data from the same camera.
+// Transparency modes (docs/rendering.md). All draw the same data from the same camera.
 enum class RenderMode {
   Opaque,    // depth-tested, no blending
   Unsorted,  // blended in dataset (streamline) order, like TrackVis

@@ -263,7 +263,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
   const glm::vec3 bg = s.background();
   auto over_blending = [] {
     glEnable(GL_BLEND);
-    // Premultiply colour, accumulate coverage: destination alpha reaches 1 (BRIEF §3 pitfall 5).
+    // Premultiply colour, accumulate coverage: destination alpha reaches 1 (docs/rendering.md, pitfall 1).
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   };
   auto clear_target = [&](GLuint target, glm::vec4 colour) {
