@@ -6,6 +6,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -16,6 +19,13 @@
 #include <gtest/gtest.h>
 
 namespace vxl::test {
+
+// The bytes of a file. Throws when it cannot be opened, so that two missing files never compare equal.
+inline std::vector<char> slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot open " + path);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
 
 // The real-world fixtures (../shared/data/real). A user's clone does not have them: tests that need
 // them call this first and are skipped with a clear message.
@@ -74,37 +84,49 @@ inline CommandResult run_program(const std::string& program, const std::string& 
 // Runs the `voxlines` CLI.
 inline CommandResult run_cli(const std::string& args) { return run_program(VOXLINES_CLI, args); }
 
-// Starts `voxlines convert ARGS...` and SIGKILLs it after each delay in turn: every run killed while
-// running must leave nothing at `out`, and the directory nothing but `in.tck` and `out.vxl` (no temporary
-// file). Returns how many runs were killed while running (the others had finished: not the subject).
+// Starts `voxlines convert ARGS...` `runs` times and SIGKILLs run r once its temporary output has
+// appeared and r milliseconds more have passed: a kill while the output is being written, whatever the
+// machine's speed. Every killed run must leave nothing at `out` (or, when the kill came after the rename,
+// a complete file that `verify` accepts), and the directory nothing but `in.tck` and `out.vxl` (no
+// temporary file). Returns how many runs were killed while their temporary output existed.
 inline int kill_conversions(const ScratchDir& dir, const std::vector<std::string>& convert_args, const std::string& out,
-                            std::initializer_list<int> delays_ms) {
+                            int runs) {
   std::vector<std::string> args = {VOXLINES_CLI, "convert"};
   args.insert(args.end(), convert_args.begin(), convert_args.end());
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  int killed_while_running = 0;
-  for (int delay_ms : delays_ms) {
+  auto expected_file = [](const std::filesystem::path& p) { return p.filename() == "in.tck" || p.filename() == "out.vxl"; };
+  auto temporary_exists = [&] {
+    for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+      if (!expected_file(e.path())) return true;
+    return false;
+  };
+  int killed_while_writing = 0;
+  for (int r = 0; r < runs; ++r) {
     pid_t pid = fork();
     if (pid == 0) {
       execv(VOXLINES_CLI, argv.data());
       _exit(127);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
-    kill(pid, SIGKILL);
     int status = 0;
-    waitpid(pid, &status, 0);
-    if (WIFSIGNALED(status)) {
-      ++killed_while_running;
-      EXPECT_FALSE(std::filesystem::exists(out)) << "killed after " << delay_ms << " ms";
-    } else {
-      std::filesystem::remove(out);
+    bool exited = false;
+    while (!(exited = waitpid(pid, &status, WNOHANG) == pid) && !temporary_exists())
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    if (!exited) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(r));
+      const bool writing = temporary_exists();
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      if (WIFSIGNALED(status) && writing) ++killed_while_writing;
     }
+    if (WIFSIGNALED(status) && std::filesystem::exists(out))
+      EXPECT_EQ(run_program(VOXLINES_CLI, "verify '" + out + "'").exit_code, 0) << "run " << r << ": a killed run left an incomplete output";
+    std::filesystem::remove(out);
     for (const auto& e : std::filesystem::directory_iterator(dir.path()))
-      EXPECT_TRUE(e.path().filename() == "in.tck" || e.path().filename() == "out.vxl") << "left behind: " << e.path();
+      EXPECT_TRUE(expected_file(e.path())) << "run " << r << " left behind: " << e.path();
   }
-  return killed_while_running;
+  return killed_while_writing;
 }
 
 }  // namespace vxl::test

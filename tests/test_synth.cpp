@@ -35,12 +35,16 @@ double ellipsoid_q(const Tractogram& t, std::uint64_t k) {
 
 TEST(Synth, SameSeedIsBitIdentical) {
   const Tractogram a = synth(5000, 7), b = synth(5000, 7);
+  ASSERT_EQ(a.streamline_count(), 5000u);  // two empty tractograms would be identical too
+  ASSERT_GT(a.point_count(), 5000u * 10);
   EXPECT_TRUE(same(a, b));
 }
 
 TEST(Synth, ThreadCountDoesNotMatter) {
   // More than one work chunk (4096 streamlines), so threads really share the work.
   const Tractogram one = synth(10000, 3, 1);
+  ASSERT_EQ(one.streamline_count(), 10000u);
+  ASSERT_GT(one.point_count(), 10000u * 10);
   EXPECT_TRUE(same(one, synth(10000, 3, 2)));
   EXPECT_TRUE(same(one, synth(10000, 3, 5)));
 }

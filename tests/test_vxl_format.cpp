@@ -16,6 +16,7 @@ namespace vxl {
 namespace {
 
 using test::ScratchDir;
+using test::slurp;
 
 // A small tractogram with voxel changes, a long step (synthetic points), one-point and empty
 // streamlines, and a group.
@@ -37,10 +38,6 @@ Tractogram small_tractogram() {
   return t;
 }
 
-std::vector<char> slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
 void dump(const std::string& p, const std::vector<char>& bytes, std::size_t n) {
   std::ofstream(p, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(n));
 }

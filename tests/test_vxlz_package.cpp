@@ -32,6 +32,7 @@ namespace vxl {
 namespace {
 
 using test::ScratchDir;
+using test::slurp;
 
 // Synthetic bundles plus the awkward cases: a step over several voxels (synthetic face points), a
 // one-point and an empty streamline, and two groups.
@@ -61,10 +62,6 @@ std::string convert_to(Tractogram t, const std::string& path, double voxel_size 
   return path;
 }
 
-std::vector<char> slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
 // Written as a new file: truncating and rewriting one makes ext4 flush it on close (auto_da_alloc),
 // which made the thousands of rewrites below take seconds.
 void dump(const std::string& p, const std::vector<char>& bytes, std::size_t n) {
