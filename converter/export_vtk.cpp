@@ -69,9 +69,13 @@ void export_vtk(const VxlFile& file, const std::string& out_path) {
   std::vector<std::uint32_t> counts;
   counts.reserve(m.streamline_count);
 
+  // The title is one line: control characters in the file name would end it early.
+  std::string source = std::filesystem::path(file.path()).filename().string();
+  for (char& c : source)
+    if (static_cast<unsigned char>(c) < ' ') c = '_';
   AtomicOutputFile out(out_path);
   BigEndianWriter w(out);
-  w.text("# vtk DataFile Version 3.0\nvoxlines export of " + std::filesystem::path(file.path()).filename().string() +
+  w.text("# vtk DataFile Version 3.0\nvoxlines export of " + source +
          " SPACE=RAS\nBINARY\nDATASET POLYDATA\nPOINTS " + std::to_string(m.point_count) + " float\n");
   const auto voxlines = file.voxlines();
   std::uint64_t j = 0;
