@@ -60,31 +60,32 @@ const std::map<std::string, Outcome>& expected_outcomes() {
       {"trx-python__small.trx", Outcome::RoundTrip},
       {"trx-python__small_compressed.trx", Outcome::RoundTrip},
       {"trx-python__small_fldr.trx", Outcome::RoundTrip},  // directory form
-      // Not streamline files we read: VTK/VTP (not supported yet), TSF (scalars), the index.
+      // VTK (legacy) and VTP (XML)
+      {"SlicerDMRI__cluster_00750.vtp", Outcome::RoundTrip},
+      {"SlicerDMRI__fiber_vtk.vtk", Outcome::RoundTrip},
+      {"SlicerDMRI__tractography.vtk", Outcome::RoundTrip},
+      {"SlicerDMRI__tractography.vtp", Outcome::RoundTrip},
+      {"TractographyFormat__example.vtk", Outcome::RoundTrip},
+      {"TractographyFormat__example.vtp", Outcome::RoundTrip},
+      {"TractographyFormat__stroke.vtk", Outcome::RoundTrip},
+      {"niivue__tract.FAT_R.vtk", Outcome::RoundTrip},
+      {"surf-ice__helix.vtk", Outcome::RoundTrip},
+      {"test_data__tckconvert__empty.vtk", Outcome::RoundTrip},  // POINTS 0, no title line
+      {"test_data__tckconvert__out0.vtk", Outcome::RoundTrip},
+      {"test_data__tckconvert__tracks-binary.vtk", Outcome::RoundTrip},
+      {"tract_querier__CG_L.vtk", Outcome::RoundTrip},
+      {"trx-javascript__gs.vtk", Outcome::RoundTrip},
+      {"ukftractography__1T_fiber.vtk", Outcome::RoundTrip},
+      {"ukftractography__seeds_tc.vtk", Outcome::RoundTrip},
+      {"ukftractography__ukf__seeds_tc.vtk", Outcome::RoundTrip},
+      {"whitematteranalysis__brain_0001.vtk", Outcome::RoundTrip},
+      {"whitematteranalysis__clusters_brain_0001.vtp", Outcome::RoundTrip},
+      // Not streamline files we read: a VTK surface mesh (POLYGONS), TSF (scalars), the index.
+      {"niivue__issue1298.vtk", Outcome::Unsupported},  // POLYGONS, no LINES
       {"SOURCES.md", Outcome::Unsupported},
-      {"SlicerDMRI__cluster_00750.vtp", Outcome::Unsupported},
-      {"SlicerDMRI__fiber_vtk.vtk", Outcome::Unsupported},
-      {"SlicerDMRI__tractography.vtk", Outcome::Unsupported},
-      {"SlicerDMRI__tractography.vtp", Outcome::Unsupported},
-      {"TractographyFormat__example.vtk", Outcome::Unsupported},
-      {"TractographyFormat__example.vtp", Outcome::Unsupported},
-      {"TractographyFormat__stroke.vtk", Outcome::Unsupported},
-      {"niivue__issue1298.vtk", Outcome::Unsupported},
       {"niivue__mni152.SLF1_R.tsf", Outcome::Unsupported},
-      {"niivue__tract.FAT_R.vtk", Outcome::Unsupported},
-      {"surf-ice__helix.vtk", Outcome::Unsupported},
       {"test_data__afd.tsf", Outcome::Unsupported},
-      {"test_data__tckconvert__empty.vtk", Outcome::Unsupported},
-      {"test_data__tckconvert__out0.vtk", Outcome::Unsupported},
-      {"test_data__tckconvert__tracks-binary.vtk", Outcome::Unsupported},
       {"test_data__tcksample__out.tsf", Outcome::Unsupported},
-      {"tract_querier__CG_L.vtk", Outcome::Unsupported},
-      {"trx-javascript__gs.vtk", Outcome::Unsupported},
-      {"ukftractography__1T_fiber.vtk", Outcome::Unsupported},
-      {"ukftractography__seeds_tc.vtk", Outcome::Unsupported},
-      {"ukftractography__ukf__seeds_tc.vtk", Outcome::Unsupported},
-      {"whitematteranalysis__brain_0001.vtk", Outcome::Unsupported},
-      {"whitematteranalysis__clusters_brain_0001.vtp", Outcome::Unsupported},
   };
   return m;
 }

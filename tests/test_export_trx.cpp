@@ -183,9 +183,9 @@ TEST(ExportTrx, CliChoosesTheFormatByExtension) {
   r = test::run_cli("export '" + vxl + "' '" + dir.file("g.tck") + "'");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(read_tck(dir.file("g.tck")).streamline_count(), 402u);
-  r = test::run_cli("export '" + vxl + "' '" + dir.file("g.vtk") + "'");
+  r = test::run_cli("export '" + vxl + "' '" + dir.file("g.vtu") + "'");
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_FALSE(std::filesystem::exists(dir.file("g.vtk")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("g.vtu")));
 }
 
 TEST(ExportTrxReal, SourceReferenceAndGroupsAreKept) {

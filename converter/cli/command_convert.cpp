@@ -36,8 +36,8 @@ void add_convert_command(CLI::App& app) {
     std::vector<std::string> tsf;
   };
   auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert a TCK / TRK (.trk.gz) / TRX tractogram to .vxl");
-  cmd->add_option("input", opt->input, "source tractogram (.tck, .trk, .trk.gz, .trx zip or directory)")->required();
+  CLI::App* cmd = app.add_subcommand("convert", "Convert a TCK / TRK (.trk.gz) / TRX / VTK / VTP tractogram to .vxl");
+  cmd->add_option("input", opt->input, "source tractogram (.tck, .trk, .trk.gz, .trx zip or directory, .vtk legacy POLYDATA, .vtp XML PolyData)")->required();
   cmd->add_option("output", opt->output, "output .vxl file (written atomically)")->required();
   cmd->add_option("--voxel-size", opt->settings.voxel_size, "voxel edge length in mm")
       ->default_val(10.0)->check(CLI::PositiveNumber);

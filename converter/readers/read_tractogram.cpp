@@ -14,12 +14,13 @@ Tractogram read_tractogram(const std::string& path) {
   if (ends(".tck")) return read_tck(path);
   if (ends(".trk") || ends(".trk.gz")) return read_trk(path);
   if (ends(".trx")) return read_trx(path);
+  if (ends(".vtk")) return read_vtk(path);
+  if (ends(".vtp")) return read_vtp(path);
   if (!std::filesystem::exists(path)) fail_input(path, std::nullopt, "no such file");
   std::string what = "unsupported file type";
   if (ends(".tsf")) what = "a TSF file holds per-point scalars, not streamlines";
-  else if (ends(".vtk") || ends(".vtp")) what = "VTK/VTP streamlines are not supported yet";
   throw Error(ErrorKind::Unsupported, path, std::nullopt,
-              what + " (supported: .tck, .trk, .trk.gz, .trx zip or directory)");
+              what + " (supported: .tck, .trk, .trk.gz, .trx zip or directory, .vtk legacy POLYDATA, .vtp XML PolyData)");
 }
 
 }  // namespace vxl

@@ -11,7 +11,7 @@
 namespace vxl::app {
 
 struct ViewerOptions {
-  std::vector<std::string> inputs;   // .vxl, or a .tck/.trk/.trx converted in memory; several: one scene
+  std::vector<std::string> inputs;   // .vxl, or a .tck/.trk/.trx/.vtk/.vtp converted in memory; several: one scene
   // How the inputs are named in messages and titles: the first file's name, "+ N more" for the others.
   std::string inputs_name() const;
   std::optional<std::string> render_png;  // headless: render one frame to this PNG and exit

@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   CLI::App cli{"voxview " VOXLINES_VERSION
                " — transparent tractogram viewer (Voxlines method).\n"
                "voxview FILE... [--render OUT.png]: a window, or headless to PNG with --render.\n"
-               "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx is converted in memory first.\n"
+               "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx/.vtk/.vtp is converted in memory first.\n"
                "Window: left drag orbits, right/middle drag (or Shift+left) pans, wheel zooms. Keys: 1/2/3 axial/sagittal/coronal,\n"
                "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, L lighting, S screenshot, R reset,\n"
                "Esc/Q quit.\n"
@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
                "(the focus) along the view direction (Shift: 10x), F1/F2/F3 toggle clip planes 1/2/3. V saves the view (see\n"
                "--save-camera) for replaying headless with --camera."};
   cli.add_option("files", o.inputs,
-                 "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx tractogram; several are shown together "
+                 "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx / .vtk / .vtp tractogram; several are shown together "
                  "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
       ->required();
   cli.add_option("--render", o.render_png, "render headless (EGL, no display needed) to this PNG and exit");

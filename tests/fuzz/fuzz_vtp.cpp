@@ -1,0 +1,16 @@
+// libFuzzer target: the VTP (VTK XML) reader on arbitrary bytes, then conversion of whatever it accepted.
+#include "convert.h"
+#include "error.h"
+#include "fuzz_input.h"
+#include "read_tractogram.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string path = vxl::fuzz::write_input(data, size, ".vtp");
+  vxl::ConvertSettings s;
+  s.threads = 1;
+  try {
+    vxl::convert_tractogram(vxl::read_vtp(path), path + ".vxl", s);
+  } catch (const vxl::Error&) {
+  }
+  return 0;
+}
