@@ -120,8 +120,9 @@ inline int kill_conversions(const ScratchDir& dir, const std::vector<std::string
       waitpid(pid, &status, 0);
       if (WIFSIGNALED(status) && writing) ++killed_while_writing;
     }
-    if (WIFSIGNALED(status) && std::filesystem::exists(out))
+    if (WIFSIGNALED(status) && std::filesystem::exists(out)) {
       EXPECT_EQ(run_program(VOXLINES_CLI, "verify '" + out + "'").exit_code, 0) << "run " << r << ": a killed run left an incomplete output";
+    }
     std::filesystem::remove(out);
     for (const auto& e : std::filesystem::directory_iterator(dir.path()))
       EXPECT_TRUE(expected_file(e.path())) << "run " << r << " left behind: " << e.path();
