@@ -11,6 +11,7 @@
 #include "error.h"
 #include "mapped_file.h"
 #include "read_tractogram.h"
+#include "regular_file.h"
 #include "tck_format.h"
 
 namespace vxl {
@@ -56,6 +57,7 @@ void read_points(const std::string& path, std::span<const std::uint8_t> bytes, s
 }  // namespace
 
 Tractogram read_tck(const std::string& path) {
+  require_regular_file(path);
   MappedFile file(path);
   const MrtrixHeader h = parse_mrtrix_header(path, file.bytes(), kTckFile);
   Tractogram t;

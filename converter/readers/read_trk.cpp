@@ -35,6 +35,7 @@
 #include "mapped_file.h"
 #include "latin1.h"
 #include "read_tractogram.h"
+#include "regular_file.h"
 
 namespace vxl {
 namespace {
@@ -308,6 +309,7 @@ std::vector<std::uint8_t> gunzip(const std::string& path, std::size_t compressed
 
 Tractogram read_trk(const std::string& path) {
   Tractogram t;
+  require_regular_file(path);
   const MappedFile file(path);
   t.source.path = path;
   t.source.format = "trk";

@@ -32,6 +32,7 @@
 #include "mapped_file.h"
 #include "latin1.h"
 #include "read_tractogram.h"
+#include "regular_file.h"
 
 namespace vxl {
 namespace {
@@ -417,6 +418,7 @@ Tractogram read_trx(const std::string& path) {
   t.source.path = path;
   t.source.format = "trx";
 
+  require_regular_file(path, /*allow_directory=*/true);
   std::optional<MappedFile> zip_file;
   std::unique_ptr<Members> members;
   std::error_code ec;

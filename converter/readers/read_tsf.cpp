@@ -9,6 +9,7 @@
 #include "error.h"
 #include "mapped_file.h"
 #include "mrtrix_header.h"
+#include "regular_file.h"
 
 namespace vxl {
 namespace {
@@ -47,6 +48,7 @@ void read_values(std::span<const std::uint8_t> bytes, std::uint64_t offset, Trac
 }  // namespace
 
 TrackScalars read_tsf(const std::string& path) {
+  require_regular_file(path);
   MappedFile file(path);
   const MrtrixHeader h = parse_mrtrix_header(path, file.bytes(), kTsfFile);
   TrackScalars s;
