@@ -154,7 +154,7 @@ bool TckStream::next(Tractogram& batch, std::uint64_t max_points, std::uint64_t 
   // The end of the data: what read_tck does after its last triplet.
   data_ended_ = true;
   std::vector<std::string> warnings;
-  tck::finish(state_, (source_.bytes - header_.data_offset) % triplet_bytes_, batch, warnings);
+  tck::finish(state_, source_.bytes - (read_end_ - buffer_size_ + buffer_used_), batch, warnings);
   streamlines_ += batch.streamline_count();
   if (!complete_) {
     tck::header_warnings(header_, streamlines_, warnings);
