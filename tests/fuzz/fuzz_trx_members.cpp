@@ -21,7 +21,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (archive == nullptr) std::abort();
   std::size_t at = 0;
   while (at < size) {
-    const std::size_t name_len = std::min<std::size_t>(data[at++], size - at);
+    const std::size_t declared_name_len = data[at++];
+    const std::size_t name_len = std::min<std::size_t>(declared_name_len, size - at);
     const std::string name(reinterpret_cast<const char*>(data + at), name_len);
     at += name_len;
     std::uint32_t len = 0;
