@@ -19,6 +19,7 @@
 #include "float16.h"
 #include "read_tractogram.h"
 #include "test_support.h"
+#include "zip_writer.h"
 
 namespace {
 
@@ -195,7 +196,7 @@ TEST(Float16, ConvertsExactly) {
 
 // ---- synthetic TRX ----
 
-using Bytes = std::vector<std::uint8_t>;
+using vxl::test::Bytes;
 
 template <typename T>
 Bytes le_bytes(const std::vector<T>& values) {
@@ -210,69 +211,7 @@ Bytes le_bytes(const std::vector<T>& values) {
 
 Bytes text(const std::string& s) { return Bytes(s.begin(), s.end()); }
 
-std::uint32_t crc32(const Bytes& data) {
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::uint8_t byte : data) {
-    c ^= byte;
-    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
-  }
-  return ~c;
-}
-
-// A minimal zip writer: stored (uncompressed) members, no zip64. Enough for small test archives.
-void write_zip(const std::string& path, const std::vector<std::pair<std::string, Bytes>>& members) {
-  Bytes out, central;
-  auto put = [](Bytes& b, std::uint32_t v, int n) {
-    for (int i = 0; i < n; ++i) b.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-  };
-  for (const auto& [name, data] : members) {
-    const std::uint32_t offset = static_cast<std::uint32_t>(out.size());
-    const std::uint32_t crc = crc32(data), size = static_cast<std::uint32_t>(data.size());
-    const std::uint16_t name_len = static_cast<std::uint16_t>(name.size());
-    put(out, 0x04034b50, 4);  // local file header
-    put(out, 20, 2);          // version needed
-    put(out, 0, 2);           // flags
-    put(out, 0, 2);           // method: stored
-    put(out, 0, 4);           // time, date
-    put(out, crc, 4);
-    put(out, size, 4);
-    put(out, size, 4);
-    put(out, name_len, 2);
-    put(out, 0, 2);  // extra length
-    out.insert(out.end(), name.begin(), name.end());
-    out.insert(out.end(), data.begin(), data.end());
-
-    put(central, 0x02014b50, 4);  // central directory header
-    put(central, 20, 2);          // version made by
-    put(central, 20, 2);          // version needed
-    put(central, 0, 2);
-    put(central, 0, 2);
-    put(central, 0, 4);
-    put(central, crc, 4);
-    put(central, size, 4);
-    put(central, size, 4);
-    put(central, name_len, 2);
-    put(central, 0, 2);  // extra
-    put(central, 0, 2);  // comment
-    put(central, 0, 2);  // disk
-    put(central, 0, 2);  // internal attributes
-    put(central, 0, 4);  // external attributes
-    put(central, offset, 4);
-    central.insert(central.end(), name.begin(), name.end());
-  }
-  const std::uint32_t cd_offset = static_cast<std::uint32_t>(out.size());
-  out.insert(out.end(), central.begin(), central.end());
-  put(out, 0x06054b50, 4);  // end of central directory
-  put(out, 0, 2);
-  put(out, 0, 2);
-  put(out, static_cast<std::uint32_t>(members.size()), 2);
-  put(out, static_cast<std::uint32_t>(members.size()), 2);
-  put(out, static_cast<std::uint32_t>(central.size()), 4);
-  put(out, cd_offset, 4);
-  put(out, 0, 2);
-  std::ofstream(path, std::ios::binary)
-      .write(reinterpret_cast<const char*>(out.data()), static_cast<std::streamsize>(out.size()));
-}
+using vxl::test::write_zip;
 
 void write_dir(const std::string& path, const std::vector<std::pair<std::string, Bytes>>& members) {
   for (const auto& [name, data] : members) {

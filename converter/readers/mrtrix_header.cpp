@@ -1,5 +1,6 @@
 #include "mrtrix_header.h"
 
+#include <charconv>
 #include <string_view>
 
 #include "error.h"
@@ -94,13 +95,22 @@ std::optional<MrtrixHeader> parse_mrtrix_header(const std::string& path, std::sp
   if (h.data_offset > file_size)
     fail_input(path, h.data_offset, name + " data offset is past the end of the file (" + std::to_string(file_size) + " bytes)");
   if (h.fields.contains("count")) {
-    try {
-      h.count = std::stoull(h.fields["count"].back().get<std::string>());
-    } catch (const std::exception&) {
-      // a malformed count is as good as a stale one: we trust the data
-    }
+    // Digits only: std::stoull would read "-5" as 2^64 - 5. A malformed count is as good as a stale one.
+    const std::string text = h.fields["count"].back().get<std::string>();
+    h.count_text = text;
+    std::uint64_t v = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (!text.empty() && ec == std::errc() && end == text.data() + text.size()) h.count = v;
   }
   return h;
+}
+
+std::optional<std::string> count_warning(const MrtrixHeader& h, std::uint64_t streamlines) {
+  if (!h.count_text) return std::nullopt;
+  const std::string data = "the data (" + std::to_string(streamlines) + " streamlines)";
+  if (!h.count) return "header count '" + *h.count_text + "' is not a number of streamlines; " + data + " is trusted";
+  if (*h.count != streamlines) return "header count " + *h.count_text + " disagrees with " + data + ": the data is trusted";
+  return std::nullopt;
 }
 
 std::optional<std::string> MrtrixHeader::last(const char* key) const {

@@ -20,7 +20,8 @@ struct MrtrixHeader {
   nlohmann::json fields = nlohmann::json::object();  // key -> array of values (keys may repeat)
   std::string datatype;
   std::uint64_t data_offset = 0;
-  std::optional<std::uint64_t> count;  // "count", when it parses (it may be stale: the data is trusted)
+  std::optional<std::string> count_text;  // "count" as the header spells it (warnings quote it)
+  std::optional<std::uint64_t> count;     // count_text, when it is a decimal number (it may be stale: the data is trusted)
   // The last value of `key`, if present.
   std::optional<std::string> last(const char* key) const;
 };
@@ -32,6 +33,9 @@ struct MrtrixFileKind {
 };
 inline constexpr MrtrixFileKind kTckFile{"mrtrix tracks", "TCK"};
 inline constexpr MrtrixFileKind kTsfFile{"mrtrix track scalars", "TSF"};
+
+// The warning about a header "count" that is no number or not `streamlines` (the data is trusted), if any.
+std::optional<std::string> count_warning(const MrtrixHeader& h, std::uint64_t streamlines);
 
 // Parses the header at the start of `bytes`, the first bytes of a file of `file_size` bytes. Returns
 // nullopt when `bytes` is shorter than the file and holds no END line yet (read more and call again);

@@ -6,11 +6,13 @@
 // Layout: text header "mrtrix tracks" / "key: value" lines (keys may repeat) / "END"; the data starts at
 // the byte offset in "file: . OFFSET". Data: xyz triplets; a triplet whose x is NaN ends a streamline, one
 // whose x is Inf ends the file. Like MRtrix we tolerate a missing Inf terminator at EOF, and trust the data
-// over a stale "count".
+// over a stale "count"; unlike MRtrix we warn about data it ignores (after the terminator, or cut by an Inf
+// x that is no whole terminator).
 #include "checksum.h"
 #include "error.h"
 #include "mapped_file.h"
 #include "read_tractogram.h"
+#include "regular_file.h"
 #include "tck_format.h"
 
 namespace vxl {
@@ -25,17 +27,22 @@ void finish(const DecodeState& s, std::uint64_t trailing, Tractogram& t, std::ve
       t.offsets.push_back(t.point_count());
       warnings.push_back("last streamline (" + std::to_string(s.points_in_current) + " points) has no NaN delimiter: kept");
     }
-  } else if (s.points_in_current > 0) {
+  } else {
+    // MRtrix ignores all this silently; we warn, as the user loses data.
+    if (s.partial_terminator)
+      warnings.push_back("the data ends at byte " + std::to_string(*s.partial_terminator) +
+                         " at a point whose x is Inf but which is not the terminator (Inf, Inf, Inf): the point and "
+                         "everything after it are ignored");
+    if (trailing != 0)
+      warnings.push_back(std::to_string(trailing) + " bytes after the Inf terminator ignored");
     // MRtrix writes a NaN before the Inf; without it the points still form a streamline.
-    t.offsets.push_back(t.point_count());
+    if (s.points_in_current > 0) t.offsets.push_back(t.point_count());
   }
 }
 
 void header_warnings(const MrtrixHeader& h, std::uint64_t streamlines, std::vector<std::string>& warnings) {
   if (h.datatype.starts_with("Float64")) warnings.push_back("Float64 coordinates rounded to float32 (spec §8)");
-  if (h.count && *h.count != streamlines)
-    warnings.push_back("header count " + std::to_string(*h.count) + " disagrees with the data (" +
-                       std::to_string(streamlines) + " streamlines): the data is trusted");
+  if (auto w = count_warning(h, streamlines)) warnings.push_back(*w);
 }
 
 }  // namespace tck
@@ -49,13 +56,14 @@ void read_points(const std::string& path, std::span<const std::uint8_t> bytes, s
   const std::uint64_t available = (bytes.size() - offset) / kTriplet;
   t.positions.reserve(3 * available);
   tck::DecodeState s;
-  tck::decode<Real, kBigEndian>(path, bytes.data() + offset, available, offset, t, s, ~std::uint64_t(0));
-  tck::finish(s, (bytes.size() - offset) % kTriplet, t, t.source.warnings);
+  const std::uint64_t used = tck::decode<Real, kBigEndian>(path, bytes.data() + offset, available, offset, t, s, ~std::uint64_t(0));
+  tck::finish(s, bytes.size() - offset - used * kTriplet, t, t.source.warnings);
 }
 
 }  // namespace
 
 Tractogram read_tck(const std::string& path) {
+  require_regular_file(path);
   MappedFile file(path);
   const MrtrixHeader h = parse_mrtrix_header(path, file.bytes(), kTckFile);
   Tractogram t;

@@ -35,6 +35,7 @@
 #include "mapped_file.h"
 #include "latin1.h"
 #include "read_tractogram.h"
+#include "regular_file.h"
 
 namespace vxl {
 namespace {
@@ -278,36 +279,137 @@ bool is_gzip(const MappedFile& file) {
   return file.size() >= 2 && file.data()[0] == 0x1F && file.data()[1] == 0x8B;
 }
 
-std::vector<std::uint8_t> gunzip(const std::string& path, std::size_t compressed_size) {
-  gzFile gz = gzopen(path.c_str(), "rb");
-  if (gz == nullptr) fail_input(path, std::nullopt, "cannot open the gzip stream");
-  gzbuffer(gz, 1u << 17);
-  std::vector<std::uint8_t> out;
-  // Streamline data compresses ~1.2-3x; start there and grow geometrically.
-  out.reserve(std::min<std::size_t>(compressed_size * 3 + 4096, std::size_t{1} << 30));
-  constexpr unsigned kChunk = 1u << 20;
-  while (true) {
-    const std::size_t old = out.size();
-    out.resize(old + kChunk);
-    const int n = gzread(gz, out.data() + old, kChunk);
-    if (n < 0) {
-      int code = 0;
-      std::string msg = gzerror(gz, &code);
-      gzclose(gz);
-      fail_input(path, std::nullopt, "corrupt gzip stream after " + std::to_string(old) +
-                                         " decompressed bytes: " + msg);
-    }
-    out.resize(old + static_cast<std::size_t>(n));
-    if (n == 0) break;
+// A .trk.gz may inflate at most this many times its own size (plus kInflateSlack). Real tractograms
+// compress 1.2-3x (float coordinates); deflate reaches ~1000x only on repetitive data such as the
+// zeros of a decompression bomb, which would otherwise fill memory.
+constexpr std::uint64_t kMaxInflateRatio = 100;
+constexpr std::uint64_t kInflateSlack = 1u << 20;
+
+// The TRK stream's bytes in order, handed out a piece at a time: straight from the mapped file, or
+// inflated from the gzip member(s) into a small buffer, so that a .trk.gz is never held inflated whole.
+class TrkBytes {
+ public:
+  explicit TrkBytes(std::span<const std::uint8_t> plain) : in_(plain) {}
+  TrkBytes(const std::string& path, std::span<const std::uint8_t> compressed, std::vector<std::string>& warnings)
+      : in_(compressed), gz_(true), path_(path), warnings_(&warnings) {
+    if (inflateInit2(&z_, 16 + MAX_WBITS) != Z_OK) throw std::bad_alloc();  // 16: gzip framing only
+    buffer_.resize(kChunk);
   }
-  gzclose(gz);
-  return out;
-}
+  ~TrkBytes() {
+    if (gz_) inflateEnd(&z_);
+  }
+  TrkBytes(const TrkBytes&) = delete;
+  TrkBytes& operator=(const TrkBytes&) = delete;
+
+  // The next n bytes (valid until the next call), or nullptr when the stream ends before n more; then
+  // left() bytes remained (and stay unconsumed).
+  const std::uint8_t* take(std::size_t n) {
+    if (!gz_) {
+      if (in_.size() - offset_ < n) return nullptr;
+      const std::uint8_t* p = in_.data() + offset_;
+      offset_ += n;
+      return p;
+    }
+    while (end_ - begin_ < n && !ended_) refill(n);
+    if (end_ - begin_ < n) return nullptr;
+    const std::uint8_t* p = buffer_.data() + begin_;
+    begin_ += n;
+    offset_ += n;
+    return p;
+  }
+  bool at_end() {
+    if (!gz_) return offset_ == in_.size();
+    while (end_ == begin_ && !ended_) refill(1);
+    return end_ == begin_;
+  }
+  std::uint64_t left() const { return gz_ ? end_ - begin_ : in_.size() - offset_; }
+  std::uint64_t offset() const { return offset_; }  // bytes of the TRK stream taken so far
+  // The TRK stream's size where it is known without reading it (a plain file).
+  std::optional<std::uint64_t> size() const { return gz_ ? std::nullopt : std::optional<std::uint64_t>(in_.size()); }
+
+ private:
+  static constexpr std::size_t kChunk = 1u << 20;
+
+  // Inflates more into the buffer, which keeps the bytes not yet taken and makes room for n of them.
+  void refill(std::size_t n) {
+    if (begin_ > 0) {
+      std::memmove(buffer_.data(), buffer_.data() + begin_, end_ - begin_);
+      end_ -= begin_;
+      begin_ = 0;
+    }
+    if (buffer_.size() < std::max(n, kChunk)) buffer_.resize(std::max(n, kChunk));
+    z_.next_out = buffer_.data() + end_;
+    z_.avail_out = static_cast<uInt>(buffer_.size() - end_);
+    while (z_.avail_out > 0 && !ended_) {
+      if (z_.avail_in == 0 && in_pos_ < in_.size()) {  // zlib counts input in 32 bits: feed it in slices
+        z_.next_in = const_cast<Bytef*>(in_.data() + in_pos_);
+        z_.avail_in = static_cast<uInt>(std::min<std::uint64_t>(in_.size() - in_pos_, 1u << 30));
+        in_pos_ += z_.avail_in;
+      }
+      const int r = inflate(&z_, Z_NO_FLUSH);
+      const std::uint64_t at = in_pos_ - z_.avail_in;  // offset in the compressed file
+      if (r == Z_STREAM_END) {
+        member_end();
+        continue;
+      }
+      if (r != Z_OK && r != Z_BUF_ERROR)
+        fail_input(path_, at, "corrupt gzip stream after " + std::to_string(inflated()) + " decompressed bytes: " +
+                                  (z_.msg ? z_.msg : "zlib error " + std::to_string(r)));
+      if (z_.avail_in == 0 && in_pos_ == in_.size() && z_.avail_out > 0)
+        fail_input(path_, at, "the gzip stream is truncated: it ends without its end-of-stream marker and CRC, after " +
+                                  std::to_string(inflated()) + " decompressed bytes");
+    }
+    end_ = buffer_.size() - z_.avail_out;
+    const std::uint64_t cap = kMaxInflateRatio * in_.size() + kInflateSlack;
+    if (inflated() > cap)
+      fail_unsupported(path_, "inflates to more than " + std::to_string(cap) + " bytes, over " +
+                                  std::to_string(kMaxInflateRatio) + " times its compressed size (" +
+                                  std::to_string(in_.size()) + " bytes); refused as a likely decompression bomb "
+                                  "(real tractograms compress about 1.2-3x). To read it anyway, gunzip it first");
+  }
+
+  // After a gzip member's CRC: another member may follow (concatenated gzip, as gzip -d reads it), or zero
+  // padding (which gzip and Python's gzip skip); anything else is not gzip data, and not ours to ignore.
+  void member_end() {
+    const std::uint64_t at = in_pos_ - z_.avail_in;
+    if (at == in_.size()) {
+      ended_ = true;
+      return;
+    }
+    const std::span<const std::uint8_t> rest = in_.subspan(at);
+    if (rest.size() >= 2 && rest[0] == 0x1F && rest[1] == 0x8B) {
+      inflated_before_reset_ += z_.total_out;
+      inflateReset(&z_);
+      return;
+    }
+    if (std::all_of(rest.begin(), rest.end(), [](std::uint8_t b) { return b == 0; })) {
+      warnings_->push_back(std::to_string(rest.size()) + " zero bytes of padding after the gzip stream ignored");
+      ended_ = true;
+      return;
+    }
+    fail_input(path_, at, std::to_string(rest.size()) + " bytes after the end of the gzip stream are not another gzip member");
+  }
+
+  std::uint64_t inflated() const { return z_.total_out + inflated_before_reset_; }
+
+  std::span<const std::uint8_t> in_;
+  std::uint64_t offset_ = 0;
+  bool gz_ = false;
+  std::string path_;
+  std::vector<std::string>* warnings_ = nullptr;
+  z_stream z_{};
+  std::uint64_t in_pos_ = 0;  // compressed bytes handed to zlib
+  std::vector<std::uint8_t> buffer_;
+  std::size_t begin_ = 0, end_ = 0;  // the inflated bytes not yet taken
+  bool ended_ = false;
+  std::uint64_t inflated_before_reset_ = 0;
+};
 
 }  // namespace
 
 Tractogram read_trk(const std::string& path) {
   Tractogram t;
+  require_regular_file(path);
   const MappedFile file(path);
   t.source.path = path;
   t.source.format = "trk";
@@ -316,17 +418,23 @@ Tractogram read_trk(const std::string& path) {
   t.source.xxh3_128 = xxh3_128_hex(file.data(), file.size());
   auto& warnings = t.source.warnings;
 
-  std::vector<std::uint8_t> inflated;
   const bool gz = is_gzip(file);
-  if (gz) inflated = gunzip(path, file.size());
-  const std::uint8_t* data = gz ? inflated.data() : file.data();
-  const std::size_t size = gz ? inflated.size() : file.size();
+  std::optional<TrkBytes> stream;
+  if (gz) stream.emplace(path, file.bytes(), warnings);
+  else stream.emplace(file.bytes());
   // Offsets in messages count bytes of the TRK stream, which for a .gz file is the decompressed one.
   const std::string where = gz ? " (offset in the decompressed data)" : "";
   auto fail_at = [&](std::uint64_t offset, const std::string& what) { fail_input(path, offset, what + where); };
 
-  if (size < kHeaderSize)
+  std::array<std::uint8_t, kHeaderSize> header_bytes;
+  if (const std::uint8_t* p = stream->take(kHeaderSize)) {
+    std::memcpy(header_bytes.data(), p, kHeaderSize);
+  } else {
+    const std::uint64_t size = stream->left();
     fail_at(size, "file ends after " + std::to_string(size) + " bytes, inside the 1000-byte TRK header");
+  }
+  const std::uint8_t* data = header_bytes.data();
+  const std::size_t size = kHeaderSize;
   if (std::memcmp(data, "TRACK", 5) != 0) fail_at(0, "not a TrackVis file: expected the magic 'TRACK'");
 
   // hdr_size tells the byte order: 1000 as stored little-endian, or 1000 after swapping (big-endian).
@@ -449,30 +557,39 @@ Tractogram read_trk(const std::string& path) {
   const std::uint64_t floats_per_point = 3 + static_cast<std::uint64_t>(n_scalars);
   const std::uint64_t point_bytes = 4 * floats_per_point;
   const std::uint64_t property_bytes = 4 * static_cast<std::uint64_t>(n_properties);
-  t.positions.reserve(3 * ((size - kHeaderSize) / point_bytes));  // an upper bound: no reallocation
+  if (const auto total = stream->size())
+    t.positions.reserve(3 * ((*total - kHeaderSize) / point_bytes));  // an upper bound: no reallocation
   for (const std::string& name : value_names(data + kOffScalarNames, n_scalars, "scalar", warnings))
     t.point_values.push_back({name, {}});
   for (const std::string& name : value_names(data + kOffPropertyNames, n_properties, "property", warnings))
     t.streamline_values.push_back({name, {}});
   const Mat4& a = voxmm_to_ras;
-  std::uint64_t off = kHeaderSize;
   std::uint64_t count = 0;
-  while (off < size) {
-    const std::uint64_t left = size - off;
-    if (left < 4)
-      fail_at(off, "truncated streamline record #" + std::to_string(count) + ": " + std::to_string(left) +
+  while (!stream->at_end()) {
+    const std::uint64_t off = stream->offset();
+    const std::uint8_t* q = stream->take(4);
+    if (q == nullptr)
+      fail_at(off, "truncated streamline record #" + std::to_string(count) + ": " + std::to_string(stream->left()) +
                        " bytes left where a 4-byte point count was expected");
-    const std::int32_t n = in.i32(off);
+    const std::int32_t n = Bytes(q, 4, big_endian).i32(0);
     if (n < 0)
       fail_at(off, "streamline #" + std::to_string(count) + " has a negative point count " + std::to_string(n));
+    // TrackVis and nibabel never write a streamline without points; zeros where records should be are
+    // what a damaged file or a decompression bomb holds, not empty streamlines.
+    if (n == 0) fail_at(off, "streamline #" + std::to_string(count) + " has no points (point count 0)");
     const std::uint64_t need = static_cast<std::uint64_t>(n) * point_bytes + property_bytes;
-    if (need > left - 4)
+    auto truncated = [&](std::uint64_t remain) {
       fail_at(off, "truncated streamline record #" + std::to_string(count) + ": " + std::to_string(n) +
                        " points need " + std::to_string(need) + " bytes after the count but only " +
-                       std::to_string(left - 4) + " remain");
-    std::uint64_t p = off + 4;
-    for (std::int32_t i = 0; i < n; ++i, p += point_bytes) {
-      const double x = in.f32(p), y = in.f32(p + 4), z = in.f32(p + 8);
+                       std::to_string(remain) + " remain");
+    };
+    if (const auto total = stream->size(); total && need > *total - off - 4) truncated(*total - off - 4);
+    for (std::int32_t i = 0; i < n; ++i) {
+      const std::uint64_t p = stream->offset();
+      q = stream->take(point_bytes);
+      if (q == nullptr) truncated(p - off - 4 + stream->left());
+      const Bytes pt(q, point_bytes, big_endian);
+      const double x = pt.f32(0), y = pt.f32(4), z = pt.f32(8);
       for (int r = 0; r < 3; ++r) {
         const float v = static_cast<float>(a[r][0] * x + a[r][1] * y + a[r][2] * z + a[r][3]);
         if (!std::isfinite(v))
@@ -480,11 +597,16 @@ Tractogram read_trk(const std::string& path) {
                          " is not finite after mapping to RAS mm");
         t.positions.push_back(v);
       }
-      for (int k = 0; k < n_scalars; ++k) t.point_values[k].values.push_back(in.f32(p + 12 + 4 * k));
+      for (int k = 0; k < n_scalars; ++k) t.point_values[k].values.push_back(pt.f32(12 + 4 * k));
     }
-    for (int k = 0; k < n_properties; ++k) t.streamline_values[k].values.push_back(in.f32(p + 4 * k));
+    if (property_bytes > 0) {
+      const std::uint64_t p = stream->offset();
+      q = stream->take(property_bytes);
+      if (q == nullptr) truncated(p - off - 4 + stream->left());
+      const Bytes props(q, property_bytes, big_endian);
+      for (int k = 0; k < n_properties; ++k) t.streamline_values[k].values.push_back(props.f32(4 * k));
+    }
     t.offsets.push_back(t.point_count());
-    off += 4 + need;
     ++count;
   }
   if (n_count != 0 && static_cast<std::uint64_t>(n_count) != count)

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -32,6 +33,7 @@
 #include "mapped_file.h"
 #include "latin1.h"
 #include "read_tractogram.h"
+#include "regular_file.h"
 
 namespace vxl {
 namespace {
@@ -59,7 +61,12 @@ class Members {
   // Regular-file members, by relative path with '/' separators, mapped to their index for read().
   const std::map<std::string, std::uint64_t>& names() const { return names_; }
   bool has(const std::string& name) const { return names_.count(name) != 0; }
-  virtual Blob read(const std::string& name) const = 0;
+  // The member's size as the archive's directory (or the file system) says, before reading it.
+  virtual std::uint64_t declared_size(const std::string& name) const = 0;
+  // The member's bytes. Refuses, naming the member, one that declares or holds more than `max_bytes`:
+  // `why` says where that bound comes from (header.json's counts fix every member's size), and no more
+  // than max_bytes + 1 are ever inflated.
+  virtual Blob read(const std::string& name, std::uint64_t max_bytes, const std::string& why) const = 0;
 
  protected:
   std::map<std::string, std::uint64_t> names_;
@@ -91,31 +98,43 @@ class ZipMembers : public Members {
         fail_input(path_, std::nullopt, "member " + s + " appears twice in the zip archive");
     }
   }
-  Blob read(const std::string& name) const override {
+  std::uint64_t declared_size(const std::string& name) const override { return stat(name).size; }
+  Blob read(const std::string& name, std::uint64_t max_bytes, const std::string& why) const override {
     zip_t* archive = archive_.get();
-    const zip_uint64_t index = names_.at(name);
-    zip_stat_t st;
-    zip_stat_init(&st);
-    if (zip_stat_index(archive, index, 0, &st) != 0 || (st.valid & ZIP_STAT_SIZE) == 0)
-      fail_input(path_, std::nullopt, name + ": cannot read the zip entry: " + zip_strerror(archive));
-    zip_file_t* f = zip_fopen_index(archive, index, 0);
+    const zip_stat_t st = stat(name);
+    if (st.size > max_bytes)
+      fail_input(path_, std::nullopt, name + ": its zip entry declares " + std::to_string(st.size) +
+                                          " bytes, more than the " + std::to_string(max_bytes) + " " + why);
+    // What the compressed bytes can inflate to at most: deflate's best ratio is 1032:1, stored is 1:1.
+    if ((st.valid & ZIP_STAT_COMP_SIZE) && (st.valid & ZIP_STAT_COMP_METHOD)) {
+      const zip_uint64_t most = st.comp_method == ZIP_CM_STORE     ? st.comp_size
+                                : st.comp_method == ZIP_CM_DEFLATE ? st.comp_size * 1032 + 1024
+                                                                   : ~zip_uint64_t{0};
+      if (st.size > most)
+        fail_input(path_, std::nullopt, name + ": its zip entry declares " + std::to_string(st.size) + " bytes, more than its " +
+                                            std::to_string(st.comp_size) + " compressed bytes can hold");
+    }
+    zip_file_t* f = zip_fopen_index(archive, names_.at(name), 0);
     if (f == nullptr) fail_input(path_, std::nullopt, name + ": cannot open the zip entry: " + zip_strerror(archive));
-    std::vector<std::uint8_t> out;
-    // The declared size comes from the archive and is not trusted for an up-front allocation beyond
-    // what a zip of this size could plausibly inflate to; the vector grows as data really arrives.
-    out.reserve(static_cast<std::size_t>(std::min<zip_uint64_t>(st.size, zip_uint64_t{1} << 28)));
-    std::uint8_t buf[1 << 16];
-    while (true) {
-      const zip_int64_t got = zip_fread(f, buf, sizeof buf);
+    // Bounded above: the whole declared size is known to be justified, so it is allocated at once. One byte
+    // beyond it is asked for to catch an entry that inflates to more than it declares.
+    std::vector<std::uint8_t> out(static_cast<std::size_t>(st.size) + 1);
+    std::uint64_t have = 0;
+    while (have < out.size()) {
+      const zip_int64_t got = zip_fread(f, out.data() + have, out.size() - have);
       if (got < 0) {
         std::string msg = zip_file_strerror(f);
         zip_fclose(f);
         fail_input(path_, std::nullopt, name + ": corrupt zip entry: " + msg);
       }
       if (got == 0) break;
-      out.insert(out.end(), buf, buf + got);
+      have += static_cast<std::uint64_t>(got);
     }
     zip_fclose(f);
+    if (have > st.size)
+      fail_input(path_, std::nullopt, name + ": zip entry inflates to more than the " + std::to_string(st.size) +
+                                          " bytes its directory entry declares");
+    out.resize(have);
     if (out.size() != st.size)
       fail_input(path_, std::nullopt, name + ": zip entry holds " + std::to_string(out.size()) +
                                           " bytes but its directory entry says " + std::to_string(st.size));
@@ -123,6 +142,14 @@ class ZipMembers : public Members {
   }
 
  private:
+  zip_stat_t stat(const std::string& name) const {
+    zip_stat_t st;
+    zip_stat_init(&st);
+    if (zip_stat_index(archive_.get(), names_.at(name), 0, &st) != 0 || (st.valid & ZIP_STAT_SIZE) == 0)
+      fail_input(path_, std::nullopt, name + ": cannot read the zip entry: " + zip_strerror(archive_.get()));
+    return st;
+  }
+
   [[noreturn]] void fail(zip_error_t& error) {
     std::string msg = zip_error_strerror(&error);
     zip_error_fini(&error);
@@ -149,7 +176,19 @@ class DirMembers : public Members {
     }
     if (ec) fail_input(path, std::nullopt, "cannot list the TRX directory: " + ec.message());
   }
-  Blob read(const std::string& name) const override { return Blob(MappedFile((root_ / name).string())); }
+  std::uint64_t declared_size(const std::string& name) const override {
+    std::error_code ec;
+    const std::uint64_t size = std::filesystem::file_size(root_ / name, ec);
+    if (ec) fail_input(root_.string(), std::nullopt, name + ": cannot stat: " + ec.message());
+    return size;
+  }
+  Blob read(const std::string& name, std::uint64_t max_bytes, const std::string& why) const override {
+    MappedFile file((root_ / name).string());  // mapped, not read: its size costs no memory yet
+    if (file.size() > max_bytes)
+      fail_input(root_.string(), std::nullopt, name + ": holds " + std::to_string(file.size()) + " bytes, more than the " +
+                                                   std::to_string(max_bytes) + " " + why);
+    return Blob(std::move(file));
+  }
 
  private:
   std::filesystem::path root_;
@@ -166,6 +205,14 @@ T load_le(const std::uint8_t* p) {
   for (std::size_t i = 0; i < sizeof(T); ++i) u |= static_cast<U>(static_cast<U>(p[i]) << (8 * i));
   return std::bit_cast<T>(u);
 }
+
+// a * b, or the largest uint64 where that overflows (a size no archive can have).
+std::uint64_t times(std::uint64_t a, std::uint64_t b) {
+  return b != 0 && a > ~std::uint64_t{0} / b ? ~std::uint64_t{0} : a * b;
+}
+
+// header.json holds a handful of keys; real ones are a few hundred bytes.
+constexpr std::uint64_t kMaxHeaderJson = 16u << 20;
 
 // JSON strings must be UTF-8; member names from a directory or an old zip may not be.
 std::string json_safe(const std::string& s) {
@@ -326,7 +373,8 @@ void read_groups(const std::string& path, const Members& members, Tractogram& t)
     const std::size_t elem = integer_dtype_size(rest.substr(dot + 1), is_signed);
     if (elem == 0)
       fail_input(path, std::nullopt, name + ": group indices must be of an integer dtype (uint8 ... int64)");
-    const Blob blob = members.read(name);
+    const Blob blob = members.read(name, times(n, elem),
+                                   "bytes a group of the " + std::to_string(n) + " streamlines can list (each once)");
     const auto bytes = blob.bytes();
     if (bytes.size() % elem != 0)
       fail_input(path, std::nullopt, name + ": size " + std::to_string(bytes.size()) + " is not a multiple of " +
@@ -372,7 +420,7 @@ float load_value(const std::uint8_t* p, const std::string& dtype) {
 
 // dpv/ or dps/ members -> value sets of `count` entries each. A member that cannot be read as such (no
 // dtype, a size that does not match) is skipped with a warning: the streamlines are still good.
-void read_value_sets(const Members& members, const std::string& folder, std::uint64_t count, Tractogram& t,
+void read_value_sets(const std::string& path, const Members& members, const std::string& folder, std::uint64_t count, Tractogram& t,
                      std::vector<ValueSet>& out) {
   for (const auto& [name, index] : members.names()) {
     if (!name.starts_with(folder)) continue;
@@ -388,15 +436,27 @@ void read_value_sets(const Members& members, const std::string& folder, std::uin
     std::uint64_t components = 1;
     if (const std::size_t d2 = base.rfind('.'); d2 != std::string::npos && d2 > 0 && d2 + 1 < base.size() &&
                                                 base.find_first_not_of("0123456789", d2 + 1) == std::string::npos) {
-      components = std::stoull(base.substr(d2 + 1));
+      // Digits only, but any number of them: a count beyond 64 bits is malformed, not an internal error.
+      const std::string digits = base.substr(d2 + 1);
+      const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), components);
+      if (ec != std::errc() || end != digits.data() + digits.size())
+        fail_input(path, std::nullopt, json_safe(name) + ": the component count " + digits + " is out of range");
       base = base.substr(0, d2);
     }
-    const Blob blob = members.read(name);
-    const auto bytes = blob.bytes();
-    if (components == 0 || components > 64 || bytes.size() != count * components * elem) {
-      t.source.warnings.push_back(json_safe(name) + ": holds " + std::to_string(bytes.size()) + " bytes, expected " +
+    // The size is judged before inflating anything: the counts fix it exactly.
+    const std::uint64_t declared = members.declared_size(name);
+    const std::uint64_t expected = times(times(count, components), elem);
+    if (components == 0 || components > 64 || declared != expected) {
+      t.source.warnings.push_back(json_safe(name) + ": holds " + std::to_string(declared) + " bytes, expected " +
                                   std::to_string(count) + " x " + std::to_string(components) + " x " +
                                   std::to_string(elem) + "; ignored");
+      continue;
+    }
+    const Blob blob = members.read(name, expected, "bytes its counts need");
+    const auto bytes = blob.bytes();
+    if (bytes.size() != expected) {
+      t.source.warnings.push_back(json_safe(name) + ": holds " + std::to_string(bytes.size()) + " bytes, expected " +
+                                  std::to_string(expected) + "; ignored");
       continue;
     }
     while (!base.empty() && base.back() == ' ') base.pop_back();  // seen in niivue's colby.trx: "effect   .float32"
@@ -417,6 +477,7 @@ Tractogram read_trx(const std::string& path) {
   t.source.path = path;
   t.source.format = "trx";
 
+  require_regular_file(path, /*allow_directory=*/true);
   std::optional<MappedFile> zip_file;
   std::unique_ptr<Members> members;
   std::error_code ec;
@@ -426,7 +487,7 @@ Tractogram read_trx(const std::string& path) {
     // (std::string compares as unsigned bytes), so the hash does not depend on listing order.
     Xxh3_128Stream hash;
     for (const auto& [name, index] : members->names()) {
-      const Blob blob = members->read(name);
+      const Blob blob = members->read(name, ~std::uint64_t{0}, "");  // mapped: no memory to bound
       hash.update(blob.bytes().data(), blob.bytes().size());
       t.source.bytes += blob.bytes().size();
     }
@@ -442,7 +503,7 @@ Tractogram read_trx(const std::string& path) {
   if (!members->has("header.json")) fail_input(path, std::nullopt, "missing member header.json");
   nlohmann::json header;
   {
-    const Blob blob = members->read("header.json");
+    const Blob blob = members->read("header.json", kMaxHeaderJson, "bytes a header.json may have");
     header = nlohmann::json::parse(blob.bytes().begin(), blob.bytes().end(), nullptr, false);
   }
   if (header.is_discarded() || !header.is_object())
@@ -490,16 +551,23 @@ Tractogram read_trx(const std::string& path) {
     fail_input(path, std::nullopt, *offsets + ": offsets must be named offsets.uint32 or offsets.uint64");
 
   {
-    const Blob blob = members->read(*offsets);
+    const std::uint64_t elem = *offsets == "offsets.uint32" ? 4 : 8;
+    const std::uint64_t entries = nb_streamlines == ~std::uint64_t{0} ? nb_streamlines : nb_streamlines + 1;
+    const Blob blob = members->read(*offsets, times(entries, elem),
+                                    "bytes that NB_STREAMLINES = " + std::to_string(nb_streamlines) + " allows (" +
+                                        "at most NB_STREAMLINES + 1 entries of " + std::to_string(elem) + " bytes)");
     read_offsets(path, *offsets, offsets->substr(8), blob.bytes(), nb_streamlines, nb_vertices, t);
   }
   {
-    const Blob blob = members->read(*positions);
+    const std::uint64_t elem = pos_dtype == "float16" ? 2 : pos_dtype == "float32" ? 4 : 8;
+    const Blob blob = members->read(*positions, times(times(nb_vertices, 3), elem),
+                                    "bytes that NB_VERTICES = " + std::to_string(nb_vertices) + " needs (3 x " +
+                                        std::to_string(elem) + " bytes per vertex)");
     read_positions(path, *positions, pos_dtype, blob.bytes(), nb_vertices, t);
   }
   read_groups(path, *members, t);
-  read_value_sets(*members, "dpv/", t.point_count(), t, t.point_values);
-  read_value_sets(*members, "dps/", t.streamline_count(), t, t.streamline_values);
+  read_value_sets(path, *members, "dpv/", t.point_count(), t, t.point_values);
+  read_value_sets(path, *members, "dps/", t.streamline_count(), t, t.streamline_values);
 
   nlohmann::json names = nlohmann::json::array();
   for (const auto& [name, index] : members->names()) names.push_back(json_safe(name));

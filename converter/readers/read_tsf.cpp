@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 
@@ -9,12 +10,19 @@
 #include "error.h"
 #include "mapped_file.h"
 #include "mrtrix_header.h"
+#include "regular_file.h"
 
 namespace vxl {
 namespace {
 
+std::string shortest(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 template <typename Real, bool kBigEndian>
-void read_values(std::span<const std::uint8_t> bytes, std::uint64_t offset, TrackScalars& s) {
+void read_values(const std::string& path, std::span<const std::uint8_t> bytes, std::uint64_t offset, TrackScalars& s) {
   const std::uint64_t available = (bytes.size() - offset) / sizeof(Real);
   s.values.reserve(available);
   const std::uint8_t* p = bytes.data() + offset;
@@ -31,6 +39,11 @@ void read_values(std::span<const std::uint8_t> bytes, std::uint64_t offset, Trac
       terminated = true;
       break;
     }
+    // Values are kept as float32; a Float64 value beyond its range would become an Inf that no range,
+    // colour map or export can use. Refused, as conversion refuses such a Float64 TCK coordinate.
+    if (!std::isfinite(static_cast<float>(v)))
+      fail_input(path, offset + i * sizeof(Real), "a value (" + shortest(v) + ")" +
+                                                      " is beyond the float32 range (Float64 values are stored as float32)");
     s.values.push_back(static_cast<float>(v));
     ++in_current;
   }
@@ -47,6 +60,7 @@ void read_values(std::span<const std::uint8_t> bytes, std::uint64_t offset, Trac
 }  // namespace
 
 TrackScalars read_tsf(const std::string& path) {
+  require_regular_file(path);
   MappedFile file(path);
   const MrtrixHeader h = parse_mrtrix_header(path, file.bytes(), kTsfFile);
   TrackScalars s;
@@ -57,11 +71,12 @@ TrackScalars read_tsf(const std::string& path) {
                   {"xxh3_128", xxh3_128_hex(file.data(), file.size())},
                   {"header", h.fields}};
   const std::string& dt = h.datatype;
-  if (dt == "Float32LE") read_values<float, false>(file.bytes(), h.data_offset, s);
-  else if (dt == "Float32BE") read_values<float, true>(file.bytes(), h.data_offset, s);
-  else if (dt == "Float64LE") read_values<double, false>(file.bytes(), h.data_offset, s);
-  else if (dt == "Float64BE") read_values<double, true>(file.bytes(), h.data_offset, s);
+  if (dt == "Float32LE") read_values<float, false>(path, file.bytes(), h.data_offset, s);
+  else if (dt == "Float32BE") read_values<float, true>(path, file.bytes(), h.data_offset, s);
+  else if (dt == "Float64LE") read_values<double, false>(path, file.bytes(), h.data_offset, s);
+  else if (dt == "Float64BE") read_values<double, true>(path, file.bytes(), h.data_offset, s);
   else fail_unsupported(path, "TSF datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+  if (auto w = count_warning(h, s.offsets.size() - 1)) s.warnings.push_back(*w);
   return s;
 }
 

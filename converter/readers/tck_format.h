@@ -23,6 +23,8 @@ namespace vxl::tck {
 struct DecodeState {
   std::uint64_t points_in_current = 0;  // points of the streamline not yet closed by a NaN
   bool terminated = false;              // an Inf triplet was seen: the data has ended
+  // The byte offset of that triplet when it is not (Inf, Inf, Inf), as MRtrix writes it: a damaged point?
+  std::optional<std::uint64_t> partial_terminator;
 };
 
 // Decodes up to `n` triplets at `p` (the first at byte `offset` of the file) into `t`: points are
@@ -45,6 +47,7 @@ std::uint64_t decode(const std::string& path, const std::uint8_t* p, std::uint64
     }
     if (std::isinf(x)) {  // end of file
       s.terminated = true;
+      if (!std::isinf(y) || !std::isinf(z)) s.partial_terminator = offset + i * kTriplet;
       return i + 1;
     }
     if (!std::isfinite(y) || !std::isfinite(z))
@@ -58,7 +61,8 @@ std::uint64_t decode(const std::string& path, const std::uint8_t* p, std::uint64
 }
 
 // After the last triplet: closes a streamline left open (adding it to `t`) and appends the warnings
-// about the end of the data. `trailing` is the number of bytes after the last whole triplet.
+// about the end of the data. `trailing` is the number of bytes after the last triplet decode consumed
+// (after the terminator, or the part of a triplet at the end of the file).
 void finish(const DecodeState& s, std::uint64_t trailing, Tractogram& t, std::vector<std::string>& warnings);
 
 // The warnings about the header that need the whole data (appended after finish()'s).

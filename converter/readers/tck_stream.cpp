@@ -10,6 +10,7 @@
 
 #include "checksum.h"
 #include "error.h"
+#include "regular_file.h"
 
 namespace vxl {
 namespace {
@@ -19,7 +20,9 @@ std::int64_t mtime_ns(const struct stat& st) { return std::int64_t(st.st_mtim.tv
 }  // namespace
 
 TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, std::uint64_t chunk_bytes) : path_(path) {
-  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  require_regular_file(path);
+  // O_NONBLOCK too: should the path become a FIFO after the check, open() still does not wait for a writer.
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd_ < 0) fail_input(path, std::nullopt, std::string("cannot open: ") + std::strerror(errno));
   struct stat st {};
   if (::fstat(fd_, &st) != 0) {
@@ -151,7 +154,7 @@ bool TckStream::next(Tractogram& batch, std::uint64_t max_points, std::uint64_t 
   // The end of the data: what read_tck does after its last triplet.
   data_ended_ = true;
   std::vector<std::string> warnings;
-  tck::finish(state_, (source_.bytes - header_.data_offset) % triplet_bytes_, batch, warnings);
+  tck::finish(state_, source_.bytes - (read_end_ - buffer_size_ + buffer_used_), batch, warnings);
   streamlines_ += batch.streamline_count();
   if (!complete_) {
     tck::header_warnings(header_, streamlines_, warnings);

@@ -13,7 +13,7 @@
 namespace vxl::fuzz {
 
 inline std::string write_input(const std::uint8_t* data, std::size_t size, const char* suffix) {
-  static const std::string path = "/dev/shm/voxlines_fuzz_" + std::to_string(::getpid()) + suffix;
+  const std::string path = "/dev/shm/voxlines_fuzz_" + std::to_string(::getpid()) + suffix;
   FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) std::abort();
   if (size > 0 && std::fwrite(data, 1, size, f) != size) std::abort();

@@ -1,0 +1,179 @@
+// Hostile source files, written by code so that the test tree holds no binary data: each function writes
+// one damaged or malicious file (or FIFO) to `path`. They stay small on disk; the bombs among them would
+// inflate to tens of MiB, which the fixed readers refuse long before.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <sys/stat.h>
+#include <zlib.h>
+
+#include "mrtrix_test_files.h"
+#include "zip_writer.h"
+
+namespace vxl::test::hostile {
+
+inline void write_file(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+// ---- gzip ----
+
+// One gzip member holding `data`; with `finish` false the stream is flushed to a byte boundary (all of
+// `data` can be inflated) but has no final block and no CRC trailer: a .gz cut short.
+inline std::string gzip(const std::string& data, bool finish = true) {
+  z_stream z{};
+  deflateInit2(&z, 9, Z_DEFLATED, 16 + MAX_WBITS, 9, Z_DEFAULT_STRATEGY);
+  std::string out(deflateBound(&z, data.size()) + 64, '\0');
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
+  z.avail_in = static_cast<uInt>(data.size());
+  z.next_out = reinterpret_cast<Bytef*>(out.data());
+  z.avail_out = static_cast<uInt>(out.size());
+  deflate(&z, finish ? Z_FINISH : Z_FULL_FLUSH);
+  out.resize(out.size() - z.avail_out);
+  deflateEnd(&z);
+  return out;
+}
+
+// ---- TRK ----
+
+// A valid little-endian version 2 TRK header: 1 mm voxels, RAS, identity vox_to_ras, no scalars.
+inline std::string trk_header(std::int32_t n_count = 0) {
+  std::string h(1000, '\0');
+  auto put = [&](std::size_t off, auto v) { std::memcpy(h.data() + off, &v, sizeof v); };
+  std::memcpy(h.data(), "TRACK", 5);
+  for (int i = 0; i < 3; ++i) put(6 + 2 * i, std::int16_t{100});
+  for (int i = 0; i < 3; ++i) put(12 + 4 * i, 1.0f);
+  for (int i = 0; i < 4; ++i) put(440 + 4 * (4 * i + i), 1.0f);
+  std::memcpy(h.data() + 948, "RAS", 3);
+  put(988, n_count);
+  put(992, std::int32_t{2});
+  put(996, std::int32_t{1000});
+  return h;
+}
+
+// One record of `n` points (x = y = z = k + 1 for point k).
+inline std::string trk_record(std::int32_t n) {
+  std::string r = raw<std::int32_t>({n});
+  for (std::int32_t k = 0; k < n; ++k) {
+    const float v = static_cast<float>(k + 1);
+    r += raw<float>({v, v, v});
+  }
+  return r;
+}
+
+// Row 5: a header, then `mib` MiB of zeros where records should be, as concatenated gzip members (each
+// MiB of zeros deflates to about 1 KiB, so the file stays small).
+inline void trk_gz_zeros(const std::string& path, int mib) {
+  const std::string zeros = gzip(std::string(1u << 20, '\0'));
+  std::string out = gzip(trk_header());
+  for (int i = 0; i < mib; ++i) out += zeros;
+  write_file(path, out);
+}
+
+// Row 5: valid one-point records, `mib` MiB of them, that deflate about 1000:1: a bomb of real-looking data.
+inline void trk_gz_record_bomb(const std::string& path, int mib) {
+  std::string records;
+  const std::string one = trk_record(1);
+  while (records.size() + one.size() <= (1u << 20)) records += one;
+  const std::string member = gzip(records);
+  std::string out = gzip(trk_header());
+  for (int i = 0; i < mib; ++i) out += member;
+  write_file(path, out);
+}
+
+// Row 7: three records whose gzip stream is cut at a record boundary (no end of stream, no CRC).
+inline void trk_gz_cut_at_record(const std::string& path, std::int32_t n_count) {
+  write_file(path, gzip(trk_header(n_count) + trk_record(2) + trk_record(3) + trk_record(1), /*finish=*/false));
+}
+
+// Row 7: a complete gzip stream followed by `tail`.
+inline void trk_gz_with_tail(const std::string& path, const std::string& tail) {
+  write_file(path, gzip(trk_header() + trk_record(2) + trk_record(3)) + tail);
+}
+
+// ---- TRX ----
+
+template <typename T>
+Bytes le(const std::vector<T>& values) {
+  Bytes out(values.size() * sizeof(T));
+  std::memcpy(out.data(), values.data(), out.size());  // the test machines are little-endian, like TRX
+  return out;
+}
+inline Bytes text(const std::string& s) { return Bytes(s.begin(), s.end()); }
+
+// A valid TRX of `n` streamlines of 2 points each, plus `extra` members.
+inline std::vector<ZipEntry> trx_entries(std::uint32_t n, std::vector<ZipEntry> extra = {}) {
+  std::vector<float> positions(6 * n, 1.0f);
+  std::vector<std::uint64_t> offsets;
+  for (std::uint32_t i = 0; i <= n; ++i) offsets.push_back(2 * i);
+  std::vector<ZipEntry> e = {
+      stored_entry("header.json", text("{\"NB_STREAMLINES\": " + std::to_string(n) +
+                                       ", \"NB_VERTICES\": " + std::to_string(2 * n) + "}")),
+      stored_entry("positions.3.float32", le(positions)), stored_entry("offsets.uint64", le(offsets))};
+  for (ZipEntry& x : extra) e.push_back(std::move(x));
+  return e;
+}
+
+// Row 1: a dps member whose component count does not fit in 64 bits.
+inline void trx_huge_component_count(const std::string& path) {
+  write_zip(path, trx_entries(3, {stored_entry("dps/c.99999999999999999999.float32", le(std::vector<float>{1, 2, 3}))}));
+}
+
+// Row 6: the offsets member replaced by `mib` MiB of deflated zeros. With `honest` the zip's directory
+// declares that size; otherwise it declares the 32 bytes the header asks for, and the data inflates past it.
+inline void trx_offsets_bomb(const std::string& path, int mib, bool honest) {
+  std::vector<ZipEntry> e = trx_entries(3);
+  ZipEntry bomb = deflated_zeros_entry("offsets.uint64", std::uint64_t(mib) << 20);
+  if (!honest) bomb.size = 4 * 8;
+  e[2] = std::move(bomb);
+  write_zip(path, e);
+}
+
+// ---- MRtrix (TCK, TSF) ----
+
+// Row 8: a TSF of three streamlines of one value each, the second 1e300 (beyond float32).
+inline void tsf_float64_out_of_range(const std::string& path) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  write_mrtrix_file(path, "mrtrix track scalars", "Float64LE", raw<double>({1, nan, 1e300, nan, 3, nan, inf}));
+}
+
+// Row 9: a TSF of three streamlines whose header says count: 99.
+inline void tsf_wrong_count(const std::string& path) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  write_mrtrix_file(path, "mrtrix track scalars", "Float32LE", raw<float>({1, nan, 2, nan, 3, nan, inf}), "count: 99\n");
+}
+
+// Row 13: a TCK of one streamline, then a point whose x alone is Inf (a damaged point, which ends the
+// data), then another streamline that is lost.
+inline void tck_inf_in_one_coordinate(const std::string& path) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  write_mrtrix_file(path, "mrtrix tracks", "Float32LE",
+                    raw<float>({1, 2, 3, 4, 5, 6, nan, nan, nan, inf, 7, 8, 9, 9, 9, nan, nan, nan, inf, inf, inf}));
+}
+
+// Row 13: a TCK whose data goes on after its (Inf, Inf, Inf) terminator.
+inline void tck_data_after_terminator(const std::string& path) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  write_mrtrix_file(path, "mrtrix tracks", "Float32LE",
+                    raw<float>({1, 2, 3, 4, 5, 6, nan, nan, nan, inf, inf, inf, 7, 8, 9, 9, 9, 9, nan, nan, nan}));
+}
+
+// Row 13: a TCK of one streamline whose header says count: -5.
+inline void tck_negative_count(const std::string& path) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  write_mrtrix_file(path, "mrtrix tracks", "Float32LE", raw<float>({1, 2, 3, 4, 5, 6, nan, nan, nan, inf, inf, inf}),
+                    "count: -5\n");
+}
+
+// Row 12: a FIFO, which no writer will ever open.
+inline void fifo(const std::string& path) { ::mkfifo(path.c_str(), 0600); }
+
+}  // namespace vxl::test::hostile
