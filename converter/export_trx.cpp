@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <unordered_set>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -41,9 +42,10 @@ std::optional<Matrix> matrix_from(const nlohmann::json& j) {
   return m;
 }
 
-// A member name made from a group name must stay one file inside groups/.
+// A member name made from a group name must stay one file inside groups/, and fit the zip's 16-bit name length.
 bool usable_member_name(const std::string& name) {
-  return !name.empty() && name != "." && name != ".." && name.find_first_of(std::string("/\\\0", 3)) == std::string::npos;
+  return !name.empty() && name != "." && name != ".." && name.find_first_of(std::string("/\\\0", 3)) == std::string::npos &&
+         name.size() <= 0xFFFF - std::string("groups/.uint32").size();
 }
 
 class ZipWriter {
@@ -97,8 +99,9 @@ class ZipWriter {
 TrxReference trx_reference(const VxlFile& file) {
   const nlohmann::json prov = nlohmann::json::parse(file.provenance_json(), nullptr, false);
   if (prov.is_object() && prov.contains("source") && prov["source"].is_object()) {
+    // PROV may hold any JSON (open() does not look into it): take each field only with the expected type.
     const nlohmann::json& src = prov["source"];
-    const std::string format = src.value("format", "");
+    const std::string format = src.contains("format") && src["format"].is_string() ? src["format"].get<std::string>() : "";
     const nlohmann::json header = src.value("header", nlohmann::json());
     std::optional<std::array<std::int64_t, 3>> dims;
     std::optional<Matrix> matrix;
@@ -147,9 +150,15 @@ void export_trx(const VxlFile& file, const std::string& out_path) {
 
   std::vector<GroupContent> groups = file.groups();
   std::vector<std::vector<std::uint32_t>> members(groups.size());
+  // Everything about the input is checked before the archive is created: a group TRX cannot hold is the
+  // input's limit (exit 4), not a failure to write (exit 5).
+  std::unordered_set<std::string> names;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     if (!usable_member_name(groups[g].name))
-      fail_unsupported(file.path(), "group name '" + groups[g].name + "' cannot be a TRX member name (groups/NAME.uint32)");
+      fail_unsupported(file.path(), "group name '" + groups[g].name.substr(0, 200) +
+                                        "' cannot be a TRX member name (groups/NAME.uint32)");
+    if (!names.insert(groups[g].name).second)
+      fail_unsupported(file.path(), "two groups are named '" + groups[g].name + "': TRX holds one groups/NAME.uint32 per name");
     if (m.streamline_count > std::numeric_limits<std::uint32_t>::max())
       fail_unsupported(file.path(), "TRX group members are uint32: more than 2^32 - 1 streamlines cannot be grouped");
     members[g].assign(groups[g].members.begin(), groups[g].members.end());

@@ -29,9 +29,10 @@ struct TrxReference {
 // From the provenance when it records one, else the default above.
 TrxReference trx_reference(const VxlFile& file);
 
-// Writes `out_path` (the archive appears only when complete). Throws vxl::Error: Unsupported for a group
-// name that cannot be a member name or more than 2^32 - 1 streamlines (group members are uint32),
-// Output when the archive cannot be written.
+// Writes `out_path` (the archive appears only when complete). Throws vxl::Error: Input for a malformed
+// file, Unsupported for a group name that cannot be a member name (or is another group's too) or more than
+// 2^32 - 1 streamlines (group members are uint32), both before the archive is created; Output only when
+// the archive cannot be written.
 void export_trx(const VxlFile& file, const std::string& out_path);
 
 }  // namespace vxl

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "error.h"
+#include "utf8_check.h"
 
 namespace vxl {
 
@@ -83,6 +84,9 @@ void VxlFile::validate() {
     std::uint32_t id;
     std::memcpy(&id, e.id, 4);
     const std::string name = section_name(id);
+    for (int k = 0; k < 4; ++k)
+      if (static_cast<unsigned char>(e.id[k]) < 0x20 || static_cast<unsigned char>(e.id[k]) > 0x7E)
+        fail_input(p, at + k, "section id '" + name + "' is not four printable ASCII characters");
     if (e.offset % kVxlAlignment != 0) fail_input(p, at + 8, "section " + name + " offset is not a multiple of 64");
     if (e.offset < previous_end) fail_input(p, at + 8, "section " + name + " overlaps the table or the previous section");
     if (e.offset > size || e.size > size - e.offset)
@@ -127,6 +131,12 @@ void VxlFile::validate() {
     if (!std::isfinite(m.grid_origin[c]) || !std::isfinite(m.bounds_min[c]) || !std::isfinite(m.bounds_max[c]))
       fail_input(p, meta_at + 64, "non-finite grid origin or bounds");
   }
+  // Every source point and every synthetic one is a vertex (spec §6.2), so these bound what a reader
+  // reserves for the points: an unchecked point_count would ask for up to 2^64 floats.
+  if (m.point_count > m.vertex_count || m.synthetic_point_count > m.vertex_count - m.point_count)
+    fail_input(p, meta_at + 8, "point_count " + std::to_string(m.point_count) + " + synthetic_point_count " +
+                                   std::to_string(m.synthetic_point_count) + " exceed vertex_count " +
+                                   std::to_string(m.vertex_count));
   auto expect_size = [&](const char (&id)[5], std::optional<std::uint64_t> expected, const char* what) {
     auto s = section(id, true);
     if (!expected || s.size() != *expected)
@@ -158,6 +168,7 @@ void VxlFile::validate() {
   auto prov = section("PROV", false);
   provenance_ = {reinterpret_cast<const char*>(prov.data()), prov.size()};
   groups_ = section("GRPS", false);
+  walk_groups([](std::string_view, std::uint64_t, std::uint64_t) {});  // structure and names: O(groups)
   if (find_section(section_id("VVAL")))
     vertex_values_ = ValueSets(section("VVAL", true), m.vertex_count, p, offset_of("VVAL"));
   if (find_section(section_id("SVAL")))
@@ -196,9 +207,9 @@ void VxlFile::validate() {
   if (m.voxel_count == 0 && m.vertex_count != 0) fail_input(p, voxt_at, "vertices without voxels");
 }
 
-std::vector<GroupContent> VxlFile::groups() const {
-  std::vector<GroupContent> out;
-  if (groups_.empty()) return out;
+void VxlFile::walk_groups(
+    const std::function<void(std::string_view name, std::uint64_t members_at, std::uint64_t count)>& visit) const {
+  if (groups_.empty()) return;
   const std::string& p = file_.path();
   const std::uint64_t at0 = find_section(section_id("GRPS"))->offset;
   std::uint64_t pos = 0;
@@ -207,18 +218,18 @@ std::vector<GroupContent> VxlFile::groups() const {
   };
   auto take = [&](void* dst, std::uint64_t n) {
     need(n);
-    if (n == 0) return;  // an empty group: dst may be null, which memcpy must not see
     std::memcpy(dst, groups_.data() + pos, n);
     pos += n;
   };
   std::uint32_t header[2];
   take(header, 8);
   for (std::uint32_t g = 0; g < header[0]; ++g) {
-    GroupContent gc;
     std::uint32_t len;
     take(&len, 4);
     need(len);
-    gc.name.assign(reinterpret_cast<const char*>(groups_.data() + pos), len);
+    const std::string_view name(reinterpret_cast<const char*>(groups_.data() + pos), len);
+    if (name.find('\0') != std::string_view::npos) fail_input(p, at0 + pos, "GRPS group name contains a NUL byte");
+    if (!is_valid_utf8(name)) fail_input(p, at0 + pos, "GRPS group name is not valid UTF-8");
     pos += len;
     std::uint64_t aligned = align_up(pos, 8);
     need(aligned - pos);
@@ -226,13 +237,25 @@ std::vector<GroupContent> VxlFile::groups() const {
     std::uint64_t count;
     take(&count, 8);
     if (count > (groups_.size() - pos) / 8) fail_input(p, at0 + pos, "GRPS member count runs past the section");
+    visit(name, pos, count);
+    pos += count * 8;
+  }
+}
+
+std::vector<GroupContent> VxlFile::groups() const {
+  std::vector<GroupContent> out;
+  const std::string& p = file_.path();
+  const std::uint64_t at0 = groups_.empty() ? 0 : find_section(section_id("GRPS"))->offset;
+  walk_groups([&](std::string_view name, std::uint64_t members_at, std::uint64_t count) {
+    GroupContent gc;
+    gc.name = name;
     gc.members.resize(count);
-    take(gc.members.data(), count * 8);
+    if (count > 0) std::memcpy(gc.members.data(), groups_.data() + members_at, count * 8);
     for (std::uint64_t i = 0; i < count; ++i)
       if (gc.members[i] >= meta_.streamline_count || (i > 0 && gc.members[i] <= gc.members[i - 1]))
-        fail_input(p, at0 + pos - 8 * (count - i), "GRPS member out of range or not increasing");
+        fail_input(p, at0 + members_at + 8 * i, "GRPS member out of range or not increasing");
     out.push_back(std::move(gc));
-  }
+  });
   return out;
 }
 

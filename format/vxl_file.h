@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -61,7 +62,8 @@ class VxlFile {
   std::span<const VoxlineEntry> voxlines() const { return voxlines_; }
   std::span<const std::uint64_t> streamline_first_voxline() const { return strm_; }
   std::string_view provenance_json() const { return provenance_; }
-  // Parses GRPS (empty when absent); throws vxl::Error when malformed.
+  // Parses GRPS (empty when absent; open() has checked its structure and names); throws vxl::Error when a
+  // member is out of range or out of order.
   std::vector<GroupContent> groups() const;
   // VVAL: per-vertex value sets (vertex_count values each); SVAL: per-streamline ones. Empty when absent.
   const ValueSets& vertex_values() const { return vertex_values_; }
@@ -70,6 +72,9 @@ class VxlFile {
  private:
   explicit VxlFile(MappedFile file) : file_(std::move(file)) {}
   void validate();
+  // Walks GRPS (spec §5.9) checking its structure and names (valid UTF-8, no NUL) but not the members:
+  // O(groups). `visit` gets each group's name and where its `count` members start in the section.
+  void walk_groups(const std::function<void(std::string_view name, std::uint64_t members_at, std::uint64_t count)>& visit) const;
 
   MappedFile file_;
   FileHeader header_{};

@@ -6,10 +6,13 @@
 #include <limits>
 
 #include "error.h"
+#include "utf8_check.h"
 
 namespace vxl {
 
-std::string value_set_name(const std::string& name) {
+std::string value_set_name(const std::string& raw) {
+  // Readers refuse a name that is not UTF-8 (VxlFile::open), so one from a non-UTF-8 file name is converted.
+  std::string name = to_valid_utf8(raw.substr(0, raw.find('\0')));
   if (name.size() <= kMaxValueSetName) return name;
   std::size_t n = kMaxValueSetName;
   while (n > 0 && (static_cast<unsigned char>(name[n]) & 0xC0) == 0x80) --n;  // not inside a character
@@ -67,9 +70,12 @@ ValueSets::ValueSets(std::span<const std::uint8_t> payload, std::uint64_t count,
     fail_input(path, at, "value-set section size " + std::to_string(payload.size()) + " does not match " +
                              std::to_string(h.set_count) + " sets of " + std::to_string(count) + " values");
   entries_ = {reinterpret_cast<const ValueSetEntry*>(payload.data() + sizeof h), h.set_count};
-  for (std::uint32_t k = 0; k < h.set_count; ++k)
+  for (std::uint32_t k = 0; k < h.set_count; ++k) {
+    const std::uint64_t entry_at = at + sizeof h + k * sizeof(ValueSetEntry);
     if (std::memchr(entries_[k].name, 0, sizeof entries_[k].name) == nullptr)
-      fail_input(path, at + sizeof h + k * sizeof(ValueSetEntry), "value-set name is not NUL-terminated");
+      fail_input(path, entry_at, "value-set name is not NUL-terminated");
+    if (!is_valid_utf8(entries_[k].name)) fail_input(path, entry_at, "value-set name is not valid UTF-8");
+  }
 }
 
 std::string ValueSets::name(std::uint32_t k) const { return entries_[k].name; }

@@ -48,7 +48,8 @@ constexpr std::uint64_t value_sets_bytes(std::uint64_t sets, std::uint64_t count
   return sets == 0 ? 0 : value_sets_data_offset(sets) + sets * value_array_stride(count);
 }
 
-// `name` cut to kMaxValueSetName bytes at a UTF-8 character boundary.
+// `name` as stored: up to its first NUL, made valid UTF-8 (invalid bytes read as Latin-1), cut to
+// kMaxValueSetName bytes at a character boundary.
 std::string value_set_name(const std::string& name);
 
 // Writing: lays out the header and names in `payload` (sized by value_sets_bytes, zero-filled) and
@@ -62,7 +63,7 @@ class ValueSets {
  public:
   ValueSets() = default;
   // Throws vxl::Error (Input) naming `path` and the byte offset (`at`: the payload's file offset) unless
-  // `payload` has the layout above with value_count == `count`.
+  // `payload` has the layout above with value_count == `count` and every name is valid UTF-8.
   ValueSets(std::span<const std::uint8_t> payload, std::uint64_t count, const std::string& path, std::uint64_t at);
 
   std::uint32_t size() const { return static_cast<std::uint32_t>(entries_.size()); }

@@ -7,6 +7,22 @@
 #include "vxl_file.h"
 
 namespace vxl::cli {
+namespace {
+
+// PROV is any JSON as far as open() is concerned (verify checks only that it parses), so every field is
+// read only when it has the expected type: a damaged provenance must not end `info` with a type error.
+std::string string_field(const nlohmann::json& object, const char* key) {
+  if (!object.is_object()) return "";
+  auto it = object.find(key);
+  return it != object.end() && it->is_string() ? it->get<std::string>() : "";
+}
+std::uint64_t count_field(const nlohmann::json& object, const char* key) {
+  if (!object.is_object()) return 0;
+  auto it = object.find(key);
+  return it != object.end() && it->is_number_unsigned() ? it->get<std::uint64_t>() : 0;
+}
+
+}  // namespace
 
 void add_info_command(CLI::App& app) {
   struct Options {
@@ -51,12 +67,14 @@ void add_info_command(CLI::App& app) {
     for (const GroupContent& g : f.groups()) groups.push_back({{"name", g.name}, {"streamlines", g.members.size()}});
     j["groups"] = groups;
     auto prov = nlohmann::json::parse(f.provenance_json(), nullptr, false);
-    if (!prov.is_discarded() && prov.contains("source")) {
-      j["source"] = {{"name", prov["source"].value("name", "")}, {"format", prov["source"].value("format", "")},
-                     {"bytes", prov["source"].value("bytes", 0)}};
+    if (prov.is_object() && prov.contains("source") && prov["source"].is_object()) {
+      const nlohmann::json& src = prov["source"];
+      j["source"] = {{"name", string_field(src, "name")}, {"format", string_field(src, "format")},
+                     {"bytes", count_field(src, "bytes")}};
     }
     if (opt->json) {
-      std::printf("%s\n", j.dump(2).c_str());
+      // open() has checked every name for UTF-8; replacing invalid bytes is the last line of defence.
+      std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
       return;
     }
     std::printf("file          %s (.vxl %s, %llu bytes)\n", opt->file.c_str(), j["version"].get<std::string>().c_str(),

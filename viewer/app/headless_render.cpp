@@ -36,7 +36,7 @@ Camera initial_camera(const glm::dvec3& lo, const glm::dvec3& hi, const ViewerOp
 
 int run_headless(const ViewerOptions& o) {
   auto t0 = std::chrono::steady_clock::now();
-  const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf);
+  const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
   HeadlessGlContext context;
   Renderer renderer(pointers(files));
   check_color_options(o.inputs_name(), renderer, o.settings);

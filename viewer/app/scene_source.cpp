@@ -11,25 +11,47 @@
 #include "renderer.h"
 #include "read_tractogram.h"
 #include "unpack.h"
+#include "vxl_verify.h"
 
 namespace vxl::app {
+namespace {
 
-VxlFile open_scene(const std::string& path, double voxel_size, const std::vector<std::string>& tsf) {
+// Full verification (spec §7, `verify`) of the .vxl at `path`; `shown` is the name the user gave.
+void verify_or_refuse(const std::string& path, const std::string& shown) {
+  const VerifyResult r = verify_vxl(path);
+  if (r.valid) return;
+  std::string problem = r.problem;
+  if (problem.starts_with(path + ": ")) problem.erase(0, path.size() + 2);  // the error names the file already
+  throw Error(ErrorKind::Input, shown, std::nullopt, "--verify: the file is damaged or malformed: " + problem);
+}
+
+}  // namespace
+
+VxlFile open_scene(const std::string& path, double voxel_size, const std::vector<std::string>& tsf, bool verify) {
   std::string lower = path;
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (!tsf.empty() && (lower.ends_with(".vxl") || lower.ends_with(".vxlz")))
     throw Error(ErrorKind::Usage, path, std::nullopt,
                 "--tsf adds values to a source tractogram converted in memory; a .vxl keeps the values it was converted "
                 "with (voxlines convert IN.tck OUT.vxl --tsf FILE.tsf)");
-  if (lower.ends_with(".vxl")) return VxlFile::open(path);
+  if (lower.ends_with(".vxl")) {
+    if (verify) verify_or_refuse(path, path);
+    return VxlFile::open(path);
+  }
   if (lower.ends_with(".vxlz")) {
     // A package is unpacked into an unlinked temporary .vxl: the mapping keeps it alive, nothing is left.
     std::filesystem::path temp = std::filesystem::temp_directory_path() /
                                  ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
     unpack_vxlz(path, temp.string(), {});
-    VxlFile f = VxlFile::open(temp.string());
-    std::filesystem::remove(temp);
-    return f;
+    try {
+      if (verify) verify_or_refuse(temp.string(), path);
+      VxlFile f = VxlFile::open(temp.string());
+      std::filesystem::remove(temp);
+      return f;
+    } catch (...) {
+      std::filesystem::remove(temp);
+      throw;
+    }
   }
 
   Tractogram t = read_tractogram(path);
@@ -51,13 +73,14 @@ VxlFile open_scene(const std::string& path, double voxel_size, const std::vector
   return f;
 }
 
-std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double voxel_size, const std::vector<std::string>& tsf) {
+std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double voxel_size, const std::vector<std::string>& tsf,
+                                 bool verify) {
   if (!tsf.empty() && paths.size() != 1)
     throw Error(ErrorKind::Usage, "", std::nullopt,
                 "--tsf needs a single input tractogram (it has one value per point of that file); convert each with "
                 "voxlines convert IN.tck OUT.vxl --tsf FILE.tsf and open the .vxl files together");
   std::vector<VxlFile> files;
-  for (const std::string& p : paths) files.push_back(open_scene(p, voxel_size, tsf));
+  for (const std::string& p : paths) files.push_back(open_scene(p, voxel_size, tsf, verify));
   return files;
 }
 

@@ -16,12 +16,16 @@ struct RenderSettings;
 namespace vxl::app {
 
 // `tsf`: MRtrix track scalar files to attach to a source tractogram (refused for a .vxl / .vxlz, whose values
-// were fixed at conversion).
-VxlFile open_scene(const std::string& path, double voxel_size_for_sources, const std::vector<std::string>& tsf = {});
+// were fixed at conversion). `verify`: before a .vxl is used, check it as `voxlines verify` does (every
+// checksum, padding byte, order and table; O(file)), and refuse it (vxl::Error, Input) naming the first
+// problem; a .vxlz's unpacked .vxl is checked the same way (the package's own checksums always are).
+// Without it a .vxl gets only open()'s O(voxels) checks (spec §7), which do not read the checksums.
+VxlFile open_scene(const std::string& path, double voxel_size_for_sources, const std::vector<std::string>& tsf = {},
+                   bool verify = false);
 
 // Opens every input of a scene (open_scene each; --tsf only with a single source input). Throws vxl::Error.
 std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double voxel_size_for_sources,
-                                 const std::vector<std::string>& tsf);
+                                 const std::vector<std::string>& tsf, bool verify = false);
 std::vector<const VxlFile*> pointers(const std::vector<VxlFile>& files);
 
 // Refuses colour options the scene cannot honour, naming the file and what it has: --color scalar without

@@ -23,6 +23,7 @@ struct ViewerOptions {
   bool orthographic = false;
   int width = 1024, height = 1024;
   double voxel_size = 10.0;          // for in-memory conversion
+  bool verify = false;               // --verify: check every .vxl in full (as `voxlines verify`) before drawing
   std::vector<std::string> tsf;      // per-point values for a .tck converted in memory
   // Window automation (tests, scripted screenshots): quit after N frames, saving a screenshot first.
   std::optional<int> frames;

@@ -25,6 +25,9 @@ int main(int argc, char** argv) {
                " — transparent tractogram viewer (Voxlines method).\n"
                "voxview FILE... [--render OUT.png]: a window, or headless to PNG with --render.\n"
                "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx/.vtk/.vtp is converted in memory first.\n"
+               "Opening a .vxl checks its structure (header, section table, section sizes, voxel table, names) in\n"
+               "O(voxels) but not its checksums: damaged positions, orders or values are drawn as they are. --verify\n"
+               "checks everything first, as 'voxlines verify' does.\n"
                "Window: left drag orbits, right/middle drag (or Shift+left) pans, wheel zooms. Keys: 1/2/3 axial/sagittal/coronal,\n"
                "Shift+1/2/3 or 4/5/6 their opposites, O orthographic, M next mode, +/- opacity, L lighting, S screenshot, R reset,\n"
                "Esc/Q quit.\n"
@@ -83,6 +86,10 @@ int main(int argc, char** argv) {
   cli.add_option("--clip", clips,
                  "clip plane AXIS,POS in RAS mm, up to 3: x,10 keeps x >= 10, -x,10 keeps x <= 10 (axes x y z, -x -y -z)")
       ->expected(1)->take_all();
+  cli.add_flag("--verify", o.verify,
+               "before drawing, check every .vxl in full (every checksum and padding byte, every order, the streamline "
+               "tables; reads the whole file, as 'voxlines verify') and refuse a damaged one (exit 3, naming the first "
+               "problem); a .vxlz's unpacked file too (a package's own checksums are always checked)");
   cli.add_option("--voxel-size", o.voxel_size, "voxel size in mm when converting a source file in memory")
       ->default_val(10.0)->check(CLI::PositiveNumber);
   cli.add_option("--frames", o.frames, "window: quit after this many frames (for scripts and tests)")->check(CLI::PositiveNumber);

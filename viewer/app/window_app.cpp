@@ -465,7 +465,7 @@ int ViewerWindow::run() {
 
 int run_window(const ViewerOptions& o) {
   GlfwLibrary glfw;  // first: without a display, fail before any slow conversion
-  const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf);
+  const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
   WindowPtr window = open_window(o);
   ViewerWindow viewer(o, files, window.get());
   return viewer.run();

@@ -81,9 +81,12 @@ glm::dvec3 Renderer::bounds_max() const {
 }
 
 glm::dmat4 Renderer::projection(const Camera& camera, double aspect) const {
-  // Near and far planes hug the scene's bounding sphere, for depth precision.
+  // Near and far planes hug the scene's bounding sphere, for depth precision. The margin is a voxel, but
+  // never more than the scene's own size: every vertex lies inside the bounds, and a voxel far larger than
+  // the scene (--voxel-size 1e8) would put the near plane (far · 1e-4) beyond every line.
   glm::dvec3 centre = (bounds_min() + bounds_max()) * 0.5;
-  double radius = std::max(1.0, glm::length(bounds_max() - bounds_min()) * 0.5 + scene_.layout().voxel_size());
+  const double half_diagonal = glm::length(bounds_max() - bounds_min()) * 0.5;
+  double radius = std::max(1.0, half_diagonal + std::min(scene_.layout().voxel_size(), std::max(1.0, half_diagonal)));
   double along = glm::dot(centre - camera.eye(), camera.forward());
   double far_mm = along + radius;
   double near_mm = camera.orthographic ? along - radius : std::max(far_mm * 1e-4, along - radius);

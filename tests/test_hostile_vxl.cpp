@@ -1,0 +1,216 @@
+// Hostile .vxl files against `open`, `info` and `export` (issue 14, rows 2-4): names that are not
+// UTF-8, section ids that are not ASCII, counts that would size a reservation, provenance of the wrong
+// JSON types. Each file is made by the generator in hostile_vxl.h; the outcome must be a clear error
+// (exit 3 for a malformed input), never an internal error (exit 70) and never a partial output.
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "error.h"
+#include "export_trx.h"
+#include "hostile_vxl.h"
+#include "test_support.h"
+#include "utf8_check.h"
+#include "vxl_file.h"
+#include "vxl_value_sets.h"
+
+namespace vxl {
+namespace {
+
+using test::ScratchDir;
+using test::VxlBytes;
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+// The error VxlFile::open gives `path` ("no error" when it opens).
+std::string open_error(const std::string& path, ErrorKind expected = ErrorKind::Input) {
+  try {
+    VxlFile::open(path);
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), expected) << e.what();
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(HostileVxl, TheGeneratedFileIsValidAndHasEveryOptionalSection) {
+  ScratchDir dir;
+  const VxlBytes b = VxlBytes::make(dir.file("h.vxl"));
+  const VxlFile f = VxlFile::open(dir.file("h.vxl"));
+  ASSERT_EQ(f.groups().size(), 2u);
+  EXPECT_EQ(f.vertex_values().name(0), "fa");
+  EXPECT_EQ(f.streamline_values().name(0), "length");
+  EXPECT_EQ(b.group_name_bytes().size(), std::string("CST_leftAF right").size());
+  EXPECT_EQ(b.value_name_bytes("VVAL").size(), 2u);
+  const auto r = test::run_cli("info --json " + q(dir.file("h.vxl")));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("\"CST_left\""), std::string::npos) << r.output;
+}
+
+// Row 2: one byte of an optional section's id XOR 0x80 made `info --json` die of nlohmann's type_error 316
+// (exit 70); ids must be printable ASCII (spec §4), and open says so.
+TEST(HostileVxl, SectionIdThatIsNotAsciiIsRefusedOnOpen) {
+  ScratchDir dir;
+  const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
+  for (const auto* id : {"PROV", "GRPS", "VVAL", "SVAL"}) {
+    for (int k = 0; k < 4; ++k) {
+      SCOPED_TRACE(std::string(id) + " byte " + std::to_string(k));
+      VxlBytes b = valid;
+      b.flip(b.entry_at(id) + k);
+      b.reseal();
+      b.write(dir.file("bad.vxl"));
+      EXPECT_NE(open_error(dir.file("bad.vxl")).find("is not four printable ASCII characters"), std::string::npos);
+    }
+  }
+  VxlBytes b = valid;
+  b.flip(b.entry_at("PROV") + 3);
+  b.write(dir.file("bad.vxl"));
+  const auto r = test::run_cli("info --json " + q(dir.file("bad.vxl")));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("at byte " + std::to_string(valid.entry_at("PROV") + 3) + ": section id"), std::string::npos)
+      << r.output;
+}
+
+// Rows 2 and 4: a group or value-set name byte XOR 0x80 (never valid UTF-8 after an ASCII byte) made
+// `info --json` exit 70 and `export x.trx` exit 5 (libzip refused the member name): open refuses it,
+// naming the byte, so both exit 3 and export leaves nothing.
+TEST(HostileVxl, NameThatIsNotUtf8IsRefusedOnOpen) {
+  ScratchDir dir;
+  const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
+  struct Case {
+    std::vector<std::uint64_t> bytes;
+    const char* message;
+  };
+  const Case cases[] = {{valid.group_name_bytes(), "GRPS group name is not valid UTF-8"},
+                        {valid.value_name_bytes("VVAL"), "value-set name is not valid UTF-8"},
+                        {valid.value_name_bytes("SVAL"), "value-set name is not valid UTF-8"}};
+  for (const Case& c : cases)
+    for (std::uint64_t at : c.bytes) {
+      SCOPED_TRACE("byte " + std::to_string(at));
+      VxlBytes b = valid;
+      b.flip(at);
+      b.reseal();  // even with its checksums right the file is malformed
+      b.write(dir.file("bad.vxl"));
+      EXPECT_NE(open_error(dir.file("bad.vxl")).find(c.message), std::string::npos);
+    }
+
+  VxlBytes b = valid;
+  b.flip(valid.group_name_bytes().front());
+  b.write(dir.file("bad.vxl"));
+  auto r = test::run_cli("info --json " + q(dir.file("bad.vxl")));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("at byte " + std::to_string(valid.group_name_bytes().front())), std::string::npos) << r.output;
+  r = test::run_cli("export " + q(dir.file("bad.vxl")) + " " + q(dir.file("out.trx")));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out.trx")));
+
+  b = valid;
+  b.flip(valid.value_name_bytes("SVAL").back());
+  b.write(dir.file("bad.vxl"));
+  r = test::run_cli("info --json " + q(dir.file("bad.vxl")));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("value-set name is not valid UTF-8"), std::string::npos) << r.output;
+}
+
+// Row 3: META point_count with its top bit set (byte 15 of META XOR 0x80: 2^63 + P) made `export x.trx`
+// reserve 3 * 2^63 floats (exit 70, "vector::reserve"). P + synthetic points <= V is checked on open.
+TEST(HostileVxl, PointCountBeyondTheVerticesIsRefusedBeforeAnyReservation) {
+  ScratchDir dir;
+  const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
+  const std::uint64_t meta = valid.offset_of("META");
+  for (const std::uint64_t at : {meta + 8 + 7, meta + 40 + 7}) {  // point_count, synthetic_point_count
+    SCOPED_TRACE("byte " + std::to_string(at));
+    VxlBytes b = valid;
+    b.flip(at);
+    b.write(dir.file("bad.vxl"));
+    EXPECT_NE(open_error(dir.file("bad.vxl")).find("exceed vertex_count"), std::string::npos);
+    for (const char* out : {"out.trx", "out.tck"}) {
+      const auto r = test::run_cli("export " + q(dir.file("bad.vxl")) + " " + q(dir.file(out)));
+      EXPECT_EQ(r.exit_code, 3) << out << ": " << r.output;
+      EXPECT_NE(r.output.find("at byte " + std::to_string(meta + 8)), std::string::npos) << r.output;
+      EXPECT_FALSE(std::filesystem::exists(dir.file(out)));
+    }
+  }
+  // One point more than the vertices is refused too; P = V - synthetic is the largest a file can hold.
+  VxlBytes b = valid;
+  MetaSection m;
+  std::memcpy(&m, b.bytes.data() + meta, sizeof m);
+  m.point_count = m.vertex_count - m.synthetic_point_count + 1;
+  std::memcpy(b.bytes.data() + meta, &m, sizeof m);
+  b.write(dir.file("bad.vxl"));
+  EXPECT_NE(open_error(dir.file("bad.vxl")).find("exceed vertex_count"), std::string::npos);
+}
+
+// PROV is any JSON to open(): fields of the wrong type made `info` exit 70 (type_error 302/306) and
+// `export x.trx` too. They are ignored now, as missing fields are.
+TEST(HostileVxl, ProvenanceOfTheWrongTypesIsIgnored) {
+  ScratchDir dir;
+  const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
+  const SectionEntry prov = valid.entry("PROV");
+  for (const std::string json : {R"({"source": 5})", R"({"source": {"name": 5, "format": [1], "bytes": "x"}})",
+                                 R"({"source": {"name": "a", "format": "trx", "bytes": -3, "header": 7}})", R"([1, 2])"}) {
+    SCOPED_TRACE(json);
+    ASSERT_LE(json.size(), prov.size);
+    VxlBytes b = valid;
+    std::memset(b.bytes.data() + prov.offset, ' ', prov.size);  // JSON allows the trailing blanks
+    std::memcpy(b.bytes.data() + prov.offset, json.data(), json.size());
+    b.reseal();
+    b.write(dir.file("p.vxl"));
+    for (const char* args : {"info --json", "info"}) {
+      const auto r = test::run_cli(std::string(args) + " " + q(dir.file("p.vxl")));
+      EXPECT_EQ(r.exit_code, 0) << args << ": " << r.output;
+    }
+    const auto r = test::run_cli("export " + q(dir.file("p.vxl")) + " " + q(dir.file("p.trx")));
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+  }
+}
+
+// The file's own name goes into the JSON as well, and a file system's names need not be UTF-8: `info --json`
+// replaces what is not (it died of type_error 316 with exit 70).
+TEST(HostileVxl, InfoJsonOfAFileNameThatIsNotUtf8) {
+  ScratchDir dir;
+  VxlBytes::make(dir.file("h.vxl")).write(dir.file("caf\xe9.vxl"));
+  const auto r = test::run_cli("info --json " + q(dir.file("caf\xe9.vxl")));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("caf\xef\xbf\xbd.vxl"), std::string::npos) << r.output;  // U+FFFD
+}
+
+// A value-set name from a file name that is not UTF-8 (a TSF called caf\xe9.tsf on a Latin-1 file
+// system) is written as UTF-8 (each byte read as Latin-1), so that the converter's own output opens.
+TEST(HostileVxl, ValueSetNamesAreWrittenAsUtf8) {
+  EXPECT_EQ(value_set_name("caf\xe9"), "caf\xc3\xa9");
+  EXPECT_EQ(value_set_name("caf\xc3\xa9"), "caf\xc3\xa9");
+  EXPECT_EQ(value_set_name(std::string("a\0b", 3)), "a");
+  EXPECT_TRUE(is_valid_utf8(value_set_name(std::string(40, 'x') + "\xff\xfe\xfd\xfc\xfb")));
+  EXPECT_FALSE(is_valid_utf8("\xc0\xaf"));      // overlong '/'
+  EXPECT_FALSE(is_valid_utf8("\xed\xa0\x80"));  // a surrogate
+  EXPECT_FALSE(is_valid_utf8("\xf4\x90\x80\x80"));  // above U+10FFFF
+  EXPECT_TRUE(is_valid_utf8("\xf4\x8f\xbf\xbf"));
+
+  ScratchDir dir;
+  Tractogram t = test::hostile_source();
+  t.point_values[0].name = "caf\xe9";
+  convert_tractogram(std::move(t), dir.file("v.vxl"), {});
+  EXPECT_EQ(VxlFile::open(dir.file("v.vxl")).vertex_values().name(0), "caf\xc3\xa9");
+}
+
+// Two groups of one name cannot both be groups/NAME.uint32: export refused them only when libzip failed to
+// add the second member (exit 5, as if the output were at fault). The input's groups are what TRX cannot hold.
+TEST(HostileVxl, ExportOfGroupsTrxCannotHoldIsUnsupportedNotAnOutputError) {
+  ScratchDir dir;
+  for (const std::string& second : {std::string("CST_left"), std::string(70000, 'g')}) {
+    Tractogram t = test::hostile_source();
+    t.groups[1].name = second;
+    convert_tractogram(std::move(t), dir.file("g.vxl"), {});
+    try {
+      export_trx(VxlFile::open(dir.file("g.vxl")), dir.file("g.trx"));
+      ADD_FAILURE() << "exported";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Unsupported) << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir.file("g.trx")));
+  }
+}
+
+}  // namespace
+}  // namespace vxl

@@ -1,0 +1,51 @@
+// A voxel far larger than the scene (issue 14, row 10: convert --voxel-size 1e8 ... 1e300) is drawn, not
+// culled away by the near plane.
+#include <filesystem>
+#include <string>
+
+#include "image_io.h"
+#include "test_support.h"
+#include "vxl_file.h"
+
+namespace vxl {
+namespace {
+
+using test::ScratchDir;
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+test::CommandResult voxview(const std::string& args) { return test::run_program(VOXVIEW_CLI, args); }
+
+int lit_pixels(const Image& img) {
+  int n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) n += (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0;
+  return n;
+}
+
+// Row 10: `convert --voxel-size 1e8` (up to 1e300) gives one voxel holding the whole tractogram, valid, but the
+// viewer drew nothing ("0 voxels drawn"): the near plane sat at 10^-4 of a far plane one voxel beyond the
+// scene, i.e. 10 m away. One voxel is drawn now, as at 1e6.
+TEST(VoxviewHugeVoxel, OneVoxelLargerThanTheSceneIsDrawn) {
+  ScratchDir dir;
+  auto r = test::run_cli("synth " + q(dir.file("in.tck")) + " --streamlines 30 --seed 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* size : {"1e6", "1e8", "1e12", "1e300"}) {
+    SCOPED_TRACE(size);
+    r = test::run_cli("convert " + q(dir.file("in.tck")) + " " + q(dir.file("big.vxl")) + " --voxel-size " + size);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const VxlFile f = VxlFile::open(dir.file("big.vxl"));
+    ASSERT_EQ(f.meta().voxel_count, 1u);
+    r = test::run_cli("verify " + q(dir.file("big.vxl")));
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    for (const char* mode : {"axis", "opaque"}) {
+      r = voxview(q(dir.file("big.vxl")) + " --render " + q(dir.file("big.png")) + " --size 64x64 --mode " + mode);
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+      EXPECT_NE(r.output.find(" 1 voxels and "), std::string::npos) << mode << ": " << r.output;
+      EXPECT_GT(lit_pixels(read_image(dir.file("big.png"))), 50) << mode;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace vxl
