@@ -134,7 +134,10 @@ TEST_F(AnatomySlices, ReaderScalesAndWindows) {
     // 2-98 % of the non-zero voxels: 40^3 of the head, 16^3 (6.4 %) of them the cube.
     EXPECT_EQ(v.window[0], 300.0f);
     EXPECT_EQ(v.window[1], 1000.0f);
-  }
+  }  // Exactly the file named: a T1.nii beside T1.nii.gz is not read in its place (nifti_clib's own search would).
+  const std::string gz = write_nifti(dir, "twin", NiftiSpec{false, true, false, ".nii.gz"});
+  std::ofstream(dir.file("twin.nii")) << "not the image";
+  EXPECT_EQ(read_nifti_volume(gz).window[1], 1000.0f);
 }
 
 // The axial slice through the focus shows the cube where the transform puts it: upper right (+x, +y),
@@ -144,7 +147,9 @@ TEST_F(AnatomySlices, SliceShowsTheCubeWhereItIs) {
     SCOPED_TRACE(std::string(spec.use_sform ? "sform" : "qform") + (spec.nifti2 ? " nifti2" : " nifti1"));
     VxlFile scene = make_scene(dir, front_and_back(), 10.0);
     Renderer r(scene);
-    r.set_volume(read_nifti_volume(write_nifti(dir, "cube", spec)));
+    // A name of its own for each: given cube.nii.gz, nifti_clib would read a cube.nii beside it.
+    const std::string name = std::string(spec.use_sform ? "s" : "q") + (spec.nifti2 ? "2" : "1") + (spec.int16_scaled ? "i" : "f");
+    r.set_volume(read_nifti_volume(write_nifti(dir, name, spec)));
     RenderSettings s = axial_only();
     s.opacity = 0.001f;  // the lines out of the way
     const Image in = render_image(r, top_view(12), s, 64, 64);
@@ -192,6 +197,35 @@ TEST_F(AnatomySlices, LinesInFrontBlendOverTheSliceLinesBehindAreHidden) {
     const Image bare = render_image(r, top_view(0), s, 64, 64);
     EXPECT_GT(bare.pixel(column_of(0.5), row_of(-7.5))[0], 100);
   }
+}
+
+// With a slab, the slices are cut by it like the lines; the `view` slice lies in the slab's middle, so it
+// stays whole in an oblique view where the axial slice shrinks to a strip.
+TEST_F(AnatomySlices, SlabShowsTheSliceInItsMiddle) {
+  VxlFile scene = make_scene(dir, front_and_back(), 10.0);
+  Renderer r(scene);
+  r.set_volume(read_nifti_volume(write_nifti(dir, "cube")));
+  Camera oblique = top_view(0);
+  oblique.elevation_deg = 50;
+  oblique.azimuth_deg = 150;
+  RenderSettings s = axial_only();
+  s.opacity = 0.001f;
+  auto grey_pixels = [&](const RenderSettings& settings) {
+    const Image img = render_image(r, oblique, settings, 64, 64);
+    int n = 0;
+    for (int y = 0; y < 64; ++y)
+      for (int x = 0; x < 64; ++x) n += img.pixel(x, y)[1] > 40;  // the head's grey (77) or the cube
+    return n;
+  };
+  const int axial = grey_pixels(s);
+  s.clipping.slab_mm = 4;
+  const int axial_in_slab = grey_pixels(s);
+  s.slices.axial = false;
+  s.slices.view_plane = true;
+  const int view_in_slab = grey_pixels(s);
+  EXPECT_GT(axial, 600);                  // the head's 40 x 40 mm, foreshortened
+  EXPECT_LT(axial_in_slab, axial / 4);    // a strip 4 mm / sin(50 deg) wide
+  EXPECT_GT(view_in_slab, 1000);          // facing the viewer: the head's 40 x 40 mm, whole
 }
 
 class AnatomyCli : public AnatomySlices {
@@ -278,6 +312,7 @@ TEST_F(AnatomyCli, BadImagesAreRefusedNamingTheFile) {
       {dir.file("missing.nii"), "no such file"},
   };
   for (const auto& [path, what] : cases) {
+    std::filesystem::remove(dir.file("out.png"));
     auto r = voxview("--image '" + path + "'");
     EXPECT_EQ(r.exit_code, 3) << path << ": " << r.output;
     EXPECT_NE(r.output.find(path), std::string::npos) << r.output;

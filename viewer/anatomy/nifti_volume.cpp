@@ -61,25 +61,78 @@ std::uint64_t available_bytes(const std::string& path, std::uint64_t wanted) {
   return total;
 }
 
-// The header must say NIfTI-1 (sizeof_hdr 348, magic "n+1"/"ni1" at byte 344) or NIfTI-2 (540, "n+2"/"ni2"
-// at byte 4), in either byte order. nifti_clib alone would also take an ANALYZE 7.5 header (no magic).
-void check_magic(const std::string& path) {
+// The header of exactly `path`, checked before nifti_clib sees it: sizeof_hdr 348 (NIfTI-1, magic "n+1" at
+// byte 344) or 540 (NIfTI-2, "n+2" at byte 4), in either byte order, and sane dimensions. (nifti_clib
+// alone would take an ANALYZE 7.5 header without magic, turn negative dimensions into 1, and, given
+// T1.nii.gz, read T1.nii instead when both exist.) The single-file kinds only: the data follow the header.
+ImagePtr read_header(const std::string& path) {
   const std::vector<unsigned char> h = read_start(path, 540);
   if (h.size() < 4) fail_input(path, 0, "not a NIfTI file: " + std::to_string(h.size()) + " bytes, shorter than any header");
-  std::int32_t size = 0, swapped = 0;
+  std::int32_t size = 0;
   std::memcpy(&size, h.data(), 4);
-  for (int i = 0; i < 4; ++i) reinterpret_cast<unsigned char*>(&swapped)[i] = h[3 - i];
-  const std::int32_t sizeof_hdr = (size == 348 || size == 540) ? size : swapped;
+  const bool swap = size != 348 && size != 540;
+  auto integer = [&](std::size_t at, int bytes) {
+    unsigned char b[8] = {};
+    for (int i = 0; i < bytes; ++i) b[i] = h[at + (swap ? bytes - 1 - i : i)];
+    std::int64_t v = 0;
+    if (bytes == 2) { std::int16_t x; std::memcpy(&x, b, 2); v = x; }
+    if (bytes == 4) { std::int32_t x; std::memcpy(&x, b, 4); v = x; }
+    if (bytes == 8) std::memcpy(&v, b, 8);
+    return v;
+  };
+  const std::int64_t sizeof_hdr = integer(0, 4);
   if (sizeof_hdr != 348 && sizeof_hdr != 540)
     fail_input(path, 0, "not a NIfTI file: expected sizeof_hdr 348 (NIfTI-1) or 540 (NIfTI-2), got " + std::to_string(size));
   if (h.size() < static_cast<std::size_t>(sizeof_hdr))
     fail_input(path, h.size(), "truncated NIfTI header: " + std::to_string(h.size()) + " of " + std::to_string(sizeof_hdr) + " bytes");
-  const std::size_t at = sizeof_hdr == 348 ? 344 : 4;
+  const bool two = sizeof_hdr == 540;
+  const std::size_t at = two ? 4 : 344;
   const char* m = reinterpret_cast<const char*>(h.data() + at);
-  const char version = sizeof_hdr == 348 ? '1' : '2';
-  if (!((m[0] == 'n' && (m[1] == '+' || m[1] == 'i') && m[2] == version && m[3] == '\0')))
-    fail_input(path, at, std::string("wrong magic: expected \"n+") + version + "\" or \"ni" + version + "\" for a " +
-                             (version == '1' ? "NIfTI-1" : "NIfTI-2") + " header");
+  const char version = two ? '2' : '1';
+  if (!(m[0] == 'n' && (m[1] == '+' || m[1] == 'i') && m[2] == version && m[3] == '\0'))
+    fail_input(path, at, std::string("wrong magic: expected \"n+") + version + "\" for a single-file " +
+                             (two ? "NIfTI-2" : "NIfTI-1") + " header");
+  if (m[1] == 'i')
+    fail_unsupported(path, "a two-file NIfTI header (.hdr with its data in .img); give a single-file .nii or .nii.gz");
+  const std::size_t dim_at = two ? 16 : 40, dim_bytes = two ? 8 : 2;
+  const std::int64_t ndim = integer(dim_at, int(dim_bytes));
+  if (ndim < 1 || ndim > 7) fail_input(path, dim_at, "dim[0] (the number of dimensions) is " + std::to_string(ndim) + ", expected 1 to 7");
+  for (int a = 1; a <= ndim; ++a) {
+    const std::int64_t d = integer(dim_at + a * dim_bytes, int(dim_bytes));
+    if (d < 1)
+      fail_input(path, dim_at + a * dim_bytes, "dimension " + std::to_string(a) + " of the image is " + std::to_string(d) + ", expected >= 1");
+  }
+  nifti_image* nim = nullptr;
+  if (two) {
+    nifti_2_header n2;
+    std::memcpy(&n2, h.data(), sizeof n2);
+    nim = nifti_convert_n2hdr2nim(n2, path.c_str());
+  } else {
+    nifti_1_header n1;
+    std::memcpy(&n1, h.data(), sizeof n1);
+    nim = nifti_convert_n1hdr2nim(n1, path.c_str());
+  }
+  if (!nim) fail_input(path, std::nullopt, "nifti_clib cannot read the NIfTI header (inconsistent fields)");
+  ImagePtr image(nim);
+  // The data are in this very file, after the header and its extensions (vox_offset).
+  free(nim->fname);
+  free(nim->iname);
+  nim->fname = nifti_strdup(path.c_str());
+  nim->iname = nifti_strdup(path.c_str());
+  double vox_offset = 0;
+  if (two) {
+    vox_offset = double(integer(168, 8));
+  } else {
+    const std::int32_t bits = static_cast<std::int32_t>(integer(108, 4));
+    float f;
+    std::memcpy(&f, &bits, 4);
+    vox_offset = f;
+  }
+  const std::size_t header_end = static_cast<std::size_t>(sizeof_hdr) + 4;  // and the extension flags
+  if (!std::isfinite(vox_offset) || vox_offset < 0 || vox_offset > 9.0e15)
+    fail_input(path, two ? 168 : 108, "vox_offset " + std::to_string(vox_offset) + " is not a byte offset");
+  nim->iname_offset = std::max<std::int64_t>(static_cast<std::int64_t>(vox_offset), std::int64_t(header_end));
+  return image;
 }
 
 template <typename T>
@@ -148,10 +201,8 @@ std::array<float, 2> percentile_window(const std::vector<float>& values, double 
 Volume read_nifti_volume(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) fail_input(path, std::nullopt, "no such file (expected a NIfTI image)");
-  check_magic(path);
   nifti_set_debug_level(0);  // the library would print its own messages; ours name the file and the cause
-  ImagePtr nim(nifti_image_read(path.c_str(), 0));
-  if (!nim) fail_input(path, std::nullopt, "nifti_clib cannot read the NIfTI header (inconsistent fields)");
+  ImagePtr nim = read_header(path);
   for (int a = 1; a <= 3; ++a)
     if (nim->dim[a] < 1 || nim->dim[a] > (std::int64_t(1) << 31))
       fail_input(path, std::nullopt, "absurd dimension " + std::to_string(a) + " of the image: " + std::to_string(nim->dim[a]) +
@@ -164,7 +215,7 @@ Volume read_nifti_volume(const std::string& path) {
   if (nim->iname_offset < 0) fail_input(path, 108, "negative vox_offset " + std::to_string(nim->iname_offset));
   // Against the file before reading: a header that claims more than the file holds (truncated, or absurd
   // dimensions) must not make the library allocate for it.
-  const std::string data_file = nim->iname ? nim->iname : path;
+  const std::string& data_file = path;
   const double wanted = double(nim->iname_offset) + bytes;
   const std::uint64_t have = available_bytes(data_file, wanted > 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(wanted));
   if (double(have) < wanted)
@@ -176,17 +227,30 @@ Volume read_nifti_volume(const std::string& path) {
   if (voxels > double(std::int64_t(1) << 30))
     fail_unsupported(path, "the image has " + std::to_string(static_cast<std::uint64_t>(voxels)) +
                                " voxels per volume; the viewer shows at most 2^30");
-  for (int a = 4; a <= 7; ++a) nim->dim[a] = 1;
-  nim->dim[0] = nim->ndim = 3;
-  if (nifti_update_dims_from_array(nim.get()) != 0) fail_input(path, std::nullopt, "inconsistent NIfTI dimensions");
-  if (nifti_image_load(nim.get()) < 0 || !nim->data)
-    fail_input(data_file, static_cast<std::uint64_t>(nim->iname_offset), "cannot read the NIfTI voxel data");
+  // The voxels of the first volume, read here rather than by nifti_image_load, which looks for the data
+  // in files beside the one named.
+  const std::size_t n = static_cast<std::size_t>(nim->dim[1] * nim->dim[2] * nim->dim[3]);
+  std::vector<unsigned char> raw(n * static_cast<std::size_t>(nim->nbyper));
+  {
+    ZnzCloser z{znzopen(path.c_str(), "rb", 1)};
+    if (znz_isnull(z.f) || znzseek(z.f, static_cast<znz_off_t>(nim->iname_offset), SEEK_SET) < 0 ||
+        znzread(raw.data(), 1, raw.size(), z.f) != raw.size())
+      fail_input(path, static_cast<std::uint64_t>(nim->iname_offset), "cannot read the NIfTI voxel data");
+  }
+  if (nim->byteorder != nifti_short_order() && nim->swapsize > 1)
+    nifti_swap_Nbytes(static_cast<int64_t>(raw.size() / nim->swapsize), nim->swapsize, raw.data());
+  nim->data = raw.data();  // borrowed for to_float; given back before nifti_image_free sees it
 
   Volume v;
   v.name = path;
-  v.dims = {nim->nx, nim->ny, nim->nz};
-  const std::size_t n = static_cast<std::size_t>(nim->nx * nim->ny * nim->nz);
-  v.values = to_float(*nim, n, path);
+  v.dims = {nim->dim[1], nim->dim[2], nim->dim[3]};
+  try {
+    v.values = to_float(*nim, n, path);
+  } catch (...) {
+    nim->data = nullptr;
+    throw;
+  }
+  nim->data = nullptr;
   const double slope = nim->scl_slope, inter = nim->scl_inter;
   const bool scaled = slope != 0.0 && std::isfinite(slope) && std::isfinite(inter);
   for (float& x : v.values) {
