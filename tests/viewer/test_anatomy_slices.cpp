@@ -237,10 +237,12 @@ class AnatomyCli : public AnatomySlices {
   void SetUp() override {
     AnatomySlices::SetUp();
     ASSERT_TRUE(std::filesystem::exists(VOXVIEW_CLI)) << VOXVIEW_CLI;
-    // Lines far from the cube, so that the brightest grey pixels are the image's.
+    // Two lines along the image's x and y edges (the view frames them): pure red and green, never grey.
     Tractogram t;
-    const float line[] = {-30.0f, -30.0f, 0.0f, -25.0f, -30.0f, 0.0f};
-    t.add_streamline(line, 2);
+    const float along_x[] = {-30.0f, -30.0f, 0.0f, 30.0f, -30.0f, 0.0f};
+    const float along_y[] = {-30.0f, -30.0f, 0.0f, -30.0f, 30.0f, 0.0f};
+    t.add_streamline(along_x, 2);
+    t.add_streamline(along_y, 2);
     make_scene(dir, t, 10.0);
   }
   // The brightest grey (R = G = B) pixel of the last picture.

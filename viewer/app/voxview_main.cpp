@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
                  "focus facing the viewer: with --slab, the slice in its middle), or none; default axial,coronal,sagittal");
   cli.add_option("--focus", focus,
                  "X,Y,Z: the focus point in RAS mm (the view's centre, where the slices cross, the slab's centre); "
-                 "default the centre of the scene");
+                 "default the centre of the tractograms' bounds");
   std::vector<std::string> clips;
   cli.add_option("--slab", slab,
                  "crop to a slab MM thick, centred on the focus point (the view's centre), perpendicular to the view "

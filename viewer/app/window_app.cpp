@@ -220,7 +220,7 @@ double ViewerWindow::aspect() const {
 Camera ViewerWindow::home_camera(double aspect, bool orthographic) const {
   ViewerOptions o = options_;
   o.orthographic = orthographic;
-  return initial_camera(renderer_.scene_min(), renderer_.scene_max(), o, aspect);
+  return initial_camera(renderer_.bounds_min(), renderer_.bounds_max(), o, aspect);
 }
 
 void ViewerWindow::reset_camera(double aspect) {

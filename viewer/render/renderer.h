@@ -71,8 +71,8 @@ class Renderer {
   const std::vector<const VxlFile*>& files() const { return files_; }
   glm::dvec3 bounds_min() const;
   glm::dvec3 bounds_max() const;
-  // The lines' bounds joined with the image's box (when there is one): what the camera frames and the
-  // depth range covers.
+  // The lines' bounds joined with the image's box (when there is one): what the depth range covers (the
+  // camera frames the lines).
   glm::dvec3 scene_min() const;
   glm::dvec3 scene_max() const;
 
