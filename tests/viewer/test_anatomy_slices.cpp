@@ -280,6 +280,24 @@ TEST_F(AnatomyCli, ImageRange) {
   EXPECT_EQ(voxview("--image-range 0,1").exit_code, 2);  // without --image
 }
 
+// The window draws the slices too (under a virtual X server, as the window tests do).
+TEST_F(AnatomyCli, WindowShowsTheSlices) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed";
+  const std::string image = write_nifti(dir, "cube");
+  auto window = [&](const std::string& extra) {
+    const std::string cmd = "xvfb-run -a -s \"-screen 0 800x600x24\" '" + std::string(VOXVIEW_CLI) + "' '" + dir.file("scene.vxl") +
+                            "' --size 64x64 --frames 2 --screenshot '" + dir.file("out.png") + "' --view axial --ortho --focus 0,0,12 " +
+                            "--image '" + image + "' --image-range 0,1000 --slices " + extra;
+    return test::run_program(cmd, "");
+  };
+  auto shown = window("axial");
+  ASSERT_EQ(shown.exit_code, 0) << shown.output;
+  EXPECT_GE(brightest_grey(), 250);  // the cube
+  auto none = window("none");
+  ASSERT_EQ(none.exit_code, 0) << none.output;
+  EXPECT_EQ(brightest_grey(), 0);
+}
+
 TEST_F(AnatomyCli, BadImagesAreRefusedNamingTheFile) {
   const std::string good = write_nifti(dir, "good");
   std::ifstream in(good, std::ios::binary);
