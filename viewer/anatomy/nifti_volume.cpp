@@ -142,11 +142,10 @@ void widen(const void* data, std::size_t n, float* out) {
 }
 
 // The voxels as float, whatever their type.
-std::vector<float> to_float(const nifti_image& nim, std::size_t n, const std::string& path) {
+std::vector<float> to_float(int datatype, const void* d, std::size_t n, const std::string& path) {
   std::vector<float> v(n);
-  const void* d = nim.data;
   const unsigned char* b = static_cast<const unsigned char*>(d);
-  switch (nim.datatype) {
+  switch (datatype) {
     case DT_UINT8: widen<std::uint8_t>(d, n, v.data()); break;
     case DT_INT8: widen<std::int8_t>(d, n, v.data()); break;
     case DT_INT16: widen<std::int16_t>(d, n, v.data()); break;
@@ -171,8 +170,8 @@ std::vector<float> to_float(const nifti_image& nim, std::size_t n, const std::st
       for (std::size_t i = 0; i < n; ++i) v[i] = (float(b[4 * i]) + b[4 * i + 1] + b[4 * i + 2]) / 3.0f;
       break;
     default:
-      fail_unsupported(path, std::string("NIfTI data type ") + nifti_datatype_string(nim.datatype) + " (" +
-                                 std::to_string(nim.datatype) + ") is not supported");
+      fail_unsupported(path, std::string("NIfTI data type ") + nifti_datatype_string(datatype) + " (" +
+                                 std::to_string(datatype) + ") is not supported");
   }
   return v;
 }
@@ -214,12 +213,11 @@ Volume read_nifti_volume(const std::string& path) {
   const double bytes = voxels * nim->nbyper;
   if (nim->iname_offset < 0) fail_input(path, 108, "negative vox_offset " + std::to_string(nim->iname_offset));
   // Against the file before reading: a header that claims more than the file holds (truncated, or absurd
-  // dimensions) must not make the library allocate for it.
-  const std::string& data_file = path;
+  // dimensions) must not make us allocate for it.
   const double wanted = double(nim->iname_offset) + bytes;
-  const std::uint64_t have = available_bytes(data_file, wanted > 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(wanted));
+  const std::uint64_t have = available_bytes(path, wanted > 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(wanted));
   if (double(have) < wanted)
-    fail_input(data_file, have,
+    fail_input(path, have,
                "truncated NIfTI image: the header's " + std::to_string(nim->dim[1]) + "x" + std::to_string(nim->dim[2]) + "x" +
                    std::to_string(nim->dim[3]) + " voxels of " + std::to_string(nim->nbyper) + " bytes at offset " +
                    std::to_string(nim->iname_offset) + " need " + std::to_string(static_cast<std::uint64_t>(wanted)) +
@@ -239,18 +237,12 @@ Volume read_nifti_volume(const std::string& path) {
   }
   if (nim->byteorder != nifti_short_order() && nim->swapsize > 1)
     nifti_swap_Nbytes(static_cast<int64_t>(raw.size() / nim->swapsize), nim->swapsize, raw.data());
-  nim->data = raw.data();  // borrowed for to_float; given back before nifti_image_free sees it
 
   Volume v;
   v.name = path;
   v.dims = {nim->dim[1], nim->dim[2], nim->dim[3]};
-  try {
-    v.values = to_float(*nim, n, path);
-  } catch (...) {
-    nim->data = nullptr;
-    throw;
-  }
-  nim->data = nullptr;
+  v.values = to_float(nim->datatype, raw.data(), n, path);
+  raw = {};
   const double slope = nim->scl_slope, inter = nim->scl_inter;
   const bool scaled = slope != 0.0 && std::isfinite(slope) && std::isfinite(inter);
   for (float& x : v.values) {

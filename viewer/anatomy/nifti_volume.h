@@ -1,6 +1,8 @@
 // Reads an anatomical image (NIfTI-1 or NIfTI-2, .nii or .nii.gz) into a render-side Volume, with
 // Debian's nifti_clib (libnifti2). Every malformed file is a vxl::Error naming it (exit 3); sizes beyond
-// what the viewer handles are exit 4.
+// what the viewer handles are exit 4. The header's size, magic and dimensions are checked against the
+// file, and the voxels read, here; nifti_clib interprets the header (types, byte order, transforms).
+// Single-file NIfTI only (.hdr/.img pairs are refused, exit 4).
 //
 //   values  any NIfTI data type, as float, scaled by scl_slope / scl_inter (slope 0: unscaled); RGB and
 //           complex types give their mean / magnitude; NaN and infinities become 0. A 4D image gives its
