@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <cstdio>
 
 #include "camera_file.h"
 #include "egl_context.h"
 #include "image_io.h"
+#include "nifti_volume.h"
 #include "offscreen_target.h"
 #include "renderer.h"
 #include "scene_source.h"
@@ -23,6 +25,7 @@ Camera initial_camera(const glm::dvec3& lo, const glm::dvec3& hi, const ViewerOp
       c.azimuth_deg = (*options.view)[0];
       c.elevation_deg = (*options.view)[1];
     }
+    if (options.focus) c.target = *options.focus;
     return c;
   }
   Camera c;
@@ -31,14 +34,19 @@ Camera initial_camera(const glm::dvec3& lo, const glm::dvec3& hi, const ViewerOp
   c.azimuth_deg = view[0];
   c.elevation_deg = view[1];
   c.frame(lo, hi, aspect);
+  if (options.focus) c.target = *options.focus;
   return c;
 }
 
 int run_headless(const ViewerOptions& o) {
   auto t0 = std::chrono::steady_clock::now();
   const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
+  std::optional<Volume> volume;
+  if (o.image) volume = read_nifti_volume(*o.image);  // before any GL work: a bad image fails fast
   HeadlessGlContext context;
   Renderer renderer(pointers(files));
+  if (volume) renderer.set_volume(*volume);
+  volume.reset();
   check_color_options(o.inputs_name(), renderer, o.settings);
   OffscreenTarget target(o.width, o.height);
   target.bind();

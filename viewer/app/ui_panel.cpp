@@ -157,6 +157,38 @@ void clipping_controls(PanelState& state, const PanelStats& stats, PanelRequests
   }
 }
 
+// The anatomical image's slices: which are shown, where they cross (the focus), the grey range.
+void image_controls(PanelState& state, const PanelStats& stats, PanelRequests& out) {
+  if (!stats.has_image) return;
+  SliceSettings& sl = state.settings.slices;
+  ImGui::Separator();
+  ImGui::AlignTextToFramePadding();
+  ImGui::TextUnformatted("Slices");
+  ImGui::SameLine();
+  ImGui::Checkbox("axial", &sl.axial);
+  ImGui::SameLine();
+  ImGui::Checkbox("coronal", &sl.coronal);
+  ImGui::SameLine();
+  ImGui::Checkbox("sagittal", &sl.sagittal);
+  ImGui::SameLine();
+  ImGui::Checkbox("view", &sl.view_plane);
+  float focus[3] = {static_cast<float>(stats.focus[0]), static_cast<float>(stats.focus[1]), static_cast<float>(stats.focus[2])};
+  if (ImGui::DragFloat3("Focus mm", focus, 0.5f, 0.0f, 0.0f, "%.1f")) out.focus = std::array<double, 3>{focus[0], focus[1], focus[2]};
+  bool automatic = !sl.range;
+  if (ImGui::Checkbox("auto grey", &automatic)) {
+    if (automatic) sl.range.reset();
+    else sl.range = stats.image_range;
+  }
+  ImGui::SameLine();
+  ImGui::BeginDisabled(automatic);
+  std::array<float, 2> r = sl.range.value_or(stats.image_range);
+  ImGui::PushItemWidth(150);
+  const float step = std::max(1e-3f, (r[1] - r[0]) / 200.0f);
+  if (ImGui::DragFloat2("range##image", r.data(), step, 0.0f, 0.0f, "%.4g") && r[1] > r[0]) sl.range = r;
+  ImGui::PopItemWidth();
+  ImGui::EndDisabled();
+}
+
 }  // namespace
 
 UiPanel::UiPanel(GLFWwindow* window) {
@@ -231,6 +263,7 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   ImGui::EndDisabled();
 
   clipping_controls(state, stats, out);
+  image_controls(state, stats, out);
 
   ImGui::Separator();
   ImGui::AlignTextToFramePadding();
@@ -292,6 +325,11 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
         "PgUp PgDn     move the slab (shift: x10; or ctrl + wheel)\n"
         "F1 F2 F3      toggle clip plane 1 2 3 (adds one through\n"
         "              the focus on x, y, z if missing)\n"
+        "Up Down       image: focus S / I (the axial slice)\n"
+        "Right Left    image: focus R / L (the sagittal slice)\n"
+        "Home End      image: focus A / P (the coronal slice)\n"
+        "              (1 mm; shift: 10 mm)\n"
+        "I             image slices shown / hidden\n"
         "Esc Q         quit");
   }
   ImGui::PopItemWidth();

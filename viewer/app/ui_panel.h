@@ -43,6 +43,9 @@ struct PanelStats {
   std::vector<std::string> value_sets;                          // what --color scalar can show
   std::vector<std::pair<std::string, std::uint64_t>> groups;    // name, streamlines
   std::array<float, 2> scalar_range = {0, 1};                   // the range in use
+  bool has_image = false;                                       // --image: the slice controls are shown
+  std::array<float, 2> image_range = {0, 1};                    // the slices' grey range in use
+  double focus[3] = {0, 0, 0};                                  // the focus point (camera target), RAS mm
 };
 
 struct PanelRequests {
@@ -51,6 +54,7 @@ struct PanelRequests {
   bool screenshot = false;
   bool save_view = false;  // write the view (camera and settings) for --camera
   double move_focus = 0;  // mm along the view direction (moves the slab)
+  std::optional<std::array<double, 3>> focus;  // a new focus point (moves the slices), RAS mm
 };
 
 class UiPanel {

@@ -14,6 +14,8 @@ struct ViewerOptions {
   std::vector<std::string> inputs;   // .vxl, or a .tck/.trk/.trx/.vtk/.vtp converted in memory; several: one scene
   // How the inputs are named in messages and titles: the first file's name, "+ N more" for the others.
   std::string inputs_name() const;
+  std::optional<std::string> image;       // an anatomical NIfTI image shown as slices under the lines
+  std::optional<glm::dvec3> focus;        // the focus point (camera target, slices, slab centre), RAS mm
   std::optional<std::string> render_png;  // headless: render one frame to this PNG and exit
   RenderSettings settings;
   std::optional<std::array<double, 2>> view;  // azimuth, elevation; default: an oblique view

@@ -33,7 +33,10 @@ int main(int argc, char** argv) {
                "Esc/Q quit.\n"
                "Slab and clip planes: C slab on/off, [ ] thinner/thicker, PageUp/PageDown or Ctrl+wheel move the slab\n"
                "(the focus) along the view direction (Shift: 10x), F1/F2/F3 toggle clip planes 1/2/3. V saves the view (see\n"
-               "--save-camera) for replaying headless with --camera."};
+               "--save-camera) for replaying headless with --camera.\n"
+               "Image slices (--image): Up/Down move the focus (and the axial slice) along S/I, Right/Left along R/L (the\n"
+               "sagittal slice), Home/End along A/P (the coronal slice), 1 mm a press (Shift: 10 mm); I shows/hides the\n"
+               "slices."};
   cli.add_option("files", o.inputs,
                  "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx / .vtk / .vtp tractogram; several are shown together "
                  "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
@@ -78,6 +81,19 @@ int main(int argc, char** argv) {
                "dark, one across it bright)");
   cli.add_option("--line-width", line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
   cli.add_option("--background", background, "black or white")->default_val("black")->check(CLI::IsMember({"black", "white"}));
+  std::string image_range, slices, focus;
+  cli.add_option("--image", o.image,
+                 "an anatomical image (NIfTI-1 or -2, .nii or .nii.gz, e.g. a T1) shown as opaque grey slices through the "
+                 "focus point under the lines (lines behind a slice are hidden by it, lines in front blend over it)");
+  cli.add_option("--image-range", image_range,
+                 "MIN,MAX: the image values shown black and white (default: the 2nd and 98th percentiles of the image's "
+                 "non-zero voxels)");
+  cli.add_option("--slices", slices,
+                 "which slices of --image to show: a comma list of axial, coronal, sagittal and view (the plane through the "
+                 "focus facing the viewer: with --slab, the slice in its middle), or none; default axial,coronal,sagittal");
+  cli.add_option("--focus", focus,
+                 "X,Y,Z: the focus point in RAS mm (the view's centre, where the slices cross, the slab's centre); "
+                 "default the centre of the tractograms' bounds");
   std::vector<std::string> clips;
   cli.add_option("--slab", slab,
                  "crop to a slab MM thick, centred on the focus point (the view's centre), perpendicular to the view "
@@ -95,12 +111,13 @@ int main(int argc, char** argv) {
   cli.add_option("--frames", o.frames, "window: quit after this many frames (for scripts and tests)")->check(CLI::PositiveNumber);
   cli.add_option("--screenshot", o.screenshot, "window: save the last frame to this PNG before quitting");
   try {
-    // "--clip -x,10": CLI11 would take "-x,10" for an option; pass it as "--clip=-x,10".
+    // "--clip -x,10", "--focus -5,0,0": CLI11 would take "-x,10" for an option; pass it as "--clip=-x,10".
     std::vector<std::string> args;
     for (int i = argc - 1; i >= 1; --i) {
       const std::string a = argv[i];
-      if (i >= 2 && std::string(argv[i - 1]) == "--clip" && a.size() > 1 && a[0] == '-' && a[1] != '-') {
-        args.push_back("--clip=" + a);
+      const std::string before = i >= 2 ? argv[i - 1] : "";
+      if ((before == "--clip" || before == "--focus") && a.size() > 1 && a[0] == '-' && a[1] != '-') {
+        args.push_back(before + "=" + a);
         --i;
       } else {
         args.push_back(a);
@@ -160,6 +177,43 @@ int main(int argc, char** argv) {
                     "--clip: expected AXIS,POS with AXIS one of x y z -x -y -z and POS in mm (e.g. -z,12.5); got '" + c + "'");
       s.clipping.planes.push_back(*plane);
     }
+    if (given("--image-range")) {
+      float lo = 0, hi = 0;
+      char end = 0;
+      if (std::sscanf(image_range.c_str(), "%f,%f%c", &lo, &hi, &end) != 2 || !std::isfinite(lo) || !std::isfinite(hi) ||
+          !(hi > lo))
+        throw Error(ErrorKind::Usage, "", std::nullopt,
+                    "--image-range: expected MIN,MAX with MIN < MAX (e.g. 0,800); got '" + image_range + "'");
+      s.slices.range = std::array<float, 2>{lo, hi};
+    }
+    if (given("--slices")) {
+      SliceSettings& sl = s.slices;
+      sl.axial = sl.coronal = sl.sagittal = sl.view_plane = false;
+      std::size_t start = 0;
+      while (slices != "none") {
+        const std::size_t comma = slices.find(',', start);
+        const std::string name = slices.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        if (name == "axial") sl.axial = true;
+        else if (name == "coronal") sl.coronal = true;
+        else if (name == "sagittal") sl.sagittal = true;
+        else if (name == "view") sl.view_plane = true;
+        else
+          throw Error(ErrorKind::Usage, "", std::nullopt,
+                      "--slices: expected a comma list of axial, coronal, sagittal, view, or none; got '" + slices + "'");
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+      }
+    }
+    if (given("--focus")) {
+      double x = 0, y = 0, z = 0;
+      char end = 0;
+      if (std::sscanf(focus.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &end) != 3 || !std::isfinite(x) || !std::isfinite(y) ||
+          !std::isfinite(z))
+        throw Error(ErrorKind::Usage, "", std::nullopt, "--focus: expected X,Y,Z in mm (e.g. 0,-10,12.5); got '" + focus + "'");
+      o.focus = glm::dvec3(x, y, z);
+    }
+    if ((given("--image-range") || given("--slices")) && !o.image)
+      throw Error(ErrorKind::Usage, "", std::nullopt, "--image-range and --slices need --image FILE.nii[.gz]");
     if (!view.empty()) {
       o.view = parse_view(view);
       if (!o.view) throw Error(ErrorKind::Usage, "", std::nullopt, "--view: unknown view '" + view + "'");

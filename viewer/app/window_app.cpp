@@ -21,6 +21,7 @@
 #include "grid_overlay.h"
 #include "headless_render.h"
 #include "image_io.h"
+#include "nifti_volume.h"
 #include "offscreen_target.h"
 #include "renderer.h"
 #include "scene_source.h"
@@ -117,7 +118,7 @@ std::filesystem::path stamped_name(const std::string& prefix, const std::string&
 // user pointer.
 class ViewerWindow {
  public:
-  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, GLFWwindow* window);
+  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume, GLFWwindow* window);
   int run();
 
  private:
@@ -128,6 +129,7 @@ class ViewerWindow {
   void on_key(int key, int action, int mods);
   void on_char(unsigned codepoint);
   void toggle_clip_plane(std::size_t i);
+  void move_focus_along(int axis, double mm);
 
   Camera home_camera(double aspect, bool orthographic) const;
   void reset_camera(double aspect);
@@ -154,14 +156,19 @@ class ViewerWindow {
   bool save_view_requested_ = false;
   RenderMode drawn_mode_ = RenderMode::Axis;  // the mode of the last frame, to clear a mode's error once another is chosen
   unsigned events_ = 0;  // input events seen, to keep drawing while something happens
+  SliceSettings hidden_slices_;  // which slices I brings back
 };
 
-ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, GLFWwindow* window)
+ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume,
+                           GLFWwindow* window)
     : options_(o),
       window_(window),
       renderer_(pointers(files)),
       grid_(renderer_),
-      controller_(Camera{}, std::max(1.0, glm::length(renderer_.bounds_max() - renderer_.bounds_min()) * 0.5)) {
+      controller_(Camera{}, 1.0) {
+  if (volume) renderer_.set_volume(*volume);
+  controller_ = CameraController(Camera{}, std::max(1.0, glm::length(renderer_.scene_max() - renderer_.scene_min()) * 0.5));
+  stats_.has_image = volume != nullptr;
   check_color_options(o.inputs_name(), renderer_, o.settings);
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
@@ -279,6 +286,13 @@ void ViewerWindow::toggle_clip_plane(std::size_t i) {
   planes.push_back(p);
 }
 
+// Moves the focus point (where the slices cross) along a RAS axis; the view follows it.
+void ViewerWindow::move_focus_along(int axis, double mm) {
+  Camera c = controller_.camera();
+  c.target[axis] += mm;
+  controller_.set_camera(c);
+}
+
 // Keys bound to a place on the keyboard: Esc and the digit row (with Shift for the opposite view).
 void ViewerWindow::on_key(int key, int action, int mods) {
   events_++;
@@ -288,6 +302,16 @@ void ViewerWindow::on_key(int key, int action, int mods) {
   if (key == GLFW_KEY_PAGE_UP || key == GLFW_KEY_PAGE_DOWN) {
     controller_.move_focus((key == GLFW_KEY_PAGE_UP ? -1.0 : 1.0) * (shift ? 10.0 : 1.0));
     return;
+  }
+  const double step = shift ? 10.0 : 1.0;
+  switch (key) {
+    case GLFW_KEY_UP: move_focus_along(2, step); return;
+    case GLFW_KEY_DOWN: move_focus_along(2, -step); return;
+    case GLFW_KEY_RIGHT: move_focus_along(0, step); return;
+    case GLFW_KEY_LEFT: move_focus_along(0, -step); return;
+    case GLFW_KEY_HOME: move_focus_along(1, step); return;
+    case GLFW_KEY_END: move_focus_along(1, -step); return;
+    default: break;
   }
   if (action != GLFW_PRESS) return;
   const char* view = nullptr;
@@ -320,6 +344,16 @@ void ViewerWindow::on_char(unsigned c) {
     case '-': case '_': s.opacity = std::clamp(s.opacity / 1.5f, 0.001f, 1.0f); break;
     case 's': case 'S': screenshot_requested_ = true; break;
     case 'l': case 'L': s.lighting = !s.lighting; break;
+    case 'i': case 'I':
+      if (s.slices.any()) {
+        hidden_slices_ = s.slices;
+        s.slices.axial = s.slices.coronal = s.slices.sagittal = s.slices.view_plane = false;
+      } else {
+        const auto range = s.slices.range;  // the grey range may have changed in the panel meanwhile
+        s.slices = hidden_slices_.any() ? hidden_slices_ : SliceSettings{};
+        s.slices.range = range;
+      }
+      break;
     case 'v': case 'V': save_view_requested_ = true; break;
     case 'r': case 'R': reset_camera(aspect()); break;
     case 'q': case 'Q': glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
@@ -374,6 +408,8 @@ void ViewerWindow::draw_scene(int width, int height) {
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
   const FrameStats& f = renderer_.stats();
   stats_.scalar_range = renderer_.scalar_range(s);
+  stats_.image_range = renderer_.slice_range(s);
+  for (int a = 0; a < 3; ++a) stats_.focus[a] = camera.target[a];
   stats_.plan_ms = f.plan_ms;
   stats_.voxels_drawn = f.voxels_drawn;
   stats_.segments_drawn = f.segments_drawn;
@@ -428,6 +464,8 @@ int ViewerWindow::run() {
     if (requests.view) controller_.set_view((*requests.view)[0], (*requests.view)[1]);
     if (requests.reset_camera) reset_camera(double(fb_w) / fb_h);
     if (requests.move_focus != 0) controller_.move_focus(requests.move_focus);
+    if (requests.focus)
+      for (int a = 0; a < 3; ++a) move_focus_along(a, (*requests.focus)[a] - controller_.camera().target[a]);
     screenshot_requested_ |= requests.screenshot;
     save_view_requested_ |= requests.save_view;
 
@@ -466,8 +504,11 @@ int ViewerWindow::run() {
 int run_window(const ViewerOptions& o) {
   GlfwLibrary glfw;  // first: without a display, fail before any slow conversion
   const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
+  std::optional<Volume> volume;
+  if (o.image) volume = read_nifti_volume(*o.image);
   WindowPtr window = open_window(o);
-  ViewerWindow viewer(o, files, window.get());
+  ViewerWindow viewer(o, files, volume ? &*volume : nullptr, window.get());
+  volume.reset();  // uploaded
   return viewer.run();
 }
 

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include <glm/gtc/type_ptr.hpp>
+
 #include "line_shaders.h"
 #include "renderer.h"
 
@@ -20,6 +22,7 @@ layout(std430, binding = 1) buffer Nodes { uvec4 nodes[]; };
 uniform uint u_capacity;
 uniform ivec4 u_band;  // x0, y0, x1, y1: only fragments inside are stored this pass
 void main() {
+  discard_behind_slices();
   ivec2 p = ivec2(gl_FragCoord.xy);
   if (p.x < u_band.x || p.y < u_band.y || p.x >= u_band.z || p.y >= u_band.w) discard;
   uint i = atomicCounterIncrement(u_counter);
@@ -113,6 +116,15 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
   FramePlan plan;
   lines_.plan(camera, aspect, PlanOrder::Any, plan, s.clipping);
   const glm::vec3 bg = s.background();
+  // The lines are composited over the opaque slices where there are some (their colour is the
+  // background there); the list pass has already dropped the fragments behind them.
+  base_.clear();
+  if (const GLuint slices = lines_.slice_color_texture()) {
+    base_.resize(std::size_t(width) * height * 4);
+    glBindTexture(GL_TEXTURE_2D, slices);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, base_.data());
+  }
 
   // Bands of rows; a band whose fragments overflow the node buffer is split in two and redone.
   std::vector<std::array<int, 2>> bands = {{0, height}};
@@ -195,6 +207,7 @@ void ExactRenderer::resolve_band(int y0, int y1, std::uint32_t stored, const glm
       // Farthest first; equal depths in a fixed (node) order, so no fragment is lost or doubled.
       std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a > b; });
       glm::vec3 color = background;
+      if (!base_.empty()) color = glm::make_vec3(base_.data() + (std::size_t(y) * width_ + x) * 4);
       for (const auto& [depth, i] : list) {
         const std::array<std::uint32_t, 4>& n = nodes_copy_[i];
         const glm::vec3 c(half_to_float(n[0] & 0xFFFF), half_to_float(n[0] >> 16), half_to_float(n[1] & 0xFFFF));

@@ -2,7 +2,8 @@
 //
 // Pass 1 stores every line fragment (colour, depth) in per-pixel linked lists (a head image, a node
 // buffer, an atomic counter). Pass 2 reads the lists back and composites each pixel's fragments back to
-// front on the CPU, in (depth, node index) order, so lists of any length are resolved exactly. When the
+// front on the CPU, in (depth, node index) order, so lists of any length are resolved exactly, over the
+// background or the anatomical slices (slice_renderer.h). When the
 // node buffer would overflow, the image is rendered in horizontal bands. Needs OpenGL 4.3.
 //
 // Why the CPU: the reference must not depend on a shader compiler. On llvmpipe 22.3 a fragment-shader
@@ -49,6 +50,7 @@ class ExactRenderer {
   std::vector<std::uint32_t> heads_copy_;
   std::vector<std::array<std::uint32_t, 4>> nodes_copy_;  // colour rg, colour ba (half floats), depth, next
   std::vector<float> rows_;
+  std::vector<float> base_;  // the slices' colour under the lines (RGBA, bottom row first); empty: none
 };
 
 }  // namespace vxl

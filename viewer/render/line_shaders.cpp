@@ -136,6 +136,13 @@ vec3 colormap(float t) {
   int i = min(int(x), SAMPLES - 2);
   return mix(u_colormap[i], u_colormap[i + 1], x - float(i));
 }
+uniform sampler2D u_slice_depth;  // slice_renderer.h: window depth of the nearest opaque slice (1: none)
+uniform int u_slice_test;         // 1: slices are drawn this frame
+// The depth test against the opaque slices, done here rather than by the depth buffer so that it holds
+// in every mode, including the multipass ones and exact's per-pixel lists.
+void discard_behind_slices() {
+  if (u_slice_test != 0 && gl_FragCoord.z > texelFetch(u_slice_depth, ivec2(gl_FragCoord.xy), 0).r) discard;
+}
 vec4 line_color() {
   vec3 base = v_mapped > 0.5 ? colormap(v_value) : v_color.rgb;
   return vec4(base * v_light.x + vec3(v_light.y), v_color.a);
@@ -145,12 +152,16 @@ vec4 line_color() {
 
 const char* const kLineOverFragment = R"(
 out vec4 frag;
-void main() { frag = line_color(); }
+void main() {
+  discard_behind_slices();
+  frag = line_color();
+}
 )";
 
 const char* const kLineWboitAccumFragment = R"(
 out vec4 accum;
 void main() {
+  discard_behind_slices();
   vec4 c = line_color();
   float a = c.a;
   // Weight function (7) of McGuire & Bavoil 2013, with depth in mm scaled to their units.
@@ -162,12 +173,16 @@ void main() {
 
 const char* const kLineWboitRevealFragment = R"(
 out vec4 reveal;
-void main() { reveal = vec4(v_color.a); }
+void main() {
+  discard_behind_slices();
+  reveal = vec4(v_color.a);
+}
 )";
 
 const char* const kLineAdditiveFragment = R"(
 out vec4 frag;
 void main() {
+  discard_behind_slices();
   vec4 c = line_color();
   frag = vec4(c.rgb * c.a, c.a);
 }
@@ -192,7 +207,7 @@ void main() {
   float revealage = texture(u_reveal, v_uv).r;
   if (revealage >= 1.0) discard;
   vec3 color = accum.rgb / max(accum.a, 1e-5);
-  frag = vec4(color, 1.0 - revealage);  // blended over the background
+  frag = vec4(color, 1.0 - revealage);  // blended over the background (or the slices drawn there)
 }
 )";
 

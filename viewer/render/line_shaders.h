@@ -13,7 +13,8 @@ inline constexpr int kShaderGroups = 64;
 std::string line_vertex(unsigned chunk_count, const char* version = "#version 330 core");
 
 // A fragment shader for the line pass: `body` (with its main) after the line inputs and line_color(),
-// which gives the fragment's colour and alpha (colour map per fragment, lighting).
+// which gives the fragment's colour and alpha (colour map per fragment, lighting), and
+// discard_behind_slices(), which each body calls first (the opaque slices hide what is behind them).
 std::string line_fragment(const char* body, const char* version = "#version 330 core");
 
 // Bodies for line_fragment.

@@ -1,5 +1,5 @@
 // What the user chooses about a picture: transparency mode, colouring, lighting, opacity, line width,
-// background, slab and clip planes.
+// background, slab and clip planes, anatomical slices.
 #pragma once
 
 #include <array>
@@ -51,6 +51,16 @@ std::string hex_color(const glm::vec3& color);
 // "NAME=#RRGGBB", "NAME=#RRGGBB:0.5", "NAME=:0" (opacity only); nullopt when malformed.
 std::optional<GroupStyle> parse_group_style(const std::string& text);
 
+// The anatomical image's slices (slice_renderer.h): which planes through the focus point (the camera's
+// target) are shown, and the grey range.
+struct SliceSettings {
+  bool axial = true, coronal = true, sagittal = true;
+  // The plane through the focus perpendicular to the view: with a slab, the slice in its middle.
+  bool view_plane = false;
+  std::optional<std::array<float, 2>> range;  // values shown black and white; none: the image's default window
+  bool any() const { return axial || coronal || sagittal || view_plane; }
+};
+
 struct RenderSettings {
   RenderMode mode = RenderMode::Axis;
   ColorMode color = ColorMode::Direction;
@@ -67,6 +77,7 @@ struct RenderSettings {
   std::vector<GroupStyle> group_styles;   // only the groups the user changed
   Clipping clipping;       // slab and clip planes (clip_planes.h)
   bool lighting = false;   // illuminated lines (line_lighting.h)
+  SliceSettings slices;    // drawn when the renderer has a volume (Renderer::set_volume)
   glm::vec3 background() const { return white_background ? glm::vec3(1.0f) : glm::vec3(0.0f); }
   // The colour and opacity factor of group `index` called `name`.
   glm::vec4 group_color(const std::string& name, std::size_t index) const;

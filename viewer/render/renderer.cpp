@@ -11,6 +11,7 @@
 #include "exact_renderer.h"
 #include "line_lighting.h"
 #include "line_shaders.h"
+#include "slice_renderer.h"
 #include "vertex_attributes.h"
 
 namespace vxl {
@@ -46,6 +47,7 @@ Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels)
 
 Renderer::~Renderer() {
   exact_.reset();
+  slices_.reset();
   for (GLuint p : {over_program_, accum_program_, reveal_program_, additive_program_, wboit_composite_, additive_composite_})
     if (p) glDeleteProgram(p);
   wboit_target_.destroy();
@@ -80,12 +82,23 @@ glm::dvec3 Renderer::bounds_max() const {
   return hi;
 }
 
+glm::dvec3 Renderer::scene_min() const { return slices_ ? glm::min(bounds_min(), slices_->ras_min()) : bounds_min(); }
+glm::dvec3 Renderer::scene_max() const { return slices_ ? glm::max(bounds_max(), slices_->ras_max()) : bounds_max(); }
+
+void Renderer::set_volume(const Volume& volume) { slices_ = std::make_unique<SliceRenderer>(volume); }
+
+std::array<float, 2> Renderer::slice_range(const RenderSettings& s) const {
+  return slices_ ? slices_->range(s.slices) : std::array<float, 2>{0, 1};
+}
+
+GLuint Renderer::slice_color_texture() const { return slices_drawn_ ? slices_->color_texture() : 0; }
+
 glm::dmat4 Renderer::projection(const Camera& camera, double aspect) const {
-  // Near and far planes hug the scene's bounding sphere, for depth precision. The margin is a voxel, but
-  // never more than the scene's own size: every vertex lies inside the bounds, and a voxel far larger than
-  // the scene (--voxel-size 1e8) would put the near plane (far · 1e-4) beyond every line.
-  glm::dvec3 centre = (bounds_min() + bounds_max()) * 0.5;
-  const double half_diagonal = glm::length(bounds_max() - bounds_min()) * 0.5;
+  // Near and far planes hug the scene's bounding sphere (lines and image), for depth precision. The margin
+  // is a voxel, but never more than the scene's own size: every vertex lies inside the bounds, and a voxel
+  // far larger than the scene (--voxel-size 1e8) would put the near plane (far · 1e-4) beyond every line.
+  glm::dvec3 centre = (scene_min() + scene_max()) * 0.5;
+  const double half_diagonal = glm::length(scene_max() - scene_min()) * 0.5;
   double radius = std::max(1.0, half_diagonal + std::min(scene_.layout().voxel_size(), std::max(1.0, half_diagonal)));
   double along = glm::dot(centre - camera.eye(), camera.forward());
   double far_mm = along + radius;
@@ -163,6 +176,14 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   if (clips > 0) glUniform4fv(glGetUniformLocation(program, "u_clip"), clips, glm::value_ptr(clip[0]));
   glUniform1i(glGetUniformLocation(program, "u_clip_count"), clips);
   enable_clip_distances(clips);
+  // The slices' depth on the first unit after the chunks' (a unit of its own: two sampler types must not
+  // share one), bound even when unused.
+  const GLint unit = static_cast<GLint>(kSamplersPerChunk * std::max<std::size_t>(1, scene_.chunks().size()));
+  glActiveTexture(GL_TEXTURE0 + unit);
+  glBindTexture(GL_TEXTURE_2D, slices_drawn_ ? slices_->depth_texture() : 0);
+  glUniform1i(glGetUniformLocation(program, "u_slice_depth"), unit);
+  glUniform1i(glGetUniformLocation(program, "u_slice_test"), slices_drawn_ ? 1 : 0);
+  glActiveTexture(GL_TEXTURE0);
 }
 
 void Renderer::enable_clip_distances(int n) {
@@ -276,7 +297,16 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
     glClearDepth(1.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   };
+  // The picture's base under the lines: the background, or the slices over it.
+  auto clear_to_base = [&] {
+    clear_target(fbo, glm::vec4(bg, 1));
+    if (slices_drawn_) slices_->copy_color();
+  };
   prepare_attributes(s);
+  // The opaque slices first: their colour is the base of the picture, their depth hides lines behind them.
+  slices_drawn_ = slices_ && s.slices.any();
+  if (slices_drawn_)
+    slices_->draw(camera, projection(camera, aspect), s.slices, clip_half_spaces(s.clipping, camera), bg, width, height);
   glLineWidth(std::max(1.0f, s.line_width));
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
@@ -284,7 +314,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
 
   switch (s.mode) {
     case RenderMode::Opaque:
-      clear_target(fbo, glm::vec4(bg, 1));
+      clear_to_base();
       glEnable(GL_DEPTH_TEST);
       glDepthFunc(GL_LESS);
       // The colour replaces, the alpha stays the clear's 1: an opaque picture (a PNG would otherwise keep
@@ -295,17 +325,17 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       glDisable(GL_DEPTH_TEST);
       break;
     case RenderMode::Unsorted:
-      clear_target(fbo, glm::vec4(bg, 1));
+      clear_to_base();
       over_blending();
       draw_dataset_order(over_program_, camera, s, aspect);
       break;
     case RenderMode::Basic:
-      clear_target(fbo, glm::vec4(bg, 1));
+      clear_to_base();
       over_blending();
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Block);
       break;
     case RenderMode::Axis:
-      clear_target(fbo, glm::vec4(bg, 1));
+      clear_to_base();
       over_blending();
       plan_.order_hysteresis = s.order_hysteresis;
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Nearest);
@@ -329,7 +359,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       draw_plan(plan_.first, plan_.count);
       const GLenum both[2] = {accum, reveal};
       glDrawBuffers(2, both);
-      clear_target(fbo, glm::vec4(bg, 1));
+      clear_to_base();
       over_blending();
       composite(wboit_composite_, {{"u_accum", wboit_target_.color[0]}, {"u_reveal", wboit_target_.color[1]}});
       break;
@@ -351,7 +381,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       glBlendFunc(GL_ONE, GL_ONE);
       bind_line_program(additive_program_, camera, s, aspect);
       draw_plan(plan_.first, plan_.count);
-      clear_target(fbo, glm::vec4(bg, 1));
+      clear_to_base();
       over_blending();
       glUseProgram(additive_composite_);
       glUniform1f(glGetUniformLocation(additive_composite_, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));

@@ -3,6 +3,7 @@
 //
 //   Renderer r(file);                       // uploads the scene (few large copies)
 //   Renderer r({&a, &b});                   // several files, their voxels sorted together every frame
+//   r.set_volume(volume);                   // optional: an anatomical image, shown as opaque slices
 //   r.draw(camera, settings, w, h, fbo);    // one frame into the bound framebuffer `fbo`
 #pragma once
 
@@ -24,6 +25,8 @@
 namespace vxl {
 
 class ExactRenderer;
+class SliceRenderer;
+struct Volume;
 
 struct FrameStats {
   double plan_ms = 0;  // CPU work of the frame: cull + sort + order pick + command building
@@ -46,6 +49,15 @@ class Renderer {
   // Throws std::runtime_error when the mode needs more than the context offers (exact on GL < 4.3).
   void draw(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
 
+  // Uploads an anatomical image; settings.slices then chooses which of its slices every frame shows under
+  // the lines. The volume need not outlive the call.
+  void set_volume(const Volume& volume);
+  bool has_volume() const { return slices_ != nullptr; }
+  // The grey range the slices use for `settings` (its range, else the image's window); {0, 1} without an image.
+  std::array<float, 2> slice_range(const RenderSettings& settings) const;
+  // The slices' colour of the last frame (RGBA32F, the background where none), 0 when none were drawn.
+  GLuint slice_color_texture() const;
+
   const FrameStats& stats() const { return stats_; }
   // The scene's groups (scene_groups.h) and value sets (per-vertex sets first, then per-streamline ones).
   const SceneGroups& groups() const { return groups_; }
@@ -59,6 +71,10 @@ class Renderer {
   const std::vector<const VxlFile*>& files() const { return files_; }
   glm::dvec3 bounds_min() const;
   glm::dvec3 bounds_max() const;
+  // The lines' bounds joined with the image's box (when there is one): what the depth range covers (the
+  // camera frames the lines).
+  glm::dvec3 scene_min() const;
+  glm::dvec3 scene_max() const;
 
   // The projection the renderer uses for `camera` (near/far planes fitted to the scene bounds).
   glm::dmat4 projection(const Camera& camera, double aspect) const;
@@ -89,6 +105,8 @@ class Renderer {
   FramePlan plan_;
   FrameStats stats_;
   std::unique_ptr<ExactRenderer> exact_;
+  std::unique_ptr<SliceRenderer> slices_;
+  bool slices_drawn_ = false;  // this frame: the line shaders test against the slices' depth
   SceneGroups groups_;
   std::vector<std::string> value_set_names_;
   std::string attributes_key_;  // what the attribute buffers hold ("" : nothing)
