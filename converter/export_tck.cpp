@@ -1,18 +1,96 @@
 #include "export_tck.h"
 
+#include <cmath>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
+#include "error.h"
+#include "export_values.h"
 #include "tck_writer.h"
 #include "vxl_streamlines.h"
 
 namespace vxl {
+namespace {
 
-void export_tck(const VxlFile& file, const std::string& out_path) {
-  TckWriter writer(out_path, file.meta().streamline_count, {"voxlines_exported_from: " + std::filesystem::path(file.path()).filename().string()});
+// The source's timestamp, when its provenance has one: MRtrix checks that a TSF's timestamp is its
+// tractogram's, so both files get the same one.
+std::vector<std::string> timestamp_line(const VxlFile& file) {
+  const nlohmann::json prov = nlohmann::json::parse(file.provenance_json(), nullptr, false);
+  if (!prov.is_object() || !prov.contains("source") || !prov["source"].is_object()) return {};
+  const nlohmann::json header = prov["source"].value("header", nlohmann::json());
+  if (!header.is_object() || !header.contains("timestamp")) return {};
+  nlohmann::json t = header["timestamp"];
+  if (t.is_array() && !t.empty()) t = t.back();
+  if (!t.is_string() || t.get<std::string>().find('\n') != std::string::npos) return {};
+  return {"timestamp: " + t.get<std::string>()};
+}
+
+// The set a TSF is asked for, by name or the first.
+std::uint32_t chosen_set(const VxlFile& file, const TckExportSettings& settings) {
+  const ValueSets& sets = file.vertex_values();
+  if (sets.empty())
+    throw Error(ErrorKind::Usage, file.path(), std::nullopt, "has no per-point values (VVAL) to write to a TSF");
+  if (!settings.value) return 0;
+  const int k = sets.find(*settings.value);
+  if (k < 0) {
+    std::string names;
+    for (std::uint32_t i = 0; i < sets.size(); ++i) names += (i ? ", '" : "'") + sets.name(i) + "'";
+    throw Error(ErrorKind::Usage, file.path(), std::nullopt, "has no per-point value set '" + *settings.value + "' (it has " + names + ")");
+  }
+  return static_cast<std::uint32_t>(k);
+}
+
+}  // namespace
+
+ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings) {
+  ExportSummary summary;
+  const MetaSection& m = file.meta();
+  summary.streamlines = m.streamline_count;
+  summary.points = m.point_count;
+  std::vector<std::string> header = {"voxlines_exported_from: " + std::filesystem::path(file.path()).filename().string()};
+
+  // The TSF's values, checked before anything is written.
+  std::vector<float> values;
+  std::uint32_t set = 0;
+  if (settings.tsf_path) {
+    set = chosen_set(file, settings);
+    summary.value_set = file.vertex_values().name(set);
+    values = values_at(file, set, source_vertex_indices(file));
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!std::isfinite(values[i]))
+        fail_unsupported(file.path(), "value set '" + summary.value_set + "' has a non-finite value (point " + std::to_string(i) +
+                                          "); a TSF cannot hold one (NaN and Inf are its separators)");
+    const std::vector<std::string> stamp = timestamp_line(file);
+    header.insert(header.end(), stamp.begin(), stamp.end());
+  } else if (settings.value) {
+    throw Error(ErrorKind::Usage, out_path, std::nullopt, "a value set is chosen for a TSF, but no TSF output is given");
+  }
+  const ValueSets& per_point = file.vertex_values();
+  if (!settings.tsf_path && !per_point.empty())
+    summary.warnings.push_back(std::to_string(per_point.size()) + " per-point value set(s) not written: a TCK holds positions only "
+                               "(add a TSF output for one of them, or export to .trx for all)");
+  if (settings.tsf_path && per_point.size() > 1)
+    summary.warnings.push_back(std::to_string(per_point.size() - 1) + " other per-point value set(s) not written: a TSF holds one "
+                               "(export to .trx for all)");
+  if (!file.streamline_values().empty())
+    summary.warnings.push_back(std::to_string(file.streamline_values().size()) +
+                               " per-streamline value set(s) not written: TCK and TSF have no place for them (export to .trx)");
+
+  TckWriter writer(out_path, m.streamline_count, header);
+  std::optional<TsfWriter> tsf;
+  if (settings.tsf_path) tsf.emplace(*settings.tsf_path, m.streamline_count, header);
+  std::uint64_t point = 0;
   WalkCallbacks cb;
-  cb.streamline = [&](std::uint64_t, std::span<const float> xyz) { writer.add(xyz); };
+  cb.streamline = [&](std::uint64_t, std::span<const float> xyz) {
+    writer.add(xyz);
+    if (tsf) tsf->add(std::span<const float>(values).subspan(point, xyz.size() / 3));
+    point += xyz.size() / 3;
+  };
   walk_streamlines(file, cb);
   writer.finish();
+  if (tsf) tsf->finish();
+  return summary;
 }
 
 }  // namespace vxl

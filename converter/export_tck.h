@@ -1,14 +1,31 @@
-// Export of a .vxl back to the source streamlines, as a TCK file (Float32LE, RAS mm).
+// Export of a .vxl back to the source streamlines, as a TCK file (Float32LE, RAS mm), and optionally one
+// per-point value set beside it as an MRtrix TSF (track scalar file).
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "vxl_file.h"
 
 namespace vxl {
 
-// Writes `out_path` atomically; the streamlines are those the converter read (spec §5.6), bit-exact for
-// float32 sources. Throws vxl::Error.
-void export_tck(const VxlFile& file, const std::string& out_path);
+struct TckExportSettings {
+  std::optional<std::string> tsf_path;  // write a per-point value set here
+  std::optional<std::string> value;     // the set to write (default: the first)
+};
+
+struct ExportSummary {
+  std::uint64_t streamlines = 0, points = 0;
+  std::string value_set;              // the set written to the TSF, if any
+  std::vector<std::string> warnings;  // values the output cannot hold (the caller decides how to show them)
+};
+
+// Writes `out_path` (and the TSF) atomically; the streamlines are those the converter read (spec §5.6),
+// bit-exact for float32 sources, and the TSF holds the source points' values bit-exact. Throws
+// vxl::Error: Usage when a TSF is asked for and the file has no per-point values or none named `value`,
+// Unsupported when a value is NaN or infinite (TSF separators), Output.
+ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings = {});
 
 }  // namespace vxl

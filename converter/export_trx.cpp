@@ -10,6 +10,7 @@
 #include <zip.h>
 
 #include "error.h"
+#include "export_values.h"
 #include "vxl_streamlines.h"
 
 namespace vxl {
@@ -164,12 +165,16 @@ void export_trx(const VxlFile& file, const std::string& out_path) {
     members[g].assign(groups[g].members.begin(), groups[g].members.end());
   }
 
+  // dpv / dps from the value sets (export_values.h); built before the archive is opened.
+  const std::vector<TrxValueMember> values = trx_value_members(file);
+
   ZipWriter zip(out_path);
   zip.add_stored("header.json", header_text.data(), header_text.size());
   zip.add_stored("positions.3.float32", positions.data(), positions.size() * sizeof(float));
   zip.add_stored("offsets.uint64", offsets.data(), offsets.size() * sizeof(std::uint64_t));
   for (std::size_t g = 0; g < groups.size(); ++g)
     zip.add_stored("groups/" + groups[g].name + ".uint32", members[g].data(), members[g].size() * sizeof(std::uint32_t));
+  for (const TrxValueMember& v : values) zip.add_stored(v.name, v.data.data(), v.data.size() * sizeof(float));
   zip.close();
 }
 

@@ -5,6 +5,8 @@
 //   positions.3.float32  the source points, RAS mm (synthetic face points dropped), bit-exact
 //   offsets.uint64       NB_STREAMLINES + 1 entries: each streamline's first point, then NB_VERTICES
 //   groups/NAME.uint32   the members of every group of the .vxl's GRPS section
+//   dpv/NAME.float32     every per-point value set (VVAL) at the source points (export_values.h)
+//   dps/NAME.float32     every per-streamline value set (SVAL); NAME[0..m-1] sets as one NAME.m.float32
 //
 // DIMENSIONS and VOXEL_TO_RASMM describe the reference image. They come from the provenance when the
 // source had them (a TRX header.json; a TRK header's dim and vox_to_ras); otherwise (TCK, synthetic)
@@ -30,9 +32,9 @@ struct TrxReference {
 TrxReference trx_reference(const VxlFile& file);
 
 // Writes `out_path` (the archive appears only when complete). Throws vxl::Error: Input for a malformed
-// file, Unsupported for a group name that cannot be a member name (or is another group's too) or more than
-// 2^32 - 1 streamlines (group members are uint32), both before the archive is created; Output only when
-// the archive cannot be written.
+// file, Unsupported for a group or value set name that cannot be a member name (or is another group's too)
+// or more than 2^32 - 1 streamlines (group members are uint32), both before the archive is created;
+// Output only when the archive cannot be written.
 void export_trx(const VxlFile& file, const std::string& out_path);
 
 }  // namespace vxl

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "error.h"
@@ -13,6 +14,7 @@
 #include "vxlz_package.h"
 #include "vxlz_quantize.h"
 #include "vxlz_tables.h"
+#include "vxlz_values.h"
 
 namespace vxl {
 namespace {
@@ -41,6 +43,40 @@ VoxlineIndex index_voxlines(const VxlFile& f) {
   for (std::uint64_t s = 0; s + 1 < strm.size(); ++s)
     if (strm[s] < strm[s + 1]) x.starts_streamline[strm[s]] = 1;
   return x;
+}
+
+// The per-vertex value sets as values per shipped point (spec §4.7): each voxline's own vertices. A
+// connecting vertex's value is not shipped: the unpacker copies the next voxline's first value, so it
+// must be that value, bit for bit, for the round trip to be exact.
+std::vector<NamedValues> shipped_point_values(const VxlFile& f, const VoxlineIndex& index) {
+  const ValueSets& sets = f.vertex_values();
+  auto voxlines = f.voxlines();
+  const std::uint64_t l = voxlines.size();
+  std::vector<NamedValues> out(sets.size());
+  for (std::uint32_t k = 0; k < sets.size(); ++k) {
+    const std::span<const float> v = sets.values(k);
+    out[k].name = sets.name(k);
+    out[k].values.resize(index.first_point.back());
+    float* dst = out[k].values.data();
+    for (std::uint64_t j = 0; j < l; ++j) {
+      const std::uint64_t own = voxlines[j].count_flags & kVoxlineCountMask;
+      const std::uint64_t first = index.first_vertex[j];
+      std::copy(v.begin() + first, v.begin() + first + own, dst + index.first_point[j]);
+      if (j + 1 < l && !index.starts_streamline[j + 1] && std::memcmp(&v[first + own], &v[index.first_vertex[j + 1]], 4) != 0)
+        fail_input(f.path(), f.find_section(section_id("VVAL"))->offset,
+                   "value set '" + out[k].name + "': a connecting vertex's value differs from the next voxline's first");
+    }
+  }
+  return out;
+}
+
+std::vector<NamedValues> streamline_values(const ValueSets& sets) {
+  std::vector<NamedValues> out(sets.size());
+  for (std::uint32_t k = 0; k < sets.size(); ++k) {
+    out[k].name = sets.name(k);
+    out[k].values.assign(sets.values(k).begin(), sets.values(k).end());
+  }
+  return out;
 }
 
 // Every vertex is a shipped point or a copy of one, so the vertices' box is the shipped points' box.
@@ -227,7 +263,11 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   // was asked for): the voxline voxels take seconds to deflate on a large tractogram, and would otherwise
   // run alone at the end.
   DeflatedTables tables;
-  parallel_invoke(threads > 1, [&] { tables = deflate_tables(c, 1); }, encode_positions);
+  parallel_invoke(threads > 1, [&] {
+    tables = deflate_tables(c, 1);
+    if (!f.vertex_values().empty()) c.point_values = encode_value_section(shipped_point_values(f, index), 1);
+    if (!f.streamline_values().empty()) c.streamline_values = encode_value_section(streamline_values(f.streamline_values()), 1);
+  }, encode_positions);
 
   PackSummary s;
   s.bytes = write_vxlz(out_path, c, tables);
@@ -235,6 +275,8 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   s.points = m.point_count;
   s.shipped_points = n;
   s.pack = pack;
+  s.point_value_sets = f.vertex_values().size();
+  s.streamline_value_sets = f.streamline_values().size();
   return s;
 }
 

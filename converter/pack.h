@@ -1,7 +1,7 @@
 // `voxlines pack`: a .vxl to a .vxlz package (spec/vxlz-package-v2.md). The tables travel exactly; the
 // vertex positions are quantised on one grid over the data's bounding cube, predicted along the
 // streamlines and Draco-coded in chunks; the orders, connecting vertices and bounds are left out
-// (the unpacker recomputes them, see unpack.h).
+// (the unpacker recomputes them, see unpack.h). The value sets travel exactly, per shipped point.
 #pragma once
 
 #include <cstdint>
@@ -22,6 +22,7 @@ struct PackSummary {
   std::uint64_t bytes = 0;           // package size
   std::uint64_t streamlines = 0, points = 0, shipped_points = 0;
   PackSection pack{};                // quantisation, stated bound, measured error
+  std::uint32_t point_value_sets = 0, streamline_value_sets = 0;  // carried exactly (spec §4.7)
 };
 
 // Validates the .vxl's tables as it reads them (the streamline walk) and writes `out_path` atomically.

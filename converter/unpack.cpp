@@ -18,6 +18,8 @@
 #include "vxlz_package.h"
 #include "vxlz_quantize.h"
 #include "vxlz_tables.h"
+#include "vxlz_values.h"
+#include "vxl_value_sets.h"
 
 namespace vxl {
 namespace {
@@ -200,6 +202,36 @@ void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, st
   }
 }
 
+// The value sets as the .vxl lays them out (spec §7 step 8): per vertex, each voxline's own values at
+// its own vertices and, at its connecting vertex, a copy of the next voxline's first value (as the
+// positions); per streamline, as shipped.
+void write_point_values(const Structure& s, const std::vector<NamedValues>& sets, std::span<std::uint8_t> payload,
+                        std::uint64_t vertex_count, unsigned threads) {
+  std::vector<std::string> names;
+  for (const NamedValues& v : sets) names.push_back(v.name);
+  const std::vector<std::span<float>> arrays = layout_value_sets(payload, names, vertex_count);
+  parallel_for(sets.size(), threads, [&](std::uint64_t k, unsigned) {
+    const float* shipped = sets[k].values.data();
+    std::uint64_t point = 0;
+    for (std::uint64_t j = 0; j < s.voxlines.size(); ++j) {
+      const std::uint64_t own = s.voxlines[j].count_flags & kVoxlineCountMask;
+      float* dst = arrays[k].data() + s.first_vertex(j);
+      std::copy(shipped + point, shipped + point + own, dst);
+      point += own;
+      if (s.connected(j)) dst[own] = shipped[point];
+    }
+  });
+  finish_value_sets(payload);
+}
+
+void write_streamline_values(const std::vector<NamedValues>& sets, std::span<std::uint8_t> payload, std::uint64_t count) {
+  std::vector<std::string> names;
+  for (const NamedValues& v : sets) names.push_back(v.name);
+  const std::vector<std::span<float>> arrays = layout_value_sets(payload, names, count);
+  for (std::size_t k = 0; k < sets.size(); ++k) std::copy(sets[k].values.begin(), sets[k].values.end(), arrays[k].begin());
+  finish_value_sets(payload);
+}
+
 template <typename T>
 std::span<std::uint8_t> bytes_of(std::span<T> s) {
   return {reinterpret_cast<std::uint8_t*>(s.data()), s.size_bytes()};
@@ -228,8 +260,19 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
     groups_bytes = encode_groups(decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count,
                                                      f.context(section_id("GRPS"))));
 
+  // Value sets (spec §4.7), checked against PACK's and META's counts before anything is inflated.
+  std::vector<NamedValues> point_values, streamline_values;
+  if (f.has_section(section_id("PVAL")))
+    point_values = decode_value_section(f.section_payload(section_id("PVAL")), f.pack().point_count,
+                                        f.context(section_id("PVAL")), threads);
+  if (f.has_section(section_id("SVAL")))
+    streamline_values = decode_value_section(f.section_payload(section_id("SVAL")), f.meta().streamline_count,
+                                             f.context(section_id("SVAL")), threads);
+
   MetaSection meta = f.meta();
-  VxlWriter out(out_path, section_sizes(meta, s.order_bytes, provenance.size(), groups_bytes.size()));
+  VxlWriter out(out_path, section_sizes(meta, s.order_bytes, provenance.size(), groups_bytes.size(),
+                                        static_cast<std::uint32_t>(point_values.size()),
+                                        static_cast<std::uint32_t>(streamline_values.size())));
   prefault_for_write(bytes_of(out.vertices()), threads);
   std::copy(s.voxels.begin(), s.voxels.end(), out.voxels().begin());
 
@@ -287,6 +330,8 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   std::copy(s.strm.begin(), s.strm.end(), out.streamline_first_voxline().begin());
   std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
   std::copy(groups_bytes.begin(), groups_bytes.end(), out.groups().begin());
+  if (!point_values.empty()) write_point_values(s, point_values, out.vertex_values(), meta.vertex_count, threads);
+  if (!streamline_values.empty()) write_streamline_values(streamline_values, out.streamline_values(), meta.streamline_count);
   out.commit(threads);
   summary.write_seconds = seconds_since(t0);
   progress("writing", 1.0);
@@ -295,6 +340,8 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   summary.points = meta.point_count;
   summary.voxels = meta.voxel_count;
   summary.pack = f.pack();
+  summary.point_value_sets = static_cast<std::uint32_t>(point_values.size());
+  summary.streamline_value_sets = static_cast<std::uint32_t>(streamline_values.size());
   return summary;
 }
 

@@ -2,7 +2,8 @@
 // as shipped (never re-voxelised: quantisation could move a point across a voxel face), the position
 // chunks are decoded in parallel straight into the output's vertex blocks, the connecting vertices are
 // written as copies of the decoded next points, and the tight bounds and the orders are recomputed from
-// the decoded vertices. The result passes `voxlines verify`.
+// the decoded vertices. The value sets come back bit-exact, per vertex as the converter laid them out.
+// The result passes `voxlines verify`.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +22,7 @@ struct UnpackSettings {
 struct UnpackSummary {
   std::uint64_t streamlines = 0, points = 0, voxels = 0;
   PackSection pack{};  // quantisation and the stated bound
+  std::uint32_t point_value_sets = 0, streamline_value_sets = 0;  // VVAL / SVAL written, bit-exact
   double decode_seconds = 0, orders_seconds = 0, write_seconds = 0;
 };
 

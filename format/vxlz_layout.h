@@ -1,4 +1,4 @@
-// On-disk structures of the .vxlz package, version 2.0 (spec/vxlz-package-v2.md; section numbers below
+// On-disk structures of the .vxlz package, version 2.1 (spec/vxlz-package-v2.md; section numbers below
 // point into it). The header and the section table entries have the .vxl layout (FileHeader,
 // SectionEntry from vxl_layout.h) with another magic; the payloads follow each other without padding.
 #pragma once
@@ -13,7 +13,9 @@ namespace vxl {
 
 inline constexpr std::array<std::uint8_t, 8> kVxlzMagic = {0x89, 'V', 'X', 'Z', '\r', '\n', 0x1A, '\n'};
 inline constexpr std::uint16_t kVxlzVersionMajor = 2;  // 1.0 coded residual triplets with no joint symbols
-inline constexpr std::uint16_t kVxlzVersionMinor = 0;
+// A writer writes minor 1 only when the package holds value sets (§4.7), else 0 (§10: the lowest
+// version that holds what it writes).
+inline constexpr std::uint16_t kVxlzVersionMinor = 1;
 inline constexpr std::uint32_t kVxlzMaxSections = 32;
 inline constexpr std::uint32_t kVxlzMinBits = 11;
 inline constexpr std::uint32_t kVxlzMaxBits = 16;

@@ -24,11 +24,11 @@ std::vector<std::uint8_t> bytes_of(const T& value) {
   return {b, b + sizeof value};
 }
 
-// The sections every package has (spec §2.2), and the optional ones a 2.0 reader knows.
+// The sections every package has (spec §2.2), and the optional ones a 2.1 reader knows.
 constexpr std::uint32_t kRequired[] = {section_id("PACK"), section_id("META"), section_id("DIRS"),
                                        section_id("VOXC"), section_id("STRL"), section_id("VXLV"),
                                        section_id("VXLC"), section_id("CHNK"), section_id("POSD")};
-constexpr std::uint32_t kOptional[] = {section_id("PROV"), section_id("GRPS")};
+constexpr std::uint32_t kOptional[] = {section_id("PROV"), section_id("GRPS"), section_id("PVAL"), section_id("SVAL")};
 
 }  // namespace
 
@@ -94,6 +94,9 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   sections.push_back({"VXLC", true, d.voxline_counts});
   if (d.provenance) sections.push_back({"PROV", false, *d.provenance});
   if (d.groups) sections.push_back({"GRPS", false, *d.groups});
+  // Optional (spec §4.7): a 2.0 reader skips them and still gets every streamline, without the values.
+  if (c.point_values) sections.push_back({"PVAL", false, *c.point_values});
+  if (c.streamline_values) sections.push_back({"SVAL", false, *c.streamline_values});
   sections.push_back({"CHNK", true, chunk_sizes});
   sections.push_back({"POSD", true, {}});
 
@@ -115,7 +118,7 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   FileHeader h{};
   std::memcpy(h.magic, kVxlzMagic.data(), 8);
   h.version_major = kVxlzVersionMajor;
-  h.version_minor = kVxlzVersionMinor;
+  h.version_minor = c.point_values || c.streamline_values ? kVxlzVersionMinor : 0;
   h.header_size = sizeof(FileHeader);
   h.file_size = position;
   h.section_table_offset = sizeof(FileHeader);

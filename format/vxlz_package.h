@@ -34,6 +34,8 @@ struct VxlzContent {
   std::vector<std::uint8_t> voxline_counts;       // VXLC
   std::optional<std::string> provenance;          // PROV, when the .vxl has one
   std::optional<std::vector<std::uint8_t>> groups;  // GRPS, when the .vxl has groups
+  // PVAL / SVAL payloads (encode_value_section, already deflated), when the .vxl has VVAL / SVAL.
+  std::optional<std::vector<std::uint8_t>> point_values, streamline_values;
   std::vector<EncodedChunk> chunks;               // Draco buffers, one pair per position chunk
 };
 
@@ -67,6 +69,11 @@ class VxlzFile {
   bool has_section(std::uint32_t id) const { return find(id) != nullptr; }
   // A zlib section inflated (spec §8 step 5); empty when an optional section is absent.
   std::vector<std::uint8_t> inflate(std::uint32_t id) const;
+  // A section's payload as stored (empty when an optional section is absent).
+  std::span<const std::uint8_t> section_payload(std::uint32_t id) const {
+    const SectionEntry* e = find(id);
+    return e ? payload(*e) : std::span<const std::uint8_t>();
+  }
   // Where errors about an inflated stream point: the section and its offset.
   StreamContext context(std::uint32_t id) const;
 

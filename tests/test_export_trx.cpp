@@ -60,7 +60,8 @@ void expect_same_streamlines(const Tractogram& expected, const Tractogram& got) 
 
 // An independent structural check of a TRX archive against the specification, in Python (zipfile +
 // numpy, no TRX library): stored members, header keys, array names and dtypes, offsets N + 1 with the
-// sentinel, positions 3 * NB_VERTICES float32, groups unsigned, increasing and below N.
+// sentinel, positions 3 * NB_VERTICES float32, groups unsigned, increasing and below N, dpv / dps
+// float32 with one row per point / streamline.
 constexpr const char* kTrxCheck = R"PY(
 import json, sys, zipfile
 import numpy as np
@@ -94,7 +95,13 @@ for g in groups:
     assert dt == np.dtype("<u4"), g
     a = np.frombuffer(z.read(g), dtype=dt)
     assert np.all(a < n) and np.all(np.diff(a.astype(np.int64)) > 0), g
-assert names == set(positions + offsets + groups + ["header.json"]), names
+values = sorted(m for m in names if m.startswith("dpv/") or m.startswith("dps/"))
+for m in values:
+    parts = m.split("/", 1)[1].split(".")
+    width = int(parts[-2]) if len(parts) == 3 else 1
+    assert len(parts) in (2, 3) and parts[-1] == "float32" and width >= 1, m
+    assert len(z.read(m)) == (v if m.startswith("dpv/") else n) * width * 4, m
+assert names == set(positions + offsets + groups + values + ["header.json"]), names
 print("TRX-OK", n, v, "|".join(g[len("groups/"):].rsplit(".", 1)[0] for g in groups))
 )PY";
 

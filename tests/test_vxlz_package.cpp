@@ -321,6 +321,12 @@ class DamagedVxlz : public ::testing::Test {
     const float jump[6] = {0, 0, 0, 40, 1, 1};
     t.add_streamline(jump, 2);
     t.groups.push_back({"g", {1, 4}});
+    // Value sets, so that every damage below also reaches the PVAL and SVAL sections (spec §4.7).
+    ValueSet fa{"fa", {}}, length{"length", {}};
+    for (std::uint64_t i = 0; i < t.point_count(); ++i) fa.values.push_back(0.25f + 0.01f * float(i));
+    for (std::uint64_t s = 0; s < t.streamline_count(); ++s) length.values.push_back(float(s) * 3.5f);
+    t.point_values.push_back(fa);
+    t.streamline_values.push_back(length);
     convert_to(std::move(t), dir.file("small.vxl"), 8);
     PackSettings s;
     s.chunk_points = 16;  // several chunks
@@ -372,6 +378,8 @@ class DamagedVxlz : public ::testing::Test {
 TEST_F(DamagedVxlz, TheGoodPackageUnpacks) {
   unpack_vxlz(good(), out(), {});
   EXPECT_TRUE(verify_vxl(out()).valid);
+  EXPECT_TRUE(VxlzFile::open(good()).has_section(section_id("PVAL")) && VxlzFile::open(good()).has_section(section_id("SVAL")));
+  EXPECT_EQ(VxlFile::open(out()).vertex_values().size(), 1u);
   EXPECT_GT(VxlzFile::open(good()).chunk_count(), 3u);
 }
 
