@@ -1,17 +1,15 @@
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <string>
 
 #include "commands.h"
 #include "convert.h"
+#include "convert_cohort.h"
+#include "convert_file.h"
 #include "error.h"
 #include "memory_size.h"
 #include "progress_bar.h"
-#include "read_tractogram.h"
-#include "read_tsf.h"
 #include "segment_orders.h"
-#include "streaming_convert.h"
 
 namespace vxl::cli {
 namespace {
@@ -29,19 +27,38 @@ long long peak_resident_kib() {
 
 void add_convert_command(CLI::App& app) {
   struct Options {
-    std::string input, output;
+    std::vector<std::string> files;
+    std::string output_dir;
+    unsigned jobs = 1;
     ConvertSettings settings;
     std::string memory_limit;
     bool verbose = false;
     std::vector<std::string> tsf;
   };
   auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert a TCK / TRK (.trk.gz) / TRX / VTK / VTP tractogram to .vxl");
-  cmd->add_option("input", opt->input, "source tractogram (.tck, .trk, .trk.gz, .trx zip or directory, .vtk legacy POLYDATA, .vtp XML PolyData)")->required();
-  cmd->add_option("output", opt->output, "output .vxl file (written atomically)")->required();
+  CLI::App* cmd = app.add_subcommand(
+      "convert",
+      "Convert a TCK / TRK (.trk.gz) / TRX / VTK / VTP tractogram to .vxl:\n"
+      "  voxlines convert IN OUT.vxl\n"
+      "  voxlines convert IN... --output-dir DIR [--jobs N]    (a cohort: DIR/NAME.vxl for each IN)");
+  cmd->add_option("files", opt->files,
+                  "IN OUT.vxl: the source tractogram (.tck, .trk, .trk.gz, .trx zip or directory, .vtk legacy POLYDATA, .vtp XML PolyData) and the output "
+                  "(written atomically); with --output-dir: one or more sources")
+      ->required();
+  CLI::Option* output_dir = cmd->add_option("--output-dir", opt->output_dir,
+                  "convert every input FILE into DIR/NAME.vxl (NAME: FILE's name without .tck/.trk/.trk.gz/.trx; "
+                  "two inputs with the same NAME are refused; DIR is created when missing). A file that fails is "
+                  "reported and the others go on; a last line says how many converted and failed")
+      ->type_name("DIR");
+  CLI::Option* jobs = cmd->add_option("--jobs", opt->jobs,
+                  "with --output-dir: convert N files at once, each with --threads / N worker threads (at least 1; "
+                  "N is at most the number of inputs)")
+      ->type_name("N")->default_val(1)->check(CLI::Range(1u, 4096u));
   cmd->add_option("--voxel-size", opt->settings.voxel_size, "voxel edge length in mm")
       ->default_val(10.0)->check(CLI::PositiveNumber);
-  cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
+  cmd->add_option("--threads", opt->settings.threads,
+                  "worker threads in all (0: all cores); --jobs N shares them, each file getting threads / N")
+      ->default_val(0);
   cmd->add_option("--orders", opt->settings.orders,
                   "precomputed order set: axis (6 orders), axis+diag (14), or random:N (N pseudo-random directions "
                   "per voxel, 2N orders, N in 1..64)")
@@ -57,7 +74,8 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--memory-limit", opt->memory_limit,
                   "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): reads the source several times and writes the "
                   "output in parts, byte-identical to a conversion without the limit. TCK sources only (TRK/TRX are "
-                  "refused); a limit too small for the data is refused, naming what needs how much")
+                  "refused); a limit too small for the data is refused, naming what needs how much. With --output-dir "
+                  "the limit is per file: --jobs N may use N times SIZE")
       ->type_name("SIZE")
       ->check(CLI::Validator(
           [](std::string& s) {
@@ -67,48 +85,39 @@ void add_convert_command(CLI::App& app) {
           ""));
   cmd->add_option("--tsf", opt->tsf,
                   "MRtrix track scalar file with one value per point of the input (repeatable); stored so that voxview "
-                  "can colour by it (--color scalar)")
+                  "can colour by it (--color scalar). Refused with several inputs")
       ->expected(1)->take_all();
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
-  cmd->callback([opt] {
+  cmd->footer(
+      "Exit codes with --output-dir: 0 every file converted; otherwise the code of the failures' kind of error when "
+      "they share one (3 bad input, 4 unsupported, 5 output), or 6 when files failed with different kinds. "
+      "Refused before any file is read: two inputs with the same NAME, --tsf with several inputs (2), an "
+      "--output-dir that cannot be created or written into (5).");
+  cmd->callback([opt, output_dir, jobs] {
+    if (!opt->memory_limit.empty()) opt->settings.memory_limit = *parse_memory_size(opt->memory_limit);
+    if (output_dir->count() > 0) {
+      CohortOptions c{opt->files, opt->output_dir, opt->jobs, opt->settings, opt->tsf, opt->verbose};
+      g_exit_code = run_cohort(c);
+      if (opt->verbose) std::printf("peak resident memory: %lld KiB\n", peak_resident_kib());
+      return;
+    }
+    if (jobs->count() > 0) throw CLI::ValidationError("--jobs converts several files at once: it needs --output-dir DIR");
+    if (opt->files.size() != 2)
+      throw CLI::ValidationError("convert takes IN OUT.vxl, or IN... --output-dir DIR (got " +
+                                 std::to_string(opt->files.size()) + " file names)");
+    const std::string& input = opt->files[0];
+    const std::string& output = opt->files[1];
     ProgressBar bar;
     opt->settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
     bar.update("reading", 0.0);
-    auto t0 = std::chrono::steady_clock::now();
-    ConvertSummary s;
-    double read_seconds = 0;
-    if (!opt->memory_limit.empty()) {
-      if (!opt->tsf.empty())
-        throw Error(ErrorKind::Unsupported, opt->input, std::nullopt,
-                    "--memory-limit does not carry --tsf values yet; convert without the limit");
-      opt->settings.memory_limit = *parse_memory_size(opt->memory_limit);
-      s = convert_streaming(opt->input, opt->output, opt->settings);
-      read_seconds = s.read_seconds;
-      bar.done();
-      for (const std::string& w : s.warnings) std::fprintf(stderr, "voxlines: warning: %s: %s\n", opt->input.c_str(), w.c_str());
-    } else {
-      Tractogram t = read_tractogram(opt->input);
-      for (const std::string& tsf : opt->tsf) attach_tsf(t, tsf);
-      read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      for (const std::string& w : t.source.warnings) {
-        bar.done();
-        std::fprintf(stderr, "voxlines: warning: %s: %s\n", opt->input.c_str(), w.c_str());
-      }
-      s = convert_tractogram(std::move(t), opt->output, opt->settings);
-      bar.done();
-    }
-    std::printf("%s: %llu streamlines, %llu points -> %llu voxels, %llu segments (%llu points added at voxel faces)\n",
-                opt->output.c_str(), (unsigned long long)s.streamlines, (unsigned long long)s.points,
-                (unsigned long long)s.voxels, (unsigned long long)s.segments, (unsigned long long)s.synthetic_points);
-    if (!opt->memory_limit.empty())
-      std::printf("memory limit %s: %llu passes over the source, voxels built in %llu parts\n",
-                  format_memory_size(opt->settings.memory_limit).c_str(), (unsigned long long)s.passes,
-                  (unsigned long long)s.partitions);
-    if (opt->verbose) {
-      std::printf("stages: read %.3f s, voxelise %.3f s, orders %.3f s, write %.3f s\n", read_seconds, s.voxelize_seconds,
-                  s.orders_seconds, s.write_seconds);
-      std::printf("peak resident memory: %lld KiB\n", peak_resident_kib());
-    }
+    const std::string report =
+        convert_file(input, output, opt->tsf, opt->settings, opt->verbose, [&](const std::string& w) {
+          bar.done();
+          std::fprintf(stderr, "voxlines: warning: %s: %s\n", input.c_str(), w.c_str());
+        });
+    bar.done();
+    std::fputs(report.c_str(), stdout);
+    if (opt->verbose) std::printf("peak resident memory: %lld KiB\n", peak_resident_kib());
   });
 }
 

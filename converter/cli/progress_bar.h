@@ -8,13 +8,17 @@ namespace vxl::cli {
 
 class ProgressBar {
  public:
-  ProgressBar();
+  // `label` is drawn before the stage (the cohort form names the file there); empty: nothing.
+  explicit ProgressBar(std::string label = {});
   ~ProgressBar();
   void update(const char* stage, double fraction);  // thread-compatible: called from one thread
   void done();
 
+  static bool stderr_is_terminal();
+
  private:
   bool enabled_;
+  std::string label_;
   std::string stage_;
   int last_percent_ = -1;
   std::chrono::steady_clock::time_point start_;

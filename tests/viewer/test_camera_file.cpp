@@ -185,17 +185,19 @@ TEST_F(BatchFigures, ASavedViewReplaysTheSamePicture) {
 }
 
 TEST_F(BatchFigures, TurntableFramesTurnAroundTheVerticalAxis) {
-  auto turn = voxview("--render " + at("t.png") + " --turntable 4 --size 64x64 --view 30,20");
+  auto turn = voxview("--render " + at("t.png") + " --turntable 4 --size 64x64 --view 30,20 --save-camera " + at("v.json"));
   ASSERT_EQ(turn.exit_code, 0) << turn.output;
   std::vector<Image> frames;
   for (int i = 0; i < 4; ++i) frames.push_back(image("t_00" + std::to_string(i) + ".png"));
   EXPECT_FALSE(std::filesystem::exists(dir.file("t.png")));
   EXPECT_FALSE(std::filesystem::exists(dir.file("t_004.png")));
-  auto plain = voxview("--render " + at("p.png") + " --size 64x64 --view 30,20");
+  // A turntable is framed for all its frames at once (so that each is whole), not like a single view: frame 0
+  // is its saved start view.
+  auto plain = voxview("--render " + at("p.png") + " --size 64x64 --camera " + at("v.json"));
   ASSERT_EQ(plain.exit_code, 0) << plain.output;
   EXPECT_EQ(compare_images(frames[0], image("p.png")).differing_pixels, 0u);
   // Frame 2 is the view from the opposite side, azimuth + 180.
-  auto opposite = voxview("--render " + at("o.png") + " --size 64x64 --view 210,20");
+  auto opposite = voxview("--render " + at("o.png") + " --size 64x64 --camera " + at("v.json") + " --view 210,20");
   ASSERT_EQ(opposite.exit_code, 0) << opposite.output;
   EXPECT_EQ(compare_images(frames[2], image("o.png")).differing_pixels, 0u);
   for (int i = 0; i < 4; ++i)

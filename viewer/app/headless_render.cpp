@@ -11,12 +11,13 @@
 #include "nifti_volume.h"
 #include "offscreen_target.h"
 #include "renderer.h"
+#include "scene_framing.h"
 #include "scene_source.h"
 #include "turntable.h"
 
 namespace vxl::app {
 
-Camera initial_camera(const glm::dvec3& lo, const glm::dvec3& hi, const ViewerOptions& options, double aspect) {
+Camera initial_camera(std::span<const glm::dvec3> points, const ViewerOptions& options, double aspect) {
   if (options.camera) {
     // A saved view is used as saved; --view and --ortho given as well still turn it.
     Camera c = *options.camera;
@@ -33,7 +34,15 @@ Camera initial_camera(const glm::dvec3& lo, const glm::dvec3& hi, const ViewerOp
   auto view = options.view.value_or(std::array<double, 2>{-35.0, 25.0});
   c.azimuth_deg = view[0];
   c.elevation_deg = view[1];
-  c.frame(lo, hi, aspect);
+  if (options.turntable > 1) {
+    glm::dvec3 lo(0.0), hi(0.0);
+    if (!points.empty()) lo = hi = points[0];
+    for (const glm::dvec3& p : points) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    const glm::dvec3 pivot = (lo + hi) * 0.5;
+    c.frame_points_about(turntable_points(points, pivot, options.turntable), pivot, aspect);
+  } else {
+    c.frame_points(points, aspect);
+  }
   if (options.focus) c.target = *options.focus;
   return c;
 }
@@ -51,7 +60,7 @@ int run_headless(const ViewerOptions& o) {
   OffscreenTarget target(o.width, o.height);
   target.bind();
   const double aspect = double(o.width) / o.height;
-  const Camera camera = initial_camera(renderer.bounds_min(), renderer.bounds_max(), o, aspect);
+  const Camera camera = initial_camera(framing_points(renderer.scene().layout()), o, aspect);
   if (o.save_camera) write_view(*o.save_camera, SavedView{camera, o.settings, std::array<int, 2>{o.width, o.height}});
   const int frames = std::max(1, o.turntable);
   for (int i = 0; i < frames; ++i) {

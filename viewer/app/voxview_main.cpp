@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
   cli.add_option("--render", o.render_png, "render headless (EGL, no display needed) to this PNG and exit");
   cli.add_option("--turntable", o.turntable,
                  "with --render: N frames turning once around the vertical (superior) axis, written as OUT_000.png, "
-                 "OUT_001.png, ... (frame i at azimuth + 360 i / N degrees; frame 0 is the plain --render view)")
+                 "OUT_001.png, ... (frame i at azimuth + 360 i / N degrees; frame 0 looks from the --view direction; "
+                 "all frames share one framing in which each is whole)")
       ->check(CLI::Range(1, 100000));
   cli.add_option("--camera", camera_file,
                  "start from a saved view (camera and settings; JSON, see --save-camera); options given as well "

@@ -24,6 +24,7 @@
 #include "nifti_volume.h"
 #include "offscreen_target.h"
 #include "renderer.h"
+#include "scene_framing.h"
 #include "scene_source.h"
 #include "ui_panel.h"
 
@@ -148,6 +149,7 @@ class ViewerWindow {
   // faint layers add up beyond 8-bit rounding and the window shows what --render writes.
   std::optional<OffscreenTarget> scene_target_;
   CameraController controller_;
+  std::vector<glm::dvec3> framing_points_;  // what the home view fills the window with (scene_framing.h)
   std::unique_ptr<UiPanel> panel_;  // created after our callbacks, which ImGui then chains to
   PanelState state_;
   PanelStats stats_;
@@ -197,6 +199,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   }
   if (o.settings.clipping.slab_mm > 0) state_.slab_thickness = o.settings.clipping.slab_mm;
 
+  framing_points_ = framing_points(renderer_.scene().layout());
   controller_.set_home(home_camera(aspect(), o.orthographic));
   controller_.reset();
 
@@ -220,7 +223,7 @@ double ViewerWindow::aspect() const {
 Camera ViewerWindow::home_camera(double aspect, bool orthographic) const {
   ViewerOptions o = options_;
   o.orthographic = orthographic;
-  return initial_camera(renderer_.bounds_min(), renderer_.bounds_max(), o, aspect);
+  return initial_camera(framing_points_, o, aspect);
 }
 
 void ViewerWindow::reset_camera(double aspect) {

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <optional>
+#include <span>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -29,8 +30,18 @@ struct Camera {
   glm::mat3 view_rotation() const;
   glm::mat4 projection(double aspect, double near_mm, double far_mm) const;
 
-  // Frames an axis-aligned box: target at its centre, distance/ortho size so that it fits.
+  // Frames an axis-aligned box: target at its centre, distance/ortho size so that its bounding sphere fits
+  // from any direction (the benchmarks' turntables rely on that).
   void frame(const glm::dvec3& box_min, const glm::dvec3& box_max, double aspect);
+
+  // For the current direction and projection: moves the target across the view and sets the distance (and
+  // ortho_height) so that `points` fill the window, kFrameMargin of each half-extent left free along the
+  // tighter of width and height, centred in both. The target's depth is the middle of the points' depths.
+  void frame_points(std::span<const glm::dvec3> points, double aspect);
+  // The same with the target kept at `pivot` (the picture centred on it): for views that turn about it.
+  void frame_points_about(std::span<const glm::dvec3> points, const glm::dvec3& pivot, double aspect);
+
+  static constexpr double kFrameMargin = 0.04;
 };
 
 // Standard views (anterior up in axial views, patient right on screen right seen from above) like mrview's: "axial"/"superior", "inferior", "sagittal"/"left", "right",

@@ -1,0 +1,53 @@
+#include "convert_file.h"
+
+#include <chrono>
+#include <cstdio>
+
+#include "error.h"
+#include "memory_size.h"
+#include "read_tractogram.h"
+#include "read_tsf.h"
+#include "streaming_convert.h"
+
+namespace vxl::cli {
+
+std::string convert_file(const std::string& input, const std::string& output, const std::vector<std::string>& tsf,
+                         const ConvertSettings& settings, bool verbose,
+                         const std::function<void(const std::string&)>& warn) {
+  auto t0 = std::chrono::steady_clock::now();
+  ConvertSummary s;
+  double read_seconds = 0;
+  if (settings.memory_limit > 0) {
+    if (!tsf.empty())
+      throw Error(ErrorKind::Unsupported, input, std::nullopt,
+                  "--memory-limit does not carry --tsf values yet; convert without the limit");
+    s = convert_streaming(input, output, settings);
+    read_seconds = s.read_seconds;
+    for (const std::string& w : s.warnings) warn(w);
+  } else {
+    Tractogram t = read_tractogram(input);
+    for (const std::string& f : tsf) attach_tsf(t, f);
+    read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (const std::string& w : t.source.warnings) warn(w);
+    s = convert_tractogram(std::move(t), output, settings);
+  }
+  char line[512];
+  std::snprintf(line, sizeof line, ": %llu streamlines, %llu points -> %llu voxels, %llu segments (%llu points added at voxel faces)\n",
+                (unsigned long long)s.streamlines, (unsigned long long)s.points,
+                (unsigned long long)s.voxels, (unsigned long long)s.segments, (unsigned long long)s.synthetic_points);
+  std::string report = output + line;
+  if (settings.memory_limit > 0) {
+    std::snprintf(line, sizeof line, "memory limit %s: %llu passes over the source, voxels built in %llu parts\n",
+                  format_memory_size(settings.memory_limit).c_str(), (unsigned long long)s.passes,
+                  (unsigned long long)s.partitions);
+    report += line;
+  }
+  if (verbose) {
+    std::snprintf(line, sizeof line, "stages: read %.3f s, voxelise %.3f s, orders %.3f s, write %.3f s\n",
+                  read_seconds, s.voxelize_seconds, s.orders_seconds, s.write_seconds);
+    report += line;
+  }
+  return report;
+}
+
+}  // namespace vxl::cli

@@ -1,0 +1,21 @@
+// One conversion IN -> OUT.vxl, shared by `voxlines convert IN OUT.vxl` and the cohort form
+// (convert_cohort.h): reads the source (whole, or streamed under settings.memory_limit), attaches the TSF
+// values, converts, and describes the result.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "convert.h"
+
+namespace vxl::cli {
+
+// Converts `input` into `output` (written atomically) and returns the lines to print on stdout: the counts,
+// the passes under a memory limit and, with `verbose`, the stage times. Each warning of the source is
+// handed to `warn` (without the file's name) as soon as it is known. Throws vxl::Error.
+std::string convert_file(const std::string& input, const std::string& output, const std::vector<std::string>& tsf,
+                         const ConvertSettings& settings, bool verbose,
+                         const std::function<void(const std::string&)>& warn);
+
+}  // namespace vxl::cli
