@@ -107,16 +107,16 @@ TEST(ConvertCohort, FailuresOfDifferentKindsExitWithSix) {
   ScratchDir dir;
   synth(dir.file("a.tck"), 100, 1);
   { std::ofstream(dir.file("bad.tck")) << "garbage"; }                   // malformed: 3
-  { std::ofstream(dir.file("lines.vtk")) << "# vtk DataFile Version"; }  // unsupported: 4
-  auto r = run_cli("convert '" + dir.file("bad.tck") + "' '" + dir.file("a.tck") + "' '" + dir.file("lines.vtk") +
+  { std::ofstream(dir.file("lines.vtu")) << "<VTKFile type=\"UnstructuredGrid\"/>"; }  // unsupported: 4
+  auto r = run_cli("convert '" + dir.file("bad.tck") + "' '" + dir.file("a.tck") + "' '" + dir.file("lines.vtu") +
                    "' --output-dir '" + dir.file("out") + "' --jobs 2");
   EXPECT_EQ(r.exit_code, 6) << r.output;
   EXPECT_TRUE(contains(r.output, "1 converted, 2 failed")) << r.output;
-  EXPECT_TRUE(contains(r.output, dir.file("lines.vtk") + ": VTK/VTP")) << r.output;
+  EXPECT_TRUE(contains(r.output, dir.file("lines.vtu") + ": unsupported file type")) << r.output;
   EXPECT_EQ(names_in(dir.file("out")), (std::set<std::string>{"a.vxl"}));
 
   // Every file failing with one kind: that kind's code.
-  auto u = run_cli("convert '" + dir.file("lines.vtk") + "' --output-dir '" + dir.file("out2") + "'");
+  auto u = run_cli("convert '" + dir.file("lines.vtu") + "' --output-dir '" + dir.file("out2") + "'");
   EXPECT_EQ(u.exit_code, 4) << u.output;
   EXPECT_TRUE(contains(u.output, "0 converted, 1 failed")) << u.output;
 }

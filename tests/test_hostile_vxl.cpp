@@ -20,7 +20,7 @@ namespace {
 using test::ScratchDir;
 using test::VxlBytes;
 
-std::string q(const std::string& s) { return "'" + s + "'"; }
+using test::q;
 
 // The error VxlFile::open gives `path` ("no error" when it opens).
 std::string open_error(const std::string& path, ErrorKind expected = ErrorKind::Input) {

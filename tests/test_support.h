@@ -81,14 +81,18 @@ inline CommandResult run_program(const std::string& program, const std::string& 
   return r;
 }
 
+// `s` in single quotes, for a shell command line.
+inline std::string q(const std::string& s) { return "'" + s + "'"; }
+
 // Runs the `voxlines` CLI.
 inline CommandResult run_cli(const std::string& args) { return run_program(VOXLINES_CLI, args); }
 
-// Starts `voxlines convert ARGS...` `runs` times and SIGKILLs run r once its temporary output has
-// appeared and r milliseconds more have passed: a kill while the output is being written, whatever the
-// machine's speed. Every killed run must leave nothing at `out` (or, when the kill came after the rename,
-// a complete file that `verify` accepts), and the directory nothing but `in.tck` and `out.vxl` (no
-// temporary file). Returns how many runs were killed while their temporary output existed.
+// Starts `voxlines convert ARGS...` `runs` times and SIGKILLs run r once it has its output open for
+// writing and r milliseconds more have passed: a kill while the output is being written, whatever the
+// machine's speed. (The output is an O_TMPFILE without a name until it is complete, so the open file is
+// looked for among the process's descriptors, /proc/PID/fd.) Every killed run must leave nothing at `out`
+// (or, when the kill came after the rename, a complete file that `verify` accepts), and the directory
+// nothing but `in.tck` and `out.vxl` (no temporary file). Returns how many runs were killed while writing.
 inline int kill_conversions(const ScratchDir& dir, const std::vector<std::string>& convert_args, const std::string& out,
                             int runs) {
   std::vector<std::string> args = {VOXLINES_CLI, "convert"};
@@ -97,9 +101,14 @@ inline int kill_conversions(const ScratchDir& dir, const std::vector<std::string
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   auto expected_file = [](const std::filesystem::path& p) { return p.filename() == "in.tck" || p.filename() == "out.vxl"; };
-  auto temporary_exists = [&] {
-    for (const auto& e : std::filesystem::directory_iterator(dir.path()))
-      if (!expected_file(e.path())) return true;
+  // Whether process `pid` has a file of `dir` other than the input open: its output in the making.
+  const std::string dir_prefix = std::filesystem::path(dir.path()).string() + "/";
+  auto writing = [&](pid_t pid) {
+    std::error_code ec;
+    for (const auto& fd : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/fd", ec)) {
+      const std::string target = std::filesystem::read_symlink(fd.path(), ec).string();
+      if (!ec && target.starts_with(dir_prefix) && !target.ends_with("/in.tck")) return true;
+    }
     return false;
   };
   int killed_while_writing = 0;
@@ -111,14 +120,14 @@ inline int kill_conversions(const ScratchDir& dir, const std::vector<std::string
     }
     int status = 0;
     bool exited = false;
-    while (!(exited = waitpid(pid, &status, WNOHANG) == pid) && !temporary_exists())
+    while (!(exited = waitpid(pid, &status, WNOHANG) == pid) && !writing(pid))
       std::this_thread::sleep_for(std::chrono::microseconds(200));
     if (!exited) {
       std::this_thread::sleep_for(std::chrono::milliseconds(r));
-      const bool writing = temporary_exists();
+      const bool was_writing = writing(pid);
       kill(pid, SIGKILL);
       waitpid(pid, &status, 0);
-      if (WIFSIGNALED(status) && writing) ++killed_while_writing;
+      if (WIFSIGNALED(status) && was_writing) ++killed_while_writing;
     }
     if (WIFSIGNALED(status) && std::filesystem::exists(out)) {
       EXPECT_EQ(run_program(VOXLINES_CLI, "verify '" + out + "'").exit_code, 0) << "run " << r << ": a killed run left an incomplete output";

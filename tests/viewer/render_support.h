@@ -34,6 +34,14 @@ inline VxlFile make_scene(const ScratchDir& dir, Tractogram t, double voxel_size
   return VxlFile::open(path);
 }
 
+// Pixels whose colour is not black.
+inline int lit_pixels(const Image& img) {
+  int n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) n += (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0;
+  return n;
+}
+
 inline Image render_image(Renderer& r, const Camera& camera, const RenderSettings& settings, int w, int h) {
   OffscreenTarget target(w, h);
   target.bind();

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "image_io.h"
+#include "render_support.h"
 #include "test_support.h"
 #include "vxl_file.h"
 
@@ -12,16 +13,10 @@ namespace {
 
 using test::ScratchDir;
 
-std::string q(const std::string& s) { return "'" + s + "'"; }
+using test::lit_pixels;
+using test::q;
 
 test::CommandResult voxview(const std::string& args) { return test::run_program(VOXVIEW_CLI, args); }
-
-int lit_pixels(const Image& img) {
-  int n = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) n += (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0;
-  return n;
-}
 
 // Row 10: `convert --voxel-size 1e8` (up to 1e300) gives one voxel holding the whole tractogram, valid, but the
 // viewer drew nothing ("0 voxels drawn"): the near plane sat at 10^-4 of a far plane one voxel beyond the

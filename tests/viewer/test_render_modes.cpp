@@ -50,12 +50,7 @@ RenderSettings settings(RenderMode mode, float opacity = 0.5f) {
 
 const std::uint8_t* centre(const Image& img) { return img.pixel(32, 31); }
 
-int lit_pixels(const Image& img) {
-  int n = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) n += (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0;
-  return n;
-}
+using test::lit_pixels;
 
 class RenderModes : public ::testing::Test {
  protected:

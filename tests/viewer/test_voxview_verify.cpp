@@ -5,6 +5,7 @@
 
 #include "hostile_vxl.h"
 #include "image_io.h"
+#include "render_support.h"
 #include "test_support.h"
 #include "vxl_file.h"
 
@@ -14,16 +15,10 @@ namespace {
 using test::ScratchDir;
 using test::VxlBytes;
 
-std::string q(const std::string& s) { return "'" + s + "'"; }
+using test::lit_pixels;
+using test::q;
 
 test::CommandResult voxview(const std::string& args) { return test::run_program(VOXVIEW_CLI, args); }
-
-int lit_pixels(const Image& img) {
-  int n = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) n += (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0;
-  return n;
-}
 
 // Row 11: one byte changed in a section open() does not read in full is drawn as it is (spec §7 keeps open
 // O(voxels)); with --verify the checksum is checked first and the file refused, exit 3, naming the problem,

@@ -43,12 +43,7 @@ bool uniform(const Image& img) {
   return true;
 }
 
-int lit_pixels(const Image& img) {
-  int n = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) n += (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0;
-  return n;
-}
+using test::lit_pixels;
 
 #define VXL_REQUIRE_XVFB()                                                                                   \
   do {                                                                                                       \
