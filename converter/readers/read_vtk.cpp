@@ -10,7 +10,6 @@
 #include <cstring>
 #include <string_view>
 
-#include "checksum.h"
 #include "error.h"
 #include "mapped_file.h"
 #include "read_tractogram.h"
@@ -388,10 +387,7 @@ class LegacyParser {
 Tractogram read_vtk(const std::string& path) {
   MappedFile file(path);
   Tractogram t = LegacyParser(path, file.bytes()).parse();
-  t.source.path = path;
-  t.source.format = "vtk";
-  t.source.bytes = file.size();
-  t.source.xxh3_128 = xxh3_128_hex(file.data(), file.size());
+  vtk::describe_source(t, path, "vtk", file.bytes());
   return t;
 }
 

@@ -18,7 +18,6 @@
 #include <pugixml.hpp>
 #include <zlib.h>
 
-#include "checksum.h"
 #include "error.h"
 #include "mapped_file.h"
 #include "read_tractogram.h"
@@ -368,10 +367,7 @@ class VtpParser {
 Tractogram read_vtp(const std::string& path) {
   MappedFile file(path);
   Tractogram t = VtpParser(path, file.bytes()).parse();
-  t.source.path = path;
-  t.source.format = "vtp";
-  t.source.bytes = file.size();
-  t.source.xxh3_128 = xxh3_128_hex(file.data(), file.size());
+  vtk::describe_source(t, path, "vtp", file.bytes());
   return t;
 }
 

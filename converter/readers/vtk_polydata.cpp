@@ -6,6 +6,7 @@
 #include <cstring>
 #include <set>
 
+#include "checksum.h"
 #include "error.h"
 
 namespace vxl::vtk {
@@ -122,6 +123,13 @@ double load_number(const std::uint8_t* p, char kind, unsigned size, bool big_end
   if (kind == 'u') return static_cast<double>(u);
   const unsigned shift = 64 - 8 * size;  // sign-extend
   return static_cast<double>(static_cast<std::int64_t>(u << shift) >> shift);
+}
+
+void describe_source(Tractogram& t, const std::string& path, const char* format, std::span<const std::uint8_t> bytes) {
+  t.source.path = path;
+  t.source.format = format;
+  t.source.bytes = bytes.size();
+  t.source.xxh3_128 = xxh3_128_hex(bytes.data(), bytes.size());
 }
 
 }  // namespace vxl::vtk

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,9 @@ struct PolyData {
 // Fills t's streamlines (one per line cell, its points gathered through the connectivity) and value
 // sets from `p`, checking every index and array size; throws vxl::Error (Input) naming `path`.
 void fill_tractogram(Tractogram& t, const std::string& path, const PolyData& p, bool lps);
+
+// The provenance of a tractogram read from `bytes`, the whole file at `path`, in format `format`.
+void describe_source(Tractogram& t, const std::string& path, const char* format, std::span<const std::uint8_t> bytes);
 
 // A legacy array name with VTK's %XX escapes (for blanks and '%') decoded.
 std::string decode_name(const std::string& name);
