@@ -18,8 +18,8 @@
 #include <thread>
 #include <vector>
 
-#include "child_process.h"
-#include "vxl_file.h"
+#include "bench/child_process.h"
+#include "format/vxl_file.h"
 
 namespace {
 

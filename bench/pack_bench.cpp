@@ -22,13 +22,13 @@
 #include <thread>
 #include <vector>
 
-#include "child_process.h"
-#include "error.h"
-#include "vxl_file.h"
-#include "vxl_streamlines.h"
-#include "vxlz_draco.h"
-#include "vxlz_layout.h"
-#include "vxlz_package.h"
+#include "bench/child_process.h"
+#include "format/error.h"
+#include "format/vxl_file.h"
+#include "format/vxl_streamlines.h"
+#include "format/vxlz_draco.h"
+#include "format/vxlz_layout.h"
+#include "format/vxlz_package.h"
 
 namespace {
 

@@ -17,11 +17,11 @@
 #include <string>
 #include <vector>
 
-#include "child_process.h"
-#include "egl_context.h"
-#include "frame_plan.h"
-#include "offscreen_target.h"
-#include "renderer.h"
+#include "bench/child_process.h"
+#include "viewer/platform/egl_context.h"
+#include "viewer/render/frame_plan.h"
+#include "viewer/platform/offscreen_target.h"
+#include "viewer/render/renderer.h"
 
 namespace {
 

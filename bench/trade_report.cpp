@@ -1,4 +1,4 @@
-#include "trade_report.h"
+#include "bench/trade_report.h"
 
 #include <algorithm>
 #include <cmath>

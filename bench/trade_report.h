@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "image_metrics.h"
+#include "viewer/platform/image_metrics.h"
 
 namespace vxl::trade {
 

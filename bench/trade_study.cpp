@@ -34,12 +34,12 @@
 #include <string>
 #include <vector>
 
-#include "egl_context.h"
-#include "image_io.h"
-#include "image_metrics.h"
-#include "offscreen_target.h"
-#include "renderer.h"
-#include "trade_report.h"
+#include "viewer/platform/egl_context.h"
+#include "viewer/platform/image_io.h"
+#include "viewer/platform/image_metrics.h"
+#include "viewer/platform/offscreen_target.h"
+#include "viewer/render/renderer.h"
+#include "bench/trade_report.h"
 
 namespace {
 

@@ -1,13 +1,13 @@
-#include "convert.h"
+#include "converter/convert.h"
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
 
-#include "error.h"
-#include "segment_orders.h"
-#include "vxl_value_sets.h"
-#include "vxl_writer.h"
+#include "format/error.h"
+#include "converter/segment_orders.h"
+#include "format/vxl_value_sets.h"
+#include "format/vxl_writer.h"
 
 #ifndef VOXLINES_VERSION
 #define VOXLINES_VERSION "0.0.0"

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "tractogram.h"
-#include "voxelize.h"
+#include "converter/tractogram.h"
+#include "converter/voxelize.h"
 
 namespace vxl {
 

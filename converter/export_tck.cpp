@@ -1,14 +1,14 @@
-#include "export_tck.h"
+#include "converter/export_tck.h"
 
 #include <cmath>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
 
-#include "error.h"
-#include "export_values.h"
-#include "tck_writer.h"
-#include "vxl_streamlines.h"
+#include "format/error.h"
+#include "converter/export_values.h"
+#include "converter/tck_writer.h"
+#include "format/vxl_streamlines.h"
 
 namespace vxl {
 namespace {

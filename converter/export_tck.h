@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "vxl_file.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "export_trx.h"
+#include "converter/export_trx.h"
 
 #include <cmath>
 #include <limits>
@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 #include <zip.h>
 
-#include "error.h"
-#include "export_values.h"
-#include "vxl_streamlines.h"
+#include "format/error.h"
+#include "converter/export_values.h"
+#include "format/vxl_streamlines.h"
 
 namespace vxl {
 namespace {

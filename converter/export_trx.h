@@ -18,7 +18,7 @@
 #include <array>
 #include <string>
 
-#include "vxl_file.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 

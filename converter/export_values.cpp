@@ -1,9 +1,9 @@
-#include "export_values.h"
+#include "converter/export_values.h"
 
 #include <charconv>
 
-#include "error.h"
-#include "vxl_streamlines.h"
+#include "format/error.h"
+#include "format/vxl_streamlines.h"
 
 namespace vxl {
 namespace {

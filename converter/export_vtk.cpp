@@ -1,4 +1,4 @@
-#include "export_vtk.h"
+#include "converter/export_vtk.h"
 
 #include <bit>
 #include <cstring>
@@ -6,9 +6,9 @@
 #include <limits>
 #include <vector>
 
-#include "atomic_output.h"
-#include "error.h"
-#include "vxl_streamlines.h"
+#include "format/atomic_output.h"
+#include "format/error.h"
+#include "format/vxl_streamlines.h"
 
 namespace vxl {
 namespace {

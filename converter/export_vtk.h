@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "vxl_file.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "memory_size.h"
+#include "converter/memory_size.h"
 
 #include <cstdio>
 #include <limits>

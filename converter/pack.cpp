@@ -1,4 +1,4 @@
-#include "pack.h"
+#include "converter/pack.h"
 
 #include <algorithm>
 #include <array>
@@ -6,15 +6,15 @@
 #include <cstring>
 #include <vector>
 
-#include "error.h"
-#include "parallel.h"
-#include "voxelize.h"
-#include "vxl_streamlines.h"
-#include "vxlz_draco.h"
-#include "vxlz_package.h"
-#include "vxlz_quantize.h"
-#include "vxlz_tables.h"
-#include "vxlz_values.h"
+#include "format/error.h"
+#include "format/parallel.h"
+#include "converter/voxelize.h"
+#include "format/vxl_streamlines.h"
+#include "format/vxlz_draco.h"
+#include "format/vxlz_package.h"
+#include "format/vxlz_quantize.h"
+#include "format/vxlz_tables.h"
+#include "format/vxlz_values.h"
 
 namespace vxl {
 namespace {

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <string>
 
-#include "vxl_file.h"
-#include "vxlz_layout.h"
+#include "format/vxl_file.h"
+#include "format/vxlz_layout.h"
 
 namespace vxl {
 

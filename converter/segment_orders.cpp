@@ -1,4 +1,4 @@
-#include "segment_orders.h"
+#include "converter/segment_orders.h"
 
 #include <algorithm>
 #include <atomic>
@@ -9,8 +9,8 @@
 #include <optional>
 #include <utility>
 
-#include "error.h"
-#include "parallel.h"
+#include "format/error.h"
+#include "format/parallel.h"
 
 namespace vxl {
 

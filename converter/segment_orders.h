@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "voxelize.h"
-#include "vxl_layout.h"
+#include "converter/voxelize.h"
+#include "format/vxl_layout.h"
 
 namespace vxl {
 

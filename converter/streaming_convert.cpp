@@ -1,4 +1,4 @@
-#include "streaming_convert.h"
+#include "converter/streaming_convert.h"
 
 #include <algorithm>
 #include <array>
@@ -12,14 +12,14 @@
 #include <malloc.h>
 #endif
 
-#include "error.h"
-#include "memory_size.h"
-#include "parallel.h"
-#include "segment_orders.h"
-#include "tck_stream.h"
-#include "voxelize.h"
-#include "voxel_table.h"
-#include "vxl_stream_writer.h"
+#include "format/error.h"
+#include "converter/memory_size.h"
+#include "format/parallel.h"
+#include "converter/segment_orders.h"
+#include "converter/readers/tck_stream.h"
+#include "converter/voxelize.h"
+#include "converter/voxel_table.h"
+#include "format/vxl_stream_writer.h"
 
 namespace vxl {
 namespace {

@@ -15,7 +15,7 @@
 
 #include <string>
 
-#include "convert.h"
+#include "converter/convert.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "synth.h"
+#include "converter/synth.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "parallel.h"
+#include "format/parallel.h"
 
 #if defined(__linux__)
 #include <sys/mman.h>

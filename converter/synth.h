@@ -24,7 +24,7 @@
 #include <array>
 #include <cstdint>
 
-#include "tractogram.h"
+#include "converter/tractogram.h"
 
 namespace vxl {
 

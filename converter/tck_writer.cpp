@@ -1,4 +1,4 @@
-#include "tck_writer.h"
+#include "converter/tck_writer.h"
 
 #include <limits>
 

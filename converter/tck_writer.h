@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "atomic_output.h"
+#include "format/atomic_output.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "unpack.h"
+#include "converter/unpack.h"
 
 #include <algorithm>
 #include <chrono>
@@ -9,17 +9,17 @@
 
 #include <nlohmann/json.hpp>
 
-#include "error.h"
-#include "parallel.h"
-#include "segment_orders.h"
-#include "voxel_table.h"
-#include "vxl_writer.h"
-#include "vxlz_draco.h"
-#include "vxlz_package.h"
-#include "vxlz_quantize.h"
-#include "vxlz_tables.h"
-#include "vxlz_values.h"
-#include "vxl_value_sets.h"
+#include "format/error.h"
+#include "format/parallel.h"
+#include "converter/segment_orders.h"
+#include "converter/voxel_table.h"
+#include "format/vxl_writer.h"
+#include "format/vxlz_draco.h"
+#include "format/vxlz_package.h"
+#include "format/vxlz_quantize.h"
+#include "format/vxlz_tables.h"
+#include "format/vxlz_values.h"
+#include "format/vxl_value_sets.h"
 
 namespace vxl {
 namespace {

@@ -9,8 +9,8 @@
 #include <cstdint>
 #include <string>
 
-#include "voxelize.h"
-#include "vxlz_layout.h"
+#include "converter/voxelize.h"
+#include "format/vxlz_layout.h"
 
 namespace vxl {
 

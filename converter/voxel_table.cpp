@@ -1,9 +1,9 @@
-#include "voxel_table.h"
+#include "converter/voxel_table.h"
 
 #include <algorithm>
 #include <sstream>
 
-#include "error.h"
+#include "format/error.h"
 
 namespace vxl::detail {
 namespace {

@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "voxelize_streamline.h"
-#include "vxl_layout.h"
+#include "converter/voxelize_streamline.h"
+#include "format/vxl_layout.h"
 
 namespace vxl::detail {
 

@@ -1,11 +1,11 @@
-#include "voxelize.h"
+#include "converter/voxelize.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-#include "parallel.h"
-#include "voxel_table.h"
+#include "format/parallel.h"
+#include "converter/voxel_table.h"
 
 namespace vxl {
 

@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "parallel.h"  // resolve_threads: the meaning of VoxelizeSettings::threads
-#include "tractogram.h"
-#include "vxl_layout.h"
+#include "format/parallel.h"  // resolve_threads: the meaning of VoxelizeSettings::threads
+#include "converter/tractogram.h"
+#include "format/vxl_layout.h"
 
 namespace vxl {
 

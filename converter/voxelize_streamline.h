@@ -11,7 +11,7 @@
 #include <limits>
 #include <vector>
 
-#include "vxl_layout.h"
+#include "format/vxl_layout.h"
 
 namespace vxl::detail {
 

@@ -1,4 +1,4 @@
-#include "atomic_output.h"
+#include "format/atomic_output.h"
 
 #include <cerrno>
 #include <cstring>
@@ -10,8 +10,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "error.h"
-#include "parallel.h"
+#include "format/error.h"
+#include "format/parallel.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "mapped_file.h"
+#include "format/mapped_file.h"
 
 #include <cerrno>
 #include <cstring>
@@ -9,7 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "error.h"
+#include "format/error.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "utf8_check.h"
+#include "format/utf8_check.h"
 
 #include <iterator>
 

@@ -1,11 +1,11 @@
-#include "vxl_file.h"
+#include "format/vxl_file.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "error.h"
-#include "utf8_check.h"
+#include "format/error.h"
+#include "format/utf8_check.h"
 
 namespace vxl {
 

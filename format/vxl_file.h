@@ -15,10 +15,10 @@
 #include <string_view>
 #include <vector>
 
-#include "mapped_file.h"
-#include "vxl_layout.h"
-#include "vxl_value_sets.h"
-#include "vxl_writer.h"
+#include "format/mapped_file.h"
+#include "format/vxl_layout.h"
+#include "format/vxl_value_sets.h"
+#include "format/vxl_writer.h"
 
 namespace vxl {
 

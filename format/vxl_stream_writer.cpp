@@ -1,4 +1,4 @@
-#include "vxl_stream_writer.h"
+#include "format/vxl_stream_writer.h"
 
 #include <cstring>
 #include <stdexcept>

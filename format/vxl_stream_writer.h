@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "atomic_output.h"
-#include "checksum.h"
-#include "vxl_layout.h"
-#include "vxl_writer.h"
+#include "format/atomic_output.h"
+#include "format/checksum.h"
+#include "format/vxl_layout.h"
+#include "format/vxl_writer.h"
 
 namespace vxl {
 

@@ -1,9 +1,9 @@
-#include "vxl_streamlines.h"
+#include "format/vxl_streamlines.h"
 
 #include <cstring>
 #include <vector>
 
-#include "error.h"
+#include "format/error.h"
 
 namespace vxl {
 

@@ -5,7 +5,7 @@
 #include <functional>
 #include <span>
 
-#include "vxl_file.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 

@@ -1,12 +1,12 @@
-#include "vxl_value_sets.h"
+#include "format/vxl_value_sets.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
 
-#include "error.h"
-#include "utf8_check.h"
+#include "format/error.h"
+#include "format/utf8_check.h"
 
 namespace vxl {
 

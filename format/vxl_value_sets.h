@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "vxl_layout.h"
+#include "format/vxl_layout.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "vxl_verify.h"
+#include "format/vxl_verify.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,10 +7,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "checksum.h"
-#include "error.h"
-#include "vxl_file.h"
-#include "vxl_streamlines.h"
+#include "format/checksum.h"
+#include "format/error.h"
+#include "format/vxl_file.h"
+#include "format/vxl_streamlines.h"
 
 namespace vxl {
 namespace {

@@ -1,11 +1,11 @@
-#include "vxl_writer.h"
+#include "format/vxl_writer.h"
 
 #include <algorithm>
 #include <cstring>
 
-#include "checksum.h"
-#include "parallel.h"
-#include "vxl_value_sets.h"
+#include "format/checksum.h"
+#include "format/parallel.h"
+#include "format/vxl_value_sets.h"
 
 namespace vxl {
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "atomic_output.h"
-#include "vxl_layout.h"
+#include "format/atomic_output.h"
+#include "format/vxl_layout.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "vxlz_draco.h"
+#include "format/vxlz_draco.h"
 
 #include <array>
 #include <cstring>
@@ -9,7 +9,7 @@
 #include <draco/compression/point_cloud/point_cloud_decoder.h>
 #include <draco/point_cloud/point_cloud_builder.h>
 
-#include "error.h"
+#include "format/error.h"
 
 namespace vxl {
 namespace {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "vxlz_layout.h"
+#include "format/vxlz_layout.h"
 
 namespace vxl {
 

@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "vxl_layout.h"
+#include "format/vxl_layout.h"
 
 namespace vxl {
 

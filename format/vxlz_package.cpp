@@ -1,15 +1,15 @@
-#include "vxlz_package.h"
+#include "format/vxlz_package.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
 
-#include "atomic_output.h"
-#include "checksum.h"
-#include "error.h"
-#include "parallel.h"
-#include "vxl_file.h"
+#include "format/atomic_output.h"
+#include "format/checksum.h"
+#include "format/error.h"
+#include "format/parallel.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 namespace {

@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "mapped_file.h"
-#include "vxl_layout.h"
-#include "vxlz_draco.h"
-#include "vxlz_layout.h"
-#include "vxlz_streams.h"
+#include "format/mapped_file.h"
+#include "format/vxl_layout.h"
+#include "format/vxlz_draco.h"
+#include "format/vxlz_layout.h"
+#include "format/vxlz_streams.h"
 
 namespace vxl {
 

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "vxlz_layout.h"
+#include "format/vxlz_layout.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "vxlz_streams.h"
+#include "format/vxlz_streams.h"
 
 #include <algorithm>
 #include <cstring>
@@ -6,7 +6,7 @@
 
 #include <zlib.h>
 
-#include "error.h"
+#include "format/error.h"
 
 namespace vxl {
 

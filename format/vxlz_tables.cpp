@@ -1,9 +1,9 @@
-#include "vxlz_tables.h"
+#include "format/vxlz_tables.h"
 
 #include <algorithm>
 #include <string>
 
-#include "error.h"
+#include "format/error.h"
 
 namespace vxl {
 namespace {

@@ -8,9 +8,9 @@
 #include <span>
 #include <vector>
 
-#include "vxl_layout.h"
-#include "vxl_writer.h"
-#include "vxlz_streams.h"
+#include "format/vxl_layout.h"
+#include "format/vxl_writer.h"
+#include "format/vxlz_streams.h"
 
 namespace vxl {
 

@@ -1,11 +1,11 @@
-#include "vxlz_values.h"
+#include "format/vxlz_values.h"
 
 #include <algorithm>
 #include <cstring>
 
-#include "error.h"
-#include "parallel.h"
-#include "vxl_value_sets.h"
+#include "format/error.h"
+#include "format/parallel.h"
+#include "format/vxl_value_sets.h"
 
 namespace vxl {
 namespace {

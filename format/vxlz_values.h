@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "vxlz_streams.h"
+#include "format/vxlz_streams.h"
 
 namespace vxl {
 

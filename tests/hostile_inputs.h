@@ -15,8 +15,8 @@
 #include <sys/stat.h>
 #include <zlib.h>
 
-#include "mrtrix_test_files.h"
-#include "zip_writer.h"
+#include "tests/mrtrix_test_files.h"
+#include "tests/zip_writer.h"
 
 namespace vxl::test::hostile {
 

@@ -13,10 +13,10 @@
 
 #include <gtest/gtest.h>
 
-#include "convert.h"
-#include "reseal_checksums.h"
-#include "vxl_layout.h"
-#include "vxl_value_sets.h"
+#include "converter/convert.h"
+#include "tests/reseal_checksums.h"
+#include "format/vxl_layout.h"
+#include "format/vxl_value_sets.h"
 
 namespace vxl::test {
 

@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <cstring>
 
-#include "checksum.h"
-#include "vxl_layout.h"
+#include "format/checksum.h"
+#include "format/vxl_layout.h"
 
 namespace vxl::test {
 

@@ -10,7 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "test_support.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

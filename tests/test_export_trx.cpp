@@ -9,15 +9,15 @@
 
 #include <nlohmann/json.hpp>
 
-#include "convert.h"
-#include "error.h"
-#include "export_tck.h"
-#include "export_trx.h"
-#include "read_tractogram.h"
-#include "synth.h"
-#include "test_support.h"
-#include "vxl_file.h"
-#include "vxl_streamlines.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "converter/export_tck.h"
+#include "converter/export_trx.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/synth.h"
+#include "tests/test_support.h"
+#include "format/vxl_file.h"
+#include "format/vxl_streamlines.h"
 
 namespace vxl {
 namespace {
@@ -53,9 +53,10 @@ Tractogram streamlines_of(const VxlFile& f) {
 void expect_same_streamlines(const Tractogram& expected, const Tractogram& got) {
   EXPECT_EQ(expected.offsets, got.offsets);
   ASSERT_EQ(expected.positions.size(), got.positions.size());
-  if (!expected.positions.empty())
+  if (!expected.positions.empty()) {
     EXPECT_EQ(std::memcmp(expected.positions.data(), got.positions.data(), expected.positions.size() * sizeof(float)), 0)
         << "positions must be bit-identical";
+  }
 }
 
 // An independent structural check of a TRX archive against the specification, in Python (zipfile +
@@ -152,7 +153,9 @@ TEST(ExportTrx, EmptyTractogram) {
   export_trx(f, dir.file("e.trx"));
   const Tractogram back = read_trx(dir.file("e.trx"));
   EXPECT_EQ(back.streamline_count(), 0u);
-  if (have_python_numpy()) EXPECT_NE(check_trx_in_python(dir, dir.file("e.trx")).find("TRX-OK 0 0"), std::string::npos);
+  if (have_python_numpy()) {
+    EXPECT_NE(check_trx_in_python(dir, dir.file("e.trx")).find("TRX-OK 0 0"), std::string::npos);
+  }
 }
 
 TEST(ExportTrx, DefaultReferenceCoversTheBounds) {
@@ -212,8 +215,9 @@ TEST(ExportTrxReal, SourceReferenceAndGroupsAreKept) {
     EXPECT_EQ(back.groups[g].name, source.groups[g].name);
     EXPECT_EQ(back.groups[g].members, source.groups[g].members);
   }
-  if (have_python_numpy())
+  if (have_python_numpy()) {
     EXPECT_NE(check_trx_in_python(dir, dir.file("afq.trx")).find("TRX-OK 508 141447 ARC_L|ARC_R"), std::string::npos);
+  }
 
   // A TRK source gives its dim and vox_to_ras.
   const Tractogram trk = read_trk(test::real("nibabel__standard.trk"));
@@ -237,7 +241,9 @@ TEST(ExportTrxReal, TckAndTrxOfRealFixturesReadBackIdentically) {
     expect_same_streamlines(expected, read_tck(dir.file("r.tck")));
     export_trx(f, dir.file("r.trx"));
     expect_same_streamlines(expected, read_trx(dir.file("r.trx")));
-    if (have_python_numpy()) EXPECT_NE(check_trx_in_python(dir, dir.file("r.trx")).find("TRX-OK"), std::string::npos);
+    if (have_python_numpy()) {
+      EXPECT_NE(check_trx_in_python(dir, dir.file("r.trx")).find("TRX-OK"), std::string::npos);
+    }
   }
 }
 

@@ -13,15 +13,15 @@
 #include <limits>
 #include <thread>
 
-#include "convert.h"
-#include "error.h"
-#include "read_tractogram.h"
-#include "synth.h"
-#include "tck_writer.h"
-#include "vxl_file.h"
-#include "vxl_streamlines.h"
-#include "vxl_verify.h"
-#include "test_support.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/synth.h"
+#include "converter/tck_writer.h"
+#include "format/vxl_file.h"
+#include "format/vxl_streamlines.h"
+#include "format/vxl_verify.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

@@ -8,12 +8,12 @@
 
 #include <gtest/gtest.h>
 
-#include "error.h"
-#include "hostile_inputs.h"
-#include "read_tractogram.h"
-#include "read_tsf.h"
-#include "tck_stream.h"
-#include "test_support.h"
+#include "format/error.h"
+#include "tests/hostile_inputs.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/readers/read_tsf.h"
+#include "converter/readers/tck_stream.h"
+#include "tests/test_support.h"
 
 namespace {
 

@@ -6,13 +6,13 @@
 #include <functional>
 #include <string>
 
-#include "error.h"
-#include "export_trx.h"
-#include "hostile_vxl.h"
-#include "test_support.h"
-#include "utf8_check.h"
-#include "vxl_file.h"
-#include "vxl_value_sets.h"
+#include "format/error.h"
+#include "converter/export_trx.h"
+#include "tests/hostile_vxl.h"
+#include "tests/test_support.h"
+#include "format/utf8_check.h"
+#include "format/vxl_file.h"
+#include "format/vxl_value_sets.h"
 
 namespace vxl {
 namespace {

@@ -9,7 +9,7 @@
 #include <thread>
 #include <vector>
 
-#include "parallel.h"
+#include "format/parallel.h"
 
 namespace vxl {
 namespace {

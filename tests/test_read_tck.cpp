@@ -4,10 +4,10 @@
 #include <cstring>
 #include <fstream>
 
-#include "error.h"
-#include "read_tractogram.h"
-#include "mrtrix_test_files.h"
-#include "test_support.h"
+#include "format/error.h"
+#include "converter/readers/read_tractogram.h"
+#include "tests/mrtrix_test_files.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

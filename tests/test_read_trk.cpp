@@ -11,9 +11,9 @@
 
 #include <gtest/gtest.h>
 
-#include "error.h"
-#include "read_tractogram.h"
-#include "test_support.h"
+#include "format/error.h"
+#include "converter/readers/read_tractogram.h"
+#include "tests/test_support.h"
 
 namespace {
 

@@ -14,12 +14,12 @@
 
 #include <gtest/gtest.h>
 
-#include "checksum.h"
-#include "error.h"
-#include "float16.h"
-#include "read_tractogram.h"
-#include "test_support.h"
-#include "zip_writer.h"
+#include "format/checksum.h"
+#include "format/error.h"
+#include "converter/readers/float16.h"
+#include "converter/readers/read_tractogram.h"
+#include "tests/test_support.h"
+#include "tests/zip_writer.h"
 
 namespace {
 

@@ -6,13 +6,13 @@
 #include <filesystem>
 #include <sstream>
 
-#include "convert.h"
-#include "error.h"
-#include "export_vtk.h"
-#include "read_tractogram.h"
-#include "test_support.h"
-#include "vtk_test_files.h"
-#include "vxl_file.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "converter/export_vtk.h"
+#include "converter/readers/read_tractogram.h"
+#include "tests/test_support.h"
+#include "tests/vtk_test_files.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 namespace {

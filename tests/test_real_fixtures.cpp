@@ -6,11 +6,11 @@
 #include <filesystem>
 #include <map>
 
-#include "convert.h"
-#include "read_tractogram.h"
-#include "vxl_file.h"
-#include "real_fixture_outcomes.h"
-#include "test_support.h"
+#include "converter/convert.h"
+#include "converter/readers/read_tractogram.h"
+#include "format/vxl_file.h"
+#include "tests/real_fixture_outcomes.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

@@ -14,18 +14,18 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "convert.h"
-#include "error.h"
-#include "memory_size.h"
-#include "read_tractogram.h"
-#include "streaming_convert.h"
-#include "synth.h"
-#include "tck_stream.h"
-#include "tck_writer.h"
-#include "vxl_file.h"
-#include "vxl_verify.h"
-#include "mrtrix_test_files.h"
-#include "test_support.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "converter/memory_size.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/streaming_convert.h"
+#include "converter/synth.h"
+#include "converter/readers/tck_stream.h"
+#include "converter/tck_writer.h"
+#include "format/vxl_file.h"
+#include "format/vxl_verify.h"
+#include "tests/mrtrix_test_files.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

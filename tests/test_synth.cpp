@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "checksum.h"
-#include "synth.h"
+#include "format/checksum.h"
+#include "converter/synth.h"
 
 namespace {
 

@@ -8,14 +8,14 @@
 #include <fstream>
 #include <functional>
 
-#include "convert.h"
-#include "error.h"
-#include "read_tractogram.h"
-#include "read_tsf.h"
-#include "mrtrix_test_files.h"
-#include "test_support.h"
-#include "vxl_file.h"
-#include "vxl_verify.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/readers/read_tsf.h"
+#include "tests/mrtrix_test_files.h"
+#include "tests/test_support.h"
+#include "format/vxl_file.h"
+#include "format/vxl_verify.h"
 
 namespace vxl {
 namespace {

@@ -9,21 +9,21 @@
 #include <functional>
 #include <limits>
 
-#include "convert.h"
-#include "error.h"
-#include "export_tck.h"
-#include "export_trx.h"
-#include "mrtrix_test_files.h"
-#include "pack.h"
-#include "read_tractogram.h"
-#include "read_tsf.h"
-#include "synth.h"
-#include "test_support.h"
-#include "unpack.h"
-#include "vxl_file.h"
-#include "vxl_verify.h"
-#include "vxlz_package.h"
-#include "vxlz_values.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "converter/export_tck.h"
+#include "converter/export_trx.h"
+#include "tests/mrtrix_test_files.h"
+#include "converter/pack.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/readers/read_tsf.h"
+#include "converter/synth.h"
+#include "tests/test_support.h"
+#include "converter/unpack.h"
+#include "format/vxl_file.h"
+#include "format/vxl_verify.h"
+#include "format/vxlz_package.h"
+#include "format/vxlz_values.h"
 
 namespace vxl {
 namespace {
@@ -138,7 +138,9 @@ TEST(ValuesPackage, SectionsAreOptionalAndAPackageWithoutValuesStays20) {
     SectionEntry e{};
     in.read(reinterpret_cast<char*>(&e), sizeof e);
     const std::string id(e.id, 4);
-    if (id == "PVAL" || id == "SVAL") EXPECT_EQ(e.flags & kSectionRequired, 0u) << id;
+    if (id == "PVAL" || id == "SVAL") {
+      EXPECT_EQ(e.flags & kSectionRequired, 0u) << id;
+    }
   }
 
   Tractogram plain = valued_tractogram(50);

@@ -5,10 +5,10 @@
 
 #include <sys/resource.h>
 
-#include "error.h"
-#include "segment_orders.h"
-#include "voxelize.h"
-#include "test_support.h"
+#include "format/error.h"
+#include "converter/segment_orders.h"
+#include "converter/voxelize.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

@@ -5,12 +5,12 @@
 #include <fstream>
 #include <iterator>
 
-#include "convert.h"
-#include "error.h"
-#include "vxl_file.h"
-#include "vxl_streamlines.h"
-#include "vxl_verify.h"
-#include "test_support.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "format/vxl_file.h"
+#include "format/vxl_streamlines.h"
+#include "format/vxl_verify.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

@@ -11,11 +11,11 @@
 
 #include <gtest/gtest.h>
 
-#include "convert.h"
-#include "error.h"
-#include "vxl_file.h"
-#include "reseal_checksums.h"
-#include "test_support.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "format/vxl_file.h"
+#include "tests/reseal_checksums.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

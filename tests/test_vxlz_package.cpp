@@ -12,21 +12,21 @@
 
 #include <nlohmann/json.hpp>
 
-#include "convert.h"
-#include "error.h"
-#include "pack.h"
-#include "read_tractogram.h"
-#include "reseal_checksums.h"
-#include "synth.h"
-#include "test_support.h"
-#include "unpack.h"
-#include "checksum.h"
-#include "vxl_file.h"
-#include "vxl_streamlines.h"
-#include "vxl_verify.h"
-#include "vxlz_draco.h"
-#include "vxlz_package.h"
-#include "vxlz_tables.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "converter/pack.h"
+#include "converter/readers/read_tractogram.h"
+#include "tests/reseal_checksums.h"
+#include "converter/synth.h"
+#include "tests/test_support.h"
+#include "converter/unpack.h"
+#include "format/checksum.h"
+#include "format/vxl_file.h"
+#include "format/vxl_streamlines.h"
+#include "format/vxl_verify.h"
+#include "format/vxlz_draco.h"
+#include "format/vxlz_package.h"
+#include "format/vxlz_tables.h"
 
 namespace vxl {
 namespace {
@@ -103,7 +103,9 @@ void expect_same_structure(const VxlFile& a, const VxlFile& b) {
   }
   const auto va = a.voxlines(), vb = b.voxlines();
   ASSERT_EQ(va.size(), vb.size());
-  if (!va.empty()) EXPECT_EQ(std::memcmp(va.data(), vb.data(), va.size_bytes()), 0);
+  if (!va.empty()) {
+    EXPECT_EQ(std::memcmp(va.data(), vb.data(), va.size_bytes()), 0);
+  }
   EXPECT_EQ(to_vector(a.streamline_first_voxline()), to_vector(b.streamline_first_voxline()));
   ASSERT_EQ(a.directions().size(), b.directions().size());
   EXPECT_EQ(std::memcmp(a.directions().data(), b.directions().data(), a.directions().size_bytes()), 0);

@@ -2,14 +2,14 @@
 #include <fstream>
 #include <string>
 
-#include "commands.h"
-#include "convert.h"
-#include "convert_cohort.h"
-#include "convert_file.h"
-#include "error.h"
-#include "memory_size.h"
-#include "progress_bar.h"
-#include "segment_orders.h"
+#include "converter/cli/commands.h"
+#include "converter/convert.h"
+#include "converter/cli/convert_cohort.h"
+#include "converter/cli/convert_file.h"
+#include "format/error.h"
+#include "converter/memory_size.h"
+#include "converter/cli/progress_bar.h"
+#include "converter/segment_orders.h"
 
 namespace vxl::cli {
 namespace {

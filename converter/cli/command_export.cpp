@@ -1,11 +1,11 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "commands.h"
-#include "error.h"
-#include "export_tck.h"
-#include "export_trx.h"
-#include "export_vtk.h"
+#include "converter/cli/commands.h"
+#include "format/error.h"
+#include "converter/export_tck.h"
+#include "converter/export_trx.h"
+#include "converter/export_vtk.h"
 
 namespace vxl::cli {
 

@@ -3,8 +3,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "commands.h"
-#include "vxl_file.h"
+#include "converter/cli/commands.h"
+#include "format/vxl_file.h"
 
 namespace vxl::cli {
 namespace {

@@ -1,8 +1,8 @@
 #include <cstdio>
 
-#include "commands.h"
-#include "pack.h"
-#include "vxl_file.h"
+#include "converter/cli/commands.h"
+#include "converter/pack.h"
+#include "format/vxl_file.h"
 
 namespace vxl::cli {
 

@@ -1,8 +1,8 @@
 #include <cstdio>
 
-#include "commands.h"
-#include "synth.h"
-#include "tck_writer.h"
+#include "converter/cli/commands.h"
+#include "converter/synth.h"
+#include "converter/tck_writer.h"
 
 namespace vxl::cli {
 

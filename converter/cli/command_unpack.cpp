@@ -1,8 +1,8 @@
 #include <cstdio>
 
-#include "commands.h"
-#include "progress_bar.h"
-#include "unpack.h"
+#include "converter/cli/commands.h"
+#include "converter/cli/progress_bar.h"
+#include "converter/unpack.h"
 
 namespace vxl::cli {
 

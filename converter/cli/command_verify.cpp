@@ -1,7 +1,7 @@
 #include <cstdio>
 
-#include "commands.h"
-#include "vxl_verify.h"
+#include "converter/cli/commands.h"
+#include "format/vxl_verify.h"
 
 namespace vxl::cli {
 

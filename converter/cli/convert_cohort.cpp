@@ -1,4 +1,4 @@
-#include "convert_cohort.h"
+#include "converter/cli/convert_cohort.h"
 
 #include <algorithm>
 #include <atomic>
@@ -15,10 +15,10 @@
 
 #include <unistd.h>
 
-#include "convert_file.h"
-#include "error.h"
-#include "parallel.h"
-#include "progress_bar.h"
+#include "converter/cli/convert_file.h"
+#include "format/error.h"
+#include "format/parallel.h"
+#include "converter/cli/progress_bar.h"
 
 namespace vxl::cli {
 namespace {

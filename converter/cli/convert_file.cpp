@@ -1,13 +1,13 @@
-#include "convert_file.h"
+#include "converter/cli/convert_file.h"
 
 #include <chrono>
 #include <cstdio>
 
-#include "error.h"
-#include "memory_size.h"
-#include "read_tractogram.h"
-#include "read_tsf.h"
-#include "streaming_convert.h"
+#include "format/error.h"
+#include "converter/memory_size.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/readers/read_tsf.h"
+#include "converter/streaming_convert.h"
 
 namespace vxl::cli {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "convert.h"
+#include "converter/convert.h"
 
 namespace vxl::cli {
 

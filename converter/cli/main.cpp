@@ -7,8 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "commands.h"
-#include "error.h"
+#include "converter/cli/commands.h"
+#include "format/error.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "progress_bar.h"
+#include "converter/cli/progress_bar.h"
 
 #include <cstdio>
 

@@ -1,9 +1,9 @@
-#include "mrtrix_header.h"
+#include "converter/readers/mrtrix_header.h"
 
 #include <charconv>
 #include <string_view>
 
-#include "error.h"
+#include "format/error.h"
 
 namespace vxl {
 namespace {

@@ -8,12 +8,12 @@
 // whose x is Inf ends the file. Like MRtrix we tolerate a missing Inf terminator at EOF, and trust the data
 // over a stale "count"; unlike MRtrix we warn about data it ignores (after the terminator, or cut by an Inf
 // x that is no whole terminator).
-#include "checksum.h"
-#include "error.h"
-#include "mapped_file.h"
-#include "read_tractogram.h"
-#include "regular_file.h"
-#include "tck_format.h"
+#include "format/checksum.h"
+#include "format/error.h"
+#include "format/mapped_file.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/readers/regular_file.h"
+#include "converter/readers/tck_format.h"
 
 namespace vxl {
 namespace tck {

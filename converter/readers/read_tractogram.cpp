@@ -1,8 +1,8 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "error.h"
-#include "read_tractogram.h"
+#include "format/error.h"
+#include "converter/readers/read_tractogram.h"
 
 namespace vxl {
 

@@ -12,7 +12,7 @@
 
 #include <string>
 
-#include "tractogram.h"
+#include "converter/tractogram.h"
 
 namespace vxl {
 

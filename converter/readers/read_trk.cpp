@@ -30,12 +30,12 @@
 
 #include <zlib.h>
 
-#include "checksum.h"
-#include "error.h"
-#include "mapped_file.h"
-#include "latin1.h"
-#include "read_tractogram.h"
-#include "regular_file.h"
+#include "format/checksum.h"
+#include "format/error.h"
+#include "format/mapped_file.h"
+#include "converter/readers/latin1.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/readers/regular_file.h"
 
 namespace vxl {
 namespace {

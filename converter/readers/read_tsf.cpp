@@ -1,4 +1,4 @@
-#include "read_tsf.h"
+#include "converter/readers/read_tsf.h"
 
 #include <bit>
 #include <cmath>
@@ -6,11 +6,11 @@
 #include <cstring>
 #include <filesystem>
 
-#include "checksum.h"
-#include "error.h"
-#include "mapped_file.h"
-#include "mrtrix_header.h"
-#include "regular_file.h"
+#include "format/checksum.h"
+#include "format/error.h"
+#include "format/mapped_file.h"
+#include "converter/readers/mrtrix_header.h"
+#include "converter/readers/regular_file.h"
 
 namespace vxl {
 namespace {

@@ -10,10 +10,10 @@
 #include <cstring>
 #include <string_view>
 
-#include "error.h"
-#include "mapped_file.h"
-#include "read_tractogram.h"
-#include "vtk_polydata.h"
+#include "format/error.h"
+#include "format/mapped_file.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/readers/vtk_polydata.h"
 
 namespace vxl {
 namespace {

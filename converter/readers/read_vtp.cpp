@@ -18,10 +18,10 @@
 #include <pugixml.hpp>
 #include <zlib.h>
 
-#include "error.h"
-#include "mapped_file.h"
-#include "read_tractogram.h"
-#include "vtk_polydata.h"
+#include "format/error.h"
+#include "format/mapped_file.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/readers/vtk_polydata.h"
 
 namespace vxl {
 namespace {

@@ -1,8 +1,8 @@
-#include "regular_file.h"
+#include "converter/readers/regular_file.h"
 
 #include <sys/stat.h>
 
-#include "error.h"
+#include "format/error.h"
 
 namespace vxl {
 

@@ -13,9 +13,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "error.h"
-#include "mrtrix_header.h"
-#include "tractogram.h"
+#include "format/error.h"
+#include "converter/readers/mrtrix_header.h"
+#include "converter/tractogram.h"
 
 namespace vxl::tck {
 

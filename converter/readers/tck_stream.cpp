@@ -1,4 +1,4 @@
-#include "tck_stream.h"
+#include "converter/readers/tck_stream.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -8,9 +8,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "checksum.h"
-#include "error.h"
-#include "regular_file.h"
+#include "format/checksum.h"
+#include "format/error.h"
+#include "converter/readers/regular_file.h"
 
 namespace vxl {
 namespace {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "tck_format.h"
-#include "tractogram.h"
+#include "converter/readers/tck_format.h"
+#include "converter/tractogram.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "vtk_polydata.h"
+#include "converter/readers/vtk_polydata.h"
 
 #include <algorithm>
 #include <bit>
@@ -6,8 +6,8 @@
 #include <cstring>
 #include <set>
 
-#include "checksum.h"
-#include "error.h"
+#include "format/checksum.h"
+#include "format/error.h"
 
 namespace vxl::vtk {
 namespace {

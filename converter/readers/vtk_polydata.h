@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "tractogram.h"
+#include "converter/tractogram.h"
 
 namespace vxl::vtk {
 

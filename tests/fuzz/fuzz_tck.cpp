@@ -8,12 +8,12 @@
 #include <iterator>
 #include <optional>
 
-#include "convert.h"
-#include "error.h"
-#include "fuzz_input.h"
-#include "read_tractogram.h"
-#include "streaming_convert.h"
-#include "tck_stream.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "tests/fuzz/fuzz_input.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/streaming_convert.h"
+#include "converter/readers/tck_stream.h"
 
 namespace {
 

@@ -10,10 +10,10 @@
 
 #include <zlib.h>
 
-#include "convert.h"
-#include "error.h"
-#include "fuzz_input.h"
-#include "read_tractogram.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "tests/fuzz/fuzz_input.h"
+#include "converter/readers/read_tractogram.h"
 
 namespace {
 

@@ -4,13 +4,13 @@
 // damage too.
 #include <vector>
 
-#include "../reseal_checksums.h"
-#include "error.h"
-#include "export_tck.h"
-#include "fuzz_input.h"
-#include "vxl_file.h"
-#include "vxl_streamlines.h"
-#include "vxl_verify.h"
+#include "tests/reseal_checksums.h"
+#include "format/error.h"
+#include "converter/export_tck.h"
+#include "tests/fuzz/fuzz_input.h"
+#include "format/vxl_file.h"
+#include "format/vxl_streamlines.h"
+#include "format/vxl_verify.h"
 
 namespace {
 

@@ -6,16 +6,16 @@
 #include <memory>
 #include <string>
 
-#include "camera.h"
-#include "convert.h"
-#include "egl_context.h"
-#include "exact_renderer.h"
-#include "image_io.h"
-#include "offscreen_target.h"
-#include "render_settings.h"
-#include "renderer.h"
-#include "test_support.h"
-#include "vxl_file.h"
+#include "viewer/render/camera.h"
+#include "converter/convert.h"
+#include "viewer/platform/egl_context.h"
+#include "viewer/render/exact_renderer.h"
+#include "viewer/platform/image_io.h"
+#include "viewer/platform/offscreen_target.h"
+#include "viewer/render/render_settings.h"
+#include "viewer/render/renderer.h"
+#include "tests/test_support.h"
+#include "format/vxl_file.h"
 
 namespace vxl::test {
 

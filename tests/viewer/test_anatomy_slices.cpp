@@ -7,8 +7,8 @@
 
 #include <nifti2_io.h>
 
-#include "nifti_volume.h"
-#include "render_support.h"
+#include "viewer/anatomy/nifti_volume.h"
+#include "tests/viewer/render_support.h"
 
 namespace vxl {
 namespace {

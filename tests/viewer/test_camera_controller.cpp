@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "camera_controller.h"
+#include "viewer/app/camera_controller.h"
 
 namespace vxl::app {
 namespace {

@@ -3,11 +3,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "camera_file.h"
-#include "error.h"
-#include "image_io.h"
-#include "test_support.h"
-#include "turntable.h"
+#include "viewer/app/camera_file.h"
+#include "format/error.h"
+#include "viewer/platform/image_io.h"
+#include "tests/test_support.h"
+#include "viewer/app/turntable.h"
 
 namespace vxl {
 namespace {

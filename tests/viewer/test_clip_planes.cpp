@@ -2,7 +2,7 @@
 // exactly by the line shader; the voxview options parse and refuse as documented.
 #include <filesystem>
 
-#include "render_support.h"
+#include "tests/viewer/render_support.h"
 
 namespace vxl {
 namespace {

@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <set>
 
-#include "render_support.h"
-#include "scene_groups.h"
+#include "tests/viewer/render_support.h"
+#include "viewer/render/scene_groups.h"
 
 namespace vxl {
 namespace {

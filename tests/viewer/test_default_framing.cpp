@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "image_io.h"
-#include "test_support.h"
+#include "viewer/platform/image_io.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "image_metrics.h"
+#include "viewer/platform/image_metrics.h"
 
 namespace vxl {
 namespace {

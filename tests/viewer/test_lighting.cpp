@@ -2,8 +2,8 @@
 // amounts line_lighting.h computes; with lighting off both show the plain colour.
 #include <algorithm>
 
-#include "line_lighting.h"
-#include "render_support.h"
+#include "viewer/render/line_lighting.h"
+#include "tests/viewer/render_support.h"
 
 namespace vxl {
 namespace {

@@ -9,16 +9,16 @@
 
 #include <glm/glm.hpp>
 
-#include "camera.h"
-#include "convert.h"
-#include "error.h"
-#include "frame_plan.h"
-#include "scene_layout.h"
-#include "segment_orders.h"
-#include "synth.h"
-#include "test_support.h"
-#include "vxl_file.h"
-#include "vxl_verify.h"
+#include "viewer/render/camera.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "viewer/render/frame_plan.h"
+#include "viewer/render/scene_layout.h"
+#include "converter/segment_orders.h"
+#include "converter/synth.h"
+#include "tests/test_support.h"
+#include "format/vxl_file.h"
+#include "format/vxl_verify.h"
 
 namespace vxl {
 namespace {

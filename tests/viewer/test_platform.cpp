@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "egl_context.h"
-#include "image_io.h"
-#include "offscreen_target.h"
+#include "viewer/platform/egl_context.h"
+#include "viewer/platform/image_io.h"
+#include "viewer/platform/offscreen_target.h"
 
 namespace fs = std::filesystem;
 using vxl::GlVersion;

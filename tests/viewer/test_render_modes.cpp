@@ -2,7 +2,7 @@
 // hand-made scenes whose correct picture is known.
 #include <cmath>
 
-#include "render_support.h"
+#include "tests/viewer/render_support.h"
 
 namespace vxl {
 namespace {

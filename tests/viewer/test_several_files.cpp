@@ -2,8 +2,8 @@
 // file after file), one group per file for colour and opacity.
 #include <filesystem>
 
-#include "render_support.h"
-#include "scene_groups.h"
+#include "tests/viewer/render_support.h"
+#include "viewer/render/scene_groups.h"
 
 namespace vxl {
 namespace {

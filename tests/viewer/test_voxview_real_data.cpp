@@ -2,9 +2,9 @@
 // the source file (converted in memory).
 #include <filesystem>
 
-#include "image_io.h"
-#include "real_fixture_outcomes.h"
-#include "test_support.h"
+#include "viewer/platform/image_io.h"
+#include "tests/real_fixture_outcomes.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

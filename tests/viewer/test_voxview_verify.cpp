@@ -3,11 +3,11 @@
 #include <filesystem>
 #include <string>
 
-#include "hostile_vxl.h"
-#include "image_io.h"
-#include "render_support.h"
-#include "test_support.h"
-#include "vxl_file.h"
+#include "tests/hostile_vxl.h"
+#include "viewer/platform/image_io.h"
+#include "tests/viewer/render_support.h"
+#include "tests/test_support.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 namespace {

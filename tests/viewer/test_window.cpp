@@ -5,10 +5,10 @@
 #include <filesystem>
 #include <string>
 
-#include "grid_overlay.h"
-#include "image_io.h"
-#include "render_support.h"
-#include "test_support.h"
+#include "viewer/render/grid_overlay.h"
+#include "viewer/platform/image_io.h"
+#include "tests/viewer/render_support.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {

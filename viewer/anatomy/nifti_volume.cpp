@@ -1,4 +1,4 @@
-#include "nifti_volume.h"
+#include "viewer/anatomy/nifti_volume.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 
 #include <nifti2_io.h>
 
-#include "error.h"
+#include "format/error.h"
 
 namespace vxl {
 namespace {

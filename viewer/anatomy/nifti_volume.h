@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "volume.h"
+#include "viewer/render/volume.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "camera_controller.h"
+#include "viewer/app/camera_controller.h"
 
 #include <algorithm>
 #include <cmath>

@@ -9,7 +9,7 @@
 //   wheel up (+steps) -> zoom in: smaller distance (perspective) or ortho_height (orthographic).
 #pragma once
 
-#include "camera.h"
+#include "viewer/render/camera.h"
 
 namespace vxl::app {
 

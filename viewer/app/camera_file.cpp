@@ -1,4 +1,4 @@
-#include "camera_file.h"
+#include "viewer/app/camera_file.h"
 
 #include <charconv>
 #include <cmath>
@@ -8,8 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "atomic_output.h"
-#include "error.h"
+#include "format/atomic_output.h"
+#include "format/error.h"
 
 namespace vxl::app {
 

@@ -26,8 +26,8 @@
 #include <optional>
 #include <string>
 
-#include "camera.h"
-#include "render_settings.h"
+#include "viewer/render/camera.h"
+#include "viewer/render/render_settings.h"
 
 namespace vxl::app {
 

@@ -1,19 +1,19 @@
-#include "headless_render.h"
+#include "viewer/app/headless_render.h"
 
 #include <algorithm>
 #include <chrono>
 #include <optional>
 #include <cstdio>
 
-#include "camera_file.h"
-#include "egl_context.h"
-#include "image_io.h"
-#include "nifti_volume.h"
-#include "offscreen_target.h"
-#include "renderer.h"
-#include "scene_framing.h"
-#include "scene_source.h"
-#include "turntable.h"
+#include "viewer/app/camera_file.h"
+#include "viewer/platform/egl_context.h"
+#include "viewer/platform/image_io.h"
+#include "viewer/anatomy/nifti_volume.h"
+#include "viewer/platform/offscreen_target.h"
+#include "viewer/render/renderer.h"
+#include "viewer/render/scene_framing.h"
+#include "viewer/app/scene_source.h"
+#include "viewer/app/turntable.h"
 
 namespace vxl::app {
 

@@ -6,9 +6,9 @@
 
 #include <glm/glm.hpp>
 
-#include "camera.h"
+#include "viewer/render/camera.h"
 
-#include "viewer_options.h"
+#include "viewer/app/viewer_options.h"
 
 namespace vxl::app {
 

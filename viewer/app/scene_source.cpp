@@ -1,17 +1,17 @@
-#include "scene_source.h"
+#include "viewer/app/scene_source.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <unistd.h>
 
-#include "convert.h"
-#include "error.h"
-#include "read_tsf.h"
-#include "renderer.h"
-#include "read_tractogram.h"
-#include "unpack.h"
-#include "vxl_verify.h"
+#include "converter/convert.h"
+#include "format/error.h"
+#include "converter/readers/read_tsf.h"
+#include "viewer/render/renderer.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/unpack.h"
+#include "format/vxl_verify.h"
 
 namespace vxl::app {
 namespace {

@@ -1,4 +1,4 @@
-#include "turntable.h"
+#include "viewer/app/turntable.h"
 
 #include <algorithm>
 #include <cmath>

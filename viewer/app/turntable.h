@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "camera.h"
+#include "viewer/render/camera.h"
 
 namespace vxl::app {
 

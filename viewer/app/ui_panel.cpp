@@ -1,4 +1,4 @@
-#include "ui_panel.h"
+#include "viewer/app/ui_panel.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -7,7 +7,7 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
 
-#include "camera.h"
+#include "viewer/render/camera.h"
 
 namespace vxl::app {
 

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "render_settings.h"
+#include "viewer/render/render_settings.h"
 
 struct GLFWwindow;
 

@@ -1,4 +1,4 @@
-#include "viewer_options.h"
+#include "viewer/app/viewer_options.h"
 
 namespace vxl::app {
 

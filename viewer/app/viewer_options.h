@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "camera.h"
-#include "render_settings.h"
+#include "viewer/render/camera.h"
+#include "viewer/render/render_settings.h"
 
 namespace vxl::app {
 

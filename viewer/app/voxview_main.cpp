@@ -6,11 +6,11 @@
 
 #include <CLI/CLI.hpp>
 
-#include "camera_file.h"
-#include "error.h"
-#include "headless_render.h"
-#include "viewer_options.h"
-#include "window_app.h"
+#include "viewer/app/camera_file.h"
+#include "format/error.h"
+#include "viewer/app/headless_render.h"
+#include "viewer/app/viewer_options.h"
+#include "viewer/app/window_app.h"
 
 int main(int argc, char** argv) {
   using namespace vxl;

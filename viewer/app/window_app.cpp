@@ -1,5 +1,5 @@
-#include "gl_driver_pinning.h"
-#include "window_app.h"
+#include "viewer/platform/gl_driver_pinning.h"
+#include "viewer/app/window_app.h"
 
 #include <algorithm>
 #include <chrono>
@@ -16,17 +16,17 @@
 #define GLFW_INCLUDE_NONE  // epoxy provides the GL declarations
 #include <GLFW/glfw3.h>
 
-#include "camera_controller.h"
-#include "camera_file.h"
-#include "grid_overlay.h"
-#include "headless_render.h"
-#include "image_io.h"
-#include "nifti_volume.h"
-#include "offscreen_target.h"
-#include "renderer.h"
-#include "scene_framing.h"
-#include "scene_source.h"
-#include "ui_panel.h"
+#include "viewer/app/camera_controller.h"
+#include "viewer/app/camera_file.h"
+#include "viewer/render/grid_overlay.h"
+#include "viewer/app/headless_render.h"
+#include "viewer/platform/image_io.h"
+#include "viewer/anatomy/nifti_volume.h"
+#include "viewer/platform/offscreen_target.h"
+#include "viewer/render/renderer.h"
+#include "viewer/render/scene_framing.h"
+#include "viewer/app/scene_source.h"
+#include "viewer/app/ui_panel.h"
 
 namespace vxl::app {
 

@@ -1,7 +1,7 @@
 // `voxview FILE`: the interactive GLFW window with the Dear ImGui panel.
 #pragma once
 
-#include "viewer_options.h"
+#include "viewer/app/viewer_options.h"
 
 namespace vxl::app {
 

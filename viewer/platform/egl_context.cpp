@@ -1,5 +1,5 @@
-#include "egl_context.h"
-#include "gl_driver_pinning.h"
+#include "viewer/platform/egl_context.h"
+#include "viewer/platform/gl_driver_pinning.h"
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>

@@ -1,4 +1,4 @@
-#include "gl_driver_pinning.h"
+#include "viewer/platform/gl_driver_pinning.h"
 
 #include <dlfcn.h>
 #include <link.h>

@@ -1,4 +1,4 @@
-#include "image_io.h"
+#include "viewer/platform/image_io.h"
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>

@@ -1,4 +1,4 @@
-#include "image_metrics.h"
+#include "viewer/platform/image_metrics.h"
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>

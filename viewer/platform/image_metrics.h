@@ -6,7 +6,7 @@
 // Errors are taken over the colour channels only: every mode renders over an opaque background, so alpha
 // is 255 everywhere and would only dilute the averages. Error values are in 8-bit levels (0..255).
 
-#include "image_io.h"
+#include "viewer/platform/image_io.h"
 
 namespace vxl {
 

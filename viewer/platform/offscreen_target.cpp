@@ -1,4 +1,4 @@
-#include "offscreen_target.h"
+#include "viewer/platform/offscreen_target.h"
 
 #include <epoxy/gl.h>
 

@@ -1,4 +1,4 @@
-#include "camera.h"
+#include "viewer/render/camera.h"
 
 #include <algorithm>
 #include <cmath>

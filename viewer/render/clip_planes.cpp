@@ -1,10 +1,10 @@
-#include "clip_planes.h"
+#include "viewer/render/clip_planes.h"
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
-#include "camera.h"
+#include "viewer/render/camera.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "colormap.h"
+#include "viewer/render/colormap.h"
 
 #include <algorithm>
 #include <cmath>

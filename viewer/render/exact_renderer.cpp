@@ -1,4 +1,4 @@
-#include "exact_renderer.h"
+#include "viewer/render/exact_renderer.h"
 
 #include <algorithm>
 #include <array>
@@ -9,8 +9,8 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "line_shaders.h"
-#include "renderer.h"
+#include "viewer/render/line_shaders.h"
+#include "viewer/render/renderer.h"
 
 namespace vxl {
 namespace {

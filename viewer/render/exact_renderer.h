@@ -18,9 +18,9 @@
 
 #include <glm/glm.hpp>
 
-#include "camera.h"
-#include "gl_util.h"
-#include "render_settings.h"
+#include "viewer/render/camera.h"
+#include "viewer/render/gl_util.h"
+#include "viewer/render/render_settings.h"
 
 namespace vxl {
 

@@ -11,7 +11,7 @@
 
 #include <glm/glm.hpp>
 
-#include "scene_layout.h"
+#include "viewer/render/scene_layout.h"
 
 namespace vxl {
 

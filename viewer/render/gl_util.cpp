@@ -1,4 +1,4 @@
-#include "gl_util.h"
+#include "viewer/render/gl_util.h"
 
 #include <stdexcept>
 #include <vector>

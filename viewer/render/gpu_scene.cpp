@@ -1,10 +1,10 @@
-#include "gpu_scene.h"
+#include "viewer/render/gpu_scene.h"
 
 #include <algorithm>
 
-#include "error.h"
-#include "parallel.h"
-#include "vxl_streamlines.h"
+#include "format/error.h"
+#include "format/parallel.h"
+#include "format/vxl_streamlines.h"
 
 namespace vxl {
 

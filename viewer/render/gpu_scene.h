@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "gl_util.h"
-#include "scene_layout.h"
-#include "vxl_file.h"
+#include "viewer/render/gl_util.h"
+#include "viewer/render/scene_layout.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 

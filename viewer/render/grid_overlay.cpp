@@ -1,12 +1,12 @@
-#include "grid_overlay.h"
+#include "viewer/render/grid_overlay.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "camera.h"
-#include "renderer.h"
+#include "viewer/render/camera.h"
+#include "viewer/render/renderer.h"
 
 namespace vxl {
 

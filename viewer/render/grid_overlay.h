@@ -12,9 +12,9 @@
 
 #include <glm/glm.hpp>
 
-#include "clip_planes.h"
-#include "frame_plan.h"
-#include "gl_util.h"
+#include "viewer/render/clip_planes.h"
+#include "viewer/render/frame_plan.h"
+#include "viewer/render/gl_util.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "line_lighting.h"
+#include "viewer/render/line_lighting.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
-#include "line_shaders.h"
+#include "viewer/render/line_shaders.h"
 
-#include "clip_planes.h"
-#include "colormap.h"
+#include "viewer/render/clip_planes.h"
+#include "viewer/render/colormap.h"
 
 namespace vxl::shaders {
 

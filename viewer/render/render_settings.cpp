@@ -1,11 +1,11 @@
-#include "render_settings.h"
+#include "viewer/render/render_settings.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
-#include "scene_groups.h"
+#include "viewer/render/scene_groups.h"
 
 namespace vxl {
 

@@ -9,8 +9,8 @@
 
 #include <glm/glm.hpp>
 
-#include "clip_planes.h"
-#include "colormap.h"
+#include "viewer/render/clip_planes.h"
+#include "viewer/render/colormap.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "renderer.h"
+#include "viewer/render/renderer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -7,12 +7,12 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "error.h"
-#include "exact_renderer.h"
-#include "line_lighting.h"
-#include "line_shaders.h"
-#include "slice_renderer.h"
-#include "vertex_attributes.h"
+#include "format/error.h"
+#include "viewer/render/exact_renderer.h"
+#include "viewer/render/line_lighting.h"
+#include "viewer/render/line_shaders.h"
+#include "viewer/render/slice_renderer.h"
+#include "viewer/render/vertex_attributes.h"
 
 namespace vxl {
 

@@ -15,12 +15,12 @@
 #include <memory>
 #include <utility>
 
-#include "camera.h"
-#include "frame_plan.h"
-#include "gl_util.h"
-#include "gpu_scene.h"
-#include "render_settings.h"
-#include "scene_groups.h"
+#include "viewer/render/camera.h"
+#include "viewer/render/frame_plan.h"
+#include "viewer/render/gl_util.h"
+#include "viewer/render/gpu_scene.h"
+#include "viewer/render/render_settings.h"
+#include "viewer/render/scene_groups.h"
 
 namespace vxl {
 

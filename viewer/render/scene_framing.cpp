@@ -1,4 +1,4 @@
-#include "scene_framing.h"
+#include "viewer/render/scene_framing.h"
 
 namespace vxl {
 

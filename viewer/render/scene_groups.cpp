@@ -1,4 +1,4 @@
-#include "scene_groups.h"
+#include "viewer/render/scene_groups.h"
 
 #include <filesystem>
 #include <limits>

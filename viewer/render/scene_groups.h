@@ -15,7 +15,7 @@
 
 #include <glm/glm.hpp>
 
-#include "vxl_file.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 

@@ -1,10 +1,10 @@
-#include "scene_layout.h"
+#include "viewer/render/scene_layout.h"
 
 #include <algorithm>
 #include <limits>
 #include <string>
 
-#include "error.h"
+#include "format/error.h"
 
 namespace vxl {
 

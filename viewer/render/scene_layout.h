@@ -26,7 +26,7 @@
 
 #include <glm/glm.hpp>
 
-#include "vxl_file.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "slice_renderer.h"
+#include "viewer/render/slice_renderer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,9 +6,9 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "clip_planes.h"
-#include "error.h"
-#include "line_shaders.h"
+#include "viewer/render/clip_planes.h"
+#include "format/error.h"
+#include "viewer/render/line_shaders.h"
 
 namespace vxl {
 namespace {

@@ -13,10 +13,10 @@
 
 #include <glm/glm.hpp>
 
-#include "camera.h"
-#include "gl_util.h"
-#include "render_settings.h"
-#include "volume.h"
+#include "viewer/render/camera.h"
+#include "viewer/render/gl_util.h"
+#include "viewer/render/render_settings.h"
+#include "viewer/render/volume.h"
 
 namespace vxl {
 

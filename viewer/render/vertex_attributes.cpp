@@ -1,8 +1,8 @@
-#include "vertex_attributes.h"
+#include "viewer/render/vertex_attributes.h"
 
 #include <limits>
 
-#include "vxl_streamlines.h"
+#include "format/vxl_streamlines.h"
 
 namespace vxl {
 

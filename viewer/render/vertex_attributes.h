@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "scene_groups.h"
-#include "vxl_file.h"
+#include "viewer/render/scene_groups.h"
+#include "format/vxl_file.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "volume.h"
+#include "viewer/render/volume.h"
 
 namespace vxl {
 
