@@ -38,9 +38,12 @@ int main(int argc, char** argv) {
   std::string threads = "0", keep;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
-    if (a == "--streamlines" && i + 1 < argc) sizes.push_back(std::stoull(argv[++i]));
-    else if (a == "--threads" && i + 1 < argc) threads = argv[++i];
-    else if (a == "--keep" && i + 1 < argc) keep = argv[++i];
+    if (a == "--streamlines" && i + 1 < argc)
+      sizes.push_back(std::stoull(argv[++i]));
+    else if (a == "--threads" && i + 1 < argc)
+      threads = argv[++i];
+    else if (a == "--keep" && i + 1 < argc)
+      keep = argv[++i];
     else {
       std::fprintf(stderr, "usage: convert_bench [--streamlines N]... [--threads T] [--keep DIR]\n");
       return 2;
@@ -48,11 +51,13 @@ int main(int argc, char** argv) {
   }
   if (sizes.empty()) sizes = {144000, 1000000};
   const std::string cli = VOXLINES_CLI;
-  std::filesystem::path dir = keep.empty() ? std::filesystem::temp_directory_path() / ("voxlines_bench_" + std::to_string(getpid()))
-                                           : std::filesystem::path(keep);
+  std::filesystem::path dir =
+      keep.empty() ? std::filesystem::temp_directory_path() / ("voxlines_bench_" + std::to_string(getpid()))
+                   : std::filesystem::path(keep);
   std::filesystem::create_directories(dir);
 
-  std::printf("machine: %u hardware threads; convert threads: %s\n", std::thread::hardware_concurrency(), threads.c_str());
+  std::printf("machine: %u hardware threads; convert threads: %s\n", std::thread::hardware_concurrency(),
+              threads.c_str());
   std::printf("%-12s %12s %10s %10s %10s %12s %12s %10s %10s %10s\n", "streamlines", "points", "synth_s", "convert_s",
               "peak_MiB", "tck_MiB", "vxl_MiB", "vxl/tck", "rss/vxl", "open_ms");
   for (std::uint64_t n : sizes) {
@@ -80,8 +85,8 @@ int main(int argc, char** argv) {
     double tck_mib = double(std::filesystem::file_size(tck)) / (1 << 20);
     double vxl_mib = double(std::filesystem::file_size(vxl)) / (1 << 20);
     std::printf("%-12llu %12llu %10.2f %10.2f %10.0f %12.1f %12.1f %10.2f %10.2f %10.2f\n", (unsigned long long)n,
-                (unsigned long long)points, synth.seconds, median(times), rss / 1024.0, tck_mib, vxl_mib, vxl_mib / tck_mib,
-                rss / 1024.0 / vxl_mib, median(opens));
+                (unsigned long long)points, synth.seconds, median(times), rss / 1024.0, tck_mib, vxl_mib,
+                vxl_mib / tck_mib, rss / 1024.0 / vxl_mib, median(opens));
     std::fflush(stdout);
     if (keep.empty()) {
       std::filesystem::remove(tck);

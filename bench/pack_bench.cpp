@@ -67,7 +67,8 @@ std::string load_average() {
 std::vector<float> source_points(const vxl::VxlFile& f) {
   std::vector<float> points;
   points.reserve(3 * f.meta().point_count);
-  vxl::walk_streamlines(f, {[&](std::uint64_t, std::span<const float> xyz) { points.insert(points.end(), xyz.begin(), xyz.end()); }, {}});
+  vxl::walk_streamlines(
+      f, {[&](std::uint64_t, std::span<const float> xyz) { points.insert(points.end(), xyz.begin(), xyz.end()); }, {}});
   return points;
 }
 
@@ -92,27 +93,37 @@ int run(int argc, char** argv) {
   int runs = 3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--bits" && i + 1 < argc) bits.push_back(static_cast<std::uint32_t>(std::stoul(argv[++i])));
-    else if (a == "--runs" && i + 1 < argc) runs = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--threads" && i + 1 < argc) threads = argv[++i];
-    else if (a == "--keep" && i + 1 < argc) keep = argv[++i];
-    else if (!a.starts_with("--")) files.push_back(a);
-    else files.clear(), i = argc;
+    if (a == "--bits" && i + 1 < argc)
+      bits.push_back(static_cast<std::uint32_t>(std::stoul(argv[++i])));
+    else if (a == "--runs" && i + 1 < argc)
+      runs = std::max(1, std::stoi(argv[++i]));
+    else if (a == "--threads" && i + 1 < argc)
+      threads = argv[++i];
+    else if (a == "--keep" && i + 1 < argc)
+      keep = argv[++i];
+    else if (!a.starts_with("--"))
+      files.push_back(a);
+    else
+      files.clear(), i = argc;
   }
   if (files.empty() || files.size() % 2 != 0) {
-    std::fprintf(stderr, "usage: pack_bench [--bits B]... [--runs R] [--threads T] [--keep DIR] FILE.vxl SOURCE.tck [...]\n");
+    std::fprintf(stderr,
+                 "usage: pack_bench [--bits B]... [--runs R] [--threads T] [--keep DIR] FILE.vxl SOURCE.tck [...]\n");
     return 2;
   }
   if (bits.empty()) bits = {11, 14, 16};
   const std::string cli = VOXLINES_CLI;
-  const std::filesystem::path dir = keep.empty() ? std::filesystem::temp_directory_path() / ("voxlines_pack_bench_" + std::to_string(getpid()))
-                                                 : std::filesystem::path(keep);
+  const std::filesystem::path dir =
+      keep.empty() ? std::filesystem::temp_directory_path() / ("voxlines_pack_bench_" + std::to_string(getpid()))
+                   : std::filesystem::path(keep);
   std::filesystem::create_directories(dir);
 
   std::printf("machine: %u hardware threads; pack/unpack threads: %s; times are medians of %d runs; load %s\n\n",
               std::thread::hardware_concurrency(), threads.c_str(), runs, load_average().c_str());
-  std::printf("| data | points | bits | package MiB | bytes/point | × TCK | positions B/pt | Draco-native B/pt | max error mm | "
-              "RMS error mm | bound mm | pack s | unpack s | unpack peak MiB |\n");
+  std::printf(
+      "| data | points | bits | package MiB | bytes/point | × TCK | positions B/pt | Draco-native B/pt | max error mm "
+      "| "
+      "RMS error mm | bound mm | pack s | unpack s | unpack peak MiB |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   try {
     for (std::size_t f = 0; f < files.size(); f += 2) {
@@ -125,7 +136,8 @@ int run(int argc, char** argv) {
       for (std::uint32_t b : bits) {
         const std::string package = (dir / (name + "_" + std::to_string(b) + ".vxlz")).string();
         const std::string unpacked = (dir / (name + "_" + std::to_string(b) + ".vxl")).string();
-        const ChildRun pack = median_run({cli, "pack", vxl, package, "--bits", std::to_string(b), "--threads", threads}, package, runs);
+        const ChildRun pack =
+            median_run({cli, "pack", vxl, package, "--bits", std::to_string(b), "--threads", threads}, package, runs);
         const ChildRun unpack = median_run({cli, "unpack", package, unpacked, "--threads", threads}, unpacked, runs);
         if (pack.exit_code != 0 || unpack.exit_code != 0) {
           std::fprintf(stderr, "pack_bench: voxlines failed on %s at %u bits (exit %d / %d)\n", vxl.c_str(), b,
@@ -134,7 +146,8 @@ int run(int argc, char** argv) {
         }
         const vxl::VxlzFile z = vxl::VxlzFile::open(package);
         double position_bytes = 0;
-        for (std::uint64_t c = 0; c < z.chunk_count(); ++c) position_bytes += double(z.chunk(c).symbols.size() + z.chunk(c).escapes.size());
+        for (std::uint64_t c = 0; c < z.chunk_count(); ++c)
+          position_bytes += double(z.chunk(c).symbols.size() + z.chunk(c).escapes.size());
         const std::vector<float> got = source_points(vxl::VxlFile::open(unpacked));
         double max_error = 0, sum_squares = 0;
         for (std::size_t i = 0; i < std::min(got.size(), expected.size()); ++i) {
@@ -146,9 +159,9 @@ int run(int argc, char** argv) {
         const double native = draco_native_bytes(expected, b, z.pack());
         const double bytes = double(z.size());
         std::printf("| %s | %.0f | %u | %.2f | %.3f | %.3f | %.3f | %.3f | %.5f | %.5f | %.5f | %.2f | %.2f | %.0f |\n",
-                    name.c_str(), points, b, bytes / 1048576.0, bytes / points, bytes / tck_bytes, position_bytes / points,
-                    native / points, max_error, rms, z.pack().error_bound, pack.seconds, unpack.seconds,
-                    double(unpack.peak_rss_kib) / 1024.0);
+                    name.c_str(), points, b, bytes / 1048576.0, bytes / points, bytes / tck_bytes,
+                    position_bytes / points, native / points, max_error, rms, z.pack().error_bound, pack.seconds,
+                    unpack.seconds, double(unpack.peak_rss_kib) / 1024.0);
         std::fflush(stdout);
         if (keep.empty()) {
           std::filesystem::remove(package);

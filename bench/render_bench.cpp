@@ -19,8 +19,8 @@
 
 #include "bench/child_process.h"
 #include "viewer/platform/egl_context.h"
-#include "viewer/render/frame_plan.h"
 #include "viewer/platform/offscreen_target.h"
+#include "viewer/render/frame_plan.h"
 #include "viewer/render/renderer.h"
 
 namespace {
@@ -55,12 +55,17 @@ int run(int argc, char** argv) {
   std::string modes_arg = "opaque,unsorted,additive,wboit,basic,axis,exact";
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
-    if (a == "--scene" && i + 1 < argc) scenes.push_back(argv[++i]);
-    else if (a == "--size" && i + 1 < argc) size = std::stoi(argv[++i]);
-    else if (a == "--frames" && i + 1 < argc) frames = std::stoi(argv[++i]);
-    else if (a == "--modes" && i + 1 < argc) modes_arg = argv[++i];
+    if (a == "--scene" && i + 1 < argc)
+      scenes.push_back(argv[++i]);
+    else if (a == "--size" && i + 1 < argc)
+      size = std::stoi(argv[++i]);
+    else if (a == "--frames" && i + 1 < argc)
+      frames = std::stoi(argv[++i]);
+    else if (a == "--modes" && i + 1 < argc)
+      modes_arg = argv[++i];
     else {
-      std::fprintf(stderr, "usage: render_bench --scene FILE.vxl[:SOURCE.tck]... [--size N] [--frames N] [--modes a,b]\n");
+      std::fprintf(stderr,
+                   "usage: render_bench --scene FILE.vxl[:SOURCE.tck]... [--size N] [--frames N] [--modes a,b]\n");
       return 2;
     }
   }
@@ -92,7 +97,8 @@ int run(int argc, char** argv) {
                 (unsigned long long)file.meta().segment_count, file.meta().voxel_count, file.meta().voxel_size,
                 renderer.scene().gpu_bytes() / 1048576.0, upload_s);
     std::printf("  first frame read back (process start -> PNG written): .vxl %.3f s", median(first_vxl));
-    if (!source.empty()) std::printf(", source %.3f s (ratio %.1fx)", median(first_src), median(first_src) / median(first_vxl));
+    if (!source.empty())
+      std::printf(", source %.3f s (ratio %.1fx)", median(first_src), median(first_src) / median(first_vxl));
     std::printf("\n");
 
     // CPU work per frame over a turntable.
@@ -124,7 +130,8 @@ int run(int argc, char** argv) {
         auto t0 = Clock::now();
         renderer.draw(cam, s, size, size, target.framebuffer());
         glFinish();
-        if (f > 0) ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());  // first: warm-up
+        if (f > 0)
+          ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());  // first: warm-up
       }
       double m = median(ms);
       if (mode == vxl::RenderMode::Unsorted) unsorted_ms = m;

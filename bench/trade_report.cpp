@@ -69,9 +69,10 @@ void write_sweep_markdown(const std::string& path, const std::string& heading, c
                "Errors against `exact` (same view, same opacity) in 8-bit levels over R, G, B, averaged over all views "
                "and opacities; frame and CPU times are medians. \"any\": the mode draws the same picture at every "
                "voxel size (dataset order or order-independent), measured once.\n\n");
-  std::fprintf(f,
-               "| mode | voxel mm | RMSE | PSNR dB | SSIM | mean abs | max abs | frame ms | CPU ms | convert s | file MiB "
-               "| GPU MiB |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::fprintf(
+      f,
+      "| mode | voxel mm | RMSE | PSNR dB | SSIM | mean abs | max abs | frame ms | CPU ms | convert s | file MiB "
+      "| GPU MiB |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const auto& [key, g] : groups) {
     const SweepRow& first = *g.front();
     std::vector<double> frame, cpu;
@@ -120,10 +121,11 @@ void write_sweep_markdown(const std::string& path, const std::string& heading, c
     }
     std::fprintf(f, "\n");
   }
-  std::fprintf(f,
-               "\n**By view** at %g mm (RMSE / SSIM, mean over opacities):\n\n| mode | axis-aligned views | oblique views "
-               "|\n|---|---:|---:|\n",
-               reference_voxel_mm);
+  std::fprintf(
+      f,
+      "\n**By view** at %g mm (RMSE / SSIM, mean over opacities):\n\n| mode | axis-aligned views | oblique views "
+      "|\n|---|---:|---:|\n",
+      reference_voxel_mm);
   for (const auto& [key, g] : at_reference) {
     std::vector<const SweepRow*> aligned, oblique;
     for (const SweepRow* r : g) (r->oblique ? oblique : aligned).push_back(r);

@@ -34,12 +34,12 @@
 #include <string>
 #include <vector>
 
+#include "bench/trade_report.h"
 #include "viewer/platform/egl_context.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/image_metrics.h"
 #include "viewer/platform/offscreen_target.h"
 #include "viewer/render/renderer.h"
-#include "bench/trade_report.h"
 
 namespace {
 
@@ -67,7 +67,7 @@ constexpr View kViews[] = {{"superior", 180, 90, false}, {"left", -90, 0, false}
 constexpr double kOpacities[] = {0.5, 0.05, 0.01};  // the paper's
 constexpr const char* kSideView = "left";           // sagittal, as the paper's comparison figure
 constexpr double kSideOpacity = 0.05;
-constexpr double kMotionElevation = 20;       // camera elevation of the flicker motions
+constexpr double kMotionElevation = 20;  // camera elevation of the flicker motions
 constexpr int kWobbleFrames = 24;
 constexpr double kWobbleAzimuth = 45, kWobbleAmplitude = 1.5;
 
@@ -123,7 +123,9 @@ class Study {
       entries_.push_back(e);
     }
     // The reference file (axis orders at the reference voxel size) goes first: exact is rendered from it.
-    auto is_reference = [&](const ManifestEntry& e) { return e.orders == "axis" && e.voxel_mm == o_.reference_voxel_mm; };
+    auto is_reference = [&](const ManifestEntry& e) {
+      return e.orders == "axis" && e.voxel_mm == o_.reference_voxel_mm;
+    };
     auto ref = std::find_if(entries_.begin(), entries_.end(), is_reference);
     if (ref == entries_.end()) throw std::runtime_error("the manifest has no axis file at the reference voxel size");
     std::rotate(entries_.begin(), ref, ref + 1);
@@ -160,8 +162,9 @@ class Study {
     if (e.orders != "axis") return {{e.orders, RenderMode::Axis}};
     std::vector<ModeSpec> modes = {{"basic", RenderMode::Basic}, {"axis", RenderMode::Axis}};
     if (reference)
-      modes.insert(modes.begin(), {{"unsorted", RenderMode::Unsorted}, {"additive", RenderMode::Additive},
-                                   {"wboit", RenderMode::Wboit}});
+      modes.insert(
+          modes.begin(),
+          {{"unsorted", RenderMode::Unsorted}, {"additive", RenderMode::Additive}, {"wboit", RenderMode::Wboit}});
     return modes;
   }
 
@@ -315,18 +318,30 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
         return argv[++i];
       };
-      if (a == "--manifest") o.manifest = value();
-      else if (a == "--out") o.out = value();
-      else if (a == "--name") o.name = value();
-      else if (a == "--size") o.size = std::stoi(value());
-      else if (a == "--reference-voxel") o.reference_voxel_mm = std::stod(value());
-      else if (a == "--flicker-size") o.flicker_size = std::stoi(value());
-      else if (a == "--flicker-frames") o.flicker_frames = std::stoi(value());
-      else if (a == "--flicker-opacity") o.flicker_opacity = std::stod(value());
-      else if (a == "--hysteresis") o.hysteresis = parse_list(value());
-      else if (a == "--no-sweep") o.sweep = false;
-      else if (a == "--no-flicker") o.flicker = false;
-      else throw std::invalid_argument("unknown argument " + a);
+      if (a == "--manifest")
+        o.manifest = value();
+      else if (a == "--out")
+        o.out = value();
+      else if (a == "--name")
+        o.name = value();
+      else if (a == "--size")
+        o.size = std::stoi(value());
+      else if (a == "--reference-voxel")
+        o.reference_voxel_mm = std::stod(value());
+      else if (a == "--flicker-size")
+        o.flicker_size = std::stoi(value());
+      else if (a == "--flicker-frames")
+        o.flicker_frames = std::stoi(value());
+      else if (a == "--flicker-opacity")
+        o.flicker_opacity = std::stod(value());
+      else if (a == "--hysteresis")
+        o.hysteresis = parse_list(value());
+      else if (a == "--no-sweep")
+        o.sweep = false;
+      else if (a == "--no-flicker")
+        o.flicker = false;
+      else
+        throw std::invalid_argument("unknown argument " + a);
     }
     if (o.manifest.empty() || o.out.empty() || o.size < 16 || o.flicker_size < 16 || o.flicker_frames < 2)
       throw std::invalid_argument("--manifest and --out are required; sizes >= 16, frames >= 2");

@@ -4,8 +4,8 @@
 #include <chrono>
 #include <filesystem>
 
-#include "format/error.h"
 #include "converter/segment_orders.h"
+#include "format/error.h"
 #include "format/vxl_value_sets.h"
 #include "format/vxl_writer.h"
 
@@ -26,8 +26,11 @@ std::string provenance_json(const SourceInfo& src, const ConvertSettings& settin
       {"dtype", src.dtype},
       {"vox_to_ras", src.vox_to_ras ? nlohmann::json(*src.vox_to_ras) : nlohmann::json(nullptr)},
   };
-  j["converter"] = {{"name", "voxlines"}, {"version", VOXLINES_VERSION}, {"voxel_size", settings.voxel_size},
-                    {"orders", settings.orders}, {"threads", threads}};
+  j["converter"] = {{"name", "voxlines"},
+                    {"version", VOXLINES_VERSION},
+                    {"voxel_size", settings.voxel_size},
+                    {"orders", settings.orders},
+                    {"threads", threads}};
   j["warnings"] = src.warnings;
   if (!src.value_files.empty()) j["value_files"] = src.value_files;
   // Invalid UTF-8 in a source header must not make the whole file unwritable: replace it.
@@ -48,16 +51,19 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   const unsigned threads = resolve_threads(settings.threads);
   for (const ValueSet& v : t.point_values)
     if (v.values.size() != t.point_count())
-      throw Error(ErrorKind::Input, t.source.path, std::nullopt, "value set '" + v.name + "' has " +
-                  std::to_string(v.values.size()) + " values for " + std::to_string(t.point_count()) + " points");
+      throw Error(ErrorKind::Input, t.source.path, std::nullopt,
+                  "value set '" + v.name + "' has " + std::to_string(v.values.size()) + " values for " +
+                      std::to_string(t.point_count()) + " points");
   for (const ValueSet& v : t.streamline_values)
     if (v.values.size() != t.streamline_count())
-      throw Error(ErrorKind::Input, t.source.path, std::nullopt, "value set '" + v.name + "' has " +
-                  std::to_string(v.values.size()) + " values for " + std::to_string(t.streamline_count()) + " streamlines");
+      throw Error(ErrorKind::Input, t.source.path, std::nullopt,
+                  "value set '" + v.name + "' has " + std::to_string(v.values.size()) + " values for " +
+                      std::to_string(t.streamline_count()) + " streamlines");
   for (auto* sets : {&t.point_values, &t.streamline_values})
     if (sets->size() > kMaxValueSets) {
-      t.source.warnings.push_back("only the first " + std::to_string(kMaxValueSets) + " of " + std::to_string(sets->size()) +
-                                  (sets == &t.point_values ? " per-point" : " per-streamline") + " value sets are kept");
+      t.source.warnings.push_back(
+          "only the first " + std::to_string(kMaxValueSets) + " of " + std::to_string(sets->size()) +
+          (sets == &t.point_values ? " per-point" : " per-streamline") + " value sets are kept");
       sets->resize(kMaxValueSets);
     }
   // PROV and GRPS are known before any work: their sizes go into the plan of the output file.
@@ -91,13 +97,15 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
                                         static_cast<std::uint32_t>(point_set_names.size()),
                                         static_cast<std::uint32_t>(streamline_set_names.size())));
   // Per-streamline values are copied as they are; per-point ones are spread over the vertices below.
-  const auto streamline_arrays = layout_value_sets(out.streamline_values(), streamline_set_names, meta.streamline_count);
+  const auto streamline_arrays =
+      layout_value_sets(out.streamline_values(), streamline_set_names, meta.streamline_count);
   for (std::size_t k = 0; k < streamline_arrays.size(); ++k)
     std::copy(t.streamline_values[k].values.begin(), t.streamline_values[k].values.end(), streamline_arrays[k].begin());
   t.streamline_values.clear();
   finish_value_sets(out.streamline_values());
   // Pass 2 writes all over these: fault them in first, in bulk (ORDR waits until the source is freed).
-  for (std::span<std::uint8_t> s : {bytes_of(out.vertices()), bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
+  for (std::span<std::uint8_t> s :
+       {bytes_of(out.vertices()), bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
     prefault_for_write(s, threads);
   VoxelBlocks blocks{out.voxels(), out.vertices(), out.voxlines(), out.streamline_first_voxline(), {}};
   blocks.vertex_values = layout_value_sets(out.vertex_values(), point_set_names, meta.vertex_count);

@@ -10,8 +10,8 @@
 namespace vxl {
 
 struct ConvertSettings {
-  double voxel_size = 10.0;   // mm; the paper's balance of speed and quality
-  unsigned threads = 0;       // 0: all hardware threads
+  double voxel_size = 10.0;  // mm; the paper's balance of speed and quality
+  unsigned threads = 0;      // 0: all hardware threads
   std::string orders = "axis";
   ProgressFn progress;
   // Bytes of memory convert_streaming may use (streaming_convert.h); 0: no limit. Not recorded in the
@@ -22,11 +22,11 @@ struct ConvertSettings {
 struct ConvertSummary {
   std::uint64_t streamlines = 0, points = 0, voxels = 0, vertices = 0, segments = 0, synthetic_points = 0;
   double voxelize_seconds = 0, orders_seconds = 0, write_seconds = 0;
-  double read_seconds = 0;      // convert_streaming only: the first pass over the source
-  std::uint64_t passes = 1;     // times the source was read
-  std::uint64_t partitions = 1;  // voxel ranges whose blocks and orders were built one after another
+  double read_seconds = 0;                      // convert_streaming only: the first pass over the source
+  std::uint64_t passes = 1;                     // times the source was read
+  std::uint64_t partitions = 1;                 // voxel ranges whose blocks and orders were built one after another
   std::vector<std::uint64_t> partition_starts;  // convert_streaming only: the first voxel of each range
-  std::vector<std::string> warnings;  // convert_streaming only: the source's (the reader's, otherwise)
+  std::vector<std::string> warnings;            // convert_streaming only: the source's (the reader's, otherwise)
 
   // The counts, as written in the file's META.
   void take_counts(const MetaSection& meta) {
@@ -41,7 +41,8 @@ struct ConvertSummary {
 
 // Consumes the tractogram (its positions are released as soon as they are copied) and writes `out_path`
 // atomically. Throws vxl::Error. settings.memory_limit is not used here.
-ConvertSummary convert_tractogram(Tractogram&& tractogram, const std::string& out_path, const ConvertSettings& settings);
+ConvertSummary convert_tractogram(Tractogram&& tractogram, const std::string& out_path,
+                                  const ConvertSettings& settings);
 
 // The PROV payload (spec §5.8) for a source converted with these settings and `threads` worker threads.
 std::string provenance_json(const SourceInfo& source, const ConvertSettings& settings, unsigned threads);

@@ -5,9 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "format/error.h"
 #include "converter/export_values.h"
 #include "converter/tck_writer.h"
+#include "format/error.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -36,7 +36,8 @@ std::uint32_t chosen_set(const VxlFile& file, const TckExportSettings& settings)
   if (k < 0) {
     std::string names;
     for (std::uint32_t i = 0; i < sets.size(); ++i) names += (i ? ", '" : "'") + sets.name(i) + "'";
-    throw Error(ErrorKind::Usage, file.path(), std::nullopt, "has no per-point value set '" + *settings.value + "' (it has " + names + ")");
+    throw Error(ErrorKind::Usage, file.path(), std::nullopt,
+                "has no per-point value set '" + *settings.value + "' (it has " + names + ")");
   }
   return static_cast<std::uint32_t>(k);
 }
@@ -48,7 +49,8 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
   const MetaSection& m = file.meta();
   summary.streamlines = m.streamline_count;
   summary.points = m.point_count;
-  std::vector<std::string> header = {"voxlines_exported_from: " + std::filesystem::path(file.path()).filename().string()};
+  std::vector<std::string> header = {"voxlines_exported_from: " +
+                                     std::filesystem::path(file.path()).filename().string()};
 
   // The TSF's values, checked before anything is written.
   std::vector<float> values;
@@ -59,23 +61,28 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
     values = values_at(file, set, source_vertex_indices(file));
     for (std::size_t i = 0; i < values.size(); ++i)
       if (!std::isfinite(values[i]))
-        fail_unsupported(file.path(), "value set '" + summary.value_set + "' has a non-finite value (point " + std::to_string(i) +
+        fail_unsupported(file.path(), "value set '" + summary.value_set + "' has a non-finite value (point " +
+                                          std::to_string(i) +
                                           "); a TSF cannot hold one (NaN and Inf are its separators)");
     const std::vector<std::string> stamp = timestamp_line(file);
     header.insert(header.end(), stamp.begin(), stamp.end());
   } else if (settings.value) {
-    throw Error(ErrorKind::Usage, out_path, std::nullopt, "a value set is chosen for a TSF, but no TSF output is given");
+    throw Error(ErrorKind::Usage, out_path, std::nullopt,
+                "a value set is chosen for a TSF, but no TSF output is given");
   }
   const ValueSets& per_point = file.vertex_values();
   if (!settings.tsf_path && !per_point.empty())
-    summary.warnings.push_back(std::to_string(per_point.size()) + " per-point value set(s) not written: a TCK holds positions only "
+    summary.warnings.push_back(std::to_string(per_point.size()) +
+                               " per-point value set(s) not written: a TCK holds positions only "
                                "(add a TSF output for one of them, or export to .trx for all)");
   if (settings.tsf_path && per_point.size() > 1)
-    summary.warnings.push_back(std::to_string(per_point.size() - 1) + " other per-point value set(s) not written: a TSF holds one "
+    summary.warnings.push_back(std::to_string(per_point.size() - 1) +
+                               " other per-point value set(s) not written: a TSF holds one "
                                "(export to .trx for all)");
   if (!file.streamline_values().empty())
-    summary.warnings.push_back(std::to_string(file.streamline_values().size()) +
-                               " per-streamline value set(s) not written: TCK and TSF have no place for them (export to .trx)");
+    summary.warnings.push_back(
+        std::to_string(file.streamline_values().size()) +
+        " per-streamline value set(s) not written: TCK and TSF have no place for them (export to .trx)");
 
   TckWriter writer(out_path, m.streamline_count, header);
   std::optional<TsfWriter> tsf;

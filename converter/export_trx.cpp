@@ -6,11 +6,11 @@
 #include <unordered_set>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 #include <zip.h>
+#include <nlohmann/json.hpp>
 
-#include "format/error.h"
 #include "converter/export_values.h"
+#include "format/error.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -36,7 +36,8 @@ std::optional<Matrix> matrix_from(const nlohmann::json& j) {
   Matrix m{};
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) {
-      const nlohmann::json& v = flat ? j[4 * r + c] : (j[r].is_array() && j[r].size() == 4 ? j[r][c] : nlohmann::json());
+      const nlohmann::json& v =
+          flat ? j[4 * r + c] : (j[r].is_array() && j[r].size() == 4 ? j[r][c] : nlohmann::json());
       if (!v.is_number() || !std::isfinite(v.get<double>())) return std::nullopt;
       m[r][c] = v.get<double>();
     }
@@ -45,7 +46,8 @@ std::optional<Matrix> matrix_from(const nlohmann::json& j) {
 
 // A member name made from a group name must stay one file inside groups/, and fit the zip's 16-bit name length.
 bool usable_member_name(const std::string& name) {
-  return !name.empty() && name != "." && name != ".." && name.find_first_of(std::string("/\\\0", 3)) == std::string::npos &&
+  return !name.empty() && name != "." && name != ".." &&
+         name.find_first_of(std::string("/\\\0", 3)) == std::string::npos &&
          name.size() <= 0xFFFF - std::string("groups/.uint32").size();
 }
 
@@ -78,7 +80,8 @@ class ZipWriter {
       fail("cannot add " + name);
     }
     // Stored, as the TRX specification recommends, so that readers can map the arrays in place.
-    if (zip_set_file_compression(zip_, static_cast<zip_uint64_t>(index), ZIP_CM_STORE, 0) < 0) fail("cannot store " + name);
+    if (zip_set_file_compression(zip_, static_cast<zip_uint64_t>(index), ZIP_CM_STORE, 0) < 0)
+      fail("cannot store " + name);
   }
 
   // Writes the archive to a temporary file beside the output and renames it into place.
@@ -102,7 +105,8 @@ TrxReference trx_reference(const VxlFile& file) {
   if (prov.is_object() && prov.contains("source") && prov["source"].is_object()) {
     // PROV may hold any JSON (open() does not look into it): take each field only with the expected type.
     const nlohmann::json& src = prov["source"];
-    const std::string format = src.contains("format") && src["format"].is_string() ? src["format"].get<std::string>() : "";
+    const std::string format =
+        src.contains("format") && src["format"].is_string() ? src["format"].get<std::string>() : "";
     const nlohmann::json header = src.value("header", nlohmann::json());
     std::optional<std::array<std::int64_t, 3>> dims;
     std::optional<Matrix> matrix;
@@ -159,7 +163,8 @@ void export_trx(const VxlFile& file, const std::string& out_path) {
       fail_unsupported(file.path(), "group name '" + groups[g].name.substr(0, 200) +
                                         "' cannot be a TRX member name (groups/NAME.uint32)");
     if (!names.insert(groups[g].name).second)
-      fail_unsupported(file.path(), "two groups are named '" + groups[g].name + "': TRX holds one groups/NAME.uint32 per name");
+      fail_unsupported(file.path(),
+                       "two groups are named '" + groups[g].name + "': TRX holds one groups/NAME.uint32 per name");
     if (m.streamline_count > std::numeric_limits<std::uint32_t>::max())
       fail_unsupported(file.path(), "TRX group members are uint32: more than 2^32 - 1 streamlines cannot be grouped");
     members[g].assign(groups[g].members.begin(), groups[g].members.end());
@@ -173,7 +178,8 @@ void export_trx(const VxlFile& file, const std::string& out_path) {
   zip.add_stored("positions.3.float32", positions.data(), positions.size() * sizeof(float));
   zip.add_stored("offsets.uint64", offsets.data(), offsets.size() * sizeof(std::uint64_t));
   for (std::size_t g = 0; g < groups.size(); ++g)
-    zip.add_stored("groups/" + groups[g].name + ".uint32", members[g].data(), members[g].size() * sizeof(std::uint32_t));
+    zip.add_stored("groups/" + groups[g].name + ".uint32", members[g].data(),
+                   members[g].size() * sizeof(std::uint32_t));
   for (const TrxValueMember& v : values) zip.add_stored(v.name, v.data.data(), v.data.size() * sizeof(float));
   zip.close();
 }

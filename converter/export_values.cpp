@@ -10,7 +10,8 @@ namespace {
 
 // A member name made from a set name must stay one file inside dpv/ or dps/.
 bool usable_member_name(const std::string& name) {
-  return !name.empty() && name != "." && name != ".." && name.find_first_of(std::string("/\\\0", 3)) == std::string::npos;
+  return !name.empty() && name != "." && name != ".." &&
+         name.find_first_of(std::string("/\\\0", 3)) == std::string::npos;
 }
 
 // "base[i]" -> base and i; nothing for other names.
@@ -37,13 +38,16 @@ void add_members(const VxlFile& file, const ValueSets& sets, const std::string& 
     std::uint32_t index = 0, m = 1;
     if (split_component(sets.name(k), base, index) && index == 0) {
       // The longest run base[0], base[1], … that follows.
-      while (k + m < sets.size() && split_component(sets.name(k + m), next_base, index) && next_base == base && index == m) ++m;
+      while (k + m < sets.size() && split_component(sets.name(k + m), next_base, index) && next_base == base &&
+             index == m)
+        ++m;
       if (m == 1) base = sets.name(k);  // a lone base[0] stays as it is named
     } else {
       base = sets.name(k);
     }
     if (!usable_member_name(base))
-      fail_unsupported(file.path(), "value set name '" + base + "' cannot be a TRX member name (" + dir + "/NAME.float32)");
+      fail_unsupported(file.path(),
+                       "value set name '" + base + "' cannot be a TRX member name (" + dir + "/NAME.float32)");
     TrxValueMember member;
     member.name = dir + "/" + base + (m > 1 ? "." + std::to_string(m) : "") + ".float32";
     member.data.resize(count * m);

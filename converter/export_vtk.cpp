@@ -75,8 +75,8 @@ void export_vtk(const VxlFile& file, const std::string& out_path) {
     if (static_cast<unsigned char>(c) < ' ') c = '_';
   AtomicOutputFile out(out_path);
   BigEndianWriter w(out);
-  w.text("# vtk DataFile Version 3.0\nvoxlines export of " + source +
-         " SPACE=RAS\nBINARY\nDATASET POLYDATA\nPOINTS " + std::to_string(m.point_count) + " float\n");
+  w.text("# vtk DataFile Version 3.0\nvoxlines export of " + source + " SPACE=RAS\nBINARY\nDATASET POLYDATA\nPOINTS " +
+         std::to_string(m.point_count) + " float\n");
   const auto voxlines = file.voxlines();
   std::uint64_t j = 0;
   WalkCallbacks cb;

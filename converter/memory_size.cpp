@@ -9,9 +9,12 @@ std::optional<std::uint64_t> parse_memory_size(std::string_view text) {
   std::uint64_t unit = 1;
   if (!text.empty()) {
     switch (text.back()) {
-      case 'K': case 'k': unit = 1ull << 10; break;
-      case 'M': case 'm': unit = 1ull << 20; break;
-      case 'G': case 'g': unit = 1ull << 30; break;
+      case 'K':
+      case 'k': unit = 1ull << 10; break;
+      case 'M':
+      case 'm': unit = 1ull << 20; break;
+      case 'G':
+      case 'g': unit = 1ull << 30; break;
       default: break;
     }
     if (unit != 1) text.remove_suffix(1);
@@ -30,10 +33,14 @@ std::optional<std::uint64_t> parse_memory_size(std::string_view text) {
 
 std::string format_memory_size(std::uint64_t bytes) {
   char buf[64];
-  if (bytes < 1024) std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(bytes));
-  else if (bytes < (1ull << 20)) std::snprintf(buf, sizeof buf, "%.1f KiB", double(bytes) / 1024.0);
-  else if (bytes < (1ull << 30)) std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / double(1 << 20));
-  else std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(1 << 30));
+  if (bytes < 1024)
+    std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(bytes));
+  else if (bytes < (1ull << 20))
+    std::snprintf(buf, sizeof buf, "%.1f KiB", double(bytes) / 1024.0);
+  else if (bytes < (1ull << 30))
+    std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / double(1 << 20));
+  else
+    std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / double(1 << 30));
   return buf;
 }
 

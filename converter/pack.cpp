@@ -6,9 +6,9 @@
 #include <cstring>
 #include <vector>
 
+#include "converter/voxelize.h"
 #include "format/error.h"
 #include "format/parallel.h"
-#include "converter/voxelize.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxlz_draco.h"
 #include "format/vxlz_package.h"
@@ -21,8 +21,8 @@ namespace {
 
 // Where each voxline's points are: its first vertex in VERT and its first shipped point (spec §5.1).
 struct VoxlineIndex {
-  std::vector<std::uint64_t> first_vertex;  // L
-  std::vector<std::uint64_t> first_point;   // L + 1, prefix sums of own counts
+  std::vector<std::uint64_t> first_vertex;      // L
+  std::vector<std::uint64_t> first_point;       // L + 1, prefix sums of own counts
   std::vector<std::uint8_t> starts_streamline;  // L
 };
 
@@ -37,7 +37,8 @@ VoxlineIndex index_voxlines(const VxlFile& f) {
   walk_streamlines(f, cb);
   x.first_point.resize(l + 1);
   x.first_point[0] = 0;
-  for (std::uint64_t j = 0; j < l; ++j) x.first_point[j + 1] = x.first_point[j] + (f.voxlines()[j].count_flags & kVoxlineCountMask);
+  for (std::uint64_t j = 0; j < l; ++j)
+    x.first_point[j + 1] = x.first_point[j] + (f.voxlines()[j].count_flags & kVoxlineCountMask);
   x.starts_streamline.assign(l, 0);
   auto strm = f.streamline_first_voxline();
   for (std::uint64_t s = 0; s + 1 < strm.size(); ++s)
@@ -62,9 +63,11 @@ std::vector<NamedValues> shipped_point_values(const VxlFile& f, const VoxlineInd
       const std::uint64_t own = voxlines[j].count_flags & kVoxlineCountMask;
       const std::uint64_t first = index.first_vertex[j];
       std::copy(v.begin() + first, v.begin() + first + own, dst + index.first_point[j]);
-      if (j + 1 < l && !index.starts_streamline[j + 1] && std::memcmp(&v[first + own], &v[index.first_vertex[j + 1]], 4) != 0)
-        fail_input(f.path(), f.find_section(section_id("VVAL"))->offset,
-                   "value set '" + out[k].name + "': a connecting vertex's value differs from the next voxline's first");
+      if (j + 1 < l && !index.starts_streamline[j + 1] &&
+          std::memcmp(&v[first + own], &v[index.first_vertex[j + 1]], 4) != 0)
+        fail_input(
+            f.path(), f.find_section(section_id("VVAL"))->offset,
+            "value set '" + out[k].name + "': a connecting vertex's value differs from the next voxline's first");
     }
   }
   return out;
@@ -170,8 +173,9 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   const unsigned threads = resolve_threads(settings.threads);
   const MetaSection& m = f.meta();
   if (m.order_set == static_cast<std::uint32_t>(OrderSet::Random))
-    fail_unsupported(f.path(), "per-voxel random order sets (.vxl VDIR) cannot be packed by package format 2.0; "
-                               "convert with --orders axis or axis+diag");
+    fail_unsupported(f.path(),
+                     "per-voxel random order sets (.vxl VDIR) cannot be packed by package format 2.0; "
+                     "convert with --orders axis or axis+diag");
   const VoxlineIndex index = index_voxlines(f);
   const std::uint64_t n = index.first_point.back();
 
@@ -215,7 +219,8 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
       const std::uint64_t start = chunk * pack.chunk_points;
       const std::uint64_t count = std::min(pack.chunk_points, n - start);
       residuals.resize(3 * count);
-      std::uint64_t j = std::upper_bound(index.first_point.begin(), index.first_point.end(), start) - index.first_point.begin() - 1;
+      std::uint64_t j =
+          std::upper_bound(index.first_point.begin(), index.first_point.end(), start) - index.first_point.begin() - 1;
       std::uint64_t in_voxline = start - index.first_point[j];
       LinearPredictor predictor;
       predictor.reset();
@@ -263,11 +268,15 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   // was asked for): the voxline voxels take seconds to deflate on a large tractogram, and would otherwise
   // run alone at the end.
   DeflatedTables tables;
-  parallel_invoke(threads > 1, [&] {
-    tables = deflate_tables(c, 1);
-    if (!f.vertex_values().empty()) c.point_values = encode_value_section(shipped_point_values(f, index), 1);
-    if (!f.streamline_values().empty()) c.streamline_values = encode_value_section(streamline_values(f.streamline_values()), 1);
-  }, encode_positions);
+  parallel_invoke(
+      threads > 1,
+      [&] {
+        tables = deflate_tables(c, 1);
+        if (!f.vertex_values().empty()) c.point_values = encode_value_section(shipped_point_values(f, index), 1);
+        if (!f.streamline_values().empty())
+          c.streamline_values = encode_value_section(streamline_values(f.streamline_values()), 1);
+      },
+      encode_positions);
 
   PackSummary s;
   s.bytes = write_vxlz(out_path, c, tables);

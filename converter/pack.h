@@ -19,9 +19,9 @@ struct PackSettings {
 };
 
 struct PackSummary {
-  std::uint64_t bytes = 0;           // package size
+  std::uint64_t bytes = 0;  // package size
   std::uint64_t streamlines = 0, points = 0, shipped_points = 0;
-  PackSection pack{};                // quantisation, stated bound, measured error
+  PackSection pack{};                                             // quantisation, stated bound, measured error
   std::uint32_t point_value_sets = 0, streamline_value_sets = 0;  // carried exactly (spec §4.7)
 };
 

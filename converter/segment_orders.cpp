@@ -34,7 +34,8 @@ OrderSetSpec parse_order_set(const std::string& name) {
   }
   if (name.starts_with("random:")) {
     const std::string count = name.substr(7);
-    const bool digits = !count.empty() && count.size() <= 2 && count.find_first_not_of("0123456789") == std::string::npos;
+    const bool digits =
+        !count.empty() && count.size() <= 2 && count.find_first_not_of("0123456789") == std::string::npos;
     const unsigned n = digits ? static_cast<unsigned>(std::stoul(count)) : 0;
     if (n >= 1 && n <= kVxlMaxStoredOrders) {
       set.kind = OrderSet::Random;
@@ -107,7 +108,9 @@ std::uint64_t sortable_bits(double d) {
 // voxels keep narrow digits.
 constexpr int kMinDigitBits = 8, kMaxDigitBits = 14;
 constexpr int kMaxPasses = (64 + kMinDigitBits - 1) / kMinDigitBits;
-int digit_bits(std::size_t n) { return std::clamp(static_cast<int>(std::bit_width(n)) - 2, kMinDigitBits, kMaxDigitBits); }
+int digit_bits(std::size_t n) {
+  return std::clamp(static_cast<int>(std::bit_width(n)) - 2, kMinDigitBits, kMaxDigitBits);
+}
 
 // One read of the items fills every pass's histogram (P known at compile time, so the loop unrolls).
 template <int P, typename Item, typename Key>
@@ -213,15 +216,18 @@ std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint3
     s.packed.resize(n);
     const std::uint64_t field = (1ull << bits) - 1;  // bits < 64 here
     for (std::size_t i = 0; i < n; ++i) s.packed[i] = ((s.keys[i] >> low) & field) << index_bits | starts[i];
-    radix_sort_bits(s.packed, s.packed_tmp, s.counts, [](std::uint64_t x) { return x; }, index_bits, bits);
+    radix_sort_bits(
+        s.packed, s.packed_tmp, s.counts, [](std::uint64_t x) { return x; }, index_bits, bits);
     const std::uint64_t index_mask = (1ull << index_bits) - 1;
-    return put_entries(dst, width, n, [&](std::size_t i) { return static_cast<std::uint32_t>(s.packed[i] & index_mask); });
+    return put_entries(dst, width, n,
+                       [&](std::size_t i) { return static_cast<std::uint32_t>(s.packed[i] & index_mask); });
   }
   s.keyed.reserve(s.max_vertices);
   s.keyed_tmp.reserve(s.max_vertices);
   s.keyed.resize(n);
   for (std::size_t i = 0; i < n; ++i) s.keyed[i] = {s.keys[i], starts[i]};
-  radix_sort_bits(s.keyed, s.keyed_tmp, s.counts, [](const KeyedSegment& k) { return k.key; }, low, bits);
+  radix_sort_bits(
+      s.keyed, s.keyed_tmp, s.counts, [](const KeyedSegment& k) { return k.key; }, low, bits);
   return put_entries(dst, width, n, [&](std::size_t i) { return s.keyed[i].local; });
 }
 
@@ -268,7 +274,9 @@ struct VoxelOrderWriter::Scratch {
 };
 
 VoxelOrderWriter::VoxelOrderWriter(const OrderSetSpec& set, std::uint32_t max_vertices)
-    : set_(&set), directions_(set.directions.size()), axis_of_(set.directions.size(), -1),
+    : set_(&set),
+      directions_(set.directions.size()),
+      axis_of_(set.directions.size(), -1),
       scratch_(std::make_unique<Scratch>()) {
   SortScratch& s = scratch_->sort;
   s.max_vertices = max_vertices;
@@ -331,7 +339,8 @@ void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const float> vertice
 }
 
 void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float> vertices, const VoxlineEnds& ends,
-                       const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads, const ProgressFn& progress) {
+                       const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,
+                       const ProgressFn& progress) {
   std::uint32_t max_vertices = 0;
   for (const VoxelEntry& v : voxels) max_vertices = std::max(max_vertices, v.vertex_count);
   std::atomic<std::size_t> done{0};
@@ -354,7 +363,8 @@ std::uint64_t order_scratch_bytes(std::uint32_t max_vertices) {
   return per_vertex * max_vertices + std::uint64_t(kMaxPasses) * (1u << kMaxDigitBits) * sizeof(std::uint32_t);
 }
 
-BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsigned threads, const ProgressFn& progress) {
+BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsigned threads,
+                         const ProgressFn& progress) {
   BuiltOrders out;
   out.directions = order_directions(set);
   vt.meta.stored_order_count = static_cast<std::uint32_t>(set.directions.size());

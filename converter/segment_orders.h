@@ -84,7 +84,8 @@ class VoxelOrderWriter {
 // Sorts every voxel's segments for every direction of `set` into `orders`, the ORDR payload laid out
 // by layout_orders (padding bytes are left as they are: zero in a fresh payload).
 void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float> vertices, const VoxlineEnds& ends,
-                       const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads, const ProgressFn& progress);
+                       const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,
+                       const ProgressFn& progress);
 
 // An upper bound of what build_orders_into allocates per worker thread (its sort buffers, growth
 // included) when no voxel has more than `max_vertices` vertices, for callers that budget memory.
@@ -93,7 +94,7 @@ std::uint64_t order_scratch_bytes(std::uint32_t max_vertices);
 struct BuiltOrders {
   std::vector<DirectionEntry> directions;
   std::vector<DirectionEntry> voxel_directions;  // the VDIR payload; empty unless the set is random
-  std::vector<std::uint8_t> bytes;  // the ORDR payload
+  std::vector<std::uint8_t> bytes;               // the ORDR payload
 };
 
 // All of the above in memory: sets the voxels' flags and order_offset and the meta's order fields.

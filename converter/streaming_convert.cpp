@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -12,13 +12,13 @@
 #include <malloc.h>
 #endif
 
-#include "format/error.h"
 #include "converter/memory_size.h"
-#include "format/parallel.h"
-#include "converter/segment_orders.h"
 #include "converter/readers/tck_stream.h"
-#include "converter/voxelize.h"
+#include "converter/segment_orders.h"
 #include "converter/voxel_table.h"
+#include "converter/voxelize.h"
+#include "format/error.h"
+#include "format/parallel.h"
 #include "format/vxl_stream_writer.h"
 
 namespace vxl {
@@ -66,10 +66,12 @@ class Budget {
     used_ += bytes - held;
     held = bytes;
   }
-  [[noreturn]] void fail(std::uint64_t needs, std::uint64_t others, const std::string& what, const std::string& hint = "") const {
+  [[noreturn]] void fail(std::uint64_t needs, std::uint64_t others, const std::string& what,
+                         const std::string& hint = "") const {
     // A quarter more than the sum, for what comes later.
     throw Error(ErrorKind::Unsupported, path_, std::nullopt,
-                "--memory-limit " + format_memory_size(limit_) + " is too small: " + what + " needs " + format_memory_size(needs) +
+                "--memory-limit " + format_memory_size(limit_) + " is too small: " + what + " needs " +
+                    format_memory_size(needs) +
                     (others > 0 ? " on top of " + format_memory_size(others) + " already taken" : std::string()) +
                     "; use --memory-limit " + memory_limit_argument((needs + others) / 4 * 5) + " or more" + hint);
   }
@@ -144,7 +146,7 @@ class StreamingConversion {
   std::uint64_t synthetic_limit_ = 0;
   Sink sink_;
   std::uint64_t sink_held_ = 0, plan_held_ = 0;
-  detail::VoxelUse use_;                   // by local id, while planning
+  detail::VoxelUse use_;                  // by local id, while planning
   std::vector<std::uint32_t> global_id_;  // local id -> voxel index
   std::vector<VoxelEntry> voxels_;
   std::vector<std::uint64_t> cursor_;  // by local id: the next vertex of its voxel to place (global index)
@@ -156,7 +158,8 @@ class StreamingConversion {
 };
 
 void StreamingConversion::fail_changed() const {
-  fail_input(path_, std::nullopt, "the file changed while it was being converted (--memory-limit reads it several times)");
+  fail_input(path_, std::nullopt,
+             "the file changed while it was being converted (--memory-limit reads it several times)");
 }
 
 void StreamingConversion::check_source_type() const {
@@ -186,14 +189,16 @@ void StreamingConversion::each_batch(const std::string& stage, Body&& body) {
   check_overflow(batches_[current]);
   while (more) {
     const int other = 1 - current;
-    parallel_invoke(read_ahead, [&] { body(static_cast<const Tractogram&>(batches_[current]), first); },
-                    [&] { more = read(other); });
+    parallel_invoke(
+        read_ahead, [&] { body(static_cast<const Tractogram&>(batches_[current]), first); },
+        [&] { more = read(other); });
     first += batches_[current].streamline_count();
     current = other;
     check_overflow(batches_[current]);
     // Both batches keep their largest size; pass 1 finds it (later passes cut the same batches).
-    const std::uint64_t bytes = (batches_[0].positions.capacity() + batches_[1].positions.capacity()) * sizeof(float) +
-                                (batches_[0].offsets.capacity() + batches_[1].offsets.capacity()) * sizeof(std::uint64_t);
+    const std::uint64_t bytes =
+        (batches_[0].positions.capacity() + batches_[1].positions.capacity()) * sizeof(float) +
+        (batches_[0].offsets.capacity() + batches_[1].offsets.capacity()) * sizeof(std::uint64_t);
     budget_.track(bytes, batch_held_, [&] {
       return "reading two batches of streamlines, one holding streamline " + std::to_string(longest_index_) + " (" +
              std::to_string(longest_) + " points) whole,";
@@ -223,7 +228,8 @@ void StreamingConversion::scan() {
         longest_ = b.offsets[k + 1] - b.offsets[k];
         longest_index_ = first + k;
       }
-    bounds.add(b.positions.data(), b.offsets.data(), 0, b.streamline_count(), first);  // stops at a bad point; reading goes on for the reader's errors
+    bounds.add(b.positions.data(), b.offsets.data(), 0, b.streamline_count(),
+               first);  // stops at a bad point; reading goes on for the reader's errors
     streamlines += b.streamline_count();
     points += b.point_count();
   });
@@ -244,7 +250,8 @@ void StreamingConversion::plan() {
   grid_ = detail::set_grid(meta_, lo_, hi_, path_);
   // plan_voxels' limit on added points, applied to the whole source (plan_voxels applies it per
   // thread's range: the two can differ only in whether a borderline source is refused).
-  synthetic_limit_ = static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(meta_.point_count)) + 4096;
+  synthetic_limit_ =
+      static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(meta_.point_count)) + 4096;
   std::uint64_t voxlines = 0, synthetic = 0, points = 0;
   const std::string voxel_hint = ", or a larger --voxel-size";
   each_batch("voxelising", [&](const Tractogram& b, std::uint64_t) {
@@ -252,7 +259,8 @@ void StreamingConversion::plan() {
     for (std::uint64_t k = 0; k < b.streamline_count(); ++k) {
       sink_.voxlines.clear();
       sink_.synthetic_xyz.clear();
-      detail::voxelize_streamline(grid_, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], sink_, synthetic_limit_ - synthetic);
+      detail::voxelize_streamline(grid_, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], sink_,
+                                  synthetic_limit_ - synthetic);
       if (sink_.too_many_synthetic) detail::fail_too_many_synthetic(path_, meta_.voxel_size, longest_step2_);
       synthetic += sink_.synthetic_xyz.size() / 3;
       const std::size_t n_local = sink_.index.coords().size();
@@ -264,10 +272,12 @@ void StreamingConversion::plan() {
       if (table > plan_held_ && table - plan_held_ > budget_.left()) {
         // Voxels turn up ever more slowly: extrapolating from the points read so far overestimates.
         const std::uint64_t read = points + b.offsets[k + 1];
-        const std::uint64_t all = static_cast<std::uint64_t>(double(n_local) * double(meta_.point_count) / double(read));
+        const std::uint64_t all =
+            static_cast<std::uint64_t>(double(n_local) * double(meta_.point_count) / double(read));
         budget_.fail(all * kPlanBytesPerVoxel, budget_.used() - plan_held_,
                      "the voxel table (" + std::to_string(n_local) + " voxels after " + std::to_string(read) + " of " +
-                         std::to_string(meta_.point_count) + " points; about " + std::to_string(all) + " in all, extrapolated)",
+                         std::to_string(meta_.point_count) + " points; about " + std::to_string(all) +
+                         " in all, extrapolated)",
                      voxel_hint);
       }
       budget_.track(table, plan_held_, [] { return std::string(); });
@@ -303,16 +313,19 @@ std::vector<Range> StreamingConversion::cut_ranges() {
   };
   auto cost = [&](const Range& r) {
     const std::uint64_t v = r.vertex_end - r.vertex_first;
-    return 12 * v + (v / 64 + 1) * 8 + (r.order_end - r.order_first) + order_threads(r) * order_scratch_bytes(r.max_vertices);
+    return 12 * v + (v / 64 + 1) * 8 + (r.order_end - r.order_first) +
+           order_threads(r) * order_scratch_bytes(r.max_vertices);
   };
   auto order_end = [&](std::size_t i) { return i < voxels_.size() ? voxels_[i].order_offset : order_bytes_; };
   auto alone = [&](std::size_t i) {
     const VoxelEntry& v = voxels_[i];
-    Range r{i, i + 1, v.vertex_first, v.vertex_first + v.vertex_count, v.order_offset, order_end(i + 1), v.vertex_count};
+    Range r{
+        i, i + 1, v.vertex_first, v.vertex_first + v.vertex_count, v.order_offset, order_end(i + 1), v.vertex_count};
     if (cost(r) > room) {
       budget_.take(cost(r),
-                   "voxel (" + std::to_string(v.coord[0]) + ", " + std::to_string(v.coord[1]) + ", " + std::to_string(v.coord[2]) +
-                       ") of " + std::to_string(v.vertex_count) + " vertices, with its orders and sort buffers,",
+                   "voxel (" + std::to_string(v.coord[0]) + ", " + std::to_string(v.coord[1]) + ", " +
+                       std::to_string(v.coord[2]) + ") of " + std::to_string(v.vertex_count) +
+                       " vertices, with its orders and sort buffers,",
                    ", or a smaller --voxel-size");
     }
     return r;
@@ -391,7 +404,8 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
         const std::uint64_t used = own + (j + 1 < n ? 1 : 0);
         std::uint64_t& cursor = cursor_[v.voxel];
         if (used > voxels_[g].vertex_first + voxels_[g].vertex_count - cursor) fail_changed();
-        detail::place_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data(), vertices.data() + 3 * (cursor - r.vertex_first));
+        detail::place_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data(),
+                              vertices.data() + 3 * (cursor - r.vertex_first));
         ends.set(cursor - r.vertex_first + used - 1);
         cursor += used;
       }
@@ -402,7 +416,8 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
   if (streamlines != meta_.streamline_count || (tables && voxline_index != meta_.voxline_count)) fail_changed();
   for (std::size_t local = 0; local < cursor_.size(); ++local) {
     const std::uint32_t g = global_id_[local];
-    if (g >= r.first && g < r.end && cursor_[local] != voxels_[g].vertex_first + voxels_[g].vertex_count) fail_changed();
+    if (g >= r.first && g < r.end && cursor_[local] != voxels_[g].vertex_first + voxels_[g].vertex_count)
+      fail_changed();
   }
   if (tables) {
     streamline_buffer.push_back(voxline_index);
@@ -422,7 +437,8 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
     v.order_offset -= r.order_first;
   }
   const std::string stage = "ordering" + of;
-  build_orders_into(range, vertices, ends, order_set_, orders, r.order_threads, [&](const char*, double f) { report(stage, f); });
+  build_orders_into(range, vertices, ends, order_set_, orders, r.order_threads,
+                    [&](const char*, double f) { report(stage, f); });
   for (VoxelEntry& v : range) {
     v.vertex_first += r.vertex_first;
     v.order_offset += r.order_first;
@@ -443,7 +459,8 @@ void StreamingConversion::write_rest() {
     const std::size_t slice = 4096;
     std::vector<DirectionEntry> voxel_directions;
     for (std::size_t first = 0; first < voxels_.size(); first += slice) {
-      const std::span<const VoxelEntry> part = std::span<const VoxelEntry>(voxels_).subspan(first, std::min(slice, voxels_.size() - first));
+      const std::span<const VoxelEntry> part =
+          std::span<const VoxelEntry>(voxels_).subspan(first, std::min(slice, voxels_.size() - first));
       voxel_directions.resize(part.size() * directions.size());
       fill_voxel_directions(order_set_, part, voxel_directions);
       out_->append_items<DirectionEntry>(VxlStreamWriter::kVdir, voxel_directions);
@@ -469,7 +486,8 @@ ConvertSummary StreamingConversion::run() {
   plan();
   build_table();
   summary_.voxelize_seconds = seconds_since(t0);
-  budget_.take(kTableBufferEntries * (sizeof(VoxlineEntry) + sizeof(std::uint64_t)), "the buffer of the voxline and streamline tables");
+  budget_.take(kTableBufferEntries * (sizeof(VoxlineEntry) + sizeof(std::uint64_t)),
+               "the buffer of the voxline and streamline tables");
   budget_.take(meta_.streamline_count * sizeof(spans_[0]), "the voxel span of every streamline");
   spans_.resize(meta_.streamline_count);
   std::vector<Range> ranges = cut_ranges();
@@ -500,7 +518,8 @@ ConvertSummary StreamingConversion::run() {
 
 }  // namespace
 
-ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path, const ConvertSettings& settings) {
+ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
+                                 const ConvertSettings& settings) {
   StreamingConversion conversion(source_path, out_path, settings);
   return conversion.run();
 }

@@ -24,6 +24,7 @@ namespace vxl {
 // small for some part of the work — naming the part, what it needs and a limit that would do — before
 // anything is written; Input when the source changes between passes; as convert_tractogram otherwise.
 // The summary's passes and partitions say how the work was split; its warnings are the source's.
-ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path, const ConvertSettings& settings);
+ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
+                                 const ConvertSettings& settings);
 
 }  // namespace vxl

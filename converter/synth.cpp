@@ -59,8 +59,12 @@ double det_log(double x) {
   const double f = (m - 1.0) / (m + 1.0);  // |f| <= 0.1716
   const double f2 = f * f;
   const double series =
-      f2 * (1.0 / 3 + f2 * (1.0 / 5 + f2 * (1.0 / 7 + f2 * (1.0 / 9 + f2 * (1.0 / 11 + f2 * (1.0 / 13 +
-      f2 * (1.0 / 15 + f2 * (1.0 / 17 + f2 * (1.0 / 19)))))))));
+      f2 *
+      (1.0 / 3 +
+       f2 * (1.0 / 5 +
+             f2 * (1.0 / 7 +
+                   f2 * (1.0 / 9 +
+                         f2 * (1.0 / 11 + f2 * (1.0 / 13 + f2 * (1.0 / 15 + f2 * (1.0 / 17 + f2 * (1.0 / 19)))))))));
   return 2.0 * (f + f * series) + static_cast<double>(e) * 0.69314718055994530942;
 }
 
@@ -102,8 +106,7 @@ inline bool inside(V3 p, double scale) { return ellipsoid_q(p) <= scale * scale;
 V3 point_in_ellipsoid(Rng& rng, double scale) {
   for (;;) {
     const V3 u{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)};
-    if (dot(u, u) <= 1.0)
-      return kCentre + scale * V3{u.x * kAxes.x, u.y * kAxes.y, u.z * kAxes.z};
+    if (dot(u, u) <= 1.0) return kCentre + scale * V3{u.x * kAxes.x, u.y * kAxes.y, u.z * kAxes.z};
   }
 }
 
@@ -139,9 +142,9 @@ struct Bundle {
 };
 
 struct BundleSpec {
-  V3 p[4];           // Bezier control points, all inside the curve ellipsoid (so the curve is too)
-  double radius;     // tube radius in the middle, mm
-  double flare;      // radius grows by (1 + flare) towards the ends
+  V3 p[4];               // Bezier control points, all inside the curve ellipsoid (so the curve is too)
+  double radius;         // tube radius in the middle, mm
+  double flare;          // radius grows by (1 + flare) towards the ends
   double max_curvature;  // 1/mm
   std::uint32_t min_samples, max_samples;
 };
@@ -178,8 +181,7 @@ std::optional<Bundle> build_bundle(const BundleSpec& spec) {
   }
 
   std::vector<V3> tangent(n);
-  for (std::uint32_t k = 0; k < n; ++k)
-    tangent[k] = normalized(c[std::min(k + 1, n - 1)] - c[k > 0 ? k - 1 : 0]);
+  for (std::uint32_t k = 0; k < n; ++k) tangent[k] = normalized(c[std::min(k + 1, n - 1)] - c[k > 0 ? k - 1 : 0]);
   for (std::uint32_t k = 0; k + 1 < n; ++k) {
     const double step = norm(c[k + 1] - c[k]);
     if (step <= 0 || norm(tangent[k + 1] - tangent[k]) > spec.max_curvature * step) return std::nullopt;
@@ -190,8 +192,8 @@ std::optional<Bundle> build_bundle(const BundleSpec& spec) {
   // Initial normal: perpendicular to the tangent, from the axis least aligned with it.
   const V3 t0 = tangent[0];
   const V3 axis = (std::fabs(t0.x) <= std::fabs(t0.y) && std::fabs(t0.x) <= std::fabs(t0.z)) ? V3{1, 0, 0}
-                  : (std::fabs(t0.y) <= std::fabs(t0.z))                                      ? V3{0, 1, 0}
-                                                                                               : V3{0, 0, 1};
+                  : (std::fabs(t0.y) <= std::fabs(t0.z))                                     ? V3{0, 1, 0}
+                                                                                             : V3{0, 0, 1};
   V3 nrm = normalized(cross(t0, axis));
   for (std::uint32_t k = 0; k < n; ++k) {
     const V3 t = tangent[k];
@@ -254,10 +256,10 @@ BundleSpec arched_curve(Rng& rng, V3 a, V3 b, double bend) {
   const V3 u = random_unit(rng);
   const V3 side = normalized(u - dot(u, dir) * dir);
   spec.p[0] = a;
-  spec.p[1] = a + (1.0 / 3.0) * chord + (bend * len * rng.uniform(0.8, 1.0)) * side +
-              random_perpendicular(rng, dir, 0.1 * len);
-  spec.p[2] = a + (2.0 / 3.0) * chord + (bend * len * rng.uniform(0.8, 1.0)) * side +
-              random_perpendicular(rng, dir, 0.1 * len);
+  spec.p[1] =
+      a + (1.0 / 3.0) * chord + (bend * len * rng.uniform(0.8, 1.0)) * side + random_perpendicular(rng, dir, 0.1 * len);
+  spec.p[2] =
+      a + (2.0 / 3.0) * chord + (bend * len * rng.uniform(0.8, 1.0)) * side + random_perpendicular(rng, dir, 0.1 * len);
   spec.p[3] = b;
   return spec;
 }
@@ -358,8 +360,7 @@ Layout build_layout(std::uint64_t seed) {
         if (long_class) {
           spec.min_samples = min_points;
           // The control polygon bounds the arc length from above: skip hopeless candidates cheaply.
-          if (norm(spec.p[1] - spec.p[0]) + norm(spec.p[2] - spec.p[1]) + norm(spec.p[3] - spec.p[2]) <
-              min_points)
+          if (norm(spec.p[1] - spec.p[0]) + norm(spec.p[2] - spec.p[1]) + norm(spec.p[3] - spec.p[2]) < min_points)
             continue;
         }
         return spec;
@@ -404,37 +405,38 @@ Layout build_layout(std::uint64_t seed) {
   // kept to the cerebrum (not the inferior surface).
   for (int i = 0; i < kUPairs; ++i) {
     BundleSpec spec;
-    us.push_back(draw_bundle(rng, [&] {
-      for (;;) {
-        const V3 d = random_unit(rng);
-        if (d.z < -0.3 || d.x > -0.1) continue;  // left hemisphere; the mirror covers the right
-        auto to_surface = [](V3 p) {
-          return kCentre + (kUCurveScale / std::sqrt(ellipsoid_q(p))) * (p - kCentre);
-        };
-        const V3 a = to_surface(kCentre + V3{d.x * kAxes.x, d.y * kAxes.y, d.z * kAxes.z});
-        const V3 inward0 = normalized(kCentre - a);
-        const V3 u = random_unit(rng);
-        const V3 side = normalized(u - dot(u, inward0) * inward0);
-        const V3 b = to_surface(a + rng.uniform(14.0, 26.0) * side);
-        const V3 mid = 0.5 * (a + b);
-        const V3 g = mid - kCentre;  // ellipsoid normal at mid: gradient of q
-        const V3 inward = -1.0 * normalized(V3{g.x / (kAxes.x * kAxes.x), g.y / (kAxes.y * kAxes.y),
-                                               g.z / (kAxes.z * kAxes.z)});
-        const double depth = rng.uniform(8.0, 14.0);
-        BundleSpec s{};
-        s.p[0] = a;
-        s.p[1] = a + depth * inward;
-        s.p[2] = b + depth * inward;
-        s.p[3] = b;
-        if (!controls_inside(s, kUCurveScale + 1e-9)) continue;
-        s.radius = rng.uniform(0.8, 1.4);
-        s.flare = rng.uniform(0.0, 0.2);
-        s.max_curvature = kMaxCurvatureU;
-        s.min_samples = kSynthMinPoints + 4;
-        s.max_samples = 60;
-        return s;
-      }
-    }, &spec));
+    us.push_back(draw_bundle(
+        rng,
+        [&] {
+          for (;;) {
+            const V3 d = random_unit(rng);
+            if (d.z < -0.3 || d.x > -0.1) continue;  // left hemisphere; the mirror covers the right
+            auto to_surface = [](V3 p) { return kCentre + (kUCurveScale / std::sqrt(ellipsoid_q(p))) * (p - kCentre); };
+            const V3 a = to_surface(kCentre + V3{d.x * kAxes.x, d.y * kAxes.y, d.z * kAxes.z});
+            const V3 inward0 = normalized(kCentre - a);
+            const V3 u = random_unit(rng);
+            const V3 side = normalized(u - dot(u, inward0) * inward0);
+            const V3 b = to_surface(a + rng.uniform(14.0, 26.0) * side);
+            const V3 mid = 0.5 * (a + b);
+            const V3 g = mid - kCentre;  // ellipsoid normal at mid: gradient of q
+            const V3 inward =
+                -1.0 * normalized(V3{g.x / (kAxes.x * kAxes.x), g.y / (kAxes.y * kAxes.y), g.z / (kAxes.z * kAxes.z)});
+            const double depth = rng.uniform(8.0, 14.0);
+            BundleSpec s{};
+            s.p[0] = a;
+            s.p[1] = a + depth * inward;
+            s.p[2] = b + depth * inward;
+            s.p[3] = b;
+            if (!controls_inside(s, kUCurveScale + 1e-9)) continue;
+            s.radius = rng.uniform(0.8, 1.4);
+            s.flare = rng.uniform(0.0, 0.2);
+            s.max_curvature = kMaxCurvatureU;
+            s.min_samples = kSynthMinPoints + 4;
+            s.max_samples = 60;
+            return s;
+          }
+        },
+        &spec));
     Bundle mirror = *build_bundle(mirrored(spec));
     mirror.weight = 0.3 + rng.uniform();
     us.push_back(std::move(mirror));
@@ -465,8 +467,7 @@ Layout build_layout(std::uint64_t seed) {
 }
 
 // Weighted pick among ids[first..] with cumulative weights cum (size ids.size() + 1).
-std::uint32_t pick(Rng& rng, const std::vector<std::uint32_t>& ids, const std::vector<double>& cum,
-                   std::size_t first) {
+std::uint32_t pick(Rng& rng, const std::vector<std::uint32_t>& ids, const std::vector<double>& cum, std::size_t first) {
   const double lo = cum[first], hi = cum.back();
   const double u = lo + (hi - lo) * rng.uniform();
   auto it = std::upper_bound(cum.begin() + static_cast<std::ptrdiff_t>(first) + 1, cum.end(), u);
@@ -524,8 +525,7 @@ struct Smoothstep {
   }
 };
 
-void generate_streamline(const Layout& layout, const Smoothstep& smooth, const Plan& plan, Rng& rng,
-                         float* out) {
+void generate_streamline(const Layout& layout, const Smoothstep& smooth, const Plan& plan, Rng& rng, float* out) {
   const Bundle& bundle = layout.bundles[plan.bundle];
   const std::uint32_t L = plan.points;
   double a0, b0;

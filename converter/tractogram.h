@@ -22,14 +22,14 @@ struct StreamlineGroup {
 
 // What the readers know of the source file, kept as provenance in the .vxl.
 struct SourceInfo {
-  std::string path;             // as given by the user
-  std::string format;           // "tck", "trk", "trx"
-  std::string dtype;            // coordinate type in the source, e.g. "Float32LE", "float16"
-  std::uint64_t bytes = 0;      // size of the source (sum of member files for a TRX directory)
-  std::string xxh3_128;         // 32 hex digits (see spec §5.8)
-  nlohmann::json header;        // the source header as JSON
+  std::string path;                                  // as given by the user
+  std::string format;                                // "tck", "trk", "trx"
+  std::string dtype;                                 // coordinate type in the source, e.g. "Float32LE", "float16"
+  std::uint64_t bytes = 0;                           // size of the source (sum of member files for a TRX directory)
+  std::string xxh3_128;                              // 32 hex digits (see spec §5.8)
+  nlohmann::json header;                             // the source header as JSON
   std::optional<std::array<double, 16>> vox_to_ras;  // row-major 4x4, when the source has one
-  std::vector<std::string> warnings;  // non-fatal problems found while reading
+  std::vector<std::string> warnings;                 // non-fatal problems found while reading
   // Files that added values (TSF): {"name", "bytes", "xxh3_128", "header"} each, for provenance.
   nlohmann::json value_files = nlohmann::json::array();
 };
@@ -42,9 +42,9 @@ struct ValueSet {
 };
 
 struct Tractogram {
-  std::vector<float> positions;        // x,y,z interleaved, 3 * point_count() floats
-  std::vector<std::uint64_t> offsets;  // streamline i = points [offsets[i], offsets[i+1]); size N+1
-  std::vector<StreamlineGroup> groups;  // TRX groups, when the source has them
+  std::vector<float> positions;             // x,y,z interleaved, 3 * point_count() floats
+  std::vector<std::uint64_t> offsets;       // streamline i = points [offsets[i], offsets[i+1]); size N+1
+  std::vector<StreamlineGroup> groups;      // TRX groups, when the source has them
   std::vector<ValueSet> point_values;       // each point_count() values, in point order
   std::vector<ValueSet> streamline_values;  // each streamline_count() values
   SourceInfo source;

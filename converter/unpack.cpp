@@ -9,17 +9,17 @@
 
 #include <nlohmann/json.hpp>
 
-#include "format/error.h"
-#include "format/parallel.h"
 #include "converter/segment_orders.h"
 #include "converter/voxel_table.h"
+#include "format/error.h"
+#include "format/parallel.h"
+#include "format/vxl_value_sets.h"
 #include "format/vxl_writer.h"
 #include "format/vxlz_draco.h"
 #include "format/vxlz_package.h"
 #include "format/vxlz_quantize.h"
 #include "format/vxlz_tables.h"
 #include "format/vxlz_values.h"
-#include "format/vxl_value_sets.h"
 
 namespace vxl {
 namespace {
@@ -39,7 +39,9 @@ struct Structure {
   std::vector<std::uint64_t> chunk_start_voxline, chunk_start_point;
 
   bool connected(std::uint64_t j) const { return !starts_streamline[j + 1]; }
-  std::uint64_t first_vertex(std::uint64_t j) const { return voxels[voxlines[j].voxel].vertex_first + offset_in_voxel[j]; }
+  std::uint64_t first_vertex(std::uint64_t j) const {
+    return voxels[voxlines[j].voxel].vertex_first + offset_in_voxel[j];
+  }
 };
 
 // Inflates and decodes the voxline table, the voxel and the count streams side by side.
@@ -65,7 +67,8 @@ Structure rebuild_structure(const VxlzFile& f) {
   const PackSection& k = f.pack();
   const std::string& p = f.path();
   Structure s;
-  const auto coords = decode_voxel_coords(f.inflate(section_id("VOXC")), m.voxel_count, m.grid_dims, f.context(section_id("VOXC")));
+  const auto coords =
+      decode_voxel_coords(f.inflate(section_id("VOXC")), m.voxel_count, m.grid_dims, f.context(section_id("VOXC")));
   s.strm = decode_streamline_voxlines(f.inflate(section_id("STRL")), m.streamline_count, m.voxline_count,
                                       f.context(section_id("STRL")));
   s.voxlines = read_voxlines(f, coords);
@@ -99,7 +102,8 @@ Structure rebuild_structure(const VxlzFile& f) {
     count += own + s.connected(j);
     voxline_count[e.voxel] += 1;
     // Chunks start every chunk_points shipped points; record which voxline holds each start.
-    while (s.chunk_start_voxline.size() < k.chunk_count && s.chunk_start_voxline.size() * k.chunk_points < points + own) {
+    while (s.chunk_start_voxline.size() < k.chunk_count &&
+           s.chunk_start_voxline.size() * k.chunk_points < points + own) {
       s.chunk_start_voxline.push_back(j);
       s.chunk_start_point.push_back(s.chunk_start_voxline.size() * k.chunk_points - k.chunk_points - points);
     }
@@ -120,8 +124,9 @@ Structure rebuild_structure(const VxlzFile& f) {
   }
   auto expect = [&](const char* what, std::uint64_t got, std::uint64_t meta_value) {
     if (got != meta_value)
-      fail_input(p, vxlc_at, std::string("voxlines give ") + std::to_string(got) + " " + what + " but META says " +
-                                 std::to_string(meta_value));
+      fail_input(p, vxlc_at,
+                 std::string("voxlines give ") + std::to_string(got) + " " + what + " but META says " +
+                     std::to_string(meta_value));
   };
   expect("vertices", vertices, m.vertex_count);
   expect("segments", vertices - l, m.segment_count);
@@ -155,7 +160,8 @@ std::string provenance_with_package(const VxlzFile& f) {
 // Decodes chunk c into VERT (spec §5, §6, §7 step 4): own points at their voxline's place, and each
 // voxline's first point also as the connecting vertex of the voxline before it in the same streamline.
 // Marks the last vertex of every voxline that ends in this chunk (for the orders).
-void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, std::span<float> vert, VoxlineEnds& ends) {
+void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, std::span<float> vert,
+                  VoxlineEnds& ends) {
   const Quantizer quantizer(f.pack());
   const std::uint64_t count = f.chunk_point_count(chunk);
   const ChunkBytes bytes = f.chunk(chunk);
@@ -224,11 +230,13 @@ void write_point_values(const Structure& s, const std::vector<NamedValues>& sets
   finish_value_sets(payload);
 }
 
-void write_streamline_values(const std::vector<NamedValues>& sets, std::span<std::uint8_t> payload, std::uint64_t count) {
+void write_streamline_values(const std::vector<NamedValues>& sets, std::span<std::uint8_t> payload,
+                             std::uint64_t count) {
   std::vector<std::string> names;
   for (const NamedValues& v : sets) names.push_back(v.name);
   const std::vector<std::span<float>> arrays = layout_value_sets(payload, names, count);
-  for (std::size_t k = 0; k < sets.size(); ++k) std::copy(sets[k].values.begin(), sets[k].values.end(), arrays[k].begin());
+  for (std::size_t k = 0; k < sets.size(); ++k)
+    std::copy(sets[k].values.begin(), sets[k].values.end(), arrays[k].begin());
   finish_value_sets(payload);
 }
 
@@ -257,8 +265,8 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   const std::string provenance = provenance_with_package(f);
   std::vector<std::uint8_t> groups_bytes;
   if (f.has_section(section_id("GRPS")))
-    groups_bytes = encode_groups(decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count,
-                                                     f.context(section_id("GRPS"))));
+    groups_bytes = encode_groups(
+        decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count, f.context(section_id("GRPS"))));
 
   // Value sets (spec §4.7), checked against PACK's and META's counts before anything is inflated.
   std::vector<NamedValues> point_values, streamline_values;
@@ -281,8 +289,10 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   VoxlineEnds ends(meta.vertex_count);
   parallel_for(f.chunk_count(), threads, [&](std::uint64_t chunk, unsigned t) {
     decode_chunk(f, s, chunk, out.vertices(), ends);
-    if (t == 0) progress("decoding", double(++done) / double(f.chunk_count()));
-    else ++done;
+    if (t == 0)
+      progress("decoding", double(++done) / double(f.chunk_count()));
+    else
+      ++done;
   });
 
   summary.decode_seconds = seconds_since(t0);
@@ -316,8 +326,10 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   for (int c = 0; c < 3; ++c) {
     meta.bounds_min[c] = meta.bounds_max[c] = 0;
     for (std::size_t i = 0; i < voxels.size(); ++i) {
-      meta.bounds_min[c] = i == 0 ? voxels[i].tight_min[c] : std::min<double>(meta.bounds_min[c], voxels[i].tight_min[c]);
-      meta.bounds_max[c] = i == 0 ? voxels[i].tight_max[c] : std::max<double>(meta.bounds_max[c], voxels[i].tight_max[c]);
+      meta.bounds_min[c] =
+          i == 0 ? voxels[i].tight_min[c] : std::min<double>(meta.bounds_min[c], voxels[i].tight_min[c]);
+      meta.bounds_max[c] =
+          i == 0 ? voxels[i].tight_max[c] : std::max<double>(meta.bounds_max[c], voxels[i].tight_max[c]);
     }
   }
   summary.orders_seconds = seconds_since(t0);
@@ -331,7 +343,8 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
   std::copy(groups_bytes.begin(), groups_bytes.end(), out.groups().begin());
   if (!point_values.empty()) write_point_values(s, point_values, out.vertex_values(), meta.vertex_count, threads);
-  if (!streamline_values.empty()) write_streamline_values(streamline_values, out.streamline_values(), meta.streamline_count);
+  if (!streamline_values.empty())
+    write_streamline_values(streamline_values, out.streamline_values(), meta.streamline_count);
   out.commit(threads);
   summary.write_seconds = seconds_since(t0);
   progress("writing", 1.0);

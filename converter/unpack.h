@@ -21,7 +21,7 @@ struct UnpackSettings {
 
 struct UnpackSummary {
   std::uint64_t streamlines = 0, points = 0, voxels = 0;
-  PackSection pack{};  // quantisation and the stated bound
+  PackSection pack{};                                             // quantisation and the stated bound
   std::uint32_t point_value_sets = 0, streamline_value_sets = 0;  // VVAL / SVAL written, bit-exact
   double decode_seconds = 0, orders_seconds = 0, write_seconds = 0;
 };

@@ -16,12 +16,14 @@ std::string format_mm(double v) {
 }
 
 [[noreturn]] void fail_non_finite(const std::string& path, std::uint64_t streamline, std::uint64_t point) {
-  throw Error(ErrorKind::Input, path, std::nullopt,
-              "non-finite coordinate in streamline " + std::to_string(streamline) + " (point " + std::to_string(point) + ")");
+  throw Error(
+      ErrorKind::Input, path, std::nullopt,
+      "non-finite coordinate in streamline " + std::to_string(streamline) + " (point " + std::to_string(point) + ")");
 }
 
 [[noreturn]] void fail_long_voxline(const std::string& path) {
-  throw Error(ErrorKind::Unsupported, path, std::nullopt, "a voxline of more than 2^31-1 points; use a smaller --voxel-size");
+  throw Error(ErrorKind::Unsupported, path, std::nullopt,
+              "a voxline of more than 2^31-1 points; use a smaller --voxel-size");
 }
 
 }  // namespace
@@ -72,7 +74,8 @@ void BoundsScan::check(const std::string& path) const {
 }
 
 void check_voxel_size(double s, const std::string& path) {
-  if (!std::isfinite(s) || !(s > 0)) throw Error(ErrorKind::Usage, path, std::nullopt, "voxel size must be a positive number of mm");
+  if (!std::isfinite(s) || !(s > 0))
+    throw Error(ErrorKind::Usage, path, std::nullopt, "voxel size must be a positive number of mm");
 }
 
 Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std::string& path) {
@@ -82,8 +85,9 @@ Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std:
     if (!(cells < double(std::numeric_limits<std::int32_t>::max()))) {
       double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
       throw Error(ErrorKind::Unsupported, path, std::nullopt,
-                  "a voxel size of " + format_mm(s) + " mm makes a grid of more than 2^31 voxels along an axis (extent " +
-                      format_mm(extent) + " mm); use --voxel-size " + format_mm(extent / 1e9) + " or larger");
+                  "a voxel size of " + format_mm(s) +
+                      " mm makes a grid of more than 2^31 voxels along an axis (extent " + format_mm(extent) +
+                      " mm); use --voxel-size " + format_mm(extent / 1e9) + " or larger");
     }
     m.grid_dims[c] = static_cast<std::int32_t>(cells);
     m.grid_origin[c] = lo[c];
@@ -95,7 +99,8 @@ Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std:
 
 void fail_too_many_synthetic(const std::string& path, double s, double longest_step2) {
   throw Error(ErrorKind::Unsupported, path, std::nullopt,
-              "voxel size " + format_mm(s) + " mm is far below the longest step (" + format_mm(std::sqrt(longest_step2)) +
+              "voxel size " + format_mm(s) + " mm is far below the longest step (" +
+                  format_mm(std::sqrt(longest_step2)) +
                   " mm): splitting steps at voxel faces would more than double the points; use --voxel-size " +
                   format_mm(std::sqrt(longest_step2)) + " or larger");
 }
@@ -126,7 +131,8 @@ std::vector<VoxelEntry> build_voxel_table(std::span<LocalVoxels> indexes, MetaSe
     const std::vector<Coord>& coords = *x.coords;
     x.global_id.resize(coords.size());
     for (std::size_t i = 0; i < coords.size(); ++i) {
-      const auto g = static_cast<std::uint32_t>(std::lower_bound(all.begin(), all.end(), coords[i], zyx_less) - all.begin());
+      const auto g =
+          static_cast<std::uint32_t>(std::lower_bound(all.begin(), all.end(), coords[i], zyx_less) - all.begin());
       x.global_id[i] = g;
       vertices[g] += x.use->vertices[i];
       segments[g] += x.use->segments[i];
@@ -137,8 +143,9 @@ std::vector<VoxelEntry> build_voxel_table(std::span<LocalVoxels> indexes, MetaSe
   std::uint64_t vertex_total = 0, segment_total = 0;
   for (std::size_t g = 0; g < n; ++g) {
     if (vertices[g] > std::numeric_limits<std::uint32_t>::max())
-      throw Error(ErrorKind::Unsupported, path, std::nullopt,
-                  "a voxel holds more than 2^32-1 vertices; use a --voxel-size smaller than " + format_mm(m.voxel_size));
+      throw Error(
+          ErrorKind::Unsupported, path, std::nullopt,
+          "a voxel holds more than 2^32-1 vertices; use a --voxel-size smaller than " + format_mm(m.voxel_size));
     VoxelEntry& v = voxels[g];
     v = {};
     v.coord[0] = all[g].x;

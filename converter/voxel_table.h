@@ -35,7 +35,8 @@ struct BoundsScan {
   std::uint64_t bad_streamline = kNone, bad_point = 0;  // the first non-finite point
 
   // Streamlines [first, end) of `offsets` (points xyz in `pts`), numbered from `index_base` in messages.
-  void add(const float* pts, const std::uint64_t* offsets, std::uint64_t first, std::uint64_t end, std::uint64_t index_base);
+  void add(const float* pts, const std::uint64_t* offsets, std::uint64_t first, std::uint64_t end,
+           std::uint64_t index_base);
   // Folds in a scan of later streamlines.
   void merge(const BoundsScan& later);
   // Throws Input for the first non-finite point, if any.

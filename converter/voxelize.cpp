@@ -4,8 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "format/parallel.h"
 #include "converter/voxel_table.h"
+#include "format/parallel.h"
 
 namespace vxl {
 
@@ -77,7 +77,8 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   // The same streamline ranges serve the bounds scan and pass 1.
   const std::vector<std::uint64_t> bounds = split_by_points(t.offsets, threads);
   std::vector<detail::BoundsScan> parts(bounds.size() - 1);
-  parallel_for(parts.size(), threads, [&](std::uint64_t c, unsigned) { parts[c].add(pts, t.offsets.data(), bounds[c], bounds[c + 1], 0); });
+  parallel_for(parts.size(), threads,
+               [&](std::uint64_t c, unsigned) { parts[c].add(pts, t.offsets.data(), bounds[c], bounds[c + 1], 0); });
   detail::BoundsScan scan;
   for (const detail::BoundsScan& part : parts) scan.merge(part);  // in streamline order: the first bad point wins
   scan.check(path);
@@ -112,7 +113,8 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   parallel_for(ranges.size(), threads, [&](std::uint64_t c, unsigned) {
     StreamlineRange& r = ranges[c];
     r.use.grow_to(r.index.coords().size());
-    for (std::uint64_t k = 0; k + 1 < r.first_voxline.size(); ++k) detail::count_voxel_use(r.streamline(k), r.use, path);
+    for (std::uint64_t k = 0; k + 1 < r.first_voxline.size(); ++k)
+      detail::count_voxel_use(r.streamline(k), r.use, path);
   });
   if (settings.progress) settings.progress("voxelising", 1.0);
 
@@ -161,7 +163,8 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
       for (std::size_t j = 0; j < streamline.size(); ++j) {
         const TempVoxline& v = streamline[j];
         std::uint64_t& cursor = r.table.cursor[v.voxel];
-        const std::uint64_t used = detail::place_voxline(streamline, j, pts, r.synthetic_xyz.data(), out.vertices.data() + 3 * cursor);
+        const std::uint64_t used =
+            detail::place_voxline(streamline, j, pts, r.synthetic_xyz.data(), out.vertices.data() + 3 * cursor);
         // Values travel with their points: a synthetic point's is interpolated where it lies on its step
         // (from source point src_first - 1 to src_first), a connecting vertex copies the next voxline's first.
         const bool connected = j + 1 < streamline.size();
@@ -179,8 +182,8 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
         }
         ends.set(cursor + used - 1);
         cursor += used;
-        out.voxlines[r.voxline_base + r.first_voxline[k] + j] = {r.table.global_id[v.voxel],
-                                                                 v.own() | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)};
+        out.voxlines[r.voxline_base + r.first_voxline[k] + j] = {
+            r.table.global_id[v.voxel], v.own() | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)};
       }
     }
   });
@@ -195,7 +198,8 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
   // Tight bounds per voxel, in pieces of 4096 voxels.
   constexpr std::size_t kPiece = 4096;
   parallel_for((out.voxels.size() + kPiece - 1) / kPiece, threads, [&](std::uint64_t p, unsigned) {
-    detail::set_tight_bounds(out.voxels.subspan(p * kPiece, std::min(kPiece, out.voxels.size() - p * kPiece)), out.vertices.data(), 0);
+    detail::set_tight_bounds(out.voxels.subspan(p * kPiece, std::min(kPiece, out.voxels.size() - p * kPiece)),
+                             out.vertices.data(), 0);
   });
   return ends;
 }

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "format/parallel.h"  // resolve_threads: the meaning of VoxelizeSettings::threads
 #include "converter/tractogram.h"
+#include "format/parallel.h"  // resolve_threads: the meaning of VoxelizeSettings::threads
 #include "format/vxl_layout.h"
 
 namespace vxl {
@@ -58,9 +58,9 @@ class VoxlineEnds {
 // The voxel blocks, without orders (build_orders adds those), in memory.
 struct VoxelizedTractogram {
   MetaSection meta{};
-  std::vector<VoxelEntry> voxels;      // sorted by (z, y, x); order_offset/flags set by build_orders
-  std::vector<float> vertices;         // 3 * vertex_count
-  std::vector<VoxlineEntry> voxlines;  // streamline order
+  std::vector<VoxelEntry> voxels;                       // sorted by (z, y, x); order_offset/flags set by build_orders
+  std::vector<float> vertices;                          // 3 * vertex_count
+  std::vector<VoxlineEntry> voxlines;                   // streamline order
   std::vector<std::uint64_t> streamline_first_voxline;  // N + 1
   VoxlineEnds voxline_ends;
 };
@@ -105,8 +105,8 @@ class VoxelPlan {
 VoxelPlan plan_voxels(const Tractogram& tractogram, const VoxelizeSettings& settings);
 
 // Pass 2: writes the voxel table (with tight bounds), the vertex blocks, their values and the voxline and
-// streamline tables into `out`, and releases the tractogram's positions and point values (the blocks then hold every point, so peak
-// memory stays bounded). Returns the voxline ends of the blocks, for build_orders.
+// streamline tables into `out`, and releases the tractogram's positions and point values (the blocks then hold every
+// point, so peak memory stays bounded). Returns the voxline ends of the blocks, for build_orders.
 VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& tractogram, const VoxelBlocks& out);
 
 // Both passes, into vectors. Consumes the tractogram's positions like place_vertices.

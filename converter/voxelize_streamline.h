@@ -145,7 +145,8 @@ void voxelize_streamline(const Grid& grid, const float* pts, std::uint64_t first
         crossings.push_back({std::clamp(t, 0.0, 1.0), c, step});
       }
     }
-    std::stable_sort(crossings.begin(), crossings.end(), [](const Crossing& x, const Crossing& y) { return x.t < y.t; });
+    std::stable_sort(crossings.begin(), crossings.end(),
+                     [](const Crossing& x, const Crossing& y) { return x.t < y.t; });
     std::int32_t at[3] = {from[0], from[1], from[2]};
     for (std::size_t k = 0; k < crossings.size();) {
       double t = crossings[k].t;

@@ -38,7 +38,9 @@ AtomicOutputFile::~AtomicOutputFile() {
   if (!committed_ && !temp_path_.empty()) ::unlink(temp_path_.c_str());
 }
 
-void AtomicOutputFile::fail(const std::string& what) const { throw Error(ErrorKind::Output, path_, std::nullopt, what); }
+void AtomicOutputFile::fail(const std::string& what) const {
+  throw Error(ErrorKind::Output, path_, std::nullopt, what);
+}
 
 void AtomicOutputFile::write(const void* data, std::size_t size) {
   if (map_ != nullptr) fail("internal error: write() on a mapped file");
@@ -84,8 +86,10 @@ void AtomicOutputFile::allocate(std::uint64_t size) {
   if (size == 0) return;
   // fallocate reserves the blocks (ENOSPC surfaces here); file systems without it get a sparse file.
   if (::fallocate(fd_, 0, 0, static_cast<off_t>(size)) != 0) {
-    if (errno != EOPNOTSUPP && errno != ENOSYS) fail(std::string("cannot reserve the output size: ") + std::strerror(errno));
-    if (::ftruncate(fd_, static_cast<off_t>(size)) != 0) fail(std::string("cannot size the output: ") + std::strerror(errno));
+    if (errno != EOPNOTSUPP && errno != ENOSYS)
+      fail(std::string("cannot reserve the output size: ") + std::strerror(errno));
+    if (::ftruncate(fd_, static_cast<off_t>(size)) != 0)
+      fail(std::string("cannot size the output: ") + std::strerror(errno));
   }
   position_ = size;
 }
@@ -131,7 +135,8 @@ void AtomicOutputFile::commit() {
     fail(std::string("close failed: ") + std::strerror(errno));
   }
   fd_ = -1;
-  if (::rename(temp_path_.c_str(), path_.c_str()) != 0) fail(std::string("cannot rename into place: ") + std::strerror(errno));
+  if (::rename(temp_path_.c_str(), path_.c_str()) != 0)
+    fail(std::string("cannot rename into place: ") + std::strerror(errno));
   committed_ = true;
 }
 
@@ -142,7 +147,8 @@ void prefault_for_write(std::span<std::uint8_t> bytes, unsigned threads) {
   const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(bytes.data()) / page * page;
   const std::uintptr_t end = reinterpret_cast<std::uintptr_t>(bytes.data() + bytes.size());
   // Whole pages per thread, and no thread for less than 8 MiB.
-  const std::uintptr_t part = std::max<std::uintptr_t>((end - begin) / resolve_threads(threads) / page * page + page, 8u << 20);
+  const std::uintptr_t part =
+      std::max<std::uintptr_t>((end - begin) / resolve_threads(threads) / page * page + page, 8u << 20);
   auto populate = [](std::uintptr_t from, std::uintptr_t to) {
     // MADV_RANDOM first: without readahead the pages come as single-page folios. With it the kernel
     // builds large folios from free 2 MiB blocks and zeroes them, and in a VM whose host has taken those

@@ -19,7 +19,7 @@ namespace vxl {
 class AtomicOutputFile {
  public:
   explicit AtomicOutputFile(std::string path);  // throws vxl::Error (Output) naming the path
-  ~AtomicOutputFile();                           // discards the data (and any mapping) unless committed
+  ~AtomicOutputFile();                          // discards the data (and any mapping) unless committed
   AtomicOutputFile(const AtomicOutputFile&) = delete;
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 

@@ -32,8 +32,7 @@ class Error : public std::runtime_error {
   const std::string& reason() const { return reason_; }
 
  private:
-  static std::string compose(const std::string& file, std::optional<std::uint64_t> offset,
-                             const std::string& what) {
+  static std::string compose(const std::string& file, std::optional<std::uint64_t> offset, const std::string& what) {
     std::string m = file.empty() ? std::string("<input>") : file;
     if (offset) m += ": at byte " + std::to_string(*offset);
     return m + ": " + what;

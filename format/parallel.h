@@ -61,8 +61,10 @@ void parallel_for(std::uint64_t count, unsigned threads, Fn&& fn) {
 template <typename A, typename B>
 void parallel_invoke(bool concurrent, A&& a, B&& b) {
   parallel_for(2, concurrent ? 2u : 1u, [&](std::uint64_t item, unsigned) {
-    if (item == 0) a();
-    else b();
+    if (item == 0)
+      a();
+    else
+      b();
   });
 }
 

@@ -65,8 +65,9 @@ void VxlFile::validate() {
                 ".vxl major version " + std::to_string(header_.version_major) + " (this reader knows 1)");
   if (header_.header_size != sizeof(FileHeader)) fail_input(p, 12, "header_size must be 64");
   if (header_.file_size != size)
-    fail_input(p, 16, "file size is " + std::to_string(size) + " bytes but the header says " +
-                          std::to_string(header_.file_size) + " (truncated or extended file)");
+    fail_input(p, 16,
+               "file size is " + std::to_string(size) + " bytes but the header says " +
+                   std::to_string(header_.file_size) + " (truncated or extended file)");
   if (header_.section_table_offset != sizeof(FileHeader)) fail_input(p, 24, "section table must start at byte 64");
   if (header_.section_count == 0 || header_.section_count > kVxlMaxSections)
     fail_input(p, 32, "section count must be 1..64");
@@ -88,7 +89,8 @@ void VxlFile::validate() {
       if (static_cast<unsigned char>(e.id[k]) < 0x20 || static_cast<unsigned char>(e.id[k]) > 0x7E)
         fail_input(p, at + k, "section id '" + name + "' is not four printable ASCII characters");
     if (e.offset % kVxlAlignment != 0) fail_input(p, at + 8, "section " + name + " offset is not a multiple of 64");
-    if (e.offset < previous_end) fail_input(p, at + 8, "section " + name + " overlaps the table or the previous section");
+    if (e.offset < previous_end)
+      fail_input(p, at + 8, "section " + name + " overlaps the table or the previous section");
     if (e.offset > size || e.size > size - e.offset)
       fail_input(p, at + 16, "section " + name + " runs past the end of the file");
     if ((e.flags & ~kSectionRequired) != 0) fail_input(p, at + 4, "section " + name + " has unknown flags");
@@ -101,10 +103,11 @@ void VxlFile::validate() {
                                           section_id("VDIR"), section_id("VVAL"), section_id("SVAL")};
     bool is_known = std::find(std::begin(known), std::end(known), id) != std::end(known);
     if (!is_known && (e.flags & kSectionRequired))
-      throw Error(ErrorKind::Unsupported, p, at, "required section " + name + " is unknown to this reader (newer writer?)");
+      throw Error(ErrorKind::Unsupported, p, at,
+                  "required section " + name + " is unknown to this reader (newer writer?)");
   }
 
-  auto section = [&](const char (&id)[5], bool required) -> std::span<const std::uint8_t> {
+  auto section = [&](const char(&id)[5], bool required) -> std::span<const std::uint8_t> {
     const SectionEntry* e = find_section(section_id(id));
     if (!e) {
       if (required) fail_input(p, 64, std::string("required section ") + id + " is missing");
@@ -112,7 +115,7 @@ void VxlFile::validate() {
     }
     return {base + e->offset, e->size};
   };
-  auto offset_of = [&](const char (&id)[5]) -> std::uint64_t { return find_section(section_id(id))->offset; };
+  auto offset_of = [&](const char(&id)[5]) -> std::uint64_t { return find_section(section_id(id))->offset; };
 
   // META and counts (§7 step 3).
   auto meta = section("META", true);
@@ -134,14 +137,14 @@ void VxlFile::validate() {
   // Every source point and every synthetic one is a vertex (spec §6.2), so these bound what a reader
   // reserves for the points: an unchecked point_count would ask for up to 2^64 floats.
   if (m.point_count > m.vertex_count || m.synthetic_point_count > m.vertex_count - m.point_count)
-    fail_input(p, meta_at + 8, "point_count " + std::to_string(m.point_count) + " + synthetic_point_count " +
-                                   std::to_string(m.synthetic_point_count) + " exceed vertex_count " +
-                                   std::to_string(m.vertex_count));
-  auto expect_size = [&](const char (&id)[5], std::optional<std::uint64_t> expected, const char* what) {
+    fail_input(p, meta_at + 8,
+               "point_count " + std::to_string(m.point_count) + " + synthetic_point_count " +
+                   std::to_string(m.synthetic_point_count) + " exceed vertex_count " + std::to_string(m.vertex_count));
+  auto expect_size = [&](const char(&id)[5], std::optional<std::uint64_t> expected, const char* what) {
     auto s = section(id, true);
     if (!expected || s.size() != *expected)
-      fail_input(p, offset_of(id), std::string("section ") + id + " size " + std::to_string(s.size()) +
-                                       " does not match " + what);
+      fail_input(p, offset_of(id),
+                 std::string("section ") + id + " size " + std::to_string(s.size()) + " does not match " + what);
     return s;
   };
   auto dirs = expect_size("DIRS", mul(m.stored_order_count, sizeof(DirectionEntry)), "stored_order_count × 16");
@@ -155,7 +158,8 @@ void VxlFile::validate() {
   // Per-voxel directions: present exactly when the order set is random (§5.10).
   const bool random_set = m.order_set == static_cast<std::uint32_t>(OrderSet::Random);
   if (random_set != (find_section(section_id("VDIR")) != nullptr))
-    fail_input(p, meta_at + 100, random_set ? "order set random needs a VDIR section" : "VDIR section without order set random");
+    fail_input(p, meta_at + 100,
+               random_set ? "order set random needs a VDIR section" : "VDIR section without order set random");
   if (random_set) {
     auto vdir = expect_size("VDIR", mul(m.voxel_count, dirs.size()), "voxel_count × stored_order_count × 16");
     voxel_directions_ = {reinterpret_cast<const DirectionEntry*>(vdir.data()), vdir.size() / sizeof(DirectionEntry)};

@@ -74,7 +74,8 @@ class VxlFile {
   void validate();
   // Walks GRPS (spec §5.9) checking its structure and names (valid UTF-8, no NUL) but not the members:
   // O(groups). `visit` gets each group's name and where its `count` members start in the section.
-  void walk_groups(const std::function<void(std::string_view name, std::uint64_t members_at, std::uint64_t count)>& visit) const;
+  void walk_groups(
+      const std::function<void(std::string_view name, std::uint64_t members_at, std::uint64_t count)>& visit) const;
 
   MappedFile file_;
   FileHeader header_{};

@@ -38,7 +38,9 @@ class VxlStreamWriter {
     append(section, {reinterpret_cast<const std::uint8_t*>(items.data()), items.size_bytes()});
   }
   void append_meta(const MetaSection& meta);  // zeroes the reserved bytes
-  std::uint64_t written(Section section) const { return entry_[section] < table_.size() ? written_[entry_[section]] : 0; }
+  std::uint64_t written(Section section) const {
+    return entry_[section] < table_.size() ? written_[entry_[section]] : 0;
+  }
 
   // Throws std::logic_error unless every payload has been appended in full; then writes the table and
   // the header and links the file into place. Without commit() the destructor discards the file.
@@ -46,8 +48,8 @@ class VxlStreamWriter {
 
  private:
   AtomicOutputFile out_;
-  std::vector<SectionEntry> table_;  // in Section order, optional sections (VDIR, GRPS) only when present
-  std::size_t entry_[kSectionCount];   // Section -> index in table_ (table_.size(): absent)
+  std::vector<SectionEntry> table_;   // in Section order, optional sections (VDIR, GRPS) only when present
+  std::size_t entry_[kSectionCount];  // Section -> index in table_ (table_.size(): absent)
   std::uint64_t file_size_ = 0;
   std::vector<std::uint64_t> written_;
   std::vector<std::unique_ptr<Xxh3_64Stream>> checksums_;

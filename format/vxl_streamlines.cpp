@@ -18,7 +18,8 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   const std::uint64_t vxln_at = f.find_section(section_id("VXLN"))->offset;
 
   if (strm[0] != 0) fail_input(p, strm_at, "streamline table must start at voxline 0");
-  if (strm[m.streamline_count] != m.voxline_count) fail_input(p, strm_at + 8 * m.streamline_count, "streamline table must end at voxline_count");
+  if (strm[m.streamline_count] != m.voxline_count)
+    fail_input(p, strm_at + 8 * m.streamline_count, "streamline table must end at voxline_count");
 
   std::vector<std::uint64_t> cursor(voxels.size());
   for (std::size_t i = 0; i < voxels.size(); ++i) cursor[i] = voxels[i].vertex_first;
@@ -27,7 +28,8 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
 
   for (std::uint64_t s = 0; s < m.streamline_count; ++s) {
     const std::uint64_t first = strm[s], last = strm[s + 1];
-    if (last < first || last > m.voxline_count) fail_input(p, strm_at + 8 * (s + 1), "streamline table not non-decreasing");
+    if (last < first || last > m.voxline_count)
+      fail_input(p, strm_at + 8 * (s + 1), "streamline table not non-decreasing");
     points.clear();
     const float* pending_connector = nullptr;  // previous voxline's connecting vertex
     for (std::uint64_t j = first; j < last; ++j) {
@@ -59,7 +61,10 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   for (std::size_t i = 0; i < voxels.size(); ++i)
     if (cursor[i] != voxels[i].vertex_first + voxels[i].vertex_count)
       fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i, "voxel block has vertices no voxline uses");
-  if (total_points != m.point_count) fail_input(p, std::nullopt, "streamlines hold " + std::to_string(total_points) + " points but META says " + std::to_string(m.point_count));
+  if (total_points != m.point_count)
+    fail_input(
+        p, std::nullopt,
+        "streamlines hold " + std::to_string(total_points) + " points but META says " + std::to_string(m.point_count));
   if (synthetic != m.synthetic_point_count) fail_input(p, std::nullopt, "synthetic point count does not match META");
 }
 

@@ -14,7 +14,8 @@ struct WalkCallbacks {
   std::function<void(std::uint64_t streamline, std::span<const float> xyz)> streamline;
   // Optional: called for every voxline with its voxel and its first vertex (global index), before the
   // streamline callback of the streamline it belongs to.
-  std::function<void(std::uint32_t voxel, std::uint64_t first_vertex, std::uint32_t own_points, bool connected)> voxline;
+  std::function<void(std::uint32_t voxel, std::uint64_t first_vertex, std::uint32_t own_points, bool connected)>
+      voxline;
 };
 
 // Checks the walk as it goes (table ranges, blocks consumed exactly, connecting vertices equal to the

@@ -56,19 +56,23 @@ void finish_value_sets(std::span<std::uint8_t> payload) {
   }
 }
 
-ValueSets::ValueSets(std::span<const std::uint8_t> payload, std::uint64_t count, const std::string& path, std::uint64_t at)
+ValueSets::ValueSets(std::span<const std::uint8_t> payload, std::uint64_t count, const std::string& path,
+                     std::uint64_t at)
     : payload_(payload), count_(count) {
-  if (payload.size() < sizeof(ValueSetsHeader)) fail_input(path, at, "value-set section shorter than its 16-byte header");
+  if (payload.size() < sizeof(ValueSetsHeader))
+    fail_input(path, at, "value-set section shorter than its 16-byte header");
   ValueSetsHeader h;
   std::memcpy(&h, payload.data(), sizeof h);
   if (h.set_count < 1 || h.set_count > kMaxValueSets) fail_input(path, at, "value-set count must be 1..64");
   if (h.value_count != count)
-    fail_input(path, at + 8, "value-set section holds " + std::to_string(h.value_count) + " values per set, expected " +
-                                 std::to_string(count));
+    fail_input(path, at + 8,
+               "value-set section holds " + std::to_string(h.value_count) + " values per set, expected " +
+                   std::to_string(count));
   // count is a META count whose sections were already checked, so this cannot overflow.
   if (payload.size() != value_sets_bytes(h.set_count, count))
-    fail_input(path, at, "value-set section size " + std::to_string(payload.size()) + " does not match " +
-                             std::to_string(h.set_count) + " sets of " + std::to_string(count) + " values");
+    fail_input(path, at,
+               "value-set section size " + std::to_string(payload.size()) + " does not match " +
+                   std::to_string(h.set_count) + " sets of " + std::to_string(count) + " values");
   entries_ = {reinterpret_cast<const ValueSetEntry*>(payload.data() + sizeof h), h.set_count};
   for (std::uint32_t k = 0; k < h.set_count; ++k) {
     const std::uint64_t entry_at = at + sizeof h + k * sizeof(ValueSetEntry);

@@ -31,7 +31,8 @@ void check_checksums_and_padding(const VxlFile& f) {
   std::memcpy(head.data(), &h, sizeof h);
   if (xxh3_64(head.data(), head.size()) != f.header().header_checksum)
     fail_input(p, 40, "header checksum mismatch (header or section table damaged)");
-  if (!all_zero(f.header().reserved, sizeof f.header().reserved)) fail_input(p, 48, "reserved header bytes are not zero");
+  if (!all_zero(f.header().reserved, sizeof f.header().reserved))
+    fail_input(p, 48, "reserved header bytes are not zero");
 
   std::vector<std::pair<std::uint64_t, std::uint64_t>> covered = {{0, table_end}};
   for (const SectionEntry& e : f.sections()) {
@@ -42,11 +43,11 @@ void check_checksums_and_padding(const VxlFile& f) {
   std::sort(covered.begin(), covered.end());
   std::uint64_t pos = 0;
   for (auto [begin, end] : covered) {
-    if (begin > pos && !all_zero(bytes.data() + pos, begin - pos))
-      fail_input(p, pos, "padding bytes are not zero");
+    if (begin > pos && !all_zero(bytes.data() + pos, begin - pos)) fail_input(p, pos, "padding bytes are not zero");
     pos = std::max(pos, end);
   }
-  if (pos < bytes.size() && !all_zero(bytes.data() + pos, bytes.size() - pos)) fail_input(p, pos, "padding bytes are not zero");
+  if (pos < bytes.size() && !all_zero(bytes.data() + pos, bytes.size() - pos))
+    fail_input(p, pos, "padding bytes are not zero");
 }
 
 void check_meta_and_dirs(const VxlFile& f) {
@@ -54,7 +55,7 @@ void check_meta_and_dirs(const VxlFile& f) {
   const MetaSection& m = f.meta();
   const std::uint64_t meta_at = f.find_section(section_id("META"))->offset;
   if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 152, "META reserved bytes are not zero");
-  auto check_unit = [&](std::span<const DirectionEntry> dirs, const char (&id)[5]) {
+  auto check_unit = [&](std::span<const DirectionEntry> dirs, const char(&id)[5]) {
     const std::uint64_t at = f.find_section(section_id(id))->offset;
     for (std::size_t k = 0; k < dirs.size(); ++k) {
       const DirectionEntry& d = dirs[k];
@@ -92,8 +93,9 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
       for (std::uint32_t n = 0; n < o.count; ++n) {
         std::uint32_t e = o[n];
         if (e + 1ull >= v.vertex_count || !is_segment_start[v.vertex_first + e] || seen[e])
-          fail_input(p, at, "voxel " + std::to_string(i) + " order " + std::to_string(k) +
-                                " is not a permutation of its segments");
+          fail_input(
+              p, at,
+              "voxel " + std::to_string(i) + " order " + std::to_string(k) + " is not a permutation of its segments");
         seen[e] = 1;
         const float* a = vertices.data() + 3 * (v.vertex_first + e);
         double key = 0;
@@ -124,14 +126,16 @@ void check_value_sets(const VxlFile& f, const ValueSets& sets, const char (&id)[
     std::memcpy(&e, bytes.data() + e_at, sizeof e);
     const std::size_t len = std::strlen(e.name);
     if (!all_zero(reinterpret_cast<const std::uint8_t*>(e.name) + len, sizeof e.name - len) || e.reserved != 0)
-      fail_input(p, at + e_at, std::string(id) + " set " + std::to_string(k) + ": name padding or reserved bytes not zero");
+      fail_input(p, at + e_at,
+                 std::string(id) + " set " + std::to_string(k) + ": name padding or reserved bytes not zero");
     float lo = INFINITY, hi = -INFINITY;
     for (float v : sets.values(k))
       if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
     const bool none = lo > hi;
     if (none ? !(std::isnan(e.min) && std::isnan(e.max)) : (e.min != lo || e.max != hi))
-      fail_input(p, at + e_at + 48, std::string(id) + " set " + std::to_string(k) + " (" + sets.name(k) +
-                                        "): min/max do not match its values");
+      fail_input(
+          p, at + e_at + 48,
+          std::string(id) + " set " + std::to_string(k) + " (" + sets.name(k) + "): min/max do not match its values");
     const std::uint64_t end = data + k * stride + 4 * h.value_count;
     if (!all_zero(bytes.data() + end, data + (k + 1) * stride - end))
       fail_input(p, at + end, std::string(id) + " padding after set " + std::to_string(k) + " is not zero");

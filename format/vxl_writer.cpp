@@ -50,7 +50,8 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
 namespace {
 
 // Section ids in file order, indexed by VxlWriter::Index; VDIR and GRPS are optional.
-constexpr const char* kSectionIds[] = {"META", "DIRS", "VDIR", "VOXT", "VERT", "ORDR", "VXLN", "STRM", "PROV", "GRPS", "VVAL", "SVAL"};
+constexpr const char* kSectionIds[] = {"META", "DIRS", "VDIR", "VOXT", "VERT", "ORDR",
+                                       "VXLN", "STRM", "PROV", "GRPS", "VVAL", "SVAL"};
 
 }  // namespace
 
@@ -102,11 +103,14 @@ std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, 
   std::memcpy(h.magic, kVxlMagic.data(), 8);
   h.version_major = kVxlVersionMajor;
   // The lowest version that holds what is written (spec §10).
-  const bool has_vdir = std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "VDIR", 4) == 0; });
+  const bool has_vdir =
+      std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "VDIR", 4) == 0; });
   const bool has_values = std::any_of(table.begin(), table.end(), [](const SectionEntry& e) {
     return std::memcmp(e.id, "VVAL", 4) == 0 || std::memcmp(e.id, "SVAL", 4) == 0;
   });
-  h.version_minor = has_values ? kVxlVersionMinorValueSets : has_vdir ? kVxlVersionMinorVoxelDirections : kVxlVersionMinor;
+  h.version_minor = has_values ? kVxlVersionMinorValueSets
+                    : has_vdir ? kVxlVersionMinorVoxelDirections
+                               : kVxlVersionMinor;
   h.header_size = sizeof(FileHeader);
   h.file_size = file_size;
   h.section_table_offset = sizeof(FileHeader);
@@ -156,7 +160,8 @@ void VxlWriter::commit(unsigned threads) {
   const SectionEntry* vert = entry(kVert);
   for (std::size_t i = 0; i < table_.size(); ++i)
     if (!(&table_[i] == vert && vertices_checksummed_)) by_size.push_back(i);
-  std::stable_sort(by_size.begin(), by_size.end(), [&](std::size_t a, std::size_t b) { return table_[a].size > table_[b].size; });
+  std::stable_sort(by_size.begin(), by_size.end(),
+                   [&](std::size_t a, std::size_t b) { return table_[a].size > table_[b].size; });
   parallel_for(by_size.size(), threads, [&](std::uint64_t k, unsigned) {
     SectionEntry& e = table_[by_size[k]];
     e.checksum = xxh3_64(file_.data() + e.offset, e.size);
@@ -173,7 +178,8 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   if (!c.groups.empty()) groups_bytes = encode_groups(c.groups);
   VxlSectionSizes sizes;
   sizes.directions = c.directions.size_bytes();
-  if (c.meta.order_set == static_cast<std::uint32_t>(OrderSet::Random)) sizes.voxel_directions = c.voxel_directions.size_bytes();
+  if (c.meta.order_set == static_cast<std::uint32_t>(OrderSet::Random))
+    sizes.voxel_directions = c.voxel_directions.size_bytes();
   sizes.voxels = c.voxels.size_bytes();
   sizes.vertices = c.vertices.size_bytes();
   sizes.orders = c.orders.size_bytes();

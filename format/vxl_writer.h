@@ -22,7 +22,7 @@ struct VxlSectionSizes {
   std::optional<std::uint64_t> voxel_directions;  // VDIR; only with order set random (spec §5.10)
   std::uint64_t voxels = 0, vertices = 0, orders = 0, voxlines = 0, streamlines = 0;
   std::uint64_t provenance = 0;
-  std::uint64_t groups = 0;  // 0: no GRPS section
+  std::uint64_t groups = 0;                                // 0: no GRPS section
   std::uint64_t vertex_values = 0, streamline_values = 0;  // VVAL, SVAL (spec §5.11); 0: absent
 };
 
@@ -34,7 +34,8 @@ VxlSectionSizes section_sizes(const MetaSection& meta, std::uint64_t order_bytes
 
 // The section table (offsets and sizes; checksums left zero) and the file size for these payloads: header
 // and table first, then each payload in file order at a multiple of 64 (spec §2, §4). VDIR only when
-// sizes.voxel_directions is set, GRPS only when sizes.groups > 0. Shared by VxlWriter and VxlStreamWriter, so that both lay out a file alike.
+// sizes.voxel_directions is set, GRPS only when sizes.groups > 0. Shared by VxlWriter and VxlStreamWriter, so that both
+// lay out a file alike.
 struct VxlLayout {
   std::vector<SectionEntry> table;
   std::uint64_t file_size = 0;

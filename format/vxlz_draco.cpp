@@ -36,7 +36,8 @@ std::vector<std::uint8_t> encode_cloud(const std::int32_t* values, std::size_t n
   draco::EncoderBuffer buffer;
   const draco::Status status = encoder.EncodeToBuffer(&buffer);
   if (!status.ok())
-    throw Error(ErrorKind::Output, "", std::nullopt, std::string("Draco could not encode a chunk: ") + status.error_msg());
+    throw Error(ErrorKind::Output, "", std::nullopt,
+                std::string("Draco could not encode a chunk: ") + status.error_msg());
   return {reinterpret_cast<const std::uint8_t*>(buffer.data()),
           reinterpret_cast<const std::uint8_t*>(buffer.data()) + buffer.size()};
 }
@@ -72,7 +73,8 @@ class DecodedCloud {
     if (!result.ok()) fail(std::string("not a Draco point cloud (") + result.status().error_msg() + ")");
     cloud_ = std::move(result).value();
     if (cloud_->num_points() != n)
-      fail("Draco point cloud holds " + std::to_string(cloud_->num_points()) + " points, expected " + std::to_string(n));
+      fail("Draco point cloud holds " + std::to_string(cloud_->num_points()) + " points, expected " +
+           std::to_string(n));
     if (cloud_->num_attributes() != 1) fail("expected exactly one Draco attribute");
     const draco::PointAttribute* att = cloud_->attribute(0);
     if (att == nullptr || att->buffer() == nullptr || att->data_type() != draco::DT_INT32 ||
@@ -80,18 +82,20 @@ class DecodedCloud {
       fail("expected a " + std::to_string(components) + "-component int32 Draco attribute");
     if (n == 0) return;
     const std::size_t stride = components * sizeof(std::int32_t);
-    if (att->is_mapping_identity() && att->byte_stride() == static_cast<std::int64_t>(stride) && att->byte_offset() == 0 &&
-        att->size() == n && att->buffer()->data_size() >= n * stride) {
+    if (att->is_mapping_identity() && att->byte_stride() == static_cast<std::int64_t>(stride) &&
+        att->byte_offset() == 0 && att->size() == n && att->buffer()->data_size() >= n * stride) {
       values_ = reinterpret_cast<const std::int32_t*>(att->buffer()->data());
       return;
     }
-    if (!att->is_mapping_identity() && att->indices_map_size() < n) fail("Draco attribute maps fewer values than points");
+    if (!att->is_mapping_identity() && att->indices_map_size() < n)
+      fail("Draco attribute maps fewer values than points");
     copy_.resize(n * components);
     for (std::size_t i = 0; i < n; ++i) {
       const draco::AttributeValueIndex index = att->mapped_index(draco::PointIndex(static_cast<std::uint32_t>(i)));
       std::array<std::int32_t, 3> v3{};
       std::array<std::int32_t, 1> v1{};
-      const bool ok = components == 1 ? att->GetValue<std::int32_t, 1>(index, &v1) : att->GetValue<std::int32_t, 3>(index, &v3);
+      const bool ok =
+          components == 1 ? att->GetValue<std::int32_t, 1>(index, &v1) : att->GetValue<std::int32_t, 3>(index, &v3);
       if (!ok) fail("Draco attribute value " + std::to_string(i) + " lies outside its buffer");
       std::memcpy(copy_.data() + i * components, components == 1 ? v1.data() : v3.data(), stride);
     }
@@ -134,7 +138,8 @@ ResidualChunk::ResidualChunk(const ChunkBytes& chunk, std::uint32_t joint_bits, 
                              const std::string& file)
     : clouds_(std::make_unique<Clouds>()), bits_(joint_bits), mask_((1u << joint_bits) - 1) {
   const std::size_t n = points;
-  symbol_ = clouds_->symbols.emplace(chunk.symbols, n, 1, "position chunk symbols", file, chunk.symbols_offset).values();
+  symbol_ =
+      clouds_->symbols.emplace(chunk.symbols, n, 1, "position chunk symbols", file, chunk.symbols_offset).values();
   if (n == 0) return;
   // Symbols above 2^3t name no triplet; 0 takes the next escape.
   const std::uint32_t largest = 1u << 3 * joint_bits;
@@ -148,9 +153,11 @@ ResidualChunk::ResidualChunk(const ChunkBytes& chunk, std::uint32_t joint_bits, 
   if (escaped == 0 && !chunk.escapes.empty())
     fail_input(file, chunk.escapes_offset, "position chunk escapes: present although no point escapes");
   if (escaped > 0 && chunk.escapes.empty())
-    fail_input(file, chunk.escapes_offset, "position chunk escapes: missing for " + std::to_string(escaped) + " escaped points");
+    fail_input(file, chunk.escapes_offset,
+               "position chunk escapes: missing for " + std::to_string(escaped) + " escaped points");
   if (escaped > 0)
-    escape_ = clouds_->escapes.emplace(chunk.escapes, escaped, 3, "position chunk escapes", file, chunk.escapes_offset).values();
+    escape_ = clouds_->escapes.emplace(chunk.escapes, escaped, 3, "position chunk escapes", file, chunk.escapes_offset)
+                  .values();
 }
 
 ResidualChunk::~ResidualChunk() = default;

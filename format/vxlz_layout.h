@@ -23,8 +23,8 @@ inline constexpr std::uint32_t kVxlzDefaultBits = 14;
 inline constexpr std::uint32_t kVxlzPredictorLinear = 1;  // §5.2
 inline constexpr std::uint64_t kVxlzDefaultChunkPoints = 1u << 18;
 inline constexpr std::uint64_t kVxlzMaxChunkPoints = (1u << 31) - 1;  // Draco point indices are 32-bit
-inline constexpr std::uint32_t kVxlzMinJointBits = 1;  // §5.3: zigzagged residuals of up to t bits per
-inline constexpr std::uint32_t kVxlzMaxJointBits = 5;  // component share one symbol (at most 2^15)
+inline constexpr std::uint32_t kVxlzMinJointBits = 1;                 // §5.3: zigzagged residuals of up to t bits per
+inline constexpr std::uint32_t kVxlzMaxJointBits = 5;                 // component share one symbol (at most 2^15)
 
 // §3
 struct PackSection {
@@ -37,8 +37,8 @@ struct PackSection {
   std::uint64_t chunk_points;
   std::uint64_t chunk_count;
   double error_bound;
-  double max_error;  // informative
-  double rms_error;  // informative
+  double max_error;          // informative
+  double rms_error;          // informative
   std::uint32_t joint_bits;  // t of the joint symbols (§5.3)
   std::uint8_t reserved[28];
 };

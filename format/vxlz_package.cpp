@@ -50,10 +50,12 @@ DeflatedTables deflate_tables(const VxlzContent& c, unsigned threads) {
                            {c.streamline_voxlines, DeflateMode::HuffmanOnly, &d.streamline_voxlines},
                            {c.voxel_coords, DeflateMode::Matching, &d.voxel_coords}};
   if (c.provenance)
-    jobs.push_back({{reinterpret_cast<const std::uint8_t*>(c.provenance->data()), c.provenance->size()}, DeflateMode::Matching,
+    jobs.push_back({{reinterpret_cast<const std::uint8_t*>(c.provenance->data()), c.provenance->size()},
+                    DeflateMode::Matching,
                     &*d.provenance});
   if (c.groups) jobs.push_back({*c.groups, DeflateMode::Matching, &*d.groups});
-  parallel_for(jobs.size(), threads, [&](std::uint64_t i, unsigned) { *jobs[i].out = deflate_section(jobs[i].raw, jobs[i].mode); });
+  parallel_for(jobs.size(), threads,
+               [&](std::uint64_t i, unsigned) { *jobs[i].out = deflate_section(jobs[i].raw, jobs[i].mode); });
   return d;
 }
 
@@ -79,7 +81,8 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   for (const EncodedChunk& chunk : c.chunks)
     for (const std::vector<std::uint8_t>* buffer : {&chunk.symbols, &chunk.escapes}) {
       const std::uint64_t n = buffer->size();
-      chunk_sizes.insert(chunk_sizes.end(), reinterpret_cast<const std::uint8_t*>(&n), reinterpret_cast<const std::uint8_t*>(&n) + 8);
+      chunk_sizes.insert(chunk_sizes.end(), reinterpret_cast<const std::uint8_t*>(&n),
+                         reinterpret_cast<const std::uint8_t*>(&n) + 8);
       posd_size += n;
       posd_checksum.update(buffer->data(), n);
     }
@@ -87,7 +90,10 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   std::vector<Section> sections;
   sections.push_back({"PACK", true, pack_bytes});
   sections.push_back({"META", true, meta_bytes});
-  sections.push_back({"DIRS", true, {reinterpret_cast<const std::uint8_t*>(c.directions.data()), c.directions.size() * sizeof(DirectionEntry)}});
+  sections.push_back(
+      {"DIRS",
+       true,
+       {reinterpret_cast<const std::uint8_t*>(c.directions.data()), c.directions.size() * sizeof(DirectionEntry)}});
   sections.push_back({"VOXC", true, d.voxel_coords});
   sections.push_back({"STRL", true, d.streamline_voxlines});
   sections.push_back({"VXLV", true, d.voxline_voxels});
@@ -172,8 +178,9 @@ void VxlzFile::validate() {
                     (h.version_major < kVxlzVersionMajor ? "; pack the .vxl again with this version)" : ")"));
   if (h.header_size != sizeof h) fail_input(p, 12, "header_size must be 64");
   if (h.file_size != size)
-    fail_input(p, 16, "file size is " + std::to_string(size) + " bytes but the header says " + std::to_string(h.file_size) +
-                          " (truncated or extended package)");
+    fail_input(p, 16,
+               "file size is " + std::to_string(size) + " bytes but the header says " + std::to_string(h.file_size) +
+                   " (truncated or extended package)");
   if (h.section_table_offset != sizeof h) fail_input(p, 24, "section table must start at byte 64");
   if (h.section_count == 0 || h.section_count > kVxlzMaxSections) fail_input(p, 32, "section count must be 1..32");
   if (h.flags != 0) fail_input(p, 36, "unknown header flags");
@@ -200,14 +207,16 @@ void VxlzFile::validate() {
     if ((e.flags & ~kSectionRequired) != 0) fail_input(p, at + 4, "section " + name + " has unknown flags");
     if (find(id) != &e) fail_input(p, at, "section " + name + " appears twice");
     if (e.offset != expected_offset)
-      fail_input(p, at + 8, "section " + name + " must start at byte " + std::to_string(expected_offset) +
-                                " (right after the previous one)");
+      fail_input(p, at + 8,
+                 "section " + name + " must start at byte " + std::to_string(expected_offset) +
+                     " (right after the previous one)");
     if (e.size > size - e.offset) fail_input(p, at + 16, "section " + name + " runs past the end of the file");
     expected_offset += e.size;
     const bool known = std::find(std::begin(kRequired), std::end(kRequired), id) != std::end(kRequired) ||
                        std::find(std::begin(kOptional), std::end(kOptional), id) != std::end(kOptional);
     if (!known && (e.flags & kSectionRequired))
-      throw Error(ErrorKind::Unsupported, p, at, "required section " + name + " is unknown to this reader (newer writer?)");
+      throw Error(ErrorKind::Unsupported, p, at,
+                  "required section " + name + " is unknown to this reader (newer writer?)");
   }
   if (expected_offset != size) fail_input(p, expected_offset, "bytes after the last section");
   for (std::uint32_t id : kRequired)
@@ -219,7 +228,7 @@ void VxlzFile::validate() {
       fail_input(p, e.offset, "checksum mismatch in section " + std::string(e.id, 4) + " (damaged package)");
 
   // Step 4: the fixed-size sections.
-  auto fixed = [&](const char (&id)[5], std::uint64_t expected, void* dst) {
+  auto fixed = [&](const char(&id)[5], std::uint64_t expected, void* dst) {
     const SectionEntry* e = find(section_id(id));
     if (e->size != expected)
       fail_input(p, e->offset, std::string("section ") + id + " must be " + std::to_string(expected) + " bytes");
@@ -231,7 +240,8 @@ void VxlzFile::validate() {
   if (k.quantization_bits < kVxlzMinBits || k.quantization_bits > kVxlzMaxBits)
     fail_input(p, pack_at, "quantization bits must be 11..16");
   if (k.predictor != kVxlzPredictorLinear)
-    throw Error(ErrorKind::Unsupported, p, pack_at + 4, "predictor " + std::to_string(k.predictor) + " (this reader knows 1)");
+    throw Error(ErrorKind::Unsupported, p, pack_at + 4,
+                "predictor " + std::to_string(k.predictor) + " (this reader knows 1)");
   for (int c = 0; c < 3; ++c)
     if (!std::isfinite(k.quant_origin[c])) fail_input(p, pack_at + 8, "quantisation origin is not finite");
   if (!std::isfinite(k.quantum) || !(k.quantum > 0)) fail_input(p, pack_at + 32, "quantum must be finite and positive");
@@ -241,7 +251,8 @@ void VxlzFile::validate() {
     if (!(std::abs(k.quant_origin[c]) <= std::numeric_limits<float>::max()) ||
         !(std::abs(k.quant_origin[c] + cube_edge) <= std::numeric_limits<float>::max()))
       fail_input(p, pack_at + 8, "quantisation cube reaches beyond the float32 range");
-  if (k.chunk_points < 1 || k.chunk_points > kVxlzMaxChunkPoints) fail_input(p, pack_at + 56, "chunk points must be 1..2^31-1");
+  if (k.chunk_points < 1 || k.chunk_points > kVxlzMaxChunkPoints)
+    fail_input(p, pack_at + 56, "chunk points must be 1..2^31-1");
   if (k.chunk_count != k.point_count / k.chunk_points + (k.point_count % k.chunk_points != 0))
     fail_input(p, pack_at + 64, "chunk count does not match point count / chunk points");
   if (k.joint_bits < kVxlzMinJointBits || k.joint_bits > kVxlzMaxJointBits)
@@ -251,7 +262,8 @@ void VxlzFile::validate() {
   const std::uint64_t meta_at = fixed("META", sizeof meta_, &meta_);
   const MetaSection& m = meta_;
   if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 152, "META reserved bytes are not zero");
-  if (!std::isfinite(m.voxel_size) || !(m.voxel_size > 0)) fail_input(p, meta_at + 56, "voxel size must be finite and positive");
+  if (!std::isfinite(m.voxel_size) || !(m.voxel_size > 0))
+    fail_input(p, meta_at + 56, "voxel size must be finite and positive");
   if (m.stored_order_count < 1 || m.stored_order_count > kVxlMaxStoredOrders)
     fail_input(p, meta_at + 52, "stored order count must be 1..64");
   if (m.voxel_count > 0x7FFFFFFFu) fail_input(p, meta_at + 48, "voxel count exceeds 2^31-1");
@@ -259,21 +271,26 @@ void VxlzFile::validate() {
     if (m.grid_dims[c] < 0) fail_input(p, meta_at + 88, "negative grid dimension");
     if (!std::isfinite(m.grid_origin[c])) fail_input(p, meta_at + 64, "grid origin is not finite");
   }
-  if (m.point_count > ~std::uint64_t(0) - m.synthetic_point_count || m.point_count + m.synthetic_point_count != k.point_count)
+  if (m.point_count > ~std::uint64_t(0) - m.synthetic_point_count ||
+      m.point_count + m.synthetic_point_count != k.point_count)
     fail_input(p, pack_at + 48, "shipped point count must be META's point count plus its synthetic point count");
 
   directions_.resize(m.stored_order_count);
-  const std::uint64_t dirs_at = fixed("DIRS", std::uint64_t(m.stored_order_count) * sizeof(DirectionEntry), directions_.data());
+  const std::uint64_t dirs_at =
+      fixed("DIRS", std::uint64_t(m.stored_order_count) * sizeof(DirectionEntry), directions_.data());
   for (std::size_t i = 0; i < directions_.size(); ++i) {
     const DirectionEntry& d = directions_[i];
-    const double len = std::sqrt(double(d.xyz[0]) * d.xyz[0] + double(d.xyz[1]) * d.xyz[1] + double(d.xyz[2]) * d.xyz[2]);
-    if (d.reserved != 0 || !(std::abs(len - 1.0) < 1e-5)) fail_input(p, dirs_at + 16 * i, "direction is not a unit vector");
+    const double len =
+        std::sqrt(double(d.xyz[0]) * d.xyz[0] + double(d.xyz[1]) * d.xyz[1] + double(d.xyz[2]) * d.xyz[2]);
+    if (d.reserved != 0 || !(std::abs(len - 1.0) < 1e-5))
+      fail_input(p, dirs_at + 16 * i, "direction is not a unit vector");
   }
 
   const SectionEntry* chnk = find(section_id("CHNK"));
   const SectionEntry* posd = find(section_id("POSD"));
   if (chnk->size / 16 != k.chunk_count || chnk->size % 16 != 0)
-    fail_input(p, chnk->offset, "CHNK must hold two 8-byte sizes per chunk (" + std::to_string(k.chunk_count) + " chunks)");
+    fail_input(p, chnk->offset,
+               "CHNK must hold two 8-byte sizes per chunk (" + std::to_string(k.chunk_count) + " chunks)");
   chunk_offsets_.assign(1, 0);
   for (std::uint64_t i = 0; i < 2 * k.chunk_count; ++i) {
     std::uint64_t n;

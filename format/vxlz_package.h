@@ -28,15 +28,15 @@ struct VxlzContent {
   PackSection pack{};  // reserved bytes are zeroed by the writer
   MetaSection meta{};
   std::vector<DirectionEntry> directions;
-  std::vector<std::uint8_t> voxel_coords;         // VOXC
-  std::vector<std::uint8_t> streamline_voxlines;  // STRL
-  std::vector<std::uint8_t> voxline_voxels;       // VXLV
-  std::vector<std::uint8_t> voxline_counts;       // VXLC
-  std::optional<std::string> provenance;          // PROV, when the .vxl has one
+  std::vector<std::uint8_t> voxel_coords;           // VOXC
+  std::vector<std::uint8_t> streamline_voxlines;    // STRL
+  std::vector<std::uint8_t> voxline_voxels;         // VXLV
+  std::vector<std::uint8_t> voxline_counts;         // VXLC
+  std::optional<std::string> provenance;            // PROV, when the .vxl has one
   std::optional<std::vector<std::uint8_t>> groups;  // GRPS, when the .vxl has groups
   // PVAL / SVAL payloads (encode_value_section, already deflated), when the .vxl has VVAL / SVAL.
   std::optional<std::vector<std::uint8_t>> point_values, streamline_values;
-  std::vector<EncodedChunk> chunks;               // Draco buffers, one pair per position chunk
+  std::vector<EncodedChunk> chunks;  // Draco buffers, one pair per position chunk
 };
 
 // The zlib payloads of the table sections (spec §4), deflated side by side on up to `threads` threads

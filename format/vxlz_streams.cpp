@@ -30,8 +30,7 @@ std::span<const std::uint8_t> VarintReader::get_bytes(std::uint64_t n) {
 }
 
 void VarintReader::expect_end() const {
-  if (pos_ != bytes_.size())
-    fail(std::to_string(bytes_.size() - pos_) + " bytes left over after the expected values");
+  if (pos_ != bytes_.size()) fail(std::to_string(bytes_.size() - pos_) + " bytes left over after the expected values");
 }
 
 void VarintReader::fail(const std::string& what) const {
@@ -43,7 +42,8 @@ std::vector<std::uint8_t> deflate_section(std::span<const std::uint8_t> raw, Def
   auto fail = [] { throw Error(ErrorKind::Output, "", std::nullopt, "zlib could not compress a package stream"); };
   z_stream z{};
   // Level 6 (zlib's default): level 9 makes these streams <1 % smaller and packing several times slower.
-  if (deflateInit2(&z, 6, Z_DEFLATED, 15, 8, mode == DeflateMode::HuffmanOnly ? Z_HUFFMAN_ONLY : Z_DEFAULT_STRATEGY) != Z_OK)
+  if (deflateInit2(&z, 6, Z_DEFLATED, 15, 8, mode == DeflateMode::HuffmanOnly ? Z_HUFFMAN_ONLY : Z_DEFAULT_STRATEGY) !=
+      Z_OK)
     fail();
   std::vector<std::uint8_t> out(8 + deflateBound(&z, static_cast<uLong>(raw.size())));
   const std::uint64_t raw_size = raw.size();
@@ -78,7 +78,8 @@ std::vector<std::uint8_t> inflate_section(std::span<const std::uint8_t> payload,
   std::memcpy(&raw_size, payload.data(), 8);
   const std::uint64_t compressed = payload.size() - 8;
   if (raw_size > 1100 * compressed + 64)
-    fail("raw size " + std::to_string(raw_size) + " is more than zlib can expand " + std::to_string(compressed) + " bytes to");
+    fail("raw size " + std::to_string(raw_size) + " is more than zlib can expand " + std::to_string(compressed) +
+         " bytes to");
   // One spare byte: a stream that inflates to more than raw_size shows itself by filling it (and zlib
   // wants a non-null output pointer even for an empty stream).
   std::vector<std::uint8_t> raw(raw_size + 1);

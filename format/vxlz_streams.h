@@ -34,7 +34,7 @@ class VarintWriter {
 // nothing in the file, so errors name the section (and its file offset) and the position in the stream.
 struct StreamContext {
   std::string file;
-  std::string section;          // four-letter id
+  std::string section;  // four-letter id
   std::uint64_t section_offset = 0;
 };
 

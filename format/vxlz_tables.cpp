@@ -10,7 +10,8 @@ namespace {
 
 // Every value takes at least one byte: a count the stream cannot hold is refused before anything is
 // allocated for it.
-void expect_room(const VarintReader& in, std::span<const std::uint8_t> stream, std::uint64_t values, std::uint64_t count) {
+void expect_room(const VarintReader& in, std::span<const std::uint8_t> stream, std::uint64_t values,
+                 std::uint64_t count) {
   if (count > stream.size() / values)
     in.fail("stream of " + std::to_string(stream.size()) + " bytes cannot hold " + std::to_string(count) + " entries");
 }
@@ -47,7 +48,8 @@ int neighbour_code(const std::int32_t (&from)[3], const std::int32_t (&to)[3]) {
   return 1 + code;
 }
 
-std::vector<std::uint8_t> encode_voxline_voxels(std::span<const VoxlineEntry> voxlines, std::span<const VoxelEntry> voxels) {
+std::vector<std::uint8_t> encode_voxline_voxels(std::span<const VoxlineEntry> voxlines,
+                                                std::span<const VoxelEntry> voxels) {
   VarintWriter out;
   std::uint32_t previous = 0;
   for (const VoxlineEntry& e : voxlines) {
@@ -73,13 +75,15 @@ std::vector<std::uint8_t> encode_group_stream(std::span<const GroupContent> grou
     out.put(g.name.size());
     out.put_bytes(g.name.data(), g.name.size());
     out.put(g.members.size());
-    for (std::size_t i = 0; i < g.members.size(); ++i) out.put(i == 0 ? g.members[0] : g.members[i] - g.members[i - 1] - 1);
+    for (std::size_t i = 0; i < g.members.size(); ++i)
+      out.put(i == 0 ? g.members[0] : g.members[i] - g.members[i - 1] - 1);
   }
   return std::move(out.bytes());
 }
 
 std::vector<std::array<std::int32_t, 3>> decode_voxel_coords(std::span<const std::uint8_t> stream, std::uint32_t count,
-                                                             const std::int32_t grid_dims[3], const StreamContext& context) {
+                                                             const std::int32_t grid_dims[3],
+                                                             const StreamContext& context) {
   VarintReader in(stream, context);
   expect_room(in, stream, 3, count);
   std::vector<std::array<std::int32_t, 3>> coords(count);
@@ -106,8 +110,9 @@ std::vector<std::array<std::int32_t, 3>> decode_voxel_coords(std::span<const std
   return coords;
 }
 
-std::vector<std::uint64_t> decode_streamline_voxlines(std::span<const std::uint8_t> stream, std::uint64_t streamline_count,
-                                                      std::uint64_t voxline_count, const StreamContext& context) {
+std::vector<std::uint64_t> decode_streamline_voxlines(std::span<const std::uint8_t> stream,
+                                                      std::uint64_t streamline_count, std::uint64_t voxline_count,
+                                                      const StreamContext& context) {
   VarintReader in(stream, context);
   expect_room(in, stream, 1, streamline_count);
   std::vector<std::uint64_t> strm(streamline_count + 1);
@@ -159,13 +164,15 @@ void decode_voxline_voxels(std::span<const std::uint8_t> stream, std::span<const
   in.expect_end();
 }
 
-void decode_voxline_counts(std::span<const std::uint8_t> stream, std::span<VoxlineEntry> voxlines, const StreamContext& context) {
+void decode_voxline_counts(std::span<const std::uint8_t> stream, std::span<VoxlineEntry> voxlines,
+                           const StreamContext& context) {
   VarintReader in(stream, context);
   expect_room(in, stream, 1, voxlines.size());
   for (std::size_t j = 0; j < voxlines.size(); ++j) {
     const std::uint64_t c = in.get();
     const std::uint64_t own = c >> 1;
-    if (own < 1 || own > kVoxlineCountMask) in.fail("voxline " + std::to_string(j) + " own point count must be 1..2^31-1");
+    if (own < 1 || own > kVoxlineCountMask)
+      in.fail("voxline " + std::to_string(j) + " own point count must be 1..2^31-1");
     voxlines[j].count_flags = static_cast<std::uint32_t>(own) | (c & 1 ? kVoxlineSyntheticFirst : 0);
   }
   in.expect_end();

@@ -64,7 +64,8 @@ std::vector<std::uint8_t> encode_value_section(std::span<const NamedValues> sets
     throw Error(ErrorKind::Unsupported, "", std::nullopt, "a package holds 1..64 value sets of a kind");
   const std::uint64_t n = sets[0].values.size();
   for (const NamedValues& s : sets)
-    if (s.values.size() != n) throw Error(ErrorKind::Input, "", std::nullopt, "value sets of one kind differ in length");
+    if (s.values.size() != n)
+      throw Error(ErrorKind::Input, "", std::nullopt, "value sets of one kind differ in length");
   std::vector<std::vector<std::uint8_t>> streams(sets.size());
   std::vector<std::uint32_t> codings(sets.size());
   parallel_for(sets.size(), threads, [&](std::uint64_t k, unsigned) {
@@ -93,7 +94,9 @@ std::vector<NamedValues> decode_value_section(std::span<const std::uint8_t> payl
                                               const StreamContext& context, unsigned threads) {
   const std::string& p = context.file;
   const std::uint64_t at = context.section_offset;
-  auto fail = [&](std::uint64_t offset, const std::string& what) { fail_input(p, at + offset, "section " + context.section + ": " + what); };
+  auto fail = [&](std::uint64_t offset, const std::string& what) {
+    fail_input(p, at + offset, "section " + context.section + ": " + what);
+  };
   ValueSectionHeader h;
   if (payload.size() < sizeof h) fail(0, "shorter than its 16-byte header");
   std::memcpy(&h, payload.data(), sizeof h);
@@ -114,17 +117,20 @@ std::vector<NamedValues> decode_value_section(std::span<const std::uint8_t> payl
     std::memcpy(&e, payload.data() + entry_at, sizeof e);
     const char* nul = static_cast<const char*>(std::memchr(e.name, 0, sizeof e.name));
     if (!nul) fail(entry_at, "set name is not NUL-terminated");
-    if (std::any_of(nul, static_cast<const char*>(e.name) + sizeof e.name, [](char c) { return c != 0; })) fail(entry_at, "set name padding is not zero");
+    if (std::any_of(nul, static_cast<const char*>(e.name) + sizeof e.name, [](char c) { return c != 0; }))
+      fail(entry_at, "set name padding is not zero");
     if (e.coding > kValueCodingXorPlanes)
-      throw Error(ErrorKind::Unsupported, p, at + entry_at + 48,
-                  "section " + context.section + ": value coding " + std::to_string(e.coding) + " (this reader knows 0 and 1)");
+      throw Error(
+          ErrorKind::Unsupported, p, at + entry_at + 48,
+          "section " + context.section + ": value coding " + std::to_string(e.coding) + " (this reader knows 0 and 1)");
     if (e.reserved != 0) fail(entry_at + 52, "reserved bytes are not zero");
     if (e.stream_size < 8 || e.stream_size > payload.size() - position)
       fail(entry_at + 56, "set stream runs past the end of the section");
     std::uint64_t raw_size;
     std::memcpy(&raw_size, payload.data() + position, 8);
     if (raw_size != 4 * count)
-      fail(position, "set stream inflates to " + std::to_string(raw_size) + " bytes, expected " + std::to_string(4 * count));
+      fail(position,
+           "set stream inflates to " + std::to_string(raw_size) + " bytes, expected " + std::to_string(4 * count));
     stream_at[k] = position;
     position += e.stream_size;
   }

@@ -114,17 +114,18 @@ inline std::vector<ZipEntry> trx_entries(std::uint32_t n, std::vector<ZipEntry> 
   std::vector<float> positions(6 * n, 1.0f);
   std::vector<std::uint64_t> offsets;
   for (std::uint32_t i = 0; i <= n; ++i) offsets.push_back(2 * i);
-  std::vector<ZipEntry> e = {
-      stored_entry("header.json", text("{\"NB_STREAMLINES\": " + std::to_string(n) +
-                                       ", \"NB_VERTICES\": " + std::to_string(2 * n) + "}")),
-      stored_entry("positions.3.float32", le(positions)), stored_entry("offsets.uint64", le(offsets))};
+  std::vector<ZipEntry> e = {stored_entry("header.json", text("{\"NB_STREAMLINES\": " + std::to_string(n) +
+                                                              ", \"NB_VERTICES\": " + std::to_string(2 * n) + "}")),
+                             stored_entry("positions.3.float32", le(positions)),
+                             stored_entry("offsets.uint64", le(offsets))};
   for (ZipEntry& x : extra) e.push_back(std::move(x));
   return e;
 }
 
 // Row 1: a dps member whose component count does not fit in 64 bits.
 inline void trx_huge_component_count(const std::string& path) {
-  write_zip(path, trx_entries(3, {stored_entry("dps/c.99999999999999999999.float32", le(std::vector<float>{1, 2, 3}))}));
+  write_zip(path,
+            trx_entries(3, {stored_entry("dps/c.99999999999999999999.float32", le(std::vector<float>{1, 2, 3}))}));
 }
 
 // Row 6: the offsets member replaced by `mib` MiB of deflated zeros. With `honest` the zip's directory
@@ -148,7 +149,8 @@ inline void tsf_float64_out_of_range(const std::string& path) {
 // Row 9: a TSF of three streamlines whose header says count: 99.
 inline void tsf_wrong_count(const std::string& path) {
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
-  write_mrtrix_file(path, "mrtrix track scalars", "Float32LE", raw<float>({1, nan, 2, nan, 3, nan, inf}), "count: 99\n");
+  write_mrtrix_file(path, "mrtrix track scalars", "Float32LE", raw<float>({1, nan, 2, nan, 3, nan, inf}),
+                    "count: 99\n");
 }
 
 // Row 13: a TCK of one streamline, then a point whose x alone is Inf (a damaged point, which ends the

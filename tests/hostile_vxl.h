@@ -14,9 +14,9 @@
 #include <gtest/gtest.h>
 
 #include "converter/convert.h"
-#include "tests/reseal_checksums.h"
 #include "format/vxl_layout.h"
 #include "format/vxl_value_sets.h"
+#include "tests/reseal_checksums.h"
 
 namespace vxl::test {
 
@@ -108,7 +108,8 @@ class VxlBytes {
   void flip(std::uint64_t at, std::uint8_t mask = 0x80) { bytes[at] = static_cast<char>(bytes[at] ^ mask); }
   void reseal() { ASSERT_TRUE(reseal_checksums(bytes.data(), bytes.size())); }
   void write(const std::string& path) const {
-    std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    std::ofstream(path, std::ios::binary | std::ios::trunc)
+        .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   }
 
   std::vector<char> bytes;

@@ -30,7 +30,8 @@ std::set<std::string> names_in(const std::filesystem::path& dir) {
 }
 
 void synth(const std::string& path, int streamlines, int seed) {
-  auto r = run_cli("synth '" + path + "' --streamlines " + std::to_string(streamlines) + " --seed " + std::to_string(seed));
+  auto r =
+      run_cli("synth '" + path + "' --streamlines " + std::to_string(streamlines) + " --seed " + std::to_string(seed));
   ASSERT_EQ(r.exit_code, 0) << r.output;
 }
 
@@ -60,9 +61,9 @@ TEST(ConvertCohort, OutputsAreTheSingleFileConversionsByteForByte) {
   const std::vector<std::string> names = {"a.vxl", "sub.ject.b.vxl", "c.vxl"};
   // --jobs 2 of --threads 2 gives each file one thread (recorded in the provenance): compare with --threads 1.
   // --jobs 1 keeps all threads for the file.
-  for (const auto& [cohort_args, single_threads] :
-       {std::pair<std::string, std::string>{"--jobs 2 --threads 2", "1"}, {"--jobs 1 --threads 2", "2"},
-        {"--jobs 3 --threads 3", "1"}}) {
+  for (const auto& [cohort_args, single_threads] : {std::pair<std::string, std::string>{"--jobs 2 --threads 2", "1"},
+                                                    {"--jobs 1 --threads 2", "2"},
+                                                    {"--jobs 3 --threads 3", "1"}}) {
     SCOPED_TRACE(cohort_args);
     const std::string out = dir.file("out");
     std::filesystem::remove_all(out);
@@ -106,7 +107,7 @@ TEST(ConvertCohort, ABadInputDoesNotStopTheOthers) {
 TEST(ConvertCohort, FailuresOfDifferentKindsExitWithSix) {
   ScratchDir dir;
   synth(dir.file("a.tck"), 100, 1);
-  { std::ofstream(dir.file("bad.tck")) << "garbage"; }                   // malformed: 3
+  { std::ofstream(dir.file("bad.tck")) << "garbage"; }                                 // malformed: 3
   { std::ofstream(dir.file("lines.vtu")) << "<VTKFile type=\"UnstructuredGrid\"/>"; }  // unsupported: 4
   auto r = run_cli("convert '" + dir.file("bad.tck") + "' '" + dir.file("a.tck") + "' '" + dir.file("lines.vtu") +
                    "' --output-dir '" + dir.file("out") + "' --jobs 2");

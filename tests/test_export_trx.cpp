@@ -10,14 +10,14 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/convert.h"
-#include "format/error.h"
 #include "converter/export_tck.h"
 #include "converter/export_trx.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/synth.h"
-#include "tests/test_support.h"
+#include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {
@@ -46,7 +46,8 @@ std::string convert_to(Tractogram t, const std::string& path) {
 // The .vxl's streamlines as a tractogram (what any export must give back).
 Tractogram streamlines_of(const VxlFile& f) {
   Tractogram t;
-  walk_streamlines(f, {[&](std::uint64_t, std::span<const float> xyz) { t.add_streamline(xyz.data(), xyz.size() / 3); }, {}});
+  walk_streamlines(
+      f, {[&](std::uint64_t, std::span<const float> xyz) { t.add_streamline(xyz.data(), xyz.size() / 3); }, {}});
   return t;
 }
 
@@ -54,7 +55,8 @@ void expect_same_streamlines(const Tractogram& expected, const Tractogram& got) 
   EXPECT_EQ(expected.offsets, got.offsets);
   ASSERT_EQ(expected.positions.size(), got.positions.size());
   if (!expected.positions.empty()) {
-    EXPECT_EQ(std::memcmp(expected.positions.data(), got.positions.data(), expected.positions.size() * sizeof(float)), 0)
+    EXPECT_EQ(std::memcmp(expected.positions.data(), got.positions.data(), expected.positions.size() * sizeof(float)),
+              0)
         << "positions must be bit-identical";
   }
 }
@@ -112,9 +114,7 @@ std::string check_trx_in_python(const ScratchDir& dir, const std::string& trx) {
   return test::run_program("/usr/bin/python3", "'" + script + "' '" + trx + "'").output;
 }
 
-bool have_python_numpy() {
-  return test::run_program("/usr/bin/python3", "-c 'import numpy'").exit_code == 0;
-}
+bool have_python_numpy() { return test::run_program("/usr/bin/python3", "-c 'import numpy'").exit_code == 0; }
 
 TEST(ExportTrx, ReadsBackIdenticallyWithGroups) {
   ScratchDir dir;
@@ -127,7 +127,8 @@ TEST(ExportTrx, ReadsBackIdenticallyWithGroups) {
   ASSERT_EQ(back.groups.size(), 2u);
   // Member names are listed in archive order; compare as a set.
   for (const StreamlineGroup& expected : grouped_tractogram().groups) {
-    auto it = std::find_if(back.groups.begin(), back.groups.end(), [&](const auto& g) { return g.name == expected.name; });
+    auto it =
+        std::find_if(back.groups.begin(), back.groups.end(), [&](const auto& g) { return g.name == expected.name; });
     ASSERT_NE(it, back.groups.end()) << expected.name;
     EXPECT_EQ(it->members, expected.members);
   }

@@ -14,10 +14,10 @@
 #include <thread>
 
 #include "converter/convert.h"
-#include "format/error.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/synth.h"
 #include "converter/tck_writer.h"
+#include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"
@@ -46,7 +46,8 @@ Tractogram shifted(double offset) {
 
 std::vector<float> walk_points(const VxlFile& f) {
   std::vector<float> out;
-  walk_streamlines(f, {[&](std::uint64_t, std::span<const float> xyz) { out.insert(out.end(), xyz.begin(), xyz.end()); }, {}});
+  walk_streamlines(
+      f, {[&](std::uint64_t, std::span<const float> xyz) { out.insert(out.end(), xyz.begin(), xyz.end()); }, {}});
   return out;
 }
 
@@ -150,7 +151,8 @@ TEST(Extremes, Float64SourcesKeepTheNearestFloat32) {
   }
   Tractogram t = read_tck(path);
   ASSERT_EQ(t.point_count(), 2u);
-  for (int i = 0; i < 6; ++i) EXPECT_EQ(t.positions[i], static_cast<float>(values[i])) << "nearest float32 of " << values[i];
+  for (int i = 0; i < 6; ++i)
+    EXPECT_EQ(t.positions[i], static_cast<float>(values[i])) << "nearest float32 of " << values[i];
   convert_tractogram(std::move(t), dir.file("f64.vxl"), {});
   std::vector<float> stored = walk_points(VxlFile::open(dir.file("f64.vxl")));
   for (int i = 0; i < 6; ++i) EXPECT_EQ(stored[i], static_cast<float>(values[i]));
@@ -193,11 +195,12 @@ TEST(Extremes, CountsAndOffsetsAreSixtyFourBitBeyondTwoToTheThirtyTwo) {
     std::uint64_t size;
   };
   std::vector<std::uint8_t> orders(ordr, 0);
-  VoxlineEntry lines[2] = {{0, static_cast<std::uint32_t>(first_count - 1)}, {1, static_cast<std::uint32_t>(second_count)}};
+  VoxlineEntry lines[2] = {{0, static_cast<std::uint32_t>(first_count - 1)},
+                           {1, static_cast<std::uint32_t>(second_count)}};
   std::uint64_t strm[2] = {0, 2};
-  std::vector<Part> parts = {{"META", &m, sizeof m},          {"DIRS", dirs, sizeof dirs},
-                             {"VOXT", v, sizeof v},           {"VERT", nullptr, vertices * 12},
-                             {"ORDR", orders.data(), ordr},   {"VXLN", lines, sizeof lines},
+  std::vector<Part> parts = {{"META", &m, sizeof m},        {"DIRS", dirs, sizeof dirs},
+                             {"VOXT", v, sizeof v},         {"VERT", nullptr, vertices * 12},
+                             {"ORDR", orders.data(), ordr}, {"VXLN", lines, sizeof lines},
                              {"STRM", strm, sizeof strm}};
   int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
   ASSERT_GE(fd, 0);
@@ -263,9 +266,11 @@ TEST(Extremes, RunningOutOfMemoryFailsCleanly) {
   const std::string tck = dir.file("in.tck"), out = dir.file("out.vxl");
   auto synth = test::run_cli("synth '" + tck + "' --streamlines 200000");
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
-  auto r = test::run_program("bash", "-c \"ulimit -v 400000; exec " + std::string(VOXLINES_CLI) + " convert '" + tck + "' '" + out + "'\"");
+  auto r = test::run_program(
+      "bash", "-c \"ulimit -v 400000; exec " + std::string(VOXLINES_CLI) + " convert '" + tck + "' '" + out + "'\"");
   EXPECT_TRUE(r.exit_code == 4 || r.exit_code == 5) << r.output;
-  EXPECT_TRUE(r.output.find("out of memory") != std::string::npos || r.output.find("Cannot allocate memory") != std::string::npos)
+  EXPECT_TRUE(r.output.find("out of memory") != std::string::npos ||
+              r.output.find("Cannot allocate memory") != std::string::npos)
       << r.output;
   EXPECT_FALSE(std::filesystem::exists(out));
 #endif

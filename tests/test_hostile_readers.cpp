@@ -8,11 +8,11 @@
 
 #include <gtest/gtest.h>
 
-#include "format/error.h"
-#include "tests/hostile_inputs.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "converter/readers/tck_stream.h"
+#include "format/error.h"
+#include "tests/hostile_inputs.h"
 #include "tests/test_support.h"
 
 namespace {
@@ -33,7 +33,8 @@ vxl::Error error_of(Read read) {
 }
 
 bool has_warning(const std::vector<std::string>& warnings, const std::string& part) {
-  return std::any_of(warnings.begin(), warnings.end(), [&](const std::string& w) { return w.find(part) != std::string::npos; });
+  return std::any_of(warnings.begin(), warnings.end(),
+                     [&](const std::string& w) { return w.find(part) != std::string::npos; });
 }
 
 // ---- row 1: a TRX member name with a component count beyond 64 bits ----
@@ -54,7 +55,8 @@ TEST(HostileTrx, ComponentCountBeyond64BitsIsMalformedAndNamesTheMember) {
 TEST(HostileTrk, ZeroPointRecordIsMalformed) {
   ScratchDir dir;
   const std::string p = dir.file("z.trk");
-  hostile::write_file(p, hostile::trk_header() + hostile::trk_record(2) + hostile::trk_record(0) + hostile::trk_record(1));
+  hostile::write_file(p,
+                      hostile::trk_header() + hostile::trk_record(2) + hostile::trk_record(0) + hostile::trk_record(1));
   const vxl::Error e = error_of([&] { (void)vxl::read_trk(p); });
   EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
   EXPECT_EQ(e.offset(), std::optional<std::uint64_t>(1000 + 4 + 2 * 12)) << e.what();
@@ -90,8 +92,8 @@ TEST(HostileTrk, GzipThatInflatesBeyondTheRatioCapIsRefused) {
 TEST(HostileTrk, ConcatenatedGzipMembersAreOneStream) {
   ScratchDir dir;
   const std::string p = dir.file("two.trk.gz");
-  hostile::write_file(p, hostile::gzip(hostile::trk_header() + hostile::trk_record(2)) +
-                             hostile::gzip(hostile::trk_record(3)));
+  hostile::write_file(
+      p, hostile::gzip(hostile::trk_header() + hostile::trk_record(2)) + hostile::gzip(hostile::trk_record(3)));
   const vxl::Tractogram t = vxl::read_trk(p);
   EXPECT_EQ(t.streamline_count(), 2u);
   EXPECT_EQ(t.point_count(), 5u);
@@ -129,7 +131,8 @@ TEST(HostileTrk, ZeroPaddingAfterTheGzipStreamIsWarned) {
   hostile::trk_gz_with_tail(p, std::string(10, '\0'));
   const vxl::Tractogram t = vxl::read_trk(p);
   EXPECT_EQ(t.streamline_count(), 2u);
-  EXPECT_TRUE(has_warning(t.source.warnings, "10 zero bytes of padding")) << ::testing::PrintToString(t.source.warnings);
+  EXPECT_TRUE(has_warning(t.source.warnings, "10 zero bytes of padding"))
+      << ::testing::PrintToString(t.source.warnings);
 }
 
 // ---- row 6: a deflated TRX member that inflates far beyond what header.json allows ----
@@ -153,7 +156,8 @@ TEST(HostileTrx, MemberInflatingPastItsDeclaredSizeIsStopped) {
   hostile::trx_offsets_bomb(p, 16, /*honest=*/false);
   const vxl::Error e = error_of([&] { (void)vxl::read_trx(p); });
   EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
-  EXPECT_NE(std::string(e.what()).find("offsets.uint64: zip entry inflates to more than the 32 bytes"), std::string::npos)
+  EXPECT_NE(std::string(e.what()).find("offsets.uint64: zip entry inflates to more than the 32 bytes"),
+            std::string::npos)
       << e.what();
 }
 
@@ -259,7 +263,8 @@ TEST(HostileInput, FifoIsRefusedNotWaitedOn) {
     SCOPED_TRACE(c);
     const auto r = vxl::test::run_program("timeout 20", std::string(VOXLINES_CLI) + " " + c);
     EXPECT_EQ(r.exit_code, 3) << r.output;
-    EXPECT_TRUE(r.output.find("is a FIFO") != std::string::npos || r.output.find("not a regular file") != std::string::npos)
+    EXPECT_TRUE(r.output.find("is a FIFO") != std::string::npos ||
+                r.output.find("not a regular file") != std::string::npos)
         << r.output;
     EXPECT_FALSE(std::filesystem::exists(out));
   }

@@ -6,13 +6,13 @@
 #include <functional>
 #include <string>
 
-#include "format/error.h"
 #include "converter/export_trx.h"
-#include "tests/hostile_vxl.h"
-#include "tests/test_support.h"
+#include "format/error.h"
 #include "format/utf8_check.h"
 #include "format/vxl_file.h"
 #include "format/vxl_value_sets.h"
+#include "tests/hostile_vxl.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {
@@ -99,7 +99,8 @@ TEST(HostileVxl, NameThatIsNotUtf8IsRefusedOnOpen) {
   b.write(dir.file("bad.vxl"));
   auto r = test::run_cli("info --json " + q(dir.file("bad.vxl")));
   EXPECT_EQ(r.exit_code, 3) << r.output;
-  EXPECT_NE(r.output.find("at byte " + std::to_string(valid.group_name_bytes().front())), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("at byte " + std::to_string(valid.group_name_bytes().front())), std::string::npos)
+      << r.output;
   r = test::run_cli("export " + q(dir.file("bad.vxl")) + " " + q(dir.file("out.trx")));
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir.file("out.trx")));
@@ -147,8 +148,9 @@ TEST(HostileVxl, ProvenanceOfTheWrongTypesIsIgnored) {
   ScratchDir dir;
   const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
   const SectionEntry prov = valid.entry("PROV");
-  for (const std::string json : {R"({"source": 5})", R"({"source": {"name": 5, "format": [1], "bytes": "x"}})",
-                                 R"({"source": {"name": "a", "format": "trx", "bytes": -3, "header": 7}})", R"([1, 2])"}) {
+  for (const std::string json :
+       {R"({"source": 5})", R"({"source": {"name": 5, "format": [1], "bytes": "x"}})",
+        R"({"source": {"name": "a", "format": "trx", "bytes": -3, "header": 7}})", R"([1, 2])"}) {
     SCOPED_TRACE(json);
     ASSERT_LE(json.size(), prov.size);
     VxlBytes b = valid;
@@ -182,8 +184,8 @@ TEST(HostileVxl, ValueSetNamesAreWrittenAsUtf8) {
   EXPECT_EQ(value_set_name("caf\xc3\xa9"), "caf\xc3\xa9");
   EXPECT_EQ(value_set_name(std::string("a\0b", 3)), "a");
   EXPECT_TRUE(is_valid_utf8(value_set_name(std::string(40, 'x') + "\xff\xfe\xfd\xfc\xfb")));
-  EXPECT_FALSE(is_valid_utf8("\xc0\xaf"));      // overlong '/'
-  EXPECT_FALSE(is_valid_utf8("\xed\xa0\x80"));  // a surrogate
+  EXPECT_FALSE(is_valid_utf8("\xc0\xaf"));          // overlong '/'
+  EXPECT_FALSE(is_valid_utf8("\xed\xa0\x80"));      // a surrogate
   EXPECT_FALSE(is_valid_utf8("\xf4\x90\x80\x80"));  // above U+10FFFF
   EXPECT_TRUE(is_valid_utf8("\xf4\x8f\xbf\xbf"));
 

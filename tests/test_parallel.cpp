@@ -65,9 +65,12 @@ TEST(Parallel, TheFirstErrorIsRethrownOnTheCallerAndStopsTheHandOut) {
 TEST(Parallel, InvokeRunsBothAndRethrows) {
   for (bool concurrent : {false, true}) {
     int a = 0, b = 0;
-    parallel_invoke(concurrent, [&] { a = 1; }, [&] { b = 2; });
+    parallel_invoke(
+        concurrent, [&] { a = 1; }, [&] { b = 2; });
     EXPECT_EQ(a + b, 3);
-    EXPECT_THROW(parallel_invoke(concurrent, [] {}, [] { throw std::logic_error("b"); }), std::logic_error);
+    EXPECT_THROW(parallel_invoke(
+                     concurrent, [] {}, [] { throw std::logic_error("b"); }),
+                 std::logic_error);
   }
 }
 

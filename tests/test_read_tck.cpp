@@ -4,20 +4,21 @@
 #include <cstring>
 #include <fstream>
 
-#include "format/error.h"
 #include "converter/readers/read_tractogram.h"
+#include "format/error.h"
 #include "tests/mrtrix_test_files.h"
 #include "tests/test_support.h"
 
 namespace vxl {
 namespace {
 
-using test::real;
 using test::raw;
+using test::real;
 using test::ScratchDir;
 
 // Writes a TCK with the given datatype from raw data bytes.
-void write_tck(const std::string& path, const std::string& datatype, const std::string& data, const std::string& extra = "") {
+void write_tck(const std::string& path, const std::string& datatype, const std::string& data,
+               const std::string& extra = "") {
   test::write_mrtrix_file(path, "mrtrix tracks", datatype, data, extra);
 }
 
@@ -58,7 +59,8 @@ TEST(TckReader, RealFixtureCounts) {
 
 // Reference values from an independent reader, nibabel 5.x (Debian python3-nibabel), obtained with:
 //   /usr/bin/python3 -c "import nibabel as nb; s=nb.streamlines.load('TractographyFormat__stroke.tck').streamlines;
-//                        print([float(x) for x in s[0][0]], [float(x) for x in s[0][1]], [float(x) for x in s[-1][-1]])"
+//                        print([float(x) for x in s[0][0]], [float(x) for x in s[0][1]], [float(x) for x in
+//                        s[-1][-1]])"
 // TCK stores float32, so the comparison is exact.
 TEST(TckReader, StrokeMatchesNibabel) {
   VXL_REQUIRE_REAL_DATA();
@@ -66,7 +68,7 @@ TEST(TckReader, StrokeMatchesNibabel) {
   ASSERT_GT(t.point_count(), 2u);
   const std::vector<float> first_two(t.positions.begin(), t.positions.begin() + 6);
   EXPECT_EQ(first_two, (std::vector<float>{63.7966423034668f, -41.454803466796875f, 2.3184967041015625f,
-                                            60.35334014892578f, -42.743751525878906f, 1.0126876831054688f}));
+                                           60.35334014892578f, -42.743751525878906f, 1.0126876831054688f}));
   const std::vector<float> last(t.positions.end() - 3, t.positions.end());
   EXPECT_EQ(last, (std::vector<float>{-64.24888610839844f, -12.375511169433594f, 1.8407669067382812f}));
 }
@@ -90,7 +92,8 @@ TEST(TckReader, BigEndianEqualsLittleEndian) {
 
 TEST(TckReader, MalformedFixturesAreRefusedWithTheFileName) {
   VXL_REQUIRE_REAL_DATA();
-  for (const char* name : {"nibabel__no_header_end.tck", "nibabel__no_header_end_eof.tck", "nibabel__no_magic_number.tck"}) {
+  for (const char* name :
+       {"nibabel__no_header_end.tck", "nibabel__no_header_end_eof.tck", "nibabel__no_magic_number.tck"}) {
     SCOPED_TRACE(name);
     try {
       read_tck(real(name));
@@ -105,8 +108,10 @@ TEST(TckReader, MalformedFixturesAreRefusedWithTheFileName) {
 TEST(TckReader, AllFourDatatypes) {
   ScratchDir dir;
   for (bool big : {false, true}) {
-    std::string f32 = raw<float>({1, 2, 3, 4, 5, 6, kNaN, kNaN, kNaN, 7, 8, 9, kNaN, kNaN, kNaN, kInf, kInf, kInf}, big);
-    std::string f64 = raw<double>({1, 2, 3, 4, 5, 6, kNaN, kNaN, kNaN, 7, 8, 9, kNaN, kNaN, kNaN, kInf, kInf, kInf}, big);
+    std::string f32 =
+        raw<float>({1, 2, 3, 4, 5, 6, kNaN, kNaN, kNaN, 7, 8, 9, kNaN, kNaN, kNaN, kInf, kInf, kInf}, big);
+    std::string f64 =
+        raw<double>({1, 2, 3, 4, 5, 6, kNaN, kNaN, kNaN, 7, 8, 9, kNaN, kNaN, kNaN, kInf, kInf, kInf}, big);
     write_tck(dir.file("a.tck"), big ? "Float32BE" : "Float32LE", f32);
     write_tck(dir.file("b.tck"), big ? "Float64BE" : "Float64LE", f64);
     Tractogram a = read_tck(dir.file("a.tck"));

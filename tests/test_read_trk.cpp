@@ -11,8 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#include "format/error.h"
 #include "converter/readers/read_tractogram.h"
+#include "format/error.h"
 #include "tests/test_support.h"
 
 namespace {

@@ -14,10 +14,10 @@
 
 #include <gtest/gtest.h>
 
-#include "format/checksum.h"
-#include "format/error.h"
 #include "converter/readers/float16.h"
 #include "converter/readers/read_tractogram.h"
+#include "format/checksum.h"
+#include "format/error.h"
 #include "tests/test_support.h"
 #include "tests/zip_writer.h"
 
@@ -80,9 +80,15 @@ TEST(ReadTrx, EveryFixtureHasTheDocumentedCounts) {
 }
 
 // Reference values: an independent reader (zipfile + numpy), run in ../shared/data/real as
-//   /usr/bin/python3 -c "import zipfile, json, numpy as np; z = zipfile.ZipFile('niivue__sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx'); h = json.loads(z.read('header.json')); p = np.frombuffer(z.read('positions.3.float32'), '<f4').reshape(-1, 3); o = np.frombuffer(z.read('offsets.uint32'), '<u4'); print(len(o) - 1, o[-1] == h['NB_VERTICES'], p[o[0]:o[0] + 2].tolist(), p[o[-1] - 1].tolist())"
+//   /usr/bin/python3 -c "import zipfile, json, numpy as np; z =
+//   zipfile.ZipFile('niivue__sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx'); h =
+//   json.loads(z.read('header.json')); p = np.frombuffer(z.read('positions.3.float32'), '<f4').reshape(-1, 3); o =
+//   np.frombuffer(z.read('offsets.uint32'), '<u4'); print(len(o) - 1, o[-1] == h['NB_VERTICES'], p[o[0]:o[0] +
+//   2].tolist(), p[o[-1] - 1].tolist())"
 // which printed
-//   508 True [[14.211463928222656, 32.482147216796875, 46.71699523925781], [14.213859558105469, 32.21466064453125, 46.29457092285156]] [-55.147674560546875, -57.2192497253418, 5.0831146240234375]
+//   508 True [[14.211463928222656, 32.482147216796875, 46.71699523925781],
+//   [14.213859558105469, 32.21466064453125, 46.29457092285156]] [-55.147674560546875,
+//   -57.2192497253418, 5.0831146240234375]
 // float32 positions are copied bit-exactly, so these compare with ==.
 TEST(ReadTrx, AfqMatchesIndependentReaderExactly) {
   VXL_REQUIRE_REAL_DATA();
@@ -120,7 +126,7 @@ TEST(ReadTrx, AfqHasGroupsArcLAndArcR) {
 
 TEST(ReadTrx, DpsvSentinelAndNoSentinelFilesAgree) {
   VXL_REQUIRE_REAL_DATA();
-  const vxl::Tractogram a = vxl::read_trx(real("niivue__dpsv.trx"));        // 460 uint32 entries
+  const vxl::Tractogram a = vxl::read_trx(real("niivue__dpsv.trx"));         // 460 uint32 entries
   const vxl::Tractogram b = vxl::read_trx(real("niivue__tests__dpsv.trx"));  // 460 uint64 entries
   const vxl::Tractogram c = vxl::read_trx(real("niivue__dps.trx"));
   EXPECT_EQ(a.offsets, b.offsets);
@@ -155,8 +161,7 @@ TEST(ReadTrx, TrxPythonZipCompressedZipAndDirectoryAgree) {
   EXPECT_EQ(stored.groups[2].members.size(), 29u);
   EXPECT_EQ(stored.groups[2].members.front(), 127u);
   EXPECT_EQ(stored.groups[2].members.back(), 964u);
-  EXPECT_EQ(stored.groups[3].members,
-            (std::vector<std::uint64_t>{342, 359, 444, 489, 501, 781, 957}));
+  EXPECT_EQ(stored.groups[3].members, (std::vector<std::uint64_t>{342, 359, 444, 489, 501, 781, 957}));
   // Directory provenance: 391495 bytes of member files (SOURCES.md).
   EXPECT_EQ(dir.source.bytes, 391495u);
   EXPECT_EQ(stored.source.bytes, 394709u);
@@ -177,9 +182,9 @@ TEST(Float16, ConvertsExactly) {
   EXPECT_EQ(vxl::half_to_float(0xC000), -2.0f);
   EXPECT_EQ(vxl::half_to_float(0x7BFF), 65504.0f);
   EXPECT_EQ(vxl::half_to_float(0x3555), 0.333251953125f);
-  EXPECT_EQ(vxl::half_to_float(0x0001), std::ldexp(1.0f, -24));  // smallest subnormal
+  EXPECT_EQ(vxl::half_to_float(0x0001), std::ldexp(1.0f, -24));         // smallest subnormal
   EXPECT_EQ(vxl::half_to_float(0x03FF), 1023 * std::ldexp(1.0f, -24));  // largest subnormal
-  EXPECT_EQ(vxl::half_to_float(0x0400), std::ldexp(1.0f, -14));  // smallest normal
+  EXPECT_EQ(vxl::half_to_float(0x0400), std::ldexp(1.0f, -14));         // smallest normal
   EXPECT_EQ(vxl::half_to_float(0x0000), 0.0f);
   EXPECT_TRUE(std::signbit(vxl::half_to_float(0x8000)));
   EXPECT_EQ(vxl::half_to_float(0x7C00), std::numeric_limits<float>::infinity());
@@ -224,7 +229,8 @@ void write_dir(const std::string& path, const std::vector<std::pair<std::string,
 
 std::string header_json(int n, int v) {
   return "{\"DIMENSIONS\": [10, 10, 10], \"VOXEL_TO_RASMM\": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], "
-         "\"NB_STREAMLINES\": " + std::to_string(n) + ", \"NB_VERTICES\": " + std::to_string(v) + "}";
+         "\"NB_STREAMLINES\": " +
+         std::to_string(n) + ", \"NB_VERTICES\": " + std::to_string(v) + "}";
 }
 
 // 3 streamlines of 2, 1 and 3 points.
@@ -305,9 +311,8 @@ TEST(ReadTrxSynthetic, DirectoryProvenanceHashesMembersInSortedPathOrder) {
 TEST(ReadTrxSynthetic, Float16AndFloat64Positions) {
   vxl::test::ScratchDir dir;
   auto members = valid_members();
-  std::vector<std::uint16_t> halves = {0x3C00, 0xC000, 0x3555, 0, 0x8000, 0x7BFF,
-                                       0x0001, 0x3800, 0x4000, 0x4200, 0x4400, 0x4500,
-                                       0x4600, 0x4700, 0x4800, 0x4880, 0x4900, 0x4980};
+  std::vector<std::uint16_t> halves = {0x3C00, 0xC000, 0x3555, 0,      0x8000, 0x7BFF, 0x0001, 0x3800, 0x4000,
+                                       0x4200, 0x4400, 0x4500, 0x4600, 0x4700, 0x4800, 0x4880, 0x4900, 0x4980};
   replace(members, "positions.3.float32", "positions.3.float16", le_bytes(halves));
   write_zip(dir.file("h.trx"), members);
   const vxl::Tractogram h = vxl::read_trx(dir.file("h.trx"));

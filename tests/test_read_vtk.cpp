@@ -7,12 +7,12 @@
 #include <sstream>
 
 #include "converter/convert.h"
-#include "format/error.h"
 #include "converter/export_vtk.h"
 #include "converter/readers/read_tractogram.h"
+#include "format/error.h"
+#include "format/vxl_file.h"
 #include "tests/test_support.h"
 #include "tests/vtk_test_files.h"
-#include "format/vxl_file.h"
 
 namespace vxl {
 namespace {
@@ -66,7 +66,8 @@ std::string legacy_ascii() {
 // BINARY, big-endian; `modern` uses the VTK 5.1 OFFSETS / CONNECTIVITY layout; `doubles` double points.
 std::string legacy_binary(bool modern, bool doubles) {
   SmallPolyData d;
-  std::string s = "# vtk DataFile Version " + std::string(modern ? "5.1" : "3.0") + "\nsmall\nBINARY\nDATASET POLYDATA\n";
+  std::string s =
+      "# vtk DataFile Version " + std::string(modern ? "5.1" : "3.0") + "\nsmall\nBINARY\nDATASET POLYDATA\n";
   s += "FIELD FieldData 1\nINFO 1 1 string\n" + std::string(1, char(0xC0 | 5)) + "hello\n";  // dataset-level: skipped
   s += std::string("POINTS 5 ") + (doubles ? "double" : "float") + "\n";
   for (float p : d.points) s += doubles ? be(static_cast<double>(p)) : be(p);
@@ -156,8 +157,8 @@ TEST(ReadVtp, EveryEncodingReadsTheSame) {
           }
   ASSERT_EQ(styles.size(), 1u + 8u + 16u);
   for (const VtpStyle& s : styles) {
-    SCOPED_TRACE(s.format + (s.appended_base64 ? " base64" : "") + (s.zlib ? " zlib" : "") + (s.uint64_header ? " UInt64" : "") +
-                 (s.big_endian ? " BigEndian" : ""));
+    SCOPED_TRACE(s.format + (s.appended_base64 ? " base64" : "") + (s.zlib ? " zlib" : "") +
+                 (s.uint64_header ? " UInt64" : "") + (s.big_endian ? " BigEndian" : ""));
     write_bytes(dir.file("s.vtp"), test::small_vtp(s));
     Tractogram t = read_vtp(dir.file("s.vtp"));
     expect_small(t);
@@ -197,7 +198,8 @@ TEST(ReadVtk, EveryTruncationIsRefusedOrReadsFewerStreamlines) {
         // A cut between two sections is a shorter valid file: no streamlines yet, or all three.
         EXPECT_TRUE(t.streamline_count() == 0 || t.streamline_count() == 3) << "cut at " << n;
       } catch (const Error& e) {
-        EXPECT_TRUE(e.kind() == ErrorKind::Input || e.kind() == ErrorKind::Unsupported) << "cut at " << n << ": " << e.what();
+        EXPECT_TRUE(e.kind() == ErrorKind::Input || e.kind() == ErrorKind::Unsupported)
+            << "cut at " << n << ": " << e.what();
       }
     }
   }
@@ -209,10 +211,11 @@ TEST(ReadVtk, AbsurdCountsAreRefusedBeforeAllocating) {
   write_bytes(dir.file("p.vtk"), head + "POINTS 4000000000000000 float\n" + be(1.0f));
   EXPECT_EQ(kind_of(dir.file("p.vtk")), ErrorKind::Input);
   EXPECT_NE(message_of(dir.file("p.vtk")).find("bytes are left"), std::string::npos) << message_of(dir.file("p.vtk"));
-  write_bytes(dir.file("l.vtk"), head + "POINTS 1 float\n" + be(1.0f) + be(2.0f) + be(3.0f) + "\nLINES 999999999999 999999999999\n" +
-                                     be(1) + be(0));
+  write_bytes(dir.file("l.vtk"), head + "POINTS 1 float\n" + be(1.0f) + be(2.0f) + be(3.0f) +
+                                     "\nLINES 999999999999 999999999999\n" + be(1) + be(0));
   EXPECT_EQ(kind_of(dir.file("l.vtk")), ErrorKind::Input);
-  write_bytes(dir.file("a.vtk"), "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 99999999999 float\n1 2 3\n");
+  write_bytes(dir.file("a.vtk"),
+              "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 99999999999 float\n1 2 3\n");
   EXPECT_EQ(kind_of(dir.file("a.vtk")), ErrorKind::Input);
   write_bytes(dir.file("f.vtk"), head + "POINTS 0 float\nPOINT_DATA 0\nFIELD f 1\nx 4294967296 4294967296 float\n");
   EXPECT_EQ(kind_of(dir.file("f.vtk")), ErrorKind::Input);
@@ -237,7 +240,9 @@ TEST(ReadVtk, OtherDatasetsAndSurfacesAreUnsupported) {
   ScratchDir dir;
   write_bytes(dir.file("u.vtk"), "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\n");
   EXPECT_EQ(kind_of(dir.file("u.vtk")), ErrorKind::Unsupported);
-  write_bytes(dir.file("s.vtk"), "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1 2\n");
+  write_bytes(dir.file("s.vtk"),
+              "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 "
+              "4\n3 0 1 2\n");
   EXPECT_EQ(kind_of(dir.file("s.vtk")), ErrorKind::Unsupported);
   EXPECT_NE(message_of(dir.file("s.vtk")).find("surface mesh"), std::string::npos);
   write_bytes(dir.file("n.vtk"), "not a vtk file\n");
@@ -251,7 +256,8 @@ TEST(ReadVtp, BadBase64IsRefused) {
   s[at + 3] = '!';
   write_bytes(dir.file("b.vtp"), s);
   EXPECT_EQ(kind_of(dir.file("b.vtp")), ErrorKind::Input);
-  EXPECT_NE(message_of(dir.file("b.vtp")).find("invalid base64 character"), std::string::npos) << message_of(dir.file("b.vtp"));
+  EXPECT_NE(message_of(dir.file("b.vtp")).find("invalid base64 character"), std::string::npos)
+      << message_of(dir.file("b.vtp"));
 }
 
 TEST(ReadVtp, TruncationsAreRefused) {
@@ -275,23 +281,30 @@ TEST(ReadVtp, TruncationsAreRefused) {
 TEST(ReadVtp, ZlibBombsAreRefused) {
   ScratchDir dir;
   auto file = [](const std::string& header_and_data, std::uint64_t points) {
-    return "<VTKFile type=\"PolyData\" byte_order=\"LittleEndian\" compressor=\"vtkZLibDataCompressor\"><PolyData><Piece "
-           "NumberOfPoints=\"" + std::to_string(points) + "\" NumberOfLines=\"1\"><Points><DataArray type=\"Float32\" "
+    return "<VTKFile type=\"PolyData\" byte_order=\"LittleEndian\" "
+           "compressor=\"vtkZLibDataCompressor\"><PolyData><Piece "
+           "NumberOfPoints=\"" +
+           std::to_string(points) +
+           "\" NumberOfLines=\"1\"><Points><DataArray type=\"Float32\" "
            "NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points></Piece></PolyData>"
-           "<AppendedData encoding=\"raw\">_" + header_and_data + "</AppendedData></VTKFile>";
+           "<AppendedData encoding=\"raw\">_" +
+           header_and_data + "</AppendedData></VTKFile>";
   };
   using test::le;
   // 1: claims 12 MB from a 20-byte block.
   const std::string small = test::zlib_compress(std::string(1000, '\0'));
   const std::uint32_t claim = 12'000'000;
   write_bytes(dir.file("ratio.vtp"), file(le<std::uint32_t>(1) + le(claim) + le<std::uint32_t>(0) +
-                                             le(static_cast<std::uint32_t>(small.size())) + small, claim / 12));
+                                              le(static_cast<std::uint32_t>(small.size())) + small,
+                                          claim / 12));
   EXPECT_EQ(kind_of(dir.file("ratio.vtp")), ErrorKind::Input);
-  EXPECT_NE(message_of(dir.file("ratio.vtp")).find("maximum ratio"), std::string::npos) << message_of(dir.file("ratio.vtp"));
+  EXPECT_NE(message_of(dir.file("ratio.vtp")).find("maximum ratio"), std::string::npos)
+      << message_of(dir.file("ratio.vtp"));
   // 2: 1 MB of zeros declared as 12 bytes.
   const std::string bomb = test::zlib_compress(std::string(1 << 20, '\0'));
   write_bytes(dir.file("bomb.vtp"), file(le<std::uint32_t>(1) + le<std::uint32_t>(12) + le<std::uint32_t>(0) +
-                                            le(static_cast<std::uint32_t>(bomb.size())) + bomb, 1));
+                                             le(static_cast<std::uint32_t>(bomb.size())) + bomb,
+                                         1));
   EXPECT_EQ(kind_of(dir.file("bomb.vtp")), ErrorKind::Input);
   EXPECT_NE(message_of(dir.file("bomb.vtp")).find("does not inflate to its declared 12 bytes"), std::string::npos)
       << message_of(dir.file("bomb.vtp"));
@@ -308,7 +321,8 @@ TEST(ReadVtp, BadIndicesAndSurfacesAreRefused) {
   EXPECT_EQ(kind_of(dir.file("i.vtp")), ErrorKind::Input);
   write_bytes(dir.file("n.vtp"), std::string(s).replace(at, 14, ">0 1 -2 4 3 0 <"));
   EXPECT_EQ(kind_of(dir.file("n.vtp")), ErrorKind::Input);
-  write_bytes(dir.file("p.vtp"), std::string(s).replace(s.find("NumberOfLines=\"3\""), 17, "NumberOfLines=\"0\" NumberOfPolys=\"2\""));
+  write_bytes(dir.file("p.vtp"),
+              std::string(s).replace(s.find("NumberOfLines=\"3\""), 17, "NumberOfLines=\"0\" NumberOfPolys=\"2\""));
   EXPECT_EQ(kind_of(dir.file("p.vtp")), ErrorKind::Unsupported);
   write_bytes(dir.file("g.vtp"), "<VTKFile type=\"UnstructuredGrid\"></VTKFile>");
   EXPECT_EQ(kind_of(dir.file("g.vtp")), ErrorKind::Unsupported);

@@ -104,20 +104,22 @@ void expect_same_voxel_contents(const std::vector<std::string>& names) {
     }
     ASSERT_EQ(a.vertices().size(), b.vertices().size());
     float worst = 0;
-    for (std::size_t k = 0; k < a.vertices().size(); ++k) worst = std::max(worst, std::abs(a.vertices()[k] - b.vertices()[k]));
+    for (std::size_t k = 0; k < a.vertices().size(); ++k)
+      worst = std::max(worst, std::abs(a.vertices()[k] - b.vertices()[k]));
     EXPECT_LT(worst, 1e-3f);
   }
 }
 
 TEST(RealFixtures, StrokeFamilyHasTheSameVoxelContents) {
   VXL_REQUIRE_REAL_DATA();
-  expect_same_voxel_contents({"TractographyFormat__stroke.tck", "TractographyFormat__stroke.trk", "niivue__stroke.trk.gz",
-                              "TractographyFormat__stroke.vtk"});
+  expect_same_voxel_contents({"TractographyFormat__stroke.tck", "TractographyFormat__stroke.trk",
+                              "niivue__stroke.trk.gz", "TractographyFormat__stroke.vtk"});
 }
 TEST(RealFixtures, ExampleFamilyHasTheSameVoxelContents) {
   VXL_REQUIRE_REAL_DATA();
   // example.vtp holds slightly different points (within 0.003 mm: RealVtk.PointsAgreeWithTheTckOfTheSameTractogram).
-  expect_same_voxel_contents({"TractographyFormat__example.tck", "TractographyFormat__example.trk", "TractographyFormat__example.vtk"});
+  expect_same_voxel_contents(
+      {"TractographyFormat__example.tck", "TractographyFormat__example.trk", "TractographyFormat__example.vtk"});
 }
 TEST(RealFixtures, GsFamilyHasTheSameVoxelContents) {
   VXL_REQUIRE_REAL_DATA();

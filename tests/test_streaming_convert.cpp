@@ -1,13 +1,13 @@
 // convert --memory-limit (streaming_convert.h): the output must be byte-identical to the in-memory
 // conversion, the work must really be split, and a limit that is too small must fail cleanly.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <optional>
-#include <chrono>
-#include <csignal>
 #include <set>
 #include <thread>
 
@@ -15,13 +15,13 @@
 #include <unistd.h>
 
 #include "converter/convert.h"
-#include "format/error.h"
 #include "converter/memory_size.h"
 #include "converter/readers/read_tractogram.h"
+#include "converter/readers/tck_stream.h"
 #include "converter/streaming_convert.h"
 #include "converter/synth.h"
-#include "converter/readers/tck_stream.h"
 #include "converter/tck_writer.h"
+#include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_verify.h"
 #include "tests/mrtrix_test_files.h"
@@ -44,7 +44,8 @@ void write_synth_tck(const std::string& path, std::uint64_t streamlines, std::ui
 }
 
 // A TCK with the given datatype and raw data bytes (as in test_read_tck.cpp).
-void write_raw_tck(const std::string& path, const std::string& datatype, const std::string& data, const std::string& extra = "") {
+void write_raw_tck(const std::string& path, const std::string& datatype, const std::string& data,
+                   const std::string& extra = "") {
   test::write_mrtrix_file(path, "mrtrix tracks", datatype, data, extra);
 }
 
@@ -62,14 +63,16 @@ ConvertSettings settings_for(double voxel_size, const std::string& orders = "axi
 }
 
 // Converts `tck` in memory and with `limit`; expects the same bytes and returns the streaming summary.
-ConvertSummary expect_identical(const ScratchDir& dir, const std::string& tck, ConvertSettings settings, std::uint64_t limit) {
+ConvertSummary expect_identical(const ScratchDir& dir, const std::string& tck, ConvertSettings settings,
+                                std::uint64_t limit) {
   const std::string whole = dir.file("whole.vxl"), limited = dir.file("limited.vxl");
   convert_tractogram(read_tractogram(tck), whole, settings);
   settings.memory_limit = limit;
   ConvertSummary s = convert_streaming(tck, limited, settings);
   std::vector<char> a = file_bytes(whole), b = file_bytes(limited);
   EXPECT_GT(a.size(), 0u);
-  EXPECT_TRUE(a == b) << "the limited conversion differs from the in-memory one (" << a.size() << " vs " << b.size() << " bytes)";
+  EXPECT_TRUE(a == b) << "the limited conversion differs from the in-memory one (" << a.size() << " vs " << b.size()
+                      << " bytes)";
   VerifyResult v = verify_vxl(limited);
   EXPECT_TRUE(v.valid) << v.problem;
   EXPECT_EQ(s.passes, s.partitions + (s.points > 0 ? 2 : 1));  // scan, plan (when there are points), one per range
@@ -80,7 +83,9 @@ ConvertSummary expect_identical(const ScratchDir& dir, const std::string& tck, C
 // Streamlines whose voxlines fall in voxels of more than one range.
 std::uint64_t streamlines_across_ranges(const std::string& vxl, const std::vector<std::uint64_t>& starts) {
   VxlFile f = VxlFile::open(vxl);
-  auto range_of = [&](std::uint32_t voxel) { return std::upper_bound(starts.begin(), starts.end(), voxel) - starts.begin(); };
+  auto range_of = [&](std::uint32_t voxel) {
+    return std::upper_bound(starts.begin(), starts.end(), voxel) - starts.begin();
+  };
   std::uint64_t across = 0;
   auto strm = f.streamline_first_voxline();
   for (std::size_t k = 0; k + 1 < strm.size(); ++k) {
@@ -102,19 +107,23 @@ TEST(StreamingConvert, TckStreamReadsWhatReadTckReads) {
       // no Inf terminator, 5 trailing bytes, last streamline without a NaN, an empty streamline, stale count
       {"open_end.tck", "Float32LE",
        raw<float>({1, 2, 3, 4, 5, 6, nan, nan, nan, nan, nan, nan, 7, 8, 9, 10, 11, 12}) + "abcde", "count: 7\n"},
-      {"f64be.tck", "Float64BE", raw<double>({1, 2, 3, 1e300, 1, 1, nan, 0, 0, 5, 5, 5, nan, 0, 0, inf, 0, 0}, true), ""},
+      {"f64be.tck", "Float64BE", raw<double>({1, 2, 3, 1e300, 1, 1, nan, 0, 0, 5, 5, 5, nan, 0, 0, inf, 0, 0}, true),
+       ""},
       {"empty.tck", "Float32LE", raw<float>({inf, inf, inf}), "count: 0\n"},
       {"delimiters.tck", "Float32LE", raw<float>({nan, 0, 0, nan, 0, 0, nan, 0, 0, inf, 0, 0}), ""},
   };
   for (const Case& c : cases) {
     const std::string path = dir.file(c.name);
-    if (c.datatype.empty()) write_synth_tck(path, 300);
-    else write_raw_tck(path, c.datatype, c.data, c.extra);
+    if (c.datatype.empty())
+      write_synth_tck(path, 300);
+    else
+      write_raw_tck(path, c.datatype, c.data, c.extra);
     Tractogram whole = read_tck(path);
     // Odd chunk and batch sizes, so that triplets, streamlines and batches end everywhere.
     for (std::uint64_t chunk : {12ull * 7, 24ull * 5 + 12, 4096ull}) {
       for (std::uint64_t batch_points : {1ull, 97ull, 1ull << 30}) {
-        SCOPED_TRACE(std::string(c.name) + " chunk " + std::to_string(chunk) + " batch " + std::to_string(batch_points));
+        SCOPED_TRACE(std::string(c.name) + " chunk " + std::to_string(chunk) + " batch " +
+                     std::to_string(batch_points));
         TckStream stream(path, 1 << 20, chunk);
         for (int pass = 0; pass < 2; ++pass) {
           if (pass > 0) stream.rewind();
@@ -124,7 +133,8 @@ TEST(StreamingConvert, TckStreamReadsWhatReadTckReads) {
             ASSERT_GT(batch.streamline_count(), 0u);
             ++batches;
             for (std::uint64_t k = 0; k < batch.streamline_count(); ++k)
-              all.add_streamline(batch.positions.data() + 3 * batch.offsets[k], batch.offsets[k + 1] - batch.offsets[k]);
+              all.add_streamline(batch.positions.data() + 3 * batch.offsets[k],
+                                 batch.offsets[k + 1] - batch.offsets[k]);
           }
           EXPECT_FALSE(stream.next(batch, batch_points));  // stays at the end
           EXPECT_EQ(all.offsets, whole.offsets);
@@ -204,7 +214,8 @@ TEST(StreamingConvert, LongStepsAndDiagonalOrdersAreIdentical) {
       std::vector<float> pts;
       for (int i = 0; i < 12; ++i) {
         const float a = 0.37f * float(s) + 0.9f * float(i);
-        pts.insert(pts.end(), {12.0f * std::cos(a) + 0.01f * float(s), 12.0f * std::sin(a), 3.1f * float(i) - 0.02f * float(s)});
+        pts.insert(pts.end(),
+                   {12.0f * std::cos(a) + 0.01f * float(s), 12.0f * std::sin(a), 3.1f * float(i) - 0.02f * float(s)});
       }
       w.add(pts);
     }
@@ -298,7 +309,9 @@ TEST(StreamingConvert, TooSmallALimitFailsCleanlyWithAUsefulSuggestion) {
     } catch (const Error& e) {
       const std::string what = e.what();
       EXPECT_EQ(e.kind(), ErrorKind::Unsupported) << what;
-      EXPECT_NE(what.find("--memory-limit " + format_memory_size(settings.memory_limit) + " is too small"), std::string::npos) << what;
+      EXPECT_NE(what.find("--memory-limit " + format_memory_size(settings.memory_limit) + " is too small"),
+                std::string::npos)
+          << what;
       EXPECT_NE(what.find(" needs "), std::string::npos) << what;
       // nothing at the output path, and no temporary file beside it
       for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
@@ -394,8 +407,8 @@ TEST(StreamingConvert, MemorySizesParse) {
   EXPECT_EQ(parse_memory_size("512M"), 512ull << 20);
   EXPECT_EQ(parse_memory_size("512m"), 512ull << 20);
   EXPECT_EQ(parse_memory_size("2G"), 2ull << 30);
-  for (const char* bad : {"", "M", "0", "0M", "-5M", "1.5G", "12X", "12 M", " 12M", "12MB", "abc", "99999999999999999999",
-                          "17179869184G"})
+  for (const char* bad : {"", "M", "0", "0M", "-5M", "1.5G", "12X", "12 M", " 12M", "12MB", "abc",
+                          "99999999999999999999", "17179869184G"})
     EXPECT_FALSE(parse_memory_size(bad)) << bad;
   EXPECT_EQ(format_memory_size(512ull << 20), "512.0 MiB");
   EXPECT_EQ(memory_limit_argument((36ull << 20) + 1), "37M");

@@ -31,11 +31,11 @@ inline std::vector<char> slurp(const std::string& path) {
 // them call this first and are skipped with a clear message.
 inline std::filesystem::path real_data_dir() { return VOXLINES_REAL_DATA_DIR; }
 inline bool have_real_data() { return std::filesystem::is_directory(real_data_dir()); }
-#define VXL_REQUIRE_REAL_DATA()                                                                  \
-  do {                                                                                           \
-    if (!::vxl::test::have_real_data())                                                          \
-      GTEST_SKIP() << "real fixtures not found at " << ::vxl::test::real_data_dir()              \
-                   << " (they live in ../shared/data/real beside the project; CI has them)";     \
+#define VXL_REQUIRE_REAL_DATA()                                                              \
+  do {                                                                                       \
+    if (!::vxl::test::have_real_data())                                                      \
+      GTEST_SKIP() << "real fixtures not found at " << ::vxl::test::real_data_dir()          \
+                   << " (they live in ../shared/data/real beside the project; CI has them)"; \
   } while (0)
 inline std::string real(const std::string& name) { return (real_data_dir() / name).string(); }
 
@@ -100,7 +100,9 @@ inline int kill_conversions(const ScratchDir& dir, const std::vector<std::string
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  auto expected_file = [](const std::filesystem::path& p) { return p.filename() == "in.tck" || p.filename() == "out.vxl"; };
+  auto expected_file = [](const std::filesystem::path& p) {
+    return p.filename() == "in.tck" || p.filename() == "out.vxl";
+  };
   // Whether process `pid` has a file of `dir` other than the input open: its output in the making.
   const std::string dir_prefix = std::filesystem::path(dir.path()).string() + "/";
   auto writing = [&](pid_t pid) {
@@ -130,7 +132,8 @@ inline int kill_conversions(const ScratchDir& dir, const std::vector<std::string
       if (WIFSIGNALED(status) && was_writing) ++killed_while_writing;
     }
     if (WIFSIGNALED(status) && std::filesystem::exists(out)) {
-      EXPECT_EQ(run_program(VOXLINES_CLI, "verify '" + out + "'").exit_code, 0) << "run " << r << ": a killed run left an incomplete output";
+      EXPECT_EQ(run_program(VOXLINES_CLI, "verify '" + out + "'").exit_code, 0)
+          << "run " << r << ": a killed run left an incomplete output";
     }
     std::filesystem::remove(out);
     for (const auto& e : std::filesystem::directory_iterator(dir.path()))

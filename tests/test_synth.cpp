@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "format/checksum.h"
 #include "converter/synth.h"
+#include "format/checksum.h"
 
 namespace {
 

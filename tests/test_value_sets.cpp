@@ -9,23 +9,24 @@
 #include <functional>
 
 #include "converter/convert.h"
-#include "format/error.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
-#include "tests/mrtrix_test_files.h"
-#include "tests/test_support.h"
+#include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_verify.h"
+#include "tests/mrtrix_test_files.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {
 
-using test::real;
 using test::raw;
+using test::real;
 using test::ScratchDir;
 
 // A TSF with the given datatype and raw data bytes (header padded so that the offset has 4 digits).
-void write_tsf(const std::string& path, const std::string& datatype, const std::string& data, const std::string& extra = "") {
+void write_tsf(const std::string& path, const std::string& datatype, const std::string& data,
+               const std::string& extra = "") {
   test::write_mrtrix_file(path, "mrtrix track scalars", datatype, data, extra);
 }
 
@@ -240,8 +241,8 @@ TEST(ValueSetsReal, TsfFixturesConvertWithTheirTractograms) {
     EXPECT_NE(f.provenance_json().find(c.tsf), std::string::npos) << "provenance names the TSF";
   }
   // A TSF made for another tractogram is refused, naming it.
-  auto wrong = test::run_cli("convert '" + real("niivue__tract.SLF1_R.tck") + "' '" + dir.file("wrong.vxl") + "' --tsf '" +
-                             real("test_data__afd.tsf") + "'");
+  auto wrong = test::run_cli("convert '" + real("niivue__tract.SLF1_R.tck") + "' '" + dir.file("wrong.vxl") +
+                             "' --tsf '" + real("test_data__afd.tsf") + "'");
   EXPECT_EQ(wrong.exit_code, 3);
   EXPECT_NE(wrong.output.find("test_data__afd.tsf"), std::string::npos) << wrong.output;
   EXPECT_NE(wrong.output.find("500 streamlines and 3408 values"), std::string::npos) << wrong.output;
@@ -276,7 +277,8 @@ TEST(ValueSetsReal, TrkScalarsAndPropertiesTrxDpvAndDps) {
   EXPECT_EQ(trx.point_values[0].name, "z");
   ASSERT_EQ(trx.point_values[0].values.size(), trx.point_count());
   // dpv "z" of this file is each point's z coordinate (float16 positions, float32 values).
-  for (std::uint64_t i = 0; i < trx.point_count(); i += 997) EXPECT_NEAR(trx.point_values[0].values[i], trx.positions[3 * i + 2], 0.05);
+  for (std::uint64_t i = 0; i < trx.point_count(); i += 997)
+    EXPECT_NEAR(trx.point_values[0].values[i], trx.positions[3 * i + 2], 0.05);
   ASSERT_EQ(trx.streamline_values.size(), 1u);
   EXPECT_EQ(trx.streamline_values[0].name, "DataSetID");
   EXPECT_EQ(trx.streamline_values[0].values.size(), trx.streamline_count());

@@ -10,20 +10,20 @@
 #include <limits>
 
 #include "converter/convert.h"
-#include "format/error.h"
 #include "converter/export_tck.h"
 #include "converter/export_trx.h"
-#include "tests/mrtrix_test_files.h"
 #include "converter/pack.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "converter/synth.h"
-#include "tests/test_support.h"
 #include "converter/unpack.h"
+#include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_verify.h"
 #include "format/vxlz_package.h"
 #include "format/vxlz_values.h"
+#include "tests/mrtrix_test_files.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {
@@ -211,7 +211,8 @@ TEST(ValuesPackage, DamagedValueSectionsAreRefusedBeforeAllocating) {
   longer.push_back(0);
   EXPECT_EQ(refused(longer), ErrorKind::Input) << "bytes after the last stream";
   for (std::size_t n = 0; n < good.size(); ++n)
-    EXPECT_EQ(refused({good.begin(), good.begin() + static_cast<std::ptrdiff_t>(n)}), ErrorKind::Input) << "truncated to " << n;
+    EXPECT_EQ(refused({good.begin(), good.begin() + static_cast<std::ptrdiff_t>(n)}), ErrorKind::Input)
+        << "truncated to " << n;
 }
 
 TEST(ValuesPackage, ConnectingValuesThatDifferFromTheNextPointAreRefused) {
@@ -302,12 +303,14 @@ TEST(ValuesExport, UnusableSetNamesAreUnsupportedWithoutOutput) {
 Tractogram tck_with_tsf(const ScratchDir& dir) {
   using test::raw;
   const float nan = NAN, inf = INFINITY;
-  test::write_mrtrix_file(dir.file("t.tck"), "mrtrix tracks", "Float32LE",
-                          raw<float>({0, 0, 0, 1, 0.5f, 0.25f, 45, 31, -17, nan, nan, nan, -3, 4, 5, nan, nan, nan,
-                                      nan, nan, nan, 2, 2, 2, 2.5f, 2.25f, 2.125f, nan, nan, nan, inf, inf, inf}),
-                          "timestamp: 1234.5\n");
+  test::write_mrtrix_file(
+      dir.file("t.tck"), "mrtrix tracks", "Float32LE",
+      raw<float>({0,   0,   0,   1,   0.5f, 0.25f, 45, 31,   -17,   nan,    nan, nan, -3,  4,   5,   nan, nan,
+                  nan, nan, nan, nan, 2,    2,     2,  2.5f, 2.25f, 2.125f, nan, nan, nan, inf, inf, inf}),
+      "timestamp: 1234.5\n");
   test::write_mrtrix_file(dir.file("afd.tsf"), "mrtrix track scalars", "Float32LE",
-                          raw<float>({0.1f, 0.2f, 0.7f, nan, 1e-40f, nan, nan, -2, 3.5f, nan, inf}), "timestamp: 1234.5\n");
+                          raw<float>({0.1f, 0.2f, 0.7f, nan, 1e-40f, nan, nan, -2, 3.5f, nan, inf}),
+                          "timestamp: 1234.5\n");
   Tractogram t = read_tractogram(dir.file("t.tck"));
   attach_tsf(t, dir.file("afd.tsf"));
   return t;
@@ -383,7 +386,8 @@ TEST(ValuesCli, PackAndExportNoLongerWarnAndTsfGoesWithTck) {
   EXPECT_TRUE(std::filesystem::exists(dir.file("v.tsf")));
   r = test::run_cli("export '" + vxl + "' '" + dir.file("w.trx") + "' --tsf '" + dir.file("w.tsf") + "'");
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  r = test::run_cli("export '" + vxl + "' '" + dir.file("w.tck") + "' --tsf '" + dir.file("w.tsf") + "' --value missing");
+  r = test::run_cli("export '" + vxl + "' '" + dir.file("w.tck") + "' --tsf '" + dir.file("w.tsf") +
+                    "' --value missing");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir.file("w.tck")));
 }

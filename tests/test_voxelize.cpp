@@ -5,9 +5,9 @@
 
 #include <sys/resource.h>
 
-#include "format/error.h"
 #include "converter/segment_orders.h"
 #include "converter/voxelize.h"
+#include "format/error.h"
 #include "tests/test_support.h"
 
 namespace vxl {
@@ -102,7 +102,8 @@ TEST(Voxelize, ResultDoesNotDependOnTheThreadCount) {
   auto four = run(std::move(copy), 5.0, 4);
   EXPECT_EQ(one.vertices, four.vertices);
   ASSERT_EQ(one.voxels.size(), four.voxels.size());
-  for (std::size_t i = 0; i < one.voxels.size(); ++i) EXPECT_EQ(0, std::memcmp(&one.voxels[i], &four.voxels[i], sizeof(VoxelEntry)));
+  for (std::size_t i = 0; i < one.voxels.size(); ++i)
+    EXPECT_EQ(0, std::memcmp(&one.voxels[i], &four.voxels[i], sizeof(VoxelEntry)));
   EXPECT_EQ(one.streamline_first_voxline, four.streamline_first_voxline);
 }
 
@@ -131,7 +132,8 @@ TEST(Voxelize, OneHugeStepIsRefusedBeforeAllocating) {
   }
   struct rusage after {};
   getrusage(RUSAGE_SELF, &after);
-  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256 * 1024) << "peak memory grew by " << (after.ru_maxrss - before.ru_maxrss) << " KiB";
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256 * 1024)
+      << "peak memory grew by " << (after.ru_maxrss - before.ru_maxrss) << " KiB";
 }
 
 TEST(SegmentOrders, AxisOrdersSortByMidpointWithStableTies) {
@@ -153,7 +155,8 @@ TEST(SegmentOrders, AxisOrdersSortByMidpointWithStableTies) {
 
 TEST(SegmentOrders, TwentyFourBitEntriesAboveU16Range) {
   std::vector<float> pts;
-  for (int i = 0; i < 70000; ++i) pts.insert(pts.end(), {float(i % 5) * 0.1f, float((i * 7) % 9) * 0.1f, float(i % 3) * 0.1f});
+  for (int i = 0; i < 70000; ++i)
+    pts.insert(pts.end(), {float(i % 5) * 0.1f, float((i * 7) % 9) * 0.1f, float(i % 3) * 0.1f});
   Tractogram t;
   t.add_streamline(pts.data(), 70000);
   auto vt = run(std::move(t));

@@ -74,7 +74,9 @@ std::vector<Case> cases() {
   using u32 = std::uint32_t;
   using u64 = std::uint64_t;
   auto meta_u64 = [](int at, u64 v) { return [=](Bytes& f) { f.set<u64>(f.meta() + at, v); }; };
-  auto meta_add = [](int at, u64 d) { return [=](Bytes& f) { f.set<u64>(f.meta() + at, f.get<u64>(f.meta() + at) + d); }; };
+  auto meta_add = [](int at, u64 d) {
+    return [=](Bytes& f) { f.set<u64>(f.meta() + at, f.get<u64>(f.meta() + at) + d); };
+  };
   return {
       {"short", [](Bytes& f) { f.b.resize(40); }, "file too short for a .vxl header"},
       {"magic", [](Bytes& f) { f.b[0] ^= 0x20; }, "bad magic"},
@@ -91,11 +93,14 @@ std::vector<Case> cases() {
          f.set<u64>(16, 128);
        },
        "section table runs past the end of the file"},
-      {"unaligned", [](Bytes& f) { f.set<u64>(f.entry_at("DIRS") + 8, f.section_at("DIRS") + 8); }, "offset is not a multiple of 64"},
-      {"overlap", [](Bytes& f) { f.set<u64>(f.entry_at("DIRS") + 8, f.section_at("META")); }, "overlaps the table or the previous section"},
+      {"unaligned", [](Bytes& f) { f.set<u64>(f.entry_at("DIRS") + 8, f.section_at("DIRS") + 8); },
+       "offset is not a multiple of 64"},
+      {"overlap", [](Bytes& f) { f.set<u64>(f.entry_at("DIRS") + 8, f.section_at("META")); },
+       "overlaps the table or the previous section"},
       {"past_end", [](Bytes& f) { f.set<u64>(f.entry_at("PROV") + 16, f.b.size()); }, "runs past the end of the file"},
       {"section_flags", [](Bytes& f) { f.set<u32>(f.entry_at("DIRS") + 4, 3); }, "has unknown flags"},
-      {"twice", [](Bytes& f) { std::memcpy(f.b.data() + f.entry_at("DIRS"), "META", 4); }, "section META appears twice"},
+      {"twice", [](Bytes& f) { std::memcpy(f.b.data() + f.entry_at("DIRS"), "META", 4); },
+       "section META appears twice"},
       {"unknown_required", [](Bytes& f) { std::memcpy(f.b.data() + f.entry_at("DIRS"), "ZZZZ", 4); },
        "required section ZZZZ is unknown to this reader", ErrorKind::Unsupported},
       {"missing",
@@ -106,15 +111,18 @@ std::vector<Case> cases() {
        },
        "required section DIRS is missing"},
       {"meta_size", [](Bytes& f) { f.set<u64>(f.entry_at("META") + 16, 192); }, "META must be 256 bytes"},
-      {"voxel_size_zero", [](Bytes& f) { f.set<double>(f.meta() + 56, 0.0); }, "voxel size must be finite and positive"},
-      {"voxel_size_nan", [](Bytes& f) { f.set<double>(f.meta() + 56, std::nan("")); }, "voxel size must be finite and positive"},
+      {"voxel_size_zero", [](Bytes& f) { f.set<double>(f.meta() + 56, 0.0); },
+       "voxel size must be finite and positive"},
+      {"voxel_size_nan", [](Bytes& f) { f.set<double>(f.meta() + 56, std::nan("")); },
+       "voxel size must be finite and positive"},
       {"no_orders", [](Bytes& f) { f.set<u32>(f.meta() + 52, 0); }, "stored order count must be 1..64"},
       {"many_orders", [](Bytes& f) { f.set<u32>(f.meta() + 52, 65); }, "stored order count must be 1..64"},
       {"voxel_count", [](Bytes& f) { f.set<u32>(f.meta() + 48, 0x80000000u); }, "voxel count exceeds 2^31-1"},
       {"grid_dims", [](Bytes& f) { f.set<std::int32_t>(f.meta() + 92, -1); }, "negative grid dimension"},
       {"grid_origin", [](Bytes& f) { f.set<double>(f.meta() + 64, INFINITY); }, "non-finite grid origin or bounds"},
       {"bounds", [](Bytes& f) { f.set<double>(f.meta() + 128, std::nan("")); }, "non-finite grid origin or bounds"},
-      {"dirs_size", [](Bytes& f) { f.set<u32>(f.meta() + 52, 4); }, "section DIRS size 48 does not match stored_order_count"},
+      {"dirs_size", [](Bytes& f) { f.set<u32>(f.meta() + 52, 4); },
+       "section DIRS size 48 does not match stored_order_count"},
       {"voxt_size", [](Bytes& f) { f.set<u32>(f.meta() + 48, f.voxel_count() + 1); }, "section VOXT size"},
       {"vert_size", meta_add(16, 1), "section VERT size"},
       {"vxln_size", meta_add(32, 1), "section VXLN size"},
@@ -122,7 +130,8 @@ std::vector<Case> cases() {
       {"strm_overflow", meta_u64(0, std::numeric_limits<u64>::max()), "section STRM size"},
       {"random_without_vdir", [](Bytes& f) { f.set<u32>(f.meta() + 100, static_cast<u32>(OrderSet::Random)); },
        "order set random needs a VDIR section"},
-      {"coord_outside", [](Bytes& f) { f.set<std::int32_t>(f.voxel(0), f.get<std::int32_t>(f.meta() + 88)); }, "voxel coordinate outside the grid"},
+      {"coord_outside", [](Bytes& f) { f.set<std::int32_t>(f.voxel(0), f.get<std::int32_t>(f.meta() + 88)); },
+       "voxel coordinate outside the grid"},
       {"coord_order",
        [](Bytes& f) {
          for (int c = 0; c < 3; ++c) {  // swap the coordinates of the first two voxels
@@ -134,16 +143,20 @@ std::vector<Case> cases() {
        "voxel coordinates not strictly increasing"},
       {"voxel_flags", [](Bytes& f) { f.set<u32>(f.voxel(0) + 12, 3); }, "voxel flags must hold the order width code"},
       {"no_vertices", [](Bytes& f) { f.set<u32>(f.voxel(0) + 48, 0); }, "voxel with no vertices"},
-      {"segments", [](Bytes& f) { f.set<u32>(f.voxel(0) + 52, f.get<u32>(f.voxel(0) + 48)); }, "voxel has as many segments as vertices"},
-      {"contiguous", [](Bytes& f) { f.set<u64>(f.voxel(1) + 40, f.get<u64>(f.voxel(1) + 40) + 1); }, "voxel vertex blocks are not contiguous"},
+      {"segments", [](Bytes& f) { f.set<u32>(f.voxel(0) + 52, f.get<u32>(f.voxel(0) + 48)); },
+       "voxel has as many segments as vertices"},
+      {"contiguous", [](Bytes& f) { f.set<u64>(f.voxel(1) + 40, f.get<u64>(f.voxel(1) + 40) + 1); },
+       "voxel vertex blocks are not contiguous"},
       {"block_past_end",
        [](Bytes& f) {
          const u64 last = f.voxel(f.voxel_count() - 1);
          f.set<u32>(last + 48, f.get<u32>(last + 48) + 1);
        },
        "voxel vertex block runs past vertex_count"},
-      {"order_offset", [](Bytes& f) { f.set<u64>(f.voxel(1) + 56, f.get<u64>(f.voxel(1) + 56) + 2); }, "order offset not a multiple of 4 or decreasing"},
-      {"orders_past_end", [](Bytes& f) { f.set<u64>(f.voxel(f.voxel_count() - 1) + 56, u64(1) << 40); }, "voxel orders run past the ORDR section"},
+      {"order_offset", [](Bytes& f) { f.set<u64>(f.voxel(1) + 56, f.get<u64>(f.voxel(1) + 56) + 2); },
+       "order offset not a multiple of 4 or decreasing"},
+      {"orders_past_end", [](Bytes& f) { f.set<u64>(f.voxel(f.voxel_count() - 1) + 56, u64(1) << 40); },
+       "voxel orders run past the ORDR section"},
       {"blocks_short",
        [](Bytes& f) {
          const u64 last = f.voxel(f.voxel_count() - 1);

@@ -13,20 +13,20 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/convert.h"
-#include "format/error.h"
 #include "converter/pack.h"
 #include "converter/readers/read_tractogram.h"
-#include "tests/reseal_checksums.h"
 #include "converter/synth.h"
-#include "tests/test_support.h"
 #include "converter/unpack.h"
 #include "format/checksum.h"
+#include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"
 #include "format/vxlz_draco.h"
 #include "format/vxlz_package.h"
 #include "format/vxlz_tables.h"
+#include "tests/reseal_checksums.h"
+#include "tests/test_support.h"
 
 namespace vxl {
 namespace {
@@ -78,7 +78,8 @@ std::vector<T> to_vector(std::span<const T> s) {
 double expected_bound(const MetaSection& m, std::uint32_t bits) {
   double range = 0, magnitude = 0;
   for (int c = 0; c < 3; ++c) range = std::max(range, m.bounds_max[c] - m.bounds_min[c]);
-  for (int c = 0; c < 3; ++c) magnitude = std::max({magnitude, std::abs(m.bounds_min[c]), std::abs(m.bounds_min[c] + range)});
+  for (int c = 0; c < 3; ++c)
+    magnitude = std::max({magnitude, std::abs(m.bounds_min[c]), std::abs(m.bounds_min[c] + range)});
   return range / double((1u << bits) - 1) / 2 + std::ldexp(magnitude, -23);
 }
 
@@ -122,7 +123,8 @@ double max_vertex_error(const VxlFile& a, const VxlFile& b) {
   const auto x = a.vertices(), y = b.vertices();
   EXPECT_EQ(x.size(), y.size());
   double worst = 0;
-  for (std::size_t i = 0; i < std::min(x.size(), y.size()); ++i) worst = std::max(worst, std::abs(double(x[i]) - double(y[i])));
+  for (std::size_t i = 0; i < std::min(x.size(), y.size()); ++i)
+    worst = std::max(worst, std::abs(double(x[i]) - double(y[i])));
   return worst;
 }
 
@@ -141,7 +143,8 @@ Streamlines streamlines_of(const VxlFile& f) {
 }
 
 // Checks the whole round trip of `vxl` at `bits` and returns the unpacked file's path.
-std::string round_trip(const ScratchDir& dir, const std::string& vxl, std::uint32_t bits, const PackSettings& base = {}) {
+std::string round_trip(const ScratchDir& dir, const std::string& vxl, std::uint32_t bits,
+                       const PackSettings& base = {}) {
   const std::string packed = dir.file("p" + std::to_string(bits) + ".vxlz");
   const std::string unpacked = dir.file("u" + std::to_string(bits) + ".vxl");
   const VxlFile original = VxlFile::open(vxl);
@@ -196,8 +199,9 @@ TEST(VxlzDraco, ChunkKeepsPointOrderAndDuplicates) {
   std::mt19937 rng(3);
   std::vector<std::int32_t> values(3 * 5000);
   for (std::size_t i = 0; i < values.size(); ++i)
-    values[i] = i % 7 == 0 ? 0 : i % 5 == 0 ? static_cast<std::int32_t>(rng() % 200001) - 100000
-                                            : static_cast<std::int32_t>(rng() % 9) - 4;
+    values[i] = i % 7 == 0   ? 0
+                : i % 5 == 0 ? static_cast<std::int32_t>(rng() % 200001) - 100000
+                             : static_cast<std::int32_t>(rng() % 9) - 4;
   for (std::size_t i = 300; i < 600; ++i) values[i] = 42;  // a run of identical points
   for (std::uint32_t t = kVxlzMinJointBits; t <= kVxlzMaxJointBits; ++t) {
     SCOPED_TRACE(t);
@@ -222,7 +226,7 @@ TEST(VxlzDraco, ChunkKeepsPointOrderAndDuplicates) {
 TEST(VxlzDraco, JointSymbols) {
   const std::int32_t zero[3] = {0, 0, 0}, mixed[3] = {-1, 1, 0}, edge[3] = {-4, 3, -4}, wide[3] = {4, 0, 0};
   EXPECT_EQ(joint_symbol(zero, 3), 1u);
-  EXPECT_EQ(joint_symbol(mixed, 3), 1u + 1u + (2u << 3));  // zigzag: -1 -> 1, 1 -> 2
+  EXPECT_EQ(joint_symbol(mixed, 3), 1u + 1u + (2u << 3));             // zigzag: -1 -> 1, 1 -> 2
   EXPECT_EQ(joint_symbol(edge, 3), 1u + 7u + (6u << 3) + (7u << 6));  // the largest symbol is 2^9
   EXPECT_EQ(joint_symbol(wide, 3), 0u) << "zigzag(4) = 8 needs 4 bits: escape";
   EXPECT_EQ(joint_symbol(wide, 4), 1u + 8u);
@@ -380,7 +384,8 @@ class DamagedVxlz : public ::testing::Test {
 TEST_F(DamagedVxlz, TheGoodPackageUnpacks) {
   unpack_vxlz(good(), out(), {});
   EXPECT_TRUE(verify_vxl(out()).valid);
-  EXPECT_TRUE(VxlzFile::open(good()).has_section(section_id("PVAL")) && VxlzFile::open(good()).has_section(section_id("SVAL")));
+  EXPECT_TRUE(VxlzFile::open(good()).has_section(section_id("PVAL")) &&
+              VxlzFile::open(good()).has_section(section_id("SVAL")));
   EXPECT_EQ(VxlFile::open(out()).vertex_values().size(), 1u);
   EXPECT_GT(VxlzFile::open(good()).chunk_count(), 3u);
 }
@@ -574,7 +579,8 @@ TEST_F(DamagedVxlz, CraftedPackagesWithValidChecksumsAreRefused) {
     c.chunks[0].escapes.clear();
     expect_crafted_refused(c, "escapes missing");
     c.chunks[0].escapes = encode_residual_chunk(std::vector<std::int32_t>(3 * (c.pack.chunk_points - 1), 1000),
-                                                c.pack.joint_bits).escapes;  // one escape too few
+                                                c.pack.joint_bits)
+                              .escapes;  // one escape too few
     expect_crafted_refused(c, "escapes short");
   }
   {

@@ -90,8 +90,9 @@ class VtpBuilder {
   std::string file(const std::string& piece_attributes, const std::string& body) const {
     std::string x = "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"" +
                     std::string(s_.big_endian ? "BigEndian" : "LittleEndian") + "\" header_type=\"" +
-                    (s_.uint64_header ? "UInt64" : "UInt32") + "\"" + (s_.zlib ? " compressor=\"vtkZLibDataCompressor\"" : "") +
-                    ">\n<PolyData>\n<Piece " + piece_attributes + ">\n" + body + "</Piece>\n</PolyData>\n";
+                    (s_.uint64_header ? "UInt64" : "UInt32") + "\"" +
+                    (s_.zlib ? " compressor=\"vtkZLibDataCompressor\"" : "") + ">\n<PolyData>\n<Piece " +
+                    piece_attributes + ">\n" + body + "</Piece>\n</PolyData>\n";
     if (s_.format == "appended")
       x += "<AppendedData encoding=\"" + std::string(s_.appended_base64 ? "base64" : "raw") + "\">\n   _" + appended_ +
            "\n</AppendedData>\n";
@@ -131,7 +132,8 @@ class VtpBuilder {
 // The tractogram of the synthetic files: 3 streamlines (3, 1 and 2 points) over 5 points, the third
 // streamline using points out of order and twice, one point data array, one 2-component cell data array.
 struct SmallPolyData {
-  std::vector<float> points = {0.5f, 1.25f, -2.0f, 1.0f / 3.0f, 4.0f, 5.0f, -7.5f, 8.0f, 9.0f, 10.0f, 11.0f, 12.0f, 1e-7f, -0.0f, 3.0f};
+  std::vector<float> points = {0.5f, 1.25f, -2.0f, 1.0f / 3.0f, 4.0f,  5.0f,  -7.5f, 8.0f,
+                               9.0f, 10.0f, 11.0f, 12.0f,       1e-7f, -0.0f, 3.0f};
   std::vector<std::int32_t> connectivity = {0, 1, 2, 4, 3, 0};
   std::vector<std::int32_t> offsets = {3, 4, 6};  // VTP: end offsets
   std::vector<float> point_values = {1, 2, 3, 4, 5};

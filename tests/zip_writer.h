@@ -18,7 +18,7 @@ using Bytes = std::vector<std::uint8_t>;
 
 struct ZipEntry {
   std::string name;
-  Bytes data;              // as stored in the archive: raw or raw-deflated
+  Bytes data;  // as stored in the archive: raw or raw-deflated
   bool deflated = false;
   std::uint32_t size = 0;  // uncompressed size the directory declares
   std::uint32_t crc = 0;

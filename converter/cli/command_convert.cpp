@@ -3,13 +3,13 @@
 #include <string>
 
 #include "converter/cli/commands.h"
-#include "converter/convert.h"
 #include "converter/cli/convert_cohort.h"
 #include "converter/cli/convert_file.h"
-#include "format/error.h"
-#include "converter/memory_size.h"
 #include "converter/cli/progress_bar.h"
+#include "converter/convert.h"
+#include "converter/memory_size.h"
 #include "converter/segment_orders.h"
+#include "format/error.h"
 
 namespace vxl::cli {
 namespace {
@@ -42,20 +42,26 @@ void add_convert_command(CLI::App& app) {
       "  voxlines convert IN OUT.vxl\n"
       "  voxlines convert IN... --output-dir DIR [--jobs N]    (a cohort: DIR/NAME.vxl for each IN)");
   cmd->add_option("files", opt->files,
-                  "IN OUT.vxl: the source tractogram (.tck, .trk, .trk.gz, .trx zip or directory, .vtk legacy POLYDATA, .vtp XML PolyData) and the output "
+                  "IN OUT.vxl: the source tractogram (.tck, .trk, .trk.gz, .trx zip or directory, .vtk legacy "
+                  "POLYDATA, .vtp XML PolyData) and the output "
                   "(written atomically); with --output-dir: one or more sources")
       ->required();
-  CLI::Option* output_dir = cmd->add_option("--output-dir", opt->output_dir,
-                  "convert every input FILE into DIR/NAME.vxl (NAME: FILE's name without .tck/.trk/.trk.gz/.trx; "
-                  "two inputs with the same NAME are refused; DIR is created when missing). A file that fails is "
-                  "reported and the others go on; a last line says how many converted and failed")
-      ->type_name("DIR");
-  CLI::Option* jobs = cmd->add_option("--jobs", opt->jobs,
-                  "with --output-dir: convert N files at once, each with --threads / N worker threads (at least 1; "
-                  "N is at most the number of inputs)")
-      ->type_name("N")->default_val(1)->check(CLI::Range(1u, 4096u));
+  CLI::Option* output_dir =
+      cmd->add_option("--output-dir", opt->output_dir,
+                      "convert every input FILE into DIR/NAME.vxl (NAME: FILE's name without .tck/.trk/.trk.gz/.trx; "
+                      "two inputs with the same NAME are refused; DIR is created when missing). A file that fails is "
+                      "reported and the others go on; a last line says how many converted and failed")
+          ->type_name("DIR");
+  CLI::Option* jobs =
+      cmd->add_option("--jobs", opt->jobs,
+                      "with --output-dir: convert N files at once, each with --threads / N worker threads (at least 1; "
+                      "N is at most the number of inputs)")
+          ->type_name("N")
+          ->default_val(1)
+          ->check(CLI::Range(1u, 4096u));
   cmd->add_option("--voxel-size", opt->settings.voxel_size, "voxel edge length in mm")
-      ->default_val(10.0)->check(CLI::PositiveNumber);
+      ->default_val(10.0)
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", opt->settings.threads,
                   "worker threads in all (0: all cores); --jobs N shares them, each file getting threads / N")
       ->default_val(0);
@@ -71,22 +77,25 @@ void add_convert_command(CLI::App& app) {
           return e.reason();
         }
       });
-  cmd->add_option("--memory-limit", opt->memory_limit,
-                  "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): reads the source several times and writes the "
-                  "output in parts, byte-identical to a conversion without the limit. TCK sources only (TRK/TRX are "
-                  "refused); a limit too small for the data is refused, naming what needs how much. With --output-dir "
-                  "the limit is per file: --jobs N may use N times SIZE")
+  cmd->add_option(
+         "--memory-limit", opt->memory_limit,
+         "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): reads the source several times and writes the "
+         "output in parts, byte-identical to a conversion without the limit. TCK sources only (TRK/TRX are "
+         "refused); a limit too small for the data is refused, naming what needs how much. With --output-dir "
+         "the limit is per file: --jobs N may use N times SIZE")
       ->type_name("SIZE")
       ->check(CLI::Validator(
           [](std::string& s) {
-            return parse_memory_size(s) ? std::string()
-                                        : "'" + s + "' is not a memory size (a number of bytes, or of KiB/MiB/GiB with K/M/G: 512M, 2G)";
+            return parse_memory_size(s)
+                       ? std::string()
+                       : "'" + s + "' is not a memory size (a number of bytes, or of KiB/MiB/GiB with K/M/G: 512M, 2G)";
           },
           ""));
   cmd->add_option("--tsf", opt->tsf,
                   "MRtrix track scalar file with one value per point of the input (repeatable); stored so that voxview "
                   "can colour by it (--color scalar). Refused with several inputs")
-      ->expected(1)->take_all();
+      ->expected(1)
+      ->take_all();
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
   cmd->footer(
       "Exit codes with --output-dir: 0 every file converted; otherwise the code of the failures' kind of error when "
@@ -101,7 +110,8 @@ void add_convert_command(CLI::App& app) {
       if (opt->verbose) std::printf("peak resident memory: %lld KiB\n", peak_resident_kib());
       return;
     }
-    if (jobs->count() > 0) throw CLI::ValidationError("--jobs converts several files at once: it needs --output-dir DIR");
+    if (jobs->count() > 0)
+      throw CLI::ValidationError("--jobs converts several files at once: it needs --output-dir DIR");
     if (opt->files.size() != 2)
       throw CLI::ValidationError("convert takes IN OUT.vxl, or IN... --output-dir DIR (got " +
                                  std::to_string(opt->files.size()) + " file names)");

@@ -2,10 +2,10 @@
 #include <cstdio>
 
 #include "converter/cli/commands.h"
-#include "format/error.h"
 #include "converter/export_tck.h"
 #include "converter/export_trx.h"
 #include "converter/export_vtk.h"
+#include "format/error.h"
 
 namespace vxl::cli {
 
@@ -16,19 +16,23 @@ void add_export_command(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "export", "Write the original streamlines of a .vxl back to TCK, TRX or legacy VTK (chosen by the output's extension)");
+      "export",
+      "Write the original streamlines of a .vxl back to TCK, TRX or legacy VTK (chosen by the output's extension)");
   cmd->add_option("input", opt->input, ".vxl file")->required();
-  cmd->add_option("output", opt->output,
-                  "output .tck (Float32LE), .trx (zip, stored: float32 positions, uint64 offsets, groups, dpv and dps kept) "
-                  "or .vtk (legacy BINARY POLYDATA, values kept as POINT_DATA / CELL_DATA scalars); written atomically")
+  cmd->add_option(
+         "output", opt->output,
+         "output .tck (Float32LE), .trx (zip, stored: float32 positions, uint64 offsets, groups, dpv and dps kept) "
+         "or .vtk (legacy BINARY POLYDATA, values kept as POINT_DATA / CELL_DATA scalars); written atomically")
       ->required();
-  cmd->add_option("--tsf", opt->tck.tsf_path, "with a .tck output: also write one per-point value set as an MRtrix TSF");
+  cmd->add_option("--tsf", opt->tck.tsf_path,
+                  "with a .tck output: also write one per-point value set as an MRtrix TSF");
   cmd->add_option("--value", opt->tck.value, "the per-point value set for --tsf (default: the first)");
   cmd->callback([opt] {
     std::string lower = opt->output;
     std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
     const bool tck = lower.ends_with(".tck"), trx = lower.ends_with(".trx"), vtk = lower.ends_with(".vtk");
-    if (!tck && !trx && !vtk) throw Error(ErrorKind::Usage, opt->output, std::nullopt, "export writes .tck, .trx or .vtk files");
+    if (!tck && !trx && !vtk)
+      throw Error(ErrorKind::Usage, opt->output, std::nullopt, "export writes .tck, .trx or .vtk files");
     if (!tck && (opt->tck.tsf_path || opt->tck.value))
       throw Error(ErrorKind::Usage, opt->output, std::nullopt,
                   "--tsf and --value go with a .tck output (a .trx or .vtk holds every value set)");

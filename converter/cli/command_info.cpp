@@ -58,7 +58,8 @@ void add_info_command(CLI::App& app) {
     j["sections"] = sections;
     auto sets = [](const ValueSets& v) {
       nlohmann::json a = nlohmann::json::array();
-      for (std::uint32_t k = 0; k < v.size(); ++k) a.push_back({{"name", v.name(k)}, {"min", v.min(k)}, {"max", v.max(k)}});
+      for (std::uint32_t k = 0; k < v.size(); ++k)
+        a.push_back({{"name", v.name(k)}, {"min", v.min(k)}, {"max", v.max(k)}});
       return a;
     };
     j["vertex_values"] = sets(f.vertex_values());
@@ -69,7 +70,8 @@ void add_info_command(CLI::App& app) {
     auto prov = nlohmann::json::parse(f.provenance_json(), nullptr, false);
     if (prov.is_object() && prov.contains("source") && prov["source"].is_object()) {
       const nlohmann::json& src = prov["source"];
-      j["source"] = {{"name", string_field(src, "name")}, {"format", string_field(src, "format")},
+      j["source"] = {{"name", string_field(src, "name")},
+                     {"format", string_field(src, "format")},
                      {"bytes", count_field(src, "bytes")}};
     }
     if (opt->json) {
@@ -81,18 +83,18 @@ void add_info_command(CLI::App& app) {
                 (unsigned long long)f.bytes().size());
     if (j.contains("source"))
       std::printf("source        %s (%s, %llu bytes)\n", j["source"]["name"].get<std::string>().c_str(),
-                  j["source"]["format"].get<std::string>().c_str(), (unsigned long long)j["source"]["bytes"].get<std::uint64_t>());
+                  j["source"]["format"].get<std::string>().c_str(),
+                  (unsigned long long)j["source"]["bytes"].get<std::uint64_t>());
     std::printf("streamlines   %llu\npoints        %llu\nvoxels        %u (grid %d x %d x %d)\n",
-                (unsigned long long)m.streamline_count, (unsigned long long)m.point_count, m.voxel_count, m.grid_dims[0],
-                m.grid_dims[1], m.grid_dims[2]);
+                (unsigned long long)m.streamline_count, (unsigned long long)m.point_count, m.voxel_count,
+                m.grid_dims[0], m.grid_dims[1], m.grid_dims[2]);
     std::printf("segments      %llu\nvertices      %llu (%llu points added at voxel faces)\n",
                 (unsigned long long)m.segment_count, (unsigned long long)m.vertex_count,
                 (unsigned long long)m.synthetic_point_count);
     std::printf("voxel size    %g mm\norders        %u stored (x2 by reversal)\n", m.voxel_size, m.stored_order_count);
     std::printf("bounds        [%.3f, %.3f, %.3f] .. [%.3f, %.3f, %.3f] mm\nsections     ", m.bounds_min[0],
                 m.bounds_min[1], m.bounds_min[2], m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]);
-    for (const SectionEntry& e : f.sections())
-      std::printf(" %.4s:%llu", e.id, (unsigned long long)e.size);
+    for (const SectionEntry& e : f.sections()) std::printf(" %.4s:%llu", e.id, (unsigned long long)e.size);
     std::printf("\n");
     for (const char* kind : {"vertex_values", "streamline_values"})
       for (const auto& v : j[kind])

@@ -12,14 +12,16 @@ void add_pack_command(CLI::App& app) {
     PackSettings settings;
   };
   auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand(
-      "pack", "Compress a .vxl into a .vxlz package for sharing: tables exact, positions quantised\n"
-              "(error at most half a quantum of range / (2^bits - 1)) and Draco-coded, value sets exact\n"
-              "(spec/vxlz-package-v2.md)");
+  CLI::App* cmd =
+      app.add_subcommand("pack",
+                         "Compress a .vxl into a .vxlz package for sharing: tables exact, positions quantised\n"
+                         "(error at most half a quantum of range / (2^bits - 1)) and Draco-coded, value sets exact\n"
+                         "(spec/vxlz-package-v2.md)");
   cmd->add_option("input", opt->input, ".vxl file")->required();
   cmd->add_option("output", opt->output, "output .vxlz package (written atomically)")->required();
   cmd->add_option("--bits", opt->settings.bits, "quantisation bits per coordinate over the data's bounding cube")
-      ->default_val(kVxlzDefaultBits)->check(CLI::Range(kVxlzMinBits, kVxlzMaxBits));
+      ->default_val(kVxlzDefaultBits)
+      ->check(CLI::Range(kVxlzMinBits, kVxlzMaxBits));
   cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
   cmd->callback([opt] {
     VxlFile f = VxlFile::open(opt->input);
@@ -28,11 +30,13 @@ void add_pack_command(CLI::App& app) {
     std::printf("%s: %llu streamlines, %llu points -> %llu bytes (%.3f bytes per point, %.3fx the .vxl)\n",
                 opt->output.c_str(), (unsigned long long)s.streamlines, (unsigned long long)s.points,
                 (unsigned long long)s.bytes, per_point, double(s.bytes) / double(f.bytes().size()));
-    std::printf("positions: %u bits over a %.3f mm cube, quantum %.6f mm; error bound %.6f mm, measured max %.6f mm, RMS %.6f mm\n",
-                s.pack.quantization_bits, s.pack.range, s.pack.quantum, s.pack.error_bound, s.pack.max_error,
-                s.pack.rms_error);
+    std::printf(
+        "positions: %u bits over a %.3f mm cube, quantum %.6f mm; error bound %.6f mm, measured max %.6f mm, RMS %.6f "
+        "mm\n",
+        s.pack.quantization_bits, s.pack.range, s.pack.quantum, s.pack.error_bound, s.pack.max_error, s.pack.rms_error);
     if (s.point_value_sets + s.streamline_value_sets > 0)
-      std::printf("values: %u per-point and %u per-streamline set(s), exact\n", s.point_value_sets, s.streamline_value_sets);
+      std::printf("values: %u per-point and %u per-streamline set(s), exact\n", s.point_value_sets,
+                  s.streamline_value_sets);
   });
 }
 

@@ -15,7 +15,8 @@ void add_synth_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "synth", "Generate a deterministic whole-brain-like tractogram (bundles of smooth ~1 mm-step curves) as TCK");
   cmd->add_option("output", opt->output, "output .tck")->required();
-  cmd->add_option("--streamlines", opt->settings.streamlines, "number of streamlines")->default_val(144000)
+  cmd->add_option("--streamlines", opt->settings.streamlines, "number of streamlines")
+      ->default_val(144000)
       ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
   cmd->add_option("--seed", opt->settings.seed, "random seed")->default_val(1);
   cmd->callback([opt] {

@@ -24,11 +24,13 @@ void add_unpack_command(CLI::App& app) {
     opt->settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
     UnpackSummary s = unpack_vxlz(opt->input, opt->output, opt->settings);
     bar.done();
-    std::printf("%s: %llu streamlines, %llu points, %llu voxels; positions within %.6f mm of the packed file (%u bits)\n",
-                opt->output.c_str(), (unsigned long long)s.streamlines, (unsigned long long)s.points,
-                (unsigned long long)s.voxels, s.pack.error_bound, s.pack.quantization_bits);
+    std::printf(
+        "%s: %llu streamlines, %llu points, %llu voxels; positions within %.6f mm of the packed file (%u bits)\n",
+        opt->output.c_str(), (unsigned long long)s.streamlines, (unsigned long long)s.points,
+        (unsigned long long)s.voxels, s.pack.error_bound, s.pack.quantization_bits);
     if (s.point_value_sets + s.streamline_value_sets > 0)
-      std::printf("values: %u per-point and %u per-streamline set(s), exact\n", s.point_value_sets, s.streamline_value_sets);
+      std::printf("values: %u per-point and %u per-streamline set(s), exact\n", s.point_value_sets,
+                  s.streamline_value_sets);
     if (opt->verbose)
       std::printf("stages: decode %.3f s, orders %.3f s, write %.3f s\n", s.decode_seconds, s.orders_seconds,
                   s.write_seconds);

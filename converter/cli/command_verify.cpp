@@ -7,9 +7,10 @@ namespace vxl::cli {
 
 void add_verify_command(CLI::App& app) {
   auto file = std::make_shared<std::string>();
-  CLI::App* cmd = app.add_subcommand(
-      "verify", "Check a .vxl completely: structure, every checksum, padding, orders, streamline tables.\n"
-                "Exit 0 when valid, 1 when invalid (the reason is printed).");
+  CLI::App* cmd =
+      app.add_subcommand("verify",
+                         "Check a .vxl completely: structure, every checksum, padding, orders, streamline tables.\n"
+                         "Exit 0 when valid, 1 when invalid (the reason is printed).");
   cmd->add_option("file", *file, ".vxl file")->required();
   cmd->callback([file] {
     VerifyResult r = verify_vxl(*file);

@@ -16,9 +16,9 @@
 #include <unistd.h>
 
 #include "converter/cli/convert_file.h"
+#include "converter/cli/progress_bar.h"
 #include "format/error.h"
 #include "format/parallel.h"
-#include "converter/cli/progress_bar.h"
 
 namespace vxl::cli {
 namespace {
@@ -78,8 +78,9 @@ unsigned threads_per_job(unsigned threads, unsigned jobs) {
 int run_cohort(const CohortOptions& o) {
   const std::size_t n = o.inputs.size();
   if (!o.tsf.empty() && n > 1)
-    throw Error(ErrorKind::Usage, o.inputs[1], std::nullopt,
-                "--tsf values belong to one tractogram: give a single input with --tsf, or convert the others without it");
+    throw Error(
+        ErrorKind::Usage, o.inputs[1], std::nullopt,
+        "--tsf values belong to one tractogram: give a single input with --tsf, or convert the others without it");
 
   // Distinct output names first: a refused command line must not create DIR or start any file.
   std::vector<std::string> outputs(n);

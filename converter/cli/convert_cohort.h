@@ -13,7 +13,7 @@ struct CohortOptions {
   std::vector<std::string> inputs;
   std::string output_dir;
   unsigned jobs = 1;
-  ConvertSettings settings;  // threads: in all (0: all cores), shared among the jobs; memory_limit: per file
+  ConvertSettings settings;      // threads: in all (0: all cores), shared among the jobs; memory_limit: per file
   std::vector<std::string> tsf;  // only with a single input
   bool verbose = false;
 };

@@ -3,11 +3,11 @@
 #include <chrono>
 #include <cstdio>
 
-#include "format/error.h"
 #include "converter/memory_size.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "converter/streaming_convert.h"
+#include "format/error.h"
 
 namespace vxl::cli {
 
@@ -32,9 +32,10 @@ std::string convert_file(const std::string& input, const std::string& output, co
     s = convert_tractogram(std::move(t), output, settings);
   }
   char line[512];
-  std::snprintf(line, sizeof line, ": %llu streamlines, %llu points -> %llu voxels, %llu segments (%llu points added at voxel faces)\n",
-                (unsigned long long)s.streamlines, (unsigned long long)s.points,
-                (unsigned long long)s.voxels, (unsigned long long)s.segments, (unsigned long long)s.synthetic_points);
+  std::snprintf(line, sizeof line,
+                ": %llu streamlines, %llu points -> %llu voxels, %llu segments (%llu points added at voxel faces)\n",
+                (unsigned long long)s.streamlines, (unsigned long long)s.points, (unsigned long long)s.voxels,
+                (unsigned long long)s.segments, (unsigned long long)s.synthetic_points);
   std::string report = output + line;
   if (settings.memory_limit > 0) {
     std::snprintf(line, sizeof line, "memory limit %s: %llu passes over the source, voxels built in %llu parts\n",

@@ -26,9 +26,10 @@ void keep_freed_memory() {
 
 int main(int argc, char** argv) {
   keep_freed_memory();
-  CLI::App app{"voxlines " VOXLINES_VERSION
-               " — voxel-chunked tractograms for fast, correct-looking transparency.\n"
-               "Exit codes: 0 ok, 1 verify found the file invalid, 2 usage, 3 bad input, 4 unsupported, 5 output error."};
+  CLI::App app{
+      "voxlines " VOXLINES_VERSION
+      " — voxel-chunked tractograms for fast, correct-looking transparency.\n"
+      "Exit codes: 0 ok, 1 verify found the file invalid, 2 usage, 3 bad input, 4 unsupported, 5 output error."};
   app.set_version_flag("--version", VOXLINES_VERSION);
   app.require_subcommand(1);
   vxl::cli::add_convert_command(app);

@@ -93,7 +93,8 @@ std::optional<MrtrixHeader> parse_mrtrix_header(const std::string& path, std::sp
   }
   if (h.data_offset < pos) fail_input(path, h.data_offset, name + " data offset points inside the header");
   if (h.data_offset > file_size)
-    fail_input(path, h.data_offset, name + " data offset is past the end of the file (" + std::to_string(file_size) + " bytes)");
+    fail_input(path, h.data_offset,
+               name + " data offset is past the end of the file (" + std::to_string(file_size) + " bytes)");
   if (h.fields.contains("count")) {
     // Digits only: std::stoull would read "-5" as 2^64 - 5. A malformed count is as good as a stale one.
     const std::string text = h.fields["count"].back().get<std::string>();
@@ -109,7 +110,8 @@ std::optional<std::string> count_warning(const MrtrixHeader& h, std::uint64_t st
   if (!h.count_text) return std::nullopt;
   const std::string data = "the data (" + std::to_string(streamlines) + " streamlines)";
   if (!h.count) return "header count '" + *h.count_text + "' is not a number of streamlines; " + data + " is trusted";
-  if (*h.count != streamlines) return "header count " + *h.count_text + " disagrees with " + data + ": the data is trusted";
+  if (*h.count != streamlines)
+    return "header count " + *h.count_text + " disagrees with " + data + ": the data is trusted";
   return std::nullopt;
 }
 

@@ -21,7 +21,7 @@ struct MrtrixHeader {
   std::string datatype;
   std::uint64_t data_offset = 0;
   std::optional<std::string> count_text;  // "count" as the header spells it (warnings quote it)
-  std::optional<std::uint64_t> count;     // count_text, when it is a decimal number (it may be stale: the data is trusted)
+  std::optional<std::uint64_t> count;  // count_text, when it is a decimal number (it may be stale: the data is trusted)
   // The last value of `key`, if present.
   std::optional<std::string> last(const char* key) const;
 };
@@ -57,8 +57,10 @@ Real load_mrtrix_value(const std::uint8_t* p) {
   Bits bits;
   std::memcpy(&bits, p, sizeof bits);
   if constexpr (kBigEndian) {
-    if constexpr (sizeof(Bits) == 4) bits = __builtin_bswap32(bits);
-    else bits = __builtin_bswap64(bits);
+    if constexpr (sizeof(Bits) == 4)
+      bits = __builtin_bswap32(bits);
+    else
+      bits = __builtin_bswap64(bits);
   }
   return std::bit_cast<Real>(bits);
 }

@@ -8,12 +8,12 @@
 // whose x is Inf ends the file. Like MRtrix we tolerate a missing Inf terminator at EOF, and trust the data
 // over a stale "count"; unlike MRtrix we warn about data it ignores (after the terminator, or cut by an Inf
 // x that is no whole terminator).
-#include "format/checksum.h"
-#include "format/error.h"
-#include "format/mapped_file.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/regular_file.h"
 #include "converter/readers/tck_format.h"
+#include "format/checksum.h"
+#include "format/error.h"
+#include "format/mapped_file.h"
 
 namespace vxl {
 namespace tck {
@@ -25,7 +25,8 @@ void finish(const DecodeState& s, std::uint64_t trailing, Tractogram& t, std::ve
     warnings.push_back(w);
     if (s.points_in_current > 0) {
       t.offsets.push_back(t.point_count());
-      warnings.push_back("last streamline (" + std::to_string(s.points_in_current) + " points) has no NaN delimiter: kept");
+      warnings.push_back("last streamline (" + std::to_string(s.points_in_current) +
+                         " points) has no NaN delimiter: kept");
     }
   } else {
     // MRtrix ignores all this silently; we warn, as the user loses data.
@@ -33,8 +34,7 @@ void finish(const DecodeState& s, std::uint64_t trailing, Tractogram& t, std::ve
       warnings.push_back("the data ends at byte " + std::to_string(*s.partial_terminator) +
                          " at a point whose x is Inf but which is not the terminator (Inf, Inf, Inf): the point and "
                          "everything after it are ignored");
-    if (trailing != 0)
-      warnings.push_back(std::to_string(trailing) + " bytes after the Inf terminator ignored");
+    if (trailing != 0) warnings.push_back(std::to_string(trailing) + " bytes after the Inf terminator ignored");
     // MRtrix writes a NaN before the Inf; without it the points still form a streamline.
     if (s.points_in_current > 0) t.offsets.push_back(t.point_count());
   }
@@ -56,7 +56,8 @@ void read_points(const std::string& path, std::span<const std::uint8_t> bytes, s
   const std::uint64_t available = (bytes.size() - offset) / kTriplet;
   t.positions.reserve(3 * available);
   tck::DecodeState s;
-  const std::uint64_t used = tck::decode<Real, kBigEndian>(path, bytes.data() + offset, available, offset, t, s, ~std::uint64_t(0));
+  const std::uint64_t used =
+      tck::decode<Real, kBigEndian>(path, bytes.data() + offset, available, offset, t, s, ~std::uint64_t(0));
   tck::finish(s, bytes.size() - offset - used * kTriplet, t, t.source.warnings);
 }
 
@@ -75,11 +76,16 @@ Tractogram read_tck(const std::string& path) {
   t.source.header = h.fields;
 
   const std::string& dt = h.datatype;
-  if (dt == "Float32LE") read_points<float, false>(path, file.bytes(), h.data_offset, t);
-  else if (dt == "Float32BE") read_points<float, true>(path, file.bytes(), h.data_offset, t);
-  else if (dt == "Float64LE") read_points<double, false>(path, file.bytes(), h.data_offset, t);
-  else if (dt == "Float64BE") read_points<double, true>(path, file.bytes(), h.data_offset, t);
-  else fail_unsupported(path, "TCK datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+  if (dt == "Float32LE")
+    read_points<float, false>(path, file.bytes(), h.data_offset, t);
+  else if (dt == "Float32BE")
+    read_points<float, true>(path, file.bytes(), h.data_offset, t);
+  else if (dt == "Float64LE")
+    read_points<double, false>(path, file.bytes(), h.data_offset, t);
+  else if (dt == "Float64BE")
+    read_points<double, true>(path, file.bytes(), h.data_offset, t);
+  else
+    fail_unsupported(path, "TCK datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
 
   tck::header_warnings(h, t.streamline_count(), t.source.warnings);
   return t;

@@ -1,8 +1,8 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "format/error.h"
 #include "converter/readers/read_tractogram.h"
+#include "format/error.h"
 
 namespace vxl {
 
@@ -19,8 +19,9 @@ Tractogram read_tractogram(const std::string& path) {
   if (!std::filesystem::exists(path)) fail_input(path, std::nullopt, "no such file");
   std::string what = "unsupported file type";
   if (ends(".tsf")) what = "a TSF file holds per-point scalars, not streamlines";
-  throw Error(ErrorKind::Unsupported, path, std::nullopt,
-              what + " (supported: .tck, .trk, .trk.gz, .trx zip or directory, .vtk legacy POLYDATA, .vtp XML PolyData)");
+  throw Error(
+      ErrorKind::Unsupported, path, std::nullopt,
+      what + " (supported: .tck, .trk, .trk.gz, .trx zip or directory, .vtk legacy POLYDATA, .vtp XML PolyData)");
 }
 
 }  // namespace vxl

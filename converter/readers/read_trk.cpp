@@ -30,12 +30,12 @@
 
 #include <zlib.h>
 
-#include "format/checksum.h"
-#include "format/error.h"
-#include "format/mapped_file.h"
 #include "converter/readers/latin1.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/regular_file.h"
+#include "format/checksum.h"
+#include "format/error.h"
+#include "format/mapped_file.h"
 
 namespace vxl {
 namespace {
@@ -43,20 +43,20 @@ namespace {
 constexpr std::size_t kHeaderSize = 1000;
 
 // Byte offsets of the header fields (TrackVis header layout).
-constexpr std::size_t kOffDim = 6;               // int16[3]
-constexpr std::size_t kOffVoxelSize = 12;        // float32[3]
-constexpr std::size_t kOffOrigin = 24;           // float32[3] (unused by TrackVis and nibabel)
-constexpr std::size_t kOffNScalars = 36;         // int16
-constexpr std::size_t kOffScalarNames = 38;      // char[10][20]
-constexpr std::size_t kOffNProperties = 238;     // int16
-constexpr std::size_t kOffPropertyNames = 240;   // char[10][20]
-constexpr std::size_t kOffVoxToRas = 440;        // float32[4][4], row-major (version 2 only)
-constexpr std::size_t kOffVoxelOrder = 948;      // char[4]
-constexpr std::size_t kOffImageOrient = 956;     // float32[6]
-constexpr std::size_t kOffInvertSwap = 982;      // uint8 invert_x, invert_y, invert_z, swap_xy, swap_yz, swap_zx
-constexpr std::size_t kOffNCount = 988;          // int32
-constexpr std::size_t kOffVersion = 992;         // int32
-constexpr std::size_t kOffHdrSize = 996;         // int32
+constexpr std::size_t kOffDim = 6;              // int16[3]
+constexpr std::size_t kOffVoxelSize = 12;       // float32[3]
+constexpr std::size_t kOffOrigin = 24;          // float32[3] (unused by TrackVis and nibabel)
+constexpr std::size_t kOffNScalars = 36;        // int16
+constexpr std::size_t kOffScalarNames = 38;     // char[10][20]
+constexpr std::size_t kOffNProperties = 238;    // int16
+constexpr std::size_t kOffPropertyNames = 240;  // char[10][20]
+constexpr std::size_t kOffVoxToRas = 440;       // float32[4][4], row-major (version 2 only)
+constexpr std::size_t kOffVoxelOrder = 948;     // char[4]
+constexpr std::size_t kOffImageOrient = 956;    // float32[6]
+constexpr std::size_t kOffInvertSwap = 982;     // uint8 invert_x, invert_y, invert_z, swap_xy, swap_yz, swap_zx
+constexpr std::size_t kOffNCount = 988;         // int32
+constexpr std::size_t kOffVersion = 992;        // int32
+constexpr std::size_t kOffHdrSize = 996;        // int32
 
 // Reads numbers of the file's byte order from an in-memory buffer. Callers bounds-check first; loads
 // go through memcpy because nothing in a TRK file is aligned beyond 4 bytes and the header-relative
@@ -132,13 +132,14 @@ std::vector<std::string> value_names(const std::uint8_t* slots, int count, const
       multiple = 0;
       for (std::size_t k = n + 1; k < 20 && p[k] >= '0' && p[k] <= '9'; ++k) multiple = multiple * 10 + (p[k] - '0');
     }
-    if (multiple == 1) names.push_back(name);
+    if (multiple == 1)
+      names.push_back(name);
     else
       for (int k = 0; k < multiple; ++k) names.push_back(name + "[" + std::to_string(k) + "]");
   }
   if (static_cast<int>(names.size()) != count)
-    warnings.push_back(std::string("the header names ") + std::to_string(names.size()) + " " + fallback + " values but holds " +
-                       std::to_string(count) + "; unnamed ones are called " + fallback + "_<k>");
+    warnings.push_back(std::string("the header names ") + std::to_string(names.size()) + " " + fallback +
+                       " values but holds " + std::to_string(count) + "; unnamed ones are called " + fallback + "_<k>");
   names.resize(count);
   for (int k = 0; k < count; ++k)
     if (names[k].empty()) names[k] = std::string(fallback) + "_" + std::to_string(k);
@@ -275,9 +276,7 @@ Mat4 reorient(const Orientation& header, const Orientation& affine, const std::a
   return m;
 }
 
-bool is_gzip(const MappedFile& file) {
-  return file.size() >= 2 && file.data()[0] == 0x1F && file.data()[1] == 0x8B;
-}
+bool is_gzip(const MappedFile& file) { return file.size() >= 2 && file.data()[0] == 0x1F && file.data()[1] == 0x8B; }
 
 // A .trk.gz may inflate at most this many times its own size (plus kInflateSlack). Real tractograms
 // compress 1.2-3x (float coordinates); deflate reaches ~1000x only on repetitive data such as the
@@ -353,18 +352,21 @@ class TrkBytes {
         continue;
       }
       if (r != Z_OK && r != Z_BUF_ERROR)
-        fail_input(path_, at, "corrupt gzip stream after " + std::to_string(inflated()) + " decompressed bytes: " +
-                                  (z_.msg ? z_.msg : "zlib error " + std::to_string(r)));
+        fail_input(path_, at,
+                   "corrupt gzip stream after " + std::to_string(inflated()) +
+                       " decompressed bytes: " + (z_.msg ? z_.msg : "zlib error " + std::to_string(r)));
       if (z_.avail_in == 0 && in_pos_ == in_.size() && z_.avail_out > 0)
-        fail_input(path_, at, "the gzip stream is truncated: it ends without its end-of-stream marker and CRC, after " +
-                                  std::to_string(inflated()) + " decompressed bytes");
+        fail_input(path_, at,
+                   "the gzip stream is truncated: it ends without its end-of-stream marker and CRC, after " +
+                       std::to_string(inflated()) + " decompressed bytes");
     }
     end_ = buffer_.size() - z_.avail_out;
     const std::uint64_t cap = kMaxInflateRatio * in_.size() + kInflateSlack;
     if (inflated() > cap)
       fail_unsupported(path_, "inflates to more than " + std::to_string(cap) + " bytes, over " +
                                   std::to_string(kMaxInflateRatio) + " times its compressed size (" +
-                                  std::to_string(in_.size()) + " bytes); refused as a likely decompression bomb "
+                                  std::to_string(in_.size()) +
+                                  " bytes); refused as a likely decompression bomb "
                                   "(real tractograms compress about 1.2-3x). To read it anyway, gunzip it first");
   }
 
@@ -387,7 +389,8 @@ class TrkBytes {
       ended_ = true;
       return;
     }
-    fail_input(path_, at, std::to_string(rest.size()) + " bytes after the end of the gzip stream are not another gzip member");
+    fail_input(path_, at,
+               std::to_string(rest.size()) + " bytes after the end of the gzip stream are not another gzip member");
   }
 
   std::uint64_t inflated() const { return z_.total_out + inflated_before_reset_; }
@@ -420,8 +423,10 @@ Tractogram read_trk(const std::string& path) {
 
   const bool gz = is_gzip(file);
   std::optional<TrkBytes> stream;
-  if (gz) stream.emplace(path, file.bytes(), warnings);
-  else stream.emplace(file.bytes());
+  if (gz)
+    stream.emplace(path, file.bytes(), warnings);
+  else
+    stream.emplace(file.bytes());
   // Offsets in messages count bytes of the TRK stream, which for a .gz file is the decompressed one.
   const std::string where = gz ? " (offset in the decompressed data)" : "";
   auto fail_at = [&](std::uint64_t offset, const std::string& what) { fail_input(path, offset, what + where); };
@@ -442,8 +447,8 @@ Tractogram read_trk(const std::string& path) {
   bool big_endian = false;
   if (le.i32(kOffHdrSize) != static_cast<std::int32_t>(kHeaderSize)) {
     if (Bytes(data, size, true).i32(kOffHdrSize) != static_cast<std::int32_t>(kHeaderSize))
-      fail_at(kOffHdrSize, "hdr_size is " + std::to_string(le.i32(kOffHdrSize)) +
-                               " (little-endian) / " + std::to_string(Bytes(data, size, true).i32(kOffHdrSize)) +
+      fail_at(kOffHdrSize, "hdr_size is " + std::to_string(le.i32(kOffHdrSize)) + " (little-endian) / " +
+                               std::to_string(Bytes(data, size, true).i32(kOffHdrSize)) +
                                " (big-endian); expected 1000");
     big_endian = true;
   }
@@ -610,8 +615,8 @@ Tractogram read_trk(const std::string& path) {
     ++count;
   }
   if (n_count != 0 && static_cast<std::uint64_t>(n_count) != count)
-    warnings.push_back("header n_count is " + std::to_string(n_count) + " but the file holds " +
-                       std::to_string(count) + " streamlines; the data is trusted");
+    warnings.push_back("header n_count is " + std::to_string(n_count) + " but the file holds " + std::to_string(count) +
+                       " streamlines; the data is trusted");
   return t;
 }
 

@@ -9,8 +9,8 @@
 // positions.3.<float16|float32|float64>, offsets.<uint32|uint64> and groups/<name>.<integer dtype>;
 // all little-endian. dpv/<name>[.<n>].<dtype> and dps/<name>[.<n>].<dtype> (any float or integer dtype)
 // become per-point and per-streamline value sets (one per component: name[0] ... name[n-1]); dpg/ is not
-// read. All member names are listed in the header JSON under "_members". Offsets come in two conventions: N + 1 entries ending with the NB_VERTICES sentinel
-// (current trx-python), or N entries without it (older files); both are accepted.
+// read. All member names are listed in the header JSON under "_members". Offsets come in two conventions: N + 1 entries
+// ending with the NB_VERTICES sentinel (current trx-python), or N entries without it (older files); both are accepted.
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -27,13 +27,13 @@
 
 #include <zip.h>
 
-#include "format/checksum.h"
-#include "format/error.h"
 #include "converter/readers/float16.h"
-#include "format/mapped_file.h"
 #include "converter/readers/latin1.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/regular_file.h"
+#include "format/checksum.h"
+#include "format/error.h"
+#include "format/mapped_file.h"
 
 namespace vxl {
 namespace {
@@ -103,16 +103,18 @@ class ZipMembers : public Members {
     zip_t* archive = archive_.get();
     const zip_stat_t st = stat(name);
     if (st.size > max_bytes)
-      fail_input(path_, std::nullopt, name + ": its zip entry declares " + std::to_string(st.size) +
-                                          " bytes, more than the " + std::to_string(max_bytes) + " " + why);
+      fail_input(path_, std::nullopt,
+                 name + ": its zip entry declares " + std::to_string(st.size) + " bytes, more than the " +
+                     std::to_string(max_bytes) + " " + why);
     // What the compressed bytes can inflate to at most: deflate's best ratio is 1032:1, stored is 1:1.
     if ((st.valid & ZIP_STAT_COMP_SIZE) && (st.valid & ZIP_STAT_COMP_METHOD)) {
       const zip_uint64_t most = st.comp_method == ZIP_CM_STORE     ? st.comp_size
                                 : st.comp_method == ZIP_CM_DEFLATE ? st.comp_size * 1032 + 1024
                                                                    : ~zip_uint64_t{0};
       if (st.size > most)
-        fail_input(path_, std::nullopt, name + ": its zip entry declares " + std::to_string(st.size) + " bytes, more than its " +
-                                            std::to_string(st.comp_size) + " compressed bytes can hold");
+        fail_input(path_, std::nullopt,
+                   name + ": its zip entry declares " + std::to_string(st.size) + " bytes, more than its " +
+                       std::to_string(st.comp_size) + " compressed bytes can hold");
     }
     zip_file_t* f = zip_fopen_index(archive, names_.at(name), 0);
     if (f == nullptr) fail_input(path_, std::nullopt, name + ": cannot open the zip entry: " + zip_strerror(archive));
@@ -132,12 +134,14 @@ class ZipMembers : public Members {
     }
     zip_fclose(f);
     if (have > st.size)
-      fail_input(path_, std::nullopt, name + ": zip entry inflates to more than the " + std::to_string(st.size) +
-                                          " bytes its directory entry declares");
+      fail_input(path_, std::nullopt,
+                 name + ": zip entry inflates to more than the " + std::to_string(st.size) +
+                     " bytes its directory entry declares");
     out.resize(have);
     if (out.size() != st.size)
-      fail_input(path_, std::nullopt, name + ": zip entry holds " + std::to_string(out.size()) +
-                                          " bytes but its directory entry says " + std::to_string(st.size));
+      fail_input(path_, std::nullopt,
+                 name + ": zip entry holds " + std::to_string(out.size()) + " bytes but its directory entry says " +
+                     std::to_string(st.size));
     return Blob(std::move(out));
   }
 
@@ -185,8 +189,9 @@ class DirMembers : public Members {
   Blob read(const std::string& name, std::uint64_t max_bytes, const std::string& why) const override {
     MappedFile file((root_ / name).string());  // mapped, not read: its size costs no memory yet
     if (file.size() > max_bytes)
-      fail_input(root_.string(), std::nullopt, name + ": holds " + std::to_string(file.size()) + " bytes, more than the " +
-                                                   std::to_string(max_bytes) + " " + why);
+      fail_input(root_.string(), std::nullopt,
+                 name + ": holds " + std::to_string(file.size()) + " bytes, more than the " +
+                     std::to_string(max_bytes) + " " + why);
     return Blob(std::move(file));
   }
 
@@ -280,20 +285,25 @@ void read_positions(const std::string& path, const std::string& member, const st
                     std::span<const std::uint8_t> bytes, std::uint64_t nb_vertices, Tractogram& t) {
   const std::size_t elem = dtype == "float16" ? 2 : dtype == "float32" ? 4 : 8;
   if (bytes.size() % (3 * elem) != 0 || bytes.size() / (3 * elem) != nb_vertices)
-    fail_input(path, std::nullopt, member + ": holds " + std::to_string(bytes.size()) + " bytes but NB_VERTICES = " +
-                                       std::to_string(nb_vertices) + " needs " + std::to_string(nb_vertices) +
-                                       " x 3 x " + std::to_string(elem));
+    fail_input(path, std::nullopt,
+               member + ": holds " + std::to_string(bytes.size()) +
+                   " bytes but NB_VERTICES = " + std::to_string(nb_vertices) + " needs " + std::to_string(nb_vertices) +
+                   " x 3 x " + std::to_string(elem));
   const std::size_t n = bytes.size() / elem;
   t.positions.resize(n);
   const std::uint8_t* p = bytes.data();
   for (std::size_t i = 0; i < n; ++i, p += elem) {
     float v;
-    if (elem == 2) v = half_to_float(load_le<std::uint16_t>(p));
-    else if (elem == 4) v = load_le<float>(p);
-    else v = static_cast<float>(load_le<double>(p));
+    if (elem == 2)
+      v = half_to_float(load_le<std::uint16_t>(p));
+    else if (elem == 4)
+      v = load_le<float>(p);
+    else
+      v = static_cast<float>(load_le<double>(p));
     if (!std::isfinite(v))
-      fail_input(path, std::nullopt, member + ": vertex " + std::to_string(i / 3) + " has a non-finite coordinate" +
-                                         (elem == 8 ? " (or one beyond the float32 range)" : ""));
+      fail_input(path, std::nullopt,
+                 member + ": vertex " + std::to_string(i / 3) + " has a non-finite coordinate" +
+                     (elem == 8 ? " (or one beyond the float32 range)" : ""));
     t.positions[i] = v;
   }
   if (elem == 8) t.source.warnings.push_back(member + ": float64 positions rounded to float32");
@@ -304,8 +314,8 @@ void read_offsets(const std::string& path, const std::string& member, const std:
                   Tractogram& t) {
   const std::size_t elem = dtype == "uint32" ? 4 : 8;
   if (bytes.size() % elem != 0)
-    fail_input(path, std::nullopt, member + ": size " + std::to_string(bytes.size()) + " is not a multiple of " +
-                                       std::to_string(elem));
+    fail_input(path, std::nullopt,
+               member + ": size " + std::to_string(bytes.size()) + " is not a multiple of " + std::to_string(elem));
   const std::uint64_t m = bytes.size() / elem;
   auto entry = [&](std::uint64_t i) {
     const std::uint8_t* p = bytes.data() + i * elem;
@@ -313,8 +323,8 @@ void read_offsets(const std::string& path, const std::string& member, const std:
   };
   const std::string expected = "NB_STREAMLINES = " + std::to_string(nb_streamlines) + " needs " +
                                std::to_string(nb_streamlines) + " entries (no sentinel) or " +
-                               std::to_string(nb_streamlines + 1) + " ending with NB_VERTICES = " +
-                               std::to_string(nb_vertices);
+                               std::to_string(nb_streamlines + 1) +
+                               " ending with NB_VERTICES = " + std::to_string(nb_vertices);
   std::uint64_t starts = 0;  // entries that are streamline starts; NB_VERTICES closes the last one
   if (m == nb_streamlines) {
     starts = m;  // the older convention without the sentinel
@@ -328,14 +338,15 @@ void read_offsets(const std::string& path, const std::string& member, const std:
       // Seen in niivue's demos/images/dpsv.trx, which holds the same 460 streamlines as the older
       // tests/images/dpsv.trx but says NB_STREAMLINES = 459.
       starts = m;
-      t.source.warnings.push_back(member + ": " + std::to_string(m) + " entries and the last (" + std::to_string(last) +
-                                  ") is below NB_VERTICES (" + std::to_string(nb_vertices) +
-                                  "), so it is no sentinel; reading " + std::to_string(m) +
-                                  " streamlines although header.json says NB_STREAMLINES = " +
-                                  std::to_string(nb_streamlines));
+      t.source.warnings.push_back(
+          member + ": " + std::to_string(m) + " entries and the last (" + std::to_string(last) +
+          ") is below NB_VERTICES (" + std::to_string(nb_vertices) + "), so it is no sentinel; reading " +
+          std::to_string(m) +
+          " streamlines although header.json says NB_STREAMLINES = " + std::to_string(nb_streamlines));
     } else {
-      fail_input(path, std::nullopt, member + ": the last entry (" + std::to_string(last) + ") points past the " +
-                                         std::to_string(nb_vertices) + " vertices");
+      fail_input(path, std::nullopt,
+                 member + ": the last entry (" + std::to_string(last) + ") points past the " +
+                     std::to_string(nb_vertices) + " vertices");
     }
   } else {
     fail_input(path, std::nullopt, member + ": has " + std::to_string(m) + " entries; " + expected);
@@ -350,11 +361,12 @@ void read_offsets(const std::string& path, const std::string& member, const std:
   for (std::uint64_t i = 0; i < starts; ++i) {
     if (t.offsets[i] > t.offsets[i + 1]) {
       if (i + 1 == starts)
-        fail_input(path, std::nullopt, member + ": entry " + std::to_string(i) + " (" + std::to_string(t.offsets[i]) +
-                                           ") points past the " + std::to_string(nb_vertices) + " vertices");
-      fail_input(path, std::nullopt, member + ": offsets decrease at entry " + std::to_string(i + 1) + " (" +
-                                         std::to_string(t.offsets[i]) + " then " + std::to_string(t.offsets[i + 1]) +
-                                         ")");
+        fail_input(path, std::nullopt,
+                   member + ": entry " + std::to_string(i) + " (" + std::to_string(t.offsets[i]) +
+                       ") points past the " + std::to_string(nb_vertices) + " vertices");
+      fail_input(path, std::nullopt,
+                 member + ": offsets decrease at entry " + std::to_string(i + 1) + " (" + std::to_string(t.offsets[i]) +
+                     " then " + std::to_string(t.offsets[i + 1]) + ")");
     }
   }
 }
@@ -377,16 +389,16 @@ void read_groups(const std::string& path, const Members& members, Tractogram& t)
                                    "bytes a group of the " + std::to_string(n) + " streamlines can list (each once)");
     const auto bytes = blob.bytes();
     if (bytes.size() % elem != 0)
-      fail_input(path, std::nullopt, name + ": size " + std::to_string(bytes.size()) + " is not a multiple of " +
-                                         std::to_string(elem));
+      fail_input(path, std::nullopt,
+                 name + ": size " + std::to_string(bytes.size()) + " is not a multiple of " + std::to_string(elem));
     StreamlineGroup g;
     g.name = json_safe(rest.substr(0, dot));
     g.members.reserve(bytes.size() / elem);
     for (std::size_t i = 0; i < bytes.size() / elem; ++i) {
       const auto v = load_index(bytes.data() + i * elem, elem, is_signed);
       if (!v || *v >= n)
-        fail_input(path, std::nullopt, name + ": entry " + std::to_string(i) + " is not a streamline index below " +
-                                           std::to_string(n));
+        fail_input(path, std::nullopt,
+                   name + ": entry " + std::to_string(i) + " is not a streamline index below " + std::to_string(n));
       g.members.push_back(*v);
     }
     std::sort(g.members.begin(), g.members.end());
@@ -420,8 +432,8 @@ float load_value(const std::uint8_t* p, const std::string& dtype) {
 
 // dpv/ or dps/ members -> value sets of `count` entries each. A member that cannot be read as such (no
 // dtype, a size that does not match) is skipped with a warning: the streamlines are still good.
-void read_value_sets(const std::string& path, const Members& members, const std::string& folder, std::uint64_t count, Tractogram& t,
-                     std::vector<ValueSet>& out) {
+void read_value_sets(const std::string& path, const Members& members, const std::string& folder, std::uint64_t count,
+                     Tractogram& t, std::vector<ValueSet>& out) {
   for (const auto& [name, index] : members.names()) {
     if (!name.starts_with(folder)) continue;
     const std::string rest = name.substr(folder.size());
@@ -464,7 +476,8 @@ void read_value_sets(const std::string& path, const Members& members, const std:
       ValueSet v;
       v.name = json_safe(base) + (components > 1 ? "[" + std::to_string(c) + "]" : "");
       v.values.resize(count);
-      for (std::uint64_t i = 0; i < count; ++i) v.values[i] = load_value(bytes.data() + (i * components + c) * elem, dtype);
+      for (std::uint64_t i = 0; i < count; ++i)
+        v.values[i] = load_value(bytes.data() + (i * components + c) * elem, dtype);
       out.push_back(std::move(v));
     }
   }
@@ -506,8 +519,7 @@ Tractogram read_trx(const std::string& path) {
     const Blob blob = members->read("header.json", kMaxHeaderJson, "bytes a header.json may have");
     header = nlohmann::json::parse(blob.bytes().begin(), blob.bytes().end(), nullptr, false);
   }
-  if (header.is_discarded() || !header.is_object())
-    fail_input(path, std::nullopt, "header.json: not a JSON object");
+  if (header.is_discarded() || !header.is_object()) fail_input(path, std::nullopt, "header.json: not a JSON object");
   auto required_count = [&](const char* key) {
     const auto it = header.find(key);
     if (it == header.end()) fail_input(path, std::nullopt, std::string("header.json: missing ") + key);
@@ -528,8 +540,10 @@ Tractogram read_trx(const std::string& path) {
         if (ok) m[4 * i + j] = row[j].get<double>();
       }
     }
-    if (ok) t.source.vox_to_ras = m;
-    else t.source.warnings.push_back("header.json: VOXEL_TO_RASMM is not a 4x4 array of numbers; ignored");
+    if (ok)
+      t.source.vox_to_ras = m;
+    else
+      t.source.warnings.push_back("header.json: VOXEL_TO_RASMM is not a 4x4 array of numbers; ignored");
   } else {
     t.source.warnings.push_back("header.json: no VOXEL_TO_RASMM");
   }

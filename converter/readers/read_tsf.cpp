@@ -6,11 +6,11 @@
 #include <cstring>
 #include <filesystem>
 
+#include "converter/readers/mrtrix_header.h"
+#include "converter/readers/regular_file.h"
 #include "format/checksum.h"
 #include "format/error.h"
 #include "format/mapped_file.h"
-#include "converter/readers/mrtrix_header.h"
-#include "converter/readers/regular_file.h"
 
 namespace vxl {
 namespace {
@@ -42,8 +42,9 @@ void read_values(const std::string& path, std::span<const std::uint8_t> bytes, s
     // Values are kept as float32; a Float64 value beyond its range would become an Inf that no range,
     // colour map or export can use. Refused, as conversion refuses such a Float64 TCK coordinate.
     if (!std::isfinite(static_cast<float>(v)))
-      fail_input(path, offset + i * sizeof(Real), "a value (" + shortest(v) + ")" +
-                                                      " is beyond the float32 range (Float64 values are stored as float32)");
+      fail_input(
+          path, offset + i * sizeof(Real),
+          "a value (" + shortest(v) + ")" + " is beyond the float32 range (Float64 values are stored as float32)");
     s.values.push_back(static_cast<float>(v));
     ++in_current;
   }
@@ -71,11 +72,16 @@ TrackScalars read_tsf(const std::string& path) {
                   {"xxh3_128", xxh3_128_hex(file.data(), file.size())},
                   {"header", h.fields}};
   const std::string& dt = h.datatype;
-  if (dt == "Float32LE") read_values<float, false>(path, file.bytes(), h.data_offset, s);
-  else if (dt == "Float32BE") read_values<float, true>(path, file.bytes(), h.data_offset, s);
-  else if (dt == "Float64LE") read_values<double, false>(path, file.bytes(), h.data_offset, s);
-  else if (dt == "Float64BE") read_values<double, true>(path, file.bytes(), h.data_offset, s);
-  else fail_unsupported(path, "TSF datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+  if (dt == "Float32LE")
+    read_values<float, false>(path, file.bytes(), h.data_offset, s);
+  else if (dt == "Float32BE")
+    read_values<float, true>(path, file.bytes(), h.data_offset, s);
+  else if (dt == "Float64LE")
+    read_values<double, false>(path, file.bytes(), h.data_offset, s);
+  else if (dt == "Float64BE")
+    read_values<double, true>(path, file.bytes(), h.data_offset, s);
+  else
+    fail_unsupported(path, "TSF datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
   if (auto w = count_warning(h, s.offsets.size() - 1)) s.warnings.push_back(*w);
   return s;
 }
@@ -84,8 +90,8 @@ void attach_tsf(Tractogram& t, const std::string& tsf_path) {
   TrackScalars s = read_tsf(tsf_path);
   const std::uint64_t n = s.offsets.size() - 1;
   const std::string counts = std::to_string(n) + " streamlines and " + std::to_string(s.values.size()) + " values";
-  const std::string expected = std::to_string(t.streamline_count()) + " streamlines and " +
-                               std::to_string(t.point_count()) + " points";
+  const std::string expected =
+      std::to_string(t.streamline_count()) + " streamlines and " + std::to_string(t.point_count()) + " points";
   const std::string source = t.source.path.empty() ? "the tractogram" : t.source.path;
   if (n != t.streamline_count() || s.values.size() != t.point_count())
     fail_input(tsf_path, std::nullopt,
@@ -100,8 +106,9 @@ void attach_tsf(Tractogram& t, const std::string& tsf_path) {
   if (s.timestamp && t.source.header.is_object() && t.source.header.contains("timestamp")) {
     const auto& ts = t.source.header["timestamp"];
     if (ts.is_array() && !ts.empty() && ts.back().is_string() && ts.back().get<std::string>() != *s.timestamp)
-      t.source.warnings.push_back(name + ".tsf: its timestamp differs from the tractogram's (the counts agree, so it "
-                                         "is used)");
+      t.source.warnings.push_back(name +
+                                  ".tsf: its timestamp differs from the tractogram's (the counts agree, so it "
+                                  "is used)");
   }
   t.point_values.push_back({name, std::move(s.values)});
   t.source.value_files.push_back(std::move(s.provenance));

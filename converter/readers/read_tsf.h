@@ -16,11 +16,11 @@
 namespace vxl {
 
 struct TrackScalars {
-  std::vector<float> values;           // all values, streamline after streamline
-  std::vector<std::uint64_t> offsets;  // streamline i = values [offsets[i], offsets[i+1]); size N+1
+  std::vector<float> values;             // all values, streamline after streamline
+  std::vector<std::uint64_t> offsets;    // streamline i = values [offsets[i], offsets[i+1]); size N+1
   std::optional<std::string> timestamp;  // the header's, which MRtrix copies from the tractogram
   std::vector<std::string> warnings;
-  nlohmann::json provenance;           // {"name", "bytes", "xxh3_128", "header"}
+  nlohmann::json provenance;  // {"name", "bytes", "xxh3_128", "header"}
 };
 
 // Throws vxl::Error (Input, Unsupported) naming the file and the byte offset where known.

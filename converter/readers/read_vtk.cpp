@@ -10,10 +10,10 @@
 #include <cstring>
 #include <string_view>
 
-#include "format/error.h"
-#include "format/mapped_file.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/vtk_polydata.h"
+#include "format/error.h"
+#include "format/mapped_file.h"
 
 namespace vxl {
 namespace {
@@ -36,10 +36,14 @@ class LegacyParser {
     std::string title = line();
     std::string encoding = trim(title);
     // tckconvert leaves the title out; the encoding line then comes second.
-    if (encoding == "ASCII" || encoding == "BINARY") title.clear();
-    else encoding = trim(line());
-    if (encoding == "BINARY") binary_ = true;
-    else if (encoding != "ASCII") fail(pos_, "expected ASCII or BINARY on line 3, found '" + encoding + "'");
+    if (encoding == "ASCII" || encoding == "BINARY")
+      title.clear();
+    else
+      encoding = trim(line());
+    if (encoding == "BINARY")
+      binary_ = true;
+    else if (encoding != "ASCII")
+      fail(pos_, "expected ASCII or BINARY on line 3, found '" + encoding + "'");
     const std::uint64_t at = skip_space();
     if (word() != "DATASET") fail(at, "expected DATASET");
     const std::string dataset = word();
@@ -103,19 +107,25 @@ class LegacyParser {
           const Type type = parse_type(word(), array_at);
           end_line();
           if (a.components == 0) fail(array_at, "FIELD array '" + a.name + "' with 0 components");
-          if (n > data_.size() || (n > 0 && a.components > data_.size() / n)) fail(array_at, "FIELD array '" + a.name + "' larger than the file");
+          if (n > data_.size() || (n > 0 && a.components > data_.size() / n))
+            fail(array_at, "FIELD array '" + a.name + "' larger than the file");
           if (type.kind == 's' || type.kind == 'b') {
             skip_special(a.components * n, type);
-            if (section) warnings_.push_back("array '" + a.name + "' holds " + (type.kind == 's' ? "strings" : "bits") + "; skipped");
+            if (section)
+              warnings_.push_back("array '" + a.name + "' holds " + (type.kind == 's' ? "strings" : "bits") +
+                                  "; skipped");
             continue;
           }
           a.values = numbers(a.components * n, type, "FIELD array '" + a.name + "'");
           if (section == 0) continue;  // dataset-level field data: not per point or cell
-          if (n != tuples) fail(array_at, "FIELD array '" + a.name + "' has " + std::to_string(n) + " tuples; expected " + std::to_string(tuples));
+          if (n != tuples)
+            fail(array_at, "FIELD array '" + a.name + "' has " + std::to_string(n) + " tuples; expected " +
+                               std::to_string(tuples));
           (section == 1 ? p.point_data : p.cell_data).push_back(std::move(a));
         }
       } else if (key == "SCALARS" || key == "VECTORS" || key == "NORMALS" || key == "TENSORS" || key == "TENSORS6" ||
-                 key == "TEXTURE_COORDINATES" || key == "COLOR_SCALARS" || key == "GLOBAL_IDS" || key == "PEDIGREE_IDS") {
+                 key == "TEXTURE_COORDINATES" || key == "COLOR_SCALARS" || key == "GLOBAL_IDS" ||
+                 key == "PEDIGREE_IDS") {
         if (section == 0) fail(key_at, key + " before POINT_DATA or CELL_DATA");
         vtk::DataArray a;
         a.name = vtk::decode_name(word());
@@ -132,7 +142,8 @@ class LegacyParser {
           if (key == "SCALARS" && !at_line_end()) a.components = count();
         }
         end_line();
-        if (a.components == 0 || a.components > data_.size() || (tuples > 0 && a.components > data_.size() / tuples)) fail(key_at, key + " '" + a.name + "' with an impossible number of components");
+        if (a.components == 0 || a.components > data_.size() || (tuples > 0 && a.components > data_.size() / tuples))
+          fail(key_at, key + " '" + a.name + "' with an impossible number of components");
         if (key == "SCALARS") {
           // LOOKUP_TABLE name: always present in files VTK writes, optional in the specification.
           const std::uint64_t save = pos_;
@@ -146,10 +157,12 @@ class LegacyParser {
         }
         if (type.kind == 's' || type.kind == 'b') {
           skip_special(a.components * tuples, type);
-          warnings_.push_back("array '" + a.name + "' holds " + std::string(type.kind == 's' ? "strings" : "bits") + "; skipped");
+          warnings_.push_back("array '" + a.name + "' holds " + std::string(type.kind == 's' ? "strings" : "bits") +
+                              "; skipped");
           continue;
         }
-        if (tuples > 0 && a.components > data_.size() / tuples) fail(key_at, key + " '" + a.name + "' larger than the file");
+        if (tuples > 0 && a.components > data_.size() / tuples)
+          fail(key_at, key + " '" + a.name + "' larger than the file");
         a.values = numbers(a.components * tuples, type, key + " '" + a.name + "'");
         if (key == "COLOR_SCALARS" && binary_)
           for (double& v : a.values) v /= 255.0;  // as in ASCII files: 0 to 1
@@ -161,7 +174,8 @@ class LegacyParser {
         if (n > data_.size()) fail(key_at, "LOOKUP_TABLE larger than the file");
         numbers(4 * n, binary_ ? Type{'u', 1} : Type{'f', 4}, "LOOKUP_TABLE");
       } else {
-        fail(key_at, "unexpected keyword '" + key + "' (expected POINTS, LINES, POINT_DATA, CELL_DATA, FIELD or an attribute)");
+        fail(key_at,
+             "unexpected keyword '" + key + "' (expected POINTS, LINES, POINT_DATA, CELL_DATA, FIELD or an attribute)");
       }
     }
 
@@ -171,24 +185,29 @@ class LegacyParser {
     if (verts > 0) warnings_.push_back(std::to_string(verts) + " VERTICES cells are not streamlines; skipped");
     if (!have_points && have_lines) fail(std::nullopt, "LINES without POINTS");
     if (!have_lines && p.point_count > 0)
-      fail_unsupported(path_, "POLYDATA without LINES: " + std::to_string(p.point_count) + " points but no streamlines");
+      fail_unsupported(path_,
+                       "POLYDATA without LINES: " + std::to_string(p.point_count) + " points but no streamlines");
     for (const auto* arrays : {&p.point_data, &p.cell_data})
       for (const vtk::DataArray& a : *arrays)
         if (arrays == &p.cell_data && a.values.size() / a.components != p.cell_count)
-          fail(std::nullopt, "CELL_DATA for " + std::to_string(a.values.size() / a.components) + " cells; the file has " +
-                                 std::to_string(p.cell_count));
+          fail(std::nullopt, "CELL_DATA for " + std::to_string(a.values.size() / a.components) +
+                                 " cells; the file has " + std::to_string(p.cell_count));
 
     const bool lps = vtk::says_lps(title);
     vtk::fill_tractogram(t, path_, p, lps);
     t.source.warnings.insert(t.source.warnings.end(), warnings_.begin(), warnings_.end());
     t.source.dtype = std::string(binary_ ? "BINARY " : "ASCII ") + points_type_;
-    t.source.header = {{"version", version_}, {"title", title}, {"encoding", binary_ ? "BINARY" : "ASCII"},
+    t.source.header = {{"version", version_},
+                       {"title", title},
+                       {"encoding", binary_ ? "BINARY" : "ASCII"},
                        {"coordinates", lps ? "LPS (title says SPACE=LPS): x and y negated" : "as written (RAS)"}};
     return t;
   }
 
  private:
-  [[noreturn]] void fail(std::optional<std::uint64_t> at, const std::string& what) const { fail_input(path_, at, what); }
+  [[noreturn]] void fail(std::optional<std::uint64_t> at, const std::string& what) const {
+    fail_input(path_, at, what);
+  }
 
   static std::string trim(std::string s) {
     while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
@@ -246,13 +265,18 @@ class LegacyParser {
 
   Type parse_type(const std::string& name, std::uint64_t at) {
     static const std::pair<const char*, Type> types[] = {
-        {"bit", {'b', 0}},          {"unsigned_char", {'u', 1}}, {"char", {'i', 1}},       {"unsigned_short", {'u', 2}},
-        {"short", {'i', 2}},        {"unsigned_int", {'u', 4}},  {"int", {'i', 4}},        {"unsigned_long", {'u', 8}},
-        {"long", {'i', 8}},         {"vtktypeint64", {'i', 8}},  {"vtktypeuint64", {'u', 8}},
-        {"vtkIdType", {'i', 4}},  // VTK writes vtkIdType arrays as 32-bit int
-        {"float", {'f', 4}},        {"double", {'f', 8}},        {"string", {'s', 0}},     {"utf8_string", {'s', 0}},
-        {"vtktypeint8", {'i', 1}},  {"vtktypeuint8", {'u', 1}},  {"vtktypeint16", {'i', 2}}, {"vtktypeuint16", {'u', 2}},
-        {"vtktypeint32", {'i', 4}}, {"vtktypeuint32", {'u', 4}}, {"signed_char", {'i', 1}}};
+        {"bit", {'b', 0}},           {"unsigned_char", {'u', 1}},
+        {"char", {'i', 1}},          {"unsigned_short", {'u', 2}},
+        {"short", {'i', 2}},         {"unsigned_int", {'u', 4}},
+        {"int", {'i', 4}},           {"unsigned_long", {'u', 8}},
+        {"long", {'i', 8}},          {"vtktypeint64", {'i', 8}},
+        {"vtktypeuint64", {'u', 8}}, {"vtkIdType", {'i', 4}},  // VTK writes vtkIdType arrays as 32-bit int
+        {"float", {'f', 4}},         {"double", {'f', 8}},
+        {"string", {'s', 0}},        {"utf8_string", {'s', 0}},
+        {"vtktypeint8", {'i', 1}},   {"vtktypeuint8", {'u', 1}},
+        {"vtktypeint16", {'i', 2}},  {"vtktypeuint16", {'u', 2}},
+        {"vtktypeint32", {'i', 4}},  {"vtktypeuint32", {'u', 4}},
+        {"signed_char", {'i', 1}}};
     for (const auto& [n, t] : types)
       if (name == n) return t;
     fail(at, "unknown data type '" + name + "'");
@@ -272,7 +296,8 @@ class LegacyParser {
       pos_ += n * type.size;
       return out;
     }
-    if (n > (left + 1) / 2) fail(pos_, what + ": " + std::to_string(n) + " values cannot fit in the " + std::to_string(left) + " bytes left");
+    if (n > (left + 1) / 2)
+      fail(pos_, what + ": " + std::to_string(n) + " values cannot fit in the " + std::to_string(left) + " bytes left");
     out.resize(n);
     for (std::uint64_t k = 0; k < n; ++k) {
       skip_space();
@@ -283,7 +308,8 @@ class LegacyParser {
       while (stop < e && !std::isspace(static_cast<unsigned char>(*stop))) ++stop;
       auto [end, ec] = std::from_chars(b, stop, out[k]);
       if (b == stop) fail(at, what + ": file ends after " + std::to_string(k) + " of " + std::to_string(n) + " values");
-      if (ec != std::errc() || end != stop) fail(at, what + ": expected a number, found '" + std::string(b, stop) + "'");
+      if (ec != std::errc() || end != stop)
+        fail(at, what + ": expected a number, found '" + std::string(b, stop) + "'");
       pos_ = static_cast<std::uint64_t>(stop - data_.data());
     }
     return out;
@@ -348,8 +374,8 @@ class LegacyParser {
       offsets.resize(o.size());
       for (std::size_t k = 0; k < o.size(); ++k) {
         if (o[k] < (k ? static_cast<double>(offsets[k - 1]) : 0.0) || o[k] > static_cast<double>(size))
-          fail(key_at, key + ": offset " + std::to_string(k) + " is " + std::to_string(o[k]) + "; expected non-decreasing, at most " +
-                           std::to_string(size));
+          fail(key_at, key + ": offset " + std::to_string(k) + " is " + std::to_string(o[k]) +
+                           "; expected non-decreasing, at most " + std::to_string(size));
         offsets[k] = static_cast<std::uint64_t>(o[k]);
       }
       if (offsets.back() != size) fail(key_at, key + ": the last offset must equal the connectivity size");
@@ -362,15 +388,18 @@ class LegacyParser {
     connectivity.reserve(size);
     std::uint64_t k = 0;
     for (std::uint64_t c = 0; c < n; ++c) {
-      if (k >= all.size()) fail(key_at, key + ": " + std::to_string(n) + " cells declared but the data ends after " + std::to_string(c));
+      if (k >= all.size())
+        fail(key_at, key + ": " + std::to_string(n) + " cells declared but the data ends after " + std::to_string(c));
       const double m = all[k++];
       if (!(m >= 0) || m > static_cast<double>(all.size() - k))
-        fail(key_at, key + ": cell " + std::to_string(c) + " claims " + std::to_string(m) + " points, more than the data left");
+        fail(key_at,
+             key + ": cell " + std::to_string(c) + " claims " + std::to_string(m) + " points, more than the data left");
       connectivity.insert(connectivity.end(), all.begin() + k, all.begin() + k + static_cast<std::uint64_t>(m));
       k += static_cast<std::uint64_t>(m);
       offsets.push_back(connectivity.size());
     }
-    if (k != all.size()) fail(key_at, key + ": " + std::to_string(all.size() - k) + " values left after " + std::to_string(n) + " cells");
+    if (k != all.size())
+      fail(key_at, key + ": " + std::to_string(all.size() - k) + " values left after " + std::to_string(n) + " cells");
     return n;
   }
 

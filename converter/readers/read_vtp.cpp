@@ -15,13 +15,13 @@
 #include <cstring>
 #include <string_view>
 
-#include <pugixml.hpp>
 #include <zlib.h>
+#include <pugixml.hpp>
 
-#include "format/error.h"
-#include "format/mapped_file.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/vtk_polydata.h"
+#include "format/error.h"
+#include "format/mapped_file.h"
 
 namespace vxl {
 namespace {
@@ -36,9 +36,9 @@ struct Type {
 
 Type parse_type(const std::string& name) {
   static const std::pair<const char*, Type> types[] = {
-      {"Int8", {'i', 1}},  {"UInt8", {'u', 1}},  {"Int16", {'i', 2}},   {"UInt16", {'u', 2}},   {"Int32", {'i', 4}},
-      {"UInt32", {'u', 4}}, {"Int64", {'i', 8}}, {"UInt64", {'u', 8}}, {"Float32", {'f', 4}}, {"Float64", {'f', 8}},
-      {"Char", {'i', 1}},  {"UChar", {'u', 1}}};
+      {"Int8", {'i', 1}},    {"UInt8", {'u', 1}},   {"Int16", {'i', 2}}, {"UInt16", {'u', 2}},
+      {"Int32", {'i', 4}},   {"UInt32", {'u', 4}},  {"Int64", {'i', 8}}, {"UInt64", {'u', 8}},
+      {"Float32", {'f', 4}}, {"Float64", {'f', 8}}, {"Char", {'i', 1}},  {"UChar", {'u', 1}}};
   for (const auto& [n, t] : types)
     if (name == n) return t;
   return {};
@@ -54,7 +54,8 @@ class ByteSource {
   std::uint64_t available() const { return base64_ ? (s_.size() - pos_) / 4 * 3 + (n_ - i_) : s_.size() - pos_; }
 
   void read(std::uint8_t* out, std::uint64_t n) {
-    if (n > available()) fail("needs " + std::to_string(n) + " bytes, but at most " + std::to_string(available()) + " remain");
+    if (n > available())
+      fail("needs " + std::to_string(n) + " bytes, but at most " + std::to_string(available()) + " remain");
     if (!base64_) {
       std::memcpy(out, s_.data() + pos_, n);
       pos_ += n;
@@ -115,7 +116,8 @@ class ByteSource {
 class VtpParser {
  public:
   VtpParser(const std::string& path, std::span<const std::uint8_t> bytes)
-      : path_(path), all_(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+      : path_(path),
+        all_(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
         budget_(64 * static_cast<std::uint64_t>(bytes.size()) + (std::uint64_t(64) << 20)) {}
 
   Tractogram parse() {
@@ -133,27 +135,36 @@ class VtpParser {
       xml = std::string(all_.substr(0, gt + 1)) + "</AppendedData></VTKFile>";
     }
     pugi::xml_document doc;
-    const pugi::xml_parse_result r = doc.load_buffer(xml.data(), xml.size(), pugi::parse_default | pugi::parse_comments);
+    const pugi::xml_parse_result r =
+        doc.load_buffer(xml.data(), xml.size(), pugi::parse_default | pugi::parse_comments);
     if (!r) fail(static_cast<std::uint64_t>(r.offset), std::string("not well-formed XML: ") + r.description());
 
     const pugi::xml_node root = doc.child("VTKFile");
     if (!root) fail(0, "expected a <VTKFile> root element");
     const std::string type = root.attribute("type").as_string();
-    if (type != "PolyData") fail_unsupported(path_, "VTKFile type '" + type + "': only PolyData (streamlines as Lines) is read");
+    if (type != "PolyData")
+      fail_unsupported(path_, "VTKFile type '" + type + "': only PolyData (streamlines as Lines) is read");
     const std::string order = root.attribute("byte_order").as_string("LittleEndian");
-    if (order == "BigEndian") big_ = true;
-    else if (order != "LittleEndian") fail(offset(root), "byte_order '" + order + "' (expected LittleEndian or BigEndian)");
+    if (order == "BigEndian")
+      big_ = true;
+    else if (order != "LittleEndian")
+      fail(offset(root), "byte_order '" + order + "' (expected LittleEndian or BigEndian)");
     const std::string header = root.attribute("header_type").as_string("UInt32");
-    if (header == "UInt64") header_size_ = 8;
-    else if (header != "UInt32") fail(offset(root), "header_type '" + header + "' (expected UInt32 or UInt64)");
+    if (header == "UInt64")
+      header_size_ = 8;
+    else if (header != "UInt32")
+      fail(offset(root), "header_type '" + header + "' (expected UInt32 or UInt64)");
     const std::string compressor = root.attribute("compressor").as_string();
-    if (compressor == "vtkZLibDataCompressor") zlib_ = true;
+    if (compressor == "vtkZLibDataCompressor")
+      zlib_ = true;
     else if (!compressor.empty())
       fail_unsupported(path_, "compressor '" + compressor + "' (only vtkZLibDataCompressor, or none, is read)");
     if (app != std::string_view::npos) {
       const std::string encoding = root.child("AppendedData").attribute("encoding").as_string("raw");
-      if (encoding == "base64") appended_base64_ = true;
-      else if (encoding != "raw") fail(app, "AppendedData encoding '" + encoding + "' (expected raw or base64)");
+      if (encoding == "base64")
+        appended_base64_ = true;
+      else if (encoding != "raw")
+        fail(app, "AppendedData encoding '" + encoding + "' (expected raw or base64)");
     }
 
     bool lps = false;
@@ -168,14 +179,18 @@ class VtpParser {
     if (pieces == 1) read_piece(poly.child("Piece"), t, lps);
     t.source.warnings.insert(t.source.warnings.end(), warnings_.begin(), warnings_.end());
     t.source.dtype = points_type_;
-    t.source.header = {{"version", root.attribute("version").as_string()}, {"byte_order", big_ ? "BigEndian" : "LittleEndian"},
-                       {"header_type", header_size_ == 8 ? "UInt64" : "UInt32"}, {"compressor", compressor},
+    t.source.header = {{"version", root.attribute("version").as_string()},
+                       {"byte_order", big_ ? "BigEndian" : "LittleEndian"},
+                       {"header_type", header_size_ == 8 ? "UInt64" : "UInt32"},
+                       {"compressor", compressor},
                        {"coordinates", lps ? "LPS (comment says SPACE=LPS): x and y negated" : "as written (RAS)"}};
     return t;
   }
 
  private:
-  [[noreturn]] void fail(std::optional<std::uint64_t> at, const std::string& what) const { fail_input(path_, at, what); }
+  [[noreturn]] void fail(std::optional<std::uint64_t> at, const std::string& what) const {
+    fail_input(path_, at, what);
+  }
   std::uint64_t offset(const pugi::xml_node& n) const { return static_cast<std::uint64_t>(n.offset_debug()); }
 
   std::uint64_t count_attribute(const pugi::xml_node& n, const char* name) {
@@ -192,12 +207,15 @@ class VtpParser {
   void read_piece(const pugi::xml_node& piece, Tractogram& t, bool lps) {
     vtk::PolyData p;
     p.point_count = count_attribute(piece, "NumberOfPoints");
-    const std::uint64_t lines = count_attribute(piece, "NumberOfLines"), verts = count_attribute(piece, "NumberOfVerts"),
-                        polys = count_attribute(piece, "NumberOfPolys"), strips = count_attribute(piece, "NumberOfStrips");
+    const std::uint64_t lines = count_attribute(piece, "NumberOfLines"),
+                        verts = count_attribute(piece, "NumberOfVerts"),
+                        polys = count_attribute(piece, "NumberOfPolys"),
+                        strips = count_attribute(piece, "NumberOfStrips");
     if (lines == 0 && (polys > 0 || strips > 0))
       fail_unsupported(path_, "a surface mesh (Polys or Strips, no Lines): only streamlines (Lines) are read");
     if (lines == 0 && p.point_count > 0)
-      fail_unsupported(path_, "PolyData without Lines: " + std::to_string(p.point_count) + " points but no streamlines");
+      fail_unsupported(path_,
+                       "PolyData without Lines: " + std::to_string(p.point_count) + " points but no streamlines");
     if (polys > 0 || strips > 0) warnings_.push_back("Polys and Strips are not streamlines; skipped");
     if (verts > 0) warnings_.push_back(std::to_string(verts) + " Verts cells are not streamlines; skipped");
     p.cells_before_lines = verts;
@@ -207,7 +225,8 @@ class VtpParser {
     const pugi::xml_node points = piece.child("Points").child("DataArray");
     if (p.point_count > 0) {
       if (!points) fail(offset(piece), "expected <Points><DataArray>");
-      if (count_attribute(points, "NumberOfComponents") != 3) fail(offset(points), "Points must have NumberOfComponents=\"3\"");
+      if (count_attribute(points, "NumberOfComponents") != 3)
+        fail(offset(points), "Points must have NumberOfComponents=\"3\"");
       const Type pt = parse_type(points.attribute("type").as_string());
       if (pt.kind != 'f') fail(offset(points), "Points must be Float32 or Float64");
       points_type_ = points.attribute("type").as_string();
@@ -225,7 +244,8 @@ class VtpParser {
       p.line_offsets.resize(lines + 1);
       for (std::uint64_t k = 0; k < lines; ++k) {
         if (!(o[k] >= static_cast<double>(p.line_offsets[k])) || o[k] >= 9007199254740992.0)
-          fail(offset(offs), "Lines offsets must be non-decreasing; offset " + std::to_string(k) + " is " + std::to_string(o[k]));
+          fail(offset(offs),
+               "Lines offsets must be non-decreasing; offset " + std::to_string(k) + " is " + std::to_string(o[k]));
         p.line_offsets[k + 1] = static_cast<std::uint64_t>(o[k]);
       }
       p.line_connectivity = decode(conn, 1, p.line_offsets.back(), "Lines connectivity");
@@ -256,15 +276,18 @@ class VtpParser {
   }
 
   // The values of one DataArray: `tuples` x `components`, as double.
-  std::vector<double> decode(const pugi::xml_node& a, std::uint64_t components, std::uint64_t tuples, const std::string& what) {
+  std::vector<double> decode(const pugi::xml_node& a, std::uint64_t components, std::uint64_t tuples,
+                             const std::string& what) {
     const Type type = parse_type(a.attribute("type").as_string());
-    if (type.kind == 0) fail(offset(a), what + ": type '" + std::string(a.attribute("type").as_string()) + "' is not numeric");
+    if (type.kind == 0)
+      fail(offset(a), what + ": type '" + std::string(a.attribute("type").as_string()) + "' is not numeric");
     if (a.attribute("NumberOfComponents") && count_attribute(a, "NumberOfComponents") != components)
       fail(offset(a), what + ": NumberOfComponents differs from " + std::to_string(components));
     if (tuples != 0 && components > ~std::uint64_t(0) / 8 / tuples) fail(offset(a), what + ": size overflows");
     const std::uint64_t n = components * tuples;
     if (8 * n > budget_)
-      fail_unsupported(path_, what + ": " + std::to_string(n) + " values exceed what a file of this size may decode to (" +
+      fail_unsupported(path_, what + ": " + std::to_string(n) +
+                                  " values exceed what a file of this size may decode to (" +
                                   "64 x its size + 64 MiB in all); refused as a likely decompression bomb");
     budget_ -= 8 * n;
     const std::string format = a.attribute("format").as_string("ascii");
@@ -296,14 +319,16 @@ class VtpParser {
     } else if (format == "appended") {
       if (appended_at_ == 0) fail(offset(a), what + ": format=\"appended\" but the file has no <AppendedData>");
       const std::uint64_t off = count_attribute(a, "offset");
-      if (off > appended_.size()) fail(offset(a), what + ": appended offset " + std::to_string(off) + " is past the end of the file");
+      if (off > appended_.size())
+        fail(offset(a), what + ": appended offset " + std::to_string(off) + " is past the end of the file");
       ByteSource src(path_, appended_.substr(off), appended_at_ + off, appended_base64_);
       bytes = block_bytes(src, n * type.size, what);
     } else {
       fail(offset(a), what + ": format '" + format + "' (expected ascii, binary or appended)");
     }
     out.resize(n);
-    for (std::uint64_t k = 0; k < n; ++k) out[k] = vtk::load_number(bytes.data() + k * type.size, type.kind, type.size, big_);
+    for (std::uint64_t k = 0; k < n; ++k)
+      out[k] = vtk::load_number(bytes.data() + k * type.size, type.kind, type.size, big_);
     return out;
   }
 
@@ -311,25 +336,30 @@ class VtpParser {
     std::vector<std::uint8_t> out;
     if (!zlib_) {
       const std::uint64_t size = src.read_uint(header_size_, big_);
-      if (size != expected) src.fail(what + ": the header says " + std::to_string(size) + " bytes; expected " + std::to_string(expected));
+      if (size != expected)
+        src.fail(what + ": the header says " + std::to_string(size) + " bytes; expected " + std::to_string(expected));
       out.resize(expected);
       src.read(out.data(), expected);
       return out;
     }
     const std::uint64_t blocks = src.read_uint(header_size_, big_), block = src.read_uint(header_size_, big_),
                         last = src.read_uint(header_size_, big_);
-    if (blocks > src.available() / header_size_) src.fail(what + ": " + std::to_string(blocks) + " compressed blocks cannot fit in the file");
+    if (blocks > src.available() / header_size_)
+      src.fail(what + ": " + std::to_string(blocks) + " compressed blocks cannot fit in the file");
     std::vector<std::uint64_t> sizes(blocks);
     for (std::uint64_t& s : sizes) {
       s = src.read_uint(header_size_, big_);
-      if (s > src.available()) src.fail(what + ": a compressed block of " + std::to_string(s) + " bytes is larger than the file");
+      if (s > src.available())
+        src.fail(what + ": a compressed block of " + std::to_string(s) + " bytes is larger than the file");
     }
     const std::uint64_t last_size = last == 0 ? block : last;
     if (blocks > 0 && (last_size > block || (blocks - 1) > (expected / std::max<std::uint64_t>(block, 1))))
-      src.fail(what + ": inconsistent compression header (block size " + std::to_string(block) + ", last " + std::to_string(last) + ")");
+      src.fail(what + ": inconsistent compression header (block size " + std::to_string(block) + ", last " +
+               std::to_string(last) + ")");
     const std::uint64_t total = blocks == 0 ? 0 : (blocks - 1) * block + last_size;
     if (total != expected)
-      src.fail(what + ": the compression header says " + std::to_string(total) + " bytes; expected " + std::to_string(expected));
+      src.fail(what + ": the compression header says " + std::to_string(total) + " bytes; expected " +
+               std::to_string(expected));
     out.resize(expected);
     std::vector<std::uint8_t> in;
     std::uint64_t at = 0;
@@ -344,8 +374,12 @@ class VtpParser {
       uLong used = static_cast<uLong>(sizes[k]);
       const int z = uncompress2(out.data() + at, &got, in.data(), &used);
       if (z != Z_OK || got != want)
-        src.fail(what + ": compressed block " + std::to_string(k) + " does not inflate to its declared " + std::to_string(want) +
-                 " bytes (zlib: " + (z == Z_BUF_ERROR ? "more data than declared or truncated" : z == Z_DATA_ERROR ? "corrupt data" : std::to_string(z)) + ")");
+        src.fail(what + ": compressed block " + std::to_string(k) + " does not inflate to its declared " +
+                 std::to_string(want) + " bytes (zlib: " +
+                 (z == Z_BUF_ERROR    ? "more data than declared or truncated"
+                  : z == Z_DATA_ERROR ? "corrupt data"
+                                      : std::to_string(z)) +
+                 ")");
       at += want;
     }
     return out;

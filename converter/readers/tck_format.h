@@ -13,9 +13,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "format/error.h"
 #include "converter/readers/mrtrix_header.h"
 #include "converter/tractogram.h"
+#include "format/error.h"
 
 namespace vxl::tck {
 
@@ -33,8 +33,8 @@ struct DecodeState {
 // streamlines count too: a file of delimiters alone is a file of empty streamlines). Returns the number
 // of triplets consumed (the terminator included).
 template <typename Real, bool kBigEndian>
-std::uint64_t decode(const std::string& path, const std::uint8_t* p, std::uint64_t n, std::uint64_t offset, Tractogram& t,
-                     DecodeState& s, std::uint64_t stop_items) {
+std::uint64_t decode(const std::string& path, const std::uint8_t* p, std::uint64_t n, std::uint64_t offset,
+                     Tractogram& t, DecodeState& s, std::uint64_t stop_items) {
   constexpr std::size_t kTriplet = 3 * sizeof(Real);
   for (std::uint64_t i = 0; i < n; ++i, p += kTriplet) {
     Real x = load_mrtrix_value<Real, kBigEndian>(p), y = load_mrtrix_value<Real, kBigEndian>(p + sizeof(Real)),
@@ -51,7 +51,8 @@ std::uint64_t decode(const std::string& path, const std::uint8_t* p, std::uint64
       return i + 1;
     }
     if (!std::isfinite(y) || !std::isfinite(z))
-      fail_input(path, offset + i * kTriplet, "non-finite coordinate inside a streamline (only x marks NaN/Inf delimiters)");
+      fail_input(path, offset + i * kTriplet,
+                 "non-finite coordinate inside a streamline (only x marks NaN/Inf delimiters)");
     t.positions.push_back(static_cast<float>(x));
     t.positions.push_back(static_cast<float>(y));
     t.positions.push_back(static_cast<float>(z));

@@ -8,14 +8,16 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "converter/readers/regular_file.h"
 #include "format/checksum.h"
 #include "format/error.h"
-#include "converter/readers/regular_file.h"
 
 namespace vxl {
 namespace {
 
-std::int64_t mtime_ns(const struct stat& st) { return std::int64_t(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec; }
+std::int64_t mtime_ns(const struct stat& st) {
+  return std::int64_t(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec;
+}
 
 }  // namespace
 
@@ -87,7 +89,8 @@ void TckStream::read_at(std::uint64_t offset, std::uint8_t* dst, std::uint64_t s
 void TckStream::check_unchanged() const {
   struct stat st {};
   if (::fstat(fd_, &st) != 0 || static_cast<std::uint64_t>(st.st_size) != source_.bytes || mtime_ns(st) != mtime_ns_)
-    fail_input(path_, std::nullopt, "the file changed while it was being converted (--memory-limit reads it several times)");
+    fail_input(path_, std::nullopt,
+               "the file changed while it was being converted (--memory-limit reads it several times)");
 }
 
 void TckStream::rewind() {
@@ -132,10 +135,14 @@ bool TckStream::next(Tractogram& batch, std::uint64_t max_points, std::uint64_t 
       const std::uint64_t offset = read_end_ - buffer_size_ + buffer_used_;
       const std::string& dt = header_.datatype;
       std::uint64_t used;
-      if (dt == "Float32LE") used = tck::decode<float, false>(path_, p, whole, offset, batch, state_, stop);
-      else if (dt == "Float32BE") used = tck::decode<float, true>(path_, p, whole, offset, batch, state_, stop);
-      else if (dt == "Float64LE") used = tck::decode<double, false>(path_, p, whole, offset, batch, state_, stop);
-      else used = tck::decode<double, true>(path_, p, whole, offset, batch, state_, stop);
+      if (dt == "Float32LE")
+        used = tck::decode<float, false>(path_, p, whole, offset, batch, state_, stop);
+      else if (dt == "Float32BE")
+        used = tck::decode<float, true>(path_, p, whole, offset, batch, state_, stop);
+      else if (dt == "Float64LE")
+        used = tck::decode<double, false>(path_, p, whole, offset, batch, state_, stop);
+      else
+        used = tck::decode<double, true>(path_, p, whole, offset, batch, state_, stop);
       buffer_used_ += used * triplet_bytes_;
       if (state_.terminated) break;
       // decode stops right after the streamline that fills the batch

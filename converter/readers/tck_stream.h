@@ -59,7 +59,7 @@ class TckStream {
   std::int64_t mtime_ns_ = 0;
   std::vector<std::uint8_t> buffer_;
   std::uint64_t buffer_used_ = 0, buffer_size_ = 0;  // consumed / valid bytes of buffer_
-  std::uint64_t read_end_ = 0;                        // file offset just after buffer_'s valid bytes
+  std::uint64_t read_end_ = 0;                       // file offset just after buffer_'s valid bytes
   tck::DecodeState state_;
   bool data_ended_ = false;
   bool overflowed_ = false;

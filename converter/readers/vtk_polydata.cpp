@@ -18,8 +18,9 @@ void add_value_sets(Tractogram& t, const DataArray& a, std::uint64_t tuples, std
                     bool per_point, const std::string& path, std::set<std::string>& used) {
   const char* where = per_point ? "point data" : "cell data";
   if (a.values.size() != tuples * a.components)
-    fail_input(path, std::nullopt, std::string(where) + " array '" + a.name + "' has " + std::to_string(a.values.size()) +
-                                       " values; expected " + std::to_string(tuples) + " x " + std::to_string(a.components));
+    fail_input(path, std::nullopt,
+               std::string(where) + " array '" + a.name + "' has " + std::to_string(a.values.size()) +
+                   " values; expected " + std::to_string(tuples) + " x " + std::to_string(a.components));
   if (a.components > kMaxComponentsKept) {
     t.source.warnings.push_back(std::string(where) + " array '" + a.name + "' has " + std::to_string(a.components) +
                                 " components; only arrays of 1 to 4 are kept as value sets");
@@ -41,7 +42,8 @@ void add_value_sets(Tractogram& t, const DataArray& a, std::uint64_t tuples, std
     } else {
       const std::uint64_t lines = line_offsets.size() - 1;
       v.values.reserve(lines);
-      for (std::uint64_t k = 0; k < lines; ++k) v.values.push_back(static_cast<float>(a.values[(first_tuple + k) * a.components + c]));
+      for (std::uint64_t k = 0; k < lines; ++k)
+        v.values.push_back(static_cast<float>(a.values[(first_tuple + k) * a.components + c]));
       t.streamline_values.push_back(std::move(v));
     }
   }
@@ -51,22 +53,26 @@ void add_value_sets(Tractogram& t, const DataArray& a, std::uint64_t tuples, std
 
 void fill_tractogram(Tractogram& t, const std::string& path, const PolyData& p, bool lps) {
   if (p.points.size() != 3 * p.point_count)
-    fail_input(path, std::nullopt, "POINTS holds " + std::to_string(p.points.size()) + " coordinates; expected 3 x " +
-                                       std::to_string(p.point_count));
+    fail_input(path, std::nullopt,
+               "POINTS holds " + std::to_string(p.points.size()) + " coordinates; expected 3 x " +
+                   std::to_string(p.point_count));
   const std::uint64_t lines = p.line_offsets.size() - 1;
   if (p.line_offsets.back() != p.line_connectivity.size())
-    fail_input(path, std::nullopt, "line offsets end at " + std::to_string(p.line_offsets.back()) + " but the connectivity has " +
-                                       std::to_string(p.line_connectivity.size()) + " entries");
+    fail_input(path, std::nullopt,
+               "line offsets end at " + std::to_string(p.line_offsets.back()) + " but the connectivity has " +
+                   std::to_string(p.line_connectivity.size()) + " entries");
   // The points of every streamline, gathered: a line may use any point, in any order, more than once.
   std::vector<std::uint64_t> gather;
   gather.reserve(p.line_connectivity.size());
   for (std::uint64_t k = 0; k < lines; ++k) {
-    if (p.line_offsets[k + 1] < p.line_offsets[k]) fail_input(path, std::nullopt, "line offsets decrease at line " + std::to_string(k));
+    if (p.line_offsets[k + 1] < p.line_offsets[k])
+      fail_input(path, std::nullopt, "line offsets decrease at line " + std::to_string(k));
     for (std::uint64_t j = p.line_offsets[k]; j < p.line_offsets[k + 1]; ++j) {
       const double i = p.line_connectivity[j];
       if (!(i >= 0 && i < static_cast<double>(p.point_count)) || i != std::floor(i))
-        fail_input(path, std::nullopt, "line " + std::to_string(k) + " refers to point " + std::to_string(i) + " of " +
-                                           std::to_string(p.point_count) + " (expected 0 to point count - 1)");
+        fail_input(path, std::nullopt,
+                   "line " + std::to_string(k) + " refers to point " + std::to_string(i) + " of " +
+                       std::to_string(p.point_count) + " (expected 0 to point count - 1)");
       gather.push_back(static_cast<std::uint64_t>(i));
     }
   }
@@ -80,9 +86,11 @@ void fill_tractogram(Tractogram& t, const std::string& path, const PolyData& p, 
   }
   t.offsets.assign(p.line_offsets.begin(), p.line_offsets.end());
   std::set<std::string> point_names, cell_names;
-  for (const DataArray& a : p.point_data) add_value_sets(t, a, p.point_count, 0, &gather, p.line_offsets, true, path, point_names);
+  for (const DataArray& a : p.point_data)
+    add_value_sets(t, a, p.point_count, 0, &gather, p.line_offsets, true, path, point_names);
   if (!p.cell_data.empty() && p.cells_before_lines + lines > p.cell_count)
-    fail_input(path, std::nullopt, "cell data for " + std::to_string(p.cell_count) + " cells, fewer than the cells declared");
+    fail_input(path, std::nullopt,
+               "cell data for " + std::to_string(p.cell_count) + " cells, fewer than the cells declared");
   for (const DataArray& a : p.cell_data)
     add_value_sets(t, a, p.cell_count, p.cells_before_lines, nullptr, p.line_offsets, false, path, cell_names);
 }

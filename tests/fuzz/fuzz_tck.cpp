@@ -9,11 +9,11 @@
 #include <optional>
 
 #include "converter/convert.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/readers/tck_stream.h"
+#include "converter/streaming_convert.h"
 #include "format/error.h"
 #include "tests/fuzz/fuzz_input.h"
-#include "converter/readers/read_tractogram.h"
-#include "converter/streaming_convert.h"
-#include "converter/readers/tck_stream.h"
 
 namespace {
 
@@ -73,7 +73,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     s.memory_limit = 64u << 20;
     try {
       vxl::convert_streaming(path, path + ".limited.vxl", s);
-      if (read_all(path + ".vxl") != read_all(path + ".limited.vxl")) finding("the limited conversion wrote other bytes");
+      if (read_all(path + ".vxl") != read_all(path + ".limited.vxl"))
+        finding("the limited conversion wrote other bytes");
     } catch (const vxl::Error& e) {
       if (std::string(e.what()).find("--memory-limit") == std::string::npos) finding("the limited conversion failed");
     }

@@ -1,7 +1,7 @@
 // libFuzzer target: the TRK reader on arbitrary bytes (a .trk, or a .trk.gz when they start with the gzip
 // magic, as the seeds from real .trk.gz files do), then on the same bytes gzipped, which must read the
-// same, so that the TRK parser is fuzzed through the gzip path too; then conversion of whatever it accepted. scripts/fuzz runs it under
-// -rss_limit_mb: a bomb the reader does not refuse is a finding.
+// same, so that the TRK parser is fuzzed through the gzip path too; then conversion of whatever it accepted.
+// scripts/fuzz runs it under -rss_limit_mb: a bomb the reader does not refuse is a finding.
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -11,9 +11,9 @@
 #include <zlib.h>
 
 #include "converter/convert.h"
+#include "converter/readers/read_tractogram.h"
 #include "format/error.h"
 #include "tests/fuzz/fuzz_input.h"
-#include "converter/readers/read_tractogram.h"
 
 namespace {
 

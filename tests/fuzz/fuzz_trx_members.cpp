@@ -10,9 +10,9 @@
 #include <zip.h>
 
 #include "converter/convert.h"
+#include "converter/readers/read_tractogram.h"
 #include "format/error.h"
 #include "tests/fuzz/fuzz_input.h"
-#include "converter/readers/read_tractogram.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = vxl::fuzz::write_input(nullptr, 0, ".trx");

@@ -4,13 +4,13 @@
 // damage too.
 #include <vector>
 
-#include "tests/reseal_checksums.h"
-#include "format/error.h"
 #include "converter/export_tck.h"
-#include "tests/fuzz/fuzz_input.h"
+#include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"
+#include "tests/fuzz/fuzz_input.h"
+#include "tests/reseal_checksums.h"
 
 namespace {
 

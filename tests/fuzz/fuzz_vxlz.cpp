@@ -6,11 +6,11 @@
 #include <filesystem>
 #include <vector>
 
-#include "tests/reseal_checksums.h"
-#include "format/error.h"
-#include "tests/fuzz/fuzz_input.h"
 #include "converter/unpack.h"
+#include "format/error.h"
 #include "format/vxl_verify.h"
+#include "tests/fuzz/fuzz_input.h"
+#include "tests/reseal_checksums.h"
 
 namespace {
 

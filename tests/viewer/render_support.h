@@ -6,16 +6,16 @@
 #include <memory>
 #include <string>
 
-#include "viewer/render/camera.h"
 #include "converter/convert.h"
+#include "format/vxl_file.h"
+#include "tests/test_support.h"
 #include "viewer/platform/egl_context.h"
-#include "viewer/render/exact_renderer.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/offscreen_target.h"
+#include "viewer/render/camera.h"
+#include "viewer/render/exact_renderer.h"
 #include "viewer/render/render_settings.h"
 #include "viewer/render/renderer.h"
-#include "tests/test_support.h"
-#include "format/vxl_file.h"
 
 namespace vxl::test {
 
@@ -26,7 +26,8 @@ inline HeadlessGlContext& gl_context() {
 }
 
 // Converts `t` to a .vxl in `dir` and opens it.
-inline VxlFile make_scene(const ScratchDir& dir, Tractogram t, double voxel_size, const std::string& name = "scene.vxl") {
+inline VxlFile make_scene(const ScratchDir& dir, Tractogram t, double voxel_size,
+                          const std::string& name = "scene.vxl") {
   ConvertSettings s;
   s.voxel_size = voxel_size;
   std::string path = dir.file(name);

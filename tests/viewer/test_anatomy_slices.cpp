@@ -7,8 +7,8 @@
 
 #include <nifti2_io.h>
 
-#include "viewer/anatomy/nifti_volume.h"
 #include "tests/viewer/render_support.h"
+#include "viewer/anatomy/nifti_volume.h"
 
 namespace vxl {
 namespace {
@@ -30,7 +30,7 @@ float true_value(double x, double y, double z) {
 
 struct NiftiSpec {
   bool nifti2 = false;
-  bool use_sform = true;  // else the qform (sform_code 0, and a wrong sform to make sure it is ignored)
+  bool use_sform = true;      // else the qform (sform_code 0, and a wrong sform to make sure it is ignored)
   bool int16_scaled = false;  // int16 stored as (value - 100) / 2 with scl_slope 2, scl_inter 100
   std::string suffix = ".nii";
 };
@@ -43,8 +43,10 @@ std::string write_nifti(const ScratchDir& dir, const std::string& name, const Ni
       for (int i = 0; i < kN; ++i) {
         const float v = true_value(31.5 - i, j - 31.5, k - 31.5);
         const std::size_t at = (std::size_t(k) * kN + j) * kN + i;
-        if (spec.int16_scaled) static_cast<int16_t*>(nim->data)[at] = static_cast<int16_t>((v - 100) / 2);
-        else static_cast<float*>(nim->data)[at] = v;
+        if (spec.int16_scaled)
+          static_cast<int16_t*>(nim->data)[at] = static_cast<int16_t>((v - 100) / 2);
+        else
+          static_cast<float*>(nim->data)[at] = v;
       }
   if (spec.int16_scaled) nim->scl_slope = 2, nim->scl_inter = 100;
   nifti_dmat44 m;
@@ -143,22 +145,24 @@ TEST_F(AnatomySlices, ReaderScalesAndWindows) {
 // The axial slice through the focus shows the cube where the transform puts it: upper right (+x, +y),
 // only while the focus is within the cube's heights; hidden, it shows nothing.
 TEST_F(AnatomySlices, SliceShowsTheCubeWhereItIs) {
-  for (const NiftiSpec& spec : {NiftiSpec{}, NiftiSpec{false, false, false, ".nii"}, NiftiSpec{true, true, true, ".nii.gz"}}) {
+  for (const NiftiSpec& spec :
+       {NiftiSpec{}, NiftiSpec{false, false, false, ".nii"}, NiftiSpec{true, true, true, ".nii.gz"}}) {
     SCOPED_TRACE(std::string(spec.use_sform ? "sform" : "qform") + (spec.nifti2 ? " nifti2" : " nifti1"));
     VxlFile scene = make_scene(dir, front_and_back(), 10.0);
     Renderer r(scene);
     // A name of its own for each: given cube.nii.gz, nifti_clib would read a cube.nii beside it.
-    const std::string name = std::string(spec.use_sform ? "s" : "q") + (spec.nifti2 ? "2" : "1") + (spec.int16_scaled ? "i" : "f");
+    const std::string name =
+        std::string(spec.use_sform ? "s" : "q") + (spec.nifti2 ? "2" : "1") + (spec.int16_scaled ? "i" : "f");
     r.set_volume(read_nifti_volume(write_nifti(dir, name, spec)));
     RenderSettings s = axial_only();
     s.opacity = 0.001f;  // the lines out of the way
     const Image in = render_image(r, top_view(12), s, 64, 64);
-    EXPECT_GE(grey(in, 12.5, 12.5), 250);            // the cube
-    EXPECT_NEAR(grey(in, -12.5, 12.5), 77, 3);       // mirrored in x: head only
-    EXPECT_NEAR(grey(in, 12.5, -12.5), 77, 3);       // mirrored in y
-    EXPECT_LE(grey(in, -26.5, 0.5), 1);              // inside the image, outside the head
+    EXPECT_GE(grey(in, 12.5, 12.5), 250);       // the cube
+    EXPECT_NEAR(grey(in, -12.5, 12.5), 77, 3);  // mirrored in x: head only
+    EXPECT_NEAR(grey(in, 12.5, -12.5), 77, 3);  // mirrored in y
+    EXPECT_LE(grey(in, -26.5, 0.5), 1);         // inside the image, outside the head
     const Image below = render_image(r, top_view(-12), s, 64, 64);
-    EXPECT_NEAR(grey(below, 12.5, 12.5), 77, 3);     // the slice moved with the focus
+    EXPECT_NEAR(grey(below, 12.5, 12.5), 77, 3);  // the slice moved with the focus
     s.slices.axial = false;
     const Image hidden = render_image(r, top_view(12), s, 64, 64);
     EXPECT_LE(grey(hidden, 12.5, 12.5), 1);
@@ -223,9 +227,9 @@ TEST_F(AnatomySlices, SlabShowsTheSliceInItsMiddle) {
   s.slices.axial = false;
   s.slices.view_plane = true;
   const int view_in_slab = grey_pixels(s);
-  EXPECT_GT(axial, 600);                  // the head's 40 x 40 mm, foreshortened
-  EXPECT_LT(axial_in_slab, axial / 4);    // a strip 4 mm / sin(50 deg) wide
-  EXPECT_GT(view_in_slab, 1000);          // facing the viewer: the head's 40 x 40 mm, whole
+  EXPECT_GT(axial, 600);                // the head's 40 x 40 mm, foreshortened
+  EXPECT_LT(axial_in_slab, axial / 4);  // a strip 4 mm / sin(50 deg) wide
+  EXPECT_GT(view_in_slab, 1000);        // facing the viewer: the head's 40 x 40 mm, whole
 }
 
 class AnatomyCli : public AnatomySlices {
@@ -285,9 +289,10 @@ TEST_F(AnatomyCli, WindowShowsTheSlices) {
   if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed";
   const std::string image = write_nifti(dir, "cube");
   auto window = [&](const std::string& extra) {
-    const std::string cmd = "xvfb-run -a -s \"-screen 0 800x600x24\" '" + std::string(VOXVIEW_CLI) + "' '" + dir.file("scene.vxl") +
-                            "' --size 64x64 --frames 2 --screenshot '" + dir.file("out.png") + "' --view axial --ortho --focus 0,0,12 " +
-                            "--image '" + image + "' --image-range 0,1000 --slices " + extra;
+    const std::string cmd = "xvfb-run -a -s \"-screen 0 800x600x24\" '" + std::string(VOXVIEW_CLI) + "' '" +
+                            dir.file("scene.vxl") + "' --size 64x64 --frames 2 --screenshot '" + dir.file("out.png") +
+                            "' --view axial --ortho --focus 0,0,12 " + "--image '" + image +
+                            "' --image-range 0,1000 --slices " + extra;
     return test::run_program(cmd, "");
   };
   auto shown = window("axial");
@@ -326,7 +331,8 @@ TEST_F(AnatomyCli, BadImagesAreRefusedNamingTheFile) {
       {write("absurd.nii", absurd), "truncated"},
       {write("huge.nii", huge), "truncated"},
       {write("negative.nii", negative), "dimension"},
-      {write("text.nii", "this is not an image at all, only some text long enough to be read as a header\n"), "not a NIfTI"},
+      {write("text.nii", "this is not an image at all, only some text long enough to be read as a header\n"),
+       "not a NIfTI"},
       {write("empty.nii", ""), "not a NIfTI"},
       {write("cut.nii.gz", gz_bytes.substr(0, gz_bytes.size() / 2)), "truncated"},
       {dir.file("missing.nii"), "no such file"},

@@ -3,11 +3,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "viewer/app/camera_file.h"
 #include "format/error.h"
-#include "viewer/platform/image_io.h"
 #include "tests/test_support.h"
+#include "viewer/app/camera_file.h"
 #include "viewer/app/turntable.h"
+#include "viewer/platform/image_io.h"
 
 namespace vxl {
 namespace {
@@ -86,7 +86,8 @@ TEST(CameraFile, RoundTripsEveryFieldExactly) {
 TEST(CameraFile, MissingKeysKeepDefaultsAndBadOnesNameFileAndKey) {
   SavedView defaults;
   defaults.settings.opacity = 0.7f;
-  SavedView v = app::parse_view_json(R"({"voxview_view": 1, "settings": {"lighting": true}, "future_key": 3})", "v.json", defaults);
+  SavedView v = app::parse_view_json(R"({"voxview_view": 1, "settings": {"lighting": true}, "future_key": 3})",
+                                     "v.json", defaults);
   EXPECT_TRUE(v.settings.lighting);
   EXPECT_EQ(v.settings.opacity, 0.7f);
   EXPECT_FALSE(v.size);
@@ -110,11 +111,13 @@ TEST(CameraFile, MissingKeysKeepDefaultsAndBadOnesNameFileAndKey) {
   EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"clip": [{"plane": "w,1"}]}})").find("settings.clip[0].plane"),
             std::string::npos);
   EXPECT_NE(error_of(R"({"voxview_view": 1, "size": [0, 10]})").find("size"), std::string::npos);
-  EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"range": [2, 1]}})").find("settings.range"), std::string::npos);
+  EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"range": [2, 1]}})").find("settings.range"),
+            std::string::npos);
   EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"groups": [{"name": "A", "color": "red"}]}})")
                 .find("settings.groups[0].color"),
             std::string::npos);
-  EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"colormap": "jet"}})").find("settings.colormap"), std::string::npos);
+  EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"colormap": "jet"}})").find("settings.colormap"),
+            std::string::npos);
 
   ScratchDir dir;
   try {
@@ -148,7 +151,9 @@ class BatchFigures : public ::testing::Test {
     auto convert = test::run_cli("convert '" + dir.file("s.tck") + "' '" + vxl + "'");
     ASSERT_EQ(convert.exit_code, 0) << convert.output;
   }
-  test::CommandResult voxview(const std::string& args) { return test::run_program(VOXVIEW_CLI, "'" + vxl + "' " + args); }
+  test::CommandResult voxview(const std::string& args) {
+    return test::run_program(VOXVIEW_CLI, "'" + vxl + "' " + args);
+  }
   Image image(const std::string& name) { return read_image(dir.file(name)); }
   std::string at(const std::string& name) { return "'" + dir.file(name) + "'"; }
 
@@ -185,7 +190,8 @@ TEST_F(BatchFigures, ASavedViewReplaysTheSamePicture) {
 }
 
 TEST_F(BatchFigures, TurntableFramesTurnAroundTheVerticalAxis) {
-  auto turn = voxview("--render " + at("t.png") + " --turntable 4 --size 64x64 --view 30,20 --save-camera " + at("v.json"));
+  auto turn =
+      voxview("--render " + at("t.png") + " --turntable 4 --size 64x64 --view 30,20 --save-camera " + at("v.json"));
   ASSERT_EQ(turn.exit_code, 0) << turn.output;
   std::vector<Image> frames;
   for (int i = 0; i < 4; ++i) frames.push_back(image("t_00" + std::to_string(i) + ".png"));
@@ -201,7 +207,8 @@ TEST_F(BatchFigures, TurntableFramesTurnAroundTheVerticalAxis) {
   ASSERT_EQ(opposite.exit_code, 0) << opposite.output;
   EXPECT_EQ(compare_images(frames[2], image("o.png")).differing_pixels, 0u);
   for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j) EXPECT_GT(compare_images(frames[i], frames[j]).differing_pixels, 100u) << i << " " << j;
+    for (int j = i + 1; j < 4; ++j)
+      EXPECT_GT(compare_images(frames[i], frames[j]).differing_pixels, 100u) << i << " " << j;
 
   auto without_render = voxview("--turntable 4");
   EXPECT_EQ(without_render.exit_code, 2);

@@ -149,9 +149,9 @@ TEST_F(ClipPlanes, AxisPlanesKeepTheirSideAndCutThroughVoxels) {
   Image three = render_image(r, top_view(), s, 64, 64);
   EXPECT_TRUE(lit(three, column_of(10.5), row_of(0.5)));
   EXPECT_TRUE(lit(three, column_of(10.5), row_of(8.5)));
-  EXPECT_TRUE(background(three, column_of(10.5), row_of(16.5)));   // z = 20 but y = 16.5 > 10
-  EXPECT_TRUE(background(three, column_of(10.5), row_of(-7.5)));   // z = -10 < -5
-  EXPECT_TRUE(background(three, column_of(-10.5), row_of(0.5)));   // x < 0
+  EXPECT_TRUE(background(three, column_of(10.5), row_of(16.5)));  // z = 20 but y = 16.5 > 10
+  EXPECT_TRUE(background(three, column_of(10.5), row_of(-7.5)));  // z = -10 < -5
+  EXPECT_TRUE(background(three, column_of(-10.5), row_of(0.5)));  // x < 0
   // A disabled plane is forgotten by the picture, not by the settings.
   for (AxisClip& p : s.clipping.planes) p.enabled = false;
   Image none = render_image(r, top_view(), s, 64, 64);
@@ -164,7 +164,8 @@ TEST_F(ClipPlanes, VoxviewOptions) {
   make_scene(dir, depth_lines(), 5.0, "lines.vxl");
   const std::string in = "'" + dir.file("lines.vxl") + "'";
   auto render = [&](const std::string& extra, const std::string& png) {
-    return test::run_program(VOXVIEW_CLI, in + " --render '" + dir.file(png) + "' --size 64x64 --view axial --ortho --mode opaque " + extra);
+    return test::run_program(
+        VOXVIEW_CLI, in + " --render '" + dir.file(png) + "' --size 64x64 --view axial --ortho --mode opaque " + extra);
   };
   auto plain = render("", "plain.png");
   ASSERT_EQ(plain.exit_code, 0) << plain.output;
@@ -172,7 +173,8 @@ TEST_F(ClipPlanes, VoxviewOptions) {
   ASSERT_EQ(clipped.exit_code, 0) << clipped.output;
   auto slab = render("--slab 4", "slab.png");
   ASSERT_EQ(slab.exit_code, 0) << slab.output;
-  Image a = read_image(dir.file("plain.png")), b = read_image(dir.file("clipped.png")), c = read_image(dir.file("slab.png"));
+  Image a = read_image(dir.file("plain.png")), b = read_image(dir.file("clipped.png")),
+        c = read_image(dir.file("slab.png"));
   int lit_a = 0, lit_b = 0, lit_c = 0;
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) {

@@ -39,10 +39,13 @@ RenderSettings opaque(ColorMode color) {
 
 void expect_colour(const Image& img, int c, int r, const glm::vec3& rgb, int tolerance, const std::string& what) {
   const std::uint8_t* p = img.pixel(c, r);
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(p[k], rgb[k] * 255.0f, tolerance) << what << " channel " << k << " at " << c << "," << r;
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(p[k], rgb[k] * 255.0f, tolerance) << what << " channel " << k << " at " << c << "," << r;
 }
 
-bool background(const Image& img, int c, int r) { return (img.pixel(c, r)[0] | img.pixel(c, r)[1] | img.pixel(c, r)[2]) == 0; }
+bool background(const Image& img, int c, int r) {
+  return (img.pixel(c, r)[0] | img.pixel(c, r)[1] | img.pixel(c, r)[2]) == 0;
+}
 
 // A 40 mm line along x on row y = 0.5, valued 0 at x = -19.5 and 1 at x = 20.5; two points only, so the
 // values of the points inserted at the 5 mm voxel faces are interpolated.
@@ -113,7 +116,8 @@ TEST_F(ColorByValue, StreamlineValuesAndMissingOnes) {
   EXPECT_EQ(r.scalar_range(s), (std::array<float, 2>{0.0f, 1.0f}));  // the stored extremes, NaN left out
   for (int k = 0; k < 3; ++k)
     for (double x : {-12.5, 0.5, 13.5})
-      expect_colour(img, column_of(x), row_of(line_y(k)), colormap_rgb(Colormap::Hot, 0.5f * k), 3, "line " + std::to_string(k));
+      expect_colour(img, column_of(x), row_of(line_y(k)), colormap_rgb(Colormap::Hot, 0.5f * k), 3,
+                    "line " + std::to_string(k));
   expect_colour(img, column_of(0.5), row_of(line_y(3)), s.fixed_color, 1, "a NaN value keeps the fixed colour");
 }
 
@@ -129,7 +133,8 @@ TEST_F(ColorByValue, GroupsHaveTheirColourAndOpacity) {
   RenderSettings s = opaque(ColorMode::Group);
   Image img = render_image(r, top_view(), s, 64, 64);
   const int group_of_line[4] = {0, 1, 0, 2};
-  for (int k = 0; k < 4; ++k) expect_colour(img, column_of(0.5), row_of(line_y(k)), group_palette(group_of_line[k]), 1, "group");
+  for (int k = 0; k < 4; ++k)
+    expect_colour(img, column_of(0.5), row_of(line_y(k)), group_palette(group_of_line[k]), 1, "group");
   EXPECT_NE(group_palette(0), group_palette(1));
 
   // A chosen colour, and a hidden group: gone even in the opaque mode, and fewer segments on screen.
@@ -214,7 +219,8 @@ Colours colours_of(const Image& img) {
 }
 
 TEST_F(ColorByValueReal, TsfFilesColourTheirTractograms) {
-  const std::string slf = "'" + real("niivue__tract.SLF1_R.tck") + "' --tsf '" + real("niivue__mni152.SLF1_R.tsf") + "'";
+  const std::string slf =
+      "'" + real("niivue__tract.SLF1_R.tck") + "' --tsf '" + real("niivue__mni152.SLF1_R.tsf") + "'";
   Colours grey = colours_of(render(slf + " --color scalar --colormap grey --line-width 2"));
   EXPECT_GT(grey.lit, 200);
   EXPECT_EQ(grey.not_grey, 0);
@@ -224,7 +230,8 @@ TEST_F(ColorByValueReal, TsfFilesColourTheirTractograms) {
 
   // Converted once, then opened as .vxl.
   const std::string vxl = dir.file("tracks.vxl");
-  auto c = test::run_cli("convert '" + real("test_data__tracks.tck") + "' '" + vxl + "' --tsf '" + real("test_data__afd.tsf") + "'");
+  auto c = test::run_cli("convert '" + real("test_data__tracks.tck") + "' '" + vxl + "' --tsf '" +
+                         real("test_data__afd.tsf") + "'");
   ASSERT_EQ(c.exit_code, 0) << c.output;
   Colours hot = colours_of(render("'" + vxl + "' --color scalar --colormap hot"));
   EXPECT_GT(hot.lit, 500);
@@ -232,18 +239,21 @@ TEST_F(ColorByValueReal, TsfFilesColourTheirTractograms) {
   EXPECT_GT(hot.distinct.size(), 30u);
 
   // A TSF of another tractogram is refused, naming it.
-  auto wrong = test::run_program(VOXVIEW_CLI, "'" + real("niivue__tract.SLF1_R.tck") + "' --tsf '" + real("test_data__afd.tsf") +
-                                                  "' --render '" + dir.file("x.png") + "'");
+  auto wrong =
+      test::run_program(VOXVIEW_CLI, "'" + real("niivue__tract.SLF1_R.tck") + "' --tsf '" + real("test_data__afd.tsf") +
+                                         "' --render '" + dir.file("x.png") + "'");
   EXPECT_EQ(wrong.exit_code, 3);
   EXPECT_NE(wrong.output.find("test_data__afd.tsf"), std::string::npos) << wrong.output;
   // Scalar colouring of a file without values says what to do.
-  auto none = test::run_program(VOXVIEW_CLI, "'" + real("niivue__tract.SLF1_R.tck") + "' --color scalar --render '" + dir.file("x.png") + "'");
+  auto none = test::run_program(
+      VOXVIEW_CLI, "'" + real("niivue__tract.SLF1_R.tck") + "' --color scalar --render '" + dir.file("x.png") + "'");
   EXPECT_EQ(none.exit_code, 2);
   EXPECT_NE(none.output.find("--tsf"), std::string::npos) << none.output;
 }
 
 TEST_F(ColorByValueReal, AfqTrxShowsItsTwoGroupsInTwoColours) {
-  const std::string afq = "'" + real("niivue__sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx") + "'";
+  const std::string afq =
+      "'" + real("niivue__sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx") + "'";
   auto count_near = [](const Image& img, const glm::vec3& rgb) {
     int n = 0;
     for (int y = 0; y < img.height; ++y)

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "viewer/platform/image_io.h"
 #include "tests/test_support.h"
+#include "viewer/platform/image_io.h"
 
 namespace vxl {
 namespace {
@@ -15,7 +15,7 @@ namespace {
 using test::ScratchDir;
 
 struct LitExtent {
-  int rows = 0, cols = 0;      // rows / columns with any lit pixel, first to last
+  int rows = 0, cols = 0;       // rows / columns with any lit pixel, first to last
   bool touches_border = false;  // a lit pixel in the outermost row or column
 };
 
@@ -69,7 +69,8 @@ TEST_F(DefaultFraming, FillsTheTighterSideOfAnyWindowWithoutCuttingOff) {
 }
 
 TEST_F(DefaultFraming, EveryTurntableFrameIsWhole) {
-  auto r = test::run_program(VOXVIEW_CLI, "'" + vxl + "' --render '" + dir.file("t.png") + "' --size 240x120 --turntable 6");
+  auto r =
+      test::run_program(VOXVIEW_CLI, "'" + vxl + "' --render '" + dir.file("t.png") + "' --size 240x120 --turntable 6");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   int filled_most = 0;
   for (int i = 0; i < 6; ++i) {

@@ -3,10 +3,10 @@
 #include <filesystem>
 #include <string>
 
-#include "viewer/platform/image_io.h"
-#include "tests/viewer/render_support.h"
-#include "tests/test_support.h"
 #include "format/vxl_file.h"
+#include "tests/test_support.h"
+#include "tests/viewer/render_support.h"
+#include "viewer/platform/image_io.h"
 
 namespace vxl {
 namespace {

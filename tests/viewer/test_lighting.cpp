@@ -2,8 +2,8 @@
 // amounts line_lighting.h computes; with lighting off both show the plain colour.
 #include <algorithm>
 
-#include "viewer/render/line_lighting.h"
 #include "tests/viewer/render_support.h"
+#include "viewer/render/line_lighting.h"
 
 namespace vxl {
 namespace {
@@ -75,7 +75,7 @@ TEST_F(Lighting, ALineAlongTheLightIsDarkerThanOneAcrossIt) {
   const glm::vec3 view(0, 0, 1);
   const float expect_along = lighting::lit_colour(s.fixed_color, light, view).r;
   const float expect_across = lighting::lit_colour(s.fixed_color, across, view).r;
-  EXPECT_LT(expect_along, 0.2f);  // the model: ambient only
+  EXPECT_LT(expect_along, 0.2f);   // the model: ambient only
   EXPECT_GT(expect_across, 0.8f);  // full diffuse and the specular peak
   EXPECT_NEAR(on_along, expect_along * 255, 2);
   EXPECT_NEAR(on_across, expect_across * 255, 2);

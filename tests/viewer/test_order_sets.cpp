@@ -9,16 +9,16 @@
 
 #include <glm/glm.hpp>
 
-#include "viewer/render/camera.h"
 #include "converter/convert.h"
-#include "format/error.h"
-#include "viewer/render/frame_plan.h"
-#include "viewer/render/scene_layout.h"
 #include "converter/segment_orders.h"
 #include "converter/synth.h"
-#include "tests/test_support.h"
+#include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_verify.h"
+#include "tests/test_support.h"
+#include "viewer/render/camera.h"
+#include "viewer/render/frame_plan.h"
+#include "viewer/render/scene_layout.h"
 
 namespace vxl {
 namespace {

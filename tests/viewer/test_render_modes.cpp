@@ -106,7 +106,8 @@ TEST_F(RenderModes, AxisAndBasicEqualExactWhereThePaperGuaranteesIt) {
     Image img = render_image(r, top_view(), settings(m), 64, 64);
     ImageDiff d = compare_images(img, exact);
     EXPECT_LE(d.max_error * 255, 1.01) << render_mode_name(m);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(centre(img)[c], right[c] * 255, 1.0) << render_mode_name(m) << " channel " << c;
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(centre(img)[c], right[c] * 255, 1.0) << render_mode_name(m) << " channel " << c;
     EXPECT_GT(lit_pixels(img), 100) << render_mode_name(m);
   }
 }
@@ -177,7 +178,8 @@ TEST_F(RenderModes, ManyChunksRenderLikeOne) {
   Tractogram t;
   for (int s = 0; s < 40; ++s) {
     std::vector<float> p;
-    for (int i = 0; i < 30; ++i) p.insert(p.end(), {float(-25 + 1.7 * i), float(-20 + s), float(std::sin(0.3 * i + s) * 8)});
+    for (int i = 0; i < 30; ++i)
+      p.insert(p.end(), {float(-25 + 1.7 * i), float(-20 + s), float(std::sin(0.3 * i + s) * 8)});
     t.add_streamline(p.data(), 30);
   }
   VxlFile f = make_scene(dir, std::move(t), 6.0);

@@ -149,13 +149,15 @@ TEST_F(SeveralFiles, VoxviewOpensSeveralFiles) {
       }
     return n;
   };
-  auto r = test::run_program(VOXVIEW_CLI, files + " --render '" + png + "' --size 96x96 --mode opaque --color group --view axial --ortho");
+  auto r = test::run_program(
+      VOXVIEW_CLI, files + " --render '" + png + "' --size 96x96 --mode opaque --color group --view axial --ortho");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("voxels"), std::string::npos);
   Image both = read_image(png);
   EXPECT_GT(count(both, group_palette(0)), 40);
   EXPECT_GT(count(both, group_palette(1)), 40);
-  r = test::run_program(VOXVIEW_CLI, files + " --render '" + png + "' --size 96x96 --mode opaque --color group --group 'b.vxl=:0'");
+  r = test::run_program(VOXVIEW_CLI,
+                        files + " --render '" + png + "' --size 96x96 --mode opaque --color group --group 'b.vxl=:0'");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   Image only_a = read_image(png);
   EXPECT_GT(count(only_a, group_palette(0)), 40);

@@ -2,9 +2,9 @@
 // the source file (converted in memory).
 #include <filesystem>
 
-#include "viewer/platform/image_io.h"
 #include "tests/real_fixture_outcomes.h"
 #include "tests/test_support.h"
+#include "viewer/platform/image_io.h"
 
 namespace vxl {
 namespace {
@@ -12,7 +12,6 @@ namespace {
 using test::Outcome;
 using test::real;
 using test::ScratchDir;
-
 
 class VoxviewRealFixture : public ::testing::TestWithParam<std::string> {};
 

@@ -3,11 +3,11 @@
 #include <filesystem>
 #include <string>
 
-#include "tests/hostile_vxl.h"
-#include "viewer/platform/image_io.h"
-#include "tests/viewer/render_support.h"
-#include "tests/test_support.h"
 #include "format/vxl_file.h"
+#include "tests/hostile_vxl.h"
+#include "tests/test_support.h"
+#include "tests/viewer/render_support.h"
+#include "viewer/platform/image_io.h"
 
 namespace vxl {
 namespace {
@@ -35,7 +35,8 @@ TEST(VoxviewVerify, RefusesADamagedChecksumThatOpenLetsThrough) {
     const char* section;
     std::uint64_t at;  // within the payload
   };
-  const Damage damages[] = {{"VERT", 1}, {"VXLN", 0}, {"PROV", 2}, {"VVAL", valid.entry("VVAL").size - 1}, {"META", 200}};
+  const Damage damages[] = {
+      {"VERT", 1}, {"VXLN", 0}, {"PROV", 2}, {"VVAL", valid.entry("VVAL").size - 1}, {"META", 200}};
   for (const Damage& d : damages) {
     SCOPED_TRACE(d.section);
     VxlBytes b = valid;

@@ -5,10 +5,10 @@
 #include <filesystem>
 #include <string>
 
-#include "viewer/render/grid_overlay.h"
-#include "viewer/platform/image_io.h"
-#include "tests/viewer/render_support.h"
 #include "tests/test_support.h"
+#include "tests/viewer/render_support.h"
+#include "viewer/platform/image_io.h"
+#include "viewer/render/grid_overlay.h"
 
 namespace vxl {
 namespace {
@@ -68,7 +68,8 @@ class Window : public ::testing::Test {
   Image window_screenshot(const std::string& input) {
     const std::string png = dir.file("shot.png");
     std::filesystem::remove(png);
-    CommandResult r = run_voxview_in_xvfb(shell_quoted(input) + " --frames 5 --screenshot " + shell_quoted(png) + " --size 320x240");
+    CommandResult r =
+        run_voxview_in_xvfb(shell_quoted(input) + " --frames 5 --screenshot " + shell_quoted(png) + " --size 320x240");
     EXPECT_EQ(r.exit_code, 0) << r.output;
     if (!std::filesystem::exists(png)) {
       ADD_FAILURE() << "no screenshot: " << r.output;
@@ -95,8 +96,8 @@ TEST_F(Window, ShowsAVxlFileAndSavesTheLastFrameWithoutThePanel) {
   // The same first frame headless: the window starts with the same camera and renderer, and the automated
   // screenshot leaves the panel out, so the pictures agree but for rasteriser details.
   const std::string headless = dir.file("headless.png");
-  CommandResult r = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + " --render " + shell_quoted(headless) +
-                                            " --size 320x240");
+  CommandResult r = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + " --render " +
+                              shell_quoted(headless) + " --size 320x240");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // Measured on llvmpipe 15: 2 pixels differed with the line shader of before colour-by-value, 1264 (1.65%)
   // with it (the same lines, some moved by a pixel: the colour branch changes the vertex shader's code, and
@@ -104,7 +105,8 @@ TEST_F(Window, ShowsAVxlFileAndSavesTheLastFrameWithoutThePanel) {
   // 2.7e-5 here, 1.2e-4 for `basic` instead of `axis`, 1.5e-3 for opacity 0.25 instead of 0.3, 5e-3 for the
   // azimuth 1 degree off.
   ImageDiff d = compare_images(shot, read_image(headless));
-  EXPECT_LT(d.differing_pixels, 320u * 240u * 25u / 1000u) << "mean error " << d.mean_error << ", max at " << d.max_x << "," << d.max_y;
+  EXPECT_LT(d.differing_pixels, 320u * 240u * 25u / 1000u)
+      << "mean error " << d.mean_error << ", max at " << d.max_x << "," << d.max_y;
   EXPECT_LT(d.mean_error, 6e-5);
 }
 
@@ -112,8 +114,10 @@ TEST_F(Window, AViewSavedInTheWindowReplaysHeadless) {
   VXL_REQUIRE_XVFB();
   make_inputs();
   const std::string view = dir.file("view.json"), shot = dir.file("window.png"), replay = dir.file("replay.png");
-  CommandResult w = run_voxview_in_xvfb(shell_quoted(vxl) + " --frames 3 --size 200x150 --view 40,15 --lighting --slab 60 --opacity 0.6"
-                                        " --save-camera " + shell_quoted(view) + " --screenshot " + shell_quoted(shot));
+  CommandResult w = run_voxview_in_xvfb(shell_quoted(vxl) +
+                                        " --frames 3 --size 200x150 --view 40,15 --lighting --slab 60 --opacity 0.6"
+                                        " --save-camera " +
+                                        shell_quoted(view) + " --screenshot " + shell_quoted(shot));
   ASSERT_EQ(w.exit_code, 0) << w.output;
   ASSERT_TRUE(std::filesystem::exists(view)) << w.output;
   CommandResult h = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + " --camera " + shell_quoted(view) +
@@ -140,8 +144,9 @@ TEST_F(Window, EveryModeRunsInTheWindow) {
   for (const char* mode : {"opaque", "unsorted", "additive", "wboit", "basic", "axis", "exact"}) {
     SCOPED_TRACE(mode);
     const std::string png = dir.file(std::string(mode) + ".png");
-    CommandResult r = run_voxview_in_xvfb(shell_quoted(vxl) + " --mode " + mode + " --ortho --view axial --frames 2 --screenshot " +
-                                          shell_quoted(png) + " --size 160x120");
+    CommandResult r =
+        run_voxview_in_xvfb(shell_quoted(vxl) + " --mode " + mode + " --ortho --view axial --frames 2 --screenshot " +
+                            shell_quoted(png) + " --size 160x120");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     Image img = read_image(png);
     EXPECT_EQ(img.width, 160);
@@ -151,7 +156,8 @@ TEST_F(Window, EveryModeRunsInTheWindow) {
 
 TEST_F(Window, WithoutADisplaySaysHowToRenderHeadless) {
   make_inputs();
-  CommandResult r = run_shell("env -u DISPLAY -u WAYLAND_DISPLAY " + shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + " --frames 1");
+  CommandResult r = run_shell("env -u DISPLAY -u WAYLAND_DISPLAY " + shell_quoted(VOXVIEW_CLI) + " " +
+                              shell_quoted(vxl) + " --frames 1");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("cannot open a window"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("--render"), std::string::npos) << r.output;

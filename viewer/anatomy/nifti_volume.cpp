@@ -67,7 +67,8 @@ std::uint64_t available_bytes(const std::string& path, std::uint64_t wanted) {
 // T1.nii.gz, read T1.nii instead when both exist.) The single-file kinds only: the data follow the header.
 ImagePtr read_header(const std::string& path) {
   const std::vector<unsigned char> h = read_start(path, 540);
-  if (h.size() < 4) fail_input(path, 0, "not a NIfTI file: " + std::to_string(h.size()) + " bytes, shorter than any header");
+  if (h.size() < 4)
+    fail_input(path, 0, "not a NIfTI file: " + std::to_string(h.size()) + " bytes, shorter than any header");
   std::int32_t size = 0;
   std::memcpy(&size, h.data(), 4);
   const bool swap = size != 348 && size != 540;
@@ -75,32 +76,45 @@ ImagePtr read_header(const std::string& path) {
     unsigned char b[8] = {};
     for (int i = 0; i < bytes; ++i) b[i] = h[at + (swap ? bytes - 1 - i : i)];
     std::int64_t v = 0;
-    if (bytes == 2) { std::int16_t x; std::memcpy(&x, b, 2); v = x; }
-    if (bytes == 4) { std::int32_t x; std::memcpy(&x, b, 4); v = x; }
+    if (bytes == 2) {
+      std::int16_t x;
+      std::memcpy(&x, b, 2);
+      v = x;
+    }
+    if (bytes == 4) {
+      std::int32_t x;
+      std::memcpy(&x, b, 4);
+      v = x;
+    }
     if (bytes == 8) std::memcpy(&v, b, 8);
     return v;
   };
   const std::int64_t sizeof_hdr = integer(0, 4);
   if (sizeof_hdr != 348 && sizeof_hdr != 540)
-    fail_input(path, 0, "not a NIfTI file: expected sizeof_hdr 348 (NIfTI-1) or 540 (NIfTI-2), got " + std::to_string(size));
+    fail_input(path, 0,
+               "not a NIfTI file: expected sizeof_hdr 348 (NIfTI-1) or 540 (NIfTI-2), got " + std::to_string(size));
   if (h.size() < static_cast<std::size_t>(sizeof_hdr))
-    fail_input(path, h.size(), "truncated NIfTI header: " + std::to_string(h.size()) + " of " + std::to_string(sizeof_hdr) + " bytes");
+    fail_input(path, h.size(),
+               "truncated NIfTI header: " + std::to_string(h.size()) + " of " + std::to_string(sizeof_hdr) + " bytes");
   const bool two = sizeof_hdr == 540;
   const std::size_t at = two ? 4 : 344;
   const char* m = reinterpret_cast<const char*>(h.data() + at);
   const char version = two ? '2' : '1';
   if (!(m[0] == 'n' && (m[1] == '+' || m[1] == 'i') && m[2] == version && m[3] == '\0'))
-    fail_input(path, at, std::string("wrong magic: expected \"n+") + version + "\" for a single-file " +
-                             (two ? "NIfTI-2" : "NIfTI-1") + " header");
+    fail_input(path, at,
+               std::string("wrong magic: expected \"n+") + version + "\" for a single-file " +
+                   (two ? "NIfTI-2" : "NIfTI-1") + " header");
   if (m[1] == 'i')
     fail_unsupported(path, "a two-file NIfTI header (.hdr with its data in .img); give a single-file .nii or .nii.gz");
   const std::size_t dim_at = two ? 16 : 40, dim_bytes = two ? 8 : 2;
   const std::int64_t ndim = integer(dim_at, int(dim_bytes));
-  if (ndim < 1 || ndim > 7) fail_input(path, dim_at, "dim[0] (the number of dimensions) is " + std::to_string(ndim) + ", expected 1 to 7");
+  if (ndim < 1 || ndim > 7)
+    fail_input(path, dim_at, "dim[0] (the number of dimensions) is " + std::to_string(ndim) + ", expected 1 to 7");
   for (int a = 1; a <= ndim; ++a) {
     const std::int64_t d = integer(dim_at + a * dim_bytes, int(dim_bytes));
     if (d < 1)
-      fail_input(path, dim_at + a * dim_bytes, "dimension " + std::to_string(a) + " of the image is " + std::to_string(d) + ", expected >= 1");
+      fail_input(path, dim_at + a * dim_bytes,
+                 "dimension " + std::to_string(a) + " of the image is " + std::to_string(d) + ", expected >= 1");
   }
   nifti_image* nim = nullptr;
   if (two) {
@@ -161,7 +175,8 @@ std::vector<float> to_float(int datatype, const void* d, std::size_t n, const st
       for (std::size_t i = 0; i < n; ++i) v[i] = std::abs(static_cast<const std::complex<float>*>(d)[i]);
       break;
     case DT_COMPLEX128:
-      for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<float>(std::abs(static_cast<const std::complex<double>*>(d)[i]));
+      for (std::size_t i = 0; i < n; ++i)
+        v[i] = static_cast<float>(std::abs(static_cast<const std::complex<double>*>(d)[i]));
       break;
     case DT_RGB24:
       for (std::size_t i = 0; i < n; ++i) v[i] = (float(b[3 * i]) + b[3 * i + 1] + b[3 * i + 2]) / 3.0f;
@@ -199,15 +214,18 @@ std::array<float, 2> percentile_window(const std::vector<float>& values, double 
 
 Volume read_nifti_volume(const std::string& path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) fail_input(path, std::nullopt, "no such file (expected a NIfTI image)");
+  if (!std::filesystem::is_regular_file(path, ec))
+    fail_input(path, std::nullopt, "no such file (expected a NIfTI image)");
   nifti_set_debug_level(0);  // the library would print its own messages; ours name the file and the cause
   ImagePtr nim = read_header(path);
   for (int a = 1; a <= 3; ++a)
     if (nim->dim[a] < 1 || nim->dim[a] > (std::int64_t(1) << 31))
-      fail_input(path, std::nullopt, "absurd dimension " + std::to_string(a) + " of the image: " + std::to_string(nim->dim[a]) +
-                                         " voxels (expected 1 to 2^31)");
+      fail_input(path, std::nullopt,
+                 "absurd dimension " + std::to_string(a) + " of the image: " + std::to_string(nim->dim[a]) +
+                     " voxels (expected 1 to 2^31)");
   if (nim->nbyper < 1 || nim->nbyper > 32)
-    fail_input(path, std::nullopt, "bytes per voxel " + std::to_string(nim->nbyper) + " for data type " + std::to_string(nim->datatype));
+    fail_input(path, std::nullopt,
+               "bytes per voxel " + std::to_string(nim->nbyper) + " for data type " + std::to_string(nim->datatype));
   // The first volume only (a 4D image's first time point).
   const double voxels = double(nim->dim[1]) * double(nim->dim[2]) * double(nim->dim[3]);
   const double bytes = voxels * nim->nbyper;
@@ -218,10 +236,11 @@ Volume read_nifti_volume(const std::string& path) {
   const std::uint64_t have = available_bytes(path, wanted > 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(wanted));
   if (double(have) < wanted)
     fail_input(path, have,
-               "truncated NIfTI image: the header's " + std::to_string(nim->dim[1]) + "x" + std::to_string(nim->dim[2]) + "x" +
-                   std::to_string(nim->dim[3]) + " voxels of " + std::to_string(nim->nbyper) + " bytes at offset " +
-                   std::to_string(nim->iname_offset) + " need " + std::to_string(static_cast<std::uint64_t>(wanted)) +
-                   " bytes, the file holds " + std::to_string(have));
+               "truncated NIfTI image: the header's " + std::to_string(nim->dim[1]) + "x" +
+                   std::to_string(nim->dim[2]) + "x" + std::to_string(nim->dim[3]) + " voxels of " +
+                   std::to_string(nim->nbyper) + " bytes at offset " + std::to_string(nim->iname_offset) + " need " +
+                   std::to_string(static_cast<std::uint64_t>(wanted)) + " bytes, the file holds " +
+                   std::to_string(have));
   if (voxels > double(std::int64_t(1) << 30))
     fail_unsupported(path, "the image has " + std::to_string(static_cast<std::uint64_t>(voxels)) +
                                " voxels per volume; the viewer shows at most 2^30");
@@ -254,9 +273,11 @@ Volume read_nifti_volume(const std::string& path) {
   for (int row = 0; row < 3; ++row)
     for (int col = 0; col < 4; ++col) v.voxel_to_ras[col][row] = m.m[row][col] * unit;  // glm: [column][row]
   const double det = glm::determinant(glm::dmat3(v.voxel_to_ras));
-  if (!std::isfinite(det) || std::abs(det) < 1e-12 || !std::isfinite(v.voxel_to_ras[3][0] + v.voxel_to_ras[3][1] + v.voxel_to_ras[3][2]))
-    fail_input(path, std::nullopt, std::string("the ") + (nim->sform_code > 0 ? "sform" : "qform") +
-                                       " is singular or not finite: no voxel-to-RAS mapping");
+  if (!std::isfinite(det) || std::abs(det) < 1e-12 ||
+      !std::isfinite(v.voxel_to_ras[3][0] + v.voxel_to_ras[3][1] + v.voxel_to_ras[3][2]))
+    fail_input(path, std::nullopt,
+               std::string("the ") + (nim->sform_code > 0 ? "sform" : "qform") +
+                   " is singular or not finite: no voxel-to-RAS mapping");
   v.window = percentile_window(v.values, 2.0, 98.0);
   return v;
 }

@@ -190,9 +190,8 @@ std::string view_json(const SavedView& v) {
   json j;
   j["voxview_view"] = kVersion;
   if (v.size) j["size"] = {(*v.size)[0], (*v.size)[1]};
-  j["camera"] = {{"target", vec(c.target)},         {"distance", c.distance},
-                 {"azimuth_deg", c.azimuth_deg},    {"elevation_deg", c.elevation_deg},
-                 {"fov_y_deg", c.fov_y_deg},        {"orthographic", c.orthographic},
+  j["camera"] = {{"target", vec(c.target)},          {"distance", c.distance},   {"azimuth_deg", c.azimuth_deg},
+                 {"elevation_deg", c.elevation_deg}, {"fov_y_deg", c.fov_y_deg}, {"orthographic", c.orthographic},
                  {"ortho_height", c.ortho_height}};
   json clip = json::array();
   for (const AxisClip& p : s.clipping.planes) clip.push_back({{"plane", axis_clip_text(p)}, {"enabled", p.enabled}});

@@ -2,18 +2,18 @@
 
 #include <algorithm>
 #include <chrono>
-#include <optional>
 #include <cstdio>
+#include <optional>
 
+#include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_file.h"
+#include "viewer/app/scene_source.h"
+#include "viewer/app/turntable.h"
 #include "viewer/platform/egl_context.h"
 #include "viewer/platform/image_io.h"
-#include "viewer/anatomy/nifti_volume.h"
 #include "viewer/platform/offscreen_target.h"
 #include "viewer/render/renderer.h"
 #include "viewer/render/scene_framing.h"
-#include "viewer/app/scene_source.h"
-#include "viewer/app/turntable.h"
 
 namespace vxl::app {
 
@@ -72,7 +72,8 @@ int run_headless(const ViewerOptions& o) {
     const FrameStats& s = renderer.stats();
     std::printf("%s: %dx%d %s, %llu voxels and %llu segments drawn, %s after %.3f s (%s)\n", png.c_str(), o.width,
                 o.height, render_mode_name(o.settings.mode), (unsigned long long)s.voxels_drawn,
-                (unsigned long long)s.segments_drawn, i == 0 ? "first frame" : "frame", seconds, context.renderer().c_str());
+                (unsigned long long)s.segments_drawn, i == 0 ? "first frame" : "frame", seconds,
+                context.renderer().c_str());
   }
   if (o.save_camera) std::printf("view saved to %s\n", o.save_camera->c_str());
   return 0;

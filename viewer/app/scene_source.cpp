@@ -1,17 +1,17 @@
 #include "viewer/app/scene_source.h"
 
+#include <unistd.h>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <unistd.h>
 
 #include "converter/convert.h"
-#include "format/error.h"
-#include "converter/readers/read_tsf.h"
-#include "viewer/render/renderer.h"
 #include "converter/readers/read_tractogram.h"
+#include "converter/readers/read_tsf.h"
 #include "converter/unpack.h"
+#include "format/error.h"
 #include "format/vxl_verify.h"
+#include "viewer/render/renderer.h"
 
 namespace vxl::app {
 namespace {
@@ -31,17 +31,19 @@ VxlFile open_scene(const std::string& path, double voxel_size, const std::vector
   std::string lower = path;
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (!tsf.empty() && (lower.ends_with(".vxl") || lower.ends_with(".vxlz")))
-    throw Error(ErrorKind::Usage, path, std::nullopt,
-                "--tsf adds values to a source tractogram converted in memory; a .vxl keeps the values it was converted "
-                "with (voxlines convert IN.tck OUT.vxl --tsf FILE.tsf)");
+    throw Error(
+        ErrorKind::Usage, path, std::nullopt,
+        "--tsf adds values to a source tractogram converted in memory; a .vxl keeps the values it was converted "
+        "with (voxlines convert IN.tck OUT.vxl --tsf FILE.tsf)");
   if (lower.ends_with(".vxl")) {
     if (verify) verify_or_refuse(path, path);
     return VxlFile::open(path);
   }
   if (lower.ends_with(".vxlz")) {
     // A package is unpacked into an unlinked temporary .vxl: the mapping keeps it alive, nothing is left.
-    std::filesystem::path temp = std::filesystem::temp_directory_path() /
-                                 ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
+    std::filesystem::path temp =
+        std::filesystem::temp_directory_path() /
+        ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
     unpack_vxlz(path, temp.string(), {});
     try {
       if (verify) verify_or_refuse(temp.string(), path);
@@ -56,9 +58,11 @@ VxlFile open_scene(const std::string& path, double voxel_size, const std::vector
 
   Tractogram t = read_tractogram(path);
   for (const std::string& f : tsf) attach_tsf(t, f);
-  for (const std::string& w : t.source.warnings) std::fprintf(stderr, "voxview: warning: %s: %s\n", path.c_str(), w.c_str());
-  std::filesystem::path temp = std::filesystem::temp_directory_path() /
-                               ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
+  for (const std::string& w : t.source.warnings)
+    std::fprintf(stderr, "voxview: warning: %s: %s\n", path.c_str(), w.c_str());
+  std::filesystem::path temp =
+      std::filesystem::temp_directory_path() /
+      ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
   ConvertSettings settings;
   settings.voxel_size = voxel_size;
   convert_tractogram(std::move(t), temp.string(), settings);
@@ -73,8 +77,8 @@ VxlFile open_scene(const std::string& path, double voxel_size, const std::vector
   return f;
 }
 
-std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double voxel_size, const std::vector<std::string>& tsf,
-                                 bool verify) {
+std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double voxel_size,
+                                 const std::vector<std::string>& tsf, bool verify) {
   if (!tsf.empty() && paths.size() != 1)
     throw Error(ErrorKind::Usage, "", std::nullopt,
                 "--tsf needs a single input tractogram (it has one value per point of that file); convert each with "
@@ -100,7 +104,8 @@ void check_color_options(const std::string& path, const Renderer& r, const Rende
                 "use a TRK with scalars or properties, a TRX with dpv or dps)");
   if (!s.scalar.empty() && std::find(names.begin(), names.end(), s.scalar) == names.end())
     throw Error(ErrorKind::Usage, path, std::nullopt,
-                "--scalar: no value set '" + s.scalar + "'" + (names.empty() ? " (it has none)" : " (it has: " + available + ")"));
+                "--scalar: no value set '" + s.scalar + "'" +
+                    (names.empty() ? " (it has none)" : " (it has: " + available + ")"));
   for (const GroupStyle& g : s.group_styles)
     if (r.groups().find(g.name) < 0) {
       std::string groups;

@@ -68,8 +68,10 @@ void colour_controls(PanelState& state, const PanelStats& stats) {
     }
     bool automatic = !s.range.has_value();
     if (ImGui::Checkbox("auto range", &automatic)) {
-      if (automatic) s.range.reset();
-      else s.range = stats.scalar_range;
+      if (automatic)
+        s.range.reset();
+      else
+        s.range = stats.scalar_range;
     }
     ImGui::SameLine();
     ImGui::BeginDisabled(automatic);
@@ -89,7 +91,8 @@ void colour_controls(PanelState& state, const PanelStats& stats) {
         if (ImGui::ColorEdit3("##colour", &c.x, ImGuiColorEditFlags_NoInputs)) s.style_of(name).color = glm::vec3(c);
         ImGui::SameLine();
         ImGui::PushItemWidth(90);
-        if (ImGui::SliderFloat("##opacity", &c.w, 0.0f, 1.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp)) s.style_of(name).opacity = c.w;
+        if (ImGui::SliderFloat("##opacity", &c.w, 0.0f, 1.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp))
+          s.style_of(name).opacity = c.w;
         ImGui::PopItemWidth();
         ImGui::SameLine();
         ImGui::Text("%s (%s)", name.c_str(), count_text(count).c_str());
@@ -172,12 +175,16 @@ void image_controls(PanelState& state, const PanelStats& stats, PanelRequests& o
   ImGui::Checkbox("sagittal", &sl.sagittal);
   ImGui::SameLine();
   ImGui::Checkbox("view", &sl.view_plane);
-  float focus[3] = {static_cast<float>(stats.focus[0]), static_cast<float>(stats.focus[1]), static_cast<float>(stats.focus[2])};
-  if (ImGui::DragFloat3("Focus mm", focus, 0.5f, 0.0f, 0.0f, "%.1f")) out.focus = std::array<double, 3>{focus[0], focus[1], focus[2]};
+  float focus[3] = {static_cast<float>(stats.focus[0]), static_cast<float>(stats.focus[1]),
+                    static_cast<float>(stats.focus[2])};
+  if (ImGui::DragFloat3("Focus mm", focus, 0.5f, 0.0f, 0.0f, "%.1f"))
+    out.focus = std::array<double, 3>{focus[0], focus[1], focus[2]};
   bool automatic = !sl.range;
   if (ImGui::Checkbox("auto grey", &automatic)) {
-    if (automatic) sl.range.reset();
-    else sl.range = stats.image_range;
+    if (automatic)
+      sl.range.reset();
+    else
+      sl.range = stats.image_range;
   }
   ImGui::SameLine();
   ImGui::BeginDisabled(automatic);
@@ -237,7 +244,8 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
     }
     ImGui::EndCombo();
   }
-  ImGui::SliderFloat("Opacity", &s.opacity, 0.001f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
+  ImGui::SliderFloat("Opacity", &s.opacity, 0.001f, 1.0f, "%.3f",
+                     ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
   ImGui::SliderFloat("Line width", &s.line_width, 1.0f, stats.max_line_width, "%.1f px", ImGuiSliderFlags_AlwaysClamp);
 
   colour_controls(state, stats);

@@ -20,25 +20,25 @@ namespace vxl::app {
 struct PanelState {
   RenderSettings settings;
   bool orthographic = false;
-  bool grid = false;               // voxel-grid overlay
-  bool grid_all = false;           // all voxels, not only those the frame draws
+  bool grid = false;      // voxel-grid overlay
+  bool grid_all = false;  // all voxels, not only those the frame draws
   bool panel_in_screenshot = false;
-  double slab_thickness = 10.0;    // mm, kept while the slab is off (settings.clipping.slab_mm is 0 then)
+  double slab_thickness = 10.0;  // mm, kept while the slab is off (settings.clipping.slab_mm is 0 then)
 };
 
 // What the panel only shows.
 struct PanelStats {
-  std::string title;               // the file shown
-  double frame_ms = 0;             // smoothed
-  double plan_ms = 0;              // CPU plan of the last frame
+  std::string title;    // the file shown
+  double frame_ms = 0;  // smoothed
+  double plan_ms = 0;   // CPU plan of the last frame
   std::uint64_t voxels_drawn = 0, voxels_total = 0;
   std::uint64_t segments_drawn = 0, segments_total = 0;
   std::uint64_t grid_cubes = 0;
   std::string gl_renderer, gl_version;
-  bool exact_available = true;     // GL >= 4.3
-  float max_line_width = 16.0f;    // the driver's wide-line limit
-  std::string error;               // shown in red until the next one replaces it
-  std::string status;              // e.g. where the last screenshot went
+  bool exact_available = true;                                  // GL >= 4.3
+  float max_line_width = 16.0f;                                 // the driver's wide-line limit
+  std::string error;                                            // shown in red until the next one replaces it
+  std::string status;                                           // e.g. where the last screenshot went
   double bounds_min[3] = {0, 0, 0}, bounds_max[3] = {0, 0, 0};  // scene bounds, for the clip-plane sliders
   std::vector<std::string> value_sets;                          // what --color scalar can show
   std::vector<std::pair<std::string, std::uint64_t>> groups;    // name, streamlines
@@ -52,8 +52,8 @@ struct PanelRequests {
   std::optional<std::array<double, 2>> view;  // azimuth, elevation
   bool reset_camera = false;
   bool screenshot = false;
-  bool save_view = false;  // write the view (camera and settings) for --camera
-  double move_focus = 0;  // mm along the view direction (moves the slab)
+  bool save_view = false;                      // write the view (camera and settings) for --camera
+  double move_focus = 0;                       // mm along the view direction (moves the slab)
   std::optional<std::array<double, 3>> focus;  // a new focus point (moves the slices), RAS mm
 };
 
@@ -79,7 +79,7 @@ class UiPanel {
 
  private:
   float x0_ = 0, y0_ = 0, x1_ = 0, y1_ = 0;  // the panel window, window units
-  bool popup_open_ = false;                   // a combo or colour picker may reach beyond the panel
+  bool popup_open_ = false;                  // a combo or colour picker may reach beyond the panel
 };
 
 }  // namespace vxl::app

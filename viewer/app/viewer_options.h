@@ -11,7 +11,7 @@
 namespace vxl::app {
 
 struct ViewerOptions {
-  std::vector<std::string> inputs;   // .vxl, or a .tck/.trk/.trx/.vtk/.vtp converted in memory; several: one scene
+  std::vector<std::string> inputs;  // .vxl, or a .tck/.trk/.trx/.vtk/.vtp converted in memory; several: one scene
   // How the inputs are named in messages and titles: the first file's name, "+ N more" for the others.
   std::string inputs_name() const;
   std::optional<std::string> image;       // an anatomical NIfTI image shown as slices under the lines
@@ -19,14 +19,14 @@ struct ViewerOptions {
   std::optional<std::string> render_png;  // headless: render one frame to this PNG and exit
   RenderSettings settings;
   std::optional<std::array<double, 2>> view;  // azimuth, elevation; default: an oblique view
-  std::optional<Camera> camera;      // a saved view's camera (--camera); --view and --ortho still apply
-  int turntable = 0;                 // headless: frames around the vertical axis (0: one plain frame)
-  std::optional<std::string> save_camera;  // write the view here (headless: after rendering)
+  std::optional<Camera> camera;               // a saved view's camera (--camera); --view and --ortho still apply
+  int turntable = 0;                          // headless: frames around the vertical axis (0: one plain frame)
+  std::optional<std::string> save_camera;     // write the view here (headless: after rendering)
   bool orthographic = false;
   int width = 1024, height = 1024;
-  double voxel_size = 10.0;          // for in-memory conversion
-  bool verify = false;               // --verify: check every .vxl in full (as `voxlines verify`) before drawing
-  std::vector<std::string> tsf;      // per-point values for a .tck converted in memory
+  double voxel_size = 10.0;      // for in-memory conversion
+  bool verify = false;           // --verify: check every .vxl in full (as `voxlines verify`) before drawing
+  std::vector<std::string> tsf;  // per-point values for a .tck converted in memory
   // Window automation (tests, scripted screenshots): quit after N frames, saving a screenshot first.
   std::optional<int> frames;
   std::optional<std::string> screenshot;

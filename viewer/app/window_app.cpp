@@ -1,5 +1,5 @@
-#include "viewer/platform/gl_driver_pinning.h"
 #include "viewer/app/window_app.h"
+#include "viewer/platform/gl_driver_pinning.h"
 
 #include <algorithm>
 #include <chrono>
@@ -16,17 +16,17 @@
 #define GLFW_INCLUDE_NONE  // epoxy provides the GL declarations
 #include <GLFW/glfw3.h>
 
+#include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_controller.h"
 #include "viewer/app/camera_file.h"
-#include "viewer/render/grid_overlay.h"
 #include "viewer/app/headless_render.h"
-#include "viewer/platform/image_io.h"
-#include "viewer/anatomy/nifti_volume.h"
-#include "viewer/platform/offscreen_target.h"
-#include "viewer/render/renderer.h"
-#include "viewer/render/scene_framing.h"
 #include "viewer/app/scene_source.h"
 #include "viewer/app/ui_panel.h"
+#include "viewer/platform/image_io.h"
+#include "viewer/platform/offscreen_target.h"
+#include "viewer/render/grid_overlay.h"
+#include "viewer/render/renderer.h"
+#include "viewer/render/scene_framing.h"
 
 namespace vxl::app {
 
@@ -64,8 +64,7 @@ WindowPtr open_window(const ViewerOptions& o) {
   std::string title = "voxview -";
   for (const std::string& in : o.inputs) title += " " + std::filesystem::path(in).filename().string();
   GLFWwindow* w = glfwCreateWindow(o.width, o.height, title.c_str(), nullptr, nullptr);
-  if (!w)
-    throw std::runtime_error("cannot open an OpenGL 3.3 core window: " + g_glfw_error + "; " + kHeadlessHint);
+  if (!w) throw std::runtime_error("cannot open an OpenGL 3.3 core window: " + g_glfw_error + "; " + kHeadlessHint);
   glfwMakeContextCurrent(w);
   glfwSwapInterval(1);
   pin_dri_drivers();  // see gl_driver_pinning.h: Mesa's GLX path loads the same driver
@@ -150,26 +149,24 @@ class ViewerWindow {
   std::optional<OffscreenTarget> scene_target_;
   CameraController controller_;
   std::vector<glm::dvec3> framing_points_;  // what the home view fills the window with (scene_framing.h)
-  std::unique_ptr<UiPanel> panel_;  // created after our callbacks, which ImGui then chains to
+  std::unique_ptr<UiPanel> panel_;          // created after our callbacks, which ImGui then chains to
   PanelState state_;
   PanelStats stats_;
   int drag_button_ = -1;
   bool screenshot_requested_ = false;
   bool save_view_requested_ = false;
-  RenderMode drawn_mode_ = RenderMode::Axis;  // the mode of the last frame, to clear a mode's error once another is chosen
-  unsigned events_ = 0;  // input events seen, to keep drawing while something happens
+  RenderMode drawn_mode_ =
+      RenderMode::Axis;          // the mode of the last frame, to clear a mode's error once another is chosen
+  unsigned events_ = 0;          // input events seen, to keep drawing while something happens
   SliceSettings hidden_slices_;  // which slices I brings back
 };
 
 ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume,
                            GLFWwindow* window)
-    : options_(o),
-      window_(window),
-      renderer_(pointers(files)),
-      grid_(renderer_),
-      controller_(Camera{}, 1.0) {
+    : options_(o), window_(window), renderer_(pointers(files)), grid_(renderer_), controller_(Camera{}, 1.0) {
   if (volume) renderer_.set_volume(*volume);
-  controller_ = CameraController(Camera{}, std::max(1.0, glm::length(renderer_.scene_max() - renderer_.scene_min()) * 0.5));
+  controller_ =
+      CameraController(Camera{}, std::max(1.0, glm::length(renderer_.scene_max() - renderer_.scene_min()) * 0.5));
   stats_.has_image = volume != nullptr;
   check_color_options(o.inputs_name(), renderer_, o.settings);
   GLint major = 0, minor = 0;
@@ -269,7 +266,8 @@ void ViewerWindow::on_scroll(double steps) {
   glfwGetCursorPos(window_, &x, &y);
   if (panel_->takes_mouse_at(x, y)) return;
   // Ctrl + wheel moves the slab through the scene (as in mrview); the plain wheel zooms.
-  if (glfwGetKey(window_, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(window_, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
+  if (glfwGetKey(window_, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
+      glfwGetKey(window_, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
     controller_.move_focus(-steps);
   else
     controller_.zoom(steps);
@@ -341,13 +339,20 @@ void ViewerWindow::on_char(unsigned c) {
   if (panel_->wants_keyboard()) return;
   RenderSettings& s = state_.settings;
   switch (c) {
-    case 'o': case 'O': controller_.set_orthographic(!controller_.camera().orthographic); break;
-    case 'm': case 'M': s.mode = next_mode(s.mode, stats_.exact_available); break;
-    case '+': case '=': s.opacity = std::clamp(s.opacity * 1.5f, 0.001f, 1.0f); break;
-    case '-': case '_': s.opacity = std::clamp(s.opacity / 1.5f, 0.001f, 1.0f); break;
-    case 's': case 'S': screenshot_requested_ = true; break;
-    case 'l': case 'L': s.lighting = !s.lighting; break;
-    case 'i': case 'I':
+    case 'o':
+    case 'O': controller_.set_orthographic(!controller_.camera().orthographic); break;
+    case 'm':
+    case 'M': s.mode = next_mode(s.mode, stats_.exact_available); break;
+    case '+':
+    case '=': s.opacity = std::clamp(s.opacity * 1.5f, 0.001f, 1.0f); break;
+    case '-':
+    case '_': s.opacity = std::clamp(s.opacity / 1.5f, 0.001f, 1.0f); break;
+    case 's':
+    case 'S': screenshot_requested_ = true; break;
+    case 'l':
+    case 'L': s.lighting = !s.lighting; break;
+    case 'i':
+    case 'I':
       if (s.slices.any()) {
         hidden_slices_ = s.slices;
         s.slices.axial = s.slices.coronal = s.slices.sagittal = s.slices.view_plane = false;
@@ -357,15 +362,20 @@ void ViewerWindow::on_char(unsigned c) {
         s.slices.range = range;
       }
       break;
-    case 'v': case 'V': save_view_requested_ = true; break;
-    case 'r': case 'R': reset_camera(aspect()); break;
-    case 'q': case 'Q': glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
-    case 'c': case 'C': {
+    case 'v':
+    case 'V': save_view_requested_ = true; break;
+    case 'r':
+    case 'R': reset_camera(aspect()); break;
+    case 'q':
+    case 'Q': glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
+    case 'c':
+    case 'C': {
       double& slab = s.clipping.slab_mm;
       slab = slab > 0 ? 0.0 : state_.slab_thickness;
       break;
     }
-    case '[': case ']': {
+    case '[':
+    case ']': {
       state_.slab_thickness = std::clamp(state_.slab_thickness * (c == ']' ? 1.25 : 0.8), 0.1, 1000.0);
       if (s.clipping.slab_mm > 0) s.clipping.slab_mm = state_.slab_thickness;
       break;
@@ -397,9 +407,10 @@ void ViewerWindow::draw_scene(int width, int height) {
   scene_target_->bind();
   drawn_mode_ = s.mode;
   if (state_.grid) {
-    const glm::vec4 colour = s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
-    grid_.draw(renderer_, camera, double(width) / height, state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn,
-               colour, s.clipping);
+    const glm::vec4 colour =
+        s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
+    grid_.draw(renderer_, camera, double(width) / height,
+               state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn, colour, s.clipping);
     stats_.grid_cubes = grid_.cubes_drawn();
   }
   glBindFramebuffer(GL_READ_FRAMEBUFFER, target);

@@ -12,14 +12,12 @@
 namespace vxl {
 
 struct Image {
-    int width = 0;
-    int height = 0;
-    std::vector<std::uint8_t> rgba;  // width*height*4 bytes, rows top-to-bottom
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba;  // width*height*4 bytes, rows top-to-bottom
 
-    std::uint8_t* pixel(int x, int y) { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
-    const std::uint8_t* pixel(int x, int y) const {
-        return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4;
-    }
+  std::uint8_t* pixel(int x, int y) { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
+  const std::uint8_t* pixel(int x, int y) const { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
 };
 
 // Writes an RGBA8 PNG (rows top-to-bottom, rgba.size() == w*h*4). Atomic: the image is written to a
@@ -35,12 +33,12 @@ Image read_image(const std::string& path);
 
 // ImageBufAlgo::compare over all four channels, values on a 0..1 scale.
 struct ImageDiff {
-    double mean_error = 0;  // mean absolute error over all channel values
-    double rms_error = 0;
-    double psnr = 0;        // dB; +inf when identical
-    double max_error = 0;
-    int max_x = 0, max_y = 0, max_channel = 0;  // where max_error occurred (y counted from the top)
-    std::uint64_t differing_pixels = 0;         // pixels with any channel different
+  double mean_error = 0;  // mean absolute error over all channel values
+  double rms_error = 0;
+  double psnr = 0;  // dB; +inf when identical
+  double max_error = 0;
+  int max_x = 0, max_y = 0, max_channel = 0;  // where max_error occurred (y counted from the top)
+  std::uint64_t differing_pixels = 0;         // pixels with any channel different
 };
 
 // Throws std::runtime_error when sizes differ or the buffers are malformed.

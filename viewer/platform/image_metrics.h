@@ -11,11 +11,11 @@
 namespace vxl {
 
 struct ImageScore {
-    double rmse = 0;      // root mean square error over R, G, B, in levels
-    double psnr = 0;      // 20 log10(255 / rmse) dB; +inf when the images are equal
-    double mean_abs = 0;  // mean absolute error over R, G, B, in levels
-    double max_abs = 0;   // largest absolute channel difference, in levels
-    double ssim = 1;      // mean SSIM of the luminance (ssim_luminance); 1 when the images are equal
+  double rmse = 0;      // root mean square error over R, G, B, in levels
+  double psnr = 0;      // 20 log10(255 / rmse) dB; +inf when the images are equal
+  double mean_abs = 0;  // mean absolute error over R, G, B, in levels
+  double max_abs = 0;   // largest absolute channel difference, in levels
+  double ssim = 1;      // mean SSIM of the luminance (ssim_luminance); 1 when the images are equal
 };
 
 // RMSE, PSNR, mean and max error through OpenImageIO's ImageBufAlgo::compare (restricted to R, G, B), and

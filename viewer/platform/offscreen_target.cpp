@@ -14,222 +14,227 @@ namespace vxl {
 namespace {
 
 std::string hex(GLenum v) {
-    char buf[16];
-    std::snprintf(buf, sizeof buf, "0x%04X", static_cast<unsigned>(v));
-    return buf;
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%04X", static_cast<unsigned>(v));
+  return buf;
 }
 
 // Saves and restores the framebuffer bindings touched by construction, resize and resolve.
 struct FramebufferBindingGuard {
-    GLint draw = 0, read = 0, rb = 0, tex = 0;
-    FramebufferBindingGuard() {
-        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw);
-        glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &read);
-        glGetIntegerv(GL_RENDERBUFFER_BINDING, &rb);
-        glGetIntegerv(GL_TEXTURE_BINDING_2D, &tex);
-    }
-    ~FramebufferBindingGuard() {
-        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(draw));
-        glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(read));
-        glBindRenderbuffer(GL_RENDERBUFFER, static_cast<GLuint>(rb));
-        glBindTexture(GL_TEXTURE_2D, static_cast<GLuint>(tex));
-    }
-    FramebufferBindingGuard(const FramebufferBindingGuard&) = delete;
-    FramebufferBindingGuard& operator=(const FramebufferBindingGuard&) = delete;
+  GLint draw = 0, read = 0, rb = 0, tex = 0;
+  FramebufferBindingGuard() {
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw);
+    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &read);
+    glGetIntegerv(GL_RENDERBUFFER_BINDING, &rb);
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &tex);
+  }
+  ~FramebufferBindingGuard() {
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(draw));
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(read));
+    glBindRenderbuffer(GL_RENDERBUFFER, static_cast<GLuint>(rb));
+    glBindTexture(GL_TEXTURE_2D, static_cast<GLuint>(tex));
+  }
+  FramebufferBindingGuard(const FramebufferBindingGuard&) = delete;
+  FramebufferBindingGuard& operator=(const FramebufferBindingGuard&) = delete;
 };
 
 void check_complete(GLenum target, const char* which) {
-    const GLenum status = glCheckFramebufferStatus(target);
-    if (status != GL_FRAMEBUFFER_COMPLETE)
-        throw std::runtime_error(std::string("OffscreenTarget: ") + which + " framebuffer incomplete (status " +
-                                 hex(status) + ")");
+  const GLenum status = glCheckFramebufferStatus(target);
+  if (status != GL_FRAMEBUFFER_COMPLETE)
+    throw std::runtime_error(std::string("OffscreenTarget: ") + which + " framebuffer incomplete (status " +
+                             hex(status) + ")");
 }
 
 // Clears stale error flags so that a later glGetError() reports our own calls (bounded: a lost
 // context may keep reporting errors).
 void drain_gl_errors() {
-    for (int i = 0; i < 32 && glGetError() != GL_NO_ERROR; ++i) {
-    }
+  for (int i = 0; i < 32 && glGetError() != GL_NO_ERROR; ++i) {
+  }
 }
 
 }  // namespace
 
 OffscreenTarget::OffscreenTarget(int width, int height, int samples)
     : width_(width), height_(height), samples_(samples) {
-    if (samples < 0) throw std::invalid_argument("OffscreenTarget: negative sample count");
-    if (samples > 0) {
-        GLint max_samples = 0;
-        glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-        if (samples > max_samples)
-            throw std::runtime_error("OffscreenTarget: " + std::to_string(samples) +
-                                     " samples requested, GL_MAX_SAMPLES is " + std::to_string(max_samples));
-    }
-    allocate();
+  if (samples < 0) throw std::invalid_argument("OffscreenTarget: negative sample count");
+  if (samples > 0) {
+    GLint max_samples = 0;
+    glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+    if (samples > max_samples)
+      throw std::runtime_error("OffscreenTarget: " + std::to_string(samples) +
+                               " samples requested, GL_MAX_SAMPLES is " + std::to_string(max_samples));
+  }
+  allocate();
 }
 
 OffscreenTarget::~OffscreenTarget() { release(); }
 
 OffscreenTarget::OffscreenTarget(OffscreenTarget&& o) noexcept
-    : width_(o.width_), height_(o.height_), samples_(o.samples_), fbo_(std::exchange(o.fbo_, 0)),
-      resolve_fbo_(std::exchange(o.resolve_fbo_, 0)), color_tex_(std::exchange(o.color_tex_, 0)),
-      color_rb_(std::exchange(o.color_rb_, 0)), depth_rb_(std::exchange(o.depth_rb_, 0)) {}
+    : width_(o.width_),
+      height_(o.height_),
+      samples_(o.samples_),
+      fbo_(std::exchange(o.fbo_, 0)),
+      resolve_fbo_(std::exchange(o.resolve_fbo_, 0)),
+      color_tex_(std::exchange(o.color_tex_, 0)),
+      color_rb_(std::exchange(o.color_rb_, 0)),
+      depth_rb_(std::exchange(o.depth_rb_, 0)) {}
 
 OffscreenTarget& OffscreenTarget::operator=(OffscreenTarget&& o) noexcept {
-    if (this != &o) {
-        release();
-        width_ = o.width_;
-        height_ = o.height_;
-        samples_ = o.samples_;
-        fbo_ = std::exchange(o.fbo_, 0);
-        resolve_fbo_ = std::exchange(o.resolve_fbo_, 0);
-        color_tex_ = std::exchange(o.color_tex_, 0);
-        color_rb_ = std::exchange(o.color_rb_, 0);
-        depth_rb_ = std::exchange(o.depth_rb_, 0);
-    }
-    return *this;
+  if (this != &o) {
+    release();
+    width_ = o.width_;
+    height_ = o.height_;
+    samples_ = o.samples_;
+    fbo_ = std::exchange(o.fbo_, 0);
+    resolve_fbo_ = std::exchange(o.resolve_fbo_, 0);
+    color_tex_ = std::exchange(o.color_tex_, 0);
+    color_rb_ = std::exchange(o.color_rb_, 0);
+    depth_rb_ = std::exchange(o.depth_rb_, 0);
+  }
+  return *this;
 }
 
 void OffscreenTarget::allocate() {
-    if (width_ <= 0 || height_ <= 0)
-        throw std::invalid_argument("OffscreenTarget: size must be positive, got " + std::to_string(width_) + "x" +
-                                    std::to_string(height_));
-    GLint max_rb = 0, max_tex = 0;
-    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
-    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
-    const int limit = std::min(max_rb, max_tex);
-    if (width_ > limit || height_ > limit)
-        throw std::runtime_error("OffscreenTarget: " + std::to_string(width_) + "x" + std::to_string(height_) +
-                                 " exceeds the GL limit of " + std::to_string(limit));
+  if (width_ <= 0 || height_ <= 0)
+    throw std::invalid_argument("OffscreenTarget: size must be positive, got " + std::to_string(width_) + "x" +
+                                std::to_string(height_));
+  GLint max_rb = 0, max_tex = 0;
+  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+  const int limit = std::min(max_rb, max_tex);
+  if (width_ > limit || height_ > limit)
+    throw std::runtime_error("OffscreenTarget: " + std::to_string(width_) + "x" + std::to_string(height_) +
+                             " exceeds the GL limit of " + std::to_string(limit));
 
-    drain_gl_errors();
-    FramebufferBindingGuard guard;
-    try {
-        glGenTextures(1, &color_tex_);
-        glBindTexture(GL_TEXTURE_2D, color_tex_);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width_, height_, 0, GL_RGBA, GL_FLOAT, nullptr);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+  drain_gl_errors();
+  FramebufferBindingGuard guard;
+  try {
+    glGenTextures(1, &color_tex_);
+    glBindTexture(GL_TEXTURE_2D, color_tex_);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width_, height_, 0, GL_RGBA, GL_FLOAT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
 
-        glGenRenderbuffers(1, &depth_rb_);
-        glBindRenderbuffer(GL_RENDERBUFFER, depth_rb_);
-        if (samples_ > 0)
-            glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_DEPTH24_STENCIL8, width_, height_);
-        else
-            glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, width_, height_);
+    glGenRenderbuffers(1, &depth_rb_);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth_rb_);
+    if (samples_ > 0)
+      glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_DEPTH24_STENCIL8, width_, height_);
+    else
+      glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, width_, height_);
 
-        if (samples_ > 0) {
-            glGenRenderbuffers(1, &color_rb_);
-            glBindRenderbuffer(GL_RENDERBUFFER, color_rb_);
-            glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_RGBA32F, width_, height_);
+    if (samples_ > 0) {
+      glGenRenderbuffers(1, &color_rb_);
+      glBindRenderbuffer(GL_RENDERBUFFER, color_rb_);
+      glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_RGBA32F, width_, height_);
 
-            glGenFramebuffers(1, &fbo_);
-            glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-            glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_rb_);
-            glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb_);
-            check_complete(GL_FRAMEBUFFER, "multisampled");
+      glGenFramebuffers(1, &fbo_);
+      glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_rb_);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb_);
+      check_complete(GL_FRAMEBUFFER, "multisampled");
 
-            glGenFramebuffers(1, &resolve_fbo_);
-            glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo_);
-            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color_tex_, 0);
-            check_complete(GL_FRAMEBUFFER, "resolve");
-        } else {
-            glGenFramebuffers(1, &fbo_);
-            glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color_tex_, 0);
-            glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb_);
-            check_complete(GL_FRAMEBUFFER, "render");
-            resolve_fbo_ = fbo_;
-        }
-        const GLenum err = glGetError();
-        if (err != GL_NO_ERROR)
-            throw std::runtime_error("OffscreenTarget: GL error " + hex(err) + " allocating " + std::to_string(width_) +
-                                     "x" + std::to_string(height_) + " (samples " + std::to_string(samples_) + ")");
-    } catch (...) {
-        release();
-        throw;
+      glGenFramebuffers(1, &resolve_fbo_);
+      glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo_);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color_tex_, 0);
+      check_complete(GL_FRAMEBUFFER, "resolve");
+    } else {
+      glGenFramebuffers(1, &fbo_);
+      glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color_tex_, 0);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb_);
+      check_complete(GL_FRAMEBUFFER, "render");
+      resolve_fbo_ = fbo_;
     }
+    const GLenum err = glGetError();
+    if (err != GL_NO_ERROR)
+      throw std::runtime_error("OffscreenTarget: GL error " + hex(err) + " allocating " + std::to_string(width_) + "x" +
+                               std::to_string(height_) + " (samples " + std::to_string(samples_) + ")");
+  } catch (...) {
+    release();
+    throw;
+  }
 }
 
 void OffscreenTarget::release() noexcept {
-    if (resolve_fbo_ != 0 && resolve_fbo_ != fbo_) glDeleteFramebuffers(1, &resolve_fbo_);
-    if (fbo_ != 0) glDeleteFramebuffers(1, &fbo_);
-    if (color_rb_ != 0) glDeleteRenderbuffers(1, &color_rb_);
-    if (depth_rb_ != 0) glDeleteRenderbuffers(1, &depth_rb_);
-    if (color_tex_ != 0) glDeleteTextures(1, &color_tex_);
-    fbo_ = resolve_fbo_ = color_rb_ = depth_rb_ = color_tex_ = 0;
+  if (resolve_fbo_ != 0 && resolve_fbo_ != fbo_) glDeleteFramebuffers(1, &resolve_fbo_);
+  if (fbo_ != 0) glDeleteFramebuffers(1, &fbo_);
+  if (color_rb_ != 0) glDeleteRenderbuffers(1, &color_rb_);
+  if (depth_rb_ != 0) glDeleteRenderbuffers(1, &depth_rb_);
+  if (color_tex_ != 0) glDeleteTextures(1, &color_tex_);
+  fbo_ = resolve_fbo_ = color_rb_ = depth_rb_ = color_tex_ = 0;
 }
 
 void OffscreenTarget::resize(int width, int height) {
-    if (width == width_ && height == height_ && fbo_ != 0) return;
-    release();
-    width_ = width;
-    height_ = height;
-    allocate();
+  if (width == width_ && height == height_ && fbo_ != 0) return;
+  release();
+  width_ = width;
+  height_ = height;
+  allocate();
 }
 
 void OffscreenTarget::bind() const {
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    glViewport(0, 0, width_, height_);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glViewport(0, 0, width_, height_);
 }
 
 void OffscreenTarget::resolve() const {
-    if (samples_ == 0) return;
-    FramebufferBindingGuard guard;
-    GLboolean scissor = glIsEnabled(GL_SCISSOR_TEST);
-    if (scissor) glDisable(GL_SCISSOR_TEST);  // the scissor test applies to blits
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo_);
-    glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    if (scissor) glEnable(GL_SCISSOR_TEST);
+  if (samples_ == 0) return;
+  FramebufferBindingGuard guard;
+  GLboolean scissor = glIsEnabled(GL_SCISSOR_TEST);
+  if (scissor) glDisable(GL_SCISSOR_TEST);  // the scissor test applies to blits
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo_);
+  glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  if (scissor) glEnable(GL_SCISSOR_TEST);
 }
 
 std::vector<std::uint8_t> OffscreenTarget::read_rgba() const {
-    resolve();
-    const std::size_t row = static_cast<std::size_t>(width_) * 4;
-    std::vector<std::uint8_t> pixels(row * static_cast<std::size_t>(height_));
+  resolve();
+  const std::size_t row = static_cast<std::size_t>(width_) * 4;
+  std::vector<std::uint8_t> pixels(row * static_cast<std::size_t>(height_));
 
-    FramebufferBindingGuard guard;
-    GLint pack_buffer = 0, alignment = 4, row_length = 0, skip_rows = 0, skip_pixels = 0;
-    glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &pack_buffer);
-    glGetIntegerv(GL_PACK_ALIGNMENT, &alignment);
-    glGetIntegerv(GL_PACK_ROW_LENGTH, &row_length);
-    glGetIntegerv(GL_PACK_SKIP_ROWS, &skip_rows);
-    glGetIntegerv(GL_PACK_SKIP_PIXELS, &skip_pixels);
-    GLint read_buffer = GL_COLOR_ATTACHMENT0;
+  FramebufferBindingGuard guard;
+  GLint pack_buffer = 0, alignment = 4, row_length = 0, skip_rows = 0, skip_pixels = 0;
+  glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &pack_buffer);
+  glGetIntegerv(GL_PACK_ALIGNMENT, &alignment);
+  glGetIntegerv(GL_PACK_ROW_LENGTH, &row_length);
+  glGetIntegerv(GL_PACK_SKIP_ROWS, &skip_rows);
+  glGetIntegerv(GL_PACK_SKIP_PIXELS, &skip_pixels);
+  GLint read_buffer = GL_COLOR_ATTACHMENT0;
 
-    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);  // else glReadPixels would write into the buffer object
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-    glPixelStorei(GL_PACK_SKIP_ROWS, 0);
-    glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
-    drain_gl_errors();
-    glGetIntegerv(GL_READ_BUFFER, &read_buffer);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
-    const GLenum err = glGetError();
-    glReadBuffer(static_cast<GLenum>(read_buffer));
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);  // else glReadPixels would write into the buffer object
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glPixelStorei(GL_PACK_SKIP_ROWS, 0);
+  glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
+  drain_gl_errors();
+  glGetIntegerv(GL_READ_BUFFER, &read_buffer);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
+  const GLenum err = glGetError();
+  glReadBuffer(static_cast<GLenum>(read_buffer));
 
-    glBindBuffer(GL_PIXEL_PACK_BUFFER, static_cast<GLuint>(pack_buffer));
-    glPixelStorei(GL_PACK_ALIGNMENT, alignment);
-    glPixelStorei(GL_PACK_ROW_LENGTH, row_length);
-    glPixelStorei(GL_PACK_SKIP_ROWS, skip_rows);
-    glPixelStorei(GL_PACK_SKIP_PIXELS, skip_pixels);
-    if (err != GL_NO_ERROR) throw std::runtime_error("OffscreenTarget: glReadPixels failed with GL error " + hex(err));
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, static_cast<GLuint>(pack_buffer));
+  glPixelStorei(GL_PACK_ALIGNMENT, alignment);
+  glPixelStorei(GL_PACK_ROW_LENGTH, row_length);
+  glPixelStorei(GL_PACK_SKIP_ROWS, skip_rows);
+  glPixelStorei(GL_PACK_SKIP_PIXELS, skip_pixels);
+  if (err != GL_NO_ERROR) throw std::runtime_error("OffscreenTarget: glReadPixels failed with GL error " + hex(err));
 
-    // GL rows run bottom-up; callers get top-down.
-    std::vector<std::uint8_t> tmp(row);
-    for (int y = 0; y < height_ / 2; ++y) {
-        std::uint8_t* a = pixels.data() + static_cast<std::size_t>(y) * row;
-        std::uint8_t* b = pixels.data() + static_cast<std::size_t>(height_ - 1 - y) * row;
-        std::memcpy(tmp.data(), a, row);
-        std::memcpy(a, b, row);
-        std::memcpy(b, tmp.data(), row);
-    }
-    return pixels;
+  // GL rows run bottom-up; callers get top-down.
+  std::vector<std::uint8_t> tmp(row);
+  for (int y = 0; y < height_ / 2; ++y) {
+    std::uint8_t* a = pixels.data() + static_cast<std::size_t>(y) * row;
+    std::uint8_t* b = pixels.data() + static_cast<std::size_t>(height_ - 1 - y) * row;
+    std::memcpy(tmp.data(), a, row);
+    std::memcpy(a, b, row);
+    std::memcpy(b, tmp.data(), row);
+  }
+  return pixels;
 }
 
 }  // namespace vxl

@@ -22,44 +22,44 @@
 namespace vxl {
 
 class OffscreenTarget {
-public:
-    OffscreenTarget(int width, int height, int samples = 0);
-    ~OffscreenTarget();
-    OffscreenTarget(const OffscreenTarget&) = delete;
-    OffscreenTarget& operator=(const OffscreenTarget&) = delete;
-    OffscreenTarget(OffscreenTarget&& other) noexcept;
-    OffscreenTarget& operator=(OffscreenTarget&& other) noexcept;
+ public:
+  OffscreenTarget(int width, int height, int samples = 0);
+  ~OffscreenTarget();
+  OffscreenTarget(const OffscreenTarget&) = delete;
+  OffscreenTarget& operator=(const OffscreenTarget&) = delete;
+  OffscreenTarget(OffscreenTarget&& other) noexcept;
+  OffscreenTarget& operator=(OffscreenTarget&& other) noexcept;
 
-    // Binds the render framebuffer (GL_FRAMEBUFFER: draw and read) and sets the viewport to the
-    // full target.
-    void bind() const;
-    // Reallocates all buffers (contents undefined afterwards). Keeps the sample count.
-    void resize(int width, int height);
+  // Binds the render framebuffer (GL_FRAMEBUFFER: draw and read) and sets the viewport to the
+  // full target.
+  void bind() const;
+  // Reallocates all buffers (contents undefined afterwards). Keeps the sample count.
+  void resize(int width, int height);
 
-    int width() const { return width_; }
-    int height() const { return height_; }
-    int samples() const { return samples_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int samples() const { return samples_; }
 
-    // Multisampled: blit colour into the single-sample texture. No-op otherwise.
-    // Restores the framebuffer bindings it changes.
-    void resolve() const;
-    // Colour converted to tightly packed RGBA8 (clamped, rounded once), width*height*4 bytes, rows top-to-bottom (GL's bottom-up
-    // order flipped). Resolves first; leaves framebuffer bindings and pack state as it found them.
-    std::vector<std::uint8_t> read_rgba() const;
+  // Multisampled: blit colour into the single-sample texture. No-op otherwise.
+  // Restores the framebuffer bindings it changes.
+  void resolve() const;
+  // Colour converted to tightly packed RGBA8 (clamped, rounded once), width*height*4 bytes, rows top-to-bottom (GL's
+  // bottom-up order flipped). Resolves first; leaves framebuffer bindings and pack state as it found them.
+  std::vector<std::uint8_t> read_rgba() const;
 
-    unsigned framebuffer() const { return fbo_; }          // the one bind() binds
-    unsigned color_texture() const { return color_tex_; }  // single-sample colour (after resolve())
+  unsigned framebuffer() const { return fbo_; }          // the one bind() binds
+  unsigned color_texture() const { return color_tex_; }  // single-sample colour (after resolve())
 
-private:
-    int width_ = 0, height_ = 0, samples_ = 0;
-    unsigned fbo_ = 0;          // render FBO
-    unsigned resolve_fbo_ = 0;  // single-sample FBO around color_tex_ (== fbo_ when samples_ == 0)
-    unsigned color_tex_ = 0;
-    unsigned color_rb_ = 0;     // multisampled colour (samples_ > 0)
-    unsigned depth_rb_ = 0;
+ private:
+  int width_ = 0, height_ = 0, samples_ = 0;
+  unsigned fbo_ = 0;          // render FBO
+  unsigned resolve_fbo_ = 0;  // single-sample FBO around color_tex_ (== fbo_ when samples_ == 0)
+  unsigned color_tex_ = 0;
+  unsigned color_rb_ = 0;  // multisampled colour (samples_ > 0)
+  unsigned depth_rb_ = 0;
 
-    void allocate();
-    void release() noexcept;
+  void allocate();
+  void release() noexcept;
 };
 
 }  // namespace vxl

@@ -125,9 +125,8 @@ std::optional<std::array<double, 2>> parse_view(const std::string& name) {
     double az, el;
   };
   static const Named views[] = {
-      {"axial", 180, 90},    {"superior", 180, 90}, {"inferior", 0, -90},  {"sagittal", -90, 0},
-      {"left", -90, 0},      {"right", 90, 0},    {"coronal", 0, 0},      {"anterior", 0, 0},
-      {"posterior", 180, 0},
+      {"axial", 180, 90}, {"superior", 180, 90}, {"inferior", 0, -90}, {"sagittal", -90, 0},  {"left", -90, 0},
+      {"right", 90, 0},   {"coronal", 0, 0},     {"anterior", 0, 0},   {"posterior", 180, 0},
   };
   for (const Named& v : views)
     if (name == v.name) return std::array<double, 2>{v.az, v.el};

@@ -14,17 +14,17 @@ namespace vxl {
 
 struct Camera {
   glm::dvec3 target{0.0};
-  double distance = 300.0;      // mm from target to eye
-  double azimuth_deg = 0.0;     // rotation about +Z (superior); 0 looks from anterior (+Y)
-  double elevation_deg = 0.0;   // +90 looks from superior
-  double fov_y_deg = 30.0;      // perspective field of view
+  double distance = 300.0;     // mm from target to eye
+  double azimuth_deg = 0.0;    // rotation about +Z (superior); 0 looks from anterior (+Y)
+  double elevation_deg = 0.0;  // +90 looks from superior
+  double fov_y_deg = 30.0;     // perspective field of view
   bool orthographic = false;
   double ortho_height = 200.0;  // mm visible vertically in orthographic mode
 
   glm::dvec3 eye() const;
-  glm::dvec3 forward() const;   // unit, eye -> target
-  glm::dvec3 up() const;        // unit, screen up
-  glm::dvec3 right() const;     // unit, screen right
+  glm::dvec3 forward() const;  // unit, eye -> target
+  glm::dvec3 up() const;       // unit, screen up
+  glm::dvec3 right() const;    // unit, screen right
 
   // Rotation from world to eye space (rows: right, up, -forward). Applied to camera-relative positions.
   glm::mat3 view_rotation() const;
@@ -44,8 +44,9 @@ struct Camera {
   static constexpr double kFrameMargin = 0.04;
 };
 
-// Standard views (anterior up in axial views, patient right on screen right seen from above) like mrview's: "axial"/"superior", "inferior", "sagittal"/"left", "right",
-// "coronal"/"anterior", "posterior", or "AZ,EL" in degrees. Returns {azimuth, elevation}.
+// Standard views (anterior up in axial views, patient right on screen right seen from above) like mrview's:
+// "axial"/"superior", "inferior", "sagittal"/"left", "right", "coronal"/"anterior", "posterior", or "AZ,EL" in degrees.
+// Returns {azimuth, elevation}.
 std::optional<std::array<double, 2>> parse_view(const std::string& name);
 
 }  // namespace vxl

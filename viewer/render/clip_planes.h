@@ -23,16 +23,16 @@ namespace vxl {
 struct Camera;
 
 struct AxisClip {
-  int axis = 0;             // 0 x, 1 y, 2 z
-  bool keep_above = true;   // true: keep coordinate >= position (+axis); false: keep <= position (-axis)
-  double position = 0;      // RAS mm
-  bool enabled = true;      // the window toggles planes without forgetting them
+  int axis = 0;            // 0 x, 1 y, 2 z
+  bool keep_above = true;  // true: keep coordinate >= position (+axis); false: keep <= position (-axis)
+  double position = 0;     // RAS mm
+  bool enabled = true;     // the window toggles planes without forgetting them
 };
 
 struct Clipping {
   static constexpr int kMaxPlanes = 3;
-  double slab_mm = 0;              // 0: no slab
-  std::vector<AxisClip> planes;    // at most kMaxPlanes
+  double slab_mm = 0;            // 0: no slab
+  std::vector<AxisClip> planes;  // at most kMaxPlanes
   bool active() const;
 };
 

@@ -15,11 +15,14 @@ std::array<glm::vec3, kColormapSamples> grey_table() {
 
 // matplotlib's "hot" segment data, evaluated at the sample points.
 std::array<glm::vec3, kColormapSamples> hot_table() {
-  auto ramp = [](double x, double x0, double y0, double x1) { return x <= x0 ? y0 : x >= x1 ? 1.0 : y0 + (1 - y0) * (x - x0) / (x1 - x0); };
+  auto ramp = [](double x, double x0, double y0, double x1) {
+    return x <= x0 ? y0 : x >= x1 ? 1.0 : y0 + (1 - y0) * (x - x0) / (x1 - x0);
+  };
   std::array<glm::vec3, kColormapSamples> t;
   for (int k = 0; k < kColormapSamples; ++k) {
     const double x = k / 32.0;
-    t[k] = glm::vec3(static_cast<float>(ramp(x, 0.0, 0.0416, 0.365079)), static_cast<float>(ramp(x, 0.365079, 0.0, 0.746032)),
+    t[k] = glm::vec3(static_cast<float>(ramp(x, 0.0, 0.0416, 0.365079)),
+                     static_cast<float>(ramp(x, 0.365079, 0.0, 0.746032)),
                      static_cast<float>(ramp(x, 0.746032, 0.0, 1.0)));
   }
   return t;

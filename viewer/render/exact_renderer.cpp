@@ -41,7 +41,6 @@ layout(binding = 0, r32ui) uniform writeonly uimage2D u_heads;
 void main() { imageStore(u_heads, ivec2(gl_GlobalInvocationID.xy), uvec4(0xFFFFFFFFu)); }
 )";
 
-
 const char* const kBlitFragment = R"(#version 330 core
 in vec2 v_uv;
 uniform sampler2D u_result;
@@ -146,7 +145,8 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
     glBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, 4, &zero);
 
     lines_.bind_line_program(list_program_, camera, s, aspect);
-    glUniform1ui(glGetUniformLocation(list_program_, "u_capacity"), static_cast<GLuint>(std::min<std::uint64_t>(capacity_, 0xFFFFFFFFu)));
+    glUniform1ui(glGetUniformLocation(list_program_, "u_capacity"),
+                 static_cast<GLuint>(std::min<std::uint64_t>(capacity_, 0xFFFFFFFFu)));
     glUniform4i(glGetUniformLocation(list_program_, "u_band"), 0, y0, width, y1);
     glBindImageTexture(0, heads_, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter_);
@@ -158,7 +158,8 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
     glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, counter_);
     glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, 4, &stored);
     if (stored > capacity_) {
-      if (y1 - y0 <= 1) throw std::runtime_error("exact mode: one pixel row has more fragments than the node buffer holds");
+      if (y1 - y0 <= 1)
+        throw std::runtime_error("exact mode: one pixel row has more fragments than the node buffer holds");
       int mid = (y0 + y1) / 2;
       bands.push_back({mid, y1});
       bands.push_back({y0, mid});

@@ -71,13 +71,15 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
     if (v.segment_count == 0 || outside(view, v)) continue;
     glm::dvec3 d = v.center - view.eye;
     // back to front = descending distance: sort ascending on the negated key
-    float key = view.orthographic ? static_cast<float>(-glm::dot(d, view.forward)) : static_cast<float>(-glm::dot(d, d));
+    float key =
+        view.orthographic ? static_cast<float>(-glm::dot(d, view.forward)) : static_cast<float>(-glm::dot(d, d));
     plan.sort_keys.push_back({key, i});
   }
   if (order != PlanOrder::Any) std::sort(plan.sort_keys.begin(), plan.sort_keys.end());
   const bool hysteresis = order == PlanOrder::Nearest && plan.order_hysteresis > 0;
   if (order == PlanOrder::Nearest && !hysteresis) plan.previous_order.clear();
-  if (hysteresis && plan.previous_order.size() != voxels.size()) plan.previous_order.assign(voxels.size(), FramePlan::kNoOrder);
+  if (hysteresis && plan.previous_order.size() != voxels.size())
+    plan.previous_order.assign(voxels.size(), FramePlan::kNoOrder);
   plan.first.reserve(plan.sort_keys.size());
   plan.count.reserve(plan.sort_keys.size());
   for (const auto& [key, i] : plan.sort_keys) {
@@ -93,7 +95,8 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
         if (previous != FramePlan::kNoOrder) {
           const std::uint32_t kept_slot = previous >> 1;
           const bool kept_reversed = previous & 1;
-          if (order_alignment(directions, slot, reversed, w) - order_alignment(directions, kept_slot, kept_reversed, w) <=
+          if (order_alignment(directions, slot, reversed, w) -
+                  order_alignment(directions, kept_slot, kept_reversed, w) <=
               plan.order_hysteresis) {
             slot = kept_slot;
             reversed = kept_reversed;

@@ -17,10 +17,10 @@ namespace vxl {
 
 struct ViewParams {
   glm::dvec3 eye;
-  glm::dvec3 forward;                 // unit view direction (used for orthographic sorting)
+  glm::dvec3 forward;  // unit view direction (used for orthographic sorting)
   bool orthographic = false;
-  std::array<glm::dvec4, 6> planes;   // frustum planes in camera-relative coordinates (p - eye), inside >= 0
-  std::vector<glm::dvec4> clip;       // slab and clip half-spaces, camera-relative likewise (clip_planes.h)
+  std::array<glm::dvec4, 6> planes;  // frustum planes in camera-relative coordinates (p - eye), inside >= 0
+  std::vector<glm::dvec4> clip;      // slab and clip half-spaces, camera-relative likewise (clip_planes.h)
 };
 
 // Frustum planes from a projection matrix and the world->eye rotation (Gribb & Hartmann).
@@ -61,6 +61,7 @@ std::pair<std::uint32_t, bool> nearest_order(std::span<const glm::vec3> directio
 
 // How close stored order {slot, reversed} is to view direction w: the cosine between the direction it
 // serves and w (nearest_order maximises it).
-double order_alignment(std::span<const glm::vec3> directions, std::uint32_t slot, bool reversed, const glm::dvec3& view_dir);
+double order_alignment(std::span<const glm::vec3> directions, std::uint32_t slot, bool reversed,
+                       const glm::dvec3& view_dir);
 
 }  // namespace vxl

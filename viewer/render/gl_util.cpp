@@ -54,7 +54,8 @@ void TextureBuffer::create(GLenum internal_format, const void* data, std::size_t
   glGenBuffers(1, &buffer);
   glBindBuffer(GL_TEXTURE_BUFFER, buffer);
   // A zero-sized buffer texture is not portable: keep at least one texel.
-  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(bytes > 0 ? bytes : 16), bytes > 0 ? data : nullptr, GL_STATIC_DRAW);
+  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(bytes > 0 ? bytes : 16), bytes > 0 ? data : nullptr,
+               GL_STATIC_DRAW);
   glGenTextures(1, &texture);
   glBindTexture(GL_TEXTURE_BUFFER, texture);
   glTexBuffer(GL_TEXTURE_BUFFER, internal_format, buffer);

@@ -39,8 +39,9 @@ void GpuScene::widen_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t l
   for (std::uint32_t e = 0; e < v.vertex_count && n < v.segment_count; ++e)
     if (is_start[e]) block[n++] = base + e;
   if (n != v.segment_count)  // a repeated entry in order 0: it is no permutation
-    throw Error(ErrorKind::Input, file.path(), file.find_section(section_id("ORDR"))->offset + v.order_offset,
-                "order 0 of voxel " + std::to_string(li) + " is not a permutation of its segments (run `voxlines verify`)");
+    throw Error(
+        ErrorKind::Input, file.path(), file.find_section(section_id("ORDR"))->offset + v.order_offset,
+        "order 0 of voxel " + std::to_string(li) + " is not a permutation of its segments (run `voxlines verify`)");
 }
 
 GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels)
@@ -92,8 +93,10 @@ void GpuScene::upload_attributes(const std::vector<std::vector<float>>& per_file
     GpuChunk& g = chunks_[i];
     g.attributes.destroy();
     const std::vector<float>* values = c.file < per_file.size() ? &per_file[c.file] : nullptr;
-    if (values == nullptr || values->empty()) g.attributes.create(GL_RG32F, nullptr, 0);
-    else g.attributes.create(GL_RG32F, values->data() + 2 * c.vertex_first, 8 * c.vertex_count);
+    if (values == nullptr || values->empty())
+      g.attributes.create(GL_RG32F, nullptr, 0);
+    else
+      g.attributes.create(GL_RG32F, values->data() + 2 * c.vertex_first, 8 * c.vertex_count);
   }
 }
 
@@ -117,7 +120,8 @@ const std::vector<std::int32_t>& GpuScene::dataset_first() {
           dataset_count_.push_back(0);
           run_chunk = c;
         }
-        for (std::uint64_t s = 0; s < segments; ++s) arr.push_back(static_cast<std::uint32_t>(first_vertex - cl.vertex_first + s));
+        for (std::uint64_t s = 0; s < segments; ++s)
+          arr.push_back(static_cast<std::uint32_t>(first_vertex - cl.vertex_first + s));
         dataset_count_.back() += static_cast<std::int32_t>(2 * segments);
       };
       walk_streamlines(*files_[fi], cb);

@@ -1,22 +1,22 @@
 // The GPU copy of a scene of one or more .vxl files: per chunk (see scene_layout.h) a positions buffer (one
-// large copy straight from the memory-mapped file), an orders buffer (stored orders widened to chunk-global u32 indices, each
-// entry checked, plus the block order), and — only when first needed — a dataset-order buffer.
+// large copy straight from the memory-mapped file), an orders buffer (stored orders widened to chunk-global u32
+// indices, each entry checked, plus the block order), and — only when first needed — a dataset-order buffer.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "format/vxl_file.h"
 #include "viewer/render/gl_util.h"
 #include "viewer/render/scene_layout.h"
-#include "format/vxl_file.h"
 
 namespace vxl {
 
 struct GpuChunk {
-  gl::TextureBuffer positions;  // GL_R32F, 3 texels per vertex
-  gl::TextureBuffer orders;     // GL_R32UI, slots x S
-  gl::TextureBuffer dataset;    // GL_R32UI, S (empty until needed)
-  gl::TextureBuffer attributes; // GL_RG32F, (value, group) per vertex (empty until a colour mode needs it)
+  gl::TextureBuffer positions;   // GL_R32F, 3 texels per vertex
+  gl::TextureBuffer orders;      // GL_R32UI, slots x S
+  gl::TextureBuffer dataset;     // GL_R32UI, S (empty until needed)
+  gl::TextureBuffer attributes;  // GL_RG32F, (value, group) per vertex (empty until a colour mode needs it)
 };
 
 class GpuScene {
@@ -24,7 +24,8 @@ class GpuScene {
   // Needs a current GL context. max_texels 0: ask the driver (GL_MAX_TEXTURE_BUFFER_SIZE). The files must
   // outlive the scene.
   GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0);
-  GpuScene(const VxlFile& file, std::uint64_t max_texels = 0) : GpuScene(std::vector<const VxlFile*>{&file}, max_texels) {}
+  GpuScene(const VxlFile& file, std::uint64_t max_texels = 0)
+      : GpuScene(std::vector<const VxlFile*>{&file}, max_texels) {}
   ~GpuScene();
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;

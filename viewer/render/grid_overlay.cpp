@@ -144,7 +144,8 @@ void GridOverlay::draw(Renderer& renderer, const Camera& camera, double aspect, 
     if (count == 0) continue;
     const MetaSection& m = renderer.files()[fi]->meta();
     // The eye in this file's grid units, split in double into an integer cell and a fraction.
-    const glm::dvec3 g = (camera.eye() - glm::dvec3(m.grid_origin[0], m.grid_origin[1], m.grid_origin[2])) / m.voxel_size;
+    const glm::dvec3 g =
+        (camera.eye() - glm::dvec3(m.grid_origin[0], m.grid_origin[1], m.grid_origin[2])) / m.voxel_size;
     const glm::dvec3 cell = glm::floor(g);
     const glm::ivec3 eye_cell(cell);
     const glm::vec3 eye_frac(g - cell);

@@ -40,7 +40,7 @@ class GridOverlay {
  private:
   GLuint program_ = 0, vao_ = 0, corners_ = 0, all_instances_ = 0, drawn_instances_ = 0;
   std::uint64_t voxel_count_ = 0, cubes_drawn_ = 0;
-  FramePlan plan_;                       // re-planned here: the renderer keeps its own plan private
+  FramePlan plan_;                        // re-planned here: the renderer keeps its own plan private
   std::vector<glm::ivec3> drawn_coords_;  // scratch, kept between frames
 };
 

@@ -7,13 +7,13 @@ namespace vxl::shaders {
 
 std::string line_vertex(unsigned chunk_count, const char* version) {
   std::string n = std::to_string(chunk_count);
-  std::string s = std::string(version) + "\n#define CHUNKS " + n + "\n#define CLIPS " + std::to_string(kMaxClipDistances) +
-                  "\n#define GROUPS " + std::to_string(kShaderGroups) + "\n#define SAMPLES " +
-                  std::to_string(kColormapSamples) + "\n";
+  std::string s = std::string(version) + "\n#define CHUNKS " + n + "\n#define CLIPS " +
+                  std::to_string(kMaxClipDistances) + "\n#define GROUPS " + std::to_string(kShaderGroups) +
+                  "\n#define SAMPLES " + std::to_string(kColormapSamples) + "\n";
   for (unsigned c = 0; c < chunk_count; ++c) {
     std::string i = std::to_string(c);
-    s += "uniform samplerBuffer u_pos" + i + ";\nuniform usamplerBuffer u_ord" + i + ";\nuniform usamplerBuffer u_dat" + i +
-         ";\nuniform samplerBuffer u_att" + i + ";\n";
+    s += "uniform samplerBuffer u_pos" + i + ";\nuniform usamplerBuffer u_ord" + i + ";\nuniform usamplerBuffer u_dat" +
+         i + ";\nuniform samplerBuffer u_att" + i + ";\n";
   }
   s += "vec3 fetch_pos(int c, int v) {\n";
   for (unsigned c = 0; c < chunk_count; ++c) {

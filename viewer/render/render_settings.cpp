@@ -14,16 +14,18 @@ struct ModeName {
   RenderMode mode;
   const char* name;
 };
-constexpr ModeName kModes[] = {{RenderMode::Opaque, "opaque"}, {RenderMode::Unsorted, "unsorted"},
+constexpr ModeName kModes[] = {{RenderMode::Opaque, "opaque"},     {RenderMode::Unsorted, "unsorted"},
                                {RenderMode::Additive, "additive"}, {RenderMode::Wboit, "wboit"},
-                               {RenderMode::Basic, "basic"}, {RenderMode::Axis, "axis"},
+                               {RenderMode::Basic, "basic"},       {RenderMode::Axis, "axis"},
                                {RenderMode::Exact, "exact"}};
 struct ColorName {
   ColorMode mode;
   const char* name;
 };
-constexpr ColorName kColors[] = {{ColorMode::Direction, "direction"}, {ColorMode::Fixed, "fixed"},
-                                 {ColorMode::Scalar, "scalar"}, {ColorMode::Group, "group"}};
+constexpr ColorName kColors[] = {{ColorMode::Direction, "direction"},
+                                 {ColorMode::Fixed, "fixed"},
+                                 {ColorMode::Scalar, "scalar"},
+                                 {ColorMode::Group, "group"}};
 }  // namespace
 
 std::optional<ColorMode> parse_color_mode(const std::string& name) {
@@ -45,9 +47,12 @@ std::optional<glm::vec3> parse_hex_color(const std::string& text) {
     int v = 0;
     for (int k = 0; k < 2; ++k) {
       const char ch = static_cast<char>(std::tolower(static_cast<unsigned char>(text[1 + 2 * i + k])));
-      if (ch >= '0' && ch <= '9') v = 16 * v + (ch - '0');
-      else if (ch >= 'a' && ch <= 'f') v = 16 * v + (ch - 'a' + 10);
-      else return std::nullopt;
+      if (ch >= '0' && ch <= '9')
+        v = 16 * v + (ch - '0');
+      else if (ch >= 'a' && ch <= 'f')
+        v = 16 * v + (ch - 'a' + 10);
+      else
+        return std::nullopt;
     }
     c[i] = v / 255.0f;
   }

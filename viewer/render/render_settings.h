@@ -65,19 +65,19 @@ struct RenderSettings {
   RenderMode mode = RenderMode::Axis;
   ColorMode color = ColorMode::Direction;
   glm::vec3 fixed_color{1.0f, 0.85f, 0.3f};
-  float opacity = 0.5f;    // 1 down to 0.001
-  float line_width = 1.0f; // pixels
+  float opacity = 0.5f;     // 1 down to 0.001
+  float line_width = 1.0f;  // pixels
   bool white_background = false;
   // `axis` mode: keep a voxel's order until another stored order is closer to its view direction by
   // more than this cosine margin (FramePlan::order_hysteresis). 0: off, the paper's rule every frame.
   float order_hysteresis = 0.0f;
-  Colormap colormap = Colormap::Viridis;  // for ColorMode::Scalar
-  std::string scalar;                     // the value set to colour by; empty: the first the scene has
+  Colormap colormap = Colormap::Viridis;      // for ColorMode::Scalar
+  std::string scalar;                         // the value set to colour by; empty: the first the scene has
   std::optional<std::array<float, 2>> range;  // values mapped to the colour map's ends; none: the set's min, max
-  std::vector<GroupStyle> group_styles;   // only the groups the user changed
-  Clipping clipping;       // slab and clip planes (clip_planes.h)
-  bool lighting = false;   // illuminated lines (line_lighting.h)
-  SliceSettings slices;    // drawn when the renderer has a volume (Renderer::set_volume)
+  std::vector<GroupStyle> group_styles;       // only the groups the user changed
+  Clipping clipping;                          // slab and clip planes (clip_planes.h)
+  bool lighting = false;                      // illuminated lines (line_lighting.h)
+  SliceSettings slices;                       // drawn when the renderer has a volume (Renderer::set_volume)
   glm::vec3 background() const { return white_background ? glm::vec3(1.0f) : glm::vec3(0.0f); }
   // The colour and opacity factor of group `index` called `name`.
   glm::vec4 group_color(const std::string& name, std::size_t index) const;

@@ -16,7 +16,8 @@
 
 namespace vxl {
 
-Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels) : Renderer(std::vector<const VxlFile*>{&file}, max_texels) {}
+Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels)
+    : Renderer(std::vector<const VxlFile*>{&file}, max_texels) {}
 
 Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels)
     : files_(files.empty() ? throw std::invalid_argument("Renderer: no files") : files),
@@ -48,7 +49,8 @@ Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels)
 Renderer::~Renderer() {
   exact_.reset();
   slices_.reset();
-  for (GLuint p : {over_program_, accum_program_, reveal_program_, additive_program_, wboit_composite_, additive_composite_})
+  for (GLuint p :
+       {over_program_, accum_program_, reveal_program_, additive_program_, wboit_composite_, additive_composite_})
     if (p) glDeleteProgram(p);
   wboit_target_.destroy();
   opaque_target_.destroy();
@@ -129,7 +131,8 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   }
   if (base.empty()) base = {0}, segments = {1}, slots = {1};
   glUniform1iv(glGetUniformLocation(program, "u_chunk_base"), static_cast<GLsizei>(base.size()), base.data());
-  glUniform1iv(glGetUniformLocation(program, "u_chunk_segments"), static_cast<GLsizei>(segments.size()), segments.data());
+  glUniform1iv(glGetUniformLocation(program, "u_chunk_segments"), static_cast<GLsizei>(segments.size()),
+               segments.data());
   glUniform1iv(glGetUniformLocation(program, "u_chunk_slots"), static_cast<GLsizei>(slots.size()), slots.data());
   for (std::size_t c = 0; c < scene_.chunks().size(); ++c) {
     const GpuChunk& g = scene_.chunks()[c];
@@ -156,7 +159,8 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   glUniform1i(glGetUniformLocation(program, "u_color_mode"), static_cast<int>(s.color));
   glUniform3fv(glGetUniformLocation(program, "u_fixed_color"), 1, glm::value_ptr(s.fixed_color));
   glUniform1i(glGetUniformLocation(program, "u_attributes"), attributes_key_.empty() ? 0 : 1);
-  glUniform3fv(glGetUniformLocation(program, "u_colormap"), kColormapSamples, glm::value_ptr(colormap_samples(s.colormap)[0]));
+  glUniform3fv(glGetUniformLocation(program, "u_colormap"), kColormapSamples,
+               glm::value_ptr(colormap_samples(s.colormap)[0]));
   const std::array<float, 2> range = scalar_range(s);
   glUniform2f(glGetUniformLocation(program, "u_range"), range[0], range[1]);
   std::vector<glm::vec4> group(shaders::kShaderGroups, glm::vec4(1.0f));
@@ -167,8 +171,8 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   glUniform1i(glGetUniformLocation(program, "u_lighting"), s.lighting ? 1 : 0);
   const glm::vec3 light = lighting::light_direction_eye();
   glUniform3fv(glGetUniformLocation(program, "u_light"), 1, glm::value_ptr(light));
-  glUniform4f(glGetUniformLocation(program, "u_light_terms"), lighting::kAmbient, lighting::kDiffuse, lighting::kSpecular,
-              lighting::kShininess);
+  glUniform4f(glGetUniformLocation(program, "u_light_terms"), lighting::kAmbient, lighting::kDiffuse,
+              lighting::kSpecular, lighting::kShininess);
   glUniform1i(glGetUniformLocation(program, "u_orthographic"), camera.orthographic ? 1 : 0);
   std::vector<glm::vec4> clip;
   for (const glm::dvec4& h : clip_half_spaces(s.clipping, camera)) clip.push_back(glm::vec4(relative_to(h, eye)));
@@ -188,8 +192,10 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
 
 void Renderer::enable_clip_distances(int n) {
   for (int i = 0; i < kMaxClipDistances; ++i) {
-    if (i < n) glEnable(GL_CLIP_DISTANCE0 + i);
-    else glDisable(GL_CLIP_DISTANCE0 + i);
+    if (i < n)
+      glEnable(GL_CLIP_DISTANCE0 + i);
+    else
+      glDisable(GL_CLIP_DISTANCE0 + i);
   }
 }
 
@@ -249,7 +255,8 @@ void Renderer::draw_plan(const std::vector<std::int32_t>& first, const std::vect
   glMultiDrawArrays(GL_LINES, first.data(), count.data(), static_cast<GLsizei>(first.size()));
 }
 
-void Renderer::draw_lines(GLuint program, const Camera& camera, const RenderSettings& s, double aspect, PlanOrder order) {
+void Renderer::draw_lines(GLuint program, const Camera& camera, const RenderSettings& s, double aspect,
+                          PlanOrder order) {
   plan(camera, aspect, order, plan_, s.clipping);
   bind_line_program(program, camera, s, aspect);
   draw_plan(plan_.first, plan_.count);
@@ -306,7 +313,8 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
   // The opaque slices first: their colour is the base of the picture, their depth hides lines behind them.
   slices_drawn_ = slices_ && s.slices.any();
   if (slices_drawn_)
-    slices_->draw(camera, projection(camera, aspect), s.slices, clip_half_spaces(s.clipping, camera), bg, width, height);
+    slices_->draw(camera, projection(camera, aspect), s.slices, clip_half_spaces(s.clipping, camera), bg, width,
+                  height);
   glLineWidth(std::max(1.0f, s.line_width));
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
@@ -385,7 +393,8 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       over_blending();
       glUseProgram(additive_composite_);
       glUniform1f(glGetUniformLocation(additive_composite_, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
-      composite(additive_composite_, {{"u_opaque", opaque_target_.color[0]}, {"u_additive", additive_target_.color[0]}});
+      composite(additive_composite_,
+                {{"u_opaque", opaque_target_.color[0]}, {"u_additive", additive_target_.color[0]}});
       break;
     }
     case RenderMode::Exact:

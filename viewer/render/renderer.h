@@ -9,11 +9,11 @@
 
 #include <array>
 #include <cstdint>
-#include <string>
-#include <vector>
 #include <initializer_list>
 #include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "viewer/render/camera.h"
 #include "viewer/render/frame_plan.h"

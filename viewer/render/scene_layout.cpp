@@ -29,7 +29,8 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
     fl.stored_orders = m.stored_order_count;
     for (const DirectionEntry& d : file.directions()) fl.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
     fl.voxel_directions.reserve(file.voxel_directions().size());
-    for (const DirectionEntry& d : file.voxel_directions()) fl.voxel_directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
+    for (const DirectionEntry& d : file.voxel_directions())
+      fl.voxel_directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
     voxel_size_ = std::max(voxel_size_, m.voxel_size);
     const std::uint32_t slots = fl.stored_orders + 1;
     auto fits = [&](std::uint64_t vertices, std::uint64_t segments) {
@@ -74,9 +75,9 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
   }
   if (chunks_.size() > kMaxChunks)
     throw Error(ErrorKind::Unsupported, where, std::nullopt,
-                "the scene needs " + std::to_string(chunks_.size()) + " GPU chunks (at most " + std::to_string(kMaxChunks) +
-                    " with a texture-buffer limit of " + std::to_string(max_texels) + " texels" +
-                    (files.size() > 1 ? "; each file takes at least one" : "") + ")");
+                "the scene needs " + std::to_string(chunks_.size()) + " GPU chunks (at most " +
+                    std::to_string(kMaxChunks) + " with a texture-buffer limit of " + std::to_string(max_texels) +
+                    " texels" + (files.size() > 1 ? "; each file takes at least one" : "") + ")");
   for (ChunkLayout& c : chunks_) {
     c.virtual_base = virtual_ids_;
     virtual_ids_ += 2 * (2 * std::uint64_t(c.slots) * c.segments + c.segments);

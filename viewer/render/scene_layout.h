@@ -31,7 +31,7 @@
 namespace vxl {
 
 struct VoxelDrawInfo {
-  glm::dvec3 center;        // cube centre, mm
+  glm::dvec3 center;  // cube centre, mm
   glm::vec3 tight_min, tight_max;
   std::uint32_t chunk;
   std::uint32_t segment_count;
@@ -50,9 +50,9 @@ struct ChunkLayout {
 // Where one file's voxels are in the scene, and its sorting directions.
 struct FileLayout {
   std::uint32_t voxel_first = 0, voxel_count = 0;
-  std::uint32_t stored_orders = 0;              // K
-  std::vector<glm::vec3> directions;            // DIRS
-  std::vector<glm::vec3> voxel_directions;      // VDIR, voxel-major, K per voxel; empty without
+  std::uint32_t stored_orders = 0;          // K
+  std::vector<glm::vec3> directions;        // DIRS
+  std::vector<glm::vec3> voxel_directions;  // VDIR, voxel-major, K per voxel; empty without
 };
 
 class SceneLayout {

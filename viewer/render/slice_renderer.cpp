@@ -6,8 +6,8 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "viewer/render/clip_planes.h"
 #include "format/error.h"
+#include "viewer/render/clip_planes.h"
 #include "viewer/render/line_shaders.h"
 
 namespace vxl {
@@ -55,8 +55,13 @@ void main() { frag = texelFetch(u_color, ivec2(gl_FragCoord.xy), 0); }
 }  // namespace
 
 SliceRenderer::SliceRenderer(const Volume& v)
-    : dims_(v.dims), voxel_to_ras_(v.voxel_to_ras), ras_to_voxel_(glm::inverse(v.voxel_to_ras)), corners_(v.corners()),
-      ras_min_(v.ras_min()), ras_max_(v.ras_max()), window_(v.window) {
+    : dims_(v.dims),
+      voxel_to_ras_(v.voxel_to_ras),
+      ras_to_voxel_(glm::inverse(v.voxel_to_ras)),
+      corners_(v.corners()),
+      ras_min_(v.ras_min()),
+      ras_max_(v.ras_max()),
+      window_(v.window) {
   GLint max_size = 0;
   glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max_size);
   for (int a = 0; a < 3; ++a)
@@ -73,7 +78,8 @@ SliceRenderer::SliceRenderer(const Volume& v)
                static_cast<GLsizei>(dims_[2]), 0, GL_RED, GL_FLOAT, v.values.data());
   glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTexParameteri(GL_TEXTURE_3D, w, GL_CLAMP_TO_EDGE);
+  for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+    glTexParameteri(GL_TEXTURE_3D, w, GL_CLAMP_TO_EDGE);
   glBindTexture(GL_TEXTURE_3D, 0);
   program_ = gl::make_program(kSliceVertex, kSliceFragment);
   copy_program_ = gl::make_program(shaders::kFullscreenVertex, kCopyFragment);
@@ -124,8 +130,10 @@ void SliceRenderer::draw(const Camera& camera, const glm::dmat4& projection, con
   if (clips > 0) glUniform4fv(glGetUniformLocation(program_, "u_clip"), clips, glm::value_ptr(planes[0]));
   glUniform1i(glGetUniformLocation(program_, "u_clip_count"), clips);
   for (int i = 0; i < kMaxClipDistances; ++i) {
-    if (i < clips) glEnable(GL_CLIP_DISTANCE0 + i);
-    else glDisable(GL_CLIP_DISTANCE0 + i);
+    if (i < clips)
+      glEnable(GL_CLIP_DISTANCE0 + i);
+    else
+      glDisable(GL_CLIP_DISTANCE0 + i);
   }
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_3D, texture_);

@@ -7,7 +7,8 @@
 namespace vxl {
 
 ValueSource find_value_set(const VxlFile& file, const std::string& name) {
-  if (int k = file.vertex_values().find(name); k >= 0) return {ValueSource::Kind::Vertex, static_cast<std::uint32_t>(k)};
+  if (int k = file.vertex_values().find(name); k >= 0)
+    return {ValueSource::Kind::Vertex, static_cast<std::uint32_t>(k)};
   if (int k = file.streamline_values().find(name); k >= 0)
     return {ValueSource::Kind::Streamline, static_cast<std::uint32_t>(k)};
   return {};
@@ -30,8 +31,9 @@ std::vector<float> vertex_attributes(const VxlFile& file, std::size_t file_index
   if (source.kind != ValueSource::Kind::Streamline && uniform_group) return out;
 
   // Per-streamline values or groups: every vertex of a voxline belongs to the streamline being walked.
-  const std::span<const float> per_streamline =
-      source.kind == ValueSource::Kind::Streamline ? file.streamline_values().values(source.set) : std::span<const float>{};
+  const std::span<const float> per_streamline = source.kind == ValueSource::Kind::Streamline
+                                                    ? file.streamline_values().values(source.set)
+                                                    : std::span<const float>{};
   std::uint64_t streamline = 0;
   WalkCallbacks cb;
   cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t own, bool connected) {

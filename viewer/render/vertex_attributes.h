@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "viewer/render/scene_groups.h"
 #include "format/vxl_file.h"
+#include "viewer/render/scene_groups.h"
 
 namespace vxl {
 

@@ -12,11 +12,11 @@
 namespace vxl {
 
 struct Volume {
-  std::string name;                  // for messages (the file it came from)
+  std::string name;  // for messages (the file it came from)
   std::array<std::int64_t, 3> dims{0, 0, 0};
-  std::vector<float> values;         // x fastest, then y, then z; already scaled to the image's units
-  glm::dmat4 voxel_to_ras{1.0};      // voxel index (centre of voxel (i, j, k)) -> RAS mm
-  std::array<float, 2> window{0, 1}; // the default grey range (values mapped to black and white)
+  std::vector<float> values;          // x fastest, then y, then z; already scaled to the image's units
+  glm::dmat4 voxel_to_ras{1.0};       // voxel index (centre of voxel (i, j, k)) -> RAS mm
+  std::array<float, 2> window{0, 1};  // the default grey range (values mapped to black and white)
 
   // The RAS corners of the volume's box (voxel faces, not centres): for fitting slices and the camera.
   std::array<glm::dvec3, 8> corners() const;
