@@ -224,6 +224,7 @@ constexpr double kCurveScale = 0.88;   // long centre curves stay inside the ell
 constexpr double kUCurveScale = 0.90;  // U-fibre centre curves likewise
 constexpr double kMaxCurvatureLong = 1.0 / 25.0;
 constexpr double kMaxCurvatureU = 1.0 / 7.0;
+constexpr double kMaxCurvatureNamed = 1.0 / 12.0;  // the arcuate's arch is tighter than a random bundle's
 // Offsets: a base point in the unit disc plus a wander of +-kWander per component, times the radius.
 // Max offset = radius * (1 + flare) * (1 + kWander * sqrt 2): long <= 3 * 1.4 * 1.36 = 5.7 mm, less than
 // the 7.2 mm margin between the 0.88-scaled ellipsoid K and the brain ellipsoid E = K / 0.88 (E = K +
@@ -303,6 +304,7 @@ struct Layout {
   std::vector<std::uint32_t> u_ids;
   std::vector<double> u_cum;
   std::size_t long_bundle_count = 0, u_bundle_count = 0;
+  std::vector<std::string> named_bundles;
 };
 
 constexpr int kAssociationPairs = 16;
@@ -318,28 +320,121 @@ constexpr double kUFraction = 0.12;  // share of streamlines that are U-fibres
 // overall mean is ~56.
 constexpr double kLengthTheta = 21.0;
 
-Layout build_layout(std::uint64_t seed) {
-  Rng rng(mix64(seed ^ 0x6C61796F75742131ULL));  // "layout!1"
-  Layout layout;
-  std::vector<Bundle> longs, us;
+// Named bundles, placed by hand so that a picture shows a few familiar structures running through one
+// another (the corticospinal tracts rise through the corpus callosum's fan, the cinguli run above it, the
+// arcuate arches around the side): the scene where sorted transparency shows what lies inside. Each is a
+// fan of sub-curves from a common stem; left-hemisphere coordinates, mirrored where `mirrored`. `weight`
+// is the bundle's share of long streamlines relative to a random bundle's ~0.8.
+struct NamedBundle {
+  const char* name;
+  V3 p0, p1;        // the stem
+  V3 p2_a, p2_b;    // the fan's third control point, from one side of the fan to the other
+  V3 end_a, end_b;  // the fanning ends
+  int fan;
+  double radius;
+  double weight;
+  bool mirrored;
+};
+const NamedBundle kNamedBundles[] = {
+    {"corpus callosum",
+     {-42, -5, 38},
+     {-14, -12, 34},
+     {14, -35, 34},
+     {14, 20, 34},
+     {42, -45, 38},
+     {42, 25, 38},
+     9,
+     2.5,
+     14.0,
+     false},
+    {"corticospinal tract",
+     {-8, -24, -36},
+     {-14, -16, -2},
+     {-20, -34, 30},
+     {-28, -4, 30},
+     {-16, -40, 55},
+     {-42, -8, 42},
+     7,
+     2.5,
+     7.0,
+     true},
+    {"cingulum",
+     {-7, 30, 8},
+     {-8, 28, 38},
+     {-8, -35, 40},
+     {-8, -35, 40},
+     {-9, -62, 12},
+     {-9, -62, 12},
+     1,
+     3.0,
+     3.0,
+     true},
+    {"arcuate fasciculus",
+     {-40, 18, 18},
+     {-40, -50, 34},
+     {-48, -52, -6},
+     {-48, -52, -6},
+     {-48, -5, -16},
+     {-48, -5, -16},
+     1,
+     3.0,
+     3.0,
+     true},
+    {"inferior fronto-occipital fasciculus",
+     {-20, 44, 4},
+     {-32, 5, -8},
+     {-34, -45, -4},
+     {-34, -45, -4},
+     {-22, -82, 6},
+     {-22, -82, 6},
+     1,
+     3.0,
+     3.0,
+     true},
+};
 
-  auto add_pair = [&](auto make) {
+// Builds the layout bundle class by bundle class, drawing from one random stream in a fixed order.
+class LayoutBuilder {
+ public:
+  explicit LayoutBuilder(std::uint64_t seed) : rng_(mix64(seed ^ 0x6C61796F75742131ULL)) {}  // "layout!1"
+
+  void add_association_pairs();
+  void add_projection_pairs();
+  void add_commissural();
+  void add_u_fibre_pairs();
+  void add_named_bundles();
+  Layout finish();
+
+ private:
+  // A long bundle and its mirror image in the right hemisphere (same shape, so equally valid).
+  template <typename Make>
+  void add_pair(Make make) {
     BundleSpec spec;
-    longs.push_back(draw_bundle(rng, make, &spec));
-    Bundle mirror = *build_bundle(mirrored(spec));  // same shape, so equally valid
-    mirror.weight = 0.3 + rng.uniform();
-    longs.push_back(std::move(mirror));
-  };
-
+    longs_.push_back(draw_bundle(rng_, make, &spec));
+    add_mirror(longs_, spec);
+  }
+  void add_mirror(std::vector<Bundle>& into, const BundleSpec& spec) {
+    Bundle mirror = *build_bundle(mirrored(spec));
+    mirror.weight = 0.3 + rng_.uniform();
+    into.push_back(std::move(mirror));
+  }
   // A cortical end: in the outer shell of the curve ellipsoid, left hemisphere.
-  auto cortical = [&](double min_abs_x) {
+  V3 cortical(double min_abs_x) {
     for (;;) {
-      const V3 p = point_in_ellipsoid(rng, kCurveScale);
+      const V3 p = point_in_ellipsoid(rng_, kCurveScale);
       if (p.x <= -min_abs_x && ellipsoid_q(p) >= 0.6 * 0.6) return p;
     }
-  };
-  // Association: both ends in the left hemisphere (the pair's mirror is on the right); the first few
-  // are long, mostly anterior-posterior fasciculi.
+  }
+  void add_fan(const NamedBundle& named, bool mirror);
+
+  Rng rng_;
+  std::vector<Bundle> longs_, us_;
+  std::vector<std::string> names_;
+};
+
+// Association: both ends in the left hemisphere (the pair's mirror is on the right); the first few are
+// long, mostly anterior-posterior fasciculi.
+void LayoutBuilder::add_association_pairs() {
   for (int i = 0; i < kAssociationPairs; ++i) {
     const bool arched = i < kArchedAssociationPairs;
     const bool long_class = i < kLongAssociationPairs;
@@ -353,10 +448,10 @@ Layout build_layout(std::uint64_t seed) {
         const V3 a = cortical(12.0), b = cortical(12.0);
         const double chord = norm(b - a);
         if (chord < min_chord || chord > max_chord) continue;
-        const double bend = rng.uniform(min_bend, max_bend);
-        BundleSpec spec = arched ? arched_curve(rng, a, b, bend) : bent_curve(rng, a, b, bend);
+        const double bend = rng_.uniform(min_bend, max_bend);
+        BundleSpec spec = arched ? arched_curve(rng_, a, b, bend) : bent_curve(rng_, a, b, bend);
         if (!controls_inside(spec, kCurveScale)) continue;
-        set_long_tube(rng, spec);
+        set_long_tube(rng_, spec);
         if (long_class) {
           spec.min_samples = min_points;
           // The control polygon bounds the arc length from above: skip hopeless candidates cheaply.
@@ -367,69 +462,78 @@ Layout build_layout(std::uint64_t seed) {
       }
     });
   }
-  // Projection: from a brainstem / internal-capsule region up to the cortex of the same hemisphere.
+}
+
+// Projection: from a brainstem / internal-capsule region up to the cortex of the same hemisphere.
+void LayoutBuilder::add_projection_pairs() {
   for (int i = 0; i < kProjectionPairs; ++i) {
     add_pair([&] {
       for (;;) {
-        const V3 a{-rng.uniform(3.0, 12.0), rng.uniform(-30.0, -12.0), rng.uniform(-42.0, -28.0)};
+        const V3 a{-rng_.uniform(3.0, 12.0), rng_.uniform(-30.0, -12.0), rng_.uniform(-42.0, -28.0)};
         const V3 b = cortical(15.0);
         if (b.z < 5.0 || norm(b - a) < 70.0) continue;
-        BundleSpec spec = bent_curve(rng, a, b, rng.uniform(0.1, 0.3));
+        BundleSpec spec = bent_curve(rng_, a, b, rng_.uniform(0.1, 0.3));
         if (!controls_inside(spec, kCurveScale)) continue;
-        set_long_tube(rng, spec);
+        set_long_tube(rng_, spec);
         return spec;
       }
     });
   }
-  // Commissural: left cortex, arching over the midline above the ventricles, to the right cortex.
+}
+
+// Commissural: left cortex, arching over the midline above the ventricles, to the right cortex.
+void LayoutBuilder::add_commissural() {
   for (int i = 0; i < kCommissural; ++i) {
-    longs.push_back(draw_bundle(rng, [&] {
+    longs_.push_back(draw_bundle(rng_, [&] {
       for (;;) {
         const V3 a = cortical(30.0);
         if (a.z < 0.0) continue;
-        const V3 b{-a.x + rng.uniform(-8.0, 8.0), a.y + rng.uniform(-15.0, 15.0), a.z + rng.uniform(-10.0, 10.0)};
-        const double ym = 0.5 * (a.y + b.y) + rng.uniform(-10.0, 10.0);
-        const double zc = std::max(a.z, b.z) + rng.uniform(5.0, 25.0);
+        const V3 b{-a.x + rng_.uniform(-8.0, 8.0), a.y + rng_.uniform(-15.0, 15.0), a.z + rng_.uniform(-10.0, 10.0)};
+        const double ym = 0.5 * (a.y + b.y) + rng_.uniform(-10.0, 10.0);
+        const double zc = std::max(a.z, b.z) + rng_.uniform(5.0, 25.0);
         BundleSpec spec{};
         spec.p[0] = a;
-        spec.p[1] = {-rng.uniform(8.0, 20.0), ym + rng.uniform(-5.0, 5.0), zc + rng.uniform(-3.0, 3.0)};
-        spec.p[2] = {rng.uniform(8.0, 20.0), ym + rng.uniform(-5.0, 5.0), zc + rng.uniform(-3.0, 3.0)};
+        spec.p[1] = {-rng_.uniform(8.0, 20.0), ym + rng_.uniform(-5.0, 5.0), zc + rng_.uniform(-3.0, 3.0)};
+        spec.p[2] = {rng_.uniform(8.0, 20.0), ym + rng_.uniform(-5.0, 5.0), zc + rng_.uniform(-3.0, 3.0)};
         spec.p[3] = b;
         if (!controls_inside(spec, kCurveScale)) continue;
-        set_long_tube(rng, spec);
+        set_long_tube(rng_, spec);
         return spec;
       }
     }));
   }
-  // U-fibres: short arcs dipping under the surface between two nearby points of the (scaled) surface,
-  // kept to the cerebrum (not the inferior surface).
+}
+
+// U-fibres: short arcs dipping under the surface between two nearby points of the (scaled) surface, kept
+// to the cerebrum (not the inferior surface).
+void LayoutBuilder::add_u_fibre_pairs() {
   for (int i = 0; i < kUPairs; ++i) {
     BundleSpec spec;
-    us.push_back(draw_bundle(
-        rng,
+    us_.push_back(draw_bundle(
+        rng_,
         [&] {
           for (;;) {
-            const V3 d = random_unit(rng);
+            const V3 d = random_unit(rng_);
             if (d.z < -0.3 || d.x > -0.1) continue;  // left hemisphere; the mirror covers the right
             auto to_surface = [](V3 p) { return kCentre + (kUCurveScale / std::sqrt(ellipsoid_q(p))) * (p - kCentre); };
             const V3 a = to_surface(kCentre + V3{d.x * kAxes.x, d.y * kAxes.y, d.z * kAxes.z});
             const V3 inward0 = normalized(kCentre - a);
-            const V3 u = random_unit(rng);
+            const V3 u = random_unit(rng_);
             const V3 side = normalized(u - dot(u, inward0) * inward0);
-            const V3 b = to_surface(a + rng.uniform(14.0, 26.0) * side);
+            const V3 b = to_surface(a + rng_.uniform(14.0, 26.0) * side);
             const V3 mid = 0.5 * (a + b);
             const V3 g = mid - kCentre;  // ellipsoid normal at mid: gradient of q
             const V3 inward =
                 -1.0 * normalized(V3{g.x / (kAxes.x * kAxes.x), g.y / (kAxes.y * kAxes.y), g.z / (kAxes.z * kAxes.z)});
-            const double depth = rng.uniform(8.0, 14.0);
+            const double depth = rng_.uniform(8.0, 14.0);
             BundleSpec s{};
             s.p[0] = a;
             s.p[1] = a + depth * inward;
             s.p[2] = b + depth * inward;
             s.p[3] = b;
             if (!controls_inside(s, kUCurveScale + 1e-9)) continue;
-            s.radius = rng.uniform(0.8, 1.4);
-            s.flare = rng.uniform(0.0, 0.2);
+            s.radius = rng_.uniform(0.8, 1.4);
+            s.flare = rng_.uniform(0.0, 0.2);
             s.max_curvature = kMaxCurvatureU;
             s.min_samples = kSynthMinPoints + 4;
             s.max_samples = 60;
@@ -437,15 +541,57 @@ Layout build_layout(std::uint64_t seed) {
           }
         },
         &spec));
-    Bundle mirror = *build_bundle(mirrored(spec));
-    mirror.weight = 0.3 + rng.uniform();
-    us.push_back(std::move(mirror));
+    add_mirror(us_, spec);
   }
+}
 
-  layout.long_bundle_count = longs.size();
-  layout.u_bundle_count = us.size();
-  for (auto& b : longs) layout.bundles.push_back(std::move(b));
-  for (auto& b : us) layout.bundles.push_back(std::move(b));
+// One named bundle: `fan` sub-curves from a common stem (p0, p1) whose far ends (p2, p3) spread from
+// `end_a` to `end_b` (the fanning ends of real bundles), each control point jittered a little.
+void LayoutBuilder::add_fan(const NamedBundle& named, bool mirror) {
+  for (int k = 0; k < named.fan; ++k) {
+    const double t = named.fan > 1 ? static_cast<double>(k) / (named.fan - 1) : 0.5;
+    BundleSpec spec;
+    Bundle b = draw_bundle(
+        rng_,
+        [&] {
+          for (;;) {
+            BundleSpec s{};
+            s.p[0] = named.p0 + V3{rng_.uniform(-2, 2), rng_.uniform(-2, 2), rng_.uniform(-2, 2)};
+            s.p[1] = named.p1 + V3{rng_.uniform(-3, 3), rng_.uniform(-3, 3), rng_.uniform(-3, 3)};
+            s.p[2] =
+                lerp(named.p2_a, named.p2_b, t) + V3{rng_.uniform(-3, 3), rng_.uniform(-3, 3), rng_.uniform(-3, 3)};
+            s.p[3] =
+                lerp(named.end_a, named.end_b, t) + V3{rng_.uniform(-3, 3), rng_.uniform(-3, 3), rng_.uniform(-3, 3)};
+            if (!controls_inside(s, kCurveScale)) continue;
+            set_long_tube(rng_, s);
+            s.radius = named.radius;
+            s.flare = 0.3;
+            s.max_curvature = kMaxCurvatureNamed;
+            return s;
+          }
+        },
+        &spec);
+    b.weight = named.weight / named.fan;
+    longs_.push_back(std::move(b));
+    if (mirror) {
+      add_mirror(longs_, spec);
+      longs_.back().weight = named.weight / named.fan;
+    }
+  }
+  names_.push_back(named.name);
+}
+
+void LayoutBuilder::add_named_bundles() {
+  for (const NamedBundle& named : kNamedBundles) add_fan(named, named.mirrored);
+}
+
+Layout LayoutBuilder::finish() {
+  Layout layout;
+  layout.long_bundle_count = longs_.size();
+  layout.u_bundle_count = us_.size();
+  layout.named_bundles = std::move(names_);
+  for (auto& b : longs_) layout.bundles.push_back(std::move(b));
+  for (auto& b : us_) layout.bundles.push_back(std::move(b));
 
   for (std::uint32_t i = 0; i < layout.long_bundle_count; ++i) layout.long_ids.push_back(i);
   std::stable_sort(layout.long_ids.begin(), layout.long_ids.end(), [&](std::uint32_t a, std::uint32_t b) {
@@ -464,6 +610,16 @@ Layout build_layout(std::uint64_t seed) {
     layout.u_cum.push_back(layout.u_cum.back() + layout.bundles[id].weight);
   }
   return layout;
+}
+
+Layout build_layout(std::uint64_t seed) {
+  LayoutBuilder builder(seed);
+  builder.add_association_pairs();
+  builder.add_projection_pairs();
+  builder.add_commissural();
+  builder.add_u_fibre_pairs();
+  builder.add_named_bundles();
+  return builder.finish();
 }
 
 // Weighted pick among ids[first..] with cumulative weights cum (size ids.size() + 1).
@@ -600,6 +756,7 @@ Tractogram synthesize_tractogram(const SynthSettings& settings) {
                      {"seed", settings.seed},
                      {"long_bundles", layout.long_bundle_count},
                      {"u_fibre_bundles", layout.u_bundle_count},
+                     {"named_bundles", layout.named_bundles},
                      {"ellipsoid_centre_mm", kSynthCentre},
                      {"ellipsoid_semi_axes_mm", kSynthSemiAxes},
                      {"step_mm", 1.0}};

@@ -2,7 +2,11 @@
 //
 // Shape: ~60 "long" bundles (association pairs mirrored across the midline, projection pairs from a
 // brainstem region to the cortex, commissural arcs over the midline) plus 64 short U-fibre bundles just
-// under the surface of a brain-sized ellipsoid (semi-axes 70 x 85 x 60 mm, centre (0, -18, 10), RAS mm).
+// under the surface of a brain-sized ellipsoid (semi-axes 70 x 85 x 60 mm, centre (0, -18, 10), RAS mm),
+// and five named bundles placed by hand, each a fan of sub-curves from a common stem: the corpus callosum,
+// and on each side the corticospinal tract (rising through the callosal fan), cingulum, arcuate fasciculus
+// and inferior fronto-occipital fasciculus (listed in the header's "named_bundles"). Seen from the front
+// (`voxview --view coronal`) they make the picture in which sorted transparency visibly matters.
 // Every bundle has a smooth centre curve (a cubic Bezier with bounded curvature, resampled at 1 mm of
 // arc length); every streamline is a random sub-range of one centre curve, displaced inside a tube of a
 // few mm whose offset wanders smoothly along the curve, and randomly reversed. Steps are about 1 mm
@@ -35,7 +39,7 @@ struct SynthSettings {
 };
 
 // Bumped whenever the output for a given (streamlines, seed) changes.
-inline constexpr int kSynthGeneratorVersion = 1;
+inline constexpr int kSynthGeneratorVersion = 2;
 
 // The brain-like ellipsoid, RAS mm.
 inline constexpr std::array<double, 3> kSynthCentre = {0.0, -18.0, 10.0};
