@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <set>
 
 #include <glm/glm.hpp>
@@ -179,6 +180,52 @@ TEST(OrderSets, EveryPlannedVoxelUsesItsNearestOwnDirection) {
       }
     }
   }
+}
+
+TEST(VisibilityOrder, NoVoxelComesAfterOneItHides) {
+  // For every two face neighbours among the planned voxels, the one across the shared face from the eye
+  // must come first. Perspective views from outside and from inside the grid, and orthographic ones.
+  ScratchDir dir;
+  VxlFile f = convert_synth(dir, "axis", 12.0, "scene.vxl");
+  SceneLayout layout(f, 1u << 30);
+  const double s = f.meta().voxel_size;
+  TestRng rng{11};
+  FramePlan plan;
+  int pairs = 0;
+  for (int view = 0; view < 12; ++view) {
+    Camera cam;
+    cam.orthographic = view % 4 == 0;
+    cam.azimuth_deg = 360 * rng.uniform();
+    cam.elevation_deg = 180 * rng.uniform() - 90;
+    cam.frame({-80, -110, -60}, {80, 80, 80}, 1.0);
+    if (view % 4 == 1) cam.distance = 30;  // the eye among the voxels
+    const ViewParams v = view_of(cam);
+    plan_frame(layout, v, PlanOrder::Visibility, plan);
+    ASSERT_GT(plan.first.size(), 10u);
+    std::map<std::array<long, 3>, std::size_t> position;  // voxel cell (i, j, k) -> place in the plan
+    const double* origin = f.meta().grid_origin;
+    for (std::size_t j = 0; j < plan.sort_keys.size(); ++j) {
+      const glm::dvec3 c = layout.voxels()[plan.sort_keys[j].second].center;
+      position[{std::lround((c.x - origin[0]) / s - 0.5), std::lround((c.y - origin[1]) / s - 0.5),
+                std::lround((c.z - origin[2]) / s - 0.5)}] = j;
+    }
+    for (const auto& [cell, j] : position)
+      for (int axis = 0; axis < 3; ++axis) {
+        std::array<long, 3> next = cell;
+        ++next[axis];
+        auto it = position.find(next);
+        if (it == position.end()) continue;
+        const double face = origin[axis] + double(cell[axis] + 1) * s;  // the shared face's coordinate
+        const double eye = v.orthographic ? -v.forward[axis] * 1e9 : v.eye[axis];
+        if (std::abs(eye - face) < 1e-9) continue;  // the eye in the face's plane: either order is right
+        ++pairs;
+        if (eye < face)
+          EXPECT_LT(it->second, j) << "the voxel beyond the face from the eye must come first";
+        else
+          EXPECT_LT(j, it->second) << "the voxel beyond the face from the eye must come first";
+      }
+  }
+  EXPECT_GT(pairs, 1000);
 }
 
 TEST(OrderSets, RandomFilesCarryRequiredPerVoxelDirectionsAndVerify) {

@@ -113,62 +113,54 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
   }
   const double aspect = double(width) / std::max(1, height);
   FramePlan plan;
-  lines_.plan(camera, aspect, PlanOrder::Any, plan, s.clipping);
-  const glm::vec3 bg = s.background();
-  // The lines are composited over the opaque slices where there are some (their colour is the
-  // background there); the list pass has already dropped the fragments behind them.
-  base_.clear();
-  if (const GLuint slices = lines_.slice_color_texture()) {
-    base_.resize(std::size_t(width) * height * 4);
-    glBindTexture(GL_TEXTURE_2D, slices);
-    glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, base_.data());
-  }
+  lines_.plan(camera, aspect, PlanOrder::Visibility, plan, s.clipping);
+  start_image(s.background());
 
-  // Bands of rows; a band whose fragments overflow the node buffer is split in two and redone.
-  std::vector<std::array<int, 2>> bands = {{0, height}};
-  bands_used_ = 0;
-  fragments_ = 0;
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, width, height);
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);
-  while (!bands.empty()) {
-    auto [y0, y1] = bands.back();
-    bands.pop_back();
-    glUseProgram(clear_program_);
-    glBindImageTexture(0, heads_, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
-    glDispatchCompute((width + 7) / 8, (height + 7) / 8, 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    const GLuint zero = 0;
-    glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, counter_);
-    glBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, 4, &zero);
+  lines_.bind_line_program(list_program_, camera, s, aspect);
+  glUniform1ui(glGetUniformLocation(list_program_, "u_capacity"),
+               static_cast<GLuint>(std::min<std::uint64_t>(capacity_, 0xFFFFFFFFu)));
+  passes_ = 0;
+  fragments_ = 0;
 
-    lines_.bind_line_program(list_program_, camera, s, aspect);
-    glUniform1ui(glGetUniformLocation(list_program_, "u_capacity"),
-                 static_cast<GLuint>(std::min<std::uint64_t>(capacity_, 0xFFFFFFFFu)));
-    glUniform4i(glGetUniformLocation(list_program_, "u_band"), 0, y0, width, y1);
-    glBindImageTexture(0, heads_, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-    glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_);
-    lines_.draw_plan(plan.first, plan.count);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
-
-    GLuint stored = 0;
-    glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, counter_);
-    glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, 4, &stored);
-    if (stored > capacity_) {
-      if (y1 - y0 <= 1)
-        throw std::runtime_error("exact mode: one pixel row has more fragments than the node buffer holds");
-      int mid = (y0 + y1) / 2;
-      bands.push_back({mid, y1});
-      bands.push_back({y0, mid});
-      continue;
+  // Depth passes: runs of voxels in visibility order, back to front, each sized from the fragments per
+  // segment measured so far to fill about half the node buffer. A run's fragments all lie behind the
+  // next run's along every ray, so compositing run after run is exact. A run that overflows is
+  // shortened and redone; one that cannot be (a single voxel, or several grids whose voxels overlap)
+  // is split into bands of rows instead.
+  const bool depth_passes = lines_.scene().layout().one_grid();
+  std::vector<std::uint64_t> segments_before(plan.count.size() + 1, 0);
+  for (std::size_t v = 0; v < plan.count.size(); ++v) segments_before[v + 1] = segments_before[v] + plan.count[v] / 2;
+  double per_segment = 0;  // fragments per segment, 0 until measured
+  std::size_t i = 0;
+  const std::size_t n = plan.count.size();
+  while (i < n) {
+    std::size_t j = n;
+    if (depth_passes && per_segment > 0) {
+      const double budget = 0.5 * double(capacity_) / per_segment;  // segments
+      j = i + 1;
+      while (j < n && double(segments_before[j + 1] - segments_before[i]) <= budget) ++j;
     }
-    ++bands_used_;
-    fragments_ += stored;
-    resolve_band(y0, y1, stored, bg);
+    const std::uint64_t stored = list_pass(plan, i, j, 0, height);
+    const std::uint64_t segments = segments_before[j] - segments_before[i];
+    if (segments > 0) per_segment = std::max(per_segment, double(stored) / double(segments));
+    if (stored <= capacity_) {
+      resolve_band(0, height, static_cast<std::uint32_t>(stored));
+    } else if (depth_passes && j - i > 1) {
+      continue;  // retry a shorter run with the new estimate
+    } else {
+      rows_in_bands(plan, i, j, height);
+    }
+    i = j;
   }
+  if (n == 0) ++passes_;
+
+  glBindTexture(GL_TEXTURE_2D, result_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, image_.data());
   Renderer::enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, width, height);
@@ -183,7 +175,72 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
   glDeleteVertexArrays(1, &vao);
 }
 
-void ExactRenderer::resolve_band(int y0, int y1, std::uint32_t stored, const glm::vec3& background) {
+void ExactRenderer::start_image(const glm::vec3& background) {
+  // The lines are composited over the opaque slices where there are some (their colour is the background
+  // there); the list pass drops the fragments behind them.
+  image_.resize(std::size_t(width_) * height_ * 4);
+  if (const GLuint slices = lines_.slice_color_texture()) {
+    glBindTexture(GL_TEXTURE_2D, slices);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, image_.data());
+  } else {
+    for (std::size_t p = 0; p < image_.size(); p += 4) {
+      image_[p] = background.r, image_[p + 1] = background.g, image_[p + 2] = background.b, image_[p + 3] = 1.0f;
+    }
+  }
+}
+
+std::uint64_t ExactRenderer::list_pass(const FramePlan& plan, std::size_t first_voxel, std::size_t end_voxel, int y0,
+                                       int y1) {
+  glUseProgram(clear_program_);
+  glBindImageTexture(0, heads_, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
+  glDispatchCompute((width_ + 7) / 8, (height_ + 7) / 8, 1);
+  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  const GLuint zero = 0;
+  glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, counter_);
+  glBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, 4, &zero);
+
+  glUseProgram(list_program_);
+  glUniform4i(glGetUniformLocation(list_program_, "u_band"), 0, y0, width_, y1);
+  glBindImageTexture(0, heads_, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+  glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_);
+  const auto from = std::ptrdiff_t(first_voxel), to = std::ptrdiff_t(end_voxel);
+  lines_.draw_plan({plan.first.begin() + from, plan.first.begin() + to},
+                   {plan.count.begin() + from, plan.count.begin() + to});
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
+
+  // The counter counts every fragment, also those past the capacity that were not stored.
+  GLuint stored = 0;
+  glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, counter_);
+  glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, 4, &stored);
+  return stored;
+}
+
+void ExactRenderer::rows_in_bands(const FramePlan& plan, std::size_t first_voxel, std::size_t end_voxel, int height) {
+  // Bands of rows; a band whose fragments overflow the node buffer is split in two and redone.
+  std::vector<std::array<int, 2>> bands = {{height / 2, height}, {0, height / 2}};
+  while (!bands.empty()) {
+    auto [y0, y1] = bands.back();
+    bands.pop_back();
+    if (y1 <= y0) continue;
+    const std::uint64_t stored = list_pass(plan, first_voxel, end_voxel, y0, y1);
+    if (stored > capacity_) {
+      if (y1 - y0 <= 1)
+        throw std::runtime_error("exact mode: one pixel row has more fragments than the node buffer holds");
+      int mid = (y0 + y1) / 2;
+      bands.push_back({mid, y1});
+      bands.push_back({y0, mid});
+      continue;
+    }
+    resolve_band(y0, y1, static_cast<std::uint32_t>(stored));
+  }
+}
+
+void ExactRenderer::resolve_band(int y0, int y1, std::uint32_t stored) {
+  ++passes_;
+  fragments_ += stored;
+  if (stored == 0) return;
   // The shaders' writes must be visible to the read-backs.
   glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   heads_copy_.resize(std::size_t(width_) * height_);
@@ -194,7 +251,6 @@ void ExactRenderer::resolve_band(int y0, int y1, std::uint32_t stored, const glm
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, nodes_);
   glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(stored) * 16, nodes_copy_.data());
 
-  rows_.resize(std::size_t(width_) * (y1 - y0) * 4);
   std::vector<std::pair<float, std::uint32_t>> list;  // (depth, node)
   for (int y = y0; y < y1; ++y)
     for (int x = 0; x < width_; ++x) {
@@ -205,22 +261,22 @@ void ExactRenderer::resolve_band(int y0, int y1, std::uint32_t stored, const glm
         std::memcpy(&depth, &nodes_copy_[i][2], 4);
         list.push_back({depth, i});
       }
-      // Farthest first; equal depths in a fixed (node) order, so no fragment is lost or doubled.
-      std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a > b; });
-      glm::vec3 color = background;
-      if (!base_.empty()) color = glm::make_vec3(base_.data() + (std::size_t(y) * width_ + x) * 4);
+      if (list.empty()) continue;
+      // Farthest first; at equal depths the fragment stored first (drawn earlier: an earlier voxel in the
+      // visibility order) goes under, as it does when runs of voxels are composited one after another.
+      std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) {
+        return a.first > b.first || (a.first == b.first && a.second < b.second);
+      });
+      float* out = image_.data() + (std::size_t(y) * width_ + x) * 4;
+      glm::vec3 color = glm::make_vec3(out);
       for (const auto& [depth, i] : list) {
         const std::array<std::uint32_t, 4>& n = nodes_copy_[i];
         const glm::vec3 c(half_to_float(n[0] & 0xFFFF), half_to_float(n[0] >> 16), half_to_float(n[1] & 0xFFFF));
         const float a = half_to_float(n[1] >> 16);
         color = c * a + color * (1.0f - a);
       }
-      float* out = rows_.data() + (std::size_t(y - y0) * width_ + x) * 4;
       out[0] = color.r, out[1] = color.g, out[2] = color.b, out[3] = 1.0f;
     }
-  glBindTexture(GL_TEXTURE_2D, result_);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, y0, width_, y1 - y0, GL_RGBA, GL_FLOAT, rows_.data());
 }
 
 }  // namespace vxl

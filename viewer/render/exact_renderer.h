@@ -1,10 +1,12 @@
 // The `exact` mode: per-fragment sorted transparency, the reference every other mode is scored against.
 //
-// Pass 1 stores every line fragment (colour, depth) in per-pixel linked lists (a head image, a node
-// buffer, an atomic counter). Pass 2 reads the lists back and composites each pixel's fragments back to
-// front on the CPU, in (depth, node index) order, so lists of any length are resolved exactly, over the
-// background or the anatomical slices (slice_renderer.h). When the
-// node buffer would overflow, the image is rendered in horizontal bands. Needs OpenGL 4.3.
+// A list pass stores line fragments (colour, depth) in per-pixel linked lists (a head image, a node
+// buffer, an atomic counter); a resolve reads the lists back and composites each pixel's fragments back
+// to front on the CPU, in (depth, node index) order, so lists of any length are resolved exactly, over
+// the background or the anatomical slices (slice_renderer.h). Memory stays bounded by drawing the voxels
+// in runs, back to front in a visibility order of the grid (frame_plan.h, PlanOrder::Visibility), each
+// run's lists composited over the picture so far: every voxel is drawn once, however many fragments the
+// scene has. A single voxel too large for the node buffer is drawn in bands of rows. Needs OpenGL 4.3.
 //
 // Why the CPU: the reference must not depend on a shader compiler. On llvmpipe 22.3 a fragment-shader
 // resolve gave wrong pixels (docs/rendering.md, pitfall 2), and so did a compute-shader resolve once a pixel held
@@ -19,6 +21,7 @@
 #include <glm/glm.hpp>
 
 #include "viewer/render/camera.h"
+#include "viewer/render/frame_plan.h"
 #include "viewer/render/gl_util.h"
 #include "viewer/render/render_settings.h"
 
@@ -32,25 +35,30 @@ class ExactRenderer {
   explicit ExactRenderer(Renderer& lines, std::uint64_t node_capacity = 0);
   ~ExactRenderer();
   void draw(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
-  int bands_used() const { return bands_used_; }  // of the last frame
+  int passes() const { return passes_; }  // list passes resolved in the last frame (depth runs and row bands)
   std::uint64_t fragments() const { return fragments_; }
 
  private:
-  // Composites the lists of rows [y0, y1) (holding `stored` nodes) into result_.
-  void resolve_band(int y0, int y1, std::uint32_t stored, const glm::vec3& background);
+  void start_image(const glm::vec3& background);
+  // Stores the fragments of plan voxels [first_voxel, end_voxel) inside rows [y0, y1) in the lists;
+  // returns how many there were (more than the capacity: the lists hold only the first ones).
+  std::uint64_t list_pass(const FramePlan& plan, std::size_t first_voxel, std::size_t end_voxel, int y0, int y1);
+  // The same voxels, in bands of rows small enough for the node buffer.
+  void rows_in_bands(const FramePlan& plan, std::size_t first_voxel, std::size_t end_voxel, int height);
+  // Composites the lists of rows [y0, y1) (holding `stored` nodes) over image_.
+  void resolve_band(int y0, int y1, std::uint32_t stored);
 
   Renderer& lines_;
   std::uint64_t capacity_ = 0;
   GLuint list_program_ = 0, clear_program_ = 0, blit_program_ = 0;
   GLuint nodes_ = 0, counter_ = 0, heads_ = 0, result_ = 0;
   int width_ = 0, height_ = 0;
-  int bands_used_ = 0;
+  int passes_ = 0;
   std::uint64_t fragments_ = 0;
   // Read-back scratch, kept between frames.
   std::vector<std::uint32_t> heads_copy_;
   std::vector<std::array<std::uint32_t, 4>> nodes_copy_;  // colour rg, colour ba (half floats), depth, next
-  std::vector<float> rows_;
-  std::vector<float> base_;  // the slices' colour under the lines (RGBA, bottom row first); empty: none
+  std::vector<float> image_;  // the picture so far (RGBA, bottom row first): slices or background, then runs
 };
 
 }  // namespace vxl

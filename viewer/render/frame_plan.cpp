@@ -71,8 +71,9 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
     if (v.segment_count == 0 || outside(view, v)) continue;
     glm::dvec3 d = v.center - view.eye;
     // back to front = descending distance: sort ascending on the negated key
-    float key =
-        view.orthographic ? static_cast<float>(-glm::dot(d, view.forward)) : static_cast<float>(-glm::dot(d, d));
+    double key = view.orthographic                ? -glm::dot(d, view.forward)
+                 : order == PlanOrder::Visibility ? -(std::abs(d.x) + std::abs(d.y) + std::abs(d.z))
+                                                  : -glm::dot(d, d);
     plan.sort_keys.push_back({key, i});
   }
   if (order != PlanOrder::Any) std::sort(plan.sort_keys.begin(), plan.sort_keys.end());

@@ -1,12 +1,26 @@
 #include "viewer/render/scene_layout.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 
 #include "format/error.h"
 
 namespace vxl {
+
+namespace {
+
+bool same_grid(const MetaSection& a, const MetaSection& b) {
+  if (a.voxel_size != b.voxel_size) return false;
+  for (int c = 0; c < 3; ++c) {
+    const double cells = (b.grid_origin[c] - a.grid_origin[c]) / a.voxel_size;
+    if (std::abs(cells - std::round(cells)) > 1e-6) return false;
+  }
+  return true;
+}
+
+}  // namespace
 
 SceneLayout::SceneLayout(const VxlFile& file, std::uint64_t max_texels)
     : SceneLayout(std::span<const VxlFile* const>(std::array<const VxlFile*, 1>{&file}), max_texels) {}
@@ -32,6 +46,7 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
     for (const DirectionEntry& d : file.voxel_directions())
       fl.voxel_directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
     voxel_size_ = std::max(voxel_size_, m.voxel_size);
+    if (fi > 0 && !same_grid(files[0]->meta(), m)) one_grid_ = false;
     const std::uint32_t slots = fl.stored_orders + 1;
     auto fits = [&](std::uint64_t vertices, std::uint64_t segments) {
       return 3 * vertices <= max_texels && slots * segments <= max_texels;

@@ -87,6 +87,9 @@ class SceneLayout {
   std::uint32_t local_voxel(std::uint32_t voxel) const { return voxel - files_[file_of(voxel)].voxel_first; }
   std::uint64_t virtual_ids() const { return virtual_ids_; }
   double voxel_size() const { return voxel_size_; }  // the largest of the files'
+  // Whether every file's voxels are cells of one grid (same size, origins a whole number of voxels
+  // apart): then PlanOrder::Visibility is a visibility order for the whole scene.
+  bool one_grid() const { return one_grid_; }
 
   // First virtual vertex id of voxel v's range in `slot`, forwards or reversed.
   std::int64_t first_id(const VoxelDrawInfo& v, std::uint32_t slot, bool reversed) const {
@@ -107,6 +110,7 @@ class SceneLayout {
   std::vector<ChunkLayout> chunks_;
   std::uint64_t virtual_ids_ = 0;
   double voxel_size_ = 0;
+  bool one_grid_ = true;
 };
 
 }  // namespace vxl
