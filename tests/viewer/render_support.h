@@ -43,6 +43,18 @@ inline int lit_pixels(const Image& img) {
   return n;
 }
 
+// An orthographic view from above (+z), `height_mm` of the scene over the image height: on a
+// 64-pixel image at the default, world (x, y) is the centre of pixel (x + 31.5, 31.5 - y).
+inline Camera top_view(double height_mm = 64) {
+  Camera c;
+  c.orthographic = true;
+  c.ortho_height = height_mm;
+  c.distance = 100;
+  c.azimuth_deg = 180;
+  c.elevation_deg = 90;
+  return c;
+}
+
 inline Image render_image(Renderer& r, const Camera& camera, const RenderSettings& settings, int w, int h) {
   OffscreenTarget target(w, h);
   target.bind();

@@ -33,15 +33,7 @@ Tractogram depth_lines() {
 int row_of(double y) { return static_cast<int>(31.5 - y); }
 int column_of(double x) { return static_cast<int>(x + 31.5); }
 
-Camera top_view() {
-  Camera c;
-  c.orthographic = true;
-  c.ortho_height = 64;
-  c.distance = 100;
-  c.azimuth_deg = 180;
-  c.elevation_deg = 90;
-  return c;
-}
+using test::top_view;
 
 RenderSettings opaque_fixed() {
   RenderSettings s;

@@ -16,16 +16,7 @@ using test::real;
 using test::render_image;
 using test::ScratchDir;
 
-// Top view, 1 mm per pixel on 64 x 64: world (x, y) is the centre of pixel (x + 31.5, 31.5 - y).
-Camera top_view() {
-  Camera c;
-  c.orthographic = true;
-  c.ortho_height = 64;
-  c.distance = 100;
-  c.azimuth_deg = 180;
-  c.elevation_deg = 90;
-  return c;
-}
+using test::top_view;
 int column_of(double x) { return static_cast<int>(x + 31.5); }
 int row_of(double y) { return static_cast<int>(31.5 - y); }
 

@@ -29,15 +29,7 @@ Tractogram two_lines(const glm::vec3& along, const glm::vec3& across) {
   return t;
 }
 
-Camera top_view() {
-  Camera c;
-  c.orthographic = true;
-  c.ortho_height = 96;
-  c.distance = 100;
-  c.azimuth_deg = 180;
-  c.elevation_deg = 90;
-  return c;
-}
+using test::top_view;
 
 // The brightest red value in columns [x0, x1).
 int brightest(const Image& img, int x0, int x1) {
@@ -64,13 +56,13 @@ TEST_F(Lighting, ALineAlongTheLightIsDarkerThanOneAcrossIt) {
   s.color = ColorMode::Fixed;
   s.fixed_color = {0.5f, 0.5f, 0.5f};
 
-  Image off = render_image(r, top_view(), s, 96, 96);
+  Image off = render_image(r, top_view(96), s, 96, 96);
   const int off_along = brightest(off, 0, 48), off_across = brightest(off, 48, 96);
   EXPECT_NEAR(off_along, 128, 1);
   EXPECT_EQ(off_along, off_across);
 
   s.lighting = true;
-  Image on = render_image(r, top_view(), s, 96, 96);
+  Image on = render_image(r, top_view(96), s, 96, 96);
   const int on_along = brightest(on, 0, 48), on_across = brightest(on, 48, 96);
   const glm::vec3 view(0, 0, 1);
   const float expect_along = lighting::lit_colour(s.fixed_color, light, view).r;
@@ -84,7 +76,7 @@ TEST_F(Lighting, ALineAlongTheLightIsDarkerThanOneAcrossIt) {
   // Running the other way round lights the same.
   VxlFile g = make_scene(dir, two_lines(-light, -across), 10.0, "reversed.vxl");
   Renderer rg(g);
-  Image reversed = render_image(rg, top_view(), s, 96, 96);
+  Image reversed = render_image(rg, top_view(96), s, 96, 96);
   EXPECT_NEAR(brightest(reversed, 0, 48), on_along, 1);
   EXPECT_NEAR(brightest(reversed, 48, 96), on_across, 1);
 
@@ -92,7 +84,7 @@ TEST_F(Lighting, ALineAlongTheLightIsDarkerThanOneAcrossIt) {
   for (RenderMode m : {RenderMode::Axis, RenderMode::Unsorted, RenderMode::Wboit}) {
     s.mode = m;
     s.opacity = 1.0f;
-    Image img = render_image(r, top_view(), s, 96, 96);
+    Image img = render_image(r, top_view(96), s, 96, 96);
     EXPECT_LT(brightest(img, 0, 48) + 60, brightest(img, 48, 96)) << render_mode_name(m);
   }
 }

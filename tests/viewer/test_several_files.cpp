@@ -41,15 +41,7 @@ VxlFile convert(const ScratchDir& dir, Tractogram t, const std::string& name, co
   return VxlFile::open(dir.file(name));
 }
 
-Camera top_view() {
-  Camera c;
-  c.orthographic = true;
-  c.ortho_height = 64;
-  c.distance = 100;
-  c.azimuth_deg = 180;
-  c.elevation_deg = 90;
-  return c;
-}
+using test::top_view;
 
 RenderSettings settings(RenderMode mode, ColorMode color = ColorMode::Group) {
   RenderSettings s;
