@@ -10,6 +10,9 @@
 
 #include <unistd.h>
 
+#include "converter/convert.h"
+#include "format/error.h"
+
 namespace vxl::fuzz {
 
 inline std::string write_input(const std::uint8_t* data, std::size_t size, const char* suffix) {
@@ -19,6 +22,18 @@ inline std::string write_input(const std::uint8_t* data, std::size_t size, const
   if (size > 0 && std::fwrite(data, 1, size, f) != size) std::abort();
   std::fclose(f);
   return path;
+}
+
+// Reads `path` with `read` and converts whatever it accepted (on one thread): conversion must cope with
+// every tractogram a reader lets through.
+template <typename Read>
+void read_and_convert(const std::string& path, Read read) {
+  try {
+    ConvertSettings s;
+    s.threads = 1;
+    convert_tractogram(read(path), path + ".vxl", s);
+  } catch (const Error&) {
+  }
 }
 
 }  // namespace vxl::fuzz

@@ -40,12 +40,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     zip_set_file_compression(archive, static_cast<zip_uint64_t>(index), ZIP_CM_DEFLATE, 1);
   }
   if (zip_close(archive) != 0) zip_discard(archive);
-  try {
-    vxl::Tractogram t = vxl::read_trx(path);
-    vxl::ConvertSettings s;
-    s.threads = 1;
-    vxl::convert_tractogram(std::move(t), path + ".vxl", s);
-  } catch (const vxl::Error&) {
-  }
+  vxl::fuzz::read_and_convert(path, [](const std::string& p) { return vxl::read_trx(p); });
   return 0;
 }
