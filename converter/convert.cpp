@@ -5,6 +5,8 @@
 #include <filesystem>
 
 #include "converter/segment_orders.h"
+#include "converter/voxel_size_auto.h"
+#include "converter/voxel_table.h"
 #include "format/error.h"
 #include "format/vxl_value_sets.h"
 #include "format/vxl_writer.h"
@@ -15,7 +17,8 @@
 
 namespace vxl {
 
-std::string provenance_json(const SourceInfo& src, const ConvertSettings& settings, unsigned threads) {
+std::string provenance_json(const SourceInfo& src, const ConvertSettings& settings, unsigned threads,
+                            const std::string& voxel_size_choice) {
   nlohmann::json j;
   j["source"] = {
       {"name", std::filesystem::path(src.path).filename().string()},
@@ -31,6 +34,7 @@ std::string provenance_json(const SourceInfo& src, const ConvertSettings& settin
                     {"voxel_size", settings.voxel_size},
                     {"orders", settings.orders},
                     {"threads", threads}};
+  if (!voxel_size_choice.empty()) j["converter"]["voxel_size_auto"] = voxel_size_choice;
   j["warnings"] = src.warnings;
   if (!src.value_files.empty()) j["value_files"] = src.value_files;
   // Invalid UTF-8 in a source header must not make the whole file unwritable: replace it.
@@ -46,9 +50,21 @@ std::span<std::uint8_t> bytes_of(std::span<T> s) {
 
 }  // namespace
 
-ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, const ConvertSettings& settings) {
+ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, const ConvertSettings& given) {
+  ConvertSettings settings = given;
   OrderSetSpec order_set = parse_order_set(settings.orders);
   const unsigned threads = resolve_threads(settings.threads);
+  std::string voxel_size_choice;
+  if (settings.voxel_size_auto) {
+    // One extra pass over the points (the voxeliser scans them again for its own bounds).
+    detail::BoundsScan scan;
+    scan.add(t.positions.data(), t.offsets.data(), 0, t.streamline_count(), 0);
+    scan.check(t.source.path);
+    const double lo[3] = {scan.lo[0], scan.lo[1], scan.lo[2]}, hi[3] = {scan.hi[0], scan.hi[1], scan.hi[2]};
+    const VoxelSizeChoice choice = choose_voxel_size(t.point_count(), lo, hi, scan.rms_step());
+    settings.voxel_size = choice.size;
+    voxel_size_choice = choice.reason;
+  }
   for (const ValueSet& v : t.point_values)
     if (v.values.size() != t.point_count())
       throw Error(ErrorKind::Input, t.source.path, std::nullopt,
@@ -67,7 +83,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
       sets->resize(kMaxValueSets);
     }
   // PROV and GRPS are known before any work: their sizes go into the plan of the output file.
-  const std::string provenance = provenance_json(t.source, settings, threads);
+  const std::string provenance = provenance_json(t.source, settings, threads, voxel_size_choice);
   std::vector<std::uint8_t> groups_bytes;
   if (!t.groups.empty()) {
     std::vector<GroupContent> groups;

@@ -11,7 +11,9 @@ namespace vxl {
 
 struct ConvertSettings {
   double voxel_size = 10.0;  // mm; the paper's balance of speed and quality
-  unsigned threads = 0;      // 0: all hardware threads
+  // Choose the voxel size from the data instead (voxel_size_auto.h); the choice is recorded in PROV.
+  bool voxel_size_auto = false;
+  unsigned threads = 0;  // 0: all hardware threads
   std::string orders = "axis";
   ProgressFn progress;
   // Bytes of memory convert_streaming may use (streaming_convert.h); 0: no limit. Not recorded in the
@@ -44,7 +46,9 @@ struct ConvertSummary {
 ConvertSummary convert_tractogram(Tractogram&& tractogram, const std::string& out_path,
                                   const ConvertSettings& settings);
 
-// The PROV payload (spec §5.8) for a source converted with these settings and `threads` worker threads.
-std::string provenance_json(const SourceInfo& source, const ConvertSettings& settings, unsigned threads);
+// The PROV payload (spec §5.8) for a source converted with these settings and `threads` worker threads;
+// `voxel_size_choice`: why --voxel-size auto chose settings.voxel_size (empty: it was given).
+std::string provenance_json(const SourceInfo& source, const ConvertSettings& settings, unsigned threads,
+                            const std::string& voxel_size_choice = {});
 
 }  // namespace vxl

@@ -15,6 +15,7 @@
 #include "converter/memory_size.h"
 #include "converter/readers/tck_stream.h"
 #include "converter/segment_orders.h"
+#include "converter/voxel_size_auto.h"
 #include "converter/voxel_table.h"
 #include "converter/voxelize.h"
 #include "format/error.h"
@@ -127,6 +128,7 @@ class StreamingConversion {
 
   std::string path_, out_path_;
   ConvertSettings settings_;
+  std::string voxel_size_choice_;  // --voxel-size auto's reason, once scan() has chosen
   Budget budget_;
   OrderSetSpec order_set_;
   unsigned threads_ = 1;
@@ -241,6 +243,11 @@ void StreamingConversion::scan() {
   longest_step2_ = bounds.longest_step2;
   meta_.streamline_count = streamlines;
   meta_.point_count = points;
+  if (settings_.voxel_size_auto) {
+    const VoxelSizeChoice choice = choose_voxel_size(points, lo_, hi_, bounds.rms_step());
+    settings_.voxel_size = choice.size;
+    voxel_size_choice_ = choice.reason;
+  }
   meta_.voxel_size = settings_.voxel_size;
 }
 
@@ -474,7 +481,7 @@ ConvertSummary StreamingConversion::run() {
   check_source_type();
   order_set_ = parse_order_set(settings_.orders);
   threads_ = resolve_threads(settings_.threads);
-  detail::check_voxel_size(settings_.voxel_size, path_);
+  if (!settings_.voxel_size_auto) detail::check_voxel_size(settings_.voxel_size, path_);
   summary_.passes = 0;
 
   auto t0 = Clock::now();
@@ -492,7 +499,7 @@ ConvertSummary StreamingConversion::run() {
   spans_.resize(meta_.streamline_count);
   std::vector<Range> ranges = cut_ranges();
 
-  const std::string provenance = provenance_json(stream_->source(), settings_, threads_);
+  const std::string provenance = provenance_json(stream_->source(), settings_, threads_, voxel_size_choice_);
   out_ = std::make_unique<VxlStreamWriter>(out_path_, section_sizes(meta_, order_bytes_, provenance.size(), 0));
   for (std::size_t k = 0; k < ranges.size(); ++k) {
     build_range(ranges[k], k, ranges.size());

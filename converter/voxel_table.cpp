@@ -33,6 +33,7 @@ void BoundsScan::add(const float* pts, const std::uint64_t* offsets, std::uint64
   // Locals, not the fields: the compiler cannot tell that `this` does not alias the points.
   float l[3] = {lo[0], lo[1], lo[2]}, h[3] = {hi[0], hi[1], hi[2]};
   double step2 = longest_step2;
+  std::uint64_t step2_sum = step2_sum_fixed, step_count = steps;
   for (std::uint64_t k = first; k < end && bad_streamline == kNone; ++k) {
     for (std::uint64_t i = offsets[k]; i < offsets[k + 1]; ++i) {
       const float* p = pts + 3 * i;
@@ -49,11 +50,15 @@ void BoundsScan::add(const float* pts, const std::uint64_t* offsets, std::uint64
         double d2 = 0;
         for (int c = 0; c < 3; ++c) d2 += (double(p[c]) - p[c - 3]) * (double(p[c]) - p[c - 3]);
         step2 = std::max(step2, d2);
+        step2_sum += static_cast<std::uint64_t>(std::min(d2, 0x1p20) * 1024.0);
+        ++step_count;
       }
     }
   }
   std::copy(l, l + 3, lo);
   std::copy(h, h + 3, hi);
+  step2_sum_fixed = step2_sum;
+  steps = step_count;
   longest_step2 = step2;
 }
 
@@ -63,6 +68,8 @@ void BoundsScan::merge(const BoundsScan& later) {
     hi[c] = std::max(hi[c], later.hi[c]);
   }
   longest_step2 = std::max(longest_step2, later.longest_step2);
+  step2_sum_fixed += later.step2_sum_fixed;
+  steps += later.steps;
   if (bad_streamline == kNone) {
     bad_streamline = later.bad_streamline;
     bad_point = later.bad_point;

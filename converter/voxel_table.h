@@ -32,6 +32,10 @@ struct BoundsScan {
   static constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
   float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   double longest_step2 = 0;
+  // Sum of squared steps in 1/1024 mm^2 (each capped at 1 m^2: no overflow below 2^34 steps) and their
+  // count, for the RMS step. Integers,
+  // so that the sum does not depend on how streamlines are split over threads or batches.
+  std::uint64_t step2_sum_fixed = 0, steps = 0;
   std::uint64_t bad_streamline = kNone, bad_point = 0;  // the first non-finite point
 
   // Streamlines [first, end) of `offsets` (points xyz in `pts`), numbered from `index_base` in messages.
@@ -41,6 +45,7 @@ struct BoundsScan {
   void merge(const BoundsScan& later);
   // Throws Input for the first non-finite point, if any.
   void check(const std::string& path) const;
+  double rms_step() const { return steps ? std::sqrt(double(step2_sum_fixed) / 1024.0 / double(steps)) : 0.0; }
 };
 
 // Vertex and segment counts per voxel of one local voxel index.

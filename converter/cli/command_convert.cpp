@@ -1,4 +1,6 @@
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <string>
 
@@ -32,6 +34,7 @@ void add_convert_command(CLI::App& app) {
     unsigned jobs = 1;
     ConvertSettings settings;
     std::string memory_limit;
+    std::string voxel_size = "10";
     bool verbose = false;
     std::vector<std::string> tsf;
   };
@@ -59,9 +62,19 @@ void add_convert_command(CLI::App& app) {
           ->type_name("N")
           ->default_val(1)
           ->check(CLI::Range(1u, 4096u));
-  cmd->add_option("--voxel-size", opt->settings.voxel_size, "voxel edge length in mm")
-      ->default_val(10.0)
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--voxel-size", opt->voxel_size,
+                  "voxel edge length in mm, or auto: chosen from the point count, extent and step length so that "
+                  "voxels stay under ~32k vertices (16-bit orders), at most 10 mm; `info` shows the choice")
+      ->type_name("MM|auto")
+      ->default_val("10")
+      ->check([](const std::string& text) -> std::string {
+        if (text == "auto") return {};
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !(v > 0) || !std::isfinite(v))
+          return "expected a positive number of mm or auto, got '" + text + "'";
+        return {};
+      });
   cmd->add_option("--threads", opt->settings.threads,
                   "worker threads in all (0: all cores); --jobs N shares them, each file getting threads / N")
       ->default_val(0);
@@ -104,6 +117,8 @@ void add_convert_command(CLI::App& app) {
       "--output-dir that cannot be created or written into (5).");
   cmd->callback([opt, output_dir, jobs] {
     if (!opt->memory_limit.empty()) opt->settings.memory_limit = *parse_memory_size(opt->memory_limit);
+    opt->settings.voxel_size_auto = opt->voxel_size == "auto";
+    if (!opt->settings.voxel_size_auto) opt->settings.voxel_size = std::strtod(opt->voxel_size.c_str(), nullptr);
     if (output_dir->count() > 0) {
       CohortOptions c{opt->files, opt->output_dir, opt->jobs, opt->settings, opt->tsf, opt->verbose};
       g_exit_code = run_cohort(c);

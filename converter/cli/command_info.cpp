@@ -74,6 +74,10 @@ void add_info_command(CLI::App& app) {
                      {"format", string_field(src, "format")},
                      {"bytes", count_field(src, "bytes")}};
     }
+    // How the voxel size was chosen, when --voxel-size auto chose it.
+    if (prov.is_object() && prov.contains("converter") && prov["converter"].is_object())
+      if (const std::string why = string_field(prov["converter"], "voxel_size_auto"); !why.empty())
+        j["voxel_size_choice"] = why;
     if (opt->json) {
       // open() has checked every name for UTF-8; replacing invalid bytes is the last line of defence.
       std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
@@ -91,7 +95,9 @@ void add_info_command(CLI::App& app) {
     std::printf("segments      %llu\nvertices      %llu (%llu points added at voxel faces)\n",
                 (unsigned long long)m.segment_count, (unsigned long long)m.vertex_count,
                 (unsigned long long)m.synthetic_point_count);
-    std::printf("voxel size    %g mm\norders        %u stored (x2 by reversal)\n", m.voxel_size, m.stored_order_count);
+    std::printf("voxel size    %g mm%s\norders        %u stored (x2 by reversal)\n", m.voxel_size,
+                j.contains("voxel_size_choice") ? (" (" + j["voxel_size_choice"].get<std::string>() + ")").c_str() : "",
+                m.stored_order_count);
     std::printf("bounds        [%.3f, %.3f, %.3f] .. [%.3f, %.3f, %.3f] mm\nsections     ", m.bounds_min[0],
                 m.bounds_min[1], m.bounds_min[2], m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]);
     for (const SectionEntry& e : f.sections()) std::printf(" %.4s:%llu", e.id, (unsigned long long)e.size);
