@@ -129,9 +129,9 @@ int run_cohort(const CohortOptions& o) {
       print(to, text);
     };
     try {
-      const std::string report = convert_file(in, outputs[i], o.tsf, settings, o.verbose, [&](const std::string& w) {
-        say(stderr, "voxlines: warning: " + in + ": " + w + "\n");
-      });
+      const std::string report = convert_file(
+          in, outputs[i], o.tsf, settings, o.verbose,
+          [&](const std::string& w) { say(stderr, "voxlines: warning: " + in + ": " + w + "\n"); }, jobs);
       say(stdout, report);
     } catch (const Error& e) {
       failed_code[i] = static_cast<int>(e.kind());

@@ -1,8 +1,12 @@
 #include "converter/cli/convert_file.h"
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 
+#include "converter/memory_available.h"
 #include "converter/memory_size.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
@@ -10,11 +14,38 @@
 #include "format/error.h"
 
 namespace vxl::cli {
+namespace {
+
+bool is_tck(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".tck";
+}
+
+}  // namespace
 
 std::string convert_file(const std::string& input, const std::string& output, const std::vector<std::string>& tsf,
-                         const ConvertSettings& settings, bool verbose,
-                         const std::function<void(const std::string&)>& warn) {
+                         const ConvertSettings& given, bool verbose,
+                         const std::function<void(const std::string&)>& warn, unsigned concurrent_files) {
   auto t0 = std::chrono::steady_clock::now();
+  ConvertSettings settings = given;
+  if (settings.memory_limit == 0 && tsf.empty() && is_tck(input)) {
+    std::error_code ec;
+    const std::uintmax_t bytes = std::filesystem::file_size(input, ec);
+    const std::optional<std::uint64_t> available = available_memory();
+    if (!ec && available) {
+      const std::uint64_t share = *available / std::max(1u, concurrent_files);
+      if (const auto limit = automatic_memory_limit(bytes, share)) {
+        settings.memory_limit = *limit;
+        std::fprintf(stderr,
+                     "voxlines: %s: converting in memory would take about %s of the %s available%s: "
+                     "streaming it within --memory-limit %s (the output is the same)\n",
+                     input.c_str(), format_memory_size(in_memory_estimate(bytes)).c_str(),
+                     format_memory_size(share).c_str(), concurrent_files > 1 ? " to each file converted at once" : "",
+                     memory_limit_argument(*limit).c_str());
+      }
+    }
+  }
   ConvertSummary s;
   double read_seconds = 0;
   if (settings.memory_limit > 0) {

@@ -1,0 +1,69 @@
+#include "converter/memory_available.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "converter/memory_size.h"
+
+namespace vxl {
+namespace {
+
+constexpr double kPeakPerSourceByte = 3.0;  // measured 2.5-2.6, rounded up
+constexpr std::uint64_t kMinimumLimit = 64ull << 20;
+// More gains little: streaming's extra passes are cheap next to the work, and a machine's other jobs keep
+// the rest.
+constexpr std::uint64_t kMaximumLimit = 6ull << 30;
+
+// The first whole number in a file (e.g. "max" gives nullopt).
+std::optional<std::uint64_t> read_number(const char* path) {
+  std::ifstream in(path);
+  std::uint64_t v = 0;
+  if (in >> v) return v;
+  return std::nullopt;
+}
+
+// A value of /proc/meminfo in bytes ("MemAvailable:   12345 kB").
+std::optional<std::uint64_t> meminfo(const std::string& key) {
+  std::ifstream in("/proc/meminfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind(key + ":", 0) == 0) {
+      std::istringstream fields(line.substr(key.size() + 1));
+      std::uint64_t kib = 0;
+      if (fields >> kib) return kib * 1024;
+    }
+  return std::nullopt;
+}
+
+std::optional<std::uint64_t> cgroup_headroom() {
+  for (auto [limit_path, usage_path] :
+       {std::pair{"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"},
+        std::pair{"/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes"}}) {
+    const auto limit = read_number(limit_path), usage = read_number(usage_path);
+    // v1 reports "no limit" as a number near 2^63.
+    if (limit && usage && *limit < (1ull << 60)) return *limit > *usage ? *limit - *usage : 0;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::uint64_t> available_memory() {
+  if (const char* text = std::getenv("VOXLINES_MEMORY_AVAILABLE")) return parse_memory_size(text);
+  std::optional<std::uint64_t> available = meminfo("MemAvailable");
+  if (const auto headroom = cgroup_headroom()) available = available ? std::min(*available, *headroom) : *headroom;
+  return available;
+}
+
+std::uint64_t in_memory_estimate(std::uint64_t source_bytes) {
+  return static_cast<std::uint64_t>(kPeakPerSourceByte * double(source_bytes));
+}
+
+std::optional<std::uint64_t> automatic_memory_limit(std::uint64_t source_bytes, std::uint64_t available) {
+  if (double(in_memory_estimate(source_bytes)) <= 0.9 * double(available)) return std::nullopt;
+  return std::clamp(available / 2, kMinimumLimit, kMaximumLimit);
+}
+
+}  // namespace vxl
