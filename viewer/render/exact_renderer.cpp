@@ -156,7 +156,6 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
     }
     i = j;
   }
-  if (n == 0) ++passes_;
 
   glBindTexture(GL_TEXTURE_2D, result_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
