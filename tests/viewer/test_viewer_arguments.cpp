@@ -158,56 +158,50 @@ TEST(ViewerArguments, ValuesParse) {
   EXPECT_FALSE(resolve_viewer_options(a).settings.slices.any());
 }
 
-TEST(ViewerArguments, BadOrConflictingOptionsAreUsageErrors) {
-  auto with = [](auto change) {
-    ViewerArguments a;
-    a.options.image = "t1.nii";
-    change(a);
-    return usage_error_of(a);
-  };
-  EXPECT_EQ(with([](ViewerArguments&) {}), "no error");
-  EXPECT_NE(with([](ViewerArguments& a) { a.options.turntable = 36; }).find("--turntable needs --render"),
-            std::string::npos);
-  EXPECT_EQ(with([](ViewerArguments& a) {
-              a.options.turntable = 36;
-              a.options.render_png = "x.png";
-            }),
-            "no error");
-  EXPECT_NE(with([](ViewerArguments& a) {
-              a.range = "1,0";
-              a.given = {"--range"};
-            }).find("--range: expected MIN,MAX"),
-            std::string::npos);
-  EXPECT_NE(with([](ViewerArguments& a) {
-              a.image_range = "5";
-              a.given = {"--image-range"};
-            }).find("--image-range: expected MIN,MAX"),
-            std::string::npos);
-  EXPECT_NE(with([](ViewerArguments& a) {
-              a.clips = {"x,1", "y,1", "z,1", "x,2"};
-            }).find("at most 3"),
-            std::string::npos);
-  EXPECT_NE(with([](ViewerArguments& a) { a.clips = {"w,1"}; }).find("--clip: expected AXIS,POS"), std::string::npos);
-  EXPECT_NE(with([](ViewerArguments& a) {
-              a.slices = "axial,top";
-              a.given = {"--slices"};
-            }).find("--slices: expected"),
-            std::string::npos);
-  EXPECT_NE(with([](ViewerArguments& a) {
-              a.focus = "1,2";
-              a.given = {"--focus"};
-            }).find("--focus: expected X,Y,Z"),
-            std::string::npos);
-  EXPECT_NE(with([](ViewerArguments& a) { a.groups = {"CST="}; }).find("--group: expected"), std::string::npos);
-  EXPECT_NE(with([](ViewerArguments& a) { a.view = "sideways"; }).find("unknown view 'sideways'"), std::string::npos);
-  EXPECT_NE(with([](ViewerArguments& a) { a.size = "0x5"; }).find("--size must be WxH"), std::string::npos);
-  EXPECT_NE(with([](ViewerArguments& a) { a.size = "16385x5"; }).find("--size must be WxH"), std::string::npos);
-  EXPECT_NE(with([](ViewerArguments& a) { a.mode = "fancy"; }).find("--mode"), std::string::npos);
+// One option given with `value`: its field set and the option marked given.
+ViewerArguments given(const char* option, std::string ViewerArguments::*field, const std::string& value) {
+  ViewerArguments a;
+  a.options.image = "t1.nii";
+  a.*field = value;
+  a.given = {option};
+  return a;
+}
 
-  ViewerArguments no_image;
-  no_image.slices = "axial";
-  no_image.given = {"--slices"};
-  EXPECT_NE(usage_error_of(no_image).find("need --image"), std::string::npos);
+TEST(ViewerArguments, BadOrConflictingOptionsAreUsageErrors) {
+  auto error_contains = [](const ViewerArguments& a, const std::string& part) {
+    const std::string error = usage_error_of(a);
+    EXPECT_NE(error.find(part), std::string::npos) << error;
+  };
+  error_contains(given("--range", &ViewerArguments::range, "1,0"), "--range: expected MIN,MAX");
+  error_contains(given("--image-range", &ViewerArguments::image_range, "5"), "--image-range: expected MIN,MAX");
+  error_contains(given("--slices", &ViewerArguments::slices, "axial,top"), "--slices: expected");
+  error_contains(given("--focus", &ViewerArguments::focus, "1,2"), "--focus: expected X,Y,Z");
+  error_contains(given("--view", &ViewerArguments::view, "sideways"), "unknown view 'sideways'");
+  error_contains(given("--size", &ViewerArguments::size, "0x5"), "--size must be WxH");
+  error_contains(given("--size", &ViewerArguments::size, "16385x5"), "--size must be WxH");
+  error_contains(given("--mode", &ViewerArguments::mode, "fancy"), "--mode: unknown mode 'fancy'");
+  error_contains(given("--color", &ViewerArguments::color, "rainbow"), "--color: unknown colour mode");
+  error_contains(given("--colormap", &ViewerArguments::colormap, "jet"), "--colormap: unknown colour map");
+  error_contains(given("--fixed-color", &ViewerArguments::fixed_color, "red"), "--fixed-color: expected #RRGGBB");
+
+  ViewerArguments a = given("--size", &ViewerArguments::size, "800x600");
+  EXPECT_EQ(usage_error_of(a), "no error");
+  a.clips = {"x,1", "y,1", "z,1", "x,2"};
+  error_contains(a, "--clip: at most 3 clip planes (got 4)");
+  a.clips = {"w,1"};
+  error_contains(a, "--clip: expected AXIS,POS");
+  a.clips.clear();
+  a.groups = {"CST="};
+  error_contains(a, "--group: expected");
+  a.groups.clear();
+  a.options.turntable = 36;
+  error_contains(a, "--turntable needs --render");
+  a.options.render_png = "x.png";
+  EXPECT_EQ(usage_error_of(a), "no error");
+
+  ViewerArguments no_image = given("--slices", &ViewerArguments::slices, "axial");
+  no_image.options.image.reset();
+  error_contains(no_image, "--image-range and --slices need --image");
 }
 
 // The schema: which options were given, values that start with '-', the lists the help takes from their tables.
