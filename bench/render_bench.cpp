@@ -95,7 +95,7 @@ int run(int argc, char** argv) {
     std::printf("\nscene %s: %llu streamlines, %llu segments, %u voxels of %g mm, GPU %.0f MiB, upload %.3f s\n",
                 vxl_path.c_str(), (unsigned long long)file.meta().streamline_count,
                 (unsigned long long)file.meta().segment_count, file.meta().voxel_count, file.meta().voxel_size,
-                renderer.scene().gpu_bytes() / 1048576.0, upload_s);
+                renderer.gpu_bytes() / 1048576.0, upload_s);
     std::printf("  first frame read back (process start -> PNG written): .vxl %.3f s", median(first_vxl));
     if (!source.empty())
       std::printf(", source %.3f s (ratio %.1fx)", median(first_src), median(first_src) / median(first_vxl));

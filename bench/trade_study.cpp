@@ -176,11 +176,11 @@ class Study {
       const bool reference = n == 0;
       VxlFile file = VxlFile::open(e.path);
       Renderer r(file);
-      const std::uint64_t scene_bytes = r.scene().gpu_bytes();
+      const std::uint64_t scene_bytes = r.gpu_bytes();
       std::vector<ModeSpec> modes = sweep_modes(e, reference);
       if (reference) modes.insert(modes.begin(), ModeSpec{"exact", RenderMode::Exact});
       for (const ModeSpec& m : modes) {
-        if (m.mode == RenderMode::Unsorted) r.scene().dataset_first();  // its one-time upload is not a frame
+        r.prepare(m.mode);  // a one-time upload is not a frame
         for (std::size_t v = 0; v < std::size(kViews); ++v)
           for (std::size_t o = 0; o < std::size(kOpacities); ++o) {
             const View& view = kViews[v];
@@ -199,7 +199,7 @@ class Study {
             row.cpu_ms = f.cpu_ms;
             row.convert_s = e.convert_s;
             row.file_bytes = file.bytes().size();
-            row.gpu_bytes = m.mode == RenderMode::Unsorted ? r.scene().gpu_bytes() : scene_bytes;
+            row.gpu_bytes = m.mode == RenderMode::Unsorted ? r.gpu_bytes() : scene_bytes;
             rows.push_back(row);
             if (reference && view.name == std::string(kSideView) && kOpacities[o] == kSideOpacity)
               write_png(o_.out + "/side_" + m.name + ".png", f.image);

@@ -17,6 +17,9 @@ enum class ErrorKind : int {
   Output = 5,       // cannot write the output
 };
 
+// The exit code of an unexpected exception (a bug rather than a bad input): EX_SOFTWARE of sysexits.h.
+inline constexpr int kExitInternalError = 70;
+
 class Error : public std::runtime_error {
  public:
   Error(ErrorKind kind, std::string file, std::optional<std::uint64_t> offset, const std::string& what)

@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
     return static_cast<int>(vxl::ErrorKind::Unsupported);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "voxlines: internal error: %s\n", e.what());
-    return 70;
+    return vxl::kExitInternalError;
   }
   return vxl::cli::g_exit_code;
 }

@@ -147,7 +147,7 @@ TEST_F(ColorByValue, GroupsHaveTheirColourAndOpacity) {
   expect_colour(half, column_of(0.5), row_of(line_y(0)), glm::vec3(1.0f), 1, "A at full opacity");
 }
 
-TEST_F(ColorByValue, ManyChunksColourLikeOne) {
+TEST_F(ColorByValue, ManyTextureSpansColourLikeOne) {
   Tractogram t;
   std::vector<float> along;
   for (int s = 0; s < 40; ++s) {
@@ -161,7 +161,7 @@ TEST_F(ColorByValue, ManyChunksColourLikeOne) {
   t.point_values.push_back({"along", along});
   VxlFile f = make_scene(dir, std::move(t), 6.0);
   Renderer one(f), many(f, 1500);
-  EXPECT_GT(many.scene().layout().chunks().size(), 3u);
+  EXPECT_GT(many.layout().texture_spans().size(), 3u);
   Camera cam = top_view();
   cam.azimuth_deg = 30;
   cam.elevation_deg = 40;

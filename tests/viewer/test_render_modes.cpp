@@ -233,7 +233,7 @@ TEST_F(RenderModes, ExactOverSeveralGridsFallsBackToRowBands) {
   EXPECT_EQ(compare_images(whole, banded).differing_pixels, 0u);
 }
 
-TEST_F(RenderModes, ManyChunksRenderLikeOne) {
+TEST_F(RenderModes, ManyTextureSpansRenderLikeOne) {
   // A tractogram spread over several voxels, uploaded with a tiny texture-buffer limit.
   Tractogram t;
   for (int s = 0; s < 40; ++s) {
@@ -244,8 +244,8 @@ TEST_F(RenderModes, ManyChunksRenderLikeOne) {
   }
   VxlFile f = make_scene(dir, std::move(t), 6.0);
   Renderer one(f), many(f, 1500);
-  EXPECT_EQ(one.scene().layout().chunks().size(), 1u);
-  EXPECT_GT(many.scene().layout().chunks().size(), 3u);
+  EXPECT_EQ(one.layout().texture_spans().size(), 1u);
+  EXPECT_GT(many.layout().texture_spans().size(), 3u);
   Camera cam = top_view();
   cam.azimuth_deg = 30;
   cam.elevation_deg = 40;

@@ -106,8 +106,8 @@ TEST_F(SeveralFiles, VoxelsOfAllFilesAreSortedTogether) {
 TEST_F(SeveralFiles, FilesWithDifferentOrderSetsAndGroupOpacity) {
   VxlFile a = convert(dir, lines_at({15, -5}, "A"), "a.vxl", "axis+diag");
   VxlFile b = convert(dir, lines_at({5, -15}, "B"), "b.vxl", "random:4");
-  Renderer r({&a, &b}, 40);  // small texture buffers: several chunks per file
-  EXPECT_GT(r.scene().layout().chunks().size(), 2u);
+  Renderer r({&a, &b}, 40);  // small texture buffers: several spans per file
+  EXPECT_GT(r.layout().texture_spans().size(), 2u);
   Image axis = render_image(r, top_view(), settings(RenderMode::Axis), 64, 64);
   Image exact = render_image(r, top_view(), settings(RenderMode::Exact), 64, 64);
   EXPECT_LE(compare_images(axis, exact).max_error * 255, 1.01);

@@ -60,7 +60,7 @@ int run_headless(const ViewerOptions& o) {
   OffscreenTarget target(o.width, o.height);
   target.bind();
   const double aspect = double(o.width) / o.height;
-  const Camera camera = initial_camera(framing_points(renderer.scene().layout()), o, aspect);
+  const Camera camera = initial_camera(framing_points(renderer.layout()), o, aspect);
   if (o.save_camera) write_view(*o.save_camera, SavedView{camera, o.settings, std::array<int, 2>{o.width, o.height}});
   const int frames = std::max(1, o.turntable);
   for (int i = 0; i < frames; ++i) {

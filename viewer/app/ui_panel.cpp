@@ -7,14 +7,12 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
 
+#include "viewer/app/key_bindings.h"
 #include "viewer/render/camera.h"
 
 namespace vxl::app {
 
 namespace {
-
-constexpr RenderMode kModes[] = {RenderMode::Opaque, RenderMode::Unsorted, RenderMode::Additive, RenderMode::Wboit,
-                                 RenderMode::Basic,  RenderMode::Axis,     RenderMode::Exact};
 
 // "1234567" -> "1.23 M": the counts span six orders of magnitude, exact digits would not be read.
 std::string count_text(std::uint64_t n) {
@@ -196,50 +194,17 @@ void image_controls(PanelState& state, const PanelStats& stats, PanelRequests& o
   ImGui::EndDisabled();
 }
 
-}  // namespace
-
-UiPanel::UiPanel(GLFWwindow* window) {
-  IMGUI_CHECKVERSION();
-  ImGui::CreateContext();
-  ImGuiIO& io = ImGui::GetIO();
-  io.IniFilename = nullptr;  // leave no imgui.ini behind in the user's directory
-  ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
-  ImGui_ImplOpenGL3_Init("#version 330 core");
-}
-
-UiPanel::~UiPanel() {
-  ImGui_ImplOpenGL3_Shutdown();
-  ImGui_ImplGlfw_Shutdown();
-  ImGui::DestroyContext();
-}
-
-bool UiPanel::takes_mouse_at(double x, double y) const {
-  if (popup_open_ || ImGui::IsAnyItemActive()) return true;
-  return x >= x0_ && x < x1_ && y >= y0_ && y < y1_;
-}
-bool UiPanel::wants_keyboard() const { return ImGui::GetIO().WantCaptureKeyboard; }
-
-PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
-  ImGui_ImplOpenGL3_NewFrame();
-  ImGui_ImplGlfw_NewFrame();
-  ImGui::NewFrame();
-  PanelRequests out;
+// The transparency mode (each described when hovered), opacity, line width, colour, lighting, background
+// and the voxel grid.
+void look_controls(PanelState& state, const PanelStats& stats) {
   RenderSettings& s = state.settings;
-
-  ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowBgAlpha(0.8f);
-  // "###" keeps the window's identity apart from its title; ImGui's built-in font is ASCII only.
-  const std::string title = "voxview: " + stats.title + "###panel";
-  ImGui::Begin(title.c_str(), nullptr, ImGuiWindowFlags_AlwaysAutoResize);
-  ImGui::PushItemWidth(170);
-
   if (ImGui::BeginCombo("Mode", render_mode_name(s.mode))) {
-    for (RenderMode m : kModes) {
-      const bool selected = m == s.mode;
-      std::string label = render_mode_name(m);
-      if (m == RenderMode::Exact && !stats.exact_available) label += " (needs GL 4.3)";
-      if (ImGui::Selectable(label.c_str(), selected)) s.mode = m;
+    for (const RenderModeInfo& m : render_modes()) {
+      const bool selected = m.mode == s.mode;
+      std::string label = m.name;
+      if (m.mode == RenderMode::Exact && !stats.exact_available) label += " (needs GL 4.3)";
+      if (ImGui::Selectable(label.c_str(), selected)) s.mode = m.mode;
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", m.description);
       if (selected) ImGui::SetItemDefaultFocus();
     }
     ImGui::EndCombo();
@@ -269,10 +234,10 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   ImGui::RadioButton("all", &grid_scope, 1);
   state.grid_all = grid_scope == 1;
   ImGui::EndDisabled();
+}
 
-  clipping_controls(state, stats, out);
-  image_controls(state, stats, out);
-
+// View presets, projection, camera reset, screenshot and saving the view.
+void view_controls(PanelState& state, PanelRequests& out) {
   ImGui::Separator();
   ImGui::AlignTextToFramePadding();
   ImGui::TextUnformatted("View");
@@ -302,7 +267,10 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   ImGui::Checkbox("with panel", &state.panel_in_screenshot);
   ImGui::SameLine();
   out.save_view = ImGui::Button("Save view");
+}
 
+// Frame time, counts, the GL driver, the last error and status, and the keys (key_bindings.h).
+void frame_information(const PanelState& state, const PanelStats& stats) {
   ImGui::Separator();
   ImGui::Text("Frame      %.2f ms", stats.frame_ms);
   ImGui::Text("Plan (CPU) %.3f ms", stats.plan_ms);
@@ -315,31 +283,51 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   if (!stats.status.empty()) ImGui::TextUnformatted(stats.status.c_str());
   ImGui::PopTextWrapPos();
 
-  if (ImGui::CollapsingHeader("Keys and mouse")) {
-    ImGui::TextUnformatted(
-        "left drag     orbit\n"
-        "right/middle  pan (or shift + left)\n"
-        "wheel         zoom\n"
-        "1 2 3         axial, sagittal, coronal\n"
-        "shift+1 2 3   inferior, right, posterior (or 4 5 6)\n"
-        "O             orthographic / perspective\n"
-        "M             next transparency mode\n"
-        "+ -           opacity x / : 1.5\n"
-        "L             lighting on / off\n"
-        "S             screenshot    R  reset camera\n"
-        "V             save the view (for --camera)\n"
-        "C             slab on / off\n"
-        "[ ]           slab thinner / thicker\n"
-        "PgUp PgDn     move the slab (shift: x10; or ctrl + wheel)\n"
-        "F1 F2 F3      toggle clip plane 1 2 3 (adds one through\n"
-        "              the focus on x, y, z if missing)\n"
-        "Up Down       image: focus S / I (the axial slice)\n"
-        "Right Left    image: focus R / L (the sagittal slice)\n"
-        "Home End      image: focus A / P (the coronal slice)\n"
-        "              (1 mm; shift: 10 mm)\n"
-        "I             image slices shown / hidden\n"
-        "Esc Q         quit");
-  }
+  static const std::string controls = controls_as_columns();
+  if (ImGui::CollapsingHeader("Keys and mouse")) ImGui::TextUnformatted(controls.c_str());
+}
+
+}  // namespace
+
+UiPanel::UiPanel(GLFWwindow* window) {
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;  // leave no imgui.ini behind in the user's directory
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+}
+
+UiPanel::~UiPanel() {
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+}
+
+bool UiPanel::takes_mouse_at(double x, double y) const {
+  if (popup_open_ || ImGui::IsAnyItemActive()) return true;
+  return x >= x0_ && x < x1_ && y >= y0_ && y < y1_;
+}
+bool UiPanel::wants_keyboard() const { return ImGui::GetIO().WantCaptureKeyboard; }
+
+PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  PanelRequests out;
+
+  ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowBgAlpha(0.8f);
+  // "###" keeps the window's identity apart from its title; ImGui's built-in font is ASCII only.
+  const std::string title = "voxview: " + stats.title + "###panel";
+  ImGui::Begin(title.c_str(), nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  ImGui::PushItemWidth(170);
+  look_controls(state, stats);
+  clipping_controls(state, stats, out);
+  image_controls(state, stats, out);
+  view_controls(state, out);
+  frame_information(state, stats);
   ImGui::PopItemWidth();
   const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
   x0_ = pos.x;

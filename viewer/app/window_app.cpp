@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "viewer/app/camera_controller.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/headless_render.h"
+#include "viewer/app/key_bindings.h"
 #include "viewer/app/scene_source.h"
 #include "viewer/app/ui_panel.h"
 #include "viewer/platform/image_io.h"
@@ -71,14 +73,15 @@ WindowPtr open_window(const ViewerOptions& o) {
   return WindowPtr(w);
 }
 
+// The mode after `m` in render_modes(), skipping exact where the context cannot run it.
 RenderMode next_mode(RenderMode m, bool exact_available) {
-  constexpr RenderMode cycle[] = {RenderMode::Opaque, RenderMode::Unsorted, RenderMode::Additive, RenderMode::Wboit,
-                                  RenderMode::Basic,  RenderMode::Axis,     RenderMode::Exact};
-  constexpr int n = sizeof cycle / sizeof cycle[0];
-  int i = static_cast<int>(std::find(cycle, cycle + n, m) - cycle);
-  do i = (i + 1) % n;
-  while (cycle[i] == RenderMode::Exact && !exact_available);
-  return cycle[i];
+  const std::span<const RenderModeInfo> modes = render_modes();
+  std::size_t i = static_cast<std::size_t>(
+      std::find_if(modes.begin(), modes.end(), [m](const RenderModeInfo& info) { return info.mode == m; }) -
+      modes.begin());
+  do i = (i + 1) % modes.size();
+  while (modes[i].mode == RenderMode::Exact && !exact_available);
+  return modes[i].mode;
 }
 
 // The default framebuffer's back buffer as RGBA8 rows top to bottom (GL counts rows from the bottom).
@@ -128,6 +131,9 @@ class ViewerWindow {
   void on_scroll(double steps);
   void on_key(int key, int action, int mods);
   void on_char(unsigned codepoint);
+  // Carries out a key's action (key_bindings.h); `shift` makes a move 10 times larger.
+  void perform(KeyAction action, bool shift);
+  void toggle_slices();
   void toggle_clip_plane(std::size_t i);
   void move_focus_along(int axis, double mm);
 
@@ -196,7 +202,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   }
   if (o.settings.clipping.slab_mm > 0) state_.slab_thickness = o.settings.clipping.slab_mm;
 
-  framing_points_ = framing_points(renderer_.scene().layout());
+  framing_points_ = framing_points(renderer_.layout());
   controller_.set_home(home_camera(aspect(), o.orthographic));
   controller_.reset();
 
@@ -294,93 +300,74 @@ void ViewerWindow::move_focus_along(int axis, double mm) {
   controller_.set_camera(c);
 }
 
-// Keys bound to a place on the keyboard: Esc and the digit row (with Shift for the opposite view).
 void ViewerWindow::on_key(int key, int action, int mods) {
   events_++;
   if ((action != GLFW_PRESS && action != GLFW_REPEAT) || panel_->wants_keyboard()) return;
   const bool shift = mods & GLFW_MOD_SHIFT;
-  // Held keys repeat only for moving the slab.
-  if (key == GLFW_KEY_PAGE_UP || key == GLFW_KEY_PAGE_DOWN) {
-    controller_.move_focus((key == GLFW_KEY_PAGE_UP ? -1.0 : 1.0) * (shift ? 10.0 : 1.0));
-    return;
-  }
-  const double step = shift ? 10.0 : 1.0;
-  switch (key) {
-    case GLFW_KEY_UP: move_focus_along(2, step); return;
-    case GLFW_KEY_DOWN: move_focus_along(2, -step); return;
-    case GLFW_KEY_RIGHT: move_focus_along(0, step); return;
-    case GLFW_KEY_LEFT: move_focus_along(0, -step); return;
-    case GLFW_KEY_HOME: move_focus_along(1, step); return;
-    case GLFW_KEY_END: move_focus_along(1, -step); return;
-    default: break;
-  }
-  if (action != GLFW_PRESS) return;
-  const char* view = nullptr;
-  switch (key) {
-    case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(window_, GLFW_TRUE); return;
-    case GLFW_KEY_F1: toggle_clip_plane(0); return;
-    case GLFW_KEY_F2: toggle_clip_plane(1); return;
-    case GLFW_KEY_F3: toggle_clip_plane(2); return;
-    case GLFW_KEY_1: view = shift ? "inferior" : "axial"; break;
-    case GLFW_KEY_2: view = shift ? "right" : "sagittal"; break;
-    case GLFW_KEY_3: view = shift ? "posterior" : "coronal"; break;
-    case GLFW_KEY_4: view = "inferior"; break;
-    case GLFW_KEY_5: view = "right"; break;
-    case GLFW_KEY_6: view = "posterior"; break;
-    default: return;
-  }
-  auto v = parse_view(view);
-  controller_.set_view((*v)[0], (*v)[1]);
+  if (const auto a = action_for_key(key, shift, action == GLFW_REPEAT)) perform(*a, shift);
 }
 
-// Keys bound to a character, so that they follow the user's keyboard layout.
 void ViewerWindow::on_char(unsigned c) {
   events_++;
   if (panel_->wants_keyboard()) return;
+  if (const auto a = action_for_char(c)) perform(*a, false);
+}
+
+// I hides the slices shown, and brings back those it hid (or the default ones).
+void ViewerWindow::toggle_slices() {
+  SliceSettings& slices = state_.settings.slices;
+  if (slices.any()) {
+    hidden_slices_ = slices;
+    slices.axial = slices.coronal = slices.sagittal = slices.view_plane = false;
+  } else {
+    const auto range = slices.range;  // the grey range may have changed in the panel meanwhile
+    slices = hidden_slices_.any() ? hidden_slices_ : SliceSettings{};
+    slices.range = range;
+  }
+}
+
+void ViewerWindow::perform(KeyAction action, bool shift) {
   RenderSettings& s = state_.settings;
-  switch (c) {
-    case 'o':
-    case 'O': controller_.set_orthographic(!controller_.camera().orthographic); break;
-    case 'm':
-    case 'M': s.mode = next_mode(s.mode, stats_.exact_available); break;
-    case '+':
-    case '=': s.opacity = std::clamp(s.opacity * 1.5f, 0.001f, 1.0f); break;
-    case '-':
-    case '_': s.opacity = std::clamp(s.opacity / 1.5f, 0.001f, 1.0f); break;
-    case 's':
-    case 'S': screenshot_requested_ = true; break;
-    case 'l':
-    case 'L': s.lighting = !s.lighting; break;
-    case 'i':
-    case 'I':
-      if (s.slices.any()) {
-        hidden_slices_ = s.slices;
-        s.slices.axial = s.slices.coronal = s.slices.sagittal = s.slices.view_plane = false;
-      } else {
-        const auto range = s.slices.range;  // the grey range may have changed in the panel meanwhile
-        s.slices = hidden_slices_.any() ? hidden_slices_ : SliceSettings{};
-        s.slices.range = range;
-      }
-      break;
-    case 'v':
-    case 'V': save_view_requested_ = true; break;
-    case 'r':
-    case 'R': reset_camera(aspect()); break;
-    case 'q':
-    case 'Q': glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
-    case 'c':
-    case 'C': {
-      double& slab = s.clipping.slab_mm;
-      slab = slab > 0 ? 0.0 : state_.slab_thickness;
-      break;
-    }
-    case '[':
-    case ']': {
-      state_.slab_thickness = std::clamp(state_.slab_thickness * (c == ']' ? 1.25 : 0.8), 0.1, 1000.0);
-      if (s.clipping.slab_mm > 0) s.clipping.slab_mm = state_.slab_thickness;
-      break;
-    }
-    default: break;
+  const double step = shift ? 10.0 : 1.0;
+  auto view = [&](const char* name) {
+    const auto v = parse_view(name);
+    controller_.set_view((*v)[0], (*v)[1]);
+  };
+  auto slab_thickness = [&](double factor) {
+    state_.slab_thickness = std::clamp(state_.slab_thickness * factor, 0.1, 1000.0);
+    if (s.clipping.slab_mm > 0) s.clipping.slab_mm = state_.slab_thickness;
+  };
+  switch (action) {
+    case KeyAction::ViewAxial: view("axial"); break;
+    case KeyAction::ViewSagittal: view("sagittal"); break;
+    case KeyAction::ViewCoronal: view("coronal"); break;
+    case KeyAction::ViewInferior: view("inferior"); break;
+    case KeyAction::ViewRight: view("right"); break;
+    case KeyAction::ViewPosterior: view("posterior"); break;
+    case KeyAction::ToggleOrthographic: controller_.set_orthographic(!controller_.camera().orthographic); break;
+    case KeyAction::NextMode: s.mode = next_mode(s.mode, stats_.exact_available); break;
+    case KeyAction::OpacityUp: s.opacity = std::clamp(s.opacity * 1.5f, 0.001f, 1.0f); break;
+    case KeyAction::OpacityDown: s.opacity = std::clamp(s.opacity / 1.5f, 0.001f, 1.0f); break;
+    case KeyAction::ToggleLighting: s.lighting = !s.lighting; break;
+    case KeyAction::Screenshot: screenshot_requested_ = true; break;
+    case KeyAction::ResetCamera: reset_camera(aspect()); break;
+    case KeyAction::SaveView: save_view_requested_ = true; break;
+    case KeyAction::ToggleSlab: s.clipping.slab_mm = s.clipping.slab_mm > 0 ? 0.0 : state_.slab_thickness; break;
+    case KeyAction::SlabThinner: slab_thickness(0.8); break;
+    case KeyAction::SlabThicker: slab_thickness(1.25); break;
+    case KeyAction::SlabNearer: controller_.move_focus(-step); break;
+    case KeyAction::SlabFarther: controller_.move_focus(step); break;
+    case KeyAction::ToggleClip1: toggle_clip_plane(0); break;
+    case KeyAction::ToggleClip2: toggle_clip_plane(1); break;
+    case KeyAction::ToggleClip3: toggle_clip_plane(2); break;
+    case KeyAction::FocusSuperior: move_focus_along(2, step); break;
+    case KeyAction::FocusInferior: move_focus_along(2, -step); break;
+    case KeyAction::FocusRight: move_focus_along(0, step); break;
+    case KeyAction::FocusLeft: move_focus_along(0, -step); break;
+    case KeyAction::FocusAnterior: move_focus_along(1, step); break;
+    case KeyAction::FocusPosterior: move_focus_along(1, -step); break;
+    case KeyAction::ToggleSlices: toggle_slices(); break;
+    case KeyAction::Quit: glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
   }
 }
 

@@ -74,8 +74,8 @@ ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity) : lin
   glGetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
   std::uint64_t bytes = std::min<std::uint64_t>(static_cast<std::uint32_t>(max_block), 256ull << 20);
   capacity_ = node_capacity ? node_capacity : bytes / 16;
-  const unsigned chunks = std::max<unsigned>(1, static_cast<unsigned>(lines.scene().layout().chunks().size()));
-  list_program_ = gl::make_program(shaders::line_vertex(chunks, "#version 430 core"),
+  const unsigned spans = std::max<unsigned>(1, static_cast<unsigned>(lines.layout().texture_spans().size()));
+  list_program_ = gl::make_program(shaders::line_vertex(spans, "#version 430 core"),
                                    shaders::line_fragment(kListFragment, "#version 430 core"));
   clear_program_ = gl::make_compute_program(kClearCompute);
   blit_program_ = gl::make_program(shaders::kFullscreenVertex, kBlitFragment);
@@ -113,7 +113,7 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
   }
   const double aspect = double(width) / std::max(1, height);
   FramePlan plan;
-  lines_.plan(camera, aspect, PlanOrder::Visibility, plan, s.clipping);
+  lines_.plan_and_count(camera, aspect, PlanOrder::Visibility, plan, s.clipping);
   start_image(s.background());
 
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
@@ -131,7 +131,7 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
   // next run's along every ray, so compositing run after run is exact. A run that overflows is
   // shortened and redone; one that cannot be (a single voxel, or several grids whose voxels overlap)
   // is split into bands of rows instead.
-  const bool depth_passes = lines_.scene().layout().one_grid();
+  const bool depth_passes = lines_.layout().one_grid();
   std::vector<std::uint64_t> segments_before(plan.count.size() + 1, 0);
   for (std::size_t v = 0; v < plan.count.size(); ++v) segments_before[v + 1] = segments_before[v] + plan.count[v] / 2;
   double per_segment = 0;  // fragments per segment, 0 until measured

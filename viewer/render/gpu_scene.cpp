@@ -14,9 +14,9 @@ std::uint64_t GpuScene::driver_limit() {
   return texels > 0 ? static_cast<std::uint64_t>(texels) : 65536;  // 65536 is the GL 3.3 minimum
 }
 
-// Widens voxel i's stored orders to chunk-global u32 and appends its block order; checks every entry,
+// Widens voxel i's stored orders to span-global u32 and appends its block order; checks every entry,
 // which open() does not (it would cost O(points) there).
-void GpuScene::widen_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t li, const ChunkLayout& c,
+void GpuScene::widen_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t li, const TextureSpan& c,
                            std::vector<std::uint32_t>& entries, std::vector<std::uint8_t>& is_start) const {
   const VoxelEntry& v = file.voxels()[li];
   const VoxelDrawInfo& d = layout_.voxels()[i];
@@ -47,10 +47,10 @@ void GpuScene::widen_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t l
 GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels)
     : files_(std::move(files)), layout_(files_, max_texels ? max_texels : driver_limit()) {
   std::vector<std::uint32_t> entries;
-  for (const ChunkLayout& c : layout_.chunks()) {
+  for (const TextureSpan& c : layout_.texture_spans()) {
     const VxlFile& file = *files_[c.file];
     const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
-    GpuChunk g;
+    GpuTextureSpan g;
     g.positions.create(GL_R32F, file.vertices().data() + 3 * c.vertex_first, 12 * c.vertex_count);
     entries.resize(std::uint64_t(c.slots) * c.segments);
     // Voxels fill disjoint ranges of every slot, so they are widened in parallel.
@@ -69,7 +69,7 @@ GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels)
     g.dataset.create(GL_R32UI, nullptr, 0);
     g.attributes.create(GL_RG32F, nullptr, 0);
     gpu_bytes_ += 12 * c.vertex_count + entries.size() * 4;
-    chunks_.push_back(g);
+    spans_.push_back(g);
   }
   entries.clear();
   entries.shrink_to_fit();
@@ -78,19 +78,19 @@ GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels)
 GpuScene::~GpuScene() { release(); }
 
 void GpuScene::release() {
-  for (GpuChunk& c : chunks_) {
+  for (GpuTextureSpan& c : spans_) {
     c.positions.destroy();
     c.orders.destroy();
     c.dataset.destroy();
     c.attributes.destroy();
   }
-  chunks_.clear();
+  spans_.clear();
 }
 
 void GpuScene::upload_attributes(const std::vector<std::vector<float>>& per_file) {
-  for (std::size_t i = 0; i < chunks_.size(); ++i) {
-    const ChunkLayout& c = layout_.chunks()[i];
-    GpuChunk& g = chunks_[i];
+  for (std::size_t i = 0; i < spans_.size(); ++i) {
+    const TextureSpan& c = layout_.texture_spans()[i];
+    GpuTextureSpan& g = spans_[i];
     g.attributes.destroy();
     const std::vector<float>* values = c.file < per_file.size() ? &per_file[c.file] : nullptr;
     if (values == nullptr || values->empty())
@@ -103,22 +103,22 @@ void GpuScene::upload_attributes(const std::vector<std::vector<float>>& per_file
 const std::vector<std::int32_t>& GpuScene::dataset_first() {
   if (!dataset_built_) {
     // Walk the streamlines, file after file: every voxline contributes its segments, in order, to its
-    // chunk's dataset array; consecutive segments in one chunk form one draw range.
-    std::vector<std::vector<std::uint32_t>> per_chunk(layout_.chunks().size());
-    std::int64_t run_chunk = -1;
+    // span's dataset array; consecutive segments in one span form one draw range.
+    std::vector<std::vector<std::uint32_t>> per_span(layout_.texture_spans().size());
+    std::int64_t run_span = -1;
     for (std::uint32_t fi = 0; fi < files_.size(); ++fi) {
       const std::uint32_t file_first = layout_.files()[fi].voxel_first;
       WalkCallbacks cb;
       cb.voxline = [&](std::uint32_t voxel, std::uint64_t first_vertex, std::uint32_t own, bool connected) {
-        const std::uint32_t c = layout_.voxels()[file_first + voxel].chunk;
-        const ChunkLayout& cl = layout_.chunks()[c];
+        const std::uint32_t c = layout_.voxels()[file_first + voxel].span;
+        const TextureSpan& cl = layout_.texture_spans()[c];
         const std::uint64_t segments = own + (connected ? 1 : 0) - 1;
         if (segments == 0) return;
-        auto& arr = per_chunk[c];
-        if (run_chunk != c) {
+        auto& arr = per_span[c];
+        if (run_span != c) {
           dataset_first_.push_back(static_cast<std::int32_t>(layout_.dataset_id(c, arr.size())));
           dataset_count_.push_back(0);
-          run_chunk = c;
+          run_span = c;
         }
         for (std::uint64_t s = 0; s < segments; ++s)
           arr.push_back(static_cast<std::uint32_t>(first_vertex - cl.vertex_first + s));
@@ -126,10 +126,10 @@ const std::vector<std::int32_t>& GpuScene::dataset_first() {
       };
       walk_streamlines(*files_[fi], cb);
     }
-    for (std::size_t c = 0; c < chunks_.size(); ++c) {
-      chunks_[c].dataset.destroy();
-      chunks_[c].dataset.create(GL_R32UI, per_chunk[c].data(), per_chunk[c].size() * 4);
-      gpu_bytes_ += per_chunk[c].size() * 4;
+    for (std::size_t c = 0; c < spans_.size(); ++c) {
+      spans_[c].dataset.destroy();
+      spans_[c].dataset.create(GL_R32UI, per_span[c].data(), per_span[c].size() * 4);
+      gpu_bytes_ += per_span[c].size() * 4;
     }
     dataset_built_ = true;
   }

@@ -1,5 +1,5 @@
-// The GPU copy of a scene of one or more .vxl files: per chunk (see scene_layout.h) a positions buffer (one
-// large copy straight from the memory-mapped file), an orders buffer (stored orders widened to chunk-global u32
+// The GPU copy of a scene of one or more .vxl files: per texture span (see scene_layout.h) a positions buffer (one
+// large copy straight from the memory-mapped file), an orders buffer (stored orders widened to span-global u32
 // indices, each entry checked, plus the block order), and — only when first needed — a dataset-order buffer.
 #pragma once
 
@@ -12,7 +12,7 @@
 
 namespace vxl {
 
-struct GpuChunk {
+struct GpuTextureSpan {
   gl::TextureBuffer positions;   // GL_R32F, 3 texels per vertex
   gl::TextureBuffer orders;      // GL_R32UI, slots x S
   gl::TextureBuffer dataset;     // GL_R32UI, S (empty until needed)
@@ -31,10 +31,10 @@ class GpuScene {
   GpuScene& operator=(const GpuScene&) = delete;
 
   const SceneLayout& layout() const { return layout_; }
-  const std::vector<GpuChunk>& chunks() const { return chunks_; }
+  const std::vector<GpuTextureSpan>& texture_spans() const { return spans_; }
   std::uint64_t gpu_bytes() const { return gpu_bytes_; }
 
-  // Replaces every chunk's attribute buffer with its vertices' share of its file's `per_file` entry (2 floats
+  // Replaces every span's attribute buffer with its vertices' share of its file's `per_file` entry (2 floats
   // per vertex of that file, vertex_attributes.h); an empty vector empties them.
   void upload_attributes(const std::vector<std::vector<float>>& per_file);
 
@@ -46,11 +46,11 @@ class GpuScene {
   static std::uint64_t driver_limit();
   void release();
   // Voxel `voxel` of the scene (`local` in its file).
-  void widen_voxel(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, const ChunkLayout& chunk,
+  void widen_voxel(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, const TextureSpan& span,
                    std::vector<std::uint32_t>& entries, std::vector<std::uint8_t>& is_start) const;
   std::vector<const VxlFile*> files_;
   SceneLayout layout_;
-  std::vector<GpuChunk> chunks_;
+  std::vector<GpuTextureSpan> spans_;
   std::uint64_t gpu_bytes_ = 0;
   bool dataset_built_ = false;
   std::vector<std::int32_t> dataset_first_, dataset_count_;

@@ -87,9 +87,9 @@ GridOverlay::~GridOverlay() {
   if (program_) glDeleteProgram(program_);
 }
 
-void GridOverlay::draw(Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour,
-                       const Clipping& clipping) {
-  const SceneLayout& layout = renderer.scene().layout();
+void GridOverlay::draw(const Renderer& renderer, const Camera& camera, double aspect, Scope scope,
+                       const glm::vec4& colour, const Clipping& clipping) {
+  const SceneLayout& layout = renderer.layout();
   const auto& files = layout.files();
   // Per file: the first instance and the count in the instance buffer (each file has its own grid).
   std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges;

@@ -32,7 +32,7 @@ class GridOverlay {
 
   // Draws into the bound framebuffer with the current viewport; blends `colour` over the picture.
   // Scope::Drawn outlines the voxels the frame draws with `clipping` (the slab and clip planes cull too).
-  void draw(Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour,
+  void draw(const Renderer& renderer, const Camera& camera, double aspect, Scope scope, const glm::vec4& colour,
             const Clipping& clipping = {});
 
   std::uint64_t cubes_drawn() const { return cubes_drawn_; }

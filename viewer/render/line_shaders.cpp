@@ -5,36 +5,36 @@
 
 namespace vxl::shaders {
 
-std::string line_vertex(unsigned chunk_count, const char* version) {
-  std::string n = std::to_string(chunk_count);
-  std::string s = std::string(version) + "\n#define CHUNKS " + n + "\n#define CLIPS " +
+std::string line_vertex(unsigned span_count, const char* version) {
+  std::string n = std::to_string(span_count);
+  std::string s = std::string(version) + "\n#define SPANS " + n + "\n#define CLIPS " +
                   std::to_string(kMaxClipDistances) + "\n#define GROUPS " + std::to_string(kShaderGroups) +
                   "\n#define SAMPLES " + std::to_string(kColormapSamples) + "\n";
-  for (unsigned c = 0; c < chunk_count; ++c) {
+  for (unsigned c = 0; c < span_count; ++c) {
     std::string i = std::to_string(c);
     s += "uniform samplerBuffer u_pos" + i + ";\nuniform usamplerBuffer u_ord" + i + ";\nuniform usamplerBuffer u_dat" +
          i + ";\nuniform samplerBuffer u_att" + i + ";\n";
   }
   s += "vec3 fetch_pos(int c, int v) {\n";
-  for (unsigned c = 0; c < chunk_count; ++c) {
+  for (unsigned c = 0; c < span_count; ++c) {
     std::string i = std::to_string(c);
     s += "  if (c == " + i + ") return vec3(texelFetch(u_pos" + i + ", 3 * v).r, texelFetch(u_pos" + i +
          ", 3 * v + 1).r, texelFetch(u_pos" + i + ", 3 * v + 2).r);\n";
   }
   s += "  return vec3(0.0);\n}\nint fetch_order(int c, int j) {\n";
-  for (unsigned c = 0; c < chunk_count; ++c)
+  for (unsigned c = 0; c < span_count; ++c)
     s += "  if (c == " + std::to_string(c) + ") return int(texelFetch(u_ord" + std::to_string(c) + ", j).r);\n";
   s += "  return 0;\n}\nint fetch_dataset(int c, int j) {\n";
-  for (unsigned c = 0; c < chunk_count; ++c)
+  for (unsigned c = 0; c < span_count; ++c)
     s += "  if (c == " + std::to_string(c) + ") return int(texelFetch(u_dat" + std::to_string(c) + ", j).r);\n";
   s += "  return 0;\n}\nvec2 fetch_attributes(int c, int v) {\n";
-  for (unsigned c = 0; c < chunk_count; ++c)
+  for (unsigned c = 0; c < span_count; ++c)
     s += "  if (c == " + std::to_string(c) + ") return texelFetch(u_att" + std::to_string(c) + ", v).rg;\n";
   s += "  return vec2(0.0);\n}\n";
   s += R"(
-uniform int u_chunk_base[CHUNKS];
-uniform int u_chunk_segments[CHUNKS];
-uniform int u_chunk_slots[CHUNKS];  // its file's stored orders + 1
+uniform int u_span_base[SPANS];
+uniform int u_span_segments[SPANS];
+uniform int u_span_slots[SPANS];  // its file's stored orders + 1
 uniform vec3 u_eye_hi;      // eye position split in two floats on the CPU (in double):
 uniform vec3 u_eye_lo;      // p - eye = (p - hi) - lo keeps the source precision far from the origin
 uniform mat3 u_rotation;    // world -> eye
@@ -61,13 +61,13 @@ out float v_depth;          // distance along the view axis, mm
 void main() {
   int id = gl_VertexID;
   int c = 0;
-  for (int k = 1; k < CHUNKS; ++k)
-    if (id >= u_chunk_base[k]) c = k;
-  int local = id - u_chunk_base[c];
+  for (int k = 1; k < SPANS; ++k)
+    if (id >= u_span_base[k]) c = k;
+  int local = id - u_span_base[c];
   int seg = local >> 1;
   int end = local & 1;
-  int S = u_chunk_segments[c];
-  int A = u_chunk_slots[c] * S;
+  int S = u_span_segments[c];
+  int A = u_span_slots[c] * S;
   int v;
   if (seg < A) {
     v = fetch_order(c, seg);

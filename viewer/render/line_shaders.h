@@ -1,5 +1,5 @@
-// GLSL sources of the line renderer. The vertex shader is generated for the scene's chunk count (samplers
-// cannot be indexed dynamically in GLSL 3.30, so each chunk gets its own samplers and an if-chain).
+// GLSL sources of the line renderer. The vertex shader is generated for the scene's texture-span count (samplers
+// cannot be indexed dynamically in GLSL 3.30, so each span gets its own samplers and an if-chain).
 #pragma once
 
 #include <string>
@@ -10,7 +10,7 @@ namespace vxl::shaders {
 inline constexpr int kShaderGroups = 64;
 
 // Vertex shader: virtual vertex id -> segment end (scene_layout.h), camera-relative position, colour.
-std::string line_vertex(unsigned chunk_count, const char* version = "#version 330 core");
+std::string line_vertex(unsigned span_count, const char* version = "#version 330 core");
 
 // A fragment shader for the line pass: `body` (with its main) after the line inputs and line_color(),
 // which gives the fragment's colour and alpha (colour map per fragment, lighting), and

@@ -10,14 +10,16 @@
 namespace vxl {
 
 namespace {
-struct ModeName {
-  RenderMode mode;
-  const char* name;
+constexpr RenderModeInfo kModes[] = {
+    {RenderMode::Opaque, "opaque", "depth-tested, no blending"},
+    {RenderMode::Unsorted, "unsorted", "blended in dataset (streamline) order, like TrackVis"},
+    {RenderMode::Additive, "additive",
+     "MRtrix-like: a depth-tested opaque pass and an additive pass, mixed by the opacity"},
+    {RenderMode::Wboit, "wboit", "weighted blended order-independent transparency (McGuire & Bavoil 2013)"},
+    {RenderMode::Basic, "basic", "voxels sorted back to front, segments in dataset order inside each voxel"},
+    {RenderMode::Axis, "axis", "voxels sorted back to front, each drawn in its nearest precomputed order (Voxlines)"},
+    {RenderMode::Exact, "exact", "per-fragment sorted reference (needs OpenGL 4.3)"},
 };
-constexpr ModeName kModes[] = {{RenderMode::Opaque, "opaque"},     {RenderMode::Unsorted, "unsorted"},
-                               {RenderMode::Additive, "additive"}, {RenderMode::Wboit, "wboit"},
-                               {RenderMode::Basic, "basic"},       {RenderMode::Axis, "axis"},
-                               {RenderMode::Exact, "exact"}};
 struct ColorName {
   ColorMode mode;
   const char* name;
@@ -102,14 +104,22 @@ GroupStyle& RenderSettings::style_of(const std::string& name) {
   return group_styles.back();
 }
 
+std::span<const RenderModeInfo> render_modes() { return kModes; }
+
+std::vector<std::string> render_mode_names() {
+  std::vector<std::string> names;
+  for (const RenderModeInfo& m : kModes) names.emplace_back(m.name);
+  return names;
+}
+
 std::optional<RenderMode> parse_render_mode(const std::string& name) {
-  for (const ModeName& m : kModes)
+  for (const RenderModeInfo& m : kModes)
     if (name == m.name) return m.mode;
   return std::nullopt;
 }
 
 const char* render_mode_name(RenderMode mode) {
-  for (const ModeName& m : kModes)
+  for (const RenderModeInfo& m : kModes)
     if (m.mode == mode) return m.name;
   return "?";
 }

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -14,16 +15,19 @@
 
 namespace vxl {
 
-// Transparency modes (docs/rendering.md). All draw the same data from the same camera.
-enum class RenderMode {
-  Opaque,    // depth-tested, no blending
-  Unsorted,  // blended in dataset (streamline) order, like TrackVis
-  Additive,  // MRtrix-like: a depth-tested opaque pass and an additive pass, mixed by the opacity
-  Wboit,     // weighted blended order-independent transparency (McGuire & Bavoil 2013)
-  Basic,     // voxels sorted back to front, segments in dataset order inside each voxel
-  Axis,      // voxels sorted back to front + the nearest precomputed order per voxel (the product)
-  Exact,     // per-fragment sorted reference (needs OpenGL >= 4.3)
+// Transparency modes (docs/rendering.md). All draw the same data from the same camera; render_modes()
+// names and describes them.
+enum class RenderMode { Opaque, Unsorted, Additive, Wboit, Basic, Axis, Exact };
+
+// The one list of the modes, in the order the panel shows them and M cycles through them: --mode, saved
+// views, the panel and the help all read it.
+struct RenderModeInfo {
+  RenderMode mode;
+  const char* name;         // as --mode and saved views spell it
+  const char* description;  // one line
 };
+std::span<const RenderModeInfo> render_modes();
+std::vector<std::string> render_mode_names();
 
 std::optional<RenderMode> parse_render_mode(const std::string& name);
 const char* render_mode_name(RenderMode mode);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <stdexcept>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -20,7 +19,7 @@ Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels)
     : Renderer(std::vector<const VxlFile*>{&file}, max_texels) {}
 
 Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels)
-    : files_(files.empty() ? throw std::invalid_argument("Renderer: no files") : files),
+    : files_(files.empty() ? throw Error(ErrorKind::Usage, "", std::nullopt, "Renderer: no files") : files),
       scene_(files_, max_texels),
       groups_(files_) {
   const VxlFile& file = *files_.front();
@@ -29,15 +28,15 @@ Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels)
       for (std::uint32_t k = 0; k < sets->size(); ++k)
         if (std::find(value_set_names_.begin(), value_set_names_.end(), sets->name(k)) == value_set_names_.end())
           value_set_names_.push_back(sets->name(k));
-  const unsigned chunks = std::max<unsigned>(1, static_cast<unsigned>(scene_.layout().chunks().size()));
+  const unsigned spans = std::max<unsigned>(1, static_cast<unsigned>(scene_.layout().texture_spans().size()));
   GLint units = 0;
   glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
-  if (static_cast<GLint>(kSamplersPerChunk * chunks) > units)
+  if (static_cast<GLint>(kSamplersPerSpan * spans) > units)
     throw Error(ErrorKind::Unsupported, file.path(), std::nullopt,
-                "the scene needs " + std::to_string(kSamplersPerChunk * chunks) + " vertex-shader textures (" +
-                    std::to_string(chunks) + " GPU chunks) but this GPU offers " + std::to_string(units));
+                "the scene needs " + std::to_string(kSamplersPerSpan * spans) + " vertex-shader textures (" +
+                    std::to_string(spans) + " GPU texture spans) but this GPU offers " + std::to_string(units));
   glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even without attributes
-  const std::string vs = shaders::line_vertex(chunks);
+  const std::string vs = shaders::line_vertex(spans);
   over_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineOverFragment));
   accum_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitAccumFragment));
   reveal_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitRevealFragment));
@@ -108,39 +107,49 @@ glm::dmat4 Renderer::projection(const Camera& camera, double aspect) const {
   return glm::dmat4(Camera(camera).projection(aspect, near_mm, std::max(far_mm, near_mm + 1.0)));
 }
 
-void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping) {
-  auto t0 = std::chrono::steady_clock::now();
+void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out,
+                    const Clipping& clipping) const {
   ViewParams view = make_view_params(camera.eye(), camera.forward(), camera.orthographic, projection(camera, aspect),
                                      glm::dmat3(camera.view_rotation()));
   for (const glm::dvec4& h : clip_half_spaces(clipping, camera)) view.clip.push_back(relative_to(h, view.eye));
   plan_frame(scene_.layout(), view, order, out);
+}
+
+void Renderer::plan_and_count(const Camera& camera, double aspect, PlanOrder order, FramePlan& out,
+                              const Clipping& clipping) {
+  auto t0 = std::chrono::steady_clock::now();
+  plan(camera, aspect, order, out, clipping);
   stats_.plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.voxels_drawn = out.voxels_drawn;
   stats_.segments_drawn = out.segments_drawn;
 }
 
+void Renderer::prepare(RenderMode mode) {
+  if (mode == RenderMode::Unsorted) scene_.dataset_first();
+}
+
 void Renderer::bind_line_program(GLuint program, const Camera& camera, const RenderSettings& s, double aspect) const {
   glUseProgram(program);
   const SceneLayout& layout = scene_.layout();
-  const auto& chunks = layout.chunks();
+  const auto& spans = layout.texture_spans();
   std::vector<GLint> base, segments, slots;
-  for (const ChunkLayout& c : chunks) {
+  for (const TextureSpan& c : spans) {
     base.push_back(static_cast<GLint>(c.virtual_base));
     segments.push_back(static_cast<GLint>(std::max<std::uint64_t>(1, c.segments)));
     slots.push_back(static_cast<GLint>(c.slots));
   }
   if (base.empty()) base = {0}, segments = {1}, slots = {1};
-  glUniform1iv(glGetUniformLocation(program, "u_chunk_base"), static_cast<GLsizei>(base.size()), base.data());
-  glUniform1iv(glGetUniformLocation(program, "u_chunk_segments"), static_cast<GLsizei>(segments.size()),
+  glUniform1iv(glGetUniformLocation(program, "u_span_base"), static_cast<GLsizei>(base.size()), base.data());
+  glUniform1iv(glGetUniformLocation(program, "u_span_segments"), static_cast<GLsizei>(segments.size()),
                segments.data());
-  glUniform1iv(glGetUniformLocation(program, "u_chunk_slots"), static_cast<GLsizei>(slots.size()), slots.data());
-  for (std::size_t c = 0; c < scene_.chunks().size(); ++c) {
-    const GpuChunk& g = scene_.chunks()[c];
-    const GLuint textures[kSamplersPerChunk] = {g.positions.texture, g.orders.texture, g.dataset.texture,
-                                                g.attributes.texture};
-    const char* names[kSamplersPerChunk] = {"u_pos", "u_ord", "u_dat", "u_att"};
-    for (int t = 0; t < kSamplersPerChunk; ++t) {
-      GLint unit = static_cast<GLint>(kSamplersPerChunk * c + t);
+  glUniform1iv(glGetUniformLocation(program, "u_span_slots"), static_cast<GLsizei>(slots.size()), slots.data());
+  for (std::size_t c = 0; c < scene_.texture_spans().size(); ++c) {
+    const GpuTextureSpan& g = scene_.texture_spans()[c];
+    const GLuint textures[kSamplersPerSpan] = {g.positions.texture, g.orders.texture, g.dataset.texture,
+                                               g.attributes.texture};
+    const char* names[kSamplersPerSpan] = {"u_pos", "u_ord", "u_dat", "u_att"};
+    for (int t = 0; t < kSamplersPerSpan; ++t) {
+      GLint unit = static_cast<GLint>(kSamplersPerSpan * c + t);
       glActiveTexture(GL_TEXTURE0 + unit);
       glBindTexture(GL_TEXTURE_BUFFER, textures[t]);
       glUniform1i(glGetUniformLocation(program, (names[t] + std::to_string(c)).c_str()), unit);
@@ -180,9 +189,9 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   if (clips > 0) glUniform4fv(glGetUniformLocation(program, "u_clip"), clips, glm::value_ptr(clip[0]));
   glUniform1i(glGetUniformLocation(program, "u_clip_count"), clips);
   enable_clip_distances(clips);
-  // The slices' depth on the first unit after the chunks' (a unit of its own: two sampler types must not
+  // The slices' depth on the first unit after the spans' (a unit of its own: two sampler types must not
   // share one), bound even when unused.
-  const GLint unit = static_cast<GLint>(kSamplersPerChunk * std::max<std::size_t>(1, scene_.chunks().size()));
+  const GLint unit = static_cast<GLint>(kSamplersPerSpan * std::max<std::size_t>(1, scene_.texture_spans().size()));
   glActiveTexture(GL_TEXTURE0 + unit);
   glBindTexture(GL_TEXTURE_2D, slices_drawn_ ? slices_->depth_texture() : 0);
   glUniform1i(glGetUniformLocation(program, "u_slice_depth"), unit);
@@ -257,7 +266,7 @@ void Renderer::draw_plan(const std::vector<std::int32_t>& first, const std::vect
 
 void Renderer::draw_lines(GLuint program, const Camera& camera, const RenderSettings& s, double aspect,
                           PlanOrder order) {
-  plan(camera, aspect, order, plan_, s.clipping);
+  plan_and_count(camera, aspect, order, plan_, s.clipping);
   bind_line_program(program, camera, s, aspect);
   draw_plan(plan_.first, plan_.count);
 }

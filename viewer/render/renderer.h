@@ -36,7 +36,7 @@ struct FrameStats {
 
 class Renderer {
  public:
-  static constexpr int kSamplersPerChunk = 4;  // positions, orders, dataset order, attributes
+  static constexpr int kSamplersPerSpan = 4;  // positions, orders, dataset order, attributes
   explicit Renderer(const VxlFile& file, std::uint64_t max_texels = 0);
   // Several files drawn as one scene: one sort over all their voxels, one group per file. The files must
   // outlive the renderer.
@@ -66,7 +66,13 @@ class Renderer {
   // and the range it maps (settings.range, else the set's stored min and max).
   std::string scalar_name(const RenderSettings& settings) const;
   std::array<float, 2> scalar_range(const RenderSettings& settings) const;
-  GpuScene& scene() { return scene_; }
+  // What the scene's voxels are and where they lie on the GPU (read-only: the grid overlay and the framing use
+  // it), and the GPU memory the scene takes.
+  const SceneLayout& layout() const { return scene_.layout(); }
+  std::uint64_t gpu_bytes() const { return scene_.gpu_bytes(); }
+  // Uploads what `mode` builds on its first frame (the unsorted mode's dataset order), so that a timed frame
+  // does not include it.
+  void prepare(RenderMode mode);
   const VxlFile& file() const { return *files_.front(); }  // the first
   const std::vector<const VxlFile*>& files() const { return files_; }
   glm::dvec3 bounds_min() const;
@@ -79,16 +85,22 @@ class Renderer {
   // The projection the renderer uses for `camera` (near/far planes fitted to the scene bounds).
   glm::dmat4 projection(const Camera& camera, double aspect) const;
 
-  // Binds the line program's uniforms and textures for `camera`; used by the exact renderer too.
+  // The frame plan for `camera`: voxels outside the frustum or the slab / clip planes of `clipping` culled.
+  // A query: stats() keeps describing the last frame drawn.
+  void plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping = {}) const;
+
+ private:
+  // The exact mode is a part of the renderer kept in its own file: it draws with the line program.
+  friend class ExactRenderer;
+
+  // plan(), recording the frame's CPU time and counts in stats().
+  void plan_and_count(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping);
+  // Binds the line program's uniforms and textures for `camera`.
   void bind_line_program(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect) const;
   void draw_plan(const std::vector<std::int32_t>& first, const std::vector<std::int32_t>& count) const;
-  // The frame plan for `camera`: voxels outside the frustum or the slab / clip planes of `clipping` culled.
-  void plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping = {});
   // Enables the first n of the line shader's clip distances and disables the others (passes without
   // gl_ClipDistance must run with none enabled).
   static void enable_clip_distances(int n);
-
- private:
   // Uploads the per-vertex (value, group) attributes that `settings` needs, when they changed.
   void prepare_attributes(const RenderSettings& settings);
   void draw_lines(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect, PlanOrder order);

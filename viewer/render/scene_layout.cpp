@@ -52,7 +52,7 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
       return 3 * vertices <= max_texels && slots * segments <= max_texels;
     };
     auto voxels = file.voxels();
-    ChunkLayout current;
+    TextureSpan current;
     current.file = fi;
     current.slots = slots;
     for (std::uint32_t li = 0; li < voxels.size(); ++li) {
@@ -63,8 +63,8 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
                     "a voxel is larger than this GPU's texture-buffer limit (" + std::to_string(max_texels) +
                         " texels); convert with a smaller --voxel-size");
       if (current.voxel_count > 0 && !fits(current.vertex_count + e.vertex_count, current.segments + e.segment_count)) {
-        chunks_.push_back(current);
-        current = ChunkLayout{};
+        spans_.push_back(current);
+        current = TextureSpan{};
         current.file = fi;
         current.slots = slots;
       }
@@ -78,22 +78,22 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
         v.tight_min[c] = e.tight_min[c];
         v.tight_max[c] = e.tight_max[c];
       }
-      v.chunk = static_cast<std::uint32_t>(chunks_.size());
+      v.span = static_cast<std::uint32_t>(spans_.size());
       v.segment_count = e.segment_count;
       v.seg_first = current.segments;
       current.voxel_count++;
       current.vertex_count += e.vertex_count;
       current.segments += e.segment_count;
     }
-    if (current.voxel_count > 0) chunks_.push_back(current);
+    if (current.voxel_count > 0) spans_.push_back(current);
     files_.push_back(std::move(fl));
   }
-  if (chunks_.size() > kMaxChunks)
+  if (spans_.size() > kMaxTextureSpans)
     throw Error(ErrorKind::Unsupported, where, std::nullopt,
-                "the scene needs " + std::to_string(chunks_.size()) + " GPU chunks (at most " +
-                    std::to_string(kMaxChunks) + " with a texture-buffer limit of " + std::to_string(max_texels) +
+                "the scene needs " + std::to_string(spans_.size()) + " GPU texture spans (at most " +
+                    std::to_string(kMaxTextureSpans) + " with a texture-buffer limit of " + std::to_string(max_texels) +
                     " texels" + (files.size() > 1 ? "; each file takes at least one" : "") + ")");
-  for (ChunkLayout& c : chunks_) {
+  for (TextureSpan& c : spans_) {
     c.virtual_base = virtual_ids_;
     virtual_ids_ += 2 * (2 * std::uint64_t(c.slots) * c.segments + c.segments);
   }

@@ -2,16 +2,16 @@
 // here, so the per-frame planning can be tested and benchmarked without a context).
 //
 // The voxels of all files form one table (file 0's, then file 1's, ...), so that one frame plan sorts them
-// all together, back to front, interleaved across files. Voxels are grouped into chunks (contiguous voxel
-// ranges of one file) small enough for the driver's texture-buffer limit. Each chunk holds, in texture
+// all together, back to front, interleaved across files. Voxels are grouped into texture spans (contiguous voxel
+// ranges of one file) small enough for the driver's texture-buffer limit. Each span holds, in texture
 // buffers:
 //   positions: 3 floats per vertex;
-//   orders:    (K + 1) "slots" of S entries each (S = the chunk's segments; K its file's stored orders): the K
+//   orders:    (K + 1) "slots" of S entries each (S = the span's segments; K its file's stored orders): the K
 //              stored orders widened to
-//              chunk-global vertex indices, then the block (dataset) order inside each voxel. A voxel owns the
+//              span-global vertex indices, then the block (dataset) order inside each voxel. A voxel owns the
 //              same range [seg_first, seg_first + n) in every slot;
 //   dataset:   S entries in streamline order (built only when the `unsorted` mode is first used).
-// The vertex shader maps gl_VertexID ("virtual vertex id") to a segment end: per chunk, ids
+// The vertex shader maps gl_VertexID ("virtual vertex id") to a segment end: per span, ids
 //   [0, 2A)        forward slot entries (A = (K + 1) S),
 //   [2A, 4A)       the same slots read backwards (entry j of a slot appears at S - 1 - j), so a voxel's
 //                  reversed order is again one contiguous range,
@@ -33,12 +33,14 @@ namespace vxl {
 struct VoxelDrawInfo {
   glm::dvec3 center;  // cube centre, mm
   glm::vec3 tight_min, tight_max;
-  std::uint32_t chunk;
+  std::uint32_t span;  // its texture span
   std::uint32_t segment_count;
-  std::uint64_t seg_first;  // within its chunk's slots
+  std::uint64_t seg_first;  // within its span's slots
 };
 
-struct ChunkLayout {
+// One set of texture buffers: a contiguous voxel range of one file. Named "span", not "chunk", because the
+// .vxlz package's position chunks are another thing.
+struct TextureSpan {
   std::uint32_t file = 0;                            // the file its voxels come from
   std::uint32_t slots = 1;                           // its file's K + 1
   std::uint32_t voxel_first = 0, voxel_count = 0;    // scene voxel range
@@ -57,12 +59,12 @@ struct FileLayout {
 
 class SceneLayout {
  public:
-  // max_texels: the driver's GL_MAX_TEXTURE_BUFFER_SIZE (tests pass small values to force many chunks).
-  // Throws vxl::Error (Unsupported) when the scene needs more than kMaxChunks chunks or 2^31 virtual ids.
+  // max_texels: the driver's GL_MAX_TEXTURE_BUFFER_SIZE (tests pass small values to force many spans).
+  // Throws vxl::Error (Unsupported) when the scene needs more than kMaxTextureSpans texture spans or 2^31 virtual ids.
   SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels);
   SceneLayout(const VxlFile& file, std::uint64_t max_texels);
 
-  static constexpr std::uint32_t kMaxChunks = 8;  // each chunk needs 4 samplers in the vertex shader
+  static constexpr std::uint32_t kMaxTextureSpans = 8;  // each span needs 4 samplers in the vertex shader
 
   // Of the first file (all of a single-file scene): K, K + 1 slots, the block order's slot, DIRS.
   std::uint32_t stored_orders() const { return files_[0].stored_orders; }
@@ -70,20 +72,20 @@ class SceneLayout {
   std::uint32_t block_slot() const { return stored_orders(); }
   const std::vector<glm::vec3>& directions() const { return files_[0].directions; }
   // The slot of a voxel's block (dataset) order: its file's K.
-  std::uint32_t block_slot(const VoxelDrawInfo& v) const { return chunks_[v.chunk].slots - 1; }
+  std::uint32_t block_slot(const VoxelDrawInfo& v) const { return spans_[v.span].slots - 1; }
   // The K directions voxel `voxel`'s stored orders are sorted by: its own (VDIR, random order sets) or
   // its file's DIRS.
   std::span<const glm::vec3> directions_of(std::uint32_t voxel) const {
-    const FileLayout& f = files_[chunks_[voxels_[voxel].chunk].file];
+    const FileLayout& f = files_[spans_[voxels_[voxel].span].file];
     if (f.voxel_directions.empty()) return f.directions;
     return std::span<const glm::vec3>(f.voxel_directions)
         .subspan(std::size_t(voxel - f.voxel_first) * f.stored_orders, f.stored_orders);
   }
   const std::vector<VoxelDrawInfo>& voxels() const { return voxels_; }
-  const std::vector<ChunkLayout>& chunks() const { return chunks_; }
+  const std::vector<TextureSpan>& texture_spans() const { return spans_; }
   const std::vector<FileLayout>& files() const { return files_; }
   // The file a scene voxel belongs to, and its index in that file's voxel table.
-  std::uint32_t file_of(std::uint32_t voxel) const { return chunks_[voxels_[voxel].chunk].file; }
+  std::uint32_t file_of(std::uint32_t voxel) const { return spans_[voxels_[voxel].span].file; }
   std::uint32_t local_voxel(std::uint32_t voxel) const { return voxel - files_[file_of(voxel)].voxel_first; }
   std::uint64_t virtual_ids() const { return virtual_ids_; }
   double voxel_size() const { return voxel_size_; }  // the largest of the files'
@@ -93,21 +95,21 @@ class SceneLayout {
 
   // First virtual vertex id of voxel v's range in `slot`, forwards or reversed.
   std::int64_t first_id(const VoxelDrawInfo& v, std::uint32_t slot, bool reversed) const {
-    const ChunkLayout& c = chunks_[v.chunk];
+    const TextureSpan& c = spans_[v.span];
     const std::uint64_t s = c.segments, a = std::uint64_t(c.slots) * s;
     std::uint64_t seg = reversed ? a + slot * s + (s - v.seg_first - v.segment_count) : slot * s + v.seg_first;
     return static_cast<std::int64_t>(c.virtual_base + 2 * seg);
   }
-  // First virtual id of entry j of a chunk's dataset-order array.
-  std::int64_t dataset_id(std::uint32_t chunk, std::uint64_t j) const {
-    const ChunkLayout& c = chunks_[chunk];
+  // First virtual id of entry j of a span's dataset-order array.
+  std::int64_t dataset_id(std::uint32_t span, std::uint64_t j) const {
+    const TextureSpan& c = spans_[span];
     return static_cast<std::int64_t>(c.virtual_base + 2 * (2 * std::uint64_t(c.slots) * c.segments + j));
   }
 
  private:
   std::vector<FileLayout> files_;
   std::vector<VoxelDrawInfo> voxels_;
-  std::vector<ChunkLayout> chunks_;
+  std::vector<TextureSpan> spans_;
   std::uint64_t virtual_ids_ = 0;
   double voxel_size_ = 0;
   bool one_grid_ = true;

@@ -70,7 +70,8 @@ SliceRenderer::SliceRenderer(const Volume& v)
                                    std::to_string(dims_[2]) + " voxels; this GPU's 3D textures hold at most " +
                                    std::to_string(max_size) + " per axis");
   if (v.values.size() != static_cast<std::size_t>(dims_[0] * dims_[1] * dims_[2]))
-    throw std::invalid_argument("SliceRenderer: the volume's values do not match its dimensions");
+    throw Error(ErrorKind::Input, v.name, std::nullopt,
+                "SliceRenderer: the volume's values do not match its dimensions");
   glGenTextures(1, &texture_);
   glBindTexture(GL_TEXTURE_3D, texture_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);

@@ -1,0 +1,240 @@
+// voxview's command line: the parser's schema (voxview_cli.h) and how the options combine with a saved view
+// and are checked (viewer_arguments.h), without running the program.
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "format/error.h"
+#include "tests/test_support.h"
+#include "viewer/app/camera_file.h"
+#include "viewer/app/key_bindings.h"
+#include "viewer/app/viewer_arguments.h"
+#include "viewer/app/voxview_cli.h"
+
+namespace vxl {
+namespace {
+
+using app::resolve_viewer_options;
+using app::ViewerArguments;
+using test::ScratchDir;
+
+// The usage error resolve_viewer_options throws, or "no error".
+std::string usage_error_of(const ViewerArguments& a) {
+  try {
+    resolve_viewer_options(a);
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Usage) << e.what();
+    return e.reason();
+  }
+  return "no error";
+}
+
+// A saved view unlike the defaults in every setting the command line can give.
+app::SavedView saved_view() {
+  app::SavedView v;
+  v.camera.azimuth_deg = 12;
+  v.camera.elevation_deg = -7;
+  v.camera.distance = 321;
+  v.settings.mode = RenderMode::Exact;
+  v.settings.opacity = 0.7f;
+  v.settings.color = ColorMode::Fixed;
+  v.settings.colormap = Colormap::Hot;
+  v.settings.white_background = true;
+  v.settings.line_width = 3;
+  v.settings.clipping.planes = {*parse_axis_clip("y,5")};
+  v.size = std::array<int, 2>{640, 480};
+  return v;
+}
+
+TEST(ViewerArguments, WithoutASavedViewTheCommandLineValuesApply) {
+  ViewerArguments a;
+  a.options.inputs = {"a.vxl"};
+  a.mode = "wboit";  // a value with no "given" mark still applies: there is nothing to override
+  a.opacity = 0.25f;
+  a.background = "white";
+  const app::ViewerOptions o = resolve_viewer_options(a);
+  EXPECT_EQ(o.settings.mode, RenderMode::Wboit);
+  EXPECT_EQ(o.settings.opacity, 0.25f);
+  EXPECT_TRUE(o.settings.white_background);
+  EXPECT_EQ(o.settings.color, ColorMode::Direction);
+  EXPECT_EQ(o.settings.colormap, Colormap::Viridis);
+  EXPECT_EQ(o.width, 1024);
+  EXPECT_EQ(o.height, 1024);
+  EXPECT_FALSE(o.camera);
+  EXPECT_EQ(o.inputs, std::vector<std::string>{"a.vxl"});
+}
+
+TEST(ViewerArguments, ASavedViewOverridesTheDefaultsAndGivenOptionsOverrideIt) {
+  ScratchDir dir;
+  const std::string path = dir.file("view.json");
+  app::write_view(path, saved_view());
+
+  ViewerArguments a;
+  a.camera_file = path;
+  {
+    const app::ViewerOptions o = resolve_viewer_options(a);
+    ASSERT_TRUE(o.camera);
+    EXPECT_EQ(o.camera->azimuth_deg, 12);
+    EXPECT_EQ(o.camera->distance, 321);
+    EXPECT_EQ(o.settings.mode, RenderMode::Exact);
+    EXPECT_EQ(o.settings.opacity, 0.7f);
+    EXPECT_EQ(o.settings.color, ColorMode::Fixed);
+    EXPECT_EQ(o.settings.colormap, Colormap::Hot);
+    EXPECT_TRUE(o.settings.white_background);
+    EXPECT_EQ(o.settings.line_width, 3);
+    ASSERT_EQ(o.settings.clipping.planes.size(), 1u);
+    EXPECT_EQ(o.settings.clipping.planes[0].axis, 1);
+    EXPECT_EQ(o.width, 640);
+    EXPECT_EQ(o.height, 480);
+  }
+
+  a.mode = "basic";
+  a.opacity = 0.5f;
+  a.size = "100x50";
+  a.clips = {"-z,2"};
+  a.given = {"--mode", "--size", "--clip"};  // --opacity not given: the saved 0.7 stays
+  const app::ViewerOptions o = resolve_viewer_options(a);
+  EXPECT_EQ(o.settings.mode, RenderMode::Basic);
+  EXPECT_EQ(o.settings.opacity, 0.7f);
+  EXPECT_TRUE(o.settings.white_background);
+  EXPECT_EQ(o.width, 100);
+  EXPECT_EQ(o.height, 50);
+  ASSERT_EQ(o.settings.clipping.planes.size(), 1u);  // given planes replace the saved ones
+  EXPECT_EQ(o.settings.clipping.planes[0].axis, 2);
+  EXPECT_FALSE(o.settings.clipping.planes[0].keep_above);
+}
+
+TEST(ViewerArguments, ASavedViewWithoutAnOpacityKeepsTheCommandLines) {
+  ScratchDir dir;
+  const std::string path = dir.file("partial.json");
+  std::ofstream(path) << R"({"voxview_view": 1, "settings": {"mode": "unsorted"}})";
+  ViewerArguments a;
+  a.camera_file = path;
+  a.opacity = 0.45f;
+  const app::ViewerOptions o = resolve_viewer_options(a);
+  EXPECT_EQ(o.settings.mode, RenderMode::Unsorted);
+  EXPECT_EQ(o.settings.opacity, 0.45f);
+  EXPECT_EQ(o.width, 1024);
+}
+
+TEST(ViewerArguments, ValuesParse) {
+  ViewerArguments a;
+  a.options.image = "t1.nii";
+  a.range = "0,0.5";
+  a.image_range = "10,800";
+  a.slices = "view,axial";
+  a.focus = "-5,0,12.5";
+  a.fixed_color = "#ff8000";
+  a.groups = {"CST=#00ff00:0.5", "AF=:0"};
+  a.view = "-35,25";
+  a.slab = 12;
+  a.given = {"--range", "--image-range", "--slices", "--focus", "--fixed-color", "--slab"};
+  const app::ViewerOptions o = resolve_viewer_options(a);
+  const RenderSettings& s = o.settings;
+  ASSERT_TRUE(s.range);
+  EXPECT_EQ(*s.range, (std::array<float, 2>{0.0f, 0.5f}));
+  ASSERT_TRUE(s.slices.range);
+  EXPECT_EQ(*s.slices.range, (std::array<float, 2>{10.0f, 800.0f}));
+  EXPECT_TRUE(s.slices.view_plane);
+  EXPECT_TRUE(s.slices.axial);
+  EXPECT_FALSE(s.slices.coronal);
+  EXPECT_FALSE(s.slices.sagittal);
+  ASSERT_TRUE(o.focus);
+  EXPECT_EQ(*o.focus, glm::dvec3(-5, 0, 12.5));
+  EXPECT_EQ(hex_color(s.fixed_color), "#ff8000");
+  ASSERT_EQ(s.group_styles.size(), 2u);
+  EXPECT_EQ(s.group_styles[0].name, "CST");
+  EXPECT_EQ(s.group_styles[0].opacity, 0.5f);
+  EXPECT_EQ(s.group_styles[1].name, "AF");
+  EXPECT_FALSE(s.group_styles[1].color);
+  EXPECT_EQ(s.group_styles[1].opacity, 0.0f);
+  ASSERT_TRUE(o.view);
+  EXPECT_EQ(*o.view, (std::array<double, 2>{-35, 25}));
+  EXPECT_EQ(s.clipping.slab_mm, 12);
+
+  a.slices = "none";
+  EXPECT_FALSE(resolve_viewer_options(a).settings.slices.any());
+}
+
+// One option given with `value`: its field set and the option marked given.
+ViewerArguments given(const char* option, std::string ViewerArguments::*field, const std::string& value) {
+  ViewerArguments a;
+  a.options.image = "t1.nii";
+  a.*field = value;
+  a.given = {option};
+  return a;
+}
+
+TEST(ViewerArguments, BadOrConflictingOptionsAreUsageErrors) {
+  auto error_contains = [](const ViewerArguments& a, const std::string& part) {
+    const std::string error = usage_error_of(a);
+    EXPECT_NE(error.find(part), std::string::npos) << error;
+  };
+  error_contains(given("--range", &ViewerArguments::range, "1,0"), "--range: expected MIN,MAX");
+  error_contains(given("--image-range", &ViewerArguments::image_range, "5"), "--image-range: expected MIN,MAX");
+  error_contains(given("--slices", &ViewerArguments::slices, "axial,top"), "--slices: expected");
+  error_contains(given("--focus", &ViewerArguments::focus, "1,2"), "--focus: expected X,Y,Z");
+  error_contains(given("--view", &ViewerArguments::view, "sideways"), "unknown view 'sideways'");
+  error_contains(given("--size", &ViewerArguments::size, "0x5"), "--size must be WxH");
+  error_contains(given("--size", &ViewerArguments::size, "16385x5"), "--size must be WxH");
+  error_contains(given("--mode", &ViewerArguments::mode, "fancy"), "--mode: unknown mode 'fancy'");
+  error_contains(given("--color", &ViewerArguments::color, "rainbow"), "--color: unknown colour mode");
+  error_contains(given("--colormap", &ViewerArguments::colormap, "jet"), "--colormap: unknown colour map");
+  error_contains(given("--fixed-color", &ViewerArguments::fixed_color, "red"), "--fixed-color: expected #RRGGBB");
+
+  ViewerArguments a = given("--size", &ViewerArguments::size, "800x600");
+  EXPECT_EQ(usage_error_of(a), "no error");
+  a.clips = {"x,1", "y,1", "z,1", "x,2"};
+  error_contains(a, "--clip: at most 3 clip planes (got 4)");
+  a.clips = {"w,1"};
+  error_contains(a, "--clip: expected AXIS,POS");
+  a.clips.clear();
+  a.groups = {"CST="};
+  error_contains(a, "--group: expected");
+  a.groups.clear();
+  a.options.turntable = 36;
+  error_contains(a, "--turntable needs --render");
+  a.options.render_png = "x.png";
+  EXPECT_EQ(usage_error_of(a), "no error");
+
+  ViewerArguments no_image = given("--slices", &ViewerArguments::slices, "axial");
+  no_image.options.image.reset();
+  error_contains(no_image, "--image-range and --slices need --image");
+}
+
+// The schema: which options were given, values that start with '-', the lists the help takes from their tables.
+TEST(VoxviewCli, ParsesNegativeValuesAndNotesGivenOptions) {
+  ViewerArguments a;
+  CLI::App cli{app::voxview_description("test")};
+  app::declare_voxview_options(cli, a);
+  const char* argv[] = {"voxview", "a.vxl", "b.tck", "--clip", "-x,10", "--focus", "-5,0,0", "--mode", "exact"};
+  app::parse_voxview_command_line(cli, a, static_cast<int>(std::size(argv)), argv);
+  EXPECT_EQ(a.options.inputs, (std::vector<std::string>{"a.vxl", "b.tck"}));
+  EXPECT_EQ(a.clips, std::vector<std::string>{"-x,10"});
+  EXPECT_EQ(a.focus, "-5,0,0");
+  EXPECT_EQ(a.mode, "exact");
+  EXPECT_EQ(a.opacity, 0.3f);
+  EXPECT_TRUE(a.was_given("--mode"));
+  EXPECT_TRUE(a.was_given("--clip"));
+  EXPECT_TRUE(a.was_given("--focus"));
+  EXPECT_FALSE(a.was_given("--opacity"));
+  EXPECT_FALSE(a.was_given("--size"));
+}
+
+TEST(VoxviewCli, ModesAndKeysComeFromTheirTables) {
+  ViewerArguments a;
+  CLI::App cli{app::voxview_description("test")};
+  app::declare_voxview_options(cli, a);
+  const std::string help = cli.help();
+  EXPECT_NE(help.find("opaque | unsorted | additive | wboit | basic | axis | exact"), std::string::npos) << help;
+  for (const app::KeyBinding& b : app::key_bindings())
+    EXPECT_NE(help.find(std::string(b.keys) + ": " + b.description), std::string::npos) << b.keys;
+
+  const char* argv[] = {"voxview", "a.vxl", "--mode", "fancy"};
+  EXPECT_THROW(app::parse_voxview_command_line(cli, a, 4, argv), CLI::ValidationError);
+}
+
+}  // namespace
+}  // namespace vxl

@@ -1,0 +1,167 @@
+#include "viewer/app/viewer_arguments.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "format/error.h"
+#include "viewer/app/camera_file.h"
+
+namespace vxl::app {
+
+namespace {
+
+[[noreturn]] void usage_error(const std::string& what) { throw Error(ErrorKind::Usage, "", std::nullopt, what); }
+
+// "MIN,MAX" with finite MIN < MAX (--range, --image-range).
+std::optional<std::array<float, 2>> parse_min_max(const std::string& text) {
+  float lo = 0, hi = 0;
+  char end = 0;
+  if (std::sscanf(text.c_str(), "%f,%f%c", &lo, &hi, &end) != 2 || !std::isfinite(lo) || !std::isfinite(hi) ||
+      !(hi > lo))
+    return std::nullopt;
+  return std::array<float, 2>{lo, hi};
+}
+
+// A saved view replaces the defaults: its settings and camera, and its size unless --size is given.
+void apply_saved_view(const ViewerArguments& a, ViewerOptions& o, std::string& size) {
+  if (a.camera_file.empty()) return;
+  SavedView defaults;
+  defaults.settings = o.settings;
+  const SavedView saved = read_view(a.camera_file, defaults);
+  o.settings = saved.settings;
+  o.camera = saved.camera;
+  if (saved.size && !a.was_given("--size"))
+    size = std::to_string((*saved.size)[0]) + "x" + std::to_string((*saved.size)[1]);
+}
+
+// Mode, opacity, colouring, groups, background, line width and lighting. `from_file`: a saved view set
+// them, and only options given explicitly change them.
+void apply_look(const ViewerArguments& a, bool from_file, RenderSettings& s) {
+  auto overrides = [&](const char* option) { return !from_file || a.was_given(option); };
+  if (overrides("--mode")) {
+    const auto mode = parse_render_mode(a.mode);
+    if (!mode) usage_error("--mode: unknown mode '" + a.mode + "'");
+    s.mode = *mode;
+  }
+  if (overrides("--opacity")) s.opacity = a.opacity;
+  if (overrides("--color")) {
+    const auto color = parse_color_mode(a.color);
+    if (!color) usage_error("--color: unknown colour mode '" + a.color + "'");
+    s.color = *color;
+  }
+  if (a.was_given("--fixed-color")) {
+    const auto fixed = parse_hex_color(a.fixed_color);
+    if (!fixed) usage_error("--fixed-color: expected #RRGGBB, got '" + a.fixed_color + "'");
+    s.fixed_color = *fixed;
+  }
+  if (a.was_given("--scalar")) s.scalar = a.scalar;
+  if (overrides("--colormap")) {
+    const auto colormap = parse_colormap(a.colormap);
+    if (!colormap) usage_error("--colormap: unknown colour map '" + a.colormap + "'");
+    s.colormap = *colormap;
+  }
+  if (a.was_given("--range")) {
+    s.range = parse_min_max(a.range);
+    if (!s.range) usage_error("--range: expected MIN,MAX with MIN < MAX (e.g. 0,0.5); got '" + a.range + "'");
+  }
+  for (const std::string& g : a.groups) {
+    const auto style = parse_group_style(g);
+    if (!style)
+      usage_error("--group: expected NAME=#RRGGBB, NAME=#RRGGBB:OPACITY or NAME=:OPACITY (opacity 0..1); got '" + g +
+                  "'");
+    GroupStyle& existing = s.style_of(style->name);
+    if (style->color) existing.color = style->color;
+    existing.opacity = style->opacity;
+  }
+  if (overrides("--background")) s.white_background = a.background == "white";
+  if (overrides("--line-width")) s.line_width = a.line_width;
+  if (a.lighting) s.lighting = true;
+}
+
+// --slab and --clip: clip planes given replace a saved view's.
+void apply_clipping(const ViewerArguments& a, Clipping& c) {
+  if (a.was_given("--slab")) c.slab_mm = a.slab;
+  if (a.clips.size() > Clipping::kMaxPlanes)
+    usage_error("--clip: at most 3 clip planes (got " + std::to_string(a.clips.size()) + ")");
+  if (!a.clips.empty()) c.planes.clear();
+  for (const std::string& text : a.clips) {
+    const auto plane = parse_axis_clip(text);
+    if (!plane)
+      usage_error("--clip: expected AXIS,POS with AXIS one of x y z -x -y -z and POS in mm (e.g. -z,12.5); got '" +
+                  text + "'");
+    c.planes.push_back(*plane);
+  }
+}
+
+// "axial,coronal", "view", "none", ...: which slices of the image are shown.
+SliceSettings parse_slices(const std::string& text, SliceSettings sl) {
+  sl.axial = sl.coronal = sl.sagittal = sl.view_plane = false;
+  std::size_t start = 0;
+  while (text != "none") {
+    const std::size_t comma = text.find(',', start);
+    const std::string name = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (name == "axial")
+      sl.axial = true;
+    else if (name == "coronal")
+      sl.coronal = true;
+    else if (name == "sagittal")
+      sl.sagittal = true;
+    else if (name == "view")
+      sl.view_plane = true;
+    else
+      usage_error("--slices: expected a comma list of axial, coronal, sagittal, view, or none; got '" + text + "'");
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return sl;
+}
+
+// --image-range, --slices and --focus.
+void apply_image(const ViewerArguments& a, ViewerOptions& o) {
+  SliceSettings& sl = o.settings.slices;
+  if (a.was_given("--image-range")) {
+    sl.range = parse_min_max(a.image_range);
+    if (!sl.range)
+      usage_error("--image-range: expected MIN,MAX with MIN < MAX (e.g. 0,800); got '" + a.image_range + "'");
+  }
+  if (a.was_given("--slices")) sl = parse_slices(a.slices, sl);
+  if (a.was_given("--focus")) {
+    double x = 0, y = 0, z = 0;
+    char end = 0;
+    if (std::sscanf(a.focus.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &end) != 3 || !std::isfinite(x) ||
+        !std::isfinite(y) || !std::isfinite(z))
+      usage_error("--focus: expected X,Y,Z in mm (e.g. 0,-10,12.5); got '" + a.focus + "'");
+    o.focus = glm::dvec3(x, y, z);
+  }
+  if ((a.was_given("--image-range") || a.was_given("--slices")) && !o.image)
+    usage_error("--image-range and --slices need --image FILE.nii[.gz]");
+}
+
+// --view and the image or window size (--size, else the saved view's, else the default).
+void apply_view_and_size(const ViewerArguments& a, const std::string& size, ViewerOptions& o) {
+  if (!a.view.empty()) {
+    o.view = parse_view(a.view);
+    if (!o.view) usage_error("--view: unknown view '" + a.view + "'");
+  }
+  if (std::sscanf(size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 1 || o.height < 1 || o.width > 16384 ||
+      o.height > 16384)
+    usage_error("--size must be WxH, each 1..16384");
+}
+
+}  // namespace
+
+ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
+  ViewerOptions o = a.options;
+  if (o.turntable && !o.render_png) usage_error("--turntable needs --render OUT.png (it writes OUT_000.png, ...)");
+  // The command line's opacity is also the default a saved view without one keeps.
+  o.settings.opacity = a.opacity;
+  std::string size = a.size;
+  apply_saved_view(a, o, size);
+  apply_look(a, o.camera.has_value(), o.settings);
+  apply_clipping(a, o.settings.clipping);
+  apply_image(a, o);
+  apply_view_and_size(a, size, o);
+  return o;
+}
+
+}  // namespace vxl::app

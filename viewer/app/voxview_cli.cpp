@@ -1,0 +1,155 @@
+#include "viewer/app/voxview_cli.h"
+
+#include <vector>
+
+#include "viewer/app/key_bindings.h"
+#include "viewer/render/render_settings.h"
+
+namespace vxl::app {
+
+namespace {
+
+std::string join(const std::vector<std::string>& items, const char* separator) {
+  std::string text;
+  for (const std::string& item : items) text += (text.empty() ? "" : separator) + item;
+  return text;
+}
+
+// argv as CLI11 takes it (reversed). "--clip -x,10", "--focus -5,0,0": CLI11 would take "-x,10" for an option,
+// so such a value is passed as "--clip=-x,10".
+std::vector<std::string> cli11_arguments(int argc, const char* const* argv) {
+  std::vector<std::string> args;
+  for (int i = argc - 1; i >= 1; --i) {
+    const std::string a = argv[i];
+    const std::string before = i >= 2 ? argv[i - 1] : "";
+    if ((before == "--clip" || before == "--focus") && a.size() > 1 && a[0] == '-' && a[1] != '-') {
+      args.push_back(before + "=" + a);
+      --i;
+    } else {
+      args.push_back(a);
+    }
+  }
+  return args;
+}
+
+}  // namespace
+
+std::string voxview_description(const std::string& version) {
+  return "voxview " + version +
+         " — transparent tractogram viewer (Voxlines method).\n"
+         "voxview FILE... [--render OUT.png]: a window, or headless to PNG with --render.\n"
+         "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx/.vtk/.vtp is converted in memory first.\n"
+         "Opening a .vxl checks its structure (header, section table, section sizes, voxel table, names) in\n"
+         "O(voxels) but not its checksums: damaged positions, orders or values are drawn as they are. --verify\n"
+         "checks everything first, as 'voxlines verify' does.\n" +
+         controls_as_paragraph(110);
+}
+
+void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
+  cli.name("voxview");
+  cli.add_option("files", a.options.inputs,
+                 "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx / .vtk / .vtp tractogram; several "
+                 "are shown together "
+                 "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
+      ->required();
+  cli.add_option("--render", a.options.render_png, "render headless (EGL, no display needed) to this PNG and exit");
+  cli.add_option("--turntable", a.options.turntable,
+                 "with --render: N frames turning once around the vertical (superior) axis, written as OUT_000.png, "
+                 "OUT_001.png, ... (frame i at azimuth + 360 i / N degrees; frame 0 looks from the --view direction; "
+                 "all frames share one framing in which each is whole)")
+      ->check(CLI::Range(1, 100000));
+  cli.add_option("--camera", a.camera_file,
+                 "start from a saved view (camera and settings; JSON, see --save-camera); options given as well "
+                 "override it");
+  cli.add_option("--save-camera", a.options.save_camera,
+                 "write the view (camera and settings) to this JSON file: headless after rendering, in the window on "
+                 "V, the panel's Save view button, or on quitting after --frames");
+  cli.add_option("--mode", a.mode, join(render_mode_names(), " | "))
+      ->default_val("axis")
+      ->check(CLI::IsMember(render_mode_names()));
+  cli.add_option("--opacity", a.opacity, "line opacity, 1 down to 0.001")
+      ->default_val(0.3)
+      ->check(CLI::Range(0.001, 1.0));
+  cli.add_option("--view", a.view,
+                 "axial, inferior, sagittal (left), right, coronal (anterior), posterior, or AZ,EL in degrees");
+  cli.add_option("--size", a.size, "image or window size WxH")->default_val("1024x1024");
+  cli.add_flag("--ortho", a.options.orthographic, "orthographic projection (default perspective)");
+  cli.add_option(
+         "--color", a.color,
+         "direction (|p1 - p0| as RGB), fixed (--fixed-color), scalar (a value set through --colormap) or group "
+         "(one colour per TRX group, or per file when several are shown)")
+      ->default_val("direction")
+      ->check(CLI::IsMember({"direction", "fixed", "scalar", "group"}));
+  cli.add_option("--fixed-color", a.fixed_color, "the fixed colour, #RRGGBB (also for points without a value)")
+      ->check([](const std::string& v) {
+        return parse_hex_color(v) ? std::string() : "expected #RRGGBB, got '" + v + "'";
+      });
+  cli.add_option("--scalar", a.scalar,
+                 "the value set to colour by (a TSF's file name, a TRK scalar or property, a TRX dpv or dps name); "
+                 "default: the first");
+  cli.add_option("--colormap", a.colormap, "grey, hot or viridis, for --color scalar")
+      ->default_val("viridis")
+      ->check(CLI::IsMember({"grey", "gray", "hot", "viridis"}));
+  cli.add_option("--range", a.range,
+                 "MIN,MAX: the values at the colour map's ends (default: the set's minimum and maximum)");
+  cli.add_option(
+         "--group", a.groups,
+         "NAME=#RRGGBB[:OPACITY] or NAME=:OPACITY: a group's colour and opacity (a factor on --opacity; 0 hides "
+         "it), repeatable")
+      ->expected(1)
+      ->take_all();
+  cli.add_option("--tsf", a.options.tsf,
+                 "a TSF file of per-point values for a .tck given as input (converted in memory), repeatable")
+      ->expected(1)
+      ->take_all();
+  cli.add_flag(
+      "--lighting", a.lighting,
+      "light the lines (illuminated lines: a line along the light, which comes from the viewer's upper left, is "
+      "dark, one across it bright)");
+  cli.add_option("--line-width", a.line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
+  cli.add_option("--background", a.background, "black or white")
+      ->default_val("black")
+      ->check(CLI::IsMember({"black", "white"}));
+  cli.add_option(
+      "--image", a.options.image,
+      "an anatomical image (NIfTI-1 or -2, .nii or .nii.gz, e.g. a T1) shown as opaque grey slices through the "
+      "focus point under the lines (lines behind a slice are hidden by it, lines in front blend over it)");
+  cli.add_option(
+      "--image-range", a.image_range,
+      "MIN,MAX: the image values shown black and white (default: the 2nd and 98th percentiles of the image's "
+      "non-zero voxels)");
+  cli.add_option(
+      "--slices", a.slices,
+      "which slices of --image to show: a comma list of axial, coronal, sagittal and view (the plane through the "
+      "focus facing the viewer: with --slab, the slice in its middle), or none; default axial,coronal,sagittal");
+  cli.add_option("--focus", a.focus,
+                 "X,Y,Z: the focus point in RAS mm (the view's centre, where the slices cross, the slab's centre); "
+                 "default the centre of the tractograms' bounds");
+  cli.add_option("--slab", a.slab,
+                 "crop to a slab MM thick, centred on the focus point (the view's centre), perpendicular to the view "
+                 "direction (mrview's crop to slab)")
+      ->check(CLI::PositiveNumber);
+  cli.add_option(
+         "--clip", a.clips,
+         "clip plane AXIS,POS in RAS mm, up to 3: x,10 keeps x >= 10, -x,10 keeps x <= 10 (axes x y z, -x -y -z)")
+      ->expected(1)
+      ->take_all();
+  cli.add_flag("--verify", a.options.verify,
+               "before drawing, check every .vxl in full (every checksum and padding byte, every order, the streamline "
+               "tables; reads the whole file, as 'voxlines verify') and refuse a damaged one (exit 3, naming the first "
+               "problem); a .vxlz's unpacked file too (a package's own checksums are always checked)");
+  cli.add_option("--voxel-size", a.options.voxel_size, "voxel size in mm when converting a source file in memory")
+      ->default_val(10.0)
+      ->check(CLI::PositiveNumber);
+  cli.add_option("--frames", a.options.frames, "window: quit after this many frames (for scripts and tests)")
+      ->check(CLI::PositiveNumber);
+  cli.add_option("--screenshot", a.options.screenshot, "window: save the last frame to this PNG before quitting");
+}
+
+void parse_voxview_command_line(CLI::App& cli, ViewerArguments& arguments, int argc, const char* const* argv) {
+  cli.parse(cli11_arguments(argc, argv));
+  for (const CLI::Option* option : cli.get_options())
+    if (option->count() > 0) arguments.given.insert(option->get_name());
+}
+
+}  // namespace vxl::app
