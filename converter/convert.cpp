@@ -4,6 +4,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "converter/position_packing.h"
 #include "converter/segment_orders.h"
 #include "converter/voxel_size_auto.h"
 #include "converter/voxel_table.h"
@@ -33,6 +34,7 @@ std::string provenance_json(const SourceInfo& src, const ConvertSettings& settin
                     {"version", VOXLINES_VERSION},
                     {"voxel_size", settings.voxel_size},
                     {"orders", settings.orders},
+                    {"positions", position_encoding_name(settings.positions)},
                     {"threads", threads}};
   if (!voxel_size_choice.empty()) j["converter"]["voxel_size_auto"] = voxel_size_choice;
   j["warnings"] = src.warnings;
@@ -105,6 +107,8 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   MetaSection meta = plan.meta();
   meta.stored_order_count = static_cast<std::uint32_t>(order_set.directions.size());
   meta.order_set = static_cast<std::uint32_t>(order_set.kind);
+  meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
+  const bool packed = settings.positions == PositionEncoding::Packed;
   const std::uint64_t order_bytes = layout_orders(plan.voxels(), meta.stored_order_count);
   std::vector<std::string> point_set_names, streamline_set_names;
   for (const ValueSet& v : t.point_values) point_set_names.push_back(v.name);
@@ -120,18 +124,23 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   t.streamline_values.clear();
   finish_value_sets(out.streamline_values());
   // Pass 2 writes all over these: fault them in first, in bulk (ORDR waits until the source is freed).
-  for (std::span<std::uint8_t> s :
-       {bytes_of(out.vertices()), bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
+  // Packed positions are placed as floats first (orders are built from them), then packed into VERT.
+  std::vector<float> float_blocks(packed ? 3 * meta.vertex_count : 0);
+  const std::span<float> vertices = packed ? std::span<float>(float_blocks) : out.float_vertices();
+  for (std::span<std::uint8_t> s : {bytes_of(out.float_vertices()), bytes_of(out.packed_vertices()),
+                                    bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
     prefault_for_write(s, threads);
-  VoxelBlocks blocks{out.voxels(), out.vertices(), out.voxlines(), out.streamline_first_voxline(), {}};
+  VoxelBlocks blocks{out.voxels(), vertices, out.voxlines(), out.streamline_first_voxline(), {}};
   blocks.vertex_values = layout_value_sets(out.vertex_values(), point_set_names, meta.vertex_count);
   VoxlineEnds ends = place_vertices(std::move(plan), std::move(t), blocks);
   finish_value_sets(out.vertex_values());
+  if (packed) pack_vertex_blocks(out.voxels(), vertices, ends, out.packed_vertices(), threads);
   summary.voxelize_seconds = seconds_since(t0);
 
   t0 = Clock::now();
   prefault_for_write(out.orders(), threads);
-  build_orders_into(out.voxels(), out.vertices(), ends, order_set, out.orders(), threads, settings.progress);
+  build_orders_into(out.voxels(), vertices, ends, order_set, out.orders(), threads, settings.progress);
+  float_blocks = {};
   summary.orders_seconds = seconds_since(t0);
 
   if (settings.progress) settings.progress("writing", 0.0);

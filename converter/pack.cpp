@@ -84,18 +84,21 @@ std::vector<NamedValues> streamline_values(const ValueSets& sets) {
 
 // Every vertex is a shipped point or a copy of one, so the vertices' box is the shipped points' box.
 // Returns false when a coordinate is not finite (the converter never writes one; quantising it would be
-// meaningless).
-bool vertex_box(std::span<const float> vertices, unsigned threads, double lo[3], double hi[3]) {
-  const std::uint64_t n = vertices.size() / 3;
+// meaningless). Read voxel by voxel, so that packed positions are decoded a block at a time.
+bool vertex_box(const VxlFile& f, unsigned threads, double lo[3], double hi[3]) {
+  auto voxels = f.voxels();
   std::vector<std::array<float, 6>> partial(threads, {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY});
   std::vector<std::uint8_t> finite(threads, 1);
-  const std::uint64_t pieces = threads * 4ull;
-  parallel_for(pieces, threads, [&](std::uint64_t piece, unsigned t) {
+  std::vector<std::vector<float>> blocks(threads);
+  parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned t) {
     auto& b = partial[t];
+    std::vector<float>& xyz = blocks[t];
+    xyz.resize(3 * std::uint64_t(voxels[i].vertex_count));
+    f.read_vertices(i, voxels[i].vertex_first, voxels[i].vertex_count, xyz.data());
     bool ok = true;
-    for (std::uint64_t i = n * piece / pieces; i < n * (piece + 1) / pieces; ++i)
+    for (std::size_t k = 0; k < xyz.size(); k += 3)
       for (int c = 0; c < 3; ++c) {
-        const float v = vertices[3 * i + c];
+        const float v = xyz[k + c];
         ok &= std::isfinite(v);
         b[c] = std::min(b[c], v);
         b[c + 3] = std::max(b[c + 3], v);
@@ -104,7 +107,7 @@ bool vertex_box(std::span<const float> vertices, unsigned threads, double lo[3],
   });
   for (int c = 0; c < 3; ++c) {
     lo[c] = hi[c] = 0;
-    if (n == 0) continue;
+    if (voxels.empty()) continue;
     lo[c] = INFINITY;
     hi[c] = -INFINITY;
     for (const auto& b : partial) {
@@ -185,7 +188,7 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   pack.quantization_bits = settings.bits;
   pack.predictor = kVxlzPredictorLinear;
   double hi[3];
-  if (!vertex_box(f.vertices(), threads, pack.quant_origin, hi))
+  if (!vertex_box(f, threads, pack.quant_origin, hi))
     fail_input(f.path(), f.find_section(section_id("VERT"))->offset, "a vertex coordinate is not finite");
   pack.range = std::max({hi[0] - pack.quant_origin[0], hi[1] - pack.quant_origin[1], hi[2] - pack.quant_origin[2]});
   pack.quantum = pack.range > 0 ? pack.range / double((1u << settings.bits) - 1) : 1.0;
@@ -209,7 +212,6 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   // Positions (spec §5): chunks are independent, so they are quantised, predicted and encoded in parallel.
   auto encode_positions = [&] {
     const Quantizer quantizer(pack);
-    const float* vertices = f.vertices().data();
     auto voxlines = f.voxlines();
     struct ErrorStats {
       double max = 0, sum_squares = 0;
@@ -224,9 +226,16 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
       std::uint64_t in_voxline = start - index.first_point[j];
       LinearPredictor predictor;
       predictor.reset();
+      // The current voxline's own points, decoded from its voxel's block.
+      std::vector<float> points;
+      auto load_voxline = [&] {
+        points.resize(3 * std::uint64_t(voxlines[j].count_flags & kVoxlineCountMask));
+        f.read_vertices(voxlines[j].voxel, index.first_vertex[j], points.size() / 3, points.data());
+      };
+      if (count > 0) load_voxline();
       for (std::uint64_t i = 0; i < count; ++i) {
         if (in_voxline == 0 && index.starts_streamline[j]) predictor.start_streamline();
-        const float* p = vertices + 3 * (index.first_vertex[j] + in_voxline);
+        const float* p = points.data() + 3 * in_voxline;
         std::array<std::int64_t, 3> k;
         for (int a = 0; a < 3; ++a) {
           k[a] = quantizer.quantize(p[a], a);
@@ -239,6 +248,7 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
         if (++in_voxline == (voxlines[j].count_flags & kVoxlineCountMask)) {
           ++j;
           in_voxline = 0;
+          if (i + 1 < count) load_voxline();
         }
       }
     };

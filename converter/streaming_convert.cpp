@@ -13,6 +13,7 @@
 #endif
 
 #include "converter/memory_size.h"
+#include "converter/position_packing.h"
 #include "converter/readers/tck_stream.h"
 #include "converter/segment_orders.h"
 #include "converter/voxel_size_auto.h"
@@ -305,13 +306,14 @@ void StreamingConversion::build_table() {
   cursor_ = std::move(table.cursor);
   meta_.stored_order_count = static_cast<std::uint32_t>(order_set_.directions.size());
   meta_.order_set = static_cast<std::uint32_t>(order_set_.kind);
+  meta_.position_encoding = static_cast<std::uint32_t>(settings_.positions);
   order_bytes_ = layout_orders(voxels_, meta_.stored_order_count);
 }
 
 // Consecutive voxels, as many per range as fit in what the limit leaves: each range's vertices (12 bytes
-// each), voxline ends (1 bit each), orders, and its ordering threads' sort buffers. The sort buffers of
-// one thread grow with the largest voxel, so a range orders with fewer threads when they would take more
-// than a quarter of the room (the orders do not depend on the thread count).
+// each, 16 with their packed words), voxline ends (1 bit each), orders, and its ordering threads' sort buffers. The
+// sort buffers of one thread grow with the largest voxel, so a range orders with fewer threads when they would take
+// more than a quarter of the room (the orders do not depend on the thread count).
 std::vector<Range> StreamingConversion::cut_ranges() {
   const std::uint64_t room = budget_.left();
   auto order_threads = [&](const Range& r) {
@@ -320,7 +322,8 @@ std::vector<Range> StreamingConversion::cut_ranges() {
   };
   auto cost = [&](const Range& r) {
     const std::uint64_t v = r.vertex_end - r.vertex_first;
-    return 12 * v + (v / 64 + 1) * 8 + (r.order_end - r.order_first) +
+    const std::uint64_t vertex_bytes = settings_.positions == PositionEncoding::Packed ? 16 : 12;
+    return vertex_bytes * v + (v / 64 + 1) * 8 + (r.order_end - r.order_first) +
            order_threads(r) * order_scratch_bytes(r.max_vertices);
   };
   auto order_end = [&](std::size_t i) { return i < voxels_.size() ? voxels_[i].order_offset : order_bytes_; };
@@ -434,15 +437,22 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
 
   const std::span<VoxelEntry> range(voxels_.data() + r.first, r.end - r.first);
   detail::set_tight_bounds(range, vertices.data(), r.vertex_first);
-  summary_.voxelize_seconds += seconds_since(t0);
 
-  // The orders, with the range's entries rebased to its own vertices and orders for the while.
-  t0 = Clock::now();
-  std::vector<std::uint8_t> orders(r.order_end - r.order_first, 0);
+  // The orders (and packed positions), with the range's entries rebased to its own vertices and orders
+  // for the while.
   for (VoxelEntry& v : range) {
     v.vertex_first -= r.vertex_first;
     v.order_offset -= r.order_first;
   }
+  std::vector<std::uint32_t> packed;
+  if (settings_.positions == PositionEncoding::Packed) {
+    packed.resize(r.vertex_end - r.vertex_first);
+    pack_vertex_blocks(range, vertices, ends, packed, threads_);
+  }
+  summary_.voxelize_seconds += seconds_since(t0);
+
+  t0 = Clock::now();
+  std::vector<std::uint8_t> orders(r.order_end - r.order_first, 0);
   const std::string stage = "ordering" + of;
   build_orders_into(range, vertices, ends, order_set_, orders, r.order_threads,
                     [&](const char*, double f) { report(stage, f); });
@@ -453,7 +463,10 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
   summary_.orders_seconds += seconds_since(t0);
 
   t0 = Clock::now();
-  out_->append_items<float>(VxlStreamWriter::kVert, vertices);
+  if (packed.empty())
+    out_->append_items<float>(VxlStreamWriter::kVert, vertices);
+  else
+    out_->append_items<std::uint32_t>(VxlStreamWriter::kVert, packed);
   out_->append(VxlStreamWriter::kOrdr, orders);
   summary_.write_seconds += seconds_since(t0);
 }

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "converter/position_packing.h"
 #include "converter/segment_orders.h"
 #include "converter/voxel_table.h"
 #include "format/error.h"
@@ -278,17 +279,22 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
                                              f.context(section_id("SVAL")), threads);
 
   MetaSection meta = f.meta();
+  meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
+  const bool packed = settings.positions == PositionEncoding::Packed;
   VxlWriter out(out_path, section_sizes(meta, s.order_bytes, provenance.size(), groups_bytes.size(),
                                         static_cast<std::uint32_t>(point_values.size()),
                                         static_cast<std::uint32_t>(streamline_values.size())));
-  prefault_for_write(bytes_of(out.vertices()), threads);
+  // Packed positions are decoded as floats first (tight bounds and orders come from them), then packed.
+  std::vector<float> float_blocks(packed ? 3 * meta.vertex_count : 0);
+  const std::span<float> vertices = packed ? std::span<float>(float_blocks) : out.float_vertices();
+  prefault_for_write(bytes_of(out.float_vertices()), threads);
   std::copy(s.voxels.begin(), s.voxels.end(), out.voxels().begin());
 
   // Positions: chunks in parallel, each into its own voxlines' places.
   std::atomic<std::uint64_t> done{0};
   VoxlineEnds ends(meta.vertex_count);
   parallel_for(f.chunk_count(), threads, [&](std::uint64_t chunk, unsigned t) {
-    decode_chunk(f, s, chunk, out.vertices(), ends);
+    decode_chunk(f, s, chunk, vertices, ends);
     if (t == 0)
       progress("decoding", double(++done) / double(f.chunk_count()));
     else
@@ -307,21 +313,25 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   // populate for all, instead of a fault per page for the voxline table's 8 bytes per voxline.
   prefault_for_write(out.file().subspan(static_cast<std::size_t>(out.orders().data() - out.file().data())), threads);
   std::span<VoxelEntry> voxels = out.voxels();
-  std::span<const float> vertices = out.vertices();
   std::vector<VoxelOrderWriter> writers;
   for (unsigned t = 0; t < threads; ++t) writers.emplace_back(set);
   std::atomic<std::uint64_t> ordered{0};
-  // One more item before the voxels: the vertices are final, so their checksum is taken here, beside
+  // One more item before the voxels: float32 vertices are final, so their checksum is taken here, beside
   // the orders, rather than alone at the end.
   parallel_for(voxels.size() + 1, threads, [&](std::uint64_t item, unsigned t) {
-    if (item == 0) return out.checksum_vertices_now();
+    if (item == 0) {
+      if (!packed) out.checksum_vertices_now();
+      return;
+    }
     VoxelEntry& v = voxels[item - 1];
     detail::set_tight_bounds({&v, 1}, vertices.data(), 0);
+    if (packed) pack_vertex_blocks({&v, 1}, vertices, ends, out.packed_vertices(), 1);
     writers[t].write(v, vertices, ends, out.orders().data() + v.order_offset);
     const std::uint64_t d = ++ordered;
     if (t == 0 && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
   });
   progress("ordering", 1.0);
+  float_blocks = {};
   // The global bounds (step 1).
   for (int c = 0; c < 3; ++c) {
     meta.bounds_min[c] = meta.bounds_max[c] = 0;

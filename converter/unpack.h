@@ -10,13 +10,15 @@
 #include <string>
 
 #include "converter/voxelize.h"
+#include "format/vxl_positions.h"
 #include "format/vxlz_layout.h"
 
 namespace vxl {
 
 struct UnpackSettings {
-  unsigned threads = 0;  // 0: all cores
-  ProgressFn progress;   // stages "decoding", "ordering", "writing"; may be empty
+  unsigned threads = 0;                                   // 0: all cores
+  PositionEncoding positions = PositionEncoding::Packed;  // of the .vxl written (spec §5.4)
+  ProgressFn progress;                                    // stages "decoding", "ordering", "writing"; may be empty
 };
 
 struct UnpackSummary {

@@ -53,6 +53,20 @@ OrderView VxlFile::order(std::size_t voxel, std::uint32_t k) const {
   return o;
 }
 
+void VxlFile::read_vertices(std::size_t voxel, std::uint64_t first, std::uint64_t count, float* xyz) const {
+  if (position_encoding() == PositionEncoding::Packed)
+    unpack_block(voxels_[voxel], packed_vertices_.data() + first, count, xyz);
+  else
+    std::copy_n(float_vertices_.data() + 3 * first, 3 * count, xyz);
+}
+
+std::vector<float> VxlFile::all_vertices() const {
+  std::vector<float> xyz(3 * meta_.vertex_count);
+  for (std::size_t i = 0; i < voxels_.size(); ++i)
+    read_vertices(i, voxels_[i].vertex_first, voxels_[i].vertex_count, xyz.data() + 3 * voxels_[i].vertex_first);
+  return xyz;
+}
+
 void VxlFile::validate() {
   const std::string& p = file_.path();
   const std::uint64_t size = file_.size();
@@ -60,9 +74,9 @@ void VxlFile::validate() {
   if (size < sizeof(FileHeader)) fail_input(p, size, "file too short for a .vxl header (64 bytes)");
   std::memcpy(&header_, base, sizeof header_);
   if (std::memcmp(header_.magic, kVxlMagic.data(), 8) != 0) fail_input(p, 0, "not a .vxl file (bad magic)");
-  if (header_.version_major != kVxlVersionMajor)
+  if (header_.version_major != kVxlVersionMajor && header_.version_major != kVxlVersionMajorPackedPositions)
     throw Error(ErrorKind::Unsupported, p, 8,
-                ".vxl major version " + std::to_string(header_.version_major) + " (this reader knows 1)");
+                ".vxl major version " + std::to_string(header_.version_major) + " (this reader knows 1 and 2)");
   if (header_.header_size != sizeof(FileHeader)) fail_input(p, 12, "header_size must be 64");
   if (header_.file_size != size)
     fail_input(p, 16,
@@ -149,7 +163,14 @@ void VxlFile::validate() {
   };
   auto dirs = expect_size("DIRS", mul(m.stored_order_count, sizeof(DirectionEntry)), "stored_order_count × 16");
   auto voxt = expect_size("VOXT", mul(m.voxel_count, sizeof(VoxelEntry)), "voxel_count × 64");
-  auto vert = expect_size("VERT", mul(m.vertex_count, 12), "vertex_count × 12");
+  // Positions (spec §5.4): float32 in every 1.x file, either encoding in 2.0.
+  const bool packed = m.position_encoding == static_cast<std::uint32_t>(PositionEncoding::Packed);
+  if (m.position_encoding > static_cast<std::uint32_t>(PositionEncoding::Packed))
+    fail_input(p, meta_at + 152, "unknown position encoding " + std::to_string(m.position_encoding));
+  if (packed && header_.version_major < kVxlVersionMajorPackedPositions)
+    fail_input(p, meta_at + 152, "packed positions in a version 1 file (they need version 2.0)");
+  auto vert = packed ? expect_size("VERT", mul(m.vertex_count, 4), "vertex_count × 4 (packed positions)")
+                     : expect_size("VERT", mul(m.vertex_count, 12), "vertex_count × 12");
   auto vxln = expect_size("VXLN", mul(m.voxline_count, sizeof(VoxlineEntry)), "voxline_count × 8");
   std::optional<std::uint64_t> strm_size =
       m.streamline_count == std::numeric_limits<std::uint64_t>::max() ? std::nullopt : mul(m.streamline_count + 1, 8);
@@ -166,7 +187,10 @@ void VxlFile::validate() {
   }
   directions_ = {reinterpret_cast<const DirectionEntry*>(dirs.data()), m.stored_order_count};
   voxels_ = {reinterpret_cast<const VoxelEntry*>(voxt.data()), m.voxel_count};
-  vertices_ = {reinterpret_cast<const float*>(vert.data()), m.vertex_count * 3};
+  if (packed)
+    packed_vertices_ = {reinterpret_cast<const std::uint32_t*>(vert.data()), m.vertex_count};
+  else
+    float_vertices_ = {reinterpret_cast<const float*>(vert.data()), m.vertex_count * 3};
   voxlines_ = {reinterpret_cast<const VoxlineEntry*>(vxln.data()), m.voxline_count};
   strm_ = {reinterpret_cast<const std::uint64_t*>(strm.data()), m.streamline_count + 1};
   auto prov = section("PROV", false);
@@ -195,6 +219,13 @@ void VxlFile::validate() {
       fail_input(p, at + 12, "voxel flags must hold the order width code for its vertex count");
     if (v.vertex_count < 1) fail_input(p, at + 48, "voxel with no vertices");
     if (v.segment_count >= v.vertex_count) fail_input(p, at + 52, "voxel has as many segments as vertices");
+    // Packed positions are decoded from the tight bounds: they must give finite values (spec §5.4).
+    if (packed)
+      for (int c = 0; c < 3; ++c)
+        if (!std::isfinite(v.tight_min[c]) || !std::isfinite(v.tight_max[c]) || !(v.tight_min[c] <= v.tight_max[c]) ||
+            !std::isfinite(v.tight_max[c] - v.tight_min[c]))
+          fail_input(p, at + 16 + 4 * c,
+                     "voxel " + std::to_string(i) + " tight bounds are not finite and ordered (packed positions)");
     if (v.vertex_first != next_vertex) fail_input(p, at + 40, "voxel vertex blocks are not contiguous");
     next_vertex += v.vertex_count;
     if (next_vertex > m.vertex_count) fail_input(p, at + 48, "voxel vertex block runs past vertex_count");

@@ -17,6 +17,7 @@
 
 #include "format/mapped_file.h"
 #include "format/vxl_layout.h"
+#include "format/vxl_positions.h"
 #include "format/vxl_value_sets.h"
 #include "format/vxl_writer.h"
 
@@ -56,7 +57,15 @@ class VxlFile {
     return voxel_directions_.subspan(voxel * directions_.size(), directions_.size());
   }
   std::span<const VoxelEntry> voxels() const { return voxels_; }
-  std::span<const float> vertices() const { return vertices_; }  // 3 * vertex_count
+  // VERT (spec §5.4): float32 triples (3 * vertex_count) or packed words (vertex_count), by encoding; the
+  // span of the other encoding is empty. read_vertices decodes either.
+  PositionEncoding position_encoding() const { return static_cast<PositionEncoding>(meta_.position_encoding); }
+  std::span<const float> float_vertices() const { return float_vertices_; }
+  std::span<const std::uint32_t> packed_vertices() const { return packed_vertices_; }
+  // Vertices [first, first + count) of voxel `voxel`'s block (global indices), as 3 * count floats.
+  void read_vertices(std::size_t voxel, std::uint64_t first, std::uint64_t count, float* xyz) const;
+  // Every vertex, decoded (3 * vertex_count floats): for tools and tests; the viewer reads by voxel.
+  std::vector<float> all_vertices() const;
   std::span<const std::uint8_t> order_bytes() const { return orders_; }
   OrderView order(std::size_t voxel, std::uint32_t k) const;
   std::span<const VoxlineEntry> voxlines() const { return voxlines_; }
@@ -84,7 +93,8 @@ class VxlFile {
   std::span<const DirectionEntry> directions_;
   std::span<const DirectionEntry> voxel_directions_;
   std::span<const VoxelEntry> voxels_;
-  std::span<const float> vertices_;
+  std::span<const float> float_vertices_;
+  std::span<const std::uint32_t> packed_vertices_;
   std::span<const std::uint8_t> orders_;
   std::span<const VoxlineEntry> voxlines_;
   std::span<const std::uint64_t> strm_;

@@ -1,4 +1,4 @@
-// On-disk structures of the .vxl format, version 1.0 (spec/vxl-format-v1.md is the reference; section
+// On-disk structures of the .vxl format, versions 1.0 to 2.0 (spec/vxl-format.md is the reference; section
 // numbers below point into it). All little-endian; every struct's layout is pinned by static_asserts so
 // a file can be used in place after mmap.
 #pragma once
@@ -16,9 +16,10 @@ inline constexpr std::array<std::uint8_t, 8> kVxlMagic = {0x89, 'V', 'X', 'L', '
 inline constexpr std::uint16_t kVxlVersionMajor = 1;
 inline constexpr std::uint16_t kVxlVersionMinor = 0;
 // Files with per-voxel directions (VDIR, spec §5.10) are version 1.1; files with value sets (VVAL, SVAL,
-// spec §5.11) are 1.2; all others stay 1.0 (spec §10).
+// spec §5.11) are 1.2; all others stay 1.0; files with packed positions (spec §5.4) are 2.0 (spec §10).
 inline constexpr std::uint16_t kVxlVersionMinorVoxelDirections = 1;
 inline constexpr std::uint16_t kVxlVersionMinorValueSets = 2;
+inline constexpr std::uint16_t kVxlVersionMajorPackedPositions = 2;
 inline constexpr std::uint64_t kVxlAlignment = 64;
 inline constexpr std::uint32_t kVxlMaxSections = 64;
 inline constexpr std::uint32_t kVxlMaxStoredOrders = 64;
@@ -75,14 +76,16 @@ struct MetaSection {
   std::uint32_t order_set;
   double bounds_min[3];
   double bounds_max[3];
-  std::uint8_t reserved[104];
+  std::uint32_t position_encoding;  // PositionEncoding (vxl_positions.h); 0 in every 1.x file
+  std::uint8_t reserved[100];
 };
 static_assert(sizeof(MetaSection) == 256);
 static_assert(offsetof(MetaSection, voxel_size) == 56);
 static_assert(offsetof(MetaSection, grid_dims) == 88);
 static_assert(offsetof(MetaSection, order_set) == 100);
 static_assert(offsetof(MetaSection, bounds_min) == 104);
-static_assert(offsetof(MetaSection, reserved) == 152);
+static_assert(offsetof(MetaSection, position_encoding) == 152);
+static_assert(offsetof(MetaSection, reserved) == 156);
 
 // §5.2
 struct DirectionEntry {

@@ -5,7 +5,8 @@
 
 namespace vxl {
 
-VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path) {
+VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes& sizes)
+    : out_(path), positions_(sizes.positions) {
   VxlLayout layout = plan_vxl_layout(sizes);
   table_ = std::move(layout.table);
   file_size_ = layout.file_size;
@@ -43,7 +44,7 @@ void VxlStreamWriter::commit() {
       throw std::logic_error("VxlStreamWriter::commit: section " + std::string(table_[i].id, 4) + " is incomplete");
     table_[i].checksum = checksums_[i]->digest();
   }
-  std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_size_);
+  std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_size_, positions_);
   out_.pwrite(header.data(), header.size(), 0);
   out_.commit();
 }

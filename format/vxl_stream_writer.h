@@ -48,6 +48,7 @@ class VxlStreamWriter {
 
  private:
   AtomicOutputFile out_;
+  PositionEncoding positions_;
   std::vector<SectionEntry> table_;   // in Section order, optional sections (VDIR, GRPS) only when present
   std::size_t entry_[kSectionCount];  // Section -> index in table_ (table_.size(): absent)
   std::uint64_t file_size_ = 0;

@@ -1,5 +1,6 @@
 #include "format/vxl_streamlines.h"
 
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -13,7 +14,7 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   auto voxels = f.voxels();
   auto voxlines = f.voxlines();
   auto strm = f.streamline_first_voxline();
-  auto vertices = f.vertices();
+  const bool packed = f.position_encoding() == PositionEncoding::Packed;
   const std::uint64_t strm_at = f.find_section(section_id("STRM"))->offset;
   const std::uint64_t vxln_at = f.find_section(section_id("VXLN"))->offset;
 
@@ -23,15 +24,25 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
 
   std::vector<std::uint64_t> cursor(voxels.size());
   for (std::size_t i = 0; i < voxels.size(); ++i) cursor[i] = voxels[i].vertex_first;
-  std::vector<float> points;
+  std::vector<float> points, block;
   std::uint64_t total_points = 0, synthetic = 0;
+  // A connecting vertex and the next voxline's first point are one source point, stored in two voxels'
+  // blocks: equal bit for bit as float32, within both voxels' error bounds when packed (spec §5.4).
+  auto same_point = [&](const float* a, std::uint32_t voxel_a, const float* b, std::uint32_t voxel_b) {
+    if (!packed) return std::memcmp(a, b, 12) == 0;
+    const double tolerance = packed_error_bound(voxels[voxel_a]) + packed_error_bound(voxels[voxel_b]);
+    for (int c = 0; c < 3; ++c)
+      if (!(std::abs(double(a[c]) - double(b[c])) <= tolerance)) return false;
+    return true;
+  };
 
   for (std::uint64_t s = 0; s < m.streamline_count; ++s) {
     const std::uint64_t first = strm[s], last = strm[s + 1];
     if (last < first || last > m.voxline_count)
       fail_input(p, strm_at + 8 * (s + 1), "streamline table not non-decreasing");
     points.clear();
-    const float* pending_connector = nullptr;  // previous voxline's connecting vertex
+    float pending_connector[3];  // previous voxline's connecting vertex, when `connector_voxel` is set
+    std::int64_t connector_voxel = -1;
     for (std::uint64_t j = first; j < last; ++j) {
       const VoxlineEntry& e = voxlines[j];
       const std::uint64_t at = vxln_at + 8 * j;
@@ -44,15 +55,18 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
       const std::uint64_t end = v.vertex_first + v.vertex_count;
       const std::uint64_t need = std::uint64_t(own) + (connected ? 1 : 0);
       if (need > end - cursor[e.voxel]) fail_input(p, at, "voxline runs past its voxel's vertex block");
-      const float* block = vertices.data() + 3 * cursor[e.voxel];
-      if (pending_connector && std::memcmp(pending_connector, block, 12) != 0)
+      block.resize(3 * need);
+      f.read_vertices(e.voxel, cursor[e.voxel], need, block.data());
+      if (connector_voxel >= 0 &&
+          !same_point(pending_connector, static_cast<std::uint32_t>(connector_voxel), block.data(), e.voxel))
         fail_input(p, at, "connecting vertex differs from the next voxline's first point");
       if (synthetic_first && j == first) fail_input(p, at, "a streamline cannot start with a synthetic point");
       if (cb.voxline) cb.voxline(e.voxel, cursor[e.voxel], own, connected);
       const std::uint32_t skip = synthetic_first ? 1 : 0;
       synthetic += skip;
-      points.insert(points.end(), block + 3 * skip, block + 3 * own);
-      pending_connector = connected ? block + 3 * own : nullptr;
+      points.insert(points.end(), block.begin() + 3 * skip, block.begin() + 3 * own);
+      connector_voxel = connected ? std::int64_t(e.voxel) : -1;
+      if (connected) std::copy_n(block.begin() + 3 * own, 3, pending_connector);
       cursor[e.voxel] += need;
     }
     total_points += points.size() / 3;

@@ -54,7 +54,7 @@ void check_meta_and_dirs(const VxlFile& f) {
   const std::string& p = f.path();
   const MetaSection& m = f.meta();
   const std::uint64_t meta_at = f.find_section(section_id("META"))->offset;
-  if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 152, "META reserved bytes are not zero");
+  if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 156, "META reserved bytes are not zero");
   auto check_unit = [&](std::span<const DirectionEntry> dirs, const char(&id)[5]) {
     const std::uint64_t at = f.find_section(section_id(id))->offset;
     for (std::size_t k = 0; k < dirs.size(); ++k) {
@@ -74,8 +74,10 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
   const std::string& p = f.path();
   const std::uint64_t ordr_at = f.find_section(section_id("ORDR"))->offset;
   auto voxels = f.voxels();
-  auto vertices = f.vertices();
+  const std::uint64_t vert_at = f.find_section(section_id("VERT"))->offset;
+  auto packed = f.packed_vertices();
   std::vector<std::uint8_t> seen;
+  std::vector<float> block;
   for (std::size_t i = 0; i < voxels.size(); ++i) {
     const VoxelEntry& v = voxels[i];
     const std::uint64_t at = ordr_at + v.order_offset;
@@ -84,6 +86,16 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
     if (starts != v.segment_count)
       fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i,
                  "voxel " + std::to_string(i) + " segment count does not match its voxlines");
+    // Packed words: the voxline-end bit exactly where no segment starts, the reserved bit clear (§5.4).
+    if (!packed.empty())
+      for (std::uint64_t g = v.vertex_first; g < v.vertex_first + v.vertex_count; ++g) {
+        const bool end = (packed[g] & kPackedVoxlineEnd) != 0;
+        if ((packed[g] & kPackedReservedBit) != 0 || end == (is_segment_start[g] != 0))
+          fail_input(p, vert_at + 4 * g,
+                     "packed vertex " + std::to_string(g) + ": voxline-end bit wrong or reserved bit set");
+      }
+    block.resize(3 * std::uint64_t(v.vertex_count));
+    f.read_vertices(i, v.vertex_first, v.vertex_count, block.data());
     for (std::uint32_t k = 0; k < f.meta().stored_order_count; ++k) {
       const DirectionEntry& dir = f.directions_of(i)[k];
       OrderView o = f.order(i, k);
@@ -97,7 +109,7 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
               p, at,
               "voxel " + std::to_string(i) + " order " + std::to_string(k) + " is not a permutation of its segments");
         seen[e] = 1;
-        const float* a = vertices.data() + 3 * (v.vertex_first + e);
+        const float* a = block.data() + 3 * std::uint64_t(e);
         double key = 0;
         for (int c = 0; c < 3; ++c) key += (double(a[c]) + double(a[c + 3])) * double(dir.xyz[c]);
         if (n > 0 && (key < previous_key || (key == previous_key && e < previous_entry)))

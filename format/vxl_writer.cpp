@@ -36,7 +36,8 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
   s.directions = std::uint64_t(m.stored_order_count) * sizeof(DirectionEntry);
   if (m.order_set == static_cast<std::uint32_t>(OrderSet::Random)) s.voxel_directions = m.voxel_count * s.directions;
   s.voxels = std::uint64_t(m.voxel_count) * sizeof(VoxelEntry);
-  s.vertices = m.vertex_count * 3 * sizeof(float);
+  s.positions = static_cast<PositionEncoding>(m.position_encoding);
+  s.vertices = m.vertex_count * vertex_bytes(s.positions);
   s.orders = order_bytes;
   s.voxlines = m.voxline_count * sizeof(VoxlineEntry);
   s.streamlines = (m.streamline_count + 1) * sizeof(std::uint64_t);
@@ -98,19 +99,22 @@ VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
   return layout;
 }
 
-std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size) {
+std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size,
+                                           PositionEncoding positions) {
   FileHeader h{};
   std::memcpy(h.magic, kVxlMagic.data(), 8);
-  h.version_major = kVxlVersionMajor;
+  const bool packed = positions == PositionEncoding::Packed;
+  h.version_major = packed ? kVxlVersionMajorPackedPositions : kVxlVersionMajor;
   // The lowest version that holds what is written (spec §10).
   const bool has_vdir =
       std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "VDIR", 4) == 0; });
   const bool has_values = std::any_of(table.begin(), table.end(), [](const SectionEntry& e) {
     return std::memcmp(e.id, "VVAL", 4) == 0 || std::memcmp(e.id, "SVAL", 4) == 0;
   });
-  h.version_minor = has_values ? kVxlVersionMinorValueSets
-                    : has_vdir ? kVxlVersionMinorVoxelDirections
-                               : kVxlVersionMinor;
+  h.version_minor = packed       ? 0
+                    : has_values ? kVxlVersionMinorValueSets
+                    : has_vdir   ? kVxlVersionMinorVoxelDirections
+                                 : kVxlVersionMinor;
   h.header_size = sizeof(FileHeader);
   h.file_size = file_size;
   h.section_table_offset = sizeof(FileHeader);
@@ -125,7 +129,7 @@ std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, 
   return bytes;
 }
 
-VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path) {
+VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path), positions_(sizes.positions) {
   VxlLayout layout = plan_vxl_layout(sizes);
   table_ = std::move(layout.table);
   file_ = out_.map(layout.file_size);
@@ -167,7 +171,7 @@ void VxlWriter::commit(unsigned threads) {
     e.checksum = xxh3_64(file_.data() + e.offset, e.size);
   });
 
-  std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_.size());
+  std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_.size(), positions_);
   std::memcpy(file_.data(), header.data(), header.size());
   file_ = {};
   out_.commit();
@@ -181,7 +185,9 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   if (c.meta.order_set == static_cast<std::uint32_t>(OrderSet::Random))
     sizes.voxel_directions = c.voxel_directions.size_bytes();
   sizes.voxels = c.voxels.size_bytes();
-  sizes.vertices = c.vertices.size_bytes();
+  sizes.positions = static_cast<PositionEncoding>(c.meta.position_encoding);
+  sizes.vertices =
+      sizes.positions == PositionEncoding::Packed ? c.packed_vertices.size_bytes() : c.vertices.size_bytes();
   sizes.orders = c.orders.size_bytes();
   sizes.voxlines = c.voxlines.size_bytes();
   sizes.streamlines = c.streamline_first_voxline.size_bytes();
@@ -196,7 +202,8 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   copy(w.directions(), c.directions.data());
   copy(w.voxel_directions(), c.voxel_directions.data());
   copy(w.voxels(), c.voxels.data());
-  copy(w.vertices(), c.vertices.data());
+  copy(w.float_vertices(), c.vertices.data());
+  copy(w.packed_vertices(), c.packed_vertices.data());
   copy(w.orders(), c.orders.data());
   copy(w.voxlines(), c.voxlines.data());
   copy(w.streamline_first_voxline(), c.streamline_first_voxline.data());

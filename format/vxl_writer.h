@@ -13,6 +13,7 @@
 
 #include "format/atomic_output.h"
 #include "format/vxl_layout.h"
+#include "format/vxl_positions.h"
 
 namespace vxl {
 
@@ -24,10 +25,11 @@ struct VxlSectionSizes {
   std::uint64_t provenance = 0;
   std::uint64_t groups = 0;                                // 0: no GRPS section
   std::uint64_t vertex_values = 0, streamline_values = 0;  // VVAL, SVAL (spec §5.11); 0: absent
+  PositionEncoding positions = PositionEncoding::Float32;  // how VERT holds them (spec §5.4); sets the version
 };
 
-// The sizes spec §5 gives for the counts in `meta` (stored_order_count included; a VDIR section when
-// order_set is random; VVAL / SVAL sections holding that many value sets, none when 0).
+// The sizes spec §5 gives for the counts in `meta` (stored_order_count and position_encoding included; a
+// VDIR section when order_set is random; VVAL / SVAL sections holding that many value sets, none when 0).
 VxlSectionSizes section_sizes(const MetaSection& meta, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
                               std::uint64_t group_bytes, std::uint32_t vertex_value_sets = 0,
                               std::uint32_t streamline_value_sets = 0);
@@ -43,9 +45,10 @@ struct VxlLayout {
 VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes);
 
 // The bytes of the header and the section table (spec §3, §4), once every checksum in `table` is set.
-// The version is the lowest that holds the table (spec §10): 1.2 with VVAL or SVAL, else 1.1 with VDIR,
-// else 1.0.
-std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size);
+// The version is the lowest that holds what is written (spec §10): 2.0 with packed positions, else 1.2
+// with VVAL or SVAL, else 1.1 with VDIR, else 1.0.
+std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size,
+                                           PositionEncoding positions);
 
 class VxlWriter {
  public:
@@ -61,7 +64,14 @@ class VxlWriter {
   // voxel_count x K entries; empty when there is no VDIR section.
   std::span<DirectionEntry> voxel_directions() { return typed<DirectionEntry>(kVdir); }
   std::span<VoxelEntry> voxels() { return typed<VoxelEntry>(kVoxt); }
-  std::span<float> vertices() { return typed<float>(kVert); }
+  // VERT as float32 triples, or as packed words (spec §5.4): the one the sizes were planned for, the
+  // other empty.
+  std::span<float> float_vertices() {
+    return positions_ == PositionEncoding::Float32 ? typed<float>(kVert) : std::span<float>{};
+  }
+  std::span<std::uint32_t> packed_vertices() {
+    return positions_ == PositionEncoding::Packed ? typed<std::uint32_t>(kVert) : std::span<std::uint32_t>{};
+  }
   std::span<std::uint8_t> orders() { return payload(kOrdr); }
   std::span<VoxlineEntry> voxlines() { return typed<VoxlineEntry>(kVxln); }
   std::span<std::uint64_t> streamline_first_voxline() { return typed<std::uint64_t>(kStrm); }
@@ -96,6 +106,7 @@ class VxlWriter {
 
   AtomicOutputFile out_;
   std::vector<SectionEntry> table_;  // in Index order, optional sections only when present
+  PositionEncoding positions_;
   bool vertices_checksummed_ = false;
   std::span<std::uint8_t> file_;
 };
@@ -107,12 +118,14 @@ struct GroupContent {
 
 // Everything a .vxl holds, in memory. The caller fills `meta` (counts must match the spans; reserved
 // bytes are zeroed by the writer) and guarantees the invariants of spec §5 (the reader re-checks them).
+// VERT is `vertices` when meta.position_encoding is float32, else `packed_vertices`.
 struct VxlContent {
   MetaSection meta{};
   std::span<const DirectionEntry> directions;
   std::span<const DirectionEntry> voxel_directions;  // VDIR, written when meta.order_set is random
   std::span<const VoxelEntry> voxels;
-  std::span<const float> vertices;  // 3 * vertex_count
+  std::span<const float> vertices;                 // 3 * vertex_count
+  std::span<const std::uint32_t> packed_vertices;  // vertex_count
   std::span<const std::uint8_t> orders;
   std::span<const VoxlineEntry> voxlines;
   std::span<const std::uint64_t> streamline_first_voxline;  // N + 1

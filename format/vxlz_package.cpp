@@ -72,6 +72,7 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   PackSection pack = c.pack;
   std::memset(pack.reserved, 0, sizeof pack.reserved);
   MetaSection meta = c.meta;
+  meta.position_encoding = 0;  // the package's positions are its own; the unpacker chooses the .vxl's
   std::memset(meta.reserved, 0, sizeof meta.reserved);
   const std::vector<std::uint8_t> pack_bytes = bytes_of(pack), meta_bytes = bytes_of(meta);
   // POSD is the chunks' buffers back to back: written from them, never gathered into one copy.
@@ -261,7 +262,9 @@ void VxlzFile::validate() {
 
   const std::uint64_t meta_at = fixed("META", sizeof meta_, &meta_);
   const MetaSection& m = meta_;
-  if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 152, "META reserved bytes are not zero");
+  // The package's copy of META carries no position encoding: its positions are its own (spec §5).
+  if (m.position_encoding != 0 || !all_zero(m.reserved, sizeof m.reserved))
+    fail_input(p, meta_at + 152, "META reserved bytes are not zero");
   if (!std::isfinite(m.voxel_size) || !(m.voxel_size > 0))
     fail_input(p, meta_at + 56, "voxel size must be finite and positive");
   if (m.stored_order_count < 1 || m.stored_order_count > kVxlMaxStoredOrders)

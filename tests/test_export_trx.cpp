@@ -38,8 +38,11 @@ Tractogram grouped_tractogram() {
   return t;
 }
 
+// float32 positions: the exports below are compared with the source bit for bit.
 std::string convert_to(Tractogram t, const std::string& path) {
-  convert_tractogram(std::move(t), path, {});
+  ConvertSettings exact;
+  exact.positions = PositionEncoding::Float32;
+  convert_tractogram(std::move(t), path, exact);
   return path;
 }
 

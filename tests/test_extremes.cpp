@@ -51,16 +51,20 @@ std::vector<float> walk_points(const VxlFile& f) {
   return out;
 }
 
+// float32 positions keep every coordinate bit for bit, however far out; packed ones stay within their
+// bound there (test_packed_positions.cpp).
 TEST(Extremes, FarFromTheOriginKeepsEveryCoordinateAndTheSameVoxels) {
   ScratchDir dir;
-  convert_tractogram(shifted(0), dir.file("origin.vxl"), {});
+  ConvertSettings exact;
+  exact.positions = PositionEncoding::Float32;
+  convert_tractogram(shifted(0), dir.file("origin.vxl"), exact);
   VxlFile base = VxlFile::open(dir.file("origin.vxl"));
   for (double offset : {1e5, -1e5, 1e6, -1e6}) {
     SCOPED_TRACE(offset);
     Tractogram t = shifted(offset);
     const std::vector<float> expected = t.positions;
     const std::string path = dir.file("far.vxl");
-    convert_tractogram(std::move(t), path, {});
+    convert_tractogram(std::move(t), path, exact);
     VerifyResult r = verify_vxl(path);
     ASSERT_TRUE(r.valid) << r.problem;
     VxlFile f = VxlFile::open(path);
@@ -130,7 +134,9 @@ TEST(Extremes, OneStreamlineOfTenMillionPoints) {
   }
   t.offsets = {0, 10'000'000};
   const std::vector<float> expected = t.positions;
-  convert_tractogram(std::move(t), dir.file("long.vxl"), {});
+  ConvertSettings exact;
+  exact.positions = PositionEncoding::Float32;  // compared bit for bit below
+  convert_tractogram(std::move(t), dir.file("long.vxl"), exact);
   VxlFile f = VxlFile::open(dir.file("long.vxl"));
   EXPECT_EQ(f.meta().point_count, 10'000'000u);
   EXPECT_EQ(f.meta().streamline_count, 1u);
@@ -231,12 +237,12 @@ TEST(Extremes, CountsAndOffsetsAreSixtyFourBitBeyondTwoToTheThirtyTwo) {
   VxlFile f = VxlFile::open(path);
   EXPECT_EQ(f.meta().vertex_count, vertices);
   EXPECT_GT(f.meta().vertex_count, std::uint64_t(1) << 32);
-  EXPECT_EQ(f.vertices().size(), 3 * vertices);
+  EXPECT_EQ(f.float_vertices().size(), 3 * vertices);
   EXPECT_EQ(f.voxels()[1].vertex_first, first_count);
   EXPECT_EQ(f.order(1, 2).width, 2u);
   EXPECT_EQ(f.order(0, 0).width, 4u);
   // The last vertex is addressable (a hole reads as zeros).
-  EXPECT_EQ(f.vertices()[3 * vertices - 1], 0.0f);
+  EXPECT_EQ(f.float_vertices()[3 * vertices - 1], 0.0f);
 }
 
 // A conversion killed at any moment leaves nothing at the output path (nor a temporary beside it).

@@ -39,7 +39,8 @@ TEST_P(RealFixture, HasItsOutcome) {
   if (!std::filesystem::exists(src)) GTEST_SKIP() << name << " is not in this copy of the fixtures";
   ScratchDir dir;
   const std::string vxl = dir.file("out.vxl"), back = dir.file("back.tck");
-  auto convert = run_cli("convert '" + src + "' '" + vxl + "' --voxel-size 10");
+  // float32 positions: the round trip below is bit for bit (packed ones are checked against their bound).
+  auto convert = run_cli("convert '" + src + "' '" + vxl + "' --voxel-size 10 --positions float32");
   switch (expected_outcomes().at(name)) {
     case Outcome::RoundTrip: {
       ASSERT_EQ(convert.exit_code, 0) << convert.output;
@@ -55,6 +56,24 @@ TEST_P(RealFixture, HasItsOutcome) {
       EXPECT_TRUE(original.positions.empty() ||
                   std::memcmp(round.positions.data(), original.positions.data(), 4 * original.positions.size()) == 0)
           << "coordinates differ after the round trip";
+
+      // Packed positions (the default): every point comes back within the bound the file states.
+      const std::string packed = dir.file("packed.vxl"), packed_back = dir.file("packed.tck");
+      ASSERT_EQ(run_cli("convert '" + src + "' '" + packed + "' --voxel-size 10").exit_code, 0);
+      auto packed_verify = run_cli("verify '" + packed + "'");
+      ASSERT_EQ(packed_verify.exit_code, 0) << packed_verify.output;
+      ASSERT_EQ(run_cli("export '" + packed + "' '" + packed_back + "'").exit_code, 0);
+      double bound = 0;
+      const VxlFile packed_file = VxlFile::open(packed);
+      EXPECT_EQ(packed_file.position_encoding(), PositionEncoding::Packed);
+      for (const VoxelEntry& v : packed_file.voxels()) bound = std::max(bound, packed_error_bound(v));
+      const Tractogram near = read_tck(packed_back);
+      EXPECT_EQ(near.offsets, original.offsets);
+      ASSERT_EQ(near.positions.size(), original.positions.size());
+      double worst = 0;
+      for (std::size_t k = 0; k < near.positions.size(); ++k)
+        worst = std::max(worst, std::abs(double(near.positions[k]) - double(original.positions[k])));
+      EXPECT_LE(worst, bound) << "packed positions beyond their stated bound";
       break;
     }
     case Outcome::BadInput:
@@ -102,10 +121,10 @@ void expect_same_voxel_contents(const std::vector<std::string>& names) {
       ASSERT_EQ(x.vertex_count, y.vertex_count) << "voxel " << v;
       ASSERT_EQ(x.segment_count, y.segment_count) << "voxel " << v;
     }
-    ASSERT_EQ(a.vertices().size(), b.vertices().size());
+    const std::vector<float> xa = a.all_vertices(), xb = b.all_vertices();
+    ASSERT_EQ(xa.size(), xb.size());
     float worst = 0;
-    for (std::size_t k = 0; k < a.vertices().size(); ++k)
-      worst = std::max(worst, std::abs(a.vertices()[k] - b.vertices()[k]));
+    for (std::size_t k = 0; k < xa.size(); ++k) worst = std::max(worst, std::abs(xa[k] - xb[k]));
     EXPECT_LT(worst, 1e-3f);
   }
 }

@@ -27,6 +27,12 @@ inline std::vector<char> slurp(const std::string& path) {
   return {std::istreambuf_iterator<char>(in), {}};
 }
 
+// Writes `bytes` to `path`, replacing it.
+inline void write_file(const std::string& path, const std::vector<char>& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
 // The real-world fixtures (../shared/data/real). A user's clone does not have them: tests that need
 // them call this first and are skipped with a clear message.
 inline std::filesystem::path real_data_dir() { return VOXLINES_REAL_DATA_DIR; }

@@ -1,5 +1,6 @@
 // The .vxl container: write -> open -> verify, and detection of every single-byte change and every
-// truncation (spec §7).
+// truncation (spec §7), for both position encodings (spec §5.4).
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -42,11 +43,12 @@ void dump(const std::string& p, const std::vector<char>& bytes, std::size_t n) {
   std::ofstream(p, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(n));
 }
 
-class VxlFormat : public ::testing::Test {
+class VxlFormat : public ::testing::TestWithParam<PositionEncoding> {
  protected:
   void SetUp() override {
     ConvertSettings s;
     s.voxel_size = 8;
+    s.positions = GetParam();
     convert_tractogram(small_tractogram(), path(), s);
   }
   std::string path() const { return dir.file("small.vxl"); }
@@ -70,10 +72,16 @@ TEST(VxlGroups, AGroupWithoutMembersIsKept) {
   EXPECT_TRUE(verify_vxl(dir.file("g.vxl")).valid);
 }
 
-TEST_F(VxlFormat, RoundTripThroughTheWalk) {
+TEST_P(VxlFormat, RoundTripThroughTheWalk) {
   VerifyResult r = verify_vxl(path());
   ASSERT_TRUE(r.valid) << r.problem;
   VxlFile f = VxlFile::open(path());
+  const bool packed = GetParam() == PositionEncoding::Packed;
+  // The lowest version that holds the file (spec §10): packed positions need 2.0.
+  EXPECT_EQ(f.header().version_major, packed ? 2 : 1);
+  EXPECT_EQ(f.header().version_minor, 0);
+  EXPECT_EQ(f.position_encoding(), GetParam());
+  EXPECT_EQ(f.find_section(section_id("VERT"))->size, f.meta().vertex_count * (packed ? 4 : 12));
   EXPECT_EQ(f.header().file_size % 64, 0u);
   for (const SectionEntry& e : f.sections()) EXPECT_EQ(e.offset % 64, 0u);
   Tractogram expected = small_tractogram();
@@ -84,15 +92,25 @@ TEST_F(VxlFormat, RoundTripThroughTheWalk) {
                          offsets.push_back(got.size() / 3);
                        },
                        {}});
-  EXPECT_EQ(got, expected.positions);
   EXPECT_EQ(offsets, expected.offsets);
+  if (!packed) {
+    EXPECT_EQ(got, expected.positions);
+  } else {
+    double bound = 0, worst = 0;
+    for (const VoxelEntry& v : f.voxels()) bound = std::max(bound, packed_error_bound(v));
+    ASSERT_EQ(got.size(), expected.positions.size());
+    for (std::size_t k = 0; k < got.size(); ++k)
+      worst = std::max(worst, std::abs(double(got[k]) - double(expected.positions[k])));
+    EXPECT_LE(worst, bound);
+    EXPECT_GT(worst, 0.0) << "8 mm voxels at 10 bits cannot hold these coordinates exactly";
+  }
   EXPECT_GT(f.meta().synthetic_point_count, 0u);
   auto groups = f.groups();
   ASSERT_EQ(groups.size(), 1u);
   EXPECT_EQ(groups[0].members, (std::vector<std::uint64_t>{0, 3, 14}));
 }
 
-TEST_F(VxlFormat, EverySingleByteChangeIsDetected) {
+TEST_P(VxlFormat, EverySingleByteChangeIsDetected) {
   std::vector<char> good = slurp(path());
   ASSERT_GT(good.size(), 1000u);
   std::string bad = dir.file("bad.vxl");
@@ -116,7 +134,7 @@ TEST_F(VxlFormat, EverySingleByteChangeIsDetected) {
   }
 }
 
-TEST_F(VxlFormat, EveryTruncationIsRefused) {
+TEST_P(VxlFormat, EveryTruncationIsRefused) {
   std::vector<char> good = slurp(path());
   std::string bad = dir.file("bad.vxl");
   for (std::size_t n = 0; n < good.size(); n += (n < 256 ? 1 : 7)) {
@@ -126,28 +144,30 @@ TEST_F(VxlFormat, EveryTruncationIsRefused) {
   }
 }
 
-TEST_F(VxlFormat, NewerMajorVersionIsUnsupported) {
+TEST_P(VxlFormat, NewerMajorVersionIsUnsupported) {
   std::vector<char> b = slurp(path());
-  b[8] = 2;
-  dump(dir.file("v2.vxl"), b, b.size());
+  b[8] = 3;
+  dump(dir.file("v3.vxl"), b, b.size());
   try {
-    VxlFile::open(dir.file("v2.vxl"));
+    VxlFile::open(dir.file("v3.vxl"));
     FAIL();
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
   }
 }
 
-TEST_F(VxlFormat, EmptyTractogramMakesAValidFile) {
+TEST_P(VxlFormat, EmptyTractogramMakesAValidFile) {
   Tractogram t;
   t.source.path = "empty.tck";
-  convert_tractogram(std::move(t), dir.file("empty.vxl"), {});
+  ConvertSettings s;
+  s.positions = GetParam();
+  convert_tractogram(std::move(t), dir.file("empty.vxl"), s);
   VerifyResult r = verify_vxl(dir.file("empty.vxl"));
   EXPECT_TRUE(r.valid) << r.problem;
   EXPECT_EQ(VxlFile::open(dir.file("empty.vxl")).meta().voxel_count, 0u);
 }
 
-TEST_F(VxlFormat, FailedConversionLeavesNoOutput) {
+TEST_P(VxlFormat, FailedConversionLeavesNoOutput) {
   Tractogram t = small_tractogram();
   t.positions[5] = NAN;
   EXPECT_THROW(convert_tractogram(std::move(t), dir.file("nan.vxl"), {}), Error);
@@ -155,6 +175,11 @@ TEST_F(VxlFormat, FailedConversionLeavesNoOutput) {
   for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
     EXPECT_EQ(entry.path().filename(), "small.vxl") << "left behind: " << entry.path();
 }
+
+INSTANTIATE_TEST_SUITE_P(Positions, VxlFormat, ::testing::Values(PositionEncoding::Float32, PositionEncoding::Packed),
+                         [](const ::testing::TestParamInfo<PositionEncoding>& info) {
+                           return std::string(position_encoding_name(info.param));
+                         });
 
 }  // namespace
 }  // namespace vxl

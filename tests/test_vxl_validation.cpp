@@ -80,7 +80,23 @@ std::vector<Case> cases() {
   return {
       {"short", [](Bytes& f) { f.b.resize(40); }, "file too short for a .vxl header"},
       {"magic", [](Bytes& f) { f.b[0] ^= 0x20; }, "bad magic"},
-      {"major", [](Bytes& f) { f.set<std::uint16_t>(8, 2); }, "major version 2", ErrorKind::Unsupported},
+      {"major", [](Bytes& f) { f.set<std::uint16_t>(8, 3); }, "major version 3", ErrorKind::Unsupported},
+      // Packed positions (the default the base file was converted with; spec §5.4).
+      {"position_encoding", [](Bytes& f) { f.set<u32>(f.meta() + 152, 2); }, "unknown position encoding 2"},
+      {"packed_in_version_1", [](Bytes& f) { f.set<std::uint16_t>(8, 1); }, "packed positions in a version 1 file"},
+      {"tight_bounds_nan", [](Bytes& f) { f.set<float>(f.voxel(1) + 20, std::nanf("")); },
+       "voxel 1 tight bounds are not finite and ordered"},
+      {"tight_bounds_reversed",
+       [](Bytes& f) {
+         f.set<float>(f.voxel(0) + 16, f.get<float>(f.voxel(0) + 28) + 1.0f);  // min x past max x
+       },
+       "voxel 0 tight bounds are not finite and ordered"},
+      {"tight_bounds_overflow",
+       [](Bytes& f) {
+         f.set<float>(f.voxel(0) + 24, -3e38f);  // max - min overflows binary32
+         f.set<float>(f.voxel(0) + 36, 3e38f);
+       },
+       "voxel 0 tight bounds are not finite and ordered"},
       {"header_size", [](Bytes& f) { f.set<u32>(12, 72); }, "header_size must be 64"},
       {"file_size", [](Bytes& f) { f.set<u64>(16, f.b.size() + 64); }, "truncated or extended file"},
       {"table_offset", [](Bytes& f) { f.set<u64>(24, 128); }, "section table must start at byte 64"},

@@ -90,6 +90,7 @@ void add_convert_command(CLI::App& app) {
           return e.reason();
         }
       });
+  add_positions_option(cmd, opt->settings.positions);
   cmd->add_option(
          "--memory-limit", opt->memory_limit,
          "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): reads the source several times and writes the "

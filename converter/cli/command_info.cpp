@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -52,6 +53,13 @@ void add_info_command(CLI::App& app) {
     j["bounds"] = {{"min", {m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]}},
                    {"max", {m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]}}};
     j["stored_orders"] = m.stored_order_count;
+    // Positions: the encoding and, when packed, the largest error any voxel allows (spec §5.4).
+    j["positions"] = position_encoding_name(f.position_encoding());
+    if (f.position_encoding() == PositionEncoding::Packed) {
+      double bound = 0;
+      for (const VoxelEntry& v : f.voxels()) bound = std::max(bound, packed_error_bound(v));
+      j["position_error_bound_mm"] = bound;
+    }
     nlohmann::json sections = nlohmann::json::array();
     for (const SectionEntry& e : f.sections())
       sections.push_back({{"id", std::string(e.id, 4)}, {"offset", e.offset}, {"bytes", e.size}});
@@ -98,6 +106,11 @@ void add_info_command(CLI::App& app) {
     std::printf("voxel size    %g mm%s\norders        %u stored (x2 by reversal)\n", m.voxel_size,
                 j.contains("voxel_size_choice") ? (" (" + j["voxel_size_choice"].get<std::string>() + ")").c_str() : "",
                 m.stored_order_count);
+    if (j.contains("position_error_bound_mm"))
+      std::printf("positions     packed (10 bits per axis per voxel; error at most %.3g um)\n",
+                  1000 * j["position_error_bound_mm"].get<double>());
+    else
+      std::printf("positions     float32 (exact)\n");
     std::printf("bounds        [%.3f, %.3f, %.3f] .. [%.3f, %.3f, %.3f] mm\nsections     ", m.bounds_min[0],
                 m.bounds_min[1], m.bounds_min[2], m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]);
     for (const SectionEntry& e : f.sections()) std::printf(" %.4s:%llu", e.id, (unsigned long long)e.size);

@@ -2,7 +2,12 @@
 // the work; errors are thrown as vxl::Error and turned into messages and exit codes by main().
 #pragma once
 
+#include <map>
+#include <string>
+
 #include <CLI/CLI.hpp>
+
+#include "format/vxl_positions.h"
 
 namespace vxl::cli {
 
@@ -13,6 +18,20 @@ void add_export_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 void add_pack_command(CLI::App& app);
 void add_unpack_command(CLI::App& app);
+
+// --positions packed|float32, shared by convert and unpack (spec §5.4).
+inline CLI::Option* add_positions_option(CLI::App* cmd, PositionEncoding& positions) {
+  const std::map<std::string, PositionEncoding> names = {{"packed", PositionEncoding::Packed},
+                                                         {"float32", PositionEncoding::Float32}};
+  return cmd
+      ->add_option("--positions", positions,
+                   "how the .vxl stores vertex positions: packed (4 bytes a vertex, 10 bits per axis across each "
+                   "voxel's bounds: within 1/2046 of the voxel's extent, about 5 um at 10 mm; `info` prints the "
+                   "bound) or float32 (12 bytes, the source's coordinates bit for bit)")
+      ->type_name("packed|float32")
+      ->default_str("packed")
+      ->transform(CLI::CheckedTransformer(names));
+}
 
 // Set by a command that wants a specific non-zero exit code without an error message (verify).
 inline int g_exit_code = 0;

@@ -51,7 +51,18 @@ GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels)
     const VxlFile& file = *files_[c.file];
     const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
     GpuTextureSpan g;
-    g.positions.create(GL_R32F, file.vertices().data() + 3 * c.vertex_first, 12 * c.vertex_count);
+    if (file.position_encoding() == PositionEncoding::Float32) {
+      g.positions.create(GL_R32F, file.float_vertices().data() + 3 * c.vertex_first, 12 * c.vertex_count);
+    } else {
+      // Packed positions (spec §5.4) are decoded here, voxel by voxel, for the float32 texture.
+      std::vector<float> xyz(3 * c.vertex_count);
+      parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned) {
+        const std::uint32_t local = c.voxel_first + static_cast<std::uint32_t>(k) - file_first;
+        const VoxelEntry& v = file.voxels()[local];
+        file.read_vertices(local, v.vertex_first, v.vertex_count, xyz.data() + 3 * (v.vertex_first - c.vertex_first));
+      });
+      g.positions.create(GL_R32F, xyz.data(), 12 * c.vertex_count);
+    }
     entries.resize(std::uint64_t(c.slots) * c.segments);
     // Voxels fill disjoint ranges of every slot, so they are widened in parallel.
     std::vector<std::vector<std::uint8_t>> is_start(resolve_threads(0));  // scratch per thread

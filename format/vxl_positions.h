@@ -1,0 +1,41 @@
+// Vertex positions of spec §5.4 in their two encodings: float32 (exact, 12 bytes per vertex) or packed
+// (4 bytes: 10 bits per axis of fixed point across the voxel's tight bounds, plus a voxline-end bit).
+//
+// Packed positions are decoded as lo + q * step in binary32, the multiply and the add rounded apart
+// (this file's .cpp is compiled without floating-point contraction), so that every reader — the
+// converter building orders, verify checking them, the viewer — sees the same coordinates.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "format/vxl_layout.h"
+
+namespace vxl {
+
+enum class PositionEncoding : std::uint32_t { Float32 = 0, Packed = 1 };
+
+inline constexpr std::uint32_t kPackedSteps = 1023;           // 10 bits: q in 0..1023 across [lo, hi]
+inline constexpr std::uint32_t kPackedAxisMask = 0x3FFu;      // bits 0-9 x, 10-19 y, 20-29 z
+inline constexpr std::uint32_t kPackedVoxlineEnd = 1u << 30;  // the last vertex of its voxline
+inline constexpr std::uint32_t kPackedReservedBit = 1u << 31;
+
+constexpr std::uint64_t vertex_bytes(PositionEncoding e) { return e == PositionEncoding::Packed ? 4 : 12; }
+const char* position_encoding_name(PositionEncoding e);  // "packed" or "float32"
+std::optional<PositionEncoding> parse_position_encoding(std::string_view name);
+
+// Quantises one voxel's block: writes each vertex's packed word (end bit clear) into `packed` and replaces
+// its coordinates in `xyz` by the values the word decodes to. The voxel's tight bounds must hold the block.
+void pack_block(const VoxelEntry& voxel, float* xyz, std::uint32_t count, std::uint32_t* packed);
+
+// Decodes `count` packed words of `voxel`'s block into 3 * count floats.
+void unpack_block(const VoxelEntry& voxel, const std::uint32_t* packed, std::uint64_t count, float* xyz);
+
+// The largest distance, per axis, between a vertex of this voxel and its packed decoding (spec §5.4):
+// (hi - lo) * (1/2046 + 2^-21) + 2^-23 * max(|lo|, |hi|) over the voxel's tight bounds, in mm.
+double packed_error_bound(const VoxelEntry& voxel);
+
+}  // namespace vxl

@@ -1,0 +1,197 @@
+// Packed vertex positions (spec §5.4): 10 bits per axis across each voxel's tight bounds. The stated error
+// bound must hold at the extremes — degenerate, tiny and huge boxes, far from the origin — both for the
+// codec alone and for whole conversions; verify must check the voxline-end bit; the CLI chooses.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "converter/convert.h"
+#include "format/vxl_file.h"
+#include "format/vxl_positions.h"
+#include "format/vxl_streamlines.h"
+#include "format/vxl_verify.h"
+#include "tests/reseal_checksums.h"
+#include "tests/test_support.h"
+
+namespace vxl {
+namespace {
+
+using test::run_cli;
+using test::ScratchDir;
+using test::slurp;
+
+// A voxel entry whose tight bounds are the cube [lo, lo + extent] (only the bounds matter to the codec).
+VoxelEntry box(double lo, double extent) {
+  VoxelEntry v{};
+  for (int c = 0; c < 3; ++c) {
+    v.tight_min[c] = static_cast<float>(lo + c * extent / 7);  // a different corner per axis
+    v.tight_max[c] = static_cast<float>(double(v.tight_min[c]) + extent);
+  }
+  return v;
+}
+
+TEST(PackedPositions, EveryPointDecodesWithinTheBoundAtTheExtremes) {
+  std::mt19937 rng(11);
+  int boxes = 0;
+  for (double lo : {0.0, -50.0, 1e5, -1e5, 3e7})
+    for (double extent : {0.0, 1e-6, 1e-3, 1.0, 10.0, 1e3, 1e5}) {
+      const VoxelEntry v = box(lo, extent);
+      // Corners, then random points inside the box (floats, as the converter has them).
+      std::vector<float> exact;
+      for (int corner = 0; corner < 8; ++corner)
+        for (int c = 0; c < 3; ++c) exact.push_back((corner >> c) & 1 ? v.tight_max[c] : v.tight_min[c]);
+      for (int i = 0; i < 500; ++i)
+        for (int c = 0; c < 3; ++c) {
+          const float t = std::uniform_real_distribution<float>(0, 1)(rng);
+          exact.push_back(
+              std::clamp(v.tight_min[c] + t * (v.tight_max[c] - v.tight_min[c]), v.tight_min[c], v.tight_max[c]));
+        }
+      const std::uint32_t n = static_cast<std::uint32_t>(exact.size() / 3);
+      std::vector<float> decoded = exact;
+      std::vector<std::uint32_t> words(n);
+      pack_block(v, decoded.data(), n, words.data());
+      std::vector<float> again(3 * n);
+      unpack_block(v, words.data(), n, again.data());
+      SCOPED_TRACE("lo " + std::to_string(lo) + ", extent " + std::to_string(extent));
+      ASSERT_EQ(std::memcmp(again.data(), decoded.data(), 4 * again.size()), 0)
+          << "pack_block's decoded values must be what unpack_block gives";
+      const double bound = packed_error_bound(v);
+      double worst = 0;
+      for (std::size_t k = 0; k < exact.size(); ++k) worst = std::max(worst, std::abs(double(decoded[k]) - exact[k]));
+      EXPECT_LE(worst, bound);
+      for (std::uint32_t w : words) EXPECT_EQ(w & ~0x3FFFFFFFu, 0u) << "only the 30 coordinate bits";
+      // The corner at the minimum decodes exactly; a degenerate box decodes every point exactly.
+      EXPECT_EQ(std::memcmp(decoded.data(), exact.data(), 12), 0);
+      if (extent == 0) {
+        EXPECT_EQ(worst, 0.0);
+      }
+      // The bound is not a loose multiple of the real error: 500 random points come close to it, where the
+      // steps are coarser than the floats there (else every float in the box decodes exactly).
+      const double ulp = std::ldexp(std::max(std::abs(lo), std::abs(lo + extent)), -23);
+      if (extent >= 1.0 && extent / kPackedSteps > 16 * ulp) {
+        EXPECT_GT(worst, bound / 8);
+      }
+      ++boxes;
+    }
+  EXPECT_EQ(boxes, 35);
+}
+
+// Streamlines with steps of about 1.3 mm, scaled by `scale` and moved by `offset`.
+Tractogram scaled_tractogram(double scale, double offset) {
+  Tractogram t;
+  t.source.path = "scaled.tck";
+  std::mt19937 rng(5);
+  std::normal_distribution<float> jitter(0, 0.4f);
+  for (int s = 0; s < 20; ++s) {
+    std::vector<float> pts;
+    float p[3] = {float(s % 5), float(s / 5), 0};
+    for (int i = 0; i < 25; ++i) {
+      p[0] += 1.0f + jitter(rng);
+      p[1] += 0.5f * jitter(rng);
+      p[2] += 0.7f + jitter(rng);
+      for (float c : p) pts.push_back(static_cast<float>(offset + scale * c));
+    }
+    t.add_streamline(pts.data(), 25);
+  }
+  return t;
+}
+
+struct Extreme {
+  const char* name;
+  double scale, offset, voxel_size;
+};
+
+class PackedConversion : public ::testing::TestWithParam<Extreme> {};
+
+// Whole conversions: every source point comes back (through the walk, i.e. `export`) within the largest
+// bound of the file's voxels, and verify accepts the file (its orders are sorted for the decoded positions).
+TEST_P(PackedConversion, EveryPointComesBackWithinTheBound) {
+  const Extreme e = GetParam();
+  ScratchDir dir;
+  Tractogram source = scaled_tractogram(e.scale, e.offset);
+  const std::vector<float> expected = source.positions;
+  ConvertSettings settings;
+  settings.voxel_size = e.voxel_size;
+  convert_tractogram(std::move(source), dir.file("p.vxl"), settings);
+  const VerifyResult verified = verify_vxl(dir.file("p.vxl"));
+  ASSERT_TRUE(verified.valid) << verified.problem;
+  const VxlFile f = VxlFile::open(dir.file("p.vxl"));
+  ASSERT_EQ(f.position_encoding(), PositionEncoding::Packed);
+  double bound = 0;
+  for (const VoxelEntry& v : f.voxels()) bound = std::max(bound, packed_error_bound(v));
+  std::vector<float> got;
+  walk_streamlines(
+      f, {[&](std::uint64_t, std::span<const float> xyz) { got.insert(got.end(), xyz.begin(), xyz.end()); }, {}});
+  ASSERT_EQ(got.size(), expected.size());
+  double worst = 0;
+  for (std::size_t k = 0; k < got.size(); ++k) worst = std::max(worst, std::abs(double(got[k]) - expected[k]));
+  EXPECT_LE(worst, bound) << f.meta().voxel_count << " voxels";
+  // The bound follows the voxel, not the scene: at most the voxel's extent (plus a step on each side
+  // for the connecting vertices) / 2046, plus the rounding of coordinates this far out.
+  const double step = 1.3 * e.scale * 3;
+  EXPECT_LE(bound, (e.voxel_size + 2 * step) * (1.0 / 2046 + 1e-6) +
+                       std::ldexp(1.0, -23) * (std::abs(e.offset) + 40 * e.scale) * 1.01);
+}
+
+INSTANTIATE_TEST_SUITE_P(Extremes, PackedConversion,
+                         ::testing::Values(Extreme{"tiny_voxels", 0.01, 0, 0.004}, Extreme{"brain", 1, 0, 10},
+                                           Extreme{"huge_voxels", 1, 0, 5000}, Extreme{"far_from_origin", 1, 1e5, 10},
+                                           Extreme{"far_and_tiny", 0.01, -1e4, 0.05},
+                                           Extreme{"planet_scale", 1e4, 0, 2e4}),
+                         [](const ::testing::TestParamInfo<Extreme>& info) { return std::string(info.param.name); });
+
+// verify checks every packed word's voxline-end bit against the voxline table, and the reserved bit.
+TEST(PackedPositions, VerifyRefusesAWrongVoxlineEndOrReservedBit) {
+  ScratchDir dir;
+  ConvertSettings settings;
+  settings.voxel_size = 8;
+  convert_tractogram(scaled_tractogram(1, 0), dir.file("p.vxl"), settings);
+  ASSERT_TRUE(verify_vxl(dir.file("p.vxl")).valid);
+  const VxlFile f = VxlFile::open(dir.file("p.vxl"));
+  const std::uint64_t vert = f.find_section(section_id("VERT"))->offset;
+  for (std::uint32_t bit : {kPackedVoxlineEnd, kPackedReservedBit})
+    for (std::uint64_t vertex : {std::uint64_t(0), f.meta().vertex_count - 1}) {
+      std::vector<char> bytes = slurp(dir.file("p.vxl"));
+      std::uint32_t word;
+      std::memcpy(&word, bytes.data() + vert + 4 * vertex, 4);
+      word ^= bit;
+      std::memcpy(bytes.data() + vert + 4 * vertex, &word, 4);
+      ASSERT_TRUE(test::reseal_checksums(bytes.data(), bytes.size()));
+      test::write_file(dir.file("bad.vxl"), bytes);
+      const VerifyResult r = verify_vxl(dir.file("bad.vxl"));
+      EXPECT_FALSE(r.valid) << "bit " << bit << " of vertex " << vertex;
+      EXPECT_NE(r.problem.find("packed vertex " + std::to_string(vertex) + ": voxline-end bit wrong or reserved bit"),
+                std::string::npos)
+          << r.problem;
+    }
+}
+
+// The command line: packed by default (version 2.0, 4 bytes a vertex), float32 on request (version 1.0,
+// the source's bits), an unknown name refused as a usage error; info names the encoding and the bound.
+TEST(PackedPositions, ConvertChoosesTheEncodingAndInfoStatesIt) {
+  ScratchDir dir;
+  ASSERT_EQ(run_cli("synth " + dir.file("s.tck") + " --streamlines 200").exit_code, 0);
+  ASSERT_EQ(run_cli("convert " + dir.file("s.tck") + " " + dir.file("packed.vxl")).exit_code, 0);
+  ASSERT_EQ(run_cli("convert " + dir.file("s.tck") + " " + dir.file("exact.vxl") + " --positions float32").exit_code,
+            0);
+  const VxlFile packed = VxlFile::open(dir.file("packed.vxl")), exact = VxlFile::open(dir.file("exact.vxl"));
+  EXPECT_EQ(packed.header().version_major, 2);
+  EXPECT_EQ(exact.header().version_major, 1);
+  EXPECT_EQ(packed.find_section(section_id("VERT"))->size * 3, exact.find_section(section_id("VERT"))->size);
+  EXPECT_LT(packed.bytes().size(), exact.bytes().size());
+  const auto info = run_cli("info " + dir.file("packed.vxl"));
+  EXPECT_NE(info.output.find("positions     packed (10 bits per axis per voxel; error at most"), std::string::npos)
+      << info.output;
+  EXPECT_NE(run_cli("info " + dir.file("exact.vxl")).output.find("positions     float32 (exact)"), std::string::npos);
+  const auto bad = run_cli("convert " + dir.file("s.tck") + " " + dir.file("bad.vxl") + " --positions half");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--positions"), std::string::npos) << bad.output;
+}
+
+}  // namespace
+}  // namespace vxl
