@@ -21,7 +21,7 @@ std::optional<std::uint64_t> available_memory();
 // The estimated peak of a conversion in memory of a TCK source of `source_bytes` bytes.
 std::uint64_t in_memory_estimate(std::uint64_t source_bytes);
 
-// The --memory-limit to stream with when the estimate exceeds 90% of `available`: half of what is
+// The --memory-limit to stream with when the estimate exceeds half of `available`: half of what is
 // available, at least 64 MiB and at most 6 GiB; nullopt when converting in memory fits.
 std::optional<std::uint64_t> automatic_memory_limit(std::uint64_t source_bytes, std::uint64_t available);
 

@@ -19,8 +19,9 @@ constexpr std::uint64_t MiB = 1ull << 20, GiB = 1ull << 30;
 TEST(MemoryAvailable, StreamsOnlyWhenTheEstimateDoesNotFit) {
   EXPECT_EQ(in_memory_estimate(100 * MiB), 300 * MiB);
   EXPECT_FALSE(automatic_memory_limit(100 * MiB, 1 * GiB));          // 300 MiB of 1 GiB
-  EXPECT_FALSE(automatic_memory_limit(300 * MiB, 1 * GiB));          // 900 MiB: within 90 %
-  EXPECT_EQ(automatic_memory_limit(350 * MiB, 1 * GiB), 512 * MiB);  // 1050 MiB: half of what there is
+  EXPECT_FALSE(automatic_memory_limit(170 * MiB, 1 * GiB));          // 510 MiB: within half
+  EXPECT_EQ(automatic_memory_limit(180 * MiB, 1 * GiB), 512 * MiB);  // 540 MiB: streamed within half
+  EXPECT_EQ(automatic_memory_limit(7 * GiB, 24 * GiB), 6 * GiB);     // the 10M set on a quiet 24 GiB machine
   EXPECT_EQ(automatic_memory_limit(7 * GiB, 22 * GiB), 6 * GiB);     // the 10M set: at most 6 GiB
   EXPECT_EQ(automatic_memory_limit(1 * GiB, 10 * MiB), 64 * MiB);    // at least 64 MiB
 }

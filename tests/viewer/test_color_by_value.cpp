@@ -160,7 +160,7 @@ TEST_F(ColorByValue, ManyTextureSpansColourLikeOne) {
   }
   t.point_values.push_back({"along", along});
   VxlFile f = make_scene(dir, std::move(t), 6.0);
-  Renderer one(f), many(f, 1500);
+  Renderer one(f), many(f, 3000);
   EXPECT_GT(many.layout().texture_spans().size(), 3u);
   Camera cam = top_view();
   cam.azimuth_deg = 30;

@@ -215,6 +215,41 @@ TEST_F(RenderModes, ExactInDepthPassesEqualsExactInOnePass) {
   EXPECT_LT(score_image(runs, whole).rmse, 1.0);
 }
 
+// The GPU copy (scene_layout.h): packed positions (4 bytes a vertex) and the three stored orders at 16 bits
+// (6 bytes a segment) serve all six directions and the block order in at most 12 bytes a source point;
+// float positions and 32-bit orders took about 29.
+TEST_F(RenderModes, TheGpuCopyTakesAtMostTwelveBytesAPoint) {
+  SynthSettings synth;
+  synth.streamlines = 20000;
+  VxlFile f = make_scene(dir, synthesize_tractogram(synth), 10.0);
+  for (const VoxelEntry& v : f.voxels()) ASSERT_LE(v.vertex_count, 65536u) << "16-bit orders throughout";
+  Renderer r(f);
+  const double per_point = double(r.gpu_bytes()) / double(f.meta().point_count);
+  EXPECT_LE(per_point, 12.0);
+  EXPECT_GT(per_point, 9.0) << "positions and orders are all there";
+}
+
+// A voxel of more than 65 536 vertices has 3-byte order entries in the file and 16 + 16 bits on the GPU (a
+// low and a high half): its stored orders must draw the same segments as its block order. In one fixed
+// colour the picture does not depend on the order (every blend applies the same function), so the two
+// are equal pixel for pixel; a wrong high half joins unrelated vertices.
+TEST_F(RenderModes, WideVoxelsDrawTheirStoredOrdersRight) {
+  SynthSettings synth;
+  synth.streamlines = 1500;
+  VxlFile f = make_scene(dir, synthesize_tractogram(synth), 1000.0);
+  ASSERT_EQ(f.meta().voxel_count, 1u);
+  ASSERT_GT(f.voxels()[0].vertex_count, 65536u);
+  Renderer r(f);
+  ASSERT_GT(r.layout().texture_spans()[0].wide_segments, 0u);
+  Camera cam = perspective_view();
+  RenderSettings axis_settings = settings(RenderMode::Axis, 0.1f), block_settings = settings(RenderMode::Basic, 0.1f);
+  axis_settings.color = block_settings.color = ColorMode::Fixed;
+  const Image axis = render_image(r, cam, axis_settings, 96, 96);
+  const Image block = render_image(r, cam, block_settings, 96, 96);
+  EXPECT_GT(lit_pixels(axis), 1000);
+  EXPECT_EQ(compare_images(axis, block).differing_pixels, 0u);
+}
+
 TEST_F(RenderModes, ExactOverSeveralGridsFallsBackToRowBands) {
   // Files on different grids overlap in space: no voxel order is a visibility order, so the runs are
   // bands of rows over all voxels.
@@ -243,7 +278,7 @@ TEST_F(RenderModes, ManyTextureSpansRenderLikeOne) {
     t.add_streamline(p.data(), 30);
   }
   VxlFile f = make_scene(dir, std::move(t), 6.0);
-  Renderer one(f), many(f, 1500);
+  Renderer one(f), many(f, 3000);
   EXPECT_EQ(one.layout().texture_spans().size(), 1u);
   EXPECT_GT(many.layout().texture_spans().size(), 3u);
   Camera cam = top_view();

@@ -107,7 +107,7 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
       }
     }
     plan.first.push_back(static_cast<std::int32_t>(layout.first_id(v, slot, reversed)));
-    plan.count.push_back(static_cast<std::int32_t>(2 * v.segment_count));
+    plan.count.push_back(layout.id_count(v, slot));
     plan.segments_drawn += v.segment_count;
   }
   plan.voxels_drawn = plan.first.size();

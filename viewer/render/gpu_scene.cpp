@@ -1,6 +1,7 @@
 #include "viewer/render/gpu_scene.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "format/error.h"
 #include "format/parallel.h"
@@ -14,83 +15,103 @@ std::uint64_t GpuScene::driver_limit() {
   return texels > 0 ? static_cast<std::uint64_t>(texels) : 65536;  // 65536 is the GL 3.3 minimum
 }
 
-// Widens voxel i's stored orders to span-global u32 and appends its block order; checks every entry,
-// which open() does not (it would cost O(points) there).
-void GpuScene::widen_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t li, const TextureSpan& c,
-                           std::vector<std::uint32_t>& entries, std::vector<std::uint8_t>& is_start) const {
+// Voxel i's part of its span: checks every order entry (open() does not: it would cost O(points) there),
+// finds the segment starts from order 0, and writes the packed words with the voxline-end bit where no
+// segment starts, the decoding info, its table entries and its orders at 16 bits (plus high halves).
+void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t li, std::uint32_t index,
+                            const TextureSpan& c, std::vector<std::uint32_t>& words, std::vector<std::uint16_t>& orders,
+                            std::vector<std::uint8_t>& is_start, std::vector<float>& xyz) const {
   const VoxelEntry& v = file.voxels()[li];
   const VoxelDrawInfo& d = layout_.voxels()[i];
-  const std::uint32_t base = static_cast<std::uint32_t>(v.vertex_first - c.vertex_first);
+  const std::uint64_t ordr_at = file.find_section(section_id("ORDR"))->offset + v.order_offset;
   is_start.assign(v.vertex_count, 0);
-  for (std::uint32_t k = 0; k + 1 < c.slots; ++k) {
+  const bool wide = v.vertex_count > kU16OrderMaxVertices;
+  for (std::uint32_t k = 0; k < c.slots; ++k) {
     OrderView o = file.order(li, k);
-    std::uint32_t* out = entries.data() + k * c.segments + d.seg_first;
+    std::uint16_t* low = orders.data() + k * c.segments + d.seg_first;
+    std::uint16_t* high = orders.data() + c.slots * c.segments + k * c.wide_segments + d.seg_first;
     for (std::uint32_t n = 0; n < o.count; ++n) {
-      std::uint32_t e = o[n];
+      const std::uint32_t e = o[n];
       if (e + 1ull >= v.vertex_count)
-        throw Error(ErrorKind::Input, file.path(), file.find_section(section_id("ORDR"))->offset + v.order_offset,
+        throw Error(ErrorKind::Input, file.path(), ordr_at,
                     "order entry out of range in voxel " + std::to_string(li) + " (run `voxlines verify`)");
-      out[n] = base + e;
+      low[n] = static_cast<std::uint16_t>(e);
+      if (wide) high[n] = static_cast<std::uint16_t>(e >> 16);
       if (k == 0) is_start[e] = 1;
     }
   }
-  std::uint32_t* block = entries.data() + layout_.block_slot(d) * c.segments + d.seg_first;
-  std::uint32_t n = 0;
-  for (std::uint32_t e = 0; e < v.vertex_count && n < v.segment_count; ++e)
-    if (is_start[e]) block[n++] = base + e;
-  if (n != v.segment_count)  // a repeated entry in order 0: it is no permutation
+  std::uint32_t starts = 0;
+  for (std::uint8_t b : is_start) starts += b;
+  if (starts != v.segment_count)  // a repeated entry in order 0: it is no permutation
     throw Error(
-        ErrorKind::Input, file.path(), file.find_section(section_id("ORDR"))->offset + v.order_offset,
+        ErrorKind::Input, file.path(), ordr_at,
         "order 0 of voxel " + std::to_string(li) + " is not a permutation of its segments (run `voxlines verify`)");
+
+  std::uint32_t* block = words.data() + d.vertex_first;
+  if (file.position_encoding() == PositionEncoding::Packed) {
+    std::copy_n(file.packed_vertices().data() + v.vertex_first, v.vertex_count, block);
+  } else {
+    xyz.resize(3 * std::uint64_t(v.vertex_count));
+    file.read_vertices(li, v.vertex_first, v.vertex_count, xyz.data());
+    pack_block(v, xyz.data(), v.vertex_count, block);
+  }
+  for (std::uint32_t n = 0; n < v.vertex_count; ++n)
+    block[n] = (block[n] & ~(kPackedVoxlineEnd | kPackedReservedBit)) | (is_start[n] ? 0u : kPackedVoxlineEnd);
+
+  // Decoding info: lo and step per axis as the spec computes them (binary32), and the block's first word.
+  std::uint32_t* info = words.data() + c.info_first() + 8ull * index;
+  for (int a = 0; a < 3; ++a) {
+    const float lo = v.tight_min[a], step = (v.tight_max[a] - v.tight_min[a]) / static_cast<float>(kPackedSteps);
+    std::memcpy(info + a, &lo, 4);
+    std::memcpy(info + 3 + a, &step, 4);
+  }
+  info[6] = static_cast<std::uint32_t>(d.vertex_first);
+  info[7] = 0;
+  const std::uint64_t group = SceneLayout::kGroup;
+  for (std::uint64_t g = d.seg_first / group; g < (d.seg_first + v.segment_count + group - 1) / group; ++g)
+    words[c.segment_table_first() + g] = index;
+  for (std::uint64_t g = d.vertex_first / group; g < (d.vertex_first + v.vertex_count + group - 1) / group; ++g)
+    words[c.vertex_table_first() + g] = index;
 }
 
 GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels)
     : files_(std::move(files)), layout_(files_, max_texels ? max_texels : driver_limit()) {
-  std::vector<std::uint32_t> entries;
+  try {
+    upload_spans();
+  } catch (...) {
+    release();  // the spans made so far: no destructor runs for a constructor that throws
+    throw;
+  }
+}
+
+void GpuScene::upload_spans() {
   for (const TextureSpan& c : layout_.texture_spans()) {
     const VxlFile& file = *files_[c.file];
     const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
-    GpuTextureSpan g;
-    if (file.position_encoding() == PositionEncoding::Float32) {
-      g.positions.create(GL_R32F, file.float_vertices().data() + 3 * c.vertex_first, 12 * c.vertex_count);
-    } else {
-      // Packed positions (spec §5.4) are decoded here, voxel by voxel, for the float32 texture.
-      std::vector<float> xyz(3 * c.vertex_count);
-      parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned) {
-        const std::uint32_t local = c.voxel_first + static_cast<std::uint32_t>(k) - file_first;
-        const VoxelEntry& v = file.voxels()[local];
-        file.read_vertices(local, v.vertex_first, v.vertex_count, xyz.data() + 3 * (v.vertex_first - c.vertex_first));
-      });
-      g.positions.create(GL_R32F, xyz.data(), 12 * c.vertex_count);
-    }
-    entries.resize(std::uint64_t(c.slots) * c.segments);
-    // Voxels fill disjoint ranges of every slot, so they are widened in parallel.
+    std::vector<std::uint32_t> words(c.words(), 0);
+    std::vector<std::uint16_t> orders(c.order_entries(), 0);
+    // Voxels fill disjoint ranges of every array, so they are uploaded in parallel.
     std::vector<std::vector<std::uint8_t>> is_start(resolve_threads(0));  // scratch per thread
-    try {
-      parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
-        const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
-        widen_voxel(file, i, i - file_first, c, entries, is_start[t]);
-      });
-    } catch (...) {
-      g.positions.destroy();
-      release();
-      throw;
-    }
-    g.orders.create(GL_R32UI, entries.data(), entries.size() * 4);
+    std::vector<std::vector<float>> xyz(resolve_threads(0));
+    parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
+      const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
+      upload_voxel(file, i, i - file_first, static_cast<std::uint32_t>(k), c, words, orders, is_start[t], xyz[t]);
+    });
+    GpuTextureSpan g;
+    g.words.create(GL_RGBA32UI, words.data(), words.size() * 4);
+    g.orders.create(GL_R16UI, orders.data(), orders.size() * 2);
     g.dataset.create(GL_R32UI, nullptr, 0);
     g.attributes.create(GL_RG32F, nullptr, 0);
-    gpu_bytes_ += 12 * c.vertex_count + entries.size() * 4;
+    gpu_bytes_ += words.size() * 4 + orders.size() * 2;
     spans_.push_back(g);
   }
-  entries.clear();
-  entries.shrink_to_fit();
 }
 
 GpuScene::~GpuScene() { release(); }
 
 void GpuScene::release() {
   for (GpuTextureSpan& c : spans_) {
-    c.positions.destroy();
+    c.words.destroy();
     c.orders.destroy();
     c.dataset.destroy();
     c.attributes.destroy();
@@ -104,10 +125,20 @@ void GpuScene::upload_attributes(const std::vector<std::vector<float>>& per_file
     GpuTextureSpan& g = spans_[i];
     g.attributes.destroy();
     const std::vector<float>* values = c.file < per_file.size() ? &per_file[c.file] : nullptr;
-    if (values == nullptr || values->empty())
+    if (values == nullptr || values->empty()) {
       g.attributes.create(GL_RG32F, nullptr, 0);
-    else
-      g.attributes.create(GL_RG32F, values->data() + 2 * c.vertex_first, 8 * c.vertex_count);
+      continue;
+    }
+    // Two floats per vertex, each voxel's at its block's place in the span (scene_layout.h).
+    std::vector<float> padded(2 * c.vertices, 0.0f);
+    const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
+    for (std::uint32_t k = 0; k < c.voxel_count; ++k) {
+      const VoxelDrawInfo& d = layout_.voxels()[c.voxel_first + k];
+      const VoxelEntry& v = files_[c.file]->voxels()[c.voxel_first + k - file_first];
+      std::copy_n(values->data() + 2 * v.vertex_first, 2 * std::uint64_t(v.vertex_count),
+                  padded.data() + 2 * d.vertex_first);
+    }
+    g.attributes.create(GL_RG32F, padded.data(), padded.size() * 4);
   }
 }
 
@@ -120,9 +151,12 @@ const std::vector<std::int32_t>& GpuScene::dataset_first() {
     for (std::uint32_t fi = 0; fi < files_.size(); ++fi) {
       const std::uint32_t file_first = layout_.files()[fi].voxel_first;
       WalkCallbacks cb;
+      const auto file_voxels = files_[fi]->voxels();
       cb.voxline = [&](std::uint32_t voxel, std::uint64_t first_vertex, std::uint32_t own, bool connected) {
-        const std::uint32_t c = layout_.voxels()[file_first + voxel].span;
-        const TextureSpan& cl = layout_.texture_spans()[c];
+        const VoxelDrawInfo& d = layout_.voxels()[file_first + voxel];
+        const std::uint32_t c = d.span;
+        // The voxline's first vertex in its span's words.
+        const std::uint64_t span_vertex = d.vertex_first + (first_vertex - file_voxels[voxel].vertex_first);
         const std::uint64_t segments = own + (connected ? 1 : 0) - 1;
         if (segments == 0) return;
         auto& arr = per_span[c];
@@ -131,8 +165,7 @@ const std::vector<std::int32_t>& GpuScene::dataset_first() {
           dataset_count_.push_back(0);
           run_span = c;
         }
-        for (std::uint64_t s = 0; s < segments; ++s)
-          arr.push_back(static_cast<std::uint32_t>(first_vertex - cl.vertex_first + s));
+        for (std::uint64_t s = 0; s < segments; ++s) arr.push_back(static_cast<std::uint32_t>(span_vertex + s));
         dataset_count_.back() += static_cast<std::int32_t>(2 * segments);
       };
       walk_streamlines(*files_[fi], cb);

@@ -1,6 +1,8 @@
-// The GPU copy of a scene of one or more .vxl files: per texture span (see scene_layout.h) a positions buffer (one
-// large copy straight from the memory-mapped file), an orders buffer (stored orders widened to span-global u32
-// indices, each entry checked, plus the block order), and — only when first needed — a dataset-order buffer.
+// The GPU copy of a scene of one or more .vxl files, laid out as scene_layout.h describes: per texture span the
+// packed positions with their voxels' decoding info and lookup tables (float32 files are packed on the way, as
+// the .vxl spec §5.4 says), the stored orders at 16 bits (32 for voxels of more than 65 536 vertices), each
+// entry checked, and — only when first needed — a dataset-order buffer and per-vertex values. About 4 bytes
+// a vertex and 2 an order entry, where float positions and widened orders took 12 and 4.
 #pragma once
 
 #include <cstdint>
@@ -13,10 +15,10 @@
 namespace vxl {
 
 struct GpuTextureSpan {
-  gl::TextureBuffer positions;   // GL_R32F, 3 texels per vertex
-  gl::TextureBuffer orders;      // GL_R32UI, slots x S
-  gl::TextureBuffer dataset;     // GL_R32UI, S (empty until needed)
-  gl::TextureBuffer attributes;  // GL_RG32F, (value, group) per vertex (empty until a colour mode needs it)
+  gl::TextureBuffer words;       // GL_RGBA32UI: packed positions, voxel info, segment and vertex tables
+  gl::TextureBuffer orders;      // GL_R16UI: K x S low halves, then K x W high halves
+  gl::TextureBuffer dataset;     // GL_R32UI, S span vertex indices (empty until needed)
+  gl::TextureBuffer attributes;  // GL_RG32F, (value, group) per span vertex (empty until a colour mode needs it)
 };
 
 class GpuScene {
@@ -44,10 +46,13 @@ class GpuScene {
 
  private:
   static std::uint64_t driver_limit();
+  void upload_spans();
   void release();
-  // Voxel `voxel` of the scene (`local` in its file).
-  void widen_voxel(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, const TextureSpan& span,
-                   std::vector<std::uint32_t>& entries, std::vector<std::uint8_t>& is_start) const;
+  // Voxel `voxel` of the scene (`local` in its file, `index` in its span): its words, info, table entries
+  // and orders into the span's arrays.
+  void upload_voxel(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, std::uint32_t index,
+                    const TextureSpan& span, std::vector<std::uint32_t>& words, std::vector<std::uint16_t>& orders,
+                    std::vector<std::uint8_t>& is_start, std::vector<float>& xyz) const;
   std::vector<const VxlFile*> files_;
   SceneLayout layout_;
   std::vector<GpuTextureSpan> spans_;

@@ -132,22 +132,31 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   glUseProgram(program);
   const SceneLayout& layout = scene_.layout();
   const auto& spans = layout.texture_spans();
-  std::vector<GLint> base, segments, slots;
+  // Per span: where its ids start and how its buffers are laid out (scene_layout.h).
+  std::vector<std::pair<const char*, std::vector<GLint>>> fields = {
+      {"u_span_base", {}},     {"u_span_segments", {}},      {"u_span_slots", {}},        {"u_span_wide", {}},
+      {"u_span_vertices", {}}, {"u_span_segment_table", {}}, {"u_span_vertex_table", {}},
+  };
   for (const TextureSpan& c : spans) {
-    base.push_back(static_cast<GLint>(c.virtual_base));
-    segments.push_back(static_cast<GLint>(std::max<std::uint64_t>(1, c.segments)));
-    slots.push_back(static_cast<GLint>(c.slots));
+    const std::uint64_t values[] = {c.virtual_base,
+                                    std::max<std::uint64_t>(1, c.segments),
+                                    c.slots,
+                                    c.wide_segments,
+                                    c.vertices,
+                                    c.segment_table_first(),
+                                    c.vertex_table_first()};
+    for (std::size_t f = 0; f < fields.size(); ++f) fields[f].second.push_back(static_cast<GLint>(values[f]));
   }
-  if (base.empty()) base = {0}, segments = {1}, slots = {1};
-  glUniform1iv(glGetUniformLocation(program, "u_span_base"), static_cast<GLsizei>(base.size()), base.data());
-  glUniform1iv(glGetUniformLocation(program, "u_span_segments"), static_cast<GLsizei>(segments.size()),
-               segments.data());
-  glUniform1iv(glGetUniformLocation(program, "u_span_slots"), static_cast<GLsizei>(slots.size()), slots.data());
+  for (auto& [name, values] : fields) {
+    if (values.empty())
+      values = {name == std::string("u_span_segments") || name == std::string("u_span_slots") ? 1 : 0};
+    glUniform1iv(glGetUniformLocation(program, name), static_cast<GLsizei>(values.size()), values.data());
+  }
   for (std::size_t c = 0; c < scene_.texture_spans().size(); ++c) {
     const GpuTextureSpan& g = scene_.texture_spans()[c];
-    const GLuint textures[kSamplersPerSpan] = {g.positions.texture, g.orders.texture, g.dataset.texture,
+    const GLuint textures[kSamplersPerSpan] = {g.words.texture, g.orders.texture, g.dataset.texture,
                                                g.attributes.texture};
-    const char* names[kSamplersPerSpan] = {"u_pos", "u_ord", "u_dat", "u_att"};
+    const char* names[kSamplersPerSpan] = {"u_words", "u_ord", "u_dat", "u_att"};
     for (int t = 0; t < kSamplersPerSpan; ++t) {
       GLint unit = static_cast<GLint>(kSamplersPerSpan * c + t);
       glActiveTexture(GL_TEXTURE0 + unit);

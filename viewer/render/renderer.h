@@ -36,7 +36,7 @@ struct FrameStats {
 
 class Renderer {
  public:
-  static constexpr int kSamplersPerSpan = 4;  // positions, orders, dataset order, attributes
+  static constexpr int kSamplersPerSpan = 4;  // words, orders, dataset order, attributes
   explicit Renderer(const VxlFile& file, std::uint64_t max_texels = 0);
   // Several files drawn as one scene: one sort over all their voxels, one group per file. The files must
   // outlive the renderer.

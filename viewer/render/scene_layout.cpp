@@ -47,31 +47,57 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
       fl.voxel_directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
     voxel_size_ = std::max(voxel_size_, m.voxel_size);
     if (fi > 0 && !same_grid(files[0]->meta(), m)) one_grid_ = false;
-    const std::uint32_t slots = fl.stored_orders + 1;
-    auto fits = [&](std::uint64_t vertices, std::uint64_t segments) {
-      return 3 * vertices <= max_texels && slots * segments <= max_texels;
-    };
+    const std::uint32_t slots = fl.stored_orders;
+    auto padded = [](std::uint64_t n) { return (n + kGroup - 1) / kGroup * kGroup; };
+    auto wide = [](const VoxelEntry& e) { return e.vertex_count > kU16OrderMaxVertices; };
+    // Both buffers of a span within the limit: its words (4 a texel) and its order entries.
+    auto fits = [&](const TextureSpan& c) { return c.words() / 4 <= max_texels && c.order_entries() <= max_texels; };
     auto voxels = file.voxels();
     TextureSpan current;
     current.file = fi;
     current.slots = slots;
+    // Sets the span's voxels' ranges: vertex blocks in file order, segment ranges wide voxels first (the
+    // high bits cover the first W entries of each slot).
+    auto close_span = [&] {
+      std::uint64_t vertex = 0, seg = 0;
+      for (bool wide_pass : {true, false})
+        for (std::uint32_t i = current.voxel_first; i < current.voxel_first + current.voxel_count; ++i) {
+          const VoxelEntry& e = voxels[i - fl.voxel_first];
+          if (wide(e) != wide_pass) continue;
+          voxels_[i].seg_first = seg;
+          seg += padded(e.segment_count);
+        }
+      for (std::uint32_t i = current.voxel_first; i < current.voxel_first + current.voxel_count; ++i) {
+        voxels_[i].vertex_first = vertex;
+        vertex += padded(voxels[i - fl.voxel_first].vertex_count);
+      }
+      spans_.push_back(current);
+    };
     for (std::uint32_t li = 0; li < voxels.size(); ++li) {
       const VoxelEntry& e = voxels[li];
       const std::uint32_t i = fl.voxel_first + li;
-      if (!fits(e.vertex_count, e.segment_count))
+      TextureSpan grown = current, alone = current;
+      alone.voxel_count = 0;
+      alone.segments = alone.wide_segments = alone.vertices = 0;
+      for (TextureSpan* c : {&grown, &alone}) {
+        c->voxel_count++;
+        c->vertices += padded(e.vertex_count);
+        c->segments += padded(e.segment_count);
+        if (wide(e)) c->wide_segments += padded(e.segment_count);
+      }
+      if (!fits(alone))
         throw Error(ErrorKind::Unsupported, file.path(), std::nullopt,
                     "a voxel is larger than this GPU's texture-buffer limit (" + std::to_string(max_texels) +
                         " texels); convert with a smaller --voxel-size");
-      if (current.voxel_count > 0 && !fits(current.vertex_count + e.vertex_count, current.segments + e.segment_count)) {
-        spans_.push_back(current);
+      if (current.voxel_count > 0 && !fits(grown)) {
+        close_span();
         current = TextureSpan{};
         current.file = fi;
         current.slots = slots;
+        grown = alone;
       }
-      if (current.voxel_count == 0) {
-        current.voxel_first = i;
-        current.vertex_first = e.vertex_first;
-      }
+      if (current.voxel_count == 0) grown.voxel_first = i;
+      current = grown;
       VoxelDrawInfo& v = voxels_[i];
       for (int c = 0; c < 3; ++c) {
         v.center[c] = m.grid_origin[c] + (e.coord[c] + 0.5) * m.voxel_size;
@@ -80,12 +106,9 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
       }
       v.span = static_cast<std::uint32_t>(spans_.size());
       v.segment_count = e.segment_count;
-      v.seg_first = current.segments;
-      current.voxel_count++;
-      current.vertex_count += e.vertex_count;
-      current.segments += e.segment_count;
+      v.vertex_count = e.vertex_count;
     }
-    if (current.voxel_count > 0) spans_.push_back(current);
+    if (current.voxel_count > 0) close_span();
     files_.push_back(std::move(fl));
   }
   if (spans_.size() > kMaxTextureSpans)
@@ -95,7 +118,7 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
                     " texels" + (files.size() > 1 ? "; each file takes at least one" : "") + ")");
   for (TextureSpan& c : spans_) {
     c.virtual_base = virtual_ids_;
-    virtual_ids_ += 2 * (2 * std::uint64_t(c.slots) * c.segments + c.segments);
+    virtual_ids_ += 2 * (2 * std::uint64_t(c.slots) * c.segments + c.vertices + c.segments);
   }
   if (virtual_ids_ > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
     throw Error(ErrorKind::Unsupported, where, std::nullopt,

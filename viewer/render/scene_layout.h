@@ -3,21 +3,27 @@
 //
 // The voxels of all files form one table (file 0's, then file 1's, ...), so that one frame plan sorts them
 // all together, back to front, interleaved across files. Voxels are grouped into texture spans (contiguous voxel
-// ranges of one file) small enough for the driver's texture-buffer limit. Each span holds, in texture
-// buffers:
-//   positions: 3 floats per vertex;
-//   orders:    (K + 1) "slots" of S entries each (S = the span's segments; K its file's stored orders): the K
-//              stored orders widened to
-//              span-global vertex indices, then the block (dataset) order inside each voxel. A voxel owns the
-//              same range [seg_first, seg_first + n) in every slot;
-//   dataset:   S entries in streamline order (built only when the `unsorted` mode is first used).
+// ranges of one file) small enough for the driver's texture-buffer limit. Each span holds, in four texture
+// buffers (gpu_scene.h says how each is filled):
+//   words:   RGBA32UI, 4 words a texel: the packed positions (.vxl spec §5.4), each voxel's block starting at a
+//            multiple of kGroup words; then 8 words of decoding info per voxel; then one voxel index per kGroup
+//            order entries (the segment table) and per kGroup vertices (the vertex table), so that the vertex
+//            shader finds any entry's or vertex's voxel with one fetch;
+//   orders:  R16UI: K "slots" of S entries each (S = the span's segments, each voxel's range starting at a
+//            multiple of kGroup; K its file's stored orders), the stored orders at 16 bits, voxel-local; then
+//            the high 16 bits of the entries of the voxels with more than 65 536 vertices, which come first in
+//            every slot (their W entries) — so 2 bytes an entry, 4 only where the file stores 3 or 4;
+//   dataset: S entries in streamline order (built only when the `unsorted` mode is first used);
+//   values:  per vertex, for the colour modes that need them.
 // The vertex shader maps gl_VertexID ("virtual vertex id") to a segment end: per span, ids
-//   [0, 2A)        forward slot entries (A = (K + 1) S),
-//   [2A, 4A)       the same slots read backwards (entry j of a slot appears at S - 1 - j), so a voxel's
-//                  reversed order is again one contiguous range,
-//   [4A, 4A + 2S)  dataset order,
+//   [0, 2A)             forward slot entries (A = K S),
+//   [2A, 4A)            the same slots read backwards (entry j of a slot appears at S - 1 - j), so a voxel's
+//                       reversed order is again one contiguous range,
+//   [4A, 4A + 2V)       the block order: segment (v, v + 1) for every vertex v of the span's blocks, dropped
+//                       where v ends its voxline (the packed word's bit 30),
+//   [4A + 2V, .. + 2S)  dataset order,
 // two ids per segment. One glMultiDrawArrays then draws any sequence of voxels, each in any stored order,
-// forwards or backwards, with no per-frame work beyond filling the first/count arrays.
+// forwards or backwards, or in block order, with no per-frame work beyond filling the first/count arrays.
 #pragma once
 
 #include <cstdint>
@@ -35,18 +41,28 @@ struct VoxelDrawInfo {
   glm::vec3 tight_min, tight_max;
   std::uint32_t span;  // its texture span
   std::uint32_t segment_count;
-  std::uint64_t seg_first;  // within its span's slots
+  std::uint32_t vertex_count;
+  std::uint64_t seg_first;     // within its span's slots; a multiple of SceneLayout::kGroup
+  std::uint64_t vertex_first;  // within its span's words; a multiple of SceneLayout::kGroup
 };
 
 // One set of texture buffers: a contiguous voxel range of one file. Named "span", not "chunk", because the
 // .vxlz package's position chunks are another thing.
 struct TextureSpan {
-  std::uint32_t file = 0;                            // the file its voxels come from
-  std::uint32_t slots = 1;                           // its file's K + 1
-  std::uint32_t voxel_first = 0, voxel_count = 0;    // scene voxel range
-  std::uint64_t vertex_first = 0, vertex_count = 0;  // vertex range within its file
-  std::uint64_t segments = 0;                        // S
-  std::uint64_t virtual_base = 0;                    // first virtual vertex id
+  std::uint32_t file = 0;                          // the file its voxels come from
+  std::uint32_t slots = 1;                         // its file's K
+  std::uint32_t voxel_first = 0, voxel_count = 0;  // scene voxel range
+  std::uint64_t segments = 0;                      // S, with each voxel's range padded to a multiple of kGroup
+  std::uint64_t wide_segments = 0;                 // W: the first W entries of each slot have high bits
+  std::uint64_t vertices = 0;                      // V, with each voxel's block padded to a multiple of kGroup
+  std::uint64_t virtual_base = 0;                  // first virtual vertex id
+  // Where the parts of the words buffer start, in words (see above); its size in words.
+  std::uint64_t info_first() const { return vertices; }
+  std::uint64_t segment_table_first() const { return vertices + 8ull * voxel_count; }
+  std::uint64_t vertex_table_first() const { return segment_table_first() + segments / kGroupSize; }
+  std::uint64_t words() const { return (vertex_table_first() + vertices / kGroupSize + 3) / 4 * 4; }
+  std::uint64_t order_entries() const { return std::uint64_t(slots) * (segments + wide_segments); }
+  static constexpr std::uint64_t kGroupSize = 32;
 };
 
 // Where one file's voxels are in the scene, and its sorting directions.
@@ -65,14 +81,13 @@ class SceneLayout {
   SceneLayout(const VxlFile& file, std::uint64_t max_texels);
 
   static constexpr std::uint32_t kMaxTextureSpans = 8;  // each span needs 4 samplers in the vertex shader
+  static constexpr std::uint64_t kGroup = TextureSpan::kGroupSize;
 
-  // Of the first file (all of a single-file scene): K, K + 1 slots, the block order's slot, DIRS.
+  // Of the first file (all of a single-file scene): K, DIRS.
   std::uint32_t stored_orders() const { return files_[0].stored_orders; }
-  std::uint32_t slots() const { return stored_orders() + 1; }
-  std::uint32_t block_slot() const { return stored_orders(); }
   const std::vector<glm::vec3>& directions() const { return files_[0].directions; }
-  // The slot of a voxel's block (dataset) order: its file's K.
-  std::uint32_t block_slot(const VoxelDrawInfo& v) const { return spans_[v.span].slots - 1; }
+  // The pseudo-slot that draws a voxel in block order: its file's K (one past its stored orders).
+  std::uint32_t block_slot(const VoxelDrawInfo& v) const { return spans_[v.span].slots; }
   // The K directions voxel `voxel`'s stored orders are sorted by: its own (VDIR, random order sets) or
   // its file's DIRS.
   std::span<const glm::vec3> directions_of(std::uint32_t voxel) const {
@@ -93,17 +108,23 @@ class SceneLayout {
   // apart): then PlanOrder::Visibility is a visibility order for the whole scene.
   bool one_grid() const { return one_grid_; }
 
-  // First virtual vertex id of voxel v's range in `slot`, forwards or reversed.
+  // First virtual vertex id of voxel v's range in `slot` (block_slot(v): block order), forwards or reversed,
+  // and how many ids from there draw it.
   std::int64_t first_id(const VoxelDrawInfo& v, std::uint32_t slot, bool reversed) const {
     const TextureSpan& c = spans_[v.span];
     const std::uint64_t s = c.segments, a = std::uint64_t(c.slots) * s;
-    std::uint64_t seg = reversed ? a + slot * s + (s - v.seg_first - v.segment_count) : slot * s + v.seg_first;
+    const std::uint64_t seg = slot == c.slots ? 2 * a + v.vertex_first
+                              : reversed      ? a + slot * s + (s - v.seg_first - v.segment_count)
+                                              : slot * s + v.seg_first;
     return static_cast<std::int64_t>(c.virtual_base + 2 * seg);
+  }
+  std::int32_t id_count(const VoxelDrawInfo& v, std::uint32_t slot) const {
+    return static_cast<std::int32_t>(2 * (slot == spans_[v.span].slots ? v.vertex_count - 1 : v.segment_count));
   }
   // First virtual id of entry j of a span's dataset-order array.
   std::int64_t dataset_id(std::uint32_t span, std::uint64_t j) const {
     const TextureSpan& c = spans_[span];
-    return static_cast<std::int64_t>(c.virtual_base + 2 * (2 * std::uint64_t(c.slots) * c.segments + j));
+    return static_cast<std::int64_t>(c.virtual_base + 2 * (2 * std::uint64_t(c.slots) * c.segments + c.vertices + j));
   }
 
  private:
