@@ -87,11 +87,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   // PROV and GRPS are known before any work: their sizes go into the plan of the output file.
   const std::string provenance = provenance_json(t.source, settings, threads, voxel_size_choice);
   std::vector<std::uint8_t> groups_bytes;
-  if (!t.groups.empty()) {
-    std::vector<GroupContent> groups;
-    for (const StreamlineGroup& g : t.groups) groups.push_back({g.name, g.members});
-    groups_bytes = encode_groups(groups);
-  }
+  if (!t.groups.empty()) groups_bytes = encode_groups(t.groups);
 
   VoxelizeSettings vs;
   vs.voxel_size = settings.voxel_size;

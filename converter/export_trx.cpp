@@ -153,7 +153,7 @@ void export_trx(const VxlFile& file, const std::string& out_path) {
   header["NB_VERTICES"] = m.point_count;
   const std::string header_text = header.dump(2);
 
-  std::vector<GroupContent> groups = file.groups();
+  std::vector<StreamlineGroup> groups = file.groups();
   std::vector<std::vector<std::uint32_t>> members(groups.size());
   // Everything about the input is checked before the archive is created: a group TRX cannot hold is the
   // input's limit (exit 4), not a failure to write (exit 5).

@@ -263,7 +263,7 @@ std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_o
   for (VoxelEntry& v : voxels) {
     v.flags = order_width_code(v.vertex_count);
     v.order_offset = total;
-    total += order_bytes(v.vertex_count, v.segment_count, stored_orders);
+    total += voxel_orders_size(v.vertex_count, v.segment_count, stored_orders);
   }
   return total;
 }

@@ -14,6 +14,7 @@
 
 #include "converter/memory_size.h"
 #include "converter/position_packing.h"
+#include "converter/readers/source_formats.h"
 #include "converter/readers/tck_stream.h"
 #include "converter/segment_orders.h"
 #include "converter/voxel_size_auto.h"
@@ -166,10 +167,10 @@ void StreamingConversion::fail_changed() const {
 }
 
 void StreamingConversion::check_source_type() const {
-  std::string lower = path_;
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (!lower.ends_with(".tck"))
-    fail_unsupported(path_, "--memory-limit streams TCK sources only (.tck); convert TRK and TRX sources without it");
+  const SourceMatch match = source_format_of(path_);
+  if (!match.format || !match.format->streamable)
+    fail_unsupported(path_, "--memory-limit streams TCK sources only (.tck); convert " +
+                                std::string(match.format ? match.format->name : "other") + " sources without it");
 }
 
 template <typename Body>
@@ -214,10 +215,10 @@ void StreamingConversion::each_batch(const std::string& stage, Body&& body) {
 void StreamingConversion::open_stream() {
   const std::uint64_t limit = settings_.memory_limit;
   budget_.take(kBaselineBytes, "the program itself");
-  const std::uint64_t chunk = std::clamp<std::uint64_t>(limit / 64, 64 << 10, 4 * kMiB);
-  budget_.take(chunk, "the read buffer");
+  const std::uint64_t read_buffer = std::clamp<std::uint64_t>(limit / 64, 64 << 10, 4 * kMiB);
+  budget_.take(read_buffer, "the read buffer");
   batch_items_ = std::clamp<std::uint64_t>(limit / 64 / 16, 1024, 1 << 20);
-  stream_ = std::make_unique<TckStream>(path_, std::max<std::uint64_t>(1, budget_.left() / 4), chunk);
+  stream_ = std::make_unique<TckStream>(path_, std::max<std::uint64_t>(1, budget_.left() / 4), read_buffer);
   max_points_held_ = budget_.left() / kHeldBytesPerPoint;
 }
 

@@ -13,12 +13,9 @@
 
 #include <nlohmann/json.hpp>
 
-namespace vxl {
+#include "format/streamline_group.h"
 
-struct StreamlineGroup {
-  std::string name;
-  std::vector<std::uint64_t> members;  // streamline indices, strictly increasing
-};
+namespace vxl {
 
 // What the readers know of the source file, kept as provenance in the .vxl.
 struct SourceInfo {

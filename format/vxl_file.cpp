@@ -67,7 +67,16 @@ std::vector<float> VxlFile::all_vertices() const {
   return xyz;
 }
 
+// The steps of spec §7's `open`, in order; each sets the spans the next relies on.
 void VxlFile::validate() {
+  validate_header();
+  validate_section_table();
+  validate_meta_and_sizes();
+  validate_voxel_table();
+}
+
+// §7 step 1.
+void VxlFile::validate_header() {
   const std::string& p = file_.path();
   const std::uint64_t size = file_.size();
   const std::uint8_t* base = file_.data();
@@ -89,8 +98,13 @@ void VxlFile::validate() {
   const std::uint64_t table_end = sizeof(FileHeader) + std::uint64_t(header_.section_count) * sizeof(SectionEntry);
   if (table_end > size) fail_input(p, 64, "section table runs past the end of the file");
   sections_ = {reinterpret_cast<const SectionEntry*>(base + sizeof(FileHeader)), header_.section_count};
+}
 
-  // Section table (§7 step 2).
+// §7 step 2: every entry in bounds, aligned, in order, unique; unknown required sections refused.
+void VxlFile::validate_section_table() {
+  const std::string& p = file_.path();
+  const std::uint64_t size = file_.size();
+  const std::uint64_t table_end = sizeof(FileHeader) + sections_.size_bytes();
   std::uint64_t previous_end = table_end;
   std::vector<std::uint32_t> seen;
   for (std::size_t i = 0; i < sections_.size(); ++i) {
@@ -120,7 +134,12 @@ void VxlFile::validate() {
       throw Error(ErrorKind::Unsupported, p, at,
                   "required section " + name + " is unknown to this reader (newer writer?)");
   }
+}
 
+// §7 step 3: META, and every section's size against its counts; sets the section spans.
+void VxlFile::validate_meta_and_sizes() {
+  const std::string& p = file_.path();
+  const std::uint8_t* base = file_.data();
   auto section = [&](const char(&id)[5], bool required) -> std::span<const std::uint8_t> {
     const SectionEntry* e = find_section(section_id(id));
     if (!e) {
@@ -201,9 +220,15 @@ void VxlFile::validate() {
     vertex_values_ = ValueSets(section("VVAL", true), m.vertex_count, p, offset_of("VVAL"));
   if (find_section(section_id("SVAL")))
     streamline_values_ = ValueSets(section("SVAL", true), m.streamline_count, p, offset_of("SVAL"));
+}
 
-  // Voxel table (§7 step 4): O(voxels).
-  const std::uint64_t voxt_at = offset_of("VOXT");
+// §7 step 4: every voxel's coordinates, flags, vertex and order ranges (and tight bounds, when packed
+// positions are decoded from them). O(voxels).
+void VxlFile::validate_voxel_table() {
+  const std::string& p = file_.path();
+  const MetaSection& m = meta_;
+  const bool packed = position_encoding() == PositionEncoding::Packed;
+  const std::uint64_t voxt_at = find_section(section_id("VOXT"))->offset;
   std::uint64_t next_vertex = 0, segments = 0, min_order_offset = 0;
   for (std::size_t i = 0; i < voxels_.size(); ++i) {
     const VoxelEntry& v = voxels_[i];
@@ -231,7 +256,7 @@ void VxlFile::validate() {
     if (next_vertex > m.vertex_count) fail_input(p, at + 48, "voxel vertex block runs past vertex_count");
     if (v.order_offset % 4 != 0 || v.order_offset < min_order_offset)
       fail_input(p, at + 56, "order offset not a multiple of 4 or decreasing");
-    std::uint64_t bytes = vxl::order_bytes(v.vertex_count, v.segment_count, m.stored_order_count);
+    std::uint64_t bytes = voxel_orders_size(v.vertex_count, v.segment_count, m.stored_order_count);
     if (v.order_offset > orders_.size() || bytes > orders_.size() - v.order_offset)
       fail_input(p, at + 56, "voxel orders run past the ORDR section");
     min_order_offset = v.order_offset + bytes;
@@ -277,12 +302,12 @@ void VxlFile::walk_groups(
   }
 }
 
-std::vector<GroupContent> VxlFile::groups() const {
-  std::vector<GroupContent> out;
+std::vector<StreamlineGroup> VxlFile::groups() const {
+  std::vector<StreamlineGroup> out;
   const std::string& p = file_.path();
   const std::uint64_t at0 = groups_.empty() ? 0 : find_section(section_id("GRPS"))->offset;
   walk_groups([&](std::string_view name, std::uint64_t members_at, std::uint64_t count) {
-    GroupContent gc;
+    StreamlineGroup gc;
     gc.name = name;
     gc.members.resize(count);
     if (count > 0) std::memcpy(gc.members.data(), groups_.data() + members_at, count * 8);

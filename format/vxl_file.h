@@ -16,10 +16,10 @@
 #include <vector>
 
 #include "format/mapped_file.h"
+#include "format/streamline_group.h"
 #include "format/vxl_layout.h"
 #include "format/vxl_positions.h"
 #include "format/vxl_value_sets.h"
-#include "format/vxl_writer.h"
 
 namespace vxl {
 
@@ -73,7 +73,7 @@ class VxlFile {
   std::string_view provenance_json() const { return provenance_; }
   // Parses GRPS (empty when absent; open() has checked its structure and names); throws vxl::Error when a
   // member is out of range or out of order.
-  std::vector<GroupContent> groups() const;
+  std::vector<StreamlineGroup> groups() const;
   // VVAL: per-vertex value sets (vertex_count values each); SVAL: per-streamline ones. Empty when absent.
   const ValueSets& vertex_values() const { return vertex_values_; }
   const ValueSets& streamline_values() const { return streamline_values_; }
@@ -81,6 +81,10 @@ class VxlFile {
  private:
   explicit VxlFile(MappedFile file) : file_(std::move(file)) {}
   void validate();
+  void validate_header();
+  void validate_section_table();
+  void validate_meta_and_sizes();
+  void validate_voxel_table();
   // Walks GRPS (spec §5.9) checking its structure and names (valid UTF-8, no NUL) but not the members:
   // O(groups). `visit` gets each group's name and where its `count` members start in the section.
   void walk_groups(

@@ -127,7 +127,7 @@ inline constexpr std::uint32_t kVoxlineCountMask = 0x7FFFFFFFu;
 constexpr std::uint64_t align_up(std::uint64_t x, std::uint64_t a) { return (x + a - 1) / a * a; }
 
 // Bytes taken by one voxel's K orders of n segments, including the padding to 4 bytes (§5.5).
-constexpr std::uint64_t order_bytes(std::uint32_t vertex_count, std::uint32_t segment_count, std::uint32_t k) {
+constexpr std::uint64_t voxel_orders_size(std::uint32_t vertex_count, std::uint32_t segment_count, std::uint32_t k) {
   return align_up(std::uint64_t(segment_count) * k * order_entry_width(vertex_count), 4);
 }
 

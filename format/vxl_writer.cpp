@@ -9,7 +9,7 @@
 
 namespace vxl {
 
-std::vector<std::uint8_t> encode_groups(std::span<const GroupContent> groups) {
+std::vector<std::uint8_t> encode_groups(std::span<const StreamlineGroup> groups) {
   std::vector<std::uint8_t> out;
   auto put = [&](const void* p, std::size_t n) {
     const auto* b = static_cast<const std::uint8_t*>(p);
@@ -17,7 +17,7 @@ std::vector<std::uint8_t> encode_groups(std::span<const GroupContent> groups) {
   };
   std::uint32_t header[2] = {static_cast<std::uint32_t>(groups.size()), 0};
   put(header, sizeof header);
-  for (const GroupContent& g : groups) {
+  for (const StreamlineGroup& g : groups) {
     std::uint32_t len = static_cast<std::uint32_t>(g.name.size());
     put(&len, 4);
     put(g.name.data(), g.name.size());

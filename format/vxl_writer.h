@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "format/atomic_output.h"
+#include "format/streamline_group.h"
 #include "format/vxl_layout.h"
 #include "format/vxl_positions.h"
 
@@ -111,11 +112,6 @@ class VxlWriter {
   std::span<std::uint8_t> file_;
 };
 
-struct GroupContent {
-  std::string name;
-  std::vector<std::uint64_t> members;  // strictly increasing streamline indices
-};
-
 // Everything a .vxl holds, in memory. The caller fills `meta` (counts must match the spans; reserved
 // bytes are zeroed by the writer) and guarantees the invariants of spec §5 (the reader re-checks them).
 // VERT is `vertices` when meta.position_encoding is float32, else `packed_vertices`.
@@ -130,13 +126,13 @@ struct VxlContent {
   std::span<const VoxlineEntry> voxlines;
   std::span<const std::uint64_t> streamline_first_voxline;  // N + 1
   std::string provenance_json;
-  std::span<const GroupContent> groups;  // GRPS is written only when non-empty
+  std::span<const StreamlineGroup> groups;  // GRPS is written only when non-empty
 };
 
 // Writes in-memory content through VxlWriter. Throws vxl::Error (Output) naming the path.
 void write_vxl(const std::string& path, const VxlContent& content);
 
 // The GRPS payload (spec §5.9), exposed for tests.
-std::vector<std::uint8_t> encode_groups(std::span<const GroupContent> groups);
+std::vector<std::uint8_t> encode_groups(std::span<const StreamlineGroup> groups);
 
 }  // namespace vxl

@@ -162,12 +162,20 @@ const SectionEntry* VxlzFile::find(std::uint32_t id) const {
   return nullptr;
 }
 
+// The steps of spec §8, in order; each sets what the next relies on.
 void VxlzFile::validate() {
+  validate_header_and_table();
+  validate_checksums();
+  validate_pack_and_meta();
+  validate_chunks();
+}
+
+// §8 steps 1 and 2: the header, then the table; payloads follow each other from the end of the table to
+// the end of the file.
+void VxlzFile::validate_header_and_table() {
   const std::string& p = file_.path();
   const std::uint64_t size = file_.size();
   const std::uint8_t* base = file_.data();
-
-  // §8 step 1: header.
   FileHeader h;
   if (size < sizeof h) fail_input(p, size, "file too short for a .vxlz header (64 bytes): truncated or not a package");
   std::memcpy(&h, base, sizeof h);
@@ -197,7 +205,6 @@ void VxlzFile::validate() {
   sections_.resize(h.section_count);
   std::memcpy(sections_.data(), base + sizeof h, sections_.size() * sizeof(SectionEntry));
 
-  // Step 2: the table. Payloads follow each other from the end of the table to the end of the file.
   std::uint64_t expected_offset = table_end;
   for (std::size_t i = 0; i < sections_.size(); ++i) {
     const SectionEntry& e = sections_[i];
@@ -222,13 +229,21 @@ void VxlzFile::validate() {
   if (expected_offset != size) fail_input(p, expected_offset, "bytes after the last section");
   for (std::uint32_t id : kRequired)
     if (!find(id)) fail_input(p, 64, "required section " + section_name(id) + " is missing");
+}
 
-  // Step 3: every checksum, before anything is decoded.
+// §8 step 3: every checksum, before anything is decoded.
+void VxlzFile::validate_checksums() const {
+  const std::string& p = file_.path();
+  const std::uint8_t* base = file_.data();
   for (const SectionEntry& e : sections_)
     if (xxh3_64(base + e.offset, e.size) != e.checksum)
       fail_input(p, e.offset, "checksum mismatch in section " + std::string(e.id, 4) + " (damaged package)");
+}
 
-  // Step 4: the fixed-size sections.
+// §8 step 4: the fixed-size sections PACK, META and DIRS.
+void VxlzFile::validate_pack_and_meta() {
+  const std::string& p = file_.path();
+  const std::uint8_t* base = file_.data();
   auto fixed = [&](const char(&id)[5], std::uint64_t expected, void* dst) {
     const SectionEntry* e = find(section_id(id));
     if (e->size != expected)
@@ -288,7 +303,13 @@ void VxlzFile::validate() {
     if (d.reserved != 0 || !(std::abs(len - 1.0) < 1e-5))
       fail_input(p, dirs_at + 16 * i, "direction is not a unit vector");
   }
+}
 
+// The chunk table: two sizes per chunk, adding up to POSD.
+void VxlzFile::validate_chunks() {
+  const std::string& p = file_.path();
+  const std::uint8_t* base = file_.data();
+  const PackSection& k = pack_;
   const SectionEntry* chnk = find(section_id("CHNK"));
   const SectionEntry* posd = find(section_id("POSD"));
   if (chnk->size / 16 != k.chunk_count || chnk->size % 16 != 0)

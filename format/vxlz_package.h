@@ -86,6 +86,10 @@ class VxlzFile {
  private:
   explicit VxlzFile(MappedFile file) : file_(std::move(file)) {}
   void validate();
+  void validate_header_and_table();
+  void validate_checksums() const;
+  void validate_pack_and_meta();
+  void validate_chunks();
   const SectionEntry* find(std::uint32_t id) const;
   std::span<const std::uint8_t> payload(const SectionEntry& e) const { return file_.bytes().subspan(e.offset, e.size); }
 

@@ -68,10 +68,10 @@ std::vector<std::uint8_t> encode_voxline_counts(std::span<const VoxlineEntry> vo
   return std::move(out.bytes());
 }
 
-std::vector<std::uint8_t> encode_group_stream(std::span<const GroupContent> groups) {
+std::vector<std::uint8_t> encode_group_stream(std::span<const StreamlineGroup> groups) {
   VarintWriter out;
   out.put(groups.size());
-  for (const GroupContent& g : groups) {
+  for (const StreamlineGroup& g : groups) {
     out.put(g.name.size());
     out.put_bytes(g.name.data(), g.name.size());
     out.put(g.members.size());
@@ -178,15 +178,15 @@ void decode_voxline_counts(std::span<const std::uint8_t> stream, std::span<Voxli
   in.expect_end();
 }
 
-std::vector<GroupContent> decode_group_stream(std::span<const std::uint8_t> stream, std::uint64_t streamline_count,
-                                              const StreamContext& context) {
+std::vector<StreamlineGroup> decode_group_stream(std::span<const std::uint8_t> stream, std::uint64_t streamline_count,
+                                                 const StreamContext& context) {
   VarintReader in(stream, context);
   const std::uint64_t group_count = in.get();
   if (group_count > 0xFFFFFFFFu) in.fail("more than 2^32-1 groups");
   expect_room(in, stream, 2, group_count);
-  std::vector<GroupContent> groups;
+  std::vector<StreamlineGroup> groups;
   for (std::uint64_t g = 0; g < group_count; ++g) {
-    GroupContent gc;
+    StreamlineGroup gc;
     std::span<const std::uint8_t> name = in.get_bytes(in.get());
     gc.name.assign(name.begin(), name.end());
     if (gc.name.find('\0') != std::string::npos) in.fail("group name contains a NUL byte");

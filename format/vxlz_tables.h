@@ -20,7 +20,7 @@ std::vector<std::uint8_t> encode_streamline_voxlines(std::span<const std::uint64
 std::vector<std::uint8_t> encode_voxline_voxels(std::span<const VoxlineEntry> voxlines,     // VXLV
                                                 std::span<const VoxelEntry> voxels);
 std::vector<std::uint8_t> encode_voxline_counts(std::span<const VoxlineEntry> voxlines);  // VXLC
-std::vector<std::uint8_t> encode_group_stream(std::span<const GroupContent> groups);      // GRPS
+std::vector<std::uint8_t> encode_group_stream(std::span<const StreamlineGroup> groups);   // GRPS
 
 // Decoders. Each throws vxl::Error (Input) naming the section unless the stream holds exactly `count`
 // well-formed values (spec §8 steps 5-6).
@@ -40,7 +40,7 @@ void decode_voxline_voxels(std::span<const std::uint8_t> stream, std::span<const
 void decode_voxline_counts(std::span<const std::uint8_t> stream, std::span<VoxlineEntry> voxlines,
                            const StreamContext& context);
 // Groups: members < streamline_count and strictly increasing, names without NUL.
-std::vector<GroupContent> decode_group_stream(std::span<const std::uint8_t> stream, std::uint64_t streamline_count,
-                                              const StreamContext& context);
+std::vector<StreamlineGroup> decode_group_stream(std::span<const std::uint8_t> stream, std::uint64_t streamline_count,
+                                                 const StreamContext& context);
 
 }  // namespace vxl

@@ -192,8 +192,8 @@ TEST(Extremes, CountsAndOffsetsAreSixtyFourBitBeyondTwoToTheThirtyTwo) {
   v[0].segment_count = v[1].segment_count = 1;
   v[0].flags = order_width_code(v[0].vertex_count);
   v[1].flags = order_width_code(v[1].vertex_count);
-  v[1].order_offset = order_bytes(v[0].vertex_count, 1, 3);
-  const std::uint64_t ordr = v[1].order_offset + order_bytes(v[1].vertex_count, 1, 3);
+  v[1].order_offset = voxel_orders_size(v[0].vertex_count, 1, 3);
+  const std::uint64_t ordr = v[1].order_offset + voxel_orders_size(v[1].vertex_count, 1, 3);
   DirectionEntry dirs[3] = {{{1, 0, 0}, 0}, {{0, 1, 0}, 0}, {{0, 0, 1}, 0}};
   struct Part {
     const char* id;

@@ -64,7 +64,7 @@ TEST(VxlGroups, AGroupWithoutMembersIsKept) {
   ConvertSettings s;
   s.voxel_size = 8;
   convert_tractogram(std::move(t), dir.file("g.vxl"), s);
-  const std::vector<GroupContent> groups = VxlFile::open(dir.file("g.vxl")).groups();
+  const std::vector<StreamlineGroup> groups = VxlFile::open(dir.file("g.vxl")).groups();
   ASSERT_EQ(groups.size(), 2u);
   EXPECT_EQ(groups[0].members, (std::vector<std::uint64_t>{0, 3, 14}));
   EXPECT_EQ(groups[1].name, "empty");

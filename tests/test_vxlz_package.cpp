@@ -603,7 +603,7 @@ TEST_F(DamagedVxlz, CraftedPackagesWithValidChecksumsAreRefused) {
   }
   {
     VxlzContent c = content();
-    c.groups = encode_group_stream(std::vector<GroupContent>{{"g", {3, 2}}});  // not increasing
+    c.groups = encode_group_stream(std::vector<StreamlineGroup>{{"g", {3, 2}}});  // not increasing
     expect_crafted_refused(c, "group order");
   }
   {

@@ -27,7 +27,7 @@ long long peak_resident_kib() {
 
 }  // namespace
 
-void add_convert_command(CLI::App& app) {
+void add_convert_command(CLI::App& app, int& exit_code) {
   struct Options {
     std::vector<std::string> files;
     std::string output_dir;
@@ -116,13 +116,13 @@ void add_convert_command(CLI::App& app) {
       "they share one (3 bad input, 4 unsupported, 5 output), or 6 when files failed with different kinds. "
       "Refused before any file is read: two inputs with the same NAME, --tsf with several inputs (2), an "
       "--output-dir that cannot be created or written into (5).");
-  cmd->callback([opt, output_dir, jobs] {
+  cmd->callback([opt, output_dir, jobs, &exit_code] {
     if (!opt->memory_limit.empty()) opt->settings.memory_limit = *parse_memory_size(opt->memory_limit);
     opt->settings.voxel_size_auto = opt->voxel_size == "auto";
     if (!opt->settings.voxel_size_auto) opt->settings.voxel_size = std::strtod(opt->voxel_size.c_str(), nullptr);
     if (output_dir->count() > 0) {
       CohortOptions c{opt->files, opt->output_dir, opt->jobs, opt->settings, opt->tsf, opt->verbose};
-      g_exit_code = run_cohort(c);
+      exit_code = run_cohort(c);
       if (opt->verbose) std::printf("peak resident memory: %lld KiB\n", peak_resident_kib());
       return;
     }

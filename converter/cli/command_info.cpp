@@ -73,7 +73,7 @@ void add_info_command(CLI::App& app) {
     j["vertex_values"] = sets(f.vertex_values());
     j["streamline_values"] = sets(f.streamline_values());
     nlohmann::json groups = nlohmann::json::array();
-    for (const GroupContent& g : f.groups()) groups.push_back({{"name", g.name}, {"streamlines", g.members.size()}});
+    for (const StreamlineGroup& g : f.groups()) groups.push_back({{"name", g.name}, {"streamlines", g.members.size()}});
     j["groups"] = groups;
     auto prov = nlohmann::json::parse(f.provenance_json(), nullptr, false);
     if (prov.is_object() && prov.contains("source") && prov["source"].is_object()) {

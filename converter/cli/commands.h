@@ -11,9 +11,11 @@
 
 namespace vxl::cli {
 
-void add_convert_command(CLI::App& app);
+// Commands whose outcome is an exit code without an error message (verify: 1 for an invalid file; a
+// cohort conversion: the failures' kind) set `exit_code`, which main returns.
+void add_convert_command(CLI::App& app, int& exit_code);
 void add_info_command(CLI::App& app);
-void add_verify_command(CLI::App& app);
+void add_verify_command(CLI::App& app, int& exit_code);
 void add_export_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 void add_pack_command(CLI::App& app);
@@ -32,8 +34,5 @@ inline CLI::Option* add_positions_option(CLI::App* cmd, PositionEncoding& positi
       ->default_str("packed")
       ->transform(CLI::CheckedTransformer(names));
 }
-
-// Set by a command that wants a specific non-zero exit code without an error message (verify).
-inline int g_exit_code = 0;
 
 }  // namespace vxl::cli

@@ -17,6 +17,7 @@
 
 #include "converter/cli/convert_file.h"
 #include "converter/cli/progress_bar.h"
+#include "converter/readers/source_formats.h"
 #include "format/error.h"
 #include "format/parallel.h"
 
@@ -55,16 +56,10 @@ std::string cohort_output_name(const std::string& input) {
   std::string path = input;
   while (path.size() > 1 && path.back() == '/') path.pop_back();  // a TRX directory given as "x.trx/"
   std::string name = fs::path(path).filename().string();
-  std::string lower = name;
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  bool stripped = false;
-  for (const std::string ext : {".trk.gz", ".tck", ".trk", ".trx"})
-    if (lower.size() > ext.size() && lower.ends_with(ext)) {
-      name.resize(name.size() - ext.size());
-      stripped = true;
-      break;
-    }
-  if (!stripped) name = fs::path(name).stem().string();
+  if (const SourceMatch match = source_format_of(name); match.format && name.size() > match.suffix.size())
+    name.resize(name.size() - match.suffix.size());
+  else
+    name = fs::path(name).stem().string();
   if (name.empty() || name == "." || name == "..")
     throw Error(ErrorKind::Usage, input, std::nullopt,
                 "has no file name to name its output after (--output-dir writes DIR/NAME.vxl)");

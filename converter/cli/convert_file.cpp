@@ -10,16 +10,16 @@
 #include "converter/memory_size.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
+#include "converter/readers/source_formats.h"
 #include "converter/streaming_convert.h"
 #include "format/error.h"
 
 namespace vxl::cli {
 namespace {
 
-bool is_tck(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".tck";
+bool is_streamable(const std::string& path) {
+  const SourceMatch match = source_format_of(path);
+  return match.format && match.format->streamable;
 }
 
 }  // namespace
@@ -29,7 +29,7 @@ std::string convert_file(const std::string& input, const std::string& output, co
                          const std::function<void(const std::string&)>& warn, unsigned concurrent_files) {
   auto t0 = std::chrono::steady_clock::now();
   ConvertSettings settings = given;
-  if (settings.memory_limit == 0 && tsf.empty() && is_tck(input)) {
+  if (settings.memory_limit == 0 && tsf.empty() && is_streamable(input)) {
     std::error_code ec;
     const std::uintmax_t bytes = std::filesystem::file_size(input, ec);
     const std::optional<std::uint64_t> available = available_memory();

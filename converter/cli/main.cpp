@@ -32,9 +32,10 @@ int main(int argc, char** argv) {
       "Exit codes: 0 ok, 1 verify found the file invalid, 2 usage, 3 bad input, 4 unsupported, 5 output error."};
   app.set_version_flag("--version", VOXLINES_VERSION);
   app.require_subcommand(1);
-  vxl::cli::add_convert_command(app);
+  int exit_code = 0;  // set by verify and by a cohort conversion
+  vxl::cli::add_convert_command(app, exit_code);
   vxl::cli::add_info_command(app);
-  vxl::cli::add_verify_command(app);
+  vxl::cli::add_verify_command(app, exit_code);
   vxl::cli::add_export_command(app);
   vxl::cli::add_synth_command(app);
   vxl::cli::add_pack_command(app);
@@ -54,5 +55,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "voxlines: internal error: %s\n", e.what());
     return vxl::kExitInternalError;
   }
-  return vxl::cli::g_exit_code;
+  return exit_code;
 }

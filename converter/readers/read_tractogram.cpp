@@ -1,27 +1,20 @@
-#include <algorithm>
+#include <cctype>
 #include <filesystem>
 
 #include "converter/readers/read_tractogram.h"
+#include "converter/readers/source_formats.h"
 #include "format/error.h"
 
 namespace vxl {
 
 Tractogram read_tractogram(const std::string& path) {
-  std::string lower = path;
-  while (lower.size() > 1 && lower.back() == '/') lower.pop_back();
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  auto ends = [&](const char* suffix) { return lower.ends_with(suffix); };
-  if (ends(".tck")) return read_tck(path);
-  if (ends(".trk") || ends(".trk.gz")) return read_trk(path);
-  if (ends(".trx")) return read_trx(path);
-  if (ends(".vtk")) return read_vtk(path);
-  if (ends(".vtp")) return read_vtp(path);
+  if (const SourceMatch match = source_format_of(path); match.format) return match.format->read(path);
   if (!std::filesystem::exists(path)) fail_input(path, std::nullopt, "no such file");
-  std::string what = "unsupported file type";
-  if (ends(".tsf")) what = "a TSF file holds per-point scalars, not streamlines";
-  throw Error(
-      ErrorKind::Unsupported, path, std::nullopt,
-      what + " (supported: .tck, .trk, .trk.gz, .trx zip or directory, .vtk legacy POLYDATA, .vtp XML PolyData)");
+  std::string lower = path;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string what =
+      lower.ends_with(".tsf") ? "a TSF file holds per-point scalars, not streamlines" : "unsupported file type";
+  throw Error(ErrorKind::Unsupported, path, std::nullopt, what + " (" + supported_sources_text() + ")");
 }
 
 }  // namespace vxl

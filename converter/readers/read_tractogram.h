@@ -22,8 +22,8 @@ Tractogram read_trx(const std::string& path);
 Tractogram read_vtk(const std::string& path);
 Tractogram read_vtp(const std::string& path);
 
-// Chooses the reader from the file name (.tck, .trk, .trk.gz, .trx or a directory ending in .trx, .vtk,
-// .vtp); throws an Unsupported error for anything else (e.g. .tsf) that says what is supported.
+// Chooses the reader from the file name (source_formats.h); throws an Unsupported error for anything else
+// (e.g. .tsf) that says what is supported.
 Tractogram read_tractogram(const std::string& path);
 
 }  // namespace vxl

@@ -292,7 +292,7 @@ class TrkBytes {
   TrkBytes(const std::string& path, std::span<const std::uint8_t> compressed, std::vector<std::string>& warnings)
       : in_(compressed), gz_(true), path_(path), warnings_(&warnings) {
     if (inflateInit2(&z_, 16 + MAX_WBITS) != Z_OK) throw std::bad_alloc();  // 16: gzip framing only
-    buffer_.resize(kChunk);
+    buffer_.resize(kReadBuffer);
   }
   ~TrkBytes() {
     if (gz_) inflateEnd(&z_);
@@ -327,7 +327,7 @@ class TrkBytes {
   std::optional<std::uint64_t> size() const { return gz_ ? std::nullopt : std::optional<std::uint64_t>(in_.size()); }
 
  private:
-  static constexpr std::size_t kChunk = 1u << 20;
+  static constexpr std::size_t kReadBuffer = 1u << 20;
 
   // Inflates more into the buffer, which keeps the bytes not yet taken and makes room for n of them.
   void refill(std::size_t n) {
@@ -336,7 +336,7 @@ class TrkBytes {
       end_ -= begin_;
       begin_ = 0;
     }
-    if (buffer_.size() < std::max(n, kChunk)) buffer_.resize(std::max(n, kChunk));
+    if (buffer_.size() < std::max(n, kReadBuffer)) buffer_.resize(std::max(n, kReadBuffer));
     z_.next_out = buffer_.data() + end_;
     z_.avail_out = static_cast<uInt>(buffer_.size() - end_);
     while (z_.avail_out > 0 && !ended_) {

@@ -21,7 +21,8 @@ std::int64_t mtime_ns(const struct stat& st) {
 
 }  // namespace
 
-TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, std::uint64_t chunk_bytes) : path_(path) {
+TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, std::uint64_t read_buffer_bytes)
+    : path_(path) {
   require_regular_file(path);
   // O_NONBLOCK too: should the path become a FIFO after the check, open() still does not wait for a writer.
   fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
@@ -66,7 +67,7 @@ TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, st
   source_.dtype = header_.datatype;
   source_.header = header_.fields;
   triplet_bytes_ = header_.datatype.starts_with("Float64") ? 24 : 12;
-  buffer_.resize(std::max<std::uint64_t>(1, chunk_bytes / triplet_bytes_) * triplet_bytes_);
+  buffer_.resize(std::max<std::uint64_t>(1, read_buffer_bytes / triplet_bytes_) * triplet_bytes_);
   rewind();
 }
 

@@ -19,9 +19,9 @@ class Xxh3_128Stream;
 class TckStream {
  public:
   // Opens `path` and parses its header, reading at most `max_header_bytes` for it (a longer header is an
-  // Unsupported error that says so). `chunk_bytes` is the size of the read buffer. Throws vxl::Error
+  // Unsupported error that says so). `read_buffer_bytes` is the size of the read buffer. Throws vxl::Error
   // like read_tck.
-  TckStream(const std::string& path, std::uint64_t max_header_bytes, std::uint64_t chunk_bytes = 4u << 20);
+  TckStream(const std::string& path, std::uint64_t max_header_bytes, std::uint64_t read_buffer_bytes = 4u << 20);
   ~TckStream();
   TckStream(const TckStream&) = delete;
   TckStream& operator=(const TckStream&) = delete;

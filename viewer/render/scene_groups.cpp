@@ -16,7 +16,7 @@ SceneGroups::SceneGroups(std::span<const VxlFile* const> files) {
     return;
   }
   const VxlFile& f = *files[0];
-  const std::vector<GroupContent> stored = f.groups();
+  const std::vector<StreamlineGroup> stored = f.groups();
   const std::uint64_t n = f.meta().streamline_count;
   if (stored.empty()) {
     groups_.push_back({file_name(f), n});

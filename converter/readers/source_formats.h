@@ -1,0 +1,35 @@
+// The source formats `voxlines convert` and `voxview` read, in one table: the file-name suffixes that
+// choose each reader, whether it can be streamed (--memory-limit), and its reader. read_tractogram, the
+// streaming converter, the cohort's output names and the viewer all look formats up here.
+#pragma once
+
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "converter/tractogram.h"
+
+namespace vxl {
+
+struct SourceFormat {
+  const char* name;                       // "TCK", ...
+  std::span<const char* const> suffixes;  // lower case, longest first where one ends another (.trk.gz, .trk)
+  bool streamable;                        // convert_streaming reads it in bounded memory
+  Tractogram (*read)(const std::string& path);
+  const char* description;  // for messages: what of the format is read
+};
+
+std::span<const SourceFormat> source_formats();
+
+// The format of `path` by its suffix (case-insensitive; a directory given as "x.trx/" counts as x.trx), and
+// the suffix that matched; null when none does.
+struct SourceMatch {
+  const SourceFormat* format = nullptr;
+  std::string_view suffix;
+};
+SourceMatch source_format_of(const std::string& path);
+
+// "supported: .tck, .trk, .trk.gz, ..." for messages.
+std::string supported_sources_text();
+
+}  // namespace vxl
