@@ -35,6 +35,7 @@ std::string provenance_json(const SourceInfo& src, const ConvertSettings& settin
                     {"voxel_size", settings.voxel_size},
                     {"orders", settings.orders},
                     {"positions", position_encoding_name(settings.positions)},
+                    {"levels", settings.levels},
                     {"threads", threads}};
   if (!voxel_size_choice.empty()) j["converter"]["voxel_size_auto"] = voxel_size_choice;
   j["warnings"] = src.warnings;
@@ -92,6 +93,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   VoxelizeSettings vs;
   vs.voxel_size = settings.voxel_size;
   vs.threads = threads;
+  vs.levels = settings.levels;
   vs.progress = settings.progress;
   using Clock = std::chrono::steady_clock;
   auto seconds_since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
@@ -105,7 +107,8 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   meta.order_set = static_cast<std::uint32_t>(order_set.kind);
   meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
   const bool packed = settings.positions == PositionEncoding::Packed;
-  const std::uint64_t order_bytes = layout_orders(plan.voxels(), meta.stored_order_count);
+  const std::uint32_t levels = settings.levels;
+  const std::uint64_t order_bytes = layout_orders(plan.voxels(), plan.levels(), levels, meta.stored_order_count);
   std::vector<std::string> point_set_names, streamline_set_names;
   for (const ValueSet& v : t.point_values) point_set_names.push_back(v.name);
   for (const ValueSet& v : t.streamline_values) streamline_set_names.push_back(v.name);
@@ -126,7 +129,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   for (std::span<std::uint8_t> s : {bytes_of(out.float_vertices()), bytes_of(out.packed_vertices()),
                                     bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
     prefault_for_write(s, threads);
-  VoxelBlocks blocks{out.voxels(), vertices, out.voxlines(), out.streamline_first_voxline(), {}};
+  VoxelBlocks blocks{out.voxels(), out.levels(), vertices, out.voxlines(), out.streamline_first_voxline(), {}};
   blocks.vertex_values = layout_value_sets(out.vertex_values(), point_set_names, meta.vertex_count);
   VoxlineEnds ends = place_vertices(std::move(plan), std::move(t), blocks);
   finish_value_sets(out.vertex_values());
@@ -135,7 +138,8 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
 
   t0 = Clock::now();
   prefault_for_write(out.orders(), threads);
-  build_orders_into(out.voxels(), vertices, ends, order_set, out.orders(), threads, settings.progress);
+  build_orders_into(out.voxels(), out.levels(), levels, vertices, ends, order_set, out.orders(), threads,
+                    settings.progress);
   float_blocks = {};
   summary.orders_seconds = seconds_since(t0);
 

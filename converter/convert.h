@@ -6,6 +6,7 @@
 
 #include "converter/tractogram.h"
 #include "converter/voxelize.h"
+#include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
 
 namespace vxl {
@@ -18,6 +19,8 @@ struct ConvertSettings {
   std::string orders = "axis";
   // Packed: 4 bytes per vertex within packed_error_bound (spec §5.4); float32: the source's bits exactly.
   PositionEncoding positions = PositionEncoding::Packed;
+  // Levels of detail (spec §5.12): 1 .. kMaxLevels; 1 writes none.
+  std::uint32_t levels = kDefaultLevels;
   ProgressFn progress;
   // Bytes of memory convert_streaming may use (streaming_convert.h); 0: no limit. Not recorded in the
   // output: a limited conversion writes the same bytes as an unlimited one.

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 
 #include "format/error.h"
@@ -258,12 +259,16 @@ void fill_voxel_directions(const OrderSetSpec& set, std::span<const VoxelEntry> 
   }
 }
 
-std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_orders) {
+std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::span<const LevelEntry> levels, std::uint32_t level_count,
+                            std::uint32_t stored_orders) {
+  if (levels.size() != voxels.size() * (level_count - 1))
+    throw std::logic_error("layout_orders: not level_count - 1 level entries per voxel");
   std::uint64_t total = 0;
-  for (VoxelEntry& v : voxels) {
+  for (std::size_t i = 0; i < voxels.size(); ++i) {
+    VoxelEntry& v = voxels[i];
     v.flags = order_width_code(v.vertex_count);
     v.order_offset = total;
-    total += voxel_orders_size(v.vertex_count, v.segment_count, stored_orders);
+    total += voxel_all_orders_size(v, level_row(levels, i, level_count), stored_orders);
   }
   return total;
 }
@@ -300,22 +305,33 @@ void VoxelOrderWriter::use_directions_of(const VoxelEntry& v) {
 VoxelOrderWriter::~VoxelOrderWriter() = default;
 VoxelOrderWriter::VoxelOrderWriter(VoxelOrderWriter&&) noexcept = default;
 
-void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const float> vertices, const VoxlineEnds& ends,
-                             std::uint8_t* dst) {
+void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const LevelEntry> row, std::span<const float> vertices,
+                             const VoxlineEnds& ends, std::uint8_t* dst) {
   use_directions_of(v);
+  const std::uint32_t k = static_cast<std::uint32_t>(directions_.size());
+  for (std::uint32_t level = 0; level <= row.size(); ++level) {
+    const LevelEntry counts = voxel_level(v, row, level);
+    if (counts.segment_count > 0) write_level(v, counts, vertices, ends, dst);
+    dst += level_orders_size(counts, k);
+  }
+}
+
+void VoxelOrderWriter::write_level(const VoxelEntry& v, const LevelEntry& level, std::span<const float> vertices,
+                                   const VoxlineEnds& ends, std::uint8_t* dst) {
   std::vector<std::uint32_t>& starts = scratch_->starts;
   SortScratch& scratch = scratch_->sort;
   // The segments start at every vertex that does not end its voxline (branch-free: ends are
   // scattered, a branch would mispredict often).
-  starts.resize(v.vertex_count);
+  starts.resize(level.vertex_count);
   std::size_t n_starts = 0;
-  for (std::uint32_t e = 0; e < v.vertex_count; ++e) {
+  for (std::uint32_t e = 0; e < level.vertex_count; ++e) {
     starts[n_starts] = e;
     n_starts += !ends.test(v.vertex_first + e);
   }
   starts.resize(n_starts);
+  if (n_starts != level.segment_count) throw std::logic_error("VoxelOrderWriter: level segment count mismatch");
   const float* block = vertices.data() + 3 * v.vertex_first;
-  const std::uint32_t width = order_entry_width(v.vertex_count);
+  const std::uint32_t width = order_entry_width(level.vertex_count);
   for (std::size_t k = 0; k < directions_.size(); ++k) {
     scratch.keys.resize(starts.size());
     const auto& d = directions_[k];
@@ -334,11 +350,12 @@ void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const float> vertice
       all_or |= bits;
       all_and &= bits;
     }
-    dst = sort_segments(starts, v.vertex_count, width, all_or ^ all_and, scratch, dst);
+    dst = sort_segments(starts, level.vertex_count, width, all_or ^ all_and, scratch, dst);
   }
 }
 
-void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float> vertices, const VoxlineEnds& ends,
+void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const LevelEntry> levels,
+                       std::uint32_t level_count, std::span<const float> vertices, const VoxlineEnds& ends,
                        const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,
                        const ProgressFn& progress) {
   std::uint32_t max_vertices = 0;
@@ -348,7 +365,8 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float
   std::vector<std::optional<VoxelOrderWriter>> writers(resolve_threads(threads));
   parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned t) {
     if (!writers[t]) writers[t].emplace(set, max_vertices);
-    writers[t]->write(voxels[i], vertices, ends, orders.data() + voxels[i].order_offset);
+    writers[t]->write(voxels[i], level_row(levels, i, level_count), vertices, ends,
+                      orders.data() + voxels[i].order_offset);
     const std::size_t d = ++done;
     if (t == 0 && progress && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
   });
@@ -369,10 +387,11 @@ BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsig
   out.directions = order_directions(set);
   vt.meta.stored_order_count = static_cast<std::uint32_t>(set.directions.size());
   vt.meta.order_set = static_cast<std::uint32_t>(set.kind);
-  out.bytes.assign(layout_orders(vt.voxels, vt.meta.stored_order_count), 0);
+  const std::uint32_t level_count = std::max<std::uint32_t>(1, vt.meta.level_count);
+  out.bytes.assign(layout_orders(vt.voxels, vt.levels, level_count, vt.meta.stored_order_count), 0);
   if (set.per_voxel()) out.voxel_directions.resize(vt.voxels.size() * set.directions.size());
   fill_voxel_directions(set, vt.voxels, out.voxel_directions);
-  build_orders_into(vt.voxels, vt.vertices, vt.voxline_ends, set, out.bytes, threads, progress);
+  build_orders_into(vt.voxels, vt.levels, level_count, vt.vertices, vt.voxline_ends, set, out.bytes, threads, progress);
   return out;
 }
 

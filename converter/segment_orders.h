@@ -17,6 +17,7 @@
 
 #include "converter/voxelize.h"
 #include "format/vxl_layout.h"
+#include "format/vxl_levels.h"
 
 namespace vxl {
 
@@ -49,9 +50,17 @@ void voxel_directions(const OrderSetSpec& set, const std::int32_t (&coord)[3], s
 // (`out` is then empty).
 void fill_voxel_directions(const OrderSetSpec& set, std::span<const VoxelEntry> voxels, std::span<DirectionEntry> out);
 
-// Sets every voxel's flags (order entry width) and order_offset for K = `stored_orders`; returns the
-// size of the ORDR payload, so that it can be allocated before the orders are built.
-std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::uint32_t stored_orders);
+// A voxel's level prefixes (its LODS entries, level_count - 1 of them) in a voxel-major LODS payload.
+inline std::span<const LevelEntry> level_row(std::span<const LevelEntry> levels, std::size_t voxel,
+                                             std::uint32_t level_count) {
+  return levels.subspan(voxel * (level_count - 1), level_count - 1);
+}
+
+// Sets every voxel's flags (order entry width) and order_offset for K = `stored_orders` and every level
+// of `levels` (voxel_count x (level_count - 1)); returns the size of the ORDR payload, so that it can be
+// allocated before the orders are built.
+std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::span<const LevelEntry> levels, std::uint32_t level_count,
+                            std::uint32_t stored_orders);
 
 // Writes one voxel's orders at a time, for callers that do other per-voxel work in the same pass (the
 // unpacker computes the voxel's tight bounds while its vertices are in cache). It keeps its sort
@@ -67,11 +76,16 @@ class VoxelOrderWriter {
 
   // Sorts voxel `v`'s segments (the vertices of its block that do not end a voxline in `ends`) for every
   // direction of the set and writes its K orders at `dst` (the ORDR payload plus v.order_offset; the
-  // voxel's flags and order_offset as layout_orders set them). Padding bytes are left as they are.
-  void write(const VoxelEntry& v, std::span<const float> vertices, const VoxlineEnds& ends, std::uint8_t* dst);
+  // voxel's flags and order_offset as layout_orders set them), then those of each coarser level in `row`
+  // (its LODS entries) after them. Padding bytes are left as they are.
+  void write(const VoxelEntry& v, std::span<const LevelEntry> row, std::span<const float> vertices,
+             const VoxlineEnds& ends, std::uint8_t* dst);
 
  private:
   void use_directions_of(const VoxelEntry& v);
+  // The K orders of the first `level.vertex_count` vertices of v's block.
+  void write_level(const VoxelEntry& v, const LevelEntry& level, std::span<const float> vertices,
+                   const VoxlineEnds& ends, std::uint8_t* dst);
 
   struct Scratch;
   const OrderSetSpec* set_;
@@ -83,7 +97,8 @@ class VoxelOrderWriter {
 
 // Sorts every voxel's segments for every direction of `set` into `orders`, the ORDR payload laid out
 // by layout_orders (padding bytes are left as they are: zero in a fresh payload).
-void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const float> vertices, const VoxlineEnds& ends,
+void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const LevelEntry> levels,
+                       std::uint32_t level_count, std::span<const float> vertices, const VoxlineEnds& ends,
                        const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,
                        const ProgressFn& progress);
 

@@ -41,6 +41,9 @@ constexpr std::uint64_t kBaselineBytes = 16 * kMiB;
 // slots, with their growth: up to 40 bytes), counts per voxel (with growth: 32), sort order, global id,
 // the table itself (64) and cursor (8) — 152 bytes, and a margin.
 constexpr std::uint64_t kPlanBytesPerVoxel = 192;
+// Each level of detail past the first adds counts per depth (32 with growth), a cursor (8), a LODS entry
+// (8) and the counts summed per voxel while the table is built (16).
+constexpr std::uint64_t plan_bytes_per_voxel(std::uint32_t levels) { return kPlanBytesPerVoxel + 64 * (levels - 1); }
 // Memory per point of a batch being read, at worst: two batches (one read while the other is processed),
 // each of whose positions may have twice the capacity in use.
 constexpr std::uint64_t kHeldBytesPerPoint = 2 * 2 * 3 * sizeof(float);
@@ -153,7 +156,9 @@ class StreamingConversion {
   detail::VoxelUse use_;                  // by local id, while planning
   std::vector<std::uint32_t> global_id_;  // local id -> voxel index
   std::vector<VoxelEntry> voxels_;
-  std::vector<std::uint64_t> cursor_;  // by local id: the next vertex of its voxel to place (global index)
+  std::vector<LevelEntry> levels_;  // LODS, voxel-major
+  // By (local id * levels + depth): the next vertex of its voxel to place for that depth (global index).
+  std::vector<std::uint64_t> cursor_;
   // Per streamline: its lowest and highest voxel index (set by the first range's pass), so that later
   // passes skip the streamlines that have no voxel in their range.
   std::vector<std::array<std::uint32_t, 2>> spans_;
@@ -255,6 +260,7 @@ void StreamingConversion::scan() {
 
 // Pass 2: the vertex and segment counts per voxel (plan_voxels' pass 1), kept per voxel only.
 void StreamingConversion::plan() {
+  use_ = detail::VoxelUse(settings_.levels);
   if (meta_.point_count == 0) return;  // no voxels (plan_voxels returns early too)
   grid_ = detail::set_grid(meta_, lo_, hi_, path_);
   // plan_voxels' limit on added points, applied to the whole source (plan_voxels applies it per
@@ -263,7 +269,7 @@ void StreamingConversion::plan() {
       static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(meta_.point_count)) + 4096;
   std::uint64_t voxlines = 0, synthetic = 0, points = 0;
   const std::string voxel_hint = ", or a larger --voxel-size";
-  each_batch("voxelising", [&](const Tractogram& b, std::uint64_t) {
+  each_batch("voxelising", [&](const Tractogram& b, std::uint64_t first) {
     const float* pts = b.positions.data();
     for (std::uint64_t k = 0; k < b.streamline_count(); ++k) {
       sink_.voxlines.clear();
@@ -274,16 +280,16 @@ void StreamingConversion::plan() {
       synthetic += sink_.synthetic_xyz.size() / 3;
       const std::size_t n_local = sink_.index.coords().size();
       use_.grow_to(n_local);
-      detail::count_voxel_use(sink_.voxlines, use_, path_);
+      detail::count_voxel_use(sink_.voxlines, streamline_depth(first + k, settings_.levels), use_, path_);
       voxlines += sink_.voxlines.size();
       // Per streamline, so that a table outgrowing the limit is caught before it goes far past it.
-      const std::uint64_t table = n_local * kPlanBytesPerVoxel;
+      const std::uint64_t table = n_local * plan_bytes_per_voxel(settings_.levels);
       if (table > plan_held_ && table - plan_held_ > budget_.left()) {
         // Voxels turn up ever more slowly: extrapolating from the points read so far overestimates.
         const std::uint64_t read = points + b.offsets[k + 1];
         const std::uint64_t all =
             static_cast<std::uint64_t>(double(n_local) * double(meta_.point_count) / double(read));
-        budget_.fail(all * kPlanBytesPerVoxel, budget_.used() - plan_held_,
+        budget_.fail(all * plan_bytes_per_voxel(settings_.levels), budget_.used() - plan_held_,
                      "the voxel table (" + std::to_string(n_local) + " voxels after " + std::to_string(read) + " of " +
                          std::to_string(meta_.point_count) + " points; about " + std::to_string(all) +
                          " in all, extrapolated)",
@@ -301,14 +307,17 @@ void StreamingConversion::plan() {
 // The voxel table sorted by (z, y, x), as plan_voxels and layout_orders make it.
 void StreamingConversion::build_table() {
   detail::LocalVoxels table{&sink_.index.coords(), &use_, {}, {}};
-  voxels_ = detail::build_voxel_table({&table, 1}, meta_, path_);
-  use_ = {};
+  use_.grow_to(sink_.index.coords().size());
+  detail::VoxelTable built = detail::build_voxel_table({&table, 1}, settings_.levels, meta_, path_);
+  voxels_ = std::move(built.voxels);
+  levels_ = std::move(built.levels);
+  use_ = detail::VoxelUse(settings_.levels);
   global_id_ = std::move(table.global_id);
   cursor_ = std::move(table.cursor);
   meta_.stored_order_count = static_cast<std::uint32_t>(order_set_.directions.size());
   meta_.order_set = static_cast<std::uint32_t>(order_set_.kind);
   meta_.position_encoding = static_cast<std::uint32_t>(settings_.positions);
-  order_bytes_ = layout_orders(voxels_, meta_.stored_order_count);
+  order_bytes_ = layout_orders(voxels_, levels_, settings_.levels, meta_.stored_order_count);
 }
 
 // Consecutive voxels, as many per range as fit in what the limit leaves: each range's vertices (12 bytes
@@ -398,6 +407,7 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
       detail::voxelize_streamline(grid_, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], sink_, synthetic_limit_);
       if (sink_.too_many_synthetic) fail_changed();
       const std::size_t n = sink_.voxlines.size();
+      const std::uint32_t levels = settings_.levels, depth = streamline_depth(first + k, levels);
       for (std::size_t j = 0; j < n; ++j) {
         const TempVoxline& v = sink_.voxlines[j];
         if (v.voxel >= global_id_.size()) fail_changed();  // a voxel pass 2 did not see
@@ -413,8 +423,10 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
         }
         if (g < r.first || g >= r.end) continue;
         const std::uint64_t used = own + (j + 1 < n ? 1 : 0);
-        std::uint64_t& cursor = cursor_[v.voxel];
-        if (used > voxels_[g].vertex_first + voxels_[g].vertex_count - cursor) fail_changed();
+        std::uint64_t& cursor = cursor_[std::size_t(v.voxel) * levels + depth];
+        const std::uint64_t end =
+            voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), depth);
+        if (cursor > end || used > end - cursor) fail_changed();
         detail::place_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data(),
                               vertices.data() + 3 * (cursor - r.vertex_first));
         ends.set(cursor - r.vertex_first + used - 1);
@@ -425,10 +437,14 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
     streamlines += b.streamline_count();
   });
   if (streamlines != meta_.streamline_count || (tables && voxline_index != meta_.voxline_count)) fail_changed();
-  for (std::size_t local = 0; local < cursor_.size(); ++local) {
+  const std::uint32_t levels = settings_.levels;
+  for (std::size_t local = 0; local < global_id_.size(); ++local) {
     const std::uint32_t g = global_id_[local];
-    if (g >= r.first && g < r.end && cursor_[local] != voxels_[g].vertex_first + voxels_[g].vertex_count)
-      fail_changed();
+    if (g < r.first || g >= r.end) continue;
+    for (std::uint32_t d = 0; d < levels; ++d)
+      if (cursor_[local * levels + d] !=
+          voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), d))
+        fail_changed();
   }
   if (tables) {
     streamline_buffer.push_back(voxline_index);
@@ -455,7 +471,9 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
   t0 = Clock::now();
   std::vector<std::uint8_t> orders(r.order_end - r.order_first, 0);
   const std::string stage = "ordering" + of;
-  build_orders_into(range, vertices, ends, order_set_, orders, r.order_threads,
+  const std::span<const LevelEntry> range_levels =
+      std::span<const LevelEntry>(levels_).subspan(r.first * (levels - 1), (r.end - r.first) * (levels - 1));
+  build_orders_into(range, range_levels, levels, vertices, ends, order_set_, orders, r.order_threads,
                     [&](const char*, double f) { report(stage, f); });
   for (VoxelEntry& v : range) {
     v.vertex_first += r.vertex_first;
@@ -488,6 +506,7 @@ void StreamingConversion::write_rest() {
     }
   }
   out_->append_items<VoxelEntry>(VxlStreamWriter::kVoxt, voxels_);
+  if (!levels_.empty()) out_->append_items<LevelEntry>(VxlStreamWriter::kLods, levels_);
 }
 
 ConvertSummary StreamingConversion::run() {
@@ -496,6 +515,7 @@ ConvertSummary StreamingConversion::run() {
   order_set_ = parse_order_set(settings_.orders);
   threads_ = resolve_threads(settings_.threads);
   if (!settings_.voxel_size_auto) detail::check_voxel_size(settings_.voxel_size, path_);
+  detail::check_level_count(settings_.levels, path_);
   summary_.passes = 0;
 
   auto t0 = Clock::now();

@@ -32,6 +32,8 @@ struct Structure {
   std::vector<VoxlineEntry> voxlines;           // L
   std::vector<std::uint8_t> starts_streamline;  // L + 1 (the last entry 1): voxline j is a streamline's first
   std::vector<VoxelEntry> voxels;               // coord, vertex and segment counts, vertex_first, order layout
+  std::vector<LevelEntry> levels;               // LODS: voxel_count x (level_count - 1)
+  std::uint32_t level_count = 1;
   std::uint64_t order_bytes = 0;
   // Voxline j's first vertex is voxels[voxel].vertex_first + offset_in_voxel[j] (< 2^32: a voxel's
   // vertex count is).
@@ -63,11 +65,12 @@ std::vector<VoxlineEntry> read_voxlines(const VxlzFile& f, std::span<const std::
   return voxlines;
 }
 
-Structure rebuild_structure(const VxlzFile& f) {
+Structure rebuild_structure(const VxlzFile& f, std::uint32_t level_count) {
   const MetaSection& m = f.meta();
   const PackSection& k = f.pack();
   const std::string& p = f.path();
   Structure s;
+  s.level_count = level_count;
   const auto coords =
       decode_voxel_coords(f.inflate(section_id("VOXC")), m.voxel_count, m.grid_dims, f.context(section_id("VOXC")));
   s.strm = decode_streamline_voxlines(f.inflate(section_id("STRL")), m.streamline_count, m.voxline_count,
@@ -85,23 +88,33 @@ Structure rebuild_structure(const VxlzFile& f) {
       fail_input(p, vxlc_at, "streamline " + std::to_string(j) + " starts with a synthetic point");
   }
 
-  // One walk: every voxline's place in its voxel, the voxels' counts, the chunk starts, the totals.
-  std::vector<std::uint64_t> vertex_count(m.voxel_count, 0), voxline_count(m.voxel_count, 0);
+  // One walk: every voxline's place among its voxel's voxlines of its streamline's depth (spec §5.12), the
+  // counts per voxel and depth, the chunk starts, the totals. Streamline by streamline: the depth is the
+  // streamline's.
+  const std::uint32_t levels = level_count;
+  std::vector<std::uint64_t> vertex_count(std::uint64_t(m.voxel_count) * levels, 0),
+      voxline_count(std::uint64_t(m.voxel_count) * levels, 0);
   s.offset_in_voxel.resize(l);
   s.chunk_start_voxline.reserve(k.chunk_count);
   s.chunk_start_point.reserve(k.chunk_count);
   std::uint64_t points = 0, synthetic = 0;
-  for (std::uint64_t j = 0; j < l; ++j) {
+  auto for_each_voxline = [&](auto&& body) {
+    for (std::uint64_t st = 0; st < m.streamline_count; ++st) {
+      const std::uint32_t depth = streamline_depth(st, levels);
+      for (std::uint64_t j = s.strm[st]; j < s.strm[st + 1]; ++j) body(j, depth);
+    }
+  };
+  for_each_voxline([&](std::uint64_t j, std::uint32_t depth) {
     const VoxlineEntry& e = s.voxlines[j];
     const std::uint64_t own = e.count_flags & kVoxlineCountMask;
-    std::uint64_t& count = vertex_count[e.voxel];
+    std::uint64_t& count = vertex_count[std::uint64_t(e.voxel) * levels + depth];
     if (count + own + s.connected(j) > 0xFFFFFFFFu)
       fail_input(p, vxlc_at, "voxel " + std::to_string(e.voxel) + " gets 2^32 or more vertices");
     if (own > k.point_count - points)
       fail_input(p, vxlc_at, "voxlines hold more points than PACK's point count " + std::to_string(k.point_count));
-    s.offset_in_voxel[j] = static_cast<std::uint32_t>(count);
+    s.offset_in_voxel[j] = static_cast<std::uint32_t>(count);  // within its depth, for now
     count += own + s.connected(j);
-    voxline_count[e.voxel] += 1;
+    voxline_count[std::uint64_t(e.voxel) * levels + depth] += 1;
     // Chunks start every chunk_points shipped points; record which voxline holds each start.
     while (s.chunk_start_voxline.size() < k.chunk_count &&
            s.chunk_start_voxline.size() * k.chunk_points < points + own) {
@@ -110,19 +123,36 @@ Structure rebuild_structure(const VxlzFile& f) {
     }
     points += own;
     synthetic += e.count_flags >> 31;
-  }
+  });
   std::uint64_t vertices = 0;
   s.voxels.resize(m.voxel_count);
+  s.levels.resize(std::uint64_t(m.voxel_count) * (levels - 1));
+  // depth_start[i * levels + d]: where depth d's voxlines begin in voxel i's block (after the deeper ones).
+  std::vector<std::uint32_t> depth_start(std::uint64_t(m.voxel_count) * levels, 0);
   for (std::uint32_t i = 0; i < m.voxel_count; ++i) {
-    if (vertex_count[i] < 1) fail_input(p, vxlc_at, "voxel " + std::to_string(i) + " gets no vertices");
+    std::uint64_t prefix_vertices = 0, prefix_segments = 0;
+    for (std::uint32_t d = levels; d-- > 0;) {
+      depth_start[std::uint64_t(i) * levels + d] = static_cast<std::uint32_t>(prefix_vertices);
+      prefix_vertices += vertex_count[std::uint64_t(i) * levels + d];
+      prefix_segments += vertex_count[std::uint64_t(i) * levels + d] - voxline_count[std::uint64_t(i) * levels + d];
+      if (prefix_vertices > 0xFFFFFFFFu)
+        fail_input(p, vxlc_at, "voxel " + std::to_string(i) + " gets 2^32 or more vertices");
+      if (d > 0)
+        s.levels[std::uint64_t(i) * (levels - 1) + d - 1] = {static_cast<std::uint32_t>(prefix_vertices),
+                                                             static_cast<std::uint32_t>(prefix_segments)};
+    }
+    if (prefix_vertices < 1) fail_input(p, vxlc_at, "voxel " + std::to_string(i) + " gets no vertices");
     VoxelEntry& v = s.voxels[i];
     v = {};
     std::copy(coords[i].begin(), coords[i].end(), v.coord);
     v.vertex_first = vertices;
-    v.vertex_count = static_cast<std::uint32_t>(vertex_count[i]);
-    v.segment_count = static_cast<std::uint32_t>(vertex_count[i] - voxline_count[i]);
-    vertices += vertex_count[i];
+    v.vertex_count = static_cast<std::uint32_t>(prefix_vertices);
+    v.segment_count = static_cast<std::uint32_t>(prefix_segments);
+    vertices += prefix_vertices;
   }
+  for_each_voxline([&](std::uint64_t j, std::uint32_t depth) {
+    s.offset_in_voxel[j] += depth_start[std::uint64_t(s.voxlines[j].voxel) * levels + depth];
+  });
   auto expect = [&](const char* what, std::uint64_t got, std::uint64_t meta_value) {
     if (got != meta_value)
       fail_input(p, vxlc_at,
@@ -134,7 +164,7 @@ Structure rebuild_structure(const VxlzFile& f) {
   expect("synthetic points", synthetic, m.synthetic_point_count);
   expect("source points", points - synthetic, m.point_count);
   expect("shipped points", points, k.point_count);
-  s.order_bytes = layout_orders(s.voxels, m.stored_order_count);
+  s.order_bytes = layout_orders(s.voxels, s.levels, levels, m.stored_order_count);
   return s;
 }
 
@@ -262,7 +292,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   const VxlzFile f = VxlzFile::open(in_path);
   if (f.meta().order_set == static_cast<std::uint32_t>(OrderSet::Random))
     fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");
-  Structure s = rebuild_structure(f);
+  Structure s = rebuild_structure(f, settings.levels);
   const std::string provenance = provenance_with_package(f);
   std::vector<std::uint8_t> groups_bytes;
   if (f.has_section(section_id("GRPS")))
@@ -280,6 +310,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
 
   MetaSection meta = f.meta();
   meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
+  meta.level_count = s.level_count > 1 && meta.voxel_count > 0 ? s.level_count : 0;
   const bool packed = settings.positions == PositionEncoding::Packed;
   VxlWriter out(out_path, section_sizes(meta, s.order_bytes, provenance.size(), groups_bytes.size(),
                                         static_cast<std::uint32_t>(point_values.size()),
@@ -289,6 +320,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   const std::span<float> vertices = packed ? std::span<float>(float_blocks) : out.float_vertices();
   prefault_for_write(bytes_of(out.float_vertices()), threads);
   std::copy(s.voxels.begin(), s.voxels.end(), out.voxels().begin());
+  std::copy(s.levels.begin(), s.levels.end(), out.levels().begin());
 
   // Positions: chunks in parallel, each into its own voxlines' places.
   std::atomic<std::uint64_t> done{0};
@@ -326,7 +358,8 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
     VoxelEntry& v = voxels[item - 1];
     detail::set_tight_bounds({&v, 1}, vertices.data(), 0);
     if (packed) pack_vertex_blocks({&v, 1}, vertices, ends, out.packed_vertices(), 1);
-    writers[t].write(v, vertices, ends, out.orders().data() + v.order_offset);
+    writers[t].write(v, level_row(s.levels, item - 1, s.level_count), vertices, ends,
+                     out.orders().data() + v.order_offset);
     const std::uint64_t d = ++ordered;
     if (t == 0 && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
   });

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "converter/voxelize.h"
+#include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
 #include "format/vxlz_layout.h"
 
@@ -18,6 +19,7 @@ namespace vxl {
 struct UnpackSettings {
   unsigned threads = 0;                                   // 0: all cores
   PositionEncoding positions = PositionEncoding::Packed;  // of the .vxl written (spec §5.4)
+  std::uint32_t levels = kDefaultLevels;                  // of the .vxl written (spec §5.12), 1 .. kMaxLevels
   ProgressFn progress;                                    // stages "decoding", "ordering", "writing"; may be empty
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <sstream>
+#include <stdexcept>
 
 #include "format/error.h"
 
@@ -104,6 +105,12 @@ Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std:
   return Grid{{lo[0], lo[1], lo[2]}, s};
 }
 
+void check_level_count(std::uint32_t levels, const std::string& path) {
+  if (levels < 1 || levels > kMaxLevels)
+    throw Error(ErrorKind::Usage, path, std::nullopt,
+                "levels of detail must be 1.." + std::to_string(kMaxLevels) + ", not " + std::to_string(levels));
+}
+
 void fail_too_many_synthetic(const std::string& path, double s, double longest_step2) {
   throw Error(ErrorKind::Unsupported, path, std::nullopt,
               "voxel size " + format_mm(s) + " mm is far below the longest step (" +
@@ -112,18 +119,20 @@ void fail_too_many_synthetic(const std::string& path, double s, double longest_s
                   format_mm(std::sqrt(longest_step2)) + " or larger");
 }
 
-void count_voxel_use(std::span<const TempVoxline> streamline, VoxelUse& use, const std::string& path) {
+void count_voxel_use(std::span<const TempVoxline> streamline, std::uint32_t depth, VoxelUse& use,
+                     const std::string& path) {
   for (std::size_t j = 0; j < streamline.size(); ++j) {
     const TempVoxline& v = streamline[j];
     const std::uint64_t own = v.own();
     if (own > kVoxlineCountMask) fail_long_voxline(path);
     const std::uint64_t used = own + (j + 1 < streamline.size() ? 1 : 0);  // + the connecting vertex
-    use.vertices[v.voxel] += used;
-    use.segments[v.voxel] += used - 1;
+    use.vertices[std::size_t(v.voxel) * use.levels + depth] += used;
+    use.segments[std::size_t(v.voxel) * use.levels + depth] += used - 1;
   }
 }
 
-std::vector<VoxelEntry> build_voxel_table(std::span<LocalVoxels> indexes, MetaSection& m, const std::string& path) {
+VoxelTable build_voxel_table(std::span<LocalVoxels> indexes, std::uint32_t level_count, MetaSection& m,
+                             const std::string& path) {
   std::vector<Coord> all;
   for (const LocalVoxels& x : indexes) all.insert(all.end(), x.coords->begin(), x.coords->end());
   std::sort(all.begin(), all.end(), zyx_less);
@@ -133,51 +142,74 @@ std::vector<VoxelEntry> build_voxel_table(std::span<LocalVoxels> indexes, MetaSe
     throw Error(ErrorKind::Unsupported, path, std::nullopt,
                 "more than 2^31 non-empty voxels; use a larger --voxel-size than " + format_mm(m.voxel_size));
 
-  std::vector<std::uint64_t> vertices(n, 0), segments(n, 0);
+  // Counts per (voxel, depth), then per voxel.
+  const std::uint32_t levels = level_count;
+  std::vector<std::uint64_t> depth_vertices(n * levels, 0), depth_segments(n * levels, 0);
   for (LocalVoxels& x : indexes) {
+    if (x.use->levels != levels) throw std::logic_error("build_voxel_table: VoxelUse has another level count");
     const std::vector<Coord>& coords = *x.coords;
     x.global_id.resize(coords.size());
     for (std::size_t i = 0; i < coords.size(); ++i) {
       const auto g =
           static_cast<std::uint32_t>(std::lower_bound(all.begin(), all.end(), coords[i], zyx_less) - all.begin());
       x.global_id[i] = g;
-      vertices[g] += x.use->vertices[i];
-      segments[g] += x.use->segments[i];
+      for (std::uint32_t d = 0; d < levels; ++d) {
+        depth_vertices[std::size_t(g) * levels + d] += x.use->vertices[i * levels + d];
+        depth_segments[std::size_t(g) * levels + d] += x.use->segments[i * levels + d];
+      }
     }
   }
 
-  std::vector<VoxelEntry> voxels(n);
+  VoxelTable table;
+  table.voxels.resize(n);
+  table.levels.resize(n * (levels - 1));
   std::uint64_t vertex_total = 0, segment_total = 0;
   for (std::size_t g = 0; g < n; ++g) {
-    if (vertices[g] > std::numeric_limits<std::uint32_t>::max())
-      throw Error(
-          ErrorKind::Unsupported, path, std::nullopt,
-          "a voxel holds more than 2^32-1 vertices; use a --voxel-size smaller than " + format_mm(m.voxel_size));
-    VoxelEntry& v = voxels[g];
+    // Level d's prefix: the voxlines of depth >= d (vxl_levels.h), summed from the deepest.
+    std::uint64_t vertices = 0, segments = 0;
+    for (std::uint32_t d = levels; d-- > 0;) {
+      vertices += depth_vertices[g * levels + d];
+      segments += depth_segments[g * levels + d];
+      if (vertices > std::numeric_limits<std::uint32_t>::max())
+        throw Error(
+            ErrorKind::Unsupported, path, std::nullopt,
+            "a voxel holds more than 2^32-1 vertices; use a --voxel-size smaller than " + format_mm(m.voxel_size));
+      if (d > 0)
+        table.levels[g * (levels - 1) + d - 1] = {static_cast<std::uint32_t>(vertices),
+                                                  static_cast<std::uint32_t>(segments)};
+    }
+    VoxelEntry& v = table.voxels[g];
     v = {};
     v.coord[0] = all[g].x;
     v.coord[1] = all[g].y;
     v.coord[2] = all[g].z;
     v.vertex_first = vertex_total;
-    v.vertex_count = static_cast<std::uint32_t>(vertices[g]);
-    v.segment_count = static_cast<std::uint32_t>(segments[g]);
-    vertex_total += vertices[g];
-    segment_total += segments[g];
+    v.vertex_count = static_cast<std::uint32_t>(vertices);
+    v.segment_count = static_cast<std::uint32_t>(segments);
+    vertex_total += vertices;
+    segment_total += segments;
   }
-  // Each index writes after the indexes before it inside every block: streamline order is kept.
-  std::vector<std::uint64_t>& next = vertices;  // reused: the counts are no longer needed
-  for (std::size_t g = 0; g < n; ++g) next[g] = voxels[g].vertex_first;
+  // Inside each block, depth by depth from the deepest; within a depth each index writes after the
+  // indexes before it: streamline order is kept.
+  std::vector<std::uint64_t>& next = depth_vertices;  // reused: the counts are no longer needed
+  for (std::size_t g = 0; g < n; ++g) {
+    const std::span<const LevelEntry> row(table.levels.data() + g * (levels - 1), levels - 1);
+    for (std::uint32_t d = 0; d < levels; ++d)
+      next[g * levels + d] = table.voxels[g].vertex_first + depth_first_vertex(row, d);
+  }
   for (LocalVoxels& x : indexes) {
-    x.cursor.resize(x.global_id.size());
-    for (std::size_t i = 0; i < x.global_id.size(); ++i) {
-      x.cursor[i] = next[x.global_id[i]];
-      next[x.global_id[i]] += x.use->vertices[i];
-    }
+    x.cursor.resize(x.global_id.size() * levels);
+    for (std::size_t i = 0; i < x.global_id.size(); ++i)
+      for (std::uint32_t d = 0; d < levels; ++d) {
+        x.cursor[i * levels + d] = next[std::size_t(x.global_id[i]) * levels + d];
+        next[std::size_t(x.global_id[i]) * levels + d] += x.use->vertices[i * levels + d];
+      }
   }
   m.voxel_count = static_cast<std::uint32_t>(n);
   m.vertex_count = vertex_total;
   m.segment_count = segment_total;
-  return voxels;
+  m.level_count = levels > 1 && n > 0 ? levels : 0;  // LODS exactly when level_count > 1 (spec §5.12)
+  return table;
 }
 
 void set_tight_bounds(std::span<VoxelEntry> voxels, const float* vertices, std::uint64_t vertex_base) {

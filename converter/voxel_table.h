@@ -23,6 +23,7 @@
 
 #include "converter/voxelize_streamline.h"
 #include "format/vxl_layout.h"
+#include "format/vxl_levels.h"
 
 namespace vxl::detail {
 
@@ -48,35 +49,48 @@ struct BoundsScan {
   double rms_step() const { return steps ? std::sqrt(double(step2_sum_fixed) / 1024.0 / double(steps)) : 0.0; }
 };
 
-// Vertex and segment counts per voxel of one local voxel index.
+// Vertex and segment counts per voxel of one local voxel index, and per streamline depth (vxl_levels.h):
+// entry local_id * levels + depth.
 struct VoxelUse {
+  std::uint32_t levels = 1;
   std::vector<std::uint64_t> vertices, segments;
+  explicit VoxelUse(std::uint32_t level_count = 1) : levels(level_count) {}
   void grow_to(std::size_t voxels) {
-    if (vertices.size() < voxels) {
-      vertices.resize(voxels, 0);
-      segments.resize(voxels, 0);
+    if (vertices.size() < voxels * levels) {
+      vertices.resize(voxels * levels, 0);
+      segments.resize(voxels * levels, 0);
     }
   }
 };
 
-// Adds one streamline's voxlines (all of them, in order) to `use`: each voxline's own points plus, but
-// for the last, the connecting vertex. Throws Unsupported for a voxline longer than spec §9 allows.
-void count_voxel_use(std::span<const TempVoxline> streamline, VoxelUse& use, const std::string& path);
+// Adds one streamline's voxlines (all of them, in order) to `use`, at the streamline's depth: each
+// voxline's own points plus, but for the last, the connecting vertex. Throws Unsupported for a voxline
+// longer than spec §9 allows.
+void count_voxel_use(std::span<const TempVoxline> streamline, std::uint32_t depth, VoxelUse& use,
+                     const std::string& path);
 
 // One local voxel index (a thread's or the whole source's) and what build_voxel_table gives back for it.
 struct LocalVoxels {
   const std::vector<Coord>* coords = nullptr;  // by local id
   const VoxelUse* use = nullptr;               // by local id
   std::vector<std::uint32_t> global_id;        // out: local id -> voxel index
-  // out: local id -> the first vertex of its block this index places (after the indexes before it)
+  // out: (local id * levels + depth) -> the first vertex of its block this index places for streamlines
+  // of that depth (after the deeper ones' and after the indexes before it)
   std::vector<std::uint64_t> cursor;
 };
 
+struct VoxelTable {
+  std::vector<VoxelEntry> voxels;
+  std::vector<LevelEntry> levels;  // the LODS payload: voxel_count x (level_count - 1); empty for one level
+};
+
 // The voxel table of spec §5.3, sorted by (z, y, x), with coord, vertex_first, vertex_count and
-// segment_count set; inside each block the indexes place their vertices in the order given (so that
-// streamline order is kept). Sets m's voxel_count, vertex_count and segment_count. Throws Unsupported
-// beyond the limits of spec §9.
-std::vector<VoxelEntry> build_voxel_table(std::span<LocalVoxels> indexes, MetaSection& m, const std::string& path);
+// segment_count set, and the level prefixes of spec §5.12 (the indexes' VoxelUse have `level_count`
+// depths); inside each block the deeper streamlines' voxlines come first and the indexes place theirs in
+// the order given (so that streamline order is kept within a depth). Sets m's voxel_count, vertex_count,
+// segment_count and level_count. Throws Unsupported beyond the limits of spec §9.
+VoxelTable build_voxel_table(std::span<LocalVoxels> indexes, std::uint32_t level_count, MetaSection& m,
+                             const std::string& path);
 
 // Writes voxline j of one streamline's list (its optional synthetic first point, its own points and, but
 // for the streamline's last voxline, the next voxline's first point) at `dst`; returns the vertices written.
@@ -99,7 +113,8 @@ inline std::uint64_t place_voxline(std::span<const TempVoxline> streamline, std:
 }
 
 // The checks, shared so that both paths refuse the same input with the same message. All throw vxl::Error.
-void check_voxel_size(double voxel_size, const std::string& path);  // Usage unless finite and > 0
+void check_voxel_size(double voxel_size, const std::string& path);      // Usage unless finite and > 0
+void check_level_count(std::uint32_t levels, const std::string& path);  // Usage unless 1 .. kMaxLevels
 // Sets the grid and bounds of `m` (voxel_size already set) for points inside [lo, hi]; Unsupported when
 // an axis would have 2^31 cells or more.
 Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std::string& path);

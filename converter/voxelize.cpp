@@ -51,6 +51,7 @@ std::vector<std::uint64_t> split_by_points(const std::vector<std::uint64_t>& off
 
 struct VoxelPlan::Work {
   unsigned threads = 1;
+  std::uint32_t levels = 1;
   std::vector<StreamlineRange> ranges;
 };
 
@@ -64,11 +65,14 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   const double s = settings.voxel_size;
   detail::check_voxel_size(s, path);
   const unsigned threads = resolve_threads(settings.threads);
+  const std::uint32_t levels = settings.levels;
+  detail::check_level_count(levels, path);
   const std::uint64_t n_streamlines = t.streamline_count(), n_points = t.point_count();
   const float* pts = t.positions.data();
 
   VoxelPlan plan;
   plan.work_->threads = threads;
+  plan.work_->levels = levels;
   MetaSection& m = plan.meta_;
   m.streamline_count = n_streamlines;
   m.point_count = n_points;
@@ -112,16 +116,19 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
     if (r.too_many_synthetic) detail::fail_too_many_synthetic(path, s, scan.longest_step2);
   parallel_for(ranges.size(), threads, [&](std::uint64_t c, unsigned) {
     StreamlineRange& r = ranges[c];
+    r.use = detail::VoxelUse(levels);
     r.use.grow_to(r.index.coords().size());
     for (std::uint64_t k = 0; k + 1 < r.first_voxline.size(); ++k)
-      detail::count_voxel_use(r.streamline(k), r.use, path);
+      detail::count_voxel_use(r.streamline(k), streamline_depth(r.first_streamline + k, levels), r.use, path);
   });
   if (settings.progress) settings.progress("voxelising", 1.0);
 
   // Global voxel table, sorted by (z, y, x).
   std::vector<detail::LocalVoxels> tables;
   for (StreamlineRange& r : ranges) tables.push_back({&r.index.coords(), &r.use, {}, {}});
-  plan.voxels_ = detail::build_voxel_table(tables, m, path);
+  detail::VoxelTable table = detail::build_voxel_table(tables, levels, m, path);
+  plan.voxels_ = std::move(table.voxels);
+  plan.levels_ = std::move(table.levels);
   std::uint64_t n_voxlines = 0, n_synthetic = 0;
   for (std::size_t c = 0; c < ranges.size(); ++c) {
     StreamlineRange& r = ranges[c];
@@ -140,13 +147,16 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
 VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& out) {
   const MetaSection& m = plan.meta_;
   const unsigned threads = plan.work_->threads;
+  const std::uint32_t levels = plan.work_->levels;
   std::vector<StreamlineRange>& ranges = plan.work_->ranges;
   const float* pts = t.positions.data();
   if (out.voxels.size() != m.voxel_count || out.vertices.size() != 3 * m.vertex_count ||
-      out.voxlines.size() != m.voxline_count || out.streamline_first_voxline.size() != m.streamline_count + 1)
+      out.voxlines.size() != m.voxline_count || out.streamline_first_voxline.size() != m.streamline_count + 1 ||
+      out.levels.size() != plan.levels_.size())
     throw std::logic_error("place_vertices: the output spans do not have the sizes of the plan");
   VoxlineEnds ends(m.vertex_count);
   std::copy(plan.voxels_.begin(), plan.voxels_.end(), out.voxels.begin());
+  std::copy(plan.levels_.begin(), plan.levels_.end(), out.levels.begin());
 
   if (out.vertex_values.size() != t.point_values.size())
     throw std::logic_error("place_vertices: one vertex value array per point value set expected");
@@ -160,9 +170,10 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
     for (std::uint64_t k = 0; k + 1 < r.first_voxline.size(); ++k) {
       out.streamline_first_voxline[r.first_streamline + k] = r.voxline_base + r.first_voxline[k];
       const std::span<const TempVoxline> streamline = r.streamline(k);
+      const std::uint32_t depth = streamline_depth(r.first_streamline + k, levels);
       for (std::size_t j = 0; j < streamline.size(); ++j) {
         const TempVoxline& v = streamline[j];
-        std::uint64_t& cursor = r.table.cursor[v.voxel];
+        std::uint64_t& cursor = r.table.cursor[std::size_t(v.voxel) * levels + depth];
         const std::uint64_t used =
             detail::place_voxline(streamline, j, pts, r.synthetic_xyz.data(), out.vertices.data() + 3 * cursor);
         // Values travel with their points: a synthetic point's is interpolated where it lies on its step
@@ -210,11 +221,13 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
   VoxelizedTractogram out;
   out.meta = plan.meta();
   out.voxels.resize(out.meta.voxel_count);
+  out.levels.resize(plan.levels().size());
   out.vertices.resize(3 * out.meta.vertex_count);
   out.voxlines.resize(out.meta.voxline_count);
   out.streamline_first_voxline.resize(out.meta.streamline_count + 1);
-  out.voxline_ends = place_vertices(std::move(plan), std::move(t),
-                                    {out.voxels, out.vertices, out.voxlines, out.streamline_first_voxline, {}});
+  out.voxline_ends =
+      place_vertices(std::move(plan), std::move(t),
+                     {out.voxels, out.levels, out.vertices, out.voxlines, out.streamline_first_voxline, {}});
   return out;
 }
 

@@ -23,6 +23,7 @@
 #include "converter/tractogram.h"
 #include "format/parallel.h"  // resolve_threads: the meaning of VoxelizeSettings::threads
 #include "format/vxl_layout.h"
+#include "format/vxl_levels.h"
 
 namespace vxl {
 
@@ -32,6 +33,8 @@ using ProgressFn = std::function<void(const char* stage, double fraction)>;
 struct VoxelizeSettings {
   double voxel_size = 10.0;  // mm
   unsigned threads = 0;      // 0: all hardware threads
+  // Levels of detail (vxl_levels.h, spec §5.12), 1 .. kMaxLevels: 1 keeps every block in streamline order.
+  std::uint32_t levels = 1;
   ProgressFn progress;
   // Refuse (with a suggested voxel size) when splitting long steps would add more than this many
   // points per source point: a guard against a voxel size far below the step length.
@@ -59,6 +62,7 @@ class VoxlineEnds {
 struct VoxelizedTractogram {
   MetaSection meta{};
   std::vector<VoxelEntry> voxels;                       // sorted by (z, y, x); order_offset/flags set by build_orders
+  std::vector<LevelEntry> levels;                       // LODS: voxel_count x (level_count - 1)
   std::vector<float> vertices;                          // 3 * vertex_count
   std::vector<VoxlineEntry> voxlines;                   // streamline order
   std::vector<std::uint64_t> streamline_first_voxline;  // N + 1
@@ -68,6 +72,7 @@ struct VoxelizedTractogram {
 // Where place_vertices writes; each span has exactly the size the plan's meta gives.
 struct VoxelBlocks {
   std::span<VoxelEntry> voxels;                       // voxel_count
+  std::span<LevelEntry> levels;                       // voxel_count x (level_count - 1)
   std::span<float> vertices;                          // 3 * vertex_count
   std::span<VoxlineEntry> voxlines;                   // voxline_count
   std::span<std::uint64_t> streamline_first_voxline;  // streamline_count + 1
@@ -88,6 +93,8 @@ class VoxelPlan {
   // Sorted by (z, y, x), with coord, vertex_first, vertex_count and segment_count set. The caller may
   // set flags and order_offset (layout_orders); place_vertices copies the entries and adds tight bounds.
   std::span<VoxelEntry> voxels() { return voxels_; }
+  // The level prefixes of each voxel (spec §5.12), voxel-major.
+  std::span<const LevelEntry> levels() const { return levels_; }
 
  private:
   struct Work;  // the per-thread voxlines (voxelize.cpp)
@@ -98,6 +105,7 @@ class VoxelPlan {
   std::unique_ptr<Work> work_;
   MetaSection meta_{};
   std::vector<VoxelEntry> voxels_;
+  std::vector<LevelEntry> levels_;
 };
 
 // Pass 1. Throws vxl::Error: Input for a non-finite coordinate, Unsupported (with a suggestion) when a

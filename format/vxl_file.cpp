@@ -44,12 +44,14 @@ const SectionEntry* VxlFile::find_section(std::uint32_t id) const {
   return nullptr;
 }
 
-OrderView VxlFile::order(std::size_t voxel, std::uint32_t k) const {
+OrderView VxlFile::order(std::size_t voxel, std::uint32_t k, std::uint32_t level) const {
   const VoxelEntry& v = voxels_[voxel];
+  const LevelEntry counts = this->level(voxel, level);
   OrderView o;
-  o.width = order_entry_width(v.vertex_count);
-  o.count = v.segment_count;
-  o.data = orders_.data() + v.order_offset + std::uint64_t(k) * v.segment_count * o.width;
+  o.width = order_entry_width(counts.vertex_count);
+  o.count = counts.segment_count;
+  o.data = orders_.data() + level_orders_offset(v, levels_of(voxel), level, meta_.stored_order_count) +
+           std::uint64_t(k) * counts.segment_count * o.width;
   return o;
 }
 
@@ -125,10 +127,10 @@ void VxlFile::validate_section_table() {
     if (std::find(seen.begin(), seen.end(), id) != seen.end()) fail_input(p, at, "section " + name + " appears twice");
     seen.push_back(id);
     previous_end = e.offset + e.size;
-    static const std::uint32_t known[] = {section_id("META"), section_id("DIRS"), section_id("VOXT"),
-                                          section_id("VERT"), section_id("ORDR"), section_id("VXLN"),
-                                          section_id("STRM"), section_id("PROV"), section_id("GRPS"),
-                                          section_id("VDIR"), section_id("VVAL"), section_id("SVAL")};
+    static const std::uint32_t known[] = {
+        section_id("META"), section_id("DIRS"), section_id("VOXT"), section_id("LODS"), section_id("VERT"),
+        section_id("ORDR"), section_id("VXLN"), section_id("STRM"), section_id("PROV"), section_id("GRPS"),
+        section_id("VDIR"), section_id("VVAL"), section_id("SVAL")};
     bool is_known = std::find(std::begin(known), std::end(known), id) != std::end(known);
     if (!is_known && (e.flags & kSectionRequired))
       throw Error(ErrorKind::Unsupported, p, at,
@@ -190,6 +192,23 @@ void VxlFile::validate_meta_and_sizes() {
     fail_input(p, meta_at + 152, "packed positions in a version 1 file (they need version 2.0)");
   auto vert = packed ? expect_size("VERT", mul(m.vertex_count, 4), "vertex_count × 4 (packed positions)")
                      : expect_size("VERT", mul(m.vertex_count, 12), "vertex_count × 12");
+  // Levels of detail (spec §5.12): LODS exactly when level_count > 1, which needs version 2.1.
+  const bool has_levels = find_section(section_id("LODS")) != nullptr;
+  if (m.level_count == 1 || m.level_count > kMaxLevels)
+    fail_input(p, meta_at + 156,
+               "level count " + std::to_string(m.level_count) + " must be 0 or 2.." + std::to_string(kMaxLevels));
+  if (has_levels != (m.level_count > 1))
+    fail_input(p, meta_at + 156,
+               has_levels ? "LODS section without a level count" : "level count without a LODS section");
+  if (has_levels &&
+      (header_.version_major < kVxlVersionMajorPackedPositions ||
+       (header_.version_major == kVxlVersionMajorPackedPositions && header_.version_minor < kVxlVersionMinorLevels)))
+    fail_input(p, meta_at + 156, "levels of detail in a file before version 2.1");
+  if (has_levels) {
+    auto lods = expect_size("LODS", mul(m.voxel_count, std::uint64_t(m.level_count - 1) * sizeof(LevelEntry)),
+                            "voxel_count × (level_count − 1) × 8");
+    levels_ = {reinterpret_cast<const LevelEntry*>(lods.data()), lods.size() / sizeof(LevelEntry)};
+  }
   auto vxln = expect_size("VXLN", mul(m.voxline_count, sizeof(VoxlineEntry)), "voxline_count × 8");
   std::optional<std::uint64_t> strm_size =
       m.streamline_count == std::numeric_limits<std::uint64_t>::max() ? std::nullopt : mul(m.streamline_count + 1, 8);
@@ -256,7 +275,18 @@ void VxlFile::validate_voxel_table() {
     if (next_vertex > m.vertex_count) fail_input(p, at + 48, "voxel vertex block runs past vertex_count");
     if (v.order_offset % 4 != 0 || v.order_offset < min_order_offset)
       fail_input(p, at + 56, "order offset not a multiple of 4 or decreasing");
-    std::uint64_t bytes = voxel_orders_size(v.vertex_count, v.segment_count, m.stored_order_count);
+    // Each level is a prefix of the finer one's vertices, with fewer segments than vertices (spec §5.12).
+    const std::span<const LevelEntry> row = levels_of(i);
+    const std::uint64_t lods_at = levels_.empty() ? 0 : find_section(section_id("LODS"))->offset;
+    for (std::uint32_t d = 0; d < row.size(); ++d) {
+      const LevelEntry finer = voxel_level(v, row, d), e = row[d];
+      if (e.vertex_count > finer.vertex_count || e.segment_count > finer.segment_count ||
+          (e.vertex_count > 0 ? e.segment_count >= e.vertex_count : e.segment_count != 0))
+        fail_input(p, lods_at + (i * row.size() + d) * sizeof(LevelEntry),
+                   "voxel " + std::to_string(i) + " level " + std::to_string(d + 1) + " is not a prefix of level " +
+                       std::to_string(d) + " with fewer segments than vertices");
+    }
+    std::uint64_t bytes = voxel_all_orders_size(v, row, m.stored_order_count);
     if (v.order_offset > orders_.size() || bytes > orders_.size() - v.order_offset)
       fail_input(p, at + 56, "voxel orders run past the ORDR section");
     min_order_offset = v.order_offset + bytes;

@@ -18,6 +18,7 @@
 #include "format/mapped_file.h"
 #include "format/streamline_group.h"
 #include "format/vxl_layout.h"
+#include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
 #include "format/vxl_value_sets.h"
 
@@ -57,6 +58,17 @@ class VxlFile {
     return voxel_directions_.subspan(voxel * directions_.size(), directions_.size());
   }
   std::span<const VoxelEntry> voxels() const { return voxels_; }
+  // Levels of detail (spec §5.12): 1 when the file has no LODS section. Level 0 is all streamlines.
+  std::uint32_t level_count() const { return std::max<std::uint32_t>(1, meta_.level_count); }
+  // Voxel `voxel`'s LODS entries (level_count - 1 of them: levels 1, 2, ...).
+  std::span<const LevelEntry> levels_of(std::size_t voxel) const {
+    const std::size_t per_voxel = level_count() - 1;
+    return levels_.subspan(voxel * per_voxel, per_voxel);
+  }
+  // The vertices (a prefix of the block) and segments of level `level` of voxel `voxel`.
+  LevelEntry level(std::size_t voxel, std::uint32_t level) const {
+    return voxel_level(voxels_[voxel], levels_of(voxel), level);
+  }
   // VERT (spec §5.4): float32 triples (3 * vertex_count) or packed words (vertex_count), by encoding; the
   // span of the other encoding is empty. read_vertices decodes either.
   PositionEncoding position_encoding() const { return static_cast<PositionEncoding>(meta_.position_encoding); }
@@ -67,7 +79,8 @@ class VxlFile {
   // Every vertex, decoded (3 * vertex_count floats): for tools and tests; the viewer reads by voxel.
   std::vector<float> all_vertices() const;
   std::span<const std::uint8_t> order_bytes() const { return orders_; }
-  OrderView order(std::size_t voxel, std::uint32_t k) const;
+  // Stored order k of voxel `voxel` at level `level` (0: full detail).
+  OrderView order(std::size_t voxel, std::uint32_t k, std::uint32_t level = 0) const;
   std::span<const VoxlineEntry> voxlines() const { return voxlines_; }
   std::span<const std::uint64_t> streamline_first_voxline() const { return strm_; }
   std::string_view provenance_json() const { return provenance_; }
@@ -97,6 +110,7 @@ class VxlFile {
   std::span<const DirectionEntry> directions_;
   std::span<const DirectionEntry> voxel_directions_;
   std::span<const VoxelEntry> voxels_;
+  std::span<const LevelEntry> levels_;
   std::span<const float> float_vertices_;
   std::span<const std::uint32_t> packed_vertices_;
   std::span<const std::uint8_t> orders_;

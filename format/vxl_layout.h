@@ -1,4 +1,4 @@
-// On-disk structures of the .vxl format, versions 1.0 to 2.0 (spec/vxl-format.md is the reference; section
+// On-disk structures of the .vxl format, versions 1.0 to 2.1 (spec/vxl-format.md is the reference; section
 // numbers below point into it). All little-endian; every struct's layout is pinned by static_asserts so
 // a file can be used in place after mmap.
 #pragma once
@@ -20,6 +20,8 @@ inline constexpr std::uint16_t kVxlVersionMinor = 0;
 inline constexpr std::uint16_t kVxlVersionMinorVoxelDirections = 1;
 inline constexpr std::uint16_t kVxlVersionMinorValueSets = 2;
 inline constexpr std::uint16_t kVxlVersionMajorPackedPositions = 2;
+// Files with levels of detail (LODS, spec §5.12) are 2.1, with either position encoding.
+inline constexpr std::uint16_t kVxlVersionMinorLevels = 1;
 inline constexpr std::uint64_t kVxlAlignment = 64;
 inline constexpr std::uint32_t kVxlMaxSections = 64;
 inline constexpr std::uint32_t kVxlMaxStoredOrders = 64;
@@ -77,7 +79,8 @@ struct MetaSection {
   double bounds_min[3];
   double bounds_max[3];
   std::uint32_t position_encoding;  // PositionEncoding (vxl_positions.h); 0 in every 1.x file
-  std::uint8_t reserved[100];
+  std::uint32_t level_count;        // levels of detail (vxl_levels.h), since 2.1; 0 before (one level)
+  std::uint8_t reserved[96];
 };
 static_assert(sizeof(MetaSection) == 256);
 static_assert(offsetof(MetaSection, voxel_size) == 56);
@@ -85,7 +88,8 @@ static_assert(offsetof(MetaSection, grid_dims) == 88);
 static_assert(offsetof(MetaSection, order_set) == 100);
 static_assert(offsetof(MetaSection, bounds_min) == 104);
 static_assert(offsetof(MetaSection, position_encoding) == 152);
-static_assert(offsetof(MetaSection, reserved) == 156);
+static_assert(offsetof(MetaSection, level_count) == 156);
+static_assert(offsetof(MetaSection, reserved) == 160);
 
 // §5.2
 struct DirectionEntry {

@@ -12,7 +12,7 @@ VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes&
   file_size_ = layout.file_size;
   written_.assign(table_.size(), 0);
   for (std::size_t i = 0; i < table_.size(); ++i) checksums_.push_back(std::make_unique<Xxh3_64Stream>());
-  static const char* const ids[kSectionCount] = {"META", "DIRS", "VDIR", "VOXT", "VERT",
+  static const char* const ids[kSectionCount] = {"META", "DIRS", "VDIR", "VOXT", "LODS", "VERT",
                                                  "ORDR", "VXLN", "STRM", "PROV", "GRPS"};
   for (std::size_t s = 0; s < kSectionCount; ++s) {
     entry_[s] = table_.size();

@@ -22,7 +22,20 @@ namespace vxl {
 
 class VxlStreamWriter {
  public:
-  enum Section : std::size_t { kMeta, kDirs, kVdir, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps, kSectionCount };
+  enum Section : std::size_t {
+    kMeta,
+    kDirs,
+    kVdir,
+    kVoxt,
+    kLods,
+    kVert,
+    kOrdr,
+    kVxln,
+    kStrm,
+    kProv,
+    kGrps,
+    kSectionCount
+  };
 
   // Creates the output at `path`, sized for these payloads (which read as zero until written).
   // Throws vxl::Error (Output).
@@ -49,7 +62,7 @@ class VxlStreamWriter {
  private:
   AtomicOutputFile out_;
   PositionEncoding positions_;
-  std::vector<SectionEntry> table_;   // in Section order, optional sections (VDIR, GRPS) only when present
+  std::vector<SectionEntry> table_;   // in Section order, optional sections (VDIR, LODS, GRPS) only when present
   std::size_t entry_[kSectionCount];  // Section -> index in table_ (table_.size(): absent)
   std::uint64_t file_size_ = 0;
   std::vector<std::uint64_t> written_;

@@ -22,8 +22,13 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   if (strm[m.streamline_count] != m.voxline_count)
     fail_input(p, strm_at + 8 * m.streamline_count, "streamline table must end at voxline_count");
 
-  std::vector<std::uint64_t> cursor(voxels.size());
-  for (std::size_t i = 0; i < voxels.size(); ++i) cursor[i] = voxels[i].vertex_first;
+  // One cursor per voxel and depth: a voxel's block holds the voxlines of deeper streamlines first (spec
+  // §5.4, §5.12), each depth's in streamline order.
+  const std::uint32_t levels = f.level_count();
+  std::vector<std::uint64_t> cursor(voxels.size() * levels);
+  for (std::size_t i = 0; i < voxels.size(); ++i)
+    for (std::uint32_t d = 0; d < levels; ++d)
+      cursor[i * levels + d] = voxels[i].vertex_first + depth_first_vertex(f.levels_of(i), d);
   std::vector<float> points, block;
   std::uint64_t total_points = 0, synthetic = 0;
   // A connecting vertex and the next voxline's first point are one source point, stored in two voxels'
@@ -38,6 +43,7 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
 
   for (std::uint64_t s = 0; s < m.streamline_count; ++s) {
     const std::uint64_t first = strm[s], last = strm[s + 1];
+    const std::uint32_t depth = streamline_depth(s, levels);
     if (last < first || last > m.voxline_count)
       fail_input(p, strm_at + 8 * (s + 1), "streamline table not non-decreasing");
     points.clear();
@@ -52,29 +58,34 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
       const bool connected = j + 1 < last;
       if (own == 0) fail_input(p, at, "voxline with no points");
       const VoxelEntry& v = voxels[e.voxel];
-      const std::uint64_t end = v.vertex_first + v.vertex_count;
+      std::uint64_t& here = cursor[e.voxel * levels + depth];
+      const std::uint64_t end = v.vertex_first + depth_end_vertex(v, f.levels_of(e.voxel), depth);
       const std::uint64_t need = std::uint64_t(own) + (connected ? 1 : 0);
-      if (need > end - cursor[e.voxel]) fail_input(p, at, "voxline runs past its voxel's vertex block");
+      if (here > end || need > end - here)
+        fail_input(p, at, "voxline runs past its voxel's vertex block (or its level's part of it)");
       block.resize(3 * need);
-      f.read_vertices(e.voxel, cursor[e.voxel], need, block.data());
+      f.read_vertices(e.voxel, here, need, block.data());
       if (connector_voxel >= 0 &&
           !same_point(pending_connector, static_cast<std::uint32_t>(connector_voxel), block.data(), e.voxel))
         fail_input(p, at, "connecting vertex differs from the next voxline's first point");
       if (synthetic_first && j == first) fail_input(p, at, "a streamline cannot start with a synthetic point");
-      if (cb.voxline) cb.voxline(e.voxel, cursor[e.voxel], own, connected);
+      if (cb.voxline) cb.voxline(e.voxel, here, own, connected);
       const std::uint32_t skip = synthetic_first ? 1 : 0;
       synthetic += skip;
       points.insert(points.end(), block.begin() + 3 * skip, block.begin() + 3 * own);
       connector_voxel = connected ? std::int64_t(e.voxel) : -1;
       if (connected) std::copy_n(block.begin() + 3 * own, 3, pending_connector);
-      cursor[e.voxel] += need;
+      here += need;
     }
     total_points += points.size() / 3;
     if (cb.streamline) cb.streamline(s, points);
   }
   for (std::size_t i = 0; i < voxels.size(); ++i)
-    if (cursor[i] != voxels[i].vertex_first + voxels[i].vertex_count)
-      fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i, "voxel block has vertices no voxline uses");
+    for (std::uint32_t d = 0; d < levels; ++d)
+      if (cursor[i * levels + d] != voxels[i].vertex_first + depth_end_vertex(voxels[i], f.levels_of(i), d))
+        fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i,
+                   "voxel block has vertices no voxline uses" +
+                       (levels > 1 ? " (at depth " + std::to_string(d) + ")" : std::string()));
   if (total_points != m.point_count)
     fail_input(
         p, std::nullopt,

@@ -54,7 +54,7 @@ void check_meta_and_dirs(const VxlFile& f) {
   const std::string& p = f.path();
   const MetaSection& m = f.meta();
   const std::uint64_t meta_at = f.find_section(section_id("META"))->offset;
-  if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 156, "META reserved bytes are not zero");
+  if (!all_zero(m.reserved, sizeof m.reserved)) fail_input(p, meta_at + 160, "META reserved bytes are not zero");
   auto check_unit = [&](std::span<const DirectionEntry> dirs, const char(&id)[5]) {
     const std::uint64_t at = f.find_section(section_id(id))->offset;
     for (std::size_t k = 0; k < dirs.size(); ++k) {
@@ -80,12 +80,6 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
   std::vector<float> block;
   for (std::size_t i = 0; i < voxels.size(); ++i) {
     const VoxelEntry& v = voxels[i];
-    const std::uint64_t at = ordr_at + v.order_offset;
-    std::uint64_t starts = 0;
-    for (std::uint32_t e = 0; e < v.vertex_count; ++e) starts += is_segment_start[v.vertex_first + e];
-    if (starts != v.segment_count)
-      fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i,
-                 "voxel " + std::to_string(i) + " segment count does not match its voxlines");
     // Packed words: the voxline-end bit exactly where no segment starts, the reserved bit clear (§5.4).
     if (!packed.empty())
       for (std::uint64_t g = v.vertex_first; g < v.vertex_first + v.vertex_count; ++g) {
@@ -96,26 +90,35 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
       }
     block.resize(3 * std::uint64_t(v.vertex_count));
     f.read_vertices(i, v.vertex_first, v.vertex_count, block.data());
-    for (std::uint32_t k = 0; k < f.meta().stored_order_count; ++k) {
-      const DirectionEntry& dir = f.directions_of(i)[k];
-      OrderView o = f.order(i, k);
-      seen.assign(v.vertex_count, 0);
-      double previous_key = -INFINITY;
-      std::uint32_t previous_entry = 0;
-      for (std::uint32_t n = 0; n < o.count; ++n) {
-        std::uint32_t e = o[n];
-        if (e + 1ull >= v.vertex_count || !is_segment_start[v.vertex_first + e] || seen[e])
-          fail_input(
-              p, at,
-              "voxel " + std::to_string(i) + " order " + std::to_string(k) + " is not a permutation of its segments");
-        seen[e] = 1;
-        const float* a = block.data() + 3 * std::uint64_t(e);
-        double key = 0;
-        for (int c = 0; c < 3; ++c) key += (double(a[c]) + double(a[c + 3])) * double(dir.xyz[c]);
-        if (n > 0 && (key < previous_key || (key == previous_key && e < previous_entry)))
-          fail_input(p, at, "voxel " + std::to_string(i) + " order " + std::to_string(k) + " is not sorted");
-        previous_key = key;
-        previous_entry = e;
+    // Each level: its segment count, and K orders of the segments in its prefix of the block (§5.12).
+    for (std::uint32_t level = 0; level < f.level_count(); ++level) {
+      const LevelEntry counts = f.level(i, level);
+      const std::uint64_t at = ordr_at + level_orders_offset(v, f.levels_of(i), level, f.meta().stored_order_count);
+      const std::string what = "voxel " + std::to_string(i) + (level > 0 ? " level " + std::to_string(level) : "");
+      std::uint64_t starts = 0;
+      for (std::uint32_t e = 0; e < counts.vertex_count; ++e) starts += is_segment_start[v.vertex_first + e];
+      if (starts != counts.segment_count)
+        fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i,
+                   what + " segment count does not match its voxlines");
+      for (std::uint32_t k = 0; k < f.meta().stored_order_count; ++k) {
+        const DirectionEntry& dir = f.directions_of(i)[k];
+        OrderView o = f.order(i, k, level);
+        seen.assign(counts.vertex_count, 0);
+        double previous_key = -INFINITY;
+        std::uint32_t previous_entry = 0;
+        for (std::uint32_t n = 0; n < o.count; ++n) {
+          std::uint32_t e = o[n];
+          if (e + 1ull >= counts.vertex_count || !is_segment_start[v.vertex_first + e] || seen[e])
+            fail_input(p, at, what + " order " + std::to_string(k) + " is not a permutation of its segments");
+          seen[e] = 1;
+          const float* a = block.data() + 3 * std::uint64_t(e);
+          double key = 0;
+          for (int c = 0; c < 3; ++c) key += (double(a[c]) + double(a[c + 3])) * double(dir.xyz[c]);
+          if (n > 0 && (key < previous_key || (key == previous_key && e < previous_entry)))
+            fail_input(p, at, what + " order " + std::to_string(k) + " is not sorted");
+          previous_key = key;
+          previous_entry = e;
+        }
       }
     }
   }

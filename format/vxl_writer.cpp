@@ -36,6 +36,7 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
   s.directions = std::uint64_t(m.stored_order_count) * sizeof(DirectionEntry);
   if (m.order_set == static_cast<std::uint32_t>(OrderSet::Random)) s.voxel_directions = m.voxel_count * s.directions;
   s.voxels = std::uint64_t(m.voxel_count) * sizeof(VoxelEntry);
+  if (m.level_count > 1) s.levels = std::uint64_t(m.voxel_count) * (m.level_count - 1) * sizeof(LevelEntry);
   s.positions = static_cast<PositionEncoding>(m.position_encoding);
   s.vertices = m.vertex_count * vertex_bytes(s.positions);
   s.orders = order_bytes;
@@ -51,7 +52,7 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
 namespace {
 
 // Section ids in file order, indexed by VxlWriter::Index; VDIR and GRPS are optional.
-constexpr const char* kSectionIds[] = {"META", "DIRS", "VDIR", "VOXT", "VERT", "ORDR",
+constexpr const char* kSectionIds[] = {"META", "DIRS", "VDIR", "VOXT", "LODS", "VERT", "ORDR",
                                        "VXLN", "STRM", "PROV", "GRPS", "VVAL", "SVAL"};
 
 }  // namespace
@@ -70,6 +71,8 @@ VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
       {"DIRS", kSectionRequired, sizes.directions, true},
       {"VDIR", kSectionRequired, sizes.voxel_directions.value_or(0), sizes.voxel_directions.has_value()},
       {"VOXT", kSectionRequired, sizes.voxels, true},
+      // Required: a reader that ignored it would misread the orders of every voxel but the first level's.
+      {"LODS", kSectionRequired, sizes.levels, sizes.levels > 0},
       {"VERT", kSectionRequired, sizes.vertices, true},
       {"ORDR", kSectionRequired, sizes.orders, true},
       {"VXLN", kSectionRequired, sizes.voxlines, true},
@@ -104,14 +107,17 @@ std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, 
   FileHeader h{};
   std::memcpy(h.magic, kVxlMagic.data(), 8);
   const bool packed = positions == PositionEncoding::Packed;
-  h.version_major = packed ? kVxlVersionMajorPackedPositions : kVxlVersionMajor;
   // The lowest version that holds what is written (spec §10).
+  const bool has_levels =
+      std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "LODS", 4) == 0; });
+  h.version_major = packed || has_levels ? kVxlVersionMajorPackedPositions : kVxlVersionMajor;
   const bool has_vdir =
       std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "VDIR", 4) == 0; });
   const bool has_values = std::any_of(table.begin(), table.end(), [](const SectionEntry& e) {
     return std::memcmp(e.id, "VVAL", 4) == 0 || std::memcmp(e.id, "SVAL", 4) == 0;
   });
-  h.version_minor = packed       ? 0
+  h.version_minor = has_levels   ? kVxlVersionMinorLevels
+                    : packed     ? 0
                     : has_values ? kVxlVersionMinorValueSets
                     : has_vdir   ? kVxlVersionMinorVoxelDirections
                                  : kVxlVersionMinor;
@@ -185,6 +191,7 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   if (c.meta.order_set == static_cast<std::uint32_t>(OrderSet::Random))
     sizes.voxel_directions = c.voxel_directions.size_bytes();
   sizes.voxels = c.voxels.size_bytes();
+  sizes.levels = c.levels.size_bytes();
   sizes.positions = static_cast<PositionEncoding>(c.meta.position_encoding);
   sizes.vertices =
       sizes.positions == PositionEncoding::Packed ? c.packed_vertices.size_bytes() : c.vertices.size_bytes();
@@ -202,6 +209,7 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   copy(w.directions(), c.directions.data());
   copy(w.voxel_directions(), c.voxel_directions.data());
   copy(w.voxels(), c.voxels.data());
+  copy(w.levels(), c.levels.data());
   copy(w.float_vertices(), c.vertices.data());
   copy(w.packed_vertices(), c.packed_vertices.data());
   copy(w.orders(), c.orders.data());

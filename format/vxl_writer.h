@@ -14,6 +14,7 @@
 #include "format/atomic_output.h"
 #include "format/streamline_group.h"
 #include "format/vxl_layout.h"
+#include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
 
 namespace vxl {
@@ -23,14 +24,16 @@ struct VxlSectionSizes {
   std::uint64_t directions = 0;
   std::optional<std::uint64_t> voxel_directions;  // VDIR; only with order set random (spec §5.10)
   std::uint64_t voxels = 0, vertices = 0, orders = 0, voxlines = 0, streamlines = 0;
+  std::uint64_t levels = 0;  // LODS (spec §5.12); 0: absent (one level)
   std::uint64_t provenance = 0;
   std::uint64_t groups = 0;                                // 0: no GRPS section
   std::uint64_t vertex_values = 0, streamline_values = 0;  // VVAL, SVAL (spec §5.11); 0: absent
   PositionEncoding positions = PositionEncoding::Float32;  // how VERT holds them (spec §5.4); sets the version
 };
 
-// The sizes spec §5 gives for the counts in `meta` (stored_order_count and position_encoding included; a
-// VDIR section when order_set is random; VVAL / SVAL sections holding that many value sets, none when 0).
+// The sizes spec §5 gives for the counts in `meta` (stored_order_count, position_encoding and level_count
+// included; a VDIR section when order_set is random; a LODS section when level_count > 1; VVAL / SVAL sections holding
+// that many value sets, none when 0).
 VxlSectionSizes section_sizes(const MetaSection& meta, std::uint64_t order_bytes, std::uint64_t provenance_bytes,
                               std::uint64_t group_bytes, std::uint32_t vertex_value_sets = 0,
                               std::uint32_t streamline_value_sets = 0);
@@ -46,8 +49,8 @@ struct VxlLayout {
 VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes);
 
 // The bytes of the header and the section table (spec §3, §4), once every checksum in `table` is set.
-// The version is the lowest that holds what is written (spec §10): 2.0 with packed positions, else 1.2
-// with VVAL or SVAL, else 1.1 with VDIR, else 1.0.
+// The version is the lowest that holds what is written (spec §10): 2.1 with LODS, else 2.0 with packed
+// positions, else 1.2 with VVAL or SVAL, else 1.1 with VDIR, else 1.0.
 std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size,
                                            PositionEncoding positions);
 
@@ -65,6 +68,8 @@ class VxlWriter {
   // voxel_count x K entries; empty when there is no VDIR section.
   std::span<DirectionEntry> voxel_directions() { return typed<DirectionEntry>(kVdir); }
   std::span<VoxelEntry> voxels() { return typed<VoxelEntry>(kVoxt); }
+  // voxel_count x (level_count - 1) entries; empty when there is no LODS section.
+  std::span<LevelEntry> levels() { return typed<LevelEntry>(kLods); }
   // VERT as float32 triples, or as packed words (spec §5.4): the one the sizes were planned for, the
   // other empty.
   std::span<float> float_vertices() {
@@ -95,8 +100,22 @@ class VxlWriter {
   void commit(unsigned threads = 0);
 
  private:
-  // Sections in file order; VDIR, GRPS, VVAL and SVAL are optional.
-  enum Index : std::size_t { kMeta, kDirs, kVdir, kVoxt, kVert, kOrdr, kVxln, kStrm, kProv, kGrps, kVval, kSval };
+  // Sections in file order; VDIR, LODS, GRPS, VVAL and SVAL are optional.
+  enum Index : std::size_t {
+    kMeta,
+    kDirs,
+    kVdir,
+    kVoxt,
+    kLods,
+    kVert,
+    kOrdr,
+    kVxln,
+    kStrm,
+    kProv,
+    kGrps,
+    kVval,
+    kSval
+  };
   SectionEntry* entry(Index i);  // null for an optional section that is absent
   std::span<std::uint8_t> payload(Index i);
   template <typename T>
@@ -120,6 +139,7 @@ struct VxlContent {
   std::span<const DirectionEntry> directions;
   std::span<const DirectionEntry> voxel_directions;  // VDIR, written when meta.order_set is random
   std::span<const VoxelEntry> voxels;
+  std::span<const LevelEntry> levels;              // LODS, voxel_count x (level_count - 1)
   std::span<const float> vertices;                 // 3 * vertex_count
   std::span<const std::uint32_t> packed_vertices;  // vertex_count
   std::span<const std::uint8_t> orders;

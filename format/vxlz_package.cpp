@@ -73,6 +73,7 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   std::memset(pack.reserved, 0, sizeof pack.reserved);
   MetaSection meta = c.meta;
   meta.position_encoding = 0;  // the package's positions are its own; the unpacker chooses the .vxl's
+  meta.level_count = 0;        // likewise its levels
   std::memset(meta.reserved, 0, sizeof meta.reserved);
   const std::vector<std::uint8_t> pack_bytes = bytes_of(pack), meta_bytes = bytes_of(meta);
   // POSD is the chunks' buffers back to back: written from them, never gathered into one copy.
@@ -277,8 +278,9 @@ void VxlzFile::validate_pack_and_meta() {
 
   const std::uint64_t meta_at = fixed("META", sizeof meta_, &meta_);
   const MetaSection& m = meta_;
-  // The package's copy of META carries no position encoding: its positions are its own (spec §5).
-  if (m.position_encoding != 0 || !all_zero(m.reserved, sizeof m.reserved))
+  // The package's copy of META carries no position encoding and no levels: its positions are its own, and
+  // the unpacker chooses the levels of the .vxl it writes (spec §5).
+  if (m.position_encoding != 0 || m.level_count != 0 || !all_zero(m.reserved, sizeof m.reserved))
     fail_input(p, meta_at + 152, "META reserved bytes are not zero");
   if (!std::isfinite(m.voxel_size) || !(m.voxel_size > 0))
     fail_input(p, meta_at + 56, "voxel size must be finite and positive");

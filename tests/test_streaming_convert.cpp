@@ -197,11 +197,17 @@ TEST(StreamingConvert, ManySmallVoxelsAndSplitLongStepsAreIdentical) {
   ScratchDir dir;
   const std::string tck = dir.file("in.tck");
   write_synth_tck(tck, 4000, 7);
-  ConvertSummary s = expect_identical(dir, tck, settings_for(1.0), 40 * kMiB);
+  // One level: the voxel table of 1 mm voxels then leaves room in 40 MiB for several ranges.
+  ConvertSettings one_level = settings_for(1.0);
+  one_level.levels = 1;
+  ConvertSummary s = expect_identical(dir, tck, one_level, 40 * kMiB);
   EXPECT_GT(s.voxels, 20000u);
   EXPECT_GT(s.synthetic_points, 100u);
   EXPECT_GE(s.partitions, 2u);
   EXPECT_GT(streamlines_across_ranges(dir.file("limited.vxl"), s.partition_starts), 100u);
+  // Levels of detail place each depth's voxlines separately in every block: identical too, in ranges.
+  s = expect_identical(dir, tck, settings_for(1.0), 70 * kMiB);
+  EXPECT_GE(s.partitions, 2u);
 }
 
 // Steps of about 11 mm across 10 mm voxels (many jump a voxel) along all axes, with the 14-order set.

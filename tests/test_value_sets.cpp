@@ -13,6 +13,7 @@
 #include "converter/readers/read_tsf.h"
 #include "format/error.h"
 #include "format/vxl_file.h"
+#include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"
 #include "tests/mrtrix_test_files.h"
 #include "tests/test_support.h"
@@ -110,21 +111,25 @@ TEST(TsfReader, AttachRefusesAFileThatDoesNotMatchPointForPoint) {
 
 // Per source point, the values a .vxl holds, walked like export walks positions: synthetic points and
 // connecting vertices are left out.
+// The per-point values of set `set` in source order (synthetic points left out), by the walk of spec §5.6.
 std::vector<float> point_values_of(const VxlFile& f, std::uint32_t set) {
   std::vector<float> out;
   const auto values = f.vertex_values().values(set);
-  std::vector<std::uint64_t> cursor;
-  for (const VoxelEntry& v : f.voxels()) cursor.push_back(v.vertex_first);
-  const auto strm = f.streamline_first_voxline();
-  for (std::uint64_t s = 0; s + 1 < strm.size(); ++s)
-    for (std::uint64_t j = strm[s]; j < strm[s + 1]; ++j) {
-      const VoxlineEntry& e = f.voxlines()[j];
-      const std::uint32_t own = e.count_flags & kVoxlineCountMask;
-      const std::uint32_t skip = (e.count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
-      for (std::uint32_t k = skip; k < own; ++k) out.push_back(values[cursor[e.voxel] + k]);
-      cursor[e.voxel] += own + (j + 1 < strm[s + 1] ? 1 : 0);
-    }
-  return out;
+  WalkCallbacks cb;
+  cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t own, bool) {
+    out.insert(out.end(), values.begin() + first, values.begin() + first + own);
+  };
+  walk_streamlines(f, cb);
+  // The walk reports synthetic first points too; drop them by the voxline table's flags.
+  std::vector<float> source;
+  std::size_t at = 0;
+  for (const VoxlineEntry& e : f.voxlines()) {
+    const std::uint32_t own = e.count_flags & kVoxlineCountMask;
+    const std::uint32_t skip = (e.count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
+    source.insert(source.end(), out.begin() + at + skip, out.begin() + at + own);
+    at += own;
+  }
+  return source;
 }
 
 TEST(ValueSets, PointValuesFollowTheirPointsIntoTheVertexBlocks) {
@@ -141,6 +146,7 @@ TEST(ValueSets, PointValuesFollowTheirPointsIntoTheVertexBlocks) {
   ConvertSettings settings;
   settings.voxel_size = 2;
   settings.positions = PositionEncoding::Float32;  // the values are checked against exact positions
+  settings.levels = 1;                             // one level: the 1.x version rules apply
   convert_tractogram(std::move(t), dir.file("v.vxl"), settings);
   VerifyResult verified = verify_vxl(dir.file("v.vxl"));
   ASSERT_TRUE(verified.valid) << verified.problem;
@@ -182,6 +188,7 @@ TEST(ValueSets, PointValuesFollowTheirPointsIntoTheVertexBlocks) {
   // Without values nothing changes: no sections, version 1.0.
   ConvertSettings exact;
   exact.positions = PositionEncoding::Float32;
+  exact.levels = 1;
   convert_tractogram(five_points(), dir.file("plain.vxl"), exact);
   VxlFile plain = VxlFile::open(dir.file("plain.vxl"));
   EXPECT_EQ(plain.header().version_minor, 0);

@@ -77,9 +77,10 @@ TEST_P(VxlFormat, RoundTripThroughTheWalk) {
   ASSERT_TRUE(r.valid) << r.problem;
   VxlFile f = VxlFile::open(path());
   const bool packed = GetParam() == PositionEncoding::Packed;
-  // The lowest version that holds the file (spec §10): packed positions need 2.0.
-  EXPECT_EQ(f.header().version_major, packed ? 2 : 1);
-  EXPECT_EQ(f.header().version_minor, 0);
+  // The lowest version that holds the file (spec §10): levels of detail (the default) need 2.1.
+  EXPECT_EQ(f.header().version_major, 2);
+  EXPECT_EQ(f.header().version_minor, 1);
+  EXPECT_GT(f.level_count(), 1u);
   EXPECT_EQ(f.position_encoding(), GetParam());
   EXPECT_EQ(f.find_section(section_id("VERT"))->size, f.meta().vertex_count * (packed ? 4 : 12));
   EXPECT_EQ(f.header().file_size % 64, 0u);

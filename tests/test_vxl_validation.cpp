@@ -182,6 +182,30 @@ std::vector<Case> cases() {
        "voxel blocks do not cover all vertices"},
       {"segment_sum", [](Bytes& f) { f.set<u32>(f.voxel(0) + 52, f.get<u32>(f.voxel(0) + 52) - 1); },
        "voxel segment counts do not add up to segment_count"},
+      // Levels of detail (spec §5.12; the base file has the default levels).
+      {"level_count_1", [](Bytes& f) { f.set<u32>(f.meta() + 156, 1); }, "level count 1 must be 0 or 2..8"},
+      {"level_count_9", [](Bytes& f) { f.set<u32>(f.meta() + 156, 9); }, "level count 9 must be 0 or 2..8"},
+      {"lods_without_level_count", [](Bytes& f) { f.set<u32>(f.meta() + 156, 0); },
+       "LODS section without a level count"},
+      {"level_count_not_lods_size", [](Bytes& f) { f.set<u32>(f.meta() + 156, 3); }, "section LODS size"},
+      {"levels_in_2_0", [](Bytes& f) { f.set<std::uint16_t>(10, 0); }, "levels of detail in a file before version 2.1"},
+      {"level_past_block", [](Bytes& f) { f.set<u32>(f.section_at("LODS"), f.get<u32>(f.voxel(0) + 48) + 1); },
+       "voxel 0 level 1 is not a prefix of level 0"},
+      {"level_segments_without_vertices",
+       [](Bytes& f) {
+         f.set<u32>(f.section_at("LODS"), 0);
+         f.set<u32>(f.section_at("LODS") + 4, 1);
+       },
+       "voxel 0 level 1 is not a prefix of level 0"},
+      {"coarser_level_past_finer",
+       [](Bytes& f) {
+         const u64 row = f.section_at("LODS");  // voxel 0: levels 1, 2, ... at 8 bytes each
+         f.set<u32>(row, 0);
+         f.set<u32>(row + 4, 0);
+         f.set<u32>(row + 8, 2);
+         f.set<u32>(row + 12, 1);
+       },
+       "voxel 0 level 2 is not a prefix of level 1"},
   };
 }
 

@@ -91,6 +91,7 @@ void add_convert_command(CLI::App& app, int& exit_code) {
         }
       });
   add_positions_option(cmd, opt->settings.positions);
+  add_levels_option(cmd, opt->settings.levels);
   cmd->add_option(
          "--memory-limit", opt->memory_limit,
          "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): reads the source several times and writes the "

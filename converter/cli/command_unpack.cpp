@@ -19,6 +19,7 @@ void add_unpack_command(CLI::App& app) {
   cmd->add_option("output", opt->output, "output .vxl (written atomically)")->required();
   cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
   add_positions_option(cmd, opt->settings.positions);
+  add_levels_option(cmd, opt->settings.levels);
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
   cmd->callback([opt] {
     ProgressBar bar;

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
 
 namespace vxl::cli {
@@ -33,6 +34,17 @@ inline CLI::Option* add_positions_option(CLI::App* cmd, PositionEncoding& positi
       ->type_name("packed|float32")
       ->default_str("packed")
       ->transform(CLI::CheckedTransformer(names));
+}
+
+// --levels N, shared by convert and unpack (spec §5.12).
+inline CLI::Option* add_levels_option(CLI::App* cmd, std::uint32_t& levels) {
+  return cmd
+      ->add_option("--levels", levels,
+                   "levels of detail: level d keeps a fixed pseudo-random 1/8^d of the streamlines, with its own "
+                   "orders, so that a viewer can draw a large file coarsely first (about 1/7 more order bytes); "
+                   "1 writes full detail only")
+      ->check(CLI::Range(1u, kMaxLevels))
+      ->default_str(std::to_string(kDefaultLevels));
 }
 
 }  // namespace vxl::cli
