@@ -15,8 +15,13 @@
 //            with order hysteresis (FramePlan::order_hysteresis) as the remedy. The order-picking modes
 //            also on a "wobble": the camera jittering by ±1.5° where many voxels sit at an order boundary.
 //
-// Writes results.csv, results.md, flicker.csv, flicker.md and side_<mode>.png (the panels of the
-// side-by-side picture) into --out. Prints progress; asserts nothing (timings never gate tests).
+//   levels   `axis` at each coarse level of detail of the reference file (.vxl spec §5.12: about 1/8^d of
+//            the streamlines, opacity compensated), scored against `exact` and against full-detail `axis`
+//            from the same view and opacity, with frame time and GPU bytes: what a coarse level costs in
+//            accuracy for what it saves.
+//
+// Writes results.csv, results.md, levels.csv, levels.md, flicker.csv, flicker.md and side_<mode>.png (the
+// panels of the side-by-side picture) into --out. Prints progress; asserts nothing (timings never gate tests).
 //
 // Usage: trade_study --manifest FILE --out DIR [--name TEXT] [--size N] [--reference-voxel MM]
 //          [--flicker-size N] [--flicker-frames N] [--flicker-opacity A] [--hysteresis M[,M...]]
@@ -24,6 +29,7 @@
 // Manifest lines: VOXEL_MM ORDERS PATH CONVERT_SECONDS (whitespace-separated; # starts a comment).
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -170,7 +176,8 @@ class Study {
 
   void sweep() {
     std::vector<SweepRow> rows;
-    std::map<std::pair<int, int>, Image> exact;  // (view, opacity) -> image
+    std::map<std::pair<int, int>, Image> exact;      // (view, opacity) -> image
+    std::map<std::pair<int, int>, Image> full_axis;  // the same, `axis` at full detail, reference file
     for (std::size_t n = 0; n < entries_.size(); ++n) {
       const ManifestEntry& e = entries_[n];
       const bool reference = n == 0;
@@ -186,6 +193,7 @@ class Study {
             const View& view = kViews[v];
             Frame f = render(r, camera(r, view.azimuth, view.elevation), m, kOpacities[o], o_.size);
             if (m.mode == RenderMode::Exact) exact[{int(v), int(o)}] = f.image;
+            if (reference && m.mode == RenderMode::Axis) full_axis[{int(v), int(o)}] = f.image;
             SweepRow row;
             row.mode = m.name;
             row.orders = e.orders;
@@ -209,12 +217,57 @@ class Study {
                     e.orders.c_str(), last.score.rmse, last.score.ssim, last.frame_ms);
         std::fflush(stdout);
       }
+      if (reference) levels(file, exact, full_axis);
     }
     trade::write_sweep_csv(o_.out + "/results.csv", rows);
     char heading[256];
     std::snprintf(heading, sizeof heading, "### %s: speed vs accuracy (%dx%d, %s)", o_.name.c_str(), o_.size, o_.size,
                   context_.renderer().c_str());
     trade::write_sweep_markdown(o_.out + "/results.md", heading, rows, o_.reference_voxel_mm);
+  }
+
+  // `axis` at every coarse level of the reference file, against exact and against full detail.
+  void levels(const VxlFile& file, const std::map<std::pair<int, int>, Image>& exact,
+              const std::map<std::pair<int, int>, Image>& full_axis) {
+    std::ofstream csv(o_.out + "/levels.csv");
+    csv << "level,view,opacity,rmse_vs_exact,ssim_vs_exact,rmse_vs_full,ssim_vs_full,frame_ms,gpu_bytes,segments\n";
+    std::ofstream md(o_.out + "/levels.md");
+    md << "### " << o_.name << ": levels of detail (`axis`, " << o_.size << "x" << o_.size
+       << ", mean over views and opacities; frame time the median)\n\n"
+       << "| level | streamlines | segments drawn | GPU MiB | RMSE vs exact | SSIM vs exact | RMSE vs full detail | "
+          "SSIM vs full detail | frame ms |\n|---|---|---|---|---|---|---|---|---|\n";
+    for (std::uint32_t level = 0; level < file.level_count(); ++level) {
+      Renderer r(file, 0, level);
+      const ModeSpec axis{"axis", RenderMode::Axis};
+      double rmse_exact = 0, ssim_exact = 0, rmse_full = 0, ssim_full = 0;
+      std::vector<double> ms;
+      std::uint64_t segments = 0;
+      for (std::size_t v = 0; v < std::size(kViews); ++v)
+        for (std::size_t o = 0; o < std::size(kOpacities); ++o) {
+          const View& view = kViews[v];
+          Frame f = render(r, camera(r, view.azimuth, view.elevation), axis, kOpacities[o], o_.size);
+          const ImageScore to_exact = score_image(f.image, exact.at({int(v), int(o)}));
+          const ImageScore to_full = score_image(f.image, full_axis.at({int(v), int(o)}));
+          rmse_exact += to_exact.rmse, ssim_exact += to_exact.ssim;
+          rmse_full += to_full.rmse, ssim_full += to_full.ssim;
+          ms.push_back(f.ms);
+          segments = std::max<std::uint64_t>(segments, r.stats().segments_drawn);
+          csv << level << ',' << view.name << ',' << kOpacities[o] << ',' << to_exact.rmse << ',' << to_exact.ssim
+              << ',' << to_full.rmse << ',' << to_full.ssim << ',' << f.ms << ',' << r.gpu_bytes() << ','
+              << r.stats().segments_drawn << '\n';
+        }
+      const double n = double(ms.size());
+      std::sort(ms.begin(), ms.end());
+      char line[320];
+      std::snprintf(line, sizeof line, "| %u | 1/%.0f | %llu | %.1f | %.2f | %.4f | %.2f | %.4f | %.0f |\n", level,
+                    std::pow(double(kLevelRatio), double(level)), (unsigned long long)segments,
+                    double(r.gpu_bytes()) / (1 << 20), rmse_exact / n, ssim_exact / n, rmse_full / n, ssim_full / n,
+                    ms[ms.size() / 2]);
+      md << line;
+      std::printf("level %u    RMSE %6.2f vs exact, %6.2f vs full detail  %7.0f ms/frame  %.1f MiB\n", level,
+                  rmse_exact / n, rmse_full / n, ms[ms.size() / 2], double(r.gpu_bytes()) / (1 << 20));
+      std::fflush(stdout);
+    }
   }
 
   // The frames of one camera motion. (Their timings are not kept: the script runs the flicker part beside

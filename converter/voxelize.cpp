@@ -134,7 +134,7 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
     StreamlineRange& r = ranges[c];
     r.table = std::move(tables[c]);
     r.table.use = nullptr;
-    r.use = {};
+    r.use = detail::VoxelUse(levels);
     r.voxline_base = n_voxlines;
     n_voxlines += r.voxlines.size();
     n_synthetic += r.synthetic_xyz.size() / 3;

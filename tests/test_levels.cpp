@@ -92,7 +92,9 @@ TEST(Levels, EachLevelIsAPrefixHoldingItsStreamlines) {
     const VoxelEntry& v = f.voxels()[voxel];
     const std::uint64_t begin = first - v.vertex_first, end = begin + own + (connected ? 1 : 0);
     EXPECT_LE(end, f.level(voxel, depth).vertex_count) << "voxline " << voxline;
-    if (depth + 1 < f.level_count()) EXPECT_GE(begin, f.level(voxel, depth + 1).vertex_count) << "voxline " << voxline;
+    if (depth + 1 < f.level_count()) {
+      EXPECT_GE(begin, f.level(voxel, depth + 1).vertex_count) << "voxline " << voxline;
+    }
     ++voxline;
     ++checked;
   };

@@ -223,6 +223,31 @@ TEST(VoxviewCli, ParsesNegativeValuesAndNotesGivenOptions) {
   EXPECT_FALSE(a.was_given("--size"));
 }
 
+TEST(VoxviewCli, LevelAndGpuMemoryParse) {
+  ViewerArguments a;
+  CLI::App cli{app::voxview_description("test")};
+  app::declare_voxview_options(cli, a);
+  const char* argv[] = {"voxview", "a.vxl", "--gpu-memory", "2G", "--level", "2"};
+  app::parse_voxview_command_line(cli, a, static_cast<int>(std::size(argv)), argv);
+  const app::ViewerOptions o = resolve_viewer_options(a);
+  EXPECT_EQ(o.gpu_memory, std::optional<std::uint64_t>(2ull << 30));
+  EXPECT_EQ(o.level, std::optional<std::uint32_t>(2));
+  ViewerArguments none;
+  EXPECT_FALSE(resolve_viewer_options(none).gpu_memory.has_value());
+  EXPECT_FALSE(resolve_viewer_options(none).level.has_value());
+  ViewerArguments bad;
+  bad.gpu_memory = "lots";
+  EXPECT_NE(usage_error_of(bad).find("--gpu-memory 'lots' is not a memory size"), std::string::npos);
+  bad.gpu_memory = "0";
+  EXPECT_NE(usage_error_of(bad).find("--gpu-memory '0' is not a memory size"), std::string::npos);
+  ViewerArguments deep;
+  CLI::App cli2{app::voxview_description("test")};
+  app::declare_voxview_options(cli2, deep);
+  const char* too_deep[] = {"voxview", "a.vxl", "--level", "8"};
+  EXPECT_THROW(app::parse_voxview_command_line(cli2, deep, static_cast<int>(std::size(too_deep)), too_deep),
+               CLI::ValidationError);
+}
+
 TEST(VoxviewCli, ModesAndKeysComeFromTheirTables) {
   ViewerArguments a;
   CLI::App cli{app::voxview_description("test")};

@@ -7,6 +7,7 @@
 
 #include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_file.h"
+#include "viewer/app/scene_detail.h"
 #include "viewer/app/scene_source.h"
 #include "viewer/app/turntable.h"
 #include "viewer/platform/egl_context.h"
@@ -53,7 +54,11 @@ int run_headless(const ViewerOptions& o) {
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);  // before any GL work: a bad image fails fast
   HeadlessGlContext context;
-  Renderer renderer(pointers(files));
+  const SceneDetail detail = choose_scene_detail(pointers(files), o.level, o.gpu_memory, GpuScene::driver_limit());
+  if (const std::string note = describe_scene_detail(detail, SceneLayout::coarsest_level(pointers(files)) + 1);
+      !note.empty())
+    std::fprintf(stderr, "voxview: %s\n", note.c_str());
+  Renderer renderer(pointers(files), 0, detail.level);
   if (volume) renderer.set_volume(*volume);
   volume.reset();
   check_color_options(o.inputs_name(), renderer, o.settings);

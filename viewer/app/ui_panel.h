@@ -35,10 +35,11 @@ struct PanelStats {
   std::uint64_t segments_drawn = 0, segments_total = 0;
   std::uint64_t grid_cubes = 0;
   std::string gl_renderer, gl_version;
-  bool exact_available = true;                                  // GL >= 4.3
-  float max_line_width = 16.0f;                                 // the driver's wide-line limit
-  std::string error;                                            // shown in red until the next one replaces it
-  std::string status;                                           // e.g. where the last screenshot went
+  std::string detail;            // the level of detail drawn and why, when not full detail (scene_detail.h)
+  bool exact_available = true;   // GL >= 4.3
+  float max_line_width = 16.0f;  // the driver's wide-line limit
+  std::string error;             // shown in red until the next one replaces it
+  std::string status;            // e.g. where the last screenshot went
   double bounds_min[3] = {0, 0, 0}, bounds_max[3] = {0, 0, 0};  // scene bounds, for the clip-plane sliders
   std::vector<std::string> value_sets;                          // what --color scalar can show
   std::vector<std::pair<std::string, std::uint64_t>> groups;    // name, streamlines

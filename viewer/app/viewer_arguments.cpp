@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "converter/memory_size.h"
 #include "format/error.h"
 #include "viewer/app/camera_file.h"
 
@@ -161,6 +162,11 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
   apply_clipping(a, o.settings.clipping);
   apply_image(a, o);
   apply_view_and_size(a, size, o);
+  if (!a.gpu_memory.empty()) {
+    o.gpu_memory = parse_memory_size(a.gpu_memory);
+    if (!o.gpu_memory || *o.gpu_memory == 0)
+      usage_error("--gpu-memory '" + a.gpu_memory + "' is not a memory size (bytes, or K/M/G: 512M, 2G)");
+  }
   return o;
 }
 

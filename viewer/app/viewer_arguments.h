@@ -24,6 +24,7 @@ struct ViewerArguments {
   double slab = 0;
   std::string image_range, slices, focus, view;
   std::string size = "1024x1024";
+  std::string gpu_memory;  // --gpu-memory SIZE
   // The options given explicitly, by long name ("--mode"): only these override a saved view.
   std::set<std::string> given;
   bool was_given(const char* option) const { return given.count(option) > 0; }

@@ -1,6 +1,7 @@
 // Everything `voxview` is told on its command line, shared by the headless and the window paths.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,9 +25,13 @@ struct ViewerOptions {
   std::optional<std::string> save_camera;     // write the view here (headless: after rendering)
   bool orthographic = false;
   int width = 1024, height = 1024;
-  double voxel_size = 10.0;      // for in-memory conversion
-  bool verify = false;           // --verify: check every .vxl in full (as `voxlines verify`) before drawing
-  std::vector<std::string> tsf;  // per-point values for a .tck converted in memory
+  double voxel_size = 10.0;  // for in-memory conversion
+  // Level of detail (.vxl spec §5.12): the one --level names, else the finest within the GPU memory budget
+  // (--gpu-memory, else a share of what the driver reports; scene_detail.h).
+  std::optional<std::uint32_t> level;
+  std::optional<std::uint64_t> gpu_memory;  // bytes
+  bool verify = false;                      // --verify: check every .vxl in full (as `voxlines verify`) before drawing
+  std::vector<std::string> tsf;             // per-point values for a .tck converted in memory
   // Window automation (tests, scripted screenshots): quit after N frames, saving a screenshot first.
   std::optional<int> frames;
   std::optional<std::string> screenshot;

@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include "format/vxl_levels.h"
 #include "viewer/app/key_bindings.h"
 #include "viewer/render/render_settings.h"
 
@@ -141,6 +142,16 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--voxel-size", a.options.voxel_size, "voxel size in mm when converting a source file in memory")
       ->default_val(10.0)
       ->check(CLI::PositiveNumber);
+  cli.add_option("--gpu-memory", a.gpu_memory,
+                 "GPU memory the lines may take (bytes, or K/M/G: 512M, 2G): the finest level of detail that fits is "
+                 "drawn (a file converted with levels keeps 1/8 of the streamlines per level, opacity compensated). "
+                 "Default: half the free memory the driver reports, or a quarter of the available RAM on a driver "
+                 "that reports none (Mesa llvmpipe)")
+      ->type_name("SIZE");
+  cli.add_option("--level", a.options.level,
+                 "draw this level of detail (0: every streamline; level d keeps about 1/8^d of them), whatever the "
+                 "GPU memory budget; at most the file's coarsest level")
+      ->check(CLI::Range(0u, kMaxLevels - 1));
   cli.add_option("--frames", a.options.frames, "window: quit after this many frames (for scripts and tests)")
       ->check(CLI::PositiveNumber);
   cli.add_option("--screenshot", a.options.screenshot, "window: save the last frame to this PNG before quitting");

@@ -22,6 +22,7 @@
 #include "viewer/app/camera_file.h"
 #include "viewer/app/headless_render.h"
 #include "viewer/app/key_bindings.h"
+#include "viewer/app/scene_detail.h"
 #include "viewer/app/scene_source.h"
 #include "viewer/app/ui_panel.h"
 #include "viewer/platform/image_io.h"
@@ -148,6 +149,7 @@ class ViewerWindow {
 
   const ViewerOptions& options_;
   GLFWwindow* window_;
+  SceneDetail detail_;  // the level of detail drawn (before renderer_, which is made with it)
   Renderer renderer_;
   GridOverlay grid_;
   // The scene is drawn here and blitted to the window: it blends in float like headless rendering, so
@@ -169,7 +171,14 @@ class ViewerWindow {
 
 ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume,
                            GLFWwindow* window)
-    : options_(o), window_(window), renderer_(pointers(files)), grid_(renderer_), controller_(Camera{}, 1.0) {
+    : options_(o),
+      window_(window),
+      detail_(choose_scene_detail(pointers(files), o.level, o.gpu_memory, GpuScene::driver_limit())),
+      renderer_(pointers(files), 0, detail_.level),
+      grid_(renderer_),
+      controller_(Camera{}, 1.0) {
+  stats_.detail = describe_scene_detail(detail_, SceneLayout::coarsest_level(pointers(files)) + 1);
+  if (!stats_.detail.empty()) std::fprintf(stderr, "voxview: %s\n", stats_.detail.c_str());
   if (volume) renderer_.set_volume(*volume);
   controller_ =
       CameraController(Camera{}, std::max(1.0, glm::length(renderer_.scene_max() - renderer_.scene_min()) * 0.5));

@@ -23,16 +23,20 @@ void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t 
                             std::vector<std::uint8_t>& is_start, std::vector<float>& xyz) const {
   const VoxelEntry& v = file.voxels()[li];
   const VoxelDrawInfo& d = layout_.voxels()[i];
-  const std::uint64_t ordr_at = file.find_section(section_id("ORDR"))->offset + v.order_offset;
-  is_start.assign(v.vertex_count, 0);
-  const bool wide = v.vertex_count > kU16OrderMaxVertices;
+  // The scene's level of the voxel: a prefix of its block and that level's orders (.vxl spec §5.12).
+  const std::uint32_t level = layout_.files()[c.file].level;
+  const LevelEntry counts = file.level(li, level);
+  const std::uint64_t ordr_at = file.find_section(section_id("ORDR"))->offset +
+                                level_orders_offset(v, file.levels_of(li), level, file.meta().stored_order_count);
+  is_start.assign(counts.vertex_count, 0);
+  const bool wide = counts.vertex_count > kU16OrderMaxVertices;
   for (std::uint32_t k = 0; k < c.slots; ++k) {
-    OrderView o = file.order(li, k);
+    OrderView o = file.order(li, k, level);
     std::uint16_t* low = orders.data() + k * c.segments + d.seg_first;
     std::uint16_t* high = orders.data() + c.slots * c.segments + k * c.wide_segments + d.seg_first;
     for (std::uint32_t n = 0; n < o.count; ++n) {
       const std::uint32_t e = o[n];
-      if (e + 1ull >= v.vertex_count)
+      if (e + 1ull >= counts.vertex_count)
         throw Error(ErrorKind::Input, file.path(), ordr_at,
                     "order entry out of range in voxel " + std::to_string(li) + " (run `voxlines verify`)");
       low[n] = static_cast<std::uint16_t>(e);
@@ -42,20 +46,20 @@ void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t 
   }
   std::uint32_t starts = 0;
   for (std::uint8_t b : is_start) starts += b;
-  if (starts != v.segment_count)  // a repeated entry in order 0: it is no permutation
+  if (starts != counts.segment_count)  // a repeated entry in order 0: it is no permutation
     throw Error(
         ErrorKind::Input, file.path(), ordr_at,
         "order 0 of voxel " + std::to_string(li) + " is not a permutation of its segments (run `voxlines verify`)");
 
   std::uint32_t* block = words.data() + d.vertex_first;
   if (file.position_encoding() == PositionEncoding::Packed) {
-    std::copy_n(file.packed_vertices().data() + v.vertex_first, v.vertex_count, block);
+    std::copy_n(file.packed_vertices().data() + v.vertex_first, counts.vertex_count, block);
   } else {
-    xyz.resize(3 * std::uint64_t(v.vertex_count));
-    file.read_vertices(li, v.vertex_first, v.vertex_count, xyz.data());
-    pack_block(v, xyz.data(), v.vertex_count, block);
+    xyz.resize(3 * std::uint64_t(counts.vertex_count));
+    file.read_vertices(li, v.vertex_first, counts.vertex_count, xyz.data());
+    pack_block(v, xyz.data(), counts.vertex_count, block);
   }
-  for (std::uint32_t n = 0; n < v.vertex_count; ++n)
+  for (std::uint32_t n = 0; n < counts.vertex_count; ++n)
     block[n] = (block[n] & ~(kPackedVoxlineEnd | kPackedReservedBit)) | (is_start[n] ? 0u : kPackedVoxlineEnd);
 
   // Decoding info: lo and step per axis as the spec computes them (binary32), and the block's first word.
@@ -68,14 +72,14 @@ void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t 
   info[6] = static_cast<std::uint32_t>(d.vertex_first);
   info[7] = 0;
   const std::uint64_t group = SceneLayout::kGroup;
-  for (std::uint64_t g = d.seg_first / group; g < (d.seg_first + v.segment_count + group - 1) / group; ++g)
+  for (std::uint64_t g = d.seg_first / group; g < (d.seg_first + counts.segment_count + group - 1) / group; ++g)
     words[c.segment_table_first() + g] = index;
-  for (std::uint64_t g = d.vertex_first / group; g < (d.vertex_first + v.vertex_count + group - 1) / group; ++g)
+  for (std::uint64_t g = d.vertex_first / group; g < (d.vertex_first + counts.vertex_count + group - 1) / group; ++g)
     words[c.vertex_table_first() + g] = index;
 }
 
-GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels)
-    : files_(std::move(files)), layout_(files_, max_texels ? max_texels : driver_limit()) {
+GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level)
+    : files_(std::move(files)), layout_(files_, max_texels ? max_texels : driver_limit(), level) {
   try {
     upload_spans();
   } catch (...) {
@@ -135,7 +139,7 @@ void GpuScene::upload_attributes(const std::vector<std::vector<float>>& per_file
     for (std::uint32_t k = 0; k < c.voxel_count; ++k) {
       const VoxelDrawInfo& d = layout_.voxels()[c.voxel_first + k];
       const VoxelEntry& v = files_[c.file]->voxels()[c.voxel_first + k - file_first];
-      std::copy_n(values->data() + 2 * v.vertex_first, 2 * std::uint64_t(v.vertex_count),
+      std::copy_n(values->data() + 2 * v.vertex_first, 2 * std::uint64_t(d.vertex_count),
                   padded.data() + 2 * d.vertex_first);
     }
     g.attributes.create(GL_RG32F, padded.data(), padded.size() * 4);
@@ -155,8 +159,10 @@ const std::vector<std::int32_t>& GpuScene::dataset_first() {
       cb.voxline = [&](std::uint32_t voxel, std::uint64_t first_vertex, std::uint32_t own, bool connected) {
         const VoxelDrawInfo& d = layout_.voxels()[file_first + voxel];
         const std::uint32_t c = d.span;
-        // The voxline's first vertex in its span's words.
-        const std::uint64_t span_vertex = d.vertex_first + (first_vertex - file_voxels[voxel].vertex_first);
+        // The voxline's first vertex in its span's words; voxlines past the level's prefix are not drawn.
+        const std::uint64_t in_block = first_vertex - file_voxels[voxel].vertex_first;
+        if (in_block >= d.vertex_count) return;
+        const std::uint64_t span_vertex = d.vertex_first + in_block;
         const std::uint64_t segments = own + (connected ? 1 : 0) - 1;
         if (segments == 0) return;
         auto& arr = per_span[c];

@@ -23,11 +23,13 @@ struct GpuTextureSpan {
 
 class GpuScene {
  public:
-  // Needs a current GL context. max_texels 0: ask the driver (GL_MAX_TEXTURE_BUFFER_SIZE). The files must
-  // outlive the scene.
-  GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0);
-  GpuScene(const VxlFile& file, std::uint64_t max_texels = 0)
-      : GpuScene(std::vector<const VxlFile*>{&file}, max_texels) {}
+  // Needs a current GL context. max_texels 0: ask the driver (GL_MAX_TEXTURE_BUFFER_SIZE). level: the level
+  // of detail uploaded (scene_layout.h). The files must outlive the scene.
+  GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0, std::uint32_t level = 0);
+  GpuScene(const VxlFile& file, std::uint64_t max_texels = 0, std::uint32_t level = 0)
+      : GpuScene(std::vector<const VxlFile*>{&file}, max_texels, level) {}
+  // The driver's GL_MAX_TEXTURE_BUFFER_SIZE (needs a current context).
+  static std::uint64_t driver_limit();
   ~GpuScene();
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;
@@ -45,7 +47,6 @@ class GpuScene {
   const std::vector<std::int32_t>& dataset_count();
 
  private:
-  static std::uint64_t driver_limit();
   void upload_spans();
   void release();
   // Voxel `voxel` of the scene (`local` in its file, `index` in its span): its words, info, table entries

@@ -15,12 +15,12 @@
 
 namespace vxl {
 
-Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels)
-    : Renderer(std::vector<const VxlFile*>{&file}, max_texels) {}
+Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels, std::uint32_t level)
+    : Renderer(std::vector<const VxlFile*>{&file}, max_texels, level) {}
 
-Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels)
+Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level)
     : files_(files.empty() ? throw Error(ErrorKind::Usage, "", std::nullopt, "Renderer: no files") : files),
-      scene_(files_, max_texels),
+      scene_(files_, max_texels, level),
       groups_(files_) {
   const VxlFile& file = *files_.front();
   for (const VxlFile* f : files_)
@@ -185,7 +185,9 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   const auto& groups = groups_.groups();
   for (std::size_t g = 0; g < groups.size() && g < group.size(); ++g) group[g] = s.group_color(groups[g].name, g);
   glUniform4fv(glGetUniformLocation(program, "u_group"), shaders::kShaderGroups, glm::value_ptr(group[0]));
-  glUniform1f(glGetUniformLocation(program, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
+  // A coarse level's segment stands for the 8^level segments it samples (.vxl spec §6.5).
+  const float opacity = SceneLayout::level_opacity(std::clamp(s.opacity, 0.001f, 1.0f), scene_.layout().level());
+  glUniform1f(glGetUniformLocation(program, "u_opacity"), opacity);
   glUniform1i(glGetUniformLocation(program, "u_lighting"), s.lighting ? 1 : 0);
   const glm::vec3 light = lighting::light_direction_eye();
   glUniform3fv(glGetUniformLocation(program, "u_light"), 1, glm::value_ptr(light));

@@ -37,10 +37,11 @@ struct FrameStats {
 class Renderer {
  public:
   static constexpr int kSamplersPerSpan = 4;  // words, orders, dataset order, attributes
-  explicit Renderer(const VxlFile& file, std::uint64_t max_texels = 0);
+  explicit Renderer(const VxlFile& file, std::uint64_t max_texels = 0, std::uint32_t level = 0);
   // Several files drawn as one scene: one sort over all their voxels, one group per file. The files must
-  // outlive the renderer.
-  explicit Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0);
+  // outlive the renderer. level: the level of detail drawn (.vxl spec §5.12; scene_layout.h), its opacity
+  // compensated so that the picture keeps its brightness.
+  explicit Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0, std::uint32_t level = 0);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;

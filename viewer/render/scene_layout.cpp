@@ -22,10 +22,46 @@ bool same_grid(const MetaSection& a, const MetaSection& b) {
 
 }  // namespace
 
-SceneLayout::SceneLayout(const VxlFile& file, std::uint64_t max_texels)
-    : SceneLayout(std::span<const VxlFile* const>(std::array<const VxlFile*, 1>{&file}), max_texels) {}
+SceneLayout::SceneLayout(const VxlFile& file, std::uint64_t max_texels, std::uint32_t level)
+    : SceneLayout(std::span<const VxlFile* const>(std::array<const VxlFile*, 1>{&file}), max_texels, level) {}
 
-SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels) {
+std::uint32_t SceneLayout::coarsest_level(std::span<const VxlFile* const> files) {
+  std::uint32_t coarsest = kMaxLevels;
+  for (const VxlFile* f : files) coarsest = std::min(coarsest, f->level_count() - 1);
+  return files.empty() ? 0 : coarsest;
+}
+
+std::uint64_t SceneLayout::upload_bytes() const {
+  std::uint64_t bytes = 0;
+  for (const TextureSpan& c : spans_) bytes += 4 * c.words() + 2 * c.order_entries() + 4 * c.segments + 8 * c.vertices;
+  return bytes;
+}
+
+std::uint32_t SceneLayout::finest_level_within(std::span<const VxlFile* const> files, std::uint64_t max_texels,
+                                               std::uint64_t budget) {
+  const std::uint32_t coarsest = coarsest_level(files);
+  std::string why;
+  for (std::uint32_t level = 0; level <= coarsest; ++level) {
+    try {
+      const SceneLayout layout(files, max_texels, level);
+      if (layout.upload_bytes() <= budget) return level;
+      why = "needs " + std::to_string(layout.upload_bytes() / (1 << 20)) + " MiB of GPU memory";
+    } catch (const Error& e) {
+      why = e.what();
+    }
+  }
+  throw Error(ErrorKind::Unsupported, files.empty() ? "" : files[0]->path(), std::nullopt,
+              "the scene does not fit the GPU memory budget of " + std::to_string(budget / (1 << 20)) +
+                  " MiB even at its coarsest level of detail (" + std::to_string(coarsest) + "): it " + why +
+                  (coarsest == 0 ? "; convert with levels of detail (voxlines convert --levels)" : ""));
+}
+
+float SceneLayout::level_opacity(float opacity, std::uint32_t level) {
+  return static_cast<float>(1.0 - std::pow(1.0 - double(opacity), std::pow(double(kLevelRatio), double(level))));
+}
+
+SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels, std::uint32_t level)
+    : level_(std::min(level, coarsest_level(files))) {
   std::uint64_t total_voxels = 0;
   for (const VxlFile* f : files) total_voxels += f->meta().voxel_count;
   if (total_voxels > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
@@ -49,7 +85,9 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
     if (fi > 0 && !same_grid(files[0]->meta(), m)) one_grid_ = false;
     const std::uint32_t slots = fl.stored_orders;
     auto padded = [](std::uint64_t n) { return (n + kGroup - 1) / kGroup * kGroup; };
-    auto wide = [](const VoxelEntry& e) { return e.vertex_count > kU16OrderMaxVertices; };
+    fl.level = level_;
+    auto wide = [](const LevelEntry& e) { return e.vertex_count > kU16OrderMaxVertices; };
+    auto counts = [&](std::uint32_t local) { return file.level(local, level_); };
     // Both buffers of a span within the limit: its words (4 a texel) and its order entries.
     auto fits = [&](const TextureSpan& c) { return c.words() / 4 <= max_texels && c.order_entries() <= max_texels; };
     auto voxels = file.voxels();
@@ -62,19 +100,20 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
       std::uint64_t vertex = 0, seg = 0;
       for (bool wide_pass : {true, false})
         for (std::uint32_t i = current.voxel_first; i < current.voxel_first + current.voxel_count; ++i) {
-          const VoxelEntry& e = voxels[i - fl.voxel_first];
+          const LevelEntry e = counts(i - fl.voxel_first);
           if (wide(e) != wide_pass) continue;
           voxels_[i].seg_first = seg;
           seg += padded(e.segment_count);
         }
       for (std::uint32_t i = current.voxel_first; i < current.voxel_first + current.voxel_count; ++i) {
         voxels_[i].vertex_first = vertex;
-        vertex += padded(voxels[i - fl.voxel_first].vertex_count);
+        vertex += padded(counts(i - fl.voxel_first).vertex_count);
       }
       spans_.push_back(current);
     };
     for (std::uint32_t li = 0; li < voxels.size(); ++li) {
-      const VoxelEntry& e = voxels[li];
+      const VoxelEntry& cube = voxels[li];
+      const LevelEntry e = counts(li);
       const std::uint32_t i = fl.voxel_first + li;
       TextureSpan grown = current, alone = current;
       alone.voxel_count = 0;
@@ -100,9 +139,9 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
       current = grown;
       VoxelDrawInfo& v = voxels_[i];
       for (int c = 0; c < 3; ++c) {
-        v.center[c] = m.grid_origin[c] + (e.coord[c] + 0.5) * m.voxel_size;
-        v.tight_min[c] = e.tight_min[c];
-        v.tight_max[c] = e.tight_max[c];
+        v.center[c] = m.grid_origin[c] + (cube.coord[c] + 0.5) * m.voxel_size;
+        v.tight_min[c] = cube.tight_min[c];
+        v.tight_max[c] = cube.tight_max[c];
       }
       v.span = static_cast<std::uint32_t>(spans_.size());
       v.segment_count = e.segment_count;

@@ -68,6 +68,7 @@ struct TextureSpan {
 // Where one file's voxels are in the scene, and its sorting directions.
 struct FileLayout {
   std::uint32_t voxel_first = 0, voxel_count = 0;
+  std::uint32_t level = 0;                  // the level of detail its voxels are drawn at (.vxl spec §5.12)
   std::uint32_t stored_orders = 0;          // K
   std::vector<glm::vec3> directions;        // DIRS
   std::vector<glm::vec3> voxel_directions;  // VDIR, voxel-major, K per voxel; empty without
@@ -76,9 +77,25 @@ struct FileLayout {
 class SceneLayout {
  public:
   // max_texels: the driver's GL_MAX_TEXTURE_BUFFER_SIZE (tests pass small values to force many spans).
-  // Throws vxl::Error (Unsupported) when the scene needs more than kMaxTextureSpans texture spans or 2^31 virtual ids.
-  SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels);
-  SceneLayout(const VxlFile& file, std::uint64_t max_texels);
+  // level: the level of detail to lay out (.vxl spec §5.12; 0: every streamline), the same for every file,
+  // at most the coarsest level all files have. Throws vxl::Error (Unsupported) when the scene needs more
+  // than kMaxTextureSpans texture spans or 2^31 virtual ids.
+  SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels, std::uint32_t level = 0);
+  SceneLayout(const VxlFile& file, std::uint64_t max_texels, std::uint32_t level = 0);
+
+  // The coarsest level every file has (0 when one has no levels).
+  static std::uint32_t coarsest_level(std::span<const VxlFile* const> files);
+  // The finest level whose layout fits the limits and whose GPU copy (upload_bytes) is at most `budget`
+  // bytes. Throws vxl::Error (Unsupported) naming what the coarsest level would need when none fits.
+  static std::uint32_t finest_level_within(std::span<const VxlFile* const> files, std::uint64_t max_texels,
+                                           std::uint64_t budget);
+  // The most the GPU copy of this layout can take, in bytes: words and orders of every span, plus the
+  // dataset order and the per-vertex attributes that some modes upload on first use.
+  std::uint64_t upload_bytes() const;
+  // The level the scene is drawn at, and the opacity that makes a segment of it stand for the 8^level
+  // segments of full detail it samples (.vxl spec §6.5): 1 - (1 - opacity)^(8^level).
+  std::uint32_t level() const { return level_; }
+  static float level_opacity(float opacity, std::uint32_t level);
 
   static constexpr std::uint32_t kMaxTextureSpans = 8;  // each span needs 4 samplers in the vertex shader
   static constexpr std::uint64_t kGroup = TextureSpan::kGroupSize;
@@ -119,7 +136,9 @@ class SceneLayout {
     return static_cast<std::int64_t>(c.virtual_base + 2 * seg);
   }
   std::int32_t id_count(const VoxelDrawInfo& v, std::uint32_t slot) const {
-    return static_cast<std::int32_t>(2 * (slot == spans_[v.span].slots ? v.vertex_count - 1 : v.segment_count));
+    if (slot == spans_[v.span].slots)
+      return v.vertex_count == 0 ? 0 : static_cast<std::int32_t>(2 * (v.vertex_count - 1));
+    return static_cast<std::int32_t>(2 * v.segment_count);
   }
   // First virtual id of entry j of a span's dataset-order array.
   std::int64_t dataset_id(std::uint32_t span, std::uint64_t j) const {
@@ -132,6 +151,7 @@ class SceneLayout {
   std::vector<VoxelDrawInfo> voxels_;
   std::vector<TextureSpan> spans_;
   std::uint64_t virtual_ids_ = 0;
+  std::uint32_t level_ = 0;
   double voxel_size_ = 0;
   bool one_grid_ = true;
 };

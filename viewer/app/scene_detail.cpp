@@ -1,0 +1,71 @@
+#include "viewer/app/scene_detail.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <epoxy/gl.h>
+
+#include "converter/memory_available.h"
+#include "converter/memory_size.h"
+#include "format/error.h"
+#include "viewer/render/scene_layout.h"
+
+namespace vxl::app {
+namespace {
+
+// GL_NVX_gpu_memory_info and GL_ATI_meminfo report free video memory in KiB; core GL has no query.
+constexpr GLenum kNvxCurrentAvailableKib = 0x9049;
+constexpr GLenum kAtiTextureFreeMemory = 0x87FC;
+
+std::optional<std::uint64_t> driver_free_bytes() {
+  GLint kib[4] = {0, 0, 0, 0};
+  if (epoxy_has_gl_extension("GL_NVX_gpu_memory_info"))
+    glGetIntegerv(kNvxCurrentAvailableKib, kib);
+  else if (epoxy_has_gl_extension("GL_ATI_meminfo"))
+    glGetIntegerv(kAtiTextureFreeMemory, kib);
+  if (glGetError() != GL_NO_ERROR || kib[0] <= 0) return std::nullopt;
+  return std::uint64_t(kib[0]) << 10;
+}
+
+}  // namespace
+
+SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::optional<std::uint32_t> level,
+                                std::optional<std::uint64_t> gpu_memory, std::uint64_t max_texels) {
+  SceneDetail d;
+  if (gpu_memory) {
+    d.budget = *gpu_memory;
+    d.budget_source = "--gpu-memory";
+  } else if (const auto free = driver_free_bytes()) {
+    d.budget = *free / 2;  // the rest for the framebuffers, the exact mode's lists and other programs
+    d.budget_source = "half the free GPU memory the driver reports";
+  } else {
+    d.budget = available_memory().value_or(std::uint64_t(4) << 30) / 4;  // the mapped file and the copy also take RAM
+    d.budget_source = "a quarter of the available memory (the driver reports no GPU memory)";
+  }
+  if (level) {
+    d.forced = true;
+    d.level = std::min(*level, SceneLayout::coarsest_level(files));
+    const SceneLayout layout(files, max_texels, d.level);
+    if (gpu_memory && layout.upload_bytes() > d.budget)
+      throw Error(ErrorKind::Unsupported, files.front()->path(), std::nullopt,
+                  "level " + std::to_string(d.level) + " needs " + format_memory_size(layout.upload_bytes()) +
+                      " of GPU memory, more than --gpu-memory " + format_memory_size(d.budget) +
+                      "; choose a coarser --level or leave it out");
+    return d;
+  }
+  d.level = SceneLayout::finest_level_within(files, max_texels, d.budget);
+  return d;
+}
+
+std::string describe_scene_detail(const SceneDetail& d, std::uint32_t levels_in_files) {
+  if (d.level == 0) return "";
+  const std::string what = "drawing level " + std::to_string(d.level) + " of " + std::to_string(levels_in_files - 1) +
+                           " (about 1/" +
+                           std::to_string(static_cast<std::uint64_t>(std::pow(double(kLevelRatio), double(d.level)))) +
+                           " of the streamlines, opacity compensated)";
+  if (d.forced) return what + " as --level asks";
+  return what + " to stay within a GPU memory budget of " + format_memory_size(d.budget) + " (" + d.budget_source +
+         (d.budget_source == "--gpu-memory" ? ")" : "; --gpu-memory sets it)");
+}
+
+}  // namespace vxl::app
