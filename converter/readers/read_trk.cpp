@@ -23,6 +23,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -408,87 +409,79 @@ class TrkBytes {
   std::uint64_t inflated_before_reset_ = 0;
 };
 
-}  // namespace
+// The header fields the reader uses, decoded in the file's byte order (stage 1 of read_trk).
+struct TrkHeader {
+  std::array<std::uint8_t, kHeaderSize> bytes{};
+  bool big_endian = false;
+  std::int32_t version = 0, n_count = 0;
+  int n_scalars = 0, n_properties = 0;
+  std::array<double, 3> dim{}, voxel_size{};
+  Mat4 recorded{};  // vox_to_ras as stored (zero in version 1)
+  bool vox_to_ras_recorded = false;
+  Bytes fields() const { return Bytes(bytes.data(), bytes.size(), big_endian); }
+};
 
-Tractogram read_trk(const std::string& path) {
-  Tractogram t;
-  require_regular_file(path);
-  const MappedFile file(path);
-  t.source.path = path;
-  t.source.format = "trk";
-  t.source.dtype = "float32";
-  t.source.bytes = file.size();
-  t.source.xxh3_128 = xxh3_128_hex(file.data(), file.size());
-  auto& warnings = t.source.warnings;
+// Reports a problem at an offset of the TRK stream (the decompressed one for a .gz file).
+using FailAt = std::function<void(std::uint64_t, const std::string&)>;
 
-  const bool gz = is_gzip(file);
-  std::optional<TrkBytes> stream;
-  if (gz)
-    stream.emplace(path, file.bytes(), warnings);
-  else
-    stream.emplace(file.bytes());
-  // Offsets in messages count bytes of the TRK stream, which for a .gz file is the decompressed one.
-  const std::string where = gz ? " (offset in the decompressed data)" : "";
-  auto fail_at = [&](std::uint64_t offset, const std::string& what) { fail_input(path, offset, what + where); };
-
-  std::array<std::uint8_t, kHeaderSize> header_bytes;
-  if (const std::uint8_t* p = stream->take(kHeaderSize)) {
-    std::memcpy(header_bytes.data(), p, kHeaderSize);
+TrkHeader read_header(TrkBytes& stream, const std::string& path, std::vector<std::string>& warnings,
+                      const FailAt& fail_at) {
+  TrkHeader h;
+  if (const std::uint8_t* p = stream.take(kHeaderSize)) {
+    std::memcpy(h.bytes.data(), p, kHeaderSize);
   } else {
-    const std::uint64_t size = stream->left();
+    const std::uint64_t size = stream.left();
     fail_at(size, "file ends after " + std::to_string(size) + " bytes, inside the 1000-byte TRK header");
   }
-  const std::uint8_t* data = header_bytes.data();
-  const std::size_t size = kHeaderSize;
+  const std::uint8_t* data = h.bytes.data();
   if (std::memcmp(data, "TRACK", 5) != 0) fail_at(0, "not a TrackVis file: expected the magic 'TRACK'");
 
   // hdr_size tells the byte order: 1000 as stored little-endian, or 1000 after swapping (big-endian).
-  const Bytes le(data, size, false);
-  bool big_endian = false;
+  const Bytes le(data, kHeaderSize, false);
   if (le.i32(kOffHdrSize) != static_cast<std::int32_t>(kHeaderSize)) {
-    if (Bytes(data, size, true).i32(kOffHdrSize) != static_cast<std::int32_t>(kHeaderSize))
+    if (Bytes(data, kHeaderSize, true).i32(kOffHdrSize) != static_cast<std::int32_t>(kHeaderSize))
       fail_at(kOffHdrSize, "hdr_size is " + std::to_string(le.i32(kOffHdrSize)) + " (little-endian) / " +
-                               std::to_string(Bytes(data, size, true).i32(kOffHdrSize)) +
+                               std::to_string(Bytes(data, kHeaderSize, true).i32(kOffHdrSize)) +
                                " (big-endian); expected 1000");
-    big_endian = true;
+    h.big_endian = true;
   }
-  const Bytes in(data, size, big_endian);
+  const Bytes in = h.fields();
 
-  const std::int32_t version = in.i32(kOffVersion);
-  if (version == 3) {
+  h.version = in.i32(kOffVersion);
+  if (h.version == 3) {
     // nibabel reads version 3 as version 2 with a warning; the layout is the same.
     warnings.push_back("TRK version 3 header read as version 2");
-  } else if (version != 1 && version != 2) {
-    fail_unsupported(path, "TRK version " + std::to_string(version) +
+  } else if (h.version != 1 && h.version != 2) {
+    fail_unsupported(path, "TRK version " + std::to_string(h.version) +
                                " (int32 at byte 992) is not supported; supported versions are 1 and 2");
   }
-
-  std::array<double, 3> dim{}, voxel_size{};
   for (int i = 0; i < 3; ++i) {
-    dim[i] = in.i16(kOffDim + 2 * i);
-    voxel_size[i] = in.f32(kOffVoxelSize + 4 * i);
+    h.dim[i] = in.i16(kOffDim + 2 * i);
+    h.voxel_size[i] = in.f32(kOffVoxelSize + 4 * i);
   }
-  const int n_scalars = in.i16(kOffNScalars);
-  const int n_properties = in.i16(kOffNProperties);
-  if (n_scalars < 0) fail_at(kOffNScalars, "negative n_scalars " + std::to_string(n_scalars));
-  if (n_properties < 0) fail_at(kOffNProperties, "negative n_properties " + std::to_string(n_properties));
-  const std::int32_t n_count = in.i32(kOffNCount);
-
+  h.n_scalars = in.i16(kOffNScalars);
+  h.n_properties = in.i16(kOffNProperties);
+  if (h.n_scalars < 0) fail_at(kOffNScalars, "negative n_scalars " + std::to_string(h.n_scalars));
+  if (h.n_properties < 0) fail_at(kOffNProperties, "negative n_properties " + std::to_string(h.n_properties));
+  h.n_count = in.i32(kOffNCount);
   // vox_to_ras exists from version 2 on; [3][3] == 0 is TrackVis's "not recorded".
-  Mat4 recorded{};
-  if (version >= 2)
+  if (h.version >= 2)
     for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) recorded[i][j] = in.f32(kOffVoxToRas + 4 * (4 * i + j));
-  const bool vox_to_ras_recorded = recorded[3][3] != 0;
-  Mat4 vox_to_ras = recorded;
-  if (!vox_to_ras_recorded) {
-    vox_to_ras = identity4();
-    warnings.push_back(version == 1 ? "TRK version 1 header has no vox_to_ras; using the identity (as nibabel)"
-                                    : "vox_to_ras is not recorded (element [3][3] is 0); using the identity "
-                                      "(as nibabel)");
-  }
+      for (int j = 0; j < 4; ++j) h.recorded[i][j] = in.f32(kOffVoxToRas + 4 * (4 * i + j));
+  h.vox_to_ras_recorded = h.recorded[3][3] != 0;
+  return h;
+}
 
-  std::string voxel_order = trim_right(latin1_field(data + kOffVoxelOrder, 4));
+// Stage 2: the affine applied to the stored points (voxmm to RAS mm), as nibabel computes it.
+Mat4 voxmm_to_ras(const TrkHeader& h, std::vector<std::string>& warnings, const FailAt& fail_at) {
+  Mat4 vox_to_ras = h.recorded;
+  if (!h.vox_to_ras_recorded) {
+    vox_to_ras = identity4();
+    warnings.push_back(h.version == 1 ? "TRK version 1 header has no vox_to_ras; using the identity (as nibabel)"
+                                      : "vox_to_ras is not recorded (element [3][3] is 0); using the identity "
+                                        "(as nibabel)");
+  }
+  std::string voxel_order = trim_right(latin1_field(h.bytes.data() + kOffVoxelOrder, 4));
   for (char& c : voxel_order)
     if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
   if (voxel_order.empty()) {
@@ -501,82 +494,79 @@ Tractogram read_trk(const std::string& path) {
   const auto affine_ornt = affine_orientation(vox_to_ras);
   if (!affine_ornt) fail_at(kOffVoxToRas, "vox_to_ras is singular: the voxel axis directions cannot be determined");
 
-  Mat4 voxmm_to_ras = identity4();  // what is applied to the stored points
-  bool voxel_size_recorded = true;
-  for (double v : voxel_size)
-    if (!(std::isfinite(v) && v != 0)) voxel_size_recorded = false;
-  if (!voxel_size_recorded) {
-    // nibabel divides by zero here and returns NaN points. A header without voxel sizes (old files,
-    // e.g. dipy's former tracks300.trk) carries no geometry at all; its points are world mm already.
-    warnings.push_back("voxel_size is not recorded (zero); points are taken as RAS mm unchanged");
-  } else {
-    if (orientation_name(*header_ornt) != orientation_name(*affine_ornt))
-      warnings.push_back("voxel_order " + voxel_order + " disagrees with the orientation of vox_to_ras (" +
-                         orientation_name(*affine_ornt) + "); voxel axes re-oriented as nibabel does");
-    Mat4 scale = identity4();
-    for (int i = 0; i < 3; ++i) scale[i][i] = 1.0 / voxel_size[i];
-    Mat4 half_voxel = identity4();
-    for (int i = 0; i < 3; ++i) half_voxel[i][3] = -0.5;
-    voxmm_to_ras = mul(vox_to_ras, mul(reorient(*header_ornt, *affine_ornt, dim), mul(half_voxel, scale)));
-  }
+  for (double v : h.voxel_size)
+    if (!(std::isfinite(v) && v != 0)) {
+      // nibabel divides by zero here and returns NaN points. A header without voxel sizes (old files,
+      // e.g. dipy's former tracks300.trk) carries no geometry at all; its points are world mm already.
+      warnings.push_back("voxel_size is not recorded (zero); points are taken as RAS mm unchanged");
+      return identity4();
+    }
+  if (orientation_name(*header_ornt) != orientation_name(*affine_ornt))
+    warnings.push_back("voxel_order " + voxel_order + " disagrees with the orientation of vox_to_ras (" +
+                       orientation_name(*affine_ornt) + "); voxel axes re-oriented as nibabel does");
+  Mat4 scale = identity4();
+  for (int i = 0; i < 3; ++i) scale[i][i] = 1.0 / h.voxel_size[i];
+  Mat4 half_voxel = identity4();
+  for (int i = 0; i < 3; ++i) half_voxel[i][3] = -0.5;
+  return mul(vox_to_ras, mul(reorient(*header_ornt, *affine_ornt, h.dim), mul(half_voxel, scale)));
+}
 
-  // Header as JSON provenance.
-  nlohmann::json h;
-  h["version"] = version;
-  h["endianness"] = big_endian ? "big" : "little";
-  if (gz) h["compression"] = "gzip";
-  h["dim"] = {in.i16(kOffDim), in.i16(kOffDim + 2), in.i16(kOffDim + 4)};
-  h["voxel_size"] = {voxel_size[0], voxel_size[1], voxel_size[2]};
-  h["origin"] = {in.f32(kOffOrigin), in.f32(kOffOrigin + 4), in.f32(kOffOrigin + 8)};
-  h["n_scalars"] = n_scalars;
-  h["scalar_names"] = slot_names(data + kOffScalarNames);
-  h["n_properties"] = n_properties;
-  h["property_names"] = slot_names(data + kOffPropertyNames);
-  if (version >= 2) {
+// Stage 3: the header as JSON provenance, with the affine actually applied.
+nlohmann::json header_provenance(const TrkHeader& h, bool gz, const Mat4& applied_affine) {
+  const Bytes in = h.fields();
+  const std::uint8_t* data = h.bytes.data();
+  nlohmann::json j;
+  j["version"] = h.version;
+  j["endianness"] = h.big_endian ? "big" : "little";
+  if (gz) j["compression"] = "gzip";
+  j["dim"] = {in.i16(kOffDim), in.i16(kOffDim + 2), in.i16(kOffDim + 4)};
+  j["voxel_size"] = {h.voxel_size[0], h.voxel_size[1], h.voxel_size[2]};
+  j["origin"] = {in.f32(kOffOrigin), in.f32(kOffOrigin + 4), in.f32(kOffOrigin + 8)};
+  j["n_scalars"] = h.n_scalars;
+  j["scalar_names"] = slot_names(data + kOffScalarNames);
+  j["n_properties"] = h.n_properties;
+  j["property_names"] = slot_names(data + kOffPropertyNames);
+  if (h.version >= 2) {
     nlohmann::json rows = nlohmann::json::array();
-    for (const auto& row : recorded) rows.push_back(row);
-    h["vox_to_ras"] = rows;
+    for (const auto& row : h.recorded) rows.push_back(row);
+    j["vox_to_ras"] = rows;
   } else {
-    h["vox_to_ras"] = nullptr;
+    j["vox_to_ras"] = nullptr;
   }
-  h["voxel_order"] = trim_right(latin1_field(data + kOffVoxelOrder, 4));
+  j["voxel_order"] = trim_right(latin1_field(data + kOffVoxelOrder, 4));
   nlohmann::json iop = nlohmann::json::array();
   for (int i = 0; i < 6; ++i) iop.push_back(in.f32(kOffImageOrient + 4 * i));
-  h["image_orientation_patient"] = iop;
+  j["image_orientation_patient"] = iop;
   static const char* kFlags[6] = {"invert_x", "invert_y", "invert_z", "swap_xy", "swap_yz", "swap_zx"};
-  for (int i = 0; i < 6; ++i) h[kFlags[i]] = data[kOffInvertSwap + i];
-  h["n_count"] = n_count;
-  h["hdr_size"] = kHeaderSize;
+  for (int i = 0; i < 6; ++i) j[kFlags[i]] = data[kOffInvertSwap + i];
+  j["n_count"] = h.n_count;
+  j["hdr_size"] = kHeaderSize;
   nlohmann::json applied = nlohmann::json::array();
-  for (const auto& row : voxmm_to_ras) applied.push_back(row);
-  h["voxmm_to_rasmm"] = applied;  // the affine actually applied to the stored points
-  t.source.header = std::move(h);
-  if (vox_to_ras_recorded) {
-    std::array<double, 16> m{};
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) m[4 * i + j] = recorded[i][j];
-    t.source.vox_to_ras = m;
-  }
+  for (const auto& row : applied_affine) applied.push_back(row);
+  j["voxmm_to_rasmm"] = applied;  // the affine actually applied to the stored points
+  return j;
+}
 
-  // Streamlines. Sizes are computed in 64 bits: n < 2^31 and 3 + n_scalars < 2^15 cannot overflow.
-  const std::uint64_t floats_per_point = 3 + static_cast<std::uint64_t>(n_scalars);
-  const std::uint64_t point_bytes = 4 * floats_per_point;
-  const std::uint64_t property_bytes = 4 * static_cast<std::uint64_t>(n_properties);
-  if (const auto total = stream->size())
+// Stage 4: the streamline records, mapped to RAS mm, with their scalars and properties.
+void read_records(TrkBytes& stream, const TrkHeader& h, const Mat4& a, Tractogram& t, const FailAt& fail_at) {
+  auto& warnings = t.source.warnings;
+  // Sizes are computed in 64 bits: n < 2^31 and 3 + n_scalars < 2^15 cannot overflow.
+  const std::uint64_t point_bytes = 4 * (3 + static_cast<std::uint64_t>(h.n_scalars));
+  const std::uint64_t property_bytes = 4 * static_cast<std::uint64_t>(h.n_properties);
+  if (const auto total = stream.size())
     t.positions.reserve(3 * ((*total - kHeaderSize) / point_bytes));  // an upper bound: no reallocation
-  for (const std::string& name : value_names(data + kOffScalarNames, n_scalars, "scalar", warnings))
+  for (const std::string& name : value_names(h.bytes.data() + kOffScalarNames, h.n_scalars, "scalar", warnings))
     t.point_values.push_back({name, {}});
-  for (const std::string& name : value_names(data + kOffPropertyNames, n_properties, "property", warnings))
+  for (const std::string& name : value_names(h.bytes.data() + kOffPropertyNames, h.n_properties, "property", warnings))
     t.streamline_values.push_back({name, {}});
-  const Mat4& a = voxmm_to_ras;
   std::uint64_t count = 0;
-  while (!stream->at_end()) {
-    const std::uint64_t off = stream->offset();
-    const std::uint8_t* q = stream->take(4);
+  while (!stream.at_end()) {
+    const std::uint64_t off = stream.offset();
+    const std::uint8_t* q = stream.take(4);
     if (q == nullptr)
-      fail_at(off, "truncated streamline record #" + std::to_string(count) + ": " + std::to_string(stream->left()) +
+      fail_at(off, "truncated streamline record #" + std::to_string(count) + ": " + std::to_string(stream.left()) +
                        " bytes left where a 4-byte point count was expected");
-    const std::int32_t n = Bytes(q, 4, big_endian).i32(0);
+    const std::int32_t n = Bytes(q, 4, h.big_endian).i32(0);
     if (n < 0)
       fail_at(off, "streamline #" + std::to_string(count) + " has a negative point count " + std::to_string(n));
     // TrackVis and nibabel never write a streamline without points; zeros where records should be are
@@ -588,12 +578,12 @@ Tractogram read_trk(const std::string& path) {
                        " points need " + std::to_string(need) + " bytes after the count but only " +
                        std::to_string(remain) + " remain");
     };
-    if (const auto total = stream->size(); total && need > *total - off - 4) truncated(*total - off - 4);
+    if (const auto total = stream.size(); total && need > *total - off - 4) truncated(*total - off - 4);
     for (std::int32_t i = 0; i < n; ++i) {
-      const std::uint64_t p = stream->offset();
-      q = stream->take(point_bytes);
-      if (q == nullptr) truncated(p - off - 4 + stream->left());
-      const Bytes pt(q, point_bytes, big_endian);
+      const std::uint64_t p = stream.offset();
+      q = stream.take(point_bytes);
+      if (q == nullptr) truncated(p - off - 4 + stream.left());
+      const Bytes pt(q, point_bytes, h.big_endian);
       const double x = pt.f32(0), y = pt.f32(4), z = pt.f32(8);
       for (int r = 0; r < 3; ++r) {
         const float v = static_cast<float>(a[r][0] * x + a[r][1] * y + a[r][2] * z + a[r][3]);
@@ -602,21 +592,56 @@ Tractogram read_trk(const std::string& path) {
                          " is not finite after mapping to RAS mm");
         t.positions.push_back(v);
       }
-      for (int k = 0; k < n_scalars; ++k) t.point_values[k].values.push_back(pt.f32(12 + 4 * k));
+      for (int k = 0; k < h.n_scalars; ++k) t.point_values[k].values.push_back(pt.f32(12 + 4 * k));
     }
     if (property_bytes > 0) {
-      const std::uint64_t p = stream->offset();
-      q = stream->take(property_bytes);
-      if (q == nullptr) truncated(p - off - 4 + stream->left());
-      const Bytes props(q, property_bytes, big_endian);
-      for (int k = 0; k < n_properties; ++k) t.streamline_values[k].values.push_back(props.f32(4 * k));
+      const std::uint64_t p = stream.offset();
+      q = stream.take(property_bytes);
+      if (q == nullptr) truncated(p - off - 4 + stream.left());
+      const Bytes props(q, property_bytes, h.big_endian);
+      for (int k = 0; k < h.n_properties; ++k) t.streamline_values[k].values.push_back(props.f32(4 * k));
     }
     t.offsets.push_back(t.point_count());
     ++count;
   }
-  if (n_count != 0 && static_cast<std::uint64_t>(n_count) != count)
-    warnings.push_back("header n_count is " + std::to_string(n_count) + " but the file holds " + std::to_string(count) +
-                       " streamlines; the data is trusted");
+  if (h.n_count != 0 && static_cast<std::uint64_t>(h.n_count) != count)
+    warnings.push_back("header n_count is " + std::to_string(h.n_count) + " but the file holds " +
+                       std::to_string(count) + " streamlines; the data is trusted");
+}
+
+}  // namespace
+
+// Header, affine, provenance, records: the four stages above.
+Tractogram read_trk(const std::string& path) {
+  Tractogram t;
+  require_regular_file(path);
+  const MappedFile file(path);
+  t.source.path = path;
+  t.source.format = "trk";
+  t.source.dtype = "float32";
+  t.source.bytes = file.size();
+  t.source.xxh3_128 = xxh3_128_hex(file.data(), file.size());
+
+  const bool gz = is_gzip(file);
+  std::optional<TrkBytes> stream;
+  if (gz)
+    stream.emplace(path, file.bytes(), t.source.warnings);
+  else
+    stream.emplace(file.bytes());
+  // Offsets in messages count bytes of the TRK stream, which for a .gz file is the decompressed one.
+  const std::string where = gz ? " (offset in the decompressed data)" : "";
+  const FailAt fail_at = [&](std::uint64_t offset, const std::string& what) { fail_input(path, offset, what + where); };
+
+  const TrkHeader header = read_header(*stream, path, t.source.warnings, fail_at);
+  const Mat4 affine = voxmm_to_ras(header, t.source.warnings, fail_at);
+  t.source.header = header_provenance(header, gz, affine);
+  if (header.vox_to_ras_recorded) {
+    std::array<double, 16> m{};
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) m[4 * i + j] = header.recorded[i][j];
+    t.source.vox_to_ras = m;
+  }
+  read_records(*stream, header, affine, t, fail_at);
   return t;
 }
 
