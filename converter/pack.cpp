@@ -166,6 +166,94 @@ std::uint32_t pick_joint_bits(bool has_points, SampleFn&& first_chunk_residuals)
   return pick;
 }
 
+// Quantisation grid (spec §3, §5.1): one cube over all shipped points (`n` of them).
+PackSection plan_quantisation(const VxlFile& f, const PackSettings& settings, std::uint64_t n, unsigned threads) {
+  PackSection pack{};
+  pack.quantization_bits = settings.bits;
+  pack.predictor = kVxlzPredictorLinear;
+  double hi[3];
+  if (!vertex_box(f, threads, pack.quant_origin, hi))
+    fail_input(f.path(), f.find_section(section_id("VERT"))->offset, "a vertex coordinate is not finite");
+  pack.range = std::max({hi[0] - pack.quant_origin[0], hi[1] - pack.quant_origin[1], hi[2] - pack.quant_origin[2]});
+  pack.quantum = pack.range > 0 ? pack.range / double((1u << settings.bits) - 1) : 1.0;
+  if (!std::isfinite(pack.quantum) || !(pack.quantum > 0))
+    throw Error(ErrorKind::Unsupported, f.path(), std::nullopt, "coordinate range too large to quantise");
+  pack.point_count = n;
+  pack.chunk_points = settings.chunk_points;
+  pack.chunk_count = n / settings.chunk_points + (n % settings.chunk_points != 0);
+  pack.error_bound = vxlz_error_bound(pack.quant_origin, pack.range, pack.quantum);
+  return pack;
+}
+
+// The positions (spec §5): every chunk quantised, predicted and encoded, in parallel (chunks are
+// independent); sets PACK's joint bits and error statistics.
+void encode_positions(const VxlFile& f, const VoxlineIndex& index, unsigned threads, VxlzContent& c) {
+  PackSection& pack = c.pack;
+  const std::uint64_t n = pack.point_count;
+  const Quantizer quantizer(pack);
+  auto voxlines = f.voxlines();
+  struct ErrorStats {
+    double max = 0, sum_squares = 0;
+  };
+  // Chunk `chunk`'s residuals (spec §5.2) into `residuals`, its quantisation errors into `e`.
+  auto chunk_residuals = [&](std::uint64_t chunk, std::vector<std::int32_t>& residuals, ErrorStats& e) {
+    const std::uint64_t start = chunk * pack.chunk_points;
+    const std::uint64_t count = std::min(pack.chunk_points, n - start);
+    residuals.resize(3 * count);
+    std::uint64_t j =
+        std::upper_bound(index.first_point.begin(), index.first_point.end(), start) - index.first_point.begin() - 1;
+    std::uint64_t in_voxline = start - index.first_point[j];
+    LinearPredictor predictor;
+    predictor.reset();
+    // The current voxline's own points, decoded from its voxel's block.
+    std::vector<float> points;
+    auto load_voxline = [&] {
+      points.resize(3 * std::uint64_t(voxlines[j].count_flags & kVoxlineCountMask));
+      f.read_vertices(voxlines[j].voxel, index.first_vertex[j], points.size() / 3, points.data());
+    };
+    if (count > 0) load_voxline();
+    for (std::uint64_t i = 0; i < count; ++i) {
+      if (in_voxline == 0 && index.starts_streamline[j]) predictor.start_streamline();
+      const float* p = points.data() + 3 * in_voxline;
+      std::array<std::int64_t, 3> k;
+      for (int a = 0; a < 3; ++a) {
+        k[a] = quantizer.quantize(p[a], a);
+        residuals[3 * i + a] = static_cast<std::int32_t>(k[a] - predictor.predict(a));
+        const double error = std::abs(double(quantizer.dequantize(k[a], a)) - double(p[a]));
+        e.max = std::max(e.max, error);
+        e.sum_squares += error * error;
+      }
+      predictor.push(k);
+      if (++in_voxline == (voxlines[j].count_flags & kVoxlineCountMask)) {
+        ++j;
+        in_voxline = 0;
+        if (i + 1 < count) load_voxline();
+      }
+    }
+  };
+  std::vector<std::vector<std::int32_t>> residuals(threads);  // one per thread, reused across chunks
+  pack.joint_bits = pick_joint_bits(pack.chunk_count > 0, [&](std::vector<std::int32_t>& sample) {
+    ErrorStats ignored;
+    chunk_residuals(0, sample, ignored);
+  });
+  c.chunks.resize(pack.chunk_count);
+  // Per chunk, summed in chunk order below: summed per thread, the RMS error's last bits (stored in PACK
+  // and in the unpacked file's provenance) depended on which thread took which chunk.
+  std::vector<ErrorStats> errors(pack.chunk_count);
+  parallel_for(pack.chunk_count, threads, [&](std::uint64_t chunk, unsigned t) {
+    ErrorStats e;  // local: neighbouring entries of `errors` share cache lines
+    chunk_residuals(chunk, residuals[t], e);
+    c.chunks[chunk] = encode_residual_chunk(residuals[t], pack.joint_bits);
+    errors[chunk] = e;
+  });
+  double sum_squares = 0;
+  for (const ErrorStats& e : errors) {
+    pack.max_error = std::max(pack.max_error, e.max);
+    sum_squares += e.sum_squares;
+  }
+  pack.rms_error = n > 0 ? std::sqrt(sum_squares / (3.0 * double(n))) : 0.0;
+}
+
 }  // namespace
 
 PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSettings& settings) {
@@ -182,23 +270,10 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   const VoxlineIndex index = index_voxlines(f);
   const std::uint64_t n = index.first_point.back();
 
-  // Quantisation grid (spec §3, §5.1): one cube over all shipped points.
+  // Quantisation grid (spec §3, §5.1).
   VxlzContent c;
-  PackSection& pack = c.pack;
-  pack.quantization_bits = settings.bits;
-  pack.predictor = kVxlzPredictorLinear;
-  double hi[3];
-  if (!vertex_box(f, threads, pack.quant_origin, hi))
-    fail_input(f.path(), f.find_section(section_id("VERT"))->offset, "a vertex coordinate is not finite");
-  pack.range = std::max({hi[0] - pack.quant_origin[0], hi[1] - pack.quant_origin[1], hi[2] - pack.quant_origin[2]});
-  pack.quantum = pack.range > 0 ? pack.range / double((1u << settings.bits) - 1) : 1.0;
-  if (!std::isfinite(pack.quantum) || !(pack.quantum > 0))
-    throw Error(ErrorKind::Unsupported, f.path(), std::nullopt, "coordinate range too large to quantise");
-  pack.point_count = n;
-  pack.chunk_points = settings.chunk_points;
-  pack.chunk_count = n / settings.chunk_points + (n % settings.chunk_points != 0);
-  pack.error_bound = vxlz_error_bound(pack.quant_origin, pack.range, pack.quantum);
-
+  c.pack = plan_quantisation(f, settings, n, threads);
+  const PackSection& pack = c.pack;
   // The exact part (spec §4).
   c.meta = m;
   c.directions.assign(f.directions().begin(), f.directions().end());
@@ -209,71 +284,6 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   if (f.find_section(section_id("PROV"))) c.provenance = std::string(f.provenance_json());
   if (f.find_section(section_id("GRPS"))) c.groups = encode_group_stream(f.groups());
 
-  // Positions (spec §5): chunks are independent, so they are quantised, predicted and encoded in parallel.
-  auto encode_positions = [&] {
-    const Quantizer quantizer(pack);
-    auto voxlines = f.voxlines();
-    struct ErrorStats {
-      double max = 0, sum_squares = 0;
-    };
-    // Chunk `chunk`'s residuals (spec §5.2) into `residuals`, its quantisation errors into `e`.
-    auto chunk_residuals = [&](std::uint64_t chunk, std::vector<std::int32_t>& residuals, ErrorStats& e) {
-      const std::uint64_t start = chunk * pack.chunk_points;
-      const std::uint64_t count = std::min(pack.chunk_points, n - start);
-      residuals.resize(3 * count);
-      std::uint64_t j =
-          std::upper_bound(index.first_point.begin(), index.first_point.end(), start) - index.first_point.begin() - 1;
-      std::uint64_t in_voxline = start - index.first_point[j];
-      LinearPredictor predictor;
-      predictor.reset();
-      // The current voxline's own points, decoded from its voxel's block.
-      std::vector<float> points;
-      auto load_voxline = [&] {
-        points.resize(3 * std::uint64_t(voxlines[j].count_flags & kVoxlineCountMask));
-        f.read_vertices(voxlines[j].voxel, index.first_vertex[j], points.size() / 3, points.data());
-      };
-      if (count > 0) load_voxline();
-      for (std::uint64_t i = 0; i < count; ++i) {
-        if (in_voxline == 0 && index.starts_streamline[j]) predictor.start_streamline();
-        const float* p = points.data() + 3 * in_voxline;
-        std::array<std::int64_t, 3> k;
-        for (int a = 0; a < 3; ++a) {
-          k[a] = quantizer.quantize(p[a], a);
-          residuals[3 * i + a] = static_cast<std::int32_t>(k[a] - predictor.predict(a));
-          const double error = std::abs(double(quantizer.dequantize(k[a], a)) - double(p[a]));
-          e.max = std::max(e.max, error);
-          e.sum_squares += error * error;
-        }
-        predictor.push(k);
-        if (++in_voxline == (voxlines[j].count_flags & kVoxlineCountMask)) {
-          ++j;
-          in_voxline = 0;
-          if (i + 1 < count) load_voxline();
-        }
-      }
-    };
-    std::vector<std::vector<std::int32_t>> residuals(threads);  // one per thread, reused across chunks
-    pack.joint_bits = pick_joint_bits(pack.chunk_count > 0, [&](std::vector<std::int32_t>& sample) {
-      ErrorStats ignored;
-      chunk_residuals(0, sample, ignored);
-    });
-    c.chunks.resize(pack.chunk_count);
-    // Per chunk, summed in chunk order below: summed per thread, the RMS error's last bits (stored in PACK
-    // and in the unpacked file's provenance) depended on which thread took which chunk.
-    std::vector<ErrorStats> errors(pack.chunk_count);
-    parallel_for(pack.chunk_count, threads, [&](std::uint64_t chunk, unsigned t) {
-      ErrorStats e;  // local: neighbouring entries of `errors` share cache lines
-      chunk_residuals(chunk, residuals[t], e);
-      c.chunks[chunk] = encode_residual_chunk(residuals[t], pack.joint_bits);
-      errors[chunk] = e;
-    });
-    double sum_squares = 0;
-    for (const ErrorStats& e : errors) {
-      pack.max_error = std::max(pack.max_error, e.max);
-      sum_squares += e.sum_squares;
-    }
-    pack.rms_error = n > 0 ? std::sqrt(sum_squares / (3.0 * double(n))) : 0.0;
-  };
   // The exact part is deflated on a thread of its own while the positions are encoded (unless one thread
   // was asked for): the voxline voxels take seconds to deflate on a large tractogram, and would otherwise
   // run alone at the end.
@@ -286,7 +296,7 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
         if (!f.streamline_values().empty())
           c.streamline_values = encode_value_section(streamline_values(f.streamline_values()), 1);
       },
-      encode_positions);
+      [&] { encode_positions(f, index, threads, c); });
 
   PackSummary s;
   s.bytes = write_vxlz(out_path, c, tables);
