@@ -12,12 +12,10 @@ VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes&
   file_size_ = layout.file_size;
   written_.assign(table_.size(), 0);
   for (std::size_t i = 0; i < table_.size(); ++i) checksums_.push_back(std::make_unique<Xxh3_64Stream>());
-  static const char* const ids[kSectionCount] = {"META", "DIRS", "VDIR", "VOXT", "LODS", "VERT",
-                                                 "ORDR", "VXLN", "STRM", "PROV", "GRPS"};
-  for (std::size_t s = 0; s < kSectionCount; ++s) {
+  for (std::size_t s = 0; s < kCount; ++s) {
     entry_[s] = table_.size();
     for (std::size_t i = 0; i < table_.size(); ++i)
-      if (std::memcmp(table_[i].id, ids[s], 4) == 0) entry_[s] = i;
+      if (std::memcmp(table_[i].id, kIds[s], 4) == 0) entry_[s] = i;
   }
   out_.allocate(file_size_);  // zeros everywhere: the padding between payloads is never written
 }

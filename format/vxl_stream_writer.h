@@ -20,22 +20,9 @@
 
 namespace vxl {
 
-class VxlStreamWriter {
+class VxlStreamWriter : public VxlSections {
  public:
-  enum Section : std::size_t {
-    kMeta,
-    kDirs,
-    kVdir,
-    kVoxt,
-    kLods,
-    kVert,
-    kOrdr,
-    kVxln,
-    kStrm,
-    kProv,
-    kGrps,
-    kSectionCount
-  };
+  using Section = Index;  // VVAL and SVAL: never planned here, so appending to them throws
 
   // Creates the output at `path`, sized for these payloads (which read as zero until written).
   // Throws vxl::Error (Output).
@@ -62,8 +49,8 @@ class VxlStreamWriter {
  private:
   AtomicOutputFile out_;
   PositionEncoding positions_;
-  std::vector<SectionEntry> table_;   // in Section order, optional sections (VDIR, LODS, GRPS) only when present
-  std::size_t entry_[kSectionCount];  // Section -> index in table_ (table_.size(): absent)
+  std::vector<SectionEntry> table_;  // in Section order, optional sections (VDIR, LODS, GRPS) only when present
+  std::size_t entry_[kCount];        // Section -> index in table_ (table_.size(): absent)
   std::uint64_t file_size_ = 0;
   std::vector<std::uint64_t> written_;
   std::vector<std::unique_ptr<Xxh3_64Stream>> checksums_;

@@ -49,14 +49,6 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
   return s;
 }
 
-namespace {
-
-// Section ids in file order, indexed by VxlWriter::Index; VDIR and GRPS are optional.
-constexpr const char* kSectionIds[] = {"META", "DIRS", "VDIR", "VOXT", "LODS", "VERT", "ORDR",
-                                       "VXLN", "STRM", "PROV", "GRPS", "VVAL", "SVAL"};
-
-}  // namespace
-
 VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
   struct Planned {
     const char* id;
@@ -143,7 +135,7 @@ VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : ou
 
 SectionEntry* VxlWriter::entry(Index i) {
   for (SectionEntry& e : table_)
-    if (std::memcmp(e.id, kSectionIds[i], 4) == 0) return &e;
+    if (std::memcmp(e.id, kIds[i], 4) == 0) return &e;
   return nullptr;  // an optional section that is not there
 }
 

@@ -54,7 +54,30 @@ VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes);
 std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size,
                                            PositionEncoding positions);
 
-class VxlWriter {
+// The sections the writers fill, in file order (spec §4), and their ids; VDIR, LODS, GRPS, VVAL and SVAL are
+// optional. One list for both writers (VxlWriter, VxlStreamWriter), so that they lay out a file alike.
+struct VxlSections {
+  enum Index : std::size_t {
+    kMeta,
+    kDirs,
+    kVdir,
+    kVoxt,
+    kLods,
+    kVert,
+    kOrdr,
+    kVxln,
+    kStrm,
+    kProv,
+    kGrps,
+    kVval,
+    kSval,
+    kCount
+  };
+  static constexpr const char* kIds[kCount] = {"META", "DIRS", "VDIR", "VOXT", "LODS", "VERT", "ORDR",
+                                               "VXLN", "STRM", "PROV", "GRPS", "VVAL", "SVAL"};
+};
+
+class VxlWriter : public VxlSections {
  public:
   // Creates the output at `path`, sized and mapped for these payloads. Throws vxl::Error (Output).
   VxlWriter(const std::string& path, const VxlSectionSizes& sizes);
@@ -100,22 +123,6 @@ class VxlWriter {
   void commit(unsigned threads = 0);
 
  private:
-  // Sections in file order; VDIR, LODS, GRPS, VVAL and SVAL are optional.
-  enum Index : std::size_t {
-    kMeta,
-    kDirs,
-    kVdir,
-    kVoxt,
-    kLods,
-    kVert,
-    kOrdr,
-    kVxln,
-    kStrm,
-    kProv,
-    kGrps,
-    kVval,
-    kSval
-  };
   SectionEntry* entry(Index i);  // null for an optional section that is absent
   std::span<std::uint8_t> payload(Index i);
   template <typename T>
