@@ -248,6 +248,7 @@ void VxlFile::validate_voxel_table() {
   const MetaSection& m = meta_;
   const bool packed = position_encoding() == PositionEncoding::Packed;
   const std::uint64_t voxt_at = find_section(section_id("VOXT"))->offset;
+  const std::uint64_t lods_at = levels_.empty() ? 0 : find_section(section_id("LODS"))->offset;
   std::uint64_t next_vertex = 0, segments = 0, min_order_offset = 0;
   for (std::size_t i = 0; i < voxels_.size(); ++i) {
     const VoxelEntry& v = voxels_[i];
@@ -277,7 +278,6 @@ void VxlFile::validate_voxel_table() {
       fail_input(p, at + 56, "order offset not a multiple of 4 or decreasing");
     // Each level is a prefix of the finer one's vertices, with fewer segments than vertices (spec §5.12).
     const std::span<const LevelEntry> row = levels_of(i);
-    const std::uint64_t lods_at = levels_.empty() ? 0 : find_section(section_id("LODS"))->offset;
     for (std::uint32_t d = 0; d < row.size(); ++d) {
       const LevelEntry finer = voxel_level(v, row, d), e = row[d];
       if (e.vertex_count > finer.vertex_count || e.segment_count > finer.segment_count ||

@@ -73,6 +73,10 @@ TEST_F(LevelsOfDetail, ACoarseLevelDrawsOnlyItsSegments) {
     EXPECT_EQ(r.layout().level(), level);
     render_image(r, whole_view(), s, 128, 128);
     EXPECT_EQ(r.stats().segments_drawn, level_segments(f, level)) << "level " << level;
+    RenderSettings unsorted = s;  // the streamline-order draw: the level's voxlines only
+    unsorted.mode = RenderMode::Unsorted;
+    render_image(r, whole_view(), unsorted, 128, 128);
+    EXPECT_EQ(r.stats().segments_drawn, level_segments(f, level)) << "unsorted, level " << level;
     if (level > 0) {
       EXPECT_LT(r.gpu_bytes() * 4, previous_bytes) << "level " << level;
     }

@@ -287,10 +287,8 @@ void Renderer::draw_dataset_order(GLuint program, const Camera& camera, const Re
   const auto& count = scene_.dataset_count();
   stats_.plan_ms = 0;
   stats_.voxels_drawn = stats_.segments_drawn = 0;
-  for (const VxlFile* f : files_) {
-    stats_.voxels_drawn += f->meta().voxel_count;
-    stats_.segments_drawn += f->meta().segment_count;
-  }
+  for (const VxlFile* f : files_) stats_.voxels_drawn += f->meta().voxel_count;
+  for (std::int32_t ids : count) stats_.segments_drawn += static_cast<std::uint64_t>(ids / 2);  // the level's
   bind_line_program(program, camera, s, aspect);
   draw_plan(first, count);
 }
