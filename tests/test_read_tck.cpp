@@ -1,4 +1,4 @@
-// TCK reader: real fixtures (counts from ../shared/data/real/SOURCES.md) and hand-made edge cases.
+// TCK reader: real fixtures (the counts their upstream projects publish) and hand-made edge cases.
 #include <algorithm>
 #include <cmath>
 #include <cstring>

@@ -25,7 +25,7 @@ struct Counts {
   std::uint64_t points;
 };
 
-// Counts from ../shared/data/real/SOURCES.md.
+// Streamline and point counts of the real fixtures, as their upstream projects publish them.
 const Counts kTrkFixtures[] = {
     {"TractographyFormat__stroke.trk", 36763, 237468},
     {"TractographyFormat__example.trk", 305, 44249},
@@ -165,7 +165,7 @@ TEST(ReadTrk, StrokeTrkAndGzipAgreeInRasMm) {
   EXPECT_EQ(b.source.header["compression"], "gzip");
   EXPECT_EQ(b.source.bytes, 2538041u);  // the compressed size on disk
   EXPECT_EQ(a.source.bytes, 2997668u);
-  // SOURCES.md notes: first points (63.797, -41.455, 2.318), (60.353, -42.744, 1.013).
+  // The fixture's published first points: (63.797, -41.455, 2.318), (60.353, -42.744, 1.013).
   expect_point_near(b, 0, {63.797, -41.455, 2.318}, 1e-3);
 }
 

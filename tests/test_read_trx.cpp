@@ -32,7 +32,7 @@ struct Counts {
   const char* dtype;
 };
 
-// Counts from ../shared/data/real/SOURCES.md, except niivue__dpsv.trx: SOURCES.md copies header.json's
+// The counts the fixtures' upstream projects publish, except niivue__dpsv.trx: the published count copies header.json's
 // NB_STREAMLINES (459), but its offsets hold 460 streamline starts and no sentinel (the last entry,
 // 95708, is below NB_VERTICES = 95865); the data is the same 460 streamlines as the older
 // niivue__tests__dpsv.trx and niivue__C_PHP.trk.gz, whose last streamline has 157 points.
@@ -162,7 +162,7 @@ TEST(ReadTrx, TrxPythonZipCompressedZipAndDirectoryAgree) {
   EXPECT_EQ(stored.groups[2].members.front(), 127u);
   EXPECT_EQ(stored.groups[2].members.back(), 964u);
   EXPECT_EQ(stored.groups[3].members, (std::vector<std::uint64_t>{342, 359, 444, 489, 501, 781, 957}));
-  // Directory provenance: 391495 bytes of member files (SOURCES.md).
+  // Directory provenance: 391495 bytes of member files (the fixture's published size).
   EXPECT_EQ(dir.source.bytes, 391495u);
   EXPECT_EQ(stored.source.bytes, 394709u);
   EXPECT_NE(dir.source.xxh3_128, stored.source.xxh3_128);

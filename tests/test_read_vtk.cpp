@@ -390,7 +390,7 @@ TEST(ExportVtk, UnknownExtensionIsAUsageError) {
   EXPECT_NE(r.output.find(".vtk"), std::string::npos) << r.output;
 }
 
-// ---- Real fixtures: the counts SOURCES.md documents ----
+// ---- Real fixtures: the counts their upstream projects publish ----
 
 TEST(RealVtk, ReadWithTheirDocumentedCounts) {
   VXL_REQUIRE_REAL_DATA();
