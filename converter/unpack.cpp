@@ -289,6 +289,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   auto t0 = Clock::now();
   progress("decoding", 0.0);
 
+  detail::check_level_count(settings.levels, in_path);
   const VxlzFile f = VxlzFile::open(in_path);
   if (f.meta().order_set == static_cast<std::uint32_t>(OrderSet::Random))
     fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");

@@ -56,7 +56,6 @@ void main() { frag = texelFetch(u_color, ivec2(gl_FragCoord.xy), 0); }
 
 SliceRenderer::SliceRenderer(const Volume& v)
     : dims_(v.dims),
-      voxel_to_ras_(v.voxel_to_ras),
       ras_to_voxel_(glm::inverse(v.voxel_to_ras)),
       corners_(v.corners()),
       ras_min_(v.ras_min()),

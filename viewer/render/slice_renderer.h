@@ -44,7 +44,7 @@ class SliceRenderer {
 
  private:
   std::array<std::int64_t, 3> dims_{};
-  glm::dmat4 voxel_to_ras_{1.0}, ras_to_voxel_{1.0};
+  glm::dmat4 ras_to_voxel_{1.0};
   std::array<glm::dvec3, 8> corners_{};
   glm::dvec3 ras_min_{0.0}, ras_max_{0.0};
   std::array<float, 2> window_{0, 1};
