@@ -3,7 +3,10 @@
 // drawn headless.
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "tests/test_support.h"
 #include "tests/viewer/render_support.h"
@@ -130,6 +133,40 @@ TEST_F(Window, AViewSavedInTheWindowReplaysHeadless) {
   ImageDiff d = compare_images(a, b);
   EXPECT_LT(d.differing_pixels, 200u * 150u / 100u) << "mean error " << d.mean_error;
   EXPECT_GT(lit_pixels(b), 200 * 150 / 200);
+}
+
+// A scripted orbit under a frame budget too small for full detail: every moving frame is drawn at a
+// coarser level, the last one (at rest) at the scene's own level, and --stats reports them.
+TEST_F(Window, MovingFramesDrawACoarserLevelWithinTheFrameBudget) {
+  VXL_REQUIRE_XVFB();
+  CommandResult synth = test::run_cli("synth --streamlines 3000 --seed 7 " + shell_quoted(tck));
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  CommandResult convert = test::run_cli("convert " + shell_quoted(tck) + " " + shell_quoted(vxl));
+  ASSERT_EQ(convert.exit_code, 0) << convert.output;
+  const std::string stats = dir.file("stats.json"), png = dir.file("shot.png");
+  CommandResult r =
+      run_voxview_in_xvfb(shell_quoted(vxl) + " --size 320x240 --frames 6 --orbit 10 --frame-budget 0.001" +
+                          " --stats " + shell_quoted(stats) + " --screenshot " + shell_quoted(png));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(stats);
+  ASSERT_TRUE(in) << "no stats file: " << r.output;
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const auto& frames = j.at("frames");
+  ASSERT_EQ(frames.size(), 6u);
+  EXPECT_EQ(frames[0].at("moving"), false);  // nothing to compare the first view with
+  EXPECT_EQ(frames[0].at("level"), 0);
+  for (std::size_t i = 1; i + 1 < frames.size(); ++i) {
+    EXPECT_EQ(frames[i].at("moving"), true) << i;
+    EXPECT_GT(frames[i].at("level").get<int>(), 0) << "a 1 us budget is never met at full detail; frame " << i;
+  }
+  EXPECT_EQ(frames.back().at("moving"), false);
+  EXPECT_EQ(frames.back().at("level"), 0);
+  EXPECT_EQ(j.at("moving_frames"), 4);
+  EXPECT_GT(j.at("first_picture_s").get<double>(), 0.0);
+  EXPECT_EQ(j.at("full_detail_s"), frames[0].at("since_start_s"));
+  EXPECT_GT(j.at("moving_p95_ms").get<double>(), 0.0);
+  EXPECT_GE(j.at("moving_p95_ms").get<double>(), j.at("moving_median_ms").get<double>());
+  EXPECT_GT(lit_pixels(read_image(png)), 320 * 240 / 100) << "the last frame, at rest, shows the scene";
 }
 
 TEST_F(Window, OpensATckDirectly) {

@@ -280,6 +280,7 @@ void frame_information(const PanelState& state, const PanelStats& stats) {
   ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + 330);
   ImGui::TextDisabled("%s, GL %s", stats.gl_renderer.c_str(), stats.gl_version.c_str());
   if (!stats.detail.empty()) ImGui::TextWrapped("%s", stats.detail.c_str());
+  if (!stats.frame_level.empty()) ImGui::TextWrapped("Drawing %s", stats.frame_level.c_str());
   if (!stats.error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.35f, 1.0f), "%s", stats.error.c_str());
   if (!stats.status.empty()) ImGui::TextUnformatted(stats.status.c_str());
   ImGui::PopTextWrapPos();

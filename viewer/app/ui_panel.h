@@ -36,6 +36,7 @@ struct PanelStats {
   std::uint64_t grid_cubes = 0;
   std::string gl_renderer, gl_version;
   std::string detail;            // the level of detail drawn and why, when not full detail (scene_detail.h)
+  std::string frame_level;       // the last frame's level when the frame budget chose a coarser one
   bool exact_available = true;   // GL >= 4.3
   float max_line_width = 16.0f;  // the driver's wide-line limit
   std::string error;             // shown in red until the next one replaces it

@@ -32,6 +32,11 @@ struct ViewerOptions {
   std::optional<std::uint64_t> gpu_memory;  // bytes
   bool verify = false;                      // --verify: check every .vxl in full (as `voxlines verify`) before drawing
   std::vector<std::string> tsf;             // per-point values for a .tck converted in memory
+  // Window: while the camera moves, draw the finest level whose measured frame time fits this budget
+  // (frame_budget.h); at rest, the scene's level. 0: no budget.
+  double frame_budget_ms = 100;
+  std::optional<double> orbit_deg;        // window: turn the camera by this azimuth every frame (benchmarks)
+  std::optional<std::string> stats_json;  // window: write each frame's level and time here on quitting
   // Window automation (tests, scripted screenshots): quit after N frames, saving a screenshot first.
   std::optional<int> frames;
   std::optional<std::string> screenshot;

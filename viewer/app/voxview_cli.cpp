@@ -152,6 +152,19 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                  "draw this level of detail (0: every streamline; level d keeps about 1/8^d of them), whatever the "
                  "GPU memory budget; at most the file's coarsest level")
       ->check(CLI::Range(0u, kMaxLevels - 1));
+  cli.add_option("--frame-budget", a.options.frame_budget_ms,
+                 "window: while the camera moves, draw the finest level of detail whose measured frame time fits this "
+                 "many milliseconds; at rest, the level --gpu-memory allows (0: always that level)")
+      ->default_val(100.0)
+      ->check(CLI::NonNegativeNumber);
+  cli.add_option(
+      "--orbit", a.options.orbit_deg,
+      "window: turn the camera by this many degrees of azimuth every frame (a scripted orbit, with --frames, "
+      "for benchmarks); the last frame is drawn at rest");
+  cli.add_option("--stats", a.options.stats_json,
+                 "window: on quitting, write every frame's level of detail and time, the first picture's and the "
+                 "first full-detail picture's time since start, and the moving frames' median and 95th percentile to "
+                 "this JSON file");
   cli.add_option("--frames", a.options.frames, "window: quit after this many frames (for scripts and tests)")
       ->check(CLI::PositiveNumber);
   cli.add_option("--screenshot", a.options.screenshot, "window: save the last frame to this PNG before quitting");

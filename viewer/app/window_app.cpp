@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -20,6 +21,8 @@
 #include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_controller.h"
 #include "viewer/app/camera_file.h"
+#include "viewer/app/frame_budget.h"
+#include "viewer/app/frame_log.h"
 #include "viewer/app/headless_render.h"
 #include "viewer/app/key_bindings.h"
 #include "viewer/app/scene_detail.h"
@@ -118,11 +121,21 @@ std::filesystem::path stamped_name(const std::string& prefix, const std::string&
   return p;
 }
 
+// Whether two cameras show the same view (what the frame budget calls "not moving").
+bool same_view(const Camera& a, const Camera& b) {
+  return a.target == b.target && a.distance == b.distance && a.azimuth_deg == b.azimuth_deg &&
+         a.elevation_deg == b.elevation_deg && a.fov_y_deg == b.fov_y_deg && a.orthographic == b.orthographic &&
+         a.ortho_height == b.ortho_height;
+}
+
 // One open window on one scene: GL objects, camera, panel, input. Callbacks reach it through the GLFW
 // user pointer.
 class ViewerWindow {
  public:
-  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume, GLFWwindow* window);
+  // `volume` must outlive the window (coarse levels upload its slices when first drawn); `start`: when
+  // voxview started, for --stats.
+  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume, GLFWwindow* window,
+               std::chrono::steady_clock::time_point start);
   int run();
 
  private:
@@ -142,15 +155,25 @@ class ViewerWindow {
   void reset_camera(double aspect);
   double aspect() const;
   void set_error(const std::string& message);
-  void draw_scene(int width, int height);
+  // Draws the scene at `level` of detail; returns the frame's time in ms.
+  double draw_scene(int width, int height, std::uint32_t level);
+  // The renderer of the scene's level, or of a coarser one (made on first use, for the frame budget).
+  Renderer& renderer_at(std::uint32_t level);
   void save_screenshot(const std::string& path, int width, int height);
   // Writes the current view (camera, settings, size) to --save-camera's path or a stamped name.
   void save_view(int width, int height);
 
   const ViewerOptions& options_;
   GLFWwindow* window_;
-  SceneDetail detail_;  // the level of detail drawn (before renderer_, which is made with it)
+  std::vector<const VxlFile*> files_;
+  const Volume* volume_;
+  SceneDetail detail_;  // the level of detail drawn at rest (before renderer_, which is made with it)
   Renderer renderer_;
+  std::map<std::uint32_t, std::unique_ptr<Renderer>> coarse_;  // coarser levels, drawn while the camera moves
+  FrameBudget budget_;
+  std::chrono::steady_clock::time_point start_;
+  std::vector<FrameRecord> frames_;     // for --stats
+  std::optional<Camera> drawn_camera_;  // the camera of the last frame
   GridOverlay grid_;
   // The scene is drawn here and blitted to the window: it blends in float like headless rendering, so
   // faint layers add up beyond 8-bit rounding and the window shows what --render writes.
@@ -170,11 +193,15 @@ class ViewerWindow {
 };
 
 ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume,
-                           GLFWwindow* window)
+                           GLFWwindow* window, std::chrono::steady_clock::time_point start)
     : options_(o),
       window_(window),
-      detail_(choose_scene_detail(pointers(files), o.level, o.gpu_memory, GpuScene::driver_limit())),
-      renderer_(pointers(files), 0, detail_.level),
+      files_(pointers(files)),
+      volume_(volume),
+      detail_(choose_scene_detail(files_, o.level, o.gpu_memory, GpuScene::driver_limit())),
+      renderer_(files_, 0, detail_.level),
+      budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
+      start_(start),
       grid_(renderer_),
       controller_(Camera{}, 1.0) {
   stats_.detail = describe_scene_detail(detail_, SceneLayout::coarsest_level(pointers(files)) + 1);
@@ -380,7 +407,18 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
   }
 }
 
-void ViewerWindow::draw_scene(int width, int height) {
+Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
+  if (level <= detail_.level) return renderer_;
+  std::unique_ptr<Renderer>& r = coarse_[level];
+  if (!r) {
+    r = std::make_unique<Renderer>(files_, 0, level);
+    if (volume_) r->set_volume(*volume_);
+  }
+  return *r;
+}
+
+double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
+  Renderer& renderer = renderer_at(level);
   RenderSettings& s = state_.settings;
   if (s.mode != drawn_mode_) stats_.error.clear();  // a new choice of mode gets a fresh start
   if (s.mode == RenderMode::Exact && !stats_.exact_available) {
@@ -393,19 +431,19 @@ void ViewerWindow::draw_scene(int width, int height) {
   if (scene_target_->width() != width || scene_target_->height() != height) scene_target_->resize(width, height);
   const GLuint target = scene_target_->framebuffer();
   try {
-    renderer_.draw(camera, s, width, height, target);
+    renderer.draw(camera, s, width, height, target);
   } catch (const std::exception& e) {
     // A mode that cannot run here (e.g. exact out of node memory): say so and keep showing something.
     set_error(std::string(render_mode_name(s.mode)) + ": " + e.what() + ": showing axis");
     s.mode = RenderMode::Axis;
-    renderer_.draw(camera, s, width, height, target);
+    renderer.draw(camera, s, width, height, target);
   }
   scene_target_->bind();
   drawn_mode_ = s.mode;
   if (state_.grid) {
     const glm::vec4 colour =
         s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
-    grid_.draw(renderer_, camera, double(width) / height,
+    grid_.draw(renderer, camera, double(width) / height,
                state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn, colour, s.clipping);
     stats_.grid_cubes = grid_.cubes_drawn();
   }
@@ -416,13 +454,15 @@ void ViewerWindow::draw_scene(int width, int height) {
   glFinish();  // the frame time should include the GPU's work, not only its submission
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
-  const FrameStats& f = renderer_.stats();
-  stats_.scalar_range = renderer_.scalar_range(s);
-  stats_.image_range = renderer_.slice_range(s);
+  const FrameStats& f = renderer.stats();
+  stats_.scalar_range = renderer.scalar_range(s);
+  stats_.image_range = renderer.slice_range(s);
   for (int a = 0; a < 3; ++a) stats_.focus[a] = camera.target[a];
   stats_.plan_ms = f.plan_ms;
   stats_.voxels_drawn = f.voxels_drawn;
   stats_.segments_drawn = f.segments_drawn;
+  stats_.frame_level = level == detail_.level ? "" : "level " + std::to_string(level) + " while the camera moves";
+  return ms;
 }
 
 void ViewerWindow::save_screenshot(const std::string& path, int width, int height) {
@@ -478,8 +518,20 @@ int ViewerWindow::run() {
       for (int a = 0; a < 3; ++a) move_focus_along(a, (*requests.focus)[a] - controller_.camera().target[a]);
     screenshot_requested_ |= requests.screenshot;
     save_view_requested_ |= requests.save_view;
+    if (options_.orbit_deg && !closing)
+      controller_.set_view(controller_.camera().azimuth_deg + *options_.orbit_deg, controller_.camera().elevation_deg);
 
-    draw_scene(fb_w, fb_h);
+    // Moving: a coarser level that fits the frame budget; at rest (and for the last, scripted frame) the
+    // scene's level. A coarse frame keeps the loop going, so that the next frame at rest refines.
+    const Camera& camera = controller_.camera();
+    const bool moving = drawn_camera_ && !closing && !same_view(*drawn_camera_, camera);
+    const std::uint32_t level = budget_.level_for(moving);
+    const double ms = draw_scene(fb_w, fb_h, level);
+    drawn_camera_ = camera;
+    budget_.record(level, ms);
+    frames_.push_back(
+        {level, moving, ms, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count()});
+    if (level != detail_.level) settle = std::max(settle, 1);
     // Screenshots show the scene alone unless the user asked for the panel too; automated ones never do.
     if (closing && options_.screenshot) save_screenshot(*options_.screenshot, fb_w, fb_h);
     // The view of the frame just drawn; scripts get it on quitting after --frames.
@@ -506,19 +558,20 @@ int ViewerWindow::run() {
     glfwSwapBuffers(window_);
     if (closing) break;
   }
+  if (options_.stats_json) write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms);
   return 0;
 }
 
 }  // namespace
 
 int run_window(const ViewerOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
   GlfwLibrary glfw;  // first: without a display, fail before any slow conversion
   const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);
   WindowPtr window = open_window(o);
-  ViewerWindow viewer(o, files, volume ? &*volume : nullptr, window.get());
-  volume.reset();  // uploaded
+  ViewerWindow viewer(o, files, volume ? &*volume : nullptr, window.get(), start);
   return viewer.run();
 }
 

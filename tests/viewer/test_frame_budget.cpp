@@ -1,0 +1,58 @@
+// The window's frame budget and its statistics (voxview --frame-budget, --stats), without a window.
+#include <gtest/gtest.h>
+
+#include "viewer/app/frame_budget.h"
+#include "viewer/app/frame_log.h"
+
+namespace vxl::app {
+namespace {
+
+TEST(FrameBudget, AtRestOrWithoutABudgetTheScenesLevel) {
+  FrameBudget budget(100, 1, 4);
+  budget.record(1, 5000);
+  EXPECT_EQ(budget.level_for(false), 1u);
+  EXPECT_EQ(FrameBudget(0, 1, 4).level_for(true), 1u);
+}
+
+TEST(FrameBudget, MovingPicksTheFinestLevelWhoseCostFits) {
+  FrameBudget budget(100, 0, 4);
+  EXPECT_EQ(budget.level_for(true), 0u) << "nothing measured: try the scene's level";
+  budget.record(0, 800);  // level 1 is estimated at 100 ms: fits exactly
+  EXPECT_DOUBLE_EQ(budget.estimate_ms(1), 100.0);
+  EXPECT_EQ(budget.level_for(true), 1u);
+  budget.record(1, 150);  // measured slower than estimated: one level coarser
+  EXPECT_EQ(budget.level_for(true), 2u);
+  EXPECT_DOUBLE_EQ(budget.estimate_ms(2), 150.0 / 8);
+  budget.record(0, 1e9);
+  budget.record(1, 1e8);
+  budget.record(2, 1e7);
+  EXPECT_EQ(budget.level_for(true), 4u) << "nothing fits: the coarsest level";
+}
+
+TEST(FrameBudget, NeverFinerThanTheSceneNorCoarserThanTheFile) {
+  FrameBudget budget(10, 2, 3);
+  budget.record(2, 5);
+  EXPECT_EQ(budget.level_for(true), 2u);
+  budget.record(2, 1000);
+  EXPECT_EQ(budget.level_for(true), 3u);
+  FrameBudget single(10, 0, 0);  // a file without levels
+  single.record(0, 1000);
+  EXPECT_EQ(single.level_for(true), 0u);
+}
+
+TEST(FrameLog, SummaryGivesTheFirstAndFullDetailPicturesAndMovingPercentiles) {
+  std::vector<FrameRecord> frames = {{2, false, 50, 0.4}, {0, false, 900, 1.3}};
+  for (int i = 1; i <= 20; ++i) frames.push_back({1, true, double(i), 1.3 + 0.1 * i});
+  const FrameSummary s = summarize_frames(frames, 0);
+  EXPECT_DOUBLE_EQ(s.first_picture_s, 0.4);
+  EXPECT_DOUBLE_EQ(s.full_detail_s, 1.3);
+  EXPECT_EQ(s.moving_frames, 20u);
+  EXPECT_DOUBLE_EQ(s.moving_median_ms, 10.0);
+  EXPECT_DOUBLE_EQ(s.moving_p95_ms, 19.0);
+  const FrameSummary none = summarize_frames({}, 0);
+  EXPECT_LT(none.first_picture_s, 0.0);
+  EXPECT_EQ(none.moving_frames, 0u);
+}
+
+}  // namespace
+}  // namespace vxl::app

@@ -1,0 +1,39 @@
+#include "viewer/app/frame_budget.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vxl::app {
+
+FrameBudget::FrameBudget(double budget_ms, std::uint32_t scene_level, std::uint32_t coarsest_level)
+    : budget_ms_(budget_ms),
+      scene_level_(std::min(scene_level, kMaxLevels - 1)),
+      coarsest_level_(std::clamp(coarsest_level, scene_level_, kMaxLevels - 1)) {}
+
+void FrameBudget::record(std::uint32_t level, double ms) {
+  if (level < kMaxLevels && ms >= 0) measured_ms_[level] = ms;
+}
+
+double FrameBudget::estimate_ms(std::uint32_t level) const {
+  if (level >= kMaxLevels) return 0;
+  if (measured_ms_[level] > 0) return measured_ms_[level];
+  // The nearest measured level, scaled by the segments: 1/8 of them per level.
+  for (std::uint32_t distance = 1; distance < kMaxLevels; ++distance)
+    for (const int sign : {-1, 1}) {
+      const int other = int(level) + sign * int(distance);
+      if (other < 0 || other >= int(kMaxLevels) || measured_ms_[other] <= 0) continue;
+      return measured_ms_[other] * std::pow(double(kLevelRatio), double(other - int(level)));
+    }
+  return 0;
+}
+
+std::uint32_t FrameBudget::level_for(bool moving) const {
+  if (!moving || budget_ms_ <= 0) return scene_level_;
+  for (std::uint32_t level = scene_level_; level <= coarsest_level_; ++level) {
+    const double ms = estimate_ms(level);
+    if (ms <= budget_ms_) return level;  // unmeasured (0): try it
+  }
+  return coarsest_level_;
+}
+
+}  // namespace vxl::app

@@ -1,0 +1,32 @@
+// Every frame the window draws — its level of detail, whether the camera moved, its time, and when it ended
+// since voxview started — and the JSON summary a benchmark reads (voxview --stats): the first picture's
+// time, the first full-detail picture's (the scene's level, drawn at rest), and the moving frames' median
+// and 95th percentile.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace vxl::app {
+
+struct FrameRecord {
+  std::uint32_t level = 0;
+  bool moving = false;
+  double ms = 0;             // drawing the frame, GPU work included
+  double since_start_s = 0;  // when it was on screen
+};
+
+struct FrameSummary {
+  double first_picture_s = -1, full_detail_s = -1;  // -1: none
+  std::size_t moving_frames = 0;
+  double moving_median_ms = 0, moving_p95_ms = 0;
+};
+
+FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint32_t scene_level);
+
+// Writes the summary, the budget and every frame as JSON to `path` (atomically). Throws vxl::Error (Output).
+void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
+                       double frame_budget_ms);
+
+}  // namespace vxl::app
