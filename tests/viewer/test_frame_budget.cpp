@@ -40,6 +40,17 @@ TEST(FrameBudget, NeverFinerThanTheSceneNorCoarserThanTheFile) {
   EXPECT_EQ(single.level_for(true), 0u);
 }
 
+TEST(FrameBudget, TheFirstPictureIsTheFinestLevelOfAtMostAMillionSegments) {
+  const std::uint64_t segments[] = {55'000'000, 7'000'000, 870'000, 110'000, 14'000};
+  EXPECT_EQ(first_picture_level(segments, 0), 2u);
+  EXPECT_EQ(first_picture_level(segments, 3), 3u) << "never finer than the scene's level";
+  const std::uint64_t small[] = {400'000, 50'000};
+  EXPECT_EQ(first_picture_level(small, 0), 0u) << "a small scene comes at full detail at once";
+  const std::uint64_t huge[] = {9'000'000'000, 1'000'000'000, 200'000'000};
+  EXPECT_EQ(first_picture_level(huge, 0), 2u) << "nothing small enough: the coarsest";
+  EXPECT_EQ(first_picture_level({}, 1), 1u);
+}
+
 TEST(FrameLog, SummaryGivesTheFirstAndFullDetailPicturesAndMovingPercentiles) {
   std::vector<FrameRecord> frames = {{2, false, 50, 0.4}, {0, false, 900, 1.3}};
   for (int i = 1; i <= 20; ++i) frames.push_back({1, true, double(i), 1.3 + 0.1 * i});

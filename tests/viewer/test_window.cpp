@@ -169,6 +169,29 @@ TEST_F(Window, MovingFramesDrawACoarserLevelWithinTheFrameBudget) {
   EXPECT_GT(lit_pixels(read_image(png)), 320 * 240 / 100) << "the last frame, at rest, shows the scene";
 }
 
+// A scene of more than a million segments shows a coarse level first, then full detail at rest.
+TEST_F(Window, TheFirstPictureIsCoarseAndFullDetailFollows) {
+  VXL_REQUIRE_XVFB();
+  CommandResult synth = test::run_cli("synth --streamlines 30000 --seed 7 " + shell_quoted(tck));
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  CommandResult convert = test::run_cli("convert " + shell_quoted(tck) + " " + shell_quoted(vxl));
+  ASSERT_EQ(convert.exit_code, 0) << convert.output;
+  const std::string stats = dir.file("stats.json");
+  CommandResult r =
+      run_voxview_in_xvfb(shell_quoted(vxl) + " --size 320x240 --frames 3 --stats " + shell_quoted(stats));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(stats);
+  ASSERT_TRUE(in) << "no stats file: " << r.output;
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const auto& frames = j.at("frames");
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[0].at("level"), 1) << "1.6M segments at full detail, 200k at level 1";
+  EXPECT_EQ(frames[1].at("level"), 0);
+  EXPECT_EQ(frames[1].at("moving"), false);
+  EXPECT_EQ(j.at("first_picture_s"), frames[0].at("since_start_s"));
+  EXPECT_EQ(j.at("full_detail_s"), frames[1].at("since_start_s"));
+}
+
 TEST_F(Window, OpensATckDirectly) {
   VXL_REQUIRE_XVFB();
   make_inputs();

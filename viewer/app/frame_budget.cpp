@@ -36,4 +36,12 @@ std::uint32_t FrameBudget::level_for(bool moving) const {
   return coarsest_level_;
 }
 
+std::uint32_t first_picture_level(std::span<const std::uint64_t> segments, std::uint32_t scene_level) {
+  if (segments.empty()) return scene_level;
+  const auto coarsest = static_cast<std::uint32_t>(segments.size() - 1);
+  for (std::uint32_t level = std::min(scene_level, coarsest); level <= coarsest; ++level)
+    if (segments[level] <= kFirstPictureSegments) return level;
+  return coarsest;
+}
+
 }  // namespace vxl::app

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 
 #include "format/vxl_levels.h"
 
@@ -29,5 +30,13 @@ class FrameBudget {
   std::uint32_t scene_level_, coarsest_level_;
   std::array<double, kMaxLevels> measured_ms_{};  // 0: not measured
 };
+
+// The window's first picture comes before the scene's level is uploaded: the finest level, from the scene's
+// level down, that draws at most this many segments. Why 1M: Mesa llvmpipe draws about 2.5M segments a
+// second at 1024x1024 on two cores, so the first picture comes within a second; a GPU draws it at once.
+inline constexpr std::uint64_t kFirstPictureSegments = 1'000'000;
+
+// `segments[d]`: the scene's segments at level d (up to the coarsest level).
+std::uint32_t first_picture_level(std::span<const std::uint64_t> segments, std::uint32_t scene_level);
 
 }  // namespace vxl::app

@@ -167,14 +167,16 @@ class ViewerWindow {
   GLFWwindow* window_;
   std::vector<const VxlFile*> files_;
   const Volume* volume_;
-  SceneDetail detail_;  // the level of detail drawn at rest (before renderer_, which is made with it)
-  Renderer renderer_;
-  std::map<std::uint32_t, std::unique_ptr<Renderer>> coarse_;  // coarser levels, drawn while the camera moves
+  SceneDetail detail_;  // the level of detail drawn at rest
+  // One renderer per level drawn, made on first use: the first picture's (coarse, so that it comes at once),
+  // the scene's (at rest), and coarser ones while the camera moves.
+  std::map<std::uint32_t, std::unique_ptr<Renderer>> renderers_;
+  std::uint32_t first_level_ = 0;
   FrameBudget budget_;
   std::chrono::steady_clock::time_point start_;
   std::vector<FrameRecord> frames_;     // for --stats
   std::optional<Camera> drawn_camera_;  // the camera of the last frame
-  GridOverlay grid_;
+  std::optional<GridOverlay> grid_;
   // The scene is drawn here and blitted to the window: it blends in float like headless rendering, so
   // faint layers add up beyond 8-bit rounding and the window shows what --render writes.
   std::optional<OffscreenTarget> scene_target_;
@@ -199,18 +201,22 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
       files_(pointers(files)),
       volume_(volume),
       detail_(choose_scene_detail(files_, o.level, o.gpu_memory, GpuScene::driver_limit())),
-      renderer_(files_, 0, detail_.level),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
       start_(start),
-      grid_(renderer_),
       controller_(Camera{}, 1.0) {
   stats_.detail = describe_scene_detail(detail_, SceneLayout::coarsest_level(pointers(files)) + 1);
   if (!stats_.detail.empty()) std::fprintf(stderr, "voxview: %s\n", stats_.detail.c_str());
-  if (volume) renderer_.set_volume(*volume);
-  controller_ =
-      CameraController(Camera{}, std::max(1.0, glm::length(renderer_.scene_max() - renderer_.scene_min()) * 0.5));
+  std::vector<std::uint64_t> segments(SceneLayout::coarsest_level(files_) + 1, 0);
+  for (const VxlFile* f : files_)
+    for (std::size_t i = 0; i < f->voxels().size(); ++i)
+      for (std::uint32_t d = 0; d < segments.size(); ++d) segments[d] += f->level(i, d).segment_count;
+  first_level_ = first_picture_level(segments, detail_.level);
+  // Scene-wide facts (bounds, groups, value sets, voxel cubes) are the same at every level.
+  Renderer& first = renderer_at(first_level_);
+  grid_.emplace(first);
+  controller_ = CameraController(Camera{}, std::max(1.0, glm::length(first.scene_max() - first.scene_min()) * 0.5));
   stats_.has_image = volume != nullptr;
-  check_color_options(o.inputs_name(), renderer_, o.settings);
+  check_color_options(o.inputs_name(), first, o.settings);
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
   glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -230,15 +236,15 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   stats_.gl_version = std::to_string(major) + "." + std::to_string(minor);
   stats_.exact_available = major * 10 + minor >= 43;
   stats_.max_line_width = std::clamp(widths[1], 1.0f, 16.0f);
-  stats_.value_sets = renderer_.value_set_names();
-  for (const SceneGroup& g : renderer_.groups().groups()) stats_.groups.emplace_back(g.name, g.streamlines);
+  stats_.value_sets = first.value_set_names();
+  for (const SceneGroup& g : first.groups().groups()) stats_.groups.emplace_back(g.name, g.streamlines);
   for (int c = 0; c < 3; ++c) {
-    stats_.bounds_min[c] = renderer_.bounds_min()[c];
-    stats_.bounds_max[c] = renderer_.bounds_max()[c];
+    stats_.bounds_min[c] = first.bounds_min()[c];
+    stats_.bounds_max[c] = first.bounds_max()[c];
   }
   if (o.settings.clipping.slab_mm > 0) state_.slab_thickness = o.settings.clipping.slab_mm;
 
-  framing_points_ = framing_points(renderer_.layout());
+  framing_points_ = framing_points(first.layout());
   controller_.set_home(home_camera(aspect(), o.orthographic));
   controller_.reset();
 
@@ -408,8 +414,7 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
 }
 
 Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
-  if (level <= detail_.level) return renderer_;
-  std::unique_ptr<Renderer>& r = coarse_[level];
+  std::unique_ptr<Renderer>& r = renderers_[std::max(level, detail_.level)];
   if (!r) {
     r = std::make_unique<Renderer>(files_, 0, level);
     if (volume_) r->set_volume(*volume_);
@@ -443,9 +448,9 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
   if (state_.grid) {
     const glm::vec4 colour =
         s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
-    grid_.draw(renderer, camera, double(width) / height,
-               state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn, colour, s.clipping);
-    stats_.grid_cubes = grid_.cubes_drawn();
+    grid_->draw(renderer, camera, double(width) / height,
+                state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn, colour, s.clipping);
+    stats_.grid_cubes = grid_->cubes_drawn();
   }
   glBindFramebuffer(GL_READ_FRAMEBUFFER, target);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
@@ -525,7 +530,8 @@ int ViewerWindow::run() {
     // scene's level. A coarse frame keeps the loop going, so that the next frame at rest refines.
     const Camera& camera = controller_.camera();
     const bool moving = drawn_camera_ && !closing && !same_view(*drawn_camera_, camera);
-    const std::uint32_t level = budget_.level_for(moving);
+    // The first picture comes at a coarse level (at once), unless it is also the last (a scripted screenshot).
+    const std::uint32_t level = closing ? detail_.level : frames_.empty() ? first_level_ : budget_.level_for(moving);
     const double ms = draw_scene(fb_w, fb_h, level);
     drawn_camera_ = camera;
     budget_.record(level, ms);
