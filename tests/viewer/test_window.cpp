@@ -60,12 +60,27 @@ class Window : public ::testing::Test {
     ASSERT_TRUE(std::filesystem::exists(VOXVIEW_CLI)) << VOXVIEW_CLI << " is not built";
   }
 
-  // A small synthetic tractogram from the project's own generator, as .tck and converted to .vxl.
-  void make_inputs() {
-    CommandResult synth = test::run_cli("synth --streamlines 300 --seed 7 " + shell_quoted(tck));
+  // A synthetic tractogram from the project's own generator, as .tck and converted to .vxl (with the
+  // default levels of detail).
+  void make_inputs(int streamlines = 300) {
+    CommandResult synth =
+        test::run_cli("synth --streamlines " + std::to_string(streamlines) + " --seed 7 " + shell_quoted(tck));
     ASSERT_EQ(synth.exit_code, 0) << synth.output;
     CommandResult convert = test::run_cli("convert --voxel-size 10 " + shell_quoted(tck) + " " + shell_quoted(vxl));
     ASSERT_EQ(convert.exit_code, 0) << convert.output;
+  }
+
+  // Runs the window on the .vxl with `args` and --stats; returns what it wrote (null when it wrote nothing).
+  nlohmann::json window_stats(const std::string& args) {
+    const std::string stats = dir.file("stats.json");
+    CommandResult r = run_voxview_in_xvfb(shell_quoted(vxl) + " " + args + " --stats " + shell_quoted(stats));
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream in(stats);
+    if (!in) {
+      ADD_FAILURE() << "no stats file: " << r.output;
+      return nullptr;
+    }
+    return nlohmann::json::parse(in);
   }
 
   Image window_screenshot(const std::string& input) {
@@ -139,18 +154,11 @@ TEST_F(Window, AViewSavedInTheWindowReplaysHeadless) {
 // coarser level, the last one (at rest) at the scene's own level, and --stats reports them.
 TEST_F(Window, MovingFramesDrawACoarserLevelWithinTheFrameBudget) {
   VXL_REQUIRE_XVFB();
-  CommandResult synth = test::run_cli("synth --streamlines 3000 --seed 7 " + shell_quoted(tck));
-  ASSERT_EQ(synth.exit_code, 0) << synth.output;
-  CommandResult convert = test::run_cli("convert " + shell_quoted(tck) + " " + shell_quoted(vxl));
-  ASSERT_EQ(convert.exit_code, 0) << convert.output;
-  const std::string stats = dir.file("stats.json"), png = dir.file("shot.png");
-  CommandResult r =
-      run_voxview_in_xvfb(shell_quoted(vxl) + " --size 320x240 --frames 6 --orbit 10 --frame-budget 0.001" +
-                          " --stats " + shell_quoted(stats) + " --screenshot " + shell_quoted(png));
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  std::ifstream in(stats);
-  ASSERT_TRUE(in) << "no stats file: " << r.output;
-  const nlohmann::json j = nlohmann::json::parse(in);
+  make_inputs(3000);
+  const std::string png = dir.file("shot.png");
+  const nlohmann::json j =
+      window_stats("--size 320x240 --frames 6 --orbit 10 --frame-budget 0.001 --screenshot " + shell_quoted(png));
+  ASSERT_FALSE(j.is_null());
   const auto& frames = j.at("frames");
   ASSERT_EQ(frames.size(), 6u);
   EXPECT_EQ(frames[0].at("moving"), false);  // nothing to compare the first view with
@@ -172,17 +180,9 @@ TEST_F(Window, MovingFramesDrawACoarserLevelWithinTheFrameBudget) {
 // A scene of more than a million segments shows a coarse level first, then full detail at rest.
 TEST_F(Window, TheFirstPictureIsCoarseAndFullDetailFollows) {
   VXL_REQUIRE_XVFB();
-  CommandResult synth = test::run_cli("synth --streamlines 30000 --seed 7 " + shell_quoted(tck));
-  ASSERT_EQ(synth.exit_code, 0) << synth.output;
-  CommandResult convert = test::run_cli("convert " + shell_quoted(tck) + " " + shell_quoted(vxl));
-  ASSERT_EQ(convert.exit_code, 0) << convert.output;
-  const std::string stats = dir.file("stats.json");
-  CommandResult r =
-      run_voxview_in_xvfb(shell_quoted(vxl) + " --size 320x240 --frames 3 --stats " + shell_quoted(stats));
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  std::ifstream in(stats);
-  ASSERT_TRUE(in) << "no stats file: " << r.output;
-  const nlohmann::json j = nlohmann::json::parse(in);
+  make_inputs(30000);
+  const nlohmann::json j = window_stats("--size 320x240 --frames 3");
+  ASSERT_FALSE(j.is_null());
   const auto& frames = j.at("frames");
   ASSERT_EQ(frames.size(), 3u);
   EXPECT_EQ(frames[0].at("level"), 1) << "1.6M segments at full detail, 200k at level 1";
