@@ -11,6 +11,7 @@
 #include "tests/test_support.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_io.h"
+#include "viewer/platform/image_metrics.h"
 #include "viewer/render/grid_overlay.h"
 
 namespace vxl {
@@ -177,19 +178,59 @@ TEST_F(Window, MovingFramesDrawACoarserLevelWithinTheFrameBudget) {
   EXPECT_GT(lit_pixels(read_image(png)), 320 * 240 / 100) << "the last frame, at rest, shows the scene";
 }
 
-// A scene of more than a million segments shows a coarse level first, then full detail at rest.
-TEST_F(Window, TheFirstPictureIsCoarseAndFullDetailFollows) {
+// A scene of more than a million segments shows a coarse level first; at rest, full detail follows in
+// pieces that each fit the frame budget (the coarse picture stays on screen meanwhile).
+TEST_F(Window, TheFirstPictureIsCoarseAndFullDetailFollowsInPieces) {
   VXL_REQUIRE_XVFB();
   make_inputs(30000);
-  const nlohmann::json j = window_stats("--size 320x240 --frames 3");
+  const nlohmann::json j = window_stats("--size 320x240 --frames 1 --until-refined --no-exact-when-still");
   ASSERT_FALSE(j.is_null());
   const auto& frames = j.at("frames");
-  ASSERT_EQ(frames.size(), 3u);
+  ASSERT_GE(frames.size(), 3u);
   EXPECT_EQ(frames[0].at("level"), 1) << "1.6M segments at full detail, 200k at level 1";
-  EXPECT_EQ(frames[1].at("level"), 0);
-  EXPECT_EQ(frames[1].at("moving"), false);
+  EXPECT_EQ(frames[0].at("work"), "whole");
   EXPECT_EQ(j.at("first_picture_s"), frames[0].at("since_start_s"));
-  EXPECT_EQ(j.at("full_detail_s"), frames[1].at("since_start_s"));
+  for (std::size_t i = 1; i < frames.size(); ++i) {
+    EXPECT_EQ(frames[i].at("work"), "full-detail piece") << i;
+    EXPECT_EQ(frames[i].at("level"), 0) << i;
+    EXPECT_EQ(frames[i].at("moving"), false) << i;
+    EXPECT_EQ(frames[i].at("completes"), i + 1 == frames.size()) << "only the last piece completes; frame " << i;
+  }
+  // The first piece assumes 1000 segments a millisecond: 100k of the 1.6M segments in the default 100 ms.
+  EXPECT_GE(j.at("refinement_pieces").get<int>(), 2);
+  EXPECT_EQ(j.at("full_detail_s"), frames.back().at("since_start_s"));
+  EXPECT_EQ(j.at("exact_s"), -1) << "--no-exact-when-still";
+}
+
+// At rest, once full detail is on screen, the axis mode goes on to the exact picture, run by run; it is
+// what headless --mode exact draws (but for a few pixels at voxel faces between runs).
+TEST_F(Window, ExactArrivesWhenTheCameraIsStill) {
+  VXL_REQUIRE_XVFB();
+  make_inputs(3000);
+  const std::string png = dir.file("still.png");
+  const nlohmann::json j =
+      window_stats("--size 200x150 --frames 1 --until-refined --frame-budget 5 --screenshot " + shell_quoted(png));
+  ASSERT_FALSE(j.is_null());
+  const auto& frames = j.at("frames");
+  ASSERT_GE(frames.size(), 3u);
+  EXPECT_EQ(frames[0].at("level"), 0) << "a small scene: full detail at once";
+  EXPECT_EQ(frames.back().at("work"), "exact piece");
+  EXPECT_EQ(frames.back().at("completes"), true);
+  EXPECT_GE(frames.size(), 3u) << "a 5 ms budget splits exact into several runs";
+  EXPECT_GT(j.at("exact_s").get<double>(), j.at("full_detail_s").get<double>());
+  EXPECT_GE(j.at("piece_p95_ms").get<double>(), j.at("piece_median_ms").get<double>());
+
+  auto headless = [&](const std::string& mode) {
+    const std::string out = dir.file(mode + ".png");
+    CommandResult h = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + " --size 200x150 --mode " + mode +
+                                " --render " + shell_quoted(out));
+    EXPECT_EQ(h.exit_code, 0) << h.output;
+    return read_image(out);
+  };
+  const Image still = read_image(png), exact = headless("exact"), axis = headless("axis");
+  ASSERT_GT(lit_pixels(exact), 200 * 150 / 100);
+  EXPECT_LT(score_image(still, exact).rmse, 0.6 * score_image(axis, exact).rmse)
+      << "the window's picture at rest is the exact one, not axis";
 }
 
 TEST_F(Window, OpensATckDirectly) {

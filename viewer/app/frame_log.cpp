@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -9,23 +11,42 @@
 
 namespace vxl::app {
 
+namespace {
+
+// The median and 95th percentile of `ms` (0 when empty).
+std::pair<double, double> median_and_p95(std::vector<double> ms) {
+  if (ms.empty()) return {0, 0};
+  std::sort(ms.begin(), ms.end());
+  auto at = [&](double q) { return ms[std::min(ms.size() - 1, std::size_t(std::ceil(q * ms.size())) - 1)]; };
+  return {at(0.5), at(0.95)};
+}
+
+const char* work_name(FrameWork w) {
+  switch (w) {
+    case FrameWork::Whole: return "whole";
+    case FrameWork::FullDetailPiece: return "full-detail piece";
+    case FrameWork::ExactPiece: return "exact piece";
+  }
+  return "?";
+}
+
+}  // namespace
+
 FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint32_t scene_level) {
   FrameSummary s;
-  std::vector<double> moving;
+  std::vector<double> moving, pieces;
   for (const FrameRecord& f : frames) {
     if (s.first_picture_s < 0) s.first_picture_s = f.since_start_s;
-    if (s.full_detail_s < 0 && !f.moving && f.level == scene_level) s.full_detail_s = f.since_start_s;
+    const bool full_detail = f.completes && !f.moving && f.level == scene_level;
+    if (s.full_detail_s < 0 && full_detail) s.full_detail_s = f.since_start_s;
+    if (s.exact_s < 0 && full_detail && f.work == FrameWork::ExactPiece) s.exact_s = f.since_start_s;
     if (f.moving) moving.push_back(f.ms);
+    if (f.work != FrameWork::Whole) pieces.push_back(f.ms);
   }
   s.moving_frames = moving.size();
-  if (!moving.empty()) {
-    std::sort(moving.begin(), moving.end());
-    auto at = [&](double q) {
-      return moving[std::min(moving.size() - 1, std::size_t(std::ceil(q * moving.size())) - 1)];
-    };
-    s.moving_median_ms = at(0.5);
-    s.moving_p95_ms = at(0.95);
-  }
+  std::tie(s.moving_median_ms, s.moving_p95_ms) = median_and_p95(moving);
+  s.pieces = pieces.size();
+  std::tie(s.piece_median_ms, s.piece_p95_ms) = median_and_p95(pieces);
   return s;
 }
 
@@ -37,12 +58,21 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
   j["frame_budget_ms"] = frame_budget_ms;
   j["first_picture_s"] = s.first_picture_s;
   j["full_detail_s"] = s.full_detail_s;
+  j["exact_s"] = s.exact_s;
   j["moving_frames"] = s.moving_frames;
   j["moving_median_ms"] = s.moving_median_ms;
   j["moving_p95_ms"] = s.moving_p95_ms;
+  j["refinement_pieces"] = s.pieces;
+  j["piece_median_ms"] = s.piece_median_ms;
+  j["piece_p95_ms"] = s.piece_p95_ms;
   nlohmann::json list = nlohmann::json::array();
   for (const FrameRecord& f : frames)
-    list.push_back({{"level", f.level}, {"moving", f.moving}, {"ms", f.ms}, {"since_start_s", f.since_start_s}});
+    list.push_back({{"level", f.level},
+                    {"moving", f.moving},
+                    {"work", work_name(f.work)},
+                    {"completes", f.completes},
+                    {"ms", f.ms},
+                    {"since_start_s", f.since_start_s}});
   j["frames"] = list;
   const std::string text = j.dump(2) + "\n";
   AtomicOutputFile out(path);

@@ -1,7 +1,8 @@
-// Every frame the window draws — its level of detail, whether the camera moved, its time, and when it ended
-// since voxview started — and the JSON summary a benchmark reads (voxview --stats): the first picture's
-// time, the first full-detail picture's (the scene's level, drawn at rest), and the moving frames' median
-// and 95th percentile.
+// Every frame the window draws — its level of detail, whether the camera moved, whether it drew a picture
+// whole or a piece of the refinement at rest (rest_refinement.h), its time, and when it ended since voxview
+// started — and the JSON summary a benchmark reads (voxview --stats): the first picture's time, the first
+// full-detail picture's (the scene's level, at rest) and the first exact one's, and the median and 95th
+// percentile of the moving frames and of the refinement's pieces (how long input waits at rest).
 #pragma once
 
 #include <cstdint>
@@ -10,17 +11,26 @@
 
 namespace vxl::app {
 
+enum class FrameWork {
+  Whole,            // a picture drawn whole, shown at once
+  FullDetailPiece,  // a piece of the full-detail picture at rest
+  ExactPiece,       // a piece of the exact picture at rest
+};
+
 struct FrameRecord {
   std::uint32_t level = 0;
   bool moving = false;
   double ms = 0;             // drawing the frame, GPU work included
   double since_start_s = 0;  // when it was on screen
+  FrameWork work = FrameWork::Whole;
+  bool completes = true;  // the picture it drew is complete and on screen (a piece: only the last one's)
 };
 
 struct FrameSummary {
-  double first_picture_s = -1, full_detail_s = -1;  // -1: none
-  std::size_t moving_frames = 0;
+  double first_picture_s = -1, full_detail_s = -1, exact_s = -1;  // -1: none
+  std::size_t moving_frames = 0, pieces = 0;
   double moving_median_ms = 0, moving_p95_ms = 0;
+  double piece_median_ms = 0, piece_p95_ms = 0;
 };
 
 FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint32_t scene_level);

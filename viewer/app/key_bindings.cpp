@@ -30,6 +30,7 @@ constexpr KeyBinding kKeys[] = {
     {KeyAction::OpacityUp, "+", "opacity x 1.5", typed("+=")},
     {KeyAction::OpacityDown, "-", "opacity / 1.5", typed("-_")},
     {KeyAction::ToggleLighting, "L", "lighting on / off", typed("lL")},
+    {KeyAction::ToggleExactWhenStill, "E", "exact when still on / off (needs OpenGL 4.3)", typed("eE")},
     {KeyAction::Screenshot, "S", "screenshot", typed("sS")},
     {KeyAction::ResetCamera, "R", "reset the camera", typed("rR")},
     {KeyAction::SaveView, "V", "save the view (for --camera)", typed("vV")},

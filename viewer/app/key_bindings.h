@@ -21,6 +21,7 @@ enum class KeyAction {
   OpacityUp,
   OpacityDown,
   ToggleLighting,
+  ToggleExactWhenStill,
   Screenshot,
   ResetCamera,
   SaveView,

@@ -215,6 +215,12 @@ void look_controls(PanelState& state, const PanelStats& stats) {
 
   colour_controls(state, stats);
   ImGui::Checkbox("Lighting", &s.lighting);
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!stats.exact_available);
+  ImGui::Checkbox("Exact when still", &state.exact_when_still);
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("at rest, basic and axis go on to the exact picture, run by run (needs OpenGL 4.3)");
+  ImGui::EndDisabled();
 
   int background = s.white_background ? 1 : 0;
   ImGui::AlignTextToFramePadding();
@@ -281,6 +287,11 @@ void frame_information(const PanelState& state, const PanelStats& stats) {
   ImGui::TextDisabled("%s, GL %s", stats.gl_renderer.c_str(), stats.gl_version.c_str());
   if (!stats.detail.empty()) ImGui::TextWrapped("%s", stats.detail.c_str());
   if (!stats.frame_level.empty()) ImGui::TextWrapped("Drawing %s", stats.frame_level.c_str());
+  if (stats.frame_budget_ms > 0)
+    ImGui::TextDisabled("Frame budget %.0f ms", stats.frame_budget_ms);
+  else
+    ImGui::TextDisabled("No frame budget: always full detail");
+  if (!stats.refinement.empty()) ImGui::TextWrapped("At rest: %s", stats.refinement.c_str());
   if (!stats.error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.35f, 1.0f), "%s", stats.error.c_str());
   if (!stats.status.empty()) ImGui::TextUnformatted(stats.status.c_str());
   ImGui::PopTextWrapPos();

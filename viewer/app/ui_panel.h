@@ -23,6 +23,7 @@ struct PanelState {
   bool grid = false;      // voxel-grid overlay
   bool grid_all = false;  // all voxels, not only those the frame draws
   bool panel_in_screenshot = false;
+  bool exact_when_still = true;  // at rest, go on to the exact picture (rest_refinement.h)
   double slab_thickness = 10.0;  // mm, kept while the slab is off (settings.clipping.slab_mm is 0 then)
 };
 
@@ -37,6 +38,8 @@ struct PanelStats {
   std::string gl_renderer, gl_version;
   std::string detail;            // the level of detail drawn and why, when not full detail (scene_detail.h)
   std::string frame_level;       // the last frame's level when the frame budget chose a coarser one
+  double frame_budget_ms = 0;    // --frame-budget (0: none)
+  std::string refinement;        // what the refinement at rest is doing (rest_refinement.h), "" when done
   bool exact_available = true;   // GL >= 4.3
   float max_line_width = 16.0f;  // the driver's wide-line limit
   std::string error;             // shown in red until the next one replaces it

@@ -35,10 +35,13 @@ struct ViewerOptions {
   // Window: while the camera moves, draw the finest level whose measured frame time fits this budget
   // (frame_budget.h); at rest, the scene's level. 0: no budget.
   double frame_budget_ms = 100;
+  // Window, at rest: after full detail, draw the exact mode run by run where GL 4.3 is there (rest_refinement.h).
+  bool exact_when_still = true;
   std::optional<double> orbit_deg;        // window: turn the camera by this azimuth every frame (benchmarks)
   std::optional<std::string> stats_json;  // window: write each frame's level and time here on quitting
   // Window automation (tests, scripted screenshots): quit after N frames, saving a screenshot first.
   std::optional<int> frames;
+  bool until_refined = false;  // with frames: after them, stay at rest until the refinement is done, then quit
   std::optional<std::string> screenshot;
 };
 

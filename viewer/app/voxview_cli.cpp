@@ -157,16 +157,23 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                  "many milliseconds; at rest, the level --gpu-memory allows (0: always that level)")
       ->default_val(100.0)
       ->check(CLI::NonNegativeNumber);
+  cli.add_flag("--no-exact-when-still{false}", a.options.exact_when_still,
+               "window: at rest, stop at the full-detail picture; by default, where OpenGL 4.3 is there, the basic "
+               "and axis modes go on to the exact picture, run by run, dropped at the first movement (key E)");
   cli.add_option(
       "--orbit", a.options.orbit_deg,
       "window: turn the camera by this many degrees of azimuth every frame (a scripted orbit, with --frames, "
-      "for benchmarks); the last frame is drawn at rest");
+      "for benchmarks); the last frame is drawn at rest (with --until-refined the camera rests after --frames)");
   cli.add_option("--stats", a.options.stats_json,
                  "window: on quitting, write every frame's level of detail and time, the first picture's and the "
-                 "first full-detail picture's time since start, and the moving frames' median and 95th percentile to "
-                 "this JSON file");
+                 "first full-detail and exact pictures' time since start, the moving frames' and the refinement "
+                 "pieces' median and 95th percentile to this JSON file");
   cli.add_option("--frames", a.options.frames, "window: quit after this many frames (for scripts and tests)")
       ->check(CLI::PositiveNumber);
+  cli.add_flag("--until-refined", a.options.until_refined,
+               "window, with --frames: after the frames, keep the camera still until the picture is refined (full "
+               "detail, then exact unless --no-exact-when-still), then quit")
+      ->needs("--frames");
   cli.add_option("--screenshot", a.options.screenshot, "window: save the last frame to this PNG before quitting");
 }
 

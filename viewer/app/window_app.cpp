@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -25,6 +26,7 @@
 #include "viewer/app/frame_log.h"
 #include "viewer/app/headless_render.h"
 #include "viewer/app/key_bindings.h"
+#include "viewer/app/rest_refinement.h"
 #include "viewer/app/scene_detail.h"
 #include "viewer/app/scene_source.h"
 #include "viewer/app/ui_panel.h"
@@ -128,6 +130,19 @@ bool same_view(const Camera& a, const Camera& b) {
          a.ortho_height == b.ortho_height;
 }
 
+// What a picture on screen depends on: when none of it changes, the window refines the picture instead of
+// drawing it again.
+struct PictureKey {
+  Camera camera;
+  RenderSettings settings;
+  int width = 0, height = 0;
+  bool grid = false, grid_all = false;
+};
+bool same_picture(const PictureKey& a, const PictureKey& b) {
+  return same_view(a.camera, b.camera) && a.settings == b.settings && a.width == b.width && a.height == b.height &&
+         a.grid == b.grid && a.grid_all == b.grid_all;
+}
+
 // One open window on one scene: GL objects, camera, panel, input. Callbacks reach it through the GLFW
 // user pointer.
 class ViewerWindow {
@@ -155,8 +170,20 @@ class ViewerWindow {
   void reset_camera(double aspect);
   double aspect() const;
   void set_error(const std::string& message);
-  // Draws the scene at `level` of detail; returns the frame's time in ms.
+  // Draws the scene whole at `level` of detail into scene_target_; returns the frame's time in ms.
   double draw_scene(int width, int height, std::uint32_t level);
+  // Draws the next piece of the refinement at rest (rest_refinement.h) into refine_target_; once the stage's
+  // picture is complete it becomes scene_target_'s and `completes` is set. Returns the piece's time in ms.
+  double refine(int width, int height, bool& completes);
+  // The grid overlay over scene_target_'s picture, when it is on.
+  void overlay_grid(const Renderer& renderer, int width, int height);
+  // The panel's figures of a complete picture drawn by `renderer`.
+  void show_frame_figures(const Renderer& renderer, std::uint32_t level);
+  // scene_target_ into the window's back buffer.
+  void present(int width, int height) const;
+  double seconds_since_start() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
   // The renderer of the scene's level, or of a coarser one (made on first use, for the frame budget).
   Renderer& renderer_at(std::uint32_t level);
   void save_screenshot(const std::string& path, int width, int height);
@@ -174,12 +201,15 @@ class ViewerWindow {
   std::uint32_t first_level_ = 0;
   FrameBudget budget_;
   std::chrono::steady_clock::time_point start_;
-  std::vector<FrameRecord> frames_;     // for --stats
-  std::optional<Camera> drawn_camera_;  // the camera of the last frame
+  std::vector<FrameRecord> frames_;  // for --stats
+  std::optional<PictureKey> drawn_;  // what the picture on screen shows (none before the first)
+  RestRefinement rest_;
+  bool pieces_begun_ = false;  // the refinement's current stage has begun its pieces
   std::optional<GridOverlay> grid_;
   // The scene is drawn here and blitted to the window: it blends in float like headless rendering, so
   // faint layers add up beyond 8-bit rounding and the window shows what --render writes.
   std::optional<OffscreenTarget> scene_target_;
+  std::optional<OffscreenTarget> refine_target_;  // the refinement's picture until it is complete
   CameraController controller_;
   std::vector<glm::dvec3> framing_points_;  // what the home view fills the window with (scene_framing.h)
   std::unique_ptr<UiPanel> panel_;          // created after our callbacks, which ImGui then chains to
@@ -203,6 +233,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
       detail_(choose_scene_detail(files_, o.level, o.gpu_memory, GpuScene::driver_limit())),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
       start_(start),
+      rest_(false, o.exact_when_still),
       controller_(Camera{}, 1.0) {
   stats_.detail = describe_scene_detail(detail_, SceneLayout::coarsest_level(pointers(files)) + 1);
   if (!stats_.detail.empty()) std::fprintf(stderr, "voxview: %s\n", stats_.detail.c_str());
@@ -235,6 +266,9 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   stats_.gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   stats_.gl_version = std::to_string(major) + "." + std::to_string(minor);
   stats_.exact_available = major * 10 + minor >= 43;
+  rest_ = RestRefinement(stats_.exact_available, o.exact_when_still);
+  state_.exact_when_still = o.exact_when_still;
+  stats_.frame_budget_ms = o.frame_budget_ms;
   stats_.max_line_width = std::clamp(widths[1], 1.0f, 16.0f);
   stats_.value_sets = first.value_set_names();
   for (const SceneGroup& g : first.groups().groups()) stats_.groups.emplace_back(g.name, g.streamlines);
@@ -391,6 +425,7 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
     case KeyAction::OpacityUp: s.opacity = std::clamp(s.opacity * 1.5f, 0.001f, 1.0f); break;
     case KeyAction::OpacityDown: s.opacity = std::clamp(s.opacity / 1.5f, 0.001f, 1.0f); break;
     case KeyAction::ToggleLighting: s.lighting = !s.lighting; break;
+    case KeyAction::ToggleExactWhenStill: state_.exact_when_still = !state_.exact_when_still; break;
     case KeyAction::Screenshot: screenshot_requested_ = true; break;
     case KeyAction::ResetCamera: reset_camera(aspect()); break;
     case KeyAction::SaveView: save_view_requested_ = true; break;
@@ -434,6 +469,7 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
   const Camera& camera = controller_.camera();
   if (!scene_target_) scene_target_.emplace(width, height);
   if (scene_target_->width() != width || scene_target_->height() != height) scene_target_->resize(width, height);
+  pieces_begun_ = false;  // a whole picture abandons the refinement's pieces
   const GLuint target = scene_target_->framebuffer();
   try {
     renderer.draw(camera, s, width, height, target);
@@ -443,31 +479,86 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
     s.mode = RenderMode::Axis;
     renderer.draw(camera, s, width, height, target);
   }
-  scene_target_->bind();
   drawn_mode_ = s.mode;
-  if (state_.grid) {
-    const glm::vec4 colour =
-        s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
-    grid_->draw(renderer, camera, double(width) / height,
-                state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn, colour, s.clipping);
-    stats_.grid_cubes = grid_->cubes_drawn();
-  }
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, target);
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-  glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  overlay_grid(renderer, width, height);
   glFinish();  // the frame time should include the GPU's work, not only its submission
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
+  show_frame_figures(renderer, level);
+  return ms;
+}
+
+void ViewerWindow::overlay_grid(const Renderer& renderer, int width, int height) {
+  scene_target_->bind();
+  if (!state_.grid) return;
+  const RenderSettings& s = state_.settings;
+  const glm::vec4 colour = s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
+  grid_->draw(renderer, controller_.camera(), double(width) / height,
+              state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn, colour, s.clipping);
+  stats_.grid_cubes = grid_->cubes_drawn();
+}
+
+void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t level) {
+  const RenderSettings& s = state_.settings;
   const FrameStats& f = renderer.stats();
   stats_.scalar_range = renderer.scalar_range(s);
   stats_.image_range = renderer.slice_range(s);
-  for (int a = 0; a < 3; ++a) stats_.focus[a] = camera.target[a];
+  for (int a = 0; a < 3; ++a) stats_.focus[a] = controller_.camera().target[a];
   stats_.plan_ms = f.plan_ms;
   stats_.voxels_drawn = f.voxels_drawn;
   stats_.segments_drawn = f.segments_drawn;
   stats_.frame_level = level == detail_.level ? "" : "level " + std::to_string(level) + " while the camera moves";
-  return ms;
+}
+
+void ViewerWindow::present(int width, int height) const {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, scene_target_->framebuffer());
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+double ViewerWindow::refine(int width, int height, bool& completes) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Renderer& renderer = renderer_at(detail_.level);
+  if (!refine_target_) refine_target_.emplace(width, height);
+  if (refine_target_->width() != width || refine_target_->height() != height) refine_target_->resize(width, height);
+  const bool exact_stage = rest_.stage() == RestStage::Exact;
+  completes = false;
+  try {
+    if (!pieces_begun_) {
+      RenderSettings s = state_.settings;
+      s.mode = rest_.stage_mode();
+      renderer.begin_pieces(controller_.camera(), s, width, height, refine_target_->framebuffer());
+      pieces_begun_ = true;
+    }
+    // Each piece fits the frame budget, so that input waits no longer at rest than while moving.
+    const double piece_ms =
+        options_.frame_budget_ms > 0 ? options_.frame_budget_ms : std::numeric_limits<double>::infinity();
+    completes = renderer.draw_piece(piece_ms);
+  } catch (const std::exception& e) {
+    // Exact out of node memory, say: keep the picture on screen and stop refining it.
+    set_error(std::string(exact_stage ? "exact when still" : render_mode_name(rest_.stage_mode())) + ": " + e.what() +
+              (exact_stage ? ": turned off" : ": showing axis"));
+    if (exact_stage) {
+      state_.exact_when_still = false;
+      rest_.set_exact_when_still(false);
+    } else {
+      state_.settings.mode = RenderMode::Axis;  // as draw_scene does: the picture is drawn again in axis
+    }
+    pieces_begun_ = false;
+    stats_.refinement = rest_.describe(0);
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  if (completes) {
+    std::swap(scene_target_, refine_target_);
+    overlay_grid(renderer, width, height);
+    show_frame_figures(renderer, detail_.level);
+    rest_.stage_complete();
+    pieces_begun_ = false;
+  }
+  stats_.refinement = rest_.describe(completes ? 0 : renderer.pieces_progress());
+  glFinish();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 void ViewerWindow::save_screenshot(const std::string& path, int width, int height) {
@@ -501,7 +592,11 @@ int ViewerWindow::run() {
       glfwWaitEvents();  // nothing moves by itself: sleep until the user does something
     }
     settle = events_ != seen ? 2 : std::max(0, settle - 1);
-    const bool closing = glfwWindowShouldClose(window_) || (automated && frame >= *options_.frames);
+    // A script's frames are done after --frames; with --until-refined it then waits, at rest, for the
+    // refinement to finish.
+    const bool frames_done = automated && frame >= *options_.frames;
+    const bool refined = drawn_ && rest_.stage() == RestStage::Done;
+    const bool closing = glfwWindowShouldClose(window_) || (frames_done && (!options_.until_refined || refined));
 
     // Render at the framebuffer's size (HiDPI), take input in window units.
     int fb_w = 0, fb_h = 0, win_h = 0;
@@ -523,21 +618,39 @@ int ViewerWindow::run() {
       for (int a = 0; a < 3; ++a) move_focus_along(a, (*requests.focus)[a] - controller_.camera().target[a]);
     screenshot_requested_ |= requests.screenshot;
     save_view_requested_ |= requests.save_view;
-    if (options_.orbit_deg && !closing)
+    if (state_.exact_when_still != rest_.exact_when_still()) {
+      rest_.set_exact_when_still(state_.exact_when_still);
+      pieces_begun_ = false;
+    }
+    if (options_.orbit_deg && !frames_done)
       controller_.set_view(controller_.camera().azimuth_deg + *options_.orbit_deg, controller_.camera().elevation_deg);
 
-    // Moving: a coarser level that fits the frame budget; at rest (and for the last, scripted frame) the
-    // scene's level. A coarse frame keeps the loop going, so that the next frame at rest refines.
+    // A changed picture is drawn whole: the first at a coarse level (at once); while the camera moves or a
+    // setting changes, at the finest level that fits the frame budget; a script's last frame at the scene's
+    // level. An unchanged one is refined at rest, a piece a frame (rest_refinement.h).
     const Camera& camera = controller_.camera();
-    const bool moving = drawn_camera_ && !closing && !same_view(*drawn_camera_, camera);
-    // The first picture comes at a coarse level (at once), unless it is also the last (a scripted screenshot).
-    const std::uint32_t level = closing ? detail_.level : frames_.empty() ? first_level_ : budget_.level_for(moving);
-    const double ms = draw_scene(fb_w, fb_h, level);
-    drawn_camera_ = camera;
-    budget_.record(level, ms);
-    frames_.push_back(
-        {level, moving, ms, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count()});
-    if (level != detail_.level) settle = std::max(settle, 1);
+    const PictureKey key{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all};
+    const bool moving = drawn_ && !closing && !same_view(drawn_->camera, camera);
+    const bool changed = !drawn_ || !same_picture(*drawn_, key);
+    const bool scripted_last = closing && frames_done && !options_.until_refined;
+    if (changed || scripted_last) {
+      const std::uint32_t level = scripted_last     ? detail_.level
+                                  : frames_.empty() ? first_level_
+                                                    : budget_.level_for(true);
+      const double ms = draw_scene(fb_w, fb_h, level);
+      budget_.record(level, ms);
+      rest_.drawn_whole(state_.settings.mode, level == detail_.level);
+      stats_.refinement = rest_.describe(0);
+      drawn_ = PictureKey{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all};
+      frames_.push_back({level, moving, ms, seconds_since_start()});
+    } else if (rest_.stage() != RestStage::Done && !closing) {
+      const FrameWork work = rest_.stage() == RestStage::Exact ? FrameWork::ExactPiece : FrameWork::FullDetailPiece;
+      bool completes = false;
+      const double ms = refine(fb_w, fb_h, completes);
+      frames_.push_back({detail_.level, false, ms, seconds_since_start(), work, completes});
+    }
+    if (rest_.stage() != RestStage::Done) settle = std::max(settle, 1);  // keep refining without input
+    present(fb_w, fb_h);
     // Screenshots show the scene alone unless the user asked for the panel too; automated ones never do.
     if (closing && options_.screenshot) save_screenshot(*options_.screenshot, fb_w, fb_h);
     // The view of the frame just drawn; scripts get it on quitting after --frames.

@@ -27,6 +27,7 @@ struct AxisClip {
   bool keep_above = true;  // true: keep coordinate >= position (+axis); false: keep <= position (-axis)
   double position = 0;     // RAS mm
   bool enabled = true;     // the window toggles planes without forgetting them
+  bool operator==(const AxisClip&) const = default;
 };
 
 struct Clipping {
@@ -34,6 +35,7 @@ struct Clipping {
   double slab_mm = 0;            // 0: no slab
   std::vector<AxisClip> planes;  // at most kMaxPlanes
   bool active() const;
+  bool operator==(const Clipping&) const = default;
 };
 
 // Half-spaces the picture keeps, at most 2 + kMaxPlanes.

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -97,6 +100,11 @@ ExactRenderer::~ExactRenderer() {
 }
 
 void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
+  begin(camera, s, width, height, fbo);
+  step(std::numeric_limits<double>::infinity());
+}
+
+void ExactRenderer::begin(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
   if (width != width_ || height != height_) {
     if (heads_) glDeleteTextures(1, &heads_);
     if (result_) glDeleteTextures(1, &result_);
@@ -111,58 +119,91 @@ void ExactRenderer::draw(const Camera& camera, const RenderSettings& s, int widt
     width_ = width;
     height_ = height;
   }
-  const double aspect = double(width) / std::max(1, height);
-  FramePlan plan;
-  lines_.plan_and_count(camera, aspect, PlanOrder::Visibility, plan, s.clipping);
+  camera_ = camera;
+  settings_ = s;
+  fbo_ = fbo;
+  lines_.plan_and_count(camera, double(width) / std::max(1, height), PlanOrder::Visibility, plan_, s.clipping);
+  segments_before_.assign(plan_.count.size() + 1, 0);
+  for (std::size_t v = 0; v < plan_.count.size(); ++v)
+    segments_before_[v + 1] = segments_before_[v] + plan_.count[v] / 2;
   start_image(s.background());
-
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-  glViewport(0, 0, width, height);
-  glDisable(GL_BLEND);
-  glDisable(GL_DEPTH_TEST);
-  lines_.bind_line_program(list_program_, camera, s, aspect);
-  glUniform1ui(glGetUniformLocation(list_program_, "u_capacity"),
-               static_cast<GLuint>(std::min<std::uint64_t>(capacity_, 0xFFFFFFFFu)));
+  next_ = 0;
+  per_segment_ = 0;
   passes_ = 0;
   fragments_ = 0;
+}
 
-  // Depth passes: runs of voxels in visibility order, back to front, each sized from the fragments per
-  // segment measured so far to fill about half the node buffer. A run's fragments all lie behind the
+double ExactRenderer::progress() const {
+  const std::uint64_t total = segments_before_.empty() ? 0 : segments_before_.back();
+  return total == 0 ? (next_ >= plan_.count.size() ? 1.0 : 0.0) : double(segments_before_[next_]) / double(total);
+}
+
+std::size_t ExactRenderer::run_end(double max_segments) const {
+  const std::size_t n = plan_.count.size();
+  // Several grids: the voxels are not in a visibility order, so they are composited in one run.
+  if (!lines_.layout().one_grid()) return n;
+  double budget = max_segments;
+  if (per_segment_ > 0) budget = std::min(budget, 0.5 * double(capacity_) / per_segment_);
+  if (!std::isfinite(budget)) return n;  // the first run of an unbounded frame measures the fragments
+  std::size_t j = next_ + 1;
+  while (j < n && double(segments_before_[j + 1] - segments_before_[next_]) <= budget) ++j;
+  return j;
+}
+
+bool ExactRenderer::step(double max_ms) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto elapsed_ms = [&] { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); };
+  // A window draws other things between steps: the state this pass needs is set again each time.
+  const double aspect = double(width_) / std::max(1, height_);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glViewport(0, 0, width_, height_);
+  glDisable(GL_BLEND);
+  glDisable(GL_DEPTH_TEST);
+  lines_.bind_line_program(list_program_, camera_, settings_, aspect);
+  glUniform1ui(glGetUniformLocation(list_program_, "u_capacity"),
+               static_cast<GLuint>(std::min<std::uint64_t>(capacity_, 0xFFFFFFFFu)));
+
+  // Depth passes: runs of voxels in visibility order, back to front. A run's fragments all lie behind the
   // next run's along every ray, so compositing run after run is exact. A run that overflows is
   // shortened and redone; one that cannot be (a single voxel, or several grids whose voxels overlap)
   // is split into bands of rows instead.
   const bool depth_passes = lines_.layout().one_grid();
-  std::vector<std::uint64_t> segments_before(plan.count.size() + 1, 0);
-  for (std::size_t v = 0; v < plan.count.size(); ++v) segments_before[v + 1] = segments_before[v] + plan.count[v] / 2;
-  double per_segment = 0;  // fragments per segment, 0 until measured
-  std::size_t i = 0;
-  const std::size_t n = plan.count.size();
-  while (i < n) {
-    std::size_t j = n;
-    if (depth_passes && per_segment > 0) {
-      const double budget = 0.5 * double(capacity_) / per_segment;  // segments
-      j = i + 1;
-      while (j < n && double(segments_before[j + 1] - segments_before[i]) <= budget) ++j;
-    }
-    const std::uint64_t stored = list_pass(plan, i, j, 0, height);
-    const std::uint64_t segments = segments_before[j] - segments_before[i];
-    if (segments > 0) per_segment = std::max(per_segment, double(stored) / double(segments));
+  const std::size_t n = plan_.count.size();
+  while (next_ < n) {
+    // Before anything is measured, a time-limited run assumes the line passes' rate (Renderer).
+    const double rate = segments_per_ms_ > 0 ? segments_per_ms_ : Renderer::kAssumedSegmentsPerMs;
+    const double max_segments =
+        std::isfinite(max_ms) ? rate * std::max(max_ms - elapsed_ms(), 0.0) : std::numeric_limits<double>::infinity();
+    const std::size_t j = run_end(max_segments);
+    const auto run_start = Clock::now();
+    const std::uint64_t stored = list_pass(next_, j, 0, height_);
+    const std::uint64_t segments = segments_before_[j] - segments_before_[next_];
+    if (segments > 0) per_segment_ = std::max(per_segment_, double(stored) / double(segments));
     if (stored <= capacity_) {
-      resolve_band(0, height, static_cast<std::uint32_t>(stored));
-    } else if (depth_passes && j - i > 1) {
+      resolve_band(0, height_, static_cast<std::uint32_t>(stored));
+    } else if (depth_passes && j - next_ > 1) {
       continue;  // retry a shorter run with the new estimate
     } else {
-      rows_in_bands(plan, i, j, height);
+      rows_in_bands(next_, j, height_);
     }
-    i = j;
+    const double run_ms = std::chrono::duration<double, std::milli>(Clock::now() - run_start).count();
+    if (segments > 0 && run_ms > 0) segments_per_ms_ = double(segments) / run_ms;
+    next_ = j;
+    if (std::isfinite(max_ms) && elapsed_ms() >= max_ms) break;
   }
+  if (next_ < n) return false;
+  show_image();
+  return true;
+}
 
+void ExactRenderer::show_image() {
   glBindTexture(GL_TEXTURE_2D, result_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, image_.data());
   Renderer::enable_clip_distances(0);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-  glViewport(0, 0, width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glViewport(0, 0, width_, height_);
   glUseProgram(blit_program_);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, result_);
@@ -189,8 +230,7 @@ void ExactRenderer::start_image(const glm::vec3& background) {
   }
 }
 
-std::uint64_t ExactRenderer::list_pass(const FramePlan& plan, std::size_t first_voxel, std::size_t end_voxel, int y0,
-                                       int y1) {
+std::uint64_t ExactRenderer::list_pass(std::size_t first_voxel, std::size_t end_voxel, int y0, int y1) {
   glUseProgram(clear_program_);
   glBindImageTexture(0, heads_, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
   glDispatchCompute((width_ + 7) / 8, (height_ + 7) / 8, 1);
@@ -204,9 +244,9 @@ std::uint64_t ExactRenderer::list_pass(const FramePlan& plan, std::size_t first_
   glBindImageTexture(0, heads_, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
   glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_);
-  const auto from = std::ptrdiff_t(first_voxel), to = std::ptrdiff_t(end_voxel);
-  lines_.draw_plan({plan.first.begin() + from, plan.first.begin() + to},
-                   {plan.count.begin() + from, plan.count.begin() + to});
+  const std::span<const std::int32_t> first(plan_.first), count(plan_.count);
+  lines_.draw_plan(first.subspan(first_voxel, end_voxel - first_voxel),
+                   count.subspan(first_voxel, end_voxel - first_voxel));
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
 
   // The counter counts every fragment, also those past the capacity that were not stored.
@@ -216,14 +256,14 @@ std::uint64_t ExactRenderer::list_pass(const FramePlan& plan, std::size_t first_
   return stored;
 }
 
-void ExactRenderer::rows_in_bands(const FramePlan& plan, std::size_t first_voxel, std::size_t end_voxel, int height) {
+void ExactRenderer::rows_in_bands(std::size_t first_voxel, std::size_t end_voxel, int height) {
   // Bands of rows; a band whose fragments overflow the node buffer is split in two and redone.
   std::vector<std::array<int, 2>> bands = {{height / 2, height}, {0, height / 2}};
   while (!bands.empty()) {
     auto [y0, y1] = bands.back();
     bands.pop_back();
     if (y1 <= y0) continue;
-    const std::uint64_t stored = list_pass(plan, first_voxel, end_voxel, y0, y1);
+    const std::uint64_t stored = list_pass(first_voxel, end_voxel, y0, y1);
     if (stored > capacity_) {
       if (y1 - y0 <= 1)
         throw std::runtime_error("exact mode: one pixel row has more fragments than the node buffer holds");

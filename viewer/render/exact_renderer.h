@@ -35,16 +35,29 @@ class ExactRenderer {
   explicit ExactRenderer(Renderer& lines, std::uint64_t node_capacity = 0);
   ~ExactRenderer();
   void draw(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
+  // draw() in pieces, so that a window takes input between them (Renderer::begin_pieces): begin() plans the
+  // frame and starts the picture; each step() composites runs of voxels for about `max_ms` (at least one
+  // run; a run is also kept short enough for that time, from the segments per millisecond measured so far)
+  // and, after the last, writes the picture to `fbo` and returns true. draw() is begin() and one unbounded step.
+  void begin(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
+  bool step(double max_ms);
+  // The share of the frame's segments composited so far (0 before the first step, 1 when done).
+  double progress() const;
   int passes() const { return passes_; }  // list passes resolved in the last frame (depth runs and row bands)
   std::uint64_t fragments() const { return fragments_; }
 
  private:
   void start_image(const glm::vec3& background);
-  // Stores the fragments of plan voxels [first_voxel, end_voxel) inside rows [y0, y1) in the lists;
+  // The end of the next run from plan voxel next_: as many voxels as fill about half the node buffer (once
+  // the fragments per segment are known) and, with a time limit, as draw in `max_segments`.
+  std::size_t run_end(double max_segments) const;
+  // Writes image_ to `fbo_`.
+  void show_image();
+  // Stores the fragments of plan_ voxels [first_voxel, end_voxel) inside rows [y0, y1) in the lists;
   // returns how many there were (more than the capacity: the lists hold only the first ones).
-  std::uint64_t list_pass(const FramePlan& plan, std::size_t first_voxel, std::size_t end_voxel, int y0, int y1);
+  std::uint64_t list_pass(std::size_t first_voxel, std::size_t end_voxel, int y0, int y1);
   // The same voxels, in bands of rows small enough for the node buffer.
-  void rows_in_bands(const FramePlan& plan, std::size_t first_voxel, std::size_t end_voxel, int height);
+  void rows_in_bands(std::size_t first_voxel, std::size_t end_voxel, int height);
   // Composites the lists of rows [y0, y1) (holding `stored` nodes) over image_.
   void resolve_band(int y0, int y1, std::uint32_t stored);
 
@@ -53,6 +66,15 @@ class ExactRenderer {
   GLuint list_program_ = 0, clear_program_ = 0, blit_program_ = 0;
   GLuint nodes_ = 0, counter_ = 0, heads_ = 0, result_ = 0;
   int width_ = 0, height_ = 0;
+  // The frame being drawn (begin() to the step() that completes it).
+  Camera camera_;
+  RenderSettings settings_;
+  GLuint fbo_ = 0;
+  FramePlan plan_;
+  std::vector<std::uint64_t> segments_before_;  // segments of plan voxels [0, v)
+  std::size_t next_ = 0;                        // the first plan voxel not composited yet
+  double per_segment_ = 0;                      // fragments per segment, 0 until measured
+  double segments_per_ms_ = 0;                  // list pass and resolve, 0 until measured
   int passes_ = 0;
   std::uint64_t fragments_ = 0;
   // Read-back scratch, kept between frames.

@@ -47,6 +47,7 @@ struct GroupStyle {
   std::string name;
   std::optional<glm::vec3> color;
   float opacity = 1.0f;
+  bool operator==(const GroupStyle&) const = default;
 };
 
 // "#RRGGBB" -> colour in [0, 1].
@@ -63,6 +64,7 @@ struct SliceSettings {
   bool view_plane = false;
   std::optional<std::array<float, 2>> range;  // values shown black and white; none: the image's default window
   bool any() const { return axial || coronal || sagittal || view_plane; }
+  bool operator==(const SliceSettings&) const = default;
 };
 
 struct RenderSettings {
@@ -86,6 +88,8 @@ struct RenderSettings {
   // The colour and opacity factor of group `index` called `name`.
   glm::vec4 group_color(const std::string& name, std::size_t index) const;
   GroupStyle& style_of(const std::string& name);  // the user's entry for `name`, added when missing
+  // Whether two settings draw the same picture (the window refines a picture until they change).
+  bool operator==(const RenderSettings&) const = default;
 };
 
 }  // namespace vxl

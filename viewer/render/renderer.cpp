@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -269,7 +271,7 @@ void Renderer::prepare_attributes(const RenderSettings& s) {
   attributes_key_ = key;
 }
 
-void Renderer::draw_plan(const std::vector<std::int32_t>& first, const std::vector<std::int32_t>& count) const {
+void Renderer::draw_plan(std::span<const std::int32_t> first, std::span<const std::int32_t> count) const {
   if (first.empty()) return;
   glBindVertexArray(vao_);
   glMultiDrawArrays(GL_LINES, first.data(), count.data(), static_cast<GLsizei>(first.size()));
@@ -307,14 +309,39 @@ void Renderer::composite(GLuint program, std::initializer_list<std::pair<const c
   glActiveTexture(GL_TEXTURE0);
 }
 
+void Renderer::over_blending() {
+  glEnable(GL_BLEND);
+  // Premultiply colour, accumulate coverage: destination alpha reaches 1 (docs/rendering.md, pitfall 1).
+  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+}
+
+void Renderer::clear_to_base(GLuint fbo, int width, int height, const glm::vec3& background) const {
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glViewport(0, 0, width, height);
+  glClearColor(background.r, background.g, background.b, 1.0f);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (slices_drawn_) slices_->copy_color();
+}
+
+void Renderer::start_frame(const Camera& camera, const RenderSettings& s, int width, int height) {
+  const double aspect = double(width) / std::max(1, height);
+  prepare_attributes(s);
+  // The opaque slices first: their colour is the base of the picture, their depth hides lines behind them.
+  slices_drawn_ = slices_ && s.slices.any();
+  if (slices_drawn_)
+    slices_->draw(camera, projection(camera, aspect), s.slices, clip_half_spaces(s.clipping, camera), s.background(),
+                  width, height);
+  glLineWidth(std::max(1.0f, s.line_width));
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+}
+
 void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
+  pieces_.reset();
   const double aspect = double(width) / std::max(1, height);
   const glm::vec3 bg = s.background();
-  auto over_blending = [] {
-    glEnable(GL_BLEND);
-    // Premultiply colour, accumulate coverage: destination alpha reaches 1 (docs/rendering.md, pitfall 1).
-    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  };
   auto clear_target = [&](GLuint target, glm::vec4 colour) {
     glBindFramebuffer(GL_FRAMEBUFFER, target);
     glViewport(0, 0, width, height);
@@ -322,25 +349,11 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
     glClearDepth(1.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   };
-  // The picture's base under the lines: the background, or the slices over it.
-  auto clear_to_base = [&] {
-    clear_target(fbo, glm::vec4(bg, 1));
-    if (slices_drawn_) slices_->copy_color();
-  };
-  prepare_attributes(s);
-  // The opaque slices first: their colour is the base of the picture, their depth hides lines behind them.
-  slices_drawn_ = slices_ && s.slices.any();
-  if (slices_drawn_)
-    slices_->draw(camera, projection(camera, aspect), s.slices, clip_half_spaces(s.clipping, camera), bg, width,
-                  height);
-  glLineWidth(std::max(1.0f, s.line_width));
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_BLEND);
-  glDepthMask(GL_TRUE);
+  start_frame(camera, s, width, height);
 
   switch (s.mode) {
     case RenderMode::Opaque:
-      clear_to_base();
+      clear_to_base(fbo, width, height, bg);
       glEnable(GL_DEPTH_TEST);
       glDepthFunc(GL_LESS);
       // The colour replaces, the alpha stays the clear's 1: an opaque picture (a PNG would otherwise keep
@@ -351,17 +364,17 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       glDisable(GL_DEPTH_TEST);
       break;
     case RenderMode::Unsorted:
-      clear_to_base();
+      clear_to_base(fbo, width, height, bg);
       over_blending();
       draw_dataset_order(over_program_, camera, s, aspect);
       break;
     case RenderMode::Basic:
-      clear_to_base();
+      clear_to_base(fbo, width, height, bg);
       over_blending();
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Block);
       break;
     case RenderMode::Axis:
-      clear_to_base();
+      clear_to_base(fbo, width, height, bg);
       over_blending();
       plan_.order_hysteresis = s.order_hysteresis;
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Nearest);
@@ -385,7 +398,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       draw_plan(plan_.first, plan_.count);
       const GLenum both[2] = {accum, reveal};
       glDrawBuffers(2, both);
-      clear_to_base();
+      clear_to_base(fbo, width, height, bg);
       over_blending();
       composite(wboit_composite_, {{"u_accum", wboit_target_.color[0]}, {"u_reveal", wboit_target_.color[1]}});
       break;
@@ -407,7 +420,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       glBlendFunc(GL_ONE, GL_ONE);
       bind_line_program(additive_program_, camera, s, aspect);
       draw_plan(plan_.first, plan_.count);
-      clear_to_base();
+      clear_to_base(fbo, width, height, bg);
       over_blending();
       glUseProgram(additive_composite_);
       glUniform1f(glGetUniformLocation(additive_composite_, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
@@ -423,6 +436,123 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
   glDisable(GL_BLEND);
   enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+}
+
+struct Renderer::Pieces {
+  enum class Kind { Whole, Voxels, Exact };
+  Kind kind = Kind::Whole;
+  Camera camera;
+  RenderSettings settings;
+  int width = 0, height = 0;
+  GLuint fbo = 0;
+  std::vector<std::int32_t> first, count;  // Kind::Voxels: the frame plan
+  std::size_t next = 0;                    // the first plan voxel not drawn yet
+  std::uint64_t segments = 0, drawn = 0;   // the plan's, and those drawn so far
+  double segments_per_ms = 0;              // measured, 0 until then
+  bool done = false;
+};
+
+void Renderer::begin_pieces(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
+  pieces_ = std::make_unique<Pieces>();
+  Pieces& p = *pieces_;
+  p.camera = camera;
+  p.settings = s;
+  p.width = width;
+  p.height = height;
+  p.fbo = fbo;
+  switch (s.mode) {
+    case RenderMode::Opaque:
+    case RenderMode::Basic:
+    case RenderMode::Axis: {
+      start_frame(camera, s, width, height);
+      clear_to_base(fbo, width, height, s.background());
+      if (s.mode == RenderMode::Axis) plan_.order_hysteresis = s.order_hysteresis;
+      const PlanOrder order = s.mode == RenderMode::Opaque  ? PlanOrder::Any
+                              : s.mode == RenderMode::Basic ? PlanOrder::Block
+                                                            : PlanOrder::Nearest;
+      plan_and_count(camera, double(width) / std::max(1, height), order, plan_, s.clipping);
+      p.kind = Pieces::Kind::Voxels;
+      p.first = plan_.first;
+      p.count = plan_.count;
+      for (std::int32_t ids : p.count) p.segments += static_cast<std::uint64_t>(ids / 2);
+      p.done = p.first.empty();
+      break;
+    }
+    case RenderMode::Exact:
+      if (!exact_) exact_ = std::make_unique<ExactRenderer>(*this);
+      start_frame(camera, s, width, height);
+      exact_->begin(camera, s, width, height, fbo);
+      p.kind = Pieces::Kind::Exact;
+      break;
+    case RenderMode::Unsorted:
+    case RenderMode::Additive:
+    case RenderMode::Wboit: p.kind = Pieces::Kind::Whole; break;
+  }
+}
+
+bool Renderer::draw_piece(double max_ms) {
+  if (!pieces_) throw std::logic_error("Renderer::draw_piece without begin_pieces");
+  if (pieces_->done) return true;
+  switch (pieces_->kind) {
+    case Pieces::Kind::Whole: {
+      std::unique_ptr<Pieces> p = std::move(pieces_);  // draw() abandons pieces: these are complete after it
+      draw(p->camera, p->settings, p->width, p->height, p->fbo);
+      pieces_ = std::move(p);
+      pieces_->done = true;
+      break;
+    }
+    case Pieces::Kind::Exact:
+      pieces_->done = exact_->step(max_ms);
+      glDisable(GL_BLEND);
+      enable_clip_distances(0);
+      return pieces_->done;
+    case Pieces::Kind::Voxels: {
+      Pieces& p = *pieces_;
+      const auto t0 = std::chrono::steady_clock::now();
+      // A window draws other things between pieces: this piece's state is set again.
+      glBindFramebuffer(GL_FRAMEBUFFER, p.fbo);
+      glViewport(0, 0, p.width, p.height);
+      glLineWidth(std::max(1.0f, p.settings.line_width));
+      glDepthMask(GL_TRUE);
+      if (p.settings.mode == RenderMode::Opaque) {  // as draw(): depth-tested, the colour replaces
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_ONE, GL_ZERO, GL_ZERO, GL_ONE);
+      } else {
+        glDisable(GL_DEPTH_TEST);
+        over_blending();
+      }
+      bind_line_program(over_program_, p.camera, p.settings, double(p.width) / std::max(1, p.height));
+      // Voxels up to what the measured rate draws in max_ms (before a measurement, llvmpipe's rate).
+      const double rate = p.segments_per_ms > 0 ? p.segments_per_ms : kAssumedSegmentsPerMs;
+      const double max_segments = std::isfinite(max_ms) ? rate * max_ms : std::numeric_limits<double>::infinity();
+      std::size_t end = p.next;
+      std::uint64_t segments = 0;
+      do segments += static_cast<std::uint64_t>(p.count[end++] / 2);
+      while (end < p.count.size() && double(segments + p.count[end] / 2) <= max_segments);
+      const std::span<const std::int32_t> first(p.first), count(p.count);
+      draw_plan(first.subspan(p.next, end - p.next), count.subspan(p.next, end - p.next));
+      glFinish();  // the piece's time includes the GPU's work, for the next piece's size
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      if (segments > 0 && ms > 0) p.segments_per_ms = double(segments) / ms;
+      p.drawn += segments;
+      p.next = end;
+      p.done = end == p.count.size();
+      glDisable(GL_BLEND);
+      glDisable(GL_DEPTH_TEST);
+      enable_clip_distances(0);
+      break;
+    }
+  }
+  return pieces_->done;
+}
+
+double Renderer::pieces_progress() const {
+  if (!pieces_) return 0;
+  if (pieces_->kind == Pieces::Kind::Exact) return exact_->progress();
+  if (pieces_->done) return 1;
+  return pieces_->segments == 0 ? 0 : double(pieces_->drawn) / double(pieces_->segments);
 }
 
 }  // namespace vxl

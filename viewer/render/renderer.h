@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <memory>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -37,6 +38,9 @@ struct FrameStats {
 class Renderer {
  public:
   static constexpr int kSamplersPerSpan = 4;  // words, orders, dataset order, attributes
+  // The drawing rate a frame in pieces assumes before it has measured one: about Mesa llvmpipe's on two
+  // cores at 1024x1024 (a GPU is faster, so its first piece is merely short).
+  static constexpr double kAssumedSegmentsPerMs = 1000;
   explicit Renderer(const VxlFile& file, std::uint64_t max_texels = 0, std::uint32_t level = 0);
   // Several files drawn as one scene: one sort over all their voxels, one group per file. The files must
   // outlive the renderer. level: the level of detail drawn (.vxl spec §5.12; scene_layout.h), its opacity
@@ -49,6 +53,18 @@ class Renderer {
   // Renders one frame into framebuffer `fbo` (0: the default one) of size width x height.
   // Throws std::runtime_error when the mode needs more than the context offers (exact on GL < 4.3).
   void draw(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
+
+  // A frame drawn in pieces, so that a window takes input between them (voxview's refinement at rest):
+  // begin_pieces() starts the picture of draw(camera, settings, ...) in `fbo` (the background or the slices)
+  // and plans it; each draw_piece() adds the next voxels, back to front, for about `max_ms` (at least one
+  // voxel) and returns true once the picture is complete. It is then the picture draw() makes: the same
+  // draws in the same order for opaque, basic and axis; exact composites runs of voxels as its draw()
+  // does, only shorter ones. Modes that blend in no order (unsorted, additive, wboit) are drawn whole by
+  // the first piece. A draw() in between abandons the pieces.
+  void begin_pieces(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
+  bool draw_piece(double max_ms);
+  // The share of the frame's segments drawn so far (1 when complete).
+  double pieces_progress() const;
 
   // Uploads an anatomical image; settings.slices then chooses which of its slices every frame shows under
   // the lines. The volume need not outlive the call.
@@ -94,11 +110,19 @@ class Renderer {
   // The exact mode is a part of the renderer kept in its own file: it draws with the line program.
   friend class ExactRenderer;
 
+  struct Pieces;
+  // What every mode does first: the per-vertex attributes, the slices (their depth hides lines behind them),
+  // line width and a neutral blend and depth state.
+  void start_frame(const Camera& camera, const RenderSettings& settings, int width, int height);
+  // Clears `fbo` to the picture's base under the lines: the background, or the slices over it.
+  void clear_to_base(GLuint fbo, int width, int height, const glm::vec3& background) const;
+  // The blend state of the over-compositing modes (basic, axis; docs/rendering.md, pitfall 1).
+  static void over_blending();
   // plan(), recording the frame's CPU time and counts in stats().
   void plan_and_count(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping);
   // Binds the line program's uniforms and textures for `camera`.
   void bind_line_program(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect) const;
-  void draw_plan(const std::vector<std::int32_t>& first, const std::vector<std::int32_t>& count) const;
+  void draw_plan(std::span<const std::int32_t> first, std::span<const std::int32_t> count) const;
   // Enables the first n of the line shader's clip distances and disables the others (passes without
   // gl_ClipDistance must run with none enabled).
   static void enable_clip_distances(int n);
@@ -118,6 +142,7 @@ class Renderer {
   FramePlan plan_;
   FrameStats stats_;
   std::unique_ptr<ExactRenderer> exact_;
+  std::unique_ptr<Pieces> pieces_;  // the frame begin_pieces() started, until draw() or the next begin
   std::unique_ptr<SliceRenderer> slices_;
   bool slices_drawn_ = false;  // this frame: the line shaders test against the slices' depth
   SceneGroups groups_;
