@@ -278,16 +278,21 @@ TEST_F(RenderModes, ManyTextureSpansRenderLikeOne) {
     t.add_streamline(p.data(), 30);
   }
   VxlFile f = make_scene(dir, std::move(t), 6.0);
-  Renderer one(f), many(f, 3000);
+  // More spans than one draw binds (Renderer::kMaxBoundSpans): the draws bind them a few at a time.
+  Renderer one(f), many(f, 3000), more_than_a_draw_binds(f, 700);
   EXPECT_EQ(one.layout().texture_spans().size(), 1u);
   EXPECT_GT(many.layout().texture_spans().size(), 3u);
+  EXPECT_GT(more_than_a_draw_binds.layout().texture_spans().size(), 2 * Renderer::kMaxBoundSpans);
   Camera cam = top_view();
   cam.azimuth_deg = 30;
   cam.elevation_deg = 40;
-  for (RenderMode m : {RenderMode::Axis, RenderMode::Basic, RenderMode::Unsorted, RenderMode::Opaque}) {
+  for (RenderMode m : {RenderMode::Axis, RenderMode::Basic, RenderMode::Unsorted, RenderMode::Opaque, RenderMode::Wboit,
+                       RenderMode::Additive, RenderMode::Exact}) {
     Image a = render_image(one, cam, settings(m, 0.3f), 64, 64);
     Image b = render_image(many, cam, settings(m, 0.3f), 64, 64);
+    Image c = render_image(more_than_a_draw_binds, cam, settings(m, 0.3f), 64, 64);
     EXPECT_EQ(compare_images(a, b).differing_pixels, 0u) << render_mode_name(m);
+    EXPECT_EQ(compare_images(a, c).differing_pixels, 0u) << render_mode_name(m);
     EXPECT_GT(lit_pixels(a), 200) << render_mode_name(m);
   }
 }

@@ -77,8 +77,7 @@ ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity) : lin
   glGetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
   std::uint64_t bytes = std::min<std::uint64_t>(static_cast<std::uint32_t>(max_block), 256ull << 20);
   capacity_ = node_capacity ? node_capacity : bytes / 16;
-  const unsigned spans = std::max<unsigned>(1, static_cast<unsigned>(lines.layout().texture_spans().size()));
-  list_program_ = gl::make_program(shaders::line_vertex(spans, "#version 430 core"),
+  list_program_ = gl::make_program(shaders::line_vertex(lines.bound_spans_, "#version 430 core"),
                                    shaders::line_fragment(kListFragment, "#version 430 core"));
   clear_program_ = gl::make_compute_program(kClearCompute);
   blit_program_ = gl::make_program(shaders::kFullscreenVertex, kBlitFragment);
@@ -244,8 +243,9 @@ std::uint64_t ExactRenderer::list_pass(std::size_t first_voxel, std::size_t end_
   glBindImageTexture(0, heads_, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
   glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_);
-  const std::span<const std::int32_t> first(plan_.first), count(plan_.count);
-  lines_.draw_plan(first.subspan(first_voxel, end_voxel - first_voxel),
+  const std::span<const std::int64_t> first(plan_.first);
+  const std::span<const std::int32_t> count(plan_.count);
+  lines_.draw_plan(list_program_, first.subspan(first_voxel, end_voxel - first_voxel),
                    count.subspan(first_voxel, end_voxel - first_voxel));
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
 

@@ -106,7 +106,7 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
         previous = static_cast<std::uint8_t>(2 * slot + (reversed ? 1 : 0));
       }
     }
-    plan.first.push_back(static_cast<std::int32_t>(layout.first_id(v, slot, reversed)));
+    plan.first.push_back(layout.first_id(v, slot, reversed));
     plan.count.push_back(layout.id_count(v, slot));
     plan.segments_drawn += v.segment_count;
   }

@@ -1,7 +1,7 @@
 // The per-frame CPU work of the Voxlines method: drop voxels outside the view frustum (and outside the
 // slab and clip planes), sort the visible
 // voxels back to front, pick each voxel's nearest precomputed order (the paper's rule), and fill the
-// first/count arrays of one glMultiDrawArrays call. No GL here.
+// first/count arrays of the multi-draws (Renderer::draw_plan). No GL here.
 #pragma once
 
 #include <array>
@@ -41,7 +41,7 @@ enum class PlanOrder {
 };
 
 struct FramePlan {
-  std::vector<std::int32_t> first;
+  std::vector<std::int64_t> first;  // virtual ids (scene_layout.h): the scene's may pass 2^31
   std::vector<std::int32_t> count;
   std::uint64_t voxels_drawn = 0;
   std::uint64_t segments_drawn = 0;

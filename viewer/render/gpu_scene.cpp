@@ -146,7 +146,7 @@ void GpuScene::upload_attributes(const std::vector<std::vector<float>>& per_file
   }
 }
 
-const std::vector<std::int32_t>& GpuScene::dataset_first() {
+const std::vector<std::int64_t>& GpuScene::dataset_first() {
   if (!dataset_built_) {
     // Walk the streamlines, file after file: every voxline contributes its segments, in order, to its
     // span's dataset array; consecutive segments in one span form one draw range.
@@ -167,7 +167,7 @@ const std::vector<std::int32_t>& GpuScene::dataset_first() {
         if (segments == 0) return;
         auto& arr = per_span[c];
         if (run_span != c) {
-          dataset_first_.push_back(static_cast<std::int32_t>(layout_.dataset_id(c, arr.size())));
+          dataset_first_.push_back(layout_.dataset_id(c, arr.size()));
           dataset_count_.push_back(0);
           run_span = c;
         }

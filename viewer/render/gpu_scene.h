@@ -43,7 +43,7 @@ class GpuScene {
   void upload_attributes(const std::vector<std::vector<float>>& per_file);
 
   // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)).
-  const std::vector<std::int32_t>& dataset_first();
+  const std::vector<std::int64_t>& dataset_first();
   const std::vector<std::int32_t>& dataset_count();
 
  private:
@@ -59,7 +59,8 @@ class GpuScene {
   std::vector<GpuTextureSpan> spans_;
   std::uint64_t gpu_bytes_ = 0;
   bool dataset_built_ = false;
-  std::vector<std::int32_t> dataset_first_, dataset_count_;
+  std::vector<std::int64_t> dataset_first_;
+  std::vector<std::int32_t> dataset_count_;
 };
 
 }  // namespace vxl

@@ -30,15 +30,19 @@ Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, 
       for (std::uint32_t k = 0; k < sets->size(); ++k)
         if (std::find(value_set_names_.begin(), value_set_names_.end(), sets->name(k)) == value_set_names_.end())
           value_set_names_.push_back(sets->name(k));
-  const unsigned spans = std::max<unsigned>(1, static_cast<unsigned>(scene_.layout().texture_spans().size()));
+  // A draw binds up to kMaxBoundSpans spans, as many as the vertex shader's texture units allow (GL 3.3
+  // promises 16: four spans).
   GLint units = 0;
   glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
-  if (static_cast<GLint>(kSamplersPerSpan * spans) > units)
+  const std::size_t spans = std::max<std::size_t>(1, scene_.layout().texture_spans().size());
+  bound_spans_ = static_cast<unsigned>(
+      std::min<std::size_t>({spans, kMaxBoundSpans, static_cast<std::size_t>(std::max(0, units)) / kSamplersPerSpan}));
+  if (bound_spans_ == 0)
     throw Error(ErrorKind::Unsupported, file.path(), std::nullopt,
-                "the scene needs " + std::to_string(kSamplersPerSpan * spans) + " vertex-shader textures (" +
-                    std::to_string(spans) + " GPU texture spans) but this GPU offers " + std::to_string(units));
+                "this GPU offers " + std::to_string(units) + " vertex-shader textures; the lines need " +
+                    std::to_string(kSamplersPerSpan));
   glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even without attributes
-  const std::string vs = shaders::line_vertex(spans);
+  const std::string vs = shaders::line_vertex(bound_spans_);
   over_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineOverFragment));
   accum_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitAccumFragment));
   reveal_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitRevealFragment));
@@ -132,41 +136,6 @@ void Renderer::prepare(RenderMode mode) {
 
 void Renderer::bind_line_program(GLuint program, const Camera& camera, const RenderSettings& s, double aspect) const {
   glUseProgram(program);
-  const SceneLayout& layout = scene_.layout();
-  const auto& spans = layout.texture_spans();
-  // Per span: where its ids start and how its buffers are laid out (scene_layout.h).
-  std::vector<std::pair<const char*, std::vector<GLint>>> fields = {
-      {"u_span_base", {}},     {"u_span_segments", {}},      {"u_span_slots", {}},        {"u_span_wide", {}},
-      {"u_span_vertices", {}}, {"u_span_segment_table", {}}, {"u_span_vertex_table", {}},
-  };
-  for (const TextureSpan& c : spans) {
-    const std::uint64_t values[] = {c.virtual_base,
-                                    std::max<std::uint64_t>(1, c.segments),
-                                    c.slots,
-                                    c.wide_segments,
-                                    c.vertices,
-                                    c.segment_table_first(),
-                                    c.vertex_table_first()};
-    for (std::size_t f = 0; f < fields.size(); ++f) fields[f].second.push_back(static_cast<GLint>(values[f]));
-  }
-  for (auto& [name, values] : fields) {
-    if (values.empty())
-      values = {name == std::string("u_span_segments") || name == std::string("u_span_slots") ? 1 : 0};
-    glUniform1iv(glGetUniformLocation(program, name), static_cast<GLsizei>(values.size()), values.data());
-  }
-  for (std::size_t c = 0; c < scene_.texture_spans().size(); ++c) {
-    const GpuTextureSpan& g = scene_.texture_spans()[c];
-    const GLuint textures[kSamplersPerSpan] = {g.words.texture, g.orders.texture, g.dataset.texture,
-                                               g.attributes.texture};
-    const char* names[kSamplersPerSpan] = {"u_words", "u_ord", "u_dat", "u_att"};
-    for (int t = 0; t < kSamplersPerSpan; ++t) {
-      GLint unit = static_cast<GLint>(kSamplersPerSpan * c + t);
-      glActiveTexture(GL_TEXTURE0 + unit);
-      glBindTexture(GL_TEXTURE_BUFFER, textures[t]);
-      glUniform1i(glGetUniformLocation(program, (names[t] + std::to_string(c)).c_str()), unit);
-    }
-  }
-  glActiveTexture(GL_TEXTURE0);
   const glm::dvec3 eye = camera.eye();
   const glm::vec3 hi(eye);
   const glm::vec3 lo(eye - glm::dvec3(hi));
@@ -204,7 +173,7 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   enable_clip_distances(clips);
   // The slices' depth on the first unit after the spans' (a unit of its own: two sampler types must not
   // share one), bound even when unused.
-  const GLint unit = static_cast<GLint>(kSamplersPerSpan * std::max<std::size_t>(1, scene_.texture_spans().size()));
+  const GLint unit = static_cast<GLint>(kSamplersPerSpan * bound_spans_);
   glActiveTexture(GL_TEXTURE0 + unit);
   glBindTexture(GL_TEXTURE_2D, slices_drawn_ ? slices_->depth_texture() : 0);
   glUniform1i(glGetUniformLocation(program, "u_slice_depth"), unit);
@@ -271,17 +240,93 @@ void Renderer::prepare_attributes(const RenderSettings& s) {
   attributes_key_ = key;
 }
 
-void Renderer::draw_plan(std::span<const std::int32_t> first, std::span<const std::int32_t> count) const {
+void Renderer::bind_spans(GLuint program, std::span<const std::uint32_t> bound,
+                          std::span<const std::int64_t> base) const {
+  const auto& spans = scene_.layout().texture_spans();
+  // Per slot: where its ids start in this draw and how its buffers are laid out (scene_layout.h); a slot
+  // left empty starts past every id.
+  std::vector<std::pair<const char*, std::vector<GLint>>> fields = {
+      {"u_span_base", {}},     {"u_span_segments", {}},      {"u_span_slots", {}},        {"u_span_wide", {}},
+      {"u_span_vertices", {}}, {"u_span_segment_table", {}}, {"u_span_vertex_table", {}},
+  };
+  for (std::size_t slot = 0; slot < bound_spans_; ++slot) {
+    std::int64_t values[] = {std::numeric_limits<std::int32_t>::max(), 1, 1, 0, 0, 0, 0};
+    if (slot < bound.size()) {
+      const TextureSpan& c = spans[bound[slot]];
+      const std::int64_t used[] = {base[slot],
+                                   static_cast<std::int64_t>(std::max<std::uint64_t>(1, c.segments)),
+                                   c.slots,
+                                   static_cast<std::int64_t>(c.wide_segments),
+                                   static_cast<std::int64_t>(c.vertices),
+                                   static_cast<std::int64_t>(c.segment_table_first()),
+                                   static_cast<std::int64_t>(c.vertex_table_first())};
+      std::copy(std::begin(used), std::end(used), values);
+    }
+    for (std::size_t f = 0; f < fields.size(); ++f) fields[f].second.push_back(static_cast<GLint>(values[f]));
+  }
+  for (const auto& [name, values] : fields)
+    glUniform1iv(glGetUniformLocation(program, name), static_cast<GLsizei>(values.size()), values.data());
+  const char* names[kSamplersPerSpan] = {"u_words", "u_ord", "u_dat", "u_att"};
+  for (std::size_t slot = 0; slot < bound_spans_; ++slot) {
+    const GpuTextureSpan* g = slot < bound.size() ? &scene_.texture_spans()[bound[slot]] : nullptr;
+    const GLuint textures[kSamplersPerSpan] = {g ? g->words.texture : 0, g ? g->orders.texture : 0,
+                                               g ? g->dataset.texture : 0, g ? g->attributes.texture : 0};
+    for (int t = 0; t < kSamplersPerSpan; ++t) {
+      const GLint unit = static_cast<GLint>(kSamplersPerSpan * slot + t);
+      glActiveTexture(GL_TEXTURE0 + unit);
+      glBindTexture(GL_TEXTURE_BUFFER, textures[t]);
+      glUniform1i(glGetUniformLocation(program, (names[t] + std::to_string(slot)).c_str()), unit);
+    }
+  }
+  glActiveTexture(GL_TEXTURE0);
+}
+
+void Renderer::draw_plan(GLuint program, std::span<const std::int64_t> first,
+                         std::span<const std::int32_t> count) const {
   if (first.empty()) return;
   glBindVertexArray(vao_);
-  glMultiDrawArrays(GL_LINES, first.data(), count.data(), static_cast<GLsizei>(first.size()));
+  const SceneLayout& layout = scene_.layout();
+  const auto& spans = layout.texture_spans();
+  // Consecutive runs of the sequence, each over at most bound_spans_ spans whose ids, rebased one after
+  // another, stay below 2^31: one multi-draw each, in order, so blending sees the same sequence.
+  std::vector<std::uint32_t> bound;
+  std::vector<std::int64_t> base;
+  std::vector<GLint> run_first;
+  std::vector<GLsizei> run_count;
+  std::int64_t next_base = 0;
+  auto flush = [&] {
+    if (run_first.empty()) return;
+    bind_spans(program, bound, base);
+    glMultiDrawArrays(GL_LINES, run_first.data(), run_count.data(), static_cast<GLsizei>(run_first.size()));
+    bound.clear();
+    base.clear();
+    run_first.clear();
+    run_count.clear();
+    next_base = 0;
+  };
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    const std::uint32_t span = layout.span_of_id(first[i]);
+    std::size_t slot = std::find(bound.begin(), bound.end(), span) - bound.begin();
+    if (slot == bound.size()) {
+      const std::int64_t ids = static_cast<std::int64_t>(spans[span].virtual_ids());
+      if (bound.size() == bound_spans_ || next_base + ids > std::numeric_limits<std::int32_t>::max()) flush();
+      slot = bound.size();
+      bound.push_back(span);
+      base.push_back(next_base);
+      next_base += ids;
+    }
+    run_first.push_back(
+        static_cast<GLint>(first[i] - static_cast<std::int64_t>(spans[span].virtual_base) + base[slot]));
+    run_count.push_back(count[i]);
+  }
+  flush();
 }
 
 void Renderer::draw_lines(GLuint program, const Camera& camera, const RenderSettings& s, double aspect,
                           PlanOrder order) {
   plan_and_count(camera, aspect, order, plan_, s.clipping);
   bind_line_program(program, camera, s, aspect);
-  draw_plan(plan_.first, plan_.count);
+  draw_plan(program, plan_.first, plan_.count);
 }
 
 void Renderer::draw_dataset_order(GLuint program, const Camera& camera, const RenderSettings& s, double aspect) {
@@ -292,7 +337,7 @@ void Renderer::draw_dataset_order(GLuint program, const Camera& camera, const Re
   for (const VxlFile* f : files_) stats_.voxels_drawn += f->meta().voxel_count;
   for (std::int32_t ids : count) stats_.segments_drawn += static_cast<std::uint64_t>(ids / 2);  // the level's
   bind_line_program(program, camera, s, aspect);
-  draw_plan(first, count);
+  draw_plan(program, first, count);
 }
 
 void Renderer::composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const {
@@ -395,7 +440,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       glClear(GL_COLOR_BUFFER_BIT);
       glBlendFunc(GL_ZERO, GL_ONE_MINUS_SRC_COLOR);
       bind_line_program(reveal_program_, camera, s, aspect);
-      draw_plan(plan_.first, plan_.count);
+      draw_plan(reveal_program_, plan_.first, plan_.count);
       const GLenum both[2] = {accum, reveal};
       glDrawBuffers(2, both);
       clear_to_base(fbo, width, height, bg);
@@ -419,7 +464,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       glEnable(GL_BLEND);
       glBlendFunc(GL_ONE, GL_ONE);
       bind_line_program(additive_program_, camera, s, aspect);
-      draw_plan(plan_.first, plan_.count);
+      draw_plan(additive_program_, plan_.first, plan_.count);
       clear_to_base(fbo, width, height, bg);
       over_blending();
       glUseProgram(additive_composite_);
@@ -445,10 +490,11 @@ struct Renderer::Pieces {
   RenderSettings settings;
   int width = 0, height = 0;
   GLuint fbo = 0;
-  std::vector<std::int32_t> first, count;  // Kind::Voxels: the frame plan
-  std::size_t next = 0;                    // the first plan voxel not drawn yet
-  std::uint64_t segments = 0, drawn = 0;   // the plan's, and those drawn so far
-  double segments_per_ms = 0;              // measured, 0 until then
+  std::vector<std::int64_t> first;  // Kind::Voxels: the frame plan
+  std::vector<std::int32_t> count;
+  std::size_t next = 0;                   // the first plan voxel not drawn yet
+  std::uint64_t segments = 0, drawn = 0;  // the plan's, and those drawn so far
+  double segments_per_ms = 0;             // measured, 0 until then
   bool done = false;
 };
 
@@ -531,8 +577,9 @@ bool Renderer::draw_piece(double max_ms) {
       std::uint64_t segments = 0;
       do segments += static_cast<std::uint64_t>(p.count[end++] / 2);
       while (end < p.count.size() && double(segments + p.count[end] / 2) <= max_segments);
-      const std::span<const std::int32_t> first(p.first), count(p.count);
-      draw_plan(first.subspan(p.next, end - p.next), count.subspan(p.next, end - p.next));
+      const std::span<const std::int64_t> first(p.first);
+      const std::span<const std::int32_t> count(p.count);
+      draw_plan(over_program_, first.subspan(p.next, end - p.next), count.subspan(p.next, end - p.next));
       glFinish();  // the piece's time includes the GPU's work, for the next piece's size
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       if (segments > 0 && ms > 0) p.segments_per_ms = double(segments) / ms;

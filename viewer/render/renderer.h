@@ -37,7 +37,8 @@ struct FrameStats {
 
 class Renderer {
  public:
-  static constexpr int kSamplersPerSpan = 4;  // words, orders, dataset order, attributes
+  static constexpr int kSamplersPerSpan = 4;        // words, orders, dataset order, attributes
+  static constexpr std::size_t kMaxBoundSpans = 8;  // spans one draw binds (each a branch in the vertex shader)
   // The drawing rate a frame in pieces assumes before it has measured one: about Mesa llvmpipe's on two
   // cores at 1024x1024 (a GPU is faster, so its first piece is merely short).
   static constexpr double kAssumedSegmentsPerMs = 1000;
@@ -122,7 +123,11 @@ class Renderer {
   void plan_and_count(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping);
   // Binds the line program's uniforms and textures for `camera`.
   void bind_line_program(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect) const;
-  void draw_plan(std::span<const std::int32_t> first, std::span<const std::int32_t> count) const;
+  // Draws the virtual-id ranges (first, count) in order with `program` (its other uniforms bound), binding
+  // the spans they lie in a few at a time.
+  void draw_plan(GLuint program, std::span<const std::int64_t> first, std::span<const std::int32_t> count) const;
+  // Binds spans `bound` to the program's span slots, their ids starting at `base` in this draw.
+  void bind_spans(GLuint program, std::span<const std::uint32_t> bound, std::span<const std::int64_t> base) const;
   // Enables the first n of the line shader's clip distances and disables the others (passes without
   // gl_ClipDistance must run with none enabled).
   static void enable_clip_distances(int n);
@@ -136,6 +141,7 @@ class Renderer {
   std::vector<const VxlFile*> files_;
   GpuScene scene_;
   GLuint vao_ = 0;
+  unsigned bound_spans_ = 1;  // span slots of the line programs
   GLuint over_program_ = 0, accum_program_ = 0, reveal_program_ = 0, additive_program_ = 0;
   GLuint wboit_composite_ = 0, additive_composite_ = 0;
   gl::RenderTarget wboit_target_, opaque_target_, additive_target_;

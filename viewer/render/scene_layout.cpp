@@ -68,7 +68,6 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
     throw Error(ErrorKind::Unsupported, files.empty() ? "" : files[0]->path(), std::nullopt,
                 "the files hold more than 2^31 voxels together");
   voxels_.resize(total_voxels);
-  const std::string where = files.empty() ? std::string() : files[0]->path();
 
   for (std::uint32_t fi = 0; fi < files.size(); ++fi) {
     const VxlFile& file = *files[fi];
@@ -88,8 +87,12 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
     fl.level = level_;
     auto wide = [](const LevelEntry& e) { return e.vertex_count > kU16OrderMaxVertices; };
     auto counts = [&](std::uint32_t local) { return file.level(local, level_); };
-    // Both buffers of a span within the limit: its words (4 a texel) and its order entries.
-    auto fits = [&](const TextureSpan& c) { return c.words() / 4 <= max_texels && c.order_entries() <= max_texels; };
+    // Both buffers of a span within the limit: its words (4 a texel) and its order entries; and its ids
+    // within one draw's.
+    auto fits = [&](const TextureSpan& c) {
+      return c.words() / 4 <= max_texels && c.order_entries() <= max_texels &&
+             c.virtual_ids() <= std::uint64_t(std::numeric_limits<std::int32_t>::max() / 2);
+    };
     auto voxels = file.voxels();
     TextureSpan current;
     current.file = fi;
@@ -150,19 +153,16 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
     if (current.voxel_count > 0) close_span();
     files_.push_back(std::move(fl));
   }
-  if (spans_.size() > kMaxTextureSpans)
-    throw Error(ErrorKind::Unsupported, where, std::nullopt,
-                "the scene needs " + std::to_string(spans_.size()) + " GPU texture spans (at most " +
-                    std::to_string(kMaxTextureSpans) + " with a texture-buffer limit of " + std::to_string(max_texels) +
-                    " texels" + (files.size() > 1 ? "; each file takes at least one" : "") + ")");
   for (TextureSpan& c : spans_) {
     c.virtual_base = virtual_ids_;
-    virtual_ids_ += 2 * (2 * std::uint64_t(c.slots) * c.segments + c.vertices + c.segments);
+    virtual_ids_ += c.virtual_ids();
   }
-  if (virtual_ids_ > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
-    throw Error(ErrorKind::Unsupported, where, std::nullopt,
-                "the scene has too many segments x orders for one draw (" + std::to_string(virtual_ids_) +
-                    " vertex ids > 2^31); use fewer stored orders");
+}
+
+std::uint32_t SceneLayout::span_of_id(std::int64_t id) const {
+  const auto after = std::upper_bound(spans_.begin(), spans_.end(), static_cast<std::uint64_t>(id),
+                                      [](std::uint64_t v, const TextureSpan& c) { return v < c.virtual_base; });
+  return static_cast<std::uint32_t>(after - spans_.begin()) - 1;
 }
 
 }  // namespace vxl

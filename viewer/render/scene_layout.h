@@ -3,7 +3,8 @@
 //
 // The voxels of all files form one table (file 0's, then file 1's, ...), so that one frame plan sorts them
 // all together, back to front, interleaved across files. Voxels are grouped into texture spans (contiguous voxel
-// ranges of one file) small enough for the driver's texture-buffer limit. Each span holds, in four texture
+// ranges of one file) small enough for the driver's texture-buffer limit; there may be any number of spans:
+// a draw binds a few at a time (Renderer::draw_plan). Each span holds, in four texture
 // buffers (gpu_scene.h says how each is filled):
 //   words:   RGBA32UI, 4 words a texel: the packed positions (.vxl spec §5.4), each voxel's block starting at a
 //            multiple of kGroup words; then 8 words of decoding info per voxel; then one voxel index per kGroup
@@ -22,8 +23,10 @@
 //   [4A, 4A + 2V)       the block order: segment (v, v + 1) for every vertex v of the span's blocks, dropped
 //                       where v ends its voxline (the packed word's bit 30),
 //   [4A + 2V, .. + 2S)  dataset order,
-// two ids per segment. One glMultiDrawArrays then draws any sequence of voxels, each in any stored order,
-// forwards or backwards, or in block order, with no per-frame work beyond filling the first/count arrays.
+// two ids per segment. The spans' id ranges follow one another ("virtual" ids, 64-bit: the scene's may pass
+// 2^31); a span's own range stays below 2^31, so that a draw of a few spans, rebased, is one
+// glMultiDrawArrays of any sequence of their voxels, each in any stored order, forwards or backwards, or in
+// block order, with no per-frame work beyond filling the first/count arrays.
 #pragma once
 
 #include <cstdint>
@@ -56,6 +59,8 @@ struct TextureSpan {
   std::uint64_t wide_segments = 0;                 // W: the first W entries of each slot have high bits
   std::uint64_t vertices = 0;                      // V, with each voxel's block padded to a multiple of kGroup
   std::uint64_t virtual_base = 0;                  // first virtual vertex id
+  // How many virtual ids the span's four ranges take (below 2^31).
+  std::uint64_t virtual_ids() const { return 2 * (2 * std::uint64_t(slots) * segments + vertices + segments); }
   // Where the parts of the words buffer start, in words (see above); its size in words.
   std::uint64_t info_first() const { return vertices; }
   std::uint64_t segment_table_first() const { return vertices + 8ull * voxel_count; }
@@ -78,8 +83,8 @@ class SceneLayout {
  public:
   // max_texels: the driver's GL_MAX_TEXTURE_BUFFER_SIZE (tests pass small values to force many spans).
   // level: the level of detail to lay out (.vxl spec §5.12; 0: every streamline), the same for every file,
-  // at most the coarsest level all files have. Throws vxl::Error (Unsupported) when the scene needs more
-  // than kMaxTextureSpans texture spans or 2^31 virtual ids.
+  // at most the coarsest level all files have. Throws vxl::Error (Unsupported) when one voxel alone does not
+  // fit a span.
   SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels, std::uint32_t level = 0);
   SceneLayout(const VxlFile& file, std::uint64_t max_texels, std::uint32_t level = 0);
 
@@ -97,7 +102,6 @@ class SceneLayout {
   std::uint32_t level() const { return level_; }
   static float level_opacity(float opacity, std::uint32_t level);
 
-  static constexpr std::uint32_t kMaxTextureSpans = 8;  // each span needs 4 samplers in the vertex shader
   static constexpr std::uint64_t kGroup = TextureSpan::kGroupSize;
 
   // Of the first file (all of a single-file scene): K, DIRS.
@@ -120,6 +124,8 @@ class SceneLayout {
   std::uint32_t file_of(std::uint32_t voxel) const { return spans_[voxels_[voxel].span].file; }
   std::uint32_t local_voxel(std::uint32_t voxel) const { return voxel - files_[file_of(voxel)].voxel_first; }
   std::uint64_t virtual_ids() const { return virtual_ids_; }
+  // The span whose range holds virtual id `id` (< virtual_ids()).
+  std::uint32_t span_of_id(std::int64_t id) const;
   double voxel_size() const { return voxel_size_; }  // the largest of the files'
   // Whether every file's voxels are cells of one grid (same size, origins a whole number of voxels
   // apart): then PlanOrder::Visibility is a visibility order for the whole scene.
