@@ -78,72 +78,135 @@ void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t 
     words[c.vertex_table_first() + g] = index;
 }
 
-GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level)
-    : files_(std::move(files)), layout_(files_, max_texels ? max_texels : driver_limit(), level) {
+GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level,
+                   std::shared_ptr<GpuMemoryPool> pool)
+    : files_(std::move(files)),
+      layout_(files_, max_texels ? max_texels : driver_limit(), level),
+      pool_(pool ? std::move(pool) : std::make_shared<GpuMemoryPool>()),
+      spans_(layout_.texture_spans().size()),
+      resident_(layout_.texture_spans().size(), false),
+      uploaded_bytes_(layout_.texture_spans().size(), 0) {
+  owner_ = pool_->add_owner([this](std::uint32_t c) { evict(c); });
   try {
-    upload_spans();
+    // A scene that fits the budget's free room is uploaded whole now; one that does not, span by span as
+    // frames need them, the nearest first.
+    std::uint64_t whole = 0;
+    for (std::uint32_t c = 0; c < spans_.size(); ++c) whole += span_bytes(c);
+    if (pool_->fits(whole)) {
+      const std::uint64_t use = pool_->begin_use();
+      for (std::uint32_t c = 0; c < spans_.size(); ++c) {
+        upload_span(c);
+        pool_->add(owner_, c, uploaded_bytes_[c], use);
+      }
+    }
   } catch (...) {
     release();  // the spans made so far: no destructor runs for a constructor that throws
+    pool_->remove_owner(owner_);
     throw;
   }
 }
 
-void GpuScene::upload_spans() {
-  for (const TextureSpan& c : layout_.texture_spans()) {
-    const VxlFile& file = *files_[c.file];
-    const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
-    std::vector<std::uint32_t> words(c.words(), 0);
-    std::vector<std::uint16_t> orders(c.order_entries(), 0);
-    // Voxels fill disjoint ranges of every array, so they are uploaded in parallel.
-    std::vector<std::vector<std::uint8_t>> is_start(resolve_threads(0));  // scratch per thread
-    std::vector<std::vector<float>> xyz(resolve_threads(0));
-    parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
-      const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
-      upload_voxel(file, i, i - file_first, static_cast<std::uint32_t>(k), c, words, orders, is_start[t], xyz[t]);
-    });
-    GpuTextureSpan g;
-    g.words.create(GL_RGBA32UI, words.data(), words.size() * 4);
-    g.orders.create(GL_R16UI, orders.data(), orders.size() * 2);
+std::uint64_t GpuScene::span_bytes(std::uint32_t c) const {
+  const TextureSpan& t = layout_.texture_spans()[c];
+  std::uint64_t bytes = 4 * t.words() + 2 * t.order_entries();
+  if (dataset_built_) bytes += 4 * dataset_per_span_[c].size();
+  if (t.file < attributes_.size() && !attributes_[t.file].empty()) bytes += 8 * t.vertices;
+  return bytes;
+}
+
+void GpuScene::upload_span(std::uint32_t ci) {
+  const TextureSpan& c = layout_.texture_spans()[ci];
+  const VxlFile& file = *files_[c.file];
+  const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
+  std::vector<std::uint32_t> words(c.words(), 0);
+  std::vector<std::uint16_t> orders(c.order_entries(), 0);
+  // Voxels fill disjoint ranges of every array, so they are uploaded in parallel.
+  std::vector<std::vector<std::uint8_t>> is_start(resolve_threads(0));  // scratch per thread
+  std::vector<std::vector<float>> xyz(resolve_threads(0));
+  parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
+    const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
+    upload_voxel(file, i, i - file_first, static_cast<std::uint32_t>(k), c, words, orders, is_start[t], xyz[t]);
+  });
+  GpuTextureSpan& g = spans_[ci];
+  g.words.create(GL_RGBA32UI, words.data(), words.size() * 4);
+  g.orders.create(GL_R16UI, orders.data(), orders.size() * 2);
+  if (dataset_built_)
+    g.dataset.create(GL_R32UI, dataset_per_span_[ci].data(), dataset_per_span_[ci].size() * 4);
+  else
     g.dataset.create(GL_R32UI, nullptr, 0);
+  const std::vector<float>* values = c.file < attributes_.size() ? &attributes_[c.file] : nullptr;
+  if (values == nullptr || values->empty()) {
     g.attributes.create(GL_RG32F, nullptr, 0);
-    gpu_bytes_ += words.size() * 4 + orders.size() * 2;
-    spans_.push_back(g);
-  }
-}
-
-GpuScene::~GpuScene() { release(); }
-
-void GpuScene::release() {
-  for (GpuTextureSpan& c : spans_) {
-    c.words.destroy();
-    c.orders.destroy();
-    c.dataset.destroy();
-    c.attributes.destroy();
-  }
-  spans_.clear();
-}
-
-void GpuScene::upload_attributes(const std::vector<std::vector<float>>& per_file) {
-  for (std::size_t i = 0; i < spans_.size(); ++i) {
-    const TextureSpan& c = layout_.texture_spans()[i];
-    GpuTextureSpan& g = spans_[i];
-    g.attributes.destroy();
-    const std::vector<float>* values = c.file < per_file.size() ? &per_file[c.file] : nullptr;
-    if (values == nullptr || values->empty()) {
-      g.attributes.create(GL_RG32F, nullptr, 0);
-      continue;
-    }
+  } else {
     // Two floats per vertex, each voxel's at its block's place in the span (scene_layout.h).
     std::vector<float> padded(2 * c.vertices, 0.0f);
-    const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
     for (std::uint32_t k = 0; k < c.voxel_count; ++k) {
       const VoxelDrawInfo& d = layout_.voxels()[c.voxel_first + k];
-      const VoxelEntry& v = files_[c.file]->voxels()[c.voxel_first + k - file_first];
+      const VoxelEntry& v = file.voxels()[c.voxel_first + k - file_first];
       std::copy_n(values->data() + 2 * v.vertex_first, 2 * std::uint64_t(d.vertex_count),
                   padded.data() + 2 * d.vertex_first);
     }
     g.attributes.create(GL_RG32F, padded.data(), padded.size() * 4);
   }
+  resident_[ci] = true;
+  uploaded_bytes_[ci] = span_bytes(ci);
+  gpu_bytes_ += uploaded_bytes_[ci];
+}
+
+void GpuScene::evict(std::uint32_t c) {
+  if (!resident_[c]) return;
+  gpu_bytes_ -= uploaded_bytes_[c];
+  spans_[c].words.destroy();
+  spans_[c].orders.destroy();
+  spans_[c].dataset.destroy();
+  spans_[c].attributes.destroy();
+  resident_[c] = false;
+}
+
+bool GpuScene::make_resident(std::span<const std::uint32_t> needed) {
+  const std::uint64_t use = pool_->begin_use();
+  for (std::uint32_t c : needed)
+    if (resident_[c]) pool_->touch(owner_, c, use);
+  bool all = true;
+  for (std::uint32_t c : needed) {
+    if (resident_[c]) continue;
+    const std::uint64_t bytes = span_bytes(c);
+    if (!pool_->reserve(bytes, use)) {
+      all = false;
+      continue;
+    }
+    upload_span(c);
+    pool_->add(owner_, c, bytes, use);
+  }
+  return all;
+}
+
+void GpuScene::upload_resident_again() {
+  std::vector<std::uint32_t> again;
+  for (std::uint32_t c = 0; c < spans_.size(); ++c)
+    if (resident_[c]) again.push_back(c);
+  for (std::uint32_t c : again) {
+    pool_->remove(owner_, c);
+    evict(c);
+  }
+  make_resident(again);
+}
+
+GpuScene::~GpuScene() {
+  release();
+  pool_->remove_owner(owner_);
+}
+
+void GpuScene::release() {
+  for (std::uint32_t c = 0; c < spans_.size(); ++c) {
+    if (resident_[c]) pool_->remove(owner_, c);
+    evict(c);
+  }
+}
+
+void GpuScene::upload_attributes(std::vector<std::vector<float>> per_file) {
+  attributes_ = std::move(per_file);
+  upload_resident_again();
 }
 
 const std::vector<std::int64_t>& GpuScene::dataset_first() {
@@ -176,12 +239,9 @@ const std::vector<std::int64_t>& GpuScene::dataset_first() {
       };
       walk_streamlines(*files_[fi], cb);
     }
-    for (std::size_t c = 0; c < spans_.size(); ++c) {
-      spans_[c].dataset.destroy();
-      spans_[c].dataset.create(GL_R32UI, per_span[c].data(), per_span[c].size() * 4);
-      gpu_bytes_ += per_span[c].size() * 4;
-    }
+    dataset_per_span_ = std::move(per_span);
     dataset_built_ = true;
+    upload_resident_again();
   }
   return dataset_first_;
 }

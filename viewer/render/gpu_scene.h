@@ -3,13 +3,22 @@
 // the .vxl spec §5.4 says), the stored orders at 16 bits (32 for voxels of more than 65 536 vertices), each
 // entry checked, and — only when first needed — a dataset-order buffer and per-vertex values. About 4 bytes
 // a vertex and 2 an order entry, where float positions and widened orders took 12 and 4.
+//
+// Spans are uploaded on demand within a GPU memory budget shared with the context's other scenes
+// (gpu_memory_pool.h): as many as fit when the scene is made, then each frame the spans its voxels lie in
+// (make_resident), the least recently used ones of any scene evicted to make room; a frame draws only
+// voxels whose span is resident. Uploading a span again gives the same bytes, so an evicted and
+// re-uploaded span draws the same picture.
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <vector>
 
 #include "format/vxl_file.h"
 #include "viewer/render/gl_util.h"
+#include "viewer/render/gpu_memory_pool.h"
 #include "viewer/render/scene_layout.h"
 
 namespace vxl {
@@ -24,8 +33,10 @@ struct GpuTextureSpan {
 class GpuScene {
  public:
   // Needs a current GL context. max_texels 0: ask the driver (GL_MAX_TEXTURE_BUFFER_SIZE). level: the level
-  // of detail uploaded (scene_layout.h). The files must outlive the scene.
-  GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0, std::uint32_t level = 0);
+  // of detail uploaded (scene_layout.h). pool: the budget shared with other scenes (none: no budget). The
+  // files must outlive the scene.
+  GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0, std::uint32_t level = 0,
+           std::shared_ptr<GpuMemoryPool> pool = nullptr);
   GpuScene(const VxlFile& file, std::uint64_t max_texels = 0, std::uint32_t level = 0)
       : GpuScene(std::vector<const VxlFile*>{&file}, max_texels, level) {}
   // The driver's GL_MAX_TEXTURE_BUFFER_SIZE (needs a current context).
@@ -35,19 +46,35 @@ class GpuScene {
   GpuScene& operator=(const GpuScene&) = delete;
 
   const SceneLayout& layout() const { return layout_; }
+  // Span c's buffers (empty while it is not resident).
   const std::vector<GpuTextureSpan>& texture_spans() const { return spans_; }
+  bool resident(std::uint32_t span) const { return resident_[span]; }
+  // The GPU memory the resident spans take.
   std::uint64_t gpu_bytes() const { return gpu_bytes_; }
+  const GpuMemoryPool& pool() const { return *pool_; }
 
-  // Replaces every span's attribute buffer with its vertices' share of its file's `per_file` entry (2 floats
-  // per vertex of that file, vertex_attributes.h); an empty vector empties them.
-  void upload_attributes(const std::vector<std::vector<float>>& per_file);
+  // Uploads the spans in `needed` that are not resident, in that order (the most important first), evicting
+  // the least recently used spans of the pool's scenes that `needed` does not hold; a span that does not fit
+  // stays out. Returns whether every span of `needed` is resident.
+  bool make_resident(std::span<const std::uint32_t> needed);
 
-  // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)).
+  // Gives every span its vertices' share of its file's `per_file` entry (2 floats per vertex of that file,
+  // vertex_attributes.h) as its attribute buffer; an empty vector empties them. Resident spans are uploaded
+  // again (their size changes).
+  void upload_attributes(std::vector<std::vector<float>> per_file);
+
+  // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)); each span's
+  // dataset array joins its upload.
   const std::vector<std::int64_t>& dataset_first();
   const std::vector<std::int32_t>& dataset_count();
 
  private:
-  void upload_spans();
+  // The bytes span c takes on the GPU with its current attributes and dataset order.
+  std::uint64_t span_bytes(std::uint32_t c) const;
+  void upload_span(std::uint32_t c);
+  void evict(std::uint32_t c);
+  // Uploads the resident spans again (after their attributes or dataset order changed), within the budget.
+  void upload_resident_again();
   void release();
   // Voxel `voxel` of the scene (`local` in its file, `index` in its span): its words, info, table entries
   // and orders into the span's arrays.
@@ -56,9 +83,15 @@ class GpuScene {
                     std::vector<std::uint8_t>& is_start, std::vector<float>& xyz) const;
   std::vector<const VxlFile*> files_;
   SceneLayout layout_;
+  std::shared_ptr<GpuMemoryPool> pool_;
+  std::uint32_t owner_ = 0;  // this scene in the pool
   std::vector<GpuTextureSpan> spans_;
+  std::vector<bool> resident_;
+  std::vector<std::uint64_t> uploaded_bytes_;  // per resident span, as the pool counts it
   std::uint64_t gpu_bytes_ = 0;
+  std::vector<std::vector<float>> attributes_;  // per file, as upload_attributes got them
   bool dataset_built_ = false;
+  std::vector<std::vector<std::uint32_t>> dataset_per_span_;
   std::vector<std::int64_t> dataset_first_;
   std::vector<std::int32_t> dataset_count_;
 };

@@ -20,9 +20,10 @@ namespace vxl {
 Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels, std::uint32_t level)
     : Renderer(std::vector<const VxlFile*>{&file}, max_texels, level) {}
 
-Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level)
+Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level,
+                   std::shared_ptr<GpuMemoryPool> pool)
     : files_(files.empty() ? throw Error(ErrorKind::Usage, "", std::nullopt, "Renderer: no files") : files),
-      scene_(files_, max_texels, level),
+      scene_(files_, max_texels, level, std::move(pool)),
       groups_(files_) {
   const VxlFile& file = *files_.front();
   for (const VxlFile* f : files_)
@@ -125,9 +126,38 @@ void Renderer::plan_and_count(const Camera& camera, double aspect, PlanOrder ord
                               const Clipping& clipping) {
   auto t0 = std::chrono::steady_clock::now();
   plan(camera, aspect, order, out, clipping);
+  keep_resident(out);
   stats_.plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.voxels_drawn = out.voxels_drawn;
   stats_.segments_drawn = out.segments_drawn;
+}
+
+void Renderer::keep_resident(FramePlan& plan) {
+  const SceneLayout& layout = scene_.layout();
+  // The spans the plan's voxels lie in, those of the nearest voxels first (a sorted plan is back to front).
+  std::vector<std::uint32_t> needed;
+  std::vector<bool> seen(layout.texture_spans().size(), false);
+  for (std::size_t i = plan.first.size(); i-- > 0;) {
+    const std::uint32_t span = layout.span_of_id(plan.first[i]);
+    if (!seen[span]) needed.push_back(span);
+    seen[span] = true;
+  }
+  stats_.voxels_waiting = 0;
+  if (scene_.make_resident(needed)) return;
+  // The budget holds only some: draw the voxels whose span is resident, in the plan's order.
+  std::size_t kept = 0;
+  plan.segments_drawn = 0;
+  for (std::size_t i = 0; i < plan.first.size(); ++i) {
+    if (!scene_.resident(layout.span_of_id(plan.first[i]))) continue;
+    plan.first[kept] = plan.first[i];
+    plan.count[kept] = plan.count[i];
+    plan.segments_drawn += static_cast<std::uint64_t>(plan.count[i] / 2);
+    ++kept;
+  }
+  stats_.voxels_waiting = plan.first.size() - kept;
+  plan.first.resize(kept);
+  plan.count.resize(kept);
+  plan.voxels_drawn = kept;
 }
 
 void Renderer::prepare(RenderMode mode) {
@@ -229,14 +259,13 @@ void Renderer::prepare_attributes(const RenderSettings& s) {
   for (std::size_t g = 0; g < groups.size(); ++g) want_groups |= s.group_color(groups[g].name, g).a != 1.0f;
   const std::string key = (name.empty() ? "" : "value:" + name) + (want_groups ? "|groups" : "");
   if (key == attributes_key_) return;
-  attributes_key_.clear();
-  scene_.upload_attributes({});
-  if (key.empty()) return;
   std::vector<std::vector<float>> per_file;
-  for (std::size_t i = 0; i < files_.size(); ++i)
-    per_file.push_back(vertex_attributes(*files_[i], i, name.empty() ? ValueSource{} : find_value_set(*files_[i], name),
-                                         want_groups ? &groups_ : nullptr));
-  scene_.upload_attributes(per_file);
+  if (!key.empty())
+    for (std::size_t i = 0; i < files_.size(); ++i)
+      per_file.push_back(vertex_attributes(*files_[i], i,
+                                           name.empty() ? ValueSource{} : find_value_set(*files_[i], name),
+                                           want_groups ? &groups_ : nullptr));
+  scene_.upload_attributes(std::move(per_file));
   attributes_key_ = key;
 }
 
@@ -330,14 +359,16 @@ void Renderer::draw_lines(GLuint program, const Camera& camera, const RenderSett
 }
 
 void Renderer::draw_dataset_order(GLuint program, const Camera& camera, const RenderSettings& s, double aspect) {
-  const auto& first = scene_.dataset_first();
-  const auto& count = scene_.dataset_count();
+  FramePlan dataset;  // runs of the streamline order, one span each
+  dataset.first = scene_.dataset_first();
+  dataset.count = scene_.dataset_count();
+  keep_resident(dataset);
   stats_.plan_ms = 0;
   stats_.voxels_drawn = stats_.segments_drawn = 0;
   for (const VxlFile* f : files_) stats_.voxels_drawn += f->meta().voxel_count;
-  for (std::int32_t ids : count) stats_.segments_drawn += static_cast<std::uint64_t>(ids / 2);  // the level's
+  for (std::int32_t ids : dataset.count) stats_.segments_drawn += static_cast<std::uint64_t>(ids / 2);  // the level's
   bind_line_program(program, camera, s, aspect);
-  draw_plan(program, first, count);
+  draw_plan(program, dataset.first, dataset.count);
 }
 
 void Renderer::composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const {

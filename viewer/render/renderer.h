@@ -30,9 +30,10 @@ class SliceRenderer;
 struct Volume;
 
 struct FrameStats {
-  double plan_ms = 0;  // CPU work of the frame: cull + sort + order pick + command building
+  double plan_ms = 0;  // CPU work of the frame: cull + sort + order pick + uploads + command building
   std::uint64_t voxels_drawn = 0;
   std::uint64_t segments_drawn = 0;
+  std::uint64_t voxels_waiting = 0;  // visible but not drawn: their span did not fit the GPU memory budget
 };
 
 class Renderer {
@@ -46,7 +47,10 @@ class Renderer {
   // Several files drawn as one scene: one sort over all their voxels, one group per file. The files must
   // outlive the renderer. level: the level of detail drawn (.vxl spec §5.12; scene_layout.h), its opacity
   // compensated so that the picture keeps its brightness.
-  explicit Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0, std::uint32_t level = 0);
+  // pool: the GPU memory budget shared with the context's other renderers (gpu_memory_pool.h; none: no
+  // budget). A frame draws the visible voxels whose span the budget holds, the nearest first.
+  explicit Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0, std::uint32_t level = 0,
+                    std::shared_ptr<GpuMemoryPool> pool = nullptr);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -88,6 +92,8 @@ class Renderer {
   // it), and the GPU memory the scene takes.
   const SceneLayout& layout() const { return scene_.layout(); }
   std::uint64_t gpu_bytes() const { return scene_.gpu_bytes(); }
+  const GpuMemoryPool& gpu_memory() const { return scene_.pool(); }
+  bool span_resident(std::uint32_t span) const { return scene_.resident(span); }
   // Uploads what `mode` builds on its first frame (the unsorted mode's dataset order), so that a timed frame
   // does not include it.
   void prepare(RenderMode mode);
@@ -119,7 +125,10 @@ class Renderer {
   void clear_to_base(GLuint fbo, int width, int height, const glm::vec3& background) const;
   // The blend state of the over-compositing modes (basic, axis; docs/rendering.md, pitfall 1).
   static void over_blending();
-  // plan(), recording the frame's CPU time and counts in stats().
+  // Makes the spans of the plan's voxels resident, the nearest first, and drops the voxels of those that
+  // do not fit the budget.
+  void keep_resident(FramePlan& plan);
+  // plan() for drawing: the spans made resident (keep_resident), the frame's CPU time and counts in stats().
   void plan_and_count(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping);
   // Binds the line program's uniforms and textures for `camera`.
   void bind_line_program(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect) const;

@@ -1,0 +1,188 @@
+// The GPU memory budget (gpu_memory_pool.h, GpuScene::make_resident): never exceeded, the nearest visible
+// spans first, the least recently used evicted, and an evicted span draws the same picture once uploaded
+// again.
+#include <memory>
+
+#include "converter/synth.h"
+#include "format/error.h"
+#include "tests/viewer/render_support.h"
+#include "viewer/platform/image_metrics.h"
+#include "viewer/render/gpu_memory_pool.h"
+
+namespace vxl {
+namespace {
+
+using test::gl_context;
+using test::lit_pixels;
+using test::make_scene;
+using test::render_image;
+using test::ScratchDir;
+
+TEST(GpuMemoryPool, EvictsTheLeastRecentlyUsedThatTheCurrentUseDoesNotNeed) {
+  GpuMemoryPool pool(100);
+  std::vector<std::uint32_t> evicted;
+  const std::uint32_t a = pool.add_owner([&](std::uint32_t piece) { evicted.push_back(piece); });
+  std::uint64_t use = pool.begin_use();
+  for (std::uint32_t piece = 0; piece < 4; ++piece) {
+    ASSERT_TRUE(pool.reserve(25, use));
+    pool.add(a, piece, 25, use);
+  }
+  EXPECT_EQ(pool.used(), 100u);
+  EXPECT_FALSE(pool.reserve(1, use)) << "every piece is in use";
+  EXPECT_TRUE(evicted.empty()) << "a refused reservation evicts nothing";
+  use = pool.begin_use();
+  pool.touch(a, 0, use);  // 0 is needed now; 1 is the least recently used of the others
+  ASSERT_TRUE(pool.reserve(30, use));
+  EXPECT_EQ(evicted, (std::vector<std::uint32_t>{1, 2}));
+  pool.add(a, 9, 30, use);
+  EXPECT_EQ(pool.used(), 80u);
+  EXPECT_EQ(pool.peak(), 100u);
+  EXPECT_EQ(pool.evictions(), 2u);
+  EXPECT_FALSE(pool.reserve(101, pool.begin_use())) << "larger than the budget";
+  pool.remove(a, 9);
+  EXPECT_EQ(pool.used(), 50u);
+}
+
+TEST(GpuMemoryPool, OwnersShareOneBudget) {
+  GpuMemoryPool pool(50);
+  std::vector<std::uint32_t> evicted_a, evicted_b;
+  const std::uint32_t a = pool.add_owner([&](std::uint32_t p) { evicted_a.push_back(p); });
+  const std::uint32_t b = pool.add_owner([&](std::uint32_t p) { evicted_b.push_back(p); });
+  std::uint64_t use = pool.begin_use();
+  ASSERT_TRUE(pool.reserve(40, use));
+  pool.add(a, 7, 40, use);
+  use = pool.begin_use();
+  ASSERT_TRUE(pool.reserve(40, use));  // b's first piece evicts a's
+  pool.add(b, 3, 40, use);
+  EXPECT_EQ(evicted_a, (std::vector<std::uint32_t>{7}));
+  EXPECT_TRUE(evicted_b.empty());
+  EXPECT_LE(pool.peak(), 50u);
+  pool.remove_owner(b);
+  EXPECT_EQ(pool.used(), 0u);
+}
+
+// A scene of many small spans under a budget that holds part of it. The voxel table is sorted by (z, y, x)
+// and spans are ranges of it, so a clip plane near the bottom or the top keeps a few spans.
+class GpuMemoryBudget : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    gl_context();
+    SynthSettings synth;
+    synth.streamlines = 2000;
+    file_.emplace(make_scene(dir_, synthesize_tractogram(synth), 12.0));
+    // Small spans: twice the smallest limit that holds the largest voxel.
+    for (kTexels = 1000;; kTexels *= 2) try {
+        SceneLayout(*file_, kTexels, 0);
+        break;
+      } catch (const vxl::Error&) {
+      }
+    kTexels *= 2;
+  }
+  std::uint64_t kTexels = 0;
+  Camera view() const {
+    Camera c;
+    c.azimuth_deg = 30;
+    c.elevation_deg = 10;
+    const MetaSection& m = file_->meta();
+    c.frame({m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]}, {m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]},
+            1.0);
+    return c;
+  }
+  // Axis mode, only what lies within 30 mm of the bottom (or the top).
+  RenderSettings near(bool bottom) const {
+    RenderSettings s;
+    s.opacity = 0.3f;
+    AxisClip p;
+    p.axis = 2;
+    p.keep_above = !bottom;
+    p.position = bottom ? file_->meta().bounds_min[2] + 30 : file_->meta().bounds_max[2] - 30;
+    s.clipping.planes.push_back(p);
+    return s;
+  }
+  std::uint64_t whole_bytes() const { return SceneLayout(*file_, kTexels, 0).upload_bytes(); }
+  ScratchDir dir_;
+  std::optional<VxlFile> file_;
+};
+
+TEST_F(GpuMemoryBudget, TheBudgetIsNeverExceededAndTheNearestSpansComeFirst) {
+  const auto pool = std::make_shared<GpuMemoryPool>(whole_bytes() / 3);
+  Renderer r({&*file_}, kTexels, 0, pool);
+  ASSERT_GT(r.layout().texture_spans().size(), 8u);
+  EXPECT_LE(r.gpu_bytes(), pool->budget()) << "made within the budget";
+  RenderSettings whole;
+  whole.opacity = 0.3f;
+  const Image img = render_image(r, view(), whole, 96, 96);
+  EXPECT_GT(lit_pixels(img), 300);
+  EXPECT_GT(r.stats().voxels_waiting, 0u) << "a third of the scene's spans cannot hold every visible voxel";
+  EXPECT_GT(r.stats().voxels_drawn, 0u);
+  // The spans were uploaded nearest voxel first (the plan is back to front), each that still fit.
+  FramePlan plan;
+  r.plan(view(), 1.0, PlanOrder::Nearest, plan);
+  ASSERT_FALSE(plan.first.empty());
+  EXPECT_TRUE(r.span_resident(r.layout().span_of_id(plan.first.back())));
+  std::vector<bool> seen(r.layout().texture_spans().size(), false);
+  std::uint64_t used = 0;
+  int waiting = 0;
+  for (std::size_t i = plan.first.size(); i-- > 0;) {
+    const std::uint32_t c = r.layout().span_of_id(plan.first[i]);
+    if (seen[c]) continue;
+    seen[c] = true;
+    const TextureSpan& t = r.layout().texture_spans()[c];
+    const std::uint64_t bytes = 4 * t.words() + 2 * t.order_entries();
+    const bool fits = used + bytes <= pool->budget();
+    if (fits) used += bytes;
+    waiting += fits ? 0 : 1;
+    EXPECT_EQ(r.span_resident(c), fits) << "span " << c;
+  }
+  EXPECT_GT(waiting, 0);
+  for (bool bottom : {true, false, true}) render_image(r, view(), near(bottom), 96, 96);
+  EXPECT_LE(pool->peak(), pool->budget());
+  EXPECT_LE(r.gpu_bytes(), pool->budget());
+  EXPECT_EQ(r.gpu_bytes(), pool->used());
+}
+
+TEST_F(GpuMemoryBudget, EvictedSpansDrawTheSamePictureWhenUploadedAgain) {
+  const auto unlimited = std::make_shared<GpuMemoryPool>();
+  Renderer reference({&*file_}, kTexels, 0, unlimited);
+  const Image bottom_reference = render_image(reference, view(), near(true), 96, 96);
+  ASSERT_GT(lit_pixels(bottom_reference), 100);
+
+  // A budget for the bottom's spans or the top's, not both.
+  Renderer probe({&*file_}, kTexels, 0, std::make_shared<GpuMemoryPool>(0));
+  render_image(probe, view(), near(true), 96, 96);
+  FramePlan bottom_plan, top_plan;
+  probe.plan(view(), 1.0, PlanOrder::Nearest, bottom_plan, near(true).clipping);
+  probe.plan(view(), 1.0, PlanOrder::Nearest, top_plan, near(false).clipping);
+  auto bytes_of = [&](const FramePlan& p) {
+    std::vector<bool> seen(probe.layout().texture_spans().size(), false);
+    std::uint64_t bytes = 0;
+    for (std::int64_t id : p.first) {
+      const std::uint32_t c = probe.layout().span_of_id(id);
+      if (seen[c]) continue;
+      seen[c] = true;
+      const TextureSpan& t = probe.layout().texture_spans()[c];
+      bytes += 4 * t.words() + 2 * t.order_entries();
+    }
+    return bytes;
+  };
+  const std::uint64_t budget = std::max(bytes_of(bottom_plan), bytes_of(top_plan));
+  ASSERT_LT(budget, whole_bytes()) << "the test needs views that do not take the whole scene";
+
+  const auto pool = std::make_shared<GpuMemoryPool>(budget);
+  Renderer r({&*file_}, kTexels, 0, pool);
+  const Image first = render_image(r, view(), near(true), 96, 96);
+  EXPECT_EQ(r.stats().voxels_waiting, 0u);
+  const std::uint64_t evictions = pool->evictions(), additions = pool->additions();
+  const Image top = render_image(r, view(), near(false), 96, 96);
+  EXPECT_EQ(r.stats().voxels_waiting, 0u);
+  EXPECT_GT(pool->evictions(), evictions) << "the top's spans made room by evicting the bottom's";
+  const Image again = render_image(r, view(), near(true), 96, 96);
+  EXPECT_GT(pool->additions(), additions + 1) << "the bottom's spans were uploaded again";
+  EXPECT_EQ(compare_images(first, again).differing_pixels, 0u);
+  EXPECT_EQ(compare_images(first, bottom_reference).differing_pixels, 0u) << "and it is the unbudgeted picture";
+  EXPECT_LE(pool->peak(), budget);
+  EXPECT_GT(lit_pixels(top), 100);
+}
+
+}  // namespace
+}  // namespace vxl
