@@ -186,5 +186,34 @@ TEST_F(LevelsOfDetail, VoxviewDrawsTheFinestLevelItsBudgetAllows) {
   EXPECT_FALSE(std::filesystem::exists(png));
 }
 
+// 10M-class behaviour at a small scale: a budget that holds only a coarse level of the whole scene still
+// draws a thin slab of it in full detail, since only the spans the slab's voxels lie in are uploaded.
+TEST_F(LevelsOfDetail, VoxviewDrawsAThinSlabInFullDetailUnderABudgetTooSmallForTheWhole) {
+  const VxlFile f = file();
+  const std::vector<const VxlFile*> files = {&f};
+  const std::uint64_t texels = std::max<std::uint64_t>(4096, SceneLayout::largest_voxel_texels(files));
+  const std::uint64_t full = SceneLayout(files, texels, 0).upload_bytes();
+  const std::string scene = dir.file("scene.vxl");
+  auto voxview = [&](const std::string& png, const std::string& args) {
+    return test::run_program(VOXVIEW_CLI, "'" + scene + "' --render '" + dir.file(png) +
+                                              "' --size 96x96 --view axial --slab 4 --span-texels 4096 " + args);
+  };
+  auto r = voxview("budget.png", "--gpu-memory " + std::to_string(full / 2));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("drawing level 0: the visible part fits the GPU memory budget"), std::string::npos)
+      << r.output;
+  r = voxview("whole.png", "--level 0");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Image budget = read_image(dir.file("budget.png")), whole = read_image(dir.file("whole.png"));
+  EXPECT_GT(test::lit_pixels(whole), 200);
+  EXPECT_EQ(compare_images(budget, whole).differing_pixels, 0u) << "every visible voxel drawn, at full detail";
+  // Without the slab the same budget takes a coarser level.
+  r = test::run_program(VOXVIEW_CLI, "'" + scene + "' --render '" + dir.file("all.png") +
+                                         "' --size 96x96 --view axial --span-texels 4096 --gpu-memory " +
+                                         std::to_string(full / 2));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("drawing level 1"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace vxl

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <optional>
 
+#include "converter/memory_size.h"
 #include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/scene_detail.h"
@@ -54,27 +56,46 @@ int run_headless(const ViewerOptions& o) {
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);  // before any GL work: a bad image fails fast
   HeadlessGlContext context;
-  const SceneDetail detail = choose_scene_detail(pointers(files), o.level, o.gpu_memory, GpuScene::driver_limit());
-  if (const std::string note = describe_scene_detail(detail, SceneLayout::coarsest_level(pointers(files)) + 1);
-      !note.empty())
-    std::fprintf(stderr, "voxview: %s\n", note.c_str());
-  Renderer renderer(pointers(files), 0, detail.level);
-  if (volume) renderer.set_volume(*volume);
+  const std::uint64_t texels = span_texels(pointers(files), o.span_texels);
+  const SceneDetail detail = choose_scene_detail(pointers(files), o.level, o.gpu_memory, texels);
+  const auto gpu_memory = std::make_shared<GpuMemoryPool>(detail.budget);
+  const double aspect = double(o.width) / o.height;
+  // The level whose whole copy fits the budget, or for one view (not a turntable, not --level) the finest
+  // level whose visible part fits: a slab or a close view of a large scene is drawn in more detail.
+  std::unique_ptr<Renderer> renderer;
+  std::optional<Camera> camera;
+  const bool per_view = !detail.forced && o.turntable <= 1 && detail.level > 0;
+  for (std::uint32_t level = per_view ? 0 : detail.level;; ++level) {
+    renderer = std::make_unique<Renderer>(pointers(files), texels, level, gpu_memory);
+    if (volume) renderer->set_volume(*volume);
+    if (!camera) camera = initial_camera(framing_points(renderer->layout()), o, aspect);
+    if (level >= detail.level) {
+      if (const std::string note = describe_scene_detail(detail, SceneLayout::coarsest_level(pointers(files)) + 1);
+          !note.empty())
+        std::fprintf(stderr, "voxview: %s\n", note.c_str());
+      break;
+    }
+    if (renderer->view_bytes(*camera, aspect, o.settings.clipping) <= detail.budget) {
+      std::fprintf(stderr,
+                   "voxview: drawing level %u: the visible part fits the GPU memory budget of %s (the whole scene "
+                   "needs level %u)\n",
+                   level, format_memory_size(detail.budget).c_str(), detail.level);
+      break;
+    }
+  }
   volume.reset();
-  check_color_options(o.inputs_name(), renderer, o.settings);
+  check_color_options(o.inputs_name(), *renderer, o.settings);
   OffscreenTarget target(o.width, o.height);
   target.bind();
-  const double aspect = double(o.width) / o.height;
-  const Camera camera = initial_camera(framing_points(renderer.layout()), o, aspect);
-  if (o.save_camera) write_view(*o.save_camera, SavedView{camera, o.settings, std::array<int, 2>{o.width, o.height}});
+  if (o.save_camera) write_view(*o.save_camera, SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}});
   const int frames = std::max(1, o.turntable);
   for (int i = 0; i < frames; ++i) {
-    renderer.draw(turntable_camera(camera, i, frames), o.settings, o.width, o.height, target.framebuffer());
+    renderer->draw(turntable_camera(*camera, i, frames), o.settings, o.width, o.height, target.framebuffer());
     std::vector<std::uint8_t> rgba = target.read_rgba();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::string png = o.turntable ? turntable_frame_path(*o.render_png, i, frames) : *o.render_png;
     write_png(png, o.width, o.height, rgba);
-    const FrameStats& s = renderer.stats();
+    const FrameStats& s = renderer->stats();
     std::printf("%s: %dx%d %s, %llu voxels and %llu segments drawn, %s after %.3f s (%s)\n", png.c_str(), o.width,
                 o.height, render_mode_name(o.settings.mode), (unsigned long long)s.voxels_drawn,
                 (unsigned long long)s.segments_drawn, i == 0 ? "first frame" : "frame", seconds,

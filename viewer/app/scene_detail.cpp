@@ -8,6 +8,7 @@
 #include "converter/memory_available.h"
 #include "converter/memory_size.h"
 #include "format/error.h"
+#include "viewer/render/gpu_scene.h"
 #include "viewer/render/scene_layout.h"
 
 namespace vxl::app {
@@ -55,6 +56,10 @@ SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::o
   }
   d.level = SceneLayout::finest_level_within(files, max_texels, d.budget);
   return d;
+}
+
+std::uint64_t span_texels(const std::vector<const VxlFile*>& files, std::uint64_t wanted) {
+  return std::min(GpuScene::driver_limit(), std::max(wanted, SceneLayout::largest_voxel_texels(files)));
 }
 
 std::string describe_scene_detail(const SceneDetail& d, std::uint32_t levels_in_files) {

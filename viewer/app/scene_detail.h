@@ -24,6 +24,10 @@ struct SceneDetail {
 SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::optional<std::uint32_t> level,
                                 std::optional<std::uint64_t> gpu_memory, std::uint64_t max_texels);
 
+// The most texels a GPU texture span may hold: `wanted` (--span-texels), raised to what the largest voxel
+// needs, within the driver's texture-buffer limit (needs a current GL context).
+std::uint64_t span_texels(const std::vector<const VxlFile*>& files, std::uint64_t wanted);
+
 // One line for the user when the scene is drawn at a coarse level; empty at full detail.
 std::string describe_scene_detail(const SceneDetail& detail, std::uint32_t levels_in_files);
 

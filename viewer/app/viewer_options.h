@@ -30,8 +30,11 @@ struct ViewerOptions {
   // (--gpu-memory, else a share of what the driver reports; scene_detail.h).
   std::optional<std::uint32_t> level;
   std::optional<std::uint64_t> gpu_memory;  // bytes
-  bool verify = false;                      // --verify: check every .vxl in full (as `voxlines verify`) before drawing
-  std::vector<std::string> tsf;             // per-point values for a .tck converted in memory
+  // The most texels a GPU texture span holds (the driver's limit when smaller): the granule a tight budget
+  // uploads and evicts (gpu_scene.h).
+  std::uint64_t span_texels = std::uint64_t(1) << 22;
+  bool verify = false;           // --verify: check every .vxl in full (as `voxlines verify`) before drawing
+  std::vector<std::string> tsf;  // per-point values for a .tck converted in memory
   // Window: while the camera moves, draw the finest level whose measured frame time fits this budget
   // (frame_budget.h); at rest, the scene's level. 0: no budget.
   double frame_budget_ms = 100;

@@ -148,6 +148,12 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                  "Default: half the free memory the driver reports, or a quarter of the available RAM on a driver "
                  "that reports none (Mesa llvmpipe)")
       ->type_name("SIZE");
+  cli.add_option("--span-texels", a.options.span_texels,
+                 "the most texels one GPU texture span holds (at most the driver's texture-buffer limit): the "
+                 "granule that a GPU memory budget too small for the whole scene uploads and evicts, nearest "
+                 "visible spans first")
+      ->default_val(std::uint64_t(1) << 22)
+      ->check(CLI::Range(std::uint64_t(1024), std::uint64_t(1) << 31));
   cli.add_option("--level", a.options.level,
                  "draw this level of detail (0: every streamline; level d keeps about 1/8^d of them), whatever the "
                  "GPU memory budget; at most the file's coarsest level")

@@ -194,7 +194,10 @@ class ViewerWindow {
   GLFWwindow* window_;
   std::vector<const VxlFile*> files_;
   const Volume* volume_;
-  SceneDetail detail_;  // the level of detail drawn at rest
+  std::uint64_t texels_;  // the most a GPU texture span holds
+  SceneDetail detail_;    // the level of detail drawn at rest
+  // The GPU memory budget every level's renderer shares: together they never take more.
+  std::shared_ptr<GpuMemoryPool> gpu_memory_;
   // One renderer per level drawn, made on first use: the first picture's (coarse, so that it comes at once),
   // the scene's (at rest), and coarser ones while the camera moves.
   std::map<std::uint32_t, std::unique_ptr<Renderer>> renderers_;
@@ -230,7 +233,9 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
       window_(window),
       files_(pointers(files)),
       volume_(volume),
-      detail_(choose_scene_detail(files_, o.level, o.gpu_memory, GpuScene::driver_limit())),
+      texels_(span_texels(files_, o.span_texels)),
+      detail_(choose_scene_detail(files_, o.level, o.gpu_memory, texels_)),
+      gpu_memory_(std::make_shared<GpuMemoryPool>(detail_.budget)),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
       start_(start),
       rest_(false, o.exact_when_still),
@@ -451,7 +456,7 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
 Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
   std::unique_ptr<Renderer>& r = renderers_[std::max(level, detail_.level)];
   if (!r) {
-    r = std::make_unique<Renderer>(files_, 0, level);
+    r = std::make_unique<Renderer>(files_, texels_, level, gpu_memory_);
     if (volume_) r->set_volume(*volume_);
   }
   return *r;

@@ -122,6 +122,20 @@ void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FrameP
   plan_frame(scene_.layout(), view, order, out);
 }
 
+std::uint64_t Renderer::view_bytes(const Camera& camera, double aspect, const Clipping& clipping) const {
+  FramePlan visible;
+  plan(camera, aspect, PlanOrder::Any, visible, clipping);
+  const SceneLayout& layout = scene_.layout();
+  std::vector<bool> seen(layout.texture_spans().size(), false);
+  std::uint64_t bytes = 0;
+  for (std::int64_t id : visible.first) {
+    const std::uint32_t span = layout.span_of_id(id);
+    if (!seen[span]) bytes += layout.span_upload_bytes(span);
+    seen[span] = true;
+  }
+  return bytes;
+}
+
 void Renderer::plan_and_count(const Camera& camera, double aspect, PlanOrder order, FramePlan& out,
                               const Clipping& clipping) {
   auto t0 = std::chrono::steady_clock::now();

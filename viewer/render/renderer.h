@@ -112,6 +112,9 @@ class Renderer {
   // The frame plan for `camera`: voxels outside the frustum or the slab / clip planes of `clipping` culled.
   // A query: stats() keeps describing the last frame drawn.
   void plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping = {}) const;
+  // The most GPU memory a frame of `camera` with `clipping` can need: the spans its visible voxels lie in,
+  // with everything a mode may upload for them (SceneLayout::span_upload_bytes).
+  std::uint64_t view_bytes(const Camera& camera, double aspect, const Clipping& clipping = {}) const;
 
  private:
   // The exact mode is a part of the renderer kept in its own file: it draws with the line program.

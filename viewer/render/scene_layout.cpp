@@ -31,9 +31,31 @@ std::uint32_t SceneLayout::coarsest_level(std::span<const VxlFile* const> files)
   return files.empty() ? 0 : coarsest;
 }
 
+std::uint64_t SceneLayout::largest_voxel_texels(std::span<const VxlFile* const> files) {
+  std::uint64_t largest = 0;
+  auto padded = [](std::uint64_t n) { return (n + kGroup - 1) / kGroup * kGroup; };
+  for (const VxlFile* f : files)
+    for (std::uint32_t i = 0; i < f->voxels().size(); ++i) {
+      const LevelEntry e = f->level(i, 0);  // level 0 holds the most
+      TextureSpan alone;
+      alone.slots = f->meta().stored_order_count;
+      alone.voxel_count = 1;
+      alone.vertices = padded(e.vertex_count);
+      alone.segments = padded(e.segment_count);
+      alone.wide_segments = e.vertex_count > kU16OrderMaxVertices ? alone.segments : 0;
+      largest = std::max({largest, alone.words() / 4, alone.order_entries()});
+    }
+  return largest;
+}
+
+std::uint64_t SceneLayout::span_upload_bytes(std::uint32_t span) const {
+  const TextureSpan& c = spans_[span];
+  return 4 * c.words() + 2 * c.order_entries() + 4 * c.segments + 8 * c.vertices;
+}
+
 std::uint64_t SceneLayout::upload_bytes() const {
   std::uint64_t bytes = 0;
-  for (const TextureSpan& c : spans_) bytes += 4 * c.words() + 2 * c.order_entries() + 4 * c.segments + 8 * c.vertices;
+  for (std::uint32_t c = 0; c < spans_.size(); ++c) bytes += span_upload_bytes(c);
   return bytes;
 }
 

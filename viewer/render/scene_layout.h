@@ -88,6 +88,8 @@ class SceneLayout {
   SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels, std::uint32_t level = 0);
   SceneLayout(const VxlFile& file, std::uint64_t max_texels, std::uint32_t level = 0);
 
+  // The texels the largest voxel's span takes at full detail: the smallest max_texels every level fits.
+  static std::uint64_t largest_voxel_texels(std::span<const VxlFile* const> files);
   // The coarsest level every file has (0 when one has no levels).
   static std::uint32_t coarsest_level(std::span<const VxlFile* const> files);
   // The finest level whose layout fits the limits and whose GPU copy (upload_bytes) is at most `budget`
@@ -97,6 +99,8 @@ class SceneLayout {
   // The most the GPU copy of this layout can take, in bytes: words and orders of every span, plus the
   // dataset order and the per-vertex attributes that some modes upload on first use.
   std::uint64_t upload_bytes() const;
+  // The same for one span.
+  std::uint64_t span_upload_bytes(std::uint32_t span) const;
   // The level the scene is drawn at, and the opacity that makes a segment of it stand for the 8^level
   // segments of full detail it samples (.vxl spec §6.5): 1 - (1 - opacity)^(8^level).
   std::uint32_t level() const { return level_; }
