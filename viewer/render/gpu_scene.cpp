@@ -146,8 +146,44 @@ void GpuScene::upload_attributes(const std::vector<std::vector<float>>& per_file
   }
 }
 
+void GpuScene::replace_dataset(const std::vector<const std::vector<std::uint32_t>*>& per_span,
+                               const std::vector<std::uint64_t>& sizes, DatasetContent content) {
+  gpu_bytes_ -= dataset_bytes_;
+  dataset_bytes_ = 0;
+  for (std::size_t c = 0; c < spans_.size(); ++c) {
+    spans_[c].dataset.destroy();
+    spans_[c].dataset.create(GL_R32UI, per_span[c] ? per_span[c]->data() : nullptr, sizes[c] * 4);
+    dataset_bytes_ += sizes[c] * 4;
+  }
+  gpu_bytes_ += dataset_bytes_;
+  dataset_content_ = content;
+}
+
+void GpuScene::prepare_view_order() {
+  if (dataset_content_ == DatasetContent::ViewOrder) return;
+  std::vector<std::uint64_t> sizes;
+  for (const TextureSpan& c : layout_.texture_spans()) sizes.push_back(c.segments);
+  replace_dataset(std::vector<const std::vector<std::uint32_t>*>(spans_.size(), nullptr), sizes,
+                  DatasetContent::ViewOrder);
+}
+
+void GpuScene::upload_view_order(const std::vector<const std::vector<std::uint32_t>*>& per_span,
+                                 const std::vector<std::pair<std::uint64_t, std::uint64_t>>& ranges) {
+  prepare_view_order();
+  for (std::size_t c = 0; c < spans_.size(); ++c) {
+    const auto [first, end] = ranges[c];
+    if (first >= end) continue;
+    glBindBuffer(GL_TEXTURE_BUFFER, spans_[c].dataset.buffer);
+    glBufferSubData(GL_TEXTURE_BUFFER, static_cast<GLintptr>(4 * first), static_cast<GLsizeiptr>(4 * (end - first)),
+                    per_span[c]->data() + first);
+  }
+  glBindBuffer(GL_TEXTURE_BUFFER, 0);
+}
+
 const std::vector<std::int32_t>& GpuScene::dataset_first() {
-  if (!dataset_built_) {
+  if (dataset_content_ != DatasetContent::StreamlineOrder) {
+    dataset_first_.clear();
+    dataset_count_.clear();
     // Walk the streamlines, file after file: every voxline contributes its segments, in order, to its
     // span's dataset array; consecutive segments in one span form one draw range.
     std::vector<std::vector<std::uint32_t>> per_span(layout_.texture_spans().size());
@@ -176,12 +212,10 @@ const std::vector<std::int32_t>& GpuScene::dataset_first() {
       };
       walk_streamlines(*files_[fi], cb);
     }
-    for (std::size_t c = 0; c < spans_.size(); ++c) {
-      spans_[c].dataset.destroy();
-      spans_[c].dataset.create(GL_R32UI, per_span[c].data(), per_span[c].size() * 4);
-      gpu_bytes_ += per_span[c].size() * 4;
-    }
-    dataset_built_ = true;
+    std::vector<const std::vector<std::uint32_t>*> arrays;
+    std::vector<std::uint64_t> sizes;
+    for (const auto& a : per_span) arrays.push_back(&a), sizes.push_back(a.size());
+    replace_dataset(arrays, sizes, DatasetContent::StreamlineOrder);
   }
   return dataset_first_;
 }

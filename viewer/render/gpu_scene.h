@@ -2,7 +2,9 @@
 // packed positions with their voxels' decoding info and lookup tables (float32 files are packed on the way, as
 // the .vxl spec §5.4 says), the stored orders at 16 bits (32 for voxels of more than 65 536 vertices), each
 // entry checked, and — only when first needed — a dataset-order buffer and per-vertex values. About 4 bytes
-// a vertex and 2 an order entry, where float positions and widened orders took 12 and 4.
+// a vertex and 2 an order entry, where float positions and widened orders took 12 and 4. The dataset-order
+// buffer holds either the streamline order (`unsorted`) or the view order the `segsort` mode writes every
+// frame (segment_sort.h), never both: the GPU memory budget counts one.
 #pragma once
 
 #include <cstdint>
@@ -17,7 +19,7 @@ namespace vxl {
 struct GpuTextureSpan {
   gl::TextureBuffer words;       // GL_RGBA32UI: packed positions, voxel info, segment and vertex tables
   gl::TextureBuffer orders;      // GL_R16UI: K x S low halves, then K x W high halves
-  gl::TextureBuffer dataset;     // GL_R32UI, S span vertex indices (empty until needed)
+  gl::TextureBuffer dataset;     // GL_R32UI, span vertex indices: streamline or view order (empty until needed)
   gl::TextureBuffer attributes;  // GL_RG32F, (value, group) per span vertex (empty until a colour mode needs it)
 };
 
@@ -42,9 +44,17 @@ class GpuScene {
   // per vertex of that file, vertex_attributes.h); an empty vector empties them.
   void upload_attributes(const std::vector<std::vector<float>>& per_file);
 
-  // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)).
+  // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)), and again after
+  // the view order replaced them.
   const std::vector<std::int32_t>& dataset_first();
   const std::vector<std::int32_t>& dataset_count();
+
+  // The `segsort` mode's view order: makes every span's dataset buffer S entries (its padded segment count,
+  // the voxels' segment ranges of scene_layout.h) when it held something else, and uploads entries
+  // [first, end) of per_span[c] into span c's. prepare_view_order() only makes the buffers.
+  void prepare_view_order();
+  void upload_view_order(const std::vector<const std::vector<std::uint32_t>*>& per_span,
+                         const std::vector<std::pair<std::uint64_t, std::uint64_t>>& ranges);
 
  private:
   void upload_spans();
@@ -58,7 +68,12 @@ class GpuScene {
   SceneLayout layout_;
   std::vector<GpuTextureSpan> spans_;
   std::uint64_t gpu_bytes_ = 0;
-  bool dataset_built_ = false;
+  enum class DatasetContent { Nothing, StreamlineOrder, ViewOrder };
+  DatasetContent dataset_content_ = DatasetContent::Nothing;
+  std::uint64_t dataset_bytes_ = 0;  // what the dataset buffers take (counted in gpu_bytes_)
+  // Replaces every span's dataset buffer by `per_span[c]` (nullptr: `sizes[c]` entries left undefined).
+  void replace_dataset(const std::vector<const std::vector<std::uint32_t>*>& per_span,
+                       const std::vector<std::uint64_t>& sizes, DatasetContent content);
   std::vector<std::int32_t> dataset_first_, dataset_count_;
 };
 
