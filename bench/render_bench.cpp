@@ -3,7 +3,8 @@
 //     for the .vxl and for the source TCK (converted in memory);
 //   * per-frame CPU work (cull + voxel sort + order pick + command building), median over a 72-view
 //     turntable, at the file's voxel size;
-//   * frame time per mode (glFinish-bounded), median of a few frames over the turntable.
+//   * frame time per mode (glFinish-bounded) and the renderer's CPU time of the frame (FrameStats::plan_ms:
+//     for segsort it includes the segment sort), medians of a few frames over the turntable.
 // Prints numbers; asserts nothing.
 //
 // Usage: render_bench --scene FILE.vxl[:SOURCE.tck] ... [--size N] [--frames N] [--modes a,b,...]
@@ -52,7 +53,7 @@ vxl::Camera turntable_camera(const vxl::Renderer& r, int step, int steps) {
 int run(int argc, char** argv) {
   std::vector<std::string> scenes;
   int size = 1024, frames = 5;
-  std::string modes_arg = "opaque,unsorted,additive,wboit,basic,axis,exact";
+  std::string modes_arg = "opaque,unsorted,additive,wboit,basic,axis,segsort,exact";
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--scene" && i + 1 < argc)
@@ -122,7 +123,8 @@ int run(int argc, char** argv) {
       vxl::RenderSettings s;
       s.mode = mode;
       s.opacity = 0.05f;
-      std::vector<double> ms;
+      std::vector<double> ms, cpu_ms;
+      renderer.prepare(mode);
       for (int f = 0; f <= frames; ++f) {
         vxl::Camera cam = turntable_camera(renderer, f, frames + 1);
         target.bind();
@@ -130,12 +132,14 @@ int run(int argc, char** argv) {
         auto t0 = Clock::now();
         renderer.draw(cam, s, size, size, target.framebuffer());
         glFinish();
-        if (f > 0)
-          ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());  // first: warm-up
+        if (f > 0) {  // the first is a warm-up
+          ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+          cpu_ms.push_back(renderer.stats().plan_ms);
+        }
       }
       double m = median(ms);
       if (mode == vxl::RenderMode::Unsorted) unsorted_ms = m;
-      std::printf("  frame time %-9s median %9.1f ms", vxl::render_mode_name(mode), m);
+      std::printf("  frame time %-9s median %9.1f ms, CPU %8.2f ms", vxl::render_mode_name(mode), m, median(cpu_ms));
       if (unsorted_ms > 0) std::printf("  (%.2fx unsorted)", m / unsorted_ms);
       std::printf("\n");
       std::fflush(stdout);

@@ -12,7 +12,7 @@ namespace vxl::trade {
 
 // One rendered image, scored against `exact` from the same view at the same opacity.
 struct SweepRow {
-  std::string mode;             // exact, unsorted, additive, wboit, basic, axis, axis+diag, random:N
+  std::string mode;             // exact, unsorted, additive, wboit, basic, axis, segsort, axis+diag, random:N
   std::string orders;           // order set of the file it was drawn from
   double voxel_mm = 0;          // voxel size of that file
   bool voxel_dependent = true;  // false: the mode draws the same picture at every voxel size
@@ -21,7 +21,7 @@ struct SweepRow {
   double opacity = 0;
   ImageScore score;
   double frame_ms = 0;   // draw, glFinish-bounded
-  double cpu_ms = 0;     // the renderer's CPU work of the frame (cull, voxel sort, order pick)
+  double cpu_ms = 0;     // the renderer's CPU work of the frame (cull, voxel sort, order pick; segsort's segment sort)
   double convert_s = 0;  // `voxlines convert` wall time of the file
   std::uint64_t file_bytes = 0, gpu_bytes = 0;
 };

@@ -1,8 +1,9 @@
 // Speed/accuracy trade study (issue 4). Input: one dataset converted at several voxel sizes and order sets,
 // listed in a manifest (written by scripts/trade-study). Two parts:
 //
-//   sweep    every mode — unsorted, additive, wboit (the baselines), basic, axis, and axis on files with
-//            other order sets (axis+diag, random:N) — from 6 views (3 axis-aligned, 3 oblique) at each
+//   sweep    every mode — unsorted, additive, wboit (the baselines), basic, axis, segsort (each voxel's
+//            segments sorted on the CPU for the view: the best any order set could reach), and axis on files
+//            with other order sets (axis+diag, random:N) — from 6 views (3 axis-aligned, 3 oblique) at each
 //            opacity, scored against `exact` from the same view at the same opacity (RMSE, PSNR, mean and
 //            max error, SSIM: image_metrics.h), with frame time, the renderer's CPU time per frame, convert
 //            time, file size and GPU bytes. `exact` does not depend on the voxelisation (it sorts every
@@ -164,9 +165,11 @@ class Study {
   }
 
   // The modes drawn from one file: ours on every file, the voxel-independent ones from the reference only.
+  // segsort depends on the voxel size (the voxels are sorted), not on the order set.
   std::vector<ModeSpec> sweep_modes(const ManifestEntry& e, bool reference) const {
     if (e.orders != "axis") return {{e.orders, RenderMode::Axis}};
-    std::vector<ModeSpec> modes = {{"basic", RenderMode::Basic}, {"axis", RenderMode::Axis}};
+    std::vector<ModeSpec> modes = {
+        {"basic", RenderMode::Basic}, {"axis", RenderMode::Axis}, {"segsort", RenderMode::Segsort}};
     if (reference)
       modes.insert(
           modes.begin(),
@@ -198,7 +201,8 @@ class Study {
             row.mode = m.name;
             row.orders = e.orders;
             row.voxel_mm = e.voxel_mm;
-            row.voxel_dependent = !reference || m.mode == RenderMode::Basic || m.mode == RenderMode::Axis;
+            row.voxel_dependent = !reference || m.mode == RenderMode::Basic || m.mode == RenderMode::Axis ||
+                                  m.mode == RenderMode::Segsort;
             row.view = view.name;
             row.oblique = view.oblique;
             row.opacity = kOpacities[o];
@@ -207,7 +211,8 @@ class Study {
             row.cpu_ms = f.cpu_ms;
             row.convert_s = e.convert_s;
             row.file_bytes = file.bytes().size();
-            row.gpu_bytes = m.mode == RenderMode::Unsorted ? r.gpu_bytes() : scene_bytes;
+            row.gpu_bytes =
+                m.mode == RenderMode::Unsorted || m.mode == RenderMode::Segsort ? r.gpu_bytes() : scene_bytes;
             rows.push_back(row);
             if (reference && view.name == std::string(kSideView) && kOpacities[o] == kSideOpacity)
               write_png(o_.out + "/side_" + m.name + ".png", f.image);
@@ -360,6 +365,11 @@ std::vector<double> parse_list(const std::string& s) {
   return out;
 }
 
+constexpr const char* kUsage =
+    "usage: trade_study --manifest FILE --out DIR [--name TEXT] [--size N] [--reference-voxel MM] "
+    "[--flicker-size N] [--flicker-frames N] [--flicker-opacity A] [--hysteresis M,...] [--no-sweep] "
+    "[--no-flicker]\n";
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -367,6 +377,15 @@ int main(int argc, char** argv) {
   try {
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i];
+      if (a == "--help" || a == "-h") {
+        std::printf(
+            "Speed vs accuracy study: every transparency mode (exact, unsorted, additive, wboit, basic, axis, "
+            "segsort, and axis on other order sets) scored against exact over 6 views x 3 opacities; writes "
+            "results.csv/.md, levels.csv/.md, flicker.csv/.md into --out.\n%sManifest lines: VOXEL_MM ORDERS "
+            "PATH CONVERT_SECONDS\n",
+            kUsage);
+        return 0;
+      }
       auto value = [&]() -> std::string {
         if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
         return argv[++i];
@@ -399,11 +418,7 @@ int main(int argc, char** argv) {
     if (o.manifest.empty() || o.out.empty() || o.size < 16 || o.flicker_size < 16 || o.flicker_frames < 2)
       throw std::invalid_argument("--manifest and --out are required; sizes >= 16, frames >= 2");
   } catch (const std::exception& e) {
-    std::fprintf(stderr,
-                 "trade_study: %s\nusage: trade_study --manifest FILE --out DIR [--name TEXT] [--size N] "
-                 "[--reference-voxel MM] [--flicker-size N] [--flicker-frames N] [--flicker-opacity A] "
-                 "[--hysteresis M,...] [--no-sweep] [--no-flicker]\n",
-                 e.what());
+    std::fprintf(stderr, "trade_study: %s\n%s", e.what(), kUsage);
     return 2;
   }
   try {

@@ -22,9 +22,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 # The reference, the baselines, then ours; one colour each, the same in every plot.
-MODES = ["unsorted", "additive", "wboit", "basic", "axis", "axis+diag"]
+MODES = ["unsorted", "additive", "wboit", "basic", "axis", "axis+diag", "segsort"]
 COLOURS = {"unsorted": "tab:gray", "additive": "tab:brown", "wboit": "tab:purple", "basic": "tab:blue",
-           "axis": "tab:red", "axis+diag": "tab:orange"}
+           "axis": "tab:red", "axis+diag": "tab:orange", "segsort": "black"}
 SIDE_PANELS = ["exact", "axis", "basic", "unsorted", "wboit"]
 
 

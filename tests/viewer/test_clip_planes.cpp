@@ -76,7 +76,7 @@ TEST_F(ClipPlanes, ParseAndPrint) {
 TEST_F(ClipPlanes, SlabShowsOnlyTheLinesInsideAndDrawsFewerVoxels) {
   VxlFile f = make_scene(dir, depth_lines(), 5.0);
   Renderer r(f);
-  for (RenderMode mode : {RenderMode::Opaque, RenderMode::Axis, RenderMode::Exact}) {
+  for (RenderMode mode : {RenderMode::Opaque, RenderMode::Axis, RenderMode::Segsort, RenderMode::Exact}) {
     RenderSettings s = opaque_fixed();
     s.mode = mode;
     s.opacity = 1.0f;

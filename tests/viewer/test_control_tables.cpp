@@ -82,7 +82,7 @@ TEST(KeyBindings, HelpListsEveryGestureAndKey) {
 
 TEST(RenderModeTable, NamesParseBackInEnumOrder) {
   const auto modes = render_modes();
-  ASSERT_EQ(modes.size(), 7u);
+  ASSERT_EQ(modes.size(), 8u);
   ASSERT_EQ(render_mode_names().size(), modes.size());
   for (std::size_t i = 0; i < modes.size(); ++i) {
     EXPECT_EQ(static_cast<std::size_t>(modes[i].mode), i);

@@ -77,6 +77,10 @@ TEST_F(LevelsOfDetail, ACoarseLevelDrawsOnlyItsSegments) {
     unsorted.mode = RenderMode::Unsorted;
     render_image(r, whole_view(), unsorted, 128, 128);
     EXPECT_EQ(r.stats().segments_drawn, level_segments(f, level)) << "unsorted, level " << level;
+    RenderSettings segsort = s;  // each voxel's level segments, sorted for the view
+    segsort.mode = RenderMode::Segsort;
+    render_image(r, whole_view(), segsort, 128, 128);
+    EXPECT_EQ(r.stats().segments_drawn, level_segments(f, level)) << "segsort, level " << level;
     if (level > 0) {
       EXPECT_LT(r.gpu_bytes() * 4, previous_bytes) << "level " << level;
     }
@@ -135,6 +139,9 @@ TEST_F(LevelsOfDetail, TheBudgetIsNeverExceeded) {
     render_image(r, whole_view(), s, 64, 64);
     EXPECT_LE(r.gpu_bytes(), budget) << "budget " << budget << ", level " << level;
     EXPECT_LE(r.gpu_bytes(), r.layout().upload_bytes());
+    s.mode = RenderMode::Segsort;  // its view order replaces the dataset order in the same buffers
+    render_image(r, whole_view(), s, 64, 64);
+    EXPECT_LE(r.gpu_bytes(), budget) << "segsort, budget " << budget << ", level " << level;
   }
 }
 

@@ -253,7 +253,8 @@ TEST(VoxviewCli, ModesAndKeysComeFromTheirTables) {
   CLI::App cli{app::voxview_description("test")};
   app::declare_voxview_options(cli, a);
   const std::string help = cli.help();
-  EXPECT_NE(help.find("opaque | unsorted | additive | wboit | basic | axis | exact"), std::string::npos) << help;
+  EXPECT_NE(help.find("opaque | unsorted | additive | wboit | basic | axis | segsort | exact"), std::string::npos)
+      << help;
   for (const app::KeyBinding& b : app::key_bindings())
     EXPECT_NE(help.find(std::string(b.keys) + ": " + b.description), std::string::npos) << b.keys;
 

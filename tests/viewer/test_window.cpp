@@ -242,7 +242,7 @@ TEST_F(Window, OpensATckDirectly) {
 TEST_F(Window, EveryModeRunsInTheWindow) {
   VXL_REQUIRE_XVFB();
   make_inputs();
-  for (const char* mode : {"opaque", "unsorted", "additive", "wboit", "basic", "axis", "exact"}) {
+  for (const char* mode : {"opaque", "unsorted", "additive", "wboit", "basic", "axis", "segsort", "exact"}) {
     SCOPED_TRACE(mode);
     const std::string png = dir.file(std::string(mode) + ".png");
     CommandResult r =

@@ -63,6 +63,7 @@ bool outside(const ViewParams& view, const VoxelDrawInfo& v) {
 void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder order, FramePlan& plan) {
   plan.first.clear();
   plan.count.clear();
+  plan.voxels.clear();
   plan.sort_keys.clear();
   plan.voxels_drawn = plan.segments_drawn = 0;
   const auto& voxels = layout.voxels();
@@ -83,6 +84,7 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
     plan.previous_order.assign(voxels.size(), FramePlan::kNoOrder);
   plan.first.reserve(plan.sort_keys.size());
   plan.count.reserve(plan.sort_keys.size());
+  plan.voxels.reserve(plan.sort_keys.size());
   for (const auto& [key, i] : plan.sort_keys) {
     const VoxelDrawInfo& v = voxels[i];
     std::uint32_t slot = layout.block_slot(v);
@@ -108,6 +110,7 @@ void plan_frame(const SceneLayout& layout, const ViewParams& view, PlanOrder ord
     }
     plan.first.push_back(layout.first_id(v, slot, reversed));
     plan.count.push_back(layout.id_count(v, slot));
+    plan.voxels.push_back(i);
     plan.segments_drawn += v.segment_count;
   }
   plan.voxels_drawn = plan.first.size();

@@ -43,6 +43,7 @@ enum class PlanOrder {
 struct FramePlan {
   std::vector<std::int64_t> first;  // virtual ids (scene_layout.h): the scene's may pass 2^31
   std::vector<std::int32_t> count;
+  std::vector<std::uint32_t> voxels;  // the scene voxel each first/count range draws
   std::uint64_t voxels_drawn = 0;
   std::uint64_t segments_drawn = 0;
 

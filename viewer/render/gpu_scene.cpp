@@ -109,7 +109,8 @@ GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels, 
 std::uint64_t GpuScene::span_bytes(std::uint32_t c) const {
   const TextureSpan& t = layout_.texture_spans()[c];
   std::uint64_t bytes = 4 * t.words() + 2 * t.order_entries();
-  if (dataset_built_) bytes += 4 * dataset_per_span_[c].size();
+  if (dataset_content_ == DatasetContent::StreamlineOrder) bytes += 4 * dataset_per_span_[c].size();
+  if (dataset_content_ == DatasetContent::ViewOrder) bytes += 4 * t.segments;
   if (t.file < attributes_.size() && !attributes_[t.file].empty()) bytes += 8 * t.vertices;
   return bytes;
 }
@@ -130,10 +131,10 @@ void GpuScene::upload_span(std::uint32_t ci) {
   GpuTextureSpan& g = spans_[ci];
   g.words.create(GL_RGBA32UI, words.data(), words.size() * 4);
   g.orders.create(GL_R16UI, orders.data(), orders.size() * 2);
-  if (dataset_built_)
+  if (dataset_content_ == DatasetContent::StreamlineOrder)
     g.dataset.create(GL_R32UI, dataset_per_span_[ci].data(), dataset_per_span_[ci].size() * 4);
-  else
-    g.dataset.create(GL_R32UI, nullptr, 0);
+  else  // the view order's entries are written every frame (upload_view_order)
+    g.dataset.create(GL_R32UI, nullptr, dataset_content_ == DatasetContent::ViewOrder ? 4 * c.segments : 0);
   const std::vector<float>* values = c.file < attributes_.size() ? &attributes_[c.file] : nullptr;
   if (values == nullptr || values->empty()) {
     g.attributes.create(GL_RG32F, nullptr, 0);
@@ -209,8 +210,37 @@ void GpuScene::upload_attributes(std::vector<std::vector<float>> per_file) {
   upload_resident_again();
 }
 
+void GpuScene::set_dataset_content(DatasetContent content) {
+  dataset_content_ = content;
+  if (content != DatasetContent::StreamlineOrder) {
+    dataset_per_span_.clear();
+    dataset_first_.clear();
+    dataset_count_.clear();
+  }
+  upload_resident_again();
+}
+
+void GpuScene::prepare_view_order() {
+  if (dataset_content_ != DatasetContent::ViewOrder) set_dataset_content(DatasetContent::ViewOrder);
+}
+
+void GpuScene::upload_view_order(const std::vector<const std::vector<std::uint32_t>*>& per_span,
+                                 const std::vector<std::pair<std::uint64_t, std::uint64_t>>& ranges) {
+  prepare_view_order();
+  for (std::size_t c = 0; c < spans_.size(); ++c) {
+    const auto [first, end] = ranges[c];
+    if (first >= end || !resident_[c]) continue;
+    glBindBuffer(GL_TEXTURE_BUFFER, spans_[c].dataset.buffer);
+    glBufferSubData(GL_TEXTURE_BUFFER, static_cast<GLintptr>(4 * first), static_cast<GLsizeiptr>(4 * (end - first)),
+                    per_span[c]->data() + first);
+  }
+  glBindBuffer(GL_TEXTURE_BUFFER, 0);
+}
+
 const std::vector<std::int64_t>& GpuScene::dataset_first() {
-  if (!dataset_built_) {
+  if (dataset_content_ != DatasetContent::StreamlineOrder) {
+    dataset_first_.clear();
+    dataset_count_.clear();
     // Walk the streamlines, file after file: every voxline contributes its segments, in order, to its
     // span's dataset array; consecutive segments in one span form one draw range.
     std::vector<std::vector<std::uint32_t>> per_span(layout_.texture_spans().size());
@@ -240,8 +270,7 @@ const std::vector<std::int64_t>& GpuScene::dataset_first() {
       walk_streamlines(*files_[fi], cb);
     }
     dataset_per_span_ = std::move(per_span);
-    dataset_built_ = true;
-    upload_resident_again();
+    set_dataset_content(DatasetContent::StreamlineOrder);
   }
   return dataset_first_;
 }

@@ -9,6 +9,9 @@
 // (make_resident), the least recently used ones of any scene evicted to make room; a frame draws only
 // voxels whose span is resident. Uploading a span again gives the same bytes, so an evicted and
 // re-uploaded span draws the same picture.
+//
+// The dataset-order buffer holds either the streamline order (`unsorted`) or the view order the `segsort`
+// mode writes every frame (segment_sort.h), never both: the GPU memory budget counts one.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +29,7 @@ namespace vxl {
 struct GpuTextureSpan {
   gl::TextureBuffer words;       // GL_RGBA32UI: packed positions, voxel info, segment and vertex tables
   gl::TextureBuffer orders;      // GL_R16UI: K x S low halves, then K x W high halves
-  gl::TextureBuffer dataset;     // GL_R32UI, S span vertex indices (empty until needed)
+  gl::TextureBuffer dataset;     // GL_R32UI, span vertex indices: streamline or view order (empty until needed)
   gl::TextureBuffer attributes;  // GL_RG32F, (value, group) per span vertex (empty until a colour mode needs it)
 };
 
@@ -63,10 +66,17 @@ class GpuScene {
   // again (their size changes).
   void upload_attributes(std::vector<std::vector<float>> per_file);
 
-  // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)); each span's
-  // dataset array joins its upload.
+  // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)), and again after
+  // the view order replaced them; each span's dataset array joins its upload.
   const std::vector<std::int64_t>& dataset_first();
   const std::vector<std::int32_t>& dataset_count();
+
+  // The `segsort` mode's view order: makes every span's dataset buffer S entries (its padded segment count,
+  // the voxels' segment ranges of scene_layout.h) when it held something else, and uploads entries
+  // [first, end) of per_span[c] into span c's. prepare_view_order() only makes the buffers.
+  void prepare_view_order();
+  void upload_view_order(const std::vector<const std::vector<std::uint32_t>*>& per_span,
+                         const std::vector<std::pair<std::uint64_t, std::uint64_t>>& ranges);
 
  private:
   // The bytes span c takes on the GPU with its current attributes and dataset order.
@@ -90,8 +100,11 @@ class GpuScene {
   std::vector<std::uint64_t> uploaded_bytes_;  // per resident span, as the pool counts it
   std::uint64_t gpu_bytes_ = 0;
   std::vector<std::vector<float>> attributes_;  // per file, as upload_attributes got them
-  bool dataset_built_ = false;
-  std::vector<std::vector<std::uint32_t>> dataset_per_span_;
+  enum class DatasetContent { Nothing, StreamlineOrder, ViewOrder };
+  DatasetContent dataset_content_ = DatasetContent::Nothing;
+  // Switches the dataset buffers' content: the resident spans are uploaded again with it.
+  void set_dataset_content(DatasetContent content);
+  std::vector<std::vector<std::uint32_t>> dataset_per_span_;  // StreamlineOrder: each span's array
   std::vector<std::int64_t> dataset_first_;
   std::vector<std::int32_t> dataset_count_;
 };

@@ -18,6 +18,9 @@ constexpr RenderModeInfo kModes[] = {
     {RenderMode::Wboit, "wboit", "weighted blended order-independent transparency (McGuire & Bavoil 2013)"},
     {RenderMode::Basic, "basic", "voxels sorted back to front, segments in dataset order inside each voxel"},
     {RenderMode::Axis, "axis", "voxels sorted back to front, each drawn in its nearest precomputed order (Voxlines)"},
+    {RenderMode::Segsort, "segsort",
+     "voxels sorted as axis, each voxel's segments sorted for the exact view on the CPU every frame: slow, a "
+     "reference for the orders"},
     {RenderMode::Exact, "exact", "per-fragment sorted reference (needs OpenGL 4.3)"},
 };
 struct ColorName {

@@ -17,7 +17,7 @@ namespace vxl {
 
 // Transparency modes (docs/rendering.md). All draw the same data from the same camera; render_modes()
 // names and describes them.
-enum class RenderMode { Opaque, Unsorted, Additive, Wboit, Basic, Axis, Exact };
+enum class RenderMode { Opaque, Unsorted, Additive, Wboit, Basic, Axis, Segsort, Exact };
 
 // The one list of the modes, in the order the panel shows them and M cycles through them: --mode, saved
 // views, the panel and the help all read it.

@@ -12,6 +12,7 @@
 #include "viewer/render/exact_renderer.h"
 #include "viewer/render/line_lighting.h"
 #include "viewer/render/line_shaders.h"
+#include "viewer/render/segment_sort.h"
 #include "viewer/render/slice_renderer.h"
 #include "viewer/render/vertex_attributes.h"
 
@@ -54,6 +55,7 @@ Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, 
 
 Renderer::~Renderer() {
   exact_.reset();
+  segment_sorter_.reset();
   slices_.reset();
   for (GLuint p :
        {over_program_, accum_program_, reveal_program_, additive_program_, wboit_composite_, additive_composite_})
@@ -165,17 +167,20 @@ void Renderer::keep_resident(FramePlan& plan) {
     if (!scene_.resident(layout.span_of_id(plan.first[i]))) continue;
     plan.first[kept] = plan.first[i];
     plan.count[kept] = plan.count[i];
+    if (!plan.voxels.empty()) plan.voxels[kept] = plan.voxels[i];
     plan.segments_drawn += static_cast<std::uint64_t>(plan.count[i] / 2);
     ++kept;
   }
   stats_.voxels_waiting = plan.first.size() - kept;
   plan.first.resize(kept);
   plan.count.resize(kept);
+  if (!plan.voxels.empty()) plan.voxels.resize(kept);
   plan.voxels_drawn = kept;
 }
 
 void Renderer::prepare(RenderMode mode) {
   if (mode == RenderMode::Unsorted) scene_.dataset_first();
+  if (mode == RenderMode::Segsort) scene_.prepare_view_order();
 }
 
 void Renderer::bind_line_program(GLuint program, const Camera& camera, const RenderSettings& s, double aspect) const {
@@ -385,6 +390,27 @@ void Renderer::draw_dataset_order(GLuint program, const Camera& camera, const Re
   draw_plan(program, dataset.first, dataset.count);
 }
 
+void Renderer::draw_segment_sorted(GLuint program, const Camera& camera, const RenderSettings& s, double aspect) {
+  // The dataset buffers take the view order first, so that the budget counts them when the spans are made
+  // resident. Then the voxels back to front as axis sorts them (Block and Nearest share the sort), then each
+  // one's segments for this view; the plan's ranges then point into the dataset buffers.
+  scene_.prepare_view_order();
+  plan_and_count(camera, aspect, PlanOrder::Block, plan_, s.clipping);
+  auto t0 = std::chrono::steady_clock::now();
+  if (!segment_sorter_) segment_sorter_ = std::make_unique<SegmentSorter>(scene_.layout(), files_);
+  segment_sorter_->sort(SegmentSortView{camera.eye(), camera.forward(), camera.orthographic}, plan_);
+  stats_.plan_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  std::vector<const std::vector<std::uint32_t>*> arrays;
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges;
+  for (std::uint32_t c = 0; c < scene_.layout().texture_spans().size(); ++c) {
+    arrays.push_back(&segment_sorter_->span_order(c));
+    ranges.push_back(segment_sorter_->written(c));
+  }
+  scene_.upload_view_order(arrays, ranges);
+  bind_line_program(program, camera, s, aspect);
+  draw_plan(program, plan_.first, plan_.count);
+}
+
 void Renderer::composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const {
   enable_clip_distances(0);
   glUseProgram(program);
@@ -468,6 +494,11 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       over_blending();
       plan_.order_hysteresis = s.order_hysteresis;
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Nearest);
+      break;
+    case RenderMode::Segsort:  // as axis, but each voxel's segments sorted for this view
+      clear_to_base(fbo, width, height, bg);
+      over_blending();
+      draw_segment_sorted(over_program_, camera, s, aspect);
       break;
     case RenderMode::Wboit: {
       wboit_target_.ensure(width, height, GL_RGBA16F, GL_RGBA16F, false);
@@ -577,7 +608,10 @@ void Renderer::begin_pieces(const Camera& camera, const RenderSettings& s, int w
       break;
     case RenderMode::Unsorted:
     case RenderMode::Additive:
-    case RenderMode::Wboit: p.kind = Pieces::Kind::Whole; break;
+    case RenderMode::Wboit:
+    case RenderMode::Segsort:  // its CPU sort is the frame's cost: drawn whole
+      p.kind = Pieces::Kind::Whole;
+      break;
   }
 }
 

@@ -26,11 +26,13 @@
 namespace vxl {
 
 class ExactRenderer;
+class SegmentSorter;
 class SliceRenderer;
 struct Volume;
 
 struct FrameStats {
-  double plan_ms = 0;  // CPU work of the frame: cull + sort + order pick + uploads + command building
+  double plan_ms = 0;  // CPU work of the frame: cull + sort + order pick + uploads + command building (segsort:
+                       // + segment sort)
   std::uint64_t voxels_drawn = 0;
   std::uint64_t segments_drawn = 0;
   std::uint64_t voxels_waiting = 0;  // visible but not drawn: their span did not fit the GPU memory budget
@@ -94,8 +96,8 @@ class Renderer {
   std::uint64_t gpu_bytes() const { return scene_.gpu_bytes(); }
   const GpuMemoryPool& gpu_memory() const { return scene_.pool(); }
   bool span_resident(std::uint32_t span) const { return scene_.resident(span); }
-  // Uploads what `mode` builds on its first frame (the unsorted mode's dataset order), so that a timed frame
-  // does not include it.
+  // Uploads what `mode` builds on its first frame (the unsorted mode's dataset order, the segsort mode's
+  // buffers), so that a timed frame does not include it.
   void prepare(RenderMode mode);
   const VxlFile& file() const { return *files_.front(); }  // the first
   const std::vector<const VxlFile*>& files() const { return files_; }
@@ -147,6 +149,9 @@ class Renderer {
   void prepare_attributes(const RenderSettings& settings);
   void draw_lines(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect, PlanOrder order);
   void draw_dataset_order(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect);
+  // The segsort mode's lines: voxels sorted as axis sorts them, each voxel's segments sorted on the CPU for
+  // this view (segment_sort.h), uploaded into the dataset buffers and drawn from there.
+  void draw_segment_sorted(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect);
   // A fullscreen pass of `program` reading the named 2D textures.
   void composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const;
 
@@ -160,7 +165,8 @@ class Renderer {
   FramePlan plan_;
   FrameStats stats_;
   std::unique_ptr<ExactRenderer> exact_;
-  std::unique_ptr<Pieces> pieces_;  // the frame begin_pieces() started, until draw() or the next begin
+  std::unique_ptr<Pieces> pieces_;                 // the frame begin_pieces() started, until draw() or the next begin
+  std::unique_ptr<SegmentSorter> segment_sorter_;  // made on first use
   std::unique_ptr<SliceRenderer> slices_;
   bool slices_drawn_ = false;  // this frame: the line shaders test against the slices' depth
   SceneGroups groups_;
