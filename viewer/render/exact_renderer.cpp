@@ -128,6 +128,7 @@ void ExactRenderer::begin(const Camera& camera, const RenderSettings& s, int wid
   start_image(s.background());
   next_ = 0;
   per_segment_ = 0;
+  composited_ms_ = 0;
   passes_ = 0;
   fragments_ = 0;
 }
@@ -171,23 +172,26 @@ bool ExactRenderer::step(double max_ms) {
   const std::size_t n = plan_.count.size();
   while (next_ < n) {
     // Before anything is measured, a time-limited run assumes the line passes' rate (Renderer).
-    const double rate = segments_per_ms_ > 0 ? segments_per_ms_ : Renderer::kAssumedSegmentsPerMs;
+    // The rate over every run so far (as Renderer::draw_piece does).
+    const double rate = composited_ms_ > 0 && next_ > 0 ? double(segments_before_[next_]) / composited_ms_
+                                                        : Renderer::kAssumedSegmentsPerMs;
     const double max_segments =
         std::isfinite(max_ms) ? rate * std::max(max_ms - elapsed_ms(), 0.0) : std::numeric_limits<double>::infinity();
     const std::size_t j = run_end(max_segments);
     const auto run_start = Clock::now();
+    auto run_ms = [&] { return std::chrono::duration<double, std::milli>(Clock::now() - run_start).count(); };
     const std::uint64_t stored = list_pass(next_, j, 0, height_);
     const std::uint64_t segments = segments_before_[j] - segments_before_[next_];
     if (segments > 0) per_segment_ = std::max(per_segment_, double(stored) / double(segments));
     if (stored <= capacity_) {
       resolve_band(0, height_, static_cast<std::uint32_t>(stored));
     } else if (depth_passes && j - next_ > 1) {
-      continue;  // retry a shorter run with the new estimate
+      composited_ms_ += run_ms();  // spent, though nothing was composited: the rate counts it
+      continue;                    // retry a shorter run with the new estimate
     } else {
       rows_in_bands(next_, j, height_);
     }
-    const double run_ms = std::chrono::duration<double, std::milli>(Clock::now() - run_start).count();
-    if (segments > 0 && run_ms > 0) segments_per_ms_ = double(segments) / run_ms;
+    composited_ms_ += run_ms();
     next_ = j;
     if (std::isfinite(max_ms) && elapsed_ms() >= max_ms) break;
   }

@@ -74,7 +74,7 @@ class ExactRenderer {
   std::vector<std::uint64_t> segments_before_;  // segments of plan voxels [0, v)
   std::size_t next_ = 0;                        // the first plan voxel not composited yet
   double per_segment_ = 0;                      // fragments per segment, 0 until measured
-  double segments_per_ms_ = 0;                  // list pass and resolve, 0 until measured
+  double composited_ms_ = 0;                    // the runs' time so far (list passes and resolves)
   int passes_ = 0;
   std::uint64_t fragments_ = 0;
   // Read-back scratch, kept between frames.

@@ -570,7 +570,7 @@ struct Renderer::Pieces {
   std::vector<std::int32_t> count;
   std::size_t next = 0;                   // the first plan voxel not drawn yet
   std::uint64_t segments = 0, drawn = 0;  // the plan's, and those drawn so far
-  double segments_per_ms = 0;             // measured, 0 until then
+  double drawn_ms = 0;                    // the pieces' time so far: drawn / drawn_ms is the measured rate
   bool done = false;
 };
 
@@ -650,7 +650,9 @@ bool Renderer::draw_piece(double max_ms) {
       }
       bind_line_program(over_program_, p.camera, p.settings, double(p.width) / std::max(1, p.height));
       // Voxels up to what the measured rate draws in max_ms (before a measurement, llvmpipe's rate).
-      const double rate = p.segments_per_ms > 0 ? p.segments_per_ms : kAssumedSegmentsPerMs;
+      // The rate over all pieces so far, not the last one's: a piece's time varies with its voxels' fragments
+      // and a software renderer's flushes, and the last rate alone made sizes swing from 5 to 400 ms.
+      const double rate = p.drawn > 0 && p.drawn_ms > 0 ? double(p.drawn) / p.drawn_ms : kAssumedSegmentsPerMs;
       const double max_segments = std::isfinite(max_ms) ? rate * max_ms : std::numeric_limits<double>::infinity();
       std::size_t end = p.next;
       std::uint64_t segments = 0;
@@ -661,7 +663,7 @@ bool Renderer::draw_piece(double max_ms) {
       draw_plan(over_program_, first.subspan(p.next, end - p.next), count.subspan(p.next, end - p.next));
       glFinish();  // the piece's time includes the GPU's work, for the next piece's size
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      if (segments > 0 && ms > 0) p.segments_per_ms = double(segments) / ms;
+      p.drawn_ms += ms;
       p.drawn += segments;
       p.next = end;
       p.done = end == p.count.size();
