@@ -66,30 +66,20 @@ Renderer::~Renderer() {
   if (vao_) glDeleteVertexArrays(1, &vao_);
 }
 
-// The union of the files' bounds (a file without points does not count).
-glm::dvec3 Renderer::bounds_min() const {
-  glm::dvec3 lo(0.0);
+// The union of the files' bounds (a file without points does not count): {min, max}.
+std::pair<glm::dvec3, glm::dvec3> Renderer::bounds() const {
+  glm::dvec3 lo(0.0), hi(0.0);
   bool any = false;
   for (const VxlFile* f : files_) {
     const MetaSection& m = f->meta();
     if (m.point_count == 0) continue;
-    const glm::dvec3 b(m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]);
-    lo = any ? glm::min(lo, b) : b;
-    any = true;
-  }
-  return lo;
-}
-glm::dvec3 Renderer::bounds_max() const {
-  glm::dvec3 hi(0.0);
-  bool any = false;
-  for (const VxlFile* f : files_) {
-    const MetaSection& m = f->meta();
-    if (m.point_count == 0) continue;
+    const glm::dvec3 a(m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]);
     const glm::dvec3 b(m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]);
+    lo = any ? glm::min(lo, a) : a;
     hi = any ? glm::max(hi, b) : b;
     any = true;
   }
-  return hi;
+  return {lo, hi};
 }
 
 glm::dvec3 Renderer::scene_min() const { return slices_ ? glm::min(bounds_min(), slices_->ras_min()) : bounds_min(); }

@@ -101,8 +101,8 @@ class Renderer {
   void prepare(RenderMode mode);
   const VxlFile& file() const { return *files_.front(); }  // the first
   const std::vector<const VxlFile*>& files() const { return files_; }
-  glm::dvec3 bounds_min() const;
-  glm::dvec3 bounds_max() const;
+  glm::dvec3 bounds_min() const { return bounds().first; }
+  glm::dvec3 bounds_max() const { return bounds().second; }
   // The lines' bounds joined with the image's box (when there is one): what the depth range covers (the
   // camera frames the lines).
   glm::dvec3 scene_min() const;
@@ -123,6 +123,8 @@ class Renderer {
   friend class ExactRenderer;
 
   struct Pieces;
+  // The union of the files' bounds: {min, max}.
+  std::pair<glm::dvec3, glm::dvec3> bounds() const;
   // What every mode does first: the per-vertex attributes, the slices (their depth hides lines behind them),
   // line width and a neutral blend and depth state.
   void start_frame(const Camera& camera, const RenderSettings& settings, int width, int height);
