@@ -184,5 +184,31 @@ TEST_F(GpuMemoryBudget, EvictedSpansDrawTheSamePictureWhenUploadedAgain) {
   EXPECT_GT(lit_pixels(top), 100);
 }
 
+// A window spreads a large upload over frames: upload_for uploads about a time limit's worth of spans a call,
+// the nearest first, and says when the view has all it needs; the picture is then the eager scene's.
+TEST_F(GpuMemoryBudget, UploadsSpreadOverCallsGiveTheSamePicture) {
+  Renderer eager({&*file_}, kTexels, 0);
+  Renderer lazy({&*file_}, kTexels, 0, std::make_shared<GpuMemoryPool>(), /*eager=*/false);
+  EXPECT_GT(eager.gpu_bytes(), 0u);
+  EXPECT_EQ(lazy.gpu_bytes(), 0u) << "nothing uploaded before a frame needs it";
+  RenderSettings s;
+  s.opacity = 0.3f;
+  int calls = 1;
+  std::uint64_t before = 0;
+  while (!lazy.upload_for(view(), 1.0, s.clipping, 1e-6)) {  // a millionth of a millisecond: one span a call
+    EXPECT_GT(lazy.gpu_bytes(), before) << "call " << calls;
+    before = lazy.gpu_bytes();
+    ++calls;
+  }
+  EXPECT_GT(calls, 4);
+  FramePlan plan;
+  lazy.plan(view(), 1.0, PlanOrder::Nearest, plan);
+  EXPECT_TRUE(lazy.span_resident(lazy.layout().span_of_id(plan.first.back())));
+  const std::uint64_t uploaded = lazy.gpu_bytes();
+  const Image a = render_image(eager, view(), s, 96, 96), b = render_image(lazy, view(), s, 96, 96);
+  EXPECT_EQ(lazy.gpu_bytes(), uploaded) << "the frame found every span it needed";
+  EXPECT_EQ(compare_images(a, b).differing_pixels, 0u);
+}
+
 }  // namespace
 }  // namespace vxl

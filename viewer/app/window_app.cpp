@@ -456,7 +456,9 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
 Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
   std::unique_ptr<Renderer>& r = renderers_[std::max(level, detail_.level)];
   if (!r) {
-    r = std::make_unique<Renderer>(files_, texels_, level, gpu_memory_);
+    // The first picture's level is uploaded whole at once; the others span by span as frames need them
+    // (the refinement at rest spreads its level's upload over frames).
+    r = std::make_unique<Renderer>(files_, texels_, level, gpu_memory_, level == first_level_);
     if (volume_) r->set_volume(*volume_);
   }
   return *r;
@@ -530,15 +532,21 @@ double ViewerWindow::refine(int width, int height, bool& completes) {
   const bool exact_stage = rest_.stage() == RestStage::Exact;
   completes = false;
   try {
+    // Each piece fits the frame budget, so that input waits no longer at rest than while moving.
+    const double piece_ms =
+        options_.frame_budget_ms > 0 ? options_.frame_budget_ms : std::numeric_limits<double>::infinity();
     if (!pieces_begun_) {
+      // The level's spans this view needs come first, a piece's time at a time (the nearest first).
+      if (!renderer.upload_for(controller_.camera(), double(width) / height, state_.settings.clipping, piece_ms)) {
+        stats_.refinement = "uploading the scene's level";
+        glFinish();
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      }
       RenderSettings s = state_.settings;
       s.mode = rest_.stage_mode();
       renderer.begin_pieces(controller_.camera(), s, width, height, refine_target_->framebuffer());
       pieces_begun_ = true;
     }
-    // Each piece fits the frame budget, so that input waits no longer at rest than while moving.
-    const double piece_ms =
-        options_.frame_budget_ms > 0 ? options_.frame_budget_ms : std::numeric_limits<double>::infinity();
     completes = renderer.draw_piece(piece_ms);
   } catch (const std::exception& e) {
     // Exact out of node memory, say: keep the picture on screen and stop refining it.

@@ -1,6 +1,7 @@
 #include "viewer/render/gpu_scene.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 
 #include "format/error.h"
@@ -79,7 +80,7 @@ void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t 
 }
 
 GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level,
-                   std::shared_ptr<GpuMemoryPool> pool)
+                   std::shared_ptr<GpuMemoryPool> pool, bool eager)
     : files_(std::move(files)),
       layout_(files_, max_texels ? max_texels : driver_limit(), level),
       pool_(pool ? std::move(pool) : std::make_shared<GpuMemoryPool>()),
@@ -92,7 +93,7 @@ GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels, 
     // frames need them, the nearest first.
     std::uint64_t whole = 0;
     for (std::uint32_t c = 0; c < spans_.size(); ++c) whole += span_bytes(c);
-    if (pool_->fits(whole)) {
+    if (eager && pool_->fits(whole)) {
       const std::uint64_t use = pool_->begin_use();
       for (std::uint32_t c = 0; c < spans_.size(); ++c) {
         upload_span(c);
@@ -164,22 +165,31 @@ void GpuScene::evict(std::uint32_t c) {
   resident_[c] = false;
 }
 
-bool GpuScene::make_resident(std::span<const std::uint32_t> needed) {
+GpuScene::Residency GpuScene::make_resident(std::span<const std::uint32_t> needed, double max_ms) {
+  const auto start = std::chrono::steady_clock::now();
   const std::uint64_t use = pool_->begin_use();
   for (std::uint32_t c : needed)
     if (resident_[c]) pool_->touch(owner_, c, use);
-  bool all = true;
+  Residency r;
+  bool uploaded = false;
   for (std::uint32_t c : needed) {
     if (resident_[c]) continue;
+    if (uploaded &&
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() >= max_ms) {
+      r.complete = false;
+      r.out_of_time = true;
+      break;
+    }
     const std::uint64_t bytes = span_bytes(c);
     if (!pool_->reserve(bytes, use)) {
-      all = false;
+      r.complete = false;
       continue;
     }
     upload_span(c);
     pool_->add(owner_, c, bytes, use);
+    uploaded = true;
   }
-  return all;
+  return r;
 }
 
 void GpuScene::upload_resident_again() {

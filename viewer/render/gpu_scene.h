@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -38,8 +39,9 @@ class GpuScene {
   // Needs a current GL context. max_texels 0: ask the driver (GL_MAX_TEXTURE_BUFFER_SIZE). level: the level
   // of detail uploaded (scene_layout.h). pool: the budget shared with other scenes (none: no budget). The
   // files must outlive the scene.
+  // eager: upload the whole scene now when it fits the pool's free room (else spans come as frames need them).
   GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0, std::uint32_t level = 0,
-           std::shared_ptr<GpuMemoryPool> pool = nullptr);
+           std::shared_ptr<GpuMemoryPool> pool = nullptr, bool eager = true);
   GpuScene(const VxlFile& file, std::uint64_t max_texels = 0, std::uint32_t level = 0)
       : GpuScene(std::vector<const VxlFile*>{&file}, max_texels, level) {}
   // The driver's GL_MAX_TEXTURE_BUFFER_SIZE (needs a current context).
@@ -58,8 +60,13 @@ class GpuScene {
 
   // Uploads the spans in `needed` that are not resident, in that order (the most important first), evicting
   // the least recently used spans of the pool's scenes that `needed` does not hold; a span that does not fit
-  // stays out. Returns whether every span of `needed` is resident.
-  bool make_resident(std::span<const std::uint32_t> needed);
+  // stays out. With a time limit, stops once `max_ms` have passed (at least one span is uploaded).
+  struct Residency {
+    bool complete = true;      // every span of `needed` is resident
+    bool out_of_time = false;  // stopped by the time limit: calling again uploads more
+  };
+  Residency make_resident(std::span<const std::uint32_t> needed,
+                          double max_ms = std::numeric_limits<double>::infinity());
 
   // Gives every span its vertices' share of its file's `per_file` entry (2 floats per vertex of that file,
   // vertex_attributes.h) as its attribute buffer; an empty vector empties them. Resident spans are uploaded

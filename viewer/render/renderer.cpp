@@ -22,9 +22,9 @@ Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels, std::uint32_t 
     : Renderer(std::vector<const VxlFile*>{&file}, max_texels, level) {}
 
 Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level,
-                   std::shared_ptr<GpuMemoryPool> pool)
+                   std::shared_ptr<GpuMemoryPool> pool, bool eager)
     : files_(files.empty() ? throw Error(ErrorKind::Usage, "", std::nullopt, "Renderer: no files") : files),
-      scene_(files_, max_texels, level, std::move(pool)),
+      scene_(files_, max_texels, level, std::move(pool), eager),
       groups_(files_) {
   const VxlFile& file = *files_.front();
   for (const VxlFile* f : files_)
@@ -138,9 +138,9 @@ void Renderer::plan_and_count(const Camera& camera, double aspect, PlanOrder ord
   stats_.segments_drawn = out.segments_drawn;
 }
 
-void Renderer::keep_resident(FramePlan& plan) {
+// The spans a plan's voxels lie in, those of the nearest voxels first (a sorted plan is back to front).
+std::vector<std::uint32_t> Renderer::spans_nearest_first(const FramePlan& plan) const {
   const SceneLayout& layout = scene_.layout();
-  // The spans the plan's voxels lie in, those of the nearest voxels first (a sorted plan is back to front).
   std::vector<std::uint32_t> needed;
   std::vector<bool> seen(layout.texture_spans().size(), false);
   for (std::size_t i = plan.first.size(); i-- > 0;) {
@@ -148,8 +148,20 @@ void Renderer::keep_resident(FramePlan& plan) {
     if (!seen[span]) needed.push_back(span);
     seen[span] = true;
   }
+  return needed;
+}
+
+bool Renderer::upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms) {
+  FramePlan nearest;
+  plan(camera, aspect, PlanOrder::Nearest, nearest, clipping);
+  return !scene_.make_resident(spans_nearest_first(nearest), max_ms).out_of_time;
+}
+
+void Renderer::keep_resident(FramePlan& plan) {
+  const SceneLayout& layout = scene_.layout();
+  const std::vector<std::uint32_t> needed = spans_nearest_first(plan);
   stats_.voxels_waiting = 0;
-  if (scene_.make_resident(needed)) return;
+  if (scene_.make_resident(needed).complete) return;
   // The budget holds only some: draw the voxels whose span is resident, in the plan's order.
   std::size_t kept = 0;
   plan.segments_drawn = 0;

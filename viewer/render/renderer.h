@@ -51,8 +51,10 @@ class Renderer {
   // compensated so that the picture keeps its brightness.
   // pool: the GPU memory budget shared with the context's other renderers (gpu_memory_pool.h; none: no
   // budget). A frame draws the visible voxels whose span the budget holds, the nearest first.
+  // eager: upload the whole scene when made, if it fits the pool's free room; else spans come as frames (or
+  // upload_for) need them.
   explicit Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0, std::uint32_t level = 0,
-                    std::shared_ptr<GpuMemoryPool> pool = nullptr);
+                    std::shared_ptr<GpuMemoryPool> pool = nullptr, bool eager = true);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -117,6 +119,10 @@ class Renderer {
   // The most GPU memory a frame of `camera` with `clipping` can need: the spans its visible voxels lie in,
   // with everything a mode may upload for them (SceneLayout::span_upload_bytes).
   std::uint64_t view_bytes(const Camera& camera, double aspect, const Clipping& clipping = {}) const;
+  // Uploads, for about `max_ms` (at least one span), the spans a frame of `camera` needs that are not
+  // resident, the nearest voxels' first, so that a window can spread a large upload over frames. True once
+  // nothing more can be uploaded for that view (all resident, or the budget holds no more).
+  bool upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms);
 
  private:
   // The exact mode is a part of the renderer kept in its own file: it draws with the line program.
@@ -132,6 +138,7 @@ class Renderer {
   void clear_to_base(GLuint fbo, int width, int height, const glm::vec3& background) const;
   // The blend state of the over-compositing modes (basic, axis; docs/rendering.md, pitfall 1).
   static void over_blending();
+  std::vector<std::uint32_t> spans_nearest_first(const FramePlan& plan) const;
   // Makes the spans of the plan's voxels resident, the nearest first, and drops the voxels of those that
   // do not fit the budget.
   void keep_resident(FramePlan& plan);
