@@ -65,5 +65,28 @@ TEST(FrameLog, SummaryGivesTheFirstAndFullDetailPicturesAndMovingPercentiles) {
   EXPECT_EQ(none.moving_frames, 0u);
 }
 
+// Refinement at rest: pieces count apart from moving frames; full detail is the first complete picture at the
+// finest level reached at rest (finer than the scene's level where a view's visible part fits); exact after it.
+TEST(FrameLog, RefinementPiecesAndTheFinestLevelReachedAtRest) {
+  using W = FrameWork;
+  const std::vector<FrameRecord> frames = {{2, false, 40, 0.2, W::Whole, true},
+                                           {1, false, 300, 0.6, W::Whole, true},
+                                           {0, false, 100, 0.7, W::FullDetailPiece, false},
+                                           {0, false, 120, 0.8, W::FullDetailPiece, true},
+                                           {0, false, 90, 0.9, W::ExactPiece, false},
+                                           {0, false, 110, 1.0, W::ExactPiece, true}};
+  const FrameSummary s = summarize_frames(frames, 1);
+  EXPECT_DOUBLE_EQ(s.first_picture_s, 0.2);
+  EXPECT_DOUBLE_EQ(s.full_detail_s, 0.8) << "level 0 was reached: the level-1 picture was not the finest";
+  EXPECT_DOUBLE_EQ(s.exact_s, 1.0);
+  EXPECT_EQ(s.pieces, 4u);
+  EXPECT_DOUBLE_EQ(s.piece_median_ms, 100.0);
+  EXPECT_DOUBLE_EQ(s.piece_p95_ms, 120.0);
+  EXPECT_EQ(s.moving_frames, 0u);
+  // Without a finer level, the scene's level at rest is full detail.
+  EXPECT_DOUBLE_EQ(summarize_frames({frames[0], frames[1]}, 1).full_detail_s, 0.6);
+  EXPECT_LT(summarize_frames({frames[0]}, 1).full_detail_s, 0.0) << "only coarser than the scene's level";
+}
+
 }  // namespace
 }  // namespace vxl::app

@@ -13,6 +13,7 @@
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/image_metrics.h"
 #include "viewer/render/grid_overlay.h"
+#include "viewer/render/scene_layout.h"
 
 namespace vxl {
 namespace {
@@ -231,6 +232,36 @@ TEST_F(Window, ExactArrivesWhenTheCameraIsStill) {
   ASSERT_GT(lit_pixels(exact), 200 * 150 / 100);
   EXPECT_LT(score_image(still, exact).rmse, 0.6 * score_image(axis, exact).rmse)
       << "the window's picture at rest is the exact one, not axis";
+}
+
+// At rest the window refines to the finest level whose visible part fits the GPU memory budget: under a
+// budget that holds only level 1 of the whole scene, a thin slab comes at full detail, as headless draws it.
+TEST_F(Window, AtRestAThinSlabIsRefinedToFullDetailUnderABudgetForLevelOne) {
+  VXL_REQUIRE_XVFB();
+  make_inputs(12000);
+  const VxlFile f = VxlFile::open(vxl);
+  const std::vector<const VxlFile*> files = {&f};
+  const std::uint64_t texels = std::max<std::uint64_t>(4096, SceneLayout::largest_voxel_texels(files));
+  const std::string budget = std::to_string(SceneLayout(files, texels, 0).upload_bytes() / 2);
+  const std::string view = " --size 200x150 --view axial --slab 4 --span-texels 4096 --gpu-memory " + budget;
+  const std::string png = dir.file("slab.png"), reference = dir.file("reference.png");
+  const nlohmann::json j =
+      window_stats(view + " --frames 1 --until-refined --no-exact-when-still --screenshot " + shell_quoted(png));
+  ASSERT_FALSE(j.is_null());
+  EXPECT_EQ(j.at("scene_level"), 1) << "the whole scene fits the budget at level 1";
+  const auto& frames = j.at("frames");
+  ASSERT_GE(frames.size(), 2u);
+  EXPECT_EQ(frames.back().at("work"), "full-detail piece");
+  EXPECT_EQ(frames.back().at("level"), 0) << "the slab's spans fit at full detail";
+  EXPECT_EQ(frames.back().at("completes"), true);
+  EXPECT_EQ(j.at("full_detail_s"), frames.back().at("since_start_s"));
+  CommandResult h =
+      run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + view + " --render " + shell_quoted(reference));
+  ASSERT_EQ(h.exit_code, 0) << h.output;
+  EXPECT_NE(h.output.find("drawing level 0: the visible part fits"), std::string::npos) << h.output;
+  const Image a = read_image(png), b = read_image(reference);
+  ASSERT_GT(lit_pixels(b), 200 * 150 / 100);
+  EXPECT_LT(compare_images(a, b).differing_pixels, 200u * 150u / 100u) << "the window's picture at rest is headless'";
 }
 
 TEST_F(Window, OpensATckDirectly) {

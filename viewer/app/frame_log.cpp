@@ -35,9 +35,14 @@ const char* work_name(FrameWork w) {
 FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint32_t scene_level) {
   FrameSummary s;
   std::vector<double> moving, pieces;
+  // Full detail: a complete picture at rest at the finest level any reached, if that is the scene's level
+  // or finer (the window refines a slab or a close view to a finer level than the whole scene's).
+  std::uint32_t finest = scene_level;
+  for (const FrameRecord& f : frames)
+    if (f.completes && !f.moving) finest = std::min(finest, f.level);
   for (const FrameRecord& f : frames) {
     if (s.first_picture_s < 0) s.first_picture_s = f.since_start_s;
-    const bool full_detail = f.completes && !f.moving && f.level == scene_level;
+    const bool full_detail = f.completes && !f.moving && f.level == finest;
     if (s.full_detail_s < 0 && full_detail) s.full_detail_s = f.since_start_s;
     if (s.exact_s < 0 && full_detail && f.work == FrameWork::ExactPiece) s.exact_s = f.since_start_s;
     if (f.moving) moving.push_back(f.ms);

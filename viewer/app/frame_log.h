@@ -1,7 +1,8 @@
 // Every frame the window draws — its level of detail, whether the camera moved, whether it drew a picture
 // whole or a piece of the refinement at rest (rest_refinement.h), its time, and when it ended since voxview
 // started — and the JSON summary a benchmark reads (voxview --stats): the first picture's time, the first
-// full-detail picture's (the scene's level, at rest) and the first exact one's, and the median and 95th
+// full-detail picture's (at rest, at the finest level reached: the scene's, or finer where the view's
+// visible part fits the budget) and the first exact one's, and the median and 95th
 // percentile of the moving frames and of the refinement's pieces (how long input waits at rest).
 #pragma once
 

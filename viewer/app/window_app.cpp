@@ -172,6 +172,12 @@ class ViewerWindow {
   void set_error(const std::string& message);
   // Draws the scene whole at `level` of detail into scene_target_; returns the frame's time in ms.
   double draw_scene(int width, int height, std::uint32_t level);
+  // The finest level whose spans visible from the current view fit the GPU memory budget, at most the
+  // scene's level (--level: that level).
+  std::uint32_t level_for_view(double aspect);
+  // Chooses rest_level_ for the view on screen, once per picture drawn whole; when the picture already is at
+  // that level, the full-detail stage is complete at once.
+  void choose_rest_level(double aspect);
   // Draws the next piece of the refinement at rest (rest_refinement.h) into refine_target_; once the stage's
   // picture is complete it becomes scene_target_'s and `completes` is set. Returns the piece's time in ms.
   double refine(int width, int height, bool& completes);
@@ -207,7 +213,11 @@ class ViewerWindow {
   std::vector<FrameRecord> frames_;  // for --stats
   std::optional<PictureKey> drawn_;  // what the picture on screen shows (none before the first)
   RestRefinement rest_;
-  bool pieces_begun_ = false;  // the refinement's current stage has begun its pieces
+  bool pieces_begun_ = false;      // the refinement's current stage has begun its pieces
+  std::uint32_t drawn_level_ = 0;  // the level of the picture on screen
+  // The level the refinement draws this view at: the finest whose visible part fits the GPU memory budget
+  // (the scene's level, or finer for a slab or a close view); none until the refinement has chosen it.
+  std::optional<std::uint32_t> rest_level_;
   std::optional<GridOverlay> grid_;
   // The scene is drawn here and blitted to the window: it blends in float like headless rendering, so
   // faint layers add up beyond 8-bit rounding and the window shows what --render writes.
@@ -454,7 +464,7 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
 }
 
 Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
-  std::unique_ptr<Renderer>& r = renderers_[std::max(level, detail_.level)];
+  std::unique_ptr<Renderer>& r = renderers_[level];
   if (!r) {
     // The first picture's level is uploaded whole at once; the others span by span as frames need them
     // (the refinement at rest spreads its level's upload over frames).
@@ -514,7 +524,10 @@ void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t le
   stats_.plan_ms = f.plan_ms;
   stats_.voxels_drawn = f.voxels_drawn;
   stats_.segments_drawn = f.segments_drawn;
-  stats_.frame_level = level == detail_.level ? "" : "level " + std::to_string(level) + " while the camera moves";
+  stats_.frame_level = level > detail_.level ? "level " + std::to_string(level) + " while the camera moves"
+                       : level < detail_.level
+                           ? "level " + std::to_string(level) + ": the visible part fits the GPU memory budget"
+                           : "";
 }
 
 void ViewerWindow::present(int width, int height) const {
@@ -524,9 +537,26 @@ void ViewerWindow::present(int width, int height) const {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
+void ViewerWindow::choose_rest_level(double aspect) {
+  if (rest_level_) return;
+  rest_level_ = level_for_view(aspect);
+  if (rest_.stage() == RestStage::FullDetail && *rest_level_ == drawn_level_) {
+    rest_.stage_complete();  // the picture on screen is already this view's full detail
+    stats_.refinement = rest_.describe(0);
+  }
+}
+
+std::uint32_t ViewerWindow::level_for_view(double aspect) {
+  if (detail_.forced) return detail_.level;
+  for (std::uint32_t level = 0; level < detail_.level; ++level)
+    if (renderer_at(level).view_bytes(controller_.camera(), aspect, state_.settings.clipping) <= detail_.budget)
+      return level;
+  return detail_.level;
+}
+
 double ViewerWindow::refine(int width, int height, bool& completes) {
   const auto t0 = std::chrono::steady_clock::now();
-  Renderer& renderer = renderer_at(detail_.level);
+  Renderer& renderer = renderer_at(*rest_level_);
   if (!refine_target_) refine_target_.emplace(width, height);
   if (refine_target_->width() != width || refine_target_->height() != height) refine_target_->resize(width, height);
   const bool exact_stage = rest_.stage() == RestStage::Exact;
@@ -565,7 +595,8 @@ double ViewerWindow::refine(int width, int height, bool& completes) {
   if (completes) {
     std::swap(scene_target_, refine_target_);
     overlay_grid(renderer, width, height);
-    show_frame_figures(renderer, detail_.level);
+    show_frame_figures(renderer, *rest_level_);
+    drawn_level_ = *rest_level_;
     rest_.stage_complete();
     pieces_begun_ = false;
   }
@@ -652,15 +683,22 @@ int ViewerWindow::run() {
                                                     : budget_.level_for(true);
       const double ms = draw_scene(fb_w, fb_h, level);
       budget_.record(level, ms);
-      rest_.drawn_whole(state_.settings.mode, level == detail_.level);
+      // Full detail for any view only at level 0 (or the level --level forces); otherwise the refinement
+      // decides, once at rest, which level this view can have.
+      rest_.drawn_whole(state_.settings.mode, level == 0 || (detail_.forced && level == detail_.level));
+      drawn_level_ = level;
+      rest_level_.reset();
       stats_.refinement = rest_.describe(0);
       drawn_ = PictureKey{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all};
       frames_.push_back({level, moving, ms, seconds_since_start()});
-    } else if (rest_.stage() != RestStage::Done && !closing) {
-      const FrameWork work = rest_.stage() == RestStage::Exact ? FrameWork::ExactPiece : FrameWork::FullDetailPiece;
-      bool completes = false;
-      const double ms = refine(fb_w, fb_h, completes);
-      frames_.push_back({detail_.level, false, ms, seconds_since_start(), work, completes});
+    } else if (!closing && rest_.stage() != RestStage::Done) {
+      choose_rest_level(double(fb_w) / fb_h);
+      if (rest_.stage() != RestStage::Done) {
+        const FrameWork work = rest_.stage() == RestStage::Exact ? FrameWork::ExactPiece : FrameWork::FullDetailPiece;
+        bool completes = false;
+        const double ms = refine(fb_w, fb_h, completes);
+        frames_.push_back({*rest_level_, false, ms, seconds_since_start(), work, completes});
+      }
     }
     if (rest_.stage() != RestStage::Done) settle = std::max(settle, 1);  // keep refining without input
     present(fb_w, fb_h);
