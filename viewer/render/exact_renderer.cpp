@@ -172,9 +172,11 @@ bool ExactRenderer::step(double max_ms) {
   const std::size_t n = plan_.count.size();
   while (next_ < n) {
     // Before anything is measured, a time-limited run assumes the line passes' rate (Renderer).
-    // The rate over every run so far (as Renderer::draw_piece does).
-    const double rate = composited_ms_ > 0 && next_ > 0 ? double(segments_before_[next_]) / composited_ms_
-                                                        : Renderer::kAssumedSegmentsPerMs;
+    // Fragments per millisecond over every run so far, and the most fragments per segment seen: nearer
+    // voxels cover more pixels a segment, so a rate in segments alone let late runs overrun the time.
+    const double rate = composited_ms_ > 0 && fragments_ > 0 && per_segment_ > 0
+                            ? double(fragments_) / composited_ms_ / per_segment_
+                            : Renderer::kAssumedSegmentsPerMs;
     const double max_segments =
         std::isfinite(max_ms) ? rate * std::max(max_ms - elapsed_ms(), 0.0) : std::numeric_limits<double>::infinity();
     const std::size_t j = run_end(max_segments);
