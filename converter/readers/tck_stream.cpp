@@ -55,9 +55,7 @@ TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, st
                                    " bytes, more than the memory limit leaves for it; raise --memory-limit");
       want = std::min({source_.bytes, max_header_bytes, want * 4});
     }
-    const std::string& dt = header_.datatype;
-    if (dt != "Float32LE" && dt != "Float32BE" && dt != "Float64LE" && dt != "Float64BE")
-      fail_unsupported(path, "TCK datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+    datatype_ = mrtrix_datatype(path, header_.datatype, kTckFile);
   } catch (...) {
     ::close(fd_);
     throw;
@@ -134,16 +132,9 @@ bool TckStream::next(Tractogram& batch, std::uint64_t max_points, std::uint64_t 
     if (whole > 0) {
       const std::uint8_t* p = buffer_.data() + buffer_used_;
       const std::uint64_t offset = read_end_ - buffer_size_ + buffer_used_;
-      const std::string& dt = header_.datatype;
-      std::uint64_t used;
-      if (dt == "Float32LE")
-        used = tck::decode<float, false>(path_, p, whole, offset, batch, state_, stop);
-      else if (dt == "Float32BE")
-        used = tck::decode<float, true>(path_, p, whole, offset, batch, state_, stop);
-      else if (dt == "Float64LE")
-        used = tck::decode<double, false>(path_, p, whole, offset, batch, state_, stop);
-      else
-        used = tck::decode<double, true>(path_, p, whole, offset, batch, state_, stop);
+      const std::uint64_t used = visit_mrtrix_datatype(datatype_, [&]<typename Real, bool kBigEndian>() {
+        return tck::decode<Real, kBigEndian>(path_, p, whole, offset, batch, state_, stop);
+      });
       buffer_used_ += used * triplet_bytes_;
       if (state_.terminated) break;
       // decode stops right after the streamline that fills the batch
