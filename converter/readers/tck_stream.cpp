@@ -4,13 +4,13 @@
 #include <cerrno>
 #include <cstring>
 
-#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "converter/readers/regular_file.h"
 #include "format/checksum.h"
 #include "format/error.h"
+#include "format/regular_file.h"
 
 namespace vxl {
 namespace {
@@ -24,19 +24,10 @@ std::int64_t mtime_ns(const struct stat& st) {
 TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, std::uint64_t read_buffer_bytes)
     : path_(path) {
   require_regular_file(path);
-  // O_NONBLOCK too: should the path become a FIFO after the check, open() still does not wait for a writer.
-  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd_ < 0) fail_input(path, std::nullopt, std::string("cannot open: ") + std::strerror(errno));
+  // open_regular_file opens with O_NONBLOCK: should the path become a FIFO after the check, it still
+  // does not wait for a writer.
   struct stat st {};
-  if (::fstat(fd_, &st) != 0) {
-    int e = errno;
-    ::close(fd_);
-    fail_input(path, std::nullopt, std::string("cannot stat: ") + std::strerror(e));
-  }
-  if (!S_ISREG(st.st_mode)) {
-    ::close(fd_);
-    fail_input(path, std::nullopt, "not a regular file");
-  }
+  fd_ = open_regular_file(path, st);
   source_.bytes = static_cast<std::uint64_t>(st.st_size);
   mtime_ns_ = mtime_ns(st);
   try {
