@@ -2,6 +2,8 @@
 
 #include <limits>
 
+#include "converter/readers/mrtrix_header.h"
+
 namespace vxl {
 
 namespace {
@@ -21,54 +23,35 @@ std::string mrtrix_header(const std::string& magic, std::uint64_t count, const s
 
 }  // namespace
 
-TckWriter::TckWriter(const std::string& path, std::uint64_t count, const std::vector<std::string>& extra_header)
-    : out_(path) {
-  const std::string head = mrtrix_header("mrtrix tracks", count, extra_header);
+MrtrixTrackWriter::MrtrixTrackWriter(const std::string& path, const char* magic, std::size_t record_values,
+                                     std::uint64_t count, const std::vector<std::string>& extra_header)
+    : out_(path), record_values_(record_values) {
+  const std::string head = mrtrix_header(magic, count, extra_header);
   out_.write(head.data(), head.size());
   buffer_.reserve(1 << 20);
 }
 
-void TckWriter::add(std::span<const float> xyz) {
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  buffer_.insert(buffer_.end(), xyz.begin(), xyz.end());
-  buffer_.insert(buffer_.end(), {nan, nan, nan});
+void MrtrixTrackWriter::add(std::span<const float> values) {
+  buffer_.insert(buffer_.end(), values.begin(), values.end());
+  buffer_.insert(buffer_.end(), record_values_, std::numeric_limits<float>::quiet_NaN());
   if (buffer_.size() >= (1 << 20)) flush();
 }
 
-void TckWriter::flush() {
+void MrtrixTrackWriter::flush() {
   out_.write(buffer_.data(), buffer_.size() * sizeof(float));
   buffer_.clear();
 }
 
-void TckWriter::finish() {
-  const float inf = std::numeric_limits<float>::infinity();
-  buffer_.insert(buffer_.end(), {inf, inf, inf});
+void MrtrixTrackWriter::finish() {
+  buffer_.insert(buffer_.end(), record_values_, std::numeric_limits<float>::infinity());
   flush();
   out_.commit();
 }
+
+TckWriter::TckWriter(const std::string& path, std::uint64_t count, const std::vector<std::string>& extra_header)
+    : MrtrixTrackWriter(path, kTckFile.magic, 3, count, extra_header) {}
 
 TsfWriter::TsfWriter(const std::string& path, std::uint64_t count, const std::vector<std::string>& extra_header)
-    : out_(path) {
-  const std::string head = mrtrix_header("mrtrix track scalars", count, extra_header);
-  out_.write(head.data(), head.size());
-  buffer_.reserve(1 << 20);
-}
-
-void TsfWriter::add(std::span<const float> values) {
-  buffer_.insert(buffer_.end(), values.begin(), values.end());
-  buffer_.push_back(std::numeric_limits<float>::quiet_NaN());
-  if (buffer_.size() >= (1 << 20)) flush();
-}
-
-void TsfWriter::flush() {
-  out_.write(buffer_.data(), buffer_.size() * sizeof(float));
-  buffer_.clear();
-}
-
-void TsfWriter::finish() {
-  buffer_.push_back(std::numeric_limits<float>::infinity());
-  flush();
-  out_.commit();
-}
+    : MrtrixTrackWriter(path, kTsfFile.magic, 1, count, extra_header) {}
 
 }  // namespace vxl

@@ -4,30 +4,19 @@
 #include <cstring>
 #include <utility>
 
-#include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "format/error.h"
+#include "format/regular_file.h"
 
 namespace vxl {
 
 MappedFile::MappedFile(const std::string& path) : path_(path) {
-  // O_NONBLOCK: opening a FIFO would otherwise wait for a writer; it has no effect on a regular file, and
-  // anything else is refused just below.
-  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) fail_input(path, std::nullopt, std::string("cannot open: ") + std::strerror(errno));
+  // A FIFO is refused at once (O_NONBLOCK), not waited on.
   struct stat st {};
-  if (::fstat(fd, &st) != 0) {
-    int e = errno;
-    ::close(fd);
-    fail_input(path, std::nullopt, std::string("cannot stat: ") + std::strerror(e));
-  }
-  if (!S_ISREG(st.st_mode)) {
-    ::close(fd);
-    fail_input(path, std::nullopt, "not a regular file");
-  }
+  const int fd = open_regular_file(path, st);
   size_ = static_cast<std::size_t>(st.st_size);
   if (size_ > 0) {
     void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);

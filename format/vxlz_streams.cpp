@@ -38,6 +38,29 @@ void VarintReader::fail(const std::string& what) const {
              "section " + context_.section + ", inflated byte " + std::to_string(pos_) + ": " + what);
 }
 
+namespace {
+
+// zlib counts in 32-bit uInt: calls `step` (deflate or inflate; its argument says whether this is the last
+// of the input) on pieces of at most 1 GiB in and out until it returns other than Z_OK, a call that
+// makes no progress ending it as Z_BUF_ERROR. Counts down `in_left` and `out_left`; returns the last code.
+template <typename Step>
+int zlib_in_pieces(z_stream& z, std::uint64_t& in_left, std::uint64_t& out_left, Step step) {
+  int rc = Z_OK;
+  while (rc == Z_OK) {
+    const uInt in_piece = static_cast<uInt>(std::min<std::uint64_t>(in_left, 1u << 30));
+    const uInt out_piece = static_cast<uInt>(std::min<std::uint64_t>(out_left, 1u << 30));
+    z.avail_in = in_piece;
+    z.avail_out = out_piece;
+    rc = step(in_piece == in_left);
+    if (rc == Z_OK && in_piece == z.avail_in && out_piece == z.avail_out) rc = Z_BUF_ERROR;  // no progress
+    in_left -= in_piece - z.avail_in;
+    out_left -= out_piece - z.avail_out;
+  }
+  return rc;
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> deflate_section(std::span<const std::uint8_t> raw, DeflateMode mode) {
   auto fail = [] { throw Error(ErrorKind::Output, "", std::nullopt, "zlib could not compress a package stream"); };
   z_stream z{};
@@ -48,21 +71,11 @@ std::vector<std::uint8_t> deflate_section(std::span<const std::uint8_t> raw, Def
   std::vector<std::uint8_t> out(8 + deflateBound(&z, static_cast<uLong>(raw.size())));
   const std::uint64_t raw_size = raw.size();
   std::memcpy(out.data(), &raw_size, 8);
-  // zlib counts in 32-bit uInt: feed and drain in pieces.
   z.next_in = const_cast<Bytef*>(raw.data());
   z.next_out = out.data() + 8;
   std::uint64_t in_left = raw.size(), out_left = out.size() - 8;
-  int rc = Z_OK;
-  while (rc == Z_OK) {
-    const uInt in_piece = static_cast<uInt>(std::min<std::uint64_t>(in_left, 1u << 30));
-    const uInt out_piece = static_cast<uInt>(std::min<std::uint64_t>(out_left, 1u << 30));
-    z.avail_in = in_piece;
-    z.avail_out = out_piece;
-    rc = deflate(&z, in_piece == in_left ? Z_FINISH : Z_NO_FLUSH);
-    if (rc == Z_OK && in_piece == z.avail_in && out_piece == z.avail_out) rc = Z_BUF_ERROR;  // no progress
-    in_left -= in_piece - z.avail_in;
-    out_left -= out_piece - z.avail_out;
-  }
+  const int rc =
+      zlib_in_pieces(z, in_left, out_left, [&](bool last_in) { return deflate(&z, last_in ? Z_FINISH : Z_NO_FLUSH); });
   deflateEnd(&z);
   if (rc != Z_STREAM_END) fail();
   out.resize(out.size() - out_left);
@@ -88,19 +101,8 @@ std::vector<std::uint8_t> inflate_section(std::span<const std::uint8_t> payload,
   if (inflateInit(&z) != Z_OK) throw Error(ErrorKind::Unsupported, context.file, std::nullopt, "zlib could not start");
   z.next_in = const_cast<Bytef*>(payload.data() + 8);
   z.next_out = raw.data();
-  // zlib counts in 32-bit uInt: feed and drain in pieces.
   std::uint64_t in_left = compressed, out_left = raw.size();
-  int rc = Z_OK;
-  while (rc == Z_OK) {
-    const uInt in_piece = static_cast<uInt>(std::min<std::uint64_t>(in_left, 1u << 30));
-    const uInt out_piece = static_cast<uInt>(std::min<std::uint64_t>(out_left, 1u << 30));
-    z.avail_in = in_piece;
-    z.avail_out = out_piece;
-    rc = inflate(&z, Z_NO_FLUSH);
-    in_left -= in_piece - z.avail_in;
-    out_left -= out_piece - z.avail_out;
-    if (rc == Z_OK && in_piece == z.avail_in && out_piece == z.avail_out) rc = Z_BUF_ERROR;  // no progress
-  }
+  const int rc = zlib_in_pieces(z, in_left, out_left, [&](bool) { return inflate(&z, Z_NO_FLUSH); });
   inflateEnd(&z);
   const std::uint64_t produced = raw.size() - out_left;
   if (produced > raw_size) fail("zlib stream inflates to more than its raw size " + std::to_string(raw_size));

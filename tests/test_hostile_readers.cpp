@@ -18,6 +18,7 @@
 namespace {
 
 namespace hostile = vxl::test::hostile;
+using vxl::test::has_warning;
 using vxl::test::ScratchDir;
 
 // The error `read` throws, or a failure when it throws none.
@@ -30,11 +31,6 @@ vxl::Error error_of(Read read) {
   }
   ADD_FAILURE() << "no error";
   return vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "no error");
-}
-
-bool has_warning(const std::vector<std::string>& warnings, const std::string& part) {
-  return std::any_of(warnings.begin(), warnings.end(),
-                     [&](const std::string& w) { return w.find(part) != std::string::npos; });
 }
 
 // ---- row 1: a TRX member name with a component count beyond 64 bits ----

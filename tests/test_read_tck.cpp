@@ -4,7 +4,10 @@
 #include <cstring>
 #include <fstream>
 
+#include "converter/readers/mrtrix_header.h"
 #include "converter/readers/read_tractogram.h"
+#include "converter/readers/read_tsf.h"
+#include "converter/readers/tck_stream.h"
 #include "format/error.h"
 #include "tests/mrtrix_test_files.h"
 #include "tests/test_support.h"
@@ -141,6 +144,43 @@ TEST(TckReader, UnknownDatatypeIsUnsupported) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
   }
+}
+
+// The datatypes and the refusal of others are one helper (mrtrix_header.h) for the TCK reader, its
+// streamed form and the TSF reader: each type reaches the decoder as its own Real and byte order, and every
+// reader refuses the same way, naming its format.
+TEST(TckReader, DatatypesAreOneListForTckTsfAndTheStream) {
+  struct Decoded {
+    std::size_t bytes;
+    bool big;
+    bool operator==(const Decoded&) const = default;
+  };
+  auto decoded = [](const char* datatype) {
+    return visit_mrtrix_datatype(mrtrix_datatype("x", datatype, kTckFile), []<typename Real, bool kBigEndian>() {
+      return Decoded{sizeof(Real), kBigEndian};
+    });
+  };
+  EXPECT_EQ(decoded("Float32LE"), (Decoded{4, false}));
+  EXPECT_EQ(decoded("Float32BE"), (Decoded{4, true}));
+  EXPECT_EQ(decoded("Float64LE"), (Decoded{8, false}));
+  EXPECT_EQ(decoded("Float64BE"), (Decoded{8, true}));
+
+  ScratchDir dir;
+  write_tck(dir.file("a.tck"), "Float32", raw<float>({kInf, kInf, kInf}));
+  test::write_mrtrix_file(dir.file("a.tsf"), "mrtrix track scalars", "Float32", raw<float>({kInf}));
+  auto error_of = [](auto read) -> std::string {
+    try {
+      read();
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+      return e.what();
+    }
+    return "no error";
+  };
+  const std::string expected = " datatype 'Float32' (expected Float32LE, Float32BE, Float64LE or Float64BE)";
+  EXPECT_EQ(error_of([&] { (void)read_tck(dir.file("a.tck")); }), dir.file("a.tck") + ": TCK" + expected);
+  EXPECT_EQ(error_of([&] { TckStream s(dir.file("a.tck"), 1 << 20); }), dir.file("a.tck") + ": TCK" + expected);
+  EXPECT_EQ(error_of([&] { (void)read_tsf(dir.file("a.tsf")); }), dir.file("a.tsf") + ": TSF" + expected);
 }
 
 TEST(TckReader, NonFiniteCoordinateInsideAStreamlineIsRefusedWithItsOffset) {

@@ -23,6 +23,7 @@
 
 namespace {
 
+using vxl::test::has_warning;
 using vxl::test::real;
 
 struct Counts {
@@ -48,12 +49,6 @@ const Counts kTrxFixtures[] = {
     {"trx-python__small_fldr.trx", 1000, 33886, "float16"},
 };
 
-bool has_warning(const vxl::Tractogram& t, const std::string& part) {
-  for (const auto& w : t.source.warnings)
-    if (w.find(part) != std::string::npos) return true;
-  return false;
-}
-
 TEST(ReadTrx, EveryFixtureHasTheDocumentedCounts) {
   VXL_REQUIRE_REAL_DATA();
   for (const auto& f : kTrxFixtures) {
@@ -71,7 +66,7 @@ TEST(ReadTrx, EveryFixtureHasTheDocumentedCounts) {
     EXPECT_NO_THROW((void)t.source.header.dump());
     // Only the mislabelled dpsv.trx deserves a warning.
     if (std::string(f.file) == "niivue__dpsv.trx") {
-      EXPECT_TRUE(has_warning(t, "NB_STREAMLINES = 459"));
+      EXPECT_TRUE(has_warning(t.source.warnings, "NB_STREAMLINES = 459"));
       EXPECT_EQ(t.source.warnings.size(), 1u);
     } else {
       EXPECT_TRUE(t.source.warnings.empty()) << t.source.warnings.front();
@@ -331,7 +326,7 @@ TEST(ReadTrxSynthetic, Float16AndFloat64Positions) {
   const vxl::Tractogram d = vxl::read_trx(dir.file("d.trx"));
   EXPECT_EQ(d.source.dtype, "float64");
   for (int i = 0; i < 18; ++i) EXPECT_EQ(d.positions[i], static_cast<float>(0.1 * i));
-  EXPECT_TRUE(has_warning(d, "float64 positions rounded to float32"));
+  EXPECT_TRUE(has_warning(d.source.warnings, "float64 positions rounded to float32"));
   EXPECT_EQ(d.source.warnings.size(), 1u);
 }
 

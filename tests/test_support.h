@@ -1,6 +1,7 @@
 // Helpers shared by the tests: where the real fixtures are, scratch directories, running the CLI.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -31,6 +32,12 @@ inline std::vector<char> slurp(const std::string& path) {
 inline void write_file(const std::string& path, const std::vector<char>& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc)
       .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// Whether one of `warnings` (a reader's or a command's) contains `part`.
+inline bool has_warning(const std::vector<std::string>& warnings, const std::string& part) {
+  return std::any_of(warnings.begin(), warnings.end(),
+                     [&](const std::string& w) { return w.find(part) != std::string::npos; });
 }
 
 // The real-world fixtures (../shared/data/real). A user's clone does not have them: tests that need

@@ -16,6 +16,15 @@ std::string_view trim(std::string_view s) {
 
 }  // namespace
 
+MrtrixDatatype mrtrix_datatype(const std::string& path, const std::string& datatype, const MrtrixFileKind& kind) {
+  if (datatype == "Float32LE") return MrtrixDatatype::kFloat32LE;
+  if (datatype == "Float32BE") return MrtrixDatatype::kFloat32BE;
+  if (datatype == "Float64LE") return MrtrixDatatype::kFloat64LE;
+  if (datatype == "Float64BE") return MrtrixDatatype::kFloat64BE;
+  fail_unsupported(path, std::string(kind.name) + " datatype '" + datatype +
+                             "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+}
+
 std::optional<MrtrixHeader> parse_mrtrix_header(const std::string& path, std::span<const std::uint8_t> bytes,
                                                 std::uint64_t file_size, const MrtrixFileKind& kind) {
   const std::string name = kind.name;

@@ -49,6 +49,27 @@ inline MrtrixHeader parse_mrtrix_header(const std::string& path, std::span<const
   return *parse_mrtrix_header(path, whole_file, whole_file.size(), kind);
 }
 
+// The number types of the data that follows the header ("datatype:"): Float32/Float64, little- or
+// big-endian. The only ones MRtrix writes to track and track scalar files.
+enum class MrtrixDatatype { kFloat32LE, kFloat32BE, kFloat64LE, kFloat64BE };
+
+// `datatype` as one of them; any other throws vxl::Error (Unsupported) naming `path`:
+// "TCK datatype 'X' (expected Float32LE, Float32BE, Float64LE or Float64BE)" (kind.name for "TCK").
+MrtrixDatatype mrtrix_datatype(const std::string& path, const std::string& datatype, const MrtrixFileKind& kind);
+
+// Returns f.template operator()<Real, kBigEndian>() for `type`: Real is float or double, kBigEndian
+// true for the BE types (as load_mrtrix_value takes them).
+template <typename F>
+decltype(auto) visit_mrtrix_datatype(MrtrixDatatype type, F&& f) {
+  switch (type) {
+    case MrtrixDatatype::kFloat32LE: return f.template operator()<float, false>();
+    case MrtrixDatatype::kFloat32BE: return f.template operator()<float, true>();
+    case MrtrixDatatype::kFloat64LE: return f.template operator()<double, false>();
+    case MrtrixDatatype::kFloat64BE: break;
+  }
+  return f.template operator()<double, true>();
+}
+
 // One value of the data that follows the header: Float32/Float64, little- or big-endian (the datatype's
 // LE/BE suffix), at any alignment.
 template <typename Real, bool kBigEndian>

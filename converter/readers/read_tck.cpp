@@ -75,17 +75,10 @@ Tractogram read_tck(const std::string& path) {
   t.source.xxh3_128 = xxh3_128_hex(file.data(), file.size());
   t.source.header = h.fields;
 
-  const std::string& dt = h.datatype;
-  if (dt == "Float32LE")
-    read_points<float, false>(path, file.bytes(), h.data_offset, t);
-  else if (dt == "Float32BE")
-    read_points<float, true>(path, file.bytes(), h.data_offset, t);
-  else if (dt == "Float64LE")
-    read_points<double, false>(path, file.bytes(), h.data_offset, t);
-  else if (dt == "Float64BE")
-    read_points<double, true>(path, file.bytes(), h.data_offset, t);
-  else
-    fail_unsupported(path, "TCK datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+  const MrtrixDatatype type = mrtrix_datatype(path, h.datatype, kTckFile);
+  visit_mrtrix_datatype(type, [&]<typename Real, bool kBigEndian>() {
+    read_points<Real, kBigEndian>(path, file.bytes(), h.data_offset, t);
+  });
 
   tck::header_warnings(h, t.streamline_count(), t.source.warnings);
   return t;

@@ -71,17 +71,10 @@ TrackScalars read_tsf(const std::string& path) {
                   {"bytes", file.size()},
                   {"xxh3_128", xxh3_128_hex(file.data(), file.size())},
                   {"header", h.fields}};
-  const std::string& dt = h.datatype;
-  if (dt == "Float32LE")
-    read_values<float, false>(path, file.bytes(), h.data_offset, s);
-  else if (dt == "Float32BE")
-    read_values<float, true>(path, file.bytes(), h.data_offset, s);
-  else if (dt == "Float64LE")
-    read_values<double, false>(path, file.bytes(), h.data_offset, s);
-  else if (dt == "Float64BE")
-    read_values<double, true>(path, file.bytes(), h.data_offset, s);
-  else
-    fail_unsupported(path, "TSF datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+  const MrtrixDatatype type = mrtrix_datatype(path, h.datatype, kTsfFile);
+  visit_mrtrix_datatype(type, [&]<typename Real, bool kBigEndian>() {
+    read_values<Real, kBigEndian>(path, file.bytes(), h.data_offset, s);
+  });
   if (auto w = count_warning(h, s.offsets.size() - 1)) s.warnings.push_back(*w);
   return s;
 }

@@ -4,13 +4,13 @@
 #include <cerrno>
 #include <cstring>
 
-#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "converter/readers/regular_file.h"
 #include "format/checksum.h"
 #include "format/error.h"
+#include "format/regular_file.h"
 
 namespace vxl {
 namespace {
@@ -24,19 +24,10 @@ std::int64_t mtime_ns(const struct stat& st) {
 TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, std::uint64_t read_buffer_bytes)
     : path_(path) {
   require_regular_file(path);
-  // O_NONBLOCK too: should the path become a FIFO after the check, open() still does not wait for a writer.
-  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd_ < 0) fail_input(path, std::nullopt, std::string("cannot open: ") + std::strerror(errno));
+  // open_regular_file opens with O_NONBLOCK: should the path become a FIFO after the check, it still
+  // does not wait for a writer.
   struct stat st {};
-  if (::fstat(fd_, &st) != 0) {
-    int e = errno;
-    ::close(fd_);
-    fail_input(path, std::nullopt, std::string("cannot stat: ") + std::strerror(e));
-  }
-  if (!S_ISREG(st.st_mode)) {
-    ::close(fd_);
-    fail_input(path, std::nullopt, "not a regular file");
-  }
+  fd_ = open_regular_file(path, st);
   source_.bytes = static_cast<std::uint64_t>(st.st_size);
   mtime_ns_ = mtime_ns(st);
   try {
@@ -55,9 +46,7 @@ TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, st
                                    " bytes, more than the memory limit leaves for it; raise --memory-limit");
       want = std::min({source_.bytes, max_header_bytes, want * 4});
     }
-    const std::string& dt = header_.datatype;
-    if (dt != "Float32LE" && dt != "Float32BE" && dt != "Float64LE" && dt != "Float64BE")
-      fail_unsupported(path, "TCK datatype '" + dt + "' (expected Float32LE, Float32BE, Float64LE or Float64BE)");
+    datatype_ = mrtrix_datatype(path, header_.datatype, kTckFile);
   } catch (...) {
     ::close(fd_);
     throw;
@@ -134,16 +123,9 @@ bool TckStream::next(Tractogram& batch, std::uint64_t max_points, std::uint64_t 
     if (whole > 0) {
       const std::uint8_t* p = buffer_.data() + buffer_used_;
       const std::uint64_t offset = read_end_ - buffer_size_ + buffer_used_;
-      const std::string& dt = header_.datatype;
-      std::uint64_t used;
-      if (dt == "Float32LE")
-        used = tck::decode<float, false>(path_, p, whole, offset, batch, state_, stop);
-      else if (dt == "Float32BE")
-        used = tck::decode<float, true>(path_, p, whole, offset, batch, state_, stop);
-      else if (dt == "Float64LE")
-        used = tck::decode<double, false>(path_, p, whole, offset, batch, state_, stop);
-      else
-        used = tck::decode<double, true>(path_, p, whole, offset, batch, state_, stop);
+      const std::uint64_t used = visit_mrtrix_datatype(datatype_, [&]<typename Real, bool kBigEndian>() {
+        return tck::decode<Real, kBigEndian>(path_, p, whole, offset, batch, state_, stop);
+      });
       buffer_used_ += used * triplet_bytes_;
       if (state_.terminated) break;
       // decode stops right after the streamline that fills the batch

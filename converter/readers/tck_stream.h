@@ -54,6 +54,7 @@ class TckStream {
   std::string path_;
   int fd_ = -1;
   MrtrixHeader header_;
+  MrtrixDatatype datatype_ = MrtrixDatatype::kFloat32LE;  // header_.datatype
   SourceInfo source_;
   std::uint32_t triplet_bytes_ = 12;
   std::int64_t mtime_ns_ = 0;
