@@ -77,8 +77,9 @@ ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity) : lin
   glGetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
   std::uint64_t bytes = std::min<std::uint64_t>(static_cast<std::uint32_t>(max_block), 256ull << 20);
   capacity_ = node_capacity ? node_capacity : bytes / 16;
-  list_program_ = gl::make_program(shaders::line_vertex(lines.bound_spans_, "#version 430 core"),
-                                   shaders::line_fragment(kListFragment, "#version 430 core"));
+  list_program_ =
+      gl::make_program(shaders::line_vertex(lines.bound_spans_, "#version 430 core"),
+                       shaders::line_fragment(kListFragment, "#version 430 core", lines.slices_ != nullptr));
   clear_program_ = gl::make_compute_program(kClearCompute);
   blit_program_ = gl::make_program(shaders::kFullscreenVertex, kBlitFragment);
   glGenBuffers(1, &nodes_);

@@ -155,9 +155,10 @@ void main() {
   return s;
 }
 
-std::string line_fragment(const char* body, const char* version) {
+std::string line_fragment(const char* body, const char* version, bool slice_test) {
   // The line's colour: from the colour map per fragment, or the vertex colour; then the lighting terms.
-  return std::string(version) + "\n#define SAMPLES " + std::to_string(kColormapSamples) + R"(
+  return std::string(version) + "\n#define SAMPLES " + std::to_string(kColormapSamples) + "\n#define SLICE_TEST " +
+         (slice_test ? "1" : "0") + R"(
 in vec4 v_color;
 in vec2 v_light;
 in float v_value;
@@ -174,7 +175,9 @@ uniform int u_slice_test;         // 1: slices are drawn this frame
 // The depth test against the opaque slices, done here rather than by the depth buffer so that it holds
 // in every mode, including the multipass ones and exact's per-pixel lists.
 void discard_behind_slices() {
+#if SLICE_TEST
   if (u_slice_test != 0 && gl_FragCoord.z > texelFetch(u_slice_depth, ivec2(gl_FragCoord.xy), 0).r) discard;
+#endif
 }
 vec4 line_color() {
   vec3 base = v_mapped > 0.5 ? colormap(v_value) : v_color.rgb;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -44,11 +45,7 @@ Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, 
                 "this GPU offers " + std::to_string(units) + " vertex-shader textures; the lines need " +
                     std::to_string(kSamplersPerSpan));
   glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even without attributes
-  const std::string vs = shaders::line_vertex(bound_spans_);
-  over_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineOverFragment));
-  accum_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitAccumFragment));
-  reveal_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitRevealFragment));
-  additive_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineAdditiveFragment));
+  make_line_programs();
   wboit_composite_ = gl::make_program(shaders::kFullscreenVertex, shaders::kWboitCompositeFragment);
   additive_composite_ = gl::make_program(shaders::kFullscreenVertex, shaders::kAdditiveCompositeFragment);
 }
@@ -85,7 +82,26 @@ std::pair<glm::dvec3, glm::dvec3> Renderer::bounds() const {
 glm::dvec3 Renderer::scene_min() const { return slices_ ? glm::min(bounds_min(), slices_->ras_min()) : bounds_min(); }
 glm::dvec3 Renderer::scene_max() const { return slices_ ? glm::max(bounds_max(), slices_->ras_max()) : bounds_max(); }
 
-void Renderer::set_volume(const Volume& volume) { slices_ = std::make_unique<SliceRenderer>(volume); }
+void Renderer::make_line_programs() {
+  for (GLuint* p : {&over_program_, &accum_program_, &reveal_program_, &additive_program_})
+    if (*p) glDeleteProgram(std::exchange(*p, 0));
+  const std::string vs = shaders::line_vertex(bound_spans_);
+  const char* const version = "#version 330 core";
+  const bool slice_test = slices_ != nullptr;
+  over_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineOverFragment, version, slice_test));
+  accum_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitAccumFragment, version, slice_test));
+  reveal_program_ =
+      gl::make_program(vs, shaders::line_fragment(shaders::kLineWboitRevealFragment, version, slice_test));
+  additive_program_ = gl::make_program(vs, shaders::line_fragment(shaders::kLineAdditiveFragment, version, slice_test));
+}
+
+void Renderer::set_volume(const Volume& volume) {
+  slices_ = std::make_unique<SliceRenderer>(volume);
+  // The line programs now test against the slices' depth; exact's list program is made again on first use.
+  make_line_programs();
+  exact_.reset();
+  pieces_.reset();
+}
 
 std::array<float, 2> Renderer::slice_range(const RenderSettings& s) const {
   return slices_ ? slices_->range(s.slices) : std::array<float, 2>{0, 1};

@@ -129,6 +129,8 @@ class Renderer {
   friend class ExactRenderer;
 
   struct Pieces;
+  // The line passes' programs, with the slices' depth test only where there is a volume.
+  void make_line_programs();
   // The union of the files' bounds: {min, max}.
   std::pair<glm::dvec3, glm::dvec3> bounds() const;
   // What every mode does first: the per-vertex attributes, the slices (their depth hides lines behind them),
