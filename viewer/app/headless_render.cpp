@@ -56,8 +56,8 @@ int run_headless(const ViewerOptions& o) {
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);  // before any GL work: a bad image fails fast
   HeadlessGlContext context;
-  const std::uint64_t texels = span_texels(pointers(files), o.span_texels);
-  const SceneDetail detail = choose_scene_detail(pointers(files), o.level, o.gpu_memory, texels);
+  const SceneDetail detail = choose_scene_detail(pointers(files), o.level, o.gpu_memory, o.span_texels);
+  const std::uint64_t texels = detail.span_texels;
   const auto gpu_memory = std::make_shared<GpuMemoryPool>(detail.budget);
   const double aspect = double(o.width) / o.height;
   // The level whose whole copy fits the budget, or for one view (not a turntable, not --level) the finest

@@ -30,8 +30,28 @@ std::optional<std::uint64_t> driver_free_bytes() {
 
 }  // namespace
 
+namespace {
+
+// The level for a span size: the one --level names (checked against --gpu-memory), else the finest that fits.
+std::uint32_t level_within(const std::vector<const VxlFile*>& files, const SceneDetail& d,
+                           std::optional<std::uint32_t> level, bool budget_given) {
+  if (level) {
+    const std::uint32_t forced = std::min(*level, SceneLayout::coarsest_level(files));
+    const SceneLayout layout(files, d.span_texels, forced);
+    if (budget_given && layout.upload_bytes() > d.budget)
+      throw Error(ErrorKind::Unsupported, files.front()->path(), std::nullopt,
+                  "level " + std::to_string(forced) + " needs " + format_memory_size(layout.upload_bytes()) +
+                      " of GPU memory, more than --gpu-memory " + format_memory_size(d.budget) +
+                      "; choose a coarser --level or leave it out");
+    return forced;
+  }
+  return SceneLayout::finest_level_within(files, d.span_texels, d.budget);
+}
+
+}  // namespace
+
 SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::optional<std::uint32_t> level,
-                                std::optional<std::uint64_t> gpu_memory, std::uint64_t max_texels) {
+                                std::optional<std::uint64_t> gpu_memory, std::optional<std::uint64_t> span_texels) {
   SceneDetail d;
   if (gpu_memory) {
     d.budget = *gpu_memory;
@@ -43,23 +63,18 @@ SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::o
     d.budget = available_memory().value_or(std::uint64_t(4) << 30) / 4;  // the mapped file and the copy also take RAM
     d.budget_source = "a quarter of the available memory (the driver reports no GPU memory)";
   }
-  if (level) {
-    d.forced = true;
-    d.level = std::min(*level, SceneLayout::coarsest_level(files));
-    const SceneLayout layout(files, max_texels, d.level);
-    if (gpu_memory && layout.upload_bytes() > d.budget)
-      throw Error(ErrorKind::Unsupported, files.front()->path(), std::nullopt,
-                  "level " + std::to_string(d.level) + " needs " + format_memory_size(layout.upload_bytes()) +
-                      " of GPU memory, more than --gpu-memory " + format_memory_size(d.budget) +
-                      "; choose a coarser --level or leave it out");
-    return d;
+  d.forced = level.has_value();
+  const std::uint64_t driver = GpuScene::driver_limit();
+  auto within_driver = [&](std::uint64_t wanted) {
+    return std::min(driver, std::max(wanted, SceneLayout::largest_voxel_texels(files)));
+  };
+  d.span_texels = within_driver(span_texels.value_or(driver));
+  d.level = level_within(files, d, level, gpu_memory.has_value());
+  if (!span_texels && d.level > 0 && !d.forced) {  // full detail does not fit: page in small spans
+    d.span_texels = within_driver(kPagingSpanTexels);
+    d.level = level_within(files, d, level, gpu_memory.has_value());
   }
-  d.level = SceneLayout::finest_level_within(files, max_texels, d.budget);
   return d;
-}
-
-std::uint64_t span_texels(const std::vector<const VxlFile*>& files, std::uint64_t wanted) {
-  return std::min(GpuScene::driver_limit(), std::max(wanted, SceneLayout::largest_voxel_texels(files)));
 }
 
 std::string describe_scene_detail(const SceneDetail& d, std::uint32_t levels_in_files) {

@@ -14,19 +14,23 @@ namespace vxl::app {
 
 struct SceneDetail {
   std::uint32_t level = 0;
-  std::uint64_t budget = 0;   // bytes
-  std::string budget_source;  // where the budget comes from, for messages
-  bool forced = false;        // --level chose the level
+  std::uint64_t span_texels = 0;  // the most texels a GPU texture span holds
+  std::uint64_t budget = 0;       // bytes
+  std::string budget_source;      // where the budget comes from, for messages
+  bool forced = false;            // --level chose the level
 };
 
-// Needs a current GL context when `gpu_memory` is not given (it asks the driver). Throws vxl::Error
+// The span size too: `span_texels` (--span-texels) when given, else the driver's texture-buffer limit when
+// full detail fits the budget (the fewest spans: a draw of one span is the cheapest, its shader needs no
+// span lookup), else kPagingSpanTexels, so that the budget can hold just the visible spans; raised to what
+// the largest voxel needs, within the driver's limit. Needs a current GL context. Throws vxl::Error
 // (Unsupported) when even the coarsest level does not fit.
 SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::optional<std::uint32_t> level,
-                                std::optional<std::uint64_t> gpu_memory, std::uint64_t max_texels);
+                                std::optional<std::uint64_t> gpu_memory,
+                                std::optional<std::uint64_t> span_texels = std::nullopt);
 
-// The most texels a GPU texture span may hold: `wanted` (--span-texels), raised to what the largest voxel
-// needs, within the driver's texture-buffer limit (needs a current GL context).
-std::uint64_t span_texels(const std::vector<const VxlFile*>& files, std::uint64_t wanted);
+// The span size when paging: 4M texels, at most 64 MiB of positions and tables and 8 MiB of orders.
+inline constexpr std::uint64_t kPagingSpanTexels = std::uint64_t(1) << 22;
 
 // One line for the user when the scene is drawn at a coarse level; empty at full detail.
 std::string describe_scene_detail(const SceneDetail& detail, std::uint32_t levels_in_files);

@@ -31,8 +31,8 @@ struct ViewerOptions {
   std::optional<std::uint32_t> level;
   std::optional<std::uint64_t> gpu_memory;  // bytes
   // The most texels a GPU texture span holds (the driver's limit when smaller): the granule a tight budget
-  // uploads and evicts (gpu_scene.h).
-  std::uint64_t span_texels = std::uint64_t(1) << 22;
+  // uploads and evicts (gpu_scene.h). None: chosen (scene_detail.h).
+  std::optional<std::uint64_t> span_texels;
   bool verify = false;           // --verify: check every .vxl in full (as `voxlines verify`) before drawing
   std::vector<std::string> tsf;  // per-point values for a .tck converted in memory
   // Window: while the camera moves, draw the finest level whose measured frame time fits this budget

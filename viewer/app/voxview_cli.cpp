@@ -151,8 +151,8 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--span-texels", a.options.span_texels,
                  "the most texels one GPU texture span holds (at most the driver's texture-buffer limit): the "
                  "granule that a GPU memory budget too small for the whole scene uploads and evicts, nearest "
-                 "visible spans first")
-      ->default_val(std::uint64_t(1) << 22)
+                 "visible spans first. Default: the driver's limit when full detail fits the budget (fewest "
+                 "spans, cheapest to draw), else 4M")
       ->check(CLI::Range(std::uint64_t(1024), std::uint64_t(1) << 31));
   cli.add_option("--level", a.options.level,
                  "draw this level of detail (0: every streamline; level d keeps about 1/8^d of them), whatever the "

@@ -200,8 +200,7 @@ class ViewerWindow {
   GLFWwindow* window_;
   std::vector<const VxlFile*> files_;
   const Volume* volume_;
-  std::uint64_t texels_;  // the most a GPU texture span holds
-  SceneDetail detail_;    // the level of detail drawn at rest
+  SceneDetail detail_;  // the level of detail drawn at rest, and the span size
   // The GPU memory budget every level's renderer shares: together they never take more.
   std::shared_ptr<GpuMemoryPool> gpu_memory_;
   // One renderer per level drawn, made on first use: the first picture's (coarse, so that it comes at once),
@@ -243,8 +242,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
       window_(window),
       files_(pointers(files)),
       volume_(volume),
-      texels_(span_texels(files_, o.span_texels)),
-      detail_(choose_scene_detail(files_, o.level, o.gpu_memory, texels_)),
+      detail_(choose_scene_detail(files_, o.level, o.gpu_memory, o.span_texels)),
       gpu_memory_(std::make_shared<GpuMemoryPool>(detail_.budget)),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
       start_(start),
@@ -468,7 +466,7 @@ Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
   if (!r) {
     // The first picture's level is uploaded whole at once; the others span by span as frames need them
     // (the refinement at rest spreads its level's upload over frames).
-    r = std::make_unique<Renderer>(files_, texels_, level, gpu_memory_, level == first_level_);
+    r = std::make_unique<Renderer>(files_, detail_.span_texels, level, gpu_memory_, level == first_level_);
     if (volume_) r->set_volume(*volume_);
   }
   return *r;

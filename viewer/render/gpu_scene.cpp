@@ -132,6 +132,17 @@ void GpuScene::upload_span(std::uint32_t ci) {
   GpuTextureSpan& g = spans_[ci];
   g.words.create(GL_RGBA32UI, words.data(), words.size() * 4);
   g.orders.create(GL_R16UI, orders.data(), orders.size() * 2);
+  upload_extras(ci);
+  resident_[ci] = true;
+  uploaded_bytes_[ci] = span_bytes(ci);
+  gpu_bytes_ += uploaded_bytes_[ci];
+}
+
+void GpuScene::upload_extras(std::uint32_t ci) {
+  const TextureSpan& c = layout_.texture_spans()[ci];
+  GpuTextureSpan& g = spans_[ci];
+  g.dataset.destroy();
+  g.attributes.destroy();
   if (dataset_content_ == DatasetContent::StreamlineOrder)
     g.dataset.create(GL_R32UI, dataset_per_span_[ci].data(), dataset_per_span_[ci].size() * 4);
   else  // the view order's entries are written every frame (upload_view_order)
@@ -139,20 +150,19 @@ void GpuScene::upload_span(std::uint32_t ci) {
   const std::vector<float>* values = c.file < attributes_.size() ? &attributes_[c.file] : nullptr;
   if (values == nullptr || values->empty()) {
     g.attributes.create(GL_RG32F, nullptr, 0);
-  } else {
-    // Two floats per vertex, each voxel's at its block's place in the span (scene_layout.h).
-    std::vector<float> padded(2 * c.vertices, 0.0f);
-    for (std::uint32_t k = 0; k < c.voxel_count; ++k) {
-      const VoxelDrawInfo& d = layout_.voxels()[c.voxel_first + k];
-      const VoxelEntry& v = file.voxels()[c.voxel_first + k - file_first];
-      std::copy_n(values->data() + 2 * v.vertex_first, 2 * std::uint64_t(d.vertex_count),
-                  padded.data() + 2 * d.vertex_first);
-    }
-    g.attributes.create(GL_RG32F, padded.data(), padded.size() * 4);
+    return;
   }
-  resident_[ci] = true;
-  uploaded_bytes_[ci] = span_bytes(ci);
-  gpu_bytes_ += uploaded_bytes_[ci];
+  // Two floats per vertex, each voxel's at its block's place in the span (scene_layout.h).
+  const VxlFile& file = *files_[c.file];
+  const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
+  std::vector<float> padded(2 * c.vertices, 0.0f);
+  for (std::uint32_t k = 0; k < c.voxel_count; ++k) {
+    const VoxelDrawInfo& d = layout_.voxels()[c.voxel_first + k];
+    const VoxelEntry& v = file.voxels()[c.voxel_first + k - file_first];
+    std::copy_n(values->data() + 2 * v.vertex_first, 2 * std::uint64_t(d.vertex_count),
+                padded.data() + 2 * d.vertex_first);
+  }
+  g.attributes.create(GL_RG32F, padded.data(), padded.size() * 4);
 }
 
 void GpuScene::evict(std::uint32_t c) {
@@ -193,14 +203,24 @@ GpuScene::Residency GpuScene::make_resident(std::span<const std::uint32_t> neede
 }
 
 void GpuScene::upload_resident_again() {
-  std::vector<std::uint32_t> again;
+  // Only the dataset and attribute buffers change: the positions and orders stay. A span whose new size
+  // does not fit the budget is evicted whole.
+  const std::uint64_t use = pool_->begin_use();
   for (std::uint32_t c = 0; c < spans_.size(); ++c)
-    if (resident_[c]) again.push_back(c);
-  for (std::uint32_t c : again) {
+    if (resident_[c]) pool_->touch(owner_, c, use);
+  for (std::uint32_t c = 0; c < spans_.size(); ++c) {
+    if (!resident_[c]) continue;
     pool_->remove(owner_, c);
-    evict(c);
+    const std::uint64_t bytes = span_bytes(c);
+    if (!pool_->reserve(bytes, use)) {
+      evict(c);
+      continue;
+    }
+    upload_extras(c);
+    gpu_bytes_ += bytes - uploaded_bytes_[c];
+    uploaded_bytes_[c] = bytes;
+    pool_->add(owner_, c, bytes, use);
   }
-  make_resident(again);
 }
 
 GpuScene::~GpuScene() {

@@ -89,8 +89,11 @@ class GpuScene {
   // The bytes span c takes on the GPU with its current attributes and dataset order.
   std::uint64_t span_bytes(std::uint32_t c) const;
   void upload_span(std::uint32_t c);
+  // Span c's dataset and attribute buffers, for the current dataset content and attributes.
+  void upload_extras(std::uint32_t c);
   void evict(std::uint32_t c);
-  // Uploads the resident spans again (after their attributes or dataset order changed), within the budget.
+  // Remakes the resident spans' dataset and attribute buffers (after what they hold changed), within the
+  // budget.
   void upload_resident_again();
   void release();
   // Voxel `voxel` of the scene (`local` in its file, `index` in its span): its words, info, table entries
