@@ -133,14 +133,8 @@ void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FrameP
 std::uint64_t Renderer::view_bytes(const Camera& camera, double aspect, const Clipping& clipping) const {
   FramePlan visible;
   plan(camera, aspect, PlanOrder::Any, visible, clipping);
-  const SceneLayout& layout = scene_.layout();
-  std::vector<bool> seen(layout.texture_spans().size(), false);
   std::uint64_t bytes = 0;
-  for (std::int64_t id : visible.first) {
-    const std::uint32_t span = layout.span_of_id(id);
-    if (!seen[span]) bytes += layout.span_upload_bytes(span);
-    seen[span] = true;
-  }
+  for (std::uint32_t span : spans_nearest_first(visible)) bytes += scene_.layout().span_upload_bytes(span);
   return bytes;
 }
 
@@ -449,6 +443,15 @@ void Renderer::over_blending() {
   glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
 }
 
+void Renderer::opaque_blending() {
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  // The colour replaces, the alpha stays the clear's 1: an opaque picture (a PNG would otherwise keep the
+  // lines' opacity as their alpha).
+  glEnable(GL_BLEND);
+  glBlendFuncSeparate(GL_ONE, GL_ZERO, GL_ZERO, GL_ONE);
+}
+
 void Renderer::clear_to_base(GLuint fbo, int width, int height, const glm::vec3& background) const {
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, width, height);
@@ -488,12 +491,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
   switch (s.mode) {
     case RenderMode::Opaque:
       clear_to_base(fbo, width, height, bg);
-      glEnable(GL_DEPTH_TEST);
-      glDepthFunc(GL_LESS);
-      // The colour replaces, the alpha stays the clear's 1: an opaque picture (a PNG would otherwise keep
-      // the lines' opacity as their alpha).
-      glEnable(GL_BLEND);
-      glBlendFuncSeparate(GL_ONE, GL_ZERO, GL_ZERO, GL_ONE);
+      opaque_blending();
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Any);
       glDisable(GL_DEPTH_TEST);
       break;
@@ -657,11 +655,8 @@ bool Renderer::draw_piece(double max_ms) {
       glViewport(0, 0, p.width, p.height);
       glLineWidth(std::max(1.0f, p.settings.line_width));
       glDepthMask(GL_TRUE);
-      if (p.settings.mode == RenderMode::Opaque) {  // as draw(): depth-tested, the colour replaces
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LESS);
-        glEnable(GL_BLEND);
-        glBlendFuncSeparate(GL_ONE, GL_ZERO, GL_ZERO, GL_ONE);
+      if (p.settings.mode == RenderMode::Opaque) {  // as draw()
+        opaque_blending();
       } else {
         glDisable(GL_DEPTH_TEST);
         over_blending();
