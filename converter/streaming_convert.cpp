@@ -7,13 +7,14 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <span>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
 
 #include "converter/memory_size.h"
-#include "converter/position_packing.h"
 #include "converter/readers/source_formats.h"
 #include "converter/readers/tck_stream.h"
 #include "converter/segment_orders.h"
@@ -22,6 +23,7 @@
 #include "converter/voxelize.h"
 #include "format/error.h"
 #include "format/parallel.h"
+#include "format/vxl_positions.h"
 #include "format/vxl_stream_writer.h"
 
 namespace vxl {
@@ -38,9 +40,9 @@ constexpr std::uint64_t kMiB = 1ull << 20;
 // measures about 7 MiB of resident memory at start; the rest is margin).
 constexpr std::uint64_t kBaselineBytes = 16 * kMiB;
 // The voxel table while it is built and used, at its peak (build_table): hash index (coordinates and
-// slots, with their growth: up to 40 bytes), counts per voxel (with growth: 32), sort order, global id,
-// the table itself (64) and cursor (8) — 152 bytes, and a margin.
-constexpr std::uint64_t kPlanBytesPerVoxel = 192;
+// slots, with their growth: up to 40 bytes), counts per voxel (with growth: 32), tight bounds (with
+// growth: 48), sort order, global id, the table itself (64) and cursor (8) — 200 bytes, and a margin.
+constexpr std::uint64_t kPlanBytesPerVoxel = 240;
 // Each level of detail past the first adds counts per depth (32 with growth), a cursor (8), a LODS entry
 // (8) and the counts summed per voxel while the table is built (16).
 constexpr std::uint64_t plan_bytes_per_voxel(std::uint32_t levels) { return kPlanBytesPerVoxel + 64 * (levels - 1); }
@@ -49,6 +51,10 @@ constexpr std::uint64_t plan_bytes_per_voxel(std::uint32_t levels) { return kPla
 constexpr std::uint64_t kHeldBytesPerPoint = 2 * 2 * 3 * sizeof(float);
 // Voxline and streamline table entries written at once.
 constexpr std::size_t kTableBufferEntries = 1 << 16;
+// The orders are built and written a run of voxels at a time, in a buffer of at most this size and an eighth
+// of the memory left (or of the largest voxel's orders, if more): large enough that each run keeps every
+// ordering thread busy.
+constexpr std::uint64_t kOrderChunkBytes = 256 * kMiB;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -102,7 +108,7 @@ struct Sink {
 // A range of the voxel table, built in one pass.
 struct Range {
   std::size_t first = 0, end = 0;  // voxels
-  std::uint64_t vertex_first = 0, vertex_end = 0, order_first = 0, order_end = 0;
+  std::uint64_t vertex_first = 0, vertex_end = 0;
   std::uint32_t max_vertices = 0;
   unsigned order_threads = 1;  // set by cut_ranges
 };
@@ -122,6 +128,17 @@ class StreamingConversion {
   void build_table();
   std::vector<Range> cut_ranges();
   void build_range(const Range& r, std::size_t index, std::size_t count);
+  void write_orders(const Range& r, std::span<const std::uint32_t> words, std::span<const float> vertices,
+                    const VoxlineEnds& ends, const std::string& stage);
+  bool packed() const { return settings_.positions == PositionEncoding::Packed; }
+  // Where voxel i's orders start in ORDR (i = voxel count: the payload's end).
+  std::uint64_t orders_start(std::size_t i) const {
+    return i < voxels_.size() ? voxels_[i].order_offset : order_bytes_;
+  }
+  // Memory per ordering thread besides its sort buffers: a voxel's packed block decoded, and its end bits.
+  std::uint64_t decode_bytes(std::uint32_t max_vertices) const {
+    return packed() ? 12ull * max_vertices + (max_vertices / 64 + 1) * 8 : 0;
+  }
   void write_rest();
   [[noreturn]] void fail_changed() const;
   // Reads the source once, calling body(batch, index of its first streamline) per batch.
@@ -154,6 +171,7 @@ class StreamingConversion {
   Sink sink_;
   std::uint64_t sink_held_ = 0, plan_held_ = 0;
   detail::VoxelUse use_;                  // by local id, while planning
+  detail::VoxelBounds bounds_;            // by local id, while planning
   std::vector<std::uint32_t> global_id_;  // local id -> voxel index
   std::vector<VoxelEntry> voxels_;
   std::vector<LevelEntry> levels_;  // LODS, voxel-major
@@ -163,6 +181,7 @@ class StreamingConversion {
   // passes skip the streamlines that have no voxel in their range.
   std::vector<std::array<std::uint32_t, 2>> spans_;
   std::uint64_t order_bytes_ = 0;
+  std::uint64_t order_chunk_bytes_ = 0;
   std::unique_ptr<VxlStreamWriter> out_;
 };
 
@@ -281,6 +300,9 @@ void StreamingConversion::plan() {
       const std::size_t n_local = sink_.index.coords().size();
       use_.grow_to(n_local);
       detail::count_voxel_use(sink_.voxlines, streamline_depth(first + k, settings_.levels), use_, path_);
+      bounds_.grow_to(n_local);
+      for (std::size_t j = 0; j < sink_.voxlines.size(); ++j)
+        bounds_.add_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data());
       voxlines += sink_.voxlines.size();
       // Per streamline, so that a table outgrowing the limit is caught before it goes far past it.
       const std::uint64_t table = n_local * plan_bytes_per_voxel(settings_.levels);
@@ -314,38 +336,40 @@ void StreamingConversion::build_table() {
   use_ = detail::VoxelUse(settings_.levels);
   global_id_ = std::move(table.global_id);
   cursor_ = std::move(table.cursor);
+  for (std::uint32_t local = 0; local < global_id_.size(); ++local)
+    bounds_.set_tight_bounds(local, voxels_[global_id_[local]]);
+  bounds_ = detail::VoxelBounds();
   meta_.stored_order_count = static_cast<std::uint32_t>(order_set_.directions.size());
   meta_.order_set = static_cast<std::uint32_t>(order_set_.kind);
   meta_.position_encoding = static_cast<std::uint32_t>(settings_.positions);
   order_bytes_ = layout_orders(voxels_, levels_, settings_.levels, meta_.stored_order_count);
 }
 
-// Consecutive voxels, as many per range as fit in what the limit leaves: each range's vertices (12 bytes
-// each, 16 with their packed words), voxline ends (1 bit each), orders, and its ordering threads' sort buffers. The
-// sort buffers of one thread grow with the largest voxel, so a range orders with fewer threads when they would take
-// more than a quarter of the room (the orders do not depend on the thread count).
+// Consecutive voxels, as many per range as fit in what the limit leaves: each range's vertices (packed:
+// 4 bytes each, the end bit inside; float32: 12 bytes and an end bit) and its ordering threads' buffers.
+// The orders are not held per range: they are built and written a chunk of voxels at a time (the chunk
+// buffer is taken before this). An ordering thread's buffers grow with the largest voxel, so a range
+// orders with fewer threads when they would take more than a quarter of the room (the orders do not
+// depend on the thread count).
 std::vector<Range> StreamingConversion::cut_ranges() {
   const std::uint64_t room = budget_.left();
+  auto per_thread = [&](const Range& r) { return order_scratch_bytes(r.max_vertices) + decode_bytes(r.max_vertices); };
   auto order_threads = [&](const Range& r) {
-    const std::uint64_t per_thread = order_scratch_bytes(r.max_vertices);
-    return static_cast<unsigned>(std::clamp<std::uint64_t>(room / 4 / per_thread, 1, threads_));
+    return static_cast<unsigned>(std::clamp<std::uint64_t>(room / 4 / per_thread(r), 1, threads_));
   };
   auto cost = [&](const Range& r) {
     const std::uint64_t v = r.vertex_end - r.vertex_first;
-    const std::uint64_t vertex_bytes = settings_.positions == PositionEncoding::Packed ? 16 : 12;
-    return vertex_bytes * v + (v / 64 + 1) * 8 + (r.order_end - r.order_first) +
-           order_threads(r) * order_scratch_bytes(r.max_vertices);
+    const std::uint64_t held = packed() ? 4 * v : 12 * v + (v / 64 + 1) * 8;
+    return held + order_threads(r) * per_thread(r);
   };
-  auto order_end = [&](std::size_t i) { return i < voxels_.size() ? voxels_[i].order_offset : order_bytes_; };
   auto alone = [&](std::size_t i) {
     const VoxelEntry& v = voxels_[i];
-    Range r{
-        i, i + 1, v.vertex_first, v.vertex_first + v.vertex_count, v.order_offset, order_end(i + 1), v.vertex_count};
+    Range r{i, i + 1, v.vertex_first, v.vertex_first + v.vertex_count, v.vertex_count};
     if (cost(r) > room) {
       budget_.take(cost(r),
                    "voxel (" + std::to_string(v.coord[0]) + ", " + std::to_string(v.coord[1]) + ", " +
                        std::to_string(v.coord[2]) + ") of " + std::to_string(v.vertex_count) +
-                       " vertices, with its orders and sort buffers,",
+                       " vertices, with its sort buffers,",
                    ", or a smaller --voxel-size");
     }
     return r;
@@ -360,7 +384,6 @@ std::vector<Range> StreamingConversion::cut_ranges() {
     Range grown = r;
     grown.end = i + 1;
     grown.vertex_end = voxels_[i].vertex_first + voxels_[i].vertex_count;
-    grown.order_end = order_end(i + 1);
     grown.max_vertices = std::max(grown.max_vertices, voxels_[i].vertex_count);
     if (cost(grown) <= room) {
       r = grown;
@@ -375,12 +398,27 @@ std::vector<Range> StreamingConversion::cut_ranges() {
 }
 
 // Pass 2 + k: the blocks and orders of one range; the first also writes the voxline and streamline tables.
+// Packed positions are packed as they are placed (the tight bounds came from pass 2), so a range holds
+// 4 bytes a vertex.
 void StreamingConversion::build_range(const Range& r, std::size_t index, std::size_t count) {
   const std::string of = " " + std::to_string(index + 1) + "/" + std::to_string(count);
   const bool tables = index == 0;
   auto t0 = Clock::now();
-  std::vector<float> vertices(3 * (r.vertex_end - r.vertex_first));
-  VoxlineEnds ends(r.vertex_end - r.vertex_first);
+  const std::uint64_t range_vertices = r.vertex_end - r.vertex_first;
+  // Every vertex of the range is written once below, so the buffers need no zeroing.
+  std::unique_ptr<std::uint32_t[]> words;
+  std::unique_ptr<float[]> vertices;
+  VoxlineEnds ends;
+  std::vector<VertexPacker> packers;
+  std::vector<float> voxline_xyz;  // one voxline's vertices on their way to being packed
+  if (packed()) {
+    words = std::make_unique_for_overwrite<std::uint32_t[]>(range_vertices);
+    packers.reserve(r.end - r.first);
+    for (std::size_t g = r.first; g < r.end; ++g) packers.emplace_back(voxels_[g]);
+  } else {
+    vertices = std::make_unique_for_overwrite<float[]>(3 * range_vertices);
+    ends = VoxlineEnds(range_vertices);
+  }
   std::vector<VoxlineEntry> voxline_buffer;
   std::vector<std::uint64_t> streamline_buffer;
   if (tables) {
@@ -427,9 +465,22 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
         const std::uint64_t end =
             voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), depth);
         if (cursor > end || used > end - cursor) fail_changed();
-        detail::place_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data(),
-                              vertices.data() + 3 * (cursor - r.vertex_first));
-        ends.set(cursor - r.vertex_first + used - 1);
+        const std::uint64_t at = cursor - r.vertex_first;
+        if (packed()) {
+          voxline_xyz.resize(3 * used);
+          detail::place_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data(), voxline_xyz.data());
+          // A vertex outside the bounds pass 2 found would be clamped: the source changed.
+          const VoxelEntry& voxel = voxels_[g];
+          for (std::uint64_t e = 0; e < used; ++e)
+            for (int c = 0; c < 3; ++c)
+              if (!(voxline_xyz[3 * e + c] >= voxel.tight_min[c] && voxline_xyz[3 * e + c] <= voxel.tight_max[c]))
+                fail_changed();
+          packers[g - r.first].pack(voxline_xyz.data(), used, words.get() + at);
+          words[at + used - 1] |= kPackedVoxlineEnd;
+        } else {
+          detail::place_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data(), vertices.get() + 3 * at);
+          ends.set(at + used - 1);
+        }
         cursor += used;
       }
       voxline_index += n;
@@ -451,43 +502,64 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
     out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, streamline_buffer);
     out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, voxline_buffer);
   }
-
-  const std::span<VoxelEntry> range(voxels_.data() + r.first, r.end - r.first);
-  detail::set_tight_bounds(range, vertices.data(), r.vertex_first);
-
-  // The orders (and packed positions), with the range's entries rebased to its own vertices and orders
-  // for the while.
-  for (VoxelEntry& v : range) {
-    v.vertex_first -= r.vertex_first;
-    v.order_offset -= r.order_first;
-  }
-  std::vector<std::uint32_t> packed;
-  if (settings_.positions == PositionEncoding::Packed) {
-    packed.resize(r.vertex_end - r.vertex_first);
-    pack_vertex_blocks(range, vertices, ends, packed, threads_);
-  }
   summary_.voxelize_seconds += seconds_since(t0);
 
   t0 = Clock::now();
-  std::vector<std::uint8_t> orders(r.order_end - r.order_first, 0);
-  const std::string stage = "ordering" + of;
-  const std::span<const LevelEntry> range_levels =
-      std::span<const LevelEntry>(levels_).subspan(r.first * (levels - 1), (r.end - r.first) * (levels - 1));
-  build_orders_into(range, range_levels, levels, vertices, ends, order_set_, orders, r.order_threads,
-                    [&](const char*, double f) { report(stage, f); });
-  for (VoxelEntry& v : range) {
-    v.vertex_first += r.vertex_first;
-    v.order_offset += r.order_first;
-  }
-  summary_.orders_seconds += seconds_since(t0);
-
-  t0 = Clock::now();
-  if (packed.empty())
-    out_->append_items<float>(VxlStreamWriter::kVert, vertices);
+  const std::span<const std::uint32_t> word_span(words.get(), packed() ? range_vertices : 0);
+  const std::span<const float> vertex_span(vertices.get(), packed() ? 0 : 3 * range_vertices);
+  if (packed())
+    out_->append_items<std::uint32_t>(VxlStreamWriter::kVert, word_span);
   else
-    out_->append_items<std::uint32_t>(VxlStreamWriter::kVert, packed);
-  out_->append(VxlStreamWriter::kOrdr, orders);
+    out_->append_items<float>(VxlStreamWriter::kVert, vertex_span);
   summary_.write_seconds += seconds_since(t0);
+
+  write_orders(r, word_span, vertex_span, ends, "ordering" + of);
+}
+
+// The orders of range r's voxels, a chunk of consecutive voxels at a time (each chunk's voxels spread
+// over the range's ordering threads), appended to ORDR. A packed block is decoded first: the orders sort
+// the positions the file holds.
+void StreamingConversion::write_orders(const Range& r, std::span<const std::uint32_t> words,
+                                       std::span<const float> vertices, const VoxlineEnds& ends,
+                                       const std::string& stage) {
+  const std::uint32_t levels = settings_.levels;
+  std::vector<std::uint8_t> chunk;
+  std::vector<std::optional<VoxelOrderWriter>> writers(r.order_threads);
+  std::vector<std::vector<float>> decoded(r.order_threads);
+  for (std::size_t first = r.first; first < r.end;) {
+    auto t0 = Clock::now();
+    std::size_t end = first + 1;
+    while (end < r.end && orders_start(end + 1) - orders_start(first) <= order_chunk_bytes_) ++end;
+    const std::uint64_t base = orders_start(first);
+    chunk.assign(orders_start(end) - base, 0);  // the padding between voxels stays zero
+    parallel_for(end - first, r.order_threads, [&](std::uint64_t i, unsigned t) {
+      const std::size_t g = first + i;
+      if (!writers[t]) writers[t].emplace(order_set_, r.max_vertices);
+      VoxelEntry v = voxels_[g];
+      const std::span<const LevelEntry> row = level_row(levels_, g, levels);
+      std::uint8_t* dst = chunk.data() + (v.order_offset - base);
+      const std::uint64_t at = v.vertex_first - r.vertex_first;
+      if (!packed()) {
+        v.vertex_first = at;
+        writers[t]->write(v, row, vertices, ends, dst);
+        return;
+      }
+      std::vector<float>& xyz = decoded[t];
+      xyz.resize(3 * std::size_t(v.vertex_count));
+      VertexPacker(v).decode(words.data() + at, v.vertex_count, xyz.data());
+      VoxlineEnds block_ends(v.vertex_count);
+      for (std::uint32_t e = 0; e < v.vertex_count; ++e)
+        if (words[at + e] & kPackedVoxlineEnd) block_ends.set(e);
+      v.vertex_first = 0;
+      writers[t]->write(v, row, xyz, block_ends, dst);
+    });
+    summary_.orders_seconds += seconds_since(t0);
+    t0 = Clock::now();
+    out_->append(VxlStreamWriter::kOrdr, chunk);
+    summary_.write_seconds += seconds_since(t0);
+    first = end;
+    report(stage, double(first - r.first) / double(std::max<std::size_t>(1, r.end - r.first)));
+  }
 }
 
 void StreamingConversion::write_rest() {
@@ -531,6 +603,10 @@ ConvertSummary StreamingConversion::run() {
                "the buffer of the voxline and streamline tables");
   budget_.take(meta_.streamline_count * sizeof(spans_[0]), "the voxel span of every streamline");
   spans_.resize(meta_.streamline_count);
+  order_chunk_bytes_ = std::min({kOrderChunkBytes, order_bytes_, budget_.left() / 8});
+  for (std::size_t i = 0; i < voxels_.size(); ++i)
+    order_chunk_bytes_ = std::max(order_chunk_bytes_, orders_start(i + 1) - orders_start(i));
+  budget_.take(order_chunk_bytes_, "the buffer of the orders being written", ", or a smaller --voxel-size");
   std::vector<Range> ranges = cut_ranges();
 
   const std::string provenance = provenance_json(stream_->source(), settings_, threads_, voxel_size_choice_);

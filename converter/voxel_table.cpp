@@ -223,8 +223,40 @@ void set_tight_bounds(std::span<VoxelEntry> voxels, const float* vertices, std::
         lo[c] = std::min(lo[c], p[3 * k + c]);
         hi[c] = std::max(hi[c], p[3 * k + c]);
       }
-    std::copy(lo, lo + 3, v.tight_min);
-    std::copy(hi, hi + 3, v.tight_max);
+    for (int c = 0; c < 3; ++c) {
+      v.tight_min[c] = lo[c] + 0.0f;  // -0 + 0 = +0
+      v.tight_max[c] = hi[c] + 0.0f;
+    }
+  }
+}
+
+void VoxelBounds::grow_to(std::size_t voxels) {
+  if (lo_.size() >= 3 * voxels) return;
+  lo_.resize(3 * voxels, INFINITY);
+  hi_.resize(3 * voxels, -INFINITY);
+}
+
+void VoxelBounds::add(std::uint32_t local, const float* xyz, std::uint64_t count) {
+  float* lo = lo_.data() + 3 * std::size_t(local);
+  float* hi = hi_.data() + 3 * std::size_t(local);
+  for (std::uint64_t k = 0; k < count; ++k)
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], xyz[3 * k + c]);
+      hi[c] = std::max(hi[c], xyz[3 * k + c]);
+    }
+}
+
+void VoxelBounds::add_voxline(std::span<const TempVoxline> streamline, std::size_t j, const float* pts,
+                              const float* synthetic_xyz) {
+  const std::uint32_t local = streamline[j].voxel;
+  for_each_voxline_run(streamline, j, pts, synthetic_xyz,
+                       [&](const float* xyz, std::uint64_t count) { add(local, xyz, count); });
+}
+
+void VoxelBounds::set_tight_bounds(std::uint32_t local, VoxelEntry& v) const {
+  for (int c = 0; c < 3; ++c) {
+    v.tight_min[c] = lo_[3 * std::size_t(local) + c] + 0.0f;
+    v.tight_max[c] = hi_[3 * std::size_t(local) + c] + 0.0f;
   }
 }
 

@@ -92,24 +92,29 @@ struct VoxelTable {
 VoxelTable build_voxel_table(std::span<LocalVoxels> indexes, std::uint32_t level_count, MetaSection& m,
                              const std::string& path);
 
-// Writes voxline j of one streamline's list (its optional synthetic first point, its own points and, but
-// for the streamline's last voxline, the next voxline's first point) at `dst`; returns the vertices written.
-inline std::uint64_t place_voxline(std::span<const TempVoxline> streamline, std::size_t j, const float* pts,
-                                   const float* synthetic_xyz, float* dst) {
+// Calls run(xyz, count) for the runs of voxline j's vertices in block order: its optional synthetic first
+// point, its own points and, but for the streamline's last voxline, the next voxline's first point.
+template <typename Run>
+void for_each_voxline_run(std::span<const TempVoxline> streamline, std::size_t j, const float* pts,
+                          const float* synthetic_xyz, Run&& run) {
   const TempVoxline& v = streamline[j];
   auto first_point = [&](const TempVoxline& x) {
     return x.synthetic != kNoSynthetic ? synthetic_xyz + 3 * x.synthetic : pts + 3 * x.src_first;
   };
+  if (v.synthetic != kNoSynthetic) run(first_point(v), std::uint64_t{1});
+  run(pts + 3 * v.src_first, std::uint64_t{v.src_count});
+  if (j + 1 < streamline.size()) run(first_point(streamline[j + 1]), std::uint64_t{1});
+}
+
+// Writes voxline j of one streamline's list (for_each_voxline_run's vertices) at `dst`; returns the
+// vertices written.
+inline std::uint64_t place_voxline(std::span<const TempVoxline> streamline, std::size_t j, const float* pts,
+                                   const float* synthetic_xyz, float* dst) {
   float* out = dst;
-  if (v.synthetic != kNoSynthetic) {
-    std::copy_n(first_point(v), 3, out);
-    out += 3;
-  }
-  std::copy_n(pts + 3 * v.src_first, 3 * std::size_t(v.src_count), out);
-  out += 3 * std::size_t(v.src_count);
-  const bool connected = j + 1 < streamline.size();
-  if (connected) std::copy_n(first_point(streamline[j + 1]), 3, out);
-  return v.own() + (connected ? 1 : 0);
+  for_each_voxline_run(streamline, j, pts, synthetic_xyz, [&](const float* xyz, std::uint64_t count) {
+    out = std::copy_n(xyz, 3 * count, out);
+  });
+  return static_cast<std::uint64_t>(out - dst) / 3;
 }
 
 // The checks, shared so that both paths refuse the same input with the same message. All throw vxl::Error.
@@ -121,6 +126,25 @@ Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std:
 [[noreturn]] void fail_too_many_synthetic(const std::string& path, double voxel_size, double longest_step2);
 
 // Each voxel's tight bounds from its block; `vertices` holds the blocks from vertex `vertex_base` on.
+// A zero bound is stored as +0 whichever zero came first, so that the bounds do not depend on the order
+// the vertices are seen in (VoxelBounds sees them in streamline order).
 void set_tight_bounds(std::span<VoxelEntry> voxels, const float* vertices, std::uint64_t vertex_base);
+
+// The tight bounds of each voxel of a local index, widened voxline by voxline while the voxlines are
+// counted: the streaming conversion knows them before it places a vertex, so that it can pack each vertex
+// as it places it (and hold 4 bytes a vertex instead of 12). Gives what set_tight_bounds gives.
+class VoxelBounds {
+ public:
+  static constexpr std::uint64_t kBytesPerVoxel = 6 * sizeof(float);
+  void grow_to(std::size_t voxels);
+  // Widens the bounds of voxline j's voxel to the vertices place_voxline writes for it.
+  void add_voxline(std::span<const TempVoxline> streamline, std::size_t j, const float* pts,
+                   const float* synthetic_xyz);
+  void set_tight_bounds(std::uint32_t local, VoxelEntry& v) const;
+
+ private:
+  void add(std::uint32_t local, const float* xyz, std::uint64_t count);
+  std::vector<float> lo_, hi_;  // 3 per local id
+};
 
 }  // namespace vxl::detail

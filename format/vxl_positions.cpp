@@ -13,48 +13,49 @@ std::optional<PositionEncoding> parse_position_encoding(std::string_view name) {
   return std::nullopt;
 }
 
-namespace {
-
-// One axis of spec §5.4: value = lo + q * step, in binary32.
-struct PackedAxis {
-  float lo, step;
-  float decode(std::uint32_t q) const {
-    const float offset = static_cast<float>(q) * step;  // rounded on its own: no fused multiply-add
-    return lo + offset;
+VertexPacker::VertexPacker(const VoxelEntry& voxel) {
+  for (int c = 0; c < 3; ++c) {
+    const float extent = voxel.tight_max[c] - voxel.tight_min[c];
+    lo_[c] = voxel.tight_min[c];
+    step_[c] = extent / static_cast<float>(kPackedSteps);
   }
-};
-
-PackedAxis axis_of(const VoxelEntry& v, int c) {
-  const float extent = v.tight_max[c] - v.tight_min[c];
-  return {v.tight_min[c], extent / static_cast<float>(kPackedSteps)};
 }
 
-}  // namespace
+float VertexPacker::decode_axis(int c, std::uint32_t q) const {
+  const float offset = static_cast<float>(q) * step_[c];  // rounded on its own: no fused multiply-add
+  return lo_[c] + offset;
+}
+
+std::uint32_t VertexPacker::pack(float* xyz) const {
+  std::uint32_t word = 0;
+  for (int c = 0; c < 3; ++c) {
+    float& x = xyz[c];
+    std::uint32_t q = 0;
+    if (step_[c] > 0) {
+      const double t = (double(x) - double(lo_[c])) / double(step_[c]);
+      q = t <= 0 ? 0 : t >= kPackedSteps ? kPackedSteps : static_cast<std::uint32_t>(std::floor(t + 0.5));
+    }
+    word |= q << (10 * c);
+    x = decode_axis(c, q);
+  }
+  return word;
+}
+
+void VertexPacker::pack(float* xyz, std::uint64_t count, std::uint32_t* packed) const {
+  for (std::uint64_t i = 0; i < count; ++i) packed[i] = pack(xyz + 3 * i);
+}
+
+void VertexPacker::decode(const std::uint32_t* packed, std::uint64_t count, float* xyz) const {
+  for (std::uint64_t i = 0; i < count; ++i)
+    for (int c = 0; c < 3; ++c) xyz[3 * i + c] = decode_axis(c, (packed[i] >> (10 * c)) & kPackedAxisMask);
+}
 
 void pack_block(const VoxelEntry& voxel, float* xyz, std::uint32_t count, std::uint32_t* packed) {
-  PackedAxis axes[3];
-  for (int c = 0; c < 3; ++c) axes[c] = axis_of(voxel, c);
-  for (std::uint32_t i = 0; i < count; ++i) {
-    std::uint32_t word = 0;
-    for (int c = 0; c < 3; ++c) {
-      float& x = xyz[3 * i + c];
-      std::uint32_t q = 0;
-      if (axes[c].step > 0) {
-        const double t = (double(x) - double(axes[c].lo)) / double(axes[c].step);
-        q = t <= 0 ? 0 : t >= kPackedSteps ? kPackedSteps : static_cast<std::uint32_t>(std::floor(t + 0.5));
-      }
-      word |= q << (10 * c);
-      x = axes[c].decode(q);
-    }
-    packed[i] = word;
-  }
+  VertexPacker(voxel).pack(xyz, count, packed);
 }
 
 void unpack_block(const VoxelEntry& voxel, const std::uint32_t* packed, std::uint64_t count, float* xyz) {
-  PackedAxis axes[3];
-  for (int c = 0; c < 3; ++c) axes[c] = axis_of(voxel, c);
-  for (std::uint64_t i = 0; i < count; ++i)
-    for (int c = 0; c < 3; ++c) xyz[3 * i + c] = axes[c].decode((packed[i] >> (10 * c)) & kPackedAxisMask);
+  VertexPacker(voxel).decode(packed, count, xyz);
 }
 
 double packed_error_bound(const VoxelEntry& voxel) {

@@ -27,6 +27,21 @@ constexpr std::uint64_t vertex_bytes(PositionEncoding e) { return e == PositionE
 const char* position_encoding_name(PositionEncoding e);  // "packed" or "float32"
 std::optional<PositionEncoding> parse_position_encoding(std::string_view name);
 
+// One voxel's quantisation (spec §5.4), for writers that pack a block a few vertices at a time.
+class VertexPacker {
+ public:
+  explicit VertexPacker(const VoxelEntry& voxel);  // the voxel's tight bounds must be set
+  // The packed word of one vertex (end bit clear); replaces its coordinates by what the word decodes to.
+  std::uint32_t pack(float* xyz) const;
+  void pack(float* xyz, std::uint64_t count, std::uint32_t* packed) const;
+  // 3 * count floats from `count` words (their end bits ignored).
+  void decode(const std::uint32_t* packed, std::uint64_t count, float* xyz) const;
+
+ private:
+  float decode_axis(int c, std::uint32_t q) const;
+  float lo_[3], step_[3];
+};
+
 // Quantises one voxel's block: writes each vertex's packed word (end bit clear) into `packed` and replaces
 // its coordinates in `xyz` by the values the word decodes to. The voxel's tight bounds must hold the block.
 void pack_block(const VoxelEntry& voxel, float* xyz, std::uint32_t count, std::uint32_t* packed);

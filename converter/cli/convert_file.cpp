@@ -69,9 +69,9 @@ std::string convert_file(const std::string& input, const std::string& output, co
                 (unsigned long long)s.segments, (unsigned long long)s.synthetic_points);
   std::string report = output + line;
   if (settings.memory_limit > 0) {
-    std::snprintf(line, sizeof line, "memory limit %s: %llu passes over the source, voxels built in %llu parts\n",
+    std::snprintf(line, sizeof line, "memory limit %s: %llu passes over the source, voxels built in %llu part%s\n",
                   format_memory_size(settings.memory_limit).c_str(), (unsigned long long)s.passes,
-                  (unsigned long long)s.partitions);
+                  (unsigned long long)s.partitions, s.partitions == 1 ? "" : "s");
     report += line;
   }
   if (verbose) {
