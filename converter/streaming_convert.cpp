@@ -5,6 +5,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -49,10 +50,14 @@ constexpr std::uint64_t plan_bytes_per_voxel(std::uint32_t levels) { return kPla
 // Memory per point of a batch being read, at worst: two batches (one read while the other is processed),
 // each of whose positions may have twice the capacity in use.
 constexpr std::uint64_t kHeldBytesPerPoint = 2 * 2 * 3 * sizeof(float);
+// Memory per point of a batch being placed (StagedPart): a voxline (24 bytes) and the voxline end of its
+// streamline (8) per point at most, and its vertex staged (at most 12 bytes). Taken up front for a batch
+// of the usual size; a batch that needs more (a long streamline is held whole) takes the rest then.
+constexpr std::uint64_t kStagedBytesPerPoint = 24 + 8 + 12;
 // Voxline and streamline table entries written at once.
 constexpr std::size_t kTableBufferEntries = 1 << 16;
-// The orders are built and written a run of voxels at a time, in a buffer of at most this size and an eighth
-// of the memory left (or of the largest voxel's orders, if more): large enough that each run keeps every
+// The orders are built a run of voxels at a time, in place in a mapped part of the output of at most this size and an
+// eighth of the memory left (or of the largest voxel's orders, if more): large enough that each run keeps every
 // ordering thread busy.
 constexpr std::uint64_t kOrderChunkBytes = 256 * kMiB;
 
@@ -94,9 +99,10 @@ class Budget {
   std::string path_;
 };
 
-// Where voxelize_streamline puts one streamline's voxlines.
-struct Sink {
-  VoxelIndex index;
+// Where voxelize_streamline puts the voxlines of one streamline (or of several, one after the other).
+template <typename Index>
+struct SinkOf {
+  Index index;
   std::vector<TempVoxline> voxlines;
   std::vector<float> synthetic_xyz;
   bool too_many_synthetic = false;
@@ -104,6 +110,8 @@ struct Sink {
     return voxlines.capacity() * sizeof(TempVoxline) + synthetic_xyz.capacity() * sizeof(float);
   }
 };
+
+using Sink = SinkOf<VoxelIndex>;
 
 // A range of the voxel table, built in one pass.
 struct Range {
@@ -128,8 +136,15 @@ class StreamingConversion {
   void build_table();
   std::vector<Range> cut_ranges();
   void build_range(const Range& r, std::size_t index, std::size_t count);
-  void write_orders(const Range& r, std::span<const std::uint32_t> words, std::span<const float> vertices,
-                    const VoxlineEnds& ends, const std::string& stage);
+  struct StagedPart;
+  struct RangePlacement;
+  void place_range(const Range& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
+  void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
+                  std::uint64_t end, StagedPart& part) const;
+  void place_part(RangePlacement& placing, std::uint64_t first, const StagedPart& part);
+  void write_orders(const Range& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
+  void write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> range_vertices,
+                          VoxelOrderWriter& writer, std::vector<float>& decoded, std::uint8_t* dst);
   bool packed() const { return settings_.positions == PositionEncoding::Packed; }
   // Where voxel i's orders start in ORDR (i = voxel count: the payload's end).
   std::uint64_t orders_start(std::size_t i) const {
@@ -169,7 +184,7 @@ class StreamingConversion {
   Grid grid_{};
   std::uint64_t synthetic_limit_ = 0;
   Sink sink_;
-  std::uint64_t sink_held_ = 0, plan_held_ = 0;
+  std::uint64_t sink_held_ = 0, plan_held_ = 0, staged_held_ = 0;
   detail::VoxelUse use_;                  // by local id, while planning
   detail::VoxelBounds bounds_;            // by local id, while planning
   std::vector<std::uint32_t> global_id_;  // local id -> voxel index
@@ -182,7 +197,36 @@ class StreamingConversion {
   std::vector<std::array<std::uint32_t, 2>> spans_;
   std::uint64_t order_bytes_ = 0;
   std::uint64_t order_chunk_bytes_ = 0;
+  VoxlineEnds ends_;  // float32 positions: the voxline ends of the range being built
   std::unique_ptr<VxlStreamWriter> out_;
+};
+
+// Part of a batch voxelised on its own thread (stage_part), waiting to be placed in order.
+struct StreamingConversion::StagedPart {
+  std::uint64_t begin = 0, end = 0;       // streamlines of the batch
+  SinkOf<detail::SharedVoxelIndex> sink;  // every voxline of the part, in order
+  std::vector<std::size_t> voxline_ends;  // per streamline: the end of its voxlines in sink.voxlines
+  std::vector<std::uint32_t> words;       // packed: the vertices of the voxlines in range, in order
+  std::vector<float> xyz;                 // float32: the same
+  std::exception_ptr error;
+  std::uint64_t bytes() const {
+    return sink.bytes() + voxline_ends.capacity() * sizeof(std::size_t) + words.capacity() * sizeof(std::uint32_t) +
+           xyz.capacity() * sizeof(float);
+  }
+};
+
+// What one range's placing pass keeps between batches.
+struct StreamingConversion::RangePlacement {
+  RangePlacement(const Range& r, bool first_range, std::span<std::uint8_t> part_of_vert)
+      : range(r), tables(first_range), window(part_of_vert) {}
+  const Range& range;
+  bool tables;                        // the first range: also the voxline and streamline tables
+  std::span<std::uint8_t> window;     // the range's part of VERT
+  std::vector<VertexPacker> packers;  // by voxel - range.first (packed positions)
+  std::vector<VoxlineEntry> voxline_buffer;
+  std::vector<std::uint64_t> streamline_buffer;
+  std::uint64_t voxline_index = 0, streamlines = 0;
+  StagedPart parts[2];
 };
 
 void StreamingConversion::fail_changed() const {
@@ -397,97 +441,62 @@ std::vector<Range> StreamingConversion::cut_ranges() {
   return ranges;
 }
 
-// Pass 2 + k: the blocks and orders of one range; the first also writes the voxline and streamline tables.
-// Packed positions are packed as they are placed (the tight bounds came from pass 2), so a range holds
-// 4 bytes a vertex.
+// Pass 2 + k: the blocks and orders of one range.
 void StreamingConversion::build_range(const Range& r, std::size_t index, std::size_t count) {
   const std::string of = " " + std::to_string(index + 1) + "/" + std::to_string(count);
   const bool tables = index == 0;
-  auto t0 = Clock::now();
   const std::uint64_t range_vertices = r.vertex_end - r.vertex_first;
-  // Every vertex of the range is written once below, so the buffers need no zeroing.
-  std::unique_ptr<std::uint32_t[]> words;
-  std::unique_ptr<float[]> vertices;
-  VoxlineEnds ends;
-  std::vector<VertexPacker> packers;
-  std::vector<float> voxline_xyz;  // one voxline's vertices on their way to being packed
+  // The range's vertices are placed straight into the output (a mapping of its part of VERT); the
+  // orders are built from them there before it is unmapped.
+  out_->append_in_place(VxlStreamWriter::kVert, range_vertices * vertex_bytes(settings_.positions), threads_,
+                        [&](std::span<std::uint8_t> window) {
+                          place_range(r, tables, of, window);
+                          write_orders(r, window, "ordering" + of);
+                        });
+}
+
+// Pass 2 + k, reading: places range r's vertices in `window` (its part of VERT); the first range also
+// writes the voxline and streamline tables. Each batch is cut in two parts that are voxelised and packed
+// on their own threads (stage_part: packing needs only the voxel, whose tight bounds came from pass 2),
+// then placed in streamline order (place_part), which is what fixes where each vertex goes.
+void StreamingConversion::place_range(const Range& r, bool tables, const std::string& of,
+                                      std::span<std::uint8_t> window) {
+  auto t0 = Clock::now();
+  RangePlacement placing(r, tables, window);
   if (packed()) {
-    words = std::make_unique_for_overwrite<std::uint32_t[]>(range_vertices);
-    packers.reserve(r.end - r.first);
-    for (std::size_t g = r.first; g < r.end; ++g) packers.emplace_back(voxels_[g]);
+    placing.packers.reserve(r.end - r.first);
+    for (std::size_t g = r.first; g < r.end; ++g) placing.packers.emplace_back(voxels_[g]);
   } else {
-    vertices = std::make_unique_for_overwrite<float[]>(3 * range_vertices);
-    ends = VoxlineEnds(range_vertices);
+    ends_ = VoxlineEnds(r.vertex_end - r.vertex_first);
   }
-  std::vector<VoxlineEntry> voxline_buffer;
-  std::vector<std::uint64_t> streamline_buffer;
   if (tables) {
-    voxline_buffer.reserve(kTableBufferEntries);
-    streamline_buffer.reserve(kTableBufferEntries);
+    placing.voxline_buffer.reserve(kTableBufferEntries);
+    placing.streamline_buffer.reserve(kTableBufferEntries);
   }
-  std::uint64_t voxline_index = 0, streamlines = 0;
   each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
-    const float* pts = b.positions.data();
-    for (std::uint64_t k = 0; k < b.streamline_count(); ++k) {
-      if (first + k >= spans_.size()) fail_changed();  // more streamlines than pass 1 saw
-      std::array<std::uint32_t, 2>& span = spans_[first + k];
-      if (!tables && (span[1] < r.first || span[0] >= r.end)) continue;  // no voxel in this range (or none at all)
-      if (tables) {
-        span = {std::numeric_limits<std::uint32_t>::max(), 0};
-        streamline_buffer.push_back(voxline_index);
-        if (streamline_buffer.size() == kTableBufferEntries) {
-          out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, streamline_buffer);
-          streamline_buffer.clear();
-        }
+    const std::uint64_t n = b.streamline_count();
+    if (first + n > spans_.size()) fail_changed();  // more streamlines than pass 1 saw
+    // Two parts of about as many points each.
+    const std::uint64_t half =
+        std::upper_bound(b.offsets.begin(), b.offsets.end(), b.point_count() / 2) - b.offsets.begin() - 1;
+    const std::uint64_t cut[3] = {0, std::min(half, n), n};
+    parallel_for(2, threads_ > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
+      StagedPart& part = placing.parts[p];
+      part.error = nullptr;
+      try {
+        stage_part(placing, b, first, cut[p], cut[p + 1], part);
+      } catch (...) {
+        part.error = std::current_exception();  // rethrown below in streamline order
       }
-      sink_.voxlines.clear();
-      sink_.synthetic_xyz.clear();
-      detail::voxelize_streamline(grid_, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], sink_, synthetic_limit_);
-      if (sink_.too_many_synthetic) fail_changed();
-      const std::size_t n = sink_.voxlines.size();
-      const std::uint32_t levels = settings_.levels, depth = streamline_depth(first + k, levels);
-      for (std::size_t j = 0; j < n; ++j) {
-        const TempVoxline& v = sink_.voxlines[j];
-        if (v.voxel >= global_id_.size()) fail_changed();  // a voxel pass 2 did not see
-        const std::uint32_t g = global_id_[v.voxel];
-        const std::uint32_t own = v.own();
-        if (tables) {
-          span = {std::min(span[0], g), std::max(span[1], g)};
-          voxline_buffer.push_back({g, own | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)});
-          if (voxline_buffer.size() == kTableBufferEntries) {
-            out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, voxline_buffer);
-            voxline_buffer.clear();
-          }
-        }
-        if (g < r.first || g >= r.end) continue;
-        const std::uint64_t used = own + (j + 1 < n ? 1 : 0);
-        std::uint64_t& cursor = cursor_[std::size_t(v.voxel) * levels + depth];
-        const std::uint64_t end =
-            voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), depth);
-        if (cursor > end || used > end - cursor) fail_changed();
-        const std::uint64_t at = cursor - r.vertex_first;
-        if (packed()) {
-          voxline_xyz.resize(3 * used);
-          detail::place_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data(), voxline_xyz.data());
-          // A vertex outside the bounds pass 2 found would be clamped: the source changed.
-          const VoxelEntry& voxel = voxels_[g];
-          for (std::uint64_t e = 0; e < used; ++e)
-            for (int c = 0; c < 3; ++c)
-              if (!(voxline_xyz[3 * e + c] >= voxel.tight_min[c] && voxline_xyz[3 * e + c] <= voxel.tight_max[c]))
-                fail_changed();
-          packers[g - r.first].pack(voxline_xyz.data(), used, words.get() + at);
-          words[at + used - 1] |= kPackedVoxlineEnd;
-        } else {
-          detail::place_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data(), vertices.get() + 3 * at);
-          ends.set(at + used - 1);
-        }
-        cursor += used;
-      }
-      voxline_index += n;
-    }
-    streamlines += b.streamline_count();
+    });
+    for (StagedPart& part : placing.parts)
+      if (part.error) std::rethrow_exception(part.error);
+    for (int p = 0; p < 2; ++p) place_part(placing, first + cut[p], placing.parts[p]);
+    const std::uint64_t staged = placing.parts[0].bytes() + placing.parts[1].bytes();
+    budget_.track(staged, staged_held_, [] { return std::string("the voxlines of a batch being placed"); });
   });
-  if (streamlines != meta_.streamline_count || (tables && voxline_index != meta_.voxline_count)) fail_changed();
+  if (placing.streamlines != meta_.streamline_count || (tables && placing.voxline_index != meta_.voxline_count))
+    fail_changed();
   const std::uint32_t levels = settings_.levels;
   for (std::size_t local = 0; local < global_id_.size(); ++local) {
     const std::uint32_t g = global_id_[local];
@@ -498,32 +507,132 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
         fail_changed();
   }
   if (tables) {
-    streamline_buffer.push_back(voxline_index);
-    out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, streamline_buffer);
-    out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, voxline_buffer);
+    placing.streamline_buffer.push_back(placing.voxline_index);
+    out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, placing.streamline_buffer);
+    out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, placing.voxline_buffer);
   }
   summary_.voxelize_seconds += seconds_since(t0);
+}
 
-  t0 = Clock::now();
-  const std::span<const std::uint32_t> word_span(words.get(), packed() ? range_vertices : 0);
-  const std::span<const float> vertex_span(vertices.get(), packed() ? 0 : 3 * range_vertices);
-  if (packed())
-    out_->append_items<std::uint32_t>(VxlStreamWriter::kVert, word_span);
-  else
-    out_->append_items<float>(VxlStreamWriter::kVert, vertex_span);
-  summary_.write_seconds += seconds_since(t0);
+// On one thread: voxelises streamlines [begin, end) of batch b (numbered from `first` in the source) and
+// stages the vertices of their voxlines in range, packed (or as float32), in streamline order.
+void StreamingConversion::stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first,
+                                     std::uint64_t begin, std::uint64_t end, StagedPart& part) const {
+  const Range& r = placing.range;
+  part.begin = begin;
+  part.end = end;
+  part.sink.index.index = &sink_.index;
+  part.sink.voxlines.clear();
+  part.sink.synthetic_xyz.clear();
+  part.voxline_ends.clear();
+  part.words.clear();
+  part.xyz.clear();
+  const float* pts = b.positions.data();
+  std::vector<float> voxline_xyz;  // one voxline's vertices on their way to being packed
+  part.sink.too_many_synthetic = false;
+  for (std::uint64_t k = begin; k < end; ++k) {
+    const std::size_t start = part.sink.voxlines.size();
+    if (!placing.tables) {
+      const std::array<std::uint32_t, 2>& span = spans_[first + k];
+      if (span[1] < r.first || span[0] >= r.end) {  // no voxel in this range (or none at all)
+        part.voxline_ends.push_back(start);
+        continue;
+      }
+    }
+    detail::voxelize_streamline(grid_, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], part.sink, synthetic_limit_);
+    if (part.sink.too_many_synthetic) fail_changed();
+    part.voxline_ends.push_back(part.sink.voxlines.size());
+    const std::span<const TempVoxline> streamline(part.sink.voxlines.data() + start, part.sink.voxlines.size() - start);
+    for (std::size_t j = 0; j < streamline.size(); ++j) {
+      const TempVoxline& v = streamline[j];
+      if (v.voxel >= global_id_.size()) fail_changed();  // a voxel pass 2 did not see
+      const std::uint32_t g = global_id_[v.voxel];
+      if (g < r.first || g >= r.end) continue;
+      const std::uint64_t used = v.own() + (j + 1 < streamline.size() ? 1 : 0);
+      if (!packed()) {
+        const std::size_t at = part.xyz.size();
+        part.xyz.resize(at + 3 * used);
+        detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), part.xyz.data() + at);
+        continue;
+      }
+      voxline_xyz.resize(3 * used);
+      detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), voxline_xyz.data());
+      // A vertex outside the bounds pass 2 found would be clamped: the source changed.
+      const VoxelEntry& voxel = voxels_[g];
+      for (std::uint64_t e = 0; e < used; ++e)
+        for (int c = 0; c < 3; ++c)
+          if (!(voxline_xyz[3 * e + c] >= voxel.tight_min[c] && voxline_xyz[3 * e + c] <= voxel.tight_max[c]))
+            fail_changed();
+      const std::size_t at = part.words.size();
+      part.words.resize(at + used);
+      placing.packers[g - r.first].pack(voxline_xyz.data(), used, part.words.data() + at);
+      part.words[at + used - 1] |= kPackedVoxlineEnd;
+    }
+  }
+}
 
-  write_orders(r, word_span, vertex_span, ends, "ordering" + of);
+// In streamline order: copies a staged part's vertices to their blocks (each voxel's next place for the
+// streamline's depth) and, for the first range, writes its voxline and streamline table entries.
+void StreamingConversion::place_part(RangePlacement& placing, std::uint64_t first, const StagedPart& part) {
+  const Range& r = placing.range;
+  const std::uint32_t levels = settings_.levels;
+  auto* const words = reinterpret_cast<std::uint32_t*>(placing.window.data());
+  auto* const vertices = reinterpret_cast<float*>(placing.window.data());
+  std::uint64_t staged = 0;  // vertices of the part placed so far
+  std::size_t start = 0;
+  for (std::uint64_t k = 0; k < part.end - part.begin; ++k) {
+    const std::size_t end = part.voxline_ends[k];
+    const std::span<const TempVoxline> streamline(part.sink.voxlines.data() + start, end - start);
+    start = end;
+    std::array<std::uint32_t, 2>& span = spans_[first + k];
+    if (placing.tables) {
+      span = {std::numeric_limits<std::uint32_t>::max(), 0};
+      placing.streamline_buffer.push_back(placing.voxline_index);
+      if (placing.streamline_buffer.size() == kTableBufferEntries) {
+        out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, placing.streamline_buffer);
+        placing.streamline_buffer.clear();
+      }
+    } else if (span[1] < r.first || span[0] >= r.end) {
+      continue;
+    }
+    const std::uint32_t depth = streamline_depth(first + k, levels);
+    for (std::size_t j = 0; j < streamline.size(); ++j) {
+      const TempVoxline& v = streamline[j];
+      const std::uint32_t g = global_id_[v.voxel];  // checked by stage_part
+      const std::uint32_t own = v.own();
+      if (placing.tables) {
+        span = {std::min(span[0], g), std::max(span[1], g)};
+        placing.voxline_buffer.push_back({g, own | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)});
+        if (placing.voxline_buffer.size() == kTableBufferEntries) {
+          out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, placing.voxline_buffer);
+          placing.voxline_buffer.clear();
+        }
+      }
+      if (g < r.first || g >= r.end) continue;
+      const std::uint64_t used = own + (j + 1 < streamline.size() ? 1 : 0);
+      std::uint64_t& cursor = cursor_[std::size_t(v.voxel) * levels + depth];
+      const std::uint64_t block_end =
+          voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), depth);
+      if (cursor > block_end || used > block_end - cursor) fail_changed();
+      const std::uint64_t at = cursor - r.vertex_first;
+      if (packed()) {
+        std::copy_n(part.words.data() + staged, used, words + at);
+      } else {
+        std::copy_n(part.xyz.data() + 3 * staged, 3 * used, vertices + 3 * at);
+        ends_.set(at + used - 1);
+      }
+      staged += used;
+      cursor += used;
+    }
+    placing.voxline_index += streamline.size();
+  }
+  placing.streamlines += part.end - part.begin;
 }
 
 // The orders of range r's voxels, a chunk of consecutive voxels at a time (each chunk's voxels spread
-// over the range's ordering threads), appended to ORDR. A packed block is decoded first: the orders sort
-// the positions the file holds.
-void StreamingConversion::write_orders(const Range& r, std::span<const std::uint32_t> words,
-                                       std::span<const float> vertices, const VoxlineEnds& ends,
+// over the range's ordering threads), built in place in ORDR.
+void StreamingConversion::write_orders(const Range& r, std::span<const std::uint8_t> range_vertices,
                                        const std::string& stage) {
-  const std::uint32_t levels = settings_.levels;
-  std::vector<std::uint8_t> chunk;
   std::vector<std::optional<VoxelOrderWriter>> writers(r.order_threads);
   std::vector<std::vector<float>> decoded(r.order_threads);
   for (std::size_t first = r.first; first < r.end;) {
@@ -531,35 +640,45 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
     std::size_t end = first + 1;
     while (end < r.end && orders_start(end + 1) - orders_start(first) <= order_chunk_bytes_) ++end;
     const std::uint64_t base = orders_start(first);
-    chunk.assign(orders_start(end) - base, 0);  // the padding between voxels stays zero
-    parallel_for(end - first, r.order_threads, [&](std::uint64_t i, unsigned t) {
-      const std::size_t g = first + i;
-      if (!writers[t]) writers[t].emplace(order_set_, r.max_vertices);
-      VoxelEntry v = voxels_[g];
-      const std::span<const LevelEntry> row = level_row(levels_, g, levels);
-      std::uint8_t* dst = chunk.data() + (v.order_offset - base);
-      const std::uint64_t at = v.vertex_first - r.vertex_first;
-      if (!packed()) {
-        v.vertex_first = at;
-        writers[t]->write(v, row, vertices, ends, dst);
-        return;
-      }
-      std::vector<float>& xyz = decoded[t];
-      xyz.resize(3 * std::size_t(v.vertex_count));
-      VertexPacker(v).decode(words.data() + at, v.vertex_count, xyz.data());
-      VoxlineEnds block_ends(v.vertex_count);
-      for (std::uint32_t e = 0; e < v.vertex_count; ++e)
-        if (words[at + e] & kPackedVoxlineEnd) block_ends.set(e);
-      v.vertex_first = 0;
-      writers[t]->write(v, row, xyz, block_ends, dst);
-    });
+    // The output's bytes read as zero until written: the padding between voxels.
+    out_->append_in_place(VxlStreamWriter::kOrdr, orders_start(end) - base, r.order_threads,
+                          [&](std::span<std::uint8_t> chunk) {
+                            parallel_for(end - first, r.order_threads, [&](std::uint64_t i, unsigned t) {
+                              if (!writers[t]) writers[t].emplace(order_set_, r.max_vertices);
+                              const std::size_t g = first + i;
+                              write_voxel_orders(r, g, range_vertices, *writers[t], decoded[t],
+                                                 chunk.data() + (voxels_[g].order_offset - base));
+                            });
+                          });
     summary_.orders_seconds += seconds_since(t0);
-    t0 = Clock::now();
-    out_->append(VxlStreamWriter::kOrdr, chunk);
-    summary_.write_seconds += seconds_since(t0);
     first = end;
     report(stage, double(first - r.first) / double(std::max<std::size_t>(1, r.end - r.first)));
   }
+}
+
+// Voxel g's orders at `dst`, from its block in `range_vertices` (range r's part of VERT). A packed block
+// is decoded into `decoded` first: the orders sort the positions the file holds.
+void StreamingConversion::write_voxel_orders(const Range& r, std::size_t g,
+                                             std::span<const std::uint8_t> range_vertices, VoxelOrderWriter& writer,
+                                             std::vector<float>& decoded, std::uint8_t* dst) {
+  VoxelEntry v = voxels_[g];
+  const std::span<const LevelEntry> row = level_row(levels_, g, settings_.levels);
+  const std::uint64_t at = v.vertex_first - r.vertex_first;
+  if (!packed()) {
+    v.vertex_first = at;
+    const std::span<const float> vertices(reinterpret_cast<const float*>(range_vertices.data()),
+                                          range_vertices.size() / sizeof(float));
+    writer.write(v, row, vertices, ends_, dst);
+    return;
+  }
+  const std::uint32_t* words = reinterpret_cast<const std::uint32_t*>(range_vertices.data()) + at;
+  decoded.resize(3 * std::size_t(v.vertex_count));
+  VertexPacker(v).decode(words, v.vertex_count, decoded.data());
+  VoxlineEnds block_ends(v.vertex_count);
+  for (std::uint32_t e = 0; e < v.vertex_count; ++e)
+    if (words[e] & kPackedVoxlineEnd) block_ends.set(e);
+  v.vertex_first = 0;
+  writer.write(v, row, decoded, block_ends, dst);
 }
 
 void StreamingConversion::write_rest() {
@@ -603,10 +722,13 @@ ConvertSummary StreamingConversion::run() {
                "the buffer of the voxline and streamline tables");
   budget_.take(meta_.streamline_count * sizeof(spans_[0]), "the voxel span of every streamline");
   spans_.resize(meta_.streamline_count);
+  // The two parts of a batch being placed (more is taken later for a batch that needs it).
+  budget_.take(kStagedBytesPerPoint * batch_items_, "the voxlines of a batch being placed");
+  staged_held_ = kStagedBytesPerPoint * batch_items_;
   order_chunk_bytes_ = std::min({kOrderChunkBytes, order_bytes_, budget_.left() / 8});
   for (std::size_t i = 0; i < voxels_.size(); ++i)
     order_chunk_bytes_ = std::max(order_chunk_bytes_, orders_start(i + 1) - orders_start(i));
-  budget_.take(order_chunk_bytes_, "the buffer of the orders being written", ", or a smaller --voxel-size");
+  budget_.take(order_chunk_bytes_, "the part of the orders being written", ", or a smaller --voxel-size");
   std::vector<Range> ranges = cut_ranges();
 
   const std::string provenance = provenance_json(stream_->source(), settings_, threads_, voxel_size_choice_);

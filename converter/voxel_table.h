@@ -111,9 +111,8 @@ void for_each_voxline_run(std::span<const TempVoxline> streamline, std::size_t j
 inline std::uint64_t place_voxline(std::span<const TempVoxline> streamline, std::size_t j, const float* pts,
                                    const float* synthetic_xyz, float* dst) {
   float* out = dst;
-  for_each_voxline_run(streamline, j, pts, synthetic_xyz, [&](const float* xyz, std::uint64_t count) {
-    out = std::copy_n(xyz, 3 * count, out);
-  });
+  for_each_voxline_run(streamline, j, pts, synthetic_xyz,
+                       [&](const float* xyz, std::uint64_t count) { out = std::copy_n(xyz, 3 * count, out); });
   return static_cast<std::uint64_t>(out - dst) / 3;
 }
 

@@ -44,10 +44,20 @@ class VoxelIndex {
       if (coords_[id] == c) return id;
     }
   }
+  // The id of a voxel already in the index, or kAbsent. Never changes the index, so threads may share it.
+  static constexpr std::uint32_t kAbsent = std::numeric_limits<std::uint32_t>::max();
+  std::uint32_t find(const Coord& c) const {
+    if (slots_.empty()) return kAbsent;
+    std::size_t mask = slots_.size() - 1;
+    for (std::size_t i = hash(c) & mask;; i = (i + 1) & mask) {
+      std::uint32_t id = slots_[i];
+      if (id == kEmpty || coords_[id] == c) return id;  // kEmpty == kAbsent
+    }
+  }
   const std::vector<Coord>& coords() const { return coords_; }
 
  private:
-  static constexpr std::uint32_t kEmpty = std::numeric_limits<std::uint32_t>::max();
+  static constexpr std::uint32_t kEmpty = kAbsent;
   static std::size_t hash(const Coord& c) {
     std::uint64_t h = std::uint64_t(std::uint32_t(c.x)) * 0x9E3779B97F4A7C15ull;
     h ^= std::uint64_t(std::uint32_t(c.y)) * 0xC2B2AE3D27D4EB4Full;
@@ -65,6 +75,13 @@ class VoxelIndex {
   }
   std::vector<std::uint32_t> slots_;
   std::vector<Coord> coords_;
+};
+
+// A complete VoxelIndex shared by threads that voxelise at once (a Sink's index for voxelize_streamline):
+// a voxel missing from it gets VoxelIndex::kAbsent instead of a new id.
+struct SharedVoxelIndex {
+  const VoxelIndex* index = nullptr;
+  std::uint32_t find_or_insert(const Coord& c) const { return index->find(c); }
 };
 
 // A voxline before its vertices are placed: an optional synthetic first point, then source points.

@@ -35,8 +35,27 @@ class AtomicOutputFile {
   std::span<std::uint8_t> map(std::uint64_t size);
 
   // Sizes the still empty file to `size` bytes like map(), without mapping it: the caller then fills it
-  // with pwrite(), which keeps the written pages out of this process's resident memory.
+  // with pwrite(), or a part at a time through map_window().
   void allocate(std::uint64_t size);
+
+  // A writable mapping of bytes [offset, offset + size) of an allocate()d file, unmapped when the window
+  // is destroyed (what was written stays in the file's page cache). Filling a part in place spares the
+  // buffer that pwrite() copies from; unmapping it when done keeps it out of resident memory after.
+  class Window {
+   public:
+    Window() = default;
+    Window(Window&& other) noexcept;
+    Window& operator=(Window&& other) noexcept;
+    ~Window();
+    std::span<std::uint8_t> bytes() const { return bytes_; }
+
+   private:
+    friend class AtomicOutputFile;
+    void* map_ = nullptr;
+    std::size_t map_size_ = 0;
+    std::span<std::uint8_t> bytes_;
+  };
+  Window map_window(std::uint64_t offset, std::uint64_t size);
 
   void commit();  // unmaps, then replaces any existing file at the path
 

@@ -30,4 +30,28 @@ class MappedFile {
   std::size_t size_ = 0;
 };
 
+// A read-only mapping of bytes [offset, offset + size) of an open file, its pages mapped at once
+// (MAP_POPULATE): a reader that goes through a large file a part at a time reads the page cache in place,
+// without pread's copy, and unmaps each part when it moves on, so the file never adds more than one
+// part to its resident memory.
+class FileWindow {
+ public:
+  FileWindow() = default;
+  // Throws vxl::Error (Input) naming `path` when the part cannot be mapped.
+  FileWindow(int fd, const std::string& path, std::uint64_t offset, std::uint64_t size);
+  ~FileWindow();
+  FileWindow(FileWindow&& other) noexcept;
+  FileWindow& operator=(FileWindow&& other) noexcept;
+  FileWindow(const FileWindow&) = delete;
+  FileWindow& operator=(const FileWindow&) = delete;
+
+  const std::uint8_t* data() const { return data_; }
+
+ private:
+  void release();
+  void* map_ = nullptr;
+  std::size_t map_size_ = 0;
+  const std::uint8_t* data_ = nullptr;
+};
+
 }  // namespace vxl

@@ -18,6 +18,7 @@ VertexPacker::VertexPacker(const VoxelEntry& voxel) {
     const float extent = voxel.tight_max[c] - voxel.tight_min[c];
     lo_[c] = voxel.tight_min[c];
     step_[c] = extent / static_cast<float>(kPackedSteps);
+    inverse_step_[c] = step_[c] > 0 ? 1.0 / double(step_[c]) : 0.0;
   }
 }
 
@@ -32,8 +33,19 @@ std::uint32_t VertexPacker::pack(float* xyz) const {
     float& x = xyz[c];
     std::uint32_t q = 0;
     if (step_[c] > 0) {
-      const double t = (double(x) - double(lo_[c])) / double(step_[c]);
-      q = t <= 0 ? 0 : t >= kPackedSteps ? kPackedSteps : static_cast<std::uint32_t>(std::floor(t + 0.5));
+      // (x - lo) / step, the spec's quotient, by a multiplication where that rounds the same: the product
+      // is within a few units in the last place of the quotient, which can only matter when t + 0.5 lies
+      // that close to an integer (in (0, 1023); elsewhere both clamp alike). Dividing cost about a fifth
+      // of the streaming conversion's placing pass.
+      const double d = double(x) - double(lo_[c]);
+      double t = d * inverse_step_[c];
+      if (t > 0 && t < kPackedSteps) {
+        const double f = t + 0.5, n = double(static_cast<std::uint32_t>(f));
+        if (f - n < 1e-9 || n + 1 - f < 1e-9) t = d / double(step_[c]);
+      }
+      // t + 0.5 > 0 here, where truncation is floor: no floor() library call per coordinate (the baseline
+      // x86-64 ISA has no rounding instruction).
+      q = t <= 0 ? 0 : t >= kPackedSteps ? kPackedSteps : static_cast<std::uint32_t>(t + 0.5);
     }
     word |= q << (10 * c);
     x = decode_axis(c, q);

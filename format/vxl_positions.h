@@ -40,6 +40,7 @@ class VertexPacker {
  private:
   float decode_axis(int c, std::uint32_t q) const;
   float lo_[3], step_[3];
+  double inverse_step_[3];
 };
 
 // Quantises one voxel's block: writes each vertex's packed word (end bit clear) into `packed` and replaces

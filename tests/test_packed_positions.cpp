@@ -110,6 +110,49 @@ class PackedConversion : public ::testing::TestWithParam<Extreme> {};
 
 // Whole conversions: every source point comes back (through the walk, i.e. `export`) within the largest
 // bound of the file's voxels, and verify accepts the file (its orders are sorted for the decoded positions).
+// The spec's q = round((x - lo) / step), computed as the quotient itself.
+std::uint32_t spec_q(double x, float lo, float step) {
+  if (!(step > 0)) return 0;
+  const double t = (x - double(lo)) / double(step);
+  return t <= 0 ? 0 : t >= kPackedSteps ? kPackedSteps : static_cast<std::uint32_t>(std::floor(t + 0.5));
+}
+
+// The packer multiplies by the inverse step instead of dividing, and divides only where t + 0.5 is
+// within 1e-9 of an integer: it must give the quotient's q everywhere, above all at the half-steps where
+// rounding turns, at the bounds, and for boxes tiny, huge and far from the origin.
+TEST(PackedPositions, ThePackerRoundsExactlyLikeTheSpecsQuotient) {
+  std::mt19937 rng(23);
+  std::uint64_t points = 0, half_steps = 0;
+  for (double lo : {0.0, -1.0, 12.5, -300.0, 1.0e6, -3.0e7}) {
+    for (double extent : {1.0e-5, 0.37, 10.0, 1234.5, 8.0e6}) {
+      const VoxelEntry v = box(lo, extent);
+      const VertexPacker packer(v);
+      for (int c = 0; c < 3; ++c) {
+        const float vlo = v.tight_min[c], step = (v.tight_max[c] - v.tight_min[c]) / float(kPackedSteps);
+        std::vector<float> xs = {v.tight_min[c], v.tight_max[c]};
+        // Every half-step (the float nearest it and its neighbours), where q changes.
+        for (std::uint32_t k = 0; k < kPackedSteps; ++k) {
+          const float half = static_cast<float>(double(vlo) + (double(k) + 0.5) * double(step));
+          xs.insert(xs.end(), {std::nextafter(half, -INFINITY), half, std::nextafter(half, INFINITY)});
+        }
+        std::uniform_real_distribution<double> inside(v.tight_min[c], v.tight_max[c]);
+        for (int i = 0; i < 3000; ++i) xs.push_back(static_cast<float>(inside(rng)));
+        for (float x : xs) {
+          float xyz[3] = {v.tight_min[0], v.tight_min[1], v.tight_min[2]};
+          xyz[c] = x;
+          const std::uint32_t word = packer.pack(xyz);
+          ASSERT_EQ((word >> (10 * c)) & kPackedAxisMask, spec_q(x, vlo, step))
+              << "x " << x << " in [" << v.tight_min[c] << ", " << v.tight_max[c] << "]";
+          ++points;
+        }
+        half_steps += kPackedSteps;
+      }
+    }
+  }
+  EXPECT_GT(half_steps, 90000u);
+  EXPECT_GT(points, 500000u);
+}
+
 TEST_P(PackedConversion, EveryPointComesBackWithinTheBound) {
   const Extreme e = GetParam();
   ScratchDir dir;
