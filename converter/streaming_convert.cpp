@@ -6,8 +6,10 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <future>
 #include <limits>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <span>
 
@@ -50,13 +52,13 @@ constexpr std::uint64_t plan_bytes_per_voxel(std::uint32_t levels) { return kPla
 // Memory per point of a batch being read, at worst: two batches (one read while the other is processed),
 // each of whose positions may have twice the capacity in use.
 constexpr std::uint64_t kHeldBytesPerPoint = 2 * 2 * 3 * sizeof(float);
-// Memory per point of a batch being placed (StagedPart): a voxline (24 bytes) and the voxline end of its
-// streamline (8) per point at most, and its vertex staged (at most 12 bytes). Taken up front for a batch
-// of the usual size; a batch that needs more (a long streamline is held whole) takes the rest then.
-constexpr std::uint64_t kStagedBytesPerPoint = 24 + 8 + 12;
+// The output is written past the page cache (DirectRegionWriter: far cheaper on a virtual machine) under
+// limits of at least this much, staged this much per section.
+constexpr std::uint64_t kDirectWritesFromLimit = 256 * kMiB;
+constexpr std::uint64_t kDirectStagingBytes = 2 * kMiB;
 // Voxline and streamline table entries written at once.
 constexpr std::size_t kTableBufferEntries = 1 << 16;
-// The orders are built a run of voxels at a time, in place in a mapped part of the output of at most this size and an
+// The orders are built a run of voxels at a time, in a buffer of at most this size and an
 // eighth of the memory left (or of the largest voxel's orders, if more): large enough that each run keeps every
 // ordering thread busy.
 constexpr std::uint64_t kOrderChunkBytes = 256 * kMiB;
@@ -141,7 +143,7 @@ class StreamingConversion {
   void place_range(const Range& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
   void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
                   std::uint64_t end, StagedPart& part) const;
-  void place_part(RangePlacement& placing, std::uint64_t first, const StagedPart& part);
+  void place_part(RangePlacement& placing, const StagedPart& part);
   void write_orders(const Range& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
   void write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> range_vertices,
                           VoxelOrderWriter& writer, std::vector<float>& decoded, std::uint8_t* dst);
@@ -197,13 +199,15 @@ class StreamingConversion {
   std::vector<std::array<std::uint32_t, 2>> spans_;
   std::uint64_t order_bytes_ = 0;
   std::uint64_t order_chunk_bytes_ = 0;
-  VoxlineEnds ends_;  // float32 positions: the voxline ends of the range being built
+  std::uint64_t direct_staging_ = 0;  // 0: the output is written through the page cache
+  VoxlineEnds ends_;                  // float32 positions: the voxline ends of the range being built
   std::unique_ptr<VxlStreamWriter> out_;
 };
 
 // Part of a batch voxelised on its own thread (stage_part), waiting to be placed in order.
 struct StreamingConversion::StagedPart {
   std::uint64_t begin = 0, end = 0;       // streamlines of the batch
+  std::uint64_t source_first = 0;         // the index of streamline `begin` in the source
   SinkOf<detail::SharedVoxelIndex> sink;  // every voxline of the part, in order
   std::vector<std::size_t> voxline_ends;  // per streamline: the end of its voxlines in sink.voxlines
   std::vector<std::uint32_t> words;       // packed: the vertices of the voxlines in range, in order
@@ -226,7 +230,7 @@ struct StreamingConversion::RangePlacement {
   std::vector<VoxlineEntry> voxline_buffer;
   std::vector<std::uint64_t> streamline_buffer;
   std::uint64_t voxline_index = 0, streamlines = 0;
-  StagedPart parts[2];
+  StagedPart parts[2][2];  // two sets of two parts: one being staged, one being placed
 };
 
 void StreamingConversion::fail_changed() const {
@@ -448,11 +452,10 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
   const std::uint64_t range_vertices = r.vertex_end - r.vertex_first;
   // The range's vertices are placed straight into the output (a mapping of its part of VERT); the
   // orders are built from them there before it is unmapped.
-  out_->append_in_place(VxlStreamWriter::kVert, range_vertices * vertex_bytes(settings_.positions), threads_,
-                        [&](std::span<std::uint8_t> window) {
-                          place_range(r, tables, of, window);
-                          write_orders(r, window, "ordering" + of);
-                        });
+  out_->append_in_place(
+      VxlStreamWriter::kVert, range_vertices * vertex_bytes(settings_.positions), threads_,
+      [&](std::span<std::uint8_t> window) { place_range(r, tables, of, window); },
+      [&](std::span<const std::uint8_t> window) { write_orders(r, window, "ordering" + of); });
 }
 
 // Pass 2 + k, reading: places range r's vertices in `window` (its part of VERT); the first range also
@@ -473,6 +476,13 @@ void StreamingConversion::place_range(const Range& r, bool tables, const std::st
     placing.voxline_buffer.reserve(kTableBufferEntries);
     placing.streamline_buffer.reserve(kTableBufferEntries);
   }
+  // Batch k is staged in two parts on two threads while batch k - 1, staged before, is placed on a third:
+  // placing (in streamline order) is the serial part of the pass.
+  int staging = 0;           // the set of parts the current batch is staged in
+  bool other_placed = true;  // whether the other set's parts are placed
+  auto place_staged = [&](int set) {
+    for (const StagedPart& part : placing.parts[set]) place_part(placing, part);
+  };
   each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
     const std::uint64_t n = b.streamline_count();
     if (first + n > spans_.size()) fail_changed();  // more streamlines than pass 1 saw
@@ -480,21 +490,30 @@ void StreamingConversion::place_range(const Range& r, bool tables, const std::st
     const std::uint64_t half =
         std::upper_bound(b.offsets.begin(), b.offsets.end(), b.point_count() / 2) - b.offsets.begin() - 1;
     const std::uint64_t cut[3] = {0, std::min(half, n), n};
-    parallel_for(2, threads_ > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
-      StagedPart& part = placing.parts[p];
-      part.error = nullptr;
+    std::exception_ptr placing_error;
+    parallel_for(3, threads_ > 1 ? 3 : 1, [&](std::uint64_t item, unsigned) {
       try {
-        stage_part(placing, b, first, cut[p], cut[p + 1], part);
+        if (item == 2) {
+          if (!other_placed) place_staged(1 - staging);
+          return;
+        }
+        stage_part(placing, b, first, cut[item], cut[item + 1], placing.parts[staging][item]);
       } catch (...) {
-        part.error = std::current_exception();  // rethrown below in streamline order
+        (item == 2 ? placing_error : placing.parts[staging][item].error) = std::current_exception();
       }
     });
-    for (StagedPart& part : placing.parts)
+    // In streamline order: the earlier batch's errors first.
+    if (placing_error) std::rethrow_exception(placing_error);
+    for (StagedPart& part : placing.parts[staging])
       if (part.error) std::rethrow_exception(part.error);
-    for (int p = 0; p < 2; ++p) place_part(placing, first + cut[p], placing.parts[p]);
-    const std::uint64_t staged = placing.parts[0].bytes() + placing.parts[1].bytes();
-    budget_.track(staged, staged_held_, [] { return std::string("the voxlines of a batch being placed"); });
+    other_placed = false;
+    staging = 1 - staging;
+    std::uint64_t staged = 0;
+    for (const auto& set : placing.parts)
+      for (const StagedPart& part : set) staged += part.bytes();
+    budget_.track(staged, staged_held_, [] { return std::string("the voxlines of two batches being placed"); });
   });
+  if (!other_placed) place_staged(1 - staging);
   if (placing.streamlines != meta_.streamline_count || (tables && placing.voxline_index != meta_.voxline_count))
     fail_changed();
   const std::uint32_t levels = settings_.levels;
@@ -521,6 +540,8 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
   const Range& r = placing.range;
   part.begin = begin;
   part.end = end;
+  part.source_first = first + begin;
+  part.error = nullptr;
   part.sink.index.index = &sink_.index;
   part.sink.voxlines.clear();
   part.sink.synthetic_xyz.clear();
@@ -565,7 +586,7 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
             fail_changed();
       const std::size_t at = part.words.size();
       part.words.resize(at + used);
-      placing.packers[g - r.first].pack(voxline_xyz.data(), used, part.words.data() + at);
+      placing.packers[g - r.first].words(voxline_xyz.data(), used, part.words.data() + at);
       part.words[at + used - 1] |= kPackedVoxlineEnd;
     }
   }
@@ -573,7 +594,8 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
 
 // In streamline order: copies a staged part's vertices to their blocks (each voxel's next place for the
 // streamline's depth) and, for the first range, writes its voxline and streamline table entries.
-void StreamingConversion::place_part(RangePlacement& placing, std::uint64_t first, const StagedPart& part) {
+void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& part) {
+  const std::uint64_t first = part.source_first;
   const Range& r = placing.range;
   const std::uint32_t levels = settings_.levels;
   auto* const words = reinterpret_cast<std::uint32_t*>(placing.window.data());
@@ -635,25 +657,40 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
                                        const std::string& stage) {
   std::vector<std::optional<VoxelOrderWriter>> writers(r.order_threads);
   std::vector<std::vector<float>> decoded(r.order_threads);
-  for (std::size_t first = r.first; first < r.end;) {
+  // With direct writes a chunk is written on its own thread while the next one is built (the write waits
+  // on the disk, not the CPU); through the page cache it is written before the next one is built.
+  std::vector<std::uint8_t> chunks[2];
+  std::vector<std::size_t> by_size;  // a chunk's voxels
+  std::future<void> writing;
+  std::size_t k = 0;
+  for (std::size_t first = r.first; first < r.end; ++k) {
     auto t0 = Clock::now();
     std::size_t end = first + 1;
     while (end < r.end && orders_start(end + 1) - orders_start(first) <= order_chunk_bytes_) ++end;
     const std::uint64_t base = orders_start(first);
-    // The output's bytes read as zero until written: the padding between voxels.
-    out_->append_in_place(VxlStreamWriter::kOrdr, orders_start(end) - base, r.order_threads,
-                          [&](std::span<std::uint8_t> chunk) {
-                            parallel_for(end - first, r.order_threads, [&](std::uint64_t i, unsigned t) {
-                              if (!writers[t]) writers[t].emplace(order_set_, r.max_vertices);
-                              const std::size_t g = first + i;
-                              write_voxel_orders(r, g, range_vertices, *writers[t], decoded[t],
-                                                 chunk.data() + (voxels_[g].order_offset - base));
-                            });
-                          });
+    std::vector<std::uint8_t>& chunk = chunks[direct_staging_ > 0 ? k % 2 : 0];
+    chunk.assign(orders_start(end) - base, 0);  // the padding between voxels stays zero
+    // Largest voxels first, so that the threads finish the chunk at about the same time.
+    by_size.resize(end - first);
+    std::iota(by_size.begin(), by_size.end(), first);
+    std::stable_sort(by_size.begin(), by_size.end(),
+                     [&](std::size_t a, std::size_t b) { return voxels_[a].vertex_count > voxels_[b].vertex_count; });
+    parallel_for(end - first, r.order_threads, [&](std::uint64_t i, unsigned t) {
+      if (!writers[t]) writers[t].emplace(order_set_, r.max_vertices);
+      const std::size_t g = by_size[i];
+      write_voxel_orders(r, g, range_vertices, *writers[t], decoded[t],
+                         chunk.data() + (voxels_[g].order_offset - base));
+    });
+    if (writing.valid()) writing.get();  // rethrows a failed write
+    if (direct_staging_ > 0)
+      writing = std::async(std::launch::async, [this, &chunk] { out_->append(VxlStreamWriter::kOrdr, chunk); });
+    else
+      out_->append(VxlStreamWriter::kOrdr, chunk);
     summary_.orders_seconds += seconds_since(t0);
     first = end;
     report(stage, double(first - r.first) / double(std::max<std::size_t>(1, r.end - r.first)));
   }
+  if (writing.valid()) writing.get();
 }
 
 // Voxel g's orders at `dst`, from its block in `range_vertices` (range r's part of VERT). A packed block
@@ -722,17 +759,34 @@ ConvertSummary StreamingConversion::run() {
                "the buffer of the voxline and streamline tables");
   budget_.take(meta_.streamline_count * sizeof(spans_[0]), "the voxel span of every streamline");
   spans_.resize(meta_.streamline_count);
-  // The two parts of a batch being placed (more is taken later for a batch that needs it).
-  budget_.take(kStagedBytesPerPoint * batch_items_, "the voxlines of a batch being placed");
-  staged_held_ = kStagedBytesPerPoint * batch_items_;
+  // The parts of two batches being placed (StagedPart), from what pass 2 counted per point: a voxline
+  // entry (24 bytes) per voxline, a voxline end (8) per streamline and a staged vertex per vertex, twice
+  // for the vectors' growth. A batch that needs more (a long streamline is held whole) takes the rest
+  // when it comes, while the limit allows.
+  {
+    const double points = double(std::max<std::uint64_t>(1, meta_.point_count));
+    const double vertices = double(meta_.point_count + meta_.synthetic_point_count + meta_.voxline_count);
+    const double per_point = (24.0 * double(meta_.voxline_count) + 8.0 * double(meta_.streamline_count) +
+                              double(vertex_bytes(settings_.positions)) * vertices) /
+                             points;
+    staged_held_ = static_cast<std::uint64_t>(2 * 2 * per_point * double(batch_items_));
+    budget_.take(staged_held_, "the voxlines of two batches being placed");
+  }
+  // Direct writes (the output bypasses the page cache) where the limit leaves room for their staging.
+  if (settings_.memory_limit >= kDirectWritesFromLimit) {
+    direct_staging_ = kDirectStagingBytes;
+    budget_.take(VxlStreamWriter::kCount * kDirectStagingBytes, "the staging of the output's direct writes");
+  }
   order_chunk_bytes_ = std::min({kOrderChunkBytes, order_bytes_, budget_.left() / 8});
   for (std::size_t i = 0; i < voxels_.size(); ++i)
     order_chunk_bytes_ = std::max(order_chunk_bytes_, orders_start(i + 1) - orders_start(i));
-  budget_.take(order_chunk_bytes_, "the part of the orders being written", ", or a smaller --voxel-size");
+  budget_.take(order_chunk_bytes_ * (direct_staging_ > 0 ? 2 : 1), "the part of the orders being written",
+               ", or a smaller --voxel-size");
   std::vector<Range> ranges = cut_ranges();
 
   const std::string provenance = provenance_json(stream_->source(), settings_, threads_, voxel_size_choice_);
-  out_ = std::make_unique<VxlStreamWriter>(out_path_, section_sizes(meta_, order_bytes_, provenance.size(), 0));
+  out_ = std::make_unique<VxlStreamWriter>(out_path_, section_sizes(meta_, order_bytes_, provenance.size(), 0),
+                                           direct_staging_);
   for (std::size_t k = 0; k < ranges.size(); ++k) {
     build_range(ranges[k], k, ranges.size());
 #if defined(__GLIBC__)

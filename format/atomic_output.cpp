@@ -35,6 +35,7 @@ AtomicOutputFile::AtomicOutputFile(std::string path) : path_(std::move(path)) {
 
 AtomicOutputFile::~AtomicOutputFile() {
   unmap();
+  if (direct_fd_ >= 0) ::close(direct_fd_);
   if (fd_ >= 0) ::close(fd_);
   if (!committed_ && !temp_path_.empty()) ::unlink(temp_path_.c_str());
 }
@@ -148,8 +149,19 @@ void AtomicOutputFile::unmap() noexcept {
   map_size_ = 0;
 }
 
+int AtomicOutputFile::direct_descriptor() {
+  if (direct_fd_ == -2) {
+    const std::string proc = "/proc/self/fd/" + std::to_string(fd_);
+    direct_fd_ = ::open(proc.c_str(), O_WRONLY | O_DIRECT | O_CLOEXEC);
+    if (direct_fd_ < 0) direct_fd_ = -1;
+  }
+  return direct_fd_;
+}
+
 void AtomicOutputFile::commit() {
   unmap();  // the data is in the page cache already; the file must not change once it has a name
+  if (direct_fd_ >= 0) ::close(direct_fd_);
+  direct_fd_ = -1;
   if (temp_path_.empty()) {
     // Link the unnamed file under a temporary name, then rename over the target (rename is atomic;
     // linkat cannot replace an existing file).

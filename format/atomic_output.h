@@ -57,6 +57,10 @@ class AtomicOutputFile {
   };
   Window map_window(std::uint64_t offset, std::uint64_t size);
 
+  // The file opened a second time with O_DIRECT, for writes that bypass the page cache
+  // (DirectRegionWriter), or -1 where that is refused. Opened on first call, closed by commit().
+  int direct_descriptor();
+
   void commit();  // unmaps, then replaces any existing file at the path
 
   const std::string& path() const { return path_; }
@@ -67,15 +71,16 @@ class AtomicOutputFile {
   std::string path_;
   std::string temp_path_;  // empty when using O_TMPFILE
   int fd_ = -1;
+  int direct_fd_ = -2;  // -2: not opened yet
   std::uint64_t position_ = 0;
   std::uint8_t* map_ = nullptr;
   std::uint64_t map_size_ = 0;
   bool committed_ = false;
 };
 
-// Faults in the pages of `bytes` (inside a map() mapping) ready for writing, in bulk and in address
-// order (MADV_POPULATE_WRITE), split over up to `threads` threads, as single-page folios (MADV_RANDOM;
-// see the .cpp for why). A caller that then writes scattered over the range is spared a page fault per
+// Faults in the pages of `bytes` (inside a map() mapping, a window, or fresh anonymous memory) ready for writing, in
+// bulk and in address order (MADV_POPULATE_WRITE), split over up to `threads` threads, as single-page folios
+// (MADV_RANDOM; see the .cpp for why). A caller that then writes scattered over the range is spared a page fault per
 // first touch of a page, which is far slower. Only a hint: without kernel support (before Linux 5.14)
 // or on failure, pages fault in on first touch as usual.
 void prefault_for_write(std::span<std::uint8_t> bytes, unsigned threads);

@@ -27,34 +27,45 @@ float VertexPacker::decode_axis(int c, std::uint32_t q) const {
   return lo_[c] + offset;
 }
 
-std::uint32_t VertexPacker::pack(float* xyz) const {
+std::uint32_t VertexPacker::quantise(int c, float x) const {
+  if (!(step_[c] > 0)) return 0;
+  const double t = (double(x) - double(lo_[c])) / double(step_[c]);
+  // t + 0.5 > 0 here, where truncation is floor: no floor() library call per coordinate (the baseline
+  // x86-64 ISA has no rounding instruction).
+  return t <= 0 ? 0 : t >= kPackedSteps ? kPackedSteps : static_cast<std::uint32_t>(t + 0.5);
+}
+
+// The spec's q = round((x - lo) / step) clamped to 0 ... 1023 is trunc(clamp(t + 0.5, 0, 1023)), here with
+// t by a multiplication by the inverse step instead of the quotient, branch-free: the product is within
+// a few units in the last place of the quotient, which can only change q where t + 0.5 lies that close to
+// an integer. There (and at the clamps) quantise() divides. Dividing cost about a quarter of the
+// streaming conversion's placing pass.
+std::uint32_t VertexPacker::word(const float* xyz) const {
   std::uint32_t word = 0;
+  bool near_integer = false;
   for (int c = 0; c < 3; ++c) {
-    float& x = xyz[c];
-    std::uint32_t q = 0;
-    if (step_[c] > 0) {
-      // (x - lo) / step, the spec's quotient, by a multiplication where that rounds the same: the product
-      // is within a few units in the last place of the quotient, which can only matter when t + 0.5 lies
-      // that close to an integer (in (0, 1023); elsewhere both clamp alike). Dividing cost about a fifth
-      // of the streaming conversion's placing pass.
-      const double d = double(x) - double(lo_[c]);
-      double t = d * inverse_step_[c];
-      if (t > 0 && t < kPackedSteps) {
-        const double f = t + 0.5, n = double(static_cast<std::uint32_t>(f));
-        if (f - n < 1e-9 || n + 1 - f < 1e-9) t = d / double(step_[c]);
-      }
-      // t + 0.5 > 0 here, where truncation is floor: no floor() library call per coordinate (the baseline
-      // x86-64 ISA has no rounding instruction).
-      q = t <= 0 ? 0 : t >= kPackedSteps ? kPackedSteps : static_cast<std::uint32_t>(t + 0.5);
-    }
+    const double f = std::clamp((double(xyz[c]) - double(lo_[c])) * inverse_step_[c] + 0.5, 0.0, double(kPackedSteps));
+    const std::uint32_t q = static_cast<std::uint32_t>(f);
+    const double fraction = f - double(q);
+    near_integer |= fraction < 1e-9 || fraction > 1 - 1e-9;
     word |= q << (10 * c);
-    x = decode_axis(c, q);
   }
+  if (near_integer) word = quantise(0, xyz[0]) | quantise(1, xyz[1]) << 10 | quantise(2, xyz[2]) << 20;
   return word;
+}
+
+std::uint32_t VertexPacker::pack(float* xyz) const {
+  const std::uint32_t packed = word(xyz);
+  for (int c = 0; c < 3; ++c) xyz[c] = decode_axis(c, (packed >> (10 * c)) & kPackedAxisMask);
+  return packed;
 }
 
 void VertexPacker::pack(float* xyz, std::uint64_t count, std::uint32_t* packed) const {
   for (std::uint64_t i = 0; i < count; ++i) packed[i] = pack(xyz + 3 * i);
+}
+
+void VertexPacker::words(const float* xyz, std::uint64_t count, std::uint32_t* packed) const {
+  for (std::uint64_t i = 0; i < count; ++i) packed[i] = word(xyz + 3 * i);
 }
 
 void VertexPacker::decode(const std::uint32_t* packed, std::uint64_t count, float* xyz) const {

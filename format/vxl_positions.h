@@ -34,10 +34,14 @@ class VertexPacker {
   // The packed word of one vertex (end bit clear); replaces its coordinates by what the word decodes to.
   std::uint32_t pack(float* xyz) const;
   void pack(float* xyz, std::uint64_t count, std::uint32_t* packed) const;
+  // The same words, leaving the coordinates as they are.
+  void words(const float* xyz, std::uint64_t count, std::uint32_t* packed) const;
   // 3 * count floats from `count` words (their end bits ignored).
   void decode(const std::uint32_t* packed, std::uint64_t count, float* xyz) const;
 
  private:
+  std::uint32_t word(const float* xyz) const;
+  std::uint32_t quantise(int c, float x) const;  // by the quotient
   float decode_axis(int c, std::uint32_t q) const;
   float lo_[3], step_[3];
   double inverse_step_[3];

@@ -5,7 +5,8 @@
 
 namespace vxl {
 
-VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes& sizes)
+VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes& sizes,
+                                 std::uint64_t direct_staging_bytes)
     : out_(path), positions_(sizes.positions) {
   VxlLayout layout = plan_vxl_layout(sizes);
   table_ = std::move(layout.table);
@@ -18,6 +19,10 @@ VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes&
       if (std::memcmp(table_[i].id, kIds[s], 4) == 0) entry_[s] = i;
   }
   out_.allocate(file_size_);  // zeros everywhere: the padding between payloads is never written
+  const int direct_fd = direct_staging_bytes > 0 ? out_.direct_descriptor() : -1;
+  if (direct_fd >= 0)
+    for (const SectionEntry& e : table_)
+      regions_.push_back(std::make_unique<DirectRegionWriter>(out_, direct_fd, e.offset, e.size, direct_staging_bytes));
 }
 
 void VxlStreamWriter::append(Section section, std::span<const std::uint8_t> bytes) {
@@ -25,7 +30,10 @@ void VxlStreamWriter::append(Section section, std::span<const std::uint8_t> byte
   if (i >= table_.size() || bytes.size() > table_[i].size - written_[i])
     throw std::logic_error("VxlStreamWriter::append: more bytes than the section was planned for");
   if (bytes.empty()) return;
-  out_.pwrite(bytes.data(), bytes.size(), table_[i].offset + written_[i]);
+  if (regions_.empty())
+    out_.pwrite(bytes.data(), bytes.size(), table_[i].offset + written_[i]);
+  else
+    regions_[i]->append(bytes);
   checksums_[i]->update(bytes.data(), bytes.size());
   written_[i] += bytes.size();
 }
@@ -45,6 +53,17 @@ void VxlStreamWriter::close_window(Section section, AtomicOutputFile::Window& wi
   checksums_[i]->update(bytes.data(), bytes.size());
   written_[i] += bytes.size();
   window = AtomicOutputFile::Window();
+}
+
+std::span<std::uint8_t> VxlStreamWriter::fill_buffer(Section section, std::uint64_t size, unsigned threads) {
+  if (size > fill_capacity_[section]) {
+    fill_buffers_[section].reset();
+    fill_buffers_[section] = std::make_unique_for_overwrite<std::uint8_t[]>(size);
+    fill_capacity_[section] = size;
+    // Fresh pages, faulted in by several threads at once rather than one by one as they are filled.
+    prefault_for_write({fill_buffers_[section].get(), size}, threads);
+  }
+  return {fill_buffers_[section].get(), size};
 }
 
 void VxlStreamWriter::append_meta(const MetaSection& meta) {

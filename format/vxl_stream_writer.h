@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <future>
 #include <memory>
 #include <span>
 #include <string>
@@ -16,6 +17,7 @@
 
 #include "format/atomic_output.h"
 #include "format/checksum.h"
+#include "format/direct_region_writer.h"
 #include "format/vxl_layout.h"
 #include "format/vxl_writer.h"
 
@@ -27,7 +29,9 @@ class VxlStreamWriter : public VxlSections {
 
   // Creates the output at `path`, sized for these payloads (which read as zero until written).
   // Throws vxl::Error (Output).
-  VxlStreamWriter(const std::string& path, const VxlSectionSizes& sizes);
+  // With `direct_staging_bytes` > 0 the payloads bypass the page cache where the file system allows
+  // (DirectRegionWriter, staged that many bytes at a time per section); the file's bytes are the same.
+  VxlStreamWriter(const std::string& path, const VxlSectionSizes& sizes, std::uint64_t direct_staging_bytes = 0);
   VxlStreamWriter(const VxlStreamWriter&) = delete;
   VxlStreamWriter& operator=(const VxlStreamWriter&) = delete;
 
@@ -38,14 +42,26 @@ class VxlStreamWriter : public VxlSections {
   void append_items(Section section, std::span<const T> items) {
     append(section, {reinterpret_cast<const std::uint8_t*>(items.data()), items.size_bytes()});
   }
-  // Appends `size` bytes that fill(std::span<std::uint8_t>) writes in place, through a mapping of the
-  // output (its pages faulted in ahead by up to `threads` threads; they read as zero until written), so
-  // that a large part needs no buffer of its own and no copy. Appends to other sections may happen
-  // inside fill(). The part is checksummed and unmapped when fill() returns.
-  template <typename Fill>
-  void append_in_place(Section section, std::uint64_t size, unsigned threads, Fill&& fill) {
+  // Appends `size` bytes that fill(std::span<std::uint8_t>) writes in place — every one of them — through
+  // a mapping of the output (its pages faulted in ahead by up to `threads` threads), so that a large part
+  // needs no buffer of its own and no copy; then calls then(std::span<const std::uint8_t>), which may
+  // still read the part. Appends to other sections may happen inside both. The part is checksummed and
+  // unmapped when then() returns. With direct writes the part is filled in a buffer (kept for the
+  // section's next part), mapping it would put it in the page cache, and written out on another thread
+  // while then() runs.
+  template <typename Fill, typename Then>
+  void append_in_place(Section section, std::uint64_t size, unsigned threads, Fill&& fill, Then&& then) {
+    if (!regions_.empty()) {
+      const std::span<std::uint8_t> buffer = fill_buffer(section, size, threads);
+      fill(buffer);
+      std::future<void> writing = std::async(std::launch::async, [&] { append(section, buffer); });
+      then(std::span<const std::uint8_t>(buffer));  // on a throw, `writing` waits for the write first
+      writing.get();
+      return;
+    }
     AtomicOutputFile::Window window = open_window(section, size, threads);
     fill(window.bytes());
+    then(std::span<const std::uint8_t>(window.bytes()));
     close_window(section, window);
   }
   void append_meta(const MetaSection& meta);  // zeroes the reserved bytes
@@ -60,6 +76,7 @@ class VxlStreamWriter : public VxlSections {
  private:
   AtomicOutputFile::Window open_window(Section section, std::uint64_t size, unsigned threads);
   void close_window(Section section, AtomicOutputFile::Window& window);
+  std::span<std::uint8_t> fill_buffer(Section section, std::uint64_t size, unsigned threads);
 
   AtomicOutputFile out_;
   PositionEncoding positions_;
@@ -68,6 +85,10 @@ class VxlStreamWriter : public VxlSections {
   std::uint64_t file_size_ = 0;
   std::vector<std::uint64_t> written_;
   std::vector<std::unique_ptr<Xxh3_64Stream>> checksums_;
+  std::vector<std::unique_ptr<DirectRegionWriter>> regions_;  // per table_ entry, with direct writes
+  // append_in_place's buffers, with direct writes
+  std::unique_ptr<std::uint8_t[]> fill_buffers_[kCount];
+  std::uint64_t fill_capacity_[kCount] = {};
 };
 
 }  // namespace vxl

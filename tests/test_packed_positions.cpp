@@ -140,7 +140,10 @@ TEST(PackedPositions, ThePackerRoundsExactlyLikeTheSpecsQuotient) {
         for (float x : xs) {
           float xyz[3] = {v.tight_min[0], v.tight_min[1], v.tight_min[2]};
           xyz[c] = x;
+          std::uint32_t only_words = 0;
+          packer.words(xyz, 1, &only_words);
           const std::uint32_t word = packer.pack(xyz);
+          ASSERT_EQ(only_words, word);
           ASSERT_EQ((word >> (10 * c)) & kPackedAxisMask, spec_q(x, vlo, step))
               << "x " << x << " in [" << v.tight_min[c] << ", " << v.tight_max[c] << "]";
           ++points;

@@ -204,16 +204,16 @@ TEST(StreamingConvert, ManySmallVoxelsAndSplitLongStepsAreIdentical) {
   const std::string tck = dir.file("in.tck");
   write_synth_tck(tck, 4000, 7);
   // One level: the voxel table of 1 mm voxels (44 MiB with what is taken before it) then leaves room in
-  // 47 MiB for a few ranges.
+  // 51 MiB for a few ranges (and the voxlines of two batches being placed: about one per point here).
   ConvertSettings one_level = settings_for(1.0);
   one_level.levels = 1;
-  ConvertSummary s = expect_identical(dir, tck, one_level, 47 * kMiB);
+  ConvertSummary s = expect_identical(dir, tck, one_level, 51 * kMiB);
   EXPECT_GT(s.voxels, 20000u);
   EXPECT_GT(s.synthetic_points, 100u);
   EXPECT_GE(s.partitions, 2u);
   EXPECT_GT(streamlines_across_ranges(dir.file("limited.vxl"), s.partition_starts), 100u);
   // Levels of detail place each depth's voxlines separately in every block: identical too, in ranges.
-  s = expect_identical(dir, tck, settings_for(1.0), 74 * kMiB);
+  s = expect_identical(dir, tck, settings_for(1.0), 81 * kMiB);
   EXPECT_GE(s.partitions, 2u);
 }
 
@@ -234,11 +234,11 @@ TEST(StreamingConvert, LongStepsAndDiagonalOrdersAreIdentical) {
     }
     w.finish();
   }
-  ConvertSummary s = expect_identical(dir, tck, settings_for(10.0, "axis+diag"), 20 * kMiB);
+  ConvertSummary s = expect_identical(dir, tck, settings_for(10.0, "axis+diag"), 24 * kMiB);
   EXPECT_GT(s.synthetic_points, 1000u);
   EXPECT_GE(s.partitions, 2u);
   // Per-voxel random directions (the VDIR section) come out the same when streamed.
-  ConvertSummary r = expect_identical(dir, tck, settings_for(10.0, "random:8"), 20 * kMiB);
+  ConvertSummary r = expect_identical(dir, tck, settings_for(10.0, "random:8"), 24 * kMiB);
   EXPECT_GE(r.partitions, 2u);
 }
 

@@ -1,0 +1,84 @@
+#include "format/direct_region_writer.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include <unistd.h>
+
+#include "format/error.h"
+
+namespace vxl {
+
+DirectRegionWriter::DirectRegionWriter(AtomicOutputFile& out, int direct_fd, std::uint64_t offset, std::uint64_t size,
+                                       std::uint64_t staging_bytes)
+    : out_(out),
+      direct_fd_(direct_fd),
+      end_(offset + size),
+      position_(offset),
+      staging_bytes_(std::max<std::uint64_t>(kBlock, (staging_bytes + kBlock - 1) / kBlock * kBlock)) {}
+
+void DirectRegionWriter::append(std::span<const std::uint8_t> bytes) {
+  if (bytes.size() > end_ - position_) throw std::logic_error("DirectRegionWriter::append: past the region's end");
+  // The block the region starts in may hold its neighbour's bytes too: written through the page cache.
+  const std::uint64_t first_block = (position_ + kBlock - 1) / kBlock * kBlock;
+  if (staged_ == 0 && position_ < first_block) {
+    const std::uint64_t n = std::min<std::uint64_t>(bytes.size(), first_block - position_);
+    out_.pwrite(bytes.data(), n, position_);
+    position_ += n;
+    bytes = bytes.subspan(n);
+  }
+  while (!bytes.empty()) {
+    if (!staging_) {
+      void* p = std::aligned_alloc(kBlock, staging_bytes_);
+      if (p == nullptr) throw std::bad_alloc();
+      staging_ = {static_cast<std::uint8_t*>(p), std::free};
+    }
+    if (staged_ == 0) staging_start_ = position_;
+    const std::uint64_t n = std::min<std::uint64_t>(bytes.size(), staging_bytes_ - staged_);
+    std::memcpy(staging_.get() + staged_, bytes.data(), n);
+    staged_ += n;
+    position_ += n;
+    bytes = bytes.subspan(n);
+    if (staged_ == staging_bytes_) write_staged(false);
+  }
+  if (position_ == end_ && staged_ > 0) write_staged(true);
+}
+
+void DirectRegionWriter::write_staged(bool last) {
+  // Whole blocks directly; the rest waits for more bytes, or, at the region's end, goes through the page
+  // cache (its block may hold the next region's bytes).
+  const std::uint64_t whole = staged_ / kBlock * kBlock;
+  write_at(staging_.get(), whole, staging_start_);
+  const std::uint64_t rest = staged_ - whole;
+  if (last) {
+    if (rest > 0) out_.pwrite(staging_.get() + whole, rest, staging_start_ + whole);
+    staged_ = 0;
+    return;
+  }
+  std::memmove(staging_.get(), staging_.get() + whole, rest);
+  staged_ = rest;
+  staging_start_ += whole;
+}
+
+void DirectRegionWriter::write_at(const std::uint8_t* data, std::uint64_t size, std::uint64_t offset) {
+  while (size > 0 && direct_fd_ >= 0) {
+    const ssize_t n = ::pwrite(direct_fd_, data, size, static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && errno == EINVAL) {
+      direct_fd_ = -1;  // no direct I/O here: the page cache it is
+      break;
+    }
+    if (n < 0)
+      throw Error(ErrorKind::Output, out_.path(), std::nullopt, std::string("write failed: ") + std::strerror(errno));
+    data += n;
+    size -= static_cast<std::uint64_t>(n);
+    offset += static_cast<std::uint64_t>(n);
+  }
+  if (size > 0) out_.pwrite(data, size, offset);
+}
+
+}  // namespace vxl

@@ -1,0 +1,50 @@
+// Sequential writes to one region of an output file that bypass the page cache (O_DIRECT) for the
+// region's whole 4 KiB blocks; the partial blocks at its two ends, which it may share with its
+// neighbours, go through ordinary pwrite.
+//
+// Why: on a virtual machine whose host takes back the guest's free memory, every page of page cache a
+// large output occupies is a fresh page the host must fault in again. Buffered writes of 2 GiB ran at
+// 0.46 GB/s on the 2-core build machine, direct ones at 2.9 GB/s (dd); the 9 GB .vxl of a 10M-streamline
+// tractogram spent more CPU on its page cache than on its orders. Direct writes also leave the page cache
+// to the source the conversion re-reads.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include "format/atomic_output.h"
+
+namespace vxl {
+
+class DirectRegionWriter {
+ public:
+  static constexpr std::uint64_t kBlock = 4096;  // offsets, sizes and buffers of direct I/O align to it
+
+  // Region [offset, offset + size) of `out`'s file; `direct_fd` is that file opened with O_DIRECT
+  // (AtomicOutputFile::direct_descriptor). Bytes are staged `staging_bytes` (rounded up to blocks) at a
+  // time. Writes nothing until the first append.
+  DirectRegionWriter(AtomicOutputFile& out, int direct_fd, std::uint64_t offset, std::uint64_t size,
+                     std::uint64_t staging_bytes);
+  DirectRegionWriter(const DirectRegionWriter&) = delete;
+  DirectRegionWriter& operator=(const DirectRegionWriter&) = delete;
+
+  // Appends the region's next bytes; the last append writes out what is staged. Throws vxl::Error
+  // (Output) when a write fails, std::logic_error past the region's size. Where the file system refuses
+  // direct I/O (EINVAL: tmpfs, some network file systems) it falls back to pwrite for good.
+  void append(std::span<const std::uint8_t> bytes);
+
+ private:
+  void write_staged(bool last);
+  void write_at(const std::uint8_t* data, std::uint64_t size, std::uint64_t offset);
+
+  AtomicOutputFile& out_;
+  int direct_fd_;
+  std::uint64_t end_, position_;  // file offsets: the region's end, the next byte appended
+  std::uint64_t staging_bytes_;
+  std::unique_ptr<std::uint8_t, void (*)(void*)> staging_{nullptr, nullptr};
+  std::uint64_t staged_ = 0;         // bytes in staging_
+  std::uint64_t staging_start_ = 0;  // the file offset of staging_[0] (block-aligned)
+};
+
+}  // namespace vxl
