@@ -43,25 +43,18 @@ void DirectRegionWriter::append(std::span<const std::uint8_t> bytes) {
     staged_ += n;
     position_ += n;
     bytes = bytes.subspan(n);
-    if (staged_ == staging_bytes_) write_staged(false);
+    if (staged_ == staging_bytes_) write_staged();
   }
-  if (position_ == end_ && staged_ > 0) write_staged(true);
+  if (position_ == end_ && staged_ > 0) write_staged();
 }
 
-void DirectRegionWriter::write_staged(bool last) {
-  // Whole blocks directly; the rest waits for more bytes, or, at the region's end, goes through the page
-  // cache (its block may hold the next region's bytes).
+void DirectRegionWriter::write_staged() {
+  // Whole blocks directly. Staging is written when full (whole blocks) or at the region's end, where the
+  // last partial block may hold the next region's bytes: that one goes through the page cache.
   const std::uint64_t whole = staged_ / kBlock * kBlock;
   write_at(staging_.get(), whole, staging_start_);
-  const std::uint64_t rest = staged_ - whole;
-  if (last) {
-    if (rest > 0) out_.pwrite(staging_.get() + whole, rest, staging_start_ + whole);
-    staged_ = 0;
-    return;
-  }
-  std::memmove(staging_.get(), staging_.get() + whole, rest);
-  staged_ = rest;
-  staging_start_ += whole;
+  if (whole < staged_) out_.pwrite(staging_.get() + whole, staged_ - whole, staging_start_ + whole);
+  staged_ = 0;
 }
 
 void DirectRegionWriter::write_at(const std::uint8_t* data, std::uint64_t size, std::uint64_t offset) {

@@ -35,7 +35,7 @@ class DirectRegionWriter {
   void append(std::span<const std::uint8_t> bytes);
 
  private:
-  void write_staged(bool last);
+  void write_staged();
   void write_at(const std::uint8_t* data, std::uint64_t size, std::uint64_t offset);
 
   AtomicOutputFile& out_;
