@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <numeric>
 #include <optional>
 #include <span>
+#include <utility>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -138,6 +140,9 @@ class StreamingConversion {
   void build_table();
   std::vector<Range> cut_ranges();
   void build_range(const Range& r, std::size_t index, std::size_t count);
+  struct PlanPart;
+  void count_part(const Tractogram& b, std::uint64_t first, std::uint64_t begin, std::uint64_t end,
+                  std::uint64_t points, std::uint64_t synthetic, PlanPart& part, const PlanPart& other) const;
   struct StagedPart;
   struct RangePlacement;
   void place_range(const Range& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
@@ -233,6 +238,28 @@ struct StreamingConversion::RangePlacement {
   StagedPart parts[2][2];  // two sets of two parts: one being staged, one being placed
 };
 
+// Part of a batch counted on its own thread in pass 2 (count_part).
+struct StreamingConversion::PlanPart {
+  Sink sink;
+  detail::VoxelUse use;
+  detail::VoxelBounds bounds;
+  std::uint64_t voxlines = 0, synthetic = 0;  // in the batch being counted
+  std::atomic<std::size_t> voxels{0};         // in sink.index, read by the other part's thread
+  std::exception_ptr error;
+  PlanPart(Sink s, detail::VoxelUse u, detail::VoxelBounds b)
+      : sink(std::move(s)), use(std::move(u)), bounds(std::move(b)), voxels(sink.index.coords().size()) {}
+  PlanPart& operator=(PlanPart&& o) noexcept {
+    sink = std::move(o.sink);
+    use = std::move(o.use);
+    bounds = std::move(o.bounds);
+    voxlines = o.voxlines;
+    synthetic = o.synthetic;
+    voxels = o.voxels.load();
+    error = o.error;
+    return *this;
+  }
+};
+
 void StreamingConversion::fail_changed() const {
   fail_input(path_, std::nullopt,
              "the file changed while it was being converted (--memory-limit reads it several times)");
@@ -325,7 +352,10 @@ void StreamingConversion::scan() {
   meta_.voxel_size = settings_.voxel_size;
 }
 
-// Pass 2: the vertex and segment counts per voxel (plan_voxels' pass 1), kept per voxel only.
+// Pass 2: the vertex and segment counts and the tight bounds per voxel (plan_voxels' pass 1), kept per
+// voxel only. Each batch is cut in two parts counted on two threads: the first into the source's voxel
+// index (sink_, use_, bounds_), the second into a part of its own (PlanPart), merged into it after the
+// batch — the counts and bounds do not depend on the order streamlines are counted in.
 void StreamingConversion::plan() {
   use_ = detail::VoxelUse(settings_.levels);
   if (meta_.point_count == 0) return;  // no voxels (plan_voxels returns early too)
@@ -334,44 +364,94 @@ void StreamingConversion::plan() {
   // thread's range: the two can differ only in whether a borderline source is refused).
   synthetic_limit_ =
       static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(meta_.point_count)) + 4096;
+  PlanPart main{std::move(sink_), std::move(use_), std::move(bounds_)},
+      other{Sink(), detail::VoxelUse(settings_.levels), {}};
+  PlanPart* parts[2] = {&main, &other};
   std::uint64_t voxlines = 0, synthetic = 0, points = 0;
-  const std::string voxel_hint = ", or a larger --voxel-size";
   each_batch("voxelising", [&](const Tractogram& b, std::uint64_t first) {
-    const float* pts = b.positions.data();
-    for (std::uint64_t k = 0; k < b.streamline_count(); ++k) {
-      sink_.voxlines.clear();
-      sink_.synthetic_xyz.clear();
-      detail::voxelize_streamline(grid_, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], sink_,
-                                  synthetic_limit_ - synthetic);
-      if (sink_.too_many_synthetic) detail::fail_too_many_synthetic(path_, meta_.voxel_size, longest_step2_);
-      synthetic += sink_.synthetic_xyz.size() / 3;
-      const std::size_t n_local = sink_.index.coords().size();
-      use_.grow_to(n_local);
-      detail::count_voxel_use(sink_.voxlines, streamline_depth(first + k, settings_.levels), use_, path_);
-      bounds_.grow_to(n_local);
-      for (std::size_t j = 0; j < sink_.voxlines.size(); ++j)
-        bounds_.add_voxline(sink_.voxlines, j, pts, sink_.synthetic_xyz.data());
-      voxlines += sink_.voxlines.size();
-      // Per streamline, so that a table outgrowing the limit is caught before it goes far past it.
-      const std::uint64_t table = n_local * plan_bytes_per_voxel(settings_.levels);
-      if (table > plan_held_ && table - plan_held_ > budget_.left()) {
-        // Voxels turn up ever more slowly: extrapolating from the points read so far overestimates.
-        const std::uint64_t read = points + b.offsets[k + 1];
-        const std::uint64_t all =
-            static_cast<std::uint64_t>(double(n_local) * double(meta_.point_count) / double(read));
-        budget_.fail(all * plan_bytes_per_voxel(settings_.levels), budget_.used() - plan_held_,
-                     "the voxel table (" + std::to_string(n_local) + " voxels after " + std::to_string(read) + " of " +
-                         std::to_string(meta_.point_count) + " points; about " + std::to_string(all) +
-                         " in all, extrapolated)",
-                     voxel_hint);
+    const std::uint64_t n = b.streamline_count();
+    const std::uint64_t half =
+        std::upper_bound(b.offsets.begin(), b.offsets.end(), b.point_count() / 2) - b.offsets.begin() - 1;
+    const std::uint64_t cut[3] = {0, std::min(half, n), n};
+    parallel_for(2, threads_ > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
+      parts[p]->error = nullptr;
+      try {
+        count_part(b, first, cut[p], cut[p + 1], points, synthetic, *parts[p], *parts[1 - p]);
+      } catch (...) {
+        parts[p]->error = std::current_exception();  // rethrown below in streamline order
       }
-      budget_.track(table, plan_held_, [] { return std::string(); });
-      budget_.track(sink_.bytes(), sink_held_, [] { return std::string("the voxline list of one streamline"); });
+    });
+    for (PlanPart* part : parts)
+      if (part->error) std::rethrow_exception(part->error);
+    for (PlanPart* part : parts) {
+      voxlines += std::exchange(part->voxlines, 0);
+      synthetic += std::exchange(part->synthetic, 0);
     }
+    if (synthetic > synthetic_limit_) detail::fail_too_many_synthetic(path_, meta_.voxel_size, longest_step2_);
+    // The second part's voxels into the first's index.
+    const std::vector<detail::Coord>& coords = other.sink.index.coords();
+    const std::uint32_t levels = settings_.levels;
+    for (std::uint32_t j = 0; j < coords.size(); ++j) {
+      const std::uint32_t i = main.sink.index.find_or_insert(coords[j]);
+      main.use.grow_to(main.sink.index.coords().size());
+      main.bounds.grow_to(main.sink.index.coords().size());
+      for (std::uint32_t d = 0; d < levels; ++d) {
+        main.use.vertices[std::size_t(i) * levels + d] += other.use.vertices[std::size_t(j) * levels + d];
+        main.use.segments[std::size_t(i) * levels + d] += other.use.segments[std::size_t(j) * levels + d];
+      }
+      main.bounds.merge(i, other.bounds, j);
+    }
+    const std::uint64_t sinks = main.sink.bytes() + other.sink.bytes();
+    other = PlanPart{Sink(), detail::VoxelUse(levels), {}};
+    main.voxels = main.sink.index.coords().size();
+    budget_.track(main.voxels * plan_bytes_per_voxel(levels), plan_held_, [] { return std::string(); });
+    budget_.track(sinks, sink_held_, [] { return std::string("the voxline lists of two streamlines"); });
     points += b.point_count();
   });
+  sink_ = std::move(main.sink);
+  use_ = std::move(main.use);
+  bounds_ = std::move(main.bounds);
   meta_.voxline_count = voxlines;
   meta_.synthetic_point_count = synthetic;
+}
+
+// On one thread: counts streamlines [begin, end) of batch b (numbered from `first`) into `part`. The other
+// part, counting at the same time, shares the limit: the voxel table is checked against the limit with both
+// parts' voxels after every streamline. `points` and `synthetic` are those of the batches before.
+void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, std::uint64_t begin, std::uint64_t end,
+                                     std::uint64_t points, std::uint64_t synthetic, PlanPart& part,
+                                     const PlanPart& other) const {
+  const float* pts = b.positions.data();
+  const std::uint64_t bytes_per_voxel = plan_bytes_per_voxel(settings_.levels);
+  for (std::uint64_t k = begin; k < end; ++k) {
+    part.sink.voxlines.clear();
+    part.sink.synthetic_xyz.clear();
+    detail::voxelize_streamline(grid_, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], part.sink,
+                                synthetic_limit_ - std::min(synthetic_limit_, synthetic + part.synthetic));
+    if (part.sink.too_many_synthetic) detail::fail_too_many_synthetic(path_, meta_.voxel_size, longest_step2_);
+    part.synthetic += part.sink.synthetic_xyz.size() / 3;
+    const std::size_t n_local = part.sink.index.coords().size();
+    part.use.grow_to(n_local);
+    detail::count_voxel_use(part.sink.voxlines, streamline_depth(first + k, settings_.levels), part.use, path_);
+    part.bounds.grow_to(n_local);
+    for (std::size_t j = 0; j < part.sink.voxlines.size(); ++j)
+      part.bounds.add_voxline(part.sink.voxlines, j, pts, part.sink.synthetic_xyz.data());
+    part.voxlines += part.sink.voxlines.size();
+    part.voxels = n_local;
+    // Per streamline, so that a table outgrowing the limit is caught before it goes far past it.
+    const std::uint64_t voxels = n_local + other.voxels.load(std::memory_order_relaxed);
+    const std::uint64_t table = voxels * bytes_per_voxel;
+    if (table > plan_held_ && table - plan_held_ > budget_.left()) {
+      // Voxels turn up ever more slowly: extrapolating from the points read so far overestimates.
+      const std::uint64_t read = points + b.offsets[k + 1];
+      const std::uint64_t all = static_cast<std::uint64_t>(double(voxels) * double(meta_.point_count) / double(read));
+      budget_.fail(all * bytes_per_voxel, budget_.used() - plan_held_,
+                   "the voxel table (" + std::to_string(voxels) + " voxels after " + std::to_string(read) + " of " +
+                       std::to_string(meta_.point_count) + " points; about " + std::to_string(all) +
+                       " in all, extrapolated)",
+                   ", or a larger --voxel-size");
+    }
+  }
 }
 
 // The voxel table sorted by (z, y, x), as plan_voxels and layout_orders make it.

@@ -237,13 +237,17 @@ void VoxelBounds::grow_to(std::size_t voxels) {
 }
 
 void VoxelBounds::add(std::uint32_t local, const float* xyz, std::uint64_t count) {
-  float* lo = lo_.data() + 3 * std::size_t(local);
-  float* hi = hi_.data() + 3 * std::size_t(local);
+  float* const lo_out = lo_.data() + 3 * std::size_t(local);
+  float* const hi_out = hi_.data() + 3 * std::size_t(local);
+  // In locals: stored through the pointers the compiler would have to assume they alias xyz.
+  float lo[3] = {lo_out[0], lo_out[1], lo_out[2]}, hi[3] = {hi_out[0], hi_out[1], hi_out[2]};
   for (std::uint64_t k = 0; k < count; ++k)
     for (int c = 0; c < 3; ++c) {
       lo[c] = std::min(lo[c], xyz[3 * k + c]);
       hi[c] = std::max(hi[c], xyz[3 * k + c]);
     }
+  std::copy(lo, lo + 3, lo_out);
+  std::copy(hi, hi + 3, hi_out);
 }
 
 void VoxelBounds::add_voxline(std::span<const TempVoxline> streamline, std::size_t j, const float* pts,
@@ -251,6 +255,11 @@ void VoxelBounds::add_voxline(std::span<const TempVoxline> streamline, std::size
   const std::uint32_t local = streamline[j].voxel;
   for_each_voxline_run(streamline, j, pts, synthetic_xyz,
                        [&](const float* xyz, std::uint64_t count) { add(local, xyz, count); });
+}
+
+void VoxelBounds::merge(std::uint32_t local, const VoxelBounds& other, std::uint32_t other_local) {
+  add(local, other.lo_.data() + 3 * std::size_t(other_local), 1);
+  add(local, other.hi_.data() + 3 * std::size_t(other_local), 1);
 }
 
 void VoxelBounds::set_tight_bounds(std::uint32_t local, VoxelEntry& v) const {

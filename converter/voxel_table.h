@@ -140,6 +140,8 @@ class VoxelBounds {
   void add_voxline(std::span<const TempVoxline> streamline, std::size_t j, const float* pts,
                    const float* synthetic_xyz);
   void set_tight_bounds(std::uint32_t local, VoxelEntry& v) const;
+  // Widens the bounds of `local` to those of `other_local` in another index's bounds.
+  void merge(std::uint32_t local, const VoxelBounds& other, std::uint32_t other_local);
 
  private:
   void add(std::uint32_t local, const float* xyz, std::uint64_t count);

@@ -98,7 +98,8 @@ struct Grid {
   double size;
   // voxel_coordinate() (spec §6.1) of a source point. Every point is >= the origin, so the quotient is
   // >= 0 and below the grid size (< 2^31), where truncation is floor: this avoids a floor() library
-  // call per coordinate (the baseline x86-64 ISA has no rounding instruction).
+  // call per coordinate (the baseline x86-64 ISA has no rounding instruction). (A product with 1 / size,
+  // divided only next to a face, measured 15 % slower: the three divisions pipeline.)
   Coord voxel_of(const float* p) const {
     return {static_cast<std::int32_t>((static_cast<double>(p[0]) - origin[0]) / size),
             static_cast<std::int32_t>((static_cast<double>(p[1]) - origin[1]) / size),

@@ -41,10 +41,9 @@ class VertexPacker {
 
  private:
   std::uint32_t word(const float* xyz) const;
-  std::uint32_t quantise(int c, float x) const;  // by the quotient
+  std::uint32_t quantise(int c, float x) const;
   float decode_axis(int c, std::uint32_t q) const;
   float lo_[3], step_[3];
-  double inverse_step_[3];
 };
 
 // Quantises one voxel's block: writes each vertex's packed word (end bit clear) into `packed` and replaces

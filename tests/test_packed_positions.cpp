@@ -117,9 +117,9 @@ std::uint32_t spec_q(double x, float lo, float step) {
   return t <= 0 ? 0 : t >= kPackedSteps ? kPackedSteps : static_cast<std::uint32_t>(std::floor(t + 0.5));
 }
 
-// The packer multiplies by the inverse step instead of dividing, and divides only where t + 0.5 is
-// within 1e-9 of an integer: it must give the quotient's q everywhere, above all at the half-steps where
-// rounding turns, at the bounds, and for boxes tiny, huge and far from the origin.
+// The packer truncates t + 0.5 where the spec rounds (floor): it must give the spec's q everywhere, above
+// all at the half-steps where rounding turns, at the bounds, and for boxes tiny, huge and far from the
+// origin; words() (no decoding) must give pack()'s words.
 TEST(PackedPositions, ThePackerRoundsExactlyLikeTheSpecsQuotient) {
   std::mt19937 rng(23);
   std::uint64_t points = 0, half_steps = 0;
