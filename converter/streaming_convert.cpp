@@ -65,6 +65,15 @@ constexpr std::size_t kTableBufferEntries = 1 << 16;
 // ordering thread busy.
 constexpr std::uint64_t kOrderChunkBytes = 256 * kMiB;
 
+// Where a batch is cut into two parts of about as many points each, for two threads: streamlines
+// [cut[0], cut[1]) and [cut[1], cut[2]).
+std::array<std::uint64_t, 3> two_parts(const Tractogram& b) {
+  const std::uint64_t n = b.streamline_count();
+  const std::uint64_t half =
+      std::upper_bound(b.offsets.begin(), b.offsets.end(), b.point_count() / 2) - b.offsets.begin() - 1;
+  return {0, std::min(half, n), n};
+}
+
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The memory the conversion holds, held against the limit.
@@ -331,8 +340,14 @@ void StreamingConversion::scan() {
         longest_ = b.offsets[k + 1] - b.offsets[k];
         longest_index_ = first + k;
       }
-    bounds.add(b.positions.data(), b.offsets.data(), 0, b.streamline_count(),
-               first);  // stops at a bad point; reading goes on for the reader's errors
+    // In two parts on two threads, merged in order (a scan stops at a bad point; reading goes on for the
+    // reader's errors).
+    const std::array<std::uint64_t, 3> cut = two_parts(b);
+    detail::BoundsScan parts[2];
+    parallel_for(2, threads_ > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
+      parts[p].add(b.positions.data(), b.offsets.data(), cut[p], cut[p + 1], first);
+    });
+    for (const detail::BoundsScan& part : parts) bounds.merge(part);
     streamlines += b.streamline_count();
     points += b.point_count();
   });
@@ -369,10 +384,7 @@ void StreamingConversion::plan() {
   PlanPart* parts[2] = {&main, &other};
   std::uint64_t voxlines = 0, synthetic = 0, points = 0;
   each_batch("voxelising", [&](const Tractogram& b, std::uint64_t first) {
-    const std::uint64_t n = b.streamline_count();
-    const std::uint64_t half =
-        std::upper_bound(b.offsets.begin(), b.offsets.end(), b.point_count() / 2) - b.offsets.begin() - 1;
-    const std::uint64_t cut[3] = {0, std::min(half, n), n};
+    const std::array<std::uint64_t, 3> cut = two_parts(b);
     parallel_for(2, threads_ > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
       parts[p]->error = nullptr;
       try {
@@ -564,12 +576,8 @@ void StreamingConversion::place_range(const Range& r, bool tables, const std::st
     for (const StagedPart& part : placing.parts[set]) place_part(placing, part);
   };
   each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
-    const std::uint64_t n = b.streamline_count();
-    if (first + n > spans_.size()) fail_changed();  // more streamlines than pass 1 saw
-    // Two parts of about as many points each.
-    const std::uint64_t half =
-        std::upper_bound(b.offsets.begin(), b.offsets.end(), b.point_count() / 2) - b.offsets.begin() - 1;
-    const std::uint64_t cut[3] = {0, std::min(half, n), n};
+    if (first + b.streamline_count() > spans_.size()) fail_changed();  // more streamlines than pass 1 saw
+    const std::array<std::uint64_t, 3> cut = two_parts(b);
     std::exception_ptr placing_error;
     parallel_for(3, threads_ > 1 ? 3 : 1, [&](std::uint64_t item, unsigned) {
       try {
