@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -96,6 +95,12 @@ class Budget {
     used_ += bytes - held;
     held = bytes;
   }
+  // Gives back what a buffer followed by track() no longer holds once it is down to `bytes`.
+  void shrink(std::uint64_t bytes, std::uint64_t& held) {
+    if (bytes >= held) return;
+    used_ -= held - bytes;
+    held = bytes;
+  }
   [[noreturn]] void fail(std::uint64_t needs, std::uint64_t others, const std::string& what,
                          const std::string& hint = "") const {
     // A quarter more than the sum, for what comes later.
@@ -151,7 +156,8 @@ class StreamingConversion {
   void build_range(const Range& r, std::size_t index, std::size_t count);
   struct PlanPart;
   void count_part(const Tractogram& b, std::uint64_t first, std::uint64_t begin, std::uint64_t end,
-                  std::uint64_t points, std::uint64_t synthetic, PlanPart& part, const PlanPart& other) const;
+                  std::uint64_t points, std::uint64_t synthetic, std::uint64_t most_voxels, std::uint64_t other_voxels,
+                  PlanPart& part) const;
   struct StagedPart;
   struct RangePlacement;
   void place_range(const Range& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
@@ -253,20 +259,7 @@ struct StreamingConversion::PlanPart {
   detail::VoxelUse use;
   detail::VoxelBounds bounds;
   std::uint64_t voxlines = 0, synthetic = 0;  // in the batch being counted
-  std::atomic<std::size_t> voxels{0};         // in sink.index, read by the other part's thread
   std::exception_ptr error;
-  PlanPart(Sink s, detail::VoxelUse u, detail::VoxelBounds b)
-      : sink(std::move(s)), use(std::move(u)), bounds(std::move(b)), voxels(sink.index.coords().size()) {}
-  PlanPart& operator=(PlanPart&& o) noexcept {
-    sink = std::move(o.sink);
-    use = std::move(o.use);
-    bounds = std::move(o.bounds);
-    voxlines = o.voxlines;
-    synthetic = o.synthetic;
-    voxels = o.voxels.load();
-    error = o.error;
-    return *this;
-  }
 };
 
 void StreamingConversion::fail_changed() const {
@@ -379,16 +372,22 @@ void StreamingConversion::plan() {
   // thread's range: the two can differ only in whether a borderline source is refused).
   synthetic_limit_ =
       static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(meta_.point_count)) + 4096;
-  PlanPart main{std::move(sink_), std::move(use_), std::move(bounds_)},
-      other{Sink(), detail::VoxelUse(settings_.levels), {}};
+  PlanPart main{std::move(sink_), std::move(use_), std::move(bounds_), 0, 0, nullptr},
+      other{Sink(), detail::VoxelUse(settings_.levels), {}, 0, 0, nullptr};
   PlanPart* parts[2] = {&main, &other};
   std::uint64_t voxlines = 0, synthetic = 0, points = 0;
   each_batch("voxelising", [&](const Tractogram& b, std::uint64_t first) {
     const std::array<std::uint64_t, 3> cut = two_parts(b);
+    // The voxels the limit leaves room for in this batch, half to each part: a part that would need more
+    // fails (no matter how many the other adds, so that the outcome does not depend on timing).
+    const std::uint64_t room = (plan_held_ + budget_.left()) / plan_bytes_per_voxel(settings_.levels);
+    const std::uint64_t start = main.sink.index.coords().size();
+    const std::uint64_t headroom = room > start ? room - start : 0;
+    const std::uint64_t most[2] = {start + headroom / 2, headroom - headroom / 2};
     parallel_for(2, threads_ > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
       parts[p]->error = nullptr;
       try {
-        count_part(b, first, cut[p], cut[p + 1], points, synthetic, *parts[p], *parts[1 - p]);
+        count_part(b, first, cut[p], cut[p + 1], points, synthetic, most[p], p == 0 ? 0 : start, *parts[p]);
       } catch (...) {
         parts[p]->error = std::current_exception();  // rethrown below in streamline order
       }
@@ -400,8 +399,10 @@ void StreamingConversion::plan() {
       synthetic += std::exchange(part->synthetic, 0);
     }
     if (synthetic > synthetic_limit_) detail::fail_too_many_synthetic(path_, meta_.voxel_size, longest_step2_);
-    // The second part's voxels into the first's index.
+    // Both parts' tables at their largest (within the limit, by the parts' shares); then the second
+    // part's voxels into the first's index.
     const std::vector<detail::Coord>& coords = other.sink.index.coords();
+    const std::uint64_t peak = main.sink.index.coords().size() + coords.size();
     const std::uint32_t levels = settings_.levels;
     for (std::uint32_t j = 0; j < coords.size(); ++j) {
       const std::uint32_t i = main.sink.index.find_or_insert(coords[j]);
@@ -414,9 +415,9 @@ void StreamingConversion::plan() {
       main.bounds.merge(i, other.bounds, j);
     }
     const std::uint64_t sinks = main.sink.bytes() + other.sink.bytes();
-    other = PlanPart{Sink(), detail::VoxelUse(levels), {}};
-    main.voxels = main.sink.index.coords().size();
-    budget_.track(main.voxels * plan_bytes_per_voxel(levels), plan_held_, [] { return std::string(); });
+    budget_.track(peak * plan_bytes_per_voxel(levels), plan_held_, [] { return std::string(); });
+    other = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0, nullptr};
+    budget_.shrink(main.sink.index.coords().size() * plan_bytes_per_voxel(levels), plan_held_);
     budget_.track(sinks, sink_held_, [] { return std::string("the voxline lists of two streamlines"); });
     points += b.point_count();
   });
@@ -427,12 +428,13 @@ void StreamingConversion::plan() {
   meta_.synthetic_point_count = synthetic;
 }
 
-// On one thread: counts streamlines [begin, end) of batch b (numbered from `first`) into `part`. The other
-// part, counting at the same time, shares the limit: the voxel table is checked against the limit with both
-// parts' voxels after every streamline. `points` and `synthetic` are those of the batches before.
+// On one thread: counts streamlines [begin, end) of batch b (numbered from `first`) into `part`, whose
+// index may grow to `most_voxels` (its share of the limit; checked after every streamline, so that a table
+// outgrowing the limit is caught before it goes far past it); `other_voxels` are the other part's at the
+// batch's start, for the message. `points` and `synthetic` are those of the batches before.
 void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, std::uint64_t begin, std::uint64_t end,
-                                     std::uint64_t points, std::uint64_t synthetic, PlanPart& part,
-                                     const PlanPart& other) const {
+                                     std::uint64_t points, std::uint64_t synthetic, std::uint64_t most_voxels,
+                                     std::uint64_t other_voxels, PlanPart& part) const {
   const float* pts = b.positions.data();
   const std::uint64_t bytes_per_voxel = plan_bytes_per_voxel(settings_.levels);
   for (std::uint64_t k = begin; k < end; ++k) {
@@ -449,11 +451,8 @@ void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, s
     for (std::size_t j = 0; j < part.sink.voxlines.size(); ++j)
       part.bounds.add_voxline(part.sink.voxlines, j, pts, part.sink.synthetic_xyz.data());
     part.voxlines += part.sink.voxlines.size();
-    part.voxels = n_local;
-    // Per streamline, so that a table outgrowing the limit is caught before it goes far past it.
-    const std::uint64_t voxels = n_local + other.voxels.load(std::memory_order_relaxed);
-    const std::uint64_t table = voxels * bytes_per_voxel;
-    if (table > plan_held_ && table - plan_held_ > budget_.left()) {
+    if (n_local > most_voxels) {
+      const std::uint64_t voxels = n_local + other_voxels;
       // Voxels turn up ever more slowly: extrapolating from the points read so far overestimates.
       const std::uint64_t read = points + b.offsets[k + 1];
       const std::uint64_t all = static_cast<std::uint64_t>(double(voxels) * double(meta_.point_count) / double(read));

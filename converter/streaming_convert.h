@@ -3,14 +3,20 @@
 // (the limit is not recorded), reading the source several times instead of holding it:
 //
 //   pass 1    bounds, checksum, warnings and the longest streamline                 (TckStream)
-//   pass 2    voxelise every streamline, keeping only the counts per voxel          -> voxel table, layout
-//   then      cut the voxel table into ranges whose vertex blocks and orders fit in what the limit leaves
-//   pass 2+k  voxelise again, place the vertices that fall in range k, build their orders, and write both
-//             at their final offsets (VxlStreamWriter); pass 3 also writes the voxline and streamline tables
+//   pass 2    voxelise every streamline, keeping only the counts and tight bounds per voxel
+//             -> voxel table, layout
+//   then      cut the voxel table into ranges whose vertex blocks (packed as they are placed: 4 bytes a
+//             vertex) fit in what the limit leaves
+//   pass 2+k  voxelise again, pack and place the vertices that fall in range k, then build their orders a
+//             chunk of voxels at a time, and write both at their final offsets (VxlStreamWriter); pass 3
+//             also writes the voxline and streamline tables
 //
-// What stays in memory: the voxel table (about 256 bytes per voxel), one read buffer and one batch of
-// whole streamlines, and one range's blocks, orders and sort buffers. The source and the output are read
-// and written with pread / pwrite, so neither enters the resident memory. Only TCK sources stream.
+// Every pass cuts its batches in two parts for two threads (the placing pass places in streamline order,
+// one batch behind). What stays in memory: the voxel table (about 240 bytes per voxel), one mapped part of
+// the source and two batches of whole streamlines, two batches' staged voxlines, one range's blocks, an
+// orders chunk or two and the sort buffers. The source is read a mapped part at a time; the output is
+// written with pwrite, or past the page cache (O_DIRECT) under limits of 256 MiB or more, so neither
+// stays in resident memory. Only TCK sources stream.
 #pragma once
 
 #include <string>
