@@ -5,7 +5,6 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <future>
 #include <limits>
 #include <memory>
@@ -232,7 +231,6 @@ struct StreamingConversion::StagedPart {
   std::vector<std::size_t> voxline_ends;  // per streamline: the end of its voxlines in sink.voxlines
   std::vector<std::uint32_t> words;       // packed: the vertices of the voxlines in range, in order
   std::vector<float> xyz;                 // float32: the same
-  std::exception_ptr error;
   std::uint64_t bytes() const {
     return sink.bytes() + voxline_ends.capacity() * sizeof(std::size_t) + words.capacity() * sizeof(std::uint32_t) +
            xyz.capacity() * sizeof(float);
@@ -259,7 +257,6 @@ struct StreamingConversion::PlanPart {
   detail::VoxelUse use;
   detail::VoxelBounds bounds;
   std::uint64_t voxlines = 0, synthetic = 0;  // in the batch being counted
-  std::exception_ptr error;
 };
 
 void StreamingConversion::fail_changed() const {
@@ -372,8 +369,8 @@ void StreamingConversion::plan() {
   // thread's range: the two can differ only in whether a borderline source is refused).
   synthetic_limit_ =
       static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(meta_.point_count)) + 4096;
-  PlanPart main{std::move(sink_), std::move(use_), std::move(bounds_), 0, 0, nullptr},
-      other{Sink(), detail::VoxelUse(settings_.levels), {}, 0, 0, nullptr};
+  PlanPart main{std::move(sink_), std::move(use_), std::move(bounds_), 0, 0},
+      other{Sink(), detail::VoxelUse(settings_.levels), {}, 0, 0};
   PlanPart* parts[2] = {&main, &other};
   std::uint64_t voxlines = 0, synthetic = 0, points = 0;
   each_batch("voxelising", [&](const Tractogram& b, std::uint64_t first) {
@@ -384,16 +381,9 @@ void StreamingConversion::plan() {
     const std::uint64_t start = main.sink.index.coords().size();
     const std::uint64_t headroom = room > start ? room - start : 0;
     const std::uint64_t most[2] = {start + headroom / 2, headroom - headroom / 2};
-    parallel_for(2, threads_ > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
-      parts[p]->error = nullptr;
-      try {
-        count_part(b, first, cut[p], cut[p + 1], points, synthetic, most[p], p == 0 ? 0 : start, *parts[p]);
-      } catch (...) {
-        parts[p]->error = std::current_exception();  // rethrown below in streamline order
-      }
+    parallel_for_first_error_in_order(2, threads_ > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
+      count_part(b, first, cut[p], cut[p + 1], points, synthetic, most[p], p == 0 ? 0 : start, *parts[p]);
     });
-    for (PlanPart* part : parts)
-      if (part->error) std::rethrow_exception(part->error);
     for (PlanPart* part : parts) {
       voxlines += std::exchange(part->voxlines, 0);
       synthetic += std::exchange(part->synthetic, 0);
@@ -416,7 +406,7 @@ void StreamingConversion::plan() {
     }
     const std::uint64_t sinks = main.sink.bytes() + other.sink.bytes();
     budget_.track(peak * plan_bytes_per_voxel(levels), plan_held_, [] { return std::string(); });
-    other = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0, nullptr};
+    other = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0};
     budget_.shrink(main.sink.index.coords().size() * plan_bytes_per_voxel(levels), plan_held_);
     budget_.track(sinks, sink_held_, [] { return std::string("the voxline lists of two streamlines"); });
     points += b.point_count();
@@ -577,22 +567,14 @@ void StreamingConversion::place_range(const Range& r, bool tables, const std::st
   each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
     if (first + b.streamline_count() > spans_.size()) fail_changed();  // more streamlines than pass 1 saw
     const std::array<std::uint64_t, 3> cut = two_parts(b);
-    std::exception_ptr placing_error;
-    parallel_for(3, threads_ > 1 ? 3 : 1, [&](std::uint64_t item, unsigned) {
-      try {
-        if (item == 2) {
-          if (!other_placed) place_staged(1 - staging);
-          return;
-        }
-        stage_part(placing, b, first, cut[item], cut[item + 1], placing.parts[staging][item]);
-      } catch (...) {
-        (item == 2 ? placing_error : placing.parts[staging][item].error) = std::current_exception();
+    // Item 0 places the earlier batch, so that its errors come first.
+    parallel_for_first_error_in_order(3, threads_ > 1 ? 3 : 1, [&](std::uint64_t item, unsigned) {
+      if (item == 0) {
+        if (!other_placed) place_staged(1 - staging);
+        return;
       }
+      stage_part(placing, b, first, cut[item - 1], cut[item], placing.parts[staging][item - 1]);
     });
-    // In streamline order: the earlier batch's errors first.
-    if (placing_error) std::rethrow_exception(placing_error);
-    for (StagedPart& part : placing.parts[staging])
-      if (part.error) std::rethrow_exception(part.error);
     other_placed = false;
     staging = 1 - staging;
     std::uint64_t staged = 0;
@@ -628,7 +610,6 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
   part.begin = begin;
   part.end = end;
   part.source_first = first + begin;
-  part.error = nullptr;
   part.sink.index.index = &sink_.index;
   part.sink.voxlines.clear();
   part.sink.synthetic_xyz.clear();

@@ -107,40 +107,10 @@ std::span<std::uint8_t> AtomicOutputFile::map(std::uint64_t size) {
   return {map_, size};
 }
 
-AtomicOutputFile::Window AtomicOutputFile::map_window(std::uint64_t offset, std::uint64_t size) {
+FileWindow AtomicOutputFile::map_window(std::uint64_t offset, std::uint64_t size) {
   if (map_ != nullptr) fail("internal error: map_window() on a mapped file");
   if (offset > position_ || size > position_ - offset) fail("internal error: map_window() past the allocated size");
-  Window w;
-  if (size == 0) return w;
-  const std::uint64_t page = static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE));
-  const std::uint64_t start = offset / page * page;
-  w.map_size_ = static_cast<std::size_t>(offset + size - start);
-  w.map_ = ::mmap(nullptr, w.map_size_, PROT_READ | PROT_WRITE, MAP_SHARED, fd_, static_cast<off_t>(start));
-  if (w.map_ == MAP_FAILED) {
-    w.map_ = nullptr;
-    fail(std::string("cannot map part of the output: ") + std::strerror(errno));
-  }
-  w.bytes_ = {static_cast<std::uint8_t*>(w.map_) + (offset - start), static_cast<std::size_t>(size)};
-  return w;
-}
-
-AtomicOutputFile::Window::Window(Window&& other) noexcept
-    : map_(std::exchange(other.map_, nullptr)),
-      map_size_(std::exchange(other.map_size_, 0)),
-      bytes_(std::exchange(other.bytes_, {})) {}
-
-AtomicOutputFile::Window& AtomicOutputFile::Window::operator=(Window&& other) noexcept {
-  if (this != &other) {
-    if (map_ != nullptr) ::munmap(map_, map_size_);
-    map_ = std::exchange(other.map_, nullptr);
-    map_size_ = std::exchange(other.map_size_, 0);
-    bytes_ = std::exchange(other.bytes_, {});
-  }
-  return *this;
-}
-
-AtomicOutputFile::Window::~Window() {
-  if (map_ != nullptr) ::munmap(map_, map_size_);
+  return FileWindow(fd_, path_, offset, size, FileWindow::Access::Write);
 }
 
 void AtomicOutputFile::unmap() noexcept {

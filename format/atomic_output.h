@@ -14,6 +14,8 @@
 #include <span>
 #include <string>
 
+#include "format/mapped_file.h"
+
 namespace vxl {
 
 class AtomicOutputFile {
@@ -38,24 +40,10 @@ class AtomicOutputFile {
   // with pwrite(), or a part at a time through map_window().
   void allocate(std::uint64_t size);
 
-  // A writable mapping of bytes [offset, offset + size) of an allocate()d file, unmapped when the window
-  // is destroyed (what was written stays in the file's page cache). Filling a part in place spares the
-  // buffer that pwrite() copies from; unmapping it when done keeps it out of resident memory after.
-  class Window {
-   public:
-    Window() = default;
-    Window(Window&& other) noexcept;
-    Window& operator=(Window&& other) noexcept;
-    ~Window();
-    std::span<std::uint8_t> bytes() const { return bytes_; }
-
-   private:
-    friend class AtomicOutputFile;
-    void* map_ = nullptr;
-    std::size_t map_size_ = 0;
-    std::span<std::uint8_t> bytes_;
-  };
-  Window map_window(std::uint64_t offset, std::uint64_t size);
+  // A writable mapping of bytes [offset, offset + size) of an allocate()d file (FileWindow::Access::Write):
+  // filling a part in place spares the buffer that pwrite() copies from; unmapping it when done keeps it
+  // out of resident memory after.
+  FileWindow map_window(std::uint64_t offset, std::uint64_t size);
 
   // The file opened a second time with O_DIRECT, for writes that bypass the page cache
   // (DirectRegionWriter), or -1 where that is refused. Opened on first call, closed by commit().

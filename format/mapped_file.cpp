@@ -51,18 +51,23 @@ void MappedFile::release() {
   size_ = 0;
 }
 
-FileWindow::FileWindow(int fd, const std::string& path, std::uint64_t offset, std::uint64_t size) {
+FileWindow::FileWindow(int fd, const std::string& path, std::uint64_t offset, std::uint64_t size, Access access) {
   if (size == 0) return;
   const std::uint64_t page = static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE));
   const std::uint64_t start = offset / page * page;
+  const bool write = access == Access::Write;
   map_size_ = static_cast<std::size_t>(offset + size - start);
-  void* p = ::mmap(nullptr, map_size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, static_cast<off_t>(start));
+  void* p = ::mmap(nullptr, map_size_, write ? PROT_READ | PROT_WRITE : PROT_READ,
+                   write ? MAP_SHARED : MAP_PRIVATE | MAP_POPULATE, fd, static_cast<off_t>(start));
   if (p == MAP_FAILED) {
     map_size_ = 0;
+    if (write)
+      throw Error(ErrorKind::Output, path, std::nullopt,
+                  std::string("cannot map part of the output: ") + std::strerror(errno));
     fail_input(path, offset, std::string("cannot map: ") + std::strerror(errno));
   }
   map_ = p;
-  data_ = static_cast<const std::uint8_t*>(p) + (offset - start);
+  bytes_ = {static_cast<std::uint8_t*>(p) + (offset - start), static_cast<std::size_t>(size)};
 }
 
 FileWindow::~FileWindow() { release(); }
@@ -70,14 +75,14 @@ FileWindow::~FileWindow() { release(); }
 FileWindow::FileWindow(FileWindow&& other) noexcept
     : map_(std::exchange(other.map_, nullptr)),
       map_size_(std::exchange(other.map_size_, 0)),
-      data_(std::exchange(other.data_, nullptr)) {}
+      bytes_(std::exchange(other.bytes_, {})) {}
 
 FileWindow& FileWindow::operator=(FileWindow&& other) noexcept {
   if (this != &other) {
     release();
     map_ = std::exchange(other.map_, nullptr);
     map_size_ = std::exchange(other.map_size_, 0);
-    data_ = std::exchange(other.data_, nullptr);
+    bytes_ = std::exchange(other.bytes_, {});
   }
   return *this;
 }
@@ -86,7 +91,7 @@ void FileWindow::release() {
   if (map_ != nullptr) ::munmap(map_, map_size_);
   map_ = nullptr;
   map_size_ = 0;
-  data_ = nullptr;
+  bytes_ = {};
 }
 
 }  // namespace vxl

@@ -30,28 +30,31 @@ class MappedFile {
   std::size_t size_ = 0;
 };
 
-// A read-only mapping of bytes [offset, offset + size) of an open file, its pages mapped at once
-// (MAP_POPULATE): a reader that goes through a large file a part at a time reads the page cache in place,
-// without pread's copy, and unmaps each part when it moves on, so the file never adds more than one
-// part to its resident memory.
+// A mapping of bytes [offset, offset + size) of an open file, unmapped when the window is destroyed.
+// Read: its pages mapped at once (MAP_POPULATE), so that a reader going through a large file a part at a
+// time reads the page cache in place, without pread's copy, and adds no more than one part to its
+// resident memory. Write (AtomicOutputFile::map_window): shared, what is written stays in the file's page
+// cache after the window is gone.
 class FileWindow {
  public:
+  enum class Access { Read, Write };
   FileWindow() = default;
-  // Throws vxl::Error (Input) naming `path` when the part cannot be mapped.
-  FileWindow(int fd, const std::string& path, std::uint64_t offset, std::uint64_t size);
+  // Throws vxl::Error naming `path` when the part cannot be mapped: Input when reading, Output when writing.
+  FileWindow(int fd, const std::string& path, std::uint64_t offset, std::uint64_t size, Access access = Access::Read);
   ~FileWindow();
   FileWindow(FileWindow&& other) noexcept;
   FileWindow& operator=(FileWindow&& other) noexcept;
   FileWindow(const FileWindow&) = delete;
   FileWindow& operator=(const FileWindow&) = delete;
 
-  const std::uint8_t* data() const { return data_; }
+  const std::uint8_t* data() const { return bytes_.data(); }
+  std::span<std::uint8_t> bytes() const { return bytes_; }  // writable only for Access::Write
 
  private:
   void release();
   void* map_ = nullptr;
   std::size_t map_size_ = 0;
-  const std::uint8_t* data_ = nullptr;
+  std::span<std::uint8_t> bytes_;
 };
 
 }  // namespace vxl

@@ -56,6 +56,23 @@ void parallel_for(std::uint64_t count, unsigned threads, Fn&& fn) {
   if (error) std::rethrow_exception(error);
 }
 
+// Like parallel_for, but every item runs to its end and the exception rethrown is that of the lowest item
+// that threw: for work cut in order (the parts of a batch of streamlines), so that the error reported is
+// the first in that order, whatever the timing.
+template <typename Fn>
+void parallel_for_first_error_in_order(std::uint64_t count, unsigned threads, Fn&& fn) {
+  std::vector<std::exception_ptr> errors(count);
+  parallel_for(count, threads, [&](std::uint64_t i, unsigned t) {
+    try {
+      fn(i, t);
+    } catch (...) {
+      errors[i] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
 // Runs a() and b() side by side (b on the calling thread), or one after the other when `concurrent` is
 // false; the exception policy is parallel_for's.
 template <typename A, typename B>

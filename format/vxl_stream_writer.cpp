@@ -38,21 +38,21 @@ void VxlStreamWriter::append(Section section, std::span<const std::uint8_t> byte
   written_[i] += bytes.size();
 }
 
-AtomicOutputFile::Window VxlStreamWriter::open_window(Section section, std::uint64_t size, unsigned threads) {
+FileWindow VxlStreamWriter::open_window(Section section, std::uint64_t size, unsigned threads) {
   const std::size_t i = entry_[section];
   if (i >= table_.size() || size > table_[i].size - written_[i])
     throw std::logic_error("VxlStreamWriter::append_in_place: more bytes than the section was planned for");
-  AtomicOutputFile::Window window = out_.map_window(table_[i].offset + written_[i], size);
+  FileWindow window = out_.map_window(table_[i].offset + written_[i], size);
   prefault_for_write(window.bytes(), threads);
   return window;
 }
 
-void VxlStreamWriter::close_window(Section section, AtomicOutputFile::Window& window) {
+void VxlStreamWriter::close_window(Section section, FileWindow& window) {
   const std::size_t i = entry_[section];
   const std::span<std::uint8_t> bytes = window.bytes();
   checksums_[i]->update(bytes.data(), bytes.size());
   written_[i] += bytes.size();
-  window = AtomicOutputFile::Window();
+  window = FileWindow();
 }
 
 std::span<std::uint8_t> VxlStreamWriter::fill_buffer(Section section, std::uint64_t size, unsigned threads) {

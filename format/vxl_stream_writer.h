@@ -59,7 +59,7 @@ class VxlStreamWriter : public VxlSections {
       writing.get();
       return;
     }
-    AtomicOutputFile::Window window = open_window(section, size, threads);
+    FileWindow window = open_window(section, size, threads);
     fill(window.bytes());
     then(std::span<const std::uint8_t>(window.bytes()));
     close_window(section, window);
@@ -74,8 +74,8 @@ class VxlStreamWriter : public VxlSections {
   void commit();
 
  private:
-  AtomicOutputFile::Window open_window(Section section, std::uint64_t size, unsigned threads);
-  void close_window(Section section, AtomicOutputFile::Window& window);
+  FileWindow open_window(Section section, std::uint64_t size, unsigned threads);
+  void close_window(Section section, FileWindow& window);
   std::span<std::uint8_t> fill_buffer(Section section, std::uint64_t size, unsigned threads);
 
   AtomicOutputFile out_;

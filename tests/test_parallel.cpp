@@ -62,6 +62,27 @@ TEST(Parallel, TheFirstErrorIsRethrownOnTheCallerAndStopsTheHandOut) {
   }
 }
 
+// Item 0 throws last (after item 2 has thrown), yet its error is the one rethrown, and every item ran.
+TEST(Parallel, InOrderTheLowestItemsErrorIsRethrownWhateverTheTiming) {
+  for (unsigned threads : {1u, 3u}) {
+    std::atomic<int> ran{0};
+    try {
+      parallel_for_first_error_in_order(3, threads, [&](std::uint64_t i, unsigned) {
+        ++ran;
+        if (i == 0) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(threads > 1 ? 30 : 0));
+          throw std::runtime_error("item 0");
+        }
+        if (i == 2) throw std::runtime_error("item 2");
+      });
+      ADD_FAILURE() << "nothing was rethrown";
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "item 0") << threads << " threads";
+    }
+    EXPECT_EQ(ran.load(), 3) << threads << " threads";
+  }
+}
+
 TEST(Parallel, InvokeRunsBothAndRethrows) {
   for (bool concurrent : {false, true}) {
     int a = 0, b = 0;
