@@ -34,6 +34,7 @@ struct ConvertSummary {
   std::uint64_t passes = 1;                     // times the source was read
   std::uint64_t partitions = 1;                 // voxel ranges whose blocks and orders were built one after another
   std::vector<std::uint64_t> partition_starts;  // convert_streaming only: the first voxel of each range
+  bool vertices_read_back = false;              // convert_streaming only: VERT written block by block, not held
   std::vector<std::string> warnings;            // convert_streaming only: the source's (the reader's, otherwise)
 
   // The counts, as written in the file's META.

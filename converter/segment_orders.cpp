@@ -311,13 +311,15 @@ void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const LevelEntry> ro
   const std::uint32_t k = static_cast<std::uint32_t>(directions_.size());
   for (std::uint32_t level = 0; level <= row.size(); ++level) {
     const LevelEntry counts = voxel_level(v, row, level);
-    if (counts.segment_count > 0) write_level(v, counts, vertices, ends, dst);
-    dst += level_orders_size(counts, k);
+    std::uint8_t* const level_end = dst + level_orders_size(counts, k);
+    if (counts.segment_count > 0) dst = write_level(v, counts, vertices, ends, dst);
+    std::fill(dst, level_end, std::uint8_t{0});  // the padding to 4 bytes
+    dst = level_end;
   }
 }
 
-void VoxelOrderWriter::write_level(const VoxelEntry& v, const LevelEntry& level, std::span<const float> vertices,
-                                   const VoxlineEnds& ends, std::uint8_t* dst) {
+std::uint8_t* VoxelOrderWriter::write_level(const VoxelEntry& v, const LevelEntry& level,
+                                            std::span<const float> vertices, const VoxlineEnds& ends, std::uint8_t* dst) {
   std::vector<std::uint32_t>& starts = scratch_->starts;
   SortScratch& scratch = scratch_->sort;
   // The segments start at every vertex that does not end its voxline (branch-free: ends are
@@ -352,6 +354,7 @@ void VoxelOrderWriter::write_level(const VoxelEntry& v, const LevelEntry& level,
     }
     dst = sort_segments(starts, level.vertex_count, width, all_or ^ all_and, scratch, dst);
   }
+  return dst;
 }
 
 void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const LevelEntry> levels,

@@ -77,14 +77,15 @@ class VoxelOrderWriter {
   // Sorts voxel `v`'s segments (the vertices of its block that do not end a voxline in `ends`) for every
   // direction of the set and writes its K orders at `dst` (the ORDR payload plus v.order_offset; the
   // voxel's flags and order_offset as layout_orders set them), then those of each coarser level in `row`
-  // (its LODS entries) after them. Padding bytes are left as they are.
+  // (its LODS entries) after them. Every byte of the voxel's orders is written, the padding (zero)
+  // included, so `dst` need not be cleared.
   void write(const VoxelEntry& v, std::span<const LevelEntry> row, std::span<const float> vertices,
              const VoxlineEnds& ends, std::uint8_t* dst);
 
  private:
   void use_directions_of(const VoxelEntry& v);
-  // The K orders of the first `level.vertex_count` vertices of v's block.
-  void write_level(const VoxelEntry& v, const LevelEntry& level, std::span<const float> vertices,
+  // The K orders of the first `level.vertex_count` vertices of v's block; returns the end of what it wrote.
+  std::uint8_t* write_level(const VoxelEntry& v, const LevelEntry& level, std::span<const float> vertices,
                    const VoxlineEnds& ends, std::uint8_t* dst);
 
   struct Scratch;
@@ -96,7 +97,7 @@ class VoxelOrderWriter {
 };
 
 // Sorts every voxel's segments for every direction of `set` into `orders`, the ORDR payload laid out
-// by layout_orders (padding bytes are left as they are: zero in a fresh payload).
+// by layout_orders (its padding bytes zeroed).
 void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const LevelEntry> levels,
                        std::uint32_t level_count, std::span<const float> vertices, const VoxlineEnds& ends,
                        const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,

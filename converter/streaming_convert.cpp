@@ -56,6 +56,15 @@ constexpr std::uint64_t kHeldBytesPerPoint = 2 * 2 * 3 * sizeof(float);
 // limits of at least this much, staged this much per section.
 constexpr std::uint64_t kDirectWritesFromLimit = 256 * kMiB;
 constexpr std::uint64_t kDirectStagingBytes = 2 * kMiB;
+// With direct writes VERT is not held in memory when its blocks are few enough: each (voxel, level)
+// block is written through a staging of its own of this size (less where an eighth of the memory left
+// does not allow, but never under the minimum), then read back a chunk of voxels at a time for their
+// orders. Why: VERT is the conversion's largest buffer (2.3 GB for 10M streamlines), and on a virtual
+// machine whose host takes back the guest's free memory every fresh page costs about as much as
+// writing and reading it back past the page cache (measured: 2.7 s per GiB faulted in, against 2.9 GB/s
+// direct writes and 1.4-3 GB/s direct reads).
+constexpr std::uint64_t kBlockStagingBytes = 128 * 1024;
+constexpr std::uint64_t kMinBlockStagingBytes = 16 * 1024;
 // Voxline and streamline table entries written at once.
 constexpr std::size_t kTableBufferEntries = 1 << 16;
 // The orders are built a run of voxels at a time, in a buffer of at most this size and an
@@ -160,12 +169,19 @@ class StreamingConversion {
   struct StagedPart;
   struct RangePlacement;
   void place_range(const Range& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
+  void open_block_writers(RangePlacement& placing) const;
   void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
                   std::uint64_t end, StagedPart& part) const;
   void place_part(RangePlacement& placing, const StagedPart& part);
   void write_orders(const Range& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
-  void write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> range_vertices,
-                          VoxelOrderWriter& writer, std::vector<float>& decoded, std::uint8_t* dst);
+  void write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> vertices,
+                          std::uint64_t vertices_first, VoxelOrderWriter& writer, std::vector<float>& decoded,
+                          std::uint8_t* dst);
+  // The (voxel, level) blocks of VERT with vertices, and the staging each of them takes in memory when
+  // written block by block (DirectRegionWriter::staging_size).
+  std::uint64_t block_staging_total(std::uint64_t staging) const;
+  // The most VERT bytes of any run of consecutive voxels whose orders fit in a chunk (read back at once).
+  std::uint64_t largest_chunk_vertex_bytes() const;
   bool packed() const { return settings_.positions == PositionEncoding::Packed; }
   // Where voxel i's orders start in ORDR (i = voxel count: the payload's end).
   std::uint64_t orders_start(std::size_t i) const {
@@ -173,7 +189,7 @@ class StreamingConversion {
   }
   // Memory per ordering thread besides its sort buffers: a voxel's packed block decoded, and its end bits.
   std::uint64_t decode_bytes(std::uint32_t max_vertices) const {
-    return packed() ? 12ull * max_vertices + (max_vertices / 64 + 1) * 8 : 0;
+    return (packed() ? 12ull * max_vertices : 0) + (max_vertices / 64 + 1) * 8;
   }
   void write_rest();
   [[noreturn]] void fail_changed() const;
@@ -219,6 +235,7 @@ class StreamingConversion {
   std::uint64_t order_bytes_ = 0;
   std::uint64_t order_chunk_bytes_ = 0;
   std::uint64_t direct_staging_ = 0;  // 0: the output is written through the page cache
+  std::uint64_t block_staging_ = 0;   // > 0: VERT is written block by block and read back, not held
   VoxlineEnds ends_;                  // float32 positions: the voxline ends of the range being built
   std::unique_ptr<VxlStreamWriter> out_;
 };
@@ -245,6 +262,8 @@ struct StreamingConversion::RangePlacement {
   bool tables;                        // the first range: also the voxline and streamline tables
   std::span<std::uint8_t> window;     // the range's part of VERT
   std::vector<VertexPacker> packers;  // by voxel - range.first (packed positions)
+  // Written block by block (block_staging_ > 0): a writer per (local voxel id, level), as cursor_.
+  std::vector<std::unique_ptr<DirectRegionWriter>> blocks;
   std::vector<VoxlineEntry> voxline_buffer;
   std::vector<std::uint64_t> streamline_buffer;
   std::uint64_t voxline_index = 0, streamlines = 0;
@@ -475,7 +494,8 @@ void StreamingConversion::build_table() {
 }
 
 // Consecutive voxels, as many per range as fit in what the limit leaves: each range's vertices (packed:
-// 4 bytes each, the end bit inside; float32: 12 bytes and an end bit) and its ordering threads' buffers.
+// 4 bytes each, the end bit inside; float32: 12 bytes and an end bit; written block by block: only the
+// float32 end bits) and its ordering threads' buffers.
 // The orders are not held per range: they are built and written a chunk of voxels at a time (the chunk
 // buffer is taken before this). An ordering thread's buffers grow with the largest voxel, so a range
 // orders with fewer threads when they would take more than a quarter of the room (the orders do not
@@ -488,7 +508,8 @@ std::vector<Range> StreamingConversion::cut_ranges() {
   };
   auto cost = [&](const Range& r) {
     const std::uint64_t v = r.vertex_end - r.vertex_first;
-    const std::uint64_t held = packed() ? 4 * v : 12 * v + (v / 64 + 1) * 8;
+    const std::uint64_t end_bits = packed() ? 0 : (v / 64 + 1) * 8;
+    const std::uint64_t held = block_staging_ > 0 ? end_bits : (packed() ? 4 : 12) * v + end_bits;
     return held + order_threads(r) * per_thread(r);
   };
   auto alone = [&](std::size_t i) {
@@ -531,6 +552,11 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
   const std::string of = " " + std::to_string(index + 1) + "/" + std::to_string(count);
   const bool tables = index == 0;
   const std::uint64_t range_vertices = r.vertex_end - r.vertex_first;
+  if (block_staging_ > 0) {  // VERT written block by block, then read back for the orders
+    place_range(r, tables, of, {});
+    write_orders(r, {}, "ordering" + of);
+    return;
+  }
   // The range's vertices are placed straight into the output (a mapping of its part of VERT); the
   // orders are built from them there before it is unmapped.
   out_->append_in_place(
@@ -547,6 +573,7 @@ void StreamingConversion::place_range(const Range& r, bool tables, const std::st
                                       std::span<std::uint8_t> window) {
   auto t0 = Clock::now();
   RangePlacement placing(r, tables, window);
+  if (block_staging_ > 0) open_block_writers(placing);
   if (packed()) {
     placing.packers.reserve(r.end - r.first);
     for (std::size_t g = r.first; g < r.end; ++g) placing.packers.emplace_back(voxels_[g]);
@@ -583,6 +610,7 @@ void StreamingConversion::place_range(const Range& r, bool tables, const std::st
     budget_.track(staged, staged_held_, [] { return std::string("the voxlines of two batches being placed"); });
   });
   if (!other_placed) place_staged(1 - staging);
+  placing.blocks.clear();  // each wrote its last bytes with its last append (checked below: all complete)
   if (placing.streamlines != meta_.streamline_count || (tables && placing.voxline_index != meta_.voxline_count))
     fail_changed();
   const std::uint32_t levels = settings_.levels;
@@ -600,6 +628,26 @@ void StreamingConversion::place_range(const Range& r, bool tables, const std::st
     out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, placing.voxline_buffer);
   }
   summary_.voxelize_seconds += seconds_since(t0);
+}
+
+// A writer per (voxel, level) block of range r with vertices, from the block's first vertex (cursor_,
+// before any is placed) to its end.
+void StreamingConversion::open_block_writers(RangePlacement& placing) const {
+  const Range& r = placing.range;
+  const std::uint32_t levels = settings_.levels;
+  const std::uint64_t bytes = vertex_bytes(settings_.positions);
+  placing.blocks.resize(cursor_.size());
+  for (std::size_t local = 0; local < global_id_.size(); ++local) {
+    const std::uint32_t g = global_id_[local];
+    if (g < r.first || g >= r.end) continue;
+    for (std::uint32_t d = 0; d < levels; ++d) {
+      const std::uint64_t first = cursor_[local * levels + d];
+      const std::uint64_t end = voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), d);
+      if (end > first)
+        placing.blocks[local * levels + d] =
+            out_->region_writer(VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, block_staging_);
+    }
+  }
 }
 
 // On one thread: voxelises streamlines [begin, end) of batch b (numbered from `first` in the source) and
@@ -705,11 +753,15 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
           voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), depth);
       if (cursor > block_end || used > block_end - cursor) fail_changed();
       const std::uint64_t at = cursor - r.vertex_first;
-      if (packed()) {
+      if (!packed()) ends_.set(at + used - 1);
+      if (!placing.blocks.empty()) {
+        const auto* from = packed() ? reinterpret_cast<const std::uint8_t*>(part.words.data() + staged)
+                                    : reinterpret_cast<const std::uint8_t*>(part.xyz.data() + 3 * staged);
+        placing.blocks[std::size_t(v.voxel) * levels + depth]->append({from, used * vertex_bytes(settings_.positions)});
+      } else if (packed()) {
         std::copy_n(part.words.data() + staged, used, words + at);
       } else {
         std::copy_n(part.xyz.data() + 3 * staged, 3 * used, vertices + 3 * at);
-        ends_.set(at + used - 1);
       }
       staged += used;
       cursor += used;
@@ -720,24 +772,52 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
 }
 
 // The orders of range r's voxels, a chunk of consecutive voxels at a time (each chunk's voxels spread
-// over the range's ordering threads), built in place in ORDR.
+// over the range's ordering threads), built in place in ORDR. The vertices are range r's part of VERT in
+// memory (`range_vertices`), or, when VERT was written block by block, read back a chunk at a time: the
+// next chunk's on another thread while this one is built.
 void StreamingConversion::write_orders(const Range& r, std::span<const std::uint8_t> range_vertices,
                                        const std::string& stage) {
   std::vector<std::optional<VoxelOrderWriter>> writers(r.order_threads);
   std::vector<std::vector<float>> decoded(r.order_threads);
-  // With direct writes a chunk is written on its own thread while the next one is built (the write waits
-  // on the disk, not the CPU); through the page cache it is written before the next one is built.
-  std::vector<std::uint8_t> chunks[2];
-  std::vector<std::size_t> by_size;  // a chunk's voxels
-  std::future<void> writing;
-  std::size_t k = 0;
-  for (std::size_t first = r.first; first < r.end; ++k) {
-    auto t0 = Clock::now();
+  std::vector<std::size_t> cuts{r.first};  // chunk c: voxels [cuts[c], cuts[c + 1])
+  while (cuts.back() < r.end) {
+    const std::size_t first = cuts.back();
     std::size_t end = first + 1;
     while (end < r.end && orders_start(end + 1) - orders_start(first) <= order_chunk_bytes_) ++end;
+    cuts.push_back(end);
+  }
+  auto vertex_start = [&](std::size_t i) { return i < r.end ? voxels_[i].vertex_first : r.vertex_end; };
+  const std::uint64_t vertex_size = vertex_bytes(settings_.positions);
+  VxlStreamWriter::ReadBackBuffer read_buffers[2];
+  if (block_staging_ > 0)
+    for (auto& b : read_buffers) b.reserve(largest_chunk_vertex_bytes());
+  auto fetch = [&](std::size_t c) {
+    return std::async(block_staging_ > 0 ? std::launch::async : std::launch::deferred, [&, c] {
+      const std::uint64_t from = vertex_start(cuts[c]), to = vertex_start(cuts[c + 1]);
+      if (block_staging_ == 0)
+        return range_vertices.subspan((from - r.vertex_first) * vertex_size, (to - from) * vertex_size);
+      return out_->read_back(VxlStreamWriter::kVert, (to - from) * vertex_size, read_buffers[c % 2]);
+    });
+  };
+  // With direct writes a chunk is written on its own thread while the next one is built (the write waits
+  // on the disk, not the CPU); through the page cache it is written before the next one is built.
+  // The buffers are taken once at the largest chunk's size and not cleared: the writers write every
+  // byte of their voxels' orders, padding included. (Regrowing and zeroing them per chunk took 3 of the
+  // 11 s of a 10M conversion's orders: fresh pages cost much on a virtual machine.)
+  std::unique_ptr<std::uint8_t[]> chunks[2];
+  std::vector<std::size_t> by_size;  // a chunk's voxels
+  std::future<std::span<const std::uint8_t>> next_vertices;
+  if (cuts.size() > 1) next_vertices = fetch(0);
+  std::future<void> writing;
+  for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
+    auto t0 = Clock::now();
+    const std::size_t first = cuts[c], end = cuts[c + 1];
+    const std::span<const std::uint8_t> vertices = next_vertices.get();
+    if (c + 2 < cuts.size()) next_vertices = fetch(c + 1);
     const std::uint64_t base = orders_start(first);
-    std::vector<std::uint8_t>& chunk = chunks[direct_staging_ > 0 ? k % 2 : 0];
-    chunk.assign(orders_start(end) - base, 0);  // the padding between voxels stays zero
+    std::unique_ptr<std::uint8_t[]>& buffer = chunks[direct_staging_ > 0 ? c % 2 : 0];
+    if (!buffer) buffer = std::make_unique_for_overwrite<std::uint8_t[]>(order_chunk_bytes_);
+    const std::span<std::uint8_t> chunk(buffer.get(), orders_start(end) - base);
     // Largest voxels first, so that the threads finish the chunk at about the same time.
     by_size.resize(end - first);
     std::iota(by_size.begin(), by_size.end(), first);
@@ -746,44 +826,74 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
     parallel_for(end - first, r.order_threads, [&](std::uint64_t i, unsigned t) {
       if (!writers[t]) writers[t].emplace(order_set_, r.max_vertices);
       const std::size_t g = by_size[i];
-      write_voxel_orders(r, g, range_vertices, *writers[t], decoded[t],
+      write_voxel_orders(r, g, vertices, vertex_start(first), *writers[t], decoded[t],
                          chunk.data() + (voxels_[g].order_offset - base));
     });
     if (writing.valid()) writing.get();  // rethrows a failed write
     if (direct_staging_ > 0)
-      writing = std::async(std::launch::async, [this, &chunk] { out_->append(VxlStreamWriter::kOrdr, chunk); });
+      writing = std::async(std::launch::async, [this, chunk] { out_->append(VxlStreamWriter::kOrdr, chunk); });
     else
       out_->append(VxlStreamWriter::kOrdr, chunk);
     summary_.orders_seconds += seconds_since(t0);
-    first = end;
-    report(stage, double(first - r.first) / double(std::max<std::size_t>(1, r.end - r.first)));
+    report(stage, double(end - r.first) / double(std::max<std::size_t>(1, r.end - r.first)));
   }
   if (writing.valid()) writing.get();
+  if (block_staging_ > 0 && r.first == r.end)  // no voxel, no vertex: nothing to read back
+    out_->read_back(VxlStreamWriter::kVert, 0, read_buffers[0]);
 }
 
-// Voxel g's orders at `dst`, from its block in `range_vertices` (range r's part of VERT). A packed block
-// is decoded into `decoded` first: the orders sort the positions the file holds.
-void StreamingConversion::write_voxel_orders(const Range& r, std::size_t g,
-                                             std::span<const std::uint8_t> range_vertices, VoxelOrderWriter& writer,
+// Voxel g's orders at `dst`, from its block in `vertices` (the part of VERT from vertex
+// `vertices_first`). A packed block is decoded into `decoded` first: the orders sort the positions the
+// file holds.
+void StreamingConversion::write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> vertices,
+                                             std::uint64_t vertices_first, VoxelOrderWriter& writer,
                                              std::vector<float>& decoded, std::uint8_t* dst) {
   VoxelEntry v = voxels_[g];
   const std::span<const LevelEntry> row = level_row(levels_, g, settings_.levels);
-  const std::uint64_t at = v.vertex_first - r.vertex_first;
+  const std::uint64_t at = v.vertex_first - vertices_first;
+  VoxlineEnds block_ends(v.vertex_count);
+  v.vertex_first = 0;
   if (!packed()) {
-    v.vertex_first = at;
-    const std::span<const float> vertices(reinterpret_cast<const float*>(range_vertices.data()),
-                                          range_vertices.size() / sizeof(float));
-    writer.write(v, row, vertices, ends_, dst);
+    const std::uint64_t in_range = voxels_[g].vertex_first - r.vertex_first;  // ends_ counts from the range
+    for (std::uint32_t e = 0; e < v.vertex_count; ++e)
+      if (ends_.test(in_range + e)) block_ends.set(e);
+    const float* xyz = reinterpret_cast<const float*>(vertices.data()) + 3 * at;
+    writer.write(v, row, {xyz, 3 * std::size_t(v.vertex_count)}, block_ends, dst);
     return;
   }
-  const std::uint32_t* words = reinterpret_cast<const std::uint32_t*>(range_vertices.data()) + at;
+  const std::uint32_t* words = reinterpret_cast<const std::uint32_t*>(vertices.data()) + at;
   decoded.resize(3 * std::size_t(v.vertex_count));
   VertexPacker(v).decode(words, v.vertex_count, decoded.data());
-  VoxlineEnds block_ends(v.vertex_count);
   for (std::uint32_t e = 0; e < v.vertex_count; ++e)
     if (words[e] & kPackedVoxlineEnd) block_ends.set(e);
-  v.vertex_first = 0;
   writer.write(v, row, decoded, block_ends, dst);
+}
+
+std::uint64_t StreamingConversion::block_staging_total(std::uint64_t staging) const {
+  const std::uint32_t levels = settings_.levels;
+  const std::uint64_t bytes = vertex_bytes(settings_.positions);
+  std::uint64_t total = 0;
+  for (std::size_t g = 0; g < voxels_.size(); ++g) {
+    std::uint64_t start = 0;
+    for (std::uint32_t d = 0; d < levels; ++d) {
+      const std::uint64_t end = depth_end_vertex(voxels_[g], level_row(levels_, g, levels), d);
+      if (end > start) total += DirectRegionWriter::staging_size((end - start) * bytes, staging);
+      start = end;
+    }
+  }
+  return total;
+}
+
+std::uint64_t StreamingConversion::largest_chunk_vertex_bytes() const {
+  std::uint64_t most = 0;
+  std::size_t end = 0;  // the end of the longest chunk from `first`: never decreases as `first` grows
+  for (std::size_t first = 0; first < voxels_.size(); ++first) {
+    end = std::max(end, first + 1);
+    while (end < voxels_.size() && orders_start(end + 1) - orders_start(first) <= order_chunk_bytes_) ++end;
+    const VoxelEntry& last = voxels_[end - 1];
+    most = std::max(most, last.vertex_first + last.vertex_count - voxels_[first].vertex_first);
+  }
+  return most * vertex_bytes(settings_.positions);
 }
 
 void StreamingConversion::write_rest() {
@@ -845,11 +955,23 @@ ConvertSummary StreamingConversion::run() {
     direct_staging_ = kDirectStagingBytes;
     budget_.take(VxlStreamWriter::kCount * kDirectStagingBytes, "the staging of the output's direct writes");
   }
+  if (direct_staging_ > 0) {
+    const std::uint64_t share = budget_.left() / 8;
+    for (std::uint64_t staging = kBlockStagingBytes; staging >= kMinBlockStagingBytes && block_staging_ == 0;
+         staging /= 2)
+      if (block_staging_total(staging) <= share) block_staging_ = staging;
+    if (block_staging_ > 0)
+      budget_.take(block_staging_total(block_staging_), "the staging of the vertex blocks' direct writes");
+  }
   order_chunk_bytes_ = std::min({kOrderChunkBytes, order_bytes_, budget_.left() / 8});
   for (std::size_t i = 0; i < voxels_.size(); ++i)
     order_chunk_bytes_ = std::max(order_chunk_bytes_, orders_start(i + 1) - orders_start(i));
   budget_.take(order_chunk_bytes_ * (direct_staging_ > 0 ? 2 : 1), "the part of the orders being written",
                ", or a smaller --voxel-size");
+  if (block_staging_ > 0) {  // two chunks' vertices read back (write_orders), and a block on either side
+    budget_.take(2 * (largest_chunk_vertex_bytes() + 2 * DirectRegionWriter::kBlock),
+                 "the vertices of the orders being built", ", or a smaller --voxel-size");
+  }
   std::vector<Range> ranges = cut_ranges();
 
   const std::string provenance = provenance_json(stream_->source(), settings_, threads_, voxel_size_choice_);
@@ -872,6 +994,7 @@ ConvertSummary StreamingConversion::run() {
 
   summary_.take_counts(meta_);
   summary_.partitions = ranges.size();
+  summary_.vertices_read_back = block_staging_ > 0;
   for (const Range& r : ranges) summary_.partition_starts.push_back(r.first);
   summary_.warnings = stream_->source().warnings;
   return summary_;

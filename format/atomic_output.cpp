@@ -83,6 +83,19 @@ void AtomicOutputFile::pwrite(const void* data, std::size_t size, std::uint64_t 
   }
 }
 
+void AtomicOutputFile::pread(void* data, std::size_t size, std::uint64_t offset) {
+  auto* p = static_cast<std::uint8_t*>(data);
+  while (size > 0) {
+    const ssize_t n = ::pread(fd_, p, size, static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(std::string("read-back failed: ") + std::strerror(errno));
+    if (n == 0) fail("read-back failed: the file ends at byte " + std::to_string(offset));
+    p += n;
+    size -= static_cast<std::size_t>(n);
+    offset += static_cast<std::uint64_t>(n);
+  }
+}
+
 void AtomicOutputFile::allocate(std::uint64_t size) {
   if (map_ != nullptr || position_ != 0) fail("internal error: allocate() on a file already written to");
   if (size == 0) return;
@@ -122,7 +135,7 @@ void AtomicOutputFile::unmap() noexcept {
 int AtomicOutputFile::direct_descriptor() {
   if (direct_fd_ == -2) {
     const std::string proc = "/proc/self/fd/" + std::to_string(fd_);
-    direct_fd_ = ::open(proc.c_str(), O_WRONLY | O_DIRECT | O_CLOEXEC);
+    direct_fd_ = ::open(proc.c_str(), O_RDWR | O_DIRECT | O_CLOEXEC);
     if (direct_fd_ < 0) direct_fd_ = -1;
   }
   return direct_fd_;

@@ -28,6 +28,9 @@ class AtomicOutputFile {
   void write(const void* data, std::size_t size);  // appends
   void write_zeros(std::size_t size);
   void pwrite(const void* data, std::size_t size, std::uint64_t offset);  // overwrites earlier bytes
+  // Reads back `size` bytes written before, from `offset`. Throws vxl::Error (Output) when the read
+  // fails or the file is shorter.
+  void pread(void* data, std::size_t size, std::uint64_t offset);
   std::uint64_t position() const { return position_; }
 
   // Sizes the still empty file to `size` bytes and maps it read-write (MAP_SHARED). Every byte reads as
@@ -45,8 +48,9 @@ class AtomicOutputFile {
   // out of resident memory after.
   FileWindow map_window(std::uint64_t offset, std::uint64_t size);
 
-  // The file opened a second time with O_DIRECT, for writes that bypass the page cache
-  // (DirectRegionWriter), or -1 where that is refused. Opened on first call, closed by commit().
+  // The file opened a second time with O_DIRECT (read-write), for writes and read-backs that bypass the
+  // page cache (DirectRegionWriter, VxlStreamWriter::read_back), or -1 where that is refused. Opened on
+  // first call, closed by commit().
   int direct_descriptor();
 
   void commit();  // unmaps, then replaces any existing file at the path

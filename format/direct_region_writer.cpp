@@ -19,7 +19,14 @@ DirectRegionWriter::DirectRegionWriter(AtomicOutputFile& out, int direct_fd, std
       direct_fd_(direct_fd),
       end_(offset + size),
       position_(offset),
-      staging_bytes_(std::max<std::uint64_t>(kBlock, (staging_bytes + kBlock - 1) / kBlock * kBlock)) {}
+      staging_bytes_(staging_size(size, staging_bytes)) {}
+
+std::uint64_t DirectRegionWriter::staging_size(std::uint64_t size, std::uint64_t staging_bytes) {
+  // A region of `size` bytes stages at most size rounded up to blocks (its first partial block is
+  // written straight away).
+  const std::uint64_t most = (size + kBlock - 1) / kBlock * kBlock;
+  return std::max<std::uint64_t>(kBlock, std::min(most, (staging_bytes + kBlock - 1) / kBlock * kBlock));
+}
 
 void DirectRegionWriter::append(std::span<const std::uint8_t> bytes) {
   if (bytes.size() > end_ - position_) throw std::logic_error("DirectRegionWriter::append: past the region's end");

@@ -22,10 +22,13 @@ class DirectRegionWriter {
   static constexpr std::uint64_t kBlock = 4096;  // offsets, sizes and buffers of direct I/O align to it
 
   // Region [offset, offset + size) of `out`'s file; `direct_fd` is that file opened with O_DIRECT
-  // (AtomicOutputFile::direct_descriptor). Bytes are staged `staging_bytes` (rounded up to blocks) at a
-  // time. Writes nothing until the first append.
+  // (AtomicOutputFile::direct_descriptor), or -1 for plain pwrite. Bytes are staged
+  // staging_size(size, staging_bytes) at a time. Writes nothing until the first append.
   DirectRegionWriter(AtomicOutputFile& out, int direct_fd, std::uint64_t offset, std::uint64_t size,
                      std::uint64_t staging_bytes);
+  // The staging buffer a region of `size` bytes takes (allocated at its first append): `staging_bytes`
+  // rounded up to blocks, but no more than the region can fill.
+  static std::uint64_t staging_size(std::uint64_t size, std::uint64_t staging_bytes);
   DirectRegionWriter(const DirectRegionWriter&) = delete;
   DirectRegionWriter& operator=(const DirectRegionWriter&) = delete;
 

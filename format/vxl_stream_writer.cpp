@@ -1,7 +1,13 @@
 #include "format/vxl_stream_writer.h"
 
+#include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <string>
+
+#include <unistd.h>
+
+#include "format/error.h"
 
 namespace vxl {
 
@@ -19,10 +25,59 @@ VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes&
       if (std::memcmp(table_[i].id, kIds[s], 4) == 0) entry_[s] = i;
   }
   out_.allocate(file_size_);  // zeros everywhere: the padding between payloads is never written
-  const int direct_fd = direct_staging_bytes > 0 ? out_.direct_descriptor() : -1;
-  if (direct_fd >= 0)
+  direct_fd_ = direct_staging_bytes > 0 ? out_.direct_descriptor() : -1;
+  if (direct_fd_ >= 0)
     for (const SectionEntry& e : table_)
-      regions_.push_back(std::make_unique<DirectRegionWriter>(out_, direct_fd, e.offset, e.size, direct_staging_bytes));
+      regions_.push_back(std::make_unique<DirectRegionWriter>(out_, direct_fd_, e.offset, e.size, direct_staging_bytes));
+}
+
+std::unique_ptr<DirectRegionWriter> VxlStreamWriter::region_writer(Section section, std::uint64_t offset,
+                                                                   std::uint64_t size, std::uint64_t staging_bytes) {
+  const std::size_t i = entry_[section];
+  if (i >= table_.size() || offset > table_[i].size || size > table_[i].size - offset)
+    throw std::logic_error("VxlStreamWriter::region_writer: a region outside the section");
+  return std::make_unique<DirectRegionWriter>(out_, direct_fd_, table_[i].offset + offset, size, staging_bytes);
+}
+
+void VxlStreamWriter::ReadBackBuffer::reserve(std::uint64_t size) {
+  constexpr std::uint64_t block = DirectRegionWriter::kBlock;
+  const std::uint64_t need = (size + block - 1) / block * block + block;  // a misaligned start adds a block
+  if (capacity >= need) return;
+  bytes.reset();
+  void* p = std::aligned_alloc(block, need);
+  if (p == nullptr) throw std::bad_alloc();
+  bytes.reset(static_cast<std::uint8_t*>(p));
+  capacity = need;
+}
+
+std::span<const std::uint8_t> VxlStreamWriter::read_back(Section section, std::uint64_t size, ReadBackBuffer& buffer) {
+  const std::size_t i = entry_[section];
+  if (i >= table_.size() || size > table_[i].size - written_[i])
+    throw std::logic_error("VxlStreamWriter::read_back: more bytes than the section holds");
+  constexpr std::uint64_t block = DirectRegionWriter::kBlock;
+  const std::uint64_t from = table_[i].offset + written_[i];
+  // Direct reads take whole blocks into a block-aligned buffer: the blocks around [from, from + size).
+  const std::uint64_t lo = from / block * block, hi = (from + size + block - 1) / block * block;
+  if (buffer.capacity < hi - lo) buffer.reserve(size);
+  std::uint8_t* const data = buffer.bytes.get() + (from - lo);
+  std::uint64_t done = 0;  // bytes of [lo, hi) read directly
+  while (direct_fd_ >= 0 && lo + done < from + size) {
+    const ssize_t n = ::pread(direct_fd_, buffer.bytes.get() + done, hi - lo - done, static_cast<off_t>(lo + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && errno == EINVAL) break;  // no direct reads here: through the page cache
+    if (n < 0)
+      throw Error(ErrorKind::Output, out_.path(), std::nullopt, std::string("read-back failed: ") + std::strerror(errno));
+    if (n == 0) break;  // the file's end, inside the last block: read the rest plainly
+    done += static_cast<std::uint64_t>(n);
+  }
+  if (lo + done < from + size) {
+    const std::uint64_t start = std::max(from, lo + done);
+    out_.pread(buffer.bytes.get() + (start - lo), from + size - start, start);
+  }
+  const std::span<const std::uint8_t> bytes(data, size);
+  checksums_[i]->update(bytes.data(), bytes.size());
+  written_[i] += size;
+  return bytes;
 }
 
 void VxlStreamWriter::append(Section section, std::span<const std::uint8_t> bytes) {

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdlib>
 #include <future>
 #include <memory>
 #include <span>
@@ -64,6 +65,22 @@ class VxlStreamWriter : public VxlSections {
     then(std::span<const std::uint8_t>(window.bytes()));
     close_window(section, window);
   }
+  // For a payload produced out of order (VERT, placed voxel by voxel in streamline order) without a
+  // buffer of its size: region_writer() writes bytes [offset, offset + size) of the payload, appended in
+  // order (direct where the file system allows, staged `staging_bytes` at a time); the regions may be
+  // written in any order, each must be complete before it is read back. read_back() then reads the
+  // payload's next `size` bytes into `buffer` (past the page cache where allowed), checksums them and
+  // counts them as appended: a payload written this way is read back whole, in order.
+  std::unique_ptr<DirectRegionWriter> region_writer(Section section, std::uint64_t offset, std::uint64_t size,
+                                                    std::uint64_t staging_bytes);
+  struct ReadBackBuffer {
+    std::unique_ptr<std::uint8_t, void (*)(void*)> bytes{nullptr, std::free};  // block-aligned
+    std::uint64_t capacity = 0;
+    // Room to read back any `size` bytes (the blocks around them) without growing.
+    void reserve(std::uint64_t size);
+  };
+  std::span<const std::uint8_t> read_back(Section section, std::uint64_t size, ReadBackBuffer& buffer);
+
   void append_meta(const MetaSection& meta);  // zeroes the reserved bytes
   std::uint64_t written(Section section) const {
     return entry_[section] < table_.size() ? written_[entry_[section]] : 0;
@@ -86,6 +103,7 @@ class VxlStreamWriter : public VxlSections {
   std::vector<std::uint64_t> written_;
   std::vector<std::unique_ptr<Xxh3_64Stream>> checksums_;
   std::vector<std::unique_ptr<DirectRegionWriter>> regions_;  // per table_ entry, with direct writes
+  int direct_fd_ = -1;  // the output opened with O_DIRECT (-1: none, or the file system refused it)
   // append_in_place's buffers, with direct writes
   std::unique_ptr<std::uint8_t[]> fill_buffers_[kCount];
   std::uint64_t fill_capacity_[kCount] = {};

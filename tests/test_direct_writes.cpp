@@ -1,7 +1,7 @@
 // Direct writes (DirectRegionWriter): regions that start and end anywhere, appended in pieces of any size
 // through a small staging buffer, must give exactly the bytes of plain writes — with O_DIRECT where the
 // file system allows it, and without it. And a streaming conversion whose limit turns direct writes on
-// must still write the in-memory conversion's bytes.
+// must still write the in-memory conversion's bytes, whether it holds VERT or writes it block by block.
 #include <algorithm>
 #include <cstdint>
 #include <fstream>
@@ -71,6 +71,10 @@ TEST(DirectWrites, RegionsOfAnySizeAppendedInPiecesGiveThePlainBytes) {
     GTEST_LOG_(INFO) << "this file system refuses O_DIRECT: only the fallback was exercised";
 }
 
+// Under a limit that turns direct writes on, VERT is written block by block as it is placed and read back
+// for the orders where its (voxel, level) blocks are few (10 mm voxels), and held in memory where their
+// staging would not fit (1 mm voxels: hundreds of thousands of blocks); packed or float32, each way must
+// write the in-memory conversion's bytes.
 TEST(DirectWrites, AStreamingConversionWithDirectWritesWritesTheInMemoryBytes) {
   ScratchDir dir;
   const std::string tck = dir.file("in.tck"), whole = dir.file("whole.vxl"), direct = dir.file("direct.vxl");
@@ -81,14 +85,27 @@ TEST(DirectWrites, AStreamingConversionWithDirectWritesWritesTheInMemoryBytes) {
       w.add({t.positions.data() + 3 * t.offsets[i], 3 * (t.offsets[i + 1] - t.offsets[i])});
     w.finish();
   }
-  ConvertSettings settings;
-  settings.threads = 2;
-  convert_tractogram(read_tractogram(tck), whole, settings);
-  settings.memory_limit = 512ull << 20;  // at least 256 MiB: direct writes
-  convert_streaming(tck, direct, settings);
-  const std::vector<std::uint8_t> a = file_bytes(whole), b = file_bytes(direct);
-  EXPECT_GT(a.size(), 1000000u);
-  EXPECT_TRUE(a == b) << "the conversion with direct writes differs (" << a.size() << " vs " << b.size() << " bytes)";
+  struct Case {
+    PositionEncoding positions;
+    double voxel_size;
+    bool read_back;
+  };
+  for (const Case c : {Case{PositionEncoding::Packed, 10.0, true}, Case{PositionEncoding::Float32, 10.0, true},
+                       Case{PositionEncoding::Packed, 1.0, false}, Case{PositionEncoding::Float32, 1.0, false}}) {
+    SCOPED_TRACE(std::string(c.positions == PositionEncoding::Packed ? "packed" : "float32") + ", " +
+                 std::to_string(c.voxel_size) + " mm");
+    ConvertSettings settings;
+    settings.threads = 2;
+    settings.positions = c.positions;
+    settings.voxel_size = c.voxel_size;
+    convert_tractogram(read_tractogram(tck), whole, settings);
+    settings.memory_limit = 512ull << 20;  // at least 256 MiB: direct writes
+    const ConvertSummary s = convert_streaming(tck, direct, settings);
+    EXPECT_EQ(s.vertices_read_back, c.read_back);
+    const std::vector<std::uint8_t> a = file_bytes(whole), b = file_bytes(direct);
+    EXPECT_GT(a.size(), 1000000u);
+    EXPECT_TRUE(a == b) << "the conversion with direct writes differs (" << a.size() << " vs " << b.size() << " bytes)";
+  }
 }
 
 }  // namespace

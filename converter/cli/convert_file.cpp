@@ -69,9 +69,10 @@ std::string convert_file(const std::string& input, const std::string& output, co
                 (unsigned long long)s.segments, (unsigned long long)s.synthetic_points);
   std::string report = output + line;
   if (settings.memory_limit > 0) {
-    std::snprintf(line, sizeof line, "memory limit %s: %llu passes over the source, voxels built in %llu part%s\n",
+    std::snprintf(line, sizeof line, "memory limit %s: %llu passes over the source, voxels built in %llu part%s%s\n",
                   format_memory_size(settings.memory_limit).c_str(), (unsigned long long)s.passes,
-                  (unsigned long long)s.partitions, s.partitions == 1 ? "" : "s");
+                  (unsigned long long)s.partitions, s.partitions == 1 ? "" : "s",
+                  s.vertices_read_back ? " (vertex blocks written as placed and read back for the orders)" : "");
     report += line;
   }
   if (verbose) {
