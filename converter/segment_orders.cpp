@@ -195,7 +195,7 @@ struct KeyedSegment {
 // grow past it: order_scratch_bytes() is a bound that callers budget with.
 struct SortScratch {
   std::uint32_t max_vertices = 0;
-  std::vector<std::uint64_t> keys, packed, packed_tmp;
+  std::vector<std::uint64_t> keys, packed_tmp;  // keys: packed with the index in place where they fit
   std::vector<KeyedSegment> keyed, keyed_tmp;
   std::vector<std::uint32_t> counts;
 };
@@ -214,14 +214,14 @@ std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint3
   const int low = std::countr_zero(varying), bits = 64 - std::countl_zero(varying) - low;
   const int index_bits = std::bit_width(vertex_count - 1);  // vertex_count >= 2 here
   if (bits + index_bits <= 64) {
-    s.packed.resize(n);
+    // In place: one array less to fill and to keep in cache (the largest voxels' do not fit).
     const std::uint64_t field = (1ull << bits) - 1;  // bits < 64 here
-    for (std::size_t i = 0; i < n; ++i) s.packed[i] = ((s.keys[i] >> low) & field) << index_bits | starts[i];
+    for (std::size_t i = 0; i < n; ++i) s.keys[i] = ((s.keys[i] >> low) & field) << index_bits | starts[i];
     radix_sort_bits(
-        s.packed, s.packed_tmp, s.counts, [](std::uint64_t x) { return x; }, index_bits, bits);
+        s.keys, s.packed_tmp, s.counts, [](std::uint64_t x) { return x; }, index_bits, bits);
     const std::uint64_t index_mask = (1ull << index_bits) - 1;
     return put_entries(dst, width, n,
-                       [&](std::size_t i) { return static_cast<std::uint32_t>(s.packed[i] & index_mask); });
+                       [&](std::size_t i) { return static_cast<std::uint32_t>(s.keys[i] & index_mask); });
   }
   s.keyed.reserve(s.max_vertices);
   s.keyed_tmp.reserve(s.max_vertices);
@@ -285,7 +285,7 @@ VoxelOrderWriter::VoxelOrderWriter(const OrderSetSpec& set, std::uint32_t max_ve
       scratch_(std::make_unique<Scratch>()) {
   SortScratch& s = scratch_->sort;
   s.max_vertices = max_vertices;
-  for (auto* v : {&s.keys, &s.packed, &s.packed_tmp}) v->reserve(max_vertices);
+  for (auto* v : {&s.keys, &s.packed_tmp}) v->reserve(max_vertices);
   scratch_->starts.reserve(max_vertices);
 }
 
@@ -377,10 +377,10 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const Level
 }
 
 std::uint64_t order_scratch_bytes(std::uint32_t max_vertices) {
-  // starts (u32) and, per segment (fewer than vertices), keys, packed and packed_tmp (u64) and, for a
-  // voxel whose keys do not pack, keyed and keyed_tmp (16 bytes): all reserved once for the largest
-  // voxel (SortScratch). Plus the histograms.
-  const std::uint64_t per_vertex = sizeof(std::uint32_t) + 3 * sizeof(std::uint64_t) + 2 * sizeof(KeyedSegment);
+  // starts (u32) and, per segment (fewer than vertices), keys and packed_tmp (u64) and, for a voxel whose
+  // keys do not pack, keyed and keyed_tmp (16 bytes): all reserved once for the largest voxel
+  // (SortScratch). Plus the histograms.
+  const std::uint64_t per_vertex = sizeof(std::uint32_t) + 2 * sizeof(std::uint64_t) + 2 * sizeof(KeyedSegment);
   return per_vertex * max_vertices + std::uint64_t(kMaxPasses) * (1u << kMaxDigitBits) * sizeof(std::uint32_t);
 }
 

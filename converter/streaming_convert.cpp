@@ -176,7 +176,7 @@ class StreamingConversion {
   void write_orders(const Range& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
   void write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> vertices,
                           std::uint64_t vertices_first, VoxelOrderWriter& writer, std::vector<float>& decoded,
-                          std::uint8_t* dst);
+                          VoxlineEnds& block_ends, std::uint8_t* dst);
   // The (voxel, level) blocks of VERT with vertices, and the staging each of them takes in memory when
   // written block by block (DirectRegionWriter::staging_size).
   std::uint64_t block_staging_total(std::uint64_t staging) const;
@@ -236,6 +236,11 @@ class StreamingConversion {
   std::uint64_t order_chunk_bytes_ = 0;
   std::uint64_t direct_staging_ = 0;  // 0: the output is written through the page cache
   std::uint64_t block_staging_ = 0;   // > 0: VERT is written block by block and read back, not held
+  // Written block by block: one buffer for the blocks' staging while they are placed, then for the
+  // orders' chunks and the vertices read back (fresh pages are dear: a buffer reused is not faulted in
+  // again).
+  std::unique_ptr<std::uint8_t, void (*)(void*)> pool_{nullptr, std::free};
+  std::uint64_t pool_chunk_bytes_ = 0, pool_read_back_bytes_ = 0;  // the orders' parts of pool_
   VoxlineEnds ends_;                  // float32 positions: the voxline ends of the range being built
   std::unique_ptr<VxlStreamWriter> out_;
 };
@@ -637,15 +642,18 @@ void StreamingConversion::open_block_writers(RangePlacement& placing) const {
   const std::uint32_t levels = settings_.levels;
   const std::uint64_t bytes = vertex_bytes(settings_.positions);
   placing.blocks.resize(cursor_.size());
+  std::uint8_t* staging = pool_.get();  // each block's staging, one after another
   for (std::size_t local = 0; local < global_id_.size(); ++local) {
     const std::uint32_t g = global_id_[local];
     if (g < r.first || g >= r.end) continue;
     for (std::uint32_t d = 0; d < levels; ++d) {
       const std::uint64_t first = cursor_[local * levels + d];
       const std::uint64_t end = voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), d);
-      if (end > first)
+      if (end > first) {
         placing.blocks[local * levels + d] =
-            out_->region_writer(VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, block_staging_);
+            out_->region_writer(VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, block_staging_, staging);
+        staging += DirectRegionWriter::staging_size((end - first) * bytes, block_staging_);
+      }
     }
   }
 }
@@ -777,8 +785,10 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
 // next chunk's on another thread while this one is built.
 void StreamingConversion::write_orders(const Range& r, std::span<const std::uint8_t> range_vertices,
                                        const std::string& stage) {
+  // Per ordering thread, sized for the range's largest voxel once (fresh pages are dear; see above).
   std::vector<std::optional<VoxelOrderWriter>> writers(r.order_threads);
   std::vector<std::vector<float>> decoded(r.order_threads);
+  std::vector<VoxlineEnds> block_ends(r.order_threads);
   std::vector<std::size_t> cuts{r.first};  // chunk c: voxels [cuts[c], cuts[c + 1])
   while (cuts.back() < r.end) {
     const std::size_t first = cuts.back();
@@ -788,9 +798,16 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
   }
   auto vertex_start = [&](std::size_t i) { return i < r.end ? voxels_[i].vertex_first : r.vertex_end; };
   const std::uint64_t vertex_size = vertex_bytes(settings_.positions);
+  // The chunks' orders and the vertices read back: in pool_ after the blocks' staging is done with.
+  std::unique_ptr<std::uint8_t[]> own_chunks[2];
+  std::uint8_t* chunks[2] = {};
   VxlStreamWriter::ReadBackBuffer read_buffers[2];
-  if (block_staging_ > 0)
-    for (auto& b : read_buffers) b.reserve(largest_chunk_vertex_bytes());
+  if (block_staging_ > 0) {
+    for (int b = 0; b < 2; ++b) {
+      chunks[b] = pool_.get() + b * pool_chunk_bytes_;
+      read_buffers[b].use({pool_.get() + 2 * pool_chunk_bytes_ + b * pool_read_back_bytes_, pool_read_back_bytes_});
+    }
+  }
   auto fetch = [&](std::size_t c) {
     return std::async(block_staging_ > 0 ? std::launch::async : std::launch::deferred, [&, c] {
       const std::uint64_t from = vertex_start(cuts[c]), to = vertex_start(cuts[c + 1]);
@@ -804,7 +821,6 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
   // The buffers are taken once at the largest chunk's size and not cleared: the writers write every
   // byte of their voxels' orders, padding included. (Regrowing and zeroing them per chunk took 3 of the
   // 11 s of a 10M conversion's orders: fresh pages cost much on a virtual machine.)
-  std::unique_ptr<std::uint8_t[]> chunks[2];
   std::vector<std::size_t> by_size;  // a chunk's voxels
   std::future<std::span<const std::uint8_t>> next_vertices;
   if (cuts.size() > 1) next_vertices = fetch(0);
@@ -815,18 +831,24 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
     const std::span<const std::uint8_t> vertices = next_vertices.get();
     if (c + 2 < cuts.size()) next_vertices = fetch(c + 1);
     const std::uint64_t base = orders_start(first);
-    std::unique_ptr<std::uint8_t[]>& buffer = chunks[direct_staging_ > 0 ? c % 2 : 0];
-    if (!buffer) buffer = std::make_unique_for_overwrite<std::uint8_t[]>(order_chunk_bytes_);
-    const std::span<std::uint8_t> chunk(buffer.get(), orders_start(end) - base);
+    const int b = direct_staging_ > 0 ? c % 2 : 0;
+    if (chunks[b] == nullptr) {
+      own_chunks[b] = std::make_unique_for_overwrite<std::uint8_t[]>(order_chunk_bytes_);
+      chunks[b] = own_chunks[b].get();
+    }
+    const std::span<std::uint8_t> chunk(chunks[b], orders_start(end) - base);
     // Largest voxels first, so that the threads finish the chunk at about the same time.
     by_size.resize(end - first);
     std::iota(by_size.begin(), by_size.end(), first);
     std::stable_sort(by_size.begin(), by_size.end(),
                      [&](std::size_t a, std::size_t b) { return voxels_[a].vertex_count > voxels_[b].vertex_count; });
     parallel_for(end - first, r.order_threads, [&](std::uint64_t i, unsigned t) {
-      if (!writers[t]) writers[t].emplace(order_set_, r.max_vertices);
+      if (!writers[t]) {
+        writers[t].emplace(order_set_, r.max_vertices);
+        if (packed()) decoded[t].reserve(3 * std::size_t(r.max_vertices));
+      }
       const std::size_t g = by_size[i];
-      write_voxel_orders(r, g, vertices, vertex_start(first), *writers[t], decoded[t],
+      write_voxel_orders(r, g, vertices, vertex_start(first), *writers[t], decoded[t], block_ends[t],
                          chunk.data() + (voxels_[g].order_offset - base));
     });
     if (writing.valid()) writing.get();  // rethrows a failed write
@@ -844,14 +866,15 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
 
 // Voxel g's orders at `dst`, from its block in `vertices` (the part of VERT from vertex
 // `vertices_first`). A packed block is decoded into `decoded` first: the orders sort the positions the
-// file holds.
+// file holds. `block_ends` gets the block's voxline ends.
 void StreamingConversion::write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> vertices,
                                              std::uint64_t vertices_first, VoxelOrderWriter& writer,
-                                             std::vector<float>& decoded, std::uint8_t* dst) {
+                                             std::vector<float>& decoded, VoxlineEnds& block_ends,
+                                             std::uint8_t* dst) {
   VoxelEntry v = voxels_[g];
   const std::span<const LevelEntry> row = level_row(levels_, g, settings_.levels);
   const std::uint64_t at = v.vertex_first - vertices_first;
-  VoxlineEnds block_ends(v.vertex_count);
+  block_ends.reset(v.vertex_count);
   v.vertex_first = 0;
   if (!packed()) {
     const std::uint64_t in_range = voxels_[g].vertex_first - r.vertex_first;  // ends_ counts from the range
@@ -960,17 +983,24 @@ ConvertSummary StreamingConversion::run() {
     for (std::uint64_t staging = kBlockStagingBytes; staging >= kMinBlockStagingBytes && block_staging_ == 0;
          staging /= 2)
       if (block_staging_total(staging) <= share) block_staging_ = staging;
-    if (block_staging_ > 0)
-      budget_.take(block_staging_total(block_staging_), "the staging of the vertex blocks' direct writes");
   }
   order_chunk_bytes_ = std::min({kOrderChunkBytes, order_bytes_, budget_.left() / 8});
   for (std::size_t i = 0; i < voxels_.size(); ++i)
     order_chunk_bytes_ = std::max(order_chunk_bytes_, orders_start(i + 1) - orders_start(i));
-  budget_.take(order_chunk_bytes_ * (direct_staging_ > 0 ? 2 : 1), "the part of the orders being written",
-               ", or a smaller --voxel-size");
-  if (block_staging_ > 0) {  // two chunks' vertices read back (write_orders), and a block on either side
-    budget_.take(2 * (largest_chunk_vertex_bytes() + 2 * DirectRegionWriter::kBlock),
-                 "the vertices of the orders being built", ", or a smaller --voxel-size");
+  if (block_staging_ > 0) {
+    // pool_: the blocks' staging, then two orders chunks and two chunks' vertices read back.
+    pool_chunk_bytes_ = (order_chunk_bytes_ + DirectRegionWriter::kBlock - 1) / DirectRegionWriter::kBlock *
+                        DirectRegionWriter::kBlock;
+    pool_read_back_bytes_ = VxlStreamWriter::ReadBackBuffer::bytes_for(largest_chunk_vertex_bytes());
+    const std::uint64_t pool = std::max(block_staging_total(block_staging_), 2 * (pool_chunk_bytes_ + pool_read_back_bytes_));
+    budget_.take(pool, "the vertex blocks being written, then the orders being built and their vertices",
+                 ", or a smaller --voxel-size");
+    void* p = std::aligned_alloc(DirectRegionWriter::kBlock, pool);
+    if (p == nullptr) throw std::bad_alloc();
+    pool_.reset(static_cast<std::uint8_t*>(p));
+  } else {
+    budget_.take(order_chunk_bytes_ * (direct_staging_ > 0 ? 2 : 1), "the part of the orders being written",
+                 ", or a smaller --voxel-size");
   }
   std::vector<Range> ranges = cut_ranges();
 

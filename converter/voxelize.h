@@ -48,6 +48,8 @@ class VoxlineEnds {
  public:
   VoxlineEnds() = default;
   explicit VoxlineEnds(std::uint64_t vertex_count) : words_((vertex_count + 63) / 64, 0) {}
+  // No end among `vertex_count` vertices, in the memory held already where it is enough.
+  void reset(std::uint64_t vertex_count) { words_.assign((vertex_count + 63) / 64, 0); }
   bool test(std::uint64_t vertex) const { return (words_[vertex >> 6] >> (vertex & 63)) & 1u; }
   // Atomic: the blocks of two threads can meet inside one word.
   void set(std::uint64_t vertex) {

@@ -14,12 +14,14 @@
 namespace vxl {
 
 DirectRegionWriter::DirectRegionWriter(AtomicOutputFile& out, int direct_fd, std::uint64_t offset, std::uint64_t size,
-                                       std::uint64_t staging_bytes)
+                                       std::uint64_t staging_bytes, std::uint8_t* staging_memory)
     : out_(out),
       direct_fd_(direct_fd),
       end_(offset + size),
       position_(offset),
-      staging_bytes_(staging_size(size, staging_bytes)) {}
+      staging_bytes_(staging_size(size, staging_bytes)) {
+  if (staging_memory != nullptr) staging_ = {staging_memory, [](void*) {}};
+}
 
 std::uint64_t DirectRegionWriter::staging_size(std::uint64_t size, std::uint64_t staging_bytes) {
   // A region of `size` bytes stages at most size rounded up to blocks (its first partial block is

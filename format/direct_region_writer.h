@@ -23,9 +23,10 @@ class DirectRegionWriter {
 
   // Region [offset, offset + size) of `out`'s file; `direct_fd` is that file opened with O_DIRECT
   // (AtomicOutputFile::direct_descriptor), or -1 for plain pwrite. Bytes are staged
-  // staging_size(size, staging_bytes) at a time. Writes nothing until the first append.
+  // staging_size(size, staging_bytes) at a time, in `staging_memory` (block-aligned, that size, owned by
+  // the caller) or in a buffer of the writer's own. Writes nothing until the first append.
   DirectRegionWriter(AtomicOutputFile& out, int direct_fd, std::uint64_t offset, std::uint64_t size,
-                     std::uint64_t staging_bytes);
+                     std::uint64_t staging_bytes, std::uint8_t* staging_memory = nullptr);
   // The staging buffer a region of `size` bytes takes (allocated at its first append): `staging_bytes`
   // rounded up to blocks, but no more than the region can fill.
   static std::uint64_t staging_size(std::uint64_t size, std::uint64_t staging_bytes);

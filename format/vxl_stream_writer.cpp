@@ -32,16 +32,23 @@ VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes&
 }
 
 std::unique_ptr<DirectRegionWriter> VxlStreamWriter::region_writer(Section section, std::uint64_t offset,
-                                                                   std::uint64_t size, std::uint64_t staging_bytes) {
+                                                                   std::uint64_t size, std::uint64_t staging_bytes,
+                                                                   std::uint8_t* staging_memory) {
   const std::size_t i = entry_[section];
   if (i >= table_.size() || offset > table_[i].size || size > table_[i].size - offset)
     throw std::logic_error("VxlStreamWriter::region_writer: a region outside the section");
-  return std::make_unique<DirectRegionWriter>(out_, direct_fd_, table_[i].offset + offset, size, staging_bytes);
+  return std::make_unique<DirectRegionWriter>(out_, direct_fd_, table_[i].offset + offset, size, staging_bytes,
+                                              staging_memory);
+}
+
+std::uint64_t VxlStreamWriter::ReadBackBuffer::bytes_for(std::uint64_t size) {
+  constexpr std::uint64_t block = DirectRegionWriter::kBlock;
+  return (size + block - 1) / block * block + block;  // a misaligned start adds a block
 }
 
 void VxlStreamWriter::ReadBackBuffer::reserve(std::uint64_t size) {
   constexpr std::uint64_t block = DirectRegionWriter::kBlock;
-  const std::uint64_t need = (size + block - 1) / block * block + block;  // a misaligned start adds a block
+  const std::uint64_t need = bytes_for(size);
   if (capacity >= need) return;
   bytes.reset();
   void* p = std::aligned_alloc(block, need);

@@ -67,17 +67,25 @@ class VxlStreamWriter : public VxlSections {
   }
   // For a payload produced out of order (VERT, placed voxel by voxel in streamline order) without a
   // buffer of its size: region_writer() writes bytes [offset, offset + size) of the payload, appended in
-  // order (direct where the file system allows, staged `staging_bytes` at a time); the regions may be
+  // order (direct where the file system allows, staged `staging_bytes` at a time, in `staging_memory` if
+  // given: see DirectRegionWriter); the regions may be
   // written in any order, each must be complete before it is read back. read_back() then reads the
   // payload's next `size` bytes into `buffer` (past the page cache where allowed), checksums them and
   // counts them as appended: a payload written this way is read back whole, in order.
   std::unique_ptr<DirectRegionWriter> region_writer(Section section, std::uint64_t offset, std::uint64_t size,
-                                                    std::uint64_t staging_bytes);
+                                                    std::uint64_t staging_bytes,
+                                                    std::uint8_t* staging_memory = nullptr);
   struct ReadBackBuffer {
     std::unique_ptr<std::uint8_t, void (*)(void*)> bytes{nullptr, std::free};  // block-aligned
     std::uint64_t capacity = 0;
     // Room to read back any `size` bytes (the blocks around them) without growing.
     void reserve(std::uint64_t size);
+    static std::uint64_t bytes_for(std::uint64_t size);  // what reserve(size) takes
+    // Reads back into `memory` (block-aligned, owned by the caller) instead.
+    void use(std::span<std::uint8_t> memory) {
+      bytes = {memory.data(), [](void*) {}};
+      capacity = memory.size();
+    }
   };
   std::span<const std::uint8_t> read_back(Section section, std::uint64_t size, ReadBackBuffer& buffer);
 
