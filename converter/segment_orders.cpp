@@ -12,6 +12,7 @@
 
 #include "format/error.h"
 #include "format/parallel.h"
+#include "format/vxl_positions.h"
 
 namespace vxl {
 
@@ -305,21 +306,55 @@ void VoxelOrderWriter::use_directions_of(const VoxelEntry& v) {
 VoxelOrderWriter::~VoxelOrderWriter() = default;
 VoxelOrderWriter::VoxelOrderWriter(VoxelOrderWriter&&) noexcept = default;
 
+// A voxel's block as float32 positions, and its voxline ends.
+struct FloatBlock {
+  const float* xyz;
+  const VoxlineEnds& ends;
+  std::uint64_t first;  // the block's first vertex in `ends`
+  float axis(std::uint32_t e, int c) const { return xyz[3 * std::size_t(e) + c]; }
+  bool ends_voxline(std::uint32_t e) const { return ends.test(first + e); }
+};
+
+// A voxel's block as packed words: a coordinate is looked up in a table of what each of the 1024
+// quanta of its axis decodes to (VertexPacker::decode_axis), so the block is never decoded whole.
+struct PackedBlock {
+  const std::uint32_t* words;
+  std::array<std::array<float, kPackedSteps + 1>, 3> decoded;
+  float axis(std::uint32_t e, int c) const { return decoded[c][(words[e] >> (10 * c)) & kPackedAxisMask]; }
+  bool ends_voxline(std::uint32_t e) const { return (words[e] & kPackedVoxlineEnd) != 0; }
+};
+
 void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const LevelEntry> row, std::span<const float> vertices,
                              const VoxlineEnds& ends, std::uint8_t* dst) {
+  write_levels(v, row, FloatBlock{vertices.data() + 3 * v.vertex_first, ends, v.vertex_first}, dst);
+}
+
+void VoxelOrderWriter::write_packed(const VoxelEntry& v, std::span<const LevelEntry> row, const std::uint32_t* words,
+                                    std::uint8_t* dst) {
+  auto block = std::make_unique<PackedBlock>();  // 12 KiB: not on the stack
+  block->words = words;
+  const VertexPacker packer(v);
+  for (int c = 0; c < 3; ++c)
+    for (std::uint32_t q = 0; q <= kPackedSteps; ++q) block->decoded[c][q] = packer.decode_axis(c, q);
+  write_levels(v, row, *block, dst);
+}
+
+template <typename Block>
+void VoxelOrderWriter::write_levels(const VoxelEntry& v, std::span<const LevelEntry> row, const Block& block,
+                                    std::uint8_t* dst) {
   use_directions_of(v);
   const std::uint32_t k = static_cast<std::uint32_t>(directions_.size());
   for (std::uint32_t level = 0; level <= row.size(); ++level) {
     const LevelEntry counts = voxel_level(v, row, level);
     std::uint8_t* const level_end = dst + level_orders_size(counts, k);
-    if (counts.segment_count > 0) dst = write_level(v, counts, vertices, ends, dst);
+    if (counts.segment_count > 0) dst = write_level(counts, block, dst);
     std::fill(dst, level_end, std::uint8_t{0});  // the padding to 4 bytes
     dst = level_end;
   }
 }
 
-std::uint8_t* VoxelOrderWriter::write_level(const VoxelEntry& v, const LevelEntry& level,
-                                            std::span<const float> vertices, const VoxlineEnds& ends, std::uint8_t* dst) {
+template <typename Block>
+std::uint8_t* VoxelOrderWriter::write_level(const LevelEntry& level, const Block& block, std::uint8_t* dst) {
   std::vector<std::uint32_t>& starts = scratch_->starts;
   SortScratch& scratch = scratch_->sort;
   // The segments start at every vertex that does not end its voxline (branch-free: ends are
@@ -328,24 +363,24 @@ std::uint8_t* VoxelOrderWriter::write_level(const VoxelEntry& v, const LevelEntr
   std::size_t n_starts = 0;
   for (std::uint32_t e = 0; e < level.vertex_count; ++e) {
     starts[n_starts] = e;
-    n_starts += !ends.test(v.vertex_first + e);
+    n_starts += !block.ends_voxline(e);
   }
   starts.resize(n_starts);
   if (n_starts != level.segment_count) throw std::logic_error("VoxelOrderWriter: level segment count mismatch");
-  const float* block = vertices.data() + 3 * v.vertex_first;
   const std::uint32_t width = order_entry_width(level.vertex_count);
   for (std::size_t k = 0; k < directions_.size(); ++k) {
     scratch.keys.resize(starts.size());
     const auto& d = directions_[k];
     std::uint64_t all_or = 0, all_and = ~0ull;
+    const int axis = axis_of_[k];
     for (std::size_t n = 0; n < starts.size(); ++n) {
-      const float* a = block + 3 * starts[n];
+      const std::uint32_t a = starts[n];  // the segment (a, a + 1)
       double key;
-      if (axis_of_[k] >= 0) {
-        key = double(a[axis_of_[k]]) + double(a[axis_of_[k] + 3]);
+      if (axis >= 0) {
+        key = double(block.axis(a, axis)) + double(block.axis(a + 1, axis));
       } else {
         key = 0;
-        for (int c = 0; c < 3; ++c) key += (double(a[c]) + double(a[c + 3])) * double(d[c]);
+        for (int c = 0; c < 3; ++c) key += (double(block.axis(a, c)) + double(block.axis(a + 1, c))) * double(d[c]);
       }
       const std::uint64_t bits = sortable_bits(key);
       scratch.keys[n] = bits;

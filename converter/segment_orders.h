@@ -81,12 +81,19 @@ class VoxelOrderWriter {
   // included, so `dst` need not be cleared.
   void write(const VoxelEntry& v, std::span<const LevelEntry> row, std::span<const float> vertices,
              const VoxlineEnds& ends, std::uint8_t* dst);
+  // The same from the voxel's packed block (v.vertex_count words, spec §5.4; the end bits inside): the
+  // orders of the positions the words decode to, without decoding the block.
+  void write_packed(const VoxelEntry& v, std::span<const LevelEntry> row, const std::uint32_t* words,
+                    std::uint8_t* dst);
 
  private:
   void use_directions_of(const VoxelEntry& v);
-  // The K orders of the first `level.vertex_count` vertices of v's block; returns the end of what it wrote.
-  std::uint8_t* write_level(const VoxelEntry& v, const LevelEntry& level, std::span<const float> vertices,
-                   const VoxlineEnds& ends, std::uint8_t* dst);
+  // Every level's orders of v's block, read through `block` (FloatBlock or PackedBlock in the .cpp).
+  template <typename Block>
+  void write_levels(const VoxelEntry& v, std::span<const LevelEntry> row, const Block& block, std::uint8_t* dst);
+  // The K orders of the first `level.vertex_count` vertices of the block; returns the end of what it wrote.
+  template <typename Block>
+  std::uint8_t* write_level(const LevelEntry& level, const Block& block, std::uint8_t* dst);
 
   struct Scratch;
   const OrderSetSpec* set_;

@@ -149,8 +149,9 @@ struct Range {
 
 class StreamingConversion {
  public:
-  StreamingConversion(const std::string& source, const std::string& out, const ConvertSettings& settings)
-      : path_(source), out_path_(out), settings_(settings), budget_(settings.memory_limit, source) {}
+  StreamingConversion(const std::string& source, const std::string& out, const ConvertSettings& settings,
+                      const StreamingTuning& tuning)
+      : path_(source), out_path_(out), settings_(settings), tuning_(tuning), budget_(settings.memory_limit, source) {}
 
   ConvertSummary run();
 
@@ -175,8 +176,8 @@ class StreamingConversion {
   void place_part(RangePlacement& placing, const StagedPart& part);
   void write_orders(const Range& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
   void write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> vertices,
-                          std::uint64_t vertices_first, VoxelOrderWriter& writer, std::vector<float>& decoded,
-                          VoxlineEnds& block_ends, std::uint8_t* dst);
+                          std::uint64_t vertices_first, VoxelOrderWriter& writer, VoxlineEnds& block_ends,
+                          std::uint8_t* dst);
   // The (voxel, level) blocks of VERT with vertices, and the staging each of them takes in memory when
   // written block by block (DirectRegionWriter::staging_size).
   std::uint64_t block_staging_total(std::uint64_t staging) const;
@@ -187,9 +188,9 @@ class StreamingConversion {
   std::uint64_t orders_start(std::size_t i) const {
     return i < voxels_.size() ? voxels_[i].order_offset : order_bytes_;
   }
-  // Memory per ordering thread besides its sort buffers: a voxel's packed block decoded, and its end bits.
-  std::uint64_t decode_bytes(std::uint32_t max_vertices) const {
-    return (packed() ? 12ull * max_vertices : 0) + (max_vertices / 64 + 1) * 8;
+  // Memory per ordering thread besides its sort buffers: a float32 block's end bits.
+  std::uint64_t end_bits_bytes(std::uint32_t max_vertices) const {
+    return packed() ? 0 : (max_vertices / 64 + 1) * 8;
   }
   void write_rest();
   [[noreturn]] void fail_changed() const;
@@ -202,6 +203,7 @@ class StreamingConversion {
 
   std::string path_, out_path_;
   ConvertSettings settings_;
+  StreamingTuning tuning_;
   std::string voxel_size_choice_;  // --voxel-size auto's reason, once scan() has chosen
   Budget budget_;
   OrderSetSpec order_set_;
@@ -240,7 +242,7 @@ class StreamingConversion {
   // orders' chunks and the vertices read back (fresh pages are dear: a buffer reused is not faulted in
   // again).
   std::unique_ptr<std::uint8_t, void (*)(void*)> pool_{nullptr, std::free};
-  std::uint64_t pool_chunk_bytes_ = 0, pool_read_back_bytes_ = 0;  // the orders' parts of pool_
+  std::uint64_t pool_bytes_ = 0, pool_chunk_bytes_ = 0, pool_read_back_bytes_ = 0;  // the orders' parts of pool_
   VoxlineEnds ends_;                  // float32 positions: the voxline ends of the range being built
   std::unique_ptr<VxlStreamWriter> out_;
 };
@@ -507,7 +509,7 @@ void StreamingConversion::build_table() {
 // depend on the thread count).
 std::vector<Range> StreamingConversion::cut_ranges() {
   const std::uint64_t room = budget_.left();
-  auto per_thread = [&](const Range& r) { return order_scratch_bytes(r.max_vertices) + decode_bytes(r.max_vertices); };
+  auto per_thread = [&](const Range& r) { return order_scratch_bytes(r.max_vertices) + end_bits_bytes(r.max_vertices); };
   auto order_threads = [&](const Range& r) {
     return static_cast<unsigned>(std::clamp<std::uint64_t>(room / 4 / per_thread(r), 1, threads_));
   };
@@ -650,9 +652,12 @@ void StreamingConversion::open_block_writers(RangePlacement& placing) const {
       const std::uint64_t first = cursor_[local * levels + d];
       const std::uint64_t end = voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), d);
       if (end > first) {
+        const std::uint64_t size = DirectRegionWriter::staging_size((end - first) * bytes, block_staging_);
+        if (std::uint64_t(staging - pool_.get()) + size > pool_bytes_)
+          throw std::logic_error("StreamingConversion: the blocks' staging outgrows its pool");
         placing.blocks[local * levels + d] =
             out_->region_writer(VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, block_staging_, staging);
-        staging += DirectRegionWriter::staging_size((end - first) * bytes, block_staging_);
+        staging += size;
       }
     }
   }
@@ -787,7 +792,6 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
                                        const std::string& stage) {
   // Per ordering thread, sized for the range's largest voxel once (fresh pages are dear; see above).
   std::vector<std::optional<VoxelOrderWriter>> writers(r.order_threads);
-  std::vector<std::vector<float>> decoded(r.order_threads);
   std::vector<VoxlineEnds> block_ends(r.order_threads);
   std::vector<std::size_t> cuts{r.first};  // chunk c: voxels [cuts[c], cuts[c + 1])
   while (cuts.back() < r.end) {
@@ -843,12 +847,9 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
     std::stable_sort(by_size.begin(), by_size.end(),
                      [&](std::size_t a, std::size_t b) { return voxels_[a].vertex_count > voxels_[b].vertex_count; });
     parallel_for(end - first, r.order_threads, [&](std::uint64_t i, unsigned t) {
-      if (!writers[t]) {
-        writers[t].emplace(order_set_, r.max_vertices);
-        if (packed()) decoded[t].reserve(3 * std::size_t(r.max_vertices));
-      }
+      if (!writers[t]) writers[t].emplace(order_set_, r.max_vertices);
       const std::size_t g = by_size[i];
-      write_voxel_orders(r, g, vertices, vertex_start(first), *writers[t], decoded[t], block_ends[t],
+      write_voxel_orders(r, g, vertices, vertex_start(first), *writers[t], block_ends[t],
                          chunk.data() + (voxels_[g].order_offset - base));
     });
     if (writing.valid()) writing.get();  // rethrows a failed write
@@ -865,18 +866,17 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
 }
 
 // Voxel g's orders at `dst`, from its block in `vertices` (the part of VERT from vertex
-// `vertices_first`). A packed block is decoded into `decoded` first: the orders sort the positions the
-// file holds. `block_ends` gets the block's voxline ends.
+// `vertices_first`): the orders sort the positions the file holds. A float32 block's voxline ends are
+// copied into `block_ends` (a packed block holds its own).
 void StreamingConversion::write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> vertices,
                                              std::uint64_t vertices_first, VoxelOrderWriter& writer,
-                                             std::vector<float>& decoded, VoxlineEnds& block_ends,
-                                             std::uint8_t* dst) {
+                                             VoxlineEnds& block_ends, std::uint8_t* dst) {
   VoxelEntry v = voxels_[g];
   const std::span<const LevelEntry> row = level_row(levels_, g, settings_.levels);
   const std::uint64_t at = v.vertex_first - vertices_first;
-  block_ends.reset(v.vertex_count);
   v.vertex_first = 0;
   if (!packed()) {
+    block_ends.reset(v.vertex_count);
     const std::uint64_t in_range = voxels_[g].vertex_first - r.vertex_first;  // ends_ counts from the range
     for (std::uint32_t e = 0; e < v.vertex_count; ++e)
       if (ends_.test(in_range + e)) block_ends.set(e);
@@ -884,12 +884,7 @@ void StreamingConversion::write_voxel_orders(const Range& r, std::size_t g, std:
     writer.write(v, row, {xyz, 3 * std::size_t(v.vertex_count)}, block_ends, dst);
     return;
   }
-  const std::uint32_t* words = reinterpret_cast<const std::uint32_t*>(vertices.data()) + at;
-  decoded.resize(3 * std::size_t(v.vertex_count));
-  VertexPacker(v).decode(words, v.vertex_count, decoded.data());
-  for (std::uint32_t e = 0; e < v.vertex_count; ++e)
-    if (words[e] & kPackedVoxlineEnd) block_ends.set(e);
-  writer.write(v, row, decoded, block_ends, dst);
+  writer.write_packed(v, row, reinterpret_cast<const std::uint32_t*>(vertices.data()) + at, dst);
 }
 
 std::uint64_t StreamingConversion::block_staging_total(std::uint64_t staging) const {
@@ -897,11 +892,10 @@ std::uint64_t StreamingConversion::block_staging_total(std::uint64_t staging) co
   const std::uint64_t bytes = vertex_bytes(settings_.positions);
   std::uint64_t total = 0;
   for (std::size_t g = 0; g < voxels_.size(); ++g) {
-    std::uint64_t start = 0;
-    for (std::uint32_t d = 0; d < levels; ++d) {
-      const std::uint64_t end = depth_end_vertex(voxels_[g], level_row(levels_, g, levels), d);
-      if (end > start) total += DirectRegionWriter::staging_size((end - start) * bytes, staging);
-      start = end;
+    const std::span<const LevelEntry> row = level_row(levels_, g, levels);
+    for (std::uint32_t d = 0; d < levels; ++d) {  // as open_block_writers cuts them
+      const std::uint64_t first = depth_first_vertex(row, d), end = depth_end_vertex(voxels_[g], row, d);
+      if (end > first) total += DirectRegionWriter::staging_size((end - first) * bytes, staging);
     }
   }
   return total;
@@ -974,28 +968,33 @@ ConvertSummary StreamingConversion::run() {
     budget_.take(staged_held_, "the voxlines of two batches being placed");
   }
   // Direct writes (the output bypasses the page cache) where the limit leaves room for their staging.
-  if (settings_.memory_limit >= kDirectWritesFromLimit) {
+  if (settings_.memory_limit >= (tuning_.direct_writes_from_limit > 0 ? tuning_.direct_writes_from_limit
+                                                                       : kDirectWritesFromLimit)) {
     direct_staging_ = kDirectStagingBytes;
     budget_.take(VxlStreamWriter::kCount * kDirectStagingBytes, "the staging of the output's direct writes");
   }
-  if (direct_staging_ > 0) {
-    const std::uint64_t share = budget_.left() / 8;
-    for (std::uint64_t staging = kBlockStagingBytes; staging >= kMinBlockStagingBytes && block_staging_ == 0;
-         staging /= 2)
-      if (block_staging_total(staging) <= share) block_staging_ = staging;
-  }
-  order_chunk_bytes_ = std::min({kOrderChunkBytes, order_bytes_, budget_.left() / 8});
+  order_chunk_bytes_ = std::min(
+      {tuning_.order_chunk_bytes > 0 ? tuning_.order_chunk_bytes : kOrderChunkBytes, order_bytes_, budget_.left() / 8});
   for (std::size_t i = 0; i < voxels_.size(); ++i)
     order_chunk_bytes_ = std::max(order_chunk_bytes_, orders_start(i + 1) - orders_start(i));
-  if (block_staging_ > 0) {
-    // pool_: the blocks' staging, then two orders chunks and two chunks' vertices read back.
-    pool_chunk_bytes_ = (order_chunk_bytes_ + DirectRegionWriter::kBlock - 1) / DirectRegionWriter::kBlock *
-                        DirectRegionWriter::kBlock;
+  if (direct_staging_ > 0) {
+    // VERT block by block when the blocks' staging takes at most an eighth of what is left and the pool
+    // (that staging, then two orders chunks and two chunks' vertices read back) at most half.
+    constexpr std::uint64_t block = DirectRegionWriter::kBlock;
+    pool_chunk_bytes_ = (order_chunk_bytes_ + block - 1) / block * block;
     pool_read_back_bytes_ = VxlStreamWriter::ReadBackBuffer::bytes_for(largest_chunk_vertex_bytes());
-    const std::uint64_t pool = std::max(block_staging_total(block_staging_), 2 * (pool_chunk_bytes_ + pool_read_back_bytes_));
-    budget_.take(pool, "the vertex blocks being written, then the orders being built and their vertices",
-                 ", or a smaller --voxel-size");
-    void* p = std::aligned_alloc(DirectRegionWriter::kBlock, pool);
+    for (std::uint64_t staging = kBlockStagingBytes; staging >= kMinBlockStagingBytes && block_staging_ == 0;
+         staging /= 2) {
+      const std::uint64_t total = block_staging_total(staging);
+      if (total <= budget_.left() / 8 &&
+          std::max(total, 2 * (pool_chunk_bytes_ + pool_read_back_bytes_)) <= budget_.left() / 2)
+        block_staging_ = staging;
+    }
+  }
+  if (block_staging_ > 0) {
+    pool_bytes_ = std::max(block_staging_total(block_staging_), 2 * (pool_chunk_bytes_ + pool_read_back_bytes_));
+    budget_.take(pool_bytes_, "the vertex blocks being written, then the orders being built and their vertices");
+    void* p = std::aligned_alloc(DirectRegionWriter::kBlock, pool_bytes_);
     if (p == nullptr) throw std::bad_alloc();
     pool_.reset(static_cast<std::uint8_t*>(p));
   } else {
@@ -1034,7 +1033,12 @@ ConvertSummary StreamingConversion::run() {
 
 ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
                                  const ConvertSettings& settings) {
-  StreamingConversion conversion(source_path, out_path, settings);
+  return convert_streaming(source_path, out_path, settings, StreamingTuning{});
+}
+
+ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
+                                 const ConvertSettings& settings, const StreamingTuning& tuning) {
+  StreamingConversion conversion(source_path, out_path, settings, tuning);
   return conversion.run();
 }
 

@@ -11,6 +11,10 @@
 //             chunk of voxels at a time, and write both at their final offsets (VxlStreamWriter); pass 3
 //             also writes the voxline and streamline tables
 //
+// With direct writes and few enough (voxel, level) blocks, VERT is not held at all: each block is
+// written through a small staging of its own as it is placed, and read back a chunk at a time for the
+// orders (one range, 3 passes for any size of source).
+//
 // Every pass cuts its batches in two parts for two threads (the placing pass places in streamline order,
 // one batch behind). What stays in memory: the voxel table (about 240 bytes per voxel), one mapped part of
 // the source and two batches of whole streamlines, two batches' staged voxlines, one range's blocks, an
@@ -19,6 +23,7 @@
 // stays in resident memory. Only TCK sources stream.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "converter/convert.h"
@@ -32,5 +37,14 @@ namespace vxl {
 // The summary's passes and partitions say how the work was split; its warnings are the source's.
 ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
                                  const ConvertSettings& settings);
+
+// Sizes the conversion otherwise derives from the limit, set by tests (to reach on small data what
+// only large data would) and benchmarks; 0 keeps the derived value. The output does not depend on them.
+struct StreamingTuning {
+  std::uint64_t direct_writes_from_limit = 0;  // direct writes under limits of at least this (default 256 MiB)
+  std::uint64_t order_chunk_bytes = 0;         // orders built and written this much at a time (or one voxel)
+};
+ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
+                                 const ConvertSettings& settings, const StreamingTuning& tuning);
 
 }  // namespace vxl

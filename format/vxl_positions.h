@@ -38,11 +38,12 @@ class VertexPacker {
   void words(const float* xyz, std::uint64_t count, std::uint32_t* packed) const;
   // 3 * count floats from `count` words (their end bits ignored).
   void decode(const std::uint32_t* packed, std::uint64_t count, float* xyz) const;
+  // Axis c's coordinate for quantum q (0..kPackedSteps), as decode() gives it.
+  float decode_axis(int c, std::uint32_t q) const;
 
  private:
   std::uint32_t word(const float* xyz) const;
   std::uint32_t quantise(int c, float x) const;
-  float decode_axis(int c, std::uint32_t q) const;
   float lo_[3], step_[3];
 };
 

@@ -50,10 +50,9 @@ void VxlStreamWriter::ReadBackBuffer::reserve(std::uint64_t size) {
   constexpr std::uint64_t block = DirectRegionWriter::kBlock;
   const std::uint64_t need = bytes_for(size);
   if (capacity >= need) return;
-  bytes.reset();
   void* p = std::aligned_alloc(block, need);
   if (p == nullptr) throw std::bad_alloc();
-  bytes.reset(static_cast<std::uint8_t*>(p));
+  bytes = {static_cast<std::uint8_t*>(p), std::free};  // not the caller's memory (use()) any longer
   capacity = need;
 }
 
