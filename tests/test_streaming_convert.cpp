@@ -187,7 +187,7 @@ TEST(StreamingConvert, SynthAt10mmIsIdenticalAcrossSeveralRanges) {
   const std::string tck = dir.file("in.tck");
   // 12000 streamlines: a range holds 4 bytes a packed vertex, so it takes this many to need several.
   write_synth_tck(tck, 12000);
-  ConvertSummary s = expect_identical(dir, tck, settings_for(10.0), 22 * kMiB);
+  ConvertSummary s = expect_identical(dir, tck, settings_for(10.0), 21 * kMiB);
   EXPECT_GE(s.partitions, 3u);
   // Float32 positions are held and written as they are, 12 bytes a vertex.
   ConvertSettings float32 = settings_for(10.0);

@@ -36,7 +36,30 @@ template <typename Real, bool kBigEndian>
 std::uint64_t decode(const std::string& path, const std::uint8_t* p, std::uint64_t n, std::uint64_t offset,
                      Tractogram& t, DecodeState& s, std::uint64_t stop_items) {
   constexpr std::size_t kTriplet = 3 * sizeof(Real);
+  // Little-endian float32 on a little-endian machine (what MRtrix writes): a run of points whose
+  // coordinates are all finite is copied as it is, a run at a time; the loop below takes what ends it.
+  constexpr bool kVerbatim = std::is_same_v<Real, float> && kBigEndian == (std::endian::native == std::endian::big);
   for (std::uint64_t i = 0; i < n; ++i, p += kTriplet) {
+    if constexpr (kVerbatim) {
+      auto finite = [](const std::uint8_t* q) {
+        std::uint32_t u[3];
+        std::memcpy(u, q, sizeof u);
+        constexpr std::uint32_t kExponent = 0x7F800000u;  // all ones: Inf or NaN
+        return ((u[0] & kExponent) != kExponent) & ((u[1] & kExponent) != kExponent) &
+               ((u[2] & kExponent) != kExponent);
+      };
+      std::uint64_t run = 0;
+      while (i + run < n && finite(p + run * kTriplet)) ++run;
+      if (run > 0) {
+        const std::size_t at = t.positions.size();
+        t.positions.resize(at + 3 * run);
+        std::memcpy(t.positions.data() + at, p, run * kTriplet);
+        s.points_in_current += run;
+        i += run;
+        p += run * kTriplet;
+        if (i == n) break;
+      }
+    }
     Real x = load_mrtrix_value<Real, kBigEndian>(p), y = load_mrtrix_value<Real, kBigEndian>(p + sizeof(Real)),
          z = load_mrtrix_value<Real, kBigEndian>(p + 2 * sizeof(Real));
     if (std::isnan(x)) {  // end of streamline
