@@ -65,6 +65,8 @@ constexpr std::uint64_t kDirectStagingBytes = 2 * kMiB;
 // direct writes and 1.4-3 GB/s direct reads).
 constexpr std::uint64_t kBlockStagingBytes = 128 * 1024;
 constexpr std::uint64_t kMinBlockStagingBytes = 16 * 1024;
+// Spare stagings for the blocks' write queue (DirectWriteQueue): how far the writes may fall behind.
+constexpr std::uint64_t kSpareBlockStagings = 32;
 // Voxline and streamline table entries written at once.
 constexpr std::size_t kTableBufferEntries = 1 << 16;
 // The orders are built a run of voxels at a time, in a buffer of at most this size and an
@@ -269,7 +271,9 @@ struct StreamingConversion::RangePlacement {
   bool tables;                        // the first range: also the voxline and streamline tables
   std::span<std::uint8_t> window;     // the range's part of VERT
   std::vector<VertexPacker> packers;  // by voxel - range.first (packed positions)
-  // Written block by block (block_staging_ > 0): a writer per (local voxel id, level), as cursor_.
+  // Written block by block (block_staging_ > 0): a writer per (local voxel id, level), as cursor_, whose
+  // full stagings are written by `queue`'s thread.
+  std::unique_ptr<DirectWriteQueue> queue;
   std::vector<std::unique_ptr<DirectRegionWriter>> blocks;
   std::vector<VoxlineEntry> voxline_buffer;
   std::vector<std::uint64_t> streamline_buffer;
@@ -617,6 +621,7 @@ void StreamingConversion::place_range(const Range& r, bool tables, const std::st
     budget_.track(staged, staged_held_, [] { return std::string("the voxlines of two batches being placed"); });
   });
   if (!other_placed) place_staged(1 - staging);
+  if (placing.queue) placing.queue->finish();  // rethrows a failed write
   placing.blocks.clear();  // each wrote its last bytes with its last append (checked below: all complete)
   if (placing.streamlines != meta_.streamline_count || (tables && placing.voxline_index != meta_.voxline_count))
     fail_changed();
@@ -644,7 +649,10 @@ void StreamingConversion::open_block_writers(RangePlacement& placing) const {
   const std::uint32_t levels = settings_.levels;
   const std::uint64_t bytes = vertex_bytes(settings_.positions);
   placing.blocks.resize(cursor_.size());
-  std::uint8_t* staging = pool_.get();  // each block's staging, one after another
+  std::uint8_t* staging = pool_.get();  // the queue's spares, then each block's staging, one after another
+  std::vector<std::uint8_t*> spares;
+  for (std::uint64_t k = 0; k < kSpareBlockStagings; ++k, staging += block_staging_) spares.push_back(staging);
+  placing.queue = out_->write_queue(std::move(spares), block_staging_);
   for (std::size_t local = 0; local < global_id_.size(); ++local) {
     const std::uint32_t g = global_id_[local];
     if (g < r.first || g >= r.end) continue;
@@ -656,7 +664,8 @@ void StreamingConversion::open_block_writers(RangePlacement& placing) const {
         if (std::uint64_t(staging - pool_.get()) + size > pool_bytes_)
           throw std::logic_error("StreamingConversion: the blocks' staging outgrows its pool");
         placing.blocks[local * levels + d] =
-            out_->region_writer(VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, block_staging_, staging);
+            out_->region_writer(VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, block_staging_, staging,
+                                placing.queue.get());
         staging += size;
       }
     }
@@ -985,14 +994,15 @@ ConvertSummary StreamingConversion::run() {
     pool_read_back_bytes_ = VxlStreamWriter::ReadBackBuffer::bytes_for(largest_chunk_vertex_bytes());
     for (std::uint64_t staging = kBlockStagingBytes; staging >= kMinBlockStagingBytes && block_staging_ == 0;
          staging /= 2) {
-      const std::uint64_t total = block_staging_total(staging);
+      const std::uint64_t total = kSpareBlockStagings * staging + block_staging_total(staging);
       if (total <= budget_.left() / 8 &&
           std::max(total, 2 * (pool_chunk_bytes_ + pool_read_back_bytes_)) <= budget_.left() / 2)
         block_staging_ = staging;
     }
   }
   if (block_staging_ > 0) {
-    pool_bytes_ = std::max(block_staging_total(block_staging_), 2 * (pool_chunk_bytes_ + pool_read_back_bytes_));
+    pool_bytes_ = std::max(kSpareBlockStagings * block_staging_ + block_staging_total(block_staging_),
+                           2 * (pool_chunk_bytes_ + pool_read_back_bytes_));
     budget_.take(pool_bytes_, "the vertex blocks being written, then the orders being built and their vertices");
     void* p = std::aligned_alloc(DirectRegionWriter::kBlock, pool_bytes_);
     if (p == nullptr) throw std::bad_alloc();

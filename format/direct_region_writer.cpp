@@ -14,12 +14,16 @@
 namespace vxl {
 
 DirectRegionWriter::DirectRegionWriter(AtomicOutputFile& out, int direct_fd, std::uint64_t offset, std::uint64_t size,
-                                       std::uint64_t staging_bytes, std::uint8_t* staging_memory)
+                                       std::uint64_t staging_bytes, std::uint8_t* staging_memory,
+                                       DirectWriteQueue* queue)
     : out_(out),
       direct_fd_(direct_fd),
       end_(offset + size),
       position_(offset),
-      staging_bytes_(staging_size(size, staging_bytes)) {
+      staging_bytes_(staging_size(size, staging_bytes)),
+      queue_(queue) {
+  if (queue != nullptr && staging_memory == nullptr)
+    throw std::logic_error("DirectRegionWriter: a queue swaps staging buffers: they must be the caller's");
   if (staging_memory != nullptr) staging_ = {staging_memory, [](void*) {}};
 }
 
@@ -58,29 +62,39 @@ void DirectRegionWriter::append(std::span<const std::uint8_t> bytes) {
 }
 
 void DirectRegionWriter::write_staged() {
-  // Whole blocks directly. Staging is written when full (whole blocks) or at the region's end, where the
-  // last partial block may hold the next region's bytes: that one goes through the page cache.
-  const std::uint64_t whole = staged_ / kBlock * kBlock;
-  write_at(staging_.get(), whole, staging_start_);
-  if (whole < staged_) out_.pwrite(staging_.get() + whole, staged_ - whole, staging_start_ + whole);
+  // Staging is written when full (whole blocks) or at the region's end.
+  const bool last = position_ == end_;
+  if (queue_ == nullptr) {
+    write_blocks(out_, direct_fd_, staging_.get(), staged_, staging_start_);
+  } else {
+    // The queue writes it while the caller goes on with a spare (none needed after the last bytes).
+    std::uint8_t* spare = queue_->submit(staging_.release(), staged_, staging_start_,
+                                         staging_bytes_ == queue_->buffer_bytes(), !last);
+    staging_ = {spare, [](void*) {}};
+  }
   staged_ = 0;
 }
 
-void DirectRegionWriter::write_at(const std::uint8_t* data, std::uint64_t size, std::uint64_t offset) {
-  while (size > 0 && direct_fd_ >= 0) {
-    const ssize_t n = ::pwrite(direct_fd_, data, size, static_cast<off_t>(offset));
+void DirectRegionWriter::write_blocks(AtomicOutputFile& out, int& direct_fd, const std::uint8_t* data,
+                                      std::uint64_t size, std::uint64_t offset) {
+  // Whole blocks directly; a last partial block may hold the next region's bytes: through the page cache.
+  std::uint64_t whole = size / kBlock * kBlock;
+  const std::uint8_t* tail = data + whole;
+  while (whole > 0 && direct_fd >= 0) {
+    const ssize_t n = ::pwrite(direct_fd, data, whole, static_cast<off_t>(offset));
     if (n < 0 && errno == EINTR) continue;
     if (n < 0 && errno == EINVAL) {
-      direct_fd_ = -1;  // no direct I/O here: the page cache it is
+      direct_fd = -1;  // no direct I/O here: the page cache it is
       break;
     }
     if (n < 0)
-      throw Error(ErrorKind::Output, out_.path(), std::nullopt, std::string("write failed: ") + std::strerror(errno));
+      throw Error(ErrorKind::Output, out.path(), std::nullopt, std::string("write failed: ") + std::strerror(errno));
     data += n;
-    size -= static_cast<std::uint64_t>(n);
+    whole -= static_cast<std::uint64_t>(n);
     offset += static_cast<std::uint64_t>(n);
   }
-  if (size > 0) out_.pwrite(data, size, offset);
+  if (whole > 0) out.pwrite(data, whole, offset);
+  if (size % kBlock > 0) out.pwrite(tail, size % kBlock, offset + whole);
 }
 
 }  // namespace vxl

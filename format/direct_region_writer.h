@@ -14,6 +14,7 @@
 #include <span>
 
 #include "format/atomic_output.h"
+#include "format/direct_write_queue.h"
 
 namespace vxl {
 
@@ -24,9 +25,12 @@ class DirectRegionWriter {
   // Region [offset, offset + size) of `out`'s file; `direct_fd` is that file opened with O_DIRECT
   // (AtomicOutputFile::direct_descriptor), or -1 for plain pwrite. Bytes are staged
   // staging_size(size, staging_bytes) at a time, in `staging_memory` (block-aligned, that size, owned by
-  // the caller) or in a buffer of the writer's own. Writes nothing until the first append.
+  // the caller) or in a buffer of the writer's own. With a `queue` (and the caller's staging memory) a
+  // full staging is handed to the queue's thread and swapped for one of its spares: the region is then
+  // written when the queue is finished. Writes nothing until the first append.
   DirectRegionWriter(AtomicOutputFile& out, int direct_fd, std::uint64_t offset, std::uint64_t size,
-                     std::uint64_t staging_bytes, std::uint8_t* staging_memory = nullptr);
+                     std::uint64_t staging_bytes, std::uint8_t* staging_memory = nullptr,
+                     DirectWriteQueue* queue = nullptr);
   // The staging buffer a region of `size` bytes takes (allocated at its first append): `staging_bytes`
   // rounded up to blocks, but no more than the region can fill.
   static std::uint64_t staging_size(std::uint64_t size, std::uint64_t staging_bytes);
@@ -38,9 +42,14 @@ class DirectRegionWriter {
   // direct I/O (EINVAL: tmpfs, some network file systems) it falls back to pwrite for good.
   void append(std::span<const std::uint8_t> bytes);
 
+  // Writes `size` bytes from `data` at file offset `offset` (block-aligned, as `data` is): whole blocks
+  // through `direct_fd` (set to -1 where the file system refuses direct I/O: then plain pwrite), a last
+  // partial block through the page cache. Throws vxl::Error (Output).
+  static void write_blocks(AtomicOutputFile& out, int& direct_fd, const std::uint8_t* data, std::uint64_t size,
+                           std::uint64_t offset);
+
  private:
   void write_staged();
-  void write_at(const std::uint8_t* data, std::uint64_t size, std::uint64_t offset);
 
   AtomicOutputFile& out_;
   int direct_fd_;
@@ -49,6 +58,7 @@ class DirectRegionWriter {
   std::unique_ptr<std::uint8_t, void (*)(void*)> staging_{nullptr, nullptr};
   std::uint64_t staged_ = 0;         // bytes in staging_
   std::uint64_t staging_start_ = 0;  // the file offset of staging_[0] (block-aligned)
+  DirectWriteQueue* queue_;
 };
 
 }  // namespace vxl

@@ -33,12 +33,18 @@ VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes&
 
 std::unique_ptr<DirectRegionWriter> VxlStreamWriter::region_writer(Section section, std::uint64_t offset,
                                                                    std::uint64_t size, std::uint64_t staging_bytes,
-                                                                   std::uint8_t* staging_memory) {
+                                                                   std::uint8_t* staging_memory,
+                                                                   DirectWriteQueue* queue) {
   const std::size_t i = entry_[section];
   if (i >= table_.size() || offset > table_[i].size || size > table_[i].size - offset)
     throw std::logic_error("VxlStreamWriter::region_writer: a region outside the section");
   return std::make_unique<DirectRegionWriter>(out_, direct_fd_, table_[i].offset + offset, size, staging_bytes,
-                                              staging_memory);
+                                              staging_memory, queue);
+}
+
+std::unique_ptr<DirectWriteQueue> VxlStreamWriter::write_queue(std::vector<std::uint8_t*> spares,
+                                                               std::uint64_t buffer_bytes) {
+  return std::make_unique<DirectWriteQueue>(out_, direct_fd_, std::move(spares), buffer_bytes);
 }
 
 std::uint64_t VxlStreamWriter::ReadBackBuffer::bytes_for(std::uint64_t size) {

@@ -73,8 +73,10 @@ class VxlStreamWriter : public VxlSections {
   // payload's next `size` bytes into `buffer` (past the page cache where allowed), checksums them and
   // counts them as appended: a payload written this way is read back whole, in order.
   std::unique_ptr<DirectRegionWriter> region_writer(Section section, std::uint64_t offset, std::uint64_t size,
-                                                    std::uint64_t staging_bytes,
-                                                    std::uint8_t* staging_memory = nullptr);
+                                                    std::uint64_t staging_bytes, std::uint8_t* staging_memory = nullptr,
+                                                    DirectWriteQueue* queue = nullptr);
+  // A queue that region writers hand their full staging to (DirectWriteQueue), writing to this file.
+  std::unique_ptr<DirectWriteQueue> write_queue(std::vector<std::uint8_t*> spares, std::uint64_t buffer_bytes);
   struct ReadBackBuffer {
     std::unique_ptr<std::uint8_t, void (*)(void*)> bytes{nullptr, std::free};  // block-aligned
     std::uint64_t capacity = 0;

@@ -3,6 +3,8 @@
 // file system allows it, and without it. And a streaming conversion whose limit turns direct writes on
 // must still write the in-memory conversion's bytes, whether it holds VERT or writes it block by block.
 #include <algorithm>
+#include <cstdlib>
+#include <memory>
 #include <cstdint>
 #include <fstream>
 #include <iterator>
@@ -19,6 +21,7 @@
 #include "converter/tck_writer.h"
 #include "format/atomic_output.h"
 #include "format/direct_region_writer.h"
+#include "format/direct_write_queue.h"
 #include "tests/test_support.h"
 
 namespace vxl {
@@ -59,7 +62,7 @@ TEST(DirectWrites, RegionsOfAnySizeAppendedInPiecesGiveThePlainBytes) {
   for (auto& b : expected) b = static_cast<std::uint8_t>(rng());
   const std::uint64_t block = DirectRegionWriter::kBlock;
   const std::vector<std::uint64_t> ends = {7,         block - 1,     block,           block + 1, 5 * block + 100,
-                                           9 * block, 9 * block + 4, 40 * block + 13, 120000,    599999,
+                                           9 * block, 9 * block + 4, 120000,    40 * block + 13, 599999,
                                            600000};
   for (bool direct : {true, false}) {
     const std::string path = dir.file(direct ? "direct.bin" : "buffered.bin");
@@ -69,6 +72,60 @@ TEST(DirectWrites, RegionsOfAnySizeAppendedInPiecesGiveThePlainBytes) {
   AtomicOutputFile probe(dir.file("probe.bin"));
   if (probe.direct_descriptor() < 0)
     GTEST_LOG_(INFO) << "this file system refuses O_DIRECT: only the fallback was exercised";
+}
+
+// All regions open at once and appended in a random interleaving (as the placing pass appends to the
+// vertex blocks), their full stagings handed to a write queue and swapped for its spares: with no spare
+// (each submit waits for its own buffer to come back) and with a few, with and without O_DIRECT.
+TEST(DirectWrites, RegionsInterleavedThroughAWriteQueueGiveThePlainBytes) {
+  ScratchDir dir;
+  std::mt19937 rng(7);
+  std::vector<std::uint8_t> expected(600000);
+  for (auto& b : expected) b = static_cast<std::uint8_t>(rng());
+  const std::uint64_t block = DirectRegionWriter::kBlock, staging = 3 * block;
+  const std::vector<std::uint64_t> ends = {7,         block - 1,     block,           block + 1, 5 * block + 100,
+                                           9 * block, 9 * block + 4, 120000,    40 * block + 13, 599999,
+                                           600000};
+  for (bool direct : {true, false}) {
+    for (std::uint64_t spare_count : {0, 3}) {
+      SCOPED_TRACE(std::string(direct ? "with" : "without") + " O_DIRECT, " + std::to_string(spare_count) + " spares");
+      const std::string path = dir.file("queued.bin");
+      AtomicOutputFile out(path);
+      out.allocate(expected.size());
+      const int direct_fd = direct ? out.direct_descriptor() : -1;
+      // The caller's memory: the spares, then each region's staging.
+      std::uint64_t memory_bytes = spare_count * staging, start = 0;
+      for (std::uint64_t end : ends) memory_bytes += DirectRegionWriter::staging_size(end - start, staging), start = end;
+      std::unique_ptr<std::uint8_t, void (*)(void*)> memory(
+          static_cast<std::uint8_t*>(std::aligned_alloc(block, memory_bytes)), std::free);
+      std::uint8_t* next = memory.get();
+      std::vector<std::uint8_t*> spares;
+      for (std::uint64_t k = 0; k < spare_count; ++k, next += staging) spares.push_back(next);
+      DirectWriteQueue queue(out, direct_fd, spares, staging);
+      std::vector<std::unique_ptr<DirectRegionWriter>> regions;
+      std::vector<std::uint64_t> at, region_end;
+      start = 0;
+      for (std::uint64_t end : ends) {
+        regions.push_back(std::make_unique<DirectRegionWriter>(out, direct_fd, start, end - start, staging, next, &queue));
+        next += DirectRegionWriter::staging_size(end - start, staging);
+        at.push_back(start);
+        region_end.push_back(end);
+        start = end;
+      }
+      for (std::size_t open = regions.size(); open > 0;) {
+        const std::size_t r = std::uniform_int_distribution<std::size_t>(0, regions.size() - 1)(rng);
+        if (at[r] == region_end[r]) continue;
+        const std::uint64_t n =
+            std::min<std::uint64_t>(region_end[r] - at[r], std::uniform_int_distribution<std::uint64_t>(1, 5000)(rng));
+        regions[r]->append({expected.data() + at[r], n});
+        at[r] += n;
+        if (at[r] == region_end[r]) --open;
+      }
+      queue.finish();
+      out.commit();
+      EXPECT_TRUE(file_bytes(path) == expected);
+    }
+  }
 }
 
 // Under a limit that turns direct writes on, VERT is written block by block as it is placed and read back
