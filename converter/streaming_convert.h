@@ -17,8 +17,9 @@
 //
 // Every pass cuts its batches in two parts for two threads (the placing pass places in streamline order,
 // one batch behind). What stays in memory: the voxel table (about 240 bytes per voxel), one mapped part of
-// the source and two batches of whole streamlines, two batches' staged voxlines, one range's blocks, an
-// orders chunk or two and the sort buffers. The source is read a mapped part at a time; the output is
+// the source and two batches of whole streamlines, two batches' staged voxlines, one range's blocks (or,
+// written block by block, their stagings and then two chunks of them read back), an orders chunk or two
+// and the sort buffers. The source is read a mapped part at a time; the output is
 // written with pwrite, or past the page cache (O_DIRECT) under limits of 256 MiB or more, so neither
 // stays in resident memory. Only TCK sources stream.
 #pragma once
