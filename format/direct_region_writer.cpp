@@ -24,6 +24,9 @@ DirectRegionWriter::DirectRegionWriter(AtomicOutputFile& out, int direct_fd, std
       queue_(queue) {
   if (queue != nullptr && staging_memory == nullptr)
     throw std::logic_error("DirectRegionWriter: a queue swaps staging buffers: they must be the caller's");
+  // A staging that can fill before the region's end is swapped for a spare of the queue's size.
+  if (queue != nullptr && staging_bytes_ > queue->buffer_bytes())
+    throw std::logic_error("DirectRegionWriter: a staging larger than the queue's buffers");
   if (staging_memory != nullptr) staging_ = {staging_memory, [](void*) {}};
 }
 

@@ -62,7 +62,13 @@ void DirectWriteQueue::run() {
       if (failed && !failure_) failure_ = failed;
     }
     --writing_;
-    if (job.recycle) spares_.push_back(job.buffer);
+    if (job.recycle) {
+      try {
+        spares_.push_back(job.buffer);
+      } catch (...) {  // out of memory: fail the writes rather than the process
+        if (!failure_) failure_ = std::current_exception();
+      }
+    }
     changed_.notify_all();
   }
 }
