@@ -274,9 +274,19 @@ std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::span<const LevelE
   return total;
 }
 
+// A voxel's block as packed words: a coordinate is looked up in a table of what each of the 1024
+// quanta of its axis decodes to (VertexPacker::decode_axis), so the block is never decoded whole.
+struct PackedBlock {
+  const std::uint32_t* words;
+  std::array<std::array<float, kPackedSteps + 1>, 3> decoded;
+  float axis(std::uint32_t e, int c) const { return decoded[c][(words[e] >> (10 * c)) & kPackedAxisMask]; }
+  bool ends_voxline(std::uint32_t e) const { return (words[e] & kPackedVoxlineEnd) != 0; }
+};
+
 struct VoxelOrderWriter::Scratch {
   std::vector<std::uint32_t> starts;
   SortScratch sort;
+  PackedBlock packed;  // write_packed's table, 12 KiB: here rather than on the stack or per voxel
 };
 
 VoxelOrderWriter::VoxelOrderWriter(const OrderSetSpec& set, std::uint32_t max_vertices)
@@ -315,15 +325,6 @@ struct FloatBlock {
   bool ends_voxline(std::uint32_t e) const { return ends.test(first + e); }
 };
 
-// A voxel's block as packed words: a coordinate is looked up in a table of what each of the 1024
-// quanta of its axis decodes to (VertexPacker::decode_axis), so the block is never decoded whole.
-struct PackedBlock {
-  const std::uint32_t* words;
-  std::array<std::array<float, kPackedSteps + 1>, 3> decoded;
-  float axis(std::uint32_t e, int c) const { return decoded[c][(words[e] >> (10 * c)) & kPackedAxisMask]; }
-  bool ends_voxline(std::uint32_t e) const { return (words[e] & kPackedVoxlineEnd) != 0; }
-};
-
 void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const LevelEntry> row, std::span<const float> vertices,
                              const VoxlineEnds& ends, std::uint8_t* dst) {
   write_levels(v, row, FloatBlock{vertices.data() + 3 * v.vertex_first, ends, v.vertex_first}, dst);
@@ -331,12 +332,12 @@ void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const LevelEntry> ro
 
 void VoxelOrderWriter::write_packed(const VoxelEntry& v, std::span<const LevelEntry> row, const std::uint32_t* words,
                                     std::uint8_t* dst) {
-  auto block = std::make_unique<PackedBlock>();  // 12 KiB: not on the stack
-  block->words = words;
+  PackedBlock& block = scratch_->packed;
+  block.words = words;
   const VertexPacker packer(v);
   for (int c = 0; c < 3; ++c)
-    for (std::uint32_t q = 0; q <= kPackedSteps; ++q) block->decoded[c][q] = packer.decode_axis(c, q);
-  write_levels(v, row, *block, dst);
+    for (std::uint32_t q = 0; q <= kPackedSteps; ++q) block.decoded[c][q] = packer.decode_axis(c, q);
+  write_levels(v, row, block, dst);
 }
 
 template <typename Block>

@@ -180,8 +180,8 @@ class StreamingConversion {
   void write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> vertices,
                           std::uint64_t vertices_first, VoxelOrderWriter& writer, VoxlineEnds& block_ends,
                           std::uint8_t* dst);
-  // The (voxel, level) blocks of VERT with vertices, and the staging each of them takes in memory when
-  // written block by block (DirectRegionWriter::staging_size).
+  // The memory VERT's stagings take when written block by block: the write queue's spares and each
+  // (voxel, level) block's own (DirectRegionWriter::staging_size), as open_block_writers carves them.
   std::uint64_t block_staging_total(std::uint64_t staging) const;
   // The most VERT bytes of any run of consecutive voxels whose orders fit in a chunk (read back at once).
   std::uint64_t largest_chunk_vertex_bytes() const;
@@ -814,11 +814,11 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
   // The chunks' orders and the vertices read back: in pool_ after the blocks' staging is done with.
   std::unique_ptr<std::uint8_t[]> own_chunks[2];
   std::uint8_t* chunks[2] = {};
-  VxlStreamWriter::ReadBackBuffer read_buffers[2];
+  std::span<std::uint8_t> read_buffers[2];
   if (block_staging_ > 0) {
     for (int b = 0; b < 2; ++b) {
       chunks[b] = pool_.get() + b * pool_chunk_bytes_;
-      read_buffers[b].use({pool_.get() + 2 * pool_chunk_bytes_ + b * pool_read_back_bytes_, pool_read_back_bytes_});
+      read_buffers[b] = {pool_.get() + 2 * pool_chunk_bytes_ + b * pool_read_back_bytes_, pool_read_back_bytes_};
     }
   }
   auto fetch = [&](std::size_t c) {
@@ -870,8 +870,6 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
     report(stage, double(end - r.first) / double(std::max<std::size_t>(1, r.end - r.first)));
   }
   if (writing.valid()) writing.get();
-  if (block_staging_ > 0 && r.first == r.end)  // no voxel, no vertex: nothing to read back
-    out_->read_back(VxlStreamWriter::kVert, 0, read_buffers[0]);
 }
 
 // Voxel g's orders at `dst`, from its block in `vertices` (the part of VERT from vertex
@@ -899,7 +897,7 @@ void StreamingConversion::write_voxel_orders(const Range& r, std::size_t g, std:
 std::uint64_t StreamingConversion::block_staging_total(std::uint64_t staging) const {
   const std::uint32_t levels = settings_.levels;
   const std::uint64_t bytes = vertex_bytes(settings_.positions);
-  std::uint64_t total = 0;
+  std::uint64_t total = kSpareBlockStagings * staging;  // the write queue's spares
   for (std::size_t g = 0; g < voxels_.size(); ++g) {
     const std::span<const LevelEntry> row = level_row(levels_, g, levels);
     for (std::uint32_t d = 0; d < levels; ++d) {  // as open_block_writers cuts them
@@ -977,8 +975,7 @@ ConvertSummary StreamingConversion::run() {
     budget_.take(staged_held_, "the voxlines of two batches being placed");
   }
   // Direct writes (the output bypasses the page cache) where the limit leaves room for their staging.
-  if (settings_.memory_limit >= (tuning_.direct_writes_from_limit > 0 ? tuning_.direct_writes_from_limit
-                                                                       : kDirectWritesFromLimit)) {
+  if (settings_.memory_limit >= kDirectWritesFromLimit) {
     direct_staging_ = kDirectStagingBytes;
     budget_.take(VxlStreamWriter::kCount * kDirectStagingBytes, "the staging of the output's direct writes");
   }
@@ -991,18 +988,17 @@ ConvertSummary StreamingConversion::run() {
     // (that staging, then two orders chunks and two chunks' vertices read back) at most half.
     constexpr std::uint64_t block = DirectRegionWriter::kBlock;
     pool_chunk_bytes_ = (order_chunk_bytes_ + block - 1) / block * block;
-    pool_read_back_bytes_ = VxlStreamWriter::ReadBackBuffer::bytes_for(largest_chunk_vertex_bytes());
+    pool_read_back_bytes_ = VxlStreamWriter::read_back_bytes(largest_chunk_vertex_bytes());
     for (std::uint64_t staging = kBlockStagingBytes; staging >= kMinBlockStagingBytes && block_staging_ == 0;
          staging /= 2) {
-      const std::uint64_t total = kSpareBlockStagings * staging + block_staging_total(staging);
+      const std::uint64_t total = block_staging_total(staging);
       if (total <= budget_.left() / 8 &&
           std::max(total, 2 * (pool_chunk_bytes_ + pool_read_back_bytes_)) <= budget_.left() / 2)
         block_staging_ = staging;
     }
   }
   if (block_staging_ > 0) {
-    pool_bytes_ = std::max(kSpareBlockStagings * block_staging_ + block_staging_total(block_staging_),
-                           2 * (pool_chunk_bytes_ + pool_read_back_bytes_));
+    pool_bytes_ = std::max(block_staging_total(block_staging_), 2 * (pool_chunk_bytes_ + pool_read_back_bytes_));
     budget_.take(pool_bytes_, "the vertex blocks being written, then the orders being built and their vertices");
     void* p = std::aligned_alloc(DirectRegionWriter::kBlock, pool_bytes_);
     if (p == nullptr) throw std::bad_alloc();

@@ -42,8 +42,7 @@ ConvertSummary convert_streaming(const std::string& source_path, const std::stri
 // Sizes the conversion otherwise derives from the limit, set by tests (to reach on small data what
 // only large data would) and benchmarks; 0 keeps the derived value. The output does not depend on them.
 struct StreamingTuning {
-  std::uint64_t direct_writes_from_limit = 0;  // direct writes under limits of at least this (default 256 MiB)
-  std::uint64_t order_chunk_bytes = 0;         // orders built and written this much at a time (or one voxel)
+  std::uint64_t order_chunk_bytes = 0;  // orders built and written this much at a time (or one voxel)
 };
 ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
                                  const ConvertSettings& settings, const StreamingTuning& tuning);

@@ -47,22 +47,13 @@ std::unique_ptr<DirectWriteQueue> VxlStreamWriter::write_queue(std::vector<std::
   return std::make_unique<DirectWriteQueue>(out_, direct_fd_, std::move(spares), buffer_bytes);
 }
 
-std::uint64_t VxlStreamWriter::ReadBackBuffer::bytes_for(std::uint64_t size) {
+std::uint64_t VxlStreamWriter::read_back_bytes(std::uint64_t size) {
   constexpr std::uint64_t block = DirectRegionWriter::kBlock;
   return (size + block - 1) / block * block + block;  // a misaligned start adds a block
 }
 
-void VxlStreamWriter::ReadBackBuffer::reserve(std::uint64_t size) {
-  constexpr std::uint64_t block = DirectRegionWriter::kBlock;
-  const std::uint64_t need = bytes_for(size);
-  if (capacity >= need) return;
-  void* p = std::aligned_alloc(block, need);
-  if (p == nullptr) throw std::bad_alloc();
-  bytes = {static_cast<std::uint8_t*>(p), std::free};  // not the caller's memory (use()) any longer
-  capacity = need;
-}
-
-std::span<const std::uint8_t> VxlStreamWriter::read_back(Section section, std::uint64_t size, ReadBackBuffer& buffer) {
+std::span<const std::uint8_t> VxlStreamWriter::read_back(Section section, std::uint64_t size,
+                                                         std::span<std::uint8_t> buffer) {
   const std::size_t i = entry_[section];
   if (i >= table_.size() || size > table_[i].size - written_[i])
     throw std::logic_error("VxlStreamWriter::read_back: more bytes than the section holds");
@@ -70,11 +61,12 @@ std::span<const std::uint8_t> VxlStreamWriter::read_back(Section section, std::u
   const std::uint64_t from = table_[i].offset + written_[i];
   // Direct reads take whole blocks into a block-aligned buffer: the blocks around [from, from + size).
   const std::uint64_t lo = from / block * block, hi = (from + size + block - 1) / block * block;
-  if (buffer.capacity < hi - lo) buffer.reserve(size);
-  std::uint8_t* const data = buffer.bytes.get() + (from - lo);
+  if (buffer.size() < hi - lo || reinterpret_cast<std::uintptr_t>(buffer.data()) % block != 0)
+    throw std::logic_error("VxlStreamWriter::read_back: the buffer is not block-aligned or too small");
+  std::uint8_t* const data = buffer.data() + (from - lo);
   std::uint64_t done = 0;  // bytes of [lo, hi) read directly
   while (direct_fd_ >= 0 && lo + done < from + size) {
-    const ssize_t n = ::pread(direct_fd_, buffer.bytes.get() + done, hi - lo - done, static_cast<off_t>(lo + done));
+    const ssize_t n = ::pread(direct_fd_, buffer.data() + done, hi - lo - done, static_cast<off_t>(lo + done));
     if (n < 0 && errno == EINTR) continue;
     if (n < 0 && errno == EINVAL) break;  // no direct reads here: through the page cache
     if (n < 0)
@@ -84,7 +76,7 @@ std::span<const std::uint8_t> VxlStreamWriter::read_back(Section section, std::u
   }
   if (lo + done < from + size) {
     const std::uint64_t start = std::max(from, lo + done);
-    out_.pread(buffer.bytes.get() + (start - lo), from + size - start, start);
+    out_.pread(buffer.data() + (start - lo), from + size - start, start);
   }
   const std::span<const std::uint8_t> bytes(data, size);
   checksums_[i]->update(bytes.data(), bytes.size());

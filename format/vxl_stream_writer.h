@@ -9,7 +9,6 @@
 #pragma once
 
 #include <cstdint>
-#include <cstdlib>
 #include <future>
 #include <memory>
 #include <span>
@@ -70,26 +69,16 @@ class VxlStreamWriter : public VxlSections {
   // order (direct where the file system allows, staged `staging_bytes` at a time, in `staging_memory` if
   // given: see DirectRegionWriter); the regions may be
   // written in any order, each must be complete before it is read back. read_back() then reads the
-  // payload's next `size` bytes into `buffer` (past the page cache where allowed), checksums them and
-  // counts them as appended: a payload written this way is read back whole, in order.
+  // payload's next `size` bytes into `buffer` (block-aligned, at least read_back_bytes(size): the blocks
+  // around them), past the page cache where allowed, checksums them and counts them as appended: a
+  // payload written this way is read back whole, in order.
   std::unique_ptr<DirectRegionWriter> region_writer(Section section, std::uint64_t offset, std::uint64_t size,
                                                     std::uint64_t staging_bytes, std::uint8_t* staging_memory = nullptr,
                                                     DirectWriteQueue* queue = nullptr);
   // A queue that region writers hand their full staging to (DirectWriteQueue), writing to this file.
   std::unique_ptr<DirectWriteQueue> write_queue(std::vector<std::uint8_t*> spares, std::uint64_t buffer_bytes);
-  struct ReadBackBuffer {
-    std::unique_ptr<std::uint8_t, void (*)(void*)> bytes{nullptr, std::free};  // block-aligned
-    std::uint64_t capacity = 0;
-    // Room to read back any `size` bytes (the blocks around them) without growing.
-    void reserve(std::uint64_t size);
-    static std::uint64_t bytes_for(std::uint64_t size);  // what reserve(size) takes
-    // Reads back into `memory` (block-aligned, owned by the caller) instead.
-    void use(std::span<std::uint8_t> memory) {
-      bytes = {memory.data(), [](void*) {}};
-      capacity = memory.size();
-    }
-  };
-  std::span<const std::uint8_t> read_back(Section section, std::uint64_t size, ReadBackBuffer& buffer);
+  static std::uint64_t read_back_bytes(std::uint64_t size);
+  std::span<const std::uint8_t> read_back(Section section, std::uint64_t size, std::span<std::uint8_t> buffer);
 
   void append_meta(const MetaSection& meta);  // zeroes the reserved bytes
   std::uint64_t written(Section section) const {
