@@ -44,13 +44,15 @@ std::uint32_t chosen_set(const VxlFile& file, const TckExportSettings& settings)
 
 }  // namespace
 
-ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings) {
+ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings,
+                         const StreamlineSubset* subset, const std::vector<std::string>& extra_header) {
   ExportSummary summary;
-  const MetaSection& m = file.meta();
-  summary.streamlines = m.streamline_count;
-  summary.points = m.point_count;
+  const SubsetCounts counts = subset_counts(file, subset);
+  summary.streamlines = counts.streamlines;
+  summary.points = counts.points;
   std::vector<std::string> header = {"voxlines_exported_from: " +
                                      std::filesystem::path(file.path()).filename().string()};
+  header.insert(header.end(), extra_header.begin(), extra_header.end());
 
   // The TSF's values, checked before anything is written.
   std::vector<float> values;
@@ -58,7 +60,7 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
   if (settings.tsf_path) {
     set = chosen_set(file, settings);
     summary.value_set = file.vertex_values().name(set);
-    values = values_at(file, set, source_vertex_indices(file));
+    values = values_at(file, set, source_vertex_indices(file, subset));
     for (std::size_t i = 0; i < values.size(); ++i)
       if (!std::isfinite(values[i]))
         fail_unsupported(file.path(), "value set '" + summary.value_set + "' has a non-finite value (point " +
@@ -84,11 +86,12 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
         std::to_string(file.streamline_values().size()) +
         " per-streamline value set(s) not written: TCK and TSF have no place for them (export to .trx)");
 
-  TckWriter writer(out_path, m.streamline_count, header);
+  TckWriter writer(out_path, counts.streamlines, header);
   std::optional<TsfWriter> tsf;
-  if (settings.tsf_path) tsf.emplace(*settings.tsf_path, m.streamline_count, header);
+  if (settings.tsf_path) tsf.emplace(*settings.tsf_path, counts.streamlines, header);
   std::uint64_t point = 0;
   WalkCallbacks cb;
+  cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };
   cb.streamline = [&](std::uint64_t, std::span<const float> xyz) {
     writer.add(xyz);
     if (tsf) tsf->add(std::span<const float>(values).subspan(point, xyz.size() / 3));

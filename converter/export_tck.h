@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "converter/streamline_subset.h"
 #include "format/vxl_file.h"
 
 namespace vxl {
@@ -23,9 +24,11 @@ struct ExportSummary {
 };
 
 // Writes `out_path` (and the TSF) atomically; the streamlines are those the converter read (spec §5.6),
-// bit-exact for float32 sources, and the TSF holds the source points' values bit-exact. Throws
+// bit-exact for float32 sources, and the TSF holds the source points' values bit-exact; only the
+// subset's streamlines when there is one. `header` lines are added to the TCK's (and TSF's) header. Throws
 // vxl::Error: Usage when a TSF is asked for and the file has no per-point values or none named `value`,
 // Unsupported when a value is NaN or infinite (TSF separators), Output.
-ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings = {});
+ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings = {},
+                         const StreamlineSubset* subset = nullptr, const std::vector<std::string>& header = {});
 
 }  // namespace vxl

@@ -131,14 +131,16 @@ TrxReference trx_reference(const VxlFile& file) {
   return r;
 }
 
-void export_trx(const VxlFile& file, const std::string& out_path) {
+void export_trx(const VxlFile& file, const std::string& out_path, const StreamlineSubset* subset) {
   const MetaSection& m = file.meta();
+  const SubsetCounts counts = subset_counts(file, subset);
   std::vector<float> positions;
-  positions.reserve(3 * m.point_count);
+  positions.reserve(3 * counts.points);
   std::vector<std::uint64_t> offsets;
-  offsets.reserve(m.streamline_count + 1);
+  offsets.reserve(counts.streamlines + 1);
   offsets.push_back(0);
   WalkCallbacks cb;
+  cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };
   cb.streamline = [&](std::uint64_t, std::span<const float> xyz) {
     positions.insert(positions.end(), xyz.begin(), xyz.end());
     offsets.push_back(positions.size() / 3);
@@ -149,8 +151,8 @@ void export_trx(const VxlFile& file, const std::string& out_path) {
   nlohmann::json header;
   header["DIMENSIONS"] = ref.dimensions;
   header["VOXEL_TO_RASMM"] = ref.voxel_to_rasmm;
-  header["NB_STREAMLINES"] = m.streamline_count;
-  header["NB_VERTICES"] = m.point_count;
+  header["NB_STREAMLINES"] = counts.streamlines;
+  header["NB_VERTICES"] = counts.points;
   const std::string header_text = header.dump(2);
 
   std::vector<StreamlineGroup> groups = file.groups();
@@ -167,11 +169,12 @@ void export_trx(const VxlFile& file, const std::string& out_path) {
                        "two groups are named '" + groups[g].name + "': TRX holds one groups/NAME.uint32 per name");
     if (m.streamline_count > std::numeric_limits<std::uint32_t>::max())
       fail_unsupported(file.path(), "TRX group members are uint32: more than 2^32 - 1 streamlines cannot be grouped");
+    if (subset) groups[g].members = subset->renumber(groups[g].members);
     members[g].assign(groups[g].members.begin(), groups[g].members.end());
   }
 
   // dpv / dps from the value sets (export_values.h); built before the archive is opened.
-  const std::vector<TrxValueMember> values = trx_value_members(file);
+  const std::vector<TrxValueMember> values = trx_value_members(file, subset);
 
   ZipWriter zip(out_path);
   zip.add_stored("header.json", header_text.data(), header_text.size());

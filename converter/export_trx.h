@@ -18,6 +18,7 @@
 #include <array>
 #include <string>
 
+#include "converter/streamline_subset.h"
 #include "format/vxl_file.h"
 
 namespace vxl {
@@ -35,6 +36,7 @@ TrxReference trx_reference(const VxlFile& file);
 // file, Unsupported for a group or value set name that cannot be a member name (or is another group's too)
 // or more than 2^32 - 1 streamlines (group members are uint32), both before the archive is created;
 // Output only when the archive cannot be written.
-void export_trx(const VxlFile& file, const std::string& out_path);
+// With a subset, only its streamlines (and their values; groups keep their members among them).
+void export_trx(const VxlFile& file, const std::string& out_path, const StreamlineSubset* subset = nullptr);
 
 }  // namespace vxl

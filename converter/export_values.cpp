@@ -29,9 +29,12 @@ bool split_component(const std::string& name, std::string& base, std::uint32_t& 
 
 // Members for one kind: `count` values per set; `dir` is "dpv" or "dps".
 void add_members(const VxlFile& file, const ValueSets& sets, const std::string& dir, std::uint64_t count,
-                 const std::vector<std::uint64_t>* vertices, std::vector<TrxValueMember>& out) {
+                 const std::vector<std::uint64_t>* vertices, const StreamlineSubset* subset,
+                 std::vector<TrxValueMember>& out) {
   auto column = [&](std::uint32_t k) {
-    return vertices ? values_at(file, k, *vertices) : std::vector<float>(sets.values(k).begin(), sets.values(k).end());
+    if (vertices) return values_at(file, k, *vertices);
+    if (subset) return subset->pick(sets.values(k));
+    return std::vector<float>(sets.values(k).begin(), sets.values(k).end());
   };
   for (std::uint32_t k = 0; k < sets.size();) {
     std::string base, next_base;
@@ -62,15 +65,14 @@ void add_members(const VxlFile& file, const ValueSets& sets, const std::string& 
 
 }  // namespace
 
-std::vector<std::uint64_t> source_vertex_indices(const VxlFile& file) {
+std::vector<std::uint64_t> source_vertex_indices(const VxlFile& file, const StreamlineSubset* subset) {
   std::vector<std::uint64_t> out;
-  out.reserve(file.meta().point_count);
-  auto voxlines = file.voxlines();
-  std::uint64_t j = 0;  // the walk visits the voxlines in table order
+  out.reserve(subset_counts(file, subset).points);
   WalkCallbacks cb;
-  cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t own, bool) {
-    const std::uint32_t skip = (voxlines[j++].count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
-    for (std::uint32_t i = skip; i < own; ++i) out.push_back(first + i);
+  cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };
+  cb.voxline = [&](const VoxlineVisit& v) {
+    if (!in_subset(subset, v.streamline)) return;
+    for (std::uint32_t i = v.synthetic_first ? 1 : 0; i < v.own_points; ++i) out.push_back(v.first_vertex + i);
   };
   walk_streamlines(file, cb);
   return out;
@@ -83,13 +85,14 @@ std::vector<float> values_at(const VxlFile& file, std::uint32_t set, const std::
   return out;
 }
 
-std::vector<TrxValueMember> trx_value_members(const VxlFile& file) {
+std::vector<TrxValueMember> trx_value_members(const VxlFile& file, const StreamlineSubset* subset) {
   std::vector<TrxValueMember> out;
   if (!file.vertex_values().empty()) {
-    const std::vector<std::uint64_t> vertices = source_vertex_indices(file);
-    add_members(file, file.vertex_values(), "dpv", vertices.size(), &vertices, out);
+    const std::vector<std::uint64_t> vertices = source_vertex_indices(file, subset);
+    add_members(file, file.vertex_values(), "dpv", vertices.size(), &vertices, nullptr, out);
   }
-  add_members(file, file.streamline_values(), "dps", file.meta().streamline_count, nullptr, out);
+  add_members(file, file.streamline_values(), "dps", subset ? subset->size() : file.meta().streamline_count, nullptr,
+              subset, out);
   return out;
 }
 

@@ -6,13 +6,15 @@
 #include <string>
 #include <vector>
 
+#include "converter/streamline_subset.h"
 #include "format/vxl_file.h"
 
 namespace vxl {
 
-// The VERT index of every source point, streamline after streamline (meta().point_count entries).
-// Throws vxl::Error (Input) for an inconsistent .vxl, as walk_streamlines does.
-std::vector<std::uint64_t> source_vertex_indices(const VxlFile& file);
+// The VERT index of every source point, streamline after streamline (meta().point_count entries), of the
+// subset's streamlines only when there is one. Throws vxl::Error (Input) for an inconsistent .vxl, as
+// walk_streamlines does.
+std::vector<std::uint64_t> source_vertex_indices(const VxlFile& file, const StreamlineSubset* subset = nullptr);
 
 // VVAL set `set` at the given vertices.
 std::vector<float> values_at(const VxlFile& file, std::uint32_t set, const std::vector<std::uint64_t>& vertices);
@@ -25,6 +27,6 @@ struct TrxValueMember {
 // The dpv (from VVAL) and dps (from SVAL) members of a TRX. Sets named NAME[0], NAME[1], … NAME[m-1] in a
 // row (how the readers split a multi-component TRX array, .vxl spec §5.11) become one NAME.m.float32
 // member again. Throws vxl::Error (Unsupported) for a name that cannot be a member name.
-std::vector<TrxValueMember> trx_value_members(const VxlFile& file);
+std::vector<TrxValueMember> trx_value_members(const VxlFile& file, const StreamlineSubset* subset = nullptr);
 
 }  // namespace vxl

@@ -54,20 +54,20 @@ std::string legacy_name(const std::string& name) {
 
 }  // namespace
 
-void export_vtk(const VxlFile& file, const std::string& out_path) {
-  const MetaSection& m = file.meta();
-  const std::uint64_t lines_size = m.streamline_count + m.point_count;
-  if (m.point_count > std::numeric_limits<std::int32_t>::max() || lines_size > std::numeric_limits<std::int32_t>::max())
+void export_vtk(const VxlFile& file, const std::string& out_path, const StreamlineSubset* subset) {
+  const SubsetCounts m = subset_counts(file, subset);
+  const std::uint64_t lines_size = m.streamlines + m.points;
+  if (m.points > std::numeric_limits<std::int32_t>::max() || lines_size > std::numeric_limits<std::int32_t>::max())
     throw Error(ErrorKind::Unsupported, out_path, std::nullopt,
-                "legacy VTK LINES use 32-bit indices: " + std::to_string(m.point_count) + " points in " +
-                    std::to_string(m.streamline_count) + " streamlines are too many (export to .tck or .trx)");
+                "legacy VTK LINES use 32-bit indices: " + std::to_string(m.points) + " points in " +
+                    std::to_string(m.streamlines) + " streamlines are too many (export to .tck or .trx)");
 
   // One walk: points go straight to the file, the per-point values and the point counts are gathered.
   const ValueSets& vv = file.vertex_values();
   std::vector<std::vector<float>> point_values(vv.size());
-  for (auto& v : point_values) v.reserve(m.point_count);
+  for (auto& v : point_values) v.reserve(m.points);
   std::vector<std::uint32_t> counts;
-  counts.reserve(m.streamline_count);
+  counts.reserve(m.streamlines);
 
   // The title is one line: control characters in the file name would end it early.
   std::string source = std::filesystem::path(file.path()).filename().string();
@@ -76,16 +76,16 @@ void export_vtk(const VxlFile& file, const std::string& out_path) {
   AtomicOutputFile out(out_path);
   BigEndianWriter w(out);
   w.text("# vtk DataFile Version 3.0\nvoxlines export of " + source + " SPACE=RAS\nBINARY\nDATASET POLYDATA\nPOINTS " +
-         std::to_string(m.point_count) + " float\n");
-  const auto voxlines = file.voxlines();
-  std::uint64_t j = 0;
+         std::to_string(m.points) + " float\n");
   WalkCallbacks cb;
-  cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t own, bool) {
-    // The walk visits the voxlines in table order; a synthetic first point has no source point.
-    const std::uint32_t skip = (voxlines[j++].count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
+  cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };
+  cb.voxline = [&](const VoxlineVisit& v) {
+    if (!in_subset(subset, v.streamline)) return;
+    // A synthetic first point has no source point.
+    const std::uint64_t from = v.first_vertex + (v.synthetic_first ? 1 : 0), to = v.first_vertex + v.own_points;
     for (std::uint32_t k = 0; k < vv.size(); ++k) {
       const auto values = vv.values(k);
-      point_values[k].insert(point_values[k].end(), values.begin() + first + skip, values.begin() + first + own);
+      point_values[k].insert(point_values[k].end(), values.begin() + from, values.begin() + to);
     }
   };
   cb.streamline = [&](std::uint64_t, std::span<const float> xyz) {
@@ -94,7 +94,7 @@ void export_vtk(const VxlFile& file, const std::string& out_path) {
   };
   walk_streamlines(file, cb);
 
-  w.text("\nLINES " + std::to_string(m.streamline_count) + " " + std::to_string(lines_size) + "\n");
+  w.text("\nLINES " + std::to_string(m.streamlines) + " " + std::to_string(lines_size) + "\n");
   std::uint32_t next = 0;
   for (std::uint32_t n : counts) {
     w.word(n);
@@ -103,15 +103,16 @@ void export_vtk(const VxlFile& file, const std::string& out_path) {
   w.text("\n");
   const ValueSets& sv = file.streamline_values();
   if (!sv.empty()) {
-    w.text("CELL_DATA " + std::to_string(m.streamline_count) + "\n");
+    w.text("CELL_DATA " + std::to_string(m.streamlines) + "\n");
     for (std::uint32_t k = 0; k < sv.size(); ++k) {
       w.text("SCALARS " + legacy_name(sv.name(k)) + " float 1\nLOOKUP_TABLE default\n");
-      for (float v : sv.values(k)) w.real(v);
+      for (float v : subset ? subset->pick(sv.values(k)) : std::vector<float>(sv.values(k).begin(), sv.values(k).end()))
+        w.real(v);
       w.text("\n");
     }
   }
   if (!point_values.empty()) {
-    w.text("POINT_DATA " + std::to_string(m.point_count) + "\n");
+    w.text("POINT_DATA " + std::to_string(m.points) + "\n");
     for (std::uint32_t k = 0; k < vv.size(); ++k) {
       w.text("SCALARS " + legacy_name(vv.name(k)) + " float 1\nLOOKUP_TABLE default\n");
       for (float v : point_values[k]) w.real(v);

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "converter/streamline_subset.h"
 #include "format/vxl_file.h"
 
 namespace vxl {
@@ -11,6 +12,7 @@ namespace vxl {
 // Writes `out_path` atomically; the points are those the converter read (spec §5.6), bit-exact for float32
 // sources, and the values those of the source points (synthetic face points dropped). Throws vxl::Error
 // (Unsupported when the tractogram is beyond the 32-bit indices of legacy LINES).
-void export_vtk(const VxlFile& file, const std::string& out_path);
+// With a subset, only its streamlines and their values.
+void export_vtk(const VxlFile& file, const std::string& out_path, const StreamlineSubset* subset = nullptr);
 
 }  // namespace vxl

@@ -33,7 +33,7 @@ VoxlineIndex index_voxlines(const VxlFile& f) {
   // The walk checks the voxline and streamline tables (ranges, blocks consumed exactly, connecting
   // vertices equal to the next first point, totals) before anything relies on them.
   WalkCallbacks cb;
-  cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t, bool) { x.first_vertex.push_back(first); };
+  cb.voxline = [&](const VoxlineVisit& v) { x.first_vertex.push_back(v.first_vertex); };
   walk_streamlines(f, cb);
   x.first_point.resize(l + 1);
   x.first_point[0] = 0;

@@ -46,6 +46,7 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
     const std::uint32_t depth = streamline_depth(s, levels);
     if (last < first || last > m.voxline_count)
       fail_input(p, strm_at + 8 * (s + 1), "streamline table not non-decreasing");
+    const bool read = !cb.read_points || cb.read_points(s);
     points.clear();
     float pending_connector[3];  // previous voxline's connecting vertex, when `connector_voxel` is set
     std::int64_t connector_voxel = -1;
@@ -57,28 +58,30 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
       const bool synthetic_first = (e.count_flags & kVoxlineSyntheticFirst) != 0;
       const bool connected = j + 1 < last;
       if (own == 0) fail_input(p, at, "voxline with no points");
+      if (synthetic_first && j == first) fail_input(p, at, "a streamline cannot start with a synthetic point");
       const VoxelEntry& v = voxels[e.voxel];
       std::uint64_t& here = cursor[e.voxel * levels + depth];
       const std::uint64_t end = v.vertex_first + depth_end_vertex(v, f.levels_of(e.voxel), depth);
       const std::uint64_t need = std::uint64_t(own) + (connected ? 1 : 0);
       if (here > end || need > end - here)
         fail_input(p, at, "voxline runs past its voxel's vertex block (or its level's part of it)");
-      block.resize(3 * need);
-      f.read_vertices(e.voxel, here, need, block.data());
-      if (connector_voxel >= 0 &&
-          !same_point(pending_connector, static_cast<std::uint32_t>(connector_voxel), block.data(), e.voxel))
-        fail_input(p, at, "connecting vertex differs from the next voxline's first point");
-      if (synthetic_first && j == first) fail_input(p, at, "a streamline cannot start with a synthetic point");
-      if (cb.voxline) cb.voxline(e.voxel, here, own, connected);
       const std::uint32_t skip = synthetic_first ? 1 : 0;
       synthetic += skip;
-      points.insert(points.end(), block.begin() + 3 * skip, block.begin() + 3 * own);
-      connector_voxel = connected ? std::int64_t(e.voxel) : -1;
-      if (connected) std::copy_n(block.begin() + 3 * own, 3, pending_connector);
+      total_points += own - skip;
+      if (read) {
+        block.resize(3 * need);
+        f.read_vertices(e.voxel, here, need, block.data());
+        if (connector_voxel >= 0 &&
+            !same_point(pending_connector, static_cast<std::uint32_t>(connector_voxel), block.data(), e.voxel))
+          fail_input(p, at, "connecting vertex differs from the next voxline's first point");
+        points.insert(points.end(), block.begin() + 3 * skip, block.begin() + 3 * own);
+        connector_voxel = connected ? std::int64_t(e.voxel) : -1;
+        if (connected) std::copy_n(block.begin() + 3 * own, 3, pending_connector);
+      }
+      if (cb.voxline) cb.voxline({s, e.voxel, here, own, synthetic_first, j == first, connected});
       here += need;
     }
-    total_points += points.size() / 3;
-    if (cb.streamline) cb.streamline(s, points);
+    if (read && cb.streamline) cb.streamline(s, points);
   }
   for (std::size_t i = 0; i < voxels.size(); ++i)
     for (std::uint32_t d = 0; d < levels; ++d)

@@ -9,17 +9,32 @@
 
 namespace vxl {
 
+// One voxline as the walk meets it: where its vertices are and what it is to its streamline.
+struct VoxlineVisit {
+  std::uint64_t streamline;    // its streamline's index in the source
+  std::uint32_t voxel;         // its voxel (index into VOXT)
+  std::uint64_t first_vertex;  // global index in VERT of its first vertex
+  std::uint32_t own_points;    // its own vertices (the connecting vertex, if any, follows them)
+  bool synthetic_first;        // its first own vertex is a point inserted at a voxel face, not a source point
+  bool first_of_streamline;    // it holds the streamline's first point
+  bool connected;              // a connecting vertex follows (it is not the streamline's last voxline)
+};
+
 struct WalkCallbacks {
-  // Called once per streamline, in order, with its source points (synthetic face points dropped).
+  // Called once per streamline whose points are read (see `read_points`), in order, with its source
+  // points (synthetic face points dropped).
   std::function<void(std::uint64_t streamline, std::span<const float> xyz)> streamline;
-  // Optional: called for every voxline with its voxel and its first vertex (global index), before the
-  // streamline callback of the streamline it belongs to.
-  std::function<void(std::uint32_t voxel, std::uint64_t first_vertex, std::uint32_t own_points, bool connected)>
-      voxline;
+  // Optional: called for every voxline, in table order, before the streamline callback of its streamline.
+  std::function<void(const VoxlineVisit&)> voxline;
+  // Optional: which streamlines' points are read and handed to `streamline` (default: all). The others
+  // are walked through the table only (their vertices are not read), so a walk over a few streamlines
+  // costs the table plus their points.
+  std::function<bool(std::uint64_t streamline)> read_points;
 };
 
 // Checks the walk as it goes (table ranges, blocks consumed exactly, connecting vertices equal to the
-// next voxline's first vertex, totals matching META) and throws vxl::Error (Input) on any inconsistency.
+// next voxline's first vertex for the streamlines read, totals matching META) and throws vxl::Error
+// (Input) on any inconsistency.
 void walk_streamlines(const VxlFile& file, const WalkCallbacks& callbacks);
 
 }  // namespace vxl

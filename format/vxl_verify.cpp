@@ -171,9 +171,9 @@ VerifyResult verify_vxl(const std::string& path) {
     // The walk marks which vertices start a segment (all but each voxline's last vertex).
     std::vector<std::uint8_t> is_segment_start(f.meta().vertex_count, 0);
     WalkCallbacks cb;
-    cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t own, bool connected) {
-      std::uint64_t n = own + (connected ? 1 : 0);
-      for (std::uint64_t i = 0; i + 1 < n; ++i) is_segment_start[first + i] = 1;
+    cb.voxline = [&](const VoxlineVisit& v) {
+      const std::uint64_t n = v.own_points + (v.connected ? 1 : 0);
+      for (std::uint64_t i = 0; i + 1 < n; ++i) is_segment_start[v.first_vertex + i] = 1;
     };
     walk_streamlines(f, cb);
     check_orders(f, is_segment_start);

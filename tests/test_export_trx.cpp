@@ -50,7 +50,7 @@ std::string convert_to(Tractogram t, const std::string& path) {
 Tractogram streamlines_of(const VxlFile& f) {
   Tractogram t;
   walk_streamlines(
-      f, {[&](std::uint64_t, std::span<const float> xyz) { t.add_streamline(xyz.data(), xyz.size() / 3); }, {}});
+      f, {[&](std::uint64_t, std::span<const float> xyz) { t.add_streamline(xyz.data(), xyz.size() / 3); }, {}, {}});
   return t;
 }
 

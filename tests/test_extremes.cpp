@@ -47,7 +47,7 @@ Tractogram shifted(double offset) {
 std::vector<float> walk_points(const VxlFile& f) {
   std::vector<float> out;
   walk_streamlines(
-      f, {[&](std::uint64_t, std::span<const float> xyz) { out.insert(out.end(), xyz.begin(), xyz.end()); }, {}});
+      f, {[&](std::uint64_t, std::span<const float> xyz) { out.insert(out.end(), xyz.begin(), xyz.end()); }, {}, {}});
   return out;
 }
 

@@ -86,7 +86,11 @@ TEST(Levels, EachLevelIsAPrefixHoldingItsStreamlines) {
   const auto strm = f.streamline_first_voxline();
   std::uint64_t voxline = 0;
   WalkCallbacks cb;
-  cb.voxline = [&](std::uint32_t voxel, std::uint64_t first, std::uint32_t own, bool connected) {
+  cb.voxline = [&](const VoxlineVisit& visit) {
+    const std::uint32_t voxel = visit.voxel;
+    const std::uint64_t first = visit.first_vertex;
+    const std::uint32_t own = visit.own_points;
+    const bool connected = visit.connected;
     while (strm[streamline + 1] <= voxline) ++streamline;
     const std::uint32_t depth = streamline_depth(streamline, 4);
     const VoxelEntry& v = f.voxels()[voxel];

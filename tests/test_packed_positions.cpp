@@ -172,7 +172,7 @@ TEST_P(PackedConversion, EveryPointComesBackWithinTheBound) {
   for (const VoxelEntry& v : f.voxels()) bound = std::max(bound, packed_error_bound(v));
   std::vector<float> got;
   walk_streamlines(
-      f, {[&](std::uint64_t, std::span<const float> xyz) { got.insert(got.end(), xyz.begin(), xyz.end()); }, {}});
+      f, {[&](std::uint64_t, std::span<const float> xyz) { got.insert(got.end(), xyz.begin(), xyz.end()); }, {}, {}});
   ASSERT_EQ(got.size(), expected.size());
   double worst = 0;
   for (std::size_t k = 0; k < got.size(); ++k) worst = std::max(worst, std::abs(double(got[k]) - expected[k]));

@@ -116,8 +116,8 @@ std::vector<float> point_values_of(const VxlFile& f, std::uint32_t set) {
   std::vector<float> out;
   const auto values = f.vertex_values().values(set);
   WalkCallbacks cb;
-  cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t own, bool) {
-    out.insert(out.end(), values.begin() + first, values.begin() + first + own);
+  cb.voxline = [&](const VoxlineVisit& v) {
+    out.insert(out.end(), values.begin() + v.first_vertex, values.begin() + v.first_vertex + v.own_points);
   };
   walk_streamlines(f, cb);
   // The walk reports synthetic first points too; drop them by the voxline table's flags.

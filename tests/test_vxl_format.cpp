@@ -92,6 +92,7 @@ TEST_P(VxlFormat, RoundTripThroughTheWalk) {
                          got.insert(got.end(), xyz.begin(), xyz.end());
                          offsets.push_back(got.size() / 3);
                        },
+                       {},
                        {}});
   EXPECT_EQ(offsets, expected.offsets);
   if (!packed) {

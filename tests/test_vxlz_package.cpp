@@ -128,7 +128,8 @@ double max_vertex_error(const VxlFile& a, const VxlFile& b) {
   EXPECT_EQ(x.size(), y.size());
   double worst = 0;
   WalkCallbacks cb;
-  cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t own, bool) {
+  cb.voxline = [&](const VoxlineVisit& v) {
+    const std::uint64_t first = v.first_vertex, own = v.own_points;
     for (std::uint64_t i = 3 * first; i < 3 * (first + own) && i < std::min(x.size(), y.size()); ++i)
       worst = std::max(worst, std::abs(double(x[i]) - double(y[i])));
   };
@@ -146,6 +147,7 @@ Streamlines streamlines_of(const VxlFile& f) {
                          s.sizes.push_back(xyz.size() / 3);
                          s.points.insert(s.points.end(), xyz.begin(), xyz.end());
                        },
+                       {},
                        {}});
   return s;
 }

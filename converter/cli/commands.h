@@ -18,6 +18,7 @@ void add_convert_command(CLI::App& app, int& exit_code);
 void add_info_command(CLI::App& app);
 void add_verify_command(CLI::App& app, int& exit_code);
 void add_export_command(CLI::App& app);
+void add_select_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 void add_pack_command(CLI::App& app);
 void add_unpack_command(CLI::App& app);

@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   vxl::cli::add_info_command(app);
   vxl::cli::add_verify_command(app, exit_code);
   vxl::cli::add_export_command(app);
+  vxl::cli::add_select_command(app);
   vxl::cli::add_synth_command(app);
   vxl::cli::add_pack_command(app);
   vxl::cli::add_unpack_command(app);

@@ -1,17 +1,6 @@
-// Reads an anatomical image (NIfTI-1 or NIfTI-2, .nii or .nii.gz) into a render-side Volume, with
-// Debian's nifti_clib (libnifti2). Every malformed file is a vxl::Error naming it (exit 3); sizes beyond
-// what the viewer handles are exit 4. The header's size, magic and dimensions are checked against the
-// file, and the voxels read, here; nifti_clib interprets the header (types, byte order, transforms).
-// Single-file NIfTI only (.hdr/.img pairs are refused, exit 4).
-//
-//   values  any NIfTI data type, as float, scaled by scl_slope / scl_inter (slope 0: unscaled); RGB and
-//           complex types give their mean / magnitude; NaN and infinities become 0. A 4D image gives its
-//           first volume.
-//   space   the sform when sform_code > 0, else the qform (the library's pixel-size matrix when neither is
-//           set), in mm (metre and micron units converted): voxel index -> RAS mm.
-//   window  the default grey range: the 2nd and 98th percentiles of the image's non-zero voxels (the air
-//           around a head is 0 in most T1s and would otherwise pull the window down); of all voxels
-//           when every one is 0.
+// An anatomical image (NIfTI, read by converter/readers/nifti_image.h) as the render-side Volume, with its
+// default grey window: the 2nd and 98th percentiles of the image's non-zero voxels (the air around a head
+// is 0 in most T1s and would otherwise pull the window down); of all voxels when every one is 0.
 #pragma once
 
 #include <array>

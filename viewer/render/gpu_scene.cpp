@@ -279,7 +279,11 @@ const std::vector<std::int64_t>& GpuScene::dataset_first() {
       const std::uint32_t file_first = layout_.files()[fi].voxel_first;
       WalkCallbacks cb;
       const auto file_voxels = files_[fi]->voxels();
-      cb.voxline = [&](std::uint32_t voxel, std::uint64_t first_vertex, std::uint32_t own, bool connected) {
+      cb.voxline = [&](const VoxlineVisit& v) {
+        const std::uint32_t voxel = v.voxel;
+        const std::uint64_t first_vertex = v.first_vertex;
+        const std::uint32_t own = v.own_points;
+        const bool connected = v.connected;
         const VoxelDrawInfo& d = layout_.voxels()[file_first + voxel];
         const std::uint32_t c = d.span;
         // The voxline's first vertex in its span's words; voxlines past the level's prefix are not drawn.

@@ -34,17 +34,16 @@ std::vector<float> vertex_attributes(const VxlFile& file, std::size_t file_index
   const std::span<const float> per_streamline = source.kind == ValueSource::Kind::Streamline
                                                     ? file.streamline_values().values(source.set)
                                                     : std::span<const float>{};
-  std::uint64_t streamline = 0;
   WalkCallbacks cb;
-  cb.voxline = [&](std::uint32_t, std::uint64_t first, std::uint32_t own, bool connected) {
-    const std::uint64_t end = first + own + (connected ? 1 : 0);
-    const float group = uniform_group ? constant_group : static_cast<float>(groups->group_of(file_index, streamline));
-    for (std::uint64_t i = first; i < end; ++i) {
-      if (!per_streamline.empty()) out[2 * i] = per_streamline[streamline];
+  cb.voxline = [&](const VoxlineVisit& v) {
+    const std::uint64_t end = v.first_vertex + v.own_points + (v.connected ? 1 : 0);
+    const float group =
+        uniform_group ? constant_group : static_cast<float>(groups->group_of(file_index, v.streamline));
+    for (std::uint64_t i = v.first_vertex; i < end; ++i) {
+      if (!per_streamline.empty()) out[2 * i] = per_streamline[v.streamline];
       out[2 * i + 1] = group;
     }
   };
-  cb.streamline = [&](std::uint64_t, std::span<const float>) { ++streamline; };
   walk_streamlines(file, cb);
   return out;
 }

@@ -1,0 +1,121 @@
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include "converter/cli/commands.h"
+#include "converter/selection/selection_output.h"
+#include "converter/selection/streamline_selection.h"
+#include "format/error.h"
+
+namespace vxl::cli {
+namespace {
+
+// The criteria as MRtrix would record them in a TCK header (one line each), so that a selection says how
+// it was made.
+std::vector<std::string> criteria_lines(const std::vector<std::string>& include, const std::vector<std::string>& ends,
+                                        const std::vector<std::string>& exclude, const SelectionCriteria& c) {
+  std::vector<std::string> out;
+  for (const std::string& r : include) out.push_back("roi: include " + r);
+  for (const std::string& r : ends) out.push_back("roi: ends_in " + r);
+  for (const std::string& r : exclude) out.push_back("roi: exclude " + r);
+  if (c.min_length) out.push_back("min_dist: " + std::to_string(*c.min_length));
+  if (c.max_length) out.push_back("max_dist: " + std::to_string(*c.max_length));
+  if (c.invert) out.push_back("voxlines_selection: inverted");
+  return out;
+}
+
+}  // namespace
+
+void add_select_command(CLI::App& app) {
+  struct Options {
+    std::string input, output;
+    std::vector<std::string> include, exclude, ends_in;
+    std::optional<double> min_length, max_length;
+    bool invert = false, count = false, json = false, verbose = false;
+    TckExportSettings tck;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "select",
+      "Select streamlines by regions and length (virtual dissection), with MRtrix tckedit's rules:\n"
+      "  voxlines select IN.vxl OUT.tck|.trx|.vtk|.vxl --include ROI [--include ROI]... [--exclude ROI]...\n"
+      "  voxlines select IN.vxl --include ROI --count [--json]\n"
+      "A streamline is kept when every --include region holds one of its points, every --ends-in region its first\n"
+      "or last point, no --exclude region any of its points, and its length is within the limits. ROI: X,Y,Z,R (a\n"
+      "sphere, RAS mm; a point at distance <= R is inside), box:X0,Y0,Z0,X1,Y1,Z1, FILE.nii[.gz] (its non-zero\n"
+      "voxels: the voxel nearest to the point) or FILE.nii[.gz]:LABEL (one label of a parcellation).\n"
+      "Points are those the .vxl stores: bit for bit the source's with --positions float32; with packed positions\n"
+      "(the default) within the bound `voxlines info` prints, so a streamline whose deciding point lies that close\n"
+      "to a region's surface may be decided differently from tckedit on the source.");
+  cmd->add_option("input", opt->input, ".vxl file")->required();
+  cmd->add_option("output", opt->output,
+                  "the selected streamlines, in source order: .tck (with --tsf: one per-point value set), .trx "
+                  "(groups, dpv, dps), .vtk or .vxl (the input's conversion settings); written atomically, valid "
+                  "when empty. Not needed with --count");
+  cmd->add_option("--include", opt->include, "a region every kept streamline passes through (repeatable)")
+      ->type_name("ROI");
+  cmd->add_option("--exclude", opt->exclude, "a region no kept streamline touches (repeatable)")->type_name("ROI");
+  cmd->add_option("--ends-in", opt->ends_in,
+                  "a region holding the first or the last point of every kept streamline (repeatable; tckedit's "
+                  "-include with -ends_only)")
+      ->type_name("ROI");
+  cmd->add_option("--min-length", opt->min_length, "keep streamlines at least this long (mm)")->type_name("MM");
+  cmd->add_option("--max-length", opt->max_length, "keep streamlines at most this long (mm)")->type_name("MM");
+  cmd->add_flag("--invert", opt->invert, "keep exactly the streamlines the criteria reject (tckedit's -inverse)");
+  cmd->add_flag("--count", opt->count, "print only the number of selected streamlines (no output file)");
+  cmd->add_flag("--json", opt->json, "print the result as JSON");
+  cmd->add_option("--tsf", opt->tck.tsf_path, "with a .tck output: also write one per-point value set as a TSF");
+  cmd->add_option("--value", opt->tck.value, "the per-point value set for --tsf (default: the first)");
+  cmd->add_flag("--verbose", opt->verbose, "say what the query touched");
+  cmd->callback([opt] {
+    if (opt->count == !opt->output.empty())
+      throw Error(ErrorKind::Usage, opt->input, std::nullopt,
+                  opt->count ? "--count prints the count: give no output file" : "give an output file, or --count");
+    if (!opt->output.empty() && !is_selection_output(opt->output))
+      throw Error(ErrorKind::Usage, opt->output, std::nullopt, "a selection is written to .tck, .trx, .vtk or .vxl");
+    for (const std::optional<double>& limit : {opt->min_length, opt->max_length})
+      if (limit && !(std::isfinite(*limit) && *limit >= 0))
+        throw Error(ErrorKind::Usage, "--min-length/--max-length", std::nullopt,
+                    "a length limit is a finite, non-negative number of mm");
+    SelectionCriteria criteria;
+    for (const std::string& r : opt->include) criteria.include.push_back(parse_region(r));
+    for (const std::string& r : opt->exclude) criteria.exclude.push_back(parse_region(r));
+    for (const std::string& r : opt->ends_in) criteria.ends_in.push_back(parse_region(r));
+    criteria.min_length = opt->min_length;
+    criteria.max_length = opt->max_length;
+    criteria.invert = opt->invert;
+
+    const VxlFile file = VxlFile::open(opt->input);
+    const SelectionResult result = select_streamlines(file, criteria);
+    const std::uint64_t total = file.meta().streamline_count;
+    std::vector<std::string> warnings;
+    if (!opt->count) {
+      const StreamlineSubset subset(total, result.streamlines);
+      warnings = write_selection(file, subset, opt->output, opt->tck,
+                                 criteria_lines(opt->include, opt->ends_in, opt->exclude, criteria));
+    }
+    for (const std::string& w : warnings) std::fprintf(stderr, "voxlines: warning: %s\n", w.c_str());
+    const std::uint64_t kept = result.streamlines.size();
+    if (opt->json) {
+      nlohmann::json j = {{"selected", kept},
+                          {"streamlines", total},
+                          {"voxels_touched", result.voxels_touched},
+                          {"voxels", file.meta().voxel_count},
+                          {"points_tested", result.points_tested},
+                          {"streamlines_measured", result.streamlines_measured}};
+      if (!opt->output.empty()) j["output"] = opt->output;
+      std::printf("%s\n", j.dump(2).c_str());
+    } else if (opt->count) {
+      std::printf("%llu\n", (unsigned long long)kept);
+    } else {
+      std::printf("%s: %llu of %llu streamlines selected\n", opt->output.c_str(), (unsigned long long)kept,
+                  (unsigned long long)total);
+    }
+    if (opt->verbose && !opt->json)
+      std::fprintf(stderr, "select: %u of %u voxels touched, %llu points tested, %llu streamlines measured\n",
+                   result.voxels_touched, file.meta().voxel_count, (unsigned long long)result.points_tested,
+                   (unsigned long long)result.streamlines_measured);
+  });
+}
+
+}  // namespace vxl::cli

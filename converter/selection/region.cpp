@@ -1,0 +1,216 @@
+#include "converter/selection/region.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+
+#include "format/error.h"
+
+namespace vxl {
+namespace {
+
+[[noreturn]] void bad_region(const std::string& text, const std::string& why) {
+  throw Error(ErrorKind::Usage, text, std::nullopt, "not a usable region: " + why);
+}
+
+// "a,b,c,..." as floats; nothing when a piece is not exactly a number.
+std::optional<std::vector<float>> parse_floats(std::string_view s) {
+  std::vector<float> out;
+  while (true) {
+    const std::size_t comma = s.find(',');
+    std::string_view piece = s.substr(0, comma);
+    while (!piece.empty() && piece.front() == ' ') piece.remove_prefix(1);
+    while (!piece.empty() && piece.back() == ' ') piece.remove_suffix(1);
+    if (!piece.empty() && piece.front() == '+') piece.remove_prefix(1);
+    float v = 0;
+    const auto [end, ec] = std::from_chars(piece.data(), piece.data() + piece.size(), v);
+    if (piece.empty() || ec != std::errc() || end != piece.data() + piece.size()) return std::nullopt;
+    out.push_back(v);
+    if (comma == std::string_view::npos) return out;
+    s.remove_prefix(comma + 1);
+  }
+}
+
+bool is_nifti_name(std::string name) {
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
+  return name.ends_with(".nii") || name.ends_with(".nii.gz");
+}
+
+bool all_finite(const std::vector<float>& v) {
+  return std::all_of(v.begin(), v.end(), [](float x) { return std::isfinite(x); });
+}
+
+}  // namespace
+
+Region Region::sphere(Point3f centre, float radius, std::string text) {
+  Region r;
+  r.shape_ = Shape::Sphere;
+  r.text_ = std::move(text);
+  r.centre_ = centre;
+  r.radius_ = radius;
+  r.radius2_ = radius * radius;
+  for (int c = 0; c < 3; ++c) r.lo_[c] = centre[c] - radius, r.hi_[c] = centre[c] + radius;
+  return r;
+}
+
+Region Region::box(Point3f lo, Point3f hi, std::string text) {
+  Region r;
+  r.shape_ = Shape::Box;
+  r.text_ = std::move(text);
+  r.lo_ = lo;
+  r.hi_ = hi;
+  return r;
+}
+
+Region Region::mask(const NiftiImage& image, std::optional<float> label, std::string text) {
+  Region r;
+  r.shape_ = Shape::Mask;
+  r.text_ = std::move(text);
+  r.dims_ = image.dims;
+  r.set_.resize(image.values.size());
+  std::array<std::int64_t, 3> first{INT64_MAX, INT64_MAX, INT64_MAX}, last{-1, -1, -1};
+  std::size_t at = 0;
+  for (std::int64_t k = 0; k < image.dims[2]; ++k)
+    for (std::int64_t j = 0; j < image.dims[1]; ++j)
+      for (std::int64_t i = 0; i < image.dims[0]; ++i, ++at) {
+        const float v = image.values[at];
+        if (label ? v != *label : v == 0.0f) continue;
+        r.set_[at] = 1;
+        const std::int64_t index[3] = {i, j, k};
+        for (int c = 0; c < 3; ++c) first[c] = std::min(first[c], index[c]), last[c] = std::max(last[c], index[c]);
+      }
+  if (last[0] < 0)
+    bad_region(r.text_, label ? "the image holds no voxel of label " + std::to_string(*label) : "the mask is empty");
+
+  // RAS -> voxel: the inverse of the image's affine, in double, then rounded to float32 as tckedit keeps it.
+  const auto& a = image.voxel_to_ras;
+  const double m[3][3] = {{a[0], a[1], a[2]}, {a[4], a[5], a[6]}, {a[8], a[9], a[10]}};
+  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  double inv[3][3];
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) {
+      // The cofactor of (col, row), over the determinant.
+      const int r0 = (col + 1) % 3, r1 = (col + 2) % 3, c0 = (row + 1) % 3, c1 = (row + 2) % 3;
+      inv[row][col] = (m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]) / det;
+    }
+  const double t[3] = {a[3], a[7], a[11]};
+  for (int row = 0; row < 3; ++row) {
+    double offset = 0;
+    for (int col = 0; col < 3; ++col) {
+      r.ras_to_voxel_[4 * row + col] = static_cast<float>(inv[row][col]);
+      offset -= inv[row][col] * t[col];
+    }
+    r.ras_to_voxel_[4 * row + 3] = static_cast<float>(offset);
+  }
+
+  // The RAS box of the set voxels' cubes: the corners of [first - 1/2, last + 1/2] through the affine,
+  // widened by a voxel's hundredth for the float32 lookup's rounding.
+  for (int c = 0; c < 3; ++c) r.lo_[c] = INFINITY, r.hi_[c] = -INFINITY;
+  for (int corner = 0; corner < 8; ++corner) {
+    double index[3];
+    for (int c = 0; c < 3; ++c) index[c] = (corner >> c & 1) ? double(last[c]) + 0.5 : double(first[c]) - 0.5;
+    for (int row = 0; row < 3; ++row) {
+      const double x = a[4 * row] * index[0] + a[4 * row + 1] * index[1] + a[4 * row + 2] * index[2] + a[4 * row + 3];
+      const double margin = 0.01 * (std::abs(a[4 * row]) + std::abs(a[4 * row + 1]) + std::abs(a[4 * row + 2]));
+      r.lo_[row] = std::min(r.lo_[row], static_cast<float>(x - margin));
+      r.hi_[row] = std::max(r.hi_[row], static_cast<float>(x + margin));
+    }
+  }
+  return r;
+}
+
+bool Region::contains(const float* p) const {
+  switch (shape_) {
+    case Shape::Sphere: {
+      // tckedit: (pos - p).squaredNorm() <= radius^2, in float32, summed x, then y, then z.
+      const float dx = centre_[0] - p[0], dy = centre_[1] - p[1], dz = centre_[2] - p[2];
+      return dx * dx + dy * dy + dz * dz <= radius2_;
+    }
+    case Shape::Box:
+      return p[0] >= lo_[0] && p[0] <= hi_[0] && p[1] >= lo_[1] && p[1] <= hi_[1] && p[2] >= lo_[2] && p[2] <= hi_[2];
+    case Shape::Mask: {
+      std::int64_t index[3];
+      for (int row = 0; row < 3; ++row) {
+        const float* m = &ras_to_voxel_[4 * row];
+        const float v = m[0] * p[0] + m[1] * p[1] + m[2] * p[2] + m[3];
+        const float rounded = std::round(v);
+        if (!(rounded >= 0.0f && rounded < float(dims_[row]))) return false;
+        index[row] = static_cast<std::int64_t>(rounded);
+      }
+      return set_[static_cast<std::size_t>((index[2] * dims_[1] + index[1]) * dims_[0] + index[0])] != 0;
+    }
+  }
+  return false;
+}
+
+bool Region::may_touch(const float* lo, const float* hi) const {
+  // A thousandth of a millimetre (relative to the coordinates' size) of slack: the float32 tests above
+  // round, a box test here must never be the one that misses a point.
+  auto slack = [](float a, float b) { return 1e-3f + 1e-6f * std::max(std::abs(a), std::abs(b)); };
+  if (shape_ == Shape::Sphere) {
+    double d2 = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double below = double(lo[c]) - centre_[c], above = double(centre_[c]) - hi[c];
+      const double d = std::max({below, above, 0.0});
+      d2 += d * d;
+    }
+    const double reach = double(radius_) + slack(centre_[0] + centre_[1] + centre_[2], radius_);
+    return d2 <= reach * reach;
+  }
+  for (int c = 0; c < 3; ++c) {
+    const float s = slack(lo_[c], hi_[c]);
+    if (hi[c] < lo_[c] - s || lo[c] > hi_[c] + s) return false;
+  }
+  return true;
+}
+
+Region parse_region(const std::string& text) {
+  std::error_code ec;
+  const bool names_file = std::filesystem::exists(text, ec);
+  if (!names_file && text.starts_with("box:")) {
+    const auto v = parse_floats(std::string_view(text).substr(4));
+    if (!v || v->size() != 6) bad_region(text, "a box is box:X0,Y0,Z0,X1,Y1,Z1 (two corners, RAS mm)");
+    if (!all_finite(*v)) bad_region(text, "a box corner is not finite");
+    const Point3f lo{(*v)[0], (*v)[1], (*v)[2]}, hi{(*v)[3], (*v)[4], (*v)[5]};
+    for (int c = 0; c < 3; ++c)
+      if (lo[c] > hi[c])
+        bad_region(text, "the box's first corner must be below its second on every axis (" + std::string(1, "xyz"[c]) +
+                             ": " + std::to_string(lo[c]) + " > " + std::to_string(hi[c]) + ")");
+    return Region::box(lo, hi, text);
+  }
+  if (!names_file) {
+    if (const auto v = parse_floats(text)) {
+      if (v->size() != 4) bad_region(text, "a sphere is X,Y,Z,R (centre and radius, RAS mm)");
+      if (!all_finite(*v)) bad_region(text, "the sphere's centre and radius must be finite");
+      if ((*v)[3] < 0) bad_region(text, "the sphere's radius is negative");
+      return Region::sphere({(*v)[0], (*v)[1], (*v)[2]}, (*v)[3], text);
+    }
+  }
+  // An image: FILE or FILE:LABEL (FILE itself may hold ':').
+  std::string path = text;
+  std::optional<float> label;
+  if (!names_file) {
+    const std::size_t colon = text.rfind(':');
+    if (colon != std::string::npos && colon > 0) {
+      const auto l = parse_floats(std::string_view(text).substr(colon + 1));
+      if (l && l->size() == 1 && std::isfinite((*l)[0])) {
+        path = text.substr(0, colon);
+        label = (*l)[0];
+      }
+    }
+  }
+  if (!std::filesystem::exists(path, ec)) {
+    bad_region(text, is_nifti_name(path) ? "no such image file"
+                                         : "expected X,Y,Z,R (a sphere), box:X0,Y0,Z0,X1,Y1,Z1, or a NIfTI mask "
+                                           "(FILE.nii, FILE.nii.gz, FILE.nii.gz:LABEL)");
+  }
+  if (!is_nifti_name(path))
+    throw Error(ErrorKind::Unsupported, path, std::nullopt,
+                "a region image must be NIfTI (.nii or .nii.gz); convert other formats first (e.g. mrconvert)");
+  return Region::mask(read_nifti_image(path), label, text);
+}
+
+}  // namespace vxl

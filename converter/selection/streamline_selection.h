@@ -1,0 +1,55 @@
+// Virtual dissection: which streamlines of a .vxl pass a set of regions and length limits, with MRtrix
+// tckedit's semantics (region.h for containment):
+//
+//   kept  when every include region contains at least one of the streamline's source points, every
+//         ends-in region contains its first or its last point (tckedit's -include with -ends_only), no
+//         exclude region contains any of its points, and its length (the sum of its segments' lengths)
+//         lies within [min_length, max_length] (widened as tckedit widens them: by a tenth of the source's
+//         step_size, or half a step over its downsample_factor, when the source header has one);
+//         `invert` keeps exactly the others.
+//
+// Points are the source points as the .vxl stores them (synthetic face points are not tested): bit for bit
+// the source's with --positions float32, within the file's packed bound otherwise, so that a streamline
+// whose deciding point lies within that bound of a region's surface may be decided differently from
+// tckedit on the source file.
+//
+// The voxel grid is the index: a region is tested only against the voxlines of the voxels whose bounds it
+// may touch, so the cost is the voxline table (8 bytes a voxline, about a tenth of the source's bytes)
+// plus the vertices of those voxels — not every point of the file. Length limits read the points of the
+// streamlines that pass the regions (all of them when there is no include region).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "converter/selection/region.h"
+#include "format/vxl_file.h"
+
+namespace vxl {
+
+struct SelectionCriteria {
+  std::vector<Region> include, exclude, ends_in;
+  std::optional<double> min_length, max_length;  // mm
+  bool invert = false;
+};
+
+struct SelectionResult {
+  std::vector<std::uint64_t> streamlines;  // the kept ones, increasing (source order)
+  // What the query touched, for --verbose and the benchmark.
+  std::uint32_t voxels_touched = 0;        // voxels some region may touch
+  std::uint64_t points_tested = 0;         // vertices read for the regions
+  std::uint64_t streamlines_measured = 0;  // streamlines whose points were read for the length limits
+};
+
+// At most this many regions in one selection (one bit each per streamline being tested).
+inline constexpr std::size_t kMaxRegions = 64;
+
+// How far tckedit widens length limits for this file's source (0 when its header has no step_size).
+double length_limit_margin(const VxlFile& file);
+
+// Throws vxl::Error: Usage for more than kMaxRegions regions or min_length > max_length, Input for a .vxl
+// whose tables do not hold together.
+SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria);
+
+}  // namespace vxl

@@ -1,0 +1,472 @@
+// Virtual dissection (voxlines select): the voxel-indexed query against a brute-force reference that tests
+// every source point of every streamline, on random spheres, boxes and masks (an oblique affine among
+// them), exclude and ends-only regions, length limits and their inverse; tckedit's containment rules at the
+// edges (a point on a sphere, a zero radius, rounding to the nearest mask voxel); the outputs (TCK, TRX with
+// groups and values, VTK, VXL, and empty ones); packed positions' flips counted and explained; hostile
+// region arguments refused with nothing written.
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "converter/convert.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/selection/region.h"
+#include "converter/selection/selection_output.h"
+#include "converter/selection/streamline_selection.h"
+#include "converter/synth.h"
+#include "format/error.h"
+#include "format/vxl_verify.h"
+#include "tests/nifti_test_files.h"
+#include "tests/test_support.h"
+
+namespace vxl {
+namespace {
+
+using test::run_cli;
+using test::ScratchDir;
+
+Tractogram synth(std::uint64_t n, std::uint64_t seed = 7) {
+  SynthSettings s;
+  s.streamlines = n;
+  s.seed = seed;
+  return synthesize_tractogram(s);
+}
+
+ConvertSettings settings(PositionEncoding positions, double voxel_size = 10.0) {
+  ConvertSettings s;
+  s.positions = positions;
+  s.voxel_size = voxel_size;
+  s.threads = 2;
+  return s;
+}
+
+// The reference: every point of every streamline of the source tested against every region.
+std::vector<std::uint64_t> brute_force(const Tractogram& t, const SelectionCriteria& c) {
+  std::vector<std::uint64_t> kept;
+  for (std::uint64_t s = 0; s < t.streamline_count(); ++s) {
+    const std::uint64_t first = t.offsets[s], last = t.offsets[s + 1];
+    auto point = [&](std::uint64_t i) { return &t.positions[3 * i]; };
+    auto anywhere = [&](const Region& r) {
+      for (std::uint64_t i = first; i < last; ++i)
+        if (r.contains(point(i))) return true;
+      return false;
+    };
+    bool pass = std::all_of(c.include.begin(), c.include.end(), anywhere) &&
+                std::none_of(c.exclude.begin(), c.exclude.end(), anywhere);
+    for (const Region& r : c.ends_in)
+      pass = pass && last > first && (r.contains(point(first)) || r.contains(point(last - 1)));
+    if (c.min_length || c.max_length) {
+      double length = 0;
+      for (std::uint64_t i = first + 1; i < last; ++i) {
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k) d2 += std::pow(double(point(i)[k]) - point(i - 1)[k], 2);
+        length += std::sqrt(d2);
+      }
+      pass = pass && !(c.min_length && length < *c.min_length) && !(c.max_length && length > *c.max_length);
+    }
+    if (pass != c.invert) kept.push_back(s);
+  }
+  return kept;
+}
+
+Region sphere(float x, float y, float z, float r) {
+  return parse_region(std::to_string(x) + "," + std::to_string(y) + "," + std::to_string(z) + "," + std::to_string(r));
+}
+
+// A label map over the synthetic brain: 2 mm voxels turned 30 degrees about z and 10 about x (an oblique
+// affine), labels 1 and 2 in two random blobs, 0 elsewhere.
+std::string write_oblique_labels(const ScratchDir& dir, std::mt19937& rng) {
+  const std::array<std::int64_t, 3> dims{90, 100, 80};
+  const double a = 30 * M_PI / 180, b = 10 * M_PI / 180, s = 2.0;
+  // R = Rz(a) * Rx(b), scaled by s; voxel (45, 50, 40) at the synthetic centre.
+  const double r[3][3] = {{std::cos(a), -std::sin(a) * std::cos(b), std::sin(a) * std::sin(b)},
+                          {std::sin(a), std::cos(a) * std::cos(b), -std::cos(a) * std::sin(b)},
+                          {0, std::sin(b), std::cos(b)}};
+  std::array<double, 12> m{};
+  for (int row = 0; row < 3; ++row) {
+    double t = kSynthCentre[row];
+    for (int col = 0; col < 3; ++col) {
+      m[4 * row + col] = s * r[row][col];
+      t -= s * r[row][col] * (col == 0 ? 45 : col == 1 ? 50 : 40);
+    }
+    m[4 * row + 3] = t;
+  }
+  std::uniform_int_distribution<int> ci(20, 70), cj(20, 80), ck(15, 65);
+  const int centres[2][3] = {{ci(rng), cj(rng), ck(rng)}, {ci(rng), cj(rng), ck(rng)}};
+  std::vector<std::int16_t> values(std::size_t(dims[0] * dims[1] * dims[2]), 0);
+  for (std::int64_t k = 0; k < dims[2]; ++k)
+    for (std::int64_t j = 0; j < dims[1]; ++j)
+      for (std::int64_t i = 0; i < dims[0]; ++i)
+        for (int l = 0; l < 2; ++l) {
+          const double d2 =
+              std::pow(i - centres[l][0], 2) + std::pow(j - centres[l][1], 2) + std::pow(k - centres[l][2], 2);
+          if (d2 < 36 + 20 * std::sin(double(i + 2 * j + 3 * k)))  // a lumpy blob, ~6 voxels across
+            values[std::size_t((k * dims[1] + j) * dims[0] + i)] = std::int16_t(l + 1);
+        }
+  const std::string path = dir.file("labels.nii.gz");
+  test::write_nifti_int16(path, dims, values, m);
+  return path;
+}
+
+class Selection : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    source_ = new Tractogram(synth(3000));
+    dir_ = new ScratchDir();
+    Tractogram copy = *source_;
+    convert_tractogram(std::move(copy), dir_->file("f32.vxl"), settings(PositionEncoding::Float32));
+    copy = *source_;
+    convert_tractogram(std::move(copy), dir_->file("f32_4mm.vxl"), settings(PositionEncoding::Float32, 4.0));
+  }
+  static void TearDownTestSuite() {
+    delete source_;
+    delete dir_;
+  }
+  static Tractogram* source_;
+  static ScratchDir* dir_;
+};
+Tractogram* Selection::source_ = nullptr;
+ScratchDir* Selection::dir_ = nullptr;
+
+TEST_F(Selection, RandomSpheresBoxesAndMasksMatchTheBruteForceReference) {
+  std::mt19937 rng(11);
+  const std::string labels = write_oblique_labels(*dir_, rng);
+  // Regions near random source points (anywhere in the bounds, most would hold nothing).
+  std::uniform_int_distribution<std::uint64_t> point(0, source_->point_count() - 1);
+  std::uniform_real_distribution<float> jitter(-10, 10), radius(0, 25), side(2, 40);
+  auto near_a_point = [&] {
+    const float* p = &source_->positions[3 * point(rng)];
+    return std::array<float, 3>{p[0] + jitter(rng), p[1] + jitter(rng), p[2] + jitter(rng)};
+  };
+  auto random_sphere = [&] {
+    const auto c = near_a_point();
+    return sphere(c[0], c[1], c[2], radius(rng));
+  };
+  auto random_box = [&] {
+    const auto c = near_a_point();
+    const float x0 = c[0] - 10, y0 = c[1] - 10, z0 = c[2] - 10;
+    return parse_region("box:" + std::to_string(x0) + "," + std::to_string(y0) + "," + std::to_string(z0) + "," +
+                        std::to_string(x0 + side(rng)) + "," + std::to_string(y0 + side(rng)) + "," +
+                        std::to_string(z0 + side(rng)));
+  };
+  auto random_region = [&](int kind) {
+    return kind == 0 ? random_sphere() : kind == 1 ? random_box() : parse_region(labels + (kind == 2 ? ":1" : ":2"));
+  };
+  int nonempty = 0, cases = 0;
+  for (const char* file : {"f32.vxl", "f32_4mm.vxl"}) {
+    const VxlFile f = VxlFile::open(dir_->file(file));
+    for (int trial = 0; trial < 40; ++trial) {
+      SelectionCriteria c;
+      c.include.push_back(random_region(trial % 4));
+      if (trial % 3 == 1) c.include.push_back(random_region((trial + 1) % 4));
+      if (trial % 5 == 2) c.exclude.push_back(random_region((trial + 2) % 2));
+      if (trial % 7 == 3) c.ends_in.push_back(random_region(trial % 2));
+      if (trial % 6 == 4) c.min_length = 60;
+      if (trial % 8 == 5) c.max_length = 120;
+      c.invert = trial % 9 == 6;
+      const SelectionResult r = select_streamlines(f, c);
+      ASSERT_EQ(r.streamlines, brute_force(*source_, c)) << file << " trial " << trial;
+      nonempty += !r.streamlines.empty() && r.streamlines.size() < source_->streamline_count();
+      ++cases;
+    }
+  }
+  // The random regions must mostly cut the set, or the comparison says little.
+  EXPECT_GT(nonempty, cases / 3);
+}
+
+TEST_F(Selection, ExcludeOnlyEndsOnlyAndLengthOnlyMatchTheReference) {
+  const VxlFile f = VxlFile::open(dir_->file("f32.vxl"));
+  std::vector<SelectionCriteria> all(4);
+  all[0].exclude.push_back(sphere(0, -18, 10, 20));
+  all[1].ends_in.push_back(parse_region("box:-80,-110,-60,0,80,80"));  // one end in the right hemisphere
+  all[2].min_length = 50, all[2].max_length = 100;
+  all[3].ends_in.push_back(sphere(-40, -20, 40, 25)), all[3].ends_in.push_back(sphere(40, -20, 40, 25));
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const SelectionResult r = select_streamlines(f, all[i]);
+    EXPECT_EQ(r.streamlines, brute_force(*source_, all[i])) << "case " << i;
+    EXPECT_FALSE(r.streamlines.empty()) << "case " << i;
+  }
+}
+
+TEST_F(Selection, RegionsOutsideEverythingOrHoldingEverything) {
+  const VxlFile f = VxlFile::open(dir_->file("f32.vxl"));
+  SelectionCriteria outside;
+  outside.include.push_back(sphere(1000, 1000, 1000, 50));
+  const SelectionResult none = select_streamlines(f, outside);
+  EXPECT_TRUE(none.streamlines.empty());
+  EXPECT_EQ(none.voxels_touched, 0u);  // no voxel read at all
+  EXPECT_EQ(none.points_tested, 0u);
+  SelectionCriteria everything;
+  everything.include.push_back(parse_region("box:-1000,-1000,-1000,1000,1000,1000"));
+  EXPECT_EQ(select_streamlines(f, everything).streamlines.size(), source_->streamline_count());
+  outside.invert = true;
+  EXPECT_EQ(select_streamlines(f, outside).streamlines.size(), source_->streamline_count());
+}
+
+TEST_F(Selection, ASmallSphereTestsOnlyTheVoxelsItTouches) {
+  const VxlFile f = VxlFile::open(dir_->file("f32.vxl"));
+  SelectionCriteria c;
+  const float* p = &source_->positions[3 * (source_->offsets[0] + 10)];  // a point of streamline 0
+  c.include.push_back(sphere(p[0], p[1], p[2], 5));
+  const SelectionResult r = select_streamlines(f, c);
+  // A 10 mm ball meets at most 2 x 2 x 2 voxel cubes of 10 mm; their tight bounds reach a step beyond the
+  // cube (the connecting vertices), so some neighbours may be looked at too, never more than 3 x 3 x 3.
+  EXPECT_LE(r.voxels_touched, 27u);
+  EXPECT_LT(r.points_tested, f.meta().point_count / 10);
+  ASSERT_FALSE(r.streamlines.empty());
+  EXPECT_EQ(r.streamlines[0], 0u);
+}
+
+TEST(SelectionRegions, ASphereHoldsItsSurfaceAsTckeditDoes) {
+  const Region r = parse_region("0,0,0,5");
+  const float on[3] = {3, 4, 0}, beyond[3] = {3, 4, 0.001f}, centre[3] = {0, 0, 0};
+  EXPECT_TRUE(r.contains(on));
+  EXPECT_FALSE(r.contains(beyond));
+  EXPECT_TRUE(r.contains(centre));
+  const Region zero = parse_region("1.5,2.5,-3.25,0");
+  const float at[3] = {1.5f, 2.5f, -3.25f}, next[3] = {1.5f, 2.5f, std::nextafter(-3.25f, 0.0f)};
+  EXPECT_TRUE(zero.contains(at));
+  EXPECT_FALSE(zero.contains(next));
+  const Region box = parse_region("box:0,0,0,1,2,3");
+  const float corner[3] = {1, 2, 3}, out[3] = {1, 2, 3.0001f};
+  EXPECT_TRUE(box.contains(corner));
+  EXPECT_FALSE(box.contains(out));
+}
+
+TEST(SelectionRegions, AMaskHoldsThePointsWhoseNearestVoxelIsSet) {
+  ScratchDir dir;
+  // 4 x 4 x 4 voxels of 2 mm, voxel (i, j, k) centred at (10 + 2i, -2j, 2k) (y flipped); voxel (1, 2, 3) = 7.
+  std::vector<std::int16_t> v(64, 0);
+  v[(3 * 4 + 2) * 4 + 1] = 7;
+  test::write_nifti_int16(dir.file("m.nii"), {4, 4, 4}, v, {2, 0, 0, 10, 0, -2, 0, 0, 0, 0, 2, 0});
+  const Region mask = parse_region(dir.file("m.nii"));
+  const Region label = parse_region(dir.file("m.nii") + ":7");
+  const float centre[3] = {12, -4, 6}, inside_edge[3] = {12.99f, -4.99f, 6.99f}, outside[3] = {13.01f, -4, 6};
+  const float far[3] = {100, 0, 0};
+  for (const Region* r : {&mask, &label}) {
+    EXPECT_TRUE(r->contains(centre));
+    EXPECT_TRUE(r->contains(inside_edge));
+    EXPECT_FALSE(r->contains(outside));
+    EXPECT_FALSE(r->contains(far));
+  }
+  try {
+    parse_region(dir.file("m.nii") + ":3");
+    ADD_FAILURE() << "an absent label was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Usage);
+    EXPECT_NE(std::string(e.what()).find("label 3"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SelectionOutputs, EveryFormatHoldsTheSelectedStreamlinesInSourceOrder) {
+  ScratchDir dir;
+  Tractogram t = synth(400, 3);
+  // Values and groups, to see them follow the selection.
+  ValueSet per_point{"fa", {}}, per_streamline{"weight", {}};
+  for (std::uint64_t i = 0; i < t.point_count(); ++i) per_point.values.push_back(float(i));
+  for (std::uint64_t s = 0; s < t.streamline_count(); ++s) per_streamline.values.push_back(float(s) / 2);
+  t.point_values.push_back(per_point);
+  t.streamline_values.push_back(per_streamline);
+  StreamlineGroup odd{"odd", {}};
+  for (std::uint64_t s = 1; s < t.streamline_count(); s += 2) odd.members.push_back(s);
+  t.groups.push_back(odd);
+  const Tractogram source = t;
+  convert_tractogram(std::move(t), dir.file("in.vxl"), settings(PositionEncoding::Float32));
+  const VxlFile f = VxlFile::open(dir.file("in.vxl"));
+  SelectionCriteria c;
+  c.include.push_back(parse_region("0,-18,10,15"));
+  const std::vector<std::uint64_t> kept = select_streamlines(f, c).streamlines;
+  ASSERT_GT(kept.size(), 5u);
+  ASSERT_LT(kept.size(), source.streamline_count());
+  const StreamlineSubset subset(source.streamline_count(), kept);
+  for (const char* name : {"out.tck", "out.trx", "out.vtk", "out.vxl"}) {
+    const std::string out = dir.file(name);
+    write_selection(f, subset, out, {}, {});
+    if (std::string(name) == "out.vxl") {
+      ASSERT_TRUE(verify_vxl(out).valid) << verify_vxl(out).problem;
+    }
+    Tractogram back = std::string(name) == "out.vxl" ? Tractogram{} : read_tractogram(out);
+    if (std::string(name) == "out.vxl") {
+      write_selection(VxlFile::open(out),
+                      StreamlineSubset(kept.size(),
+                                       [&] {
+                                         std::vector<std::uint64_t> all(kept.size());
+                                         for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+                                         return all;
+                                       }()),
+                      dir.file("back.trx"), {}, {});
+      back = read_tractogram(dir.file("back.trx"));
+    }
+    ASSERT_EQ(back.streamline_count(), kept.size()) << name;
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+      const std::uint64_t s = kept[i];
+      const std::uint64_t n = source.offsets[s + 1] - source.offsets[s];
+      ASSERT_EQ(back.offsets[i + 1] - back.offsets[i], n) << name << " streamline " << i;
+      EXPECT_TRUE(std::equal(source.positions.begin() + 3 * source.offsets[s],
+                             source.positions.begin() + 3 * source.offsets[s + 1],
+                             back.positions.begin() + 3 * back.offsets[i]))
+          << name << " streamline " << i;
+    }
+    if (std::string(name) == "out.tck") continue;  // a TCK holds positions only
+    ASSERT_EQ(back.point_values.size(), 1u) << name;
+    for (std::size_t i = 0; i < kept.size(); ++i)
+      EXPECT_EQ(back.point_values[0].values[back.offsets[i]], float(source.offsets[kept[i]])) << name;
+    ASSERT_EQ(back.streamline_values.size(), 1u) << name;
+    for (std::size_t i = 0; i < kept.size(); ++i)
+      EXPECT_EQ(back.streamline_values[0].values[i], float(kept[i]) / 2) << name;
+    if (std::string(name) == "out.vtk") continue;  // legacy VTK has no groups
+    ASSERT_EQ(back.groups.size(), 1u) << name;
+    std::vector<std::uint64_t> odd_kept;
+    for (std::size_t i = 0; i < kept.size(); ++i)
+      if (kept[i] % 2 == 1) odd_kept.push_back(i);
+    EXPECT_EQ(back.groups[0].members, odd_kept) << name;
+  }
+}
+
+TEST(SelectionOutputs, AnEmptySelectionWritesValidEmptyFiles) {
+  ScratchDir dir;
+  convert_tractogram(synth(50), dir.file("in.vxl"), settings(PositionEncoding::Packed));
+  for (const char* name : {"e.tck", "e.trx", "e.vtk", "e.vxl"}) {
+    const test::CommandResult r =
+        run_cli("select " + test::q(dir.file("in.vxl")) + " " + test::q(dir.file(name)) + " --include 5000,0,0,1");
+    ASSERT_EQ(r.exit_code, 0) << name << ": " << r.output;
+    EXPECT_NE(r.output.find("0 of 50 streamlines selected"), std::string::npos) << r.output;
+    if (std::string(name) == "e.vxl") {
+      EXPECT_TRUE(verify_vxl(dir.file(name)).valid) << verify_vxl(dir.file(name)).problem;
+      EXPECT_EQ(VxlFile::open(dir.file(name)).meta().streamline_count, 0u);
+    } else {
+      EXPECT_EQ(read_tractogram(dir.file(name)).streamline_count(), 0u) << name;
+    }
+  }
+}
+
+// Packed positions move a point by up to the file's bound: a streamline whose deciding point lies that
+// close to a region's surface may be decided differently. Count them on a realistic set and check that
+// every one is explained by such a point.
+TEST(SelectionPrecision, PackedPositionsFlipOnlyStreamlinesWithAPointAtTheSurface) {
+  ScratchDir dir;
+  const Tractogram source = synth(4000, 5);
+  Tractogram a = source, b = source;
+  convert_tractogram(std::move(a), dir.file("f32.vxl"), settings(PositionEncoding::Float32));
+  convert_tractogram(std::move(b), dir.file("packed.vxl"), settings(PositionEncoding::Packed));
+  const VxlFile exact = VxlFile::open(dir.file("f32.vxl")), packed = VxlFile::open(dir.file("packed.vxl"));
+  double bound = 0;
+  for (const VoxelEntry& v : packed.voxels()) bound = std::max(bound, packed_error_bound(v));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> x(-60, 60), y(-90, 60), z(-40, 60);
+  std::uint64_t flips = 0, selected = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const float cx = x(rng), cy = y(rng), cz = z(rng), r = 10;
+    SelectionCriteria c;
+    c.include.push_back(sphere(cx, cy, cz, r));
+    const auto e = select_streamlines(exact, c).streamlines, p = select_streamlines(packed, c).streamlines;
+    selected += e.size();
+    std::vector<std::uint64_t> differ;
+    std::set_symmetric_difference(e.begin(), e.end(), p.begin(), p.end(), std::back_inserter(differ));
+    flips += differ.size();
+    for (std::uint64_t s : differ) {
+      double nearest = INFINITY;  // the distance of the streamline's nearest point to the sphere's surface
+      for (std::uint64_t i = source.offsets[s]; i < source.offsets[s + 1]; ++i) {
+        const float* q = &source.positions[3 * i];
+        const double d =
+            std::sqrt(std::pow(q[0] - double(cx), 2) + std::pow(q[1] - double(cy), 2) + std::pow(q[2] - double(cz), 2));
+        nearest = std::min(nearest, std::abs(d - r));
+      }
+      EXPECT_LE(nearest, 2 * std::sqrt(3.0) * bound) << "streamline " << s << " flipped with no point near the surface";
+    }
+  }
+  ASSERT_GT(selected, 1000u);
+  std::printf("packed vs float32 positions: %llu flips in %llu selections of 60 spheres of 10 mm (bound %.2g mm)\n",
+              (unsigned long long)flips, (unsigned long long)selected, bound);
+  EXPECT_LE(double(flips), 0.002 * double(selected));
+}
+
+TEST(SelectionCli, CountJsonAndTheCriteriaInTheTckHeader) {
+  ScratchDir dir;
+  convert_tractogram(synth(300), dir.file("in.vxl"), settings(PositionEncoding::Float32));
+  const std::string in = test::q(dir.file("in.vxl"));
+  const test::CommandResult count = run_cli("select " + in + " --include 0,-18,10,20 --count");
+  ASSERT_EQ(count.exit_code, 0) << count.output;
+  const std::uint64_t n = std::stoull(count.output);
+  EXPECT_GT(n, 0u);
+  const test::CommandResult json = run_cli("select " + in + " --include 0,-18,10,20 --count --json");
+  ASSERT_EQ(json.exit_code, 0) << json.output;
+  EXPECT_EQ(nlohmann::json::parse(json.output)["selected"].get<std::uint64_t>(), n);
+  const test::CommandResult written =
+      run_cli("select " + in + " " + test::q(dir.file("o.tck")) + " --include 0,-18,10,20 --exclude 0,0,0,1");
+  ASSERT_EQ(written.exit_code, 0) << written.output;
+  const Tractogram back = read_tractogram(dir.file("o.tck"));
+  EXPECT_LE(back.streamline_count(), n);
+  EXPECT_NE(back.source.header.dump().find("include 0,-18,10,20"), std::string::npos) << back.source.header.dump();
+}
+
+TEST(SelectionCli, HostileRegionsAreRefusedNamingTheArgumentAndWriteNothing) {
+  ScratchDir dir;
+  convert_tractogram(synth(50), dir.file("in.vxl"), settings(PositionEncoding::Packed));
+  test::write_file(dir.file("text.nii"), {'n', 'o', 't', ' ', 'n', 'i', 'f', 't', 'i'});
+  std::vector<std::int16_t> one(8, 0);
+  one[3] = 2;
+  test::write_nifti_int16(dir.file("atlas.nii.gz"), {2, 2, 2}, one, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0});
+  // A .nii.gz whose header claims 2^16 x 2^16 x 2^10 voxels: refused from the header, before inflating.
+  std::vector<std::int16_t> tiny(8, 1);
+  test::write_nifti_int16(dir.file("huge.nii.gz"), {2, 2, 2}, tiny, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0});
+  {
+    // Patch dim[1..3] (bytes 42..47 of the uncompressed header) through zlib.
+    std::vector<char> raw;
+    gzFile in = gzopen(dir.file("huge.nii.gz").c_str(), "rb");
+    char buf[4096];
+    for (int n; (n = gzread(in, buf, sizeof buf)) > 0;) raw.insert(raw.end(), buf, buf + n);
+    gzclose(in);
+    const std::int16_t dims[3] = {32767, 32767, 1024};
+    std::memcpy(raw.data() + 42, dims, sizeof dims);
+    gzFile out = gzopen(dir.file("huge.nii.gz").c_str(), "wb");
+    gzwrite(out, raw.data(), unsigned(raw.size()));
+    gzclose(out);
+  }
+  struct Case {
+    std::string region;
+    int code;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {"0,0,0,-1", 2, "radius is negative"},
+      {"0,0,0,nan", 2, "finite"},
+      {"0,0,inf,3", 2, "finite"},
+      {"0,0,3", 2, "X,Y,Z,R"},
+      {"box:0,0,0,-1,5,5", 2, "below its second"},
+      {"box:0,0,0,1,1", 2, "box:X0"},
+      {dir.file("text.nii"), 3, "not a NIfTI file"},
+      {dir.file("atlas.nii.gz") + ":9", 2, "no voxel of label 9"},
+      {dir.file("missing.nii.gz"), 2, "no such image file"},
+      {dir.file("huge.nii.gz"), 4, "voxels"},
+      {"nonsense", 2, "expected X,Y,Z,R"},
+  };
+  for (const Case& c : cases) {
+    const std::string out = dir.file("out.tck");
+    const test::CommandResult r =
+        run_cli("select " + test::q(dir.file("in.vxl")) + " " + test::q(out) + " --include " + test::q(c.region));
+    EXPECT_EQ(r.exit_code, c.code) << c.region << ": " << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.region << ": " << r.output;
+    EXPECT_NE(r.output.find(c.region.substr(0, 20)), std::string::npos) << "the message must name the argument";
+    EXPECT_FALSE(std::filesystem::exists(out)) << c.region;
+  }
+  const test::CommandResult lengths =
+      run_cli("select " + test::q(dir.file("in.vxl")) + " --count --min-length 50 --max-length 10");
+  EXPECT_EQ(lengths.exit_code, 2) << lengths.output;
+  const test::CommandResult no_output = run_cli("select " + test::q(dir.file("in.vxl")) + " --include 0,0,0,5");
+  EXPECT_EQ(no_output.exit_code, 2) << no_output.output;
+  const test::CommandResult wrong_extension =
+      run_cli("select " + test::q(dir.file("in.vxl")) + " " + test::q(dir.file("o.trk")) + " --include 0,0,0,5");
+  EXPECT_EQ(wrong_extension.exit_code, 2) << wrong_extension.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("o.trk")));
+}
+
+}  // namespace
+}  // namespace vxl
