@@ -102,7 +102,9 @@ void add_select_command(CLI::App& app) {
                           {"voxels_touched", result.voxels_touched},
                           {"voxels", file.meta().voxel_count},
                           {"points_tested", result.points_tested},
-                          {"streamlines_measured", result.streamlines_measured}};
+                          {"streamlines_measured", result.streamlines_measured},
+                          {"bytes_read", result.bytes_read},
+                          {"file_bytes", file.bytes().size()}};
       if (!opt->output.empty()) j["output"] = opt->output;
       std::printf("%s\n", j.dump(2).c_str());
     } else if (opt->count) {
@@ -112,9 +114,12 @@ void add_select_command(CLI::App& app) {
                   (unsigned long long)total);
     }
     if (opt->verbose && !opt->json)
-      std::fprintf(stderr, "select: %u of %u voxels touched, %llu points tested, %llu streamlines measured\n",
+      std::fprintf(stderr,
+                   "select: %u of %u voxels touched, %llu points tested, %llu streamlines measured, %llu of %llu "
+                   "bytes read\n",
                    result.voxels_touched, file.meta().voxel_count, (unsigned long long)result.points_tested,
-                   (unsigned long long)result.streamlines_measured);
+                   (unsigned long long)result.streamlines_measured, (unsigned long long)result.bytes_read,
+                   (unsigned long long)file.bytes().size());
   });
 }
 

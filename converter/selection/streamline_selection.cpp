@@ -131,6 +131,9 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
   };
   walk_streamlines(file, cb);
   decide_until(n);
+  const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
+  result.bytes_read = file.voxels().size_bytes() + file.streamline_first_voxline().size_bytes() +
+                      file.voxlines().size_bytes() + result.points_tested * vertex_bytes;
 
   // Length limits: the points of the streamlines still in.
   if (criteria.min_length || criteria.max_length) {
@@ -139,6 +142,7 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
     lengths.read_points = [&](std::uint64_t s) { return passes[s] != 0; };
     lengths.streamline = [&](std::uint64_t s, std::span<const float> points) {
       ++result.streamlines_measured;
+      result.bytes_read += points.size() / 3 * vertex_bytes;
       const double length = polyline_length(points);
       if ((criteria.min_length && length < *criteria.min_length - margin) ||
           (criteria.max_length && length > *criteria.max_length + margin))

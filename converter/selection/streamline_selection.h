@@ -40,6 +40,7 @@ struct SelectionResult {
   std::uint32_t voxels_touched = 0;        // voxels some region may touch
   std::uint64_t points_tested = 0;         // vertices read for the regions
   std::uint64_t streamlines_measured = 0;  // streamlines whose points were read for the length limits
+  std::uint64_t bytes_read = 0;            // of the file: the tables walked and the vertices read
 };
 
 // At most this many regions in one selection (one bit each per streamline being tested).

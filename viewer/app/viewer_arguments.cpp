@@ -1,11 +1,13 @@
 #include "viewer/app/viewer_arguments.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "converter/memory_size.h"
 #include "format/error.h"
 #include "viewer/app/camera_file.h"
+#include "viewer/render/scene_groups.h"
 
 namespace vxl::app {
 
@@ -149,6 +151,21 @@ void apply_view_and_size(const ViewerArguments& a, const std::string& size, View
     usage_error("--size must be WxH, each 1..16384");
 }
 
+// Focus and context opacities as the groups "selected" and "context": the scene's opacity is the larger,
+// each group's factor its share of it.
+void apply_selection(const ViewerArguments& a, ViewerOptions& o) {
+  if (!o.selecting()) {
+    if (a.was_given("--focus-opacity") || a.was_given("--context-opacity"))
+      usage_error("--focus-opacity and --context-opacity go with a selection (--include, --exclude, --ends-in)");
+    return;
+  }
+  RenderSettings& s = o.settings;
+  const float focus = a.focus_opacity.value_or(s.opacity), context = a.context_opacity;
+  s.opacity = std::max(focus, context);
+  s.style_of(SceneGroups::kSelected).opacity = focus / s.opacity;
+  s.style_of(SceneGroups::kContext).opacity = context / s.opacity;
+}
+
 }  // namespace
 
 ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
@@ -162,6 +179,7 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
   apply_clipping(a, o.settings.clipping);
   apply_image(a, o);
   apply_view_and_size(a, size, o);
+  apply_selection(a, o);
   if (!a.gpu_memory.empty()) {
     o.gpu_memory = parse_memory_size(a.gpu_memory);
     if (!o.gpu_memory || *o.gpu_memory == 0)

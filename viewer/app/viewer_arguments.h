@@ -25,6 +25,9 @@ struct ViewerArguments {
   std::string image_range, slices, focus, view;
   std::string size = "1024x1024";
   std::string gpu_memory;  // --gpu-memory SIZE
+  // With a selection: the focus's opacity (default --opacity) and the context's (0 hides it).
+  std::optional<float> focus_opacity;
+  float context_opacity = 0.02f;
   // The options given explicitly, by long name ("--mode"): only these override a saved view.
   std::set<std::string> given;
   bool was_given(const char* option) const { return given.count(option) > 0; }

@@ -46,6 +46,10 @@ struct ViewerOptions {
   std::optional<int> frames;
   bool until_refined = false;  // with frames: after them, stay at rest until the refinement is done, then quit
   std::optional<std::string> screenshot;
+  // A selection (`voxlines select`'s regions and rules): its streamlines are the focus, the others context,
+  // with the opacities of the groups "selected" and "context" (scene_selection.h).
+  std::vector<std::string> include, exclude, ends_in;
+  bool selecting() const { return !include.empty() || !exclude.empty() || !ends_in.empty(); }
 };
 
 }  // namespace vxl::app

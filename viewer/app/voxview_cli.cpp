@@ -99,6 +99,28 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
          "it), repeatable")
       ->expected(1)
       ->take_all();
+  cli.add_option("--include", a.options.include,
+                 "select the streamlines that pass through this region (as `voxlines select`: X,Y,Z,R, "
+                 "box:X0,Y0,Z0,X1,Y1,Z1, FILE.nii[.gz][:LABEL]); they are drawn as the focus, the others as "
+                 "context, in one back-to-front pass (repeatable)")
+      ->type_name("ROI")
+      ->expected(1)
+      ->take_all();
+  cli.add_option("--exclude", a.options.exclude, "leave out of the selection the streamlines touching this region")
+      ->type_name("ROI")
+      ->expected(1)
+      ->take_all();
+  cli.add_option("--ends-in", a.options.ends_in, "select the streamlines with an end in this region")
+      ->type_name("ROI")
+      ->expected(1)
+      ->take_all();
+  cli.add_option("--focus-opacity", a.focus_opacity, "with a selection: the selected streamlines' opacity "
+                                                      "(default --opacity)")
+      ->check(CLI::Range(0.001, 1.0));
+  cli.add_option("--context-opacity", a.context_opacity,
+                 "with a selection: the other streamlines' opacity (0 hides them)")
+      ->default_val(0.02)
+      ->check(CLI::Range(0.0, 1.0));
   cli.add_option("--tsf", a.options.tsf,
                  "a TSF file of per-point values for a .tck given as input (converted in memory), repeatable")
       ->expected(1)

@@ -22,6 +22,7 @@
 #include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_controller.h"
 #include "viewer/app/camera_file.h"
+#include "viewer/app/scene_selection.h"
 #include "viewer/app/frame_budget.h"
 #include "viewer/app/frame_log.h"
 #include "viewer/app/headless_render.h"
@@ -149,8 +150,9 @@ class ViewerWindow {
  public:
   // `volume` must outlive the window (coarse levels upload its slices when first drawn); `start`: when
   // voxview started, for --stats.
-  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume, GLFWwindow* window,
-               std::chrono::steady_clock::time_point start);
+  // `selection`: the groups every renderer draws instead of the files' own (a selection's focus and context).
+  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume,
+               std::optional<SceneGroups> selection, GLFWwindow* window, std::chrono::steady_clock::time_point start);
   int run();
 
  private:
@@ -200,6 +202,7 @@ class ViewerWindow {
   GLFWwindow* window_;
   std::vector<const VxlFile*> files_;
   const Volume* volume_;
+  std::optional<SceneGroups> selection_;
   SceneDetail detail_;  // the level of detail drawn at rest, and the span size
   // The GPU memory budget every level's renderer shares: together they never take more.
   std::shared_ptr<GpuMemoryPool> gpu_memory_;
@@ -237,11 +240,13 @@ class ViewerWindow {
 };
 
 ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume,
-                           GLFWwindow* window, std::chrono::steady_clock::time_point start)
+                           std::optional<SceneGroups> selection, GLFWwindow* window,
+                           std::chrono::steady_clock::time_point start)
     : options_(o),
       window_(window),
       files_(pointers(files)),
       volume_(volume),
+      selection_(std::move(selection)),
       detail_(choose_scene_detail(files_, o.level, o.gpu_memory, o.span_texels)),
       gpu_memory_(std::make_shared<GpuMemoryPool>(detail_.budget)),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
@@ -468,6 +473,7 @@ Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
     // (the refinement at rest spreads its level's upload over frames).
     r = std::make_unique<Renderer>(files_, detail_.span_texels, level, gpu_memory_, level == first_level_);
     if (volume_) r->set_volume(*volume_);
+    if (selection_) r->set_groups(*selection_);
   }
   return *r;
 }
@@ -738,8 +744,9 @@ int run_window(const ViewerOptions& o) {
   const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);
+  std::optional<SceneGroups> selection = select_in_scene(pointers(files), o);
   WindowPtr window = open_window(o);
-  ViewerWindow viewer(o, files, volume ? &*volume : nullptr, window.get(), start);
+  ViewerWindow viewer(o, files, volume ? &*volume : nullptr, std::move(selection), window.get(), start);
   return viewer.run();
 }
 

@@ -283,6 +283,11 @@ std::array<float, 2> Renderer::scalar_range(const RenderSettings& s) const {
   return {lo, hi};
 }
 
+void Renderer::set_groups(SceneGroups groups) {
+  groups_ = std::move(groups);
+  attributes_key_ = "(groups replaced)";  // no key a frame asks for: the next one uploads
+}
+
 void Renderer::prepare_attributes(const RenderSettings& s) {
   const std::string name = s.color == ColorMode::Scalar ? scalar_name(s) : std::string();
   bool want_groups = s.color == ColorMode::Group;

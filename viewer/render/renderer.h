@@ -87,6 +87,8 @@ class Renderer {
   const FrameStats& stats() const { return stats_; }
   // The scene's groups (scene_groups.h) and value sets (per-vertex sets first, then per-streamline ones).
   const SceneGroups& groups() const { return groups_; }
+  // Replaces the groups (e.g. with a selection's focus and context); the next frame uploads them.
+  void set_groups(SceneGroups groups);
   const std::vector<std::string>& value_set_names() const { return value_set_names_; }
   // The value set ColorMode::Scalar shows for `settings` (its `scalar`, else the first; empty when none),
   // and the range it maps (settings.range, else the set's stored min and max).

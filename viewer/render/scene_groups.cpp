@@ -42,6 +42,21 @@ SceneGroups::SceneGroups(std::span<const VxlFile* const> files) {
   if (ungrouped > 0) groups_.push_back({"(ungrouped)", ungrouped});
 }
 
+SceneGroups SceneGroups::selection(std::span<const VxlFile* const> files,
+                                   const std::vector<std::vector<std::uint64_t>>& kept) {
+  SceneGroups out;
+  out.groups_ = {{kSelected, 0}, {kContext, 0}};
+  out.files_.resize(files.size());
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const std::uint64_t n = files[i]->meta().streamline_count;
+    out.files_[i].of_streamline.assign(n, 1);
+    for (std::uint64_t s : kept[i]) out.files_[i].of_streamline[s] = 0;
+    out.groups_[0].streamlines += kept[i].size();
+    out.groups_[1].streamlines += n - kept[i].size();
+  }
+  return out;
+}
+
 int SceneGroups::find(const std::string& name) const {
   for (std::size_t g = 0; g < groups_.size(); ++g)
     if (groups_[g].name == name) return static_cast<int>(g);

@@ -3,7 +3,10 @@
 //   several files shown together  one group per file, named after the file;
 //   one file with groups (GRPS)    its groups (TRX bundles); a streamline listed in several takes the
 //                                  first that lists it; those in none form a last group, "(ungrouped)";
-//   one file without groups        one group, named after the file.
+//   one file without groups        one group, named after the file;
+//   a selection (voxlines select's rules, one kept list per file)
+//                                  two groups, "selected" (the focus) and "context" (every other streamline),
+//                                  whatever the files' own groups.
 //
 // Group g gets palette colour g (matplotlib's tab10, repeating) unless the user chose one.
 #pragma once
@@ -29,6 +32,11 @@ class SceneGroups {
   SceneGroups() = default;
   // Reads GRPS (throws vxl::Error naming the file when it is malformed).
   explicit SceneGroups(std::span<const VxlFile* const> files);
+  // The focus and context of a selection: `kept[i]` lists file i's selected streamlines (increasing).
+  static SceneGroups selection(std::span<const VxlFile* const> files,
+                               const std::vector<std::vector<std::uint64_t>>& kept);
+  static constexpr const char* kSelected = "selected";
+  static constexpr const char* kContext = "context";
 
   const std::vector<SceneGroup>& groups() const { return groups_; }
   std::uint32_t group_of(std::size_t file, std::uint64_t streamline) const {

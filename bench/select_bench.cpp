@@ -1,0 +1,143 @@
+// Selection benchmark: `voxlines select` on a .vxl against MRtrix `tckedit` on its TCK, for spheres of 5, 10
+// and 20 mm at three places — the densest voxel (a bundle's core), the top of the brain (cortex) and outside
+// the bounds (empty space) — and one exclude. Each query: the selected count of both, the wall time of both
+// (medians, warm page cache), their ratio, and the bytes of the file `select` reads (its tables and the
+// vertices it tests) against the TCK's size (tckedit reads all of it). tckedit is run only when it is
+// installed; nothing else needs it.
+//
+// Usage: select_bench FILE.tck FILE.vxl [--rounds N] [--tckedit-rounds N]
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/child_process.h"
+#include "format/vxl_file.h"
+
+namespace {
+
+using vxl::bench::run_child;
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+std::string sphere(const std::array<double, 3>& c, double r) {
+  char s[128];
+  std::snprintf(s, sizeof s, "%.3f,%.3f,%.3f,%g", c[0], c[1], c[2], r);
+  return s;
+}
+
+// The `count:` of a TCK header (tckedit writes the true count there when it finishes).
+long long tck_count(const std::string& path) {
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line) && line != "END";)
+    if (line.rfind("count:", 0) == 0) return std::stoll(line.substr(6));
+  return -1;
+}
+
+std::string find_tckedit() {
+  for (const char* dir : {"/usr/bin", "/usr/local/bin"})
+    if (std::filesystem::exists(std::string(dir) + "/tckedit")) return std::string(dir) + "/tckedit";
+  return "";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: select_bench FILE.tck FILE.vxl [--rounds N] [--tckedit-rounds N]\n");
+    return 2;
+  }
+  const std::string tck = argv[1], vxl_path = argv[2];
+  int rounds = 5, tckedit_rounds = 3;
+  for (int i = 3; i + 1 < argc; i += 2) {
+    const std::string a = argv[i];
+    if (a == "--rounds") rounds = std::stoi(argv[i + 1]);
+    if (a == "--tckedit-rounds") tckedit_rounds = std::stoi(argv[i + 1]);
+  }
+  const vxl::VxlFile file = vxl::VxlFile::open(vxl_path);
+  const auto voxels = file.voxels();
+  // The places: the centre of the voxel holding the most vertices, the top of the voxel reaching highest,
+  // and 30 mm beyond the bounds.
+  std::size_t densest = 0, top = 0;
+  for (std::size_t i = 0; i < voxels.size(); ++i) {
+    if (voxels[i].vertex_count > voxels[densest].vertex_count) densest = i;
+    if (voxels[i].tight_max[2] > voxels[top].tight_max[2]) top = i;
+  }
+  auto centre = [&](std::size_t i) {
+    std::array<double, 3> c;
+    for (int k = 0; k < 3; ++k) c[k] = (double(voxels[i].tight_min[k]) + voxels[i].tight_max[k]) / 2;
+    return c;
+  };
+  std::array<double, 3> cortex = centre(top);
+  cortex[2] = voxels[top].tight_max[2] - 5;
+  const auto& m = file.meta();
+  const std::array<double, 3> empty{m.bounds_max[0] + 30, m.bounds_max[1] + 30, m.bounds_max[2] + 30};
+  struct Query {
+    std::string name;
+    std::vector<std::string> ours, theirs;
+  };
+  std::vector<Query> queries;
+  for (const auto& [name, c] :
+       {std::pair{"dense", centre(densest)}, std::pair{"cortex", cortex}, std::pair{"empty", empty}})
+    for (double r : {5.0, 10.0, 20.0})
+      queries.push_back({std::string(name) + " " + std::to_string(int(r)) + " mm",
+                         {"--include", sphere(c, r)},
+                         {"-include", sphere(c, r)}});
+  const std::array<double, 3> beside{centre(densest)[0] + 6, centre(densest)[1], centre(densest)[2]};
+  queries.push_back({"dense 10 mm, exclude 4 mm",
+                     {"--include", sphere(centre(densest), 10), "--exclude", sphere(beside, 4)},
+                     {"-include", sphere(centre(densest), 10), "-exclude", sphere(beside, 4)}});
+
+  const std::string cli = VOXLINES_CLI, tckedit = find_tckedit();
+  const auto tck_bytes = std::filesystem::file_size(tck);
+  const std::string out = (std::filesystem::temp_directory_path() / "select_bench_out.tck").string();
+  std::printf("file: %s (%llu streamlines, %llu bytes; TCK %llu bytes)\n", vxl_path.c_str(),
+              (unsigned long long)m.streamline_count, (unsigned long long)file.bytes().size(),
+              (unsigned long long)tck_bytes);
+  std::printf("tckedit: %s\n", tckedit.empty() ? "not installed (its columns are empty)" : tckedit.c_str());
+  std::printf("%-28s %9s %9s %10s %10s %8s %14s\n", "query", "selected", "tckedit", "select s", "tckedit s", "ratio",
+              "select bytes");
+  for (const Query& q : queries) {
+    // The count and bytes from --json, then the timed runs writing the TCK.
+    std::vector<std::string> count_args = {cli, "select", vxl_path, "--count", "--json"};
+    count_args.insert(count_args.end(), q.ours.begin(), q.ours.end());
+    const std::string json_path = out + ".json";
+    std::string command;
+    for (const std::string& a : count_args) command += "'" + a + "' ";
+    if (std::system((command + "> '" + json_path + "'").c_str()) != 0) {
+      std::fprintf(stderr, "select failed: %s\n", command.c_str());
+      return 1;
+    }
+    std::ifstream json_in(json_path);
+    const nlohmann::json j = nlohmann::json::parse(json_in);
+    std::vector<std::string> args = {cli, "select", vxl_path, out};
+    args.insert(args.end(), q.ours.begin(), q.ours.end());
+    run_child(args, true);  // warm
+    std::vector<double> ours;
+    for (int r = 0; r < rounds; ++r) ours.push_back(run_child(args, true).seconds);
+    double theirs = -1;
+    long long their_count = -1;
+    if (!tckedit.empty()) {
+      std::vector<std::string> t = {tckedit, "-quiet", "-force", "-nthreads", "0", tck, out};
+      t.insert(t.end(), q.theirs.begin(), q.theirs.end());
+      std::vector<double> times;
+      for (int r = 0; r < tckedit_rounds; ++r) times.push_back(run_child(t, true).seconds);
+      theirs = median(times);
+      their_count = tck_count(out);
+    }
+    const double ours_s = median(ours);
+    std::printf("%-28s %9llu %9lld %10.3f %10.3f %8.1f %14llu\n", q.name.c_str(),
+                (unsigned long long)j["selected"].get<std::uint64_t>(), their_count, ours_s, theirs,
+                theirs > 0 ? theirs / ours_s : 0.0, (unsigned long long)j["bytes_read"].get<std::uint64_t>());
+  }
+  std::filesystem::remove(out);
+  std::filesystem::remove(out + ".json");
+  return 0;
+}
