@@ -114,8 +114,9 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
       ->type_name("ROI")
       ->expected(1)
       ->take_all();
-  cli.add_option("--focus-opacity", a.focus_opacity, "with a selection: the selected streamlines' opacity "
-                                                      "(default --opacity)")
+  cli.add_option("--focus-opacity", a.focus_opacity,
+                 "with a selection: the selected streamlines' opacity "
+                 "(default --opacity)")
       ->check(CLI::Range(0.001, 1.0));
   cli.add_option("--context-opacity", a.context_opacity,
                  "with a selection: the other streamlines' opacity (0 hides them)")

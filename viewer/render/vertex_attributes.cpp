@@ -37,8 +37,7 @@ std::vector<float> vertex_attributes(const VxlFile& file, std::size_t file_index
   WalkCallbacks cb;
   cb.voxline = [&](const VoxlineVisit& v) {
     const std::uint64_t end = v.first_vertex + v.own_points + (v.connected ? 1 : 0);
-    const float group =
-        uniform_group ? constant_group : static_cast<float>(groups->group_of(file_index, v.streamline));
+    const float group = uniform_group ? constant_group : static_cast<float>(groups->group_of(file_index, v.streamline));
     for (std::uint64_t i = v.first_vertex; i < end; ++i) {
       if (!per_streamline.empty()) out[2 * i] = per_streamline[v.streamline];
       out[2 * i + 1] = group;
