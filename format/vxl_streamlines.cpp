@@ -25,10 +25,13 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   // One cursor per voxel and depth: a voxel's block holds the voxlines of deeper streamlines first (spec
   // §5.4, §5.12), each depth's in streamline order.
   const std::uint32_t levels = f.level_count();
-  std::vector<std::uint64_t> cursor(voxels.size() * levels);
+  // Each cursor's end is kept beside it: a walk that reads few streamlines costs these lookups per voxline.
+  std::vector<std::uint64_t> cursor(voxels.size() * levels), cursor_end(voxels.size() * levels);
   for (std::size_t i = 0; i < voxels.size(); ++i)
-    for (std::uint32_t d = 0; d < levels; ++d)
+    for (std::uint32_t d = 0; d < levels; ++d) {
       cursor[i * levels + d] = voxels[i].vertex_first + depth_first_vertex(f.levels_of(i), d);
+      cursor_end[i * levels + d] = voxels[i].vertex_first + depth_end_vertex(voxels[i], f.levels_of(i), d);
+    }
   std::vector<float> points, block;
   std::uint64_t total_points = 0, synthetic = 0;
   // A connecting vertex and the next voxline's first point are one source point, stored in two voxels'
@@ -59,9 +62,8 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
       const bool connected = j + 1 < last;
       if (own == 0) fail_input(p, at, "voxline with no points");
       if (synthetic_first && j == first) fail_input(p, at, "a streamline cannot start with a synthetic point");
-      const VoxelEntry& v = voxels[e.voxel];
       std::uint64_t& here = cursor[e.voxel * levels + depth];
-      const std::uint64_t end = v.vertex_first + depth_end_vertex(v, f.levels_of(e.voxel), depth);
+      const std::uint64_t end = cursor_end[e.voxel * levels + depth];
       const std::uint64_t need = std::uint64_t(own) + (connected ? 1 : 0);
       if (here > end || need > end - here)
         fail_input(p, at, "voxline runs past its voxel's vertex block (or its level's part of it)");
@@ -85,7 +87,7 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   }
   for (std::size_t i = 0; i < voxels.size(); ++i)
     for (std::uint32_t d = 0; d < levels; ++d)
-      if (cursor[i * levels + d] != voxels[i].vertex_first + depth_end_vertex(voxels[i], f.levels_of(i), d))
+      if (cursor[i * levels + d] != cursor_end[i * levels + d])
         fail_input(p, f.find_section(section_id("VOXT"))->offset + 64 * i,
                    "voxel block has vertices no voxline uses" +
                        (levels > 1 ? " (at depth " + std::to_string(d) + ")" : std::string()));

