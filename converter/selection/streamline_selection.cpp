@@ -102,7 +102,7 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
   // A voxline's vertices are found by its voxel's cursor (spec §5.6), so cursors are kept for the touched
   // voxels alone and a voxline elsewhere costs one table entry and one look at its voxel's bits: this loop
   // is the query's cost for a small region, and it is written out rather than run through walk_streamlines'
-  // callbacks for that reason (5x faster on the 1M set).
+  // callbacks for that reason (with the cursor ends below, the empty query on the 1M set went from 0.3 s to 0.12 s).
   const auto strm = file.streamline_first_voxline();
   const auto voxlines = file.voxlines();
   const auto voxels = file.voxels();
