@@ -115,6 +115,7 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
       for (std::uint32_t d = 0; d < levels; ++d)
         cursor[i * levels + d] = voxels[i].vertex_first + depth_first_vertex(file.levels_of(i), d);
   std::vector<std::uint8_t> passes(n, 0);
+  result.streamlines_per_region.assign(table.regions.size(), 0);
   std::vector<float> xyz;
   if (strm[0] != 0) fail_input(file.path(), strm_at, "streamline table must start at voxline 0");
   for (std::uint64_t s = 0; s < n; ++s) {
@@ -126,7 +127,8 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
     bool depth_known = false;
     for (std::uint64_t j = first; j < last; ++j) {
       const VoxlineEntry& e = voxlines[j];
-      if (e.voxel >= voxels.size()) fail_input(file.path(), vxln_at + 8 * j, "voxline refers to a voxel past the table");
+      if (e.voxel >= voxels.size())
+        fail_input(file.path(), vxln_at + 8 * j, "voxline refers to a voxel past the table");
       const Bits touching = voxel_regions[e.voxel];
       if (touching == 0) continue;
       if (!depth_known) depth = streamline_depth(s, levels), depth_known = true;
@@ -134,11 +136,12 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
       const bool connected = j + 1 < last, first_of_streamline = j == first;
       if (own == 0) fail_input(file.path(), vxln_at + 8 * j, "voxline with no points");
       std::uint64_t& here = cursor[std::size_t(e.voxel) * levels + depth];
-      const std::uint64_t end = voxels[e.voxel].vertex_first +
-                                depth_end_vertex(voxels[e.voxel], file.levels_of(e.voxel), depth);
+      const std::uint64_t end =
+          voxels[e.voxel].vertex_first + depth_end_vertex(voxels[e.voxel], file.levels_of(e.voxel), depth);
       const std::uint64_t need = std::uint64_t(own) + (connected ? 1 : 0);
       if (here > end || need > end - here)
-        fail_input(file.path(), vxln_at + 8 * j, "voxline runs past its voxel's vertex block (or its level's part of it)");
+        fail_input(file.path(), vxln_at + 8 * j,
+                   "voxline runs past its voxel's vertex block (or its level's part of it)");
       const std::uint64_t first_vertex = here;
       here += need;
       const Bits wanted = touching & ~hit;
@@ -160,6 +163,7 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
       }
     }
     passes[s] = (hit & needed) == needed && (hit & table.exclude) == 0;
+    for (Bits b = hit; b != 0; b &= b - 1) ++result.streamlines_per_region[std::countr_zero(b)];
   }
   const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
   result.bytes_read = file.voxels().size_bytes() + file.streamline_first_voxline().size_bytes() +

@@ -41,6 +41,9 @@ struct SelectionResult {
   std::uint64_t points_tested = 0;         // vertices read for the regions
   std::uint64_t streamlines_measured = 0;  // streamlines whose points were read for the length limits
   std::uint64_t bytes_read = 0;            // of the file: the tables walked and the vertices read
+  // Per region (includes, then ends-in, then excludes, each in the order given): the streamlines it holds
+  // a point of (ends-in: an end point), whatever the other criteria.
+  std::vector<std::uint64_t> streamlines_per_region;
 };
 
 // At most this many regions in one selection (one bit each per streamline being tested).

@@ -374,5 +374,28 @@ TEST_F(WindowGridOverlay, DrawnScopeKeepsOnlyTheVoxelsInView) {
   EXPECT_EQ(grid.cubes_drawn(), 2u);
 }
 
+// The window draws a command-line selection as the headless path does (focus and context, the context hidden
+// here): the same picture but for rasteriser details.
+TEST_F(Window, ASelectionLooksAsItDoesHeadless) {
+  VXL_REQUIRE_XVFB();
+  make_inputs();
+  const std::string args = " --size 320x240 --include 0,-18,10,15 --context-opacity 0 --focus-opacity 0.8";
+  const std::string shot = dir.file("shot.png"), headless = dir.file("headless.png");
+  CommandResult w = run_voxview_in_xvfb(shell_quoted(vxl) + args + " --frames 5 --screenshot " + shell_quoted(shot));
+  ASSERT_EQ(w.exit_code, 0) << w.output;
+  CommandResult h =
+      run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + args + " --render " + shell_quoted(headless));
+  ASSERT_EQ(h.exit_code, 0) << h.output;
+  const Image a = read_image(shot), b = read_image(headless);
+  ImageDiff d = compare_images(a, b);
+  EXPECT_LT(d.mean_error, 6e-5) << "differing pixels " << d.differing_pixels;
+  // And the selection shows less than the whole tractogram does.
+  CommandResult all = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) +
+                                " --size 320x240 --opacity 0.8 --render " + shell_quoted(dir.file("all.png")));
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  EXPECT_LT(lit_pixels(b), lit_pixels(read_image(dir.file("all.png"))) * 9 / 10);
+  EXPECT_GT(lit_pixels(b), 50);
+}
+
 }  // namespace
 }  // namespace vxl

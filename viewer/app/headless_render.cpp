@@ -9,6 +9,7 @@
 #include "converter/memory_size.h"
 #include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_file.h"
+#include "viewer/app/region_editor.h"
 #include "viewer/app/scene_detail.h"
 #include "viewer/app/scene_selection.h"
 #include "viewer/app/scene_source.h"
@@ -56,7 +57,12 @@ int run_headless(const ViewerOptions& o) {
   const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);  // before any GL work: a bad image fails fast
-  const std::optional<SceneGroups> selection = select_in_scene(pointers(files), o);
+  std::optional<SceneSelection> selection;            // before any GL work too: a bad region fails fast
+  if (o.selecting()) {
+    selection = select_in_scene(pointers(files), RegionEditor(o).criteria());
+    std::fprintf(stderr, "voxview: %llu of %llu streamlines selected (the focus; the others are context)\n",
+                 (unsigned long long)selection->selected, (unsigned long long)selection->total);
+  }
   HeadlessGlContext context;
   const SceneDetail detail = choose_scene_detail(pointers(files), o.level, o.gpu_memory, o.span_texels);
   const std::uint64_t texels = detail.span_texels;
@@ -70,7 +76,7 @@ int run_headless(const ViewerOptions& o) {
   for (std::uint32_t level = per_view ? 0 : detail.level;; ++level) {
     renderer = std::make_unique<Renderer>(pointers(files), texels, level, gpu_memory);
     if (volume) renderer->set_volume(*volume);
-    if (selection) renderer->set_groups(*selection);
+    if (selection) renderer->set_groups(selection->groups);
     if (!camera) camera = initial_camera(framing_points(renderer->layout()), o, aspect);
     if (level >= detail.level) {
       if (const std::string note = describe_scene_detail(detail, SceneLayout::coarsest_level(pointers(files)) + 1);

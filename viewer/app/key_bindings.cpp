@@ -74,6 +74,13 @@ constexpr KeyBinding kKeys[] = {
      {},
      kRepeats},
     {KeyAction::ToggleSlices, "I", "image slices shown / hidden", typed("iI")},
+    {KeyAction::AddRegion, "G", "selection: a 10 mm sphere at the focus (the focus keys then move it)", typed("gG")},
+    {KeyAction::RemoveRegion, "Delete", "selection: remove the active region", key(GLFW_KEY_DELETE)},
+    {KeyAction::NextRegion, "Tab", "selection: the next region becomes the active one", key(GLFW_KEY_TAB)},
+    {KeyAction::ToggleRegionRole, "X", "selection: the active region includes / excludes", typed("xX")},
+    {KeyAction::RegionSmaller, ",", "selection: the active sphere / 1.25", typed(",<")},
+    {KeyAction::RegionLarger, ".", "selection: the active sphere x 1.25", typed(".>")},
+    {KeyAction::SaveSelection, "W", "selection: write the selected streamlines to a .tck", typed("wW")},
     {KeyAction::Quit, "Esc, Q", "quit", key(GLFW_KEY_ESCAPE), typed("qQ")},
 };
 

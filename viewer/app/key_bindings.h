@@ -40,6 +40,13 @@ enum class KeyAction {
   FocusAnterior,  // ... along A/P (the coronal slice)
   FocusPosterior,
   ToggleSlices,
+  AddRegion,  // a sphere at the focus; the focus keys then move it
+  RemoveRegion,
+  NextRegion,
+  ToggleRegionRole,
+  RegionSmaller,
+  RegionLarger,
+  SaveSelection,
   Quit,
 };
 

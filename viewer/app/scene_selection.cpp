@@ -1,27 +1,20 @@
 #include "viewer/app/scene_selection.h"
 
-#include <cstdio>
-
-#include "converter/selection/streamline_selection.h"
-
 namespace vxl::app {
 
-std::optional<SceneGroups> select_in_scene(std::span<const VxlFile* const> files, const ViewerOptions& o) {
-  if (!o.selecting()) return std::nullopt;
-  SelectionCriteria criteria;
-  for (const std::string& r : o.include) criteria.include.push_back(parse_region(r));
-  for (const std::string& r : o.exclude) criteria.exclude.push_back(parse_region(r));
-  for (const std::string& r : o.ends_in) criteria.ends_in.push_back(parse_region(r));
-  std::vector<std::vector<std::uint64_t>> kept;
-  std::uint64_t selected = 0, total = 0;
+SceneSelection select_in_scene(std::span<const VxlFile* const> files, const SelectionCriteria& criteria) {
+  SceneSelection out;
   for (const VxlFile* f : files) {
-    kept.push_back(select_streamlines(*f, criteria).streamlines);
-    selected += kept.back().size();
-    total += f->meta().streamline_count;
+    SelectionResult r = select_streamlines(*f, criteria);
+    out.streamlines_per_region.resize(r.streamlines_per_region.size(), 0);
+    for (std::size_t i = 0; i < r.streamlines_per_region.size(); ++i)
+      out.streamlines_per_region[i] += r.streamlines_per_region[i];
+    out.selected += r.streamlines.size();
+    out.total += f->meta().streamline_count;
+    out.kept.push_back(std::move(r.streamlines));
   }
-  std::fprintf(stderr, "voxview: %llu of %llu streamlines selected (the focus; the others are context)\n",
-               (unsigned long long)selected, (unsigned long long)total);
-  return SceneGroups::selection(files, kept);
+  out.groups = SceneGroups::selection(files, out.kept);
+  return out;
 }
 
 }  // namespace vxl::app

@@ -100,6 +100,38 @@ void colour_controls(PanelState& state, const PanelStats& stats) {
   }
 }
 
+// The selection's regions: each with its role and how many streamlines it holds; the active one's radius
+// (a sphere) and role can be changed, and it can be removed; a sphere can be added at the focus.
+void selection_controls(const PanelStats& stats, PanelRequests& out) {
+  if (!ImGui::CollapsingHeader("Selection", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  out.add_region = ImGui::Button("Add sphere at focus");
+  if (!stats.regions.empty()) {
+    ImGui::SameLine();
+    out.save_selection = ImGui::Button("Save selection");
+  }
+  for (std::size_t i = 0; i < stats.regions.size(); ++i) {
+    const PanelStats::Region& r = stats.regions[i];
+    ImGui::PushID(static_cast<int>(i));
+    const std::string label = r.role + " " + r.argument + " (" + count_text(r.streamlines) + ")";
+    if (ImGui::Selectable(label.c_str(), r.active)) out.activate_region = i;
+    ImGui::PopID();
+  }
+  for (const PanelStats::Region& r : stats.regions) {
+    if (!r.active) continue;
+    if (r.sphere) {
+      float radius = static_cast<float>(r.radius);
+      ImGui::PushItemWidth(110);
+      if (ImGui::DragFloat("radius (mm)", &radius, 0.1f, 0.0f, 200.0f, "%.1f")) out.region_radius = radius;
+      ImGui::PopItemWidth();
+      ImGui::SameLine();
+    }
+    out.toggle_region = ImGui::Button(r.role == "include" ? "Make exclude" : "Make include");
+    ImGui::SameLine();
+    out.remove_region = ImGui::Button("Remove");
+  }
+  if (!stats.selection.empty()) ImGui::TextUnformatted(stats.selection.c_str());
+}
+
 // Slab (thickness, move) and up to three clip planes (on/off, side and axis, position within the bounds).
 void clipping_controls(PanelState& state, const PanelStats& stats, PanelRequests& out) {
   Clipping& c = state.settings.clipping;
@@ -339,6 +371,7 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   look_controls(state, stats);
   clipping_controls(state, stats, out);
   image_controls(state, stats, out);
+  selection_controls(stats, out);
   view_controls(state, out);
   frame_information(state, stats);
   ImGui::PopItemWidth();

@@ -51,6 +51,15 @@ struct PanelStats {
   bool has_image = false;                                       // --image: the slice controls are shown
   std::array<float, 2> image_range = {0, 1};                    // the slices' grey range in use
   double focus[3] = {0, 0, 0};                                  // the focus point (camera target), RAS mm
+  // The selection's regions (region_editor.h) and what they select.
+  struct Region {
+    std::string role, argument;  // "include", "exclude", "ends in"; as `voxlines select` takes it
+    std::uint64_t streamlines = 0;
+    bool sphere = false, active = false;
+    double radius = 0;
+  };
+  std::vector<Region> regions;
+  std::string selection;  // "N of M streamlines selected", "" without regions
 };
 
 struct PanelRequests {
@@ -60,6 +69,10 @@ struct PanelRequests {
   bool save_view = false;                      // write the view (camera and settings) for --camera
   double move_focus = 0;                       // mm along the view direction (moves the slab)
   std::optional<std::array<double, 3>> focus;  // a new focus point (moves the slices), RAS mm
+  // Selection: add a sphere at the focus, make a region active, edit or remove the active one, save.
+  bool add_region = false, remove_region = false, toggle_region = false, save_selection = false;
+  std::optional<std::size_t> activate_region;
+  std::optional<double> region_radius;
 };
 
 class UiPanel {

@@ -19,6 +19,7 @@
 #define GLFW_INCLUDE_NONE  // epoxy provides the GL declarations
 #include <GLFW/glfw3.h>
 
+#include "converter/selection/selection_output.h"
 #include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_controller.h"
 #include "viewer/app/camera_file.h"
@@ -26,6 +27,7 @@
 #include "viewer/app/frame_log.h"
 #include "viewer/app/headless_render.h"
 #include "viewer/app/key_bindings.h"
+#include "viewer/app/region_editor.h"
 #include "viewer/app/rest_refinement.h"
 #include "viewer/app/scene_detail.h"
 #include "viewer/app/scene_selection.h"
@@ -138,10 +140,11 @@ struct PictureKey {
   RenderSettings settings;
   int width = 0, height = 0;
   bool grid = false, grid_all = false;
+  std::uint64_t selection = 0;  // the regions' revision the picture was drawn with
 };
 bool same_picture(const PictureKey& a, const PictureKey& b) {
   return same_view(a.camera, b.camera) && a.settings == b.settings && a.width == b.width && a.height == b.height &&
-         a.grid == b.grid && a.grid_all == b.grid_all;
+         a.grid == b.grid && a.grid_all == b.grid_all && a.selection == b.selection;
 }
 
 // One open window on one scene: GL objects, camera, panel, input. Callbacks reach it through the GLFW
@@ -150,9 +153,9 @@ class ViewerWindow {
  public:
   // `volume` must outlive the window (coarse levels upload its slices when first drawn); `start`: when
   // voxview started, for --stats.
-  // `selection`: the groups every renderer draws instead of the files' own (a selection's focus and context).
-  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume,
-               std::optional<SceneGroups> selection, GLFWwindow* window, std::chrono::steady_clock::time_point start);
+  // `regions`: the selection's regions (region_editor.h), edited in the window.
+  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume, RegionEditor regions,
+               GLFWwindow* window, std::chrono::steady_clock::time_point start);
   int run();
 
  private:
@@ -167,6 +170,11 @@ class ViewerWindow {
   void toggle_slices();
   void toggle_clip_plane(std::size_t i);
   void move_focus_along(int axis, double mm);
+  // Selects again when the regions changed since the last selection, and hands the focus and context to
+  // every renderer (without regions: the files' own groups again).
+  void update_selection();
+  // Writes the selected streamlines of every file to a stamped .tck (a key or the panel).
+  void save_selection();
 
   Camera home_camera(double aspect, bool orthographic) const;
   void reset_camera(double aspect);
@@ -202,7 +210,9 @@ class ViewerWindow {
   GLFWwindow* window_;
   std::vector<const VxlFile*> files_;
   const Volume* volume_;
-  std::optional<SceneGroups> selection_;
+  RegionEditor regions_;
+  std::optional<SceneSelection> selection_;  // of the regions' revision `selection_revision_`
+  std::optional<std::uint64_t> selection_revision_;
   SceneDetail detail_;  // the level of detail drawn at rest, and the span size
   // The GPU memory budget every level's renderer shares: together they never take more.
   std::shared_ptr<GpuMemoryPool> gpu_memory_;
@@ -240,13 +250,12 @@ class ViewerWindow {
 };
 
 ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume,
-                           std::optional<SceneGroups> selection, GLFWwindow* window,
-                           std::chrono::steady_clock::time_point start)
+                           RegionEditor regions, GLFWwindow* window, std::chrono::steady_clock::time_point start)
     : options_(o),
       window_(window),
       files_(pointers(files)),
       volume_(volume),
-      selection_(std::move(selection)),
+      regions_(std::move(regions)),
       detail_(choose_scene_detail(files_, o.level, o.gpu_memory, o.span_texels)),
       gpu_memory_(std::make_shared<GpuMemoryPool>(detail_.budget)),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
@@ -260,6 +269,8 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
     for (std::size_t i = 0; i < f->voxels().size(); ++i)
       for (std::uint32_t d = 0; d < segments.size(); ++d) segments[d] += f->level(i, d).segment_count;
   first_level_ = first_picture_level(segments, detail_.level);
+  // The command line's selection first: its groups are those the options name.
+  update_selection();
   // Scene-wide facts (bounds, groups, value sets, voxel cubes) are the same at every level.
   Renderer& first = renderer_at(first_level_);
   grid_.emplace(first);
@@ -289,7 +300,6 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   stats_.frame_budget_ms = o.frame_budget_ms;
   stats_.max_line_width = std::clamp(widths[1], 1.0f, 16.0f);
   stats_.value_sets = first.value_set_names();
-  for (const SceneGroup& g : first.groups().groups()) stats_.groups.emplace_back(g.name, g.streamlines);
   for (int c = 0; c < 3; ++c) {
     stats_.bounds_min[c] = first.bounds_min()[c];
     stats_.bounds_max[c] = first.bounds_max()[c];
@@ -392,6 +402,66 @@ void ViewerWindow::move_focus_along(int axis, double mm) {
   Camera c = controller_.camera();
   c.target[axis] += mm;
   controller_.set_camera(c);
+  regions_.move_active_to({c.target[0], c.target[1], c.target[2]});  // the active sphere follows the focus
+}
+
+void ViewerWindow::update_selection() {
+  // The panel's list, every frame: which region is active changes without a new selection.
+  stats_.regions.clear();
+  for (std::size_t i = 0; i < regions_.regions().size(); ++i) {
+    const EditorRegion& r = regions_.regions()[i];
+    stats_.regions.push_back(
+        {r.role_name(), r.argument(), r.streamlines, r.centre.has_value(), regions_.active() == i, r.radius});
+  }
+  if (selection_revision_ == regions_.revision()) return;
+  selection_revision_ = regions_.revision();
+  try {
+    if (regions_.empty()) {
+      selection_.reset();
+      stats_.selection.clear();
+    } else {
+      const auto t0 = std::chrono::steady_clock::now();
+      selection_ = select_in_scene(files_, regions_.criteria());
+      regions_.set_counts(selection_->streamlines_per_region);
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      stats_.selection = std::to_string(selection_->selected) + " of " + std::to_string(selection_->total) +
+                         " streamlines selected (" + std::to_string(int(ms + 0.5)) + " ms)";
+      RenderSettings& s = state_.settings;
+      // Regions added in the window to a scene started without: the context faint, as --context-opacity's default.
+      if (s.find_style(SceneGroups::kContext) == nullptr)
+        s.style_of(SceneGroups::kContext).opacity = std::min(1.0f, 0.02f / s.opacity);
+    }
+  } catch (const std::exception& e) {
+    set_error(e.what());
+    selection_.reset();
+  }
+  const SceneGroups groups = selection_ ? selection_->groups : SceneGroups(files_);
+  for (auto& [level, r] : renderers_)
+    if (r) r->set_groups(groups);
+  stats_.groups.clear();
+  for (const SceneGroup& g : groups.groups()) stats_.groups.emplace_back(g.name, g.streamlines);
+  for (std::size_t i = 0; i < stats_.regions.size(); ++i)
+    stats_.regions[i].streamlines = regions_.regions()[i].streamlines;
+}
+
+void ViewerWindow::save_selection() {
+  if (!selection_) {
+    set_error("no selection to save: add a region first (G)");
+    return;
+  }
+  for (std::size_t i = 0; i < files_.size(); ++i) {
+    const std::string path =
+        stamped_name("voxview-selection-", files_.size() > 1 ? "-" + std::to_string(i) + ".tck" : ".tck").string();
+    try {
+      write_selection(*files_[i], StreamlineSubset(files_[i]->meta().streamline_count, selection_->kept[i]), path, {},
+                      {});
+      stats_.status = "selection saved to " + path;
+      std::printf("voxview: %zu streamlines saved to %s\n", selection_->kept[i].size(), path.c_str());
+      std::fflush(stdout);
+    } catch (const std::exception& e) {
+      set_error(e.what());
+    }
+  }
 }
 
 void ViewerWindow::on_key(int key, int action, int mods) {
@@ -462,6 +532,17 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
     case KeyAction::FocusAnterior: move_focus_along(1, step); break;
     case KeyAction::FocusPosterior: move_focus_along(1, -step); break;
     case KeyAction::ToggleSlices: toggle_slices(); break;
+    case KeyAction::AddRegion: {
+      const glm::dvec3 f = controller_.camera().target;
+      regions_.add_sphere({f.x, f.y, f.z});
+      break;
+    }
+    case KeyAction::RemoveRegion: regions_.remove_active(); break;
+    case KeyAction::NextRegion: regions_.activate_next(); break;
+    case KeyAction::ToggleRegionRole: regions_.toggle_role(); break;
+    case KeyAction::RegionSmaller: regions_.scale_radius(1 / 1.25); break;
+    case KeyAction::RegionLarger: regions_.scale_radius(1.25); break;
+    case KeyAction::SaveSelection: save_selection(); break;
     case KeyAction::Quit: glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
   }
 }
@@ -473,7 +554,7 @@ Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
     // (the refinement at rest spreads its level's upload over frames).
     r = std::make_unique<Renderer>(files_, detail_.span_texels, level, gpu_memory_, level == first_level_);
     if (volume_) r->set_volume(*volume_);
-    if (selection_) r->set_groups(*selection_);
+    if (selection_) r->set_groups(selection_->groups);
   }
   return *r;
 }
@@ -664,6 +745,12 @@ int ViewerWindow::run() {
     if (requests.move_focus != 0) controller_.move_focus(requests.move_focus);
     if (requests.focus)
       for (int a = 0; a < 3; ++a) move_focus_along(a, (*requests.focus)[a] - controller_.camera().target[a]);
+    if (requests.add_region) perform(KeyAction::AddRegion, false);
+    if (requests.activate_region) regions_.activate(*requests.activate_region);
+    if (requests.region_radius) regions_.set_radius(*requests.region_radius);
+    if (requests.toggle_region) regions_.toggle_role();
+    if (requests.remove_region) regions_.remove_active();
+    if (requests.save_selection) save_selection();
     screenshot_requested_ |= requests.screenshot;
     save_view_requested_ |= requests.save_view;
     if (state_.exact_when_still != rest_.exact_when_still()) {
@@ -677,7 +764,8 @@ int ViewerWindow::run() {
     // setting changes, at the finest level that fits the frame budget; a script's last frame at the scene's
     // level. An unchanged one is refined at rest, a piece a frame (rest_refinement.h).
     const Camera& camera = controller_.camera();
-    const PictureKey key{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all};
+    update_selection();
+    const PictureKey key{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all, regions_.revision()};
     const bool moving = drawn_ && !closing && !same_view(drawn_->camera, camera);
     const bool changed = !drawn_ || !same_picture(*drawn_, key);
     const bool scripted_last = closing && frames_done && !options_.until_refined;
@@ -693,7 +781,7 @@ int ViewerWindow::run() {
       drawn_level_ = level;
       rest_level_.reset();
       stats_.refinement = rest_.describe(0);
-      drawn_ = PictureKey{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all};
+      drawn_ = key;
       frames_.push_back({level, moving, ms, seconds_since_start()});
     } else if (!closing && rest_.stage() != RestStage::Done) {
       choose_rest_level(double(fb_w) / fb_h);
@@ -744,9 +832,9 @@ int run_window(const ViewerOptions& o) {
   const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);
-  std::optional<SceneGroups> selection = select_in_scene(pointers(files), o);
+  RegionEditor regions(o);  // parses the regions: a bad one fails before the window opens
   WindowPtr window = open_window(o);
-  ViewerWindow viewer(o, files, volume ? &*volume : nullptr, std::move(selection), window.get(), start);
+  ViewerWindow viewer(o, files, volume ? &*volume : nullptr, std::move(regions), window.get(), start);
   return viewer.run();
 }
 

@@ -100,6 +100,12 @@ glm::vec4 RenderSettings::group_color(const std::string& name, std::size_t index
   return glm::vec4(group_palette(index), 1.0f);
 }
 
+const GroupStyle* RenderSettings::find_style(const std::string& name) const {
+  for (const GroupStyle& g : group_styles)
+    if (g.name == name) return &g;
+  return nullptr;
+}
+
 GroupStyle& RenderSettings::style_of(const std::string& name) {
   for (GroupStyle& g : group_styles)
     if (g.name == name) return g;

@@ -87,7 +87,8 @@ struct RenderSettings {
   glm::vec3 background() const { return white_background ? glm::vec3(1.0f) : glm::vec3(0.0f); }
   // The colour and opacity factor of group `index` called `name`.
   glm::vec4 group_color(const std::string& name, std::size_t index) const;
-  GroupStyle& style_of(const std::string& name);  // the user's entry for `name`, added when missing
+  GroupStyle& style_of(const std::string& name);                // the user's entry for `name`, added when missing
+  const GroupStyle* find_style(const std::string& name) const;  // the user's entry for `name`, if any
   // Whether two settings draw the same picture (the window refines a picture until they change).
   bool operator==(const RenderSettings&) const = default;
 };
