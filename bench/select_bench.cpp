@@ -5,7 +5,8 @@
 // vertices it tests) against the TCK's size (tckedit reads all of it). tckedit is run only when it is
 // installed; nothing else needs it.
 //
-// Usage: select_bench FILE.tck FILE.vxl [--rounds N] [--tckedit-rounds N]
+// Usage: select_bench FILE.tck FILE.vxl [--rounds N] [--tckedit-rounds N] [--voxlines PATH]
+// (--voxlines: the program to time, by default the build's; a copy keeps a long run apart from rebuilds)
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -51,15 +52,17 @@ std::string find_tckedit() {
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: select_bench FILE.tck FILE.vxl [--rounds N] [--tckedit-rounds N]\n");
+    std::fprintf(stderr, "usage: select_bench FILE.tck FILE.vxl [--rounds N] [--tckedit-rounds N] [--voxlines PATH]\n");
     return 2;
   }
   const std::string tck = argv[1], vxl_path = argv[2];
   int rounds = 5, tckedit_rounds = 3;
+  std::string cli = VOXLINES_CLI;
   for (int i = 3; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--rounds") rounds = std::stoi(argv[i + 1]);
     if (a == "--tckedit-rounds") tckedit_rounds = std::stoi(argv[i + 1]);
+    if (a == "--voxlines") cli = argv[i + 1];
   }
   const vxl::VxlFile file = vxl::VxlFile::open(vxl_path);
   const auto voxels = file.voxels();
@@ -95,7 +98,7 @@ int main(int argc, char** argv) {
                      {"--include", sphere(centre(densest), 10), "--exclude", sphere(beside, 4)},
                      {"-include", sphere(centre(densest), 10), "-exclude", sphere(beside, 4)}});
 
-  const std::string cli = VOXLINES_CLI, tckedit = find_tckedit();
+  const std::string tckedit = find_tckedit();
   const auto tck_bytes = std::filesystem::file_size(tck);
   const std::string out = (std::filesystem::temp_directory_path() / "select_bench_out.tck").string();
   std::printf("file: %s (%llu streamlines, %llu bytes; TCK %llu bytes)\n", vxl_path.c_str(),
@@ -119,16 +122,25 @@ int main(int argc, char** argv) {
     const nlohmann::json j = nlohmann::json::parse(json_in);
     std::vector<std::string> args = {cli, "select", vxl_path, out};
     args.insert(args.end(), q.ours.begin(), q.ours.end());
-    run_child(args, true);  // warm
+    // A run that fails must not pass for a fast one.
+    auto timed = [&](const std::vector<std::string>& command) {
+      const vxl::bench::ChildRun run = run_child(command, true);
+      if (run.exit_code != 0) {
+        std::fprintf(stderr, "failed (exit %d): %s ...\n", run.exit_code, command[0].c_str());
+        std::exit(1);
+      }
+      return run.seconds;
+    };
+    timed(args);  // warm
     std::vector<double> ours;
-    for (int r = 0; r < rounds; ++r) ours.push_back(run_child(args, true).seconds);
+    for (int r = 0; r < rounds; ++r) ours.push_back(timed(args));
     double theirs = -1;
     long long their_count = -1;
     if (!tckedit.empty()) {
       std::vector<std::string> t = {tckedit, "-quiet", "-force", "-nthreads", "0", tck, out};
       t.insert(t.end(), q.theirs.begin(), q.theirs.end());
       std::vector<double> times;
-      for (int r = 0; r < tckedit_rounds; ++r) times.push_back(run_child(t, true).seconds);
+      for (int r = 0; r < tckedit_rounds; ++r) times.push_back(timed(t));
       theirs = median(times);
       their_count = tck_count(out);
     }
