@@ -83,6 +83,25 @@ TEST(CameraFile, RoundTripsEveryFieldExactly) {
   EXPECT_EQ(b.size, a.size);
 }
 
+// A view with a selection keeps its regions; one without writes no "selection" key.
+TEST(CameraFile, TheSelectionsRegionsRoundTrip) {
+  SavedView a = unusual_view();
+  a.include = {"-9,-23,-30,6", "box:0,0,0,1,1,1"};
+  a.exclude = {"atlas.nii.gz:3"};
+  a.ends_in = {"1,2,3,4"};
+  const SavedView b = app::parse_view_json(app::view_json(a), "mem.json");
+  EXPECT_EQ(b.include, a.include);
+  EXPECT_EQ(b.exclude, a.exclude);
+  EXPECT_EQ(b.ends_in, a.ends_in);
+  EXPECT_EQ(app::view_json(unusual_view()).find("selection"), std::string::npos);
+  try {
+    app::parse_view_json(R"({"voxview_view": 1, "selection": {"include": [3]}})", "bad.json");
+    ADD_FAILURE() << "a number was taken for a region";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("selection.include"), std::string::npos) << e.what();
+  }
+}
+
 TEST(CameraFile, MissingKeysKeepDefaultsAndBadOnesNameFileAndKey) {
   SavedView defaults;
   defaults.settings.opacity = 0.7f;

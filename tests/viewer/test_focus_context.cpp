@@ -138,5 +138,21 @@ TEST_F(FocusContext, VoxviewSelectsFromTheCommandLine) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("y.png")));
 }
 
+// A saved view keeps the selection: replayed without any region on the command line, the same picture.
+TEST_F(FocusContext, ASavedViewKeepsTheSelection) {
+  make_scene(dir, crossing_lines(), 10.0, "lines.vxl");
+  const std::string in = test::q(dir.file("lines.vxl"));
+  const test::CommandResult save =
+      test::run_program(VOXVIEW_CLI, in + " --render " + test::q(dir.file("a.png")) +
+                                         " --size 64x64 --include 0.5,20.5,-10,1 --context-opacity 0.1 --save-camera " +
+                                         test::q(dir.file("v.json")));
+  ASSERT_EQ(save.exit_code, 0) << save.output;
+  const test::CommandResult replay = test::run_program(
+      VOXVIEW_CLI, in + " --render " + test::q(dir.file("b.png")) + " --camera " + test::q(dir.file("v.json")));
+  ASSERT_EQ(replay.exit_code, 0) << replay.output;
+  EXPECT_NE(replay.output.find("1 of 2 streamlines selected"), std::string::npos) << replay.output;
+  EXPECT_EQ(test::slurp(dir.file("a.png")), test::slurp(dir.file("b.png")));
+}
+
 }  // namespace
 }  // namespace vxl

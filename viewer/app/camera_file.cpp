@@ -1,5 +1,6 @@
 #include "viewer/app/camera_file.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -215,6 +216,8 @@ std::string view_json(const SavedView& v) {
                    {"order_hysteresis", shortest(s.order_hysteresis)},
                    {"slab_mm", s.clipping.slab_mm},
                    {"clip", clip}};
+  if (!v.include.empty() || !v.exclude.empty() || !v.ends_in.empty())
+    j["selection"] = {{"include", v.include}, {"exclude", v.exclude}, {"ends_in", v.ends_in}};
   return j.dump(2) + "\n";
 }
 
@@ -238,6 +241,21 @@ SavedView parse_view_json(const std::string& text, const std::string& path, cons
   }
   read_camera(top.object("camera"), v.camera);
   read_settings(top.object("settings"), v.settings);
+  if (const json* selection = top.find("selection")) {
+    if (!selection->is_object())
+      top.fail("selection", "an object {\"include\": [...], \"exclude\": [...], \"ends_in\": [...]}");
+    const Reader r(*selection, path, "selection.");
+    for (auto [key, list] :
+         {std::pair{"include", &v.include}, std::pair{"exclude", &v.exclude}, std::pair{"ends_in", &v.ends_in}}) {
+      const json* regions = r.find(key);
+      if (!regions) continue;
+      if (!regions->is_array() ||
+          !std::all_of(regions->begin(), regions->end(), [](const json& x) { return x.is_string(); }))
+        r.fail(key, "an array of regions as voxlines select takes them (\"X,Y,Z,R\", \"box:...\", \"FILE.nii.gz\")");
+      list->clear();
+      for (const json& x : *regions) list->push_back(x.get<std::string>());
+    }
+  }
   return v;
 }
 

@@ -13,8 +13,12 @@
 //                  "colormap": "viridis", "scalar": "", "range": null,
 //                  "groups": [{"name": "ARC_L", "color": "#e41a1c", "opacity": 1}],
 //                  "line_width": 1, "background": "black", "lighting": false, "order_hysteresis": 0,
-//                  "slab_mm": 0, "clip": [{"plane": "-x,10", "enabled": true}]}
+//                  "slab_mm": 0, "clip": [{"plane": "-x,10", "enabled": true}]},
+//     "selection": {"include": ["-9,-23,-30,6"], "exclude": [], "ends_in": []}
 //   }
+//
+// "selection" (the regions of voxview --include, --exclude, --ends-in and of the window) is written only
+// when there are regions.
 //
 // Numbers are written with enough digits to read back the same double or float. On reading, a missing key
 // keeps its default (a hand-written file may give only what it changes) and unknown keys are ignored (a
@@ -25,6 +29,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "viewer/render/camera.h"
 #include "viewer/render/render_settings.h"
@@ -34,7 +39,8 @@ namespace vxl::app {
 struct SavedView {
   Camera camera;
   RenderSettings settings;
-  std::optional<std::array<int, 2>> size;  // width, height
+  std::optional<std::array<int, 2>> size;              // width, height
+  std::vector<std::string> include, exclude, ends_in;  // the selection's regions, as voxlines select takes them
 };
 
 // Throws vxl::Error: Input (naming the file and key) for malformed content, Input when unreadable.

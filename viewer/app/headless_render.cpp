@@ -96,7 +96,9 @@ int run_headless(const ViewerOptions& o) {
   check_color_options(o.inputs_name(), *renderer, o.settings);
   OffscreenTarget target(o.width, o.height);
   target.bind();
-  if (o.save_camera) write_view(*o.save_camera, SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}});
+  if (o.save_camera)
+    write_view(*o.save_camera,
+               SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}, o.include, o.exclude, o.ends_in});
   const int frames = std::max(1, o.turntable);
   for (int i = 0; i < frames; ++i) {
     renderer->draw(turntable_camera(*camera, i, frames), o.settings, o.width, o.height, target.framebuffer());

@@ -33,6 +33,12 @@ void apply_saved_view(const ViewerArguments& a, ViewerOptions& o, std::string& s
   const SavedView saved = read_view(a.camera_file, defaults);
   o.settings = saved.settings;
   o.camera = saved.camera;
+  // The saved regions, unless the command line gives its own.
+  if (!o.selecting()) {
+    o.include = saved.include;
+    o.exclude = saved.exclude;
+    o.ends_in = saved.ends_in;
+  }
   if (saved.size && !a.was_given("--size"))
     size = std::to_string((*saved.size)[0]) + "x" + std::to_string((*saved.size)[1]);
 }
@@ -160,7 +166,12 @@ void apply_selection(const ViewerArguments& a, ViewerOptions& o) {
     return;
   }
   RenderSettings& s = o.settings;
-  const float focus = a.focus_opacity.value_or(s.opacity), context = a.context_opacity;
+  // A saved view's focus and context opacities stay unless the command line gives others.
+  const GroupStyle* saved_focus = s.find_style(SceneGroups::kSelected);
+  const GroupStyle* saved_context = s.find_style(SceneGroups::kContext);
+  const float focus = a.focus_opacity.value_or(saved_focus ? saved_focus->opacity * s.opacity : s.opacity);
+  const float context =
+      a.was_given("--context-opacity") || !saved_context ? a.context_opacity : saved_context->opacity * s.opacity;
   s.opacity = std::max(focus, context);
   s.style_of(SceneGroups::kSelected).opacity = focus / s.opacity;
   s.style_of(SceneGroups::kContext).opacity = context / s.opacity;

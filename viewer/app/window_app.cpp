@@ -700,7 +700,13 @@ void ViewerWindow::save_screenshot(const std::string& path, int width, int heigh
 void ViewerWindow::save_view(int width, int height) {
   const std::string path = options_.save_camera.value_or(stamped_name("voxview-view-", ".json").string());
   try {
-    write_view(path, SavedView{controller_.camera(), state_.settings, std::array<int, 2>{width, height}});
+    SavedView view{controller_.camera(), state_.settings, std::array<int, 2>{width, height}, {}, {}, {}};
+    for (const EditorRegion& r : regions_.regions())
+      (r.role == EditorRegion::Role::Include   ? view.include
+       : r.role == EditorRegion::Role::Exclude ? view.exclude
+                                               : view.ends_in)
+          .push_back(r.argument());
+    write_view(path, view);
     stats_.status = "view saved to " + path;
     std::printf("voxview: view saved to %s (replay: voxview FILE --camera '%s' --render OUT.png)\n", path.c_str(),
                 path.c_str());
