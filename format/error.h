@@ -36,9 +36,10 @@ class Error : public std::runtime_error {
 
  private:
   static std::string compose(const std::string& file, std::optional<std::uint64_t> offset, const std::string& what) {
-    std::string m = file.empty() ? std::string("<input>") : file;
-    if (offset) m += ": at byte " + std::to_string(*offset);
-    return m + ": " + what;
+    // An error about no file in particular (a command-line option) says only what is wrong.
+    std::string m = file;
+    if (offset) m += (m.empty() ? "at byte " : ": at byte ") + std::to_string(*offset);
+    return m.empty() ? what : m + ": " + what;
   }
 
   ErrorKind kind_;

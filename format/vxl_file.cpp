@@ -6,6 +6,7 @@
 
 #include "format/error.h"
 #include "format/utf8_check.h"
+#include "format/vxlz_layout.h"
 
 namespace vxl {
 
@@ -77,11 +78,35 @@ void VxlFile::validate() {
   validate_voxel_table();
 }
 
+namespace {
+
+// What a file that is not a .vxl is, from its first bytes, and what to do with it: a message a user can act
+// on; "" when unknown.
+std::string other_format_hint(const std::uint8_t* bytes, std::uint64_t size) {
+  const char* convert = ", not a .vxl file: convert it first (voxlines convert IN OUT.vxl)";
+  const std::string_view start(reinterpret_cast<const char*>(bytes), std::min<std::uint64_t>(size, 64));
+  if (start.starts_with("mrtrix tracks")) return std::string("this is an MRtrix TCK file") + convert;
+  if (start.starts_with("mrtrix track scalars"))
+    return "this is an MRtrix TSF file (values for a TCK), not a .vxl file";
+  if (start.starts_with("TRACK")) return std::string("this is a TrackVis TRK file") + convert;
+  if (start.starts_with("# vtk DataFile")) return std::string("this is a legacy VTK file") + convert;
+  if (start.starts_with("<?xml") || start.starts_with("<VTKFile"))
+    return std::string("this is an XML file (a VTK .vtp?)") + convert;
+  if (start.starts_with("PK\x03\x04")) return std::string("this is a zip archive (a TRX file?)") + convert;
+  if (start.starts_with("\x1f\x8b")) return std::string("this is a gzip file (a .trk.gz?)") + convert;
+  if (size >= 8 && std::memcmp(bytes, kVxlzMagic.data(), 8) == 0)
+    return "this is a .vxlz package, not a .vxl file: voxlines unpack IN.vxlz OUT.vxl makes the .vxl";
+  return "";
+}
+
+}  // namespace
+
 // §7 step 1.
 void VxlFile::validate_header() {
   const std::string& p = file_.path();
   const std::uint64_t size = file_.size();
   const std::uint8_t* base = file_.data();
+  if (const std::string hint = other_format_hint(base, size); !hint.empty()) fail_input(p, 0, hint);
   if (size < sizeof(FileHeader)) fail_input(p, size, "file too short for a .vxl header (64 bytes)");
   std::memcpy(&header_, base, sizeof header_);
   if (std::memcmp(header_.magic, kVxlMagic.data(), 8) != 0) fail_input(p, 0, "not a .vxl file (bad magic)");

@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -134,6 +136,13 @@ void add_convert_command(CLI::App& app, int& exit_code) {
                                  std::to_string(opt->files.size()) + " file names)");
     const std::string& input = opt->files[0];
     const std::string& output = opt->files[1];
+    // A .vxl under another name would pass for the other format (a TCK reader then fails on it).
+    std::string lower = output;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (!lower.ends_with(".vxl"))
+      throw Error(ErrorKind::Usage, output, std::nullopt,
+                  "convert writes a .vxl file: name the output OUT.vxl (to write TCK, TRX or VTK from a .vxl use "
+                  "`voxlines export IN.vxl OUT.tck`, or `voxlines select` for some of its streamlines)");
     ProgressBar bar;
     opt->settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
     bar.update("reading", 0.0);

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "converter/cli/commands.h"
+#include "converter/command_line_typos.h"
 #include "format/error.h"
 
 namespace {
@@ -44,6 +45,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    if (const std::string typo = vxl::typo_message(app, argc, argv); !typo.empty() && e.get_exit_code() != 0) {
+      std::fprintf(stderr, "voxlines: error: %s\n", typo.c_str());
+      return static_cast<int>(vxl::ErrorKind::Usage);
+    }
     int code = app.exit(e);
     return code == 0 ? 0 : static_cast<int>(vxl::ErrorKind::Usage);
   } catch (const vxl::Error& e) {

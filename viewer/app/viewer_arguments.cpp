@@ -150,7 +150,9 @@ void apply_image(const ViewerArguments& a, ViewerOptions& o) {
 void apply_view_and_size(const ViewerArguments& a, const std::string& size, ViewerOptions& o) {
   if (!a.view.empty()) {
     o.view = parse_view(a.view);
-    if (!o.view) usage_error("--view: unknown view '" + a.view + "'");
+    if (!o.view)
+      usage_error("--view: unknown view '" + a.view +
+                  "' (expected axial, inferior, sagittal, right, coronal, posterior, or AZ,EL in degrees)");
   }
   if (std::sscanf(size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 1 || o.height < 1 || o.width > 16384 ||
       o.height > 16384)

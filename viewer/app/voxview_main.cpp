@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "converter/command_line_typos.h"
 #include "format/error.h"
 #include "viewer/app/headless_render.h"
 #include "viewer/app/viewer_arguments.h"
@@ -22,6 +23,10 @@ int main(int argc, char** argv) {
     const app::ViewerOptions options = app::resolve_viewer_options(arguments);
     return options.render_png ? app::run_headless(options) : app::run_window(options);
   } catch (const CLI::ParseError& e) {
+    if (const std::string typo = typo_message(cli, argc, argv); !typo.empty() && e.get_exit_code() != 0) {
+      std::fprintf(stderr, "voxview: error: %s\n", typo.c_str());
+      return static_cast<int>(ErrorKind::Usage);
+    }
     int code = cli.exit(e);
     return code == 0 ? 0 : static_cast<int>(ErrorKind::Usage);
   } catch (const Error& e) {

@@ -1,0 +1,64 @@
+// The command line's rough edges: a convert output that is not .vxl, a source given where a .vxl is
+// expected, and mistyped commands and options answered with the nearest known name.
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "converter/command_line_typos.h"
+#include "converter/convert.h"
+#include "converter/synth.h"
+#include "tests/test_support.h"
+
+namespace vxl {
+namespace {
+
+using test::q;
+using test::run_cli;
+using test::ScratchDir;
+
+TEST(CommandLine, ConvertRefusesAnOutputThatIsNotVxl) {
+  ScratchDir dir;
+  ASSERT_EQ(run_cli("synth " + q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  for (const char* name : {"out.tck", "out", "out.trx"}) {
+    const test::CommandResult r = run_cli("convert " + q(dir.file("a.tck")) + " " + q(dir.file(name)));
+    EXPECT_EQ(r.exit_code, 2) << name << ": " << r.output;
+    EXPECT_NE(r.output.find("voxlines export"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file(name))) << name;
+  }
+  EXPECT_EQ(run_cli("convert " + q(dir.file("a.tck")) + " " + q(dir.file("OUT.VXL"))).exit_code, 0);
+}
+
+TEST(CommandLine, InfoAndVerifyNameTheFormatOfASourceGivenForAVxl) {
+  ScratchDir dir;
+  ASSERT_EQ(run_cli("synth " + q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  const test::CommandResult info = run_cli("info " + q(dir.file("a.tck")));
+  EXPECT_EQ(info.exit_code, 3) << info.output;
+  EXPECT_NE(info.output.find("this is an MRtrix TCK file, not a .vxl file"), std::string::npos) << info.output;
+  const test::CommandResult verify = run_cli("verify " + q(dir.file("a.tck")));
+  EXPECT_EQ(verify.exit_code, 1) << verify.output;
+  EXPECT_NE(verify.output.find("MRtrix TCK"), std::string::npos) << verify.output;
+  test::write_file(dir.file("t.trk"), {'T', 'R', 'A', 'C', 'K', 0, 0, 0, 0, 0});
+  EXPECT_NE(run_cli("info " + q(dir.file("t.trk"))).output.find("TrackVis TRK"), std::string::npos);
+}
+
+TEST(CommandLine, TyposGetTheNearestName) {
+  EXPECT_EQ(nearest_name("convet", {"convert", "info", "verify"}), "convert");
+  EXPECT_EQ(nearest_name("--voxelsize", {"--voxel-size", "--verbose"}), "--voxel-size");
+  EXPECT_EQ(nearest_name("frobnicate", {"convert", "info"}), "");
+  const test::CommandResult command = run_cli("convet a b");
+  EXPECT_EQ(command.exit_code, 2);
+  EXPECT_NE(command.output.find("unknown command 'convet'; did you mean 'convert'?"), std::string::npos)
+      << command.output;
+  const test::CommandResult option = run_cli("convert a.tck b.vxl --voxelsize 5");
+  EXPECT_EQ(option.exit_code, 2);
+  EXPECT_NE(option.output.find("unknown option --voxelsize; did you mean --voxel-size?"), std::string::npos)
+      << option.output;
+  EXPECT_NE(option.output.find("convert --help"), std::string::npos) << option.output;
+  // A known option with a bad value keeps the parser's own message.
+  const test::CommandResult value = run_cli("convert a.tck b.vxl --levels 99");
+  EXPECT_EQ(value.exit_code, 2);
+  EXPECT_EQ(value.output.find("unknown option"), std::string::npos) << value.output;
+}
+
+}  // namespace
+}  // namespace vxl
