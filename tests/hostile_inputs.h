@@ -16,6 +16,7 @@
 #include <zlib.h>
 
 #include "tests/mrtrix_test_files.h"
+#include "tests/vtk_test_files.h"
 #include "tests/zip_writer.h"
 
 namespace vxl::test::hostile {
@@ -136,6 +137,21 @@ inline void trx_offsets_bomb(const std::string& path, int mib, bool honest) {
   if (!honest) bomb.size = 4 * 8;
   e[2] = std::move(bomb);
   write_zip(path, e);
+}
+
+// ---- VTK and VTP ----
+
+// A legacy VTK whose POINTS count N makes 3 x N wrap past 2^64: the data holds exactly as many numbers
+// as the wrapped product, then one line over the first two points.
+inline void vtk_points_count_wraps(const std::string& path, std::uint64_t n, bool binary) {
+  const std::uint64_t wrapped = 3 * n;  // unsigned: wraps on purpose
+  std::string s = "# vtk DataFile Version 3.0\nhostile\n" + std::string(binary ? "BINARY" : "ASCII") +
+                  "\nDATASET POLYDATA\nPOINTS " + std::to_string(n) + " float\n";
+  for (std::uint64_t k = 0; k < wrapped; ++k)
+    s += binary ? test::be(static_cast<float>(k + 1)) : std::to_string(k + 1) + " ";
+  s += "\nLINES 1 3\n";
+  s += binary ? test::be<std::int32_t>(2) + test::be<std::int32_t>(0) + test::be<std::int32_t>(1) : "2 0 1";
+  write_file(path, s + "\n");
 }
 
 // ---- MRtrix (TCK, TSF) ----

@@ -20,6 +20,7 @@
 
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/vtk_polydata.h"
+#include "format/checked_count.h"
 #include "format/error.h"
 #include "format/mapped_file.h"
 
@@ -283,9 +284,8 @@ class VtpParser {
       fail(offset(a), what + ": type '" + std::string(a.attribute("type").as_string()) + "' is not numeric");
     if (a.attribute("NumberOfComponents") && count_attribute(a, "NumberOfComponents") != components)
       fail(offset(a), what + ": NumberOfComponents differs from " + std::to_string(components));
-    if (tuples != 0 && components > ~std::uint64_t(0) / 8 / tuples) fail(offset(a), what + ": size overflows");
-    const std::uint64_t n = components * tuples;
-    if (8 * n > budget_)
+    const std::uint64_t n = checked_product(components, tuples, path_, offset(a), what + " size");
+    if (n > budget_ / 8)
       fail_unsupported(path_, what + ": " + std::to_string(n) +
                                   " values exceed what a file of this size may decode to (" +
                                   "64 x its size + 64 MiB in all); refused as a likely decompression bomb");

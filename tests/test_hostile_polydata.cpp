@@ -1,0 +1,74 @@
+// Hostile legacy VTK and XML VTP files (tests/hostile_inputs.h writes them): counts that wrap, cells
+// numbered against VTK's rules, arrays that say more or less than they hold. Each must be refused with the
+// documented kind of error, naming the file, and the command line must write nothing.
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "converter/readers/read_tractogram.h"
+#include "format/checked_count.h"
+#include "format/error.h"
+#include "tests/hostile_inputs.h"
+#include "tests/test_support.h"
+
+namespace {
+
+namespace hostile = vxl::test::hostile;
+using vxl::test::ScratchDir;
+
+// The error `read` throws, or a failure when it throws none.
+template <typename Read>
+vxl::Error error_of(Read read) {
+  try {
+    read();
+  } catch (const vxl::Error& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error";
+  return vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "no error");
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+// `convert IN OUT.vxl` exits with `code`, names IN and leaves nothing at OUT.
+void expect_convert_refused(const ScratchDir& dir, const std::string& in, int code) {
+  const std::string out = dir.file("out.vxl");
+  const auto r = vxl::test::run_cli("convert " + vxl::test::q(in) + " " + vxl::test::q(out));
+  EXPECT_EQ(r.exit_code, code) << r.output;
+  EXPECT_TRUE(contains(r.output, std::filesystem::path(in).filename().string())) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CheckedCount, ProductsAndSumsBeyond64BitsAreRefused) {
+  constexpr std::uint64_t max = ~std::uint64_t(0);
+  EXPECT_EQ(vxl::count_product(3, 6148914691236517205u), std::optional<std::uint64_t>(max));
+  EXPECT_FALSE(vxl::count_product(3, 6148914691236517206u));
+  EXPECT_FALSE(vxl::count_product(std::uint64_t(1) << 32, std::uint64_t(1) << 32));
+  EXPECT_EQ(vxl::count_product(0, max), std::optional<std::uint64_t>(0));
+  EXPECT_EQ(vxl::count_sum(max - 1, 1), std::optional<std::uint64_t>(max));
+  EXPECT_FALSE(vxl::count_sum(max, 1));
+  const vxl::Error e = error_of([] { (void)vxl::checked_product(3, max, "f.vtk", 12, "POINTS count"); });
+  EXPECT_EQ(e.kind(), vxl::ErrorKind::Input);
+  EXPECT_EQ(std::string(e.what()), "f.vtk: at byte 12: POINTS count: 3 x 18446744073709551615 does not fit in 64 bits");
+}
+
+// 3 x N wraps to 2, 8 and 1 values: the file holds exactly that many, so only the product's overflow
+// tells the count is a lie.
+TEST(HostileVtk, PointsCountWhoseTripleWrapsIsMalformed) {
+  ScratchDir dir;
+  for (const std::uint64_t n : {6148914691236517206u, 6148914691236517208u, 12297829382473034411u})
+    for (const bool binary : {false, true}) {
+      SCOPED_TRACE(std::to_string(n) + (binary ? " BINARY" : " ASCII"));
+      const std::string p = dir.file("points.vtk");
+      hostile::vtk_points_count_wraps(p, n, binary);
+      const vxl::Error e = error_of([&] { (void)vxl::read_tractogram(p); });
+      EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
+      EXPECT_TRUE(contains(e.what(), "POINTS count: 3 x " + std::to_string(n) + " does not fit in 64 bits"))
+          << e.what();
+      EXPECT_TRUE(e.offset().has_value()) << e.what();
+      expect_convert_refused(dir, p, 3);
+    }
+}
+
+}  // namespace
