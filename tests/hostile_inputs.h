@@ -154,6 +154,19 @@ inline void vtk_points_count_wraps(const std::string& path, std::uint64_t n, boo
   write_file(path, s + "\n");
 }
 
+// The small VTP tractogram (3 lines, a 2-component cell array) with extra cell counts in its Piece:
+// `verts`, `polys` and `strips` chosen so that the sum of all cells wraps past 2^64 back to 3, the number
+// of cell tuples the file holds.
+inline void vtp_cell_count_wraps(const std::string& path, std::uint64_t verts, std::uint64_t polys,
+                                 std::uint64_t strips) {
+  std::string s = test::small_vtp({});
+  const std::string lines = "NumberOfLines=\"3\"";
+  s.replace(s.find(lines), lines.size(),
+            lines + " NumberOfVerts=\"" + std::to_string(verts) + "\" NumberOfPolys=\"" + std::to_string(polys) +
+                "\" NumberOfStrips=\"" + std::to_string(strips) + "\"");
+  write_file(path, s);
+}
+
 // ---- MRtrix (TCK, TSF) ----
 
 // Row 8: a TSF of three streamlines of one value each, the second 1e300 (beyond float32).

@@ -71,4 +71,23 @@ TEST(HostileVtk, PointsCountWhoseTripleWrapsIsMalformed) {
     }
 }
 
+// NumberOfVerts (or Polys, Strips) near 2^64 makes the sum of the cells wrap back to the 3 tuples the cell
+// data holds; the lines' cell values would then be read far before the array.
+TEST(HostileVtp, CellCountsThatWrapAreMalformed) {
+  ScratchDir dir;
+  constexpr std::uint64_t max = ~std::uint64_t(0);
+  struct Counts {
+    std::uint64_t verts, polys, strips;
+  };
+  for (const Counts c : {Counts{max, 1, 0}, Counts{max - 2, 3, 0}, Counts{1, max, 0}, Counts{0, 2, max - 1}}) {
+    SCOPED_TRACE(std::to_string(c.verts) + " " + std::to_string(c.polys) + " " + std::to_string(c.strips));
+    const std::string p = dir.file("cells.vtp");
+    hostile::vtp_cell_count_wraps(p, c.verts, c.polys, c.strips);
+    const vxl::Error e = error_of([&] { (void)vxl::read_tractogram(p); });
+    EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
+    EXPECT_TRUE(contains(e.what(), "does not fit in 64 bits")) << e.what();
+    expect_convert_refused(dir, p, 3);
+  }
+}
+
 }  // namespace

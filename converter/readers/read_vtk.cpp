@@ -73,7 +73,7 @@ class LegacyParser {
         std::vector<std::uint64_t> offsets{0};
         std::vector<double> connectivity;
         const std::uint64_t n = cells(offsets, connectivity, key_at, key);
-        p.cell_count += n;
+        p.cell_count = checked_sum(p.cell_count, n, path_, key_at, "the number of cells");
         if (key == "LINES") {
           if (have_lines) fail(key_at, "a second LINES section");
           p.line_offsets = std::move(offsets);
@@ -81,7 +81,7 @@ class LegacyParser {
           p.cells_before_lines = verts;
           have_lines = true;
         } else if (key == "VERTICES") {
-          verts += n;
+          verts = checked_sum(verts, n, path_, key_at, "the number of VERTICES cells");
         } else if (n > 0) {
           surface = key;
         }

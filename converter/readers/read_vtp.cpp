@@ -220,8 +220,10 @@ class VtpParser {
     if (polys > 0 || strips > 0) warnings_.push_back("Polys and Strips are not streamlines; skipped");
     if (verts > 0) warnings_.push_back(std::to_string(verts) + " Verts cells are not streamlines; skipped");
     p.cells_before_lines = verts;
-    p.cell_count = verts + lines + polys + strips;
-    if (p.cell_count < lines) fail(offset(piece), "cell counts overflow");
+    const auto cells = [&](std::uint64_t a, std::uint64_t b) {
+      return checked_sum(a, b, path_, offset(piece), "NumberOfVerts + NumberOfLines + NumberOfPolys + NumberOfStrips");
+    };
+    p.cell_count = cells(cells(cells(verts, lines), polys), strips);
 
     const pugi::xml_node points = piece.child("Points").child("DataArray");
     if (p.point_count > 0) {

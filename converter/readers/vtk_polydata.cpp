@@ -89,7 +89,8 @@ void fill_tractogram(Tractogram& t, const std::string& path, const PolyData& p, 
   std::set<std::string> point_names, cell_names;
   for (const DataArray& a : p.point_data)
     add_value_sets(t, a, p.point_count, 0, &gather, p.line_offsets, true, path, point_names);
-  if (!p.cell_data.empty() && p.cells_before_lines + lines > p.cell_count)
+  if (!p.cell_data.empty() &&
+      checked_sum(p.cells_before_lines, lines, path, std::nullopt, "cells up to the last line") > p.cell_count)
     fail_input(path, std::nullopt,
                "cell data for " + std::to_string(p.cell_count) + " cells, fewer than the cells declared");
   for (const DataArray& a : p.cell_data)
