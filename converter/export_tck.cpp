@@ -8,6 +8,7 @@
 #include "converter/export_values.h"
 #include "converter/tck_writer.h"
 #include "format/error.h"
+#include "format/json_limits.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -16,7 +17,7 @@ namespace {
 // The source's timestamp, when its provenance has one: MRtrix checks that a TSF's timestamp is its
 // tractogram's, so both files get the same one.
 std::vector<std::string> timestamp_line(const VxlFile& file) {
-  const nlohmann::json prov = nlohmann::json::parse(file.provenance_json(), nullptr, false);
+  const nlohmann::json prov = parse_json(file.provenance_json(), file.path(), file.provenance_offset(), "PROV");
   if (!prov.is_object() || !prov.contains("source") || !prov["source"].is_object()) return {};
   const nlohmann::json header = prov["source"].value("header", nlohmann::json());
   if (!header.is_object() || !header.contains("timestamp")) return {};

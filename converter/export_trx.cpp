@@ -11,6 +11,7 @@
 
 #include "converter/export_values.h"
 #include "format/error.h"
+#include "format/json_limits.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -101,7 +102,7 @@ class ZipWriter {
 }  // namespace
 
 TrxReference trx_reference(const VxlFile& file) {
-  const nlohmann::json prov = nlohmann::json::parse(file.provenance_json(), nullptr, false);
+  const nlohmann::json prov = parse_json(file.provenance_json(), file.path(), file.provenance_offset(), "PROV");
   if (prov.is_object() && prov.contains("source") && prov["source"].is_object()) {
     // PROV may hold any JSON (open() does not look into it): take each field only with the expected type.
     const nlohmann::json& src = prov["source"];

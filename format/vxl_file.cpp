@@ -34,6 +34,11 @@ const SectionEntry* VxlFile::find_section(std::uint32_t id) const {
   return nullptr;
 }
 
+std::uint64_t VxlFile::provenance_offset() const {
+  const SectionEntry* s = find_section(section_id("PROV"));
+  return s ? s->offset : 0;
+}
+
 OrderView VxlFile::order(std::size_t voxel, std::uint32_t k, std::uint32_t level) const {
   const VoxelEntry& v = voxels_[voxel];
   const LevelEntry counts = this->level(voxel, level);

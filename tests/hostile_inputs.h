@@ -139,6 +139,17 @@ inline void trx_offsets_bomb(const std::string& path, int mib, bool honest) {
   write_zip(path, e);
 }
 
+// Arrays nested `depth` deep: `[[[...]]]`.
+inline std::string nested_json(std::size_t depth) { return std::string(depth, '[') + std::string(depth, ']'); }
+
+// A valid TRX of 3 streamlines whose header.json also holds arrays nested `depth` deep.
+inline void trx_deep_header(const std::string& path, std::size_t depth) {
+  std::vector<ZipEntry> e = trx_entries(3);
+  e[0] = stored_entry("header.json",
+                      text("{\"NB_STREAMLINES\": 3, \"NB_VERTICES\": 6, \"deep\": " + nested_json(depth) + "}"));
+  write_zip(path, e);
+}
+
 // ---- VTK and VTP ----
 
 // A legacy VTK whose POINTS count N makes 3 x N wrap past 2^64: the data holds exactly as many numbers

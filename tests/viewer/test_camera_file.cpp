@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "format/error.h"
+#include "format/json_limits.h"
 #include "tests/test_support.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/turntable.h"
@@ -118,6 +119,14 @@ TEST(CameraFile, MissingKeysKeepDefaultsAndBadOnesNameFileAndKey) {
             std::string::npos);
   EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"colormap": "jet"}})").find("settings.colormap"),
             std::string::npos);
+
+  // Nested 100000 deep, the file crashed the viewer by stack overflow: refused before it is parsed.
+  const std::string deep =
+      error_of(R"({"voxview_view": 1, "x": )" + std::string(100000, '[') + std::string(100000, ']') + "}");
+  EXPECT_NE(deep.find("bad.json: at byte " + std::to_string(25 + kMaxJsonDepth - 1) +
+                      ": view file: JSON nested deeper than " + std::to_string(kMaxJsonDepth)),
+            std::string::npos)
+      << deep;
 
   ScratchDir dir;
   try {

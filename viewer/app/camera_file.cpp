@@ -10,6 +10,7 @@
 
 #include "format/atomic_output.h"
 #include "format/error.h"
+#include "format/json_limits.h"
 
 namespace vxl::app {
 
@@ -219,7 +220,7 @@ std::string view_json(const SavedView& v) {
 }
 
 SavedView parse_view_json(const std::string& text, const std::string& path, const SavedView& defaults) {
-  json j = json::parse(text, nullptr, false);
+  json j = parse_json(text, path, 0, "view file");
   if (j.is_discarded() || !j.is_object()) fail_input(path, std::nullopt, "not a JSON object (a voxview view file)");
   const Reader top(j, path, "");
   const json* version = top.find("voxview_view");
