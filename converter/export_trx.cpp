@@ -12,6 +12,7 @@
 #include "converter/export_values.h"
 #include "format/error.h"
 #include "format/json_limits.h"
+#include "format/output_path.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -56,7 +57,8 @@ class ZipWriter {
  public:
   explicit ZipWriter(const std::string& path) : path_(path) {
     int code = 0;
-    zip_ = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &code);
+    // libzip writes a temporary file and renames it over the path: the output rule applies.
+    zip_ = zip_open(output_target(path).c_str(), ZIP_CREATE | ZIP_TRUNCATE, &code);
     if (!zip_) {
       zip_error_t e;
       zip_error_init_with_code(&e, code);

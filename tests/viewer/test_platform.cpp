@@ -6,6 +6,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -19,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "format/error.h"
 #include "viewer/platform/egl_context.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/offscreen_target.h"
@@ -524,6 +526,36 @@ TEST(PlatformImageIo, WriteFailuresLeaveNothingAndNameThePath) {
   // A failed overwrite keeps the previous file.
   expect_fail(path, 5, 5, img.rgba);
   EXPECT_TRUE(vxl::read_image(path).rgba == other.rgba);
+}
+
+// The output rule (format/output_path.h): a FIFO or a device is refused as an output error and left as it
+// was, a symbolic link is followed and kept, a missing folder is an output error (voxview exit 5).
+TEST(PlatformImageIo, WritePngRefusesFifosAndDevicesAndFollowsLinks) {
+  TempDir dir;
+  const Image img = test_pattern(4, 4);
+  const std::string fifo = (dir.path() / "fifo.png").string(), null_link = (dir.path() / "null.png").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  fs::create_symlink("/dev/null", null_link);
+  for (const std::string& path : {fifo, null_link, (dir.path() / "missing" / "x.png").string()}) {
+    try {
+      vxl::write_png(path, img);
+      ADD_FAILURE() << "no exception for " << path;
+    } catch (const vxl::Error& e) {
+      EXPECT_EQ(e.kind(), vxl::ErrorKind::Output) << e.what();
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(null_link)));
+  EXPECT_TRUE(fs::is_character_file(fs::symlink_status("/dev/null")));
+  EXPECT_EQ(dir.entries().size(), 2u) << "a temporary file left";
+
+  fs::create_directory(dir.path() / "sub");
+  const std::string link = (dir.path() / "link.png").string();
+  fs::create_symlink("sub/real.png", link);
+  vxl::write_png(link, img);
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+  EXPECT_TRUE(vxl::read_image((dir.path() / "sub" / "real.png").string()).rgba == img.rgba);
 }
 
 TEST(PlatformImageIo, ReadErrorsAndRgbFiles) {

@@ -15,6 +15,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "format/output_path.h"
+
 namespace vxl {
 
 namespace fs = std::filesystem;
@@ -77,10 +79,8 @@ void write_png(const std::string& path, int w, int h, const std::vector<std::uin
                 std::to_string(h) + " RGBA8 needs " + std::to_string(static_cast<std::size_t>(w) * h * 4) + ", for",
             path);
 
-  const fs::path target(path);
+  const fs::path target(output_target(path));
   std::error_code ec;
-  if (fs::is_directory(target, ec)) io_fail("write_png: path is a directory:", path);
-
   const fs::path tmp = reserve_temp_file(target);
   try {
     // The format is named explicitly: the temporary name's extension is not ".png".
