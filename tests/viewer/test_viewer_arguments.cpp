@@ -1,15 +1,18 @@
 // voxview's command line: the parser's schema (voxview_cli.h) and how the options combine with a saved view
 // and are checked (viewer_arguments.h), without running the program.
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "format/error.h"
 #include "tests/test_support.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/key_bindings.h"
+#include "viewer/app/turntable.h"
 #include "viewer/app/viewer_arguments.h"
 #include "viewer/app/voxview_cli.h"
 
@@ -202,6 +205,61 @@ TEST(ViewerArguments, BadOrConflictingOptionsAreUsageErrors) {
   ViewerArguments no_image = given("--slices", &ViewerArguments::slices, "axial");
   no_image.options.image.reset();
   error_contains(no_image, "--image-range and --slices need --image");
+}
+
+// Every output is checked before anything is read or drawn: --render into a missing folder or onto a
+// folder exited 70 after the rendering; a FIFO or a device was replaced by a regular file.
+TEST(ViewerArguments, OutputPathsAreCheckedFirstAndNeverReplaceAFifoOrDevice) {
+  ScratchDir dir;
+  const std::string fifo = dir.file("fifo.png"), null_link = dir.file("null.png");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::filesystem::create_symlink("/dev/null", null_link);
+  auto output_error_of = [](const ViewerArguments& a) -> std::string {
+    try {
+      resolve_viewer_options(a);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Output) << e.what();
+      return e.what();
+    }
+    return "no error";
+  };
+  auto rendering_to = [](const std::string& png) {
+    ViewerArguments a;
+    a.options.inputs = {"a.vxl"};
+    a.options.render_png = png;
+    return a;
+  };
+  EXPECT_NE(output_error_of(rendering_to(dir.file("missing/x.png"))).find("cannot write into the folder"),
+            std::string::npos);
+  EXPECT_NE(output_error_of(rendering_to(dir.file(""))).find("is a directory"), std::string::npos);
+  EXPECT_NE(output_error_of(rendering_to(fifo)).find("is a FIFO"), std::string::npos);
+  EXPECT_NE(output_error_of(rendering_to(null_link)).find("is a character device"), std::string::npos);
+  EXPECT_EQ(output_error_of(rendering_to(dir.file("new.png"))), "no error");
+
+  // The second of three turntable frames.
+  ViewerArguments turn = rendering_to(dir.file("t.png"));
+  turn.options.turntable = 3;
+  ASSERT_EQ(::mkfifo(app::turntable_frame_path(dir.file("t.png"), 1, 3).c_str(), 0600), 0);
+  EXPECT_NE(output_error_of(turn).find("t_001.png: is a FIFO"), std::string::npos) << output_error_of(turn);
+
+  for (auto field :
+       {&app::ViewerOptions::save_camera, &app::ViewerOptions::stats_json, &app::ViewerOptions::screenshot}) {
+    ViewerArguments a;
+    a.options.inputs = {"a.vxl"};
+    a.options.*field = fifo;
+    EXPECT_NE(output_error_of(a).find("is a FIFO"), std::string::npos);
+  }
+  struct stat st {};
+  ASSERT_EQ(::lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  ASSERT_EQ(::lstat("/dev/null", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode));
+
+  // The program: exit 5, before the input is even opened.
+  for (const std::string& out : {dir.file("missing/x.png"), dir.file(""), fifo}) {
+    const auto r = test::run_program(VOXVIEW_CLI, test::q(dir.file("absent.vxl")) + " --render " + test::q(out));
+    EXPECT_EQ(r.exit_code, 5) << r.output;
+  }
 }
 
 // The schema: which options were given, values that start with '-', the lists the help takes from their tables.

@@ -1,11 +1,14 @@
 #include "viewer/app/viewer_arguments.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "converter/memory_size.h"
 #include "format/error.h"
+#include "format/output_path.h"
 #include "viewer/app/camera_file.h"
+#include "viewer/app/turntable.h"
 
 namespace vxl::app {
 
@@ -149,6 +152,18 @@ void apply_view_and_size(const ViewerArguments& a, const std::string& size, View
     usage_error("--size must be WxH, each 1..16384");
 }
 
+// Every output path, before anything is read or drawn: a missing folder, a directory, a FIFO or a device
+// is refused now (exit 5) rather than after the rendering, and never replaced (format/output_path.h).
+void check_outputs(const ViewerOptions& o) {
+  if (o.render_png) {
+    const int frames = std::max(1, o.turntable);
+    for (int i = 0; i < frames; ++i)
+      (void)output_target(o.turntable ? turntable_frame_path(*o.render_png, i, frames) : *o.render_png);
+  }
+  for (const auto* path : {&o.save_camera, &o.stats_json, &o.screenshot})
+    if (*path) (void)output_target(**path);
+}
+
 }  // namespace
 
 ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
@@ -167,6 +182,7 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
     if (!o.gpu_memory || *o.gpu_memory == 0)
       usage_error("--gpu-memory '" + a.gpu_memory + "' is not a memory size (bytes, or K/M/G: 512M, 2G)");
   }
+  check_outputs(o);
   return o;
 }
 
