@@ -9,6 +9,7 @@
 #include "converter/tck_writer.h"
 #include "format/error.h"
 #include "format/json_limits.h"
+#include "format/output_path.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -46,6 +47,10 @@ std::uint32_t chosen_set(const VxlFile& file, const TckExportSettings& settings)
 }  // namespace
 
 ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings) {
+  // Both are renamed into place at the end: the second would replace the first.
+  if (settings.tsf_path && same_output(out_path, *settings.tsf_path))
+    throw Error(ErrorKind::Usage, *settings.tsf_path, std::nullopt,
+                "is the same file as the TCK output " + out_path + ": the TSF needs a file of its own");
   ExportSummary summary;
   const MetaSection& m = file.meta();
   summary.streamlines = m.streamline_count;

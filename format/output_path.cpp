@@ -57,4 +57,15 @@ std::string output_target(const std::string& path) {
   throw Error(ErrorKind::Output, path, std::nullopt, "too many levels of symbolic links");
 }
 
+bool same_output(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  const std::string ta = output_target(a), tb = output_target(b);
+  struct stat sa, sb;
+  if (::stat(ta.c_str(), &sa) == 0 && ::stat(tb.c_str(), &sb) == 0)
+    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  std::error_code ea, eb;
+  const fs::path ca = fs::weakly_canonical(ta, ea), cb = fs::weakly_canonical(tb, eb);
+  return !ea && !eb ? ca == cb : fs::absolute(ta).lexically_normal() == fs::absolute(tb).lexically_normal();
+}
+
 }  // namespace vxl

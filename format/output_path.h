@@ -17,4 +17,9 @@ namespace vxl {
 // Throws vxl::Error (Output) naming `path` when the rule refuses it (or a link cannot be followed).
 std::string output_target(const std::string& path);
 
+// True when outputs `a` and `b` are one file: the same path once symbolic links, `.` and `..` are
+// resolved, or, for files that exist, the same file under two names (a hard link). Throws what
+// output_target throws.
+bool same_output(const std::string& a, const std::string& b);
+
 }  // namespace vxl

@@ -143,4 +143,37 @@ TEST(OutputPath, MissingFolderOrAFolderAsOutputIsAnOutputError) {
   }
 }
 
+// `export X.vxl OUT.tck --tsf OUT.tck` exited 0 with the TSF renamed over the TCK: the streamlines were lost.
+// Refused (exit 2) under any name for the same file, and nothing is written.
+TEST(OutputPath, TsfOnTheTckItselfIsAUsageError) {
+  ScratchDir dir;
+  const std::string vxl = dir.file("values.vxl"), tck = dir.file("out.tck"), sub = dir.file("sub");
+  vxl::test::VxlBytes::make(vxl);
+  fs::create_directory(sub);
+  fs::create_symlink("../out.tck", dir.file("sub/link.tsf"));
+  const std::vector<std::string> same_names = {tck, sub + "/../out.tck", dir.file("./out.tck"),
+                                               dir.file("sub/link.tsf")};
+  for (const std::string& tsf : same_names) {
+    SCOPED_TRACE(tsf);
+    const auto r = vxl::test::run_cli("export " + q(vxl) + " " + q(tck) + " --tsf " + q(tsf));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "is the same file as the TCK output")) << r.output;
+    EXPECT_FALSE(fs::exists(tck));
+  }
+  // An existing TCK, and a hard link to it: kept as it was.
+  vxl::test::hostile::write_file(tck, "old");
+  fs::create_hard_link(tck, dir.file("hard.tsf"));
+  for (const std::string& tsf : {tck, dir.file("hard.tsf"), dir.file("sub/link.tsf")}) {
+    SCOPED_TRACE(tsf);
+    const auto r = vxl::test::run_cli("export " + q(vxl) + " " + q(tck) + " --tsf " + q(tsf));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_EQ(fs::file_size(tck), 3u);
+  }
+  // Two files: both written.
+  const auto r = vxl::test::run_cli("export " + q(vxl) + " " + q(tck) + " --tsf " + q(dir.file("out.tsf")));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_GT(fs::file_size(tck), 3u);
+  EXPECT_GT(fs::file_size(dir.file("out.tsf")), 0u);
+}
+
 }  // namespace
