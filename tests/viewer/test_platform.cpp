@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -590,6 +591,33 @@ TEST(PlatformImageIo, ReadErrorsAndRgbFiles) {
   ASSERT_EQ(img.width, 2);
   ASSERT_EQ(img.height, 1);
   EXPECT_EQ(img.rgba, (std::vector<std::uint8_t>{10, 20, 30, 255, 40, 50, 60, 255}));
+}
+
+// --size 16384x8192 (or a view file's "size") exited 70 with "framebuffer incomplete": the driver caps
+// a buffer's bytes below its per-side limit. Both limits are now an Unsupported error (exit 4) that says
+// what fits.
+TEST_F(PlatformTarget, SizesTheDriverCannotHoldAreUnsupportedAndSayWhatFits) {
+  GLint max_tex = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+  try {
+    OffscreenTarget t(max_tex + 1, 16);
+    ADD_FAILURE() << "no error";
+  } catch (const vxl::Error& e) {
+    EXPECT_EQ(e.kind(), vxl::ErrorKind::Unsupported) << e.what();
+    EXPECT_NE(std::string(e.what()).find("limit of "), std::string::npos) << e.what();
+  }
+  // llvmpipe cannot allocate the 2 GiB float colour buffer of 16384x8192. A driver that can passes; one
+  // that cannot must say so as an Unsupported error.
+  try {
+    OffscreenTarget t(std::min(16384, max_tex), std::min(8192, max_tex));
+    std::printf("[ platform ] %dx%d allocates on this driver\n", t.width(), t.height());
+  } catch (const vxl::Error& e) {
+    EXPECT_EQ(e.kind(), vxl::ErrorKind::Unsupported) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the largest of this shape it allocates is "), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("is none"), std::string::npos) << e.what();
+  }
+  OffscreenTarget small(8, 8);  // the context is still usable
+  EXPECT_EQ(small.read_rgba().size(), 8u * 8u * 4u);
 }
 
 TEST_F(PlatformTarget, RenderedImageSurvivesPng) {

@@ -262,6 +262,25 @@ TEST(ViewerArguments, OutputPathsAreCheckedFirstAndNeverReplaceAFifoOrDevice) {
   }
 }
 
+// A size the GL driver cannot allocate, from --size or from a view file, is exit 4 naming what fits (it
+// was exit 70, "framebuffer incomplete"); a driver that allocates it draws it.
+TEST(Voxview, SizeBeyondWhatTheDriverAllocatesIsUnsupported) {
+  ScratchDir dir;
+  const std::string tck = dir.file("s.tck"), vxl = dir.file("s.vxl"), view = dir.file("big.json");
+  ASSERT_EQ(test::run_cli("synth " + test::q(tck) + " --streamlines 20").exit_code, 0);
+  ASSERT_EQ(test::run_cli("convert " + test::q(tck) + " " + test::q(vxl)).exit_code, 0);
+  std::ofstream(view) << R"({"voxview_view": 1, "size": [16384, 8192]})";
+  for (const std::string& size : {std::string("--size 16384x8192"), "--camera " + test::q(view)}) {
+    SCOPED_TRACE(size);
+    const auto r =
+        test::run_program(VOXVIEW_CLI, test::q(vxl) + " --render " + test::q(dir.file("o.png")) + " " + size);
+    if (r.exit_code == 0) continue;
+    EXPECT_EQ(r.exit_code, 4) << r.output;
+    EXPECT_NE(r.output.find("image size 16384x8192: the GL driver cannot allocate"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("o.png")));
+  }
+}
+
 // The schema: which options were given, values that start with '-', the lists the help takes from their tables.
 TEST(VoxviewCli, ParsesNegativeValuesAndNotesGivenOptions) {
   ViewerArguments a;
