@@ -281,6 +281,34 @@ TEST(Voxview, SizeBeyondWhatTheDriverAllocatesIsUnsupported) {
   }
 }
 
+// A view file whose scalar, groups or colouring the scene cannot honour is a bad file (exit 3, naming it);
+// the same from the command line stays a usage error (exit 2). Both exited 2.
+TEST(Voxview, ColourSettingsFromAViewFileAreTheFilesErrors) {
+  ScratchDir dir;
+  const std::string tck = dir.file("s.tck"), vxl = dir.file("s.vxl"), png = dir.file("o.png");
+  ASSERT_EQ(test::run_cli("synth " + test::q(tck) + " --streamlines 20").exit_code, 0);
+  ASSERT_EQ(test::run_cli("convert " + test::q(tck) + " " + test::q(vxl)).exit_code, 0);
+  const std::vector<std::pair<std::string, std::string>> settings = {
+      {R"("scalar": "fa")", "settings.scalar: no value set 'fa'"},
+      {R"("groups": [{"name": "CST", "opacity": 0.5}])", "settings.groups: no group 'CST'"},
+      {R"("color": "scalar")", "settings.color: no per-point or per-streamline values"}};
+  for (const auto& [setting, message] : settings) {
+    SCOPED_TRACE(setting);
+    const std::string view = dir.file("v.json");
+    std::ofstream(view) << R"({"voxview_view": 1, "settings": {)" + setting + "}}";
+    const auto r = test::run_program(
+        VOXVIEW_CLI, test::q(vxl) + " --camera " + test::q(view) + " --render " + test::q(png) + " --size 32x32");
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("v.json: " + message), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("in " + vxl), std::string::npos) << r.output;
+  }
+  for (const std::string& option : {"--scalar fa", "--group CST=:0.5", "--color scalar"}) {
+    const auto r = test::run_program(VOXVIEW_CLI, test::q(vxl) + " " + option + " --render " + test::q(png));
+    EXPECT_EQ(r.exit_code, 2) << option << ": " << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(png));
+}
+
 // The schema: which options were given, values that start with '-', the lists the help takes from their tables.
 TEST(VoxviewCli, ParsesNegativeValuesAndNotesGivenOptions) {
   ViewerArguments a;

@@ -84,7 +84,7 @@ int run_headless(const ViewerOptions& o) {
     }
   }
   volume.reset();
-  check_color_options(o.inputs_name(), *renderer, o.settings);
+  check_color_options(o.inputs_name(), *renderer, o.settings, o.from_view_file);
   OffscreenTarget target(o.width, o.height);
   target.bind();
   if (o.save_camera) write_view(*o.save_camera, SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}});

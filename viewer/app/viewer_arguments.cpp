@@ -34,6 +34,18 @@ void apply_saved_view(const ViewerArguments& a, ViewerOptions& o, std::string& s
   const SavedView saved = read_view(a.camera_file, defaults);
   o.settings = saved.settings;
   o.camera = saved.camera;
+  // What the file names and the command line does not replace is checked against the scene as the file's.
+  ViewFileSettings& from_file = o.from_view_file;
+  from_file.path = a.camera_file;
+  from_file.color = !a.was_given("--color");
+  from_file.scalar = !a.was_given("--scalar");
+  for (const GroupStyle& g : saved.settings.group_styles) {
+    const bool given = std::any_of(a.groups.begin(), a.groups.end(), [&](const std::string& text) {
+      const auto style = parse_group_style(text);
+      return style && style->name == g.name;
+    });
+    if (!given) from_file.groups.push_back(g.name);
+  }
   if (saved.size && !a.was_given("--size"))
     size = std::to_string((*saved.size)[0]) + "x" + std::to_string((*saved.size)[1]);
 }

@@ -11,6 +11,14 @@
 
 namespace vxl::app {
 
+// The colour settings a saved view (--camera FILE) gave and the command line left. A scene that cannot
+// honour them makes the file the problem (exit 3, naming it), not the command line (exit 2).
+struct ViewFileSettings {
+  std::string path;  // empty: no view file
+  bool color = false, scalar = false;
+  std::vector<std::string> groups;
+};
+
 struct ViewerOptions {
   std::vector<std::string> inputs;  // .vxl, or a .tck/.trk/.trx/.vtk/.vtp converted in memory; several: one scene
   // How the inputs are named in messages and titles: the first file's name, "+ N more" for the others.
@@ -46,6 +54,7 @@ struct ViewerOptions {
   std::optional<int> frames;
   bool until_refined = false;  // with frames: after them, stay at rest until the refinement is done, then quit
   std::optional<std::string> screenshot;
+  ViewFileSettings from_view_file;
 };
 
 }  // namespace vxl::app

@@ -260,7 +260,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   grid_.emplace(first);
   controller_ = CameraController(Camera{}, std::max(1.0, glm::length(first.scene_max() - first.scene_min()) * 0.5));
   stats_.has_image = volume != nullptr;
-  check_color_options(o.inputs_name(), first, o.settings);
+  check_color_options(o.inputs_name(), first, o.settings, o.from_view_file);
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
   glGetIntegerv(GL_MINOR_VERSION, &minor);
