@@ -178,6 +178,14 @@ inline void vtp_cell_count_wraps(const std::string& path, std::uint64_t verts, s
   write_file(path, s);
 }
 
+// The small VTP tractogram in `style` whose Piece claims `points` points: more than its arrays hold.
+inline void vtp_points_beyond_arrays(const std::string& path, const test::VtpStyle& style, std::uint64_t points) {
+  std::string s = test::small_vtp(style);
+  const std::string declared = "NumberOfPoints=\"5\"";
+  s.replace(s.find(declared), declared.size(), "NumberOfPoints=\"" + std::to_string(points) + "\"");
+  write_file(path, s);
+}
+
 // ---- MRtrix (TCK, TSF) ----
 
 // Row 8: a TSF of three streamlines of one value each, the second 1e300 (beyond float32).

@@ -3,6 +3,7 @@
 // documented kind of error, naming the file, and the command line must write nothing.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -88,6 +89,29 @@ TEST(HostileVtp, CellCountsThatWrapAreMalformed) {
     EXPECT_TRUE(contains(e.what(), "does not fit in 64 bits")) << e.what();
     expect_convert_refused(dir, p, 3);
   }
+}
+
+// Counts far beyond what an array holds were refused as "a likely decompression bomb" (exit 4) before
+// the array's own headers were read, also where nothing is compressed; a count its bytes, text or block
+// headers contradict is malformed (exit 3). Only data that agrees with its count is held to the budget.
+TEST(HostileVtp, CountsBeyondWhatTheArraysHoldAreMalformed) {
+  ScratchDir dir;
+  std::vector<vxl::test::VtpStyle> styles(6);
+  styles[1].format = "ascii";
+  styles[2].format = styles[3].format = styles[5].format = "appended";
+  styles[3].appended_base64 = true;
+  styles[4].zlib = styles[5].zlib = true;
+  for (const vxl::test::VtpStyle& style : styles)
+    for (const std::uint64_t points : {std::uint64_t{6}, std::uint64_t{100000000}, std::uint64_t{1} << 40}) {
+      SCOPED_TRACE(style.format + (style.appended_base64 ? " base64" : "") + (style.zlib ? " zlib " : " ") +
+                   std::to_string(points));
+      const std::string p = dir.file("counts.vtp");
+      hostile::vtp_points_beyond_arrays(p, style, points);
+      const vxl::Error e = error_of([&] { (void)vxl::read_tractogram(p); });
+      EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
+      EXPECT_TRUE(contains(e.what(), "Points")) << e.what();
+      expect_convert_refused(dir, p, 3);
+    }
 }
 
 }  // namespace

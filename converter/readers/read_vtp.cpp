@@ -13,6 +13,7 @@
 // decoded arrays together against a budget proportional to the file size.
 #include <charconv>
 #include <cstring>
+#include <functional>
 #include <string_view>
 
 #include <zlib.h>
@@ -287,16 +288,21 @@ class VtpParser {
     if (a.attribute("NumberOfComponents") && count_attribute(a, "NumberOfComponents") != components)
       fail(offset(a), what + ": NumberOfComponents differs from " + std::to_string(components));
     const std::uint64_t n = checked_product(components, tuples, path_, offset(a), what + " size");
-    if (n > budget_ / 8)
-      fail_unsupported(path_, what + ": " + std::to_string(n) +
-                                  " values exceed what a file of this size may decode to (" +
-                                  "64 x its size + 64 MiB in all); refused as a likely decompression bomb");
-    budget_ -= 8 * n;
+    // Charged once the array's own headers (or text) agree with the count: a count they contradict, or
+    // beyond the bytes an uncompressed array has, is malformed (exit 3), not a likely bomb (exit 4).
+    auto charge_budget = [&] {
+      if (n > budget_ / 8)
+        fail_unsupported(path_, what + ": " + std::to_string(n) +
+                                    " values exceed what a file of this size may decode to (" +
+                                    "64 x its size + 64 MiB in all); refused as a likely decompression bomb");
+      budget_ -= 8 * n;
+    };
     const std::string format = a.attribute("format").as_string("ascii");
     std::vector<double> out;
     if (format == "ascii") {
       const std::string_view text = a.child_value();
       if (n > text.size() / 2 + 1) fail(offset(a), what + ": " + std::to_string(n) + " values cannot fit in its text");
+      charge_budget();
       out.resize(n);
       std::size_t pos = 0;
       for (std::uint64_t k = 0; k < n; ++k) {
@@ -317,14 +323,14 @@ class VtpParser {
       // The text's own node gives its file offset (the parsed copy starts with the file's bytes).
       const pugi::xml_node text_node = a.first_child();
       ByteSource src(path_, text, text_node ? offset(text_node) : offset(a), true);
-      bytes = block_bytes(src, n * type.size, what);
+      bytes = block_bytes(src, n * type.size, what, charge_budget);
     } else if (format == "appended") {
       if (appended_at_ == 0) fail(offset(a), what + ": format=\"appended\" but the file has no <AppendedData>");
       const std::uint64_t off = count_attribute(a, "offset");
       if (off > appended_.size())
         fail(offset(a), what + ": appended offset " + std::to_string(off) + " is past the end of the file");
       ByteSource src(path_, appended_.substr(off), appended_at_ + off, appended_base64_);
-      bytes = block_bytes(src, n * type.size, what);
+      bytes = block_bytes(src, n * type.size, what, charge_budget);
     } else {
       fail(offset(a), what + ": format '" + format + "' (expected ascii, binary or appended)");
     }
@@ -334,12 +340,19 @@ class VtpParser {
     return out;
   }
 
-  std::vector<std::uint8_t> block_bytes(ByteSource& src, std::uint64_t expected, const std::string& what) {
+  // An array's bytes. `charge_budget` is called once the block headers agree with the `expected` size,
+  // before anything is allocated for it.
+  std::vector<std::uint8_t> block_bytes(ByteSource& src, std::uint64_t expected, const std::string& what,
+                                        const std::function<void()>& charge_budget) {
     std::vector<std::uint8_t> out;
     if (!zlib_) {
       const std::uint64_t size = src.read_uint(header_size_, big_);
       if (size != expected)
         src.fail(what + ": the header says " + std::to_string(size) + " bytes; expected " + std::to_string(expected));
+      if (expected > src.available())
+        src.fail(what + ": " + std::to_string(expected) + " bytes, but at most " + std::to_string(src.available()) +
+                 " remain");
+      charge_budget();
       out.resize(expected);
       src.read(out.data(), expected);
       return out;
@@ -362,6 +375,7 @@ class VtpParser {
     if (total != expected)
       src.fail(what + ": the compression header says " + std::to_string(total) + " bytes; expected " +
                std::to_string(expected));
+    charge_budget();
     out.resize(expected);
     std::vector<std::uint8_t> in;
     std::uint64_t at = 0;
