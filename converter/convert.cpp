@@ -78,13 +78,15 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
       throw Error(ErrorKind::Input, t.source.path, std::nullopt,
                   "value set '" + v.name + "' has " + std::to_string(v.values.size()) + " values for " +
                       std::to_string(t.streamline_count()) + " streamlines");
+  // Warnings of the conversion itself: in PROV with the reader's, and in the summary for the caller to show.
+  std::vector<std::string> warnings;
   for (auto* sets : {&t.point_values, &t.streamline_values})
     if (sets->size() > kMaxValueSets) {
-      t.source.warnings.push_back(
-          "only the first " + std::to_string(kMaxValueSets) + " of " + std::to_string(sets->size()) +
-          (sets == &t.point_values ? " per-point" : " per-streamline") + " value sets are kept");
+      warnings.push_back("only the first " + std::to_string(kMaxValueSets) + " of " + std::to_string(sets->size()) +
+                         (sets == &t.point_values ? " per-point" : " per-streamline") + " value sets are kept");
       sets->resize(kMaxValueSets);
     }
+  t.source.warnings.insert(t.source.warnings.end(), warnings.begin(), warnings.end());
   // PROV and GRPS are known before any work: their sizes go into the plan of the output file.
   const std::string provenance = provenance_json(t.source, settings, threads, voxel_size_choice);
   std::vector<std::uint8_t> groups_bytes;
@@ -98,6 +100,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   using Clock = std::chrono::steady_clock;
   auto seconds_since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   ConvertSummary summary;
+  summary.warnings = std::move(warnings);
   auto t0 = Clock::now();
 
   // Pass 1 fixes every size; the output is then mapped and filled in place (no copies of the sections).

@@ -65,7 +65,8 @@ VxlFile open_scene(const std::string& path, double voxel_size, const std::vector
       ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
   ConvertSettings settings;
   settings.voxel_size = voxel_size;
-  convert_tractogram(std::move(t), temp.string(), settings);
+  for (const std::string& w : convert_tractogram(std::move(t), temp.string(), settings).warnings)
+    std::fprintf(stderr, "voxview: warning: %s: %s\n", path.c_str(), w.c_str());
   VxlFile f = VxlFile::open(temp.string());
   std::filesystem::remove(temp);  // the mapping keeps the data; nothing is left behind
   std::string tsf_options;
