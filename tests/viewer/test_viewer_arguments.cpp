@@ -2,6 +2,7 @@
 // and are checked (viewer_arguments.h), without running the program.
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -205,6 +206,43 @@ TEST(ViewerArguments, BadOrConflictingOptionsAreUsageErrors) {
   ViewerArguments no_image = given("--slices", &ViewerArguments::slices, "axial");
   no_image.options.image.reset();
   error_contains(no_image, "--image-range and --slices need --image");
+}
+
+// Options that draw nothing (an azimuth of 1e308, a slab of 1e-300 mm, a focus at 1e308 mm) or make no
+// sense (a frame budget of NaN, an infinite orbit) were accepted; they are usage errors now.
+TEST(ViewerArguments, OptionsThatDrawNothingAreUsageErrors) {
+  auto error_contains = [](const ViewerArguments& a, const std::string& part) {
+    const std::string error = usage_error_of(a);
+    EXPECT_NE(error.find(part), std::string::npos) << error;
+  };
+  ViewerArguments view = given("--view", &ViewerArguments::view, "1e308,1e308");
+  error_contains(view, "--view: unknown view '1e308,1e308'");
+  ViewerArguments slab;
+  slab.slab = 1e-300;
+  slab.given.insert("--slab");
+  error_contains(slab, "--slab: expected a thickness in [0.001, 1e+07] mm");
+  error_contains(given("--focus", &ViewerArguments::focus, "1e308,0,0"), "--focus: expected X,Y,Z");
+  ViewerArguments budget;
+  budget.options.frame_budget_ms = std::numeric_limits<double>::quiet_NaN();
+  error_contains(budget, "--frame-budget: expected milliseconds");
+  ViewerArguments orbit;
+  orbit.options.orbit_deg = std::numeric_limits<double>::infinity();
+  error_contains(orbit, "--orbit: expected degrees");
+  EXPECT_EQ(usage_error_of(given("--view", &ViewerArguments::view, "-720,95")), "no error");  // elevation clamped
+}
+
+// A view file without "camera" gave the default camera (target at the origin, 300 mm away): a picture of
+// whatever lies there. It is framed now, as without a view file; its settings still apply.
+TEST(ViewerArguments, AViewFileWithoutACameraIsFramedAsWithoutOne) {
+  ScratchDir dir;
+  const std::string path = dir.file("look.json");
+  std::ofstream(path) << R"({"voxview_view": 1, "settings": {"lighting": true, "mode": "exact"}})";
+  ViewerArguments a;
+  a.camera_file = path;
+  const app::ViewerOptions o = resolve_viewer_options(a);
+  EXPECT_FALSE(o.camera);
+  EXPECT_TRUE(o.settings.lighting);
+  EXPECT_EQ(o.settings.mode, RenderMode::Exact);
 }
 
 // Every output is checked before anything is read or drawn: --render into a missing folder or onto a
