@@ -64,7 +64,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
     scan.add(t.positions.data(), t.offsets.data(), 0, t.streamline_count(), 0);
     scan.check(t.source.path);
     const double lo[3] = {scan.lo[0], scan.lo[1], scan.lo[2]}, hi[3] = {scan.hi[0], scan.hi[1], scan.hi[2]};
-    const VoxelSizeChoice choice = choose_voxel_size(t.point_count(), lo, hi, scan.rms_step());
+    const VoxelSizeChoice choice = choose_voxel_size(t.point_count(), lo, hi, scan.rms_step(), t.source.path);
     settings.voxel_size = choice.size;
     voxel_size_choice = choice.reason;
   }
