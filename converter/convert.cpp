@@ -86,6 +86,14 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
                          (sets == &t.point_values ? " per-point" : " per-streamline") + " value sets are kept");
       sets->resize(kMaxValueSets);
     }
+  // Names every reader of the file accepts (`verify`, `export`, voxview): mapped here, said in a warning.
+  for (auto* sets : {&t.point_values, &t.streamline_values}) {
+    std::vector<std::string> names;
+    for (const ValueSet& v : *sets) names.push_back(v.name);
+    const std::vector<std::string> usable =
+        usable_value_set_names(names, sets == &t.point_values ? "point_values" : "streamline_values", warnings);
+    for (std::size_t k = 0; k < sets->size(); ++k) (*sets)[k].name = usable[k];
+  }
   t.source.warnings.insert(t.source.warnings.end(), warnings.begin(), warnings.end());
   // PROV and GRPS are known before any work: their sizes go into the plan of the output file.
   const std::string provenance = provenance_json(t.source, settings, threads, voxel_size_choice);

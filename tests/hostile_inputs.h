@@ -186,6 +186,16 @@ inline void vtp_points_beyond_arrays(const std::string& path, const test::VtpSty
   write_file(path, s);
 }
 
+// A legacy VTK of one 2-point line with one point-data array per name in `names`, each written as given
+// (VTK's %XX escapes and all).
+inline void vtk_point_arrays_named(const std::string& path, const std::vector<std::string>& names) {
+  std::string s =
+      "# vtk DataFile Version 3.0\nnames\nASCII\nDATASET POLYDATA\nPOINTS 2 float\n0 0 0 1 1 1\n"
+      "LINES 1 3\n2 0 1\nPOINT_DATA 2\n";
+  for (const std::string& name : names) s += "SCALARS " + name + " float 1\nLOOKUP_TABLE default\n1 2\n";
+  write_file(path, s);
+}
+
 // ---- MRtrix (TCK, TSF) ----
 
 // Row 8: a TSF of three streamlines of one value each, the second 1e300 (beyond float32).

@@ -10,6 +10,7 @@
 #include "converter/readers/read_tractogram.h"
 #include "format/checked_count.h"
 #include "format/error.h"
+#include "format/vxl_file.h"
 #include "tests/hostile_inputs.h"
 #include "tests/test_support.h"
 
@@ -112,6 +113,29 @@ TEST(HostileVtp, CountsBeyondWhatTheArraysHoldAreMalformed) {
       EXPECT_TRUE(contains(e.what(), "Points")) << e.what();
       expect_convert_refused(dir, p, 3);
     }
+}
+
+// A VTK array named %00 became a value set named "" (the empty-name rule came before the NUL), a%00b was
+// cut to a; `verify` passed the file and `export .trx` refused it (exit 4). Names are mapped at conversion
+// to ones every command accepts, each change warned about.
+TEST(HostileVtk, ArrayNamesAreMappedToNamesEveryCommandAccepts) {
+  ScratchDir dir;
+  const std::string in = dir.file("names.vtk"), vxl = dir.file("names.vxl");
+  // Decoded: "\0", "a\0b", "a", "x/y", "x%2Fy", "..", "back\\slash".
+  hostile::vtk_point_arrays_named(in, {"%00", "a%00b", "a", "x%2Fy", "x%252Fy", "..", "back\\slash"});
+  const auto c = vxl::test::run_cli("convert " + vxl::test::q(in) + " " + vxl::test::q(vxl));
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_TRUE(contains(c.output, "value set '\\0' written as '%00'")) << c.output;
+  EXPECT_TRUE(contains(c.output, "value set 'x%2Fy' written as 'x%2Fy (2)'")) << c.output;
+  const vxl::VxlFile f = vxl::VxlFile::open(vxl);
+  std::vector<std::string> names;
+  for (std::uint32_t k = 0; k < f.vertex_values().size(); ++k) names.push_back(f.vertex_values().name(k));
+  EXPECT_EQ(names, (std::vector<std::string>{"%00", "a%00b", "a", "x%2Fy", "x%2Fy (2)", "%2E%2E", "back%5Cslash"}));
+  for (const std::string& args :
+       {"verify " + vxl::test::q(vxl), "export " + vxl::test::q(vxl) + " " + vxl::test::q(dir.file("names.trx"))}) {
+    const auto r = vxl::test::run_cli(args);
+    EXPECT_EQ(r.exit_code, 0) << args << ": " << r.output;
+  }
 }
 
 }  // namespace
