@@ -196,6 +196,24 @@ inline void vtk_point_arrays_named(const std::string& path, const std::vector<st
   write_file(path, s);
 }
 
+// A VTP of one 2-point line whose points are one zlib block (appended, raw) with `junk` after the zlib
+// stream, inside the block's declared compressed size; with no junk, a valid file.
+inline void vtp_zlib_block_with_junk(const std::string& path, const std::string& junk) {
+  const std::string points =
+      test::le(0.0f) + test::le(0.0f) + test::le(0.0f) + test::le(1.0f) + test::le(2.0f) + test::le(3.0f);
+  const std::string block = test::zlib_compress(points) + junk;
+  const std::string header = test::le<std::uint32_t>(1) + test::le<std::uint32_t>(24) + test::le<std::uint32_t>(0) +
+                             test::le(static_cast<std::uint32_t>(block.size()));
+  write_file(path,
+             "<VTKFile type=\"PolyData\" byte_order=\"LittleEndian\" compressor=\"vtkZLibDataCompressor\">"
+             "<PolyData><Piece NumberOfPoints=\"2\" NumberOfLines=\"1\"><Points><DataArray type=\"Float32\" "
+             "NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points><Lines>"
+             "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1</DataArray>"
+             "<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">2</DataArray></Lines></Piece></PolyData>"
+             "<AppendedData encoding=\"raw\">_" +
+                 header + block + "</AppendedData></VTKFile>");
+}
+
 // ---- MRtrix (TCK, TSF) ----
 
 // Row 8: a TSF of three streamlines of one value each, the second 1e300 (beyond float32).

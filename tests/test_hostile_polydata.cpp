@@ -3,6 +3,7 @@
 // documented kind of error, naming the file, and the command line must write nothing.
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -136,6 +137,93 @@ TEST(HostileVtk, ArrayNamesAreMappedToNamesEveryCommandAccepts) {
     const auto r = vxl::test::run_cli(args);
     EXPECT_EQ(r.exit_code, 0) << args << ": " << r.output;
   }
+}
+
+// Malformed files that were read as something else: fractional offsets (1.5 read as 1), integer arrays
+// with fractions, an ASCII array longer than declared. Each is malformed now.
+TEST(HostileVtk, FractionsAndSurplusValuesAreMalformed) {
+  ScratchDir dir;
+  const std::string head =
+      "# vtk DataFile Version 5.1\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 1 1 2 2 2\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {head + "LINES 3 3\nOFFSETS vtktypeint64\n0 1.5 3\nCONNECTIVITY vtktypeint64\n0 1 2\n",
+       "LINES OFFSETS: expected an integer, found '1.5'"},
+      {head + "LINES 2 3\nOFFSETS vtktypeint64\n0 3\nCONNECTIVITY vtktypeint64\n0 1 2.5\n",
+       "LINES CONNECTIVITY: expected an integer, found '2.5'"},
+      {head + "LINES 1 4\n3 0 1 2 7\n", ""},
+      {"# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 2 float\n0 0 0 1 1 1 7\nLINES 1 3\n2 0 1\n",
+       ""}};
+  for (const auto& [text, message] : cases) {
+    SCOPED_TRACE(text);
+    const std::string p = dir.file("f.vtk");
+    hostile::write_file(p, text);
+    const vxl::Error e = error_of([&] { (void)vxl::read_tractogram(p); });
+    EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
+    EXPECT_TRUE(contains(e.what(), message)) << e.what();
+  }
+}
+
+TEST(HostileVtp, FractionalOffsetsAndSurplusAsciiValuesAreMalformed) {
+  ScratchDir dir;
+  vxl::test::VtpStyle ascii;
+  ascii.format = "ascii";
+  const std::string valid = vxl::test::small_vtp(ascii);
+  const std::string offsets = ">3 4 6 <", points = ">0.5 1.25 -2 ";
+  ASSERT_TRUE(contains(valid, offsets));
+  ASSERT_TRUE(contains(valid, points));
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {std::string(valid).replace(valid.find(offsets), offsets.size(), ">2.5 4 6 <"), "expected an integer"},
+      {std::string(valid).replace(valid.find(offsets), offsets.size(), ">3 4 6 7 <"),
+       "more values than the 3 declared"},
+      {std::string(valid).replace(valid.find(points), points.size(), ">0.5 1.25 -2 9 "), "more values than the 15"}};
+  for (const auto& [text, message] : cases) {
+    const std::string p = dir.file("f.vtp");
+    hostile::write_file(p, text);
+    const vxl::Error e = error_of([&] { (void)vxl::read_tractogram(p); });
+    EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
+    EXPECT_TRUE(contains(e.what(), message)) << e.what();
+  }
+  // Float offsets that are whole numbers stay valid.
+  vxl::test::VtpBuilder b({});
+  const vxl::test::SmallPolyData d;
+  const std::string body = "<Points>\n" + b.data_array("Float32", "Points", 3, d.points) + "</Points>\n<Lines>\n" +
+                           b.data_array("Int32", "connectivity", 1, d.connectivity) +
+                           b.data_array("Float32", "offsets", 1, std::vector<float>{3, 4, 6}) + "</Lines>\n";
+  hostile::write_file(dir.file("float.vtp"), b.file("NumberOfPoints=\"5\" NumberOfLines=\"3\"", body));
+  EXPECT_EQ(vxl::read_tractogram(dir.file("float.vtp")).streamline_count(), 3u);
+  vxl::test::VtpBuilder c({});
+  const std::string fractional = "<Points>\n" + c.data_array("Float32", "Points", 3, d.points) +
+                                 "</Points>\n<Lines>\n" + c.data_array("Int32", "connectivity", 1, d.connectivity) +
+                                 c.data_array("Float32", "offsets", 1, std::vector<float>{1.5f, 4, 6}) + "</Lines>\n";
+  hostile::write_file(dir.file("fraction.vtp"), c.file("NumberOfPoints=\"5\" NumberOfLines=\"3\"", fractional));
+  EXPECT_TRUE(contains(error_of([&] { (void)vxl::read_tractogram(dir.file("fraction.vtp")); }).what(),
+                       "offsets must be non-decreasing integers; offset 0 is 1.5"));
+}
+
+// Bytes after a block's zlib stream, inside its declared compressed size, were ignored.
+TEST(HostileVtp, JunkAfterAZlibStreamIsMalformed) {
+  ScratchDir dir;
+  const std::string p = dir.file("z.vtp");
+  hostile::vtp_zlib_block_with_junk(p, "");
+  EXPECT_EQ(vxl::read_tractogram(p).point_count(), 2u);
+  hostile::vtp_zlib_block_with_junk(p, "JUNK");
+  const vxl::Error e = error_of([&] { (void)vxl::read_tractogram(p); });
+  EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
+  EXPECT_TRUE(contains(e.what(), "junk after the zlib stream")) << e.what();
+}
+
+// VTK numbers cells vertices first, then lines, whatever order the file lists them in: with VERTICES after
+// LINES the line took the vertex's cell value (10 where the file says 42).
+TEST(HostileVtk, VerticesAfterLinesStillComeFirstInCellData) {
+  ScratchDir dir;
+  const std::string p = dir.file("v.vtk");
+  hostile::write_file(
+      p,
+      "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 1 1 2 2 2\n"
+      "LINES 1 3\n2 0 1\nVERTICES 1 2\n1 2\nCELL_DATA 2\nSCALARS c float 1\nLOOKUP_TABLE default\n10 42\n");
+  const vxl::Tractogram t = vxl::read_tractogram(p);
+  ASSERT_EQ(t.streamline_values.size(), 1u);
+  EXPECT_EQ(t.streamline_values[0].values, std::vector<float>{42});
 }
 
 }  // namespace

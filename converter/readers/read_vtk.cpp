@@ -7,6 +7,7 @@
 //
 // Every count is checked against the bytes left before anything is allocated for it.
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <string_view>
 
@@ -78,7 +79,6 @@ class LegacyParser {
           if (have_lines) fail(key_at, "a second LINES section");
           p.line_offsets = std::move(offsets);
           p.line_connectivity = std::move(connectivity);
-          p.cells_before_lines = verts;
           have_lines = true;
         } else if (key == "VERTICES") {
           verts = checked_sum(verts, n, path_, key_at, "the number of VERTICES cells");
@@ -197,6 +197,8 @@ class LegacyParser {
           fail(std::nullopt, "CELL_DATA for " + std::to_string(a.values.size() / a.components) +
                                  " cells; the file has " + std::to_string(p.cell_count));
 
+    // VTK numbers the cells vertices first, then lines, whatever order the sections come in.
+    p.cells_before_lines = verts;
     const bool lps = vtk::says_lps(title);
     vtk::fill_tractogram(t, path_, p, lps);
     t.source.warnings.insert(t.source.warnings.end(), warnings_.begin(), warnings_.end());
@@ -314,6 +316,8 @@ class LegacyParser {
       if (b == stop) fail(at, what + ": file ends after " + std::to_string(k) + " of " + std::to_string(n) + " values");
       if (ec != std::errc() || end != stop)
         fail(at, what + ": expected a number, found '" + std::string(b, stop) + "'");
+      if (type.kind != 'f' && out[k] != std::floor(out[k]))
+        fail(at, what + ": expected an integer, found '" + std::string(b, stop) + "'");
       pos_ = static_cast<std::uint64_t>(stop - data_.data());
     }
     return out;

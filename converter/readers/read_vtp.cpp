@@ -12,6 +12,7 @@
 // bytes that hold it, a compressed block's declared size against zlib's maximum ratio (1032:1), and all
 // decoded arrays together against a budget proportional to the file size.
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <functional>
 #include <string_view>
@@ -247,9 +248,9 @@ class VtpParser {
       const std::vector<double> o = decode(offs, 1, lines, "Lines offsets");
       p.line_offsets.resize(lines + 1);
       for (std::uint64_t k = 0; k < lines; ++k) {
-        if (!(o[k] >= static_cast<double>(p.line_offsets[k])) || o[k] >= 9007199254740992.0)
-          fail(offset(offs),
-               "Lines offsets must be non-decreasing; offset " + std::to_string(k) + " is " + std::to_string(o[k]));
+        if (!(o[k] >= static_cast<double>(p.line_offsets[k])) || o[k] >= 9007199254740992.0 || o[k] != std::floor(o[k]))
+          fail(offset(offs), "Lines offsets must be non-decreasing integers; offset " + std::to_string(k) + " is " +
+                                 std::to_string(o[k]));
         p.line_offsets[k + 1] = static_cast<std::uint64_t>(o[k]);
       }
       p.line_connectivity = decode(conn, 1, p.line_offsets.back(), "Lines connectivity");
@@ -313,8 +314,14 @@ class VtpParser {
         auto [end, ec] = std::from_chars(text.data() + pos, text.data() + stop, out[k]);
         if (ec != std::errc() || end != text.data() + stop)
           fail(offset(a), what + ": expected a number, found '" + std::string(text.substr(pos, stop - pos)) + "'");
+        if (type.kind != 'f' && out[k] != std::floor(out[k]))
+          fail(offset(a), what + ": expected an integer, found '" + std::string(text.substr(pos, stop - pos)) + "'");
         pos = stop;
       }
+      while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
+      if (pos < text.size())
+        fail(offset(a), what + ": more values than the " + std::to_string(n) + " declared (from '" +
+                            std::string(text.substr(pos, std::min<std::size_t>(20, text.size() - pos))) + "')");
       return out;
     }
     std::vector<std::uint8_t> bytes;
@@ -389,6 +396,9 @@ class VtpParser {
       uLongf got = static_cast<uLongf>(want);
       uLong used = static_cast<uLong>(sizes[k]);
       const int z = uncompress2(out.data() + at, &got, in.data(), &used);
+      if (z == Z_OK && got == want && used != sizes[k])
+        src.fail(what + ": compressed block " + std::to_string(k) + " ends after " + std::to_string(used) + " of its " +
+                 std::to_string(sizes[k]) + " bytes (junk after the zlib stream)");
       if (z != Z_OK || got != want)
         src.fail(what + ": compressed block " + std::to_string(k) + " does not inflate to its declared " +
                  std::to_string(want) + " bytes (zlib: " +
