@@ -226,4 +226,27 @@ TEST(HostileVtk, VerticesAfterLinesStillComeFirstInCellData) {
   EXPECT_EQ(t.streamline_values[0].values, std::vector<float>{42});
 }
 
+// A valid VTP was refused when a comment before the data named <AppendedData> (the block was found by a
+// text search); a '>' inside a quoted attribute of the real tag cut it short.
+TEST(HostileVtp, AppendedDataIsFoundAsAnElementNotAsText) {
+  ScratchDir dir;
+  for (const bool base64 : {false, true}) {
+    vxl::test::VtpStyle style;
+    style.format = "appended";
+    style.appended_base64 = base64;
+    style.zlib = true;
+    std::string s = vxl::test::small_vtp(style);
+    const std::size_t root = s.find("<PolyData>");
+    ASSERT_NE(root, std::string::npos);
+    s.insert(root, "<!-- the arrays are in <AppendedData encoding=\"raw\"> _ below -->\n");
+    const std::string tag = "<AppendedData encoding=";
+    s.insert(s.find(tag) + std::string("<AppendedData").size(), " note=\"a > b\"");
+    const std::string p = dir.file("comment.vtp");
+    hostile::write_file(p, s);
+    const vxl::Tractogram t = vxl::read_tractogram(p);
+    EXPECT_EQ(t.streamline_count(), 3u);
+    EXPECT_EQ(t.point_count(), 6u);
+  }
+}
+
 }  // namespace

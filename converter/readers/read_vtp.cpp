@@ -3,10 +3,11 @@
 // and appended (raw or base64), uncompressed or vtkZLibDataCompressor blocks, header_type UInt32 or UInt64,
 // byte_order LittleEndian or BigEndian. Coordinates: see vtk_polydata.h.
 //
-// The XML is parsed by pugixml. Raw appended data is not XML, so the document is cut at <AppendedData>
-// and its bytes are addressed directly. Base64 is decoded here (a few lines): VTK writes the header and
-// the data of an array as separately padded base64 chunks, which general-purpose decoders reject or
-// silently mangle; this one decodes chunk after chunk and refuses any character outside the alphabet.
+// The XML is parsed by pugixml. Raw appended data is not XML, so the document is cut after the
+// <AppendedData> start tag the parser finds, and its bytes are addressed directly. Base64 is decoded here (a few
+// lines): VTK writes the header and the data of an array as separately padded base64 chunks, which general-purpose
+// decoders reject or silently mangle; this one decodes chunk after chunk and refuses any character outside the
+// alphabet.
 //
 // Nothing is allocated before it is checked against the file: an uncompressed array's size against the
 // bytes that hold it, a compressed block's declared size against zlib's maximum ratio (1032:1), and all
@@ -124,22 +125,37 @@ class VtpParser {
         budget_(64 * static_cast<std::uint64_t>(bytes.size()) + (std::uint64_t(64) << 20)) {}
 
   Tractogram parse() {
-    // Raw appended bytes are not XML: parse the document up to <AppendedData ...> and close it ourselves.
-    std::string xml(all_);
-    const std::size_t app = all_.find("<AppendedData");
+    // Raw appended bytes are not XML: the document is parsed up to the end of the <AppendedData> start tag,
+    // then closed. Which tag that is, the parser says, not a text search: the first "<AppendedData" in the
+    // text is taken when the parsed prefix has it as the element (the usual case: only the prefix is
+    // copied); otherwise (it was in a comment, say) the whole file is parsed, and as a parse that fails keeps
+    // the nodes before the error, the element found there is the real one.
+    constexpr unsigned kFlags = pugi::parse_default | pugi::parse_comments;
+    pugi::xml_document doc;
+    pugi::xml_parse_result r;
+    // Parses the document cut after the tag at `at`: true when that tag is the <AppendedData> element.
+    auto parse_cut_at = [&](std::size_t at) {
+      const std::size_t gt = tag_end(at);
+      if (gt == std::string_view::npos) return false;
+      const std::string xml = std::string(all_.substr(0, gt + 1)) + "</AppendedData></VTKFile>";
+      r = doc.load_buffer(xml.data(), xml.size(), kFlags);
+      const pugi::xml_node element = doc.child("VTKFile").child("AppendedData");
+      return r && element && offset(element) == at + 1;  // offset_debug: the name, after the '<'
+    };
+    std::size_t app = all_.find("<AppendedData");
+    if (app == std::string_view::npos || !parse_cut_at(app)) {
+      r = doc.load_buffer(all_.data(), all_.size(), kFlags);
+      const pugi::xml_node element = doc.child("VTKFile").child("AppendedData");
+      app = element ? offset(element) - 1 : std::string_view::npos;
+      if (app != std::string_view::npos && !parse_cut_at(app)) fail(app, "<AppendedData> tag is not well-formed");
+    }
     if (app != std::string_view::npos) {
-      const std::size_t gt = all_.find('>', app);
-      if (gt == std::string_view::npos) fail(app, "unterminated <AppendedData> tag");
-      std::size_t us = gt + 1;
+      std::size_t us = tag_end(app) + 1;
       while (us < all_.size() && std::isspace(static_cast<unsigned char>(all_[us]))) ++us;
       if (us >= all_.size() || all_[us] != '_') fail(us, "expected '_' at the start of the appended data");
       appended_ = all_.substr(us + 1);
       appended_at_ = us + 1;
-      xml = std::string(all_.substr(0, gt + 1)) + "</AppendedData></VTKFile>";
     }
-    pugi::xml_document doc;
-    const pugi::xml_parse_result r =
-        doc.load_buffer(xml.data(), xml.size(), pugi::parse_default | pugi::parse_comments);
     if (!r) fail(static_cast<std::uint64_t>(r.offset), std::string("not well-formed XML: ") + r.description());
 
     const pugi::xml_node root = doc.child("VTKFile");
@@ -195,6 +211,20 @@ class VtpParser {
     fail_input(path_, at, what);
   }
   std::uint64_t offset(const pugi::xml_node& n) const { return static_cast<std::uint64_t>(n.offset_debug()); }
+  // The '>' that ends the tag starting at `at` ('>' inside quoted attribute values does not), or npos.
+  std::size_t tag_end(std::size_t at) const {
+    char quote = 0;
+    for (std::size_t k = at; k < all_.size(); ++k) {
+      if (quote) {
+        if (all_[k] == quote) quote = 0;
+      } else if (all_[k] == '"' || all_[k] == '\'') {
+        quote = all_[k];
+      } else if (all_[k] == '>') {
+        return k;
+      }
+    }
+    return std::string_view::npos;
+  }
 
   std::uint64_t count_attribute(const pugi::xml_node& n, const char* name) {
     const pugi::xml_attribute a = n.attribute(name);
