@@ -64,7 +64,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
     scan.add(t.positions.data(), t.offsets.data(), 0, t.streamline_count(), 0);
     scan.check(t.source.path);
     const double lo[3] = {scan.lo[0], scan.lo[1], scan.lo[2]}, hi[3] = {scan.hi[0], scan.hi[1], scan.hi[2]};
-    const VoxelSizeChoice choice = choose_voxel_size(t.point_count(), lo, hi, scan.rms_step());
+    const VoxelSizeChoice choice = choose_voxel_size(t.point_count(), lo, hi, scan.rms_step(), t.source.path);
     settings.voxel_size = choice.size;
     voxel_size_choice = choice.reason;
   }
@@ -78,13 +78,23 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
       throw Error(ErrorKind::Input, t.source.path, std::nullopt,
                   "value set '" + v.name + "' has " + std::to_string(v.values.size()) + " values for " +
                       std::to_string(t.streamline_count()) + " streamlines");
+  // Warnings of the conversion itself: in PROV with the reader's, and in the summary for the caller to show.
+  std::vector<std::string> warnings;
   for (auto* sets : {&t.point_values, &t.streamline_values})
     if (sets->size() > kMaxValueSets) {
-      t.source.warnings.push_back(
-          "only the first " + std::to_string(kMaxValueSets) + " of " + std::to_string(sets->size()) +
-          (sets == &t.point_values ? " per-point" : " per-streamline") + " value sets are kept");
+      warnings.push_back("only the first " + std::to_string(kMaxValueSets) + " of " + std::to_string(sets->size()) +
+                         (sets == &t.point_values ? " per-point" : " per-streamline") + " value sets are kept");
       sets->resize(kMaxValueSets);
     }
+  // Names every reader of the file accepts (`verify`, `export`, voxview): mapped here, said in a warning.
+  for (auto* sets : {&t.point_values, &t.streamline_values}) {
+    std::vector<std::string> names;
+    for (const ValueSet& v : *sets) names.push_back(v.name);
+    const std::vector<std::string> usable =
+        usable_value_set_names(names, sets == &t.point_values ? "point_values" : "streamline_values", warnings);
+    for (std::size_t k = 0; k < sets->size(); ++k) (*sets)[k].name = usable[k];
+  }
+  t.source.warnings.insert(t.source.warnings.end(), warnings.begin(), warnings.end());
   // PROV and GRPS are known before any work: their sizes go into the plan of the output file.
   const std::string provenance = provenance_json(t.source, settings, threads, voxel_size_choice);
   std::vector<std::uint8_t> groups_bytes;
@@ -98,6 +108,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   using Clock = std::chrono::steady_clock;
   auto seconds_since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   ConvertSummary summary;
+  summary.warnings = std::move(warnings);
   auto t0 = Clock::now();
 
   // Pass 1 fixes every size; the output is then mapped and filled in place (no copies of the sections).

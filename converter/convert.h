@@ -35,7 +35,9 @@ struct ConvertSummary {
   std::uint64_t partitions = 1;                 // voxel ranges whose blocks and orders were built one after another
   std::vector<std::uint64_t> partition_starts;  // convert_streaming only: the first voxel of each range
   bool vertices_read_back = false;              // convert_streaming only: VERT written block by block, not held
-  std::vector<std::string> warnings;            // convert_streaming only: the source's (the reader's, otherwise)
+  // convert_streaming: the source's; convert_tractogram: the conversion's own (the reader's are in the
+  // Tractogram, for its caller to show).
+  std::vector<std::string> warnings;
 
   // The counts, as written in the file's META.
   void take_counts(const MetaSection& meta) {

@@ -8,6 +8,8 @@
 #include "converter/export_values.h"
 #include "converter/tck_writer.h"
 #include "format/error.h"
+#include "format/json_limits.h"
+#include "format/output_path.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -16,7 +18,7 @@ namespace {
 // The source's timestamp, when its provenance has one: MRtrix checks that a TSF's timestamp is its
 // tractogram's, so both files get the same one.
 std::vector<std::string> timestamp_line(const VxlFile& file) {
-  const nlohmann::json prov = nlohmann::json::parse(file.provenance_json(), nullptr, false);
+  const nlohmann::json prov = parse_json(file.provenance_json(), file.path(), file.provenance_offset(), "PROV");
   if (!prov.is_object() || !prov.contains("source") || !prov["source"].is_object()) return {};
   const nlohmann::json header = prov["source"].value("header", nlohmann::json());
   if (!header.is_object() || !header.contains("timestamp")) return {};
@@ -46,6 +48,10 @@ std::uint32_t chosen_set(const VxlFile& file, const TckExportSettings& settings)
 
 ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings,
                          const StreamlineSubset* subset, const std::vector<std::string>& extra_header) {
+  // Both are renamed into place at the end: the second would replace the first.
+  if (settings.tsf_path && same_output(out_path, *settings.tsf_path))
+    throw Error(ErrorKind::Usage, *settings.tsf_path, std::nullopt,
+                "is the same file as the TCK output " + out_path + ": the TSF needs a file of its own");
   ExportSummary summary;
   const SubsetCounts counts = subset_counts(file, subset);
   summary.streamlines = counts.streamlines;

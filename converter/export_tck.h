@@ -26,7 +26,8 @@ struct ExportSummary {
 // Writes `out_path` (and the TSF) atomically; the streamlines are those the converter read (spec §5.6),
 // bit-exact for float32 sources, and the TSF holds the source points' values bit-exact; only the
 // subset's streamlines when there is one. `header` lines are added to the TCK's (and TSF's) header. Throws
-// vxl::Error: Usage when a TSF is asked for and the file has no per-point values or none named `value`,
+// vxl::Error: Usage when a TSF is asked for and the file has no per-point values or none named `value`, or
+// when the TSF and the TCK are one file (by any name),
 // Unsupported when a value is NaN or infinite (TSF separators), Output.
 ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings = {},
                          const StreamlineSubset* subset = nullptr, const std::vector<std::string>& header = {});

@@ -11,6 +11,8 @@
 
 #include "converter/export_values.h"
 #include "format/error.h"
+#include "format/json_limits.h"
+#include "format/output_path.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -55,7 +57,8 @@ class ZipWriter {
  public:
   explicit ZipWriter(const std::string& path) : path_(path) {
     int code = 0;
-    zip_ = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &code);
+    // libzip writes a temporary file and renames it over the path: the output rule applies.
+    zip_ = zip_open(output_target(path).c_str(), ZIP_CREATE | ZIP_TRUNCATE, &code);
     if (!zip_) {
       zip_error_t e;
       zip_error_init_with_code(&e, code);
@@ -101,7 +104,7 @@ class ZipWriter {
 }  // namespace
 
 TrxReference trx_reference(const VxlFile& file) {
-  const nlohmann::json prov = nlohmann::json::parse(file.provenance_json(), nullptr, false);
+  const nlohmann::json prov = parse_json(file.provenance_json(), file.path(), file.provenance_offset(), "PROV");
   if (prov.is_object() && prov.contains("source") && prov["source"].is_object()) {
     // PROV may hold any JSON (open() does not look into it): take each field only with the expected type.
     const nlohmann::json& src = prov["source"];

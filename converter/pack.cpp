@@ -8,6 +8,7 @@
 
 #include "converter/voxelize.h"
 #include "format/error.h"
+#include "format/json_limits.h"
 #include "format/parallel.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxlz_draco.h"
@@ -281,7 +282,11 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
   c.streamline_voxlines = encode_streamline_voxlines(f.streamline_first_voxline());
   c.voxline_voxels = encode_voxline_voxels(f.voxlines(), f.voxels());
   c.voxline_counts = encode_voxline_counts(f.voxlines());
-  if (f.find_section(section_id("PROV"))) c.provenance = std::string(f.provenance_json());
+  if (f.find_section(section_id("PROV"))) {
+    // Nesting that unpack would refuse is refused here, not packed into a file that cannot be unpacked.
+    (void)parse_json(f.provenance_json(), f.path(), f.provenance_offset(), "PROV");
+    c.provenance = std::string(f.provenance_json());
+  }
   if (f.find_section(section_id("GRPS"))) c.groups = encode_group_stream(f.groups());
 
   // The exact part is deflated on a thread of its own while the positions are encoded (unless one thread

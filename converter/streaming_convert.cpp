@@ -380,7 +380,7 @@ void StreamingConversion::scan() {
   meta_.streamline_count = streamlines;
   meta_.point_count = points;
   if (settings_.voxel_size_auto) {
-    const VoxelSizeChoice choice = choose_voxel_size(points, lo_, hi_, bounds.rms_step());
+    const VoxelSizeChoice choice = choose_voxel_size(points, lo_, hi_, bounds.rms_step(), path_);
     settings_.voxel_size = choice.size;
     voxel_size_choice_ = choice.reason;
   }

@@ -13,6 +13,7 @@
 #include "converter/segment_orders.h"
 #include "converter/voxel_table.h"
 #include "format/error.h"
+#include "format/json_limits.h"
 #include "format/parallel.h"
 #include "format/vxl_value_sets.h"
 #include "format/vxl_writer.h"
@@ -173,7 +174,7 @@ std::string provenance_with_package(const VxlzFile& f) {
   nlohmann::json j = nlohmann::json::object();
   if (f.has_section(section_id("PROV"))) {
     const std::vector<std::uint8_t> raw = f.inflate(section_id("PROV"));
-    j = nlohmann::json::parse(raw.begin(), raw.end(), nullptr, false);
+    j = parse_json({reinterpret_cast<const char*>(raw.data()), raw.size()}, f.path(), std::nullopt, "PROV");
     if (j.is_discarded() || !j.is_object())
       fail_input(f.path(), f.context(section_id("PROV")).section_offset, "PROV is not a JSON object");
   }

@@ -13,7 +13,9 @@
 //   at least 3 x the RMS step                        (at most ~40 % connecting vertices)
 //   at least cbrt(occupied volume / 20 000)          (at most ~20 000 voxels: frame planning stays ~1 ms)
 // rounded down to one of 1, 1.25, 1.5, 2, 2.5, 3, 3.5, 4, 5, 6, 7, 8, 10 mm (after the lower bounds, to a
-// value not below them). The synthetic 144k set gets 10 mm, the 1M set 8 mm, a 10M set 4 mm.
+// value not below them; 10 mm when they ask for more). The synthetic 144k set gets 10 mm, the 1M set 8 mm,
+// a 10M set 4 mm. Points that no listed size can convert (an extent beyond 2^31 voxels of 10 mm, steps that
+// 10 mm voxels would split into more points than the source has) are refused rather than given a size.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +28,9 @@ struct VoxelSizeChoice {
   std::string reason;  // one line, for `info` and the provenance
 };
 
-// `rms_step`: the root mean square distance between consecutive points (0 when there are none).
-VoxelSizeChoice choose_voxel_size(std::uint64_t points, const double lo[3], const double hi[3], double rms_step);
+// `rms_step`: the root mean square distance between consecutive points (0 when there are none). Throws
+// vxl::Error (Unsupported) naming `path`, with the size to give instead, for points no listed size converts.
+VoxelSizeChoice choose_voxel_size(std::uint64_t points, const double lo[3], const double hi[3], double rms_step,
+                                  const std::string& path = "");
 
 }  // namespace vxl

@@ -12,14 +12,14 @@
 #include <unistd.h>
 
 #include "format/error.h"
+#include "format/output_path.h"
 #include "format/parallel.h"
 
 namespace vxl {
 
-AtomicOutputFile::AtomicOutputFile(std::string path) : path_(std::move(path)) {
-  std::filesystem::path p(path_);
+AtomicOutputFile::AtomicOutputFile(std::string path) : path_(std::move(path)), target_(output_target(path_)) {
+  std::filesystem::path p(target_);
   std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
-  if (std::filesystem::is_directory(p)) fail("is a directory");
   fd_ = ::open(dir.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0644);
   if (fd_ < 0) {
     // O_TMPFILE unsupported here: fall back to a hidden temporary name beside the output.
@@ -148,7 +148,7 @@ void AtomicOutputFile::commit() {
   if (temp_path_.empty()) {
     // Link the unnamed file under a temporary name, then rename over the target (rename is atomic;
     // linkat cannot replace an existing file).
-    std::filesystem::path p(path_);
+    std::filesystem::path p(target_);
     std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
     std::string proc = "/proc/self/fd/" + std::to_string(fd_);
     for (int attempt = 0;; ++attempt) {
@@ -167,7 +167,7 @@ void AtomicOutputFile::commit() {
     fail(std::string("close failed: ") + std::strerror(errno));
   }
   fd_ = -1;
-  if (::rename(temp_path_.c_str(), path_.c_str()) != 0)
+  if (::rename(temp_path_.c_str(), target_.c_str()) != 0)
     fail(std::string("cannot rename into place: ") + std::strerror(errno));
   committed_ = true;
 }

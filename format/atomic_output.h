@@ -20,7 +20,8 @@ namespace vxl {
 
 class AtomicOutputFile {
  public:
-  explicit AtomicOutputFile(std::string path);  // throws vxl::Error (Output) naming the path
+  // Throws vxl::Error (Output) naming the path, also when format/output_path.h's rule refuses it.
+  explicit AtomicOutputFile(std::string path);
   ~AtomicOutputFile();                          // discards the data (and any mapping) unless committed
   AtomicOutputFile(const AtomicOutputFile&) = delete;
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
@@ -53,7 +54,7 @@ class AtomicOutputFile {
   // first call, closed by commit().
   int direct_descriptor();
 
-  void commit();  // unmaps, then replaces any existing file at the path
+  void commit();  // unmaps, then replaces any existing file at the path (where its symbolic links lead)
 
   const std::string& path() const { return path_; }
 
@@ -61,6 +62,7 @@ class AtomicOutputFile {
   [[noreturn]] void fail(const std::string& what) const;
   void unmap() noexcept;
   std::string path_;
+  std::string target_;     // path_, or where its symbolic links lead
   std::string temp_path_;  // empty when using O_TMPFILE
   int fd_ = -1;
   int direct_fd_ = -2;  // -2: not opened yet

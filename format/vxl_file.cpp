@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "format/checked_count.h"
 #include "format/error.h"
 #include "format/utf8_check.h"
 #include "format/vxlz_layout.h"
@@ -19,17 +20,6 @@ std::string section_name(std::uint32_t id) {
   return s;
 }
 
-namespace {
-
-// a * b, or nullopt on overflow.
-std::optional<std::uint64_t> mul(std::uint64_t a, std::uint64_t b) {
-  std::uint64_t r;
-  if (__builtin_mul_overflow(a, b, &r)) return std::nullopt;
-  return r;
-}
-
-}  // namespace
-
 VxlFile VxlFile::open(const std::string& path) {
   VxlFile f{MappedFile(path)};
   f.validate();
@@ -43,6 +33,11 @@ const SectionEntry* VxlFile::find_section(std::uint32_t id) const {
     if (eid == id) return &e;
   }
   return nullptr;
+}
+
+std::uint64_t VxlFile::provenance_offset() const {
+  const SectionEntry* s = find_section(section_id("PROV"));
+  return s ? s->offset : 0;
 }
 
 OrderView VxlFile::order(std::size_t voxel, std::uint32_t k, std::uint32_t level) const {
@@ -207,16 +202,17 @@ void VxlFile::validate_meta_and_sizes() {
                  std::string("section ") + id + " size " + std::to_string(s.size()) + " does not match " + what);
     return s;
   };
-  auto dirs = expect_size("DIRS", mul(m.stored_order_count, sizeof(DirectionEntry)), "stored_order_count × 16");
-  auto voxt = expect_size("VOXT", mul(m.voxel_count, sizeof(VoxelEntry)), "voxel_count × 64");
+  auto dirs =
+      expect_size("DIRS", count_product(m.stored_order_count, sizeof(DirectionEntry)), "stored_order_count × 16");
+  auto voxt = expect_size("VOXT", count_product(m.voxel_count, sizeof(VoxelEntry)), "voxel_count × 64");
   // Positions (spec §5.4): float32 in every 1.x file, either encoding in 2.0.
   const bool packed = m.position_encoding == static_cast<std::uint32_t>(PositionEncoding::Packed);
   if (m.position_encoding > static_cast<std::uint32_t>(PositionEncoding::Packed))
     fail_input(p, meta_at + 152, "unknown position encoding " + std::to_string(m.position_encoding));
   if (packed && header_.version_major < kVxlVersionMajorPackedPositions)
     fail_input(p, meta_at + 152, "packed positions in a version 1 file (they need version 2.0)");
-  auto vert = packed ? expect_size("VERT", mul(m.vertex_count, 4), "vertex_count × 4 (packed positions)")
-                     : expect_size("VERT", mul(m.vertex_count, 12), "vertex_count × 12");
+  auto vert = packed ? expect_size("VERT", count_product(m.vertex_count, 4), "vertex_count × 4 (packed positions)")
+                     : expect_size("VERT", count_product(m.vertex_count, 12), "vertex_count × 12");
   // Levels of detail (spec §5.12): LODS exactly when level_count > 1, which needs version 2.1.
   const bool has_levels = find_section(section_id("LODS")) != nullptr;
   if (m.level_count == 1 || m.level_count > kMaxLevels)
@@ -230,13 +226,14 @@ void VxlFile::validate_meta_and_sizes() {
        (header_.version_major == kVxlVersionMajorPackedPositions && header_.version_minor < kVxlVersionMinorLevels)))
     fail_input(p, meta_at + 156, "levels of detail in a file before version 2.1");
   if (has_levels) {
-    auto lods = expect_size("LODS", mul(m.voxel_count, std::uint64_t(m.level_count - 1) * sizeof(LevelEntry)),
+    auto lods = expect_size("LODS", count_product(m.voxel_count, std::uint64_t(m.level_count - 1) * sizeof(LevelEntry)),
                             "voxel_count × (level_count − 1) × 8");
     levels_ = {reinterpret_cast<const LevelEntry*>(lods.data()), lods.size() / sizeof(LevelEntry)};
   }
-  auto vxln = expect_size("VXLN", mul(m.voxline_count, sizeof(VoxlineEntry)), "voxline_count × 8");
-  std::optional<std::uint64_t> strm_size =
-      m.streamline_count == std::numeric_limits<std::uint64_t>::max() ? std::nullopt : mul(m.streamline_count + 1, 8);
+  auto vxln = expect_size("VXLN", count_product(m.voxline_count, sizeof(VoxlineEntry)), "voxline_count × 8");
+  std::optional<std::uint64_t> strm_size = m.streamline_count == std::numeric_limits<std::uint64_t>::max()
+                                               ? std::nullopt
+                                               : count_product(m.streamline_count + 1, 8);
   auto strm = expect_size("STRM", strm_size, "(streamline_count + 1) × 8");
   orders_ = section("ORDR", true);
   // Per-voxel directions: present exactly when the order set is random (§5.10).
@@ -245,7 +242,7 @@ void VxlFile::validate_meta_and_sizes() {
     fail_input(p, meta_at + 100,
                random_set ? "order set random needs a VDIR section" : "VDIR section without order set random");
   if (random_set) {
-    auto vdir = expect_size("VDIR", mul(m.voxel_count, dirs.size()), "voxel_count × stored_order_count × 16");
+    auto vdir = expect_size("VDIR", count_product(m.voxel_count, dirs.size()), "voxel_count × stored_order_count × 16");
     voxel_directions_ = {reinterpret_cast<const DirectionEntry*>(vdir.data()), vdir.size() / sizeof(DirectionEntry)};
   }
   directions_ = {reinterpret_cast<const DirectionEntry*>(dirs.data()), m.stored_order_count};

@@ -84,6 +84,8 @@ class VxlFile {
   std::span<const VoxlineEntry> voxlines() const { return voxlines_; }
   std::span<const std::uint64_t> streamline_first_voxline() const { return strm_; }
   std::string_view provenance_json() const { return provenance_; }
+  // Where PROV starts in the file (0 when the file has none).
+  std::uint64_t provenance_offset() const;
   // Parses GRPS (empty when absent; open() has checked its structure and names); throws vxl::Error when a
   // member is out of range or out of order.
   std::vector<StreamlineGroup> groups() const;

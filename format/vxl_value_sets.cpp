@@ -4,19 +4,55 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <set>
 
 #include "format/error.h"
 #include "format/utf8_check.h"
 
 namespace vxl {
 
-std::string value_set_name(const std::string& raw) {
-  // Readers refuse a name that is not UTF-8 (VxlFile::open), so one from a non-UTF-8 file name is converted.
-  std::string name = to_valid_utf8(raw.substr(0, raw.find('\0')));
-  if (name.size() <= kMaxValueSetName) return name;
-  std::size_t n = kMaxValueSetName;
+namespace {
+
+// `name` cut to at most `bytes` bytes at a character boundary.
+std::string cut_to(std::string name, std::size_t bytes) {
+  if (name.size() <= bytes) return name;
+  std::size_t n = bytes;
   while (n > 0 && (static_cast<unsigned char>(name[n]) & 0xC0) == 0x80) --n;  // not inside a character
   return name.substr(0, n);
+}
+
+}  // namespace
+
+std::string value_set_name(const std::string& raw) {
+  std::string escaped;
+  for (char c : raw) escaped += c == '\0' ? "%00" : c == '/' ? "%2F" : c == '\\' ? "%5C" : std::string(1, c);
+  // Readers refuse a name that is not UTF-8 (VxlFile::open), so one from a non-UTF-8 file name is converted.
+  return cut_to(to_valid_utf8(escaped), kMaxValueSetName);
+}
+
+std::vector<std::string> usable_value_set_names(std::span<const std::string> names, const std::string& fallback,
+                                                std::vector<std::string>& warnings) {
+  std::vector<std::string> out;
+  std::set<std::string> used;
+  for (const std::string& raw : names) {
+    std::string name = value_set_name(raw);
+    if (name.empty()) name = fallback;
+    if (name == ".") name = "%2E";
+    if (name == "..") name = "%2E%2E";
+    const std::string base = name;
+    for (int k = 2; used.count(name); ++k) {
+      const std::string suffix = " (" + std::to_string(k) + ")";
+      name = cut_to(base, kMaxValueSetName - suffix.size()) + suffix;
+    }
+    if (name != raw) {
+      std::string shown;
+      for (char c : raw) shown += c == '\0' ? std::string("\\0") : std::string(1, c);
+      warnings.push_back("value set '" + to_valid_utf8(shown) + "' written as '" + name + "'");
+    }
+    used.insert(name);
+    out.push_back(std::move(name));
+  }
+  return out;
 }
 
 std::vector<std::span<float>> layout_value_sets(std::span<std::uint8_t> payload, std::span<const std::string> names,

@@ -48,9 +48,16 @@ constexpr std::uint64_t value_sets_bytes(std::uint64_t sets, std::uint64_t count
   return sets == 0 ? 0 : value_sets_data_offset(sets) + sets * value_array_stride(count);
 }
 
-// `name` as stored: up to its first NUL, made valid UTF-8 (invalid bytes read as Latin-1), cut to
-// kMaxValueSetName bytes at a character boundary.
+// `name` as stored: NUL, '/' and '\' written as VTK escapes them (%00, %2F, %5C: a stored name ends at
+// its NUL, and `export` makes TRX members dpv/NAME.float32), made valid UTF-8 (invalid bytes read as
+// Latin-1), cut to kMaxValueSetName bytes at a character boundary.
 std::string value_set_name(const std::string& name);
+
+// The names one kind of value sets is written under, from the source's, each one that `verify` and
+// `export` accept: value_set_name of each; "" as `fallback`, "." and ".." as %2E and %2E%2E; and unique (a
+// name met before gets " (2)", " (3)", ...). Each name changed adds a warning to `warnings`.
+std::vector<std::string> usable_value_set_names(std::span<const std::string> names, const std::string& fallback,
+                                                std::vector<std::string>& warnings);
 
 // Writing: lays out the header and names in `payload` (sized by value_sets_bytes, zero-filled) and
 // returns the arrays for the caller to fill; then finish_value_sets records each array's min and max.

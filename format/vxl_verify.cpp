@@ -9,6 +9,7 @@
 
 #include "format/checksum.h"
 #include "format/error.h"
+#include "format/json_limits.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 
@@ -177,8 +178,9 @@ VerifyResult verify_vxl(const std::string& path) {
     };
     walk_streamlines(f, cb);
     check_orders(f, is_segment_start);
-    if (!f.provenance_json().empty() && !nlohmann::json::accept(f.provenance_json()))
-      fail_input(path, f.find_section(section_id("PROV"))->offset, "provenance is not valid JSON");
+    if (!f.provenance_json().empty() &&
+        (parse_json(f.provenance_json(), path, f.provenance_offset(), "provenance").is_discarded()))
+      fail_input(path, f.provenance_offset(), "provenance is not valid JSON");
     f.groups();
     check_value_sets(f, f.vertex_values(), "VVAL");
     check_value_sets(f, f.streamline_values(), "SVAL");

@@ -16,6 +16,7 @@
 #include <zlib.h>
 
 #include "tests/mrtrix_test_files.h"
+#include "tests/vtk_test_files.h"
 #include "tests/zip_writer.h"
 
 namespace vxl::test::hostile {
@@ -136,6 +137,81 @@ inline void trx_offsets_bomb(const std::string& path, int mib, bool honest) {
   if (!honest) bomb.size = 4 * 8;
   e[2] = std::move(bomb);
   write_zip(path, e);
+}
+
+// Arrays nested `depth` deep: `[[[...]]]`.
+inline std::string nested_json(std::size_t depth) { return std::string(depth, '[') + std::string(depth, ']'); }
+
+// A valid TRX of 3 streamlines whose header.json also holds arrays nested `depth` deep.
+inline void trx_deep_header(const std::string& path, std::size_t depth) {
+  std::vector<ZipEntry> e = trx_entries(3);
+  e[0] = stored_entry("header.json",
+                      text("{\"NB_STREAMLINES\": 3, \"NB_VERTICES\": 6, \"deep\": " + nested_json(depth) + "}"));
+  write_zip(path, e);
+}
+
+// ---- VTK and VTP ----
+
+// A legacy VTK whose POINTS count N makes 3 x N wrap past 2^64: the data holds exactly as many numbers
+// as the wrapped product, then one line over the first two points.
+inline void vtk_points_count_wraps(const std::string& path, std::uint64_t n, bool binary) {
+  const std::uint64_t wrapped = 3 * n;  // unsigned: wraps on purpose
+  std::string s = "# vtk DataFile Version 3.0\nhostile\n" + std::string(binary ? "BINARY" : "ASCII") +
+                  "\nDATASET POLYDATA\nPOINTS " + std::to_string(n) + " float\n";
+  for (std::uint64_t k = 0; k < wrapped; ++k)
+    s += binary ? test::be(static_cast<float>(k + 1)) : std::to_string(k + 1) + " ";
+  s += "\nLINES 1 3\n";
+  s += binary ? test::be<std::int32_t>(2) + test::be<std::int32_t>(0) + test::be<std::int32_t>(1) : "2 0 1";
+  write_file(path, s + "\n");
+}
+
+// The small VTP tractogram (3 lines, a 2-component cell array) with extra cell counts in its Piece:
+// `verts`, `polys` and `strips` chosen so that the sum of all cells wraps past 2^64 back to 3, the number
+// of cell tuples the file holds.
+inline void vtp_cell_count_wraps(const std::string& path, std::uint64_t verts, std::uint64_t polys,
+                                 std::uint64_t strips) {
+  std::string s = test::small_vtp({});
+  const std::string lines = "NumberOfLines=\"3\"";
+  s.replace(s.find(lines), lines.size(),
+            lines + " NumberOfVerts=\"" + std::to_string(verts) + "\" NumberOfPolys=\"" + std::to_string(polys) +
+                "\" NumberOfStrips=\"" + std::to_string(strips) + "\"");
+  write_file(path, s);
+}
+
+// The small VTP tractogram in `style` whose Piece claims `points` points: more than its arrays hold.
+inline void vtp_points_beyond_arrays(const std::string& path, const test::VtpStyle& style, std::uint64_t points) {
+  std::string s = test::small_vtp(style);
+  const std::string declared = "NumberOfPoints=\"5\"";
+  s.replace(s.find(declared), declared.size(), "NumberOfPoints=\"" + std::to_string(points) + "\"");
+  write_file(path, s);
+}
+
+// A legacy VTK of one 2-point line with one point-data array per name in `names`, each written as given
+// (VTK's %XX escapes and all).
+inline void vtk_point_arrays_named(const std::string& path, const std::vector<std::string>& names) {
+  std::string s =
+      "# vtk DataFile Version 3.0\nnames\nASCII\nDATASET POLYDATA\nPOINTS 2 float\n0 0 0 1 1 1\n"
+      "LINES 1 3\n2 0 1\nPOINT_DATA 2\n";
+  for (const std::string& name : names) s += "SCALARS " + name + " float 1\nLOOKUP_TABLE default\n1 2\n";
+  write_file(path, s);
+}
+
+// A VTP of one 2-point line whose points are one zlib block (appended, raw) with `junk` after the zlib
+// stream, inside the block's declared compressed size; with no junk, a valid file.
+inline void vtp_zlib_block_with_junk(const std::string& path, const std::string& junk) {
+  const std::string points =
+      test::le(0.0f) + test::le(0.0f) + test::le(0.0f) + test::le(1.0f) + test::le(2.0f) + test::le(3.0f);
+  const std::string block = test::zlib_compress(points) + junk;
+  const std::string header = test::le<std::uint32_t>(1) + test::le<std::uint32_t>(24) + test::le<std::uint32_t>(0) +
+                             test::le(static_cast<std::uint32_t>(block.size()));
+  write_file(path,
+             "<VTKFile type=\"PolyData\" byte_order=\"LittleEndian\" compressor=\"vtkZLibDataCompressor\">"
+             "<PolyData><Piece NumberOfPoints=\"2\" NumberOfLines=\"1\"><Points><DataArray type=\"Float32\" "
+             "NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points><Lines>"
+             "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1</DataArray>"
+             "<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">2</DataArray></Lines></Piece></PolyData>"
+             "<AppendedData encoding=\"raw\">_" +
+                 header + block + "</AppendedData></VTKFile>");
 }
 
 // ---- MRtrix (TCK, TSF) ----

@@ -4,6 +4,7 @@
 // damage gets past them). Nothing is committed as data: every damaged file is made here, in the test.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -114,5 +115,26 @@ class VxlBytes {
 
   std::vector<char> bytes;
 };
+
+// A valid file whose PROV holds, in the source's header, arrays nested `depth` deep (`depth` + 3 in all),
+// checksums resealed: the converter writes no such PROV, a hand-made file can. The header's string that
+// the conversion wrote is replaced by as many brackets, so no offset moves.
+inline VxlBytes vxl_with_deep_provenance(const std::string& path, std::size_t depth) {
+  Tractogram t = hostile_source();
+  const std::string pad(2 * depth, 'x');
+  t.source.header = {{"deep", pad}};
+  convert_tractogram(std::move(t), path, {});
+  std::ifstream in(path, std::ios::binary);
+  VxlBytes b;
+  b.bytes.assign(std::istreambuf_iterator<char>(in), {});
+  const std::string quoted = '"' + pad + '"';
+  const auto at = std::search(b.bytes.begin(), b.bytes.end(), quoted.begin(), quoted.end());
+  EXPECT_NE(at, b.bytes.end());
+  if (at == b.bytes.end()) return b;
+  const std::string deep = std::string(depth, '[') + std::string(depth, ']') + "  ";
+  std::copy(deep.begin(), deep.end(), at);
+  b.reseal();
+  return b;
+}
 
 }  // namespace vxl::test

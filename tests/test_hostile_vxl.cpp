@@ -182,7 +182,8 @@ TEST(HostileVxl, InfoJsonOfAFileNameThatIsNotUtf8) {
 TEST(HostileVxl, ValueSetNamesAreWrittenAsUtf8) {
   EXPECT_EQ(value_set_name("caf\xe9"), "caf\xc3\xa9");
   EXPECT_EQ(value_set_name("caf\xc3\xa9"), "caf\xc3\xa9");
-  EXPECT_EQ(value_set_name(std::string("a\0b", 3)), "a");
+  EXPECT_EQ(value_set_name(std::string("a\0b", 3)), "a%00b");  // a stored name ends at its NUL: escaped
+  EXPECT_EQ(value_set_name("a/b\\c"), "a%2Fb%5Cc");            // one TRX member file each
   EXPECT_TRUE(is_valid_utf8(value_set_name(std::string(40, 'x') + "\xff\xfe\xfd\xfc\xfb")));
   EXPECT_FALSE(is_valid_utf8("\xc0\xaf"));          // overlong '/'
   EXPECT_FALSE(is_valid_utf8("\xed\xa0\x80"));      // a surrogate

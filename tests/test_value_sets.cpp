@@ -196,6 +196,23 @@ TEST(ValueSets, PointValuesFollowTheirPointsIntoTheVertexBlocks) {
   EXPECT_EQ(plain.find_section(section_id("VVAL")), nullptr);
 }
 
+// Beyond 64 value sets the rest are dropped: that was said only inside PROV, never on stderr.
+TEST(ValueSets, SetsBeyondTheCapAreDroppedWithAWarningOnStderr) {
+  ScratchDir dir;
+  std::string vtk =
+      "# vtk DataFile Version 3.0\nsets\nASCII\nDATASET POLYDATA\nPOINTS 2 float\n0 0 0 1 1 1\n"
+      "LINES 1 3\n2 0 1\nPOINT_DATA 2\n";
+  for (int k = 0; k < 65; ++k) vtk += "SCALARS s" + std::to_string(k) + " float 1\nLOOKUP_TABLE default\n1 2\n";
+  const std::string in = dir.file("sets.vtk"), out = dir.file("sets.vxl");
+  std::ofstream(in) << vtk;
+  const auto r = test::run_cli("convert " + test::q(in) + " " + test::q(out));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("warning: " + in + ": only the first 64 of 65 per-point value sets are kept"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(VxlFile::open(out).vertex_values().size(), 64u);
+}
+
 TEST(ValueSets, OpenRefusesAMalformedSection) {
   ScratchDir dir;
   Tractogram t = five_points();

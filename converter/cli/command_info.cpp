@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/cli/commands.h"
+#include "format/json_limits.h"
 #include "format/vxl_file.h"
 
 namespace vxl::cli {
@@ -75,7 +76,7 @@ void add_info_command(CLI::App& app) {
     nlohmann::json groups = nlohmann::json::array();
     for (const StreamlineGroup& g : f.groups()) groups.push_back({{"name", g.name}, {"streamlines", g.members.size()}});
     j["groups"] = groups;
-    auto prov = nlohmann::json::parse(f.provenance_json(), nullptr, false);
+    auto prov = parse_json(f.provenance_json(), f.path(), f.provenance_offset(), "PROV");
     if (prov.is_object() && prov.contains("source") && prov["source"].is_object()) {
       const nlohmann::json& src = prov["source"];
       j["source"] = {{"name", string_field(src, "name")},

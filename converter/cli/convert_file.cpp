@@ -61,6 +61,7 @@ std::string convert_file(const std::string& input, const std::string& output, co
     read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const std::string& w : t.source.warnings) warn(w);
     s = convert_tractogram(std::move(t), output, settings);
+    for (const std::string& w : s.warnings) warn(w);
   }
   char line[512];
   std::snprintf(line, sizeof line,

@@ -33,6 +33,7 @@
 #include "converter/readers/regular_file.h"
 #include "format/checksum.h"
 #include "format/error.h"
+#include "format/json_limits.h"
 #include "format/mapped_file.h"
 
 namespace vxl {
@@ -517,7 +518,9 @@ Tractogram read_trx(const std::string& path) {
   nlohmann::json header;
   {
     const Blob blob = members->read("header.json", kMaxHeaderJson, "bytes a header.json may have");
-    header = nlohmann::json::parse(blob.bytes().begin(), blob.bytes().end(), nullptr, false);
+    const auto bytes = blob.bytes();
+    header = parse_json({reinterpret_cast<const char*>(bytes.data()), bytes.size()}, path, std::nullopt, "header.json",
+                        kMaxSourceJsonDepth);
   }
   if (header.is_discarded() || !header.is_object()) fail_input(path, std::nullopt, "header.json: not a JSON object");
   auto required_count = [&](const char* key) {

@@ -7,11 +7,13 @@
 //
 // Every count is checked against the bytes left before anything is allocated for it.
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <string_view>
 
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/vtk_polydata.h"
+#include "format/checked_count.h"
 #include "format/error.h"
 #include "format/mapped_file.h"
 
@@ -66,21 +68,20 @@ class LegacyParser {
         const Type type = parse_type(points_type_, key_at);
         if (type.kind != 'f') fail(key_at, "POINTS must be float or double");
         end_line();
-        p.points = numbers(3 * p.point_count, type, "POINTS");
+        p.points = numbers(checked_product(3, p.point_count, path_, key_at, "POINTS count"), type, "POINTS");
         have_points = true;
       } else if (key == "LINES" || key == "VERTICES" || key == "POLYGONS" || key == "TRIANGLE_STRIPS") {
         std::vector<std::uint64_t> offsets{0};
         std::vector<double> connectivity;
         const std::uint64_t n = cells(offsets, connectivity, key_at, key);
-        p.cell_count += n;
+        p.cell_count = checked_sum(p.cell_count, n, path_, key_at, "the number of cells");
         if (key == "LINES") {
           if (have_lines) fail(key_at, "a second LINES section");
           p.line_offsets = std::move(offsets);
           p.line_connectivity = std::move(connectivity);
-          p.cells_before_lines = verts;
           have_lines = true;
         } else if (key == "VERTICES") {
-          verts += n;
+          verts = checked_sum(verts, n, path_, key_at, "the number of VERTICES cells");
         } else if (n > 0) {
           surface = key;
         }
@@ -109,14 +110,15 @@ class LegacyParser {
           if (a.components == 0) fail(array_at, "FIELD array '" + a.name + "' with 0 components");
           if (n > data_.size() || (n > 0 && a.components > data_.size() / n))
             fail(array_at, "FIELD array '" + a.name + "' larger than the file");
+          const std::uint64_t values = checked_product(a.components, n, path_, array_at, "FIELD array size");
           if (type.kind == 's' || type.kind == 'b') {
-            skip_special(a.components * n, type);
+            skip_special(values, type);
             if (section)
               warnings_.push_back("array '" + a.name + "' holds " + (type.kind == 's' ? "strings" : "bits") +
                                   "; skipped");
             continue;
           }
-          a.values = numbers(a.components * n, type, "FIELD array '" + a.name + "'");
+          a.values = numbers(values, type, "FIELD array '" + a.name + "'");
           if (section == 0) continue;  // dataset-level field data: not per point or cell
           if (n != tuples)
             fail(array_at, "FIELD array '" + a.name + "' has " + std::to_string(n) + " tuples; expected " +
@@ -155,15 +157,16 @@ class LegacyParser {
             pos_ = save;
           }
         }
+        const std::uint64_t values = checked_product(a.components, tuples, path_, key_at, key + " size");
         if (type.kind == 's' || type.kind == 'b') {
-          skip_special(a.components * tuples, type);
+          skip_special(values, type);
           warnings_.push_back("array '" + a.name + "' holds " + std::string(type.kind == 's' ? "strings" : "bits") +
                               "; skipped");
           continue;
         }
         if (tuples > 0 && a.components > data_.size() / tuples)
           fail(key_at, key + " '" + a.name + "' larger than the file");
-        a.values = numbers(a.components * tuples, type, key + " '" + a.name + "'");
+        a.values = numbers(values, type, key + " '" + a.name + "'");
         if (key == "COLOR_SCALARS" && binary_)
           for (double& v : a.values) v /= 255.0;  // as in ASCII files: 0 to 1
         (section == 1 ? p.point_data : p.cell_data).push_back(std::move(a));
@@ -172,7 +175,8 @@ class LegacyParser {
         const std::uint64_t n = count();
         end_line();
         if (n > data_.size()) fail(key_at, "LOOKUP_TABLE larger than the file");
-        numbers(4 * n, binary_ ? Type{'u', 1} : Type{'f', 4}, "LOOKUP_TABLE");
+        numbers(checked_product(4, n, path_, key_at, "LOOKUP_TABLE size"), binary_ ? Type{'u', 1} : Type{'f', 4},
+                "LOOKUP_TABLE");
       } else {
         fail(key_at,
              "unexpected keyword '" + key + "' (expected POINTS, LINES, POINT_DATA, CELL_DATA, FIELD or an attribute)");
@@ -193,6 +197,8 @@ class LegacyParser {
           fail(std::nullopt, "CELL_DATA for " + std::to_string(a.values.size() / a.components) +
                                  " cells; the file has " + std::to_string(p.cell_count));
 
+    // VTK numbers the cells vertices first, then lines, whatever order the sections come in.
+    p.cells_before_lines = verts;
     const bool lps = vtk::says_lps(title);
     vtk::fill_tractogram(t, path_, p, lps);
     t.source.warnings.insert(t.source.warnings.end(), warnings_.begin(), warnings_.end());
@@ -310,6 +316,8 @@ class LegacyParser {
       if (b == stop) fail(at, what + ": file ends after " + std::to_string(k) + " of " + std::to_string(n) + " values");
       if (ec != std::errc() || end != stop)
         fail(at, what + ": expected a number, found '" + std::string(b, stop) + "'");
+      if (type.kind != 'f' && out[k] != std::floor(out[k]))
+        fail(at, what + ": expected an integer, found '" + std::string(b, stop) + "'");
       pos_ = static_cast<std::uint64_t>(stop - data_.data());
     }
     return out;
@@ -319,7 +327,7 @@ class LegacyParser {
   void skip_special(std::uint64_t n, Type type) {
     if (type.kind == 'b') {
       if (binary_) {
-        const std::uint64_t bytes = (n + 7) / 8;
+        const std::uint64_t bytes = n / 8 + (n % 8 != 0);
         if (bytes > data_.size() - pos_) fail(pos_, "bit array larger than the rest of the file");
         pos_ += bytes;
       } else {

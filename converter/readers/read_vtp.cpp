@@ -3,16 +3,19 @@
 // and appended (raw or base64), uncompressed or vtkZLibDataCompressor blocks, header_type UInt32 or UInt64,
 // byte_order LittleEndian or BigEndian. Coordinates: see vtk_polydata.h.
 //
-// The XML is parsed by pugixml. Raw appended data is not XML, so the document is cut at <AppendedData>
-// and its bytes are addressed directly. Base64 is decoded here (a few lines): VTK writes the header and
-// the data of an array as separately padded base64 chunks, which general-purpose decoders reject or
-// silently mangle; this one decodes chunk after chunk and refuses any character outside the alphabet.
+// The XML is parsed by pugixml. Raw appended data is not XML, so the document is cut after the
+// <AppendedData> start tag the parser finds, and its bytes are addressed directly. Base64 is decoded here (a few
+// lines): VTK writes the header and the data of an array as separately padded base64 chunks, which general-purpose
+// decoders reject or silently mangle; this one decodes chunk after chunk and refuses any character outside the
+// alphabet.
 //
 // Nothing is allocated before it is checked against the file: an uncompressed array's size against the
 // bytes that hold it, a compressed block's declared size against zlib's maximum ratio (1032:1), and all
 // decoded arrays together against a budget proportional to the file size.
 #include <charconv>
+#include <cmath>
 #include <cstring>
+#include <functional>
 #include <string_view>
 
 #include <zlib.h>
@@ -20,6 +23,7 @@
 
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/vtk_polydata.h"
+#include "format/checked_count.h"
 #include "format/error.h"
 #include "format/mapped_file.h"
 
@@ -121,22 +125,37 @@ class VtpParser {
         budget_(64 * static_cast<std::uint64_t>(bytes.size()) + (std::uint64_t(64) << 20)) {}
 
   Tractogram parse() {
-    // Raw appended bytes are not XML: parse the document up to <AppendedData ...> and close it ourselves.
-    std::string xml(all_);
-    const std::size_t app = all_.find("<AppendedData");
+    // Raw appended bytes are not XML: the document is parsed up to the end of the <AppendedData> start tag,
+    // then closed. Which tag that is, the parser says, not a text search: the first "<AppendedData" in the
+    // text is taken when the parsed prefix has it as the element (the usual case: only the prefix is
+    // copied); otherwise (it was in a comment, say) the whole file is parsed, and as a parse that fails keeps
+    // the nodes before the error, the element found there is the real one.
+    constexpr unsigned kFlags = pugi::parse_default | pugi::parse_comments;
+    pugi::xml_document doc;
+    pugi::xml_parse_result r;
+    // Parses the document cut after the tag at `at`: true when that tag is the <AppendedData> element.
+    auto parse_cut_at = [&](std::size_t at) {
+      const std::size_t gt = tag_end(at);
+      if (gt == std::string_view::npos) return false;
+      const std::string xml = std::string(all_.substr(0, gt + 1)) + "</AppendedData></VTKFile>";
+      r = doc.load_buffer(xml.data(), xml.size(), kFlags);
+      const pugi::xml_node element = doc.child("VTKFile").child("AppendedData");
+      return r && element && offset(element) == at + 1;  // offset_debug: the name, after the '<'
+    };
+    std::size_t app = all_.find("<AppendedData");
+    if (app == std::string_view::npos || !parse_cut_at(app)) {
+      r = doc.load_buffer(all_.data(), all_.size(), kFlags);
+      const pugi::xml_node element = doc.child("VTKFile").child("AppendedData");
+      app = element ? offset(element) - 1 : std::string_view::npos;
+      if (app != std::string_view::npos && !parse_cut_at(app)) fail(app, "<AppendedData> tag is not well-formed");
+    }
     if (app != std::string_view::npos) {
-      const std::size_t gt = all_.find('>', app);
-      if (gt == std::string_view::npos) fail(app, "unterminated <AppendedData> tag");
-      std::size_t us = gt + 1;
+      std::size_t us = tag_end(app) + 1;
       while (us < all_.size() && std::isspace(static_cast<unsigned char>(all_[us]))) ++us;
       if (us >= all_.size() || all_[us] != '_') fail(us, "expected '_' at the start of the appended data");
       appended_ = all_.substr(us + 1);
       appended_at_ = us + 1;
-      xml = std::string(all_.substr(0, gt + 1)) + "</AppendedData></VTKFile>";
     }
-    pugi::xml_document doc;
-    const pugi::xml_parse_result r =
-        doc.load_buffer(xml.data(), xml.size(), pugi::parse_default | pugi::parse_comments);
     if (!r) fail(static_cast<std::uint64_t>(r.offset), std::string("not well-formed XML: ") + r.description());
 
     const pugi::xml_node root = doc.child("VTKFile");
@@ -192,6 +211,20 @@ class VtpParser {
     fail_input(path_, at, what);
   }
   std::uint64_t offset(const pugi::xml_node& n) const { return static_cast<std::uint64_t>(n.offset_debug()); }
+  // The '>' that ends the tag starting at `at` ('>' inside quoted attribute values does not), or npos.
+  std::size_t tag_end(std::size_t at) const {
+    char quote = 0;
+    for (std::size_t k = at; k < all_.size(); ++k) {
+      if (quote) {
+        if (all_[k] == quote) quote = 0;
+      } else if (all_[k] == '"' || all_[k] == '\'') {
+        quote = all_[k];
+      } else if (all_[k] == '>') {
+        return k;
+      }
+    }
+    return std::string_view::npos;
+  }
 
   std::uint64_t count_attribute(const pugi::xml_node& n, const char* name) {
     const pugi::xml_attribute a = n.attribute(name);
@@ -219,8 +252,10 @@ class VtpParser {
     if (polys > 0 || strips > 0) warnings_.push_back("Polys and Strips are not streamlines; skipped");
     if (verts > 0) warnings_.push_back(std::to_string(verts) + " Verts cells are not streamlines; skipped");
     p.cells_before_lines = verts;
-    p.cell_count = verts + lines + polys + strips;
-    if (p.cell_count < lines) fail(offset(piece), "cell counts overflow");
+    const auto cells = [&](std::uint64_t a, std::uint64_t b) {
+      return checked_sum(a, b, path_, offset(piece), "NumberOfVerts + NumberOfLines + NumberOfPolys + NumberOfStrips");
+    };
+    p.cell_count = cells(cells(cells(verts, lines), polys), strips);
 
     const pugi::xml_node points = piece.child("Points").child("DataArray");
     if (p.point_count > 0) {
@@ -243,9 +278,9 @@ class VtpParser {
       const std::vector<double> o = decode(offs, 1, lines, "Lines offsets");
       p.line_offsets.resize(lines + 1);
       for (std::uint64_t k = 0; k < lines; ++k) {
-        if (!(o[k] >= static_cast<double>(p.line_offsets[k])) || o[k] >= 9007199254740992.0)
-          fail(offset(offs),
-               "Lines offsets must be non-decreasing; offset " + std::to_string(k) + " is " + std::to_string(o[k]));
+        if (!(o[k] >= static_cast<double>(p.line_offsets[k])) || o[k] >= 9007199254740992.0 || o[k] != std::floor(o[k]))
+          fail(offset(offs), "Lines offsets must be non-decreasing integers; offset " + std::to_string(k) + " is " +
+                                 std::to_string(o[k]));
         p.line_offsets[k + 1] = static_cast<std::uint64_t>(o[k]);
       }
       p.line_connectivity = decode(conn, 1, p.line_offsets.back(), "Lines connectivity");
@@ -283,18 +318,22 @@ class VtpParser {
       fail(offset(a), what + ": type '" + std::string(a.attribute("type").as_string()) + "' is not numeric");
     if (a.attribute("NumberOfComponents") && count_attribute(a, "NumberOfComponents") != components)
       fail(offset(a), what + ": NumberOfComponents differs from " + std::to_string(components));
-    if (tuples != 0 && components > ~std::uint64_t(0) / 8 / tuples) fail(offset(a), what + ": size overflows");
-    const std::uint64_t n = components * tuples;
-    if (8 * n > budget_)
-      fail_unsupported(path_, what + ": " + std::to_string(n) +
-                                  " values exceed what a file of this size may decode to (" +
-                                  "64 x its size + 64 MiB in all); refused as a likely decompression bomb");
-    budget_ -= 8 * n;
+    const std::uint64_t n = checked_product(components, tuples, path_, offset(a), what + " size");
+    // Charged once the array's own headers (or text) agree with the count: a count they contradict, or
+    // beyond the bytes an uncompressed array has, is malformed (exit 3), not a likely bomb (exit 4).
+    auto charge_budget = [&] {
+      if (n > budget_ / 8)
+        fail_unsupported(path_, what + ": " + std::to_string(n) +
+                                    " values exceed what a file of this size may decode to (" +
+                                    "64 x its size + 64 MiB in all); refused as a likely decompression bomb");
+      budget_ -= 8 * n;
+    };
     const std::string format = a.attribute("format").as_string("ascii");
     std::vector<double> out;
     if (format == "ascii") {
       const std::string_view text = a.child_value();
       if (n > text.size() / 2 + 1) fail(offset(a), what + ": " + std::to_string(n) + " values cannot fit in its text");
+      charge_budget();
       out.resize(n);
       std::size_t pos = 0;
       for (std::uint64_t k = 0; k < n; ++k) {
@@ -305,8 +344,14 @@ class VtpParser {
         auto [end, ec] = std::from_chars(text.data() + pos, text.data() + stop, out[k]);
         if (ec != std::errc() || end != text.data() + stop)
           fail(offset(a), what + ": expected a number, found '" + std::string(text.substr(pos, stop - pos)) + "'");
+        if (type.kind != 'f' && out[k] != std::floor(out[k]))
+          fail(offset(a), what + ": expected an integer, found '" + std::string(text.substr(pos, stop - pos)) + "'");
         pos = stop;
       }
+      while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
+      if (pos < text.size())
+        fail(offset(a), what + ": more values than the " + std::to_string(n) + " declared (from '" +
+                            std::string(text.substr(pos, std::min<std::size_t>(20, text.size() - pos))) + "')");
       return out;
     }
     std::vector<std::uint8_t> bytes;
@@ -315,14 +360,14 @@ class VtpParser {
       // The text's own node gives its file offset (the parsed copy starts with the file's bytes).
       const pugi::xml_node text_node = a.first_child();
       ByteSource src(path_, text, text_node ? offset(text_node) : offset(a), true);
-      bytes = block_bytes(src, n * type.size, what);
+      bytes = block_bytes(src, n * type.size, what, charge_budget);
     } else if (format == "appended") {
       if (appended_at_ == 0) fail(offset(a), what + ": format=\"appended\" but the file has no <AppendedData>");
       const std::uint64_t off = count_attribute(a, "offset");
       if (off > appended_.size())
         fail(offset(a), what + ": appended offset " + std::to_string(off) + " is past the end of the file");
       ByteSource src(path_, appended_.substr(off), appended_at_ + off, appended_base64_);
-      bytes = block_bytes(src, n * type.size, what);
+      bytes = block_bytes(src, n * type.size, what, charge_budget);
     } else {
       fail(offset(a), what + ": format '" + format + "' (expected ascii, binary or appended)");
     }
@@ -332,12 +377,19 @@ class VtpParser {
     return out;
   }
 
-  std::vector<std::uint8_t> block_bytes(ByteSource& src, std::uint64_t expected, const std::string& what) {
+  // An array's bytes. `charge_budget` is called once the block headers agree with the `expected` size,
+  // before anything is allocated for it.
+  std::vector<std::uint8_t> block_bytes(ByteSource& src, std::uint64_t expected, const std::string& what,
+                                        const std::function<void()>& charge_budget) {
     std::vector<std::uint8_t> out;
     if (!zlib_) {
       const std::uint64_t size = src.read_uint(header_size_, big_);
       if (size != expected)
         src.fail(what + ": the header says " + std::to_string(size) + " bytes; expected " + std::to_string(expected));
+      if (expected > src.available())
+        src.fail(what + ": " + std::to_string(expected) + " bytes, but at most " + std::to_string(src.available()) +
+                 " remain");
+      charge_budget();
       out.resize(expected);
       src.read(out.data(), expected);
       return out;
@@ -360,6 +412,7 @@ class VtpParser {
     if (total != expected)
       src.fail(what + ": the compression header says " + std::to_string(total) + " bytes; expected " +
                std::to_string(expected));
+    charge_budget();
     out.resize(expected);
     std::vector<std::uint8_t> in;
     std::uint64_t at = 0;
@@ -373,6 +426,9 @@ class VtpParser {
       uLongf got = static_cast<uLongf>(want);
       uLong used = static_cast<uLong>(sizes[k]);
       const int z = uncompress2(out.data() + at, &got, in.data(), &used);
+      if (z == Z_OK && got == want && used != sizes[k])
+        src.fail(what + ": compressed block " + std::to_string(k) + " ends after " + std::to_string(used) + " of its " +
+                 std::to_string(sizes[k]) + " bytes (junk after the zlib stream)");
       if (z != Z_OK || got != want)
         src.fail(what + ": compressed block " + std::to_string(k) + " does not inflate to its declared " +
                  std::to_string(want) + " bytes (zlib: " +

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <set>
 
+#include "format/checked_count.h"
 #include "format/checksum.h"
 #include "format/error.h"
 
@@ -17,7 +18,7 @@ void add_value_sets(Tractogram& t, const DataArray& a, std::uint64_t tuples, std
                     const std::vector<std::uint64_t>* gather, const std::vector<std::uint64_t>& line_offsets,
                     bool per_point, const std::string& path, std::set<std::string>& used) {
   const char* where = per_point ? "point data" : "cell data";
-  if (a.values.size() != tuples * a.components)
+  if (a.values.size() != checked_product(tuples, a.components, path, std::nullopt, std::string(where) + " size"))
     fail_input(path, std::nullopt,
                std::string(where) + " array '" + a.name + "' has " + std::to_string(a.values.size()) +
                    " values; expected " + std::to_string(tuples) + " x " + std::to_string(a.components));
@@ -52,7 +53,7 @@ void add_value_sets(Tractogram& t, const DataArray& a, std::uint64_t tuples, std
 }  // namespace
 
 void fill_tractogram(Tractogram& t, const std::string& path, const PolyData& p, bool lps) {
-  if (p.points.size() != 3 * p.point_count)
+  if (p.points.size() != checked_product(3, p.point_count, path, std::nullopt, "POINTS count"))
     fail_input(path, std::nullopt,
                "POINTS holds " + std::to_string(p.points.size()) + " coordinates; expected 3 x " +
                    std::to_string(p.point_count));
@@ -88,7 +89,8 @@ void fill_tractogram(Tractogram& t, const std::string& path, const PolyData& p, 
   std::set<std::string> point_names, cell_names;
   for (const DataArray& a : p.point_data)
     add_value_sets(t, a, p.point_count, 0, &gather, p.line_offsets, true, path, point_names);
-  if (!p.cell_data.empty() && p.cells_before_lines + lines > p.cell_count)
+  if (!p.cell_data.empty() &&
+      checked_sum(p.cells_before_lines, lines, path, std::nullopt, "cells up to the last line") > p.cell_count)
     fail_input(path, std::nullopt,
                "cell data for " + std::to_string(p.cell_count) + " cells, fewer than the cells declared");
   for (const DataArray& a : p.cell_data)

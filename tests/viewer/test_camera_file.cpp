@@ -2,8 +2,12 @@
 // --turntable writes N frames around the vertical axis, frame 0 being the plain render.
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "format/error.h"
+#include "format/json_limits.h"
 #include "tests/test_support.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/turntable.h"
@@ -138,6 +142,14 @@ TEST(CameraFile, MissingKeysKeepDefaultsAndBadOnesNameFileAndKey) {
   EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"colormap": "jet"}})").find("settings.colormap"),
             std::string::npos);
 
+  // Nested 100000 deep, the file crashed the viewer by stack overflow: refused before it is parsed.
+  const std::string deep =
+      error_of(R"({"voxview_view": 1, "x": )" + std::string(100000, '[') + std::string(100000, ']') + "}");
+  EXPECT_NE(deep.find("bad.json: at byte " + std::to_string(25 + kMaxJsonDepth - 1) +
+                      ": view file: JSON nested deeper than " + std::to_string(kMaxJsonDepth)),
+            std::string::npos)
+      << deep;
+
   ScratchDir dir;
   try {
     app::read_view(dir.file("missing.json"));
@@ -145,6 +157,35 @@ TEST(CameraFile, MissingKeysKeepDefaultsAndBadOnesNameFileAndKey) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("missing.json"), std::string::npos);
   }
+}
+
+// A view file's camera or slab beyond what draws a picture (ViewLimits) was accepted and drew nothing.
+TEST(CameraFile, CamerasAndSlabsThatDrawNothingAreRefused) {
+  auto error_of = [](const std::string& inner) -> std::string {
+    try {
+      app::parse_view_json(R"({"voxview_view": 1, )" + inner + "}", "v.json");
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
+      return e.what();
+    }
+    return "no error";
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"("camera": {"distance": 1e308})", "camera.distance: expected mm in [0.001, 1e+07]"},
+      {R"("camera": {"distance": 1e-300})", "camera.distance"},
+      {R"("camera": {"ortho_height": 1e308})", "camera.ortho_height"},
+      {R"("camera": {"azimuth_deg": 1e308})", "camera.azimuth_deg: expected degrees within +-1e+06"},
+      {R"("camera": {"target": [0, 1e308, 0]})", "camera.target"},
+      {R"("camera": {"fov_y_deg": 1e-300})", "camera.fov_y_deg: expected degrees in [1, 179]"},
+      {R"("camera": {"fov_y_deg": 179.99999})", "camera.fov_y_deg"},
+      {R"("settings": {"slab_mm": 1e-300})", "settings.slab_mm: expected a thickness in [0.001, 1e+07] mm"},
+      {R"("settings": {"slab_mm": 1e308})", "settings.slab_mm"},
+  };
+  for (const auto& [inner, message] : cases)
+    EXPECT_NE(error_of(inner).find("v.json: " + message), std::string::npos) << inner << ": " << error_of(inner);
+  for (const char* fine : {R"("camera": {"distance": 1e6, "azimuth_deg": -720, "fov_y_deg": 179})",
+                           R"("settings": {"slab_mm": 0})", R"("settings": {"slab_mm": 0.5})"})
+    EXPECT_EQ(error_of(fine), "no error") << fine;
 }
 
 TEST(CameraFile, TurntableFrameNames) {

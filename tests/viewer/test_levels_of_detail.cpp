@@ -163,6 +163,26 @@ TEST_F(LevelsOfDetail, ATextureLimitTooSmallForFullDetailLeavesACoarserLevel) {
   EXPECT_GT(test::lit_pixels(render_image(r, whole_view(), s, 96, 96)), 500);
 }
 
+// A budget below 1 MiB was reported as "0 MiB" on both sides ("needs 0 MiB ... budget of 0 MiB"): small
+// sizes are given in bytes.
+TEST_F(LevelsOfDetail, ABudgetNoLevelFitsSaysBothSizesInBytes) {
+  const VxlFile f = file();
+  const std::vector<const VxlFile*> files = {&f};
+  const std::uint32_t coarsest = SceneLayout::coarsest_level(files);
+  const std::uint64_t needs = SceneLayout(files, ~0ull, coarsest).upload_bytes();
+  ASSERT_LT(needs, 1u << 20);
+  try {
+    (void)SceneLayout::finest_level_within(files, ~0ull, 1);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+    const std::string m = e.what();
+    EXPECT_NE(m.find("GPU memory budget of 1 bytes"), std::string::npos) << m;
+    EXPECT_NE(m.find("needs " + std::to_string(needs) + " bytes of GPU memory"), std::string::npos) << m;
+    EXPECT_EQ(m.find(" 0 MiB"), std::string::npos) << m;
+  }
+}
+
 // voxview says which level it draws and why, and refuses a budget no level fits (exit 4, unsupported)
 // without writing a picture.
 TEST_F(LevelsOfDetail, VoxviewDrawsTheFinestLevelItsBudgetAllows) {

@@ -6,9 +6,11 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "format/error.h"
 #include "viewer/platform/egl_context.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/offscreen_target.h"
@@ -526,6 +529,36 @@ TEST(PlatformImageIo, WriteFailuresLeaveNothingAndNameThePath) {
   EXPECT_TRUE(vxl::read_image(path).rgba == other.rgba);
 }
 
+// The output rule (format/output_path.h): a FIFO or a device is refused as an output error and left as it
+// was, a symbolic link is followed and kept, a missing folder is an output error (voxview exit 5).
+TEST(PlatformImageIo, WritePngRefusesFifosAndDevicesAndFollowsLinks) {
+  TempDir dir;
+  const Image img = test_pattern(4, 4);
+  const std::string fifo = (dir.path() / "fifo.png").string(), null_link = (dir.path() / "null.png").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  fs::create_symlink("/dev/null", null_link);
+  for (const std::string& path : {fifo, null_link, (dir.path() / "missing" / "x.png").string()}) {
+    try {
+      vxl::write_png(path, img);
+      ADD_FAILURE() << "no exception for " << path;
+    } catch (const vxl::Error& e) {
+      EXPECT_EQ(e.kind(), vxl::ErrorKind::Output) << e.what();
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(null_link)));
+  EXPECT_TRUE(fs::is_character_file(fs::symlink_status("/dev/null")));
+  EXPECT_EQ(dir.entries().size(), 2u) << "a temporary file left";
+
+  fs::create_directory(dir.path() / "sub");
+  const std::string link = (dir.path() / "link.png").string();
+  fs::create_symlink("sub/real.png", link);
+  vxl::write_png(link, img);
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+  EXPECT_TRUE(vxl::read_image((dir.path() / "sub" / "real.png").string()).rgba == img.rgba);
+}
+
 TEST(PlatformImageIo, ReadErrorsAndRgbFiles) {
   TempDir dir;
   const std::string missing = (dir.path() / "nope.png").string();
@@ -558,6 +591,33 @@ TEST(PlatformImageIo, ReadErrorsAndRgbFiles) {
   ASSERT_EQ(img.width, 2);
   ASSERT_EQ(img.height, 1);
   EXPECT_EQ(img.rgba, (std::vector<std::uint8_t>{10, 20, 30, 255, 40, 50, 60, 255}));
+}
+
+// --size 16384x8192 (or a view file's "size") exited 70 with "framebuffer incomplete": the driver caps
+// a buffer's bytes below its per-side limit. Both limits are now an Unsupported error (exit 4) that says
+// what fits.
+TEST_F(PlatformTarget, SizesTheDriverCannotHoldAreUnsupportedAndSayWhatFits) {
+  GLint max_tex = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+  try {
+    OffscreenTarget t(max_tex + 1, 16);
+    ADD_FAILURE() << "no error";
+  } catch (const vxl::Error& e) {
+    EXPECT_EQ(e.kind(), vxl::ErrorKind::Unsupported) << e.what();
+    EXPECT_NE(std::string(e.what()).find("limit of "), std::string::npos) << e.what();
+  }
+  // llvmpipe cannot allocate the 2 GiB float colour buffer of 16384x8192. A driver that can passes; one
+  // that cannot must say so as an Unsupported error.
+  try {
+    OffscreenTarget t(std::min(16384, max_tex), std::min(8192, max_tex));
+    std::printf("[ platform ] %dx%d allocates on this driver\n", t.width(), t.height());
+  } catch (const vxl::Error& e) {
+    EXPECT_EQ(e.kind(), vxl::ErrorKind::Unsupported) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the largest of this shape it allocates is "), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("is none"), std::string::npos) << e.what();
+  }
+  OffscreenTarget small(8, 8);  // the context is still usable
+  EXPECT_EQ(small.read_rgba().size(), 8u * 8u * 4u);
 }
 
 TEST_F(PlatformTarget, RenderedImageSurvivesPng) {

@@ -1,15 +1,19 @@
 // voxview's command line: the parser's schema (voxview_cli.h) and how the options combine with a saved view
 // and are checked (viewer_arguments.h), without running the program.
+#include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "format/error.h"
 #include "tests/test_support.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/key_bindings.h"
+#include "viewer/app/turntable.h"
 #include "viewer/app/viewer_arguments.h"
 #include "viewer/app/voxview_cli.h"
 
@@ -202,6 +206,145 @@ TEST(ViewerArguments, BadOrConflictingOptionsAreUsageErrors) {
   ViewerArguments no_image = given("--slices", &ViewerArguments::slices, "axial");
   no_image.options.image.reset();
   error_contains(no_image, "--image-range and --slices need --image");
+}
+
+// Options that draw nothing (an azimuth of 1e308, a slab of 1e-300 mm, a focus at 1e308 mm) or make no
+// sense (a frame budget of NaN, an infinite orbit) were accepted; they are usage errors now.
+TEST(ViewerArguments, OptionsThatDrawNothingAreUsageErrors) {
+  auto error_contains = [](const ViewerArguments& a, const std::string& part) {
+    const std::string error = usage_error_of(a);
+    EXPECT_NE(error.find(part), std::string::npos) << error;
+  };
+  ViewerArguments view = given("--view", &ViewerArguments::view, "1e308,1e308");
+  error_contains(view, "--view: unknown view '1e308,1e308'");
+  ViewerArguments slab;
+  slab.slab = 1e-300;
+  slab.given.insert("--slab");
+  error_contains(slab, "--slab: expected a thickness in [0.001, 1e+07] mm");
+  error_contains(given("--focus", &ViewerArguments::focus, "1e308,0,0"), "--focus: expected X,Y,Z");
+  ViewerArguments budget;
+  budget.options.frame_budget_ms = std::numeric_limits<double>::quiet_NaN();
+  error_contains(budget, "--frame-budget: expected milliseconds");
+  ViewerArguments orbit;
+  orbit.options.orbit_deg = std::numeric_limits<double>::infinity();
+  error_contains(orbit, "--orbit: expected degrees");
+  EXPECT_EQ(usage_error_of(given("--view", &ViewerArguments::view, "-720,95")), "no error");  // elevation clamped
+}
+
+// A view file without "camera" gave the default camera (target at the origin, 300 mm away): a picture of
+// whatever lies there. It is framed now, as without a view file; its settings still apply.
+TEST(ViewerArguments, AViewFileWithoutACameraIsFramedAsWithoutOne) {
+  ScratchDir dir;
+  const std::string path = dir.file("look.json");
+  std::ofstream(path) << R"({"voxview_view": 1, "settings": {"lighting": true, "mode": "exact"}})";
+  ViewerArguments a;
+  a.camera_file = path;
+  const app::ViewerOptions o = resolve_viewer_options(a);
+  EXPECT_FALSE(o.camera);
+  EXPECT_TRUE(o.settings.lighting);
+  EXPECT_EQ(o.settings.mode, RenderMode::Exact);
+}
+
+// Every output is checked before anything is read or drawn: --render into a missing folder or onto a
+// folder exited 70 after the rendering; a FIFO or a device was replaced by a regular file.
+TEST(ViewerArguments, OutputPathsAreCheckedFirstAndNeverReplaceAFifoOrDevice) {
+  ScratchDir dir;
+  const std::string fifo = dir.file("fifo.png"), null_link = dir.file("null.png");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::filesystem::create_symlink("/dev/null", null_link);
+  auto output_error_of = [](const ViewerArguments& a) -> std::string {
+    try {
+      resolve_viewer_options(a);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Output) << e.what();
+      return e.what();
+    }
+    return "no error";
+  };
+  auto rendering_to = [](const std::string& png) {
+    ViewerArguments a;
+    a.options.inputs = {"a.vxl"};
+    a.options.render_png = png;
+    return a;
+  };
+  EXPECT_NE(output_error_of(rendering_to(dir.file("missing/x.png"))).find("cannot write into the folder"),
+            std::string::npos);
+  EXPECT_NE(output_error_of(rendering_to(dir.file(""))).find("is a directory"), std::string::npos);
+  EXPECT_NE(output_error_of(rendering_to(fifo)).find("is a FIFO"), std::string::npos);
+  EXPECT_NE(output_error_of(rendering_to(null_link)).find("is a character device"), std::string::npos);
+  EXPECT_EQ(output_error_of(rendering_to(dir.file("new.png"))), "no error");
+
+  // The second of three turntable frames.
+  ViewerArguments turn = rendering_to(dir.file("t.png"));
+  turn.options.turntable = 3;
+  ASSERT_EQ(::mkfifo(app::turntable_frame_path(dir.file("t.png"), 1, 3).c_str(), 0600), 0);
+  EXPECT_NE(output_error_of(turn).find("t_001.png: is a FIFO"), std::string::npos) << output_error_of(turn);
+
+  for (auto field :
+       {&app::ViewerOptions::save_camera, &app::ViewerOptions::stats_json, &app::ViewerOptions::screenshot}) {
+    ViewerArguments a;
+    a.options.inputs = {"a.vxl"};
+    a.options.*field = fifo;
+    EXPECT_NE(output_error_of(a).find("is a FIFO"), std::string::npos);
+  }
+  struct stat st {};
+  ASSERT_EQ(::lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  ASSERT_EQ(::lstat("/dev/null", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode));
+
+  // The program: exit 5, before the input is even opened.
+  for (const std::string& out : {dir.file("missing/x.png"), dir.file(""), fifo}) {
+    const auto r = test::run_program(VOXVIEW_CLI, test::q(dir.file("absent.vxl")) + " --render " + test::q(out));
+    EXPECT_EQ(r.exit_code, 5) << r.output;
+  }
+}
+
+// A size the GL driver cannot allocate, from --size or from a view file, is exit 4 naming what fits (it
+// was exit 70, "framebuffer incomplete"); a driver that allocates it draws it.
+TEST(Voxview, SizeBeyondWhatTheDriverAllocatesIsUnsupported) {
+  ScratchDir dir;
+  const std::string tck = dir.file("s.tck"), vxl = dir.file("s.vxl"), view = dir.file("big.json");
+  ASSERT_EQ(test::run_cli("synth " + test::q(tck) + " --streamlines 20").exit_code, 0);
+  ASSERT_EQ(test::run_cli("convert " + test::q(tck) + " " + test::q(vxl)).exit_code, 0);
+  std::ofstream(view) << R"({"voxview_view": 1, "size": [16384, 8192]})";
+  for (const std::string& size : {std::string("--size 16384x8192"), "--camera " + test::q(view)}) {
+    SCOPED_TRACE(size);
+    const auto r =
+        test::run_program(VOXVIEW_CLI, test::q(vxl) + " --render " + test::q(dir.file("o.png")) + " " + size);
+    if (r.exit_code == 0) continue;
+    EXPECT_EQ(r.exit_code, 4) << r.output;
+    EXPECT_NE(r.output.find("image size 16384x8192: the GL driver cannot allocate"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("o.png")));
+  }
+}
+
+// A view file whose scalar, groups or colouring the scene cannot honour is a bad file (exit 3, naming it);
+// the same from the command line stays a usage error (exit 2). Both exited 2.
+TEST(Voxview, ColourSettingsFromAViewFileAreTheFilesErrors) {
+  ScratchDir dir;
+  const std::string tck = dir.file("s.tck"), vxl = dir.file("s.vxl"), png = dir.file("o.png");
+  ASSERT_EQ(test::run_cli("synth " + test::q(tck) + " --streamlines 20").exit_code, 0);
+  ASSERT_EQ(test::run_cli("convert " + test::q(tck) + " " + test::q(vxl)).exit_code, 0);
+  const std::vector<std::pair<std::string, std::string>> settings = {
+      {R"("scalar": "fa")", "settings.scalar: no value set 'fa'"},
+      {R"("groups": [{"name": "CST", "opacity": 0.5}])", "settings.groups: no group 'CST'"},
+      {R"("color": "scalar")", "settings.color: no per-point or per-streamline values"}};
+  for (const auto& [setting, message] : settings) {
+    SCOPED_TRACE(setting);
+    const std::string view = dir.file("v.json");
+    std::ofstream(view) << R"({"voxview_view": 1, "settings": {)" + setting + "}}";
+    const auto r = test::run_program(
+        VOXVIEW_CLI, test::q(vxl) + " --camera " + test::q(view) + " --render " + test::q(png) + " --size 32x32");
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("v.json: " + message), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("in " + vxl), std::string::npos) << r.output;
+  }
+  for (const std::string& option : {"--scalar fa", "--group CST=:0.5", "--color scalar"}) {
+    const auto r = test::run_program(VOXVIEW_CLI, test::q(vxl) + " " + option + " --render " + test::q(png));
+    EXPECT_EQ(r.exit_code, 2) << option << ": " << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(png));
 }
 
 // The schema: which options were given, values that start with '-', the lists the help takes from their tables.

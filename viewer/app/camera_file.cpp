@@ -11,6 +11,7 @@
 
 #include "format/atomic_output.h"
 #include "format/error.h"
+#include "format/json_limits.h"
 
 namespace vxl::app {
 
@@ -27,6 +28,12 @@ double shortest(float f) {
   auto r = std::to_chars(buf, buf + sizeof buf, f);
   *r.ptr = '\0';
   return std::strtod(buf, nullptr);
+}
+
+std::string shortest_text(double d) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, d);
+  return std::string(buf, r.ptr);
 }
 
 json vec(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
@@ -101,9 +108,17 @@ void read_camera(const Reader& r, Camera& c) {
   r.number("fov_y_deg", c.fov_y_deg);
   r.boolean("orthographic", c.orthographic);
   r.number("ortho_height", c.ortho_height);
-  if (!(c.distance > 0)) r.fail("distance", "a positive number of mm");
-  if (!(c.ortho_height > 0)) r.fail("ortho_height", "a positive number of mm");
-  if (!(c.fov_y_deg > 0 && c.fov_y_deg < 180)) r.fail("fov_y_deg", "degrees in (0, 180)");
+  using L = ViewLimits;
+  const std::string mm = "mm in [" + shortest_text(L::kMinMm) + ", " + shortest_text(L::kMaxMm) + "]";
+  for (int i = 0; i < 3; ++i)
+    if (!(std::abs(c.target[i]) <= L::kMaxMm))
+      r.fail("target", "coordinates within +-" + shortest_text(L::kMaxMm) + " mm");
+  if (!(c.distance >= L::kMinMm && c.distance <= L::kMaxMm)) r.fail("distance", mm);
+  if (!(c.ortho_height >= L::kMinMm && c.ortho_height <= L::kMaxMm)) r.fail("ortho_height", mm);
+  if (!(c.fov_y_deg >= L::kMinFovDeg && c.fov_y_deg <= L::kMaxFovDeg))
+    r.fail("fov_y_deg", "degrees in [" + shortest_text(L::kMinFovDeg) + ", " + shortest_text(L::kMaxFovDeg) + "]");
+  if (!(std::abs(c.azimuth_deg) <= L::kMaxAzimuthDeg))
+    r.fail("azimuth_deg", "degrees within +-" + shortest_text(L::kMaxAzimuthDeg));
   if (std::abs(c.elevation_deg) > 90) r.fail("elevation_deg", "degrees in [-90, 90]");
 }
 
@@ -166,7 +181,7 @@ void read_settings(const Reader& r, RenderSettings& s) {
   r.boolean("lighting", s.lighting);
   r.number("order_hysteresis", s.order_hysteresis);
   r.number("slab_mm", s.clipping.slab_mm);
-  if (s.clipping.slab_mm < 0) r.fail("slab_mm", "a thickness >= 0 mm (0: no slab)");
+  if (!slab_is_drawable(s.clipping.slab_mm)) r.fail("slab_mm", slab_range_text() + " (0: no slab)");
   if (const json* clip = r.find("clip")) {
     if (!clip->is_array() || clip->size() > Clipping::kMaxPlanes) r.fail("clip", "an array of at most 3 planes");
     s.clipping.planes.clear();
@@ -184,6 +199,12 @@ void read_settings(const Reader& r, RenderSettings& s) {
 }
 
 }  // namespace
+
+bool slab_is_drawable(double mm) { return mm == 0 || (mm >= ViewLimits::kMinMm && mm <= ViewLimits::kMaxMm); }
+
+std::string slab_range_text() {
+  return "a thickness in [" + shortest_text(ViewLimits::kMinMm) + ", " + shortest_text(ViewLimits::kMaxMm) + "] mm";
+}
 
 std::string view_json(const SavedView& v) {
   const Camera& c = v.camera;
@@ -222,7 +243,7 @@ std::string view_json(const SavedView& v) {
 }
 
 SavedView parse_view_json(const std::string& text, const std::string& path, const SavedView& defaults) {
-  json j = json::parse(text, nullptr, false);
+  json j = parse_json(text, path, 0, "view file");
   if (j.is_discarded() || !j.is_object()) fail_input(path, std::nullopt, "not a JSON object (a voxview view file)");
   const Reader top(j, path, "");
   const json* version = top.find("voxview_view");
@@ -239,6 +260,7 @@ SavedView parse_view_json(const std::string& text, const std::string& path, cons
     if (w < 1 || h < 1 || w > 16384 || h > 16384) top.fail("size", "[width, height], each 1..16384");
     v.size = std::array<int, 2>{static_cast<int>(w), static_cast<int>(h)};
   }
+  v.has_camera = top.find("camera") != nullptr;
   read_camera(top.object("camera"), v.camera);
   read_settings(top.object("settings"), v.settings);
   if (const json* selection = top.find("selection")) {

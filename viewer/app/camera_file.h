@@ -39,11 +39,17 @@ namespace vxl::app {
 struct SavedView {
   Camera camera;
   RenderSettings settings;
-  std::optional<std::array<int, 2>> size;              // width, height
+  std::optional<std::array<int, 2>> size;  // width, height
+  bool has_camera = true;                  // false: the file has no "camera", and the view is framed as without one
   std::vector<std::string> include, exclude, ends_in;  // the selection's regions, as voxlines select takes them
 };
 
-// Throws vxl::Error: Input (naming the file and key) for malformed content, Input when unreadable.
+// A slab thickness that draws something: 0 (no slab), or within ViewLimits; and the range in words.
+bool slab_is_drawable(double mm);
+std::string slab_range_text();
+
+// Throws vxl::Error: Input (naming the file and key) for malformed content or a camera beyond ViewLimits,
+// Input when unreadable.
 SavedView read_view(const std::string& path, const SavedView& defaults = {});
 // Atomic (the file appears complete or not at all); throws vxl::Error (Output) naming the path.
 void write_view(const std::string& path, const SavedView& view);

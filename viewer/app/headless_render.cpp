@@ -93,12 +93,12 @@ int run_headless(const ViewerOptions& o) {
     }
   }
   volume.reset();
-  check_color_options(o.inputs_name(), *renderer, o.settings);
+  check_color_options(o.inputs_name(), *renderer, o.settings, o.from_view_file);
   OffscreenTarget target(o.width, o.height);
   target.bind();
   if (o.save_camera)
     write_view(*o.save_camera,
-               SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}, o.include, o.exclude, o.ends_in});
+               SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}, true, o.include, o.exclude, o.ends_in});
   const int frames = std::max(1, o.turntable);
   for (int i = 0; i < frames; ++i) {
     renderer->draw(turntable_camera(*camera, i, frames), o.settings, o.width, o.height, target.framebuffer());

@@ -65,7 +65,8 @@ VxlFile open_scene(const std::string& path, double voxel_size, const std::vector
       ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
   ConvertSettings settings;
   settings.voxel_size = voxel_size;
-  convert_tractogram(std::move(t), temp.string(), settings);
+  for (const std::string& w : convert_tractogram(std::move(t), temp.string(), settings).warnings)
+    std::fprintf(stderr, "voxview: warning: %s: %s\n", path.c_str(), w.c_str());
   VxlFile f = VxlFile::open(temp.string());
   std::filesystem::remove(temp);  // the mapping keeps the data; nothing is left behind
   std::string tsf_options;
@@ -94,23 +95,32 @@ std::vector<const VxlFile*> pointers(const std::vector<VxlFile>& files) {
   return out;
 }
 
-void check_color_options(const std::string& path, const Renderer& r, const RenderSettings& s) {
+void check_color_options(const std::string& path, const Renderer& r, const RenderSettings& s,
+                         const ViewFileSettings& from_view_file) {
+  // The option's error, or the view file's when it set the value: "--scalar: ..." or "FILE: settings.scalar: ...
+  // in INPUT".
+  auto refuse = [&](bool from_file, const std::string& option, const std::string& key, const std::string& what) {
+    if (from_file)
+      throw Error(ErrorKind::Input, from_view_file.path, std::nullopt, "settings." + key + ": " + what + " in " + path);
+    throw Error(ErrorKind::Usage, path, std::nullopt, option + ": " + what);
+  };
   const auto& names = r.value_set_names();
   std::string available;
   for (const std::string& n : names) available += (available.empty() ? "" : ", ") + n;
   if (s.color == ColorMode::Scalar && names.empty())
-    throw Error(ErrorKind::Usage, path, std::nullopt,
-                "--color scalar: this tractogram has no per-point or per-streamline values (add a TSF with --tsf, or "
-                "use a TRK with scalars or properties, a TRX with dpv or dps)");
+    refuse(from_view_file.color, "--color scalar", "color",
+           "no per-point or per-streamline values to colour by (add a TSF with --tsf, or use a TRK with scalars or "
+           "properties, a TRX with dpv or dps)");
   if (!s.scalar.empty() && std::find(names.begin(), names.end(), s.scalar) == names.end())
-    throw Error(ErrorKind::Usage, path, std::nullopt,
-                "--scalar: no value set '" + s.scalar + "'" +
-                    (names.empty() ? " (it has none)" : " (it has: " + available + ")"));
+    refuse(from_view_file.scalar, "--scalar", "scalar",
+           "no value set '" + s.scalar + "'" + (names.empty() ? " (it has none)" : " (it has: " + available + ")"));
   for (const GroupStyle& g : s.group_styles)
     if (r.groups().find(g.name) < 0) {
       std::string groups;
       for (const SceneGroup& sg : r.groups().groups()) groups += (groups.empty() ? "" : ", ") + sg.name;
-      throw Error(ErrorKind::Usage, path, std::nullopt, "--group: no group '" + g.name + "' (groups: " + groups + ")");
+      const auto& file_groups = from_view_file.groups;
+      refuse(std::find(file_groups.begin(), file_groups.end(), g.name) != file_groups.end(), "--group", "groups",
+             "no group '" + g.name + "' (groups: " + groups + ")");
     }
 }
 

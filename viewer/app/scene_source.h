@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "format/vxl_file.h"
+#include "viewer/app/viewer_options.h"
 
 namespace vxl {
 class Renderer;
@@ -29,7 +30,9 @@ std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double v
 std::vector<const VxlFile*> pointers(const std::vector<VxlFile>& files);
 
 // Refuses colour options the scene cannot honour, naming the file and what it has: --color scalar without
-// values, an unknown --scalar, a --group that is no group of the scene.
-void check_color_options(const std::string& path, const Renderer& renderer, const RenderSettings& settings);
+// values, an unknown --scalar, a --group that is no group of the scene (Usage); the same settings from a
+// view file (`from_view_file`) are that file's error (Input).
+void check_color_options(const std::string& path, const Renderer& renderer, const RenderSettings& settings,
+                         const ViewFileSettings& from_view_file = {});
 
 }  // namespace vxl::app

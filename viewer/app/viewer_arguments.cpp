@@ -6,8 +6,10 @@
 
 #include "converter/memory_size.h"
 #include "format/error.h"
+#include "format/output_path.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/render/scene_groups.h"
+#include "viewer/app/turntable.h"
 
 namespace vxl::app {
 
@@ -32,12 +34,24 @@ void apply_saved_view(const ViewerArguments& a, ViewerOptions& o, std::string& s
   defaults.settings = o.settings;
   const SavedView saved = read_view(a.camera_file, defaults);
   o.settings = saved.settings;
-  o.camera = saved.camera;
+  if (saved.has_camera) o.camera = saved.camera;
   // The saved regions, unless the command line gives its own.
   if (!o.selecting()) {
     o.include = saved.include;
     o.exclude = saved.exclude;
     o.ends_in = saved.ends_in;
+  }
+  // What the file names and the command line does not replace is checked against the scene as the file's.
+  ViewFileSettings& from_file = o.from_view_file;
+  from_file.path = a.camera_file;
+  from_file.color = !a.was_given("--color");
+  from_file.scalar = !a.was_given("--scalar");
+  for (const GroupStyle& g : saved.settings.group_styles) {
+    const bool given = std::any_of(a.groups.begin(), a.groups.end(), [&](const std::string& text) {
+      const auto style = parse_group_style(text);
+      return style && style->name == g.name;
+    });
+    if (!given) from_file.groups.push_back(g.name);
   }
   if (saved.size && !a.was_given("--size"))
     size = std::to_string((*saved.size)[0]) + "x" + std::to_string((*saved.size)[1]);
@@ -89,7 +103,10 @@ void apply_look(const ViewerArguments& a, bool from_file, RenderSettings& s) {
 
 // --slab and --clip: clip planes given replace a saved view's.
 void apply_clipping(const ViewerArguments& a, Clipping& c) {
-  if (a.was_given("--slab")) c.slab_mm = a.slab;
+  if (a.was_given("--slab")) {
+    if (!slab_is_drawable(a.slab) || a.slab == 0) usage_error("--slab: expected " + slab_range_text());
+    c.slab_mm = a.slab;
+  }
   if (a.clips.size() > Clipping::kMaxPlanes)
     usage_error("--clip: at most 3 clip planes (got " + std::to_string(a.clips.size()) + ")");
   if (!a.clips.empty()) c.planes.clear();
@@ -137,9 +154,9 @@ void apply_image(const ViewerArguments& a, ViewerOptions& o) {
   if (a.was_given("--focus")) {
     double x = 0, y = 0, z = 0;
     char end = 0;
-    if (std::sscanf(a.focus.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &end) != 3 || !std::isfinite(x) ||
-        !std::isfinite(y) || !std::isfinite(z))
-      usage_error("--focus: expected X,Y,Z in mm (e.g. 0,-10,12.5); got '" + a.focus + "'");
+    if (std::sscanf(a.focus.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &end) != 3 ||
+        !(std::max({std::abs(x), std::abs(y), std::abs(z)}) <= ViewLimits::kMaxMm))
+      usage_error("--focus: expected X,Y,Z in mm within +-1e7 (e.g. 0,-10,12.5); got '" + a.focus + "'");
     o.focus = glm::dvec3(x, y, z);
   }
   if ((a.was_given("--image-range") || a.was_given("--slices")) && !o.image)
@@ -152,7 +169,8 @@ void apply_view_and_size(const ViewerArguments& a, const std::string& size, View
     o.view = parse_view(a.view);
     if (!o.view)
       usage_error("--view: unknown view '" + a.view +
-                  "' (expected axial, inferior, sagittal, right, coronal, posterior, or AZ,EL in degrees)");
+                  "' (expected axial, inferior, sagittal, right, coronal, posterior, or AZ,EL in degrees, the azimuth "
+                  "within +-1e6)");
   }
   if (std::sscanf(size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 1 || o.height < 1 || o.width > 16384 ||
       o.height > 16384)
@@ -179,6 +197,18 @@ void apply_selection(const ViewerArguments& a, ViewerOptions& o) {
   s.style_of(SceneGroups::kContext).opacity = context / s.opacity;
 }
 
+// Every output path, before anything is read or drawn: a missing folder, a directory, a FIFO or a device
+// is refused now (exit 5) rather than after the rendering, and never replaced (format/output_path.h).
+void check_outputs(const ViewerOptions& o) {
+  if (o.render_png) {
+    const int frames = std::max(1, o.turntable);
+    for (int i = 0; i < frames; ++i)
+      (void)output_target(o.turntable ? turntable_frame_path(*o.render_png, i, frames) : *o.render_png);
+  }
+  for (const auto* path : {&o.save_camera, &o.stats_json, &o.screenshot})
+    if (*path) (void)output_target(**path);
+}
+
 }  // namespace
 
 ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
@@ -188,7 +218,7 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
   o.settings.opacity = a.opacity;
   std::string size = a.size;
   apply_saved_view(a, o, size);
-  apply_look(a, o.camera.has_value(), o.settings);
+  apply_look(a, !a.camera_file.empty(), o.settings);
   apply_clipping(a, o.settings.clipping);
   apply_image(a, o);
   apply_view_and_size(a, size, o);
@@ -198,6 +228,10 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
     if (!o.gpu_memory || *o.gpu_memory == 0)
       usage_error("--gpu-memory '" + a.gpu_memory + "' is not a memory size (bytes, or K/M/G: 512M, 2G)");
   }
+  if (!(o.frame_budget_ms >= 0 && o.frame_budget_ms <= 1e6))
+    usage_error("--frame-budget: expected milliseconds in [0, 1e6]");
+  if (o.orbit_deg && !(std::abs(*o.orbit_deg) <= 360)) usage_error("--orbit: expected degrees in [-360, 360]");
+  check_outputs(o);
   return o;
 }
 

@@ -11,6 +11,14 @@
 
 namespace vxl::app {
 
+// The colour settings a saved view (--camera FILE) gave and the command line left. A scene that cannot
+// honour them makes the file the problem (exit 3, naming it), not the command line (exit 2).
+struct ViewFileSettings {
+  std::string path;  // empty: no view file
+  bool color = false, scalar = false;
+  std::vector<std::string> groups;
+};
+
 struct ViewerOptions {
   std::vector<std::string> inputs;  // .vxl, or a .tck/.trk/.trx/.vtk/.vtp converted in memory; several: one scene
   // How the inputs are named in messages and titles: the first file's name, "+ N more" for the others.
@@ -50,6 +58,7 @@ struct ViewerOptions {
   // with the opacities of the groups "selected" and "context" (scene_selection.h).
   std::vector<std::string> include, exclude, ends_in;
   bool selecting() const { return !include.empty() || !exclude.empty() || !ends_in.empty(); }
+  ViewFileSettings from_view_file;
 };
 
 }  // namespace vxl::app

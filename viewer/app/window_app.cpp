@@ -276,7 +276,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   grid_.emplace(first);
   controller_ = CameraController(Camera{}, std::max(1.0, glm::length(first.scene_max() - first.scene_min()) * 0.5));
   stats_.has_image = volume != nullptr;
-  check_color_options(o.inputs_name(), first, o.settings);
+  check_color_options(o.inputs_name(), first, o.settings, o.from_view_file);
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
   glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -700,7 +700,12 @@ void ViewerWindow::save_screenshot(const std::string& path, int width, int heigh
 void ViewerWindow::save_view(int width, int height) {
   const std::string path = options_.save_camera.value_or(stamped_name("voxview-view-", ".json").string());
   try {
-    SavedView view{controller_.camera(), state_.settings, std::array<int, 2>{width, height}, {}, {}, {}};
+    SavedView view{controller_.camera(), state_.settings, std::array<int, 2>{width, height}, true, {}, {}, {}};
+    // Without regions the focus and context groups are gone: a view naming them would not replay.
+    if (regions_.empty())
+      std::erase_if(view.settings.group_styles, [](const GroupStyle& g) {
+        return g.name == SceneGroups::kSelected || g.name == SceneGroups::kContext;
+      });
     for (const EditorRegion& r : regions_.regions())
       (r.role == EditorRegion::Role::Include   ? view.include
        : r.role == EditorRegion::Role::Exclude ? view.exclude

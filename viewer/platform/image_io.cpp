@@ -15,6 +15,9 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "format/error.h"
+#include "format/output_path.h"
+
 namespace vxl {
 
 namespace fs = std::filesystem;
@@ -25,9 +28,14 @@ namespace {
   throw std::runtime_error(what + " '" + path + "'" + (detail.empty() ? "" : ": " + detail));
 }
 
+// The output cannot be written (a missing folder, no permission, a full disk): exit 5, not a bug.
+[[noreturn]] void output_fail(const std::string& path, const std::string& what, const std::string& detail = {}) {
+  throw Error(ErrorKind::Output, path, std::nullopt, what + (detail.empty() ? "" : ": " + detail));
+}
+
 // Reserves a unique temporary name next to `target` (O_EXCL, mode 0666 & ~umask, like the final
-// file would get). Returns the path; the file exists and is empty.
-fs::path reserve_temp_file(const fs::path& target) {
+// file would get). Returns the path; the file exists and is empty. Errors name `shown`, the path as given.
+fs::path reserve_temp_file(const fs::path& target, const std::string& shown) {
   static std::atomic<unsigned> counter{0};
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::random_device rd;
@@ -40,19 +48,18 @@ fs::path reserve_temp_file(const fs::path& target) {
       ::close(fd);
       return tmp;
     }
-    if (errno != EEXIST)
-      io_fail("write_png: cannot create a temporary file for", target.string(), std::strerror(errno));
+    if (errno != EEXIST) output_fail(shown, "cannot create a temporary file in " + dir.string(), std::strerror(errno));
   }
-  io_fail("write_png: cannot find a free temporary name for", target.string());
+  output_fail(shown, "cannot find a free temporary name in " + dir.string());
 }
 
 void fsync_file(const fs::path& p, const std::string& target) {
   const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) io_fail("write_png: cannot reopen the temporary file for", target, std::strerror(errno));
+  if (fd < 0) output_fail(target, "cannot reopen the temporary file", std::strerror(errno));
   const int rc = ::fsync(fd);
   const int err = errno;
   ::close(fd);
-  if (rc != 0) io_fail("write_png: fsync failed for", target, std::strerror(err));
+  if (rc != 0) output_fail(target, "fsync failed", std::strerror(err));
 }
 
 OIIO::ImageBuf wrap(const Image& img, const char* which) {
@@ -77,28 +84,26 @@ void write_png(const std::string& path, int w, int h, const std::vector<std::uin
                 std::to_string(h) + " RGBA8 needs " + std::to_string(static_cast<std::size_t>(w) * h * 4) + ", for",
             path);
 
-  const fs::path target(path);
+  const fs::path target(output_target(path));
   std::error_code ec;
-  if (fs::is_directory(target, ec)) io_fail("write_png: path is a directory:", path);
-
-  const fs::path tmp = reserve_temp_file(target);
+  const fs::path tmp = reserve_temp_file(target, path);
   try {
     // The format is named explicitly: the temporary name's extension is not ".png".
     auto out = OIIO::ImageOutput::create("png");
     if (!out) io_fail("write_png: OpenImageIO has no PNG writer for", path, OIIO::geterror());
     OIIO::ImageSpec spec(w, h, 4, OIIO::TypeDesc::UINT8);
     spec.attribute("oiio:UnassociatedAlpha", 1);  // bytes are straight alpha: write them verbatim
-    if (!out->open(tmp.string(), spec)) io_fail("write_png: cannot open", path, out->geterror());
+    if (!out->open(tmp.string(), spec)) output_fail(path, "cannot open the PNG for writing", out->geterror());
     if (!out->write_image(OIIO::TypeDesc::UINT8, rgba.data())) {
       const std::string err = out->geterror();
       out->close();
-      io_fail("write_png: cannot write", path, err);
+      output_fail(path, "cannot write the PNG", err);
     }
-    if (!out->close()) io_fail("write_png: cannot finish", path, out->geterror());
+    if (!out->close()) output_fail(path, "cannot finish the PNG", out->geterror());
     out.reset();
     fsync_file(tmp, path);
     fs::rename(tmp, target, ec);
-    if (ec) io_fail("write_png: cannot rename the temporary file to", path, ec.message());
+    if (ec) output_fail(path, "cannot rename the temporary file into place", ec.message());
   } catch (...) {
     std::error_code ignore;
     fs::remove(tmp, ignore);

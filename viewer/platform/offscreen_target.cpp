@@ -9,6 +9,8 @@
 #include <string>
 #include <utility>
 
+#include "format/error.h"
+
 namespace vxl {
 
 namespace {
@@ -38,11 +40,11 @@ struct FramebufferBindingGuard {
   FramebufferBindingGuard& operator=(const FramebufferBindingGuard&) = delete;
 };
 
-void check_complete(GLenum target, const char* which) {
+// Why the bound framebuffer cannot be drawn to, or "" when it can.
+std::string incomplete(GLenum target, const char* which) {
   const GLenum status = glCheckFramebufferStatus(target);
-  if (status != GL_FRAMEBUFFER_COMPLETE)
-    throw std::runtime_error(std::string("OffscreenTarget: ") + which + " framebuffer incomplete (status " +
-                             hex(status) + ")");
+  if (status == GL_FRAMEBUFFER_COMPLETE) return "";
+  return std::string(which) + " framebuffer incomplete, status " + hex(status);
 }
 
 // Clears stale error flags so that a later glGetError() reports our own calls (bounded: a lost
@@ -98,64 +100,86 @@ void OffscreenTarget::allocate() {
   if (width_ <= 0 || height_ <= 0)
     throw std::invalid_argument("OffscreenTarget: size must be positive, got " + std::to_string(width_) + "x" +
                                 std::to_string(height_));
-  GLint max_rb = 0, max_tex = 0;
+  const std::string size = "image size " + std::to_string(width_) + "x" + std::to_string(height_);
+  GLint max_rb = 0, max_tex = 0, max_viewport[2] = {0, 0};
   glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
-  const int limit = std::min(max_rb, max_tex);
+  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
+  const int limit = std::min({max_rb, max_tex, max_viewport[0], max_viewport[1]});
   if (width_ > limit || height_ > limit)
-    throw std::runtime_error("OffscreenTarget: " + std::to_string(width_) + "x" + std::to_string(height_) +
-                             " exceeds the GL limit of " + std::to_string(limit));
+    throw Error(ErrorKind::Unsupported, size, std::nullopt,
+                "beyond the GL driver's limit of " + std::to_string(limit) +
+                    " pixels a side (GL_MAX_TEXTURE_SIZE, GL_MAX_RENDERBUFFER_SIZE, GL_MAX_VIEWPORT_DIMS)");
+  const std::string why = try_allocate();
+  if (why.empty()) return;
+  // Drivers also cap a buffer's bytes (llvmpipe refuses the 2 GiB float colour buffer of 16384x8192),
+  // which no query tells: find the largest size of this shape that allocates, to say what can be drawn.
+  const int width = width_, height = height_;
+  std::string largest = "none";
+  for (double scale = 0.9; scale * std::max(width, height) >= 1; scale *= 0.9) {
+    width_ = std::max(1, static_cast<int>(width * scale));
+    height_ = std::max(1, static_cast<int>(height * scale));
+    if (try_allocate().empty()) {
+      largest = std::to_string(width_) + "x" + std::to_string(height_);
+      release();
+      break;
+    }
+  }
+  width_ = width, height_ = height;
+  throw Error(ErrorKind::Unsupported, size, std::nullopt,
+              "the GL driver cannot allocate a framebuffer this large (" + why +
+                  "); the largest of this shape it allocates is " + largest);
+}
 
+std::string OffscreenTarget::try_allocate() {
   drain_gl_errors();
   FramebufferBindingGuard guard;
-  try {
-    glGenTextures(1, &color_tex_);
-    glBindTexture(GL_TEXTURE_2D, color_tex_);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width_, height_, 0, GL_RGBA, GL_FLOAT, nullptr);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+  std::string why;
+  glGenTextures(1, &color_tex_);
+  glBindTexture(GL_TEXTURE_2D, color_tex_);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width_, height_, 0, GL_RGBA, GL_FLOAT, nullptr);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
 
-    glGenRenderbuffers(1, &depth_rb_);
-    glBindRenderbuffer(GL_RENDERBUFFER, depth_rb_);
-    if (samples_ > 0)
-      glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_DEPTH24_STENCIL8, width_, height_);
-    else
-      glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, width_, height_);
+  glGenRenderbuffers(1, &depth_rb_);
+  glBindRenderbuffer(GL_RENDERBUFFER, depth_rb_);
+  if (samples_ > 0)
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_DEPTH24_STENCIL8, width_, height_);
+  else
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, width_, height_);
 
-    if (samples_ > 0) {
-      glGenRenderbuffers(1, &color_rb_);
-      glBindRenderbuffer(GL_RENDERBUFFER, color_rb_);
-      glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_RGBA32F, width_, height_);
+  if (samples_ > 0) {
+    glGenRenderbuffers(1, &color_rb_);
+    glBindRenderbuffer(GL_RENDERBUFFER, color_rb_);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_RGBA32F, width_, height_);
 
-      glGenFramebuffers(1, &fbo_);
-      glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_rb_);
-      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb_);
-      check_complete(GL_FRAMEBUFFER, "multisampled");
+    glGenFramebuffers(1, &fbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_rb_);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb_);
+    why = incomplete(GL_FRAMEBUFFER, "multisampled");
 
-      glGenFramebuffers(1, &resolve_fbo_);
-      glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo_);
-      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color_tex_, 0);
-      check_complete(GL_FRAMEBUFFER, "resolve");
-    } else {
-      glGenFramebuffers(1, &fbo_);
-      glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color_tex_, 0);
-      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb_);
-      check_complete(GL_FRAMEBUFFER, "render");
-      resolve_fbo_ = fbo_;
-    }
-    const GLenum err = glGetError();
-    if (err != GL_NO_ERROR)
-      throw std::runtime_error("OffscreenTarget: GL error " + hex(err) + " allocating " + std::to_string(width_) + "x" +
-                               std::to_string(height_) + " (samples " + std::to_string(samples_) + ")");
-  } catch (...) {
-    release();
-    throw;
+    glGenFramebuffers(1, &resolve_fbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color_tex_, 0);
+    if (why.empty()) why = incomplete(GL_FRAMEBUFFER, "resolve");
+  } else {
+    glGenFramebuffers(1, &fbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color_tex_, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb_);
+    why = incomplete(GL_FRAMEBUFFER, "render");
+    resolve_fbo_ = fbo_;
   }
+  const GLenum err = glGetError();
+  if (why.empty() && err != GL_NO_ERROR)
+    why = "GL error " + hex(err) + " allocating " + std::to_string(width_) + "x" + std::to_string(height_) +
+          " (samples " + std::to_string(samples_) + ")";
+  if (!why.empty()) release();
+  return why;
 }
 
 void OffscreenTarget::release() noexcept {

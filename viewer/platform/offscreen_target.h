@@ -17,12 +17,16 @@
 // that context (or one sharing with it) current.
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace vxl {
 
 class OffscreenTarget {
  public:
+  // Throws vxl::Error (Unsupported) when the driver cannot hold a framebuffer of this size: beyond its
+  // per-side limits (the message gives them), or beyond what it allocates (the message gives the largest
+  // size of this shape it does).
   OffscreenTarget(int width, int height, int samples = 0);
   ~OffscreenTarget();
   OffscreenTarget(const OffscreenTarget&) = delete;
@@ -59,6 +63,7 @@ class OffscreenTarget {
   unsigned depth_rb_ = 0;
 
   void allocate();
+  std::string try_allocate();  // "" when every buffer was made, else why not (and nothing is held)
   void release() noexcept;
 };
 

@@ -136,7 +136,8 @@ std::optional<std::array<double, 2>> parse_view(const std::string& name) {
   double az = std::strtod(name.c_str(), &end);
   if (end != name.c_str() + comma) return std::nullopt;
   double el = std::strtod(name.c_str() + comma + 1, &end);
-  if (*end != '\0' || !std::isfinite(az) || !std::isfinite(el)) return std::nullopt;
+  if (*end != '\0' || !std::isfinite(az) || !std::isfinite(el) || std::abs(az) > ViewLimits::kMaxAzimuthDeg)
+    return std::nullopt;
   return std::array<double, 2>{az, std::clamp(el, -90.0, 90.0)};
 }
 

@@ -44,9 +44,19 @@ struct Camera {
   static constexpr double kFrameMargin = 0.04;
 };
 
+// The views drawn. Beyond these a double no longer gives a picture (an azimuth of 1e308 degrees has no
+// angle left, a target or distance of 1e308 mm puts every line on one pixel, a field of view or a slab of
+// 1e-300 shows nothing), so view files and options outside them are refused.
+struct ViewLimits {
+  static constexpr double kMaxMm = 1e7;   // |target| per axis, distance, ortho height, slab: 10 km
+  static constexpr double kMinMm = 1e-3;  // distance, ortho height, slab when on: 1 micrometre
+  static constexpr double kMaxAzimuthDeg = 1e6;
+  static constexpr double kMinFovDeg = 1, kMaxFovDeg = 179;
+};
+
 // Standard views (anterior up in axial views, patient right on screen right seen from above) like mrview's:
-// "axial"/"superior", "inferior", "sagittal"/"left", "right", "coronal"/"anterior", "posterior", or "AZ,EL" in degrees.
-// Returns {azimuth, elevation}.
+// "axial"/"superior", "inferior", "sagittal"/"left", "right", "coronal"/"anterior", "posterior", or "AZ,EL" in degrees
+// (elevation clamped to [-90, 90]; an azimuth beyond ViewLimits is no view). Returns {azimuth, elevation}.
 std::optional<std::array<double, 2>> parse_view(const std::string& name);
 
 }  // namespace vxl

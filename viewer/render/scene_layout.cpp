@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -18,6 +19,14 @@ bool same_grid(const MetaSection& a, const MetaSection& b) {
     if (std::abs(cells - std::round(cells)) > 1e-6) return false;
   }
   return true;
+}
+
+// A size in bytes below 1 MiB (budgets of a few bytes or KiB are allowed), else in MiB: never "0 MiB".
+std::string memory_size(std::uint64_t bytes) {
+  if (bytes < (std::uint64_t(1) << 20)) return std::to_string(bytes) + " bytes";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / double(1 << 20));
+  return buf;
 }
 
 }  // namespace
@@ -67,14 +76,14 @@ std::uint32_t SceneLayout::finest_level_within(std::span<const VxlFile* const> f
     try {
       const SceneLayout layout(files, max_texels, level);
       if (layout.upload_bytes() <= budget) return level;
-      why = "needs " + std::to_string(layout.upload_bytes() / (1 << 20)) + " MiB of GPU memory";
+      why = "needs " + memory_size(layout.upload_bytes()) + " of GPU memory";
     } catch (const Error& e) {
       why = e.what();
     }
   }
   throw Error(ErrorKind::Unsupported, files.empty() ? "" : files[0]->path(), std::nullopt,
-              "the scene does not fit the GPU memory budget of " + std::to_string(budget / (1 << 20)) +
-                  " MiB even at its coarsest level of detail (" + std::to_string(coarsest) + "): it " + why +
+              "the scene does not fit the GPU memory budget of " + memory_size(budget) +
+                  " even at its coarsest level of detail (" + std::to_string(coarsest) + "): it " + why +
                   (coarsest == 0 ? "; convert with levels of detail (voxlines convert --levels)" : ""));
 }
 
