@@ -15,6 +15,7 @@
 #include "format/error.h"
 #include "format/json_limits.h"
 #include "format/parallel.h"
+#include "format/vxl_file.h"
 #include "format/vxl_value_sets.h"
 #include "format/vxl_writer.h"
 #include "format/vxlz_draco.h"
@@ -377,6 +378,13 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
           i == 0 ? voxels[i].tight_max[c] : std::max<double>(meta.bounds_max[c], voxels[i].tight_max[c]);
     }
   }
+  // A damaged package's grid, or positions it decodes outside their voxels, would make a file open() refuses.
+  check_grid_geometry(meta, f.path(), std::nullopt);
+  for (std::size_t i = 0; i < voxels.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      if (!tight_bounds_in_place(meta, voxels[i], c))
+        fail_input(f.path(), std::nullopt,
+                   "the positions decode outside their voxels: " + misplaced_voxel(meta, voxels[i], i, c));
   summary.orders_seconds = seconds_since(t0);
 
   t0 = Clock::now();

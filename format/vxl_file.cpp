@@ -189,6 +189,7 @@ void VxlFile::validate_meta_and_sizes() {
     if (!std::isfinite(m.grid_origin[c]) || !std::isfinite(m.bounds_min[c]) || !std::isfinite(m.bounds_max[c]))
       fail_input(p, meta_at + 64, "non-finite grid origin or bounds");
   }
+  check_grid_geometry(m, p, meta_at);
   // Every source point and every synthetic one is a vertex (spec §6.2), so these bound what a reader
   // reserves for the points: an unchecked point_count would ask for up to 2^64 floats.
   if (m.point_count > m.vertex_count || m.synthetic_point_count > m.vertex_count - m.point_count)
@@ -265,6 +266,40 @@ void VxlFile::validate_meta_and_sizes() {
 
 // §7 step 4: every voxel's coordinates, flags, vertex and order ranges (and tight bounds, when packed
 // positions are decoded from them). O(voxels).
+bool tight_bounds_in_place(const MetaSection& m, const VoxelEntry& v, int c) {
+  const double cell_lo = m.grid_origin[c] + double(v.coord[c]) * m.voxel_size;
+  const double lo = std::max(cell_lo - 1.5 * m.voxel_size, m.bounds_min[c] - m.voxel_size);
+  const double hi = std::min(cell_lo + 2.5 * m.voxel_size, m.bounds_max[c] + m.voxel_size);
+  return v.tight_min[c] >= lo && v.tight_max[c] <= hi;
+}
+
+std::string misplaced_voxel(const MetaSection& m, const VoxelEntry& v, std::size_t index, int c) {
+  const double cell_lo = m.grid_origin[c] + double(v.coord[c]) * m.voxel_size;
+  return "voxel " + std::to_string(index) + " tight bounds on " + std::string(1, "xyz"[c]) +
+         " lie outside its cell and the file's bounds (" + std::to_string(v.tight_min[c]) + " .. " +
+         std::to_string(v.tight_max[c]) + " mm, the cell's " + std::to_string(cell_lo) + " .. " +
+         std::to_string(cell_lo + m.voxel_size) + " mm)";
+}
+
+void check_grid_geometry(const MetaSection& m, const std::string& p, std::optional<std::uint64_t> meta_at) {
+  const double s = m.voxel_size;
+  auto at = [&](std::uint64_t field) {
+    return meta_at ? std::optional<std::uint64_t>(*meta_at + field) : std::nullopt;
+  };
+  for (int c = 0; c < 3; ++c) {
+    const std::string axis = std::string(1, "xyz"[c]);
+    if (!(m.bounds_min[c] <= m.bounds_max[c])) fail_input(p, at(104 + 8 * c), "bounds_min above bounds_max on " + axis);
+    if (!(std::abs(m.grid_origin[c] - m.bounds_min[c]) <= s))
+      fail_input(p, at(64 + 8 * c), "grid origin is not at bounds_min on " + axis);
+    const double cells = std::floor((m.bounds_max[c] - m.bounds_min[c]) / s) + 1;
+    if (!(std::abs(double(m.grid_dims[c]) - cells) <= 1))
+      fail_input(p, at(88 + 4 * c),
+                 "grid_dims on " + axis + " is " + std::to_string(m.grid_dims[c]) +
+                     "; the bounds and voxel size make " +
+                     std::to_string(static_cast<std::uint64_t>(std::min(cells, 1e19))) + " cells");
+  }
+}
+
 void VxlFile::validate_voxel_table() {
   const std::string& p = file_.path();
   const MetaSection& m = meta_;
@@ -293,6 +328,8 @@ void VxlFile::validate_voxel_table() {
             !std::isfinite(v.tight_max[c] - v.tight_min[c]))
           fail_input(p, at + 16 + 4 * c,
                      "voxel " + std::to_string(i) + " tight bounds are not finite and ordered (packed positions)");
+    for (int c = 0; c < 3; ++c)
+      if (!tight_bounds_in_place(m, v, c)) fail_input(p, at + 16 + 4 * c, misplaced_voxel(m, v, i, c));
     if (v.vertex_first != next_vertex) fail_input(p, at + 40, "voxel vertex blocks are not contiguous");
     next_vertex += v.vertex_count;
     if (next_vertex > m.vertex_count) fail_input(p, at + 48, "voxel vertex block runs past vertex_count");

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -35,6 +36,18 @@ struct OrderView {
     return v;
   }
 };
+
+// Whether voxel `v`'s tight bounds on axis `c` lie where every writer puts them: within the file's bounds,
+// and at most a step (shorter than a voxel edge: longer ones are split at the faces) outside the voxel's
+// cell, half an edge more of slack for rounding. A file that moves them is drawn where its lines are not.
+bool tight_bounds_in_place(const MetaSection& meta, const VoxelEntry& v, int c);
+// The grid as every writer lays it out (spec §6.1): its origin at bounds_min, grid_dims cells of voxel_size
+// covering the bounds, one voxel edge of slack for rounding. A file whose bounds, origin, size or
+// dimensions were changed would be drawn far from its lines, or not at all. Throws vxl::Error (Input)
+// naming `path` and the field's offset from `meta_at`.
+void check_grid_geometry(const MetaSection& meta, const std::string& path, std::optional<std::uint64_t> meta_at);
+// What is wrong, for an error message: voxel `index`'s bounds on `c` and its cell's.
+std::string misplaced_voxel(const MetaSection& meta, const VoxelEntry& v, std::size_t index, int c);
 
 class VxlFile {
  public:

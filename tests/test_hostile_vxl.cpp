@@ -2,9 +2,11 @@
 // UTF-8, section ids that are not ASCII, counts that would size a reservation, provenance of the wrong
 // JSON types. Each file is made by the generator in hostile_vxl.h; the outcome must be a clear error
 // (exit 3 for a malformed input), never an internal error (exit 70) and never a partial output.
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "converter/export_trx.h"
 #include "format/error.h"
@@ -140,6 +142,59 @@ TEST(HostileVxl, PointCountBeyondTheVerticesIsRefusedBeforeAnyReservation) {
   std::memcpy(b.bytes.data() + meta, &m, sizeof m);
   b.write(dir.file("bad.vxl"));
   EXPECT_NE(open_error(dir.file("bad.vxl")).find("exceed vertex_count"), std::string::npos);
+}
+
+// Geometry a resealed file moves (a voxel's tight bounds 1e6 mm away or at 1e38, bounds or origin at
+// 1e308, a voxel size or grid that no longer covers the bounds) was drawn as a blank picture (exit 0) and
+// passed verify: open() now refuses it (exit 3), so verify and the viewer do too.
+TEST(HostileVxl, GeometryMovedAwayFromTheLinesIsRefusedOnOpen) {
+  ScratchDir dir;
+  const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
+  const std::uint64_t meta = valid.offset_of("META"), voxt = valid.offset_of("VOXT");
+  struct Case {
+    const char* name;
+    std::function<void(VxlBytes&)> damage;
+    const char* message;
+  };
+  auto put_f32 = [](VxlBytes& b, std::uint64_t at, float v) { std::memcpy(b.bytes.data() + at, &v, 4); };
+  auto put_f64 = [](VxlBytes& b, std::uint64_t at, double v) { std::memcpy(b.bytes.data() + at, &v, 8); };
+  auto add_f32 = [](VxlBytes& b, std::uint64_t at, float d) {
+    float v;
+    std::memcpy(&v, b.bytes.data() + at, 4);
+    v += d;
+    std::memcpy(b.bytes.data() + at, &v, 4);
+  };
+  const std::vector<Case> cases = {
+      {"tight bounds moved 1e6 mm",
+       [&](VxlBytes& b) {
+         add_f32(b, voxt + 16, 1e6f);
+         add_f32(b, voxt + 28, 1e6f);
+       },
+       "voxel 0 tight bounds on x lie outside its cell"},
+      {"tight max at 1e38", [&](VxlBytes& b) { put_f32(b, voxt + 64 + 36, 1e38f); },
+       "voxel 1 tight bounds on z lie outside its cell"},
+      {"bounds max at 1e308", [&](VxlBytes& b) { put_f64(b, meta + 128, 1e308); }, "grid_dims on x is"},
+      {"origin at 1e308", [&](VxlBytes& b) { put_f64(b, meta + 64 + 8, 1e308); }, "grid origin is not at bounds_min"},
+      {"voxel size 1e30", [&](VxlBytes& b) { put_f64(b, meta + 56, 1e30); }, "the bounds and voxel size make"},
+      {"voxel size 1e-30", [&](VxlBytes& b) { put_f64(b, meta + 56, 1e-30); }, "the bounds and voxel size make"},
+      {"grid dims 2^30",
+       [&](VxlBytes& b) {
+         const std::int32_t d = 1 << 30;
+         std::memcpy(b.bytes.data() + meta + 88, &d, 4);
+       },
+       "grid_dims on x is 1073741824"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    VxlBytes b = valid;
+    c.damage(b);
+    b.reseal();
+    b.write(dir.file("bad.vxl"));
+    EXPECT_NE(open_error(dir.file("bad.vxl")).find(c.message), std::string::npos) << open_error(dir.file("bad.vxl"));
+    EXPECT_EQ(test::run_cli("info " + q(dir.file("bad.vxl"))).exit_code, 3);
+    const auto v = test::run_cli("verify " + q(dir.file("bad.vxl")));
+    EXPECT_EQ(v.exit_code, 1) << v.output;
+  }
 }
 
 // PROV is any JSON to open(): fields of the wrong type made `info` exit 70 (type_error 302/306) and
