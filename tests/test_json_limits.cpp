@@ -85,14 +85,16 @@ TEST(JsonLimits, DeepProvenanceIsRefusedByEveryCommand) {
   vxl::test::vxl_with_deep_provenance(p, 100000).write(p);
   for (const std::string& args : {"info " + q(p), "info --json " + q(p), "export " + q(p) + " " + q(dir.file("o.trx")),
                                   "export " + q(p) + " " + q(dir.file("o.tck")) + " --tsf " + q(dir.file("o.tsf")),
-                                  "pack " + q(p) + " " + q(dir.file("o.vxlz"))}) {
+                                  "pack " + q(p) + " " + q(dir.file("o.vxlz")),
+                                  "select " + q(p) + " " + q(dir.file("o.vxl")) + " --include 0,0,0,1000",
+                                  "select " + q(p) + " --count --min-length 1"}) {
     SCOPED_TRACE(args);
     const auto r = vxl::test::run_cli(args);
     EXPECT_EQ(r.exit_code, 3) << r.output;
     EXPECT_TRUE(contains(r.output, "deep.vxl: at byte ")) << r.output;
     EXPECT_TRUE(contains(r.output, "PROV: " + kTooDeep)) << r.output;
   }
-  for (const char* out : {"o.trx", "o.tck", "o.tsf", "o.vxlz"})
+  for (const char* out : {"o.trx", "o.tck", "o.tsf", "o.vxlz", "o.vxl"})
     EXPECT_FALSE(std::filesystem::exists(dir.file(out))) << out;
   const auto v = vxl::test::run_cli("verify " + q(p));
   EXPECT_EQ(v.exit_code, 1) << v.output;

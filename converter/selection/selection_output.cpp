@@ -9,6 +9,7 @@
 #include "converter/export_values.h"
 #include "converter/export_vtk.h"
 #include "format/error.h"
+#include "format/json_limits.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -24,7 +25,7 @@ std::string lower_case(std::string s) {
 SourceInfo source_of(const VxlFile& file) {
   SourceInfo info;
   info.path = file.path();
-  const nlohmann::json prov = nlohmann::json::parse(file.provenance_json(), nullptr, false);
+  const nlohmann::json prov = parse_json(file.provenance_json(), file.path(), file.provenance_offset(), "PROV");
   if (!prov.is_object() || !prov.contains("source") || !prov["source"].is_object()) return info;
   const nlohmann::json& src = prov["source"];
   auto text = [&](const char* key) {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "format/error.h"
+#include "format/json_limits.h"
 #include "format/vxl_positions.h"
 #include "format/vxl_streamlines.h"
 
@@ -66,7 +67,7 @@ double polyline_length(std::span<const float> xyz) {
 
 // A number from the source header kept in PROV (a TCK's "key: value" lines are arrays of strings there).
 std::optional<double> source_header_number(const VxlFile& file, const char* key) {
-  const nlohmann::json prov = nlohmann::json::parse(file.provenance_json(), nullptr, false);
+  const nlohmann::json prov = parse_json(file.provenance_json(), file.path(), file.provenance_offset(), "PROV");
   if (!prov.is_object() || !prov.contains("source") || !prov["source"].is_object()) return std::nullopt;
   const nlohmann::json header = prov["source"].value("header", nlohmann::json());
   if (!header.is_object() || !header.contains(key)) return std::nullopt;
