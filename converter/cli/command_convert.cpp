@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -139,7 +140,7 @@ void add_convert_command(CLI::App& app, int& exit_code) {
     // A .vxl under another name would pass for the other format (a TCK reader then fails on it).
     std::string lower = output;
     std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (!lower.ends_with(".vxl"))
+    if (!lower.ends_with(".vxl") && !std::filesystem::is_directory(output))  // a folder: the output rule's (exit 5)
       throw Error(ErrorKind::Usage, output, std::nullopt,
                   "convert writes a .vxl file: name the output OUT.vxl (to write TCK, TRX or VTK from a .vxl use "
                   "`voxlines export IN.vxl OUT.tck`, or `voxlines select` for some of its streamlines)");

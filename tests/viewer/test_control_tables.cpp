@@ -42,7 +42,9 @@ TEST(KeyBindings, KeysAndCharactersMapToTheirActions) {
   EXPECT_EQ(action_for_char('_'), KeyAction::OpacityDown);
   EXPECT_EQ(action_for_char(']'), KeyAction::SlabThicker);
   EXPECT_EQ(action_for_char('q'), KeyAction::Quit);
-  EXPECT_FALSE(action_for_char('x'));
+  EXPECT_EQ(action_for_char('x'), KeyAction::ToggleRegionRole);
+  EXPECT_EQ(action_for_char('g'), KeyAction::AddRegion);
+  EXPECT_FALSE(action_for_char('z'));
   EXPECT_FALSE(action_for_char('!'));
   EXPECT_FALSE(action_for_char(0x263A));
 }
