@@ -1,4 +1,4 @@
-// Conversion benchmark (issue: converter and format v1). For `voxlines synth` sets of the given sizes it
+// Conversion benchmark. For `voxlines synth` sets of the given sizes it
 // prints: convert wall time and peak RSS (the real `voxlines convert` in a child process, measured with
 // wait4), output size relative to the TCK, and open time (mmap + table validation, median of 21).
 //

@@ -1,4 +1,4 @@
-// Package benchmark (issue: sharing, .vxlz). For each .vxl and the TCK it was converted from, and each
+// Package benchmark. For each .vxl and the TCK it was converted from, and each
 // number of quantisation bits, it prints: package size (bytes per source point, ratio to the TCK), the
 // share of the Draco-coded positions next to what Draco's own quantisation and prediction would take
 // for the same points (the baseline the spec's predictor is measured against), the largest and RMS

@@ -1,4 +1,4 @@
-// Viewer benchmark (issue: viewer and renderer). For each scene (.vxl, with its source TCK):
+// Viewer benchmark. For each scene (.vxl, with its source TCK):
 //   * time from process start to the first frame read back: `voxview FILE --render` as a child process,
 //     for the .vxl and for the source TCK (converted in memory);
 //   * per-frame CPU work (cull + voxel sort + order pick + command building), median over a 72-view

@@ -1,4 +1,4 @@
-// Speed/accuracy trade study (issue 4). Input: one dataset converted at several voxel sizes and order sets,
+// Speed/accuracy trade study. Input: one dataset converted at several voxel sizes and order sets,
 // listed in a manifest (written by scripts/trade-study). Two parts:
 //
 //   sweep    every mode — unsorted, additive, wboit (the baselines), basic, axis, segsort (each voxel's

@@ -1,4 +1,4 @@
-// Numerical stability and limits at the extremes (issue: robustness). Each test states the documented
+// Numerical stability and limits at the extremes. Each test states the documented
 // outcome (README "Precision policy and limits", spec §8–§9).
 #include <fcntl.h>
 #include <signal.h>

@@ -1,6 +1,6 @@
 // Hostile source files (tests/hostile_inputs.h writes them): each must be refused with a vxl::Error of
 // the right kind, or read with a warning where data would otherwise be lost silently. Every test here
-// failed before the reader was fixed (issue 14's rows are named in each test's comment).
+// failed before the reader was fixed.
 #include <algorithm>
 #include <filesystem>
 #include <string>

@@ -1,4 +1,4 @@
-// Hostile .vxl files against `open`, `info` and `export` (issue 14, rows 2-4): names that are not
+// Hostile .vxl files against `open`, `info` and `export`: names that are not
 // UTF-8, section ids that are not ASCII, counts that would size a reservation, provenance of the wrong
 // JSON types. Each file is made by the generator in hostile_vxl.h; the outcome must be a clear error
 // (exit 3 for a malformed input), never an internal error (exit 70) and never a partial output.

@@ -1,4 +1,4 @@
-// A voxel far larger than the scene (issue 14, row 10: convert --voxel-size 1e8 ... 1e300) is drawn, not
+// A voxel far larger than the scene (convert --voxel-size 1e8 ... 1e300) is drawn, not
 // culled away by the near plane.
 #include <filesystem>
 #include <string>

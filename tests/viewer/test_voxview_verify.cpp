@@ -1,4 +1,4 @@
-// `voxview --verify` (issue 14, row 11): refuses what open() lets through by design (a damaged checksum,
+// `voxview --verify`: refuses what open() lets through by design (a damaged checksum,
 // spec §7) before anything is drawn.
 #include <filesystem>
 #include <string>
