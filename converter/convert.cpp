@@ -12,10 +12,6 @@
 #include "format/vxl_value_sets.h"
 #include "format/vxl_writer.h"
 
-#ifndef VOXLINES_VERSION
-#define VOXLINES_VERSION "0.0.0"
-#endif
-
 namespace vxl {
 
 std::string provenance_json(const SourceInfo& src, const ConvertSettings& settings, unsigned threads,

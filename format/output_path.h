@@ -1,5 +1,6 @@
 // The one rule for every output path (a .vxl, .vxlz, .tck, .tsf, .trx, .vtk, a PNG, a view or stats
-// file). Outputs are written to a temporary file and renamed into place, and a rename replaces whatever
+// file). Outputs are written to a temporary file (unnamed, O_TMPFILE, where the file system allows) that is
+// renamed into place when complete, and a rename replaces whatever
 // has the name: a device node or a FIFO would be destroyed (as root, `--render /dev/null` made /dev/null a
 // regular file), a symbolic link would be cut. So, before anything is written:
 //   - no file at the path: it is created, in a folder that must exist;

@@ -1,11 +1,13 @@
-// The project's one way to run work on several threads. Every parallel loop of the converter, the
-// package codec, the writer and the viewer's upload goes through parallel_for, so that they share one
+// The project's one way to run a parallel loop. Every parallel loop of the converter, the package codec,
+// the writer and the viewer's upload goes through parallel_for, so that they share one
 // rule for the thread count (0 = all hardware threads) and one exception policy: the first exception
 // thrown by any item stops the hand-out of further items and is rethrown on the caller's thread once
 // every thread has joined (items already running finish; later exceptions are dropped).
 //
 // Threads are started per call, not kept in a pool: every call here runs for milliseconds to seconds,
-// so the start-up (tens of microseconds) does not show, and nothing outlives the call.
+// so the start-up (tens of microseconds) does not show, and nothing outlives the call. (Work that overlaps
+// with a loop rather than splitting one — the streaming converter's next batch, the direct-write queue —
+// runs on its own thread, std::async or one std::thread, owned by the object that needs it.)
 // Lives in format/, the library every other one links, so that all of them can use it.
 #pragma once
 

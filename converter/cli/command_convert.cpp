@@ -13,6 +13,7 @@
 #include "converter/cli/progress_bar.h"
 #include "converter/convert.h"
 #include "converter/memory_size.h"
+#include "converter/readers/source_formats.h"
 #include "converter/segment_orders.h"
 #include "format/error.h"
 
@@ -48,14 +49,14 @@ void add_convert_command(CLI::App& app, int& exit_code) {
       "  voxlines convert IN OUT.vxl\n"
       "  voxlines convert IN... --output-dir DIR [--jobs N]    (a cohort: DIR/NAME.vxl for each IN)");
   cmd->add_option("files", opt->files,
-                  "IN OUT.vxl: the source tractogram (.tck, .trk, .trk.gz, .trx zip or directory, .vtk legacy "
-                  "POLYDATA, .vtp XML PolyData) and the output "
-                  "(written atomically); with --output-dir: one or more sources")
+                  "IN OUT.vxl: the source tractogram (" + source_descriptions_text() +
+                      ") and the output (written atomically); with --output-dir: one or more sources")
       ->required();
   CLI::Option* output_dir =
       cmd->add_option("--output-dir", opt->output_dir,
-                      "convert every input FILE into DIR/NAME.vxl (NAME: FILE's name without .tck/.trk/.trk.gz/.trx; "
-                      "two inputs with the same NAME are refused; DIR is created when missing). A file that fails is "
+                      "convert every input FILE into DIR/NAME.vxl (NAME: FILE's name without " +
+                          source_suffixes_text("/") +
+                          "; two inputs with the same NAME are refused; DIR is created when missing). A file that fails is "
                       "reported and the others go on; a last line says how many converted and failed")
           ->type_name("DIR");
   CLI::Option* jobs =

@@ -34,7 +34,7 @@ inline CLI::Option* add_positions_option(CLI::App* cmd, PositionEncoding& positi
                    "bound) or float32 (12 bytes, the source's coordinates bit for bit)")
       ->type_name("packed|float32")
       ->default_str("packed")
-      ->transform(CLI::CheckedTransformer(names));
+      ->transform(CLI::CheckedTransformer(names).description(""));
 }
 
 // --levels N, shared by convert and unpack (spec §5.12).

@@ -21,8 +21,8 @@ struct CohortOptions {
 // Exit code when files failed with more than one kind of error (one kind: that kind's code).
 inline constexpr int kCohortMixedFailures = 6;
 
-// The output name of an input: its file name without .tck, .trk, .trk.gz or .trx (any case; another
-// extension: the last one), plus ".vxl". Throws vxl::Error (Usage) when nothing is left.
+// The output name of an input: its file name without its source suffix (readers/source_formats.h; any
+// case; another extension: the last one), plus ".vxl". Throws vxl::Error (Usage) when nothing is left.
 std::string cohort_output_name(const std::string& input);
 
 // Worker threads for each file when `jobs` files are converted at once out of `threads` in all.

@@ -37,9 +37,18 @@ SourceMatch source_format_of(const std::string& path) {
   return {};
 }
 
-std::string supported_sources_text() {
-  std::string text = "supported: ";
+std::string source_descriptions_text() {
+  std::string text;
   for (const SourceFormat& f : kFormats) text += std::string(&f == &kFormats[0] ? "" : ", ") + f.description;
+  return text;
+}
+
+std::string supported_sources_text() { return "supported: " + source_descriptions_text(); }
+
+std::string source_suffixes_text(const std::string& separator) {
+  std::string text;
+  for (const SourceFormat& f : kFormats)
+    for (const char* suffix : f.suffixes) text += (text.empty() ? "" : separator) + std::string(suffix);
   return text;
 }
 

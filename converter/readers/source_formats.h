@@ -29,7 +29,12 @@ struct SourceMatch {
 };
 SourceMatch source_format_of(const std::string& path);
 
-// "supported: .tck, .trk, .trk.gz, ..." for messages.
+// ".tck, .trk, .trk.gz, .trx zip or directory, ..." for help texts, and the same after "supported: " for
+// messages.
+std::string source_descriptions_text();
 std::string supported_sources_text();
+
+// Every suffix that chooses a reader, joined by `separator`: ".tck/.trk.gz/.trk/.trx/.vtk/.vtp" for help texts.
+std::string source_suffixes_text(const std::string& separator);
 
 }  // namespace vxl

@@ -1,6 +1,9 @@
 // voxview's command line: a mistyped option gets the nearest one, an unknown view the list of views, and
-// messages about options carry no file name.
+// messages about options carry no file name; a picture is written in the format its extension names.
+#include <filesystem>
+
 #include "tests/test_support.h"
+#include "viewer/platform/image_io.h"
 
 namespace vxl {
 namespace {
@@ -16,6 +19,41 @@ TEST(VoxviewCommandLine, TyposAndUnknownViewsSayWhatIsKnown) {
   EXPECT_EQ(view.exit_code, 2);
   EXPECT_NE(view.output.find("unknown view 'axil' (expected axial,"), std::string::npos) << view.output;
   EXPECT_EQ(view.output.find("<input>"), std::string::npos) << view.output;
+}
+
+TEST(VoxviewCommandLine, APictureIsWrittenInTheFormatItsExtensionNames) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  struct Case {
+    const char* name;
+    std::string magic;  // the format's first bytes
+  };
+  const Case cases[] = {{"a.png", "\x89PNG"}, {"a.jpg", "\xFF\xD8\xFF"}, {"a.TIFF", "II*"}, {"a.exr", "v/1\x01"}};
+  Image png;
+  for (const Case& c : cases) {
+    const test::CommandResult r = test::run_program(
+        VOXVIEW_CLI, test::q(dir.file("a.tck")) + " --size 64x48 --render " + test::q(dir.file(c.name)));
+    ASSERT_EQ(r.exit_code, 0) << c.name << ": " << r.output;
+    const std::vector<char> bytes = test::slurp(dir.file(c.name));
+    ASSERT_GE(bytes.size(), c.magic.size());
+    EXPECT_EQ(std::string(bytes.begin(), bytes.begin() + c.magic.size()), c.magic) << c.name;
+    // Every format holds the same picture (JPEG within its compression).
+    const Image read = read_image(dir.file(c.name));
+    EXPECT_EQ(read.width, 64);
+    EXPECT_EQ(read.height, 48);
+    if (png.width == 0) {
+      png = read;
+    } else {
+      const double tolerance = c.magic[0] == '\xFF' ? 0.03 : 0.003;
+      EXPECT_LE(compare_images(png, read).mean_error, tolerance) << c.name;
+    }
+  }
+  // An extension that names no format is a usage error before anything is drawn, and writes nothing.
+  const test::CommandResult bmp =
+      test::run_program(VOXVIEW_CLI, test::q(dir.file("a.tck")) + " --render " + test::q(dir.file("a.bmp")));
+  EXPECT_EQ(bmp.exit_code, 2) << bmp.output;
+  EXPECT_NE(bmp.output.find("names no picture format"), std::string::npos) << bmp.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.bmp")));
 }
 
 }  // namespace

@@ -125,7 +125,11 @@ void read_camera(const Reader& r, Camera& c) {
 void read_settings(const Reader& r, RenderSettings& s) {
   if (const std::string* mode = r.text("mode")) {
     auto m = parse_render_mode(*mode);
-    if (!m) r.fail("mode", "opaque, unsorted, additive, wboit, basic, axis or exact");
+    if (!m) {
+      std::string names;
+      for (const std::string& name : render_mode_names()) names += (names.empty() ? "" : ", ") + name;
+      r.fail("mode", "one of " + names);
+    }
     s.mode = *m;
   }
   r.number("opacity", s.opacity);

@@ -105,7 +105,7 @@ int run_headless(const ViewerOptions& o) {
     std::vector<std::uint8_t> rgba = target.read_rgba();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::string png = o.turntable ? turntable_frame_path(*o.render_png, i, frames) : *o.render_png;
-    write_png(png, o.width, o.height, rgba);
+    write_picture(png, o.width, o.height, rgba);
     const FrameStats& s = renderer->stats();
     std::printf("%s: %dx%d %s, %llu voxels and %llu segments drawn, %s after %.3f s (%s)\n", png.c_str(), o.width,
                 o.height, render_mode_name(o.settings.mode), (unsigned long long)s.voxels_drawn,

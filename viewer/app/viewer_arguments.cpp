@@ -10,6 +10,7 @@
 #include "viewer/app/camera_file.h"
 #include "viewer/render/scene_groups.h"
 #include "viewer/app/turntable.h"
+#include "viewer/platform/image_io.h"
 
 namespace vxl::app {
 
@@ -175,6 +176,7 @@ void apply_view_and_size(const ViewerArguments& a, const std::string& size, View
   if (std::sscanf(size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 1 || o.height < 1 || o.width > 16384 ||
       o.height > 16384)
     usage_error("--size must be WxH, each 1..16384");
+  o.size_given = a.was_given("--size") || size != a.size;
 }
 
 // Focus and context opacities as the groups "selected" and "context": the scene's opacity is the larger,
@@ -200,6 +202,10 @@ void apply_selection(const ViewerArguments& a, ViewerOptions& o) {
 // Every output path, before anything is read or drawn: a missing folder, a directory, a FIFO or a device
 // is refused now (exit 5) rather than after the rendering, and never replaced (format/output_path.h).
 void check_outputs(const ViewerOptions& o) {
+  for (const auto* path : {&o.render_png, &o.screenshot})
+    if (*path && picture_format_of(**path).empty())
+      usage_error(**path + ": the extension names no picture format voxview writes: use " +
+                  picture_formats_text());
   if (o.render_png) {
     const int frames = std::max(1, o.turntable);
     for (int i = 0; i < frames; ++i)

@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include "converter/readers/source_formats.h"
 #include "format/vxl_levels.h"
 #include "viewer/app/key_bindings.h"
 #include "viewer/render/render_settings.h"
@@ -39,7 +40,7 @@ std::string voxview_description(const std::string& version) {
   return "voxview " + version +
          " — transparent tractogram viewer (Voxlines method).\n"
          "voxview FILE... [--render OUT.png]: a window, or headless to PNG with --render.\n"
-         "Opens a .vxl instantly (memory-mapped); a .tck/.trk/.trx/.vtk/.vtp is converted in memory first.\n"
+         "Opens a .vxl instantly (memory-mapped); a " + source_suffixes_text("/") + " is converted in memory first.\n"
          "Opening a .vxl checks its structure (header, section table, section sizes, voxel table, names) in\n"
          "O(voxels) but not its checksums: damaged positions, orders or values are drawn as they are. --verify\n"
          "checks everything first, as 'voxlines verify' does.\n" +
@@ -53,7 +54,7 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                  "are shown together "
                  "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
       ->required();
-  cli.add_option("--render", a.options.render_png, "render headless (EGL, no display needed) to this PNG and exit");
+  cli.add_option("--render", a.options.render_png, "render headless (EGL, no display needed) to this picture and exit: PNG, or JPEG, TIFF or OpenEXR by the extension (.jpg, .tif, .exr)");
   cli.add_option("--turntable", a.options.turntable,
                  "with --render: N frames turning once around the vertical (superior) axis, written as OUT_000.png, "
                  "OUT_001.png, ... (frame i at azimuth + 360 i / N degrees; frame 0 looks from the --view direction; "
@@ -203,7 +204,7 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                "window, with --frames: after the frames, keep the camera still until the picture is refined (full "
                "detail, then exact unless --no-exact-when-still), then quit")
       ->needs("--frames");
-  cli.add_option("--screenshot", a.options.screenshot, "window: save the last frame to this PNG before quitting");
+  cli.add_option("--screenshot", a.options.screenshot, "window: save the last frame to this picture before quitting (.png, .jpg, .tif or .exr)");
 }
 
 void parse_voxview_command_line(CLI::App& cli, ViewerArguments& arguments, int argc, const char* const* argv) {

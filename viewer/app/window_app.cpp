@@ -25,6 +25,8 @@
 #include "viewer/app/camera_file.h"
 #include "viewer/app/frame_budget.h"
 #include "viewer/app/frame_log.h"
+#include "viewer/app/frame_pacing.h"
+#include "viewer/app/window_size.h"
 #include "viewer/app/headless_render.h"
 #include "viewer/app/key_bindings.h"
 #include "viewer/app/region_editor.h"
@@ -74,7 +76,15 @@ WindowPtr open_window(const ViewerOptions& o) {
   glfwWindowHint(GLFW_DEPTH_BITS, 24);  // the opaque mode depth-tests in the default framebuffer
   std::string title = "voxview -";
   for (const std::string& in : o.inputs) title += " " + std::filesystem::path(in).filename().string();
-  GLFWwindow* w = glfwCreateWindow(o.width, o.height, title.c_str(), nullptr, nullptr);
+  // The default size is for a large screen: on a smaller one (a 1280x800 laptop) it is scaled down to fit.
+  // A size given by --size or a saved view is kept.
+  std::array<int, 2> size{o.width, o.height};
+  if (!o.size_given) {
+    int x = 0, y = 0, area_w = 0, area_h = 0;
+    if (GLFWmonitor* monitor = glfwGetPrimaryMonitor()) glfwGetMonitorWorkarea(monitor, &x, &y, &area_w, &area_h);
+    size = fit_to_work_area(o.width, o.height, area_w, area_h);
+  }
+  GLFWwindow* w = glfwCreateWindow(size[0], size[1], title.c_str(), nullptr, nullptr);
   if (!w) throw std::runtime_error("cannot open an OpenGL 3.3 core window: " + g_glfw_error + "; " + kHeadlessHint);
   glfwMakeContextCurrent(w);
   glfwSwapInterval(1);
@@ -691,7 +701,8 @@ double ViewerWindow::refine(int width, int height, bool& completes) {
 }
 
 void ViewerWindow::save_screenshot(const std::string& path, int width, int height) {
-  write_png(path, read_back_buffer(width, height));
+  const Image picture = read_back_buffer(width, height);
+  write_picture(path, picture.width, picture.height, picture.rgba);
   stats_.status = "saved " + path;
   std::printf("voxview: screenshot %dx%d saved to %s\n", width, height, path.c_str());
   std::fflush(stdout);
@@ -723,15 +734,15 @@ void ViewerWindow::save_view(int width, int height) {
 
 int ViewerWindow::run() {
   const bool automated = options_.frames.has_value();
-  int settle = 2;  // frames still to draw after the last event: ImGui needs one to show hover and clicks
+  FramePacing pacing;
   for (long frame = 1;; ++frame) {
     const unsigned seen = events_;
-    if (automated || settle > 0) {
+    if (automated || !pacing.may_wait()) {
       glfwPollEvents();
     } else {
       glfwWaitEvents();  // nothing moves by itself: sleep until the user does something
     }
-    settle = events_ != seen ? 2 : std::max(0, settle - 1);
+    pacing.frame_started(events_ != seen);
     // A script's frames are done after --frames; with --until-refined it then waits, at rest, for the
     // refinement to finish.
     const bool frames_done = automated && frame >= *options_.frames;
@@ -780,6 +791,7 @@ int ViewerWindow::run() {
     const bool moving = drawn_ && !closing && !same_view(drawn_->camera, camera);
     const bool changed = !drawn_ || !same_picture(*drawn_, key);
     const bool scripted_last = closing && frames_done && !options_.until_refined;
+    bool drawn_now = false;  // the picture (and so what the panel should say) changed after the panel was built
     if (changed || scripted_last) {
       const std::uint32_t level = scripted_last     ? detail_.level
                                   : frames_.empty() ? first_level_
@@ -794,16 +806,19 @@ int ViewerWindow::run() {
       stats_.refinement = rest_.describe(0);
       drawn_ = key;
       frames_.push_back({level, moving, ms, seconds_since_start()});
-    } else if (!closing && rest_.stage() != RestStage::Done) {
+      drawn_now = true;
+    }
+    if (!changed && !scripted_last && !closing && rest_.stage() != RestStage::Done) {
       choose_rest_level(double(fb_w) / fb_h);
       if (rest_.stage() != RestStage::Done) {
         const FrameWork work = rest_.stage() == RestStage::Exact ? FrameWork::ExactPiece : FrameWork::FullDetailPiece;
         bool completes = false;
         const double ms = refine(fb_w, fb_h, completes);
         frames_.push_back({*rest_level_, false, ms, seconds_since_start(), work, completes});
+        drawn_now = true;
       }
     }
-    if (rest_.stage() != RestStage::Done) settle = std::max(settle, 1);  // keep refining without input
+    pacing.frame_ended(rest_.stage() != RestStage::Done, drawn_now);
     present(fb_w, fb_h);
     // Screenshots show the scene alone unless the user asked for the panel too; automated ones never do.
     if (closing && options_.screenshot) save_screenshot(*options_.screenshot, fb_w, fb_h);

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -75,7 +76,11 @@ OIIO::ImageBuf wrap(const Image& img, const char* which) {
 
 }  // namespace
 
-void write_png(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba) {
+namespace {
+
+// Writes `rgba` as `format` (an OpenImageIO format name) to `path`, atomically (see write_png).
+void write_image_as(const std::string& format, const std::string& path, int w, int h,
+                    const std::vector<std::uint8_t>& rgba) {
   if (path.empty()) throw std::runtime_error("write_png: empty path");
   if (w <= 0 || h <= 0)
     io_fail("write_png: invalid size " + std::to_string(w) + "x" + std::to_string(h) + " for", path);
@@ -88,18 +93,22 @@ void write_png(const std::string& path, int w, int h, const std::vector<std::uin
   std::error_code ec;
   const fs::path tmp = reserve_temp_file(target, path);
   try {
-    // The format is named explicitly: the temporary name's extension is not ".png".
-    auto out = OIIO::ImageOutput::create("png");
-    if (!out) io_fail("write_png: OpenImageIO has no PNG writer for", path, OIIO::geterror());
-    OIIO::ImageSpec spec(w, h, 4, OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:UnassociatedAlpha", 1);  // bytes are straight alpha: write them verbatim
-    if (!out->open(tmp.string(), spec)) output_fail(path, "cannot open the PNG for writing", out->geterror());
-    if (!out->write_image(OIIO::TypeDesc::UINT8, rgba.data())) {
+    // The format is named explicitly: the temporary name's extension is not the output's.
+    auto out = OIIO::ImageOutput::create(format);
+    if (!out) io_fail("OpenImageIO has no " + format + " writer for", path, OIIO::geterror());
+    // JPEG holds no alpha: write the colour channels only (a stride of 4 bytes a pixel skips it).
+    const int channels = format == "jpeg" ? 3 : 4;
+    OIIO::ImageSpec spec(w, h, channels, format == "openexr" ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
+    if (channels == 4) spec.attribute("oiio:UnassociatedAlpha", 1);  // straight alpha: write the bytes verbatim
+    if (format == "jpeg") spec.attribute("CompressionQuality", 95);
+    const std::string what = "the " + format + " picture";
+    if (!out->open(tmp.string(), spec)) output_fail(path, "cannot open " + what + " for writing", out->geterror());
+    if (!out->write_image(OIIO::TypeDesc::UINT8, rgba.data(), 4)) {
       const std::string err = out->geterror();
       out->close();
-      output_fail(path, "cannot write the PNG", err);
+      output_fail(path, "cannot write " + what, err);
     }
-    if (!out->close()) output_fail(path, "cannot finish the PNG", out->geterror());
+    if (!out->close()) output_fail(path, "cannot finish " + what, out->geterror());
     out.reset();
     fsync_file(tmp, path);
     fs::rename(tmp, target, ec);
@@ -109,6 +118,32 @@ void write_png(const std::string& path, int w, int h, const std::vector<std::uin
     fs::remove(tmp, ignore);
     throw;
   }
+}
+
+}  // namespace
+
+void write_png(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba) {
+  write_image_as("png", path, w, h, rgba);
+}
+
+std::string picture_format_of(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext.empty() || ext == ".png") return "png";
+  if (ext == ".jpg" || ext == ".jpeg") return "jpeg";
+  if (ext == ".tif" || ext == ".tiff") return "tiff";
+  if (ext == ".exr") return "openexr";
+  return {};
+}
+
+const char* picture_formats_text() { return "PNG (.png), JPEG (.jpg, .jpeg), TIFF (.tif, .tiff) or OpenEXR (.exr)"; }
+
+void write_picture(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba) {
+  const std::string format = picture_format_of(path);
+  if (format.empty())
+    throw Error(ErrorKind::Usage, path, std::nullopt,
+                std::string("the extension names no picture format voxview writes: use ") + picture_formats_text());
+  write_image_as(format, path, w, h, rgba);
 }
 
 Image read_image(const std::string& path) {

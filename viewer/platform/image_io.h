@@ -1,5 +1,6 @@
 #pragma once
-// Image files through OpenImageIO: PNG output (atomic), RGBA8 input and numeric comparison.
+// Image files through OpenImageIO: PNG, JPEG, TIFF or OpenEXR output (atomic), RGBA8 input and numeric
+// comparison.
 //
 // Alpha is straight (unassociated) on both sides: the bytes given to write_png are the bytes in the
 // file, and read_image returns the file's bytes. (OpenImageIO would otherwise un-premultiply on PNG
@@ -27,6 +28,15 @@ struct Image {
 // vxl::Error (Output) naming `path` when it cannot be written, std::runtime_error for a malformed image.
 void write_png(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba);
 inline void write_png(const std::string& path, const Image& img) { write_png(path, img.width, img.height, img.rgba); }
+
+// The picture format a path's extension names (case-insensitive): "png" (.png, or no extension), "jpeg"
+// (.jpg, .jpeg; no alpha: the alpha channel is dropped), "tiff" (.tif, .tiff) or "openexr" (.exr, half
+// floats); empty for any other.
+std::string picture_format_of(const std::string& path);
+// "PNG (.png), JPEG (.jpg, .jpeg), TIFF (.tif, .tiff) or OpenEXR (.exr)", for messages.
+const char* picture_formats_text();
+// As write_png, in the format the extension names. Throws vxl::Error (Usage) for an extension that names none.
+void write_picture(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba);
 
 // Reads any format OpenImageIO knows (first subimage) as RGBA8: grey -> RGB, missing alpha -> 255,
 // extra channels dropped, other bit depths converted. Throws std::runtime_error naming `path`.

@@ -1,0 +1,161 @@
+// Golden bytes: files written once from a pinned input (tests/data/golden/, scripts/regenerate-golden) and
+// committed. The writers must reproduce them byte for byte, and the readers must decode them to the input's
+// coordinates, so that a writer and a reader wrong in the same way cannot pass by agreeing with each other.
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "converter/readers/read_tractogram.h"
+#include "converter/streaming_convert.h"
+#include "format/vxl_file.h"
+#include "format/vxl_streamlines.h"
+#include "format/vxlz_package.h"
+#include "tests/test_support.h"
+
+namespace vxl {
+namespace {
+
+using test::q;
+using test::run_cli;
+using test::ScratchDir;
+using test::slurp;
+
+std::string golden(const std::string& name) { return std::string(VOXLINES_TEST_DATA_DIR) + "/golden/" + name; }
+
+// The pinned options: the same as scripts/regenerate-golden's.
+const std::string kPinnedOptions = " --voxel-size 8 --levels 2 --threads 1";
+const std::string kRegenerate =
+    " (when the change of bytes is intended: scripts/regenerate-golden, and review the diff of tests/data/golden/)";
+
+// Byte-for-byte equality, reporting the first differing offset rather than two dumps.
+void expect_same_bytes(const std::string& written, const std::string& golden_path) {
+  const std::vector<char> a = slurp(written), b = slurp(golden_path);
+  ASSERT_EQ(a.size(), b.size()) << written << " vs " << golden_path << kRegenerate;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    ASSERT_EQ(a[i], b[i]) << "first difference at byte " << i << " of " << golden_path << kRegenerate;
+}
+
+struct Streamlines {
+  std::vector<std::vector<float>> xyz;
+};
+
+Streamlines decode_vxl(const std::string& path) {
+  const VxlFile file = VxlFile::open(path);
+  Streamlines out;
+  WalkCallbacks callbacks;
+  callbacks.streamline = [&](std::uint64_t index, std::span<const float> xyz) {
+    EXPECT_EQ(index, out.xyz.size());
+    out.xyz.emplace_back(xyz.begin(), xyz.end());
+  };
+  walk_streamlines(file, callbacks);
+  return out;
+}
+
+Streamlines pinned_input() {
+  const Tractogram t = read_tractogram(golden("pinned.tck"));
+  Streamlines out;
+  for (std::size_t s = 0; s < t.streamline_count(); ++s)
+    out.xyz.emplace_back(t.positions.begin() + 3 * t.offsets[s], t.positions.begin() + 3 * t.offsets[s + 1]);
+  return out;
+}
+
+// Every coordinate of `decoded` within `tolerance` mm of the pinned input's (0: bit for bit).
+void expect_coordinates(const Streamlines& decoded, double tolerance) {
+  const Streamlines input = pinned_input();
+  ASSERT_EQ(decoded.xyz.size(), input.xyz.size());
+  double worst = 0;
+  for (std::size_t s = 0; s < input.xyz.size(); ++s) {
+    ASSERT_EQ(decoded.xyz[s].size(), input.xyz[s].size()) << "streamline " << s;
+    for (std::size_t i = 0; i < input.xyz[s].size(); ++i)
+      worst = std::max(worst, std::abs(double(decoded.xyz[s][i]) - double(input.xyz[s][i])));
+  }
+  EXPECT_LE(worst, tolerance);
+}
+
+TEST(GoldenBytes, TheCommittedFilesAreTheOnesListedInTheirChecksums) {
+  const std::string command =
+      "cd " + q(std::string(VOXLINES_TEST_DATA_DIR) + "/golden") + " && sha256sum --check --strict --quiet SHA256SUMS";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+}
+
+TEST(GoldenBytes, TheInputIsTheOnePinned) {
+  // Known coordinates, read with an independent reader (nibabel) when the input was pinned: the first
+  // point of the first streamline and the last of the last one.
+  const Streamlines input = pinned_input();
+  ASSERT_EQ(input.xyz.size(), 8u);
+  EXPECT_EQ(input.xyz[0].size(), 3u * 32);
+  EXPECT_EQ(input.xyz[7].size(), 3u * 76);
+  EXPECT_FLOAT_EQ(input.xyz[0][0], 22.180646896362305f);
+  EXPECT_FLOAT_EQ(input.xyz[0][1], -22.12089729309082f);
+  EXPECT_FLOAT_EQ(input.xyz[0][2], 23.863332748413086f);
+  const std::vector<float>& last = input.xyz[7];
+  EXPECT_FLOAT_EQ(last[last.size() - 3], -9.0084228515625f);
+  EXPECT_FLOAT_EQ(last[last.size() - 2], -15.260669708251953f);
+  EXPECT_FLOAT_EQ(last[last.size() - 1], -29.45517349243164f);
+}
+
+TEST(GoldenBytes, ConvertWritesThePackedFile) {
+  ScratchDir dir;
+  const auto r = run_cli("convert " + q(golden("pinned.tck")) + " " + q(dir.file("packed.vxl")) + kPinnedOptions);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  expect_same_bytes(dir.file("packed.vxl"), golden("packed.vxl"));
+}
+
+TEST(GoldenBytes, ConvertWritesTheFloat32File) {
+  ScratchDir dir;
+  const auto r = run_cli("convert " + q(golden("pinned.tck")) + " " + q(dir.file("float32.vxl")) + kPinnedOptions +
+                         " --positions float32");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  expect_same_bytes(dir.file("float32.vxl"), golden("float32.vxl"));
+}
+
+TEST(GoldenBytes, AStreamedConversionWritesThePackedFile) {
+  ScratchDir dir;
+  ConvertSettings settings;  // the pinned options
+  settings.voxel_size = 8;
+  settings.levels = 2;
+  settings.threads = 1;
+  settings.memory_limit = 20 * (std::uint64_t(1) << 20);  // the smallest limit the program accepts
+  StreamingTuning tuning;
+  tuning.order_chunk_bytes = 256;  // orders built and written a few voxels at a time
+  const ConvertSummary s = convert_streaming(golden("pinned.tck"), dir.file("streamed.vxl"), settings, tuning);
+  EXPECT_GE(s.passes, 3u);  // scan, plan, place: the source was streamed, not held
+  expect_same_bytes(dir.file("streamed.vxl"), golden("packed.vxl"));
+}
+
+TEST(GoldenBytes, PackWritesThePackage) {
+  ScratchDir dir;
+  const auto r = run_cli("pack " + q(golden("packed.vxl")) + " " + q(dir.file("package.vxlz")) + " --threads 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  expect_same_bytes(dir.file("package.vxlz"), golden("package.vxlz"));
+}
+
+TEST(GoldenBytes, UnpackWritesTheUnpackedFile) {
+  ScratchDir dir;
+  const auto r = run_cli("unpack " + q(golden("package.vxlz")) + " " + q(dir.file("unpacked.vxl")) + " --threads 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  expect_same_bytes(dir.file("unpacked.vxl"), golden("unpacked.vxl"));
+}
+
+TEST(GoldenBytes, TheFloat32FileDecodesToTheInputBitForBit) {
+  expect_coordinates(decode_vxl(golden("float32.vxl")), 0);
+}
+
+TEST(GoldenBytes, ThePackedFileDecodesWithinItsBound) {
+  // 10 bits per axis over 8 mm voxels: within 4.5 um per axis (spec §5.4).
+  expect_coordinates(decode_vxl(golden("packed.vxl")), 0.0045);
+}
+
+TEST(GoldenBytes, TheUnpackedFileDecodesWithinThePackagesBoundAndARepack) {
+  const VxlzFile package = VxlzFile::open(golden("package.vxlz"));
+  EXPECT_EQ(package.meta().streamline_count, 8u);
+  EXPECT_EQ(package.meta().point_count, 418u);
+  // The package's stated bound (against the packed file) plus the packed file's own and the re-pack's.
+  expect_coordinates(decode_vxl(golden("unpacked.vxl")), package.pack().error_bound + 2 * 0.0045);
+}
+
+}  // namespace
+}  // namespace vxl
