@@ -147,12 +147,18 @@ void VxlFile::validate_section_table() {
     if (std::find(seen.begin(), seen.end(), id) != seen.end()) fail_input(p, at, "section " + name + " appears twice");
     seen.push_back(id);
     previous_end = e.offset + e.size;
-    static const std::uint32_t known[] = {
-        section_id("META"), section_id("DIRS"), section_id("VOXT"), section_id("LODS"), section_id("VERT"),
-        section_id("ORDR"), section_id("VXLN"), section_id("STRM"), section_id("PROV"), section_id("GRPS"),
-        section_id("VDIR"), section_id("VVAL"), section_id("SVAL")};
-    bool is_known = std::find(std::begin(known), std::end(known), id) != std::end(known);
-    if (!is_known && (e.flags & kSectionRequired))
+    // The sections a reader must understand to draw the file right (spec §4): they carry the required flag,
+    // or an older reader that skipped them (LODS, VDIR) would draw garbage without a word.
+    static const std::uint32_t required[] = {section_id("META"), section_id("DIRS"), section_id("VOXT"),
+                                             section_id("LODS"), section_id("VERT"), section_id("ORDR"),
+                                             section_id("VXLN"), section_id("STRM"), section_id("VDIR")};
+    static const std::uint32_t optional[] = {section_id("PROV"), section_id("GRPS"), section_id("VVAL"),
+                                             section_id("SVAL")};
+    const bool is_required = std::find(std::begin(required), std::end(required), id) != std::end(required);
+    const bool is_optional = std::find(std::begin(optional), std::end(optional), id) != std::end(optional);
+    if (is_required && !(e.flags & kSectionRequired))
+      fail_input(p, at + 4, "section " + name + " must carry the required flag (spec §4)");
+    if (!is_required && !is_optional && (e.flags & kSectionRequired))
       throw Error(ErrorKind::Unsupported, p, at,
                   "required section " + name + " is unknown to this reader (newer writer?)");
   }
@@ -205,6 +211,7 @@ void VxlFile::validate_meta_and_sizes() {
   };
   auto dirs =
       expect_size("DIRS", count_product(m.stored_order_count, sizeof(DirectionEntry)), "stored_order_count × 16");
+  check_order_set(m, p, meta_at);
   auto voxt = expect_size("VOXT", count_product(m.voxel_count, sizeof(VoxelEntry)), "voxel_count × 64");
   // Positions (spec §5.4): float32 in every 1.x file, either encoding in 2.0.
   const bool packed = m.position_encoding == static_cast<std::uint32_t>(PositionEncoding::Packed);
@@ -279,6 +286,18 @@ std::string misplaced_voxel(const MetaSection& m, const VoxelEntry& v, std::size
          " lie outside its cell and the file's bounds (" + std::to_string(v.tight_min[c]) + " .. " +
          std::to_string(v.tight_max[c]) + " mm, the cell's " + std::to_string(cell_lo) + " .. " +
          std::to_string(cell_lo + m.voxel_size) + " mm)";
+}
+
+void check_order_set(const MetaSection& m, const std::string& p, std::uint64_t meta_at) {
+  if (m.order_set > static_cast<std::uint32_t>(OrderSet::Random))
+    fail_input(p, meta_at + 100, "unknown order set " + std::to_string(m.order_set) + " (expected 0, 1 or 2)");
+  const std::uint32_t fixed_count = m.order_set == static_cast<std::uint32_t>(OrderSet::Axis)       ? 3
+                                    : m.order_set == static_cast<std::uint32_t>(OrderSet::AxisDiag) ? 7
+                                                                                                    : 0;
+  if (fixed_count != 0 && m.stored_order_count != fixed_count)
+    fail_input(p, meta_at + 52,
+               "stored order count " + std::to_string(m.stored_order_count) + " for order set " +
+                   std::to_string(m.order_set) + " (it stores " + std::to_string(fixed_count) + ")");
 }
 
 void check_grid_geometry(const MetaSection& m, const std::string& p, std::optional<std::uint64_t> meta_at) {

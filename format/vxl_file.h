@@ -46,6 +46,9 @@ bool tight_bounds_in_place(const MetaSection& meta, const VoxelEntry& v, int c);
 // dimensions were changed would be drawn far from its lines, or not at all. Throws vxl::Error (Input)
 // naming `path` and the field's offset from `meta_at`.
 void check_grid_geometry(const MetaSection& meta, const std::string& path, std::optional<std::uint64_t> meta_at);
+// The order set as spec §5.3 defines them: axis (0) stores 3 directions, axis+diag (1) 7, random (2) any
+// 1..64; another set is unknown. Throws vxl::Error (Input) naming `path` and the field's offset.
+void check_order_set(const MetaSection& meta, const std::string& path, std::uint64_t meta_at);
 // What is wrong, for an error message: voxel `index`'s bounds on `c` and its cell's.
 std::string misplaced_voxel(const MetaSection& meta, const VoxelEntry& v, std::size_t index, int c);
 

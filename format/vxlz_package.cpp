@@ -286,6 +286,7 @@ void VxlzFile::validate_pack_and_meta() {
     fail_input(p, meta_at + 56, "voxel size must be finite and positive");
   if (m.stored_order_count < 1 || m.stored_order_count > kVxlMaxStoredOrders)
     fail_input(p, meta_at + 52, "stored order count must be 1..64");
+  check_order_set(m, p, meta_at);
   if (m.voxel_count > 0x7FFFFFFFu) fail_input(p, meta_at + 48, "voxel count exceeds 2^31-1");
   for (int c = 0; c < 3; ++c) {
     if (m.grid_dims[c] < 0) fail_input(p, meta_at + 88, "negative grid dimension");

@@ -197,6 +197,40 @@ TEST(HostileVxl, GeometryMovedAwayFromTheLinesIsRefusedOnOpen) {
   }
 }
 
+// META fields that contradict the sections, and a required section marked optional, resealed so that only
+// the structure can tell: open() refuses them (so every reader does), `info` exits 3 and `verify` says invalid.
+TEST(HostileVxl, MetaFieldsThatContradictTheSectionsAreRefusedOnOpen) {
+  ScratchDir dir;
+  const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
+  const std::uint64_t meta = valid.offset_of("META");
+  auto put_u32 = [](VxlBytes& b, std::uint64_t at, std::uint32_t v) { std::memcpy(b.bytes.data() + at, &v, 4); };
+  struct Case {
+    const char* name;
+    std::function<void(VxlBytes&)> damage;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      {"order set 7", [&](VxlBytes& b) { put_u32(b, meta + 100, 7); }, "unknown order set 7 (expected 0, 1 or 2)"},
+      {"order set 1 (axis+diag) with K = 3", [&](VxlBytes& b) { put_u32(b, meta + 100, 1); },
+       "stored order count 3 for order set 1 (it stores 7)"},
+      {"levels not marked required", [&](VxlBytes& b) { put_u32(b, b.entry_at("LODS") + 4, 0); },
+       "section LODS must carry the required flag"},
+      {"orders not marked required", [&](VxlBytes& b) { put_u32(b, b.entry_at("ORDR") + 4, 0); },
+       "section ORDR must carry the required flag"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    VxlBytes b = valid;
+    c.damage(b);
+    b.reseal();
+    b.write(dir.file("bad.vxl"));
+    EXPECT_NE(open_error(dir.file("bad.vxl")).find(c.message), std::string::npos) << open_error(dir.file("bad.vxl"));
+    EXPECT_EQ(test::run_cli("info " + q(dir.file("bad.vxl"))).exit_code, 3);
+    const auto v = test::run_cli("verify " + q(dir.file("bad.vxl")));
+    EXPECT_EQ(v.exit_code, 1) << v.output;
+  }
+}
+
 // PROV is any JSON to open(): fields of the wrong type made `info` exit 70 (type_error 302/306) and
 // `export x.trx` too. They are ignored now, as missing fields are.
 TEST(HostileVxl, ProvenanceOfTheWrongTypesIsIgnored) {
