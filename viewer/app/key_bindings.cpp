@@ -89,6 +89,7 @@ constexpr MouseGesture kMouse[] = {
     {"right/middle drag", "pan (or Shift+left drag)"},
     {"wheel", "zoom"},
     {"Ctrl+wheel", "move the slab (the focus)"},
+    {"Shift+wheel", "selection: the active sphere's radius"},
 };
 
 bool matches_key(const KeyInput& in, int code, bool shift) {

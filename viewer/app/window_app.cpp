@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -323,7 +324,8 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   glfwSetWindowUserPointer(window_, this);
   glfwSetMouseButtonCallback(window_, [](GLFWwindow* w, int b, int a, int m) { of(w).on_mouse_button(b, a, m); });
   glfwSetCursorPosCallback(window_, [](GLFWwindow* w, double x, double y) { of(w).on_cursor(x, y); });
-  glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double dy) { of(w).on_scroll(dy); });
+  // Some systems turn Shift + wheel into a horizontal scroll: take whichever axis moved.
+  glfwSetScrollCallback(window_, [](GLFWwindow* w, double dx, double dy) { of(w).on_scroll(dy != 0 ? dy : dx); });
   glfwSetKeyCallback(window_, [](GLFWwindow* w, int k, int, int a, int m) { of(w).on_key(k, a, m); });
   glfwSetCharCallback(window_, [](GLFWwindow* w, unsigned c) { of(w).on_char(c); });
   glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* w, int, int) { of(w).events_++; });
@@ -385,10 +387,15 @@ void ViewerWindow::on_scroll(double steps) {
   double x = 0, y = 0;
   glfwGetCursorPos(window_, &x, &y);
   if (panel_->takes_mouse_at(x, y)) return;
-  // Ctrl + wheel moves the slab through the scene (as in mrview); the plain wheel zooms.
-  if (glfwGetKey(window_, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
-      glfwGetKey(window_, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
+  // Ctrl + wheel moves the slab through the scene (as in mrview), Shift + wheel changes the active region's
+  // radius (Ctrl + wheel is taken by the slab); the plain wheel zooms.
+  auto held = [&](int left, int right) {
+    return glfwGetKey(window_, left) == GLFW_PRESS || glfwGetKey(window_, right) == GLFW_PRESS;
+  };
+  if (held(GLFW_KEY_LEFT_CONTROL, GLFW_KEY_RIGHT_CONTROL))
     controller_.move_focus(-steps);
+  else if (held(GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT) && !regions_.empty())
+    regions_.scale_radius(std::pow(RegionEditor::kRadiusStep, steps));
   else
     controller_.zoom(steps);
 }
@@ -550,8 +557,8 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
     case KeyAction::RemoveRegion: regions_.remove_active(); break;
     case KeyAction::NextRegion: regions_.activate_next(); break;
     case KeyAction::ToggleRegionRole: regions_.toggle_role(); break;
-    case KeyAction::RegionSmaller: regions_.scale_radius(1 / 1.25); break;
-    case KeyAction::RegionLarger: regions_.scale_radius(1.25); break;
+    case KeyAction::RegionSmaller: regions_.scale_radius(1 / RegionEditor::kRadiusStep); break;
+    case KeyAction::RegionLarger: regions_.scale_radius(RegionEditor::kRadiusStep); break;
     case KeyAction::SaveSelection: save_selection(); break;
     case KeyAction::Quit: glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
   }
