@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "converter/export_groups.h"
 #include "converter/export_values.h"
 #include "converter/tck_writer.h"
 #include "format/error.h"
@@ -47,7 +48,14 @@ std::uint32_t chosen_set(const VxlFile& file, const TckExportSettings& settings)
 }  // namespace
 
 ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings,
-                         const StreamlineSubset* subset, const std::vector<std::string>& extra_header) {
+                         const StreamlineSubset* given_subset, const std::vector<std::string>& extra_header) {
+  std::optional<StreamlineSubset> group;
+  if (settings.group) {
+    if (given_subset)
+      throw Error(ErrorKind::Usage, out_path, std::nullopt, "a group is chosen for a selection (--group)");
+    group.emplace(group_subset(file, *settings.group));
+  }
+  const StreamlineSubset* subset = group ? &*group : given_subset;
   // Both are renamed into place at the end: the second would replace the first.
   if (settings.tsf_path && same_output(out_path, *settings.tsf_path))
     throw Error(ErrorKind::Usage, *settings.tsf_path, std::nullopt,
@@ -91,6 +99,9 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
     summary.warnings.push_back(
         std::to_string(file.streamline_values().size()) +
         " per-streamline value set(s) not written: TCK and TSF have no place for them (export to .trx)");
+
+  if (!settings.group)
+    if (std::optional<std::string> lost = groups_not_written(file, "a TCK", subset)) summary.warnings.push_back(*lost);
 
   TckWriter writer(out_path, counts.streamlines, header);
   std::optional<TsfWriter> tsf;
