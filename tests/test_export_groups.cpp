@@ -149,7 +149,8 @@ TEST(ExportGroups, SplitGroupsWritesOneTckAndTsfPerGroup) {
 }
 
 TEST(ExportGroups, FileNamesAreSafeAndUnique) {
-  const std::vector<StreamlineGroup> groups = {{"a/b", {}}, {"a_b", {}}, {"..", {}}, {"A_B", {}}, {"x\ny", {}}, {"", {}}};
+  const std::vector<StreamlineGroup> groups = {{"a/b", {}}, {"a_b", {}},  {"..", {}},
+                                               {"A_B", {}}, {"x\ny", {}}, {"", {}}};
   EXPECT_EQ(group_file_names(groups), (std::vector<std::string>{"a_b", "a_b_2", "_..", "A_B_3", "x_y", "_"}));
 }
 

@@ -25,8 +25,8 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN(), kInf = std::nume
 std::string tracked_tck(const ScratchDir& dir) {
   const std::string path = dir.file("tracked.tck");
   test::write_mrtrix_file(path, "mrtrix tracks", "Float32LE",
-                          test::raw<float>({0, 0, 0, 1, 0, 0, 2, 0, 0, kNaN, kNaN, kNaN, 0, 1, 0, 0, 2, 0, kNaN, kNaN,
-                                            kNaN, kInf, kInf, kInf}),
+                          test::raw<float>({0, 0, 0, 1, 0, 0, 2,    0,    0,    kNaN, kNaN, kNaN,
+                                            0, 1, 0, 0, 2, 0, kNaN, kNaN, kNaN, kInf, kInf, kInf}),
                           "command_history: tckgen fod.mif out.tck -select 2\n"
                           "command_history: tckedit out.tck tracked.tck\n"
                           "count: 2\ntotal_count: 1000\nmax_dist: 250\nmin_dist: 10\nmethod: iFOD2\n"
@@ -66,8 +66,7 @@ TEST(ExportTck, KeepsTheSourceHeaderProperties) {
     EXPECT_EQ(h.fields["min_dist"], values({"10"}));
     EXPECT_EQ(h.fields["method"], values({"iFOD2"}));
     EXPECT_EQ(h.fields["source"], values({"fod.mif"}));
-    EXPECT_EQ(h.fields["command_history"],
-              values({"tckgen fod.mif out.tck -select 2", "tckedit out.tck tracked.tck"}));
+    EXPECT_EQ(h.fields["command_history"], values({"tckgen fod.mif out.tck -select 2", "tckedit out.tck tracked.tck"}));
     // As tckedit: the source's ROIs are prior ones; count is the writer's; total_count is not carried.
     EXPECT_EQ(h.fields["prior_roi"], values({"seed mask.mif", "include sphere 1,2,3,4"}));
     EXPECT_FALSE(h.fields.contains("roi"));

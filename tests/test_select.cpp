@@ -468,9 +468,9 @@ TEST(SelectionCli, HostileRegionsAreRefusedNamingTheArgumentAndWriteNothing) {
   const test::CommandResult no_output = run_cli("select " + test::q(dir.file("in.vxl")) + " --include 0,0,0,5");
   EXPECT_EQ(no_output.exit_code, 2) << no_output.output;
   const test::CommandResult wrong_extension =
-      run_cli("select " + test::q(dir.file("in.vxl")) + " " + test::q(dir.file("o.trk")) + " --include 0,0,0,5");
+      run_cli("select " + test::q(dir.file("in.vxl")) + " " + test::q(dir.file("o.trk.xz")) + " --include 0,0,0,5");
   EXPECT_EQ(wrong_extension.exit_code, 2) << wrong_extension.output;
-  EXPECT_FALSE(std::filesystem::exists(dir.file("o.trk")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("o.trk.xz")));
 }
 
 }  // namespace

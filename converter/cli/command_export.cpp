@@ -5,6 +5,7 @@
 #include "converter/cli/commands.h"
 #include "converter/export_groups.h"
 #include "converter/export_tck.h"
+#include "converter/export_trk.h"
 #include "converter/export_trx.h"
 #include "converter/export_vtk.h"
 #include "format/error.h"
@@ -27,13 +28,15 @@ void add_export_command(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "export",
-      "Write the original streamlines of a .vxl back to TCK, TRX or legacy VTK (chosen by the output's extension)");
+      "Write the original streamlines of a .vxl back to TCK, TRX, legacy VTK or TrackVis TRK (chosen by the output's "
+      "extension)");
   cmd->add_option("input", opt->input, ".vxl file")->required();
   cmd->add_option(
       "output", opt->output,
       "output .tck (Float32LE, the source TCK header's properties kept), .trx (zip, stored: float32 positions, "
       "uint64 offsets, groups, dpv and dps kept) or .vtk (legacy BINARY POLYDATA, values kept as POINT_DATA / "
-      "CELL_DATA scalars, groups as 0/1 CELL_DATA arrays); written atomically. Not with --split-groups");
+      "CELL_DATA scalars, groups as 0/1 CELL_DATA arrays) or .trk / .trk.gz (TrackVis v2: a TRK source's header, "
+      "values as scalars and properties); written atomically. Not with --split-groups");
   cmd->add_option("--tsf", opt->tck.tsf_path,
                   "with a .tck output: also write one per-point value set as an MRtrix TSF");
   cmd->add_option("--value", opt->tck.value,
@@ -60,12 +63,13 @@ void add_export_command(CLI::App& app) {
     if (opt->output.empty()) throw Error(ErrorKind::Usage, opt->input, std::nullopt, "export needs an output file");
     std::string lower = opt->output;
     std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-    const bool tck = lower.ends_with(".tck"), trx = lower.ends_with(".trx"), vtk = lower.ends_with(".vtk");
-    if (!tck && !trx && !vtk)
-      throw Error(ErrorKind::Usage, opt->output, std::nullopt, "export writes .tck, .trx or .vtk files");
+    const bool tck = lower.ends_with(".tck"), trx = lower.ends_with(".trx"), vtk = lower.ends_with(".vtk"),
+               trk = lower.ends_with(".trk") || lower.ends_with(".trk.gz");
+    if (!tck && !trx && !vtk && !trk)
+      throw Error(ErrorKind::Usage, opt->output, std::nullopt, "export writes .tck, .trx, .vtk, .trk or .trk.gz files");
     if (!tck && (opt->tck.tsf_path || opt->tck.value))
       throw Error(ErrorKind::Usage, opt->output, std::nullopt,
-                  "--tsf and --value go with a .tck output (a .trx or .vtk holds every value set)");
+                  "--tsf and --value go with a .tck output (a .trx, .vtk or .trk holds the value sets)");
     VxlFile f = VxlFile::open(opt->input);
     std::optional<StreamlineSubset> group;
     if (opt->tck.group && !tck) group.emplace(group_subset(f, *opt->tck.group));
@@ -74,6 +78,13 @@ void add_export_command(CLI::App& app) {
       const ExportSummary s = export_tck(f, opt->output, opt->tck);
       print_warnings(s.warnings);
       if (opt->tck.tsf_path) std::printf("%s: value set '%s'\n", opt->tck.tsf_path->c_str(), s.value_set.c_str());
+      std::printf("%s: %llu streamlines, %llu points\n", opt->output.c_str(), (unsigned long long)s.streamlines,
+                  (unsigned long long)s.points);
+      return;
+    }
+    if (trk) {
+      const TrkExportSummary s = export_trk(f, opt->output, group ? &*group : nullptr);
+      print_warnings(s.warnings);
       std::printf("%s: %llu streamlines, %llu points\n", opt->output.c_str(), (unsigned long long)s.streamlines,
                   (unsigned long long)s.points);
       return;
