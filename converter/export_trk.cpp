@@ -304,12 +304,12 @@ TrkExportSummary export_trk(const VxlFile& file, const std::string& out_path, co
   TrkSink out(out_path, lower.ends_with(".gz"));
   out.write(header.data(), header.size());
   std::vector<float> record;
-  std::uint64_t point = 0, written = 0;  // over the source points / streamlines written
+  std::uint64_t point = 0, walked = 0;  // source points and streamlines of the subset so far
   WalkCallbacks cb;
   cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };
   cb.streamline = [&](std::uint64_t, std::span<const float> xyz) {
     const std::uint64_t n = xyz.size() / 3;
-    const std::uint64_t index = written++;
+    const std::uint64_t index = walked++;
     if (n == 0) return;
     if (n > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
       fail_unsupported(out_path, "a streamline of " + std::to_string(n) + " points is more than TRK counts");

@@ -143,6 +143,17 @@ TEST(ExportTrk, SetsBeyondTheNameSlotsAreNamedInAWarning) {
   EXPECT_TRUE(back.source.warnings.empty()) << ::testing::PrintToString(back.source.warnings);
 }
 
+TEST(ExportTrk, OneGroupThroughTheCommandLine) {
+  ScratchDir dir;
+  convert_exact(valued_tractogram(), dir.file("v.vxl"));
+  const auto r = test::run_cli("export " + q(dir.file("v.vxl")) + " " + q(dir.file("left.TRK")) + " --group left");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("2 streamlines"), std::string::npos) << r.output;
+  const Tractogram back = read_trk(dir.file("left.TRK"));
+  ASSERT_EQ(back.streamline_count(), 2u);
+  EXPECT_EQ(back.streamline_values[0].values, (std::vector<float>{0.0f, 4.5f})) << "streamlines 0 and 3";
+}
+
 TEST(ExportTrkReal, TrkFixturesComeBackWithTheirHeaders) {
   VXL_REQUIRE_REAL_DATA();
   ScratchDir dir;
