@@ -15,6 +15,7 @@
 #include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
+#include "tests/export_test_support.h"
 #include "tests/test_support.h"
 
 namespace vxl {
@@ -39,10 +40,7 @@ Tractogram grouped_tractogram() {
 }
 
 VxlFile grouped_vxl(const ScratchDir& dir) {
-  ConvertSettings exact;
-  exact.positions = PositionEncoding::Float32;
-  convert_tractogram(grouped_tractogram(), dir.file("g.vxl"), exact);
-  return VxlFile::open(dir.file("g.vxl"));
+  return VxlFile::open(test::convert_float32(grouped_tractogram(), dir.file("g.vxl")));
 }
 
 // Streamline s of a tractogram, x,y,z interleaved.

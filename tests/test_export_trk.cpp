@@ -11,6 +11,7 @@
 #include "converter/readers/read_tractogram.h"
 #include "converter/synth.h"
 #include "format/vxl_file.h"
+#include "tests/export_test_support.h"
 #include "tests/test_support.h"
 
 namespace vxl {
@@ -40,13 +41,6 @@ Tractogram valued_tractogram() {
   return t;
 }
 
-std::string convert_exact(Tractogram t, const std::string& path) {
-  ConvertSettings exact;
-  exact.positions = PositionEncoding::Float32;
-  convert_tractogram(std::move(t), path, exact);
-  return path;
-}
-
 // Same streamlines (the source's without its empty ones) to float precision: a point is stored in voxmm,
 // measured from the grid's corner, so its rounding is that of the largest voxmm, which is at most twice
 // the largest coordinate for the grids here.
@@ -69,7 +63,7 @@ void expect_close_streamlines(const Tractogram& source, const Tractogram& back) 
 
 TEST(ExportTrk, ReadsBackWithItsValuesUnderADefaultRasHeader) {
   ScratchDir dir;
-  const VxlFile f = VxlFile::open(convert_exact(valued_tractogram(), dir.file("v.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(valued_tractogram(), dir.file("v.vxl")));
   const TrkExportSummary s = export_trk(f, dir.file("v.trk"));
   EXPECT_EQ(s.streamlines, 200u);
   EXPECT_TRUE(test::has_warning(s.warnings, "1 streamline(s) without points not written"));
@@ -118,7 +112,7 @@ TEST(ExportTrk, KeepsTheHeaderOfATrkSource) {
       {"image_orientation_patient", {1.0, 0.0, 0.0, 0.0, 1.0, 0.0}},
       {"invert_x", 0},
       {"swap_xy", 1}};
-  const VxlFile f = VxlFile::open(convert_exact(t, dir.file("t.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(t, dir.file("t.vxl")));
   export_trk(f, dir.file("t.trk"));
   const Tractogram back = read_trk(dir.file("t.trk"));
   expect_close_streamlines(t, back);
@@ -133,7 +127,7 @@ TEST(ExportTrk, SetsBeyondTheNameSlotsAreNamedInAWarning) {
   t.point_values.resize(1);
   for (int k = 0; k < 10; ++k) t.point_values.push_back({"s" + std::to_string(k), t.point_values[0].values});
   t.point_values.push_back({"a_name_of_twenty_one_", t.point_values[0].values});
-  const VxlFile f = VxlFile::open(convert_exact(std::move(t), dir.file("t.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(std::move(t), dir.file("t.vxl")));
   const TrkExportSummary s = export_trk(f, dir.file("t.trk"));
   EXPECT_TRUE(test::has_warning(s.warnings, "per-point value set(s) not written: 's9', 'a_name_of_twenty_one_' (name)"))
       << ::testing::PrintToString(s.warnings);
@@ -145,7 +139,7 @@ TEST(ExportTrk, SetsBeyondTheNameSlotsAreNamedInAWarning) {
 
 TEST(ExportTrk, OneGroupThroughTheCommandLine) {
   ScratchDir dir;
-  convert_exact(valued_tractogram(), dir.file("v.vxl"));
+  test::convert_float32(valued_tractogram(), dir.file("v.vxl"));
   const auto r = test::run_cli("export " + q(dir.file("v.vxl")) + " " + q(dir.file("left.TRK")) + " --group left");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("2 streamlines"), std::string::npos) << r.output;
@@ -160,7 +154,7 @@ TEST(ExportTrkReal, TrkFixturesComeBackWithTheirHeaders) {
   for (const char* name : {"nibabel__complex.trk", "nibabel__standard.LPS.trk", "niivue__colby.trk"}) {
     SCOPED_TRACE(name);
     const Tractogram source = read_trk(test::real(name));
-    const VxlFile f = VxlFile::open(convert_exact(read_trk(test::real(name)), dir.file("r.vxl")));
+    const VxlFile f = VxlFile::open(test::convert_float32(read_trk(test::real(name)), dir.file("r.vxl")));
     export_trk(f, dir.file("r.trk.gz"));
     const Tractogram back = read_trk(dir.file("r.trk.gz"));
     expect_close_streamlines(source, back);
