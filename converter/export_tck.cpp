@@ -2,9 +2,11 @@
 
 #include <cmath>
 #include <filesystem>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
+#include "converter/export_groups.h"
 #include "converter/export_values.h"
 #include "converter/tck_writer.h"
 #include "format/error.h"
@@ -15,17 +17,52 @@
 namespace vxl {
 namespace {
 
-// The source's timestamp, when its provenance has one: MRtrix checks that a TSF's timestamp is its
-// tractogram's, so both files get the same one.
-std::vector<std::string> timestamp_line(const VxlFile& file) {
+// The source TCK header's properties (step_size, method, max_dist, ROIs, command_history, …) as tckedit
+// carries them over, so that MRtrix tools reading the export (tcksift, length thresholds) still see them:
+// one "key: value" line per value (multi-line values one line each), the keys the writer owns (datatype,
+// file, count, total_count) and those `own_keys` sets left out, "roi" renamed "prior_roi". The timestamp
+// is the source's, unlike tckedit's new one: the streamlines are the source's, so its TSF files stay
+// valid with the export. Nothing for a source of another format.
+std::vector<std::string> source_header_lines(const VxlFile& file, const std::set<std::string>& own_keys) {
   const nlohmann::json prov = parse_json(file.provenance_json(), file.path(), file.provenance_offset(), "PROV");
   if (!prov.is_object() || !prov.contains("source") || !prov["source"].is_object()) return {};
-  const nlohmann::json header = prov["source"].value("header", nlohmann::json());
-  if (!header.is_object() || !header.contains("timestamp")) return {};
-  nlohmann::json t = header["timestamp"];
-  if (t.is_array() && !t.empty()) t = t.back();
-  if (!t.is_string() || t.get<std::string>().find('\n') != std::string::npos) return {};
-  return {"timestamp: " + t.get<std::string>()};
+  const nlohmann::json& source = prov["source"];
+  if (source.value("format", nlohmann::json()) != "tck") return {};
+  const nlohmann::json header = source.value("header", nlohmann::json());
+  if (!header.is_object()) return {};
+  static const std::set<std::string> kWriters = {"datatype", "file", "count", "total_count", "voxlines_exported_from"};
+  std::vector<std::string> lines;
+  for (const auto& [key, values] : header.items()) {
+    if (key.empty() || key.find_first_of(":\n\r") != std::string::npos || key == "END" || kWriters.contains(key))
+      continue;
+    const std::string name = key == "roi" ? "prior_roi" : key;
+    if (own_keys.contains(name)) continue;
+    std::vector<nlohmann::json> list = values.is_array() ? std::vector<nlohmann::json>(values.begin(), values.end())
+                                                         : std::vector<nlohmann::json>{values};
+    if (key == "timestamp" && !list.empty()) list.erase(list.begin(), list.end() - 1);
+    for (const nlohmann::json& v : list) {
+      if (!v.is_string()) continue;
+      const std::string text = v.get<std::string>();
+      // MRtrix reads an ROI as "TYPE SPEC" and crashes on less (tckinfo does, on such a source too).
+      if (name == "prior_roi" && text.find_first_not_of(' ', text.find(' ')) == std::string::npos) continue;
+      for (std::size_t from = 0; from <= text.size();) {
+        std::size_t to = text.find('\n', from);
+        if (to == std::string::npos) to = text.size();
+        std::string part = text.substr(from, to - from);
+        if (!part.empty() && part.back() == '\r') part.pop_back();
+        lines.push_back(name + ": " + part);
+        from = to + 1;
+      }
+    }
+  }
+  return lines;
+}
+
+// The keys of "key: value" lines.
+std::set<std::string> keys_of(const std::vector<std::string>& lines) {
+  std::set<std::string> keys;
+  for (const std::string& line : lines) keys.insert(line.substr(0, line.find(':')));
+  return keys;
 }
 
 // The set a TSF is asked for, by name or the first.
@@ -47,7 +84,14 @@ std::uint32_t chosen_set(const VxlFile& file, const TckExportSettings& settings)
 }  // namespace
 
 ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const TckExportSettings& settings,
-                         const StreamlineSubset* subset, const std::vector<std::string>& extra_header) {
+                         const StreamlineSubset* given_subset, const std::vector<std::string>& extra_header) {
+  std::optional<StreamlineSubset> group;
+  if (settings.group) {
+    if (given_subset)
+      throw Error(ErrorKind::Usage, out_path, std::nullopt, "a group is chosen for a selection (--group)");
+    group.emplace(group_subset(file, *settings.group));
+  }
+  const StreamlineSubset* subset = group ? &*group : given_subset;
   // Both are renamed into place at the end: the second would replace the first.
   if (settings.tsf_path && same_output(out_path, *settings.tsf_path))
     throw Error(ErrorKind::Usage, *settings.tsf_path, std::nullopt,
@@ -58,6 +102,8 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
   summary.points = counts.points;
   std::vector<std::string> header = {"voxlines_exported_from: " +
                                      std::filesystem::path(file.path()).filename().string()};
+  const std::vector<std::string> source = source_header_lines(file, keys_of(extra_header));
+  header.insert(header.end(), source.begin(), source.end());
   header.insert(header.end(), extra_header.begin(), extra_header.end());
 
   // The TSF's values, checked before anything is written.
@@ -72,8 +118,6 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
         fail_unsupported(file.path(), "value set '" + summary.value_set + "' has a non-finite value (point " +
                                           std::to_string(i) +
                                           "); a TSF cannot hold one (NaN and Inf are its separators)");
-    const std::vector<std::string> stamp = timestamp_line(file);
-    header.insert(header.end(), stamp.begin(), stamp.end());
   } else if (settings.value) {
     throw Error(ErrorKind::Usage, out_path, std::nullopt,
                 "a value set is chosen for a TSF, but no TSF output is given");
@@ -91,6 +135,9 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
     summary.warnings.push_back(
         std::to_string(file.streamline_values().size()) +
         " per-streamline value set(s) not written: TCK and TSF have no place for them (export to .trx)");
+
+  if (!settings.group)
+    if (std::optional<std::string> lost = groups_not_written(file, "a TCK", subset)) summary.warnings.push_back(*lost);
 
   TckWriter writer(out_path, counts.streamlines, header);
   std::optional<TsfWriter> tsf;

@@ -36,6 +36,27 @@ void add_members(const VxlFile& file, const ValueSets& sets, const std::string& 
     if (subset) return subset->pick(sets.values(k));
     return std::vector<float>(sets.values(k).begin(), sets.values(k).end());
   };
+  for (const ValueSetRun& run : value_set_runs(sets)) {
+    const std::string& base = run.name;
+    const std::uint32_t k = run.first, m = run.components;
+    if (!usable_member_name(base))
+      fail_unsupported(file.path(),
+                       "value set name '" + base + "' cannot be a TRX member name (" + dir + "/NAME.float32)");
+    TrxValueMember member;
+    member.name = dir + "/" + base + (m > 1 ? "." + std::to_string(m) : "") + ".float32";
+    member.data.resize(count * m);
+    for (std::uint32_t c = 0; c < m; ++c) {
+      const std::vector<float> v = column(k + c);
+      for (std::uint64_t i = 0; i < count; ++i) member.data[i * m + c] = v[i];
+    }
+    out.push_back(std::move(member));
+  }
+}
+
+}  // namespace
+
+std::vector<ValueSetRun> value_set_runs(const ValueSets& sets) {
+  std::vector<ValueSetRun> runs;
   for (std::uint32_t k = 0; k < sets.size();) {
     std::string base, next_base;
     std::uint32_t index = 0, m = 1;
@@ -48,22 +69,11 @@ void add_members(const VxlFile& file, const ValueSets& sets, const std::string& 
     } else {
       base = sets.name(k);
     }
-    if (!usable_member_name(base))
-      fail_unsupported(file.path(),
-                       "value set name '" + base + "' cannot be a TRX member name (" + dir + "/NAME.float32)");
-    TrxValueMember member;
-    member.name = dir + "/" + base + (m > 1 ? "." + std::to_string(m) : "") + ".float32";
-    member.data.resize(count * m);
-    for (std::uint32_t c = 0; c < m; ++c) {
-      const std::vector<float> v = column(k + c);
-      for (std::uint64_t i = 0; i < count; ++i) member.data[i * m + c] = v[i];
-    }
-    out.push_back(std::move(member));
+    runs.push_back({base, k, m});
     k += m;
   }
+  return runs;
 }
-
-}  // namespace
 
 std::vector<std::uint64_t> source_vertex_indices(const VxlFile& file, const StreamlineSubset* subset) {
   std::vector<std::uint64_t> out;

@@ -19,6 +19,15 @@ std::vector<std::uint64_t> source_vertex_indices(const VxlFile& file, const Stre
 // VVAL set `set` at the given vertices.
 std::vector<float> values_at(const VxlFile& file, std::uint32_t set, const std::vector<std::uint64_t>& vertices);
 
+// The sets as runs: NAME[0], NAME[1], … NAME[m-1] in a row (how the readers split a multi-component
+// TRX, TRK or VTK array, .vxl spec §5.11) as one run {NAME, first set, m}; every other set a run of one
+// under its own name (a lone NAME[0] too).
+struct ValueSetRun {
+  std::string name;
+  std::uint32_t first = 0, components = 1;
+};
+std::vector<ValueSetRun> value_set_runs(const ValueSets& sets);
+
 struct TrxValueMember {
   std::string name;         // "dpv/NAME.float32", "dps/NAME.3.float32", ...
   std::vector<float> data;  // row-major: one row of `components` values per point or streamline

@@ -27,6 +27,10 @@ class BigEndianWriter {
     flush();
     out_.write(s.data(), s.size());
   }
+  void bytes(const std::vector<std::uint8_t>& b) {
+    flush();
+    out_.write(b.data(), b.size());
+  }
   void flush() {
     out_.write(buffer_.data(), buffer_.size() * 4);
     buffer_.clear();
@@ -102,14 +106,29 @@ void export_vtk(const VxlFile& file, const std::string& out_path, const Streamli
   }
   w.text("\n");
   const ValueSets& sv = file.streamline_values();
+  const std::vector<StreamlineGroup> groups = file.groups();
+  if (!sv.empty() || !groups.empty()) w.text("CELL_DATA " + std::to_string(m.streamlines) + "\n");
   if (!sv.empty()) {
-    w.text("CELL_DATA " + std::to_string(m.streamlines) + "\n");
     for (std::uint32_t k = 0; k < sv.size(); ++k) {
       w.text("SCALARS " + legacy_name(sv.name(k)) + " float 1\nLOOKUP_TABLE default\n");
       for (float v : subset ? subset->pick(sv.values(k)) : std::vector<float>(sv.values(k).begin(), sv.values(k).end()))
         w.real(v);
       w.text("\n");
     }
+  }
+  // A group is a 0/1 array: VTK has no groups, and every reader keeps cell arrays (ours as values).
+  for (const StreamlineGroup& g : groups) {
+    std::vector<std::uint8_t> member(file.meta().streamline_count, 0);
+    for (std::uint64_t s : g.members) member[s] = 1;
+    if (subset) {
+      std::vector<std::uint8_t> picked;
+      picked.reserve(subset->size());
+      for (std::uint64_t s : subset->indices()) picked.push_back(member[s]);
+      member = std::move(picked);
+    }
+    w.text("SCALARS " + legacy_name(g.name) + " unsigned_char 1\nLOOKUP_TABLE default\n");
+    w.bytes(member);
+    w.text("\n");
   }
   if (!point_values.empty()) {
     w.text("POINT_DATA " + std::to_string(m.points) + "\n");

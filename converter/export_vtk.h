@@ -1,5 +1,7 @@
 // Export of a .vxl to legacy VTK: BINARY (big-endian, as VTK writes it) POLYDATA, one LINES cell per
-// streamline; per-vertex value sets as POINT_DATA SCALARS, per-streamline ones as CELL_DATA SCALARS.
+// streamline; per-vertex value sets as POINT_DATA SCALARS, per-streamline ones as CELL_DATA SCALARS, and
+// each group as a CELL_DATA unsigned_char array named after it (1: member, 0: not), which the readers
+// (ours included) take as a per-streamline value set.
 #pragma once
 
 #include <string>

@@ -351,6 +351,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   std::vector<VoxelOrderWriter> writers;
   for (unsigned t = 0; t < threads; ++t) writers.emplace_back(set);
   std::atomic<std::uint64_t> ordered{0};
+  std::vector<double> repack_bound(threads, 0.0);  // per thread: the largest of its voxels' packing bounds
   // One more item before the voxels: float32 vertices are final, so their checksum is taken here, beside
   // the orders, rather than alone at the end.
   parallel_for(voxels.size() + 1, threads, [&](std::uint64_t item, unsigned t) {
@@ -360,7 +361,10 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
     }
     VoxelEntry& v = voxels[item - 1];
     detail::set_tight_bounds({&v, 1}, vertices.data(), 0);
-    if (packed) pack_vertex_blocks({&v, 1}, vertices, ends, out.packed_vertices(), 1);
+    if (packed) {
+      pack_vertex_blocks({&v, 1}, vertices, ends, out.packed_vertices(), 1);
+      repack_bound[t] = std::max(repack_bound[t], packed_error_bound(v));
+    }
     writers[t].write(v, level_row(s.levels, item - 1, s.level_count), vertices, ends,
                      out.orders().data() + v.order_offset);
     const std::uint64_t d = ++ordered;
@@ -406,6 +410,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   summary.points = meta.point_count;
   summary.voxels = meta.voxel_count;
   summary.pack = f.pack();
+  summary.repack_error_bound = *std::max_element(repack_bound.begin(), repack_bound.end());
   summary.point_value_sets = static_cast<std::uint32_t>(point_values.size());
   summary.streamline_value_sets = static_cast<std::uint32_t>(streamline_values.size());
   return summary;

@@ -17,6 +17,7 @@
 #include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
+#include "tests/export_test_support.h"
 #include "tests/test_support.h"
 
 namespace vxl {
@@ -36,14 +37,6 @@ Tractogram grouped_tractogram() {
   t.groups.push_back({"CST_left", {0, 5, 6, 400}});
   t.groups.push_back({"AF right", {1, 401}});
   return t;
-}
-
-// float32 positions: the exports below are compared with the source bit for bit.
-std::string convert_to(Tractogram t, const std::string& path) {
-  ConvertSettings exact;
-  exact.positions = PositionEncoding::Float32;
-  convert_tractogram(std::move(t), path, exact);
-  return path;
 }
 
 // The .vxl's streamlines as a tractogram (what any export must give back).
@@ -121,7 +114,7 @@ bool have_python_numpy() { return test::run_program("/usr/bin/python3", "-c 'imp
 
 TEST(ExportTrx, ReadsBackIdenticallyWithGroups) {
   ScratchDir dir;
-  const VxlFile f = VxlFile::open(convert_to(grouped_tractogram(), dir.file("g.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(grouped_tractogram(), dir.file("g.vxl")));
   ASSERT_GT(f.meta().synthetic_point_count, 0u);
   export_trx(f, dir.file("g.trx"));
   const Tractogram back = read_trx(dir.file("g.trx"));
@@ -142,7 +135,7 @@ TEST(ExportTrx, ReadsBackIdenticallyWithGroups) {
 TEST(ExportTrx, StructureFollowsTheSpecificationInAnIndependentReader) {
   if (!have_python_numpy()) GTEST_SKIP() << "/usr/bin/python3 with numpy is needed for the independent check";
   ScratchDir dir;
-  const VxlFile f = VxlFile::open(convert_to(grouped_tractogram(), dir.file("g.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(grouped_tractogram(), dir.file("g.vxl")));
   export_trx(f, dir.file("g.trx"));
   const std::string out = check_trx_in_python(dir, dir.file("g.trx"));
   EXPECT_NE(out.find("TRX-OK 402 " + std::to_string(f.meta().point_count) + " AF right|CST_left"), std::string::npos)
@@ -153,7 +146,7 @@ TEST(ExportTrx, EmptyTractogram) {
   ScratchDir dir;
   Tractogram t;
   t.source.path = "empty.tck";
-  const VxlFile f = VxlFile::open(convert_to(std::move(t), dir.file("e.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(std::move(t), dir.file("e.vxl")));
   export_trx(f, dir.file("e.trx"));
   const Tractogram back = read_trx(dir.file("e.trx"));
   EXPECT_EQ(back.streamline_count(), 0u);
@@ -164,7 +157,7 @@ TEST(ExportTrx, EmptyTractogram) {
 
 TEST(ExportTrx, DefaultReferenceCoversTheBounds) {
   ScratchDir dir;
-  const VxlFile f = VxlFile::open(convert_to(grouped_tractogram(), dir.file("g.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(grouped_tractogram(), dir.file("g.vxl")));
   const TrxReference r = trx_reference(f);
   for (int c = 0; c < 3; ++c) {
     EXPECT_EQ(r.voxel_to_rasmm[c][c], 1.0);
@@ -178,7 +171,7 @@ TEST(ExportTrx, GroupNameThatCannotBeAMemberIsUnsupported) {
   ScratchDir dir;
   Tractogram t = grouped_tractogram();
   t.groups.push_back({"a/b", {2}});
-  const VxlFile f = VxlFile::open(convert_to(std::move(t), dir.file("g.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(std::move(t), dir.file("g.vxl")));
   try {
     export_trx(f, dir.file("g.trx"));
     FAIL();
@@ -190,7 +183,7 @@ TEST(ExportTrx, GroupNameThatCannotBeAMemberIsUnsupported) {
 
 TEST(ExportTrx, CliChoosesTheFormatByExtension) {
   ScratchDir dir;
-  const std::string vxl = convert_to(grouped_tractogram(), dir.file("g.vxl"));
+  const std::string vxl = test::convert_float32(grouped_tractogram(), dir.file("g.vxl"));
   auto r = test::run_cli("export '" + vxl + "' '" + dir.file("g.TRX") + "'");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(read_trx(dir.file("g.TRX")).streamline_count(), 402u);
@@ -207,7 +200,7 @@ TEST(ExportTrxReal, SourceReferenceAndGroupsAreKept) {
   ScratchDir dir;
   const std::string afq = "niivue__sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx";
   const Tractogram source = read_trx(test::real(afq));
-  const VxlFile f = VxlFile::open(convert_to(read_trx(test::real(afq)), dir.file("afq.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(read_trx(test::real(afq)), dir.file("afq.vxl")));
   export_trx(f, dir.file("afq.trx"));
   const Tractogram back = read_trx(dir.file("afq.trx"));
   expect_same_streamlines(streamlines_of(f), back);
@@ -225,7 +218,8 @@ TEST(ExportTrxReal, SourceReferenceAndGroupsAreKept) {
 
   // A TRK source gives its dim and vox_to_ras.
   const Tractogram trk = read_trk(test::real("nibabel__standard.trk"));
-  const VxlFile g = VxlFile::open(convert_to(read_trk(test::real("nibabel__standard.trk")), dir.file("trk.vxl")));
+  const VxlFile g =
+      VxlFile::open(test::convert_float32(read_trk(test::real("nibabel__standard.trk")), dir.file("trk.vxl")));
   const TrxReference r = trx_reference(g);
   ASSERT_TRUE(trk.source.vox_to_ras);
   for (int i = 0; i < 4; ++i)
@@ -239,7 +233,7 @@ TEST(ExportTrxReal, TckAndTrxOfRealFixturesReadBackIdentically) {
   for (const char* name : {"TractographyFormat__stroke.tck", "trx-python__small.trx", "niivue__C_PHP.trk.gz",
                            "nibabel__empty.tck", "mrtrix3__tmp.tck"}) {
     SCOPED_TRACE(name);
-    const VxlFile f = VxlFile::open(convert_to(read_tractogram(test::real(name)), dir.file("r.vxl")));
+    const VxlFile f = VxlFile::open(test::convert_float32(read_tractogram(test::real(name)), dir.file("r.vxl")));
     const Tractogram expected = streamlines_of(f);
     export_tck(f, dir.file("r.tck"));
     expect_same_streamlines(expected, read_tck(dir.file("r.tck")));

@@ -659,3 +659,45 @@ TEST(VxlzPackageReal, StrokeAndAfqRoundTrip) {
 
 }  // namespace
 }  // namespace vxl
+
+namespace vxl {
+namespace {
+
+// `unpack` packs the positions it writes again by default: the bound it prints must cover both steps, as
+// measured between the .vxl that was packed and the unpacked one.
+TEST(VxlzPackageOptions, UnpackPrintsABoundThatHoldsForWhatItWrote) {
+  ScratchDir dir;
+  const std::string vxl = convert_to(test_tractogram(), dir.file("s.vxl"));
+  ASSERT_EQ(test::run_cli("pack " + test::q(vxl) + " " + test::q(dir.file("s.vxlz"))).exit_code, 0);
+  const VxlFile original = VxlFile::open(vxl);
+  auto printed_bound = [](const std::string& output) {
+    const std::size_t at = output.find("positions within ");
+    EXPECT_NE(at, std::string::npos) << output;
+    return at == std::string::npos ? 0.0 : std::stod(output.substr(at + 17));
+  };
+  for (const char* positions : {"packed", "float32"}) {
+    SCOPED_TRACE(positions);
+    const std::string out = dir.file(std::string("u_") + positions + ".vxl");
+    const auto r = test::run_cli("unpack " + test::q(dir.file("s.vxlz")) + " " + test::q(out) + " --positions " +
+                                 positions);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const double bound = printed_bound(r.output);
+    const double error = max_vertex_error(original, VxlFile::open(out));
+    EXPECT_LE(error, bound) << r.output;
+    const UnpackSummary s = unpack_vxlz(dir.file("s.vxlz"), dir.file("again.vxl"), [&] {
+      UnpackSettings u;
+      u.positions = std::string(positions) == "packed" ? PositionEncoding::Packed : PositionEncoding::Float32;
+      return u;
+    }());
+    if (std::string(positions) == "packed") {
+      EXPECT_GT(s.repack_error_bound, 0.0);
+      EXPECT_GT(error, s.pack.error_bound) << "re-packing moves points beyond the package's own bound";
+    } else {
+      EXPECT_EQ(s.repack_error_bound, 0.0);
+    }
+    EXPECT_NEAR(bound, s.error_bound(), 1e-6) << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace vxl

@@ -34,6 +34,7 @@
 #include "converter/readers/latin1.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/regular_file.h"
+#include "converter/readers/trk_header.h"
 #include "format/checksum.h"
 #include "format/error.h"
 #include "format/mapped_file.h"
@@ -41,23 +42,7 @@
 namespace vxl {
 namespace {
 
-constexpr std::size_t kHeaderSize = 1000;
-
-// Byte offsets of the header fields (TrackVis header layout).
-constexpr std::size_t kOffDim = 6;              // int16[3]
-constexpr std::size_t kOffVoxelSize = 12;       // float32[3]
-constexpr std::size_t kOffOrigin = 24;          // float32[3] (unused by TrackVis and nibabel)
-constexpr std::size_t kOffNScalars = 36;        // int16
-constexpr std::size_t kOffScalarNames = 38;     // char[10][20]
-constexpr std::size_t kOffNProperties = 238;    // int16
-constexpr std::size_t kOffPropertyNames = 240;  // char[10][20]
-constexpr std::size_t kOffVoxToRas = 440;       // float32[4][4], row-major (version 2 only)
-constexpr std::size_t kOffVoxelOrder = 948;     // char[4]
-constexpr std::size_t kOffImageOrient = 956;    // float32[6]
-constexpr std::size_t kOffInvertSwap = 982;     // uint8 invert_x, invert_y, invert_z, swap_xy, swap_yz, swap_zx
-constexpr std::size_t kOffNCount = 988;         // int32
-constexpr std::size_t kOffVersion = 992;        // int32
-constexpr std::size_t kOffHdrSize = 996;        // int32
+using namespace trk;
 
 // Reads numbers of the file's byte order from an in-memory buffer. Callers bounds-check first; loads
 // go through memcpy because nothing in a TRK file is aligned beyond 4 bytes and the header-relative
@@ -146,8 +131,6 @@ std::vector<std::string> value_names(const std::uint8_t* slots, int count, const
     if (names[k].empty()) names[k] = std::string(fallback) + "_" + std::to_string(k);
   return names;
 }
-
-using Mat4 = std::array<std::array<double, 4>, 4>;
 
 Mat4 identity4() {
   Mat4 m{};
@@ -610,6 +593,21 @@ void read_records(TrkBytes& stream, const TrkHeader& h, const Mat4& a, Tractogra
 }
 
 }  // namespace
+
+namespace trk {
+
+Mat4 voxmm_to_rasmm(std::span<const std::uint8_t> header, const std::string& path, std::vector<std::string>& warnings) {
+  TrkBytes stream(header);
+  const FailAt fail_at = [&](std::uint64_t offset, const std::string& what) { fail_input(path, offset, what); };
+  return voxmm_to_ras(read_header(stream, path, warnings, fail_at), warnings, fail_at);
+}
+
+std::optional<std::string> orientation_code(const Mat4& vox_to_ras) {
+  const auto o = affine_orientation(vox_to_ras);
+  return o ? std::optional<std::string>(orientation_name(*o)) : std::nullopt;
+}
+
+}  // namespace trk
 
 // Header, affine, provenance, records: the four stages above.
 Tractogram read_trk(const std::string& path) {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/convert.h"
+#include "converter/export_trk.h"
 #include "converter/export_trx.h"
 #include "converter/export_values.h"
 #include "converter/export_vtk.h"
@@ -84,7 +85,8 @@ Tractogram subset_tractogram(const VxlFile& file, const StreamlineSubset& subset
 
 bool is_selection_output(const std::string& path) {
   const std::string lower = lower_case(path);
-  return lower.ends_with(".tck") || lower.ends_with(".trx") || lower.ends_with(".vtk") || lower.ends_with(".vxl");
+  return lower.ends_with(".tck") || lower.ends_with(".trx") || lower.ends_with(".vtk") || lower.ends_with(".vxl") ||
+         lower.ends_with(".trk") || lower.ends_with(".trk.gz");
 }
 
 std::vector<std::string> write_selection(const VxlFile& file, const StreamlineSubset& subset,
@@ -94,15 +96,17 @@ std::vector<std::string> write_selection(const VxlFile& file, const StreamlineSu
   if (lower.ends_with(".tck")) return export_tck(file, out_path, tck, &subset, header).warnings;
   if (tck.tsf_path || tck.value)
     throw Error(ErrorKind::Usage, out_path, std::nullopt,
-                "--tsf and --value go with a .tck output (a .trx, .vtk or .vxl holds every value set)");
+                "--tsf and --value go with a .tck output (a .trx, .vtk, .trk or .vxl holds the value sets)");
   if (lower.ends_with(".trx")) {
     export_trx(file, out_path, &subset);
+  } else if (lower.ends_with(".trk") || lower.ends_with(".trk.gz")) {
+    return export_trk(file, out_path, &subset).warnings;
   } else if (lower.ends_with(".vtk")) {
     export_vtk(file, out_path, &subset);
   } else if (lower.ends_with(".vxl")) {
     convert_tractogram(subset_tractogram(file, subset), out_path, settings_of(file));
   } else {
-    throw Error(ErrorKind::Usage, out_path, std::nullopt, "a selection is written to .tck, .trx, .vtk or .vxl");
+    throw Error(ErrorKind::Usage, out_path, std::nullopt, "a selection is written to .tck, .trx, .vtk, .trk or .vxl");
   }
   return {};
 }

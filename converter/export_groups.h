@@ -1,0 +1,39 @@
+// The groups of a .vxl (GRPS) in exports to formats without groups (TCK, VTK): one group's streamlines as
+// a subset, one TCK per group, file names made from group names, and the warning when groups are lost.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "converter/export_tck.h"
+#include "converter/streamline_subset.h"
+#include "format/vxl_file.h"
+
+namespace vxl {
+
+// The streamlines of group `name`. Throws vxl::Error (Usage) when the file has no such group, naming those
+// it has.
+StreamlineSubset group_subset(const VxlFile& file, const std::string& name);
+
+// "N group(s) not written: FORMAT has no place for them: 'A' (n streamlines), ..." when the file has
+// groups with members among the written streamlines (`subset`, or all); nothing otherwise.
+std::optional<std::string> groups_not_written(const VxlFile& file, const std::string& format,
+                                              const StreamlineSubset* subset = nullptr);
+
+// One file name per group (same order), without the extension: the group name with '/', '\', control
+// characters and a leading '.' replaced by '_' (never empty), made unique, ignoring case, by "_2", "_3", …
+std::vector<std::string> group_file_names(const std::vector<StreamlineGroup>& groups);
+
+struct SplitGroupFile {
+  std::string group, tck, tsf;  // tsf empty when none was written
+  ExportSummary summary;
+};
+
+// Writes DIR/NAME.tck for every group (and DIR/NAME.tsf beside each when `value` names a per-point set),
+// creating DIR when its parent exists. Each file is written atomically. Throws vxl::Error: Usage when the
+// file has no groups or no per-point set `value`; Output when DIR cannot be made or written.
+std::vector<SplitGroupFile> export_tck_per_group(const VxlFile& file, const std::string& dir,
+                                                 const std::optional<std::string>& value);
+
+}  // namespace vxl
