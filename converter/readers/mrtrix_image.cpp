@@ -7,9 +7,8 @@
 #include <optional>
 #include <vector>
 
-#include "converter/readers/gzip_bytes.h"
+#include "converter/readers/image_file.h"
 #include "converter/readers/mrtrix_header.h"
-#include "converter/readers/nifti_image.h"
 #include "converter/readers/regular_file.h"
 #include "converter/readers/voxel_samples.h"
 #include "format/error.h"
@@ -146,22 +145,13 @@ Layout layout(const std::string& path, const std::optional<std::string>& text, s
 }  // namespace
 
 VolumeImage read_mrtrix_image(const std::string& path, const ImageLimits& limits) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail_input(path, std::nullopt, "no such file (expected an MRtrix image)");
-  require_regular_file(path);
-  const MappedFile file(path);
-  const bool gz = is_gzip(file.bytes());
-  std::vector<std::string> warnings;  // zero padding after the gzip stream: harmless
-  const std::uint64_t cap = inflate_cap(file.size()) - kInflateSlack + kImageInflateSlack;
-  std::optional<GzipBytes> stream;
-  if (gz)
-    stream.emplace(path, file.bytes(), warnings, cap, "real images compress about 2-10x, masks far more");
-  else
-    stream.emplace(file.bytes());
+  ImageFile file(path, "an MRtrix");
+  GzipBytes& stream = file.bytes();
+  const bool gz = file.gzipped();
 
   bool ended = false;
-  std::vector<std::uint8_t> text = header_bytes(path, *stream, ended);
-  std::uint64_t known_size = gz ? (stream->at_end() ? text.size() : UINT64_MAX) : file.size();
+  std::vector<std::uint8_t> text = header_bytes(path, stream, ended);
+  std::uint64_t known_size = gz ? (stream.at_end() ? text.size() : UINT64_MAX) : file.file_size();
   // MRtrix ends a .mih (a header alone) at the end of the file, without an END line.
   const bool mih = lower(path).ends_with(".mih");
   if (mih && !gz && !ended) {
@@ -230,38 +220,33 @@ VolumeImage read_mrtrix_image(const std::string& path, const ImageLimits& limits
   for (std::size_t a = 0; a < axes; ++a)
     if (a < 3 || order.reversed[a]) last += double(dim[a] - 1) * stride[a];
   const double wanted = double(h.data_offset) + (last + 1) * double(size);
-  if (gz && wanted > double(cap))
-    fail_unsupported(path, "the header's data need " + std::to_string(static_cast<std::uint64_t>(wanted)) +
-                               " bytes, over " + std::to_string(kMaxInflateRatio) + " times the compressed size (" +
-                               std::to_string(file.size()) + " bytes) plus " +
-                               std::to_string(kImageInflateSlack >> 20) +
-                               " MiB; refused as a likely decompression bomb. To read it anyway, gunzip it first");
+  file.check_claim(wanted, "the header's data");
 
   // The data: this stream, or the file a .mih names beside it.
   std::optional<MappedFile> other;
   std::optional<GzipBytes> other_stream;
-  GzipBytes* data = &*stream;
+  GzipBytes* data = &stream;
   std::string data_path = path;
   std::uint64_t skip = h.data_offset - (h.data_file == "." ? text.size() : 0);
   if (h.data_file != ".") {
     if (gz) fail_unsupported(path, "a gzipped MRtrix header naming another data file");
     data_path = (std::filesystem::path(path).parent_path() / h.data_file).string();
-    if (!std::filesystem::exists(data_path, ec))
+    if (std::error_code ec; !std::filesystem::exists(data_path, ec))
       fail_input(path, std::nullopt, "the data file '" + h.data_file + "' it names does not exist");
     require_regular_file(data_path);
     other.emplace(data_path);
     other_stream.emplace(other->bytes());
     data = &*other_stream;
   }
-  const std::string where = gz ? " (offset in the decompressed data)" : "";
   const auto truncated = [&](std::uint64_t at) {
     fail_input(data_path, at,
                "truncated MRtrix image data: the header's " + field("dim") + " voxels of " + std::to_string(size) +
                    " bytes at offset " + std::to_string(h.data_offset) + " need " +
                    std::to_string(static_cast<std::uint64_t>(wanted)) + " bytes, the file holds " + std::to_string(at) +
-                   where);
+                   file.offset_note());
   };
-  if (!gz && wanted > double(other ? other->size() : file.size())) truncated(other ? other->size() : file.size());
+  const std::uint64_t data_size = other ? other->size() : file.file_size();
+  if (!gz && wanted > double(data_size)) truncated(data_size);
   if (!data->skip(skip)) truncated(data->offset() + data->left());
 
   VolumeImage v;
@@ -300,8 +285,7 @@ VolumeImage read_mrtrix_image(const std::string& path, const ImageLimits& limits
     }
     at += std::int64_t(count);
   }
-  if (gz)
-    while (!stream->at_end()) stream->skip(stream->left());
+  file.finish();
   return v;
 }
 

@@ -10,9 +10,8 @@
 //   scaling    optional "offset,multiplier": value = offset + multiplier * stored
 //   file       ". OFFSET" (this file) or, in a .mih, "NAME [OFFSET]" beside it; data in several files is
 //              refused (exit 4)
-// A .mif.gz is inflated through converter/readers/gzip_bytes.h under the limits of
-// converter/readers/nifti_image.h, and the sizes are checked against the caller's ImageLimits before any
-// voxel is read.
+// A .mif.gz is inflated through converter/readers/image_file.h as a .nii.gz is, and the sizes are checked against the
+// caller's ImageLimits before any voxel is read.
 #pragma once
 
 #include <string>

@@ -4,18 +4,15 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
 #include <memory>
 #include <optional>
 #include <vector>
 
 #include <nifti2_io.h>
 
-#include "converter/readers/gzip_bytes.h"
-#include "converter/readers/regular_file.h"
+#include "converter/readers/image_file.h"
 #include "converter/readers/voxel_samples.h"
 #include "format/error.h"
-#include "format/mapped_file.h"
 
 namespace vxl {
 namespace {
@@ -158,23 +155,12 @@ std::array<double, 16> voxel_to_ras(const nifti_image& nim, const std::string& p
 }  // namespace
 
 VolumeImage read_nifti_image(const std::string& path, const ImageLimits& limits) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail_input(path, std::nullopt, "no such file (expected a NIfTI image)");
-  require_regular_file(path);
   nifti_set_debug_level(0);  // the library would print its own messages; ours name the file and the cause
-  const MappedFile file(path);
-  const bool gz = is_gzip(file.bytes());
-  std::vector<std::string> warnings;  // zero padding after the gzip stream: harmless, and an image has no provenance
-  const std::uint64_t cap = inflate_cap(file.size()) - kInflateSlack + kImageInflateSlack;
-  std::optional<GzipBytes> stream;
-  if (gz)
-    stream.emplace(path, file.bytes(), warnings, cap, "real images compress about 2-10x, masks far more");
-  else
-    stream.emplace(file.bytes());
-  const std::string where = gz ? " (offset in the decompressed data)" : "";
+  ImageFile file(path, "a NIfTI");
+  GzipBytes& stream = file.bytes();
 
   std::vector<unsigned char> h;
-  const ImagePtr nim = read_header(path, *stream, h);
+  const ImagePtr nim = read_header(path, stream, h);
   const std::array<std::int64_t, 3> dims{nim->dim[1], nim->dim[2], nim->dim[3]};
   for (int a = 0; a < 3; ++a)
     if (dims[a] < 1 || dims[a] > (std::int64_t(1) << 31))
@@ -189,23 +175,17 @@ VolumeImage read_nifti_image(const std::string& path, const ImageLimits& limits)
   const std::size_t size = sample_bytes(type);
   const std::uint64_t start = static_cast<std::uint64_t>(nim->iname_offset);
   const double wanted = double(start) + double(n) * double(size);
-  if (gz && wanted > double(cap))
-    fail_unsupported(path, "the header's " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
-                               std::to_string(dims[2]) + " voxels of " + std::to_string(size) + " bytes need " +
-                               std::to_string(static_cast<std::uint64_t>(wanted)) + " bytes, over " +
-                               std::to_string(kMaxInflateRatio) + " times the compressed size (" +
-                               std::to_string(file.size()) + " bytes) plus " +
-                               std::to_string(kImageInflateSlack >> 20) +
-                               " MiB; refused as a likely decompression bomb. To read it anyway, gunzip it first");
+  file.check_claim(wanted, "the header's " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
+                               std::to_string(dims[2]) + " voxels of " + std::to_string(size) + " bytes");
   const auto truncated = [&](std::uint64_t at) {
     fail_input(path, at,
                "truncated NIfTI image: the header's " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
                    std::to_string(dims[2]) + " voxels of " + std::to_string(size) + " bytes at offset " +
                    std::to_string(start) + " need " + std::to_string(static_cast<std::uint64_t>(wanted)) +
-                   " bytes, the file holds " + std::to_string(at) + where);
+                   " bytes, the file holds " + std::to_string(at) + file.offset_note());
   };
-  if (!gz && wanted > double(file.size())) truncated(file.size());
-  if (!stream->skip(start - h.size())) truncated(stream->offset() + stream->left());
+  if (!file.gzipped() && wanted > double(file.file_size())) truncated(file.file_size());
+  if (!stream.skip(start - h.size())) truncated(stream.offset() + stream.left());
 
   VolumeImage v;
   v.path = path;
@@ -220,16 +200,15 @@ VolumeImage read_nifti_image(const std::string& path, const ImageLimits& limits)
   const std::size_t block = std::max<std::size_t>(1, (std::size_t(1) << 20) / size);
   while (v.values.size() < n) {
     const std::size_t count = std::min(block, n - v.values.size());
-    const std::uint8_t* p = stream->take(count * size);
-    if (!p) truncated(stream->offset() + stream->left());
+    const std::uint8_t* p = stream.take(count * size);
+    if (!p) truncated(stream.offset() + stream.left());
     const std::size_t done = v.values.size();
     v.values.resize(done + count);
     samples_to_float(type, swap, p, count, v.values.data() + done, scaled ? slope : 1.0, scaled ? inter : 0.0);
   }
   // The rest of a gzip stream (a 4D image's other volumes) is inflated and dropped: its CRC, and what
   // follows it, are checked as for any gzip file.
-  if (gz)
-    while (!stream->at_end()) stream->skip(stream->left());
+  file.finish();
   return v;
 }
 
