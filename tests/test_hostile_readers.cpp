@@ -2,17 +2,21 @@
 // the right kind, or read with a warning where data would otherwise be lost silently. Every test here
 // failed before the reader was fixed.
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "converter/readers/nifti_image.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "converter/readers/tck_stream.h"
 #include "format/error.h"
 #include "tests/hostile_inputs.h"
+#include "tests/nifti_test_files.h"
 #include "tests/test_support.h"
 
 namespace {
@@ -236,6 +240,121 @@ TEST(HostileTck, NegativeCountIsQuotedAsWritten) {
 // ---- row 12: a FIFO as input must not hang ----
 
 // Through the CLI under `timeout`, so that a reader that blocks on the FIFO fails the test (exit 124)
+// ---- NIfTI images (.nii.gz read through the .trk.gz rules) ----
+
+// 64 x 64 x 64 int16 voxels of small pseudo-random values: they compress, into Huffman-coded blocks
+// that a flipped byte damages.
+std::string nifti_noise() {
+  std::string data(64 * 64 * 64 * 2, '\0');
+  std::uint32_t x = 12345;
+  for (std::size_t i = 0; i < data.size(); i += 2) {
+    x = x * 1664525u + 1013904223u;
+    data[i] = static_cast<char>((x >> 24) & 0x0F);
+  }
+  return vxl::test::nifti1_bytes({64, 64, 64}, 4, 16, data);
+}
+
+// Exit 3 naming the file and where zlib failed, having allocated only what it had read.
+TEST(NiftiImage, DamagedGzipIsExit3) {
+  ScratchDir dir;
+  std::string gz = hostile::gzip(nifti_noise());
+  ASSERT_GT(gz.size(), 100000u);
+  for (std::size_t at = 70000; at < 70016; ++at) gz[at] = static_cast<char>(~gz[at]);
+  const std::string p = dir.file("damaged.nii.gz");
+  hostile::write_file(p, gz);
+  const vxl::Error e = error_of([&] { (void)vxl::read_volume_image(p); });
+  EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
+  ASSERT_TRUE(e.offset().has_value()) << e.what();
+  EXPECT_GE(*e.offset(), 70000u) << e.what();
+  EXPECT_NE(std::string(e.what()).find("corrupt gzip stream"), std::string::npos) << e.what();
+}
+
+// The same damage under a header claiming 8 GiB (1024^3 float64): exit 3 too, having allocated nothing for
+// the claim.
+TEST(NiftiImage, DamagedGzipClaimingGigabytesIsExit3) {
+  ScratchDir dir;
+  std::string nii = nifti_noise();
+  const std::int16_t dims[3] = {1024, 1024, 1024};
+  std::memcpy(nii.data() + 42, dims, sizeof dims);
+  const std::int16_t float64[2] = {64, 64};
+  std::memcpy(nii.data() + 70, float64, sizeof float64);
+  std::string gz = hostile::gzip(nii);
+  for (std::size_t at = 70000; at < 70016; ++at) gz[at] = static_cast<char>(~gz[at]);
+  const std::string p = dir.file("claims8g.nii.gz");
+  hostile::write_file(p, gz);
+  const vxl::Error e = error_of([&] { (void)vxl::read_volume_image(p); });
+  EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
+  EXPECT_NE(std::string(e.what()).find("corrupt gzip stream"), std::string::npos) << e.what();
+}
+
+// 128 MiB of zeros (a 130 KB file) claimed by a 512^3 uint8 header: refused before inflating, where the
+// whole image would have been read at several times its size.
+TEST(NiftiImage, GzipBombIsRefusedFromItsHeader) {
+  ScratchDir dir;
+  const std::string zeros = hostile::gzip(std::string(1u << 20, '\0'));
+  std::string gz = hostile::gzip(vxl::test::nifti1_bytes({512, 512, 512}, 2, 8, ""));
+  for (int i = 0; i < 128; ++i) gz += zeros;
+  const std::string p = dir.file("bomb.nii.gz");
+  hostile::write_file(p, gz);
+  ASSERT_LT(std::filesystem::file_size(p), 200000u);
+  const vxl::Error e = error_of([&] { (void)vxl::read_volume_image(p); });
+  EXPECT_EQ(e.kind(), vxl::ErrorKind::Unsupported) << e.what();
+  EXPECT_NE(std::string(e.what()).find("decompression bomb"), std::string::npos) << e.what();
+  // A mask of zeros and a few ones compresses a thousandfold too: 64 MiB pass whatever the ratio.
+  std::string mask(256 * 256 * 256, '\0');
+  mask[1000] = 1;
+  const std::string q = dir.file("mask.nii.gz");
+  hostile::write_file(q, hostile::gzip(vxl::test::nifti1_bytes({256, 256, 256}, 2, 8, mask)));
+  ASSERT_LT(std::filesystem::file_size(q), 100000u);
+  const vxl::VolumeImage m = vxl::read_volume_image(q);
+  EXPECT_EQ(m.values[1000], 1.0f);
+}
+
+TEST(NiftiImage, GzipWithoutItsTrailerOrWithJunkAfterIsExit3) {
+  ScratchDir dir;
+  const std::string nii = vxl::test::nifti1_bytes({2, 2, 2}, 2, 8, std::string(8, '\1'));
+  const std::string cut = dir.file("cut.nii.gz"), junk = dir.file("junk.nii.gz"), pad = dir.file("pad.nii.gz");
+  hostile::write_file(cut, hostile::gzip(nii, /*finish=*/false));
+  hostile::write_file(junk, hostile::gzip(nii) + "garbage");
+  hostile::write_file(pad, hostile::gzip(nii) + std::string(10, '\0'));
+  const vxl::Error c = error_of([&] { (void)vxl::read_volume_image(cut); });
+  EXPECT_EQ(c.kind(), vxl::ErrorKind::Input) << c.what();
+  EXPECT_NE(std::string(c.what()).find("without its end-of-stream marker"), std::string::npos) << c.what();
+  const vxl::Error j = error_of([&] { (void)vxl::read_volume_image(junk); });
+  EXPECT_EQ(j.kind(), vxl::ErrorKind::Input) << j.what();
+  EXPECT_EQ(j.offset(), std::optional<std::uint64_t>(std::filesystem::file_size(junk) - 7)) << j.what();
+  EXPECT_EQ(vxl::read_volume_image(pad).values.size(), 8u);  // zero padding, as gzip and .trk.gz allow
+}
+
+TEST(NiftiImage, BinaryDatatypeIsUnsupportedNamingIt) {
+  ScratchDir dir;
+  const std::string p = dir.file("bits.nii");
+  hostile::write_file(p, vxl::test::nifti1_bytes({8, 1, 1}, 1, 1, std::string(1, '\xFF')));
+  const vxl::Error e = error_of([&] { (void)vxl::read_volume_image(p); });
+  EXPECT_EQ(e.kind(), vxl::ErrorKind::Unsupported) << e.what();
+  EXPECT_NE(std::string(e.what()).find("datatype 1 (BINARY)"), std::string::npos) << e.what();
+}
+
+TEST(NiftiImage, AbsurdTransformsAreExit3) {
+  ScratchDir dir;
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::pair<std::array<float, 12>, const char*> cases[] = {
+      {{1e30f, 0, 0, 0, 0, 1e30f, 0, 0, 0, 0, 1e30f, 0}, "1e+30 mm long"},
+      {{1e-9f, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}, "1e-09 mm long"},
+      {{1, 0, 0, 2e6f, 0, 1, 0, 0, 0, 0, 1, 0}, "puts voxel 0,0,0 at 2e+06"},
+      {{1, 0, 0, inf, 0, 1, 0, 0, 0, 0, 1, 0}, "not finite"},
+      {{1, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0}, "singular"},  // the third axis along the first
+  };
+  for (const auto& [sform, says] : cases) {
+    const std::string p = dir.file("affine.nii");
+    hostile::write_file(p, vxl::test::nifti1_bytes({2, 2, 2}, 2, 8, std::string(8, '\1'), sform));
+    const vxl::Error e = error_of([&] { (void)vxl::read_volume_image(p); });
+    EXPECT_EQ(e.kind(), vxl::ErrorKind::Input) << e.what();
+    EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << says << ": " << e.what();
+    EXPECT_NE(std::string(e.what()).find("1e-06 to 10000 mm"), std::string::npos) << e.what();
+  }
+}
+
 // instead of hanging it.
 TEST(HostileInput, FifoIsRefusedNotWaitedOn) {
   ScratchDir dir;

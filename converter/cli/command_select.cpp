@@ -42,8 +42,8 @@ void add_select_command(CLI::App& app) {
       "  voxlines select IN.vxl --include ROI --count [--json]\n"
       "A streamline is kept when every --include region holds one of its points, every --ends-in region its first\n"
       "or last point, no --exclude region any of its points, and its length is within the limits. ROI: X,Y,Z,R (a\n"
-      "sphere, RAS mm; a point at distance <= R is inside), box:X0,Y0,Z0,X1,Y1,Z1, FILE.nii[.gz] (its non-zero\n"
-      "voxels: the voxel nearest to the point) or FILE.nii[.gz]:LABEL (one label of a parcellation).\n"
+      "sphere, RAS mm; a point at distance <= R is inside), box:X0,Y0,Z0,X1,Y1,Z1, FILE.nii[.gz] or FILE.mif[.gz]\n"
+      "(its non-zero voxels: the voxel nearest to the point) or FILE.nii[.gz]:LABEL (one label of a parcellation).\n"
       "Points are those the .vxl stores: bit for bit the source's with --positions float32; with packed positions\n"
       "(the default) within the bound `voxlines info` prints, so a streamline whose deciding point lies that close\n"
       "to a region's surface may be decided differently from tckedit on the source.");

@@ -90,20 +90,41 @@ std::optional<MrtrixHeader> parse_mrtrix_header(const std::string& path, std::sp
   };
   h.datatype = single("datatype");
   std::string file = single("file");
-  if (file.size() < 2 || file[0] != '.' || file[1] != ' ')
-    fail_unsupported(path, name + " 'file:' must be '. OFFSET' (data in the same file); got '" + file + "'");
-  try {
-    std::size_t used = 0;
-    long long off = std::stoll(file.substr(2), &used);
-    if (off < 0) throw std::out_of_range("negative");
-    h.data_offset = static_cast<std::uint64_t>(off);
-  } catch (const std::exception&) {
-    fail_input(path, std::nullopt, name + " 'file:' offset is not a number: '" + file + "'");
+  if (kind.data_elsewhere) {
+    if (h.fields["file"].size() > 1)
+      fail_unsupported(path, name + " data split across " + std::to_string(h.fields["file"].size()) +
+                                 " files ('file:' entries); convert it to a single .mif first");
+    // "NAME [OFFSET]": the name may hold spaces, the offset is the last word when it is a number.
+    const std::size_t space = file.rfind(' ');
+    const std::string tail = space == std::string::npos ? "" : file.substr(space + 1);
+    const bool numbered = !tail.empty() && tail.find_first_not_of("0123456789") == std::string::npos;
+    h.data_file = numbered ? std::string(trim(std::string_view(file).substr(0, space))) : file;
+    if (h.data_file.empty()) fail_input(path, std::nullopt, name + " 'file:' names no file: '" + file + "'");
+    file = ". " + (numbered ? tail : "0");
+    if (h.data_file != ".") {
+      std::uint64_t off = 0;
+      const auto [end, ec] = std::from_chars(tail.data(), tail.data() + tail.size(), off);
+      if (numbered && (ec != std::errc() || end != tail.data() + tail.size()))
+        fail_input(path, std::nullopt, name + " 'file:' offset is not a number: '" + file + "'");
+      h.data_offset = off;
+    }
   }
-  if (h.data_offset < pos) fail_input(path, h.data_offset, name + " data offset points inside the header");
-  if (h.data_offset > file_size)
-    fail_input(path, h.data_offset,
-               name + " data offset is past the end of the file (" + std::to_string(file_size) + " bytes)");
+  if (h.data_file == ".") {
+    if (file.size() < 2 || file[0] != '.' || file[1] != ' ')
+      fail_unsupported(path, name + " 'file:' must be '. OFFSET' (data in the same file); got '" + file + "'");
+    try {
+      std::size_t used = 0;
+      long long off = std::stoll(file.substr(2), &used);
+      if (off < 0) throw std::out_of_range("negative");
+      h.data_offset = static_cast<std::uint64_t>(off);
+    } catch (const std::exception&) {
+      fail_input(path, std::nullopt, name + " 'file:' offset is not a number: '" + file + "'");
+    }
+    if (h.data_offset < pos) fail_input(path, h.data_offset, name + " data offset points inside the header");
+    if (h.data_offset > file_size)
+      fail_input(path, h.data_offset,
+                 name + " data offset is past the end of the file (" + std::to_string(file_size) + " bytes)");
+  }
   if (h.fields.contains("count")) {
     // Digits only: std::stoull would read "-5" as 2^64 - 5. A malformed count is as good as a stale one.
     const std::string text = h.fields["count"].back().get<std::string>();

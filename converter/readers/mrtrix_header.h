@@ -1,7 +1,8 @@
-// The text header MRtrix puts in front of its track files (TCK, "mrtrix tracks") and track scalar
-// files (TSF, "mrtrix track scalars"): a magic line, "key: value" lines (keys may repeat; a line without
-// a colon continues the previous value), "END". Required: "datatype" and "file: . OFFSET" (data in the
-// same file, after the header). One parser for both, and for a whole file as for its first bytes.
+// The text header MRtrix puts in front of its track files (TCK, "mrtrix tracks"), track scalar files
+// (TSF, "mrtrix track scalars") and images (.mif/.mih, "mrtrix image"): a magic line, "key: value" lines
+// (keys may repeat; a line without a colon continues the previous value), "END". Required: "datatype" and
+// "file: . OFFSET" (data in the same file, after the header); an image's header (.mih) may name another
+// file instead, "file: NAME [OFFSET]". One parser for all, and for a whole file as for its first bytes.
 #pragma once
 
 #include <bit>
@@ -20,6 +21,7 @@ struct MrtrixHeader {
   nlohmann::json fields = nlohmann::json::object();  // key -> array of values (keys may repeat)
   std::string datatype;
   std::uint64_t data_offset = 0;
+  std::string data_file = ".";            // "." is this file (only images name another)
   std::optional<std::string> count_text;  // "count" as the header spells it (warnings quote it)
   std::optional<std::uint64_t> count;  // count_text, when it is a decimal number (it may be stale: the data is trusted)
   // The last value of `key`, if present.
@@ -30,9 +32,11 @@ struct MrtrixHeader {
 struct MrtrixFileKind {
   const char* magic;
   const char* name;
+  bool data_elsewhere = false;  // "file:" may name another file
 };
 inline constexpr MrtrixFileKind kTckFile{"mrtrix tracks", "TCK"};
 inline constexpr MrtrixFileKind kTsfFile{"mrtrix track scalars", "TSF"};
+inline constexpr MrtrixFileKind kImageFile{"mrtrix image", "MRtrix image", true};
 
 // The warning about a header "count" that is no number or not `streamlines` (the data is trusted), if any.
 std::optional<std::string> count_warning(const MrtrixHeader& h, std::uint64_t streamlines);

@@ -2,14 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <complex>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include <nifti2_io.h>
 
+#include "converter/readers/image_file.h"
+#include "converter/readers/voxel_samples.h"
 #include "format/error.h"
 
 namespace vxl {
@@ -20,55 +22,43 @@ struct ImageDeleter {
 };
 using ImagePtr = std::unique_ptr<nifti_image, ImageDeleter>;
 
-struct ZnzCloser {
-  znzFile f;
-  ~ZnzCloser() {
-    if (!znz_isnull(f)) znzclose(f);
+// The file's voxel type, or a refusal naming it (exit 4).
+SampleType sample_type(int datatype, const std::string& path) {
+  switch (datatype) {
+    case DT_UINT8: return SampleType::kUInt8;
+    case DT_INT8: return SampleType::kInt8;
+    case DT_INT16: return SampleType::kInt16;
+    case DT_UINT16: return SampleType::kUInt16;
+    case DT_INT32: return SampleType::kInt32;
+    case DT_UINT32: return SampleType::kUInt32;
+    case DT_INT64: return SampleType::kInt64;
+    case DT_UINT64: return SampleType::kUInt64;
+    case DT_FLOAT32: return SampleType::kFloat32;
+    case DT_FLOAT64: return SampleType::kFloat64;
+    case DT_FLOAT128: return SampleType::kFloat128;
+    case DT_COMPLEX64: return SampleType::kComplex64;
+    case DT_COMPLEX128: return SampleType::kComplex128;
+    case DT_RGB24: return SampleType::kRgb24;
+    case DT_RGBA32: return SampleType::kRgba32;
+    default: break;
   }
-};
-
-bool ends_with(const std::string& s, const std::string& tail) {
-  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
-}
-
-// Up to `limit` bytes of `path`, through zlib when it is gzipped.
-std::vector<unsigned char> read_start(const std::string& path, std::size_t limit) {
-  ZnzCloser z{znzopen(path.c_str(), "rb", 1)};
-  if (znz_isnull(z.f)) fail_input(path, std::nullopt, "cannot open the file");
-  std::vector<unsigned char> bytes(limit);
-  bytes.resize(znzread(bytes.data(), 1, limit, z.f));
-  return bytes;
-}
-
-// How many bytes `path` holds, up to `wanted` (a gzipped file is decompressed to count: its size says
-// nothing about its contents).
-std::uint64_t available_bytes(const std::string& path, std::uint64_t wanted) {
-  if (!ends_with(path, ".gz")) {
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(path, ec);
-    if (ec) fail_input(path, std::nullopt, "cannot read the file's size: " + ec.message());
-    return size;
-  }
-  ZnzCloser z{znzopen(path.c_str(), "rb", 1)};
-  if (znz_isnull(z.f)) fail_input(path, std::nullopt, "cannot open the file");
-  std::vector<unsigned char> chunk(1 << 20);
-  std::uint64_t total = 0;
-  while (total < wanted) {
-    const std::size_t n = znzread(chunk.data(), 1, chunk.size(), z.f);
-    if (n == 0) break;
-    total += n;
-  }
-  return total;
+  const bool known = datatype == DT_BINARY || datatype == DT_COMPLEX256;
+  fail_unsupported(path,
+                   std::string("NIfTI datatype ") + std::to_string(datatype) +
+                       (known ? std::string(" (") + nifti_datatype_string(datatype) + ")" : std::string()) +
+                       " is not supported" +
+                       (known ? "; convert the image to UINT8, INT16 or FLOAT32 first" : ": it is no NIfTI datatype"));
 }
 
 // The header of exactly `path`, checked before nifti_clib sees it: sizeof_hdr 348 (NIfTI-1, magic "n+1" at
 // byte 344) or 540 (NIfTI-2, "n+2" at byte 4), in either byte order, and sane dimensions. (nifti_clib
-// alone would take an ANALYZE 7.5 header without magic, turn negative dimensions into 1, and, given
-// T1.nii.gz, read T1.nii instead when both exist.) The single-file kinds only: the data follow the header.
-ImagePtr read_header(const std::string& path) {
-  const std::vector<unsigned char> h = read_start(path, 540);
-  if (h.size() < 4)
-    fail_input(path, 0, "not a NIfTI file: " + std::to_string(h.size()) + " bytes, shorter than any header");
+// alone would take an ANALYZE 7.5 header without magic and turn negative dimensions into 1.) The
+// single-file kinds only: the data follow the header. `h` holds the header's bytes on return.
+ImagePtr read_header(const std::string& path, GzipBytes& stream, std::vector<unsigned char>& h) {
+  const std::uint8_t* start = stream.take(4);
+  if (!start)
+    fail_input(path, 0, "not a NIfTI file: " + std::to_string(stream.left()) + " bytes, shorter than any header");
+  h.assign(start, start + 4);
   std::int32_t size = 0;
   std::memcpy(&size, h.data(), 4);
   const bool swap = size != 348 && size != 540;
@@ -93,9 +83,12 @@ ImagePtr read_header(const std::string& path) {
   if (sizeof_hdr != 348 && sizeof_hdr != 540)
     fail_input(path, 0,
                "not a NIfTI file: expected sizeof_hdr 348 (NIfTI-1) or 540 (NIfTI-2), got " + std::to_string(size));
-  if (h.size() < static_cast<std::size_t>(sizeof_hdr))
-    fail_input(path, h.size(),
-               "truncated NIfTI header: " + std::to_string(h.size()) + " of " + std::to_string(sizeof_hdr) + " bytes");
+  const std::uint8_t* rest = stream.take(static_cast<std::size_t>(sizeof_hdr) - 4);
+  if (!rest)
+    fail_input(path, 4 + stream.left(),
+               "truncated NIfTI header: " + std::to_string(4 + stream.left()) + " of " + std::to_string(sizeof_hdr) +
+                   " bytes");
+  h.insert(h.end(), rest, rest + sizeof_hdr - 4);
   const bool two = sizeof_hdr == 540;
   const std::size_t at = two ? 4 : 344;
   const char* m = reinterpret_cast<const char*>(h.data() + at);
@@ -116,6 +109,8 @@ ImagePtr read_header(const std::string& path) {
       fail_input(path, dim_at + a * dim_bytes,
                  "dimension " + std::to_string(a) + " of the image is " + std::to_string(d) + ", expected >= 1");
   }
+  // The datatype before nifti_clib, which refuses one it does not know with a message of its own.
+  (void)sample_type(static_cast<int>(integer(two ? 12 : 70, 2)), path);
   nifti_image* nim = nullptr;
   if (two) {
     nifti_2_header n2;
@@ -128,11 +123,6 @@ ImagePtr read_header(const std::string& path) {
   }
   if (!nim) fail_input(path, std::nullopt, "nifti_clib cannot read the NIfTI header (inconsistent fields)");
   ImagePtr image(nim);
-  // The data are in this very file, after the header and its extensions (vox_offset).
-  free(nim->fname);
-  free(nim->iname);
-  nim->fname = nifti_strdup(path.c_str());
-  nim->iname = nifti_strdup(path.c_str());
   double vox_offset = 0;
   if (two) {
     vox_offset = double(integer(168, 8));
@@ -145,124 +135,80 @@ ImagePtr read_header(const std::string& path) {
   const std::size_t header_end = static_cast<std::size_t>(sizeof_hdr) + 4;  // and the extension flags
   if (!std::isfinite(vox_offset) || vox_offset < 0 || vox_offset > 9.0e15)
     fail_input(path, two ? 168 : 108, "vox_offset " + std::to_string(vox_offset) + " is not a byte offset");
+  // The data are in this very file, after the header and its extensions.
   nim->iname_offset = std::max<std::int64_t>(static_cast<std::int64_t>(vox_offset), std::int64_t(header_end));
   return image;
 }
 
-template <typename T>
-void widen(const void* data, std::size_t n, float* out) {
-  const T* p = static_cast<const T*>(data);
-  for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(p[i]);
-}
-
-// The voxels as float, whatever their type.
-std::vector<float> to_float(int datatype, const void* d, std::size_t n, const std::string& path) {
-  std::vector<float> v(n);
-  const unsigned char* b = static_cast<const unsigned char*>(d);
-  switch (datatype) {
-    case DT_UINT8: widen<std::uint8_t>(d, n, v.data()); break;
-    case DT_INT8: widen<std::int8_t>(d, n, v.data()); break;
-    case DT_INT16: widen<std::int16_t>(d, n, v.data()); break;
-    case DT_UINT16: widen<std::uint16_t>(d, n, v.data()); break;
-    case DT_INT32: widen<std::int32_t>(d, n, v.data()); break;
-    case DT_UINT32: widen<std::uint32_t>(d, n, v.data()); break;
-    case DT_INT64: widen<std::int64_t>(d, n, v.data()); break;
-    case DT_UINT64: widen<std::uint64_t>(d, n, v.data()); break;
-    case DT_FLOAT32: widen<float>(d, n, v.data()); break;
-    case DT_FLOAT64: widen<double>(d, n, v.data()); break;
-    case DT_FLOAT128: widen<long double>(d, n, v.data()); break;
-    case DT_COMPLEX64:
-      for (std::size_t i = 0; i < n; ++i) v[i] = std::abs(static_cast<const std::complex<float>*>(d)[i]);
-      break;
-    case DT_COMPLEX128:
-      for (std::size_t i = 0; i < n; ++i)
-        v[i] = static_cast<float>(std::abs(static_cast<const std::complex<double>*>(d)[i]));
-      break;
-    case DT_RGB24:
-      for (std::size_t i = 0; i < n; ++i) v[i] = (float(b[3 * i]) + b[3 * i + 1] + b[3 * i + 2]) / 3.0f;
-      break;
-    case DT_RGBA32:
-      for (std::size_t i = 0; i < n; ++i) v[i] = (float(b[4 * i]) + b[4 * i + 1] + b[4 * i + 2]) / 3.0f;
-      break;
-    default:
-      fail_unsupported(path, std::string("NIfTI data type ") + nifti_datatype_string(datatype) + " (" +
-                                 std::to_string(datatype) + ") is not supported");
-  }
-  return v;
+// voxel index -> RAS mm from the header's sform (or qform), checked.
+std::array<double, 16> voxel_to_ras(const nifti_image& nim, const std::string& path) {
+  const nifti_dmat44& m = nim.sform_code > 0 ? nim.sto_xyz : nim.qto_xyz;
+  const double unit = nim.xyz_units == NIFTI_UNITS_METER ? 1000.0 : nim.xyz_units == NIFTI_UNITS_MICRON ? 0.001 : 1.0;
+  std::array<double, 16> a{};
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 4; ++col) a[4 * row + col] = m.m[row][col] * unit;
+  a[15] = 1.0;
+  check_voxel_to_ras(path, a, nim.sform_code > 0 ? "the sform" : nim.qform_code > 0 ? "the qform" : "pixdim");
+  return a;
 }
 
 }  // namespace
 
-NiftiImage read_nifti_image(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    fail_input(path, std::nullopt, "no such file (expected a NIfTI image)");
+VolumeImage read_nifti_image(const std::string& path, const ImageLimits& limits) {
   nifti_set_debug_level(0);  // the library would print its own messages; ours name the file and the cause
-  ImagePtr nim = read_header(path);
-  for (int a = 1; a <= 3; ++a)
-    if (nim->dim[a] < 1 || nim->dim[a] > (std::int64_t(1) << 31))
-      fail_input(path, std::nullopt,
-                 "absurd dimension " + std::to_string(a) + " of the image: " + std::to_string(nim->dim[a]) +
-                     " voxels (expected 1 to 2^31)");
-  if (nim->nbyper < 1 || nim->nbyper > 32)
-    fail_input(path, std::nullopt,
-               "bytes per voxel " + std::to_string(nim->nbyper) + " for data type " + std::to_string(nim->datatype));
-  // The first volume only (a 4D image's first time point).
-  const double voxels = double(nim->dim[1]) * double(nim->dim[2]) * double(nim->dim[3]);
-  const double bytes = voxels * nim->nbyper;
-  if (nim->iname_offset < 0) fail_input(path, 108, "negative vox_offset " + std::to_string(nim->iname_offset));
-  // From the header alone, before anything is inflated: a compressed file's size says nothing of what it
-  // claims to hold.
-  if (voxels > double(std::int64_t(1) << 30))
-    fail_unsupported(path, "the image has " + std::to_string(static_cast<std::uint64_t>(voxels)) +
-                               " voxels per volume; at most 2^30 are read");
-  // Against the file before reading: a header that claims more than the file holds (truncated, or absurd
-  // dimensions) must not make us allocate for it.
-  const double wanted = double(nim->iname_offset) + bytes;
-  const std::uint64_t have = available_bytes(path, wanted > 1.8e19 ? UINT64_MAX : static_cast<std::uint64_t>(wanted));
-  if (double(have) < wanted)
-    fail_input(path, have,
-               "truncated NIfTI image: the header's " + std::to_string(nim->dim[1]) + "x" +
-                   std::to_string(nim->dim[2]) + "x" + std::to_string(nim->dim[3]) + " voxels of " +
-                   std::to_string(nim->nbyper) + " bytes at offset " + std::to_string(nim->iname_offset) + " need " +
-                   std::to_string(static_cast<std::uint64_t>(wanted)) + " bytes, the file holds " +
-                   std::to_string(have));
-  // The voxels of the first volume, read here rather than by nifti_image_load, which looks for the data
-  // in files beside the one named.
-  const std::size_t n = static_cast<std::size_t>(nim->dim[1] * nim->dim[2] * nim->dim[3]);
-  std::vector<unsigned char> raw(n * static_cast<std::size_t>(nim->nbyper));
-  {
-    ZnzCloser z{znzopen(path.c_str(), "rb", 1)};
-    if (znz_isnull(z.f) || znzseek(z.f, static_cast<znz_off_t>(nim->iname_offset), SEEK_SET) < 0 ||
-        znzread(raw.data(), 1, raw.size(), z.f) != raw.size())
-      fail_input(path, static_cast<std::uint64_t>(nim->iname_offset), "cannot read the NIfTI voxel data");
-  }
-  if (nim->byteorder != nifti_short_order() && nim->swapsize > 1)
-    nifti_swap_Nbytes(static_cast<int64_t>(raw.size() / nim->swapsize), nim->swapsize, raw.data());
+  ImageFile file(path, "a NIfTI");
+  GzipBytes& stream = file.bytes();
 
-  NiftiImage v;
+  std::vector<unsigned char> h;
+  const ImagePtr nim = read_header(path, stream, h);
+  const std::array<std::int64_t, 3> dims{nim->dim[1], nim->dim[2], nim->dim[3]};
+  for (int a = 0; a < 3; ++a)
+    if (dims[a] < 1 || dims[a] > (std::int64_t(1) << 31))
+      fail_input(path, std::nullopt,
+                 "absurd dimension " + std::to_string(a + 1) + " of the image: " + std::to_string(dims[a]) +
+                     " voxels (expected 1 to 2^31)");
+  const SampleType type = sample_type(nim->datatype, path);
+  // From the header alone, before anything is inflated or allocated.
+  check_image_size(path, dims, limits);
+  const std::array<double, 16> affine = voxel_to_ras(*nim, path);
+  const std::size_t n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);  // the first volume
+  const std::size_t size = sample_bytes(type);
+  const std::uint64_t start = static_cast<std::uint64_t>(nim->iname_offset);
+  const double wanted = double(start) + double(n) * double(size);
+  file.check_claim(wanted, "the header's " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
+                               std::to_string(dims[2]) + " voxels of " + std::to_string(size) + " bytes");
+  const auto truncated = [&](std::uint64_t at) {
+    fail_input(path, at,
+               "truncated NIfTI image: the header's " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
+                   std::to_string(dims[2]) + " voxels of " + std::to_string(size) + " bytes at offset " +
+                   std::to_string(start) + " need " + std::to_string(static_cast<std::uint64_t>(wanted)) +
+                   " bytes, the file holds " + std::to_string(at) + file.offset_note());
+  };
+  if (!file.gzipped() && wanted > double(file.file_size())) truncated(file.file_size());
+  if (!stream.skip(start - h.size())) truncated(stream.offset() + stream.left());
+
+  VolumeImage v;
   v.path = path;
-  v.dims = {nim->dim[1], nim->dim[2], nim->dim[3]};
-  v.values = to_float(nim->datatype, raw.data(), n, path);
-  raw = {};
+  v.dims = dims;
+  v.voxel_to_ras = affine;
+  const bool swap = nim->byteorder != nifti_short_order();
   const double slope = nim->scl_slope, inter = nim->scl_inter;
   const bool scaled = slope != 0.0 && std::isfinite(slope) && std::isfinite(inter);
-  for (float& x : v.values) {
-    if (scaled) x = static_cast<float>(x * slope + inter);
-    if (!std::isfinite(x)) x = 0.0f;
+  // A block at a time, in the file's type: the destination grows as data arrive, so that a damaged stream
+  // is refused having allocated little more than what it held.
+  v.values.reserve(n);
+  const std::size_t block = std::max<std::size_t>(1, (std::size_t(1) << 20) / size);
+  while (v.values.size() < n) {
+    const std::size_t count = std::min(block, n - v.values.size());
+    const std::uint8_t* p = stream.take(count * size);
+    if (!p) truncated(stream.offset() + stream.left());
+    const std::size_t done = v.values.size();
+    v.values.resize(done + count);
+    samples_to_float(type, swap, p, count, v.values.data() + done, scaled ? slope : 1.0, scaled ? inter : 0.0);
   }
-  const nifti_dmat44& m = nim->sform_code > 0 ? nim->sto_xyz : nim->qto_xyz;
-  const double unit = nim->xyz_units == NIFTI_UNITS_METER ? 1000.0 : nim->xyz_units == NIFTI_UNITS_MICRON ? 0.001 : 1.0;
-  for (int row = 0; row < 3; ++row)
-    for (int col = 0; col < 4; ++col) v.voxel_to_ras[4 * row + col] = m.m[row][col] * unit;
-  v.voxel_to_ras[15] = 1.0;
-  const auto& a = v.voxel_to_ras;
-  const double det = a[0] * (a[5] * a[10] - a[6] * a[9]) - a[1] * (a[4] * a[10] - a[6] * a[8]) +
-                     a[2] * (a[4] * a[9] - a[5] * a[8]);
-  if (!std::isfinite(det) || std::abs(det) < 1e-12 || !std::isfinite(a[3] + a[7] + a[11]))
-    fail_input(path, std::nullopt,
-               std::string("the ") + (nim->sform_code > 0 ? "sform" : "qform") +
-                   " is singular or not finite: no voxel-to-RAS mapping");
+  // The rest of a gzip stream (a 4D image's other volumes) is inflated and dropped: its CRC, and what
+  // follows it, are checked as for any gzip file.
+  file.finish();
   return v;
 }
 

@@ -29,8 +29,7 @@
 #include <string>
 #include <vector>
 
-#include <zlib.h>
-
+#include "converter/readers/gzip_bytes.h"
 #include "converter/readers/latin1.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/regular_file.h"
@@ -260,138 +259,6 @@ Mat4 reorient(const Orientation& header, const Orientation& affine, const std::a
   return m;
 }
 
-bool is_gzip(const MappedFile& file) { return file.size() >= 2 && file.data()[0] == 0x1F && file.data()[1] == 0x8B; }
-
-// A .trk.gz may inflate at most this many times its own size (plus kInflateSlack). Real tractograms
-// compress 1.2-3x (float coordinates); deflate reaches ~1000x only on repetitive data such as the
-// zeros of a decompression bomb, which would otherwise fill memory.
-constexpr std::uint64_t kMaxInflateRatio = 100;
-constexpr std::uint64_t kInflateSlack = 1u << 20;
-
-// The TRK stream's bytes in order, handed out a piece at a time: straight from the mapped file, or
-// inflated from the gzip member(s) into a small buffer, so that a .trk.gz is never held inflated whole.
-class TrkBytes {
- public:
-  explicit TrkBytes(std::span<const std::uint8_t> plain) : in_(plain) {}
-  TrkBytes(const std::string& path, std::span<const std::uint8_t> compressed, std::vector<std::string>& warnings)
-      : in_(compressed), gz_(true), path_(path), warnings_(&warnings) {
-    if (inflateInit2(&z_, 16 + MAX_WBITS) != Z_OK) throw std::bad_alloc();  // 16: gzip framing only
-    buffer_.resize(kReadBuffer);
-  }
-  ~TrkBytes() {
-    if (gz_) inflateEnd(&z_);
-  }
-  TrkBytes(const TrkBytes&) = delete;
-  TrkBytes& operator=(const TrkBytes&) = delete;
-
-  // The next n bytes (valid until the next call), or nullptr when the stream ends before n more; then
-  // left() bytes remained (and stay unconsumed).
-  const std::uint8_t* take(std::size_t n) {
-    if (!gz_) {
-      if (in_.size() - offset_ < n) return nullptr;
-      const std::uint8_t* p = in_.data() + offset_;
-      offset_ += n;
-      return p;
-    }
-    while (end_ - begin_ < n && !ended_) refill(n);
-    if (end_ - begin_ < n) return nullptr;
-    const std::uint8_t* p = buffer_.data() + begin_;
-    begin_ += n;
-    offset_ += n;
-    return p;
-  }
-  bool at_end() {
-    if (!gz_) return offset_ == in_.size();
-    while (end_ == begin_ && !ended_) refill(1);
-    return end_ == begin_;
-  }
-  std::uint64_t left() const { return gz_ ? end_ - begin_ : in_.size() - offset_; }
-  std::uint64_t offset() const { return offset_; }  // bytes of the TRK stream taken so far
-  // The TRK stream's size where it is known without reading it (a plain file).
-  std::optional<std::uint64_t> size() const { return gz_ ? std::nullopt : std::optional<std::uint64_t>(in_.size()); }
-
- private:
-  static constexpr std::size_t kReadBuffer = 1u << 20;
-
-  // Inflates more into the buffer, which keeps the bytes not yet taken and makes room for n of them.
-  void refill(std::size_t n) {
-    if (begin_ > 0) {
-      std::memmove(buffer_.data(), buffer_.data() + begin_, end_ - begin_);
-      end_ -= begin_;
-      begin_ = 0;
-    }
-    if (buffer_.size() < std::max(n, kReadBuffer)) buffer_.resize(std::max(n, kReadBuffer));
-    z_.next_out = buffer_.data() + end_;
-    z_.avail_out = static_cast<uInt>(buffer_.size() - end_);
-    while (z_.avail_out > 0 && !ended_) {
-      if (z_.avail_in == 0 && in_pos_ < in_.size()) {  // zlib counts input in 32 bits: feed it in slices
-        z_.next_in = const_cast<Bytef*>(in_.data() + in_pos_);
-        z_.avail_in = static_cast<uInt>(std::min<std::uint64_t>(in_.size() - in_pos_, 1u << 30));
-        in_pos_ += z_.avail_in;
-      }
-      const int r = inflate(&z_, Z_NO_FLUSH);
-      const std::uint64_t at = in_pos_ - z_.avail_in;  // offset in the compressed file
-      if (r == Z_STREAM_END) {
-        member_end();
-        continue;
-      }
-      if (r != Z_OK && r != Z_BUF_ERROR)
-        fail_input(path_, at,
-                   "corrupt gzip stream after " + std::to_string(inflated()) +
-                       " decompressed bytes: " + (z_.msg ? z_.msg : "zlib error " + std::to_string(r)));
-      if (z_.avail_in == 0 && in_pos_ == in_.size() && z_.avail_out > 0)
-        fail_input(path_, at,
-                   "the gzip stream is truncated: it ends without its end-of-stream marker and CRC, after " +
-                       std::to_string(inflated()) + " decompressed bytes");
-    }
-    end_ = buffer_.size() - z_.avail_out;
-    const std::uint64_t cap = kMaxInflateRatio * in_.size() + kInflateSlack;
-    if (inflated() > cap)
-      fail_unsupported(path_, "inflates to more than " + std::to_string(cap) + " bytes, over " +
-                                  std::to_string(kMaxInflateRatio) + " times its compressed size (" +
-                                  std::to_string(in_.size()) +
-                                  " bytes); refused as a likely decompression bomb "
-                                  "(real tractograms compress about 1.2-3x). To read it anyway, gunzip it first");
-  }
-
-  // After a gzip member's CRC: another member may follow (concatenated gzip, as gzip -d reads it), or zero
-  // padding (which gzip and Python's gzip skip); anything else is not gzip data, and not ours to ignore.
-  void member_end() {
-    const std::uint64_t at = in_pos_ - z_.avail_in;
-    if (at == in_.size()) {
-      ended_ = true;
-      return;
-    }
-    const std::span<const std::uint8_t> rest = in_.subspan(at);
-    if (rest.size() >= 2 && rest[0] == 0x1F && rest[1] == 0x8B) {
-      inflated_before_reset_ += z_.total_out;
-      inflateReset(&z_);
-      return;
-    }
-    if (std::all_of(rest.begin(), rest.end(), [](std::uint8_t b) { return b == 0; })) {
-      warnings_->push_back(std::to_string(rest.size()) + " zero bytes of padding after the gzip stream ignored");
-      ended_ = true;
-      return;
-    }
-    fail_input(path_, at,
-               std::to_string(rest.size()) + " bytes after the end of the gzip stream are not another gzip member");
-  }
-
-  std::uint64_t inflated() const { return z_.total_out + inflated_before_reset_; }
-
-  std::span<const std::uint8_t> in_;
-  std::uint64_t offset_ = 0;
-  bool gz_ = false;
-  std::string path_;
-  std::vector<std::string>* warnings_ = nullptr;
-  z_stream z_{};
-  std::uint64_t in_pos_ = 0;  // compressed bytes handed to zlib
-  std::vector<std::uint8_t> buffer_;
-  std::size_t begin_ = 0, end_ = 0;  // the inflated bytes not yet taken
-  bool ended_ = false;
-  std::uint64_t inflated_before_reset_ = 0;
-};
-
 // The header fields the reader uses, decoded in the file's byte order (stage 1 of read_trk).
 struct TrkHeader {
   std::array<std::uint8_t, kHeaderSize> bytes{};
@@ -407,7 +274,7 @@ struct TrkHeader {
 // Reports a problem at an offset of the TRK stream (the decompressed one for a .gz file).
 using FailAt = std::function<void(std::uint64_t, const std::string&)>;
 
-TrkHeader read_header(TrkBytes& stream, const std::string& path, std::vector<std::string>& warnings,
+TrkHeader read_header(GzipBytes& stream, const std::string& path, std::vector<std::string>& warnings,
                       const FailAt& fail_at) {
   TrkHeader h;
   if (const std::uint8_t* p = stream.take(kHeaderSize)) {
@@ -531,7 +398,7 @@ nlohmann::json header_provenance(const TrkHeader& h, bool gz, const Mat4& applie
 }
 
 // Stage 4: the streamline records, mapped to RAS mm, with their scalars and properties.
-void read_records(TrkBytes& stream, const TrkHeader& h, const Mat4& a, Tractogram& t, const FailAt& fail_at) {
+void read_records(GzipBytes& stream, const TrkHeader& h, const Mat4& a, Tractogram& t, const FailAt& fail_at) {
   auto& warnings = t.source.warnings;
   // Sizes are computed in 64 bits: n < 2^31 and 3 + n_scalars < 2^15 cannot overflow.
   const std::uint64_t point_bytes = 4 * (3 + static_cast<std::uint64_t>(h.n_scalars));
@@ -620,10 +487,11 @@ Tractogram read_trk(const std::string& path) {
   t.source.bytes = file.size();
   t.source.xxh3_128 = xxh3_128_hex(file.data(), file.size());
 
-  const bool gz = is_gzip(file);
-  std::optional<TrkBytes> stream;
+  const bool gz = is_gzip(file.bytes());
+  std::optional<GzipBytes> stream;
   if (gz)
-    stream.emplace(path, file.bytes(), t.source.warnings);
+    stream.emplace(path, file.bytes(), t.source.warnings, inflate_cap(file.size()),
+                   "real tractograms compress about 1.2-3x");
   else
     stream.emplace(file.bytes());
   // Offsets in messages count bytes of the TRK stream, which for a .gz file is the decompressed one.

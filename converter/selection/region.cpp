@@ -32,11 +32,6 @@ std::optional<std::vector<float>> parse_floats(std::string_view s) {
   }
 }
 
-bool is_nifti_name(std::string name) {
-  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
-  return name.ends_with(".nii") || name.ends_with(".nii.gz");
-}
-
 bool all_finite(const std::vector<float>& v) {
   return std::all_of(v.begin(), v.end(), [](float x) { return std::isfinite(x); });
 }
@@ -63,7 +58,7 @@ Region Region::box(Point3f lo, Point3f hi, std::string text) {
   return r;
 }
 
-Region Region::mask(const NiftiImage& image, std::optional<float> label, std::string text) {
+Region Region::mask(const VolumeImage& image, std::optional<float> label, std::string text) {
   Region r;
   r.shape_ = Shape::Mask;
   r.text_ = std::move(text);
@@ -203,14 +198,16 @@ Region parse_region(const std::string& text) {
     }
   }
   if (!std::filesystem::exists(path, ec)) {
-    bad_region(text, is_nifti_name(path) ? "no such image file"
-                                         : "expected X,Y,Z,R (a sphere), box:X0,Y0,Z0,X1,Y1,Z1, or a NIfTI mask "
-                                           "(FILE.nii, FILE.nii.gz, FILE.nii.gz:LABEL)");
+    bad_region(text, is_image_name(path)
+                         ? "no such image file"
+                         : "expected X,Y,Z,R (a sphere), box:X0,Y0,Z0,X1,Y1,Z1, or a mask image "
+                           "(FILE.nii, FILE.nii.gz, FILE.mif, FILE.mif.gz, FILE.mih, FILE.nii.gz:LABEL)");
   }
-  if (!is_nifti_name(path))
+  if (!is_image_name(path))
     throw Error(ErrorKind::Unsupported, path, std::nullopt,
-                "a region image must be NIfTI (.nii or .nii.gz); convert other formats first (e.g. mrconvert)");
-  return Region::mask(read_nifti_image(path), label, text);
+                "a region image must be NIfTI (.nii, .nii.gz) or MRtrix (.mif, .mif.gz, .mih); convert other formats "
+                "first (e.g. mrconvert)");
+  return Region::mask(read_volume_image(path), label, text);
 }
 
 }  // namespace vxl

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "converter/readers/nifti_image.h"
+#include "converter/readers/volume_image.h"
 
 namespace vxl {
 
@@ -32,7 +32,7 @@ class Region {
   static Region box(Point3f lo, Point3f hi, std::string text);
   // `label`: the voxels holding exactly this value; none: every non-zero voxel. Throws vxl::Error (Usage)
   // naming `text` when no voxel is selected (an empty mask, or a label the image does not hold).
-  static Region mask(const NiftiImage& image, std::optional<float> label, std::string text);
+  static Region mask(const VolumeImage& image, std::optional<float> label, std::string text);
 
   Shape shape() const { return shape_; }
   // The argument it was made from, for messages and provenance.

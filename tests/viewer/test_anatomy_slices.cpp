@@ -7,6 +7,8 @@
 
 #include <nifti2_io.h>
 
+#include "converter/readers/volume_image.h"
+#include "format/error.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/anatomy/nifti_volume.h"
 
@@ -303,6 +305,26 @@ TEST_F(AnatomyCli, WindowShowsTheSlices) {
   EXPECT_EQ(brightest_grey(), 0);
 }
 
+// The 3-D texture's limits are the viewer's: the converter's reader takes the same image.
+TEST(AnatomyVolume, TextureLimitIsTheViewersOwn) {
+  ScratchDir dir;
+  const int64_t dims[8] = {3, 2049, 2, 2, 1, 1, 1, 1};
+  nifti_image* nim = nifti_make_new_nim(dims, DT_UINT8, 1);
+  nim->nifti_type = NIFTI_FTYPE_NIFTI1_1;
+  const std::string path = dir.file("wide.nii");
+  ASSERT_EQ(nifti_set_filenames(nim, path.c_str(), 0, 1), 0);
+  nifti_image_write(nim);
+  nifti_image_free(nim);
+  EXPECT_EQ(read_volume_image(path).dims[0], 2049);
+  try {
+    (void)read_nifti_volume(path);
+    ADD_FAILURE() << "a 2049-voxel axis was taken";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported) << e.what();
+    EXPECT_NE(std::string(e.what()).find("at most 2048 along each axis"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(AnatomyCli, BadImagesAreRefusedNamingTheFile) {
   const std::string good = write_nifti(dir, "good");
   std::ifstream in(good, std::ios::binary);
@@ -314,8 +336,8 @@ TEST_F(AnatomyCli, BadImagesAreRefusedNamingTheFile) {
   };
   std::string wrong_magic = bytes;
   wrong_magic[344] = 'x';
-  std::string absurd = bytes;  // dim[1] (int16 at byte 42) = 30000: 30000 x 64 x 64 floats
-  absurd[42] = static_cast<char>(30000 & 0xFF), absurd[43] = static_cast<char>(30000 >> 8);
+  std::string absurd = bytes;  // dim[1] (int16 at byte 42) = 2000: 2000 x 64 x 64 floats
+  absurd[42] = static_cast<char>(2000 & 0xFF), absurd[43] = static_cast<char>(2000 >> 8);
   std::string huge = bytes;  // dim[1..3] = 32767 each: 3.5e13 voxels
   for (int at : {42, 44, 46}) huge[at] = static_cast<char>(0xFF), huge[at + 1] = 0x7F;
   std::string negative = bytes;  // dim[2] = -5
@@ -329,7 +351,8 @@ TEST_F(AnatomyCli, BadImagesAreRefusedNamingTheFile) {
       {write("header_only.nii", bytes.substr(0, 200)), "truncated NIfTI header"},
       {write("magic.nii", wrong_magic), "magic"},
       {write("absurd.nii", absurd), "truncated"},
-      {write("huge.nii", huge), "at most 2^30"},  // refused from the header (exit 4), before reading
+      {write("huge.nii", huge), "at most 2048"},  // refused from the header (exit 4), before reading
+      {write("head.mgz", bytes), "FreeSurfer"},
       {write("negative.nii", negative), "dimension"},
       {write("text.nii", "this is not an image at all, only some text long enough to be read as a header\n"),
        "not a NIfTI"},
@@ -341,7 +364,7 @@ TEST_F(AnatomyCli, BadImagesAreRefusedNamingTheFile) {
     std::filesystem::remove(dir.file("out.png"));
     auto r = voxview("--image '" + path + "'");
     // Sizes beyond the reader's limit are exit 4, whatever the file holds; the rest is malformed (3).
-    EXPECT_EQ(r.exit_code, what == "at most 2^30" ? 4 : 3) << path << ": " << r.output;
+    EXPECT_EQ(r.exit_code, what == "at most 2048" || what == "FreeSurfer" ? 4 : 3) << path << ": " << r.output;
     EXPECT_NE(r.output.find(path), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(what), std::string::npos) << what << ": " << r.output;
     EXPECT_FALSE(std::filesystem::exists(dir.file("out.png"))) << path;

@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
-#include "converter/readers/nifti_image.h"
+#include "converter/readers/volume_image.h"
 
 namespace vxl {
 
@@ -27,7 +28,13 @@ std::array<float, 2> percentile_window(const std::vector<float>& values, double 
 }
 
 Volume read_nifti_volume(const std::string& path) {
-  NiftiImage image = read_nifti_image(path);
+  // A 3-D texture: OpenGL promises 2048 texels along each axis, and the float copy must fit in memory
+  // beside the lines.
+  ImageLimits limits;
+  limits.max_axis = 2048;
+  limits.max_voxels = std::uint64_t(1) << 28;
+  limits.reason = "voxview draws it as a 3-D texture of at most 2048 voxels along an axis and 2^28 voxels in all";
+  VolumeImage image = read_volume_image(path, limits);
   Volume v;
   v.name = path;
   v.dims = image.dims;

@@ -1,4 +1,4 @@
-// An anatomical image (NIfTI, read by converter/readers/nifti_image.h) as the render-side Volume, with its
+// An anatomical image (NIfTI or MRtrix, read by converter/readers/volume_image.h) as the render-side Volume, with its
 // default grey window: the 2nd and 98th percentiles of the image's non-zero voxels (the air around a head
 // is 0 in most T1s and would otherwise pull the window down); of all voxels when every one is 0.
 #pragma once

@@ -137,7 +137,7 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
       ->check(CLI::IsMember({"black", "white"}));
   cli.add_option(
       "--image", a.options.image,
-      "an anatomical image (NIfTI-1 or -2, .nii or .nii.gz, e.g. a T1) shown as opaque grey slices through the "
+      "an anatomical image (NIfTI-1 or -2, .nii or .nii.gz; MRtrix .mif, .mif.gz or .mih; e.g. a T1) shown as opaque grey slices through the "
       "focus point under the lines (lines behind a slice are hidden by it, lines in front blend over it)");
   cli.add_option(
       "--image-range", a.image_range,

@@ -1,0 +1,44 @@
+#include "converter/readers/image_file.h"
+
+#include <filesystem>
+
+#include "converter/readers/regular_file.h"
+#include "format/error.h"
+
+namespace vxl {
+namespace {
+
+MappedFile open_image(const std::string& path, const std::string& format) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    fail_input(path, std::nullopt, "no such file (expected " + format + " image)");
+  require_regular_file(path);
+  return MappedFile(path);
+}
+
+}  // namespace
+
+ImageFile::ImageFile(const std::string& path, const std::string& format)
+    : path_(path), file_(open_image(path, format)) {
+  cap_ = inflate_cap(file_.size()) - kInflateSlack + kImageInflateSlack;
+  if (is_gzip(file_.bytes()))
+    stream_.emplace(path, file_.bytes(), warnings_, cap_, "real images compress about 2-10x, masks far more");
+  else
+    stream_.emplace(file_.bytes());
+}
+
+void ImageFile::check_claim(double needed, const std::string& claim) const {
+  if (gzipped() && needed > double(cap_))
+    fail_unsupported(path_, claim + " need " + std::to_string(static_cast<std::uint64_t>(needed)) + " bytes, over " +
+                                std::to_string(kMaxInflateRatio) + " times the compressed size (" +
+                                std::to_string(file_.size()) + " bytes) plus " +
+                                std::to_string(kImageInflateSlack >> 20) +
+                                " MiB; refused as a likely decompression bomb. To read it anyway, gunzip it first");
+}
+
+void ImageFile::finish() {
+  if (gzipped())
+    while (!stream_->at_end()) stream_->skip(stream_->left());
+}
+
+}  // namespace vxl
