@@ -464,7 +464,7 @@ void read_records(GzipBytes& stream, const TrkHeader& h, const Mat4& a, Tractogr
 namespace trk {
 
 Mat4 voxmm_to_rasmm(std::span<const std::uint8_t> header, const std::string& path, std::vector<std::string>& warnings) {
-  TrkBytes stream(header);
+  GzipBytes stream(header);
   const FailAt fail_at = [&](std::uint64_t offset, const std::string& what) { fail_input(path, offset, what); };
   return voxmm_to_ras(read_header(stream, path, warnings, fail_at), warnings, fail_at);
 }
