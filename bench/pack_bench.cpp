@@ -68,7 +68,9 @@ std::vector<float> source_points(const vxl::VxlFile& f) {
   std::vector<float> points;
   points.reserve(3 * f.meta().point_count);
   vxl::walk_streamlines(
-      f, {[&](std::uint64_t, std::span<const float> xyz) { points.insert(points.end(), xyz.begin(), xyz.end()); }, {}, {}});
+      f, {[&](std::uint64_t, std::span<const float> xyz) { points.insert(points.end(), xyz.begin(), xyz.end()); },
+          {},
+          {}});
   return points;
 }
 

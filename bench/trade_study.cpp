@@ -333,7 +333,7 @@ class Study {
         for (const ModeSpec& m : modes) {
           if (!motion.all_modes && m.mode != RenderMode::Axis && m.mode != RenderMode::Exact) continue;
           if (m.mode == RenderMode::Segsort) continue;  // 72 CPU sorts a turntable: kept to the sweep's 18 frames
-          Renderer r(file);  // fresh: no order memory from an earlier run
+          Renderer r(file);                             // fresh: no order memory from an earlier run
           std::vector<Image> frames = frames_of(r, m, motion);
           if (m.mode == RenderMode::Exact) exact = frames;
           FlickerRow row = flicker_row(motion, m.name, frames, exact);

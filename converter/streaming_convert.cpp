@@ -191,9 +191,7 @@ class StreamingConversion {
     return i < voxels_.size() ? voxels_[i].order_offset : order_bytes_;
   }
   // Memory per ordering thread besides its sort buffers: a float32 block's end bits.
-  std::uint64_t end_bits_bytes(std::uint32_t max_vertices) const {
-    return packed() ? 0 : (max_vertices / 64 + 1) * 8;
-  }
+  std::uint64_t end_bits_bytes(std::uint32_t max_vertices) const { return packed() ? 0 : (max_vertices / 64 + 1) * 8; }
   void write_rest();
   [[noreturn]] void fail_changed() const;
   // Reads the source once, calling body(batch, index of its first streamline) per batch.
@@ -245,7 +243,7 @@ class StreamingConversion {
   // again).
   std::unique_ptr<std::uint8_t, void (*)(void*)> pool_{nullptr, std::free};
   std::uint64_t pool_bytes_ = 0, pool_chunk_bytes_ = 0, pool_read_back_bytes_ = 0;  // the orders' parts of pool_
-  VoxlineEnds ends_;                  // float32 positions: the voxline ends of the range being built
+  VoxlineEnds ends_;  // float32 positions: the voxline ends of the range being built
   std::unique_ptr<VxlStreamWriter> out_;
 };
 
@@ -513,7 +511,9 @@ void StreamingConversion::build_table() {
 // depend on the thread count).
 std::vector<Range> StreamingConversion::cut_ranges() {
   const std::uint64_t room = budget_.left();
-  auto per_thread = [&](const Range& r) { return order_scratch_bytes(r.max_vertices) + end_bits_bytes(r.max_vertices); };
+  auto per_thread = [&](const Range& r) {
+    return order_scratch_bytes(r.max_vertices) + end_bits_bytes(r.max_vertices);
+  };
   auto order_threads = [&](const Range& r) {
     return static_cast<unsigned>(std::clamp<std::uint64_t>(room / 4 / per_thread(r), 1, threads_));
   };
@@ -658,14 +658,14 @@ void StreamingConversion::open_block_writers(RangePlacement& placing) const {
     if (g < r.first || g >= r.end) continue;
     for (std::uint32_t d = 0; d < levels; ++d) {
       const std::uint64_t first = cursor_[local * levels + d];
-      const std::uint64_t end = voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), d);
+      const std::uint64_t end =
+          voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), d);
       if (end > first) {
         const std::uint64_t size = DirectRegionWriter::staging_size((end - first) * bytes, block_staging_);
         if (std::uint64_t(staging - pool_.get()) + size > pool_bytes_)
           throw std::logic_error("StreamingConversion: the blocks' staging outgrows its pool");
-        placing.blocks[local * levels + d] =
-            out_->region_writer(VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, block_staging_, staging,
-                                placing.queue.get());
+        placing.blocks[local * levels + d] = out_->region_writer(
+            VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, block_staging_, staging, placing.queue.get());
         staging += size;
       }
     }

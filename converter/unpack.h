@@ -25,7 +25,7 @@ struct UnpackSettings {
 
 struct UnpackSummary {
   std::uint64_t streamlines = 0, points = 0, voxels = 0;
-  PackSection pack{};                                             // quantisation and the stated bound
+  PackSection pack{};             // quantisation and the stated bound
   double repack_error_bound = 0;  // of the packed positions written (0 for float32), per axis, in mm
   // How far, per axis, a written position may lie from the packed .vxl's: the package's quantisation
   // and then the output's own packing.

@@ -22,7 +22,7 @@ class AtomicOutputFile {
  public:
   // Throws vxl::Error (Output) naming the path, also when format/output_path.h's rule refuses it.
   explicit AtomicOutputFile(std::string path);
-  ~AtomicOutputFile();                          // discards the data (and any mapping) unless committed
+  ~AtomicOutputFile();  // discards the data (and any mapping) unless committed
   AtomicOutputFile(const AtomicOutputFile&) = delete;
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 

@@ -71,8 +71,8 @@ void DirectRegionWriter::write_staged() {
     write_blocks(out_, direct_fd_, staging_.get(), staged_, staging_start_);
   } else {
     // The queue writes it while the caller goes on with a spare (none needed after the last bytes).
-    std::uint8_t* spare = queue_->submit(staging_.release(), staged_, staging_start_,
-                                         staging_bytes_ == queue_->buffer_bytes(), !last);
+    std::uint8_t* spare =
+        queue_->submit(staging_.release(), staged_, staging_start_, staging_bytes_ == queue_->buffer_bytes(), !last);
     staging_ = {spare, [](void*) {}};
   }
   staged_ = 0;

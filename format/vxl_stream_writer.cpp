@@ -28,7 +28,8 @@ VxlStreamWriter::VxlStreamWriter(const std::string& path, const VxlSectionSizes&
   direct_fd_ = direct_staging_bytes > 0 ? out_.direct_descriptor() : -1;
   if (direct_fd_ >= 0)
     for (const SectionEntry& e : table_)
-      regions_.push_back(std::make_unique<DirectRegionWriter>(out_, direct_fd_, e.offset, e.size, direct_staging_bytes));
+      regions_.push_back(
+          std::make_unique<DirectRegionWriter>(out_, direct_fd_, e.offset, e.size, direct_staging_bytes));
 }
 
 std::unique_ptr<DirectRegionWriter> VxlStreamWriter::region_writer(Section section, std::uint64_t offset,
@@ -70,7 +71,8 @@ std::span<const std::uint8_t> VxlStreamWriter::read_back(Section section, std::u
     if (n < 0 && errno == EINTR) continue;
     if (n < 0 && errno == EINVAL) break;  // no direct reads here: through the page cache
     if (n < 0)
-      throw Error(ErrorKind::Output, out_.path(), std::nullopt, std::string("read-back failed: ") + std::strerror(errno));
+      throw Error(ErrorKind::Output, out_.path(), std::nullopt,
+                  std::string("read-back failed: ") + std::strerror(errno));
     if (n == 0) break;  // the file's end, inside the last block: read the rest plainly
     done += static_cast<std::uint64_t>(n);
   }

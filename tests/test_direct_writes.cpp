@@ -3,11 +3,11 @@
 // file system allows it, and without it. And a streaming conversion whose limit turns direct writes on
 // must still write the in-memory conversion's bytes, whether it holds VERT or writes it block by block.
 #include <algorithm>
-#include <cstdlib>
-#include <memory>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -61,8 +61,8 @@ TEST(DirectWrites, RegionsOfAnySizeAppendedInPiecesGiveThePlainBytes) {
   std::vector<std::uint8_t> expected(600000);
   for (auto& b : expected) b = static_cast<std::uint8_t>(rng());
   const std::uint64_t block = DirectRegionWriter::kBlock;
-  const std::vector<std::uint64_t> ends = {7,         block - 1,     block,           block + 1, 5 * block + 100,
-                                           9 * block, 9 * block + 4, 120000,    40 * block + 13, 599999,
+  const std::vector<std::uint64_t> ends = {7,         block - 1,     block,  block + 1,       5 * block + 100,
+                                           9 * block, 9 * block + 4, 120000, 40 * block + 13, 599999,
                                            600000};
   for (bool direct : {true, false}) {
     const std::string path = dir.file(direct ? "direct.bin" : "buffered.bin");
@@ -83,8 +83,8 @@ TEST(DirectWrites, RegionsInterleavedThroughAWriteQueueGiveThePlainBytes) {
   std::vector<std::uint8_t> expected(600000);
   for (auto& b : expected) b = static_cast<std::uint8_t>(rng());
   const std::uint64_t block = DirectRegionWriter::kBlock, staging = 3 * block;
-  const std::vector<std::uint64_t> ends = {7,         block - 1,     block,           block + 1, 5 * block + 100,
-                                           9 * block, 9 * block + 4, 120000,    40 * block + 13, 599999,
+  const std::vector<std::uint64_t> ends = {7,         block - 1,     block,  block + 1,       5 * block + 100,
+                                           9 * block, 9 * block + 4, 120000, 40 * block + 13, 599999,
                                            600000};
   for (bool direct : {true, false}) {
     for (std::uint64_t spare_count : {0, 3}) {
@@ -95,7 +95,8 @@ TEST(DirectWrites, RegionsInterleavedThroughAWriteQueueGiveThePlainBytes) {
       const int direct_fd = direct ? out.direct_descriptor() : -1;
       // The caller's memory: the spares, then each region's staging.
       std::uint64_t memory_bytes = spare_count * staging, start = 0;
-      for (std::uint64_t end : ends) memory_bytes += DirectRegionWriter::staging_size(end - start, staging), start = end;
+      for (std::uint64_t end : ends)
+        memory_bytes += DirectRegionWriter::staging_size(end - start, staging), start = end;
       std::unique_ptr<std::uint8_t, void (*)(void*)> memory(
           static_cast<std::uint8_t*>(std::aligned_alloc(block, memory_bytes)), std::free);
       std::uint8_t* next = memory.get();
@@ -106,7 +107,8 @@ TEST(DirectWrites, RegionsInterleavedThroughAWriteQueueGiveThePlainBytes) {
       std::vector<std::uint64_t> at, region_end;
       start = 0;
       for (std::uint64_t end : ends) {
-        regions.push_back(std::make_unique<DirectRegionWriter>(out, direct_fd, start, end - start, staging, next, &queue));
+        regions.push_back(
+            std::make_unique<DirectRegionWriter>(out, direct_fd, start, end - start, staging, next, &queue));
         next += DirectRegionWriter::staging_size(end - start, staging);
         at.push_back(start);
         region_end.push_back(end);

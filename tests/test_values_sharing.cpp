@@ -358,8 +358,7 @@ TEST(ValuesExport, TsfChoosesTheSetAndRefusesWhatItCannotWrite) {
   settings.value = "odd values";
   const ExportSummary s = export_tck(f, dir.file("o.tck"), settings);
   EXPECT_EQ(s.value_set, "odd values");
-  EXPECT_EQ(s.warnings.size(), 3u)
-      << "one other per-point set, the per-streamline sets and the groups are not written";
+  EXPECT_EQ(s.warnings.size(), 3u) << "one other per-point set, the per-streamline sets and the groups are not written";
   Tractogram back = read_tractogram(dir.file("o.tck"));
   attach_tsf(back, dir.file("o.tsf"));
   EXPECT_TRUE(same_floats(back.point_values[0].values, valued_tractogram(40).point_values[1].values));

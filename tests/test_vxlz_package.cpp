@@ -678,8 +678,8 @@ TEST(VxlzPackageOptions, UnpackPrintsABoundThatHoldsForWhatItWrote) {
   for (const char* positions : {"packed", "float32"}) {
     SCOPED_TRACE(positions);
     const std::string out = dir.file(std::string("u_") + positions + ".vxl");
-    const auto r = test::run_cli("unpack " + test::q(dir.file("s.vxlz")) + " " + test::q(out) + " --positions " +
-                                 positions);
+    const auto r =
+        test::run_cli("unpack " + test::q(dir.file("s.vxlz")) + " " + test::q(out) + " --positions " + positions);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const double bound = printed_bound(r.output);
     const double error = max_vertex_error(original, VxlFile::open(out));

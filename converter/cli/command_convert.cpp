@@ -53,11 +53,11 @@ void add_convert_command(CLI::App& app, int& exit_code) {
                       ") and the output (written atomically); with --output-dir: one or more sources")
       ->required();
   CLI::Option* output_dir =
-      cmd->add_option("--output-dir", opt->output_dir,
-                      "convert every input FILE into DIR/NAME.vxl (NAME: FILE's name without " +
-                          source_suffixes_text("/") +
-                          "; two inputs with the same NAME are refused; DIR is created when missing). A file that fails is "
-                      "reported and the others go on; a last line says how many converted and failed")
+      cmd->add_option(
+             "--output-dir", opt->output_dir,
+             "convert every input FILE into DIR/NAME.vxl (NAME: FILE's name without " + source_suffixes_text("/") +
+                 "; two inputs with the same NAME are refused; DIR is created when missing). A file that fails is "
+                 "reported and the others go on; a last line says how many converted and failed")
           ->type_name("DIR");
   CLI::Option* jobs =
       cmd->add_option("--jobs", opt->jobs,

@@ -26,10 +26,11 @@ void add_unpack_command(CLI::App& app) {
     opt->settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
     UnpackSummary s = unpack_vxlz(opt->input, opt->output, opt->settings);
     bar.done();
-    std::printf("%s: %llu streamlines, %llu points, %llu voxels; positions within %.6f mm of the packed file "
-                "per axis (package %.6f mm at %u bits",
-                opt->output.c_str(), (unsigned long long)s.streamlines, (unsigned long long)s.points,
-                (unsigned long long)s.voxels, s.error_bound(), s.pack.error_bound, s.pack.quantization_bits);
+    std::printf(
+        "%s: %llu streamlines, %llu points, %llu voxels; positions within %.6f mm of the packed file "
+        "per axis (package %.6f mm at %u bits",
+        opt->output.c_str(), (unsigned long long)s.streamlines, (unsigned long long)s.points,
+        (unsigned long long)s.voxels, s.error_bound(), s.pack.error_bound, s.pack.quantization_bits);
     if (s.repack_error_bound > 0)
       std::printf(" + packed positions %.6f mm; --positions float32 writes the package's", s.repack_error_bound);
     std::printf(")\n");

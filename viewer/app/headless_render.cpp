@@ -97,8 +97,8 @@ int run_headless(const ViewerOptions& o) {
   OffscreenTarget target(o.width, o.height);
   target.bind();
   if (o.save_camera)
-    write_view(*o.save_camera,
-               SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}, true, o.include, o.exclude, o.ends_in});
+    write_view(*o.save_camera, SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}, true, o.include,
+                                         o.exclude, o.ends_in});
   const int frames = std::max(1, o.turntable);
   for (int i = 0; i < frames; ++i) {
     renderer->draw(turntable_camera(*camera, i, frames), o.settings, o.width, o.height, target.framebuffer());

@@ -41,11 +41,11 @@ class RegionEditor {
   void remove_active();
   void activate(std::size_t index);
   void activate_next();
-  void toggle_role();                // the active region: include <-> exclude (ends-in becomes exclude)
+  void toggle_role();  // the active region: include <-> exclude (ends-in becomes exclude)
   // The radius factor of one key press (, and .) or one wheel step with Shift.
   static constexpr double kRadiusStep = 1.25;
-  void scale_radius(double factor);  // the active sphere
-  void set_radius(double radius);    // the active sphere; at least 0
+  void scale_radius(double factor);                          // the active sphere
+  void set_radius(double radius);                            // the active sphere; at least 0
   void move_active_to(const std::array<double, 3>& centre);  // the active sphere, if it is one
 
   // The regions as selection criteria (parsed; throws vxl::Error naming a bad one), and back, each region's

@@ -8,9 +8,9 @@
 #include "format/error.h"
 #include "format/output_path.h"
 #include "viewer/app/camera_file.h"
-#include "viewer/render/scene_groups.h"
 #include "viewer/app/turntable.h"
 #include "viewer/platform/image_io.h"
+#include "viewer/render/scene_groups.h"
 
 namespace vxl::app {
 
@@ -204,8 +204,7 @@ void apply_selection(const ViewerArguments& a, ViewerOptions& o) {
 void check_outputs(const ViewerOptions& o) {
   for (const auto* path : {&o.render_png, &o.screenshot})
     if (*path && picture_format_of(**path).empty())
-      usage_error(**path + ": the extension names no picture format voxview writes: use " +
-                  picture_formats_text());
+      usage_error(**path + ": the extension names no picture format voxview writes: use " + picture_formats_text());
   if (o.render_png) {
     const int frames = std::max(1, o.turntable);
     for (int i = 0; i < frames; ++i)

@@ -20,7 +20,8 @@ struct ViewFileSettings {
 };
 
 struct ViewerOptions {
-  std::vector<std::string> inputs;  // .vxl, or a source (readers/source_formats.h) converted in memory; several: one scene
+  std::vector<std::string>
+      inputs;  // .vxl, or a source (readers/source_formats.h) converted in memory; several: one scene
   // How the inputs are named in messages and titles: the first file's name, "+ N more" for the others.
   std::string inputs_name() const;
   std::optional<std::string> image;       // an anatomical NIfTI image shown as slices under the lines
@@ -33,7 +34,7 @@ struct ViewerOptions {
   std::optional<std::string> save_camera;     // write the view here (headless: after rendering)
   bool orthographic = false;
   int width = 1024, height = 1024;
-  bool size_given = false;  // by --size or a saved view: the window keeps it (else it fits the screen)
+  bool size_given = false;   // by --size or a saved view: the window keeps it (else it fits the screen)
   double voxel_size = 10.0;  // for in-memory conversion
   // Level of detail (.vxl spec §5.12): the one --level names, else the finest within the GPU memory budget
   // (--gpu-memory, else a share of what the driver reports; scene_detail.h).

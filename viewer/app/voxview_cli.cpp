@@ -40,7 +40,9 @@ std::string voxview_description(const std::string& version) {
   return "voxview " + version +
          " — transparent tractogram viewer (Voxlines method).\n"
          "voxview FILE... [--render OUT.png]: a window, or headless to PNG with --render.\n"
-         "Opens a .vxl instantly (memory-mapped); a " + source_suffixes_text("/") + " is converted in memory first.\n"
+         "Opens a .vxl instantly (memory-mapped); a " +
+         source_suffixes_text("/") +
+         " is converted in memory first.\n"
          "Opening a .vxl checks its structure (header, section table, section sizes, voxel table, names) in\n"
          "O(voxels) but not its checksums: damaged positions, orders or values are drawn as they are. --verify\n"
          "checks everything first, as 'voxlines verify' does.\n" +
@@ -54,7 +56,9 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                  "are shown together "
                  "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
       ->required();
-  cli.add_option("--render", a.options.render_png, "render headless (EGL, no display needed) to this picture and exit: PNG, or JPEG, TIFF or OpenEXR by the extension (.jpg, .tif, .exr)");
+  cli.add_option("--render", a.options.render_png,
+                 "render headless (EGL, no display needed) to this picture and exit: PNG, or JPEG, TIFF or OpenEXR by "
+                 "the extension (.jpg, .tif, .exr)");
   cli.add_option("--turntable", a.options.turntable,
                  "with --render: N frames turning once around the vertical (superior) axis, written as OUT_000.png, "
                  "OUT_001.png, ... (frame i at azimuth + 360 i / N degrees; frame 0 looks from the --view direction; "
@@ -135,10 +139,10 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--background", a.background, "black or white")
       ->default_val("black")
       ->check(CLI::IsMember({"black", "white"}));
-  cli.add_option(
-      "--image", a.options.image,
-      "an anatomical image (NIfTI-1 or -2, .nii or .nii.gz; MRtrix .mif, .mif.gz or .mih; e.g. a T1) shown as opaque grey slices through the "
-      "focus point under the lines (lines behind a slice are hidden by it, lines in front blend over it)");
+  cli.add_option("--image", a.options.image,
+                 "an anatomical image (NIfTI-1 or -2, .nii or .nii.gz; MRtrix .mif, .mif.gz or .mih; e.g. a T1) shown "
+                 "as opaque grey slices through the "
+                 "focus point under the lines (lines behind a slice are hidden by it, lines in front blend over it)");
   cli.add_option(
       "--image-range", a.image_range,
       "MIN,MAX: the image values shown black and white (default: the 2nd and 98th percentiles of the image's "
@@ -204,7 +208,8 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                "window, with --frames: after the frames, keep the camera still until the picture is refined (full "
                "detail, then exact unless --no-exact-when-still), then quit")
       ->needs("--frames");
-  cli.add_option("--screenshot", a.options.screenshot, "window: save the last frame to this picture before quitting (.png, .jpg, .tif or .exr)");
+  cli.add_option("--screenshot", a.options.screenshot,
+                 "window: save the last frame to this picture before quitting (.png, .jpg, .tif or .exr)");
 }
 
 void parse_voxview_command_line(CLI::App& cli, ViewerArguments& arguments, int argc, const char* const* argv) {
