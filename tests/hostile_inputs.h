@@ -9,17 +9,33 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <sys/stat.h>
 #include <zlib.h>
 
+#include <gtest/gtest.h>
+
+#include "format/error.h"
 #include "tests/mrtrix_test_files.h"
 #include "tests/vtk_test_files.h"
 #include "tests/zip_writer.h"
 
 namespace vxl::test::hostile {
+
+// The error `read` throws, or a failure when it throws none.
+template <typename Read>
+vxl::Error error_of(Read read) {
+  try {
+    read();
+  } catch (const vxl::Error& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error";
+  return vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "no error");
+}
 
 inline void write_file(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;

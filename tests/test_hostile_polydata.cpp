@@ -18,19 +18,8 @@
 namespace {
 
 namespace hostile = vxl::test::hostile;
+using hostile::error_of;
 using vxl::test::ScratchDir;
-
-// The error `read` throws, or a failure when it throws none.
-template <typename Read>
-vxl::Error error_of(Read read) {
-  try {
-    read();
-  } catch (const vxl::Error& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error";
-  return vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "no error");
-}
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 

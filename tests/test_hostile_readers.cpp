@@ -22,20 +22,9 @@
 namespace {
 
 namespace hostile = vxl::test::hostile;
+using hostile::error_of;
 using vxl::test::has_warning;
 using vxl::test::ScratchDir;
-
-// The error `read` throws, or a failure when it throws none.
-template <typename Read>
-vxl::Error error_of(Read read) {
-  try {
-    read();
-  } catch (const vxl::Error& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error";
-  return vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "no error");
-}
 
 // ---- row 1: a TRX member name with a component count beyond 64 bits ----
 
