@@ -292,6 +292,9 @@ void VxlzFile::validate_pack_and_meta() {
     if (m.grid_dims[c] < 0) fail_input(p, meta_at + 88, "negative grid dimension");
     if (!std::isfinite(m.grid_origin[c])) fail_input(p, meta_at + 64, "grid origin is not finite");
   }
+  // Bounds, origin, voxel size and grid dimensions must agree as in a .vxl (spec §7): the unpacker recomputes
+  // the bounds from the decoded positions, but the grid it writes voxels into is this one.
+  check_grid_geometry(m, p, meta_at);
   if (m.point_count > ~std::uint64_t(0) - m.synthetic_point_count ||
       m.point_count + m.synthetic_point_count != k.point_count)
     fail_input(p, pack_at + 48, "shipped point count must be META's point count plus its synthetic point count");

@@ -35,6 +35,29 @@ std::string open_error(const std::string& path, ErrorKind expected = ErrorKind::
   return "no error";
 }
 
+// One way to damage a valid file, and the words open() must then say.
+struct ResealedDamage {
+  const char* name;
+  std::function<void(VxlBytes&)> damage;
+  const char* message;
+};
+
+// Each damage applied to `valid` and resealed (so that only the structure can tell): open() refuses it with
+// its message, `info` exits 3 and `verify` says invalid.
+void expect_refused_on_open(const ScratchDir& dir, const VxlBytes& valid, const std::vector<ResealedDamage>& cases) {
+  for (const ResealedDamage& c : cases) {
+    SCOPED_TRACE(c.name);
+    VxlBytes b = valid;
+    c.damage(b);
+    b.reseal();
+    b.write(dir.file("bad.vxl"));
+    EXPECT_NE(open_error(dir.file("bad.vxl")).find(c.message), std::string::npos) << open_error(dir.file("bad.vxl"));
+    EXPECT_EQ(test::run_cli("info " + q(dir.file("bad.vxl"))).exit_code, 3);
+    const auto v = test::run_cli("verify " + q(dir.file("bad.vxl")));
+    EXPECT_EQ(v.exit_code, 1) << v.output;
+  }
+}
+
 TEST(HostileVxl, TheGeneratedFileIsValidAndHasEveryOptionalSection) {
   ScratchDir dir;
   const VxlBytes b = VxlBytes::make(dir.file("h.vxl"));
@@ -151,11 +174,6 @@ TEST(HostileVxl, GeometryMovedAwayFromTheLinesIsRefusedOnOpen) {
   ScratchDir dir;
   const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
   const std::uint64_t meta = valid.offset_of("META"), voxt = valid.offset_of("VOXT");
-  struct Case {
-    const char* name;
-    std::function<void(VxlBytes&)> damage;
-    const char* message;
-  };
   auto put_f32 = [](VxlBytes& b, std::uint64_t at, float v) { std::memcpy(b.bytes.data() + at, &v, 4); };
   auto put_f64 = [](VxlBytes& b, std::uint64_t at, double v) { std::memcpy(b.bytes.data() + at, &v, 8); };
   auto add_f32 = [](VxlBytes& b, std::uint64_t at, float d) {
@@ -164,71 +182,49 @@ TEST(HostileVxl, GeometryMovedAwayFromTheLinesIsRefusedOnOpen) {
     v += d;
     std::memcpy(b.bytes.data() + at, &v, 4);
   };
-  const std::vector<Case> cases = {
-      {"tight bounds moved 1e6 mm",
-       [&](VxlBytes& b) {
-         add_f32(b, voxt + 16, 1e6f);
-         add_f32(b, voxt + 28, 1e6f);
-       },
-       "voxel 0 tight bounds on x lie outside its cell"},
-      {"tight max at 1e38", [&](VxlBytes& b) { put_f32(b, voxt + 64 + 36, 1e38f); },
-       "voxel 1 tight bounds on z lie outside its cell"},
-      {"bounds max at 1e308", [&](VxlBytes& b) { put_f64(b, meta + 128, 1e308); }, "grid_dims on x is"},
-      {"origin at 1e308", [&](VxlBytes& b) { put_f64(b, meta + 64 + 8, 1e308); }, "grid origin is not at bounds_min"},
-      {"voxel size 1e30", [&](VxlBytes& b) { put_f64(b, meta + 56, 1e30); }, "the bounds and voxel size make"},
-      {"voxel size 1e-30", [&](VxlBytes& b) { put_f64(b, meta + 56, 1e-30); }, "the bounds and voxel size make"},
-      {"grid dims 2^30",
-       [&](VxlBytes& b) {
-         const std::int32_t d = 1 << 30;
-         std::memcpy(b.bytes.data() + meta + 88, &d, 4);
-       },
-       "grid_dims on x is 1073741824"},
-  };
-  for (const Case& c : cases) {
-    SCOPED_TRACE(c.name);
-    VxlBytes b = valid;
-    c.damage(b);
-    b.reseal();
-    b.write(dir.file("bad.vxl"));
-    EXPECT_NE(open_error(dir.file("bad.vxl")).find(c.message), std::string::npos) << open_error(dir.file("bad.vxl"));
-    EXPECT_EQ(test::run_cli("info " + q(dir.file("bad.vxl"))).exit_code, 3);
-    const auto v = test::run_cli("verify " + q(dir.file("bad.vxl")));
-    EXPECT_EQ(v.exit_code, 1) << v.output;
-  }
+  expect_refused_on_open(
+      dir, valid,
+      {
+          {"tight bounds moved 1e6 mm",
+           [&](VxlBytes& b) {
+             add_f32(b, voxt + 16, 1e6f);
+             add_f32(b, voxt + 28, 1e6f);
+           },
+           "voxel 0 tight bounds on x lie outside its cell"},
+          {"tight max at 1e38", [&](VxlBytes& b) { put_f32(b, voxt + 64 + 36, 1e38f); },
+           "voxel 1 tight bounds on z lie outside its cell"},
+          {"bounds max at 1e308", [&](VxlBytes& b) { put_f64(b, meta + 128, 1e308); }, "grid_dims on x is"},
+          {"origin at 1e308", [&](VxlBytes& b) { put_f64(b, meta + 64 + 8, 1e308); },
+           "grid origin is not at bounds_min"},
+          {"voxel size 1e30", [&](VxlBytes& b) { put_f64(b, meta + 56, 1e30); }, "the bounds and voxel size make"},
+          {"voxel size 1e-30", [&](VxlBytes& b) { put_f64(b, meta + 56, 1e-30); }, "the bounds and voxel size make"},
+          {"grid dims 2^30",
+           [&](VxlBytes& b) {
+             const std::int32_t d = 1 << 30;
+             std::memcpy(b.bytes.data() + meta + 88, &d, 4);
+           },
+           "grid_dims on x is 1073741824"},
+      });
 }
 
-// META fields that contradict the sections, and a required section marked optional, resealed so that only
-// the structure can tell: open() refuses them (so every reader does), `info` exits 3 and `verify` says invalid.
+// META fields that contradict the sections, and a required section marked optional: open() refuses them (so
+// every reader does).
 TEST(HostileVxl, MetaFieldsThatContradictTheSectionsAreRefusedOnOpen) {
   ScratchDir dir;
   const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
   const std::uint64_t meta = valid.offset_of("META");
   auto put_u32 = [](VxlBytes& b, std::uint64_t at, std::uint32_t v) { std::memcpy(b.bytes.data() + at, &v, 4); };
-  struct Case {
-    const char* name;
-    std::function<void(VxlBytes&)> damage;
-    const char* message;
-  };
-  const std::vector<Case> cases = {
-      {"order set 7", [&](VxlBytes& b) { put_u32(b, meta + 100, 7); }, "unknown order set 7 (expected 0, 1 or 2)"},
-      {"order set 1 (axis+diag) with K = 3", [&](VxlBytes& b) { put_u32(b, meta + 100, 1); },
-       "stored order count 3 for order set 1 (it stores 7)"},
-      {"levels not marked required", [&](VxlBytes& b) { put_u32(b, b.entry_at("LODS") + 4, 0); },
-       "section LODS must carry the required flag"},
-      {"orders not marked required", [&](VxlBytes& b) { put_u32(b, b.entry_at("ORDR") + 4, 0); },
-       "section ORDR must carry the required flag"},
-  };
-  for (const Case& c : cases) {
-    SCOPED_TRACE(c.name);
-    VxlBytes b = valid;
-    c.damage(b);
-    b.reseal();
-    b.write(dir.file("bad.vxl"));
-    EXPECT_NE(open_error(dir.file("bad.vxl")).find(c.message), std::string::npos) << open_error(dir.file("bad.vxl"));
-    EXPECT_EQ(test::run_cli("info " + q(dir.file("bad.vxl"))).exit_code, 3);
-    const auto v = test::run_cli("verify " + q(dir.file("bad.vxl")));
-    EXPECT_EQ(v.exit_code, 1) << v.output;
-  }
+  expect_refused_on_open(
+      dir, valid,
+      {
+          {"order set 7", [&](VxlBytes& b) { put_u32(b, meta + 100, 7); }, "unknown order set 7 (expected 0, 1 or 2)"},
+          {"order set 1 (axis+diag) with K = 3", [&](VxlBytes& b) { put_u32(b, meta + 100, 1); },
+           "stored order count 3 for order set 1 (it stores 7)"},
+          {"levels not marked required", [&](VxlBytes& b) { put_u32(b, b.entry_at("LODS") + 4, 0); },
+           "section LODS must carry the required flag"},
+          {"orders not marked required", [&](VxlBytes& b) { put_u32(b, b.entry_at("ORDR") + 4, 0); },
+           "section ORDR must carry the required flag"},
+      });
 }
 
 // PROV is any JSON to open(): fields of the wrong type made `info` exit 70 (type_error 302/306) and

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <random>
 
@@ -612,6 +613,41 @@ TEST_F(DamagedVxlz, CraftedPackagesWithValidChecksumsAreRefused) {
     VxlzContent c = content();
     c.provenance = "[1, 2]";
     expect_crafted_refused(c, "provenance not an object");
+  }
+}
+
+// A package's META whose bounds, origin, voxel size or grid dimensions contradict each other, written with
+// valid checksums: refused when the package is opened (so by unpack and info), as the same fields are in a .vxl.
+TEST_F(DamagedVxlz, MetaFieldsThatContradictTheGridAreRefusedOnOpen) {
+  struct Case {
+    const char* name;
+    std::function<void(MetaSection&)> damage;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      {"bounds max at 1e308", [](MetaSection& m) { m.bounds_max[0] = 1e308; }, "grid_dims on x is"},
+      {"origin at 1e308", [](MetaSection& m) { m.grid_origin[1] = 1e308; }, "grid origin is not at bounds_min on y"},
+      {"voxel size 1e30", [](MetaSection& m) { m.voxel_size = 1e30; }, "the bounds and voxel size make"},
+      {"voxel size 1e-30", [](MetaSection& m) { m.voxel_size = 1e-30; }, "the bounds and voxel size make"},
+      {"grid dims 2^30", [](MetaSection& m) { m.grid_dims[2] = 1 << 30; }, "grid_dims on z is 1073741824"},
+      {"bounds min above max", [](MetaSection& m) { std::swap(m.bounds_min[0], m.bounds_max[0]); },
+       "bounds_min above bounds_max on x"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    VxlzContent crafted = content();
+    c.damage(crafted.meta);
+    const std::string path = dir.file("crafted.vxlz");
+    write_vxlz(path, crafted);
+    try {
+      (void)VxlzFile::open(path);
+      ADD_FAILURE() << "opened";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos) << e.what();
+    }
+    expect_refused(path, c.name);
+    EXPECT_EQ(test::run_cli("info '" + path + "'").exit_code, 3);
   }
 }
 
