@@ -86,7 +86,7 @@ inline std::string trk_record(std::int32_t n) {
   return r;
 }
 
-// Row 5: a header, then `mib` MiB of zeros where records should be, as concatenated gzip members (each
+// A header, then `mib` MiB of zeros where records should be, as concatenated gzip members (each
 // MiB of zeros deflates to about 1 KiB, so the file stays small).
 inline void trk_gz_zeros(const std::string& path, int mib) {
   const std::string zeros = gzip(std::string(1u << 20, '\0'));
@@ -95,7 +95,7 @@ inline void trk_gz_zeros(const std::string& path, int mib) {
   write_file(path, out);
 }
 
-// Row 5: valid one-point records, `mib` MiB of them, that deflate about 1000:1: a bomb of real-looking data.
+// Valid one-point records, `mib` MiB of them, that deflate about 1000:1: a bomb of real-looking data.
 inline void trk_gz_record_bomb(const std::string& path, int mib) {
   std::string records;
   const std::string one = trk_record(1);
@@ -106,12 +106,12 @@ inline void trk_gz_record_bomb(const std::string& path, int mib) {
   write_file(path, out);
 }
 
-// Row 7: three records whose gzip stream is cut at a record boundary (no end of stream, no CRC).
+// Three records whose gzip stream is cut at a record boundary (no end of stream, no CRC).
 inline void trk_gz_cut_at_record(const std::string& path, std::int32_t n_count) {
   write_file(path, gzip(trk_header(n_count) + trk_record(2) + trk_record(3) + trk_record(1), /*finish=*/false));
 }
 
-// Row 7: a complete gzip stream followed by `tail`.
+// A complete gzip stream followed by `tail`.
 inline void trk_gz_with_tail(const std::string& path, const std::string& tail) {
   write_file(path, gzip(trk_header() + trk_record(2) + trk_record(3)) + tail);
 }
@@ -139,13 +139,13 @@ inline std::vector<ZipEntry> trx_entries(std::uint32_t n, std::vector<ZipEntry> 
   return e;
 }
 
-// Row 1: a dps member whose component count does not fit in 64 bits.
+// A dps member whose component count does not fit in 64 bits.
 inline void trx_huge_component_count(const std::string& path) {
   write_zip(path,
             trx_entries(3, {stored_entry("dps/c.99999999999999999999.float32", le(std::vector<float>{1, 2, 3}))}));
 }
 
-// Row 6: the offsets member replaced by `mib` MiB of deflated zeros. With `honest` the zip's directory
+// The offsets member replaced by `mib` MiB of deflated zeros. With `honest` the zip's directory
 // declares that size; otherwise it declares the 32 bytes the header asks for, and the data inflates past it.
 inline void trx_offsets_bomb(const std::string& path, int mib, bool honest) {
   std::vector<ZipEntry> e = trx_entries(3);
@@ -232,20 +232,20 @@ inline void vtp_zlib_block_with_junk(const std::string& path, const std::string&
 
 // ---- MRtrix (TCK, TSF) ----
 
-// Row 8: a TSF of three streamlines of one value each, the second 1e300 (beyond float32).
+// A TSF of three streamlines of one value each, the second 1e300 (beyond float32).
 inline void tsf_float64_out_of_range(const std::string& path) {
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   write_mrtrix_file(path, "mrtrix track scalars", "Float64LE", raw<double>({1, nan, 1e300, nan, 3, nan, inf}));
 }
 
-// Row 9: a TSF of three streamlines whose header says count: 99.
+// A TSF of three streamlines whose header says count: 99.
 inline void tsf_wrong_count(const std::string& path) {
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   write_mrtrix_file(path, "mrtrix track scalars", "Float32LE", raw<float>({1, nan, 2, nan, 3, nan, inf}),
                     "count: 99\n");
 }
 
-// Row 13: a TCK of one streamline, then a point whose x alone is Inf (a damaged point, which ends the
+// A TCK of one streamline, then a point whose x alone is Inf (a damaged point, which ends the
 // data), then another streamline that is lost.
 inline void tck_inf_in_one_coordinate(const std::string& path) {
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
@@ -253,21 +253,21 @@ inline void tck_inf_in_one_coordinate(const std::string& path) {
                     raw<float>({1, 2, 3, 4, 5, 6, nan, nan, nan, inf, 7, 8, 9, 9, 9, nan, nan, nan, inf, inf, inf}));
 }
 
-// Row 13: a TCK whose data goes on after its (Inf, Inf, Inf) terminator.
+// A TCK whose data goes on after its (Inf, Inf, Inf) terminator.
 inline void tck_data_after_terminator(const std::string& path) {
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   write_mrtrix_file(path, "mrtrix tracks", "Float32LE",
                     raw<float>({1, 2, 3, 4, 5, 6, nan, nan, nan, inf, inf, inf, 7, 8, 9, 9, 9, 9, nan, nan, nan}));
 }
 
-// Row 13: a TCK of one streamline whose header says count: -5.
+// A TCK of one streamline whose header says count: -5.
 inline void tck_negative_count(const std::string& path) {
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   write_mrtrix_file(path, "mrtrix tracks", "Float32LE", raw<float>({1, 2, 3, 4, 5, 6, nan, nan, nan, inf, inf, inf}),
                     "count: -5\n");
 }
 
-// Row 12: a FIFO, which no writer will ever open.
+// A FIFO, which no writer will ever open.
 inline void fifo(const std::string& path) { ::mkfifo(path.c_str(), 0600); }
 
 }  // namespace vxl::test::hostile

@@ -72,7 +72,7 @@ TEST(HostileVxl, TheGeneratedFileIsValidAndHasEveryOptionalSection) {
   EXPECT_NE(r.output.find("\"CST_left\""), std::string::npos) << r.output;
 }
 
-// Row 2: one byte of an optional section's id XOR 0x80 made `info --json` die of nlohmann's type_error 316
+// One byte of an optional section's id XOR 0x80 made `info --json` die of nlohmann's type_error 316
 // (exit 70); ids must be printable ASCII (spec §4), and open says so.
 TEST(HostileVxl, SectionIdThatIsNotAsciiIsRefusedOnOpen) {
   ScratchDir dir;
@@ -138,7 +138,7 @@ TEST(HostileVxl, NameThatIsNotUtf8IsRefusedOnOpen) {
   EXPECT_NE(r.output.find("value-set name is not valid UTF-8"), std::string::npos) << r.output;
 }
 
-// Row 3: META point_count with its top bit set (byte 15 of META XOR 0x80: 2^63 + P) made `export x.trx`
+// META point_count with its top bit set (byte 15 of META XOR 0x80: 2^63 + P) made `export x.trx`
 // reserve 3 * 2^63 floats (exit 70, "vector::reserve"). P + synthetic points <= V is checked on open.
 TEST(HostileVxl, PointCountBeyondTheVerticesIsRefusedBeforeAnyReservation) {
   ScratchDir dir;

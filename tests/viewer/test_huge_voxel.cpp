@@ -18,7 +18,7 @@ using test::q;
 
 test::CommandResult voxview(const std::string& args) { return test::run_program(VOXVIEW_CLI, args); }
 
-// Row 10: `convert --voxel-size 1e8` (up to 1e300) gives one voxel holding the whole tractogram, valid, but the
+// `convert --voxel-size 1e8` (up to 1e300) gives one voxel holding the whole tractogram, valid, but the
 // viewer drew nothing ("0 voxels drawn"): the near plane sat at 10^-4 of a far plane one voxel beyond the
 // scene, i.e. 10 m away. One voxel is drawn now, as at 1e6.
 TEST(VoxviewHugeVoxel, OneVoxelLargerThanTheSceneIsDrawn) {

@@ -20,7 +20,7 @@ using test::q;
 
 test::CommandResult voxview(const std::string& args) { return test::run_program(VOXVIEW_CLI, args); }
 
-// Row 11: one byte changed in a section open() does not read in full is drawn as it is (spec §7 keeps open
+// One byte changed in a section open() does not read in full is drawn as it is (spec §7 keeps open
 // O(voxels)); with --verify the checksum is checked first and the file refused, exit 3, naming the problem,
 // and nothing is drawn.
 TEST(VoxviewVerify, RefusesADamagedChecksumThatOpenLetsThrough) {
