@@ -1,9 +1,8 @@
 // Saved views (`voxview --camera FILE.json`, `--save-camera FILE.json`, the window's V key): everything
 // that decides a picture apart from the data — the camera, the render settings (mode, opacity, colour mode,
 // colour map, range, group colours, line width, background, lighting, orientation labels, colour bar, slab and
-// clip planes) and the image
-// size — as a small JSON file, so
-// that a view found in the window can be rendered again headless, identically, for a figure.
+// clip planes) and the image size — as a small JSON file, so that a view found in the window can be rendered
+// again headless, identically, for a figure.
 //
 //   {
 //     "voxview_view": 1,
