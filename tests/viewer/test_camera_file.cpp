@@ -38,7 +38,9 @@ SavedView unusual_view() {
   s.range = std::array<float, 2>{0.1f, 0.9f};
   s.group_styles = {{"ARC_L", glm::vec3(1, 0, 0), 0.25f}, {"ARC_R", std::nullopt, 0.0f}};
   s.line_width = 2.5f;
-  s.white_background = true;
+  s.background_color = {0.1f, 0.2f, 0.3f};  // no #RRGGBB says it exactly
+  s.orientation_labels = true;
+  s.colorbar = true;
   s.lighting = true;
   s.order_hysteresis = 0.05f;
   s.clipping.slab_mm = 12.5;
@@ -73,7 +75,9 @@ TEST(CameraFile, RoundTripsEveryFieldExactly) {
     EXPECT_EQ(t.group_styles[i].opacity, s.group_styles[i].opacity);
   }
   EXPECT_EQ(t.line_width, s.line_width);
-  EXPECT_EQ(t.white_background, s.white_background);
+  EXPECT_EQ(t.background_color, s.background_color);
+  EXPECT_EQ(t.orientation_labels, s.orientation_labels);
+  EXPECT_EQ(t.colorbar, s.colorbar);
   EXPECT_EQ(t.lighting, s.lighting);
   EXPECT_EQ(t.order_hysteresis, s.order_hysteresis);
   EXPECT_EQ(t.clipping.slab_mm, s.clipping.slab_mm);
@@ -141,6 +145,15 @@ TEST(CameraFile, MissingKeysKeepDefaultsAndBadOnesNameFileAndKey) {
             std::string::npos);
   EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"colormap": "jet"}})").find("settings.colormap"),
             std::string::npos);
+  const std::string background = error_of(R"({"voxview_view": 1, "settings": {"background": "purple"}})");
+  EXPECT_NE(background.find("settings.background"), std::string::npos) << background;
+  EXPECT_NE(background.find("#RRGGBB"), std::string::npos) << background;
+  EXPECT_NE(error_of(R"({"voxview_view": 1, "settings": {"colorbar": 1}})").find("settings.colorbar"),
+            std::string::npos);
+  // A file written before any colour but black and white still reads.
+  EXPECT_EQ(app::parse_view_json(R"({"voxview_view": 1, "settings": {"background": "white"}})", "old.json")
+                .settings.background_color,
+            glm::vec3(1.0f));
 
   // Nested 100000 deep, the file crashed the viewer by stack overflow: refused before it is parsed.
   const std::string deep =

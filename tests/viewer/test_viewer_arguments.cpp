@@ -45,7 +45,8 @@ app::SavedView saved_view() {
   v.settings.opacity = 0.7f;
   v.settings.color = ColorMode::Fixed;
   v.settings.colormap = Colormap::Hot;
-  v.settings.white_background = true;
+  v.settings.background_color = glm::vec3(1.0f);
+  v.settings.orientation_labels = true;
   v.settings.line_width = 3;
   v.settings.clipping.planes = {*parse_axis_clip("y,5")};
   v.size = std::array<int, 2>{640, 480};
@@ -61,7 +62,7 @@ TEST(ViewerArguments, WithoutASavedViewTheCommandLineValuesApply) {
   const app::ViewerOptions o = resolve_viewer_options(a);
   EXPECT_EQ(o.settings.mode, RenderMode::Wboit);
   EXPECT_EQ(o.settings.opacity, 0.25f);
-  EXPECT_TRUE(o.settings.white_background);
+  EXPECT_EQ(o.settings.background_color, glm::vec3(1.0f));
   EXPECT_EQ(o.settings.color, ColorMode::Direction);
   EXPECT_EQ(o.settings.colormap, Colormap::Viridis);
   EXPECT_EQ(o.width, 1024);
@@ -86,7 +87,8 @@ TEST(ViewerArguments, ASavedViewOverridesTheDefaultsAndGivenOptionsOverrideIt) {
     EXPECT_EQ(o.settings.opacity, 0.7f);
     EXPECT_EQ(o.settings.color, ColorMode::Fixed);
     EXPECT_EQ(o.settings.colormap, Colormap::Hot);
-    EXPECT_TRUE(o.settings.white_background);
+    EXPECT_EQ(o.settings.background_color, glm::vec3(1.0f));
+    EXPECT_TRUE(o.settings.orientation_labels);
     EXPECT_EQ(o.settings.line_width, 3);
     ASSERT_EQ(o.settings.clipping.planes.size(), 1u);
     EXPECT_EQ(o.settings.clipping.planes[0].axis, 1);
@@ -102,7 +104,7 @@ TEST(ViewerArguments, ASavedViewOverridesTheDefaultsAndGivenOptionsOverrideIt) {
   const app::ViewerOptions o = resolve_viewer_options(a);
   EXPECT_EQ(o.settings.mode, RenderMode::Basic);
   EXPECT_EQ(o.settings.opacity, 0.7f);
-  EXPECT_TRUE(o.settings.white_background);
+  EXPECT_EQ(o.settings.background_color, glm::vec3(1.0f));
   EXPECT_EQ(o.width, 100);
   EXPECT_EQ(o.height, 50);
   ASSERT_EQ(o.settings.clipping.planes.size(), 1u);  // given planes replace the saved ones
@@ -187,6 +189,13 @@ TEST(ViewerArguments, BadOrConflictingOptionsAreUsageErrors) {
   error_contains(given("--color", &ViewerArguments::color, "rainbow"), "--color: unknown colour mode");
   error_contains(given("--colormap", &ViewerArguments::colormap, "jet"), "--colormap: unknown colour map");
   error_contains(given("--fixed-color", &ViewerArguments::fixed_color, "red"), "--fixed-color: expected #RRGGBB");
+  error_contains(given("--background", &ViewerArguments::background, "purple"),
+                 "--background: expected a name (black, white, grey, darkgrey, lightgrey), #RRGGBB");
+  ViewerArguments colorbar;
+  colorbar.colorbar = true;
+  error_contains(colorbar, "--colorbar goes with --color scalar");
+  colorbar.color = "scalar";
+  EXPECT_EQ(usage_error_of(colorbar), "no error");
 
   ViewerArguments a = given("--size", &ViewerArguments::size, "800x600");
   EXPECT_EQ(usage_error_of(a), "no error");

@@ -397,5 +397,29 @@ TEST_F(Window, ASelectionLooksAsItDoesHeadless) {
   EXPECT_GT(lit_pixels(b), 50);
 }
 
+// The orientation letters, the triad and a background colour are drawn in the window as in --render.
+TEST_F(Window, OrientationLabelsAndABackgroundLookAsTheyDoHeadless) {
+  VXL_REQUIRE_XVFB();
+  make_inputs();
+  const std::string args = " --size 320x240 --background '#203040'";
+  const std::string shot = dir.file("shot.png"), headless = dir.file("headless.png"), bare = dir.file("bare.png");
+  CommandResult w = run_voxview_in_xvfb(shell_quoted(vxl) + args + " --orientation-labels --frames 5 --screenshot " +
+                                        shell_quoted(shot));
+  ASSERT_EQ(w.exit_code, 0) << w.output;
+  CommandResult h = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + args +
+                              " --orientation-labels --render " + shell_quoted(headless));
+  ASSERT_EQ(h.exit_code, 0) << h.output;
+  CommandResult b =
+      run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + args + " --render " + shell_quoted(bare));
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const Image a = read_image(shot);
+  const ImageDiff same = compare_images(a, read_image(headless));
+  EXPECT_LT(same.mean_error, 6e-5) << "differing pixels " << same.differing_pixels;
+  // Without the labels the picture differs by far more than the window and headless paths do.
+  EXPECT_GT(compare_images(a, read_image(bare)).mean_error, 10 * std::max(same.mean_error, 1e-5));
+  EXPECT_EQ(a.pixel(0, 0)[0], 0x20);
+  EXPECT_EQ(a.pixel(0, 0)[2], 0x40);
+}
+
 }  // namespace
 }  // namespace vxl

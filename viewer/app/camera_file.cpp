@@ -12,6 +12,7 @@
 #include "format/atomic_output.h"
 #include "format/error.h"
 #include "format/json_limits.h"
+#include "viewer/render/background_color.h"
 
 namespace vxl::app {
 
@@ -179,10 +180,13 @@ void read_settings(const Reader& r, RenderSettings& s) {
   r.number("line_width", s.line_width);
   if (!(s.line_width >= 1.0f && s.line_width <= 16.0f)) r.fail("line_width", "pixels in [1, 16]");
   if (const std::string* bg = r.text("background")) {
-    if (*bg != "black" && *bg != "white") r.fail("background", "black or white");
-    s.white_background = *bg == "white";
+    const auto colour = parse_background_color(*bg);
+    if (!colour) r.fail("background", background_color_forms());
+    s.background_color = *colour;
   }
   r.boolean("lighting", s.lighting);
+  r.boolean("orientation_labels", s.orientation_labels);
+  r.boolean("colorbar", s.colorbar);
   r.number("order_hysteresis", s.order_hysteresis);
   r.number("slab_mm", s.clipping.slab_mm);
   if (!slab_is_drawable(s.clipping.slab_mm)) r.fail("slab_mm", slab_range_text() + " (0: no slab)");
@@ -236,8 +240,10 @@ std::string view_json(const SavedView& v) {
                    {"range", s.range ? json::array({shortest((*s.range)[0]), shortest((*s.range)[1])}) : json(nullptr)},
                    {"groups", groups},
                    {"line_width", shortest(s.line_width)},
-                   {"background", s.white_background ? "white" : "black"},
+                   {"background", background_color_text(s.background_color)},
                    {"lighting", s.lighting},
+                   {"orientation_labels", s.orientation_labels},
+                   {"colorbar", s.colorbar},
                    {"order_hysteresis", shortest(s.order_hysteresis)},
                    {"slab_mm", s.clipping.slab_mm},
                    {"clip", clip}};

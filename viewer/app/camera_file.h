@@ -1,8 +1,8 @@
 // Saved views (`voxview --camera FILE.json`, `--save-camera FILE.json`, the window's V key): everything
 // that decides a picture apart from the data — the camera, the render settings (mode, opacity, colour mode,
-// colour map, range, group colours, line width, background, lighting, slab and clip planes) and the image
-// size — as a small JSON file, so
-// that a view found in the window can be rendered again headless, identically, for a figure.
+// colour map, range, group colours, line width, background, lighting, orientation labels, colour bar, slab and
+// clip planes) and the image size — as a small JSON file, so that a view found in the window can be rendered
+// again headless, identically, for a figure.
 //
 //   {
 //     "voxview_view": 1,
@@ -12,11 +12,13 @@
 //     "settings": {"mode": "axis", "opacity": 0.3, "color": "direction", "fixed_color": [1, 0.85, 0.3],
 //                  "colormap": "viridis", "scalar": "", "range": null,
 //                  "groups": [{"name": "ARC_L", "color": "#e41a1c", "opacity": 1}],
-//                  "line_width": 1, "background": "black", "lighting": false, "order_hysteresis": 0,
+//                  "line_width": 1, "background": "black", "lighting": false, "orientation_labels": false,
+//                  "colorbar": false, "order_hysteresis": 0,
 //                  "slab_mm": 0, "clip": [{"plane": "-x,10", "enabled": true}]},
 //     "selection": {"include": ["-9,-23,-30,6"], "exclude": [], "ends_in": []}
 //   }
 //
+// "background" takes what --background takes (a name, "#RRGGBB" or "R,G,B"; background_color.h).
 // "selection" (the regions of voxview --include, --exclude, --ends-in and of the window) is written only
 // when there are regions.
 //

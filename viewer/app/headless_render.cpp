@@ -9,6 +9,7 @@
 #include "converter/memory_size.h"
 #include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_file.h"
+#include "viewer/app/picture_annotations.h"
 #include "viewer/app/region_editor.h"
 #include "viewer/app/scene_detail.h"
 #include "viewer/app/scene_selection.h"
@@ -100,8 +101,15 @@ int run_headless(const ViewerOptions& o) {
     write_view(*o.save_camera, SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}, true, o.include,
                                          o.exclude, o.ends_in});
   const int frames = std::max(1, o.turntable);
+  std::optional<PictureAnnotations> annotations;
+  if (PictureAnnotations::wanted(o.settings)) annotations.emplace();
   for (int i = 0; i < frames; ++i) {
-    renderer->draw(turntable_camera(*camera, i, frames), o.settings, o.width, o.height, target.framebuffer());
+    const Camera frame_camera = turntable_camera(*camera, i, frames);
+    renderer->draw(frame_camera, o.settings, o.width, o.height, target.framebuffer());
+    if (annotations) {
+      target.bind();
+      annotations->draw(frame_camera, o.settings, *renderer, o.width, o.height);
+    }
     std::vector<std::uint8_t> rgba = target.read_rgba();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::string png = o.turntable ? turntable_frame_path(*o.render_png, i, frames) : *o.render_png;

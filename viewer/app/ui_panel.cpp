@@ -226,8 +226,8 @@ void image_controls(PanelState& state, const PanelStats& stats, PanelRequests& o
   ImGui::EndDisabled();
 }
 
-// The transparency mode (each described when hovered), opacity, line width, colour, lighting, background
-// and the voxel grid.
+// The transparency mode (each described when hovered), opacity, line width, colour, lighting, background,
+// orientation labels, colour bar and the voxel grid.
 void look_controls(PanelState& state, const PanelStats& stats) {
   RenderSettings& s = state.settings;
   if (ImGui::BeginCombo("Mode", render_mode_name(s.mode))) {
@@ -254,14 +254,22 @@ void look_controls(PanelState& state, const PanelStats& stats) {
     ImGui::SetTooltip("at rest, basic and axis go on to the exact picture, run by run (needs OpenGL 4.3)");
   ImGui::EndDisabled();
 
-  int background = s.white_background ? 1 : 0;
+  // Black and white at a click, any colour through the picker.
   ImGui::AlignTextToFramePadding();
   ImGui::TextUnformatted("Background");
   ImGui::SameLine();
-  ImGui::RadioButton("black", &background, 0);
+  if (ImGui::Button("black")) s.background_color = glm::vec3(0.0f);
   ImGui::SameLine();
-  ImGui::RadioButton("white", &background, 1);
-  s.white_background = background == 1;
+  if (ImGui::Button("white")) s.background_color = glm::vec3(1.0f);
+  ImGui::SameLine();
+  ImGui::ColorEdit3("##background colour", &s.background_color.x, ImGuiColorEditFlags_NoInputs);
+
+  ImGui::Checkbox("Orientation labels", &s.orientation_labels);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("L/R, P/A, I/S at the picture's edges and an axes triad");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(s.color != ColorMode::Scalar);
+  ImGui::Checkbox("Colour bar", &s.colorbar);
+  ImGui::EndDisabled();
 
   ImGui::Checkbox("Voxel grid", &state.grid);
   ImGui::SameLine();

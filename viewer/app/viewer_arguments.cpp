@@ -10,6 +10,7 @@
 #include "viewer/app/camera_file.h"
 #include "viewer/app/turntable.h"
 #include "viewer/platform/image_io.h"
+#include "viewer/render/background_color.h"
 #include "viewer/render/scene_groups.h"
 
 namespace vxl::app {
@@ -58,8 +59,8 @@ void apply_saved_view(const ViewerArguments& a, ViewerOptions& o, std::string& s
     size = std::to_string((*saved.size)[0]) + "x" + std::to_string((*saved.size)[1]);
 }
 
-// Mode, opacity, colouring, groups, background, line width and lighting. `from_file`: a saved view set
-// them, and only options given explicitly change them.
+// Mode, opacity, colouring, groups, background, line width, lighting and what is drawn over the picture. `from_file`: a
+// saved view set them, and only options given explicitly change them.
 void apply_look(const ViewerArguments& a, bool from_file, RenderSettings& s) {
   auto overrides = [&](const char* option) { return !from_file || a.was_given(option); };
   if (overrides("--mode")) {
@@ -97,9 +98,19 @@ void apply_look(const ViewerArguments& a, bool from_file, RenderSettings& s) {
     if (style->color) existing.color = style->color;
     existing.opacity = style->opacity;
   }
-  if (overrides("--background")) s.white_background = a.background == "white";
+  if (overrides("--background")) {
+    const auto background = parse_background_color(a.background);
+    if (!background) usage_error("--background: expected " + background_color_forms() + "; got '" + a.background + "'");
+    s.background_color = *background;
+  }
   if (overrides("--line-width")) s.line_width = a.line_width;
   if (a.lighting) s.lighting = true;
+  if (a.orientation_labels) s.orientation_labels = true;
+  if (a.colorbar) {
+    // The bar shows the colour map and range of the values the lines are coloured by.
+    if (s.color != ColorMode::Scalar) usage_error("--colorbar goes with --color scalar (a saved view's colour too)");
+    s.colorbar = true;
+  }
 }
 
 // --slab and --clip: clip planes given replace a saved view's.

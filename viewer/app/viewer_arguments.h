@@ -21,6 +21,7 @@ struct ViewerArguments {
   std::string fixed_color, scalar, range;
   std::vector<std::string> groups, clips;
   bool lighting = false;
+  bool orientation_labels = false, colorbar = false;
   double slab = 0;
   std::string image_range, slices, focus, view;
   std::string size = "1024x1024";

@@ -5,6 +5,7 @@
 #include "converter/readers/source_formats.h"
 #include "format/vxl_levels.h"
 #include "viewer/app/key_bindings.h"
+#include "viewer/render/background_color.h"
 #include "viewer/render/render_settings.h"
 
 namespace vxl::app {
@@ -136,9 +137,15 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
       "light the lines (illuminated lines: a line along the light, which comes from the viewer's upper left, is "
       "dark, one across it bright)");
   cli.add_option("--line-width", a.line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
-  cli.add_option("--background", a.background, "black or white")
-      ->default_val("black")
-      ->check(CLI::IsMember({"black", "white"}));
+  cli.add_option("--background", a.background, "the background colour: " + background_color_forms())
+      ->default_val("black");
+  cli.add_flag("--orientation-labels", a.orientation_labels,
+               "label the picture's edges with the anatomical directions the world's axes point to there (L/R "
+               "for x, P/A for y, I/S for z; RAS: R, A and S are +x, +y and +z) and draw an axes triad in the lower "
+               "left corner (x red, y green, z blue), so that radiological and neurological views are never guessed");
+  cli.add_flag("--colorbar", a.colorbar,
+               "with --color scalar: a colour bar at the right edge, the colour map from --range's minimum (bottom) "
+               "to its maximum (top), with both numbers and the value set's name");
   cli.add_option("--image", a.options.image,
                  "an anatomical image (NIfTI-1 or -2, .nii or .nii.gz; MRtrix .mif, .mif.gz or .mih; e.g. a T1) shown "
                  "as opaque grey slices through the "

@@ -29,6 +29,7 @@
 #include "viewer/app/frame_pacing.h"
 #include "viewer/app/headless_render.h"
 #include "viewer/app/key_bindings.h"
+#include "viewer/app/picture_annotations.h"
 #include "viewer/app/region_editor.h"
 #include "viewer/app/rest_refinement.h"
 #include "viewer/app/scene_detail.h"
@@ -38,6 +39,7 @@
 #include "viewer/app/window_size.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/offscreen_target.h"
+#include "viewer/render/background_color.h"
 #include "viewer/render/grid_overlay.h"
 #include "viewer/render/renderer.h"
 #include "viewer/render/scene_framing.h"
@@ -202,8 +204,8 @@ class ViewerWindow {
   // Draws the next piece of the refinement at rest (rest_refinement.h) into refine_target_; once the stage's
   // picture is complete it becomes scene_target_'s and `completes` is set. Returns the piece's time in ms.
   double refine(int width, int height, bool& completes);
-  // The grid overlay over scene_target_'s picture, when it is on.
-  void overlay_grid(const Renderer& renderer, int width, int height);
+  // The grid overlay and the annotations (picture_annotations.h) over scene_target_'s picture, when they are on.
+  void draw_overlays(const Renderer& renderer, int width, int height);
   // The panel's figures of a complete picture drawn by `renderer`.
   void show_frame_figures(const Renderer& renderer, std::uint32_t level);
   // scene_target_ into the window's back buffer.
@@ -242,6 +244,7 @@ class ViewerWindow {
   // (the scene's level, or finer for a slab or a close view); none until the refinement has chosen it.
   std::optional<std::uint32_t> rest_level_;
   std::optional<GridOverlay> grid_;
+  std::optional<PictureAnnotations> annotations_;  // made when first wanted
   // The scene is drawn here and blitted to the window: it blends in float like headless rendering, so
   // faint layers add up beyond 8-bit rounding and the window shows what --render writes.
   std::optional<OffscreenTarget> scene_target_;
@@ -599,7 +602,7 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
     renderer.draw(camera, s, width, height, target);
   }
   drawn_mode_ = s.mode;
-  overlay_grid(renderer, width, height);
+  draw_overlays(renderer, width, height);
   glFinish();  // the frame time should include the GPU's work, not only its submission
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
@@ -607,14 +610,21 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
   return ms;
 }
 
-void ViewerWindow::overlay_grid(const Renderer& renderer, int width, int height) {
+void ViewerWindow::draw_overlays(const Renderer& renderer, int width, int height) {
   scene_target_->bind();
-  if (!state_.grid) return;
   const RenderSettings& s = state_.settings;
-  const glm::vec4 colour = s.white_background ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
-  grid_->draw(renderer, controller_.camera(), double(width) / height,
-              state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn, colour, s.clipping);
-  stats_.grid_cubes = grid_->cubes_drawn();
+  if (state_.grid) {
+    const glm::vec4 colour =
+        background_is_light(s.background()) ? glm::vec4(0.1f, 0.1f, 0.1f, 0.25f) : glm::vec4(0.8f, 0.8f, 0.8f, 0.25f);
+    grid_->draw(renderer, controller_.camera(), double(width) / height,
+                state_.grid_all ? GridOverlay::Scope::All : GridOverlay::Scope::Drawn, colour, s.clipping);
+    stats_.grid_cubes = grid_->cubes_drawn();
+  }
+  // Over the grid too: the letters and the colour bar stay readable.
+  if (PictureAnnotations::wanted(s)) {
+    if (!annotations_) annotations_.emplace();
+    annotations_->draw(controller_.camera(), s, renderer, width, height);
+  }
 }
 
 void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t level) {
@@ -696,7 +706,7 @@ double ViewerWindow::refine(int width, int height, bool& completes) {
   }
   if (completes) {
     std::swap(scene_target_, refine_target_);
-    overlay_grid(renderer, width, height);
+    draw_overlays(renderer, width, height);
     show_frame_figures(renderer, *rest_level_);
     drawn_level_ = *rest_level_;
     rest_.stage_complete();

@@ -71,9 +71,9 @@ struct RenderSettings {
   RenderMode mode = RenderMode::Axis;
   ColorMode color = ColorMode::Direction;
   glm::vec3 fixed_color{1.0f, 0.85f, 0.3f};
-  float opacity = 0.5f;     // 1 down to 0.001
-  float line_width = 1.0f;  // pixels
-  bool white_background = false;
+  float opacity = 0.5f;              // 1 down to 0.001
+  float line_width = 1.0f;           // pixels
+  glm::vec3 background_color{0.0f};  // background_color.h parses and names it
   // `axis` mode: keep a voxel's order until another stored order is closer to its view direction by
   // more than this cosine margin (FramePlan::order_hysteresis). 0: off, the paper's rule every frame.
   float order_hysteresis = 0.0f;
@@ -84,7 +84,11 @@ struct RenderSettings {
   Clipping clipping;                          // slab and clip planes (clip_planes.h)
   bool lighting = false;                      // illuminated lines (line_lighting.h)
   SliceSettings slices;                       // drawn when the renderer has a volume (Renderer::set_volume)
-  glm::vec3 background() const { return white_background ? glm::vec3(1.0f) : glm::vec3(0.0f); }
+  // Drawn over the picture (picture_annotations.h), not by the renderer: L/R, A/P, S/I at the picture's
+  // edges and an axes triad; with ColorMode::Scalar, a colour bar with the range and the value set's name.
+  bool orientation_labels = false;
+  bool colorbar = false;
+  glm::vec3 background() const { return background_color; }
   // The colour and opacity factor of group `index` called `name`.
   glm::vec4 group_color(const std::string& name, std::size_t index) const;
   GroupStyle& style_of(const std::string& name);                // the user's entry for `name`, added when missing
