@@ -89,10 +89,14 @@ void add_export_command(CLI::App& app) {
                   (unsigned long long)s.points);
       return;
     }
-    if (trx)
+    if (trx) {
       export_trx(f, opt->output, group ? &*group : nullptr);
-    else
+    } else {
+      // Groups become 0/1 cell arrays in a VTK; their rows of values (TRX dpg) have no place there.
+      if (std::optional<std::string> lost = group_values_not_written(f, "a VTK", opt->tck.group))
+        print_warnings({*lost});
       export_vtk(f, opt->output, group ? &*group : nullptr);
+    }
     std::printf("%s: %llu streamlines, %llu points\n", opt->output.c_str(), (unsigned long long)counts.streamlines,
                 (unsigned long long)counts.points);
   });
