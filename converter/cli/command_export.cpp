@@ -34,7 +34,7 @@ void add_export_command(CLI::App& app) {
   cmd->add_option(
       "output", opt->output,
       "output .tck (Float32LE, the source TCK header's properties kept), .trx (zip, stored: float32 positions, "
-      "uint64 offsets, groups, dpv and dps kept) or .vtk (legacy BINARY POLYDATA, values kept as POINT_DATA / "
+      "uint64 offsets, groups, dpv, dps and dpg kept) or .vtk (legacy BINARY POLYDATA, values kept as POINT_DATA / "
       "CELL_DATA scalars, groups as 0/1 CELL_DATA arrays) or .trk / .trk.gz (TrackVis v2: a TRK source's header, "
       "values as scalars and properties); written atomically. Not with --split-groups");
   cmd->add_option("--tsf", opt->tck.tsf_path,
