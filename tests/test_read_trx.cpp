@@ -69,7 +69,7 @@ TEST(ReadTrx, EveryFixtureHasTheDocumentedCounts) {
       EXPECT_TRUE(has_warning(t.source.warnings, "NB_STREAMLINES = 459"));
       EXPECT_EQ(t.source.warnings.size(), 1u);
     } else if (std::string(f.file).starts_with("trx-python__small")) {
-      EXPECT_EQ(t.source.warnings.size(), 2u);  // groups CC and CST_L
+      EXPECT_EQ(t.source.warnings.size(), 3u);  // groups CC, CST_L and CST_R
       EXPECT_TRUE(has_warning(t.source.warnings, "duplicate indices collapsed"));
     } else {
       EXPECT_TRUE(t.source.warnings.empty()) << t.source.warnings.front();
@@ -154,7 +154,7 @@ TEST(ReadTrx, TrxPythonZipCompressedZipAndDirectoryAgree) {
   ASSERT_EQ(stored.groups.size(), 5u);  // AF_L, AF_R, CC, CST_L, CST_R (int64 indices)
   EXPECT_EQ(stored.groups[0].name, "AF_L");
   EXPECT_EQ(stored.groups[2].name, "CC");
-  // groups/CC.int64 holds 34 unsorted indices with 5 repeats (e.g. 260, 260) and CST_L 14 with 7:
+  // groups/CC.int64 holds 34 unsorted indices with 5 repeats (e.g. 260, 260), CST_L 14 with 7, CST_R 9 with 2:
   // members come back sorted and deduplicated, with a warning per group.
   EXPECT_EQ(stored.groups[2].members.size(), 29u);
   EXPECT_EQ(stored.groups[2].members.front(), 127u);

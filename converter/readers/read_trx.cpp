@@ -504,9 +504,15 @@ void read_group_values(const Members& members, Tractogram& t) {
     const std::string group = slash == std::string::npos ? "" : rest.substr(0, slash);
     const std::string file = slash == std::string::npos ? "" : rest.substr(slash + 1);
     const std::size_t dot = file.rfind('.');
-    const std::optional<GroupValueType> type =
-        dot == std::string::npos ? std::nullopt : group_value_type(file.substr(dot + 1));
-    if (group.empty() || file.find('/') != std::string::npos || dot == std::string::npos || dot == 0 || !type) {
+    // A plain value and a flag, not an optional: GCC 12 takes the optional's value for uninitialised.
+    GroupValueType type{};
+    bool typed = false;
+    if (dot != std::string::npos)
+      if (const std::optional<GroupValueType> known = group_value_type(file.substr(dot + 1))) {
+        type = *known;
+        typed = true;
+      }
+    if (group.empty() || file.find('/') != std::string::npos || dot == std::string::npos || dot == 0 || !typed) {
       t.source.warnings.push_back(json_safe(name) + ": not dpg/<group>/<name>[.<components>].<dtype>; ignored");
       continue;
     }
@@ -538,7 +544,7 @@ void read_group_values(const Members& members, Tractogram& t) {
                                   " with another dtype or component count; ignored");
       continue;
     }
-    const std::uint64_t elem = group_value_type_size(*type);
+    const std::uint64_t elem = group_value_type_size(type);
     const std::uint64_t declared = members.declared_size(name);
     const std::uint64_t expected = times(components, elem);
     if (components == 0 || components > kMaxGroupValueComponents || declared != expected) {
@@ -556,7 +562,7 @@ void read_group_values(const Members& members, Tractogram& t) {
     GroupValues v;
     v.group = group_index;
     v.name = row_name;
-    v.type = *type;
+    v.type = type;
     v.components = static_cast<std::uint32_t>(components);
     v.bytes.assign(blob.bytes().begin(), blob.bytes().end());
     t.group_values.push_back(std::move(v));
