@@ -326,12 +326,15 @@ TEST(TrxGroupValuesReal, TrxPythonSmallKeepsItsRowsAndCountsItsRepeats) {
   for (const char* name : {"trx-python__small.trx", "trx-python__small_compressed.trx", "trx-python__small_fldr.trx"}) {
     SCOPED_TRACE(name);
     const Tractogram source = read_trx(test::real(name));
-    // groups/CC.int64 lists 34 indices of 29 streamlines, groups/CST_L.int64 14 of 7.
+    // groups/CC.int64 lists 34 indices of 29 streamlines, groups/CST_L.int64 14 of 7, CST_R 9 of 7.
     EXPECT_TRUE(has_warning(source.source.warnings,
                             "group CC: 5 duplicate indices collapsed (34 listed in groups/CC.int64, 29 streamlines)"));
     EXPECT_TRUE(
         has_warning(source.source.warnings,
                     "group CST_L: 7 duplicate indices collapsed (14 listed in groups/CST_L.int64, 7 streamlines)"));
+    EXPECT_TRUE(
+        has_warning(source.source.warnings,
+                    "group CST_R: 2 duplicate indices collapsed (9 listed in groups/CST_R.int64, 7 streamlines)"));
     const std::map<std::string, Bytes> rows = rows_by_member(source.groups, source.group_values);
     EXPECT_EQ(rows.size(), 11u);  // CC, AF_L, AF_R: colour, mean FA, volume; CST_L, CST_R: colour
     ASSERT_TRUE(rows.contains("CC/shuffle_colors.3.uint8"));
