@@ -20,6 +20,7 @@
 #include "converter/export_trx.h"
 #include "converter/pack.h"
 #include "converter/readers/read_tractogram.h"
+#include "converter/selection/selection_output.h"
 #include "converter/unpack.h"
 #include "format/error.h"
 #include "format/vxl_file.h"
@@ -50,8 +51,8 @@ Bytes text(const std::string& s) { return Bytes(s.begin(), s.end()); }
 const std::uint64_t kNanBits = 0x7FF800000000BEEFull;
 const std::uint64_t kMinusZeroBits = 0x8000000000000000ull;
 
-// 3 streamlines; group "bundle A" lists streamline 2 and 0 twice each, group "B" holds streamline 1; four
-// rows of values per group in four dtypes.
+// 3 streamlines; group "bundle A" lists streamline 2 twice (a member may list at most NB_STREAMLINES
+// entries), group "B" holds streamline 1; four rows of values per group in four dtypes.
 std::vector<std::pair<std::string, Bytes>> trx_members() {
   const std::vector<float> positions = {0, 0, 0, 1, 0, 0, 0, 5, 0, 1, 5, 0, 2, 5, 0, 0, 9, 9};
   return {
@@ -59,7 +60,7 @@ std::vector<std::pair<std::string, Bytes>> trx_members() {
                            "[[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], \"NB_STREAMLINES\": 3, \"NB_VERTICES\": 6}")},
       {"positions.3.float32", le_bytes(positions)},
       {"offsets.uint64", le_bytes(std::vector<std::uint64_t>{0, 2, 5, 6})},
-      {"groups/bundle A.uint16", le_bytes(std::vector<std::uint16_t>{2, 0, 2, 0})},
+      {"groups/bundle A.uint16", le_bytes(std::vector<std::uint16_t>{2, 0, 2})},
       {"groups/B.int32", le_bytes(std::vector<std::int32_t>{1})},
       {"dpg/bundle A/color.3.uint8", Bytes{255, 128, 0}},
       {"dpg/bundle A/mean_fa.float16", le_bytes(std::vector<std::uint16_t>{0x3800})},  // 0.5
@@ -116,7 +117,7 @@ TEST(TrxGroupValues, ReadFromZipAndDirectoryInTheirDtype) {
     EXPECT_EQ(members_of(t.groups, "bundle A"), (std::vector<std::uint64_t>{0, 2}));
     EXPECT_EQ(members_of(t.groups, "B"), (std::vector<std::uint64_t>{1}));
     // The one warning: the repeats of "bundle A", with their count.
-    EXPECT_EQ(t.source.warnings, (std::vector<std::string>{"group bundle A: 2 duplicate indices collapsed (4 listed "
+    EXPECT_EQ(t.source.warnings, (std::vector<std::string>{"group bundle A: 1 duplicate indices collapsed (3 listed "
                                                            "in groups/bundle A.uint16, 2 streamlines)"}));
   }
 }
@@ -180,6 +181,12 @@ TEST(TrxGroupValues, SurviveConvertPackUnpackAndExportByteForByte) {
   const Tractogram subset = read_trx(dir.file("only_b.trx"));
   EXPECT_EQ(subset.streamline_count(), 1u);
   EXPECT_EQ(rows_by_member(subset.groups, subset.group_values), expected_rows());
+  // So does a selection written as a .vxl (`select … OUT.vxl`), and one written as a .vtk says what it drops.
+  EXPECT_TRUE(write_selection(b, only_b, dir.file("only_b.vxl"), {}, {}).empty());
+  const VxlFile selected = VxlFile::open(dir.file("only_b.vxl"));
+  EXPECT_EQ(rows_by_member(selected.groups(), selected.group_values()), expected_rows());
+  EXPECT_TRUE(has_warning(write_selection(b, only_b, dir.file("only_b.vtk"), {}, {}),
+                          "4 row(s) of values per group (TRX dpg) not written: a VTK"));
 }
 
 TEST(TrxGroupValues, ExportsWithoutAPlaceForThemWarn) {
@@ -211,7 +218,7 @@ TEST(TrxGroupValues, InfoListsTheRows) {
   test::write_zip(dir.file("a.trx"), trx_members());
   const test::CommandResult convert = test::run_cli("convert " + q(dir.file("a.trx")) + " " + q(dir.file("a.vxl")));
   ASSERT_EQ(convert.exit_code, 0) << convert.output;
-  EXPECT_NE(convert.output.find("group bundle A: 2 duplicate indices collapsed"), std::string::npos) << convert.output;
+  EXPECT_NE(convert.output.find("group bundle A: 1 duplicate indices collapsed"), std::string::npos) << convert.output;
   const test::CommandResult json = test::run_cli("info --json " + q(dir.file("a.vxl")));
   ASSERT_EQ(json.exit_code, 0) << json.output;
   const nlohmann::json j = nlohmann::json::parse(json.output);
