@@ -23,6 +23,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <vector>
@@ -497,6 +498,10 @@ void read_value_sets(const std::string& path, const Members& members, const std:
 // dtype. A member that cannot be read as such (no such group, no dtype, a size that does not match) is
 // skipped with a warning, like a malformed dpv or dps: the streamlines are still good.
 void read_group_values(const Members& members, Tractogram& t) {
+  // Looked up by name, and rows seen, in O(log n): an archive may hold many members.
+  std::map<std::string, std::uint32_t> group_by_name;
+  for (std::size_t g = t.groups.size(); g-- > 0;) group_by_name[t.groups[g].name] = static_cast<std::uint32_t>(g);
+  std::set<std::pair<std::uint32_t, std::string>> seen;
   for (const auto& [name, index] : members.names()) {
     if (!name.starts_with("dpg/")) continue;
     const std::string rest = name.substr(4);
@@ -525,21 +530,19 @@ void read_group_values(const Members& members, Tractogram& t) {
       if (ec != std::errc() || end != digits.data() + digits.size()) components = 0;  // refused below
       base = base.substr(0, d2);
     }
-    const auto owner = std::find_if(t.groups.begin(), t.groups.end(),
-                                    [&](const StreamlineGroup& g) { return g.name == json_safe(group); });
-    if (owner == t.groups.end()) {
+    const auto owner = group_by_name.find(json_safe(group));  // the first group of that name
+    if (owner == group_by_name.end()) {
       t.source.warnings.push_back(json_safe(name) + ": no groups/" + json_safe(group) + ".<dtype> member; ignored");
       continue;
     }
     const std::string row_name = json_safe(base);
-    const auto group_index = static_cast<std::uint32_t>(owner - t.groups.begin());
+    const std::uint32_t group_index = owner->second;
     if (row_name.size() > kMaxGroupValueNameBytes) {
       t.source.warnings.push_back(json_safe(name) + ": a name longer than " + std::to_string(kMaxGroupValueNameBytes) +
                                   " bytes; ignored");
       continue;
     }
-    if (std::any_of(t.group_values.begin(), t.group_values.end(),
-                    [&](const GroupValues& v) { return v.group == group_index && v.name == row_name; })) {
+    if (seen.contains({group_index, row_name})) {
       t.source.warnings.push_back(json_safe(name) + ": a second dpg/" + json_safe(group) + "/" + row_name +
                                   " with another dtype or component count; ignored");
       continue;
@@ -565,6 +568,7 @@ void read_group_values(const Members& members, Tractogram& t) {
     v.type = type;
     v.components = static_cast<std::uint32_t>(components);
     v.bytes.assign(blob.bytes().begin(), blob.bytes().end());
+    seen.emplace(group_index, row_name);
     t.group_values.push_back(std::move(v));
   }
 }
