@@ -95,6 +95,8 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   const std::string provenance = provenance_json(t.source, settings, threads, voxel_size_choice);
   std::vector<std::uint8_t> groups_bytes;
   if (!t.groups.empty()) groups_bytes = encode_groups(t.groups);
+  std::vector<std::uint8_t> group_values_bytes;
+  if (!t.group_values.empty()) group_values_bytes = encode_group_values(t.group_values);
 
   VoxelizeSettings vs;
   vs.voxel_size = settings.voxel_size;
@@ -119,9 +121,11 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   std::vector<std::string> point_set_names, streamline_set_names;
   for (const ValueSet& v : t.point_values) point_set_names.push_back(v.name);
   for (const ValueSet& v : t.streamline_values) streamline_set_names.push_back(v.name);
-  VxlWriter out(out_path, section_sizes(meta, order_bytes, provenance.size(), groups_bytes.size(),
+  VxlSectionSizes sizes = section_sizes(meta, order_bytes, provenance.size(), groups_bytes.size(),
                                         static_cast<std::uint32_t>(point_set_names.size()),
-                                        static_cast<std::uint32_t>(streamline_set_names.size())));
+                                        static_cast<std::uint32_t>(streamline_set_names.size()));
+  sizes.group_values = group_values_bytes.size();
+  VxlWriter out(out_path, sizes);
   // Per-streamline values are copied as they are; per-point ones are spread over the vertices below.
   const auto streamline_arrays =
       layout_value_sets(out.streamline_values(), streamline_set_names, meta.streamline_count);
@@ -158,6 +162,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   fill_voxel_directions(order_set, out.voxels(), out.voxel_directions());
   std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
   std::copy(groups_bytes.begin(), groups_bytes.end(), out.groups().begin());
+  std::copy(group_values_bytes.begin(), group_values_bytes.end(), out.group_values().begin());
   out.commit(threads);
   summary.write_seconds = seconds_since(t0);
   if (settings.progress) settings.progress("writing", 1.0);

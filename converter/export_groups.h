@@ -1,5 +1,6 @@
 // The groups of a .vxl (GRPS) in exports to formats without groups (TCK, VTK): one group's streamlines as
-// a subset, one TCK per group, file names made from group names, and the warning when groups are lost.
+// a subset, one TCK per group, file names made from group names, and the warnings when groups or their rows
+// of values (TRX dpg) are lost.
 #pragma once
 
 #include <optional>
@@ -20,6 +21,11 @@ StreamlineSubset group_subset(const VxlFile& file, const std::string& name);
 // groups with members among the written streamlines (`subset`, or all); nothing otherwise.
 std::optional<std::string> groups_not_written(const VxlFile& file, const std::string& format,
                                               const StreamlineSubset* subset = nullptr);
+
+// "N row(s) of values per group (TRX dpg) not written: FORMAT has no place for them: 'GROUP/NAME', ..." when
+// the file has such rows (GDAT; only group `only_group`'s when given); nothing otherwise.
+std::optional<std::string> group_values_not_written(const VxlFile& file, const std::string& format,
+                                                    const std::optional<std::string>& only_group = std::nullopt);
 
 // One file name per group (same order), without the extension: the group name with '/', '\', control
 // characters and a leading '.' replaced by '_' (never empty), made unique, ignoring case, by "_2", "_3", …

@@ -138,6 +138,8 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
 
   if (!settings.group)
     if (std::optional<std::string> lost = groups_not_written(file, "a TCK", subset)) summary.warnings.push_back(*lost);
+  if (std::optional<std::string> lost = group_values_not_written(file, "a TCK", settings.group))
+    summary.warnings.push_back(*lost);
 
   TckWriter writer(out_path, counts.streamlines, header);
   std::optional<TsfWriter> tsf;

@@ -263,6 +263,7 @@ TrkExportSummary export_trk(const VxlFile& file, const std::string& out_path, co
   const std::vector<std::uint32_t> properties =
       slot_sets(file.streamline_values(), "per-streamline", summary.warnings, property_names);
   if (std::optional<std::string> lost = groups_not_written(file, "a TRK", subset)) summary.warnings.push_back(*lost);
+  if (std::optional<std::string> lost = group_values_not_written(file, "a TRK")) summary.warnings.push_back(*lost);
 
   // Empty streamlines are not written, so the count is known only after the walk: the header is built
   // first with the count of the non-empty ones, from the tables.

@@ -176,6 +176,16 @@ void export_trx(const VxlFile& file, const std::string& out_path, const Streamli
     members[g].assign(groups[g].members.begin(), groups[g].members.end());
   }
 
+  // dpg/<group>/<name>[.<n>].<dtype>: each row's bytes as the source had them (spec §5.13).
+  const std::vector<GroupValues>& rows = file.group_values();
+  std::vector<std::string> row_members;
+  for (const GroupValues& v : rows) {
+    row_members.push_back("dpg/" + groups[v.group].name + "/" + group_value_file_name(v));
+    if (row_members.back().size() > 0xFFFF)
+      fail_unsupported(file.path(), "the dpg member for '" + v.name.substr(0, 200) + "' of group '" +
+                                        groups[v.group].name.substr(0, 200) + "' is longer than a zip name can be");
+  }
+
   // dpv / dps from the value sets (export_values.h); built before the archive is opened.
   const std::vector<TrxValueMember> values = trx_value_members(file, subset);
 
@@ -187,6 +197,8 @@ void export_trx(const VxlFile& file, const std::string& out_path, const Streamli
     zip.add_stored("groups/" + groups[g].name + ".uint32", members[g].data(),
                    members[g].size() * sizeof(std::uint32_t));
   for (const TrxValueMember& v : values) zip.add_stored(v.name, v.data.data(), v.data.size() * sizeof(float));
+  for (std::size_t r = 0; r < rows.size(); ++r)
+    zip.add_stored(row_members[r], rows[r].bytes.data(), rows[r].bytes.size());
   zip.close();
 }
 

@@ -7,6 +7,7 @@
 //   groups/NAME.uint32   the members of every group of the .vxl's GRPS section
 //   dpv/NAME.float32     every per-point value set (VVAL) at the source points (export_values.h)
 //   dps/NAME.float32     every per-streamline value set (SVAL); NAME[0..m-1] sets as one NAME.m.float32
+//   dpg/GROUP/NAME[.n].DTYPE  every row of values per group (GDAT), its bytes and dtype as the source had them
 //
 // DIMENSIONS and VOXEL_TO_RASMM describe the reference image. They come from the provenance when the
 // source had them (a TRX header.json; a TRK header's dim and vox_to_ras); otherwise (TCK, synthetic)

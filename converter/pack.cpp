@@ -288,6 +288,8 @@ PackSummary pack_vxl(const VxlFile& f, const std::string& out_path, const PackSe
     c.provenance = std::string(f.provenance_json());
   }
   if (f.find_section(section_id("GRPS"))) c.groups = encode_group_stream(f.groups());
+  // Values per group travel as the .vxl's GDAT payload, re-encoded from what open() checked (spec §4.8).
+  if (!f.group_values().empty()) c.group_values = encode_group_values(f.group_values());
 
   // The exact part is deflated on a thread of its own while the positions are encoded (unless one thread
   // was asked for): the voxline voxels take seconds to deflate on a large tractogram, and would otherwise

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "format/streamline_group.h"
+#include "format/vxl_group_values.h"
 
 namespace vxl {
 
@@ -42,6 +43,7 @@ struct Tractogram {
   std::vector<float> positions;             // x,y,z interleaved, 3 * point_count() floats
   std::vector<std::uint64_t> offsets;       // streamline i = points [offsets[i], offsets[i+1]); size N+1
   std::vector<StreamlineGroup> groups;      // TRX groups, when the source has them
+  std::vector<GroupValues> group_values;    // TRX dpg: one row per (group, name), in the source's dtype
   std::vector<ValueSet> point_values;       // each point_count() values, in point order
   std::vector<ValueSet> streamline_values;  // each streamline_count() values
   SourceInfo source;

@@ -16,6 +16,7 @@
 #include "format/json_limits.h"
 #include "format/parallel.h"
 #include "format/vxl_file.h"
+#include "format/vxl_group_values.h"
 #include "format/vxl_value_sets.h"
 #include "format/vxl_writer.h"
 #include "format/vxlz_draco.h"
@@ -278,6 +279,18 @@ std::span<std::uint8_t> bytes_of(std::span<T> s) {
   return {reinterpret_cast<std::uint8_t*>(s.data()), s.size_bytes()};
 }
 
+// GDAT (package spec §4.8): the .vxl payload, deflated. Checked as a .vxl reader checks it, against the
+// package's groups, so that the .vxl written opens.
+std::vector<std::uint8_t> unpacked_group_values(const VxlzFile& f, std::uint64_t group_count) {
+  const StreamContext context = f.context(section_id("GDAT"));
+  std::vector<std::uint8_t> raw = f.inflate(section_id("GDAT"));
+  (void)decode_group_values(raw, group_count, [&](std::uint64_t pos, const std::string& what) {
+    fail_input(context.file, context.section_offset,
+               "section GDAT, inflated byte " + std::to_string(pos) + ": " + what);
+  });
+  return raw;
+}
+
 }  // namespace
 
 UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
@@ -298,9 +311,16 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   Structure s = rebuild_structure(f, settings.levels);
   const std::string provenance = provenance_with_package(f);
   std::vector<std::uint8_t> groups_bytes;
-  if (f.has_section(section_id("GRPS")))
-    groups_bytes = encode_groups(
-        decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count, f.context(section_id("GRPS"))));
+  std::uint64_t group_count = 0;
+  if (f.has_section(section_id("GRPS"))) {
+    const std::vector<StreamlineGroup> groups =
+        decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count, f.context(section_id("GRPS")));
+    group_count = groups.size();
+    groups_bytes = encode_groups(groups);
+  }
+  // GDAT travels as the .vxl payload (package spec §4.8): checked against the groups, written back as it came.
+  std::vector<std::uint8_t> group_values_bytes;
+  if (f.has_section(section_id("GDAT"))) group_values_bytes = unpacked_group_values(f, group_count);
 
   // Value sets (spec §4.7), checked against PACK's and META's counts before anything is inflated.
   std::vector<NamedValues> point_values, streamline_values;
@@ -315,9 +335,11 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
   meta.level_count = s.level_count > 1 && meta.voxel_count > 0 ? s.level_count : 0;
   const bool packed = settings.positions == PositionEncoding::Packed;
-  VxlWriter out(out_path, section_sizes(meta, s.order_bytes, provenance.size(), groups_bytes.size(),
+  VxlSectionSizes sizes = section_sizes(meta, s.order_bytes, provenance.size(), groups_bytes.size(),
                                         static_cast<std::uint32_t>(point_values.size()),
-                                        static_cast<std::uint32_t>(streamline_values.size())));
+                                        static_cast<std::uint32_t>(streamline_values.size()));
+  sizes.group_values = group_values_bytes.size();
+  VxlWriter out(out_path, sizes);
   // Packed positions are decoded as floats first (tight bounds and orders come from them), then packed.
   std::vector<float> float_blocks(packed ? 3 * meta.vertex_count : 0);
   const std::span<float> vertices = packed ? std::span<float>(float_blocks) : out.float_vertices();
@@ -399,6 +421,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   std::copy(s.strm.begin(), s.strm.end(), out.streamline_first_voxline().begin());
   std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
   std::copy(groups_bytes.begin(), groups_bytes.end(), out.groups().begin());
+  std::copy(group_values_bytes.begin(), group_values_bytes.end(), out.group_values().begin());
   if (!point_values.empty()) write_point_values(s, point_values, out.vertex_values(), meta.vertex_count, threads);
   if (!streamline_values.empty())
     write_streamline_values(streamline_values, out.streamline_values(), meta.streamline_count);

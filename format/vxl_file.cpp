@@ -153,7 +153,7 @@ void VxlFile::validate_section_table() {
                                              section_id("LODS"), section_id("VERT"), section_id("ORDR"),
                                              section_id("VXLN"), section_id("STRM"), section_id("VDIR")};
     static const std::uint32_t optional[] = {section_id("PROV"), section_id("GRPS"), section_id("VVAL"),
-                                             section_id("SVAL")};
+                                             section_id("SVAL"), section_id("GDAT")};
     const bool is_required = std::find(std::begin(required), std::end(required), id) != std::end(required);
     const bool is_optional = std::find(std::begin(optional), std::end(optional), id) != std::end(optional);
     if (is_required && !(e.flags & kSectionRequired))
@@ -264,7 +264,15 @@ void VxlFile::validate_meta_and_sizes() {
   auto prov = section("PROV", false);
   provenance_ = {reinterpret_cast<const char*>(prov.data()), prov.size()};
   groups_ = section("GRPS", false);
-  walk_groups([](std::string_view, std::uint64_t, std::uint64_t) {});  // structure and names: O(groups)
+  std::uint64_t group_count = 0;
+  walk_groups([&](std::string_view, std::uint64_t, std::uint64_t) { ++group_count; });  // O(groups)
+  if (find_section(section_id("GDAT"))) {
+    // Small (one row per group and name): parsed and checked whole, O(its bytes).
+    const std::uint64_t at0 = offset_of("GDAT");
+    group_values_ =
+        decode_group_values(section("GDAT", false), group_count,
+                            [&](std::uint64_t pos, const std::string& what) { fail_input(p, at0 + pos, what); });
+  }
   if (find_section(section_id("VVAL")))
     vertex_values_ = ValueSets(section("VVAL", true), m.vertex_count, p, offset_of("VVAL"));
   if (find_section(section_id("SVAL")))

@@ -18,6 +18,7 @@
 
 #include "format/mapped_file.h"
 #include "format/streamline_group.h"
+#include "format/vxl_group_values.h"
 #include "format/vxl_layout.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
@@ -105,6 +106,8 @@ class VxlFile {
   // Parses GRPS (empty when absent; open() has checked its structure and names); throws vxl::Error when a
   // member is out of range or out of order.
   std::vector<StreamlineGroup> groups() const;
+  // GDAT: values per group (TRX dpg), checked by open() against the groups; empty when absent.
+  const std::vector<GroupValues>& group_values() const { return group_values_; }
   // VVAL: per-vertex value sets (vertex_count values each); SVAL: per-streamline ones. Empty when absent.
   const ValueSets& vertex_values() const { return vertex_values_; }
   const ValueSets& streamline_values() const { return streamline_values_; }
@@ -137,6 +140,7 @@ class VxlFile {
   std::string_view provenance_;
   std::span<const std::uint8_t> groups_;
   ValueSets vertex_values_, streamline_values_;
+  std::vector<GroupValues> group_values_;
 };
 
 std::string section_name(std::uint32_t id);

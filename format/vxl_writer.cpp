@@ -74,6 +74,8 @@ VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
       // Optional: a reader that does not know them still draws the picture, in the other colour modes.
       {"VVAL", 0, sizes.vertex_values, sizes.vertex_values > 0},
       {"SVAL", 0, sizes.streamline_values, sizes.streamline_values > 0},
+      // Optional, and no version change (spec §10): a reader that skips it loses the TRX dpg rows only.
+      {"GDAT", 0, sizes.group_values, sizes.group_values > 0},
   };
   std::size_t present = 0;
   for (const Planned& p : planned) present += p.present;
@@ -178,6 +180,8 @@ void VxlWriter::commit(unsigned threads) {
 void write_vxl(const std::string& path, const VxlContent& c) {
   std::vector<std::uint8_t> groups_bytes;
   if (!c.groups.empty()) groups_bytes = encode_groups(c.groups);
+  std::vector<std::uint8_t> group_values_bytes;
+  if (!c.group_values.empty()) group_values_bytes = encode_group_values(c.group_values);
   VxlSectionSizes sizes;
   sizes.directions = c.directions.size_bytes();
   if (c.meta.order_set == static_cast<std::uint32_t>(OrderSet::Random))
@@ -192,6 +196,7 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   sizes.streamlines = c.streamline_first_voxline.size_bytes();
   sizes.provenance = c.provenance_json.size();
   sizes.groups = groups_bytes.size();
+  sizes.group_values = group_values_bytes.size();
 
   VxlWriter w(path, sizes);
   auto copy = [](auto dst, const void* src) {
@@ -209,6 +214,7 @@ void write_vxl(const std::string& path, const VxlContent& c) {
   copy(w.streamline_first_voxline(), c.streamline_first_voxline.data());
   copy(w.provenance(), c.provenance_json.data());
   copy(w.groups(), groups_bytes.data());
+  copy(w.group_values(), group_values_bytes.data());
   w.commit();
 }
 

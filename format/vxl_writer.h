@@ -13,6 +13,7 @@
 
 #include "format/atomic_output.h"
 #include "format/streamline_group.h"
+#include "format/vxl_group_values.h"
 #include "format/vxl_layout.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
@@ -27,6 +28,7 @@ struct VxlSectionSizes {
   std::uint64_t levels = 0;  // LODS (spec §5.12); 0: absent (one level)
   std::uint64_t provenance = 0;
   std::uint64_t groups = 0;                                // 0: no GRPS section
+  std::uint64_t group_values = 0;                          // GDAT (spec §5.13); 0: absent
   std::uint64_t vertex_values = 0, streamline_values = 0;  // VVAL, SVAL (spec §5.11); 0: absent
   PositionEncoding positions = PositionEncoding::Float32;  // how VERT holds them (spec §5.4); sets the version
 };
@@ -54,7 +56,7 @@ VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes);
 std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size,
                                            PositionEncoding positions);
 
-// The sections the writers fill, in file order (spec §4), and their ids; VDIR, LODS, GRPS, VVAL and SVAL are
+// The sections the writers fill, in file order (spec §4), and their ids; VDIR, LODS, GRPS, VVAL, SVAL and GDAT are
 // optional. One list for both writers (VxlWriter, VxlStreamWriter), so that they lay out a file alike.
 struct VxlSections {
   enum Index : std::size_t {
@@ -71,10 +73,11 @@ struct VxlSections {
     kGrps,
     kVval,
     kSval,
+    kGdat,
     kCount
   };
   static constexpr const char* kIds[kCount] = {"META", "DIRS", "VDIR", "VOXT", "LODS", "VERT", "ORDR",
-                                               "VXLN", "STRM", "PROV", "GRPS", "VVAL", "SVAL"};
+                                               "VXLN", "STRM", "PROV", "GRPS", "VVAL", "SVAL", "GDAT"};
 };
 
 class VxlWriter : public VxlSections {
@@ -116,6 +119,7 @@ class VxlWriter : public VxlSections {
   // VVAL and SVAL payloads (vxl_value_sets.h: layout_value_sets, finish_value_sets); empty when absent.
   std::span<std::uint8_t> vertex_values() { return payload(kVval); }
   std::span<std::uint8_t> streamline_values() { return payload(kSval); }
+  std::span<std::uint8_t> group_values() { return payload(kGdat); }  // empty when there is no GDAT section
 
   // Checksums every payload (sections spread over up to `threads` threads; 0: all hardware threads),
   // writes the section table and the header, unmaps and links the file into place. The spans above
@@ -153,7 +157,8 @@ struct VxlContent {
   std::span<const VoxlineEntry> voxlines;
   std::span<const std::uint64_t> streamline_first_voxline;  // N + 1
   std::string provenance_json;
-  std::span<const StreamlineGroup> groups;  // GRPS is written only when non-empty
+  std::span<const StreamlineGroup> groups;    // GRPS is written only when non-empty
+  std::span<const GroupValues> group_values;  // GDAT is written only when non-empty
 };
 
 // Writes in-memory content through VxlWriter. Throws vxl::Error (Output) naming the path.

@@ -28,7 +28,8 @@ std::vector<std::uint8_t> bytes_of(const T& value) {
 constexpr std::uint32_t kRequired[] = {section_id("PACK"), section_id("META"), section_id("DIRS"),
                                        section_id("VOXC"), section_id("STRL"), section_id("VXLV"),
                                        section_id("VXLC"), section_id("CHNK"), section_id("POSD")};
-constexpr std::uint32_t kOptional[] = {section_id("PROV"), section_id("GRPS"), section_id("PVAL"), section_id("SVAL")};
+constexpr std::uint32_t kOptional[] = {section_id("PROV"), section_id("GRPS"), section_id("PVAL"), section_id("SVAL"),
+                                       section_id("GDAT")};
 
 }  // namespace
 
@@ -36,6 +37,7 @@ DeflatedTables deflate_tables(const VxlzContent& c, unsigned threads) {
   DeflatedTables d;
   if (c.provenance) d.provenance.emplace();
   if (c.groups) d.groups.emplace();
+  if (c.group_values) d.group_values.emplace();
   struct Job {
     std::span<const std::uint8_t> raw;
     DeflateMode mode;
@@ -54,6 +56,7 @@ DeflatedTables deflate_tables(const VxlzContent& c, unsigned threads) {
                     DeflateMode::Matching,
                     &*d.provenance});
   if (c.groups) jobs.push_back({*c.groups, DeflateMode::Matching, &*d.groups});
+  if (c.group_values) jobs.push_back({*c.group_values, DeflateMode::Matching, &*d.group_values});
   parallel_for(jobs.size(), threads,
                [&](std::uint64_t i, unsigned) { *jobs[i].out = deflate_section(jobs[i].raw, jobs[i].mode); });
   return d;
@@ -105,6 +108,8 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   // Optional (spec §4.7): a 2.0 reader skips them and still gets every streamline, without the values.
   if (c.point_values) sections.push_back({"PVAL", false, *c.point_values});
   if (c.streamline_values) sections.push_back({"SVAL", false, *c.streamline_values});
+  // Optional (spec §4.8): a reader that skips it loses the rows of values per group only.
+  if (d.group_values) sections.push_back({"GDAT", false, *d.group_values});
   sections.push_back({"CHNK", true, chunk_sizes});
   sections.push_back({"POSD", true, {}});
 

@@ -28,12 +28,13 @@ struct VxlzContent {
   PackSection pack{};  // reserved bytes are zeroed by the writer
   MetaSection meta{};
   std::vector<DirectionEntry> directions;
-  std::vector<std::uint8_t> voxel_coords;           // VOXC
-  std::vector<std::uint8_t> streamline_voxlines;    // STRL
-  std::vector<std::uint8_t> voxline_voxels;         // VXLV
-  std::vector<std::uint8_t> voxline_counts;         // VXLC
-  std::optional<std::string> provenance;            // PROV, when the .vxl has one
-  std::optional<std::vector<std::uint8_t>> groups;  // GRPS, when the .vxl has groups
+  std::vector<std::uint8_t> voxel_coords;                 // VOXC
+  std::vector<std::uint8_t> streamline_voxlines;          // STRL
+  std::vector<std::uint8_t> voxline_voxels;               // VXLV
+  std::vector<std::uint8_t> voxline_counts;               // VXLC
+  std::optional<std::string> provenance;                  // PROV, when the .vxl has one
+  std::optional<std::vector<std::uint8_t>> groups;        // GRPS, when the .vxl has groups
+  std::optional<std::vector<std::uint8_t>> group_values;  // GDAT (the .vxl payload), when the .vxl has it
   // PVAL / SVAL payloads (encode_value_section, already deflated), when the .vxl has VVAL / SVAL.
   std::optional<std::vector<std::uint8_t>> point_values, streamline_values;
   std::vector<EncodedChunk> chunks;  // Draco buffers, one pair per position chunk
@@ -44,7 +45,7 @@ struct VxlzContent {
 // positions. Throws vxl::Error (Output).
 struct DeflatedTables {
   std::vector<std::uint8_t> voxel_coords, streamline_voxlines, voxline_voxels, voxline_counts;
-  std::optional<std::vector<std::uint8_t>> provenance, groups;  // when the content has them
+  std::optional<std::vector<std::uint8_t>> provenance, groups, group_values;  // when the content has them
 };
 DeflatedTables deflate_tables(const VxlzContent& content, unsigned threads = 0);
 

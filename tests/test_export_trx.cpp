@@ -60,7 +60,7 @@ void expect_same_streamlines(const Tractogram& expected, const Tractogram& got) 
 // An independent structural check of a TRX archive against the specification, in Python (zipfile +
 // numpy, no TRX library): stored members, header keys, array names and dtypes, offsets N + 1 with the
 // sentinel, positions 3 * NB_VERTICES float32, groups unsigned, increasing and below N, dpv / dps
-// float32 with one row per point / streamline.
+// float32 with one row per point / streamline, dpg one row per existing group.
 constexpr const char* kTrxCheck = R"PY(
 import json, sys, zipfile
 import numpy as np
@@ -100,7 +100,15 @@ for m in values:
     width = int(parts[-2]) if len(parts) == 3 else 1
     assert len(parts) in (2, 3) and parts[-1] == "float32" and width >= 1, m
     assert len(z.read(m)) == (v if m.startswith("dpv/") else n) * width * 4, m
-assert names == set(positions + offsets + groups + values + ["header.json"]), names
+group_names = set(g[len("groups/"):].rsplit(".", 1)[0] for g in groups)
+rows = sorted(m for m in names if m.startswith("dpg/"))
+for m in rows:
+    _, group, file = m.split("/")
+    parts = file.split(".")
+    width = int(parts[-2]) if len(parts) >= 3 and parts[-2].isdigit() else 1
+    assert group in group_names and width >= 1, m
+    assert len(z.read(m)) == width * np.dtype(parts[-1]).itemsize, m
+assert names == set(positions + offsets + groups + values + rows + ["header.json"]), names
 print("TRX-OK", n, v, "|".join(g[len("groups/"):].rsplit(".", 1)[0] for g in groups))
 )PY";
 

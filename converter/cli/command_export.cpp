@@ -34,7 +34,7 @@ void add_export_command(CLI::App& app) {
   cmd->add_option(
       "output", opt->output,
       "output .tck (Float32LE, the source TCK header's properties kept), .trx (zip, stored: float32 positions, "
-      "uint64 offsets, groups, dpv and dps kept) or .vtk (legacy BINARY POLYDATA, values kept as POINT_DATA / "
+      "uint64 offsets, groups, dpv, dps and dpg kept) or .vtk (legacy BINARY POLYDATA, values kept as POINT_DATA / "
       "CELL_DATA scalars, groups as 0/1 CELL_DATA arrays) or .trk / .trk.gz (TrackVis v2: a TRK source's header, "
       "values as scalars and properties); written atomically. Not with --split-groups");
   cmd->add_option("--tsf", opt->tck.tsf_path,
@@ -89,10 +89,14 @@ void add_export_command(CLI::App& app) {
                   (unsigned long long)s.points);
       return;
     }
-    if (trx)
+    if (trx) {
       export_trx(f, opt->output, group ? &*group : nullptr);
-    else
+    } else {
+      // Groups become 0/1 cell arrays in a VTK; their rows of values (TRX dpg) have no place there.
+      if (std::optional<std::string> lost = group_values_not_written(f, "a VTK", opt->tck.group))
+        print_warnings({*lost});
       export_vtk(f, opt->output, group ? &*group : nullptr);
+    }
     std::printf("%s: %llu streamlines, %llu points\n", opt->output.c_str(), (unsigned long long)counts.streamlines,
                 (unsigned long long)counts.points);
   });

@@ -1,10 +1,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include <nlohmann/json.hpp>
 
 #include "converter/cli/commands.h"
+#include "converter/readers/float16.h"
 #include "format/json_limits.h"
 #include "format/vxl_file.h"
 
@@ -22,6 +24,33 @@ std::uint64_t count_field(const nlohmann::json& object, const char* key) {
   if (!object.is_object()) return 0;
   auto it = object.find(key);
   return it != object.end() && it->is_number_unsigned() ? it->get<std::uint64_t>() : 0;
+}
+
+// One row of values per group (GDAT) as JSON numbers: integers exactly, floats as binary64 (NaN: null).
+nlohmann::json row_numbers(const GroupValues& v) {
+  nlohmann::json a = nlohmann::json::array();
+  const std::size_t size = group_value_type_size(v.type);
+  for (std::size_t i = 0; i < v.components; ++i) {
+    const std::uint8_t* p = v.bytes.data() + i * size;
+    auto load = [&](auto x) {
+      std::memcpy(&x, p, sizeof x);  // little-endian, as every platform this runs on (spec §1)
+      return x;
+    };
+    switch (v.type) {
+      case GroupValueType::Uint8: a.push_back(load(std::uint8_t{})); break;
+      case GroupValueType::Uint16: a.push_back(load(std::uint16_t{})); break;
+      case GroupValueType::Uint32: a.push_back(load(std::uint32_t{})); break;
+      case GroupValueType::Uint64: a.push_back(load(std::uint64_t{})); break;
+      case GroupValueType::Int8: a.push_back(load(std::int8_t{})); break;
+      case GroupValueType::Int16: a.push_back(load(std::int16_t{})); break;
+      case GroupValueType::Int32: a.push_back(load(std::int32_t{})); break;
+      case GroupValueType::Int64: a.push_back(load(std::int64_t{})); break;
+      case GroupValueType::Float16: a.push_back(half_to_float(load(std::uint16_t{}))); break;
+      case GroupValueType::Float32: a.push_back(load(float{})); break;
+      case GroupValueType::Float64: a.push_back(load(double{})); break;
+    }
+  }
+  return a;
 }
 
 }  // namespace
@@ -74,7 +103,13 @@ void add_info_command(CLI::App& app) {
     j["vertex_values"] = sets(f.vertex_values());
     j["streamline_values"] = sets(f.streamline_values());
     nlohmann::json groups = nlohmann::json::array();
-    for (const StreamlineGroup& g : f.groups()) groups.push_back({{"name", g.name}, {"streamlines", g.members.size()}});
+    for (const StreamlineGroup& g : f.groups())
+      groups.push_back({{"name", g.name}, {"streamlines", g.members.size()}, {"values", nlohmann::json::array()}});
+    for (const GroupValues& v : f.group_values())
+      groups[v.group]["values"].push_back({{"name", v.name},
+                                           {"dtype", group_value_type_name(v.type)},
+                                           {"components", v.components},
+                                           {"values", row_numbers(v)}});
     j["groups"] = groups;
     auto prov = parse_json(f.provenance_json(), f.path(), f.provenance_offset(), "PROV");
     if (prov.is_object() && prov.contains("source") && prov["source"].is_object()) {
@@ -121,9 +156,20 @@ void add_info_command(CLI::App& app) {
         std::printf("%-13s %s [%g, %g]\n", kind == std::string("vertex_values") ? "point values" : "streamline values",
                     v["name"].get<std::string>().c_str(), v["min"].is_number() ? v["min"].get<double>() : NAN,
                     v["max"].is_number() ? v["max"].get<double>() : NAN);
-    for (const auto& g : j["groups"])
+    for (const auto& g : j["groups"]) {
       std::printf("group         %s (%llu streamlines)\n", g["name"].get<std::string>().c_str(),
                   (unsigned long long)g["streamlines"].get<std::uint64_t>());
+      for (const auto& v : g["values"]) {
+        // At most 8 numbers a row: a long row (a matrix, a histogram) is there in full with --json.
+        std::string numbers;
+        const auto& row = v["values"];
+        for (std::size_t i = 0; i < std::min<std::size_t>(row.size(), 8); ++i) numbers += " " + row[i].dump();
+        if (row.size() > 8) numbers += " ...";
+        std::printf("  values      %s (%s x %llu):%s\n", v["name"].get<std::string>().c_str(),
+                    v["dtype"].get<std::string>().c_str(), (unsigned long long)v["components"].get<std::uint32_t>(),
+                    numbers.c_str());
+      }
+    }
   });
 }
 

@@ -50,7 +50,7 @@ void add_select_command(CLI::App& app) {
   cmd->add_option("input", opt->input, ".vxl file")->required();
   cmd->add_option("output", opt->output,
                   "the selected streamlines, in source order: .tck (with --tsf: one per-point value set), .trx "
-                  "(groups, dpv, dps), .vtk or .vxl (the input's conversion settings); written atomically, valid "
+                  "(groups, dpv, dps, dpg), .vtk or .vxl (the input's conversion settings); written atomically, valid "
                   "when empty. Not needed with --count");
   cmd->add_option("--include", opt->include, "a region every kept streamline passes through (repeatable)")
       ->type_name("ROI");

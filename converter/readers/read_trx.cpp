@@ -8,8 +8,10 @@
 // Members used: header.json (NB_STREAMLINES, NB_VERTICES, VOXEL_TO_RASMM, DIMENSIONS),
 // positions.3.<float16|float32|float64>, offsets.<uint32|uint64> and groups/<name>.<integer dtype>;
 // all little-endian. dpv/<name>[.<n>].<dtype> and dps/<name>[.<n>].<dtype> (any float or integer dtype)
-// become per-point and per-streamline value sets (one per component: name[0] ... name[n-1]); dpg/ is not
-// read. All member names are listed in the header JSON under "_members". Offsets come in two conventions: N + 1 entries
+// become per-point and per-streamline value sets (one per component: name[0] ... name[n-1]);
+// dpg/<group>/<name>[.<n>].<dtype> become rows of values per group, kept in their dtype. A group is a set:
+// an index listed twice in one groups/ member counts once, with a warning giving how many were collapsed.
+// All member names are listed in the header JSON under "_members". Offsets come in two conventions: N + 1 entries
 // ending with the NB_VERTICES sentinel (current trx-python), or N entries without it (older files); both are accepted.
 #include <algorithm>
 #include <array>
@@ -21,6 +23,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <vector>
@@ -403,7 +406,14 @@ void read_groups(const std::string& path, const Members& members, Tractogram& t)
       g.members.push_back(*v);
     }
     std::sort(g.members.begin(), g.members.end());
+    const std::size_t listed = g.members.size();
     g.members.erase(std::unique(g.members.begin(), g.members.end()), g.members.end());
+    // Membership is a set (spec §5.9 stores strictly increasing members): a repeat adds nothing to the
+    // group, but it may be a mistake in the source, so it is said, not silently dropped.
+    if (const std::size_t repeats = listed - g.members.size(); repeats > 0)
+      t.source.warnings.push_back("group " + g.name + ": " + std::to_string(repeats) +
+                                  " duplicate indices collapsed (" + std::to_string(listed) + " listed in " +
+                                  json_safe(name) + ", " + std::to_string(g.members.size()) + " streamlines)");
     t.groups.push_back(std::move(g));
   }
 }
@@ -481,6 +491,85 @@ void read_value_sets(const std::string& path, const Members& members, const std:
         v.values[i] = load_value(bytes.data() + (i * components + c) * elem, dtype);
       out.push_back(std::move(v));
     }
+  }
+}
+
+// dpg/<group>/<name>[.<n>].<dtype> members -> one row of n values per group and name, kept as bytes in their
+// dtype. A member that cannot be read as such (no such group, no dtype, a size that does not match) is
+// skipped with a warning, like a malformed dpv or dps: the streamlines are still good.
+void read_group_values(const Members& members, Tractogram& t) {
+  // Looked up by name, and rows seen, in O(log n): an archive may hold many members.
+  std::map<std::string, std::uint32_t> group_by_name;
+  for (std::size_t g = t.groups.size(); g-- > 0;) group_by_name[t.groups[g].name] = static_cast<std::uint32_t>(g);
+  std::set<std::pair<std::uint32_t, std::string>> seen;
+  for (const auto& [name, index] : members.names()) {
+    if (!name.starts_with("dpg/")) continue;
+    const std::string rest = name.substr(4);
+    const std::size_t slash = rest.find('/');
+    const std::string group = slash == std::string::npos ? "" : rest.substr(0, slash);
+    const std::string file = slash == std::string::npos ? "" : rest.substr(slash + 1);
+    const std::size_t dot = file.rfind('.');
+    // A plain value and a flag, not an optional: GCC 12 takes the optional's value for uninitialised.
+    GroupValueType type{};
+    bool typed = false;
+    if (dot != std::string::npos)
+      if (const std::optional<GroupValueType> known = group_value_type(file.substr(dot + 1))) {
+        type = *known;
+        typed = true;
+      }
+    if (group.empty() || file.find('/') != std::string::npos || dot == std::string::npos || dot == 0 || !typed) {
+      t.source.warnings.push_back(json_safe(name) + ": not dpg/<group>/<name>[.<components>].<dtype>; ignored");
+      continue;
+    }
+    std::string base = file.substr(0, dot);
+    std::uint64_t components = 1;
+    if (const std::size_t d2 = base.rfind('.'); d2 != std::string::npos && d2 > 0 && d2 + 1 < base.size() &&
+                                                base.find_first_not_of("0123456789", d2 + 1) == std::string::npos) {
+      const std::string digits = base.substr(d2 + 1);
+      const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), components);
+      if (ec != std::errc() || end != digits.data() + digits.size()) components = 0;  // refused below
+      base = base.substr(0, d2);
+    }
+    const auto owner = group_by_name.find(json_safe(group));  // the first group of that name
+    if (owner == group_by_name.end()) {
+      t.source.warnings.push_back(json_safe(name) + ": no groups/" + json_safe(group) + ".<dtype> member; ignored");
+      continue;
+    }
+    const std::string row_name = json_safe(base);
+    const std::uint32_t group_index = owner->second;
+    if (row_name.size() > kMaxGroupValueNameBytes) {
+      t.source.warnings.push_back(json_safe(name) + ": a name longer than " + std::to_string(kMaxGroupValueNameBytes) +
+                                  " bytes; ignored");
+      continue;
+    }
+    if (seen.contains({group_index, row_name})) {
+      t.source.warnings.push_back(json_safe(name) + ": a second dpg/" + json_safe(group) + "/" + row_name +
+                                  " with another dtype or component count; ignored");
+      continue;
+    }
+    const std::uint64_t elem = group_value_type_size(type);
+    const std::uint64_t declared = members.declared_size(name);
+    const std::uint64_t expected = times(components, elem);
+    if (components == 0 || components > kMaxGroupValueComponents || declared != expected) {
+      t.source.warnings.push_back(json_safe(name) + ": holds " + std::to_string(declared) +
+                                  " bytes, expected one row of " + std::to_string(components) + " x " +
+                                  std::to_string(elem) + "; ignored");
+      continue;
+    }
+    const Blob blob = members.read(name, expected, "bytes its row needs");
+    if (blob.bytes().size() != expected) {
+      t.source.warnings.push_back(json_safe(name) + ": holds " + std::to_string(blob.bytes().size()) +
+                                  " bytes, expected " + std::to_string(expected) + "; ignored");
+      continue;
+    }
+    GroupValues v;
+    v.group = group_index;
+    v.name = row_name;
+    v.type = type;
+    v.components = static_cast<std::uint32_t>(components);
+    v.bytes.assign(blob.bytes().begin(), blob.bytes().end());
+    seen.emplace(group_index, row_name);
+    t.group_values.push_back(std::move(v));
   }
 }
 
@@ -585,6 +674,7 @@ Tractogram read_trx(const std::string& path) {
   read_groups(path, *members, t);
   read_value_sets(path, *members, "dpv/", t.point_count(), t, t.point_values);
   read_value_sets(path, *members, "dps/", t.streamline_count(), t, t.streamline_values);
+  read_group_values(*members, t);
 
   nlohmann::json names = nlohmann::json::array();
   for (const auto& [name, index] : members->names()) names.push_back(json_safe(name));

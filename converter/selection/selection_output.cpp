@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/convert.h"
+#include "converter/export_groups.h"
 #include "converter/export_trk.h"
 #include "converter/export_trx.h"
 #include "converter/export_values.h"
@@ -57,7 +58,7 @@ ConvertSettings settings_of(const VxlFile& file) {
   return s;
 }
 
-// The subset as an in-memory tractogram: positions, values and groups.
+// The subset as an in-memory tractogram: positions, values, groups and their rows (GDAT).
 Tractogram subset_tractogram(const VxlFile& file, const StreamlineSubset& subset) {
   Tractogram t;
   t.source = source_of(file);
@@ -78,6 +79,7 @@ Tractogram subset_tractogram(const VxlFile& file, const StreamlineSubset& subset
     g.members = subset.renumber(g.members);
     t.groups.push_back(std::move(g));
   }
+  t.group_values = file.group_values();  // a group's row describes the group, kept with it
   return t;
 }
 
@@ -103,6 +105,7 @@ std::vector<std::string> write_selection(const VxlFile& file, const StreamlineSu
     return export_trk(file, out_path, &subset).warnings;
   } else if (lower.ends_with(".vtk")) {
     export_vtk(file, out_path, &subset);
+    if (std::optional<std::string> lost = group_values_not_written(file, "a VTK")) return {*lost};
   } else if (lower.ends_with(".vxl")) {
     convert_tractogram(subset_tractogram(file, subset), out_path, settings_of(file));
   } else {
