@@ -173,6 +173,14 @@ TEST_F(Window, MovingFramesDrawACoarserLevelWithinTheFrameBudget) {
   EXPECT_EQ(frames.back().at("level"), 0);
   EXPECT_EQ(j.at("moving_frames"), 4);
   EXPECT_GT(j.at("first_picture_s").get<double>(), 0.0);
+  // On screen after it was drawn (the swap that shows it), and after the window and the viewer were made.
+  const auto& startup = j.at("startup");
+  EXPECT_GT(startup.at("window_open_s").get<double>(), 0.0);
+  EXPECT_GE(startup.at("viewer_ready_s").get<double>(), startup.at("window_open_s").get<double>());
+  EXPECT_GE(j.at("first_picture_s").get<double>(), startup.at("viewer_ready_s").get<double>());
+  EXPECT_GT(j.at("first_on_screen_s").get<double>(), j.at("first_picture_s").get<double>());
+  EXPECT_LT(j.at("first_on_screen_s").get<double>(), frames[1].at("since_start_s").get<double>());
+  EXPECT_EQ(startup.at("first_on_screen_s"), j.at("first_on_screen_s"));
   EXPECT_EQ(j.at("full_detail_s"), frames[0].at("since_start_s"));
   EXPECT_GT(j.at("moving_p95_ms").get<double>(), 0.0);
   EXPECT_GE(j.at("moving_p95_ms").get<double>(), j.at("moving_median_ms").get<double>());

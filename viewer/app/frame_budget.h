@@ -32,9 +32,11 @@ class FrameBudget {
 };
 
 // The window's first picture comes before the scene's level is uploaded: the finest level, from the scene's
-// level down, that draws at most this many segments. Why 1M: Mesa llvmpipe draws about 2.5M segments a
-// second at 1024x1024 on two cores, so the first picture comes within a second; a GPU draws it at once.
-inline constexpr std::uint64_t kFirstPictureSegments = 1'000'000;
+// level down, that draws at most this many segments. Why 250k: Mesa llvmpipe draws 0.4-2.5M segments a
+// second at 1280x800 on two cores (busy to quiet), and the first picture must reach the screen within a
+// second of the process starting, of which loading the program and opening the window take 0.3-0.8 s;
+// a GPU draws it at once.
+inline constexpr std::uint64_t kFirstPictureSegments = 250'000;
 
 // `segments[d]`: the scene's segments at level d (up to the coarsest level).
 std::uint32_t first_picture_level(std::span<const std::uint64_t> segments, std::uint32_t scene_level);

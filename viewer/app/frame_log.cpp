@@ -56,11 +56,16 @@ FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint3
 }
 
 void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
-                       double frame_budget_ms) {
+                       double frame_budget_ms, const StartupTimes& startup) {
   const FrameSummary s = summarize_frames(frames, scene_level);
   nlohmann::json j;
   j["scene_level"] = scene_level;
   j["frame_budget_ms"] = frame_budget_ms;
+  // The figure a user sees: the first picture as it reaches the screen, everything before it included.
+  j["first_on_screen_s"] = startup.first_on_screen_s;
+  j["startup"] = {{"window_open_s", startup.window_open_s},
+                  {"viewer_ready_s", startup.viewer_ready_s},
+                  {"first_on_screen_s", startup.first_on_screen_s}};
   j["first_picture_s"] = s.first_picture_s;
   j["full_detail_s"] = s.full_detail_s;
   j["exact_s"] = s.exact_s;

@@ -34,10 +34,18 @@ struct FrameSummary {
   double piece_median_ms = 0, piece_p95_ms = 0;
 };
 
+// Where the time before the first picture on screen went, in seconds since the process started
+// (process_clock.h); -1 where not reached.
+struct StartupTimes {
+  double window_open_s = -1;      // the window and its GL context exist (the scene files are open before it)
+  double viewer_ready_s = -1;     // the first level uploaded, the shaders built, the panel made
+  double first_on_screen_s = -1;  // the buffer swap that shows the first drawn picture has completed
+};
+
 FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint32_t scene_level);
 
 // Writes the summary, the budget and every frame as JSON to `path` (atomically). Throws vxl::Error (Output).
 void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
-                       double frame_budget_ms);
+                       double frame_budget_ms, const StartupTimes& startup = {});
 
 }  // namespace vxl::app

@@ -81,6 +81,7 @@ constexpr KeyBinding kKeys[] = {
     {KeyAction::RegionSmaller, ",", "selection: the active sphere / 1.25", typed(",<")},
     {KeyAction::RegionLarger, ".", "selection: the active sphere x 1.25", typed(".>")},
     {KeyAction::SaveSelection, "W", "selection: write the selected streamlines to a .tck", typed("wW")},
+    {KeyAction::TogglePanel, "H", "panel collapsed / open (uncovers the picture)", typed("hH")},
     {KeyAction::Quit, "Esc, Q", "quit", key(GLFW_KEY_ESCAPE), typed("qQ")},
 };
 

@@ -47,6 +47,7 @@ enum class KeyAction {
   RegionSmaller,
   RegionLarger,
   SaveSelection,
+  TogglePanel,  // the panel collapsed to its title bar / open: it covers part of the picture
   Quit,
 };
 

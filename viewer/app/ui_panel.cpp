@@ -374,15 +374,19 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
   ImGui::SetNextWindowBgAlpha(0.8f);
   // "###" keeps the window's identity apart from its title; ImGui's built-in font is ASCII only.
   const std::string title = "voxview: " + stats.title + "###panel";
-  ImGui::Begin(title.c_str(), nullptr, ImGuiWindowFlags_AlwaysAutoResize);
-  ImGui::PushItemWidth(170);
-  look_controls(state, stats);
-  clipping_controls(state, stats, out);
-  image_controls(state, stats, out);
-  selection_controls(stats, out);
-  view_controls(state, out);
-  frame_information(state, stats);
-  ImGui::PopItemWidth();
+  if (state.panel_collapsed != collapsed_) ImGui::SetNextWindowCollapsed(state.panel_collapsed, ImGuiCond_Always);
+  if (ImGui::Begin(title.c_str(), nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    ImGui::PushItemWidth(170);
+    look_controls(state, stats);
+    clipping_controls(state, stats, out);
+    image_controls(state, stats, out);
+    selection_controls(stats, out);
+    view_controls(state, out);
+    frame_information(state, stats);
+    ImGui::PopItemWidth();
+  }
+  // The title bar's arrow collapses it too: the state follows whichever did.
+  state.panel_collapsed = collapsed_ = ImGui::IsWindowCollapsed();
   const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
   x0_ = pos.x;
   y0_ = pos.y;

@@ -23,6 +23,7 @@ struct PanelState {
   bool grid = false;      // voxel-grid overlay
   bool grid_all = false;  // all voxels, not only those the frame draws
   bool panel_in_screenshot = false;
+  bool panel_collapsed = false;  // only the title bar shows (H, or its arrow)
   bool exact_when_still = true;  // at rest, go on to the exact picture (rest_refinement.h)
   double slab_thickness = 10.0;  // mm, kept while the slab is off (settings.clipping.slab_mm is 0 then)
 };
@@ -98,6 +99,7 @@ class UiPanel {
  private:
   float x0_ = 0, y0_ = 0, x1_ = 0, y1_ = 0;  // the panel window, window units
   bool popup_open_ = false;                  // a combo or colour picker may reach beyond the panel
+  bool collapsed_ = false;                   // as the panel last was: a change in PanelState is the H key's
 };
 
 }  // namespace vxl::app

@@ -30,6 +30,7 @@
 #include "viewer/app/headless_render.h"
 #include "viewer/app/key_bindings.h"
 #include "viewer/app/picture_annotations.h"
+#include "viewer/app/process_clock.h"
 #include "viewer/app/region_editor.h"
 #include "viewer/app/rest_refinement.h"
 #include "viewer/app/scene_detail.h"
@@ -168,7 +169,7 @@ class ViewerWindow {
   // voxview started, for --stats.
   // `regions`: the selection's regions (region_editor.h), edited in the window.
   ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume, RegionEditor regions,
-               GLFWwindow* window, std::chrono::steady_clock::time_point start);
+               GLFWwindow* window, std::chrono::steady_clock::time_point start, StartupTimes startup);
   int run();
 
  private:
@@ -236,6 +237,7 @@ class ViewerWindow {
   FrameBudget budget_;
   std::chrono::steady_clock::time_point start_;
   std::vector<FrameRecord> frames_;  // for --stats
+  StartupTimes startup_;             // for --stats
   std::optional<PictureKey> drawn_;  // what the picture on screen shows (none before the first)
   RestRefinement rest_;
   bool pieces_begun_ = false;      // the refinement's current stage has begun its pieces
@@ -264,7 +266,8 @@ class ViewerWindow {
 };
 
 ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume,
-                           RegionEditor regions, GLFWwindow* window, std::chrono::steady_clock::time_point start)
+                           RegionEditor regions, GLFWwindow* window, std::chrono::steady_clock::time_point start,
+                           StartupTimes startup)
     : options_(o),
       window_(window),
       files_(pointers(files)),
@@ -274,6 +277,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
       gpu_memory_(std::make_shared<GpuMemoryPool>(detail_.budget)),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
       start_(start),
+      startup_(startup),
       rest_(false, o.exact_when_still),
       controller_(Camera{}, 1.0) {
   stats_.detail = describe_scene_detail(detail_, SceneLayout::coarsest_level(pointers(files)) + 1);
@@ -334,6 +338,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* w, int, int) { of(w).events_++; });
   glfwSetWindowRefreshCallback(window_, [](GLFWwindow* w) { of(w).events_++; });
   panel_ = std::make_unique<UiPanel>(window_);
+  startup_.viewer_ready_s = seconds_since_start();
 }
 
 double ViewerWindow::aspect() const {
@@ -563,6 +568,7 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
     case KeyAction::RegionSmaller: regions_.scale_radius(1 / RegionEditor::kRadiusStep); break;
     case KeyAction::RegionLarger: regions_.scale_radius(RegionEditor::kRadiusStep); break;
     case KeyAction::SaveSelection: save_selection(); break;
+    case KeyAction::TogglePanel: state_.panel_collapsed = !state_.panel_collapsed; break;
     case KeyAction::Quit: glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
   }
 }
@@ -861,23 +867,30 @@ int ViewerWindow::run() {
     }
     screenshot_requested_ = false;
     glfwSwapBuffers(window_);
+    if (startup_.first_on_screen_s < 0 && !frames_.empty()) {
+      glFinish();  // the swap has been carried out, not only queued
+      startup_.first_on_screen_s = seconds_since_start();
+    }
     if (closing) break;
   }
-  if (options_.stats_json) write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms);
+  if (options_.stats_json)
+    write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms, startup_);
   return 0;
 }
 
 }  // namespace
 
 int run_window(const ViewerOptions& o) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = process_start();
   GlfwLibrary glfw;  // first: without a display, fail before any slow conversion
   const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);
   RegionEditor regions(o);  // parses the regions: a bad one fails before the window opens
   WindowPtr window = open_window(o);
-  ViewerWindow viewer(o, files, volume ? &*volume : nullptr, std::move(regions), window.get(), start);
+  StartupTimes startup;
+  startup.window_open_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ViewerWindow viewer(o, files, volume ? &*volume : nullptr, std::move(regions), window.get(), start, startup);
   return viewer.run();
 }
 
