@@ -22,6 +22,9 @@ inline constexpr std::uint16_t kVxlVersionMinorValueSets = 2;
 inline constexpr std::uint16_t kVxlVersionMajorPackedPositions = 2;
 // Files with levels of detail (LODS, spec §5.12) are 2.1, with either position encoding.
 inline constexpr std::uint16_t kVxlVersionMinorLevels = 1;
+// Files with values per group (GDAT, spec §5.13) are 1.3 when they would otherwise be 1.x, 2.2 when 2.x.
+inline constexpr std::uint16_t kVxlVersionMinorGroupValues1 = 3;
+inline constexpr std::uint16_t kVxlVersionMinorGroupValues2 = 2;
 inline constexpr std::uint64_t kVxlAlignment = 64;
 inline constexpr std::uint32_t kVxlMaxSections = 64;
 inline constexpr std::uint32_t kVxlMaxStoredOrders = 64;

@@ -110,11 +110,15 @@ std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, 
   const bool has_values = std::any_of(table.begin(), table.end(), [](const SectionEntry& e) {
     return std::memcmp(e.id, "VVAL", 4) == 0 || std::memcmp(e.id, "SVAL", 4) == 0;
   });
-  h.version_minor = has_levels   ? kVxlVersionMinorLevels
-                    : packed     ? 0
-                    : has_values ? kVxlVersionMinorValueSets
-                    : has_vdir   ? kVxlVersionMinorVoxelDirections
-                                 : kVxlVersionMinor;
+  const bool has_group_values =
+      std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "GDAT", 4) == 0; });
+  if (h.version_major == kVxlVersionMajorPackedPositions)
+    h.version_minor = has_group_values ? kVxlVersionMinorGroupValues2 : has_levels ? kVxlVersionMinorLevels : 0;
+  else
+    h.version_minor = has_group_values ? kVxlVersionMinorGroupValues1
+                      : has_values     ? kVxlVersionMinorValueSets
+                      : has_vdir       ? kVxlVersionMinorVoxelDirections
+                                       : kVxlVersionMinor;
   h.header_size = sizeof(FileHeader);
   h.file_size = file_size;
   h.section_table_offset = sizeof(FileHeader);

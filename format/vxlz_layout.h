@@ -13,9 +13,10 @@ namespace vxl {
 
 inline constexpr std::array<std::uint8_t, 8> kVxlzMagic = {0x89, 'V', 'X', 'Z', '\r', '\n', 0x1A, '\n'};
 inline constexpr std::uint16_t kVxlzVersionMajor = 2;  // 1.0 coded residual triplets with no joint symbols
-// A writer writes minor 1 only when the package holds value sets (§4.7), else 0 (§10: the lowest
-// version that holds what it writes).
+// A writer writes minor 2 when the package holds values per group (§4.8), else 1 when it holds value sets
+// (§4.7), else 0 (§10: the lowest version that holds what it writes).
 inline constexpr std::uint16_t kVxlzVersionMinor = 1;
+inline constexpr std::uint16_t kVxlzVersionMinorGroupValues = 2;
 inline constexpr std::uint32_t kVxlzMaxSections = 32;
 inline constexpr std::uint32_t kVxlzMinBits = 11;
 inline constexpr std::uint32_t kVxlzMaxBits = 16;

@@ -131,7 +131,9 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   FileHeader h{};
   std::memcpy(h.magic, kVxlzMagic.data(), 8);
   h.version_major = kVxlzVersionMajor;
-  h.version_minor = c.point_values || c.streamline_values ? kVxlzVersionMinor : 0;
+  h.version_minor = c.group_values                          ? kVxlzVersionMinorGroupValues
+                    : c.point_values || c.streamline_values ? kVxlzVersionMinor
+                                                            : 0;
   h.header_size = sizeof(FileHeader);
   h.file_size = position;
   h.section_table_offset = sizeof(FileHeader);

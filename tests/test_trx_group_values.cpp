@@ -325,6 +325,41 @@ TEST(GdatSection, FilesWithoutGroupValuesHaveNoSection) {
   EXPECT_EQ(f.groups().size(), 2u);
 }
 
+// The version a file with GDAT carries (spec §10): 2.2 with packed positions or levels, 1.3 otherwise; a
+// package with it is 2.2. Files without it keep the version they had before GDAT existed.
+TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
+  ScratchDir dir;
+  test::write_zip(dir.file("a.trx"), trx_members());
+  auto version_of = [](const FileHeader& h) {
+    return std::to_string(h.version_major) + "." + std::to_string(h.version_minor);
+  };
+  auto package_version_of = [](const std::string& path) {
+    const std::vector<char> b = test::slurp(path);
+    std::uint16_t v[2];
+    std::memcpy(v, b.data() + 8, 4);
+    return std::to_string(v[0]) + "." + std::to_string(v[1]);
+  };
+  convert_tractogram(read_trx(dir.file("a.trx")), dir.file("packed.vxl"), ConvertSettings{});
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("packed.vxl")).header()), "2.2");
+  ConvertSettings plain;
+  plain.positions = PositionEncoding::Float32;
+  plain.levels = 1;
+  convert_tractogram(read_trx(dir.file("a.trx")), dir.file("plain.vxl"), plain);
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("plain.vxl")).header()), "1.3");
+  pack_vxl(VxlFile::open(dir.file("packed.vxl")), dir.file("a.vxlz"), PackSettings{});
+  EXPECT_EQ(package_version_of(dir.file("a.vxlz")), "2.2");
+
+  auto members = trx_members();
+  std::erase_if(members, [](const auto& m) { return m.first.starts_with("dpg/"); });
+  test::write_zip(dir.file("b.trx"), members);
+  convert_tractogram(read_trx(dir.file("b.trx")), dir.file("b.vxl"), ConvertSettings{});
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("b.vxl")).header()), "2.1");
+  convert_tractogram(read_trx(dir.file("b.trx")), dir.file("b_plain.vxl"), plain);
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("b_plain.vxl")).header()), "1.0");
+  pack_vxl(VxlFile::open(dir.file("b.vxl")), dir.file("b.vxlz"), PackSettings{});
+  EXPECT_EQ(package_version_of(dir.file("b.vxlz")), "2.0");
+}
+
 // ---- the real fixture: trx-python's small.trx (groups with repeated indices and dpg rows) ----
 
 TEST(TrxGroupValuesReal, TrxPythonSmallKeepsItsRowsAndCountsItsRepeats) {
