@@ -234,6 +234,30 @@ TEST_F(Window, ExactArrivesWhenTheCameraIsStill) {
       << "the window's picture at rest is the exact one, not axis";
 }
 
+// The window shows the selection's regions as shells by default, through its refinement in pieces up to
+// exact: at rest its picture is the headless one with --show-regions, not the one without.
+TEST_F(Window, RegionShellsAreShownAtRest) {
+  VXL_REQUIRE_XVFB();
+  make_inputs();
+  const std::string selection = " --size 200x150 --include 0,0,0,30 --context-opacity 0.3";
+  const std::string png = dir.file("regions.png");
+  const nlohmann::json j = window_stats(selection + " --frames 1 --until-refined --screenshot " + shell_quoted(png));
+  ASSERT_FALSE(j.is_null());
+  EXPECT_EQ(j.at("frames").back().at("work"), "exact piece");
+  auto headless = [&](const std::string& name, const std::string& extra) {
+    const std::string out = dir.file(name);
+    CommandResult h = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + selection +
+                                " --mode exact --render " + shell_quoted(out) + extra);
+    EXPECT_EQ(h.exit_code, 0) << h.output;
+    return read_image(out);
+  };
+  const Image still = read_image(png), shown = headless("shown.png", " --show-regions"),
+              plain = headless("plain.png", "");
+  const double to_plain = score_image(plain, shown).rmse;
+  ASSERT_GT(to_plain, 0) << "the shell changes the picture";
+  EXPECT_LT(score_image(still, shown).rmse, 0.5 * to_plain) << "the window at rest shows the shells";
+}
+
 // At rest the window refines to the finest level whose visible part fits the GPU memory budget: under a
 // budget that holds only level 1 of the whole scene, a thin slab comes at full detail, as headless draws it.
 TEST_F(Window, AtRestAThinSlabIsRefinedToFullDetailUnderABudgetForLevelOne) {

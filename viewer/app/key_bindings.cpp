@@ -91,7 +91,7 @@ constexpr MouseGesture kMouse[] = {
     {"wheel", "zoom"},
     {"Ctrl+wheel", "move the slab (the focus)"},
     {"Shift+wheel", "selection: the active sphere's radius"},
-    {"Ctrl+left drag", "selection: move the sphere under the cursor (else the active one) across the view"},
+    {"Ctrl+left drag", "selection: move the sphere under the cursor (or the active one)"},
 };
 
 bool matches_key(const KeyInput& in, int code, bool shift) {
