@@ -46,6 +46,7 @@ TEST(KeyBindings, KeysAndCharactersMapToTheirActions) {
   EXPECT_EQ(action_for_char('g'), KeyAction::AddRegion);
   EXPECT_EQ(action_for_char('h'), KeyAction::TogglePanel);
   EXPECT_EQ(action_for_char('H'), KeyAction::TogglePanel);
+  EXPECT_EQ(action_for_char('b'), KeyAction::ToggleRegionShells);
   EXPECT_FALSE(action_for_char('z'));
   EXPECT_FALSE(action_for_char('!'));
   EXPECT_FALSE(action_for_char(0x263A));

@@ -242,6 +242,30 @@ TEST_F(Window, ExactArrivesWhenTheCameraIsStill) {
       << "the window's picture at rest is the exact one, not axis";
 }
 
+// The window shows the selection's regions as shells by default, through its refinement in pieces up to
+// exact: at rest its picture is the headless one with --show-regions, not the one without.
+TEST_F(Window, RegionShellsAreShownAtRest) {
+  VXL_REQUIRE_XVFB();
+  make_inputs();
+  const std::string selection = " --size 200x150 --include 0,0,0,30 --context-opacity 0.3";
+  const std::string png = dir.file("regions.png");
+  const nlohmann::json j = window_stats(selection + " --frames 1 --until-refined --screenshot " + shell_quoted(png));
+  ASSERT_FALSE(j.is_null());
+  EXPECT_EQ(j.at("frames").back().at("work"), "exact piece");
+  auto headless = [&](const std::string& name, const std::string& extra) {
+    const std::string out = dir.file(name);
+    CommandResult h = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + selection +
+                                " --mode exact --render " + shell_quoted(out) + extra);
+    EXPECT_EQ(h.exit_code, 0) << h.output;
+    return read_image(out);
+  };
+  const Image still = read_image(png), shown = headless("shown.png", " --show-regions"),
+              plain = headless("plain.png", "");
+  const double to_plain = score_image(plain, shown).rmse;
+  ASSERT_GT(to_plain, 0) << "the shell changes the picture";
+  EXPECT_LT(score_image(still, shown).rmse, 0.5 * to_plain) << "the window at rest shows the shells";
+}
+
 // At rest the window refines to the finest level whose visible part fits the GPU memory budget: under a
 // budget that holds only level 1 of the whole scene, a thin slab comes at full detail, as headless draws it.
 TEST_F(Window, AtRestAThinSlabIsRefinedToFullDetailUnderABudgetForLevelOne) {
@@ -391,18 +415,23 @@ TEST_F(Window, ASelectionLooksAsItDoesHeadless) {
   const std::string shot = dir.file("shot.png"), headless = dir.file("headless.png");
   CommandResult w = run_voxview_in_xvfb(shell_quoted(vxl) + args + " --frames 5 --screenshot " + shell_quoted(shot));
   ASSERT_EQ(w.exit_code, 0) << w.output;
-  CommandResult h =
-      run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + args + " --render " + shell_quoted(headless));
+  // The window shows the region's shell unless B hides it: headless draws it with --show-regions.
+  CommandResult h = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + args + " --show-regions --render " +
+                              shell_quoted(headless));
   ASSERT_EQ(h.exit_code, 0) << h.output;
   const Image a = read_image(shot), b = read_image(headless);
   ImageDiff d = compare_images(a, b);
   EXPECT_LT(d.mean_error, 6e-5) << "differing pixels " << d.differing_pixels;
-  // And the selection shows less than the whole tractogram does.
+  // And the selection (without its shell) shows less than the whole tractogram does.
+  CommandResult plain = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + args + " --render " +
+                                  shell_quoted(dir.file("plain.png")));
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  const Image selected = read_image(dir.file("plain.png"));
   CommandResult all = run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) +
                                 " --size 320x240 --opacity 0.8 --render " + shell_quoted(dir.file("all.png")));
   ASSERT_EQ(all.exit_code, 0) << all.output;
-  EXPECT_LT(lit_pixels(b), lit_pixels(read_image(dir.file("all.png"))) * 9 / 10);
-  EXPECT_GT(lit_pixels(b), 50);
+  EXPECT_LT(lit_pixels(selected), lit_pixels(read_image(dir.file("all.png"))) * 9 / 10);
+  EXPECT_GT(lit_pixels(selected), 50);
 }
 
 // The orientation letters, the triad and a background colour are drawn in the window as in --render.

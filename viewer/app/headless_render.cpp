@@ -59,8 +59,11 @@ int run_headless(const ViewerOptions& o) {
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);  // before any GL work: a bad image fails fast
   std::optional<SceneSelection> selection;            // before any GL work too: a bad region fails fast
+  std::vector<RegionShape> shells;                    // drawn with --show-regions
   if (o.selecting()) {
-    selection = select_in_scene(pointers(files), RegionEditor(o).criteria());
+    const RegionEditor regions(o);
+    selection = select_in_scene(pointers(files), regions.criteria());
+    if (o.show_regions) shells = regions.shapes();
     std::fprintf(stderr, "voxview: %llu of %llu streamlines selected (the focus; the others are context)\n",
                  (unsigned long long)selection->selected, (unsigned long long)selection->total);
   }
@@ -95,6 +98,8 @@ int run_headless(const ViewerOptions& o) {
   }
   volume.reset();
   check_color_options(o.inputs_name(), *renderer, o.settings, o.from_view_file);
+  RenderSettings settings = o.settings;
+  settings.regions = shells;
   OffscreenTarget target(o.width, o.height);
   target.bind();
   if (o.save_camera)
@@ -105,7 +110,7 @@ int run_headless(const ViewerOptions& o) {
   if (PictureAnnotations::wanted(o.settings)) annotations.emplace();
   for (int i = 0; i < frames; ++i) {
     const Camera frame_camera = turntable_camera(*camera, i, frames);
-    renderer->draw(frame_camera, o.settings, o.width, o.height, target.framebuffer());
+    renderer->draw(frame_camera, settings, o.width, o.height, target.framebuffer());
     if (annotations) {
       target.bind();
       annotations->draw(frame_camera, o.settings, *renderer, o.width, o.height);

@@ -78,6 +78,7 @@ constexpr KeyBinding kKeys[] = {
     {KeyAction::RemoveRegion, "Delete", "selection: remove the active region", key(GLFW_KEY_DELETE)},
     {KeyAction::NextRegion, "Tab", "selection: the next region becomes the active one", key(GLFW_KEY_TAB)},
     {KeyAction::ToggleRegionRole, "X", "selection: the active region includes / excludes", typed("xX")},
+    {KeyAction::ToggleRegionShells, "B", "selection: the regions' shells shown / hidden", typed("bB")},
     {KeyAction::RegionSmaller, ",", "selection: the active sphere / 1.25", typed(",<")},
     {KeyAction::RegionLarger, ".", "selection: the active sphere x 1.25", typed(".>")},
     {KeyAction::SaveSelection, "W", "selection: write the selected streamlines to a .tck", typed("wW")},
@@ -91,6 +92,7 @@ constexpr MouseGesture kMouse[] = {
     {"wheel", "zoom"},
     {"Ctrl+wheel", "move the slab (the focus)"},
     {"Shift+wheel", "selection: the active sphere's radius"},
+    {"Ctrl+left drag", "selection: move the sphere under the cursor (or the active one)"},
 };
 
 bool matches_key(const KeyInput& in, int code, bool shift) {

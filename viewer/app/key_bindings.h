@@ -44,6 +44,7 @@ enum class KeyAction {
   RemoveRegion,
   NextRegion,
   ToggleRegionRole,
+  ToggleRegionShells,
   RegionSmaller,
   RegionLarger,
   SaveSelection,

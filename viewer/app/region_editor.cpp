@@ -41,6 +41,11 @@ void RegionEditor::parse_all() {
         continue;
       }
     }
+    if (region.shape() == Region::Shape::Box) {
+      std::array<double, 6> c{};
+      if (std::sscanf(r.text.c_str(), "box:%lf,%lf,%lf,%lf,%lf,%lf", &c[0], &c[1], &c[2], &c[3], &c[4], &c[5]) == 6)
+        r.box = c;
+    }
     parsed_.emplace_back(std::move(region));
   }
 }
@@ -92,6 +97,38 @@ void RegionEditor::move_active_to(const std::array<double, 3>& centre) {
   if (!active_ || !regions_[*active_].centre || *regions_[*active_].centre == centre) return;
   regions_[*active_].centre = centre;
   ++revision_;
+}
+
+void RegionEditor::move_active_by(const std::array<double, 3>& offset) {
+  if (!active_ || !regions_[*active_].centre) return;
+  const std::array<double, 3>& c = *regions_[*active_].centre;
+  move_active_to({c[0] + offset[0], c[1] + offset[1], c[2] + offset[2]});
+}
+
+std::vector<RegionShape> RegionEditor::shapes() const {
+  std::vector<RegionShape> out;
+  for (std::size_t i = 0; i < regions_.size(); ++i) {
+    const EditorRegion& r = regions_[i];
+    RegionShape s;
+    s.role = r.role == EditorRegion::Role::Include   ? RegionShape::Role::Include
+             : r.role == EditorRegion::Role::Exclude ? RegionShape::Role::Exclude
+                                                     : RegionShape::Role::EndsIn;
+    s.active = active_ == i;
+    if (r.centre) {
+      s.kind = RegionShape::Kind::Sphere;
+      s.centre = {(*r.centre)[0], (*r.centre)[1], (*r.centre)[2]};
+      s.radius = r.radius;
+    } else if (r.box) {
+      const std::array<double, 6>& b = *r.box;
+      s.kind = RegionShape::Kind::Box;
+      s.lo = {b[0], b[1], b[2]};
+      s.hi = {b[3], b[4], b[5]};
+    } else {
+      continue;  // a mask
+    }
+    out.push_back(s);
+  }
+  return out;
 }
 
 SelectionCriteria RegionEditor::criteria() const {

@@ -12,6 +12,7 @@
 
 #include "converter/selection/streamline_selection.h"
 #include "viewer/app/viewer_options.h"
+#include "viewer/render/region_shapes.h"
 
 namespace vxl::app {
 
@@ -21,7 +22,8 @@ struct EditorRegion {
   std::string text;                             // the argument as given (masks, boxes and given spheres)
   std::optional<std::array<double, 3>> centre;  // a sphere the window can move and resize
   double radius = 0;
-  std::uint64_t streamlines = 0;  // streamlines with a point in it, at the last selection
+  std::uint64_t streamlines = 0;             // streamlines with a point in it, at the last selection
+  std::optional<std::array<double, 6>> box;  // a box's corners X0,Y0,Z0,X1,Y1,Z1 (drawn, not edited)
   // The region as `voxlines select` takes it: X,Y,Z,R for a sphere, else the text.
   std::string argument() const;
   const char* role_name() const;
@@ -47,6 +49,11 @@ class RegionEditor {
   void scale_radius(double factor);                          // the active sphere
   void set_radius(double radius);                            // the active sphere; at least 0
   void move_active_to(const std::array<double, 3>& centre);  // the active sphere, if it is one
+  void move_active_by(const std::array<double, 3>& offset);  // the active sphere, if it is one
+
+  // The spheres and boxes as the renderer draws them (region_shapes.h), the active one marked; masks have
+  // no shape to draw and are left out.
+  std::vector<RegionShape> shapes() const;
 
   // The regions as selection criteria (parsed; throws vxl::Error naming a bad one), and back, each region's
   // count from the selection's per-region counts.

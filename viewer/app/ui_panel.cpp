@@ -101,13 +101,16 @@ void colour_controls(PanelState& state, const PanelStats& stats) {
 }
 
 // The selection's regions: each with its role and how many streamlines it holds; the active one's radius
-// (a sphere) and role can be changed, and it can be removed; a sphere can be added at the focus.
-void selection_controls(const PanelStats& stats, PanelRequests& out) {
+// (a sphere) and role can be changed, and it can be removed; a sphere can be added at the focus; the
+// regions' shells shown or hidden.
+void selection_controls(PanelState& state, const PanelStats& stats, PanelRequests& out) {
   if (!ImGui::CollapsingHeader("Selection", ImGuiTreeNodeFlags_DefaultOpen)) return;
   out.add_region = ImGui::Button("Add sphere at focus");
   if (!stats.regions.empty()) {
     ImGui::SameLine();
     out.save_selection = ImGui::Button("Save selection");
+    ImGui::SameLine();
+    ImGui::Checkbox("Shells", &state.show_regions);  // the regions drawn around the lines (B)
   }
   for (std::size_t i = 0; i < stats.regions.size(); ++i) {
     const PanelStats::Region& r = stats.regions[i];
@@ -380,7 +383,7 @@ PanelRequests UiPanel::build(PanelState& state, const PanelStats& stats) {
     look_controls(state, stats);
     clipping_controls(state, stats, out);
     image_controls(state, stats, out);
-    selection_controls(stats, out);
+    selection_controls(state, stats, out);
     view_controls(state, out);
     frame_information(state, stats);
     ImGui::PopItemWidth();

@@ -25,6 +25,7 @@ struct PanelState {
   bool panel_in_screenshot = false;
   bool panel_collapsed = false;  // only the title bar shows (H, or its arrow)
   bool exact_when_still = true;  // at rest, go on to the exact picture (rest_refinement.h)
+  bool show_regions = true;      // the selection's spheres and boxes drawn as shells (region_shells.h)
   double slab_thickness = 10.0;  // mm, kept while the slab is off (settings.clipping.slab_mm is 0 then)
 };
 

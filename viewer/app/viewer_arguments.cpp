@@ -196,6 +196,7 @@ void apply_selection(const ViewerArguments& a, ViewerOptions& o) {
   if (!o.selecting()) {
     if (a.was_given("--focus-opacity") || a.was_given("--context-opacity"))
       usage_error("--focus-opacity and --context-opacity go with a selection (--include, --exclude, --ends-in)");
+    if (o.show_regions) usage_error("--show-regions goes with a selection (--include, --exclude, --ends-in)");
     return;
   }
   RenderSettings& s = o.settings;

@@ -60,6 +60,9 @@ struct ViewerOptions {
   // with the opacities of the groups "selected" and "context" (scene_selection.h).
   std::vector<std::string> include, exclude, ends_in;
   bool selecting() const { return !include.empty() || !exclude.empty() || !ends_in.empty(); }
+  // Headless: draw the regions' spheres and boxes as translucent shells (region_shells.h). The window
+  // shows them unless the user hides them (H, the panel).
+  bool show_regions = false;
   ViewFileSettings from_view_file;
 };
 

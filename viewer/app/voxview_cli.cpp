@@ -120,6 +120,10 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
       ->type_name("ROI")
       ->expected(1)
       ->take_all();
+  cli.add_flag("--show-regions", a.options.show_regions,
+               "with a selection: draw its spheres and boxes as faint translucent shells (include green, exclude "
+               "red, ends-in blue; the active, last region brighter), their back halves under the lines and their "
+               "front halves over them (the window shows them unless B hides them)");
   cli.add_option("--focus-opacity", a.focus_opacity,
                  "with a selection: the selected streamlines' opacity "
                  "(default --opacity)")

@@ -31,6 +31,7 @@
 #include "viewer/app/key_bindings.h"
 #include "viewer/app/picture_annotations.h"
 #include "viewer/app/process_clock.h"
+#include "viewer/app/region_drag.h"
 #include "viewer/app/region_editor.h"
 #include "viewer/app/rest_refinement.h"
 #include "viewer/app/scene_detail.h"
@@ -176,6 +177,7 @@ class ViewerWindow {
   static ViewerWindow& of(GLFWwindow* w) { return *static_cast<ViewerWindow*>(glfwGetWindowUserPointer(w)); }
   void on_mouse_button(int button, int action, int mods);
   void on_cursor(double x, double y);
+  void begin_region_drag(double x, double y);
   void on_scroll(double steps);
   void on_key(int key, int action, int mods);
   void on_char(unsigned codepoint);
@@ -257,6 +259,8 @@ class ViewerWindow {
   PanelState state_;
   PanelStats stats_;
   int drag_button_ = -1;
+  bool dragging_region_ = false;   // Ctrl + left drag: the active sphere follows the cursor
+  glm::dvec2 region_cursor_{0.0};  // the cursor at the drag's last move
   bool screenshot_requested_ = false;
   bool save_view_requested_ = false;
   RenderMode drawn_mode_ =
@@ -370,6 +374,7 @@ void ViewerWindow::on_mouse_button(int button, int action, int mods) {
     if (button == drag_button_) {
       controller_.end_drag();
       drag_button_ = -1;
+      dragging_region_ = false;
     }
     return;
   }
@@ -377,6 +382,10 @@ void ViewerWindow::on_mouse_button(int button, int action, int mods) {
   double x = 0, y = 0;
   glfwGetCursorPos(window_, &x, &y);
   if (drag_button_ != -1 || panel_->takes_mouse_at(x, y)) return;
+  if (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_CONTROL)) {
+    begin_region_drag(x, y);
+    return;
+  }
   DragMode mode = DragMode::None;
   if (button == GLFW_MOUSE_BUTTON_LEFT) mode = (mods & GLFW_MOD_SHIFT) ? DragMode::Pan : DragMode::Orbit;
   if (button == GLFW_MOUSE_BUTTON_RIGHT || button == GLFW_MOUSE_BUTTON_MIDDLE) mode = DragMode::Pan;
@@ -387,7 +396,44 @@ void ViewerWindow::on_mouse_button(int button, int action, int mods) {
 
 void ViewerWindow::on_cursor(double x, double y) {
   events_++;
+  if (dragging_region_) {
+    int w = 0, h = 0;
+    glfwGetWindowSize(window_, &w, &h);
+    const std::optional<std::size_t> active = regions_.active();
+    if (active && regions_.regions()[*active].centre) {
+      const std::array<double, 3>& c = *regions_.regions()[*active].centre;
+      const glm::dvec3 move =
+          drag_in_view_plane(controller_.camera(), {c[0], c[1], c[2]}, region_cursor_, {x, y}, w, h);
+      regions_.move_active_by({move.x, move.y, move.z});  // the selection follows (update_selection)
+    }
+    region_cursor_ = {x, y};
+    return;
+  }
   if (controller_.dragging() != DragMode::None) controller_.drag_to(x, y);
+}
+
+// Ctrl + left press: the sphere under the cursor becomes the active one (else the active one stays) and
+// follows the cursor until the button is released.
+void ViewerWindow::begin_region_drag(double x, double y) {
+  std::vector<RegionShape> spheres;
+  std::vector<std::size_t> index;  // the region of each sphere
+  for (std::size_t i = 0; i < regions_.regions().size(); ++i) {
+    const EditorRegion& r = regions_.regions()[i];
+    if (!r.centre) continue;
+    RegionShape s;
+    s.centre = {(*r.centre)[0], (*r.centre)[1], (*r.centre)[2]};
+    s.radius = r.radius;
+    spheres.push_back(s);
+    index.push_back(i);
+  }
+  int w = 0, h = 0;
+  glfwGetWindowSize(window_, &w, &h);
+  if (const auto hit = pick_sphere(pick_ray(controller_.camera(), x, y, w, h), spheres)) regions_.activate(index[*hit]);
+  const std::optional<std::size_t> active = regions_.active();
+  if (!active || !regions_.regions()[*active].centre) return;
+  dragging_region_ = true;
+  region_cursor_ = {x, y};
+  drag_button_ = GLFW_MOUSE_BUTTON_LEFT;
 }
 
 void ViewerWindow::on_scroll(double steps) {
@@ -427,7 +473,9 @@ void ViewerWindow::move_focus_along(int axis, double mm) {
   Camera c = controller_.camera();
   c.target[axis] += mm;
   controller_.set_camera(c);
-  regions_.move_active_to({c.target[0], c.target[1], c.target[2]});  // the active sphere follows the focus
+  std::array<double, 3> offset{0, 0, 0};
+  offset[axis] = mm;
+  regions_.move_active_by(offset);  // the active sphere moves with the focus (a dragged one from where it is)
 }
 
 void ViewerWindow::update_selection() {
@@ -565,6 +613,7 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
     case KeyAction::RemoveRegion: regions_.remove_active(); break;
     case KeyAction::NextRegion: regions_.activate_next(); break;
     case KeyAction::ToggleRegionRole: regions_.toggle_role(); break;
+    case KeyAction::ToggleRegionShells: state_.show_regions = !state_.show_regions; break;
     case KeyAction::RegionSmaller: regions_.scale_radius(1 / RegionEditor::kRadiusStep); break;
     case KeyAction::RegionLarger: regions_.scale_radius(RegionEditor::kRadiusStep); break;
     case KeyAction::SaveSelection: save_selection(); break;
@@ -810,6 +859,7 @@ int ViewerWindow::run() {
     // level. An unchanged one is refined at rest, a piece a frame (rest_refinement.h).
     const Camera& camera = controller_.camera();
     update_selection();
+    state_.settings.regions = state_.show_regions ? regions_.shapes() : std::vector<RegionShape>{};
     const PictureKey key{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all, regions_.revision()};
     const bool moving = drawn_ && !closing && !same_view(drawn_->camera, camera);
     const bool changed = !drawn_ || !same_picture(*drawn_, key);

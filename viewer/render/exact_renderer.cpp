@@ -225,7 +225,11 @@ void ExactRenderer::start_image(const glm::vec3& background) {
   // The lines are composited over the opaque slices where there are some (their colour is the background
   // there); the list pass drops the fragments behind them.
   image_.resize(std::size_t(width_) * height_ * 4);
-  if (const GLuint slices = lines_.slice_color_texture()) {
+  if (lines_.base_in_framebuffer()) {  // the region shells' back halves are drawn on it (renderer.h)
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, width_, height_, GL_RGBA, GL_FLOAT, image_.data());
+  } else if (const GLuint slices = lines_.slice_color_texture()) {
     glBindTexture(GL_TEXTURE_2D, slices);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, image_.data());

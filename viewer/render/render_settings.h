@@ -12,6 +12,7 @@
 
 #include "viewer/render/clip_planes.h"
 #include "viewer/render/colormap.h"
+#include "viewer/render/region_shapes.h"
 
 namespace vxl {
 
@@ -84,6 +85,8 @@ struct RenderSettings {
   Clipping clipping;                          // slab and clip planes (clip_planes.h)
   bool lighting = false;                      // illuminated lines (line_lighting.h)
   SliceSettings slices;                       // drawn when the renderer has a volume (Renderer::set_volume)
+  // The selection's regions drawn as translucent shells around the lines (region_shells.h); empty: none.
+  std::vector<RegionShape> regions;
   // Drawn over the picture (picture_annotations.h), not by the renderer: L/R, A/P, S/I at the picture's
   // edges and an axes triad; with ColorMode::Scalar, a colour bar with the range and the value set's name.
   bool orientation_labels = false;

@@ -13,6 +13,7 @@
 #include "viewer/render/exact_renderer.h"
 #include "viewer/render/line_lighting.h"
 #include "viewer/render/line_shaders.h"
+#include "viewer/render/region_shells.h"
 #include "viewer/render/segment_sort.h"
 #include "viewer/render/slice_renderer.h"
 #include "viewer/render/vertex_attributes.h"
@@ -496,28 +497,33 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
   switch (s.mode) {
     case RenderMode::Opaque:
       clear_to_base(fbo, width, height, bg);
+      draw_shells(ShellHalf::Back, camera, s, width, height);
       opaque_blending();
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Any);
       glDisable(GL_DEPTH_TEST);
       break;
     case RenderMode::Unsorted:
       clear_to_base(fbo, width, height, bg);
+      draw_shells(ShellHalf::Back, camera, s, width, height);
       over_blending();
       draw_dataset_order(over_program_, camera, s, aspect);
       break;
     case RenderMode::Basic:
       clear_to_base(fbo, width, height, bg);
+      draw_shells(ShellHalf::Back, camera, s, width, height);
       over_blending();
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Block);
       break;
     case RenderMode::Axis:
       clear_to_base(fbo, width, height, bg);
+      draw_shells(ShellHalf::Back, camera, s, width, height);
       over_blending();
       plan_.order_hysteresis = s.order_hysteresis;
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Nearest);
       break;
     case RenderMode::Segsort:  // as axis, but each voxel's segments sorted for this view
       clear_to_base(fbo, width, height, bg);
+      draw_shells(ShellHalf::Back, camera, s, width, height);
       over_blending();
       draw_segment_sorted(over_program_, camera, s, aspect);
       break;
@@ -541,6 +547,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       const GLenum both[2] = {accum, reveal};
       glDrawBuffers(2, both);
       clear_to_base(fbo, width, height, bg);
+      draw_shells(ShellHalf::Back, camera, s, width, height);
       over_blending();
       composite(wboit_composite_, {{"u_accum", wboit_target_.color[0]}, {"u_reveal", wboit_target_.color[1]}});
       break;
@@ -563,6 +570,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       bind_line_program(additive_program_, camera, s, aspect);
       draw_plan(additive_program_, plan_.first, plan_.count);
       clear_to_base(fbo, width, height, bg);
+      draw_shells(ShellHalf::Back, camera, s, width, height);
       over_blending();
       glUseProgram(additive_composite_);
       glUniform1f(glGetUniformLocation(additive_composite_, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
@@ -572,9 +580,11 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
     }
     case RenderMode::Exact:
       if (!exact_) exact_ = std::make_unique<ExactRenderer>(*this);
+      shells_under_exact(camera, s, width, height, fbo);
       exact_->draw(camera, s, width, height, fbo);
       break;
   }
+  draw_shells(ShellHalf::Front, camera, s, width, height);
   glDisable(GL_BLEND);
   enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
@@ -609,6 +619,7 @@ void Renderer::begin_pieces(const Camera& camera, const RenderSettings& s, int w
     case RenderMode::Axis: {
       start_frame(camera, s, width, height);
       clear_to_base(fbo, width, height, s.background());
+      draw_shells(ShellHalf::Back, camera, s, width, height);
       if (s.mode == RenderMode::Axis) plan_.order_hysteresis = s.order_hysteresis;
       const PlanOrder order = s.mode == RenderMode::Opaque  ? PlanOrder::Any
                               : s.mode == RenderMode::Basic ? PlanOrder::Block
@@ -619,11 +630,13 @@ void Renderer::begin_pieces(const Camera& camera, const RenderSettings& s, int w
       p.count = plan_.count;
       for (std::int32_t ids : p.count) p.segments += static_cast<std::uint64_t>(ids / 2);
       p.done = p.first.empty();
+      if (p.done) draw_front_shells(p);
       break;
     }
     case RenderMode::Exact:
       if (!exact_) exact_ = std::make_unique<ExactRenderer>(*this);
       start_frame(camera, s, width, height);
+      shells_under_exact(camera, s, width, height, fbo);
       exact_->begin(camera, s, width, height, fbo);
       p.kind = Pieces::Kind::Exact;
       break;
@@ -649,6 +662,7 @@ bool Renderer::draw_piece(double max_ms) {
     }
     case Pieces::Kind::Exact:
       pieces_->done = exact_->step(max_ms);
+      if (pieces_->done) draw_front_shells(*pieces_);
       glDisable(GL_BLEND);
       enable_clip_distances(0);
       return pieces_->done;
@@ -685,6 +699,7 @@ bool Renderer::draw_piece(double max_ms) {
       p.drawn += segments;
       p.next = end;
       p.done = end == p.count.size();
+      if (p.done) draw_front_shells(p);
       glDisable(GL_BLEND);
       glDisable(GL_DEPTH_TEST);
       enable_clip_distances(0);
@@ -692,6 +707,29 @@ bool Renderer::draw_piece(double max_ms) {
     }
   }
   return pieces_->done;
+}
+
+void Renderer::draw_front_shells(const Pieces& p) {
+  glBindFramebuffer(GL_FRAMEBUFFER, p.fbo);
+  glViewport(0, 0, p.width, p.height);
+  draw_shells(ShellHalf::Front, p.camera, p.settings, p.width, p.height);
+}
+
+void Renderer::draw_shells(ShellHalf half, const Camera& camera, const RenderSettings& s, int width, int height) {
+  if (s.regions.empty()) return;
+  if (!shells_) shells_ = std::make_unique<RegionShells>();
+  enable_clip_distances(0);
+  shells_->draw(camera, projection(camera, double(width) / std::max(1, height)), s.regions, half,
+                slices_drawn_ ? slices_->depth_texture() : 0);
+}
+
+void Renderer::shells_under_exact(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
+  // exact composites its lists over a picture on the CPU: with shells, that picture is the framebuffer's
+  // base with the back halves on it, read back by ExactRenderer::start_image.
+  base_in_framebuffer_ = !s.regions.empty();
+  if (!base_in_framebuffer_) return;
+  clear_to_base(fbo, width, height, s.background());
+  draw_shells(ShellHalf::Back, camera, s, width, height);
 }
 
 double Renderer::pieces_progress() const {

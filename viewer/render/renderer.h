@@ -20,12 +20,14 @@
 #include "viewer/render/frame_plan.h"
 #include "viewer/render/gl_util.h"
 #include "viewer/render/gpu_scene.h"
+#include "viewer/render/region_shapes.h"
 #include "viewer/render/render_settings.h"
 #include "viewer/render/scene_groups.h"
 
 namespace vxl {
 
 class ExactRenderer;
+class RegionShells;
 class SegmentSorter;
 class SliceRenderer;
 struct Volume;
@@ -83,6 +85,9 @@ class Renderer {
   std::array<float, 2> slice_range(const RenderSettings& settings) const;
   // The slices' colour of the last frame (RGBA32F, the background where none), 0 when none were drawn.
   GLuint slice_color_texture() const;
+  // Whether this frame's base (background or slices, and the back halves of the region shells) is in the
+  // framebuffer rather than only in slice_color_texture(): exact then reads it from there.
+  bool base_in_framebuffer() const { return base_in_framebuffer_; }
 
   const FrameStats& stats() const { return stats_; }
   // The scene's groups (scene_groups.h) and value sets (per-vertex sets first, then per-streamline ones).
@@ -140,6 +145,12 @@ class Renderer {
   void start_frame(const Camera& camera, const RenderSettings& settings, int width, int height);
   // Clears `fbo` to the picture's base under the lines: the background, or the slices over it.
   void clear_to_base(GLuint fbo, int width, int height, const glm::vec3& background) const;
+  // Blends one half of settings.regions' shells (region_shells.h) over the bound framebuffer: the back half
+  // over the base before the lines, the front half after them.
+  void draw_shells(ShellHalf half, const Camera& camera, const RenderSettings& settings, int width, int height);
+  void draw_front_shells(const Pieces& pieces);
+  // exact with shells: its base in `fbo` with the back halves drawn on it (base_in_framebuffer()).
+  void shells_under_exact(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
   // The blend state of the over-compositing modes (basic, axis; docs/rendering.md, pitfall 1).
   static void over_blending();
   // The depth and blend state of the opaque mode.
@@ -184,6 +195,8 @@ class Renderer {
   std::unique_ptr<Pieces> pieces_;                 // the frame begin_pieces() started, until draw() or the next begin
   std::unique_ptr<SegmentSorter> segment_sorter_;  // made on first use
   std::unique_ptr<SliceRenderer> slices_;
+  std::unique_ptr<RegionShells> shells_;  // made when regions are first shown
+  bool base_in_framebuffer_ = false;
   bool slices_drawn_ = false;  // this frame: the line shaders test against the slices' depth
   SceneGroups groups_;
   std::vector<std::string> value_set_names_;
