@@ -218,14 +218,7 @@ Bytes text(const std::string& s) { return Bytes(s.begin(), s.end()); }
 
 using vxl::test::write_zip;
 
-void write_dir(const std::string& path, const std::vector<std::pair<std::string, Bytes>>& members) {
-  for (const auto& [name, data] : members) {
-    const std::filesystem::path p = std::filesystem::path(path) / name;
-    std::filesystem::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary)
-        .write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
-  }
-}
+using vxl::test::write_dir;
 
 std::string header_json(int n, int v) {
   return "{\"DIMENSIONS\": [10, 10, 10], \"VOXEL_TO_RASMM\": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], "

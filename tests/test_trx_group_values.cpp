@@ -68,14 +68,7 @@ std::vector<std::pair<std::string, Bytes>> trx_members() {
       {"dpg/B/odd.2.float64", le_bytes(std::vector<std::uint64_t>{kNanBits, kMinusZeroBits})}};
 }
 
-void write_dir(const std::string& path, const std::vector<std::pair<std::string, Bytes>>& members) {
-  for (const auto& [name, data] : members) {
-    const std::filesystem::path p = std::filesystem::path(path) / name;
-    std::filesystem::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary)
-        .write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
-  }
-}
+using test::write_dir;
 
 // The rows as "group/name.n.dtype" -> bytes, independent of order and of group indices.
 std::map<std::string, Bytes> rows_by_member(const std::vector<StreamlineGroup>& groups,

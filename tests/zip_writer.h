@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
@@ -118,6 +119,16 @@ inline void write_zip(const std::string& path, const std::vector<std::pair<std::
   std::vector<ZipEntry> entries;
   for (const auto& [name, data] : members) entries.push_back(stored_entry(name, data));
   write_zip(path, entries);
+}
+
+// The same members as the files of a TRX directory (a TRX may be a folder instead of a zip).
+inline void write_dir(const std::string& path, const std::vector<std::pair<std::string, Bytes>>& members) {
+  for (const auto& [name, data] : members) {
+    const std::filesystem::path p = std::filesystem::path(path) / name;
+    std::filesystem::create_directories(p.parent_path());
+    std::ofstream(p, std::ios::binary)
+        .write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
+  }
 }
 
 }  // namespace vxl::test

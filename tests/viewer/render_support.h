@@ -55,6 +55,10 @@ inline Camera top_view(double height_mm = 64) {
   return c;
 }
 
+// The pixel column and row whose centre world x and y fall in, under top_view() on a 64 x 64 image.
+inline int column_of(double x) { return static_cast<int>(x + 31.5); }
+inline int row_of(double y) { return static_cast<int>(31.5 - y); }
+
 inline Image render_image(Renderer& r, const Camera& camera, const RenderSettings& settings, int w, int h) {
   OffscreenTarget target(w, h);
   target.bind();

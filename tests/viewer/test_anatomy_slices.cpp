@@ -81,18 +81,13 @@ std::string write_nifti(const ScratchDir& dir, const std::string& name, const Ni
 
 // Seen from above (anterior up, right on the right) on a 64 x 64 image at 1 mm per pixel: world (x, y) =
 // (c - 31.5, 31.5 - r) at the centre of pixel (c, r); the focus (the axial slice) at height z.
-Camera top_view(double z) {
-  Camera c;
-  c.orthographic = true;
-  c.ortho_height = 64;
-  c.distance = 100;
-  c.azimuth_deg = 180;
-  c.elevation_deg = 90;
+Camera top_view_at(double z) {
+  Camera c = test::top_view();
   c.target = {0, 0, z};
   return c;
 }
-int column_of(double x) { return static_cast<int>(x + 31.5); }
-int row_of(double y) { return static_cast<int>(31.5 - y); }
+using test::column_of;
+using test::row_of;
 
 // Two red lines along x: one 10 mm above the axial slice at z = 0 (in front, seen from above) on row
 // y = 8.5, one 10 mm below it (behind) on row y = -7.5.
@@ -158,15 +153,15 @@ TEST_F(AnatomySlices, SliceShowsTheCubeWhereItIs) {
     r.set_volume(read_nifti_volume(write_nifti(dir, name, spec)));
     RenderSettings s = axial_only();
     s.opacity = 0.001f;  // the lines out of the way
-    const Image in = render_image(r, top_view(12), s, 64, 64);
+    const Image in = render_image(r, top_view_at(12), s, 64, 64);
     EXPECT_GE(grey(in, 12.5, 12.5), 250);       // the cube
     EXPECT_NEAR(grey(in, -12.5, 12.5), 77, 3);  // mirrored in x: head only
     EXPECT_NEAR(grey(in, 12.5, -12.5), 77, 3);  // mirrored in y
     EXPECT_LE(grey(in, -26.5, 0.5), 1);         // inside the image, outside the head
-    const Image below = render_image(r, top_view(-12), s, 64, 64);
+    const Image below = render_image(r, top_view_at(-12), s, 64, 64);
     EXPECT_NEAR(grey(below, 12.5, 12.5), 77, 3);  // the slice moved with the focus
     s.slices.axial = false;
-    const Image hidden = render_image(r, top_view(12), s, 64, 64);
+    const Image hidden = render_image(r, top_view_at(12), s, 64, 64);
     EXPECT_LE(grey(hidden, 12.5, 12.5), 1);
   }
 }
@@ -185,7 +180,7 @@ TEST_F(AnatomySlices, LinesInFrontBlendOverTheSliceLinesBehindAreHidden) {
     RenderSettings s = axial_only();
     s.mode = mode;
     s.opacity = 0.5f;
-    const Image img = render_image(r, top_view(0), s, 64, 64);
+    const Image img = render_image(r, top_view_at(0), s, 64, 64);
     // The line's coverage over the slice: opaque replaces; additive mixes its opaque pass (1) and its
     // additive pass (0.5) by the opacity; the others blend at the opacity.
     const double a = mode == RenderMode::Opaque ? 1.0 : mode == RenderMode::Additive ? 0.75 : 0.5;
@@ -200,7 +195,7 @@ TEST_F(AnatomySlices, LinesInFrontBlendOverTheSliceLinesBehindAreHidden) {
     }
     // With the slices off the back line shows: the test above sees what it means to.
     s.slices.axial = false;
-    const Image bare = render_image(r, top_view(0), s, 64, 64);
+    const Image bare = render_image(r, top_view_at(0), s, 64, 64);
     EXPECT_GT(bare.pixel(column_of(0.5), row_of(-7.5))[0], 100);
   }
 }
@@ -211,7 +206,7 @@ TEST_F(AnatomySlices, SlabShowsTheSliceInItsMiddle) {
   VxlFile scene = make_scene(dir, front_and_back(), 10.0);
   Renderer r(scene);
   r.set_volume(read_nifti_volume(write_nifti(dir, "cube")));
-  Camera oblique = top_view(0);
+  Camera oblique = top_view_at(0);
   oblique.elevation_deg = 50;
   oblique.azimuth_deg = 150;
   RenderSettings s = axial_only();

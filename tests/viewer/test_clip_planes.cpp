@@ -30,8 +30,8 @@ Tractogram depth_lines() {
   return t;
 }
 
-int row_of(double y) { return static_cast<int>(31.5 - y); }
-int column_of(double x) { return static_cast<int>(x + 31.5); }
+using test::column_of;
+using test::row_of;
 
 using test::top_view;
 

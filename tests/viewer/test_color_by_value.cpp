@@ -16,9 +16,9 @@ using test::real;
 using test::render_image;
 using test::ScratchDir;
 
+using test::column_of;
+using test::row_of;
 using test::top_view;
-int column_of(double x) { return static_cast<int>(x + 31.5); }
-int row_of(double y) { return static_cast<int>(31.5 - y); }
 
 RenderSettings opaque(ColorMode color) {
   RenderSettings s;

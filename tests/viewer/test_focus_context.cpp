@@ -16,9 +16,8 @@ using test::render_image;
 using test::ScratchDir;
 using test::top_view;
 
-// Seen from above on a 64 x 64 image: world (x, y) is the centre of pixel (x + 31.5, 31.5 - y).
-int column_of(double x) { return static_cast<int>(x + 31.5); }
-int row_of(double y) { return static_cast<int>(31.5 - y); }
+using test::column_of;
+using test::row_of;
 
 // Line 0 along x at y = 0.5, 10 mm above (in front, seen from above); line 1 along y at x = 0.5, 10 mm
 // below. They cross at pixel (32, 31).

@@ -18,9 +18,8 @@ using test::render_image;
 using test::ScratchDir;
 using test::top_view;
 
-// World (x, y) is the centre of pixel (x + 31.5, 31.5 - y).
-int column_of(double x) { return static_cast<int>(x + 31.5); }
-int row_of(double y) { return static_cast<int>(31.5 - y); }
+using test::column_of;
+using test::row_of;
 
 // One line along x at y = 0.5, 2 mm above z = 0 (towards the viewer), through the sphere.
 Tractogram one_line() {
