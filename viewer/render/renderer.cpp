@@ -458,13 +458,15 @@ void Renderer::opaque_blending() {
   glBlendFuncSeparate(GL_ONE, GL_ZERO, GL_ZERO, GL_ONE);
 }
 
-void Renderer::clear_to_base(GLuint fbo, int width, int height, const glm::vec3& background) const {
+void Renderer::clear_to_base(GLuint fbo, const Camera& camera, const RenderSettings& s, int width, int height) {
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, width, height);
+  const glm::vec3 background = s.background();
   glClearColor(background.r, background.g, background.b, 1.0f);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   if (slices_drawn_) slices_->copy_color();
+  draw_shells(ShellHalf::Back, camera, s, width, height);
 }
 
 void Renderer::start_frame(const Camera& camera, const RenderSettings& s, int width, int height) {
@@ -484,7 +486,6 @@ void Renderer::start_frame(const Camera& camera, const RenderSettings& s, int wi
 void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
   pieces_.reset();
   const double aspect = double(width) / std::max(1, height);
-  const glm::vec3 bg = s.background();
   auto clear_target = [&](GLuint target, glm::vec4 colour) {
     glBindFramebuffer(GL_FRAMEBUFFER, target);
     glViewport(0, 0, width, height);
@@ -496,34 +497,29 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
 
   switch (s.mode) {
     case RenderMode::Opaque:
-      clear_to_base(fbo, width, height, bg);
-      draw_shells(ShellHalf::Back, camera, s, width, height);
+      clear_to_base(fbo, camera, s, width, height);
       opaque_blending();
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Any);
       glDisable(GL_DEPTH_TEST);
       break;
     case RenderMode::Unsorted:
-      clear_to_base(fbo, width, height, bg);
-      draw_shells(ShellHalf::Back, camera, s, width, height);
+      clear_to_base(fbo, camera, s, width, height);
       over_blending();
       draw_dataset_order(over_program_, camera, s, aspect);
       break;
     case RenderMode::Basic:
-      clear_to_base(fbo, width, height, bg);
-      draw_shells(ShellHalf::Back, camera, s, width, height);
+      clear_to_base(fbo, camera, s, width, height);
       over_blending();
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Block);
       break;
     case RenderMode::Axis:
-      clear_to_base(fbo, width, height, bg);
-      draw_shells(ShellHalf::Back, camera, s, width, height);
+      clear_to_base(fbo, camera, s, width, height);
       over_blending();
       plan_.order_hysteresis = s.order_hysteresis;
       draw_lines(over_program_, camera, s, aspect, PlanOrder::Nearest);
       break;
     case RenderMode::Segsort:  // as axis, but each voxel's segments sorted for this view
-      clear_to_base(fbo, width, height, bg);
-      draw_shells(ShellHalf::Back, camera, s, width, height);
+      clear_to_base(fbo, camera, s, width, height);
       over_blending();
       draw_segment_sorted(over_program_, camera, s, aspect);
       break;
@@ -546,8 +542,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       draw_plan(reveal_program_, plan_.first, plan_.count);
       const GLenum both[2] = {accum, reveal};
       glDrawBuffers(2, both);
-      clear_to_base(fbo, width, height, bg);
-      draw_shells(ShellHalf::Back, camera, s, width, height);
+      clear_to_base(fbo, camera, s, width, height);
       over_blending();
       composite(wboit_composite_, {{"u_accum", wboit_target_.color[0]}, {"u_reveal", wboit_target_.color[1]}});
       break;
@@ -569,8 +564,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
       glBlendFunc(GL_ONE, GL_ONE);
       bind_line_program(additive_program_, camera, s, aspect);
       draw_plan(additive_program_, plan_.first, plan_.count);
-      clear_to_base(fbo, width, height, bg);
-      draw_shells(ShellHalf::Back, camera, s, width, height);
+      clear_to_base(fbo, camera, s, width, height);
       over_blending();
       glUseProgram(additive_composite_);
       glUniform1f(glGetUniformLocation(additive_composite_, "u_opacity"), std::clamp(s.opacity, 0.001f, 1.0f));
@@ -618,8 +612,7 @@ void Renderer::begin_pieces(const Camera& camera, const RenderSettings& s, int w
     case RenderMode::Basic:
     case RenderMode::Axis: {
       start_frame(camera, s, width, height);
-      clear_to_base(fbo, width, height, s.background());
-      draw_shells(ShellHalf::Back, camera, s, width, height);
+      clear_to_base(fbo, camera, s, width, height);
       if (s.mode == RenderMode::Axis) plan_.order_hysteresis = s.order_hysteresis;
       const PlanOrder order = s.mode == RenderMode::Opaque  ? PlanOrder::Any
                               : s.mode == RenderMode::Basic ? PlanOrder::Block
@@ -728,8 +721,7 @@ void Renderer::shells_under_exact(const Camera& camera, const RenderSettings& s,
   // base with the back halves on it, read back by ExactRenderer::start_image.
   base_in_framebuffer_ = !s.regions.empty();
   if (!base_in_framebuffer_) return;
-  clear_to_base(fbo, width, height, s.background());
-  draw_shells(ShellHalf::Back, camera, s, width, height);
+  clear_to_base(fbo, camera, s, width, height);
 }
 
 double Renderer::pieces_progress() const {

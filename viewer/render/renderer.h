@@ -143,8 +143,9 @@ class Renderer {
   // What every mode does first: the per-vertex attributes, the slices (their depth hides lines behind them),
   // line width and a neutral blend and depth state.
   void start_frame(const Camera& camera, const RenderSettings& settings, int width, int height);
-  // Clears `fbo` to the picture's base under the lines: the background, or the slices over it.
-  void clear_to_base(GLuint fbo, int width, int height, const glm::vec3& background) const;
+  // Clears `fbo` to the picture's base under the lines: the background, or the slices over it, with the back
+  // halves of settings.regions' shells blended on.
+  void clear_to_base(GLuint fbo, const Camera& camera, const RenderSettings& settings, int width, int height);
   // Blends one half of settings.regions' shells (region_shells.h) over the bound framebuffer: the back half
   // over the base before the lines, the front half after them.
   void draw_shells(ShellHalf half, const Camera& camera, const RenderSettings& settings, int width, int height);
