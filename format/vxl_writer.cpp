@@ -74,7 +74,7 @@ VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
       // Optional: a reader that does not know them still draws the picture, in the other colour modes.
       {"VVAL", 0, sizes.vertex_values, sizes.vertex_values > 0},
       {"SVAL", 0, sizes.streamline_values, sizes.streamline_values > 0},
-      // Optional, and no version change (spec §10): a reader that skips it loses the TRX dpg rows only.
+      // Optional (1.3 / 2.2, spec §10): a reader that skips it loses the TRX dpg rows only.
       {"GDAT", 0, sizes.group_values, sizes.group_values > 0},
   };
   std::size_t present = 0;
