@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <map>
+#include <optional>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -23,6 +25,7 @@
 #include "converter/synth.h"
 #include "format/error.h"
 #include "format/vxl_verify.h"
+#include "tests/hostile_vxl.h"
 #include "tests/nifti_test_files.h"
 #include "tests/test_support.h"
 
@@ -160,8 +163,11 @@ TEST_F(Selection, RandomSpheresBoxesAndMasksMatchTheBruteForceReference) {
     return kind == 0 ? random_sphere() : kind == 1 ? random_box() : parse_region(labels + (kind == 2 ? ":1" : ":2"));
   };
   int nonempty = 0, cases = 0;
+  std::map<std::string, std::optional<VoxelVoxlines>> index;
   for (const char* file : {"f32.vxl", "f32_4mm.vxl"}) {
     const VxlFile f = VxlFile::open(dir_->file(file));
+    index[file] = VoxelVoxlines::build(f, 2);
+    ASSERT_TRUE(index[file].has_value());
     for (int trial = 0; trial < 40; ++trial) {
       SelectionCriteria c;
       c.include.push_back(random_region(trial % 4));
@@ -173,6 +179,10 @@ TEST_F(Selection, RandomSpheresBoxesAndMasksMatchTheBruteForceReference) {
       c.invert = trial % 9 == 6;
       const SelectionResult r = select_streamlines(f, c);
       ASSERT_EQ(r.streamlines, brute_force(*source_, c)) << file << " trial " << trial;
+      // Through the per-voxel index: the same streamlines, the same count per region.
+      const SelectionResult indexed = select_streamlines(f, c, &*index.at(file));
+      ASSERT_EQ(indexed.streamlines, r.streamlines) << file << " trial " << trial;
+      ASSERT_EQ(indexed.streamlines_per_region, r.streamlines_per_region) << file << " trial " << trial;
       nonempty += !r.streamlines.empty() && r.streamlines.size() < source_->streamline_count();
       ++cases;
     }
@@ -222,6 +232,107 @@ TEST_F(Selection, ASmallSphereTestsOnlyTheVoxelsItTouches) {
   EXPECT_LT(r.points_tested, f.meta().point_count / 10);
   ASSERT_FALSE(r.streamlines.empty());
   EXPECT_EQ(r.streamlines[0], 0u);
+}
+
+// The per-voxel index is VXLN inverted: every voxline once, under its own voxel, in streamline order; with packed
+// positions and levels of detail (a cursor per depth) it selects what the scan of the whole table selects.
+TEST(SelectionIndex, ListsEveryVoxlineOnceAndSelectsWhatTheScanSelects) {
+  ScratchDir dir;
+  ConvertSettings packed = settings(PositionEncoding::Packed, 4.0);
+  packed.levels = 4;
+  convert_tractogram(synth(3000, 5), dir.file("p.vxl"), packed);
+  const VxlFile f = VxlFile::open(dir.file("p.vxl"));
+  ASSERT_GT(f.level_count(), 1u);
+  const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f, 2);
+  ASSERT_TRUE(index.has_value());
+  // The expected lists, from a walk of VXLN in streamline order (spec §5.6, §5.7, §6.5).
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> expected(f.voxels().size());
+  const auto strm = f.streamline_first_voxline();
+  for (std::uint64_t s = 0; s + 1 < strm.size(); ++s)
+    for (std::uint64_t j = strm[s]; j < strm[s + 1]; ++j) {
+      const VoxlineEntry& e = f.voxlines()[j];
+      std::uint32_t bits = (e.count_flags & kVoxlineCountMask) | streamline_depth(s, f.level_count()) << 29;
+      if (e.count_flags & kVoxlineSyntheticFirst) bits |= IndexedVoxline::kSyntheticFirst;
+      if (j == strm[s]) bits |= IndexedVoxline::kFirstOfStreamline;
+      if (j + 1 == strm[s + 1]) bits |= IndexedVoxline::kLastOfStreamline;
+      expected[e.voxel].emplace_back(std::uint32_t(s), bits);
+    }
+  for (std::size_t v = 0; v < f.voxels().size(); ++v) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> listed;
+    for (const IndexedVoxline& e : index->of_voxel(v)) listed.emplace_back(e.streamline, e.bits);
+    ASSERT_EQ(listed, expected[v]) << "voxel " << v;
+  }
+
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<std::size_t> voxel(0, f.voxels().size() - 1);
+  std::uniform_real_distribution<float> radius(0, 20);
+  int cut = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const VoxelEntry& v = f.voxels()[voxel(rng)];
+    SelectionCriteria c;
+    c.include.push_back(sphere(v.tight_min[0], v.tight_max[1], v.tight_min[2], radius(rng)));
+    if (trial % 3 == 0) c.ends_in.push_back(sphere(v.tight_max[0], v.tight_min[1], v.tight_max[2], 15));
+    if (trial % 4 == 1) c.exclude.push_back(sphere(v.tight_max[0], v.tight_max[1], v.tight_max[2], 6));
+    const SelectionResult scan = select_streamlines(f, c), indexed = select_streamlines(f, c, &*index);
+    ASSERT_EQ(indexed.streamlines, scan.streamlines) << "trial " << trial;
+    ASSERT_EQ(indexed.streamlines_per_region, scan.streamlines_per_region) << "trial " << trial;
+    cut += !scan.streamlines.empty() && scan.streamlines.size() < 3000;
+  }
+  EXPECT_GT(cut, 10);
+  // A small sphere: the index reads the few touched voxels' lists, not the whole voxline table.
+  const VoxelEntry& v = f.voxels()[f.voxels().size() / 2];
+  SelectionCriteria small;
+  small.include.push_back(sphere(v.tight_min[0] + 1, v.tight_min[1] + 1, v.tight_min[2] + 1, 2));
+  const SelectionResult scan = select_streamlines(f, small), indexed = select_streamlines(f, small, &*index);
+  EXPECT_EQ(indexed.streamlines, scan.streamlines);
+  const std::uint64_t always = f.voxels().size_bytes();  // both look at every voxel's bounds
+  EXPECT_LT(indexed.bytes_read - always - indexed.points_tested * 4,
+            (scan.bytes_read - always - scan.points_tested * 4) / 4);
+}
+
+// Voxline and streamline tables that do not hold together, checksums resealed so that only the structure
+// can tell: building the index, and selecting with or without it, is refused naming the file (Input) —
+// never a read past a table.
+TEST(SelectionIndex, TablesThatDoNotHoldTogetherAreRefused) {
+  ScratchDir dir;
+  const test::VxlBytes valid = test::VxlBytes::make(dir.file("h.vxl"));
+  const std::uint64_t vxln = valid.offset_of("VXLN"), strm = valid.offset_of("STRM");
+  struct Damage {
+    const char* name;
+    std::uint64_t at;
+    std::uint32_t value;
+  };
+  const Damage cases[] = {{"voxel past the table", vxln + 8 * 3, 1u << 30},
+                          {"voxline with no points", vxln + 8 * 3 + 4, 0},
+                          {"more points than the block holds", vxln + 8 * 3 + 4, 1u << 20},
+                          {"streamline table decreasing", strm + 8 * 5, 0},
+                          {"streamline table past the voxlines", strm + 8 * 40, 1u << 30}};
+  SelectionCriteria everywhere;
+  everywhere.include.push_back(parse_region("box:-1000,-1000,-1000,1000,1000,1000"));
+  for (const Damage& d : cases) {
+    SCOPED_TRACE(d.name);
+    test::VxlBytes b = valid;
+    std::memcpy(b.bytes.data() + d.at, &d.value, 4);
+    b.reseal();
+    b.write(dir.file("bad.vxl"));
+    const VxlFile f = VxlFile::open(dir.file("bad.vxl"));
+    auto refused = [&](const auto& run) {
+      try {
+        run();
+      } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
+        EXPECT_NE(std::string(e.what()).find("bad.vxl"), std::string::npos) << e.what();
+        return true;
+      }
+      return false;
+    };
+    EXPECT_TRUE(refused([&] { select_streamlines(f, everywhere); }));
+    std::optional<VoxelVoxlines> index;
+    if (!refused([&] { index = VoxelVoxlines::build(f, 2); })) {
+      ASSERT_TRUE(index.has_value());
+      EXPECT_TRUE(refused([&] { select_streamlines(f, everywhere, &*index); }));
+    }
+  }
 }
 
 TEST(SelectionRegions, ASphereHoldsItsSurfaceAsTckeditDoes) {

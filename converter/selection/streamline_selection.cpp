@@ -1,5 +1,7 @@
 #include "converter/selection/streamline_selection.h"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <string>
 
@@ -81,6 +83,150 @@ std::optional<double> source_header_number(const VxlFile& file, const char* key)
   }
 }
 
+// The regions one streamline's points fell in (a streamline with none is not listed).
+struct StreamlineHits {
+  std::uint64_t streamline;
+  Bits regions;
+};
+
+// One voxline, as a region test needs it.
+struct VoxlinePlace {
+  std::uint32_t voxel = 0, own = 0;
+  bool synthetic_first = false, first_of_streamline = false, connected = false;
+  std::uint64_t first_vertex = 0;
+};
+
+// What the two ways of finding the hits share: the regions, the voxels they may touch, the file's tables.
+struct HitSearch {
+  const VxlFile& file;
+  const RegionTable& table;
+  const std::vector<Bits>& voxel_regions;
+  SelectionResult& result;
+  std::span<const std::uint64_t> strm = file.streamline_first_voxline();
+  std::span<const VoxlineEntry> voxlines = file.voxlines();
+  std::span<const VoxelEntry> voxels = file.voxels();
+  std::uint32_t levels = file.level_count();
+  std::uint64_t strm_at = file.find_section(section_id("STRM"))->offset;
+  std::uint64_t vxln_at = file.find_section(section_id("VXLN"))->offset;
+  std::vector<float> xyz = {};
+
+  // Tests one voxline in a voxel the regions may touch against those regions still `open` for its
+  // streamline; returns the regions holding one of its points.
+  Bits test_voxline(const VoxlinePlace& v, Bits open) {
+    const Bits touching = voxel_regions[v.voxel] & open;
+    const Bits anywhere = touching & (table.include | table.exclude);
+    const Bits at_ends = (v.first_of_streamline || !v.connected) ? touching & table.ends : 0;
+    if ((anywhere | at_ends) == 0) return 0;
+    xyz.resize(3 * std::size_t(v.own));
+    file.read_vertices(v.voxel, v.first_vertex, v.own, xyz.data());
+    const std::uint32_t from = v.synthetic_first ? 1 : 0;
+    result.points_tested += v.own - from;
+    Bits hit = 0;
+    for (std::uint32_t i = from; i < v.own; ++i) {
+      const float* p = &xyz[3 * std::size_t(i)];
+      Bits test = anywhere & ~hit;
+      if ((i == 0 && v.first_of_streamline) || (i + 1 == v.own && !v.connected)) test |= at_ends & ~hit;
+      for (Bits b = test; b != 0; b &= b - 1) {
+        const int r = std::countr_zero(b);
+        if (table.regions[r]->contains(p)) hit |= Bits(1) << r;
+      }
+    }
+    return hit;
+  }
+
+  // Where the voxlines of depth `depth` start and end in a voxel's block (spec §5.4, §5.12).
+  std::uint64_t depth_start(std::size_t voxel, std::uint32_t depth) const {
+    return voxels[voxel].vertex_first + depth_first_vertex(file.levels_of(voxel), depth);
+  }
+  std::uint64_t depth_end(std::size_t voxel, std::uint32_t depth) const {
+    return voxels[voxel].vertex_first + depth_end_vertex(voxels[voxel], file.levels_of(voxel), depth);
+  }
+};
+
+// Claims a voxline's vertices at its voxel's `cursor` (for its depth; the part ends at `end`): `own` plus
+// the connecting vertex unless it ends its streamline. False when they run past the end.
+bool claim_vertices(VoxlinePlace& v, std::uint64_t& cursor, std::uint64_t end) {
+  const std::uint64_t need = std::uint64_t(v.own) + (v.connected ? 1 : 0);
+  if (cursor > end || need > end - cursor) return false;
+  v.first_vertex = cursor;
+  cursor += need;
+  return true;
+}
+
+// Every streamline in order, through the whole voxline table. A voxline's vertices are found by its
+// voxel's cursor (spec §5.6), so cursors are kept for the touched voxels alone and a voxline elsewhere
+// costs one table entry and one look at its voxel's bits; written out rather than run through
+// walk_streamlines' callbacks for that reason (the empty query on the 1M set went from 0.3 s to 0.12 s).
+std::vector<StreamlineHits> hits_by_scan(HitSearch& q) {
+  const std::uint64_t n = q.file.meta().streamline_count;
+  std::vector<std::uint64_t> cursor(q.voxels.size() * q.levels, 0), end(cursor.size(), 0);
+  for (std::size_t i = 0; i < q.voxels.size(); ++i)
+    if (q.voxel_regions[i] != 0)
+      for (std::uint32_t d = 0; d < q.levels; ++d)
+        cursor[i * q.levels + d] = q.depth_start(i, d), end[i * q.levels + d] = q.depth_end(i, d);
+  if (q.strm[0] != 0) fail_input(q.file.path(), q.strm_at, "streamline table must start at voxline 0");
+  std::vector<StreamlineHits> hits;
+  for (std::uint64_t s = 0; s < n; ++s) {
+    const std::uint64_t first = q.strm[s], last = q.strm[s + 1];
+    if (last < first || last > q.voxlines.size())
+      fail_input(q.file.path(), q.strm_at + 8 * (s + 1), "streamline table not non-decreasing");
+    Bits hit = 0;
+    const std::uint32_t depth = streamline_depth(s, q.levels);
+    for (std::uint64_t j = first; j < last; ++j) {
+      const VoxlineEntry& e = q.voxlines[j];
+      if (e.voxel >= q.voxels.size())
+        fail_input(q.file.path(), q.vxln_at + 8 * j, "voxline refers to a voxel past the table");
+      if (q.voxel_regions[e.voxel] == 0) continue;
+      VoxlinePlace v{e.voxel, e.count_flags & kVoxlineCountMask, (e.count_flags & kVoxlineSyntheticFirst) != 0,
+                     j == first, j + 1 < last};
+      if (v.own == 0) fail_input(q.file.path(), q.vxln_at + 8 * j, "voxline with no points");
+      const std::size_t k = std::size_t(e.voxel) * q.levels + depth;
+      if (!claim_vertices(v, cursor[k], end[k]))
+        fail_input(q.file.path(), q.vxln_at + 8 * j,
+                   "voxline runs past its voxel's vertex block (or its level's part of it)");
+      hit |= q.test_voxline(v, ~hit);
+    }
+    if (hit != 0) hits.push_back({s, hit});
+  }
+  q.result.bytes_read += q.strm.size_bytes() + q.voxlines.size_bytes();
+  return hits;
+}
+
+// Only the voxels the regions may touch, through their lists (VoxelVoxlines): a voxel's list is in
+// streamline order, the order of its block's voxlines within a depth, so its cursors are walked as the
+// scan walks them, and the list, read in order, is all a voxline costs.
+std::vector<StreamlineHits> hits_by_index(HitSearch& q, const VoxelVoxlines& index) {
+  std::vector<StreamlineHits> hits;
+  std::vector<std::uint64_t> cursor(q.levels), end(q.levels);
+  const std::uint64_t voxt_at = q.file.find_section(section_id("VOXT"))->offset;
+  for (std::size_t voxel = 0; voxel < q.voxels.size(); ++voxel) {
+    if (q.voxel_regions[voxel] == 0) continue;
+    for (std::uint32_t d = 0; d < q.levels; ++d) cursor[d] = q.depth_start(voxel, d), end[d] = q.depth_end(voxel, d);
+    const auto list = index.of_voxel(voxel);
+    for (const IndexedVoxline& e : list) {
+      VoxlinePlace v{std::uint32_t(voxel), e.own(), (e.bits & IndexedVoxline::kSyntheticFirst) != 0,
+                     (e.bits & IndexedVoxline::kFirstOfStreamline) != 0,
+                     (e.bits & IndexedVoxline::kLastOfStreamline) == 0};
+      if (e.depth() >= q.levels || !claim_vertices(v, cursor[e.depth()], end[e.depth()]))
+        fail_input(q.file.path(), voxt_at + sizeof(VoxelEntry) * voxel,
+                   "the voxel's voxlines run past its vertex block (or a level's part of it)");
+      if (const Bits hit = q.test_voxline(v, ~Bits(0)); hit != 0) hits.push_back({e.streamline, hit});
+    }
+    q.result.bytes_read += list.size_bytes();
+  }
+  // One entry per streamline, in streamline order, as the scan gives them.
+  std::sort(hits.begin(), hits.end(),
+            [](const StreamlineHits& a, const StreamlineHits& b) { return a.streamline < b.streamline; });
+  std::size_t kept = 0;
+  for (const StreamlineHits& h : hits)
+    if (kept > 0 && hits[kept - 1].streamline == h.streamline)
+      hits[kept - 1].regions |= h.regions;
+    else
+      hits[kept++] = h;
+  hits.resize(kept);
+  return hits;
+}
+
 }  // namespace
 
 double length_limit_margin(const VxlFile& file) {
@@ -90,85 +236,26 @@ double length_limit_margin(const VxlFile& file) {
   return (downsample && *downsample > 0 ? 0.5 / *downsample : 0.1) * *step;
 }
 
-SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria) {
+SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria, const VoxelVoxlines* index) {
   if (criteria.min_length && criteria.max_length && *criteria.min_length > *criteria.max_length)
     throw Error(ErrorKind::Usage, "--min-length", std::nullopt, "the minimum length is above the maximum length");
   const RegionTable table(criteria);
   SelectionResult result;
   const std::uint64_t n = file.meta().streamline_count;
   const std::vector<Bits> voxel_regions = regions_per_voxel(file, table, result.voxels_touched);
-  const Bits needed = table.include | table.ends;
+  result.bytes_read = file.voxels().size_bytes();
+  HitSearch search{file, table, voxel_regions, result};
+  const std::vector<StreamlineHits> hits = index ? hits_by_index(search, *index) : hits_by_scan(search);
 
-  // Pass over the voxline table: each streamline's regions hit, from the voxlines in touched voxels only.
-  // A voxline's vertices are found by its voxel's cursor (spec §5.6), so cursors are kept for the touched
-  // voxels alone and a voxline elsewhere costs one table entry and one look at its voxel's bits: this loop
-  // is the query's cost for a small region, and it is written out rather than run through walk_streamlines'
-  // callbacks for that reason (with the cursor ends below, the empty query on the 1M set went from 0.3 s to 0.12 s).
-  const auto strm = file.streamline_first_voxline();
-  const auto voxlines = file.voxlines();
-  const auto voxels = file.voxels();
-  const std::uint32_t levels = file.level_count();
-  const std::uint64_t strm_at = file.find_section(section_id("STRM"))->offset;
-  const std::uint64_t vxln_at = file.find_section(section_id("VXLN"))->offset;
-  std::vector<std::uint64_t> cursor(voxels.size() * levels, 0);
-  for (std::size_t i = 0; i < voxels.size(); ++i)
-    if (voxel_regions[i] != 0)
-      for (std::uint32_t d = 0; d < levels; ++d)
-        cursor[i * levels + d] = voxels[i].vertex_first + depth_first_vertex(file.levels_of(i), d);
-  std::vector<std::uint8_t> passes(n, 0);
+  const Bits needed = table.include | table.ends;
+  std::vector<std::uint8_t> passes(n, needed == 0 ? 1 : 0);
   result.streamlines_per_region.assign(table.regions.size(), 0);
-  std::vector<float> xyz;
-  if (strm[0] != 0) fail_input(file.path(), strm_at, "streamline table must start at voxline 0");
-  for (std::uint64_t s = 0; s < n; ++s) {
-    const std::uint64_t first = strm[s], last = strm[s + 1];
-    if (last < first || last > voxlines.size())
-      fail_input(file.path(), strm_at + 8 * (s + 1), "streamline table not non-decreasing");
-    Bits hit = 0;
-    std::uint32_t depth = 0;
-    bool depth_known = false;
-    for (std::uint64_t j = first; j < last; ++j) {
-      const VoxlineEntry& e = voxlines[j];
-      if (e.voxel >= voxels.size())
-        fail_input(file.path(), vxln_at + 8 * j, "voxline refers to a voxel past the table");
-      const Bits touching = voxel_regions[e.voxel];
-      if (touching == 0) continue;
-      if (!depth_known) depth = streamline_depth(s, levels), depth_known = true;
-      const std::uint32_t own = e.count_flags & kVoxlineCountMask;
-      const bool connected = j + 1 < last, first_of_streamline = j == first;
-      if (own == 0) fail_input(file.path(), vxln_at + 8 * j, "voxline with no points");
-      std::uint64_t& here = cursor[std::size_t(e.voxel) * levels + depth];
-      const std::uint64_t end =
-          voxels[e.voxel].vertex_first + depth_end_vertex(voxels[e.voxel], file.levels_of(e.voxel), depth);
-      const std::uint64_t need = std::uint64_t(own) + (connected ? 1 : 0);
-      if (here > end || need > end - here)
-        fail_input(file.path(), vxln_at + 8 * j,
-                   "voxline runs past its voxel's vertex block (or its level's part of it)");
-      const std::uint64_t first_vertex = here;
-      here += need;
-      const Bits wanted = touching & ~hit;
-      const Bits anywhere = wanted & (table.include | table.exclude);
-      const Bits at_ends = (first_of_streamline || !connected) ? wanted & table.ends : 0;
-      if ((anywhere | at_ends) == 0) continue;
-      xyz.resize(3 * std::size_t(own));
-      file.read_vertices(e.voxel, first_vertex, own, xyz.data());
-      const std::uint32_t from = (e.count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
-      result.points_tested += own - from;
-      for (std::uint32_t i = from; i < own; ++i) {
-        const float* p = &xyz[3 * std::size_t(i)];
-        Bits test = anywhere & ~hit;
-        if ((i == 0 && first_of_streamline) || (i + 1 == own && !connected)) test |= at_ends & ~hit;
-        for (Bits b = test; b != 0; b &= b - 1) {
-          const int r = std::countr_zero(b);
-          if (table.regions[r]->contains(p)) hit |= Bits(1) << r;
-        }
-      }
-    }
-    passes[s] = (hit & needed) == needed && (hit & table.exclude) == 0;
-    for (Bits b = hit; b != 0; b &= b - 1) ++result.streamlines_per_region[std::countr_zero(b)];
+  for (const StreamlineHits& h : hits) {
+    passes[h.streamline] = (h.regions & needed) == needed && (h.regions & table.exclude) == 0;
+    for (Bits b = h.regions; b != 0; b &= b - 1) ++result.streamlines_per_region[std::countr_zero(b)];
   }
   const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
-  result.bytes_read = file.voxels().size_bytes() + file.streamline_first_voxline().size_bytes() +
-                      file.voxlines().size_bytes() + result.points_tested * vertex_bytes;
+  result.bytes_read += result.points_tested * vertex_bytes;
 
   // Length limits: the points of the streamlines still in.
   if (criteria.min_length || criteria.max_length) {

@@ -14,9 +14,10 @@
 // tckedit on the source file.
 //
 // The voxel grid is the index: a region is tested only against the voxlines of the voxels whose bounds it
-// may touch, so the cost is the voxline table (8 bytes a voxline, about a tenth of the source's bytes)
-// plus the vertices of those voxels — not every point of the file. Length limits read the points of the
-// streamlines that pass the regions (all of them when there is no include region).
+// may touch. Without a VoxelVoxlines index the streamlines crossing them are found by walking the voxline
+// table (8 bytes a voxline, about a tenth of the source's bytes); with one, from those voxels' lists alone,
+// so that the cost follows the regions, not the file. Length limits read the points of the streamlines
+// that pass the regions (all of them when there is no include region), through the whole voxline table.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +25,7 @@
 #include <vector>
 
 #include "converter/selection/region.h"
+#include "converter/selection/voxel_voxlines.h"
 #include "format/vxl_file.h"
 
 namespace vxl {
@@ -53,7 +55,9 @@ inline constexpr std::size_t kMaxRegions = 64;
 double length_limit_margin(const VxlFile& file);
 
 // Throws vxl::Error: Usage for more than kMaxRegions regions or min_length > max_length, Input for a .vxl
-// whose tables do not hold together.
-SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria);
+// whose tables do not hold together. `index`, when given, must be VoxelVoxlines::build(file)'s: the
+// result is the same with or without it.
+SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria,
+                                   const VoxelVoxlines* index = nullptr);
 
 }  // namespace vxl

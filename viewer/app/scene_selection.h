@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -20,6 +21,13 @@ struct SceneSelection {
   std::uint64_t selected = 0, total = 0;
 };
 
-SceneSelection select_in_scene(std::span<const VxlFile* const> files, const SelectionCriteria& criteria);
+// `indexes`: empty, or one per file (VoxelVoxlines::build's, std::nullopt for a file too large for one),
+// for selections repeated as regions move: each then reads the voxels its regions touch, not every file's
+// whole voxline table.
+SceneSelection select_in_scene(std::span<const VxlFile* const> files, const SelectionCriteria& criteria,
+                               std::span<const std::optional<VoxelVoxlines>> indexes = {});
+
+// The indexes select_in_scene takes, one per file.
+std::vector<std::optional<VoxelVoxlines>> build_selection_indexes(std::span<const VxlFile* const> files);
 
 }  // namespace vxl::app

@@ -228,6 +228,8 @@ class ViewerWindow {
   const Volume* volume_;
   RegionEditor regions_;
   std::optional<SceneSelection> selection_;  // of the regions' revision `selection_revision_`
+  // Built with the first selection and kept, so that a region moved is re-selected from the voxels it touches.
+  std::vector<std::optional<VoxelVoxlines>> selection_indexes_;
   std::optional<std::uint64_t> selection_revision_;
   SceneDetail detail_;  // the level of detail drawn at rest, and the span size
   // The GPU memory budget every level's renderer shares: together they never take more.
@@ -493,8 +495,9 @@ void ViewerWindow::update_selection() {
       selection_.reset();
       stats_.selection.clear();
     } else {
+      if (selection_indexes_.empty()) selection_indexes_ = build_selection_indexes(files_);
       const auto t0 = std::chrono::steady_clock::now();
-      selection_ = select_in_scene(files_, regions_.criteria());
+      selection_ = select_in_scene(files_, regions_.criteria(), selection_indexes_);
       regions_.set_counts(selection_->streamlines_per_region);
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       stats_.selection = std::to_string(selection_->selected) + " of " + std::to_string(selection_->total) +

@@ -1,0 +1,117 @@
+// Region drag benchmark: what the viewer computes on the CPU each time a region moves, for a 10 mm sphere
+// dragged in a straight line through the middle of a .vxl's bounds (left to right, then back to front),
+// as voxview recomputes it: the selection (`voxlines select`'s rules) through the whole voxline table and
+// through the per-voxel index (VoxelVoxlines, built once when the first region appears: its build time and
+// bytes are printed), then the focus/context groups and the per-vertex attributes the line shader reads
+// (vertex_attributes.h), which the window uploads after each change. Medians and p95 per step.
+//
+// Usage: drag_bench FILE.vxl [--steps N] [--radius MM] [--attributes]
+// (--attributes: also time the per-vertex attribute rebuild; it needs 8 bytes per vertex of memory)
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "converter/selection/streamline_selection.h"
+#include "converter/selection/voxel_voxlines.h"
+#include "format/vxl_file.h"
+#include "viewer/render/scene_groups.h"
+#include "viewer/render/vertex_attributes.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+struct Spread {
+  double median = 0, p95 = 0;
+};
+Spread spread(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return {v[v.size() / 2], v[std::min(v.size() - 1, v.size() * 95 / 100)]};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: drag_bench FILE.vxl [--steps N] [--radius MM] [--attributes]\n");
+    return 2;
+  }
+  int steps = 40;
+  double radius = 10;
+  bool attributes = false;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--steps" && i + 1 < argc) steps = std::max(2, std::stoi(argv[++i]));
+    if (a == "--radius" && i + 1 < argc) radius = std::stod(argv[++i]);
+    if (a == "--attributes") attributes = true;
+  }
+  try {
+    const vxl::VxlFile file = vxl::VxlFile::open(argv[1]);
+    const vxl::MetaSection& m = file.meta();
+    auto t0 = Clock::now();
+    const std::optional<vxl::VoxelVoxlines> index = vxl::VoxelVoxlines::build(file);
+    const double build_ms = ms_since(t0);
+    if (!index) {
+      std::fprintf(stderr, "drag_bench: %s has too many voxlines for the index\n", argv[1]);
+      return 1;
+    }
+    std::printf("file %s: %llu streamlines, %llu voxlines, %zu voxels\n", argv[1],
+                static_cast<unsigned long long>(m.streamline_count),
+                static_cast<unsigned long long>(file.voxlines().size()), file.voxels().size());
+    std::printf("index build: %.0f ms, %.1f MB (4 bytes a voxline, 8 a voxel)\n", build_ms, index->bytes() / 1e6);
+
+    std::vector<double> scan_ms, indexed_ms, groups_ms, attributes_ms;
+    std::uint64_t selected_total = 0;
+    const std::vector<const vxl::VxlFile*> files = {&file};
+    for (int axis : {0, 1}) {
+      for (int step = 0; step < steps; ++step) {
+        float centre[3];
+        for (int c = 0; c < 3; ++c) centre[c] = 0.5f * (m.bounds_min[c] + m.bounds_max[c]);
+        const double t = double(step) / (steps - 1);
+        centre[axis] = float(m.bounds_min[axis] + t * (m.bounds_max[axis] - m.bounds_min[axis]));
+        vxl::SelectionCriteria c;
+        c.include.push_back(vxl::parse_region(std::to_string(centre[0]) + "," + std::to_string(centre[1]) + "," +
+                                              std::to_string(centre[2]) + "," + std::to_string(radius)));
+        t0 = Clock::now();
+        const vxl::SelectionResult scan = vxl::select_streamlines(file, c);
+        scan_ms.push_back(ms_since(t0));
+        t0 = Clock::now();
+        vxl::SelectionResult indexed = vxl::select_streamlines(file, c, &*index);
+        indexed_ms.push_back(ms_since(t0));
+        if (indexed.streamlines != scan.streamlines) {
+          std::fprintf(stderr, "drag_bench: the index and the scan disagree at step %d\n", step);
+          return 1;
+        }
+        selected_total += indexed.streamlines.size();
+        t0 = Clock::now();
+        const vxl::SceneGroups groups = vxl::SceneGroups::selection(files, {std::move(indexed.streamlines)});
+        groups_ms.push_back(ms_since(t0));
+        if (attributes) {
+          t0 = Clock::now();
+          const std::vector<float> a = vxl::vertex_attributes(file, 0, {}, &groups);
+          attributes_ms.push_back(ms_since(t0));
+        }
+      }
+    }
+    auto row = [](const char* what, const std::vector<double>& v) {
+      if (v.empty()) return;
+      const Spread s = spread(v);
+      std::printf("| %s | %.1f | %.1f |\n", what, s.median, s.p95);
+    };
+    std::printf("%d positions of a %g mm sphere, %.0f streamlines selected on average\n\n", 2 * steps, radius,
+                double(selected_total) / (2 * steps));
+    std::printf("| per position | median ms | p95 ms |\n|---|---:|---:|\n");
+    row("select, scanning the voxline table", scan_ms);
+    row("select, through the per-voxel index", indexed_ms);
+    row("focus/context groups", groups_ms);
+    row("per-vertex attributes (before upload)", attributes_ms);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "drag_bench: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,93 @@
+#include "converter/selection/voxel_voxlines.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "format/error.h"
+#include "format/parallel.h"
+#include "format/vxl_levels.h"
+
+namespace vxl {
+namespace {
+
+// STRM as spec §5.7 has it: from 0, non-decreasing, ending at the voxline count.
+void check_streamline_table(const VxlFile& file) {
+  const auto strm = file.streamline_first_voxline();
+  const std::uint64_t at = file.find_section(section_id("STRM"))->offset;
+  if (strm[0] != 0) fail_input(file.path(), at, "streamline table must start at voxline 0");
+  for (std::size_t s = 1; s < strm.size(); ++s)
+    if (strm[s] < strm[s - 1]) fail_input(file.path(), at + 8 * s, "streamline table not non-decreasing");
+  if (strm.back() != file.voxlines().size())
+    fail_input(file.path(), at + 8 * (strm.size() - 1), "streamline table must end at the voxline count");
+}
+
+}  // namespace
+
+std::optional<VoxelVoxlines> VoxelVoxlines::build(const VxlFile& file, unsigned threads) {
+  const auto strm = file.streamline_first_voxline();
+  const auto voxlines = file.voxlines();
+  const std::size_t voxel_count = file.voxels().size();
+  const std::uint64_t n = file.meta().streamline_count;
+  if (n > std::numeric_limits<std::uint32_t>::max()) return std::nullopt;
+  check_streamline_table(file);
+  const std::uint64_t vxln_at = file.find_section(section_id("VXLN"))->offset;
+  const std::uint32_t levels = file.level_count();
+
+  // A counting sort in contiguous runs of streamlines, one count row per run, so that runs count and
+  // scatter side by side and each voxel's list still comes out in streamline order. Fewer runs when the
+  // rows would outweigh the table (many voxels, few voxlines).
+  const std::uint64_t runs =
+      std::clamp<std::uint64_t>(voxlines.size() / (4 * voxel_count + 1), 1, std::max<std::uint64_t>(n, 1));
+  const std::uint64_t chunks = std::min<std::uint64_t>(runs, resolve_threads(threads));
+  const std::uint64_t per_chunk = (n + chunks - 1) / chunks;
+  auto streamlines_of = [&](std::uint64_t c) {
+    return std::pair(std::min(c * per_chunk, n), std::min((c + 1) * per_chunk, n));
+  };
+  std::vector<std::uint64_t> at(chunks * voxel_count, 0);
+  bool too_long = false;
+  parallel_for_first_error_in_order(chunks, threads, [&](std::uint64_t c, unsigned) {
+    std::uint64_t* row = &at[c * voxel_count];
+    const auto [begin, end] = streamlines_of(c);
+    for (std::uint64_t j = strm[begin]; j < strm[end]; ++j) {
+      const VoxlineEntry& e = voxlines[j];
+      if (e.voxel >= voxel_count) fail_input(file.path(), vxln_at + 8 * j, "voxline refers to a voxel past the table");
+      const std::uint32_t own = e.count_flags & kVoxlineCountMask;
+      if (own == 0) fail_input(file.path(), vxln_at + 8 * j, "voxline with no points");
+      if (own > IndexedVoxline::kCountMask) too_long = true;
+      ++row[e.voxel];
+    }
+  });
+  if (too_long) return std::nullopt;
+
+  VoxelVoxlines index;
+  index.first_.assign(voxel_count + 1, 0);
+  std::uint64_t total = 0;
+  for (std::size_t v = 0; v < voxel_count; ++v) {
+    index.first_[v] = total;
+    for (std::uint64_t c = 0; c < chunks; ++c) {
+      const std::uint64_t count = at[c * voxel_count + v];
+      at[c * voxel_count + v] = total;  // becomes where run c writes voxel v's next voxline
+      total += count;
+    }
+  }
+  index.first_[voxel_count] = total;
+  index.entries_.resize(total);
+  parallel_for(chunks, threads, [&](std::uint64_t c, unsigned) {
+    std::uint64_t* row = &at[c * voxel_count];
+    const auto [begin, end] = streamlines_of(c);
+    for (std::uint64_t s = begin; s < end; ++s) {
+      const std::uint32_t depth = streamline_depth(s, levels) << 29;
+      for (std::uint64_t j = strm[s]; j < strm[s + 1]; ++j) {
+        const VoxlineEntry& e = voxlines[j];
+        std::uint32_t bits = (e.count_flags & kVoxlineCountMask) | depth;
+        if (e.count_flags & kVoxlineSyntheticFirst) bits |= IndexedVoxline::kSyntheticFirst;
+        if (j == strm[s]) bits |= IndexedVoxline::kFirstOfStreamline;
+        if (j + 1 == strm[s + 1]) bits |= IndexedVoxline::kLastOfStreamline;
+        index.entries_[row[e.voxel]++] = {std::uint32_t(s), bits};
+      }
+    }
+  });
+  return index;
+}
+
+}  // namespace vxl
