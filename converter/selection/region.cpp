@@ -141,10 +141,34 @@ bool Region::contains(const float* p) const {
   return false;
 }
 
+namespace {
+
+// A thousandth of a millimetre (relative to the coordinates' size) of slack: the float32 point tests round,
+// a box test must never be the one that decides otherwise.
+float slack(float a, float b) { return 1e-3f + 1e-6f * std::max(std::abs(a), std::abs(b)); }
+
+}  // namespace
+
+bool Region::holds_box(const float* lo, const float* hi) const {
+  if (shape_ == Shape::Mask) return false;
+  if (shape_ == Shape::Sphere) {
+    // The farthest corner (a ball is convex: it holds the box when it holds every corner).
+    double d2 = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double d = std::max(std::abs(double(lo[c]) - centre_[c]), std::abs(double(hi[c]) - centre_[c]));
+      d2 += d * d;
+    }
+    const double reach = double(radius_) - slack(centre_[0] + centre_[1] + centre_[2], radius_);
+    return reach > 0 && d2 <= reach * reach;
+  }
+  for (int c = 0; c < 3; ++c) {
+    const float s = slack(lo_[c], hi_[c]);
+    if (lo[c] < lo_[c] + s || hi[c] > hi_[c] - s) return false;
+  }
+  return true;
+}
+
 bool Region::may_touch(const float* lo, const float* hi) const {
-  // A thousandth of a millimetre (relative to the coordinates' size) of slack: the float32 tests above
-  // round, a box test here must never be the one that misses a point.
-  auto slack = [](float a, float b) { return 1e-3f + 1e-6f * std::max(std::abs(a), std::abs(b)); };
   if (shape_ == Shape::Sphere) {
     double d2 = 0;
     for (int c = 0; c < 3; ++c) {

@@ -9,6 +9,7 @@
 
 #include "format/error.h"
 #include "format/json_limits.h"
+#include "format/parallel.h"
 #include "format/vxl_positions.h"
 #include "format/vxl_streamlines.h"
 
@@ -38,21 +39,26 @@ struct RegionTable {
   }
 };
 
-// Per voxel, the regions that may touch its bounds (decoded packed positions may stray from the tight
-// bounds by the file's error bound, so the box is widened by it).
-std::vector<Bits> regions_per_voxel(const VxlFile& file, const RegionTable& table, std::uint32_t& touched) {
+// Per voxel, the regions that may touch its bounds and those that hold them whole (decoded packed positions
+// may stray from the tight bounds by the file's error bound, so the box is widened by it).
+struct VoxelRegions {
+  std::vector<Bits> touching, holding;
+};
+VoxelRegions regions_per_voxel(const VxlFile& file, const RegionTable& table, std::uint32_t& touched) {
   const auto voxels = file.voxels();
   const bool packed = file.position_encoding() == PositionEncoding::Packed;
-  std::vector<Bits> out(voxels.size(), 0);
+  VoxelRegions out{std::vector<Bits>(voxels.size(), 0), std::vector<Bits>(voxels.size(), 0)};
   touched = 0;
   for (std::size_t i = 0; i < voxels.size(); ++i) {
     const VoxelEntry& v = voxels[i];
     float lo[3], hi[3];
     const float widen = packed ? static_cast<float>(packed_error_bound(v)) : 0.0f;
     for (int c = 0; c < 3; ++c) lo[c] = v.tight_min[c] - widen, hi[c] = v.tight_max[c] + widen;
-    for (std::size_t r = 0; r < table.regions.size(); ++r)
-      if (table.regions[r]->may_touch(lo, hi)) out[i] |= Bits(1) << r;
-    touched += out[i] != 0;
+    for (std::size_t r = 0; r < table.regions.size(); ++r) {
+      if (table.regions[r]->may_touch(lo, hi)) out.touching[i] |= Bits(1) << r;
+      if (table.regions[r]->holds_box(lo, hi)) out.holding[i] |= Bits(1) << r;
+    }
+    touched += out.touching[i] != 0;
   }
   return out;
 }
@@ -100,8 +106,8 @@ struct VoxlinePlace {
 struct HitSearch {
   const VxlFile& file;
   const RegionTable& table;
-  const std::vector<Bits>& voxel_regions;
-  SelectionResult& result;
+  const VoxelRegions& voxel_regions;
+  std::uint64_t points_tested = 0;
   std::span<const std::uint64_t> strm = file.streamline_first_voxline();
   std::span<const VoxlineEntry> voxlines = file.voxlines();
   std::span<const VoxelEntry> voxels = file.voxels();
@@ -113,19 +119,25 @@ struct HitSearch {
   // Tests one voxline in a voxel the regions may touch against those regions still `open` for its
   // streamline; returns the regions holding one of its points.
   Bits test_voxline(const VoxlinePlace& v, Bits open) {
-    const Bits touching = voxel_regions[v.voxel] & open;
+    const Bits touching = voxel_regions.touching[v.voxel] & open;
     const Bits anywhere = touching & (table.include | table.exclude);
     const Bits at_ends = (v.first_of_streamline || !v.connected) ? touching & table.ends : 0;
     if ((anywhere | at_ends) == 0) return 0;
+    const std::uint32_t from = v.synthetic_first ? 1 : 0;
+    if (from >= v.own) return 0;  // only a synthetic point: nothing to test
+    // A region holding the whole voxel holds every point tested here (a voxline's end point is a source
+    // point: synthetic points are never first or last of a streamline).
+    const Bits held = voxel_regions.holding[v.voxel];
+    Bits hit = (anywhere | at_ends) & held;
+    const Bits left = (anywhere | at_ends) & ~held;
+    if (left == 0) return hit;
     xyz.resize(3 * std::size_t(v.own));
     file.read_vertices(v.voxel, v.first_vertex, v.own, xyz.data());
-    const std::uint32_t from = v.synthetic_first ? 1 : 0;
-    result.points_tested += v.own - from;
-    Bits hit = 0;
+    points_tested += v.own - from;
     for (std::uint32_t i = from; i < v.own; ++i) {
       const float* p = &xyz[3 * std::size_t(i)];
-      Bits test = anywhere & ~hit;
-      if ((i == 0 && v.first_of_streamline) || (i + 1 == v.own && !v.connected)) test |= at_ends & ~hit;
+      Bits test = anywhere & left & ~hit;
+      if ((i == 0 && v.first_of_streamline) || (i + 1 == v.own && !v.connected)) test |= at_ends & left & ~hit;
       for (Bits b = test; b != 0; b &= b - 1) {
         const int r = std::countr_zero(b);
         if (table.regions[r]->contains(p)) hit |= Bits(1) << r;
@@ -157,11 +169,11 @@ bool claim_vertices(VoxlinePlace& v, std::uint64_t& cursor, std::uint64_t end) {
 // voxel's cursor (spec §5.6), so cursors are kept for the touched voxels alone and a voxline elsewhere
 // costs one table entry and one look at its voxel's bits; written out rather than run through
 // walk_streamlines' callbacks for that reason (the empty query on the 1M set went from 0.3 s to 0.12 s).
-std::vector<StreamlineHits> hits_by_scan(HitSearch& q) {
+std::vector<StreamlineHits> hits_by_scan(HitSearch& q, std::uint64_t& bytes_read) {
   const std::uint64_t n = q.file.meta().streamline_count;
   std::vector<std::uint64_t> cursor(q.voxels.size() * q.levels, 0), end(cursor.size(), 0);
   for (std::size_t i = 0; i < q.voxels.size(); ++i)
-    if (q.voxel_regions[i] != 0)
+    if (q.voxel_regions.touching[i] != 0)
       for (std::uint32_t d = 0; d < q.levels; ++d)
         cursor[i * q.levels + d] = q.depth_start(i, d), end[i * q.levels + d] = q.depth_end(i, d);
   if (q.strm[0] != 0) fail_input(q.file.path(), q.strm_at, "streamline table must start at voxline 0");
@@ -176,7 +188,7 @@ std::vector<StreamlineHits> hits_by_scan(HitSearch& q) {
       const VoxlineEntry& e = q.voxlines[j];
       if (e.voxel >= q.voxels.size())
         fail_input(q.file.path(), q.vxln_at + 8 * j, "voxline refers to a voxel past the table");
-      if (q.voxel_regions[e.voxel] == 0) continue;
+      if (q.voxel_regions.touching[e.voxel] == 0) continue;
       VoxlinePlace v{e.voxel, e.count_flags & kVoxlineCountMask, (e.count_flags & kVoxlineSyntheticFirst) != 0,
                      j == first, j + 1 < last};
       if (v.own == 0) fail_input(q.file.path(), q.vxln_at + 8 * j, "voxline with no points");
@@ -188,32 +200,43 @@ std::vector<StreamlineHits> hits_by_scan(HitSearch& q) {
     }
     if (hit != 0) hits.push_back({s, hit});
   }
-  q.result.bytes_read += q.strm.size_bytes() + q.voxlines.size_bytes();
+  bytes_read += q.strm.size_bytes() + q.voxlines.size_bytes();
   return hits;
 }
 
 // Only the voxels the regions may touch, through their lists (VoxelVoxlines): a voxel's list is in
 // streamline order, the order of its block's voxlines within a depth, so its cursors are walked as the
-// scan walks them, and the list, read in order, is all a voxline costs.
-std::vector<StreamlineHits> hits_by_index(HitSearch& q, const VoxelVoxlines& index) {
-  std::vector<StreamlineHits> hits;
-  std::vector<std::uint64_t> cursor(q.levels), end(q.levels);
+// scan walks them, and the list, read in order, is all a voxline costs. Voxels are independent here, so
+// they are searched side by side (the hits sorted afterwards; the first error in voxel order reported).
+std::vector<StreamlineHits> hits_by_index(HitSearch& q, const VoxelVoxlines& index, std::uint64_t& bytes_read) {
+  std::vector<std::uint32_t> touched;
+  for (std::size_t voxel = 0; voxel < q.voxels.size(); ++voxel)
+    if (q.voxel_regions.touching[voxel] != 0) touched.push_back(std::uint32_t(voxel));
   const std::uint64_t voxt_at = q.file.find_section(section_id("VOXT"))->offset;
-  for (std::size_t voxel = 0; voxel < q.voxels.size(); ++voxel) {
-    if (q.voxel_regions[voxel] == 0) continue;
-    for (std::uint32_t d = 0; d < q.levels; ++d) cursor[d] = q.depth_start(voxel, d), end[d] = q.depth_end(voxel, d);
-    const auto list = index.of_voxel(voxel);
-    for (const IndexedVoxline& e : list) {
-      VoxlinePlace v{std::uint32_t(voxel), e.own(), (e.bits & IndexedVoxline::kSyntheticFirst) != 0,
+  std::vector<std::vector<StreamlineHits>> per_voxel(touched.size());
+  std::vector<HitSearch> per_thread(resolve_threads(0), q);
+  parallel_for_first_error_in_order(touched.size(), 0, [&](std::uint64_t k, unsigned t) {
+    HitSearch& search = per_thread[t];
+    const std::uint32_t voxel = touched[k];
+    std::vector<std::uint64_t> cursor(q.levels), end(q.levels);
+    for (std::uint32_t d = 0; d < q.levels; ++d)
+      cursor[d] = search.depth_start(voxel, d), end[d] = search.depth_end(voxel, d);
+    for (const IndexedVoxline& e : index.of_voxel(voxel)) {
+      VoxlinePlace v{voxel, e.own(), (e.bits & IndexedVoxline::kSyntheticFirst) != 0,
                      (e.bits & IndexedVoxline::kFirstOfStreamline) != 0,
                      (e.bits & IndexedVoxline::kLastOfStreamline) == 0};
       if (e.depth() >= q.levels || !claim_vertices(v, cursor[e.depth()], end[e.depth()]))
         fail_input(q.file.path(), voxt_at + sizeof(VoxelEntry) * voxel,
                    "the voxel's voxlines run past its vertex block (or a level's part of it)");
-      if (const Bits hit = q.test_voxline(v, ~Bits(0)); hit != 0) hits.push_back({e.streamline, hit});
+      if (const Bits hit = search.test_voxline(v, ~Bits(0)); hit != 0) per_voxel[k].push_back({e.streamline, hit});
     }
-    q.result.bytes_read += list.size_bytes();
+  });
+  std::vector<StreamlineHits> hits;
+  for (std::size_t k = 0; k < touched.size(); ++k) {
+    hits.insert(hits.end(), per_voxel[k].begin(), per_voxel[k].end());
+    bytes_read += index.of_voxel(touched[k]).size_bytes();
   }
+  for (const HitSearch& search : per_thread) q.points_tested += search.points_tested;
   // One entry per streamline, in streamline order, as the scan gives them.
   std::sort(hits.begin(), hits.end(),
             [](const StreamlineHits& a, const StreamlineHits& b) { return a.streamline < b.streamline; });
@@ -242,10 +265,12 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
   const RegionTable table(criteria);
   SelectionResult result;
   const std::uint64_t n = file.meta().streamline_count;
-  const std::vector<Bits> voxel_regions = regions_per_voxel(file, table, result.voxels_touched);
+  const VoxelRegions voxel_regions = regions_per_voxel(file, table, result.voxels_touched);
   result.bytes_read = file.voxels().size_bytes();
-  HitSearch search{file, table, voxel_regions, result};
-  const std::vector<StreamlineHits> hits = index ? hits_by_index(search, *index) : hits_by_scan(search);
+  HitSearch search{file, table, voxel_regions};
+  const std::vector<StreamlineHits> hits =
+      index ? hits_by_index(search, *index, result.bytes_read) : hits_by_scan(search, result.bytes_read);
+  result.points_tested = search.points_tested;
 
   const Bits needed = table.include | table.ends;
   std::vector<std::uint8_t> passes(n, needed == 0 ? 1 : 0);

@@ -104,6 +104,36 @@ TEST_F(FocusContext, ContextOpacityZeroHidesTheRest) {
   }
 }
 
+// A region moved in the window: the renderer gets a new selection (set_groups) and uploads only the byte
+// per streamline; its picture is that of a renderer made for the new selection, in every mode, for every
+// file of the scene (the second file's streamlines come after the first's in that table).
+TEST_F(FocusContext, ANewSelectionOnTheSameRendererDrawsAsAFreshRenderer) {
+  const VxlFile a = make_scene(dir, crossing_lines(), 10.0, "a.vxl");
+  Tractogram shifted = crossing_lines();
+  for (std::size_t i = 0; i < shifted.positions.size(); i += 3) shifted.positions[i] += 5.0f;  // x + 5 mm
+  const VxlFile b = make_scene(dir, std::move(shifted), 10.0, "b.vxl");
+  const std::vector<const VxlFile*> files = {&a, &b};
+  Renderer moving(files);
+  const std::vector<std::vector<std::vector<std::uint64_t>>> selections = {{{0}, {1}}, {{1}, {}}, {{}, {0, 1}}};
+  for (RenderMode mode : {RenderMode::Axis, RenderMode::Wboit, RenderMode::Exact}) {
+    RenderSettings s = focus_red_context_blue(0.8f, 0.3f);
+    s.mode = mode;
+    for (const auto& kept : selections) {
+      SCOPED_TRACE(std::string(render_mode_name(mode)) + " selection " + std::to_string(&kept - &selections[0]));
+      moving.set_groups(SceneGroups::selection(files, kept));
+      const Image updated = render_image(moving, top_view(), s, 64, 64);
+      Renderer fresh(files);
+      fresh.set_groups(SceneGroups::selection(files, kept));
+      const Image expected = render_image(fresh, top_view(), s, 64, 64);
+      EXPECT_EQ(updated.rgba, expected.rgba);
+      // And the selection shows: some red (focus) pixel exactly when something is selected.
+      bool red = false;
+      for (std::size_t p = 0; p + 3 < updated.rgba.size(); p += 4) red |= updated.rgba[p] > 100;
+      EXPECT_EQ(red, !kept[0].empty() || !kept[1].empty());
+    }
+  }
+}
+
 // voxview --include: the command line selects and draws (the picture's focus red, the context hidden), and
 // the opacities need a selection.
 TEST_F(FocusContext, VoxviewSelectsFromTheCommandLine) {

@@ -147,22 +147,22 @@ void GpuScene::upload_extras(std::uint32_t ci) {
     g.dataset.create(GL_R32UI, dataset_per_span_[ci].data(), dataset_per_span_[ci].size() * 4);
   else  // the view order's entries are written every frame (upload_view_order)
     g.dataset.create(GL_R32UI, nullptr, dataset_content_ == DatasetContent::ViewOrder ? 4 * c.segments : 0);
-  const std::vector<float>* values = c.file < attributes_.size() ? &attributes_[c.file] : nullptr;
+  const std::vector<std::uint32_t>* values = c.file < attributes_.size() ? &attributes_[c.file] : nullptr;
   if (values == nullptr || values->empty()) {
-    g.attributes.create(GL_RG32F, nullptr, 0);
+    g.attributes.create(GL_RG32UI, nullptr, 0);
     return;
   }
-  // Two floats per vertex, each voxel's at its block's place in the span (scene_layout.h).
+  // Two words per vertex, each voxel's at its block's place in the span (scene_layout.h).
   const VxlFile& file = *files_[c.file];
   const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
-  std::vector<float> padded(2 * c.vertices, 0.0f);
+  std::vector<std::uint32_t> padded(2 * c.vertices, 0);
   for (std::uint32_t k = 0; k < c.voxel_count; ++k) {
     const VoxelDrawInfo& d = layout_.voxels()[c.voxel_first + k];
     const VoxelEntry& v = file.voxels()[c.voxel_first + k - file_first];
     std::copy_n(values->data() + 2 * v.vertex_first, 2 * std::uint64_t(d.vertex_count),
                 padded.data() + 2 * d.vertex_first);
   }
-  g.attributes.create(GL_RG32F, padded.data(), padded.size() * 4);
+  g.attributes.create(GL_RG32UI, padded.data(), padded.size() * 4);
 }
 
 void GpuScene::evict(std::uint32_t c) {
@@ -235,7 +235,7 @@ void GpuScene::release() {
   }
 }
 
-void GpuScene::upload_attributes(std::vector<std::vector<float>> per_file) {
+void GpuScene::upload_attributes(std::vector<std::vector<std::uint32_t>> per_file) {
   attributes_ = std::move(per_file);
   upload_resident_again();
 }

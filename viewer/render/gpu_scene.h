@@ -28,10 +28,11 @@
 namespace vxl {
 
 struct GpuTextureSpan {
-  gl::TextureBuffer words;       // GL_RGBA32UI: packed positions, voxel info, segment and vertex tables
-  gl::TextureBuffer orders;      // GL_R16UI: K x S low halves, then K x W high halves
-  gl::TextureBuffer dataset;     // GL_R32UI, span vertex indices: streamline or view order (empty until needed)
-  gl::TextureBuffer attributes;  // GL_RG32F, (value, group) per span vertex (empty until a colour mode needs it)
+  gl::TextureBuffer words;    // GL_RGBA32UI: packed positions, voxel info, segment and vertex tables
+  gl::TextureBuffer orders;   // GL_R16UI: K x S low halves, then K x W high halves
+  gl::TextureBuffer dataset;  // GL_R32UI, span vertex indices: streamline or view order (empty until needed)
+  gl::TextureBuffer
+      attributes;  // GL_RG32UI, (value bits, streamline) per span vertex (empty until a colour mode needs it)
 };
 
 class GpuScene {
@@ -68,10 +69,10 @@ class GpuScene {
   Residency make_resident(std::span<const std::uint32_t> needed,
                           double max_ms = std::numeric_limits<double>::infinity());
 
-  // Gives every span its vertices' share of its file's `per_file` entry (2 floats per vertex of that file,
+  // Gives every span its vertices' share of its file's `per_file` entry (2 words per vertex of that file,
   // vertex_attributes.h) as its attribute buffer; an empty vector empties them. Resident spans are uploaded
   // again (their size changes).
-  void upload_attributes(std::vector<std::vector<float>> per_file);
+  void upload_attributes(std::vector<std::vector<std::uint32_t>> per_file);
 
   // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)), and again after
   // the view order replaced them; each span's dataset array joins its upload.
@@ -109,7 +110,7 @@ class GpuScene {
   std::vector<bool> resident_;
   std::vector<std::uint64_t> uploaded_bytes_;  // per resident span, as the pool counts it
   std::uint64_t gpu_bytes_ = 0;
-  std::vector<std::vector<float>> attributes_;  // per file, as upload_attributes got them
+  std::vector<std::vector<std::uint32_t>> attributes_;  // per file, as upload_attributes got them
   enum class DatasetContent { Nothing, StreamlineOrder, ViewOrder };
   DatasetContent dataset_content_ = DatasetContent::Nothing;
   // Switches the dataset buffers' content: the resident spans are uploaded again with it.

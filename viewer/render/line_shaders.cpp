@@ -13,7 +13,7 @@ std::string line_vertex(unsigned span_count, const char* version) {
   for (unsigned c = 0; c < span_count; ++c) {
     std::string i = std::to_string(c);
     s += "uniform usamplerBuffer u_words" + i + ";\nuniform usamplerBuffer u_ord" + i +
-         ";\nuniform usamplerBuffer u_dat" + i + ";\nuniform samplerBuffer u_att" + i + ";\n";
+         ";\nuniform usamplerBuffer u_dat" + i + ";\nuniform usamplerBuffer u_att" + i + ";\n";
   }
   // One function per buffer kind, choosing the span's sampler (GLSL 3.30 cannot index sampler arrays
   // with a computed index).
@@ -26,10 +26,10 @@ std::string line_vertex(unsigned span_count, const char* version) {
   s += "  return 0;\n}\nint fetch_dataset(int c, int j) {\n";
   for (unsigned c = 0; c < span_count; ++c)
     s += "  if (c == " + std::to_string(c) + ") return int(texelFetch(u_dat" + std::to_string(c) + ", j).r);\n";
-  s += "  return 0;\n}\nvec2 fetch_attributes(int c, int v) {\n";
+  s += "  return 0;\n}\nuvec2 fetch_attributes(int c, int v) {\n";
   for (unsigned c = 0; c < span_count; ++c)
     s += "  if (c == " + std::to_string(c) + ") return texelFetch(u_att" + std::to_string(c) + ", v).rg;\n";
-  s += "  return vec2(0.0);\n}\n";
+  s += "  return uvec2(0u);\n}\n";
   s += R"(
 // The spans' layout (scene_layout.h): S padded segments per slot, K slots, the first W entries of each
 // slot with high halves, V padded vertices, where the segment and vertex tables start (in words).
@@ -54,7 +54,8 @@ uniform mat3 u_rotation;    // world -> eye
 uniform mat4 u_projection;
 uniform int u_color_mode;   // 0 direction, 1 fixed, 2 scalar, 3 group
 uniform vec3 u_fixed_color;
-uniform int u_attributes;   // 1: read (value, group) per vertex (vertex_attributes.h)
+uniform int u_attributes;   // 1: read (value bits, streamline) per vertex (vertex_attributes.h)
+uniform usamplerBuffer u_streamline_group;  // per streamline of the scene: its group mod GROUPS
 uniform vec2 u_range;       // value -> t = (value - x) / (y - x)
 uniform vec4 u_group[GROUPS];  // per group (index mod GROUPS): colour, opacity factor
 uniform float u_opacity;
@@ -125,13 +126,14 @@ void main() {
   v_value = 0.0;
   bool hidden = false;
   if (u_attributes != 0) {
-    vec2 a = fetch_attributes(c, v + end);
-    vec4 group = u_group[int(a.y) % GROUPS];
+    uvec2 a = fetch_attributes(c, v + end);
+    float value = uintBitsToFloat(a.x);
+    vec4 group = u_group[int(texelFetch(u_streamline_group, int(a.y)).r) % GROUPS];
     alpha *= group.a;
     // A missing or non-finite value keeps the fixed colour.
-    if (u_color_mode == 2 && !isnan(a.x) && !isinf(a.x)) {
+    if (u_color_mode == 2 && !isnan(value) && !isinf(value)) {
       v_mapped = 1.0;
-      v_value = (a.x - u_range.x) / (u_range.y - u_range.x);
+      v_value = (value - u_range.x) / (u_range.y - u_range.x);
     }
     if (u_color_mode == 3) color = group.rgb;
     hidden = group.a <= 0.0;

@@ -34,17 +34,17 @@ Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, 
       for (std::uint32_t k = 0; k < sets->size(); ++k)
         if (std::find(value_set_names_.begin(), value_set_names_.end(), sets->name(k)) == value_set_names_.end())
           value_set_names_.push_back(sets->name(k));
-  // A draw binds up to kMaxBoundSpans spans, as many as the vertex shader's texture units allow (GL 3.3
-  // promises 16: four spans).
+  // A draw binds up to kMaxBoundSpans spans, as many as the vertex shader's texture units allow beside the
+  // streamline groups' table (GL 3.3 promises 16: three spans).
   GLint units = 0;
   glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
   const std::size_t spans = std::max<std::size_t>(1, scene_.layout().texture_spans().size());
-  bound_spans_ = static_cast<unsigned>(
-      std::min<std::size_t>({spans, kMaxBoundSpans, static_cast<std::size_t>(std::max(0, units)) / kSamplersPerSpan}));
+  bound_spans_ = static_cast<unsigned>(std::min<std::size_t>(
+      {spans, kMaxBoundSpans, static_cast<std::size_t>(std::max(0, units - 1)) / kSamplersPerSpan}));
   if (bound_spans_ == 0)
     throw Error(ErrorKind::Unsupported, file.path(), std::nullopt,
                 "this GPU offers " + std::to_string(units) + " vertex-shader textures; the lines need " +
-                    std::to_string(kSamplersPerSpan));
+                    std::to_string(kSamplersPerSpan + 1));
   glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even without attributes
   make_line_programs();
   wboit_composite_ = gl::make_program(shaders::kFullscreenVertex, shaders::kWboitCompositeFragment);
@@ -58,6 +58,7 @@ Renderer::~Renderer() {
   for (GLuint p :
        {over_program_, accum_program_, reveal_program_, additive_program_, wboit_composite_, additive_composite_})
     if (p) glDeleteProgram(p);
+  streamline_groups_.destroy();
   wboit_target_.destroy();
   opaque_target_.destroy();
   additive_target_.destroy();
@@ -233,9 +234,13 @@ void Renderer::bind_line_program(GLuint program, const Camera& camera, const Ren
   if (clips > 0) glUniform4fv(glGetUniformLocation(program, "u_clip"), clips, glm::value_ptr(clip[0]));
   glUniform1i(glGetUniformLocation(program, "u_clip_count"), clips);
   enable_clip_distances(clips);
-  // The slices' depth on the first unit after the spans' (a unit of its own: two sampler types must not
-  // share one), bound even when unused.
-  const GLint unit = static_cast<GLint>(kSamplersPerSpan * bound_spans_);
+  // The streamline groups' table on the first unit after the spans', the slices' depth on the next (units
+  // of their own: two sampler types must not share one), bound even when unused.
+  const GLint groups_unit = static_cast<GLint>(kSamplersPerSpan * bound_spans_);
+  glActiveTexture(GL_TEXTURE0 + groups_unit);
+  glBindTexture(GL_TEXTURE_BUFFER, streamline_groups_.texture);
+  glUniform1i(glGetUniformLocation(program, "u_streamline_group"), groups_unit);
+  const GLint unit = groups_unit + 1;
   glActiveTexture(GL_TEXTURE0 + unit);
   glBindTexture(GL_TEXTURE_2D, slices_drawn_ ? slices_->depth_texture() : 0);
   glUniform1i(glGetUniformLocation(program, "u_slice_depth"), unit);
@@ -286,7 +291,7 @@ std::array<float, 2> Renderer::scalar_range(const RenderSettings& s) const {
 
 void Renderer::set_groups(SceneGroups groups) {
   groups_ = std::move(groups);
-  attributes_key_ = "(groups replaced)";  // no key a frame asks for: the next one uploads
+  streamline_groups_stale_ = true;  // the next frame uploads the table; the per-vertex words stay
 }
 
 void Renderer::prepare_attributes(const RenderSettings& s) {
@@ -294,16 +299,45 @@ void Renderer::prepare_attributes(const RenderSettings& s) {
   bool want_groups = s.color == ColorMode::Group;
   const auto& groups = groups_.groups();
   for (std::size_t g = 0; g < groups.size(); ++g) want_groups |= s.group_color(groups[g].name, g).a != 1.0f;
-  const std::string key = (name.empty() ? "" : "value:" + name) + (want_groups ? "|groups" : "");
-  if (key == attributes_key_) return;
-  std::vector<std::vector<float>> per_file;
-  if (!key.empty())
-    for (std::size_t i = 0; i < files_.size(); ++i)
-      per_file.push_back(vertex_attributes(*files_[i], i,
-                                           name.empty() ? ValueSource{} : find_value_set(*files_[i], name),
-                                           want_groups ? &groups_ : nullptr));
-  scene_.upload_attributes(std::move(per_file));
-  attributes_key_ = key;
+  const std::string key = name.empty() && !want_groups ? "" : "value:" + name;
+  if (key != attributes_key_) {
+    std::vector<std::vector<std::uint32_t>> per_file;
+    std::uint64_t first_streamline = 0;
+    if (!key.empty())
+      for (const VxlFile* f : files_) {
+        per_file.push_back(vertex_attributes(*f, name.empty() ? ValueSource{} : find_value_set(*f, name),
+                                             static_cast<std::uint32_t>(first_streamline)));
+        first_streamline += f->meta().streamline_count;
+      }
+    scene_.upload_attributes(std::move(per_file));
+    attributes_key_ = key;
+  }
+  if (!key.empty() && streamline_groups_stale_) upload_streamline_groups();
+}
+
+void Renderer::upload_streamline_groups() {
+  std::uint64_t total = 0;
+  for (const VxlFile* f : files_) total += f->meta().streamline_count;
+  GLint max_texels = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+  if (total > static_cast<std::uint64_t>(std::max(0, max_texels)) || total > 0xFFFFFFFFu)
+    throw Error(ErrorKind::Unsupported, files_.front()->path(), std::nullopt,
+                "colour or opacity by group needs a table of " + std::to_string(total) +
+                    " streamlines; this GPU's buffer textures hold " + std::to_string(max_texels));
+  std::vector<std::uint8_t> table(std::max<std::uint64_t>(total, 1), 0);
+  std::uint64_t at = 0;
+  for (std::size_t i = 0; i < files_.size(); ++i) {
+    const std::uint64_t n = files_[i]->meta().streamline_count;
+    if (groups_.uniform(i))
+      std::fill_n(table.begin() + at, n, std::uint8_t(groups_.group_of(i, 0) % shaders::kShaderGroups));
+    else
+      for (std::uint64_t s = 0; s < n; ++s)
+        table[at + s] = std::uint8_t(groups_.group_of(i, s) % shaders::kShaderGroups);
+    at += n;
+  }
+  streamline_groups_.destroy();
+  streamline_groups_.create(GL_R8UI, table.data(), table.size());
+  streamline_groups_stale_ = false;
 }
 
 void Renderer::bind_spans(GLuint program, std::span<const std::uint32_t> bound,

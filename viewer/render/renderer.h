@@ -173,8 +173,10 @@ class Renderer {
   // Enables the first n of the line shader's clip distances and disables the others (passes without
   // gl_ClipDistance must run with none enabled).
   static void enable_clip_distances(int n);
-  // Uploads the per-vertex (value, group) attributes that `settings` needs, when they changed.
+  // Uploads the per-vertex (value, streamline) attributes that `settings` needs when they changed, and
+  // the streamline groups' table when the groups changed.
   void prepare_attributes(const RenderSettings& settings);
+  void upload_streamline_groups();
   void draw_lines(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect, PlanOrder order);
   void draw_dataset_order(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect);
   // The segsort mode's lines: voxels sorted as axis sorts them, each voxel's segments sorted on the CPU for
@@ -202,6 +204,10 @@ class Renderer {
   SceneGroups groups_;
   std::vector<std::string> value_set_names_;
   std::string attributes_key_;  // what the attribute buffers hold ("" : nothing)
+  // One byte per streamline of the scene (the files' streamlines one after another): its group mod the
+  // shader's group table. A new selection or grouping uploads this alone, not the per-vertex attributes.
+  gl::TextureBuffer streamline_groups_;
+  bool streamline_groups_stale_ = true;
 };
 
 }  // namespace vxl

@@ -1,7 +1,9 @@
 // What the line shader reads per vertex besides its position when colouring by value or by group: two
-// floats, (value, group index). Built on the CPU only when a colour mode or a group's opacity needs them,
-// from the file's value sets (VVAL as it is; SVAL and groups spread to the vertices by a walk of the
-// voxline table, spec §5.6).
+// 32-bit words, (value as float bits, streamline number in the scene). The group of a streamline is not
+// here but in a table of one byte per streamline (Renderer), so that a new selection or grouping uploads
+// that table alone and the per-vertex words stay: built on the CPU only when a colour mode or a group's
+// opacity first needs them, from the file's value sets (VVAL as it is; SVAL and the streamline numbers
+// spread to the vertices by a walk of the voxline table, spec §5.6).
 #pragma once
 
 #include <cstdint>
@@ -9,7 +11,6 @@
 #include <vector>
 
 #include "format/vxl_file.h"
-#include "viewer/render/scene_groups.h"
 
 namespace vxl {
 
@@ -22,9 +23,9 @@ struct ValueSource {
 // The set called `name` in `file`, per-vertex sets first; Kind::None when it has none of that name.
 ValueSource find_value_set(const VxlFile& file, const std::string& name);
 
-// 2 * vertex_count floats: per vertex its value (NaN where `source` is None) and its group index (0 when
-// `groups` is null). `file_index` is the file's position in `groups`.
-std::vector<float> vertex_attributes(const VxlFile& file, std::size_t file_index, const ValueSource& source,
-                                     const SceneGroups* groups);
+// 2 * vertex_count words: per vertex the bits of its value (a NaN where `source` is None) and
+// `first_streamline` + the number of its streamline in the file.
+std::vector<std::uint32_t> vertex_attributes(const VxlFile& file, const ValueSource& source,
+                                             std::uint32_t first_streamline);
 
 }  // namespace vxl
