@@ -406,6 +406,26 @@ TEST_F(WindowGridOverlay, DrawnScopeKeepsOnlyTheVoxelsInView) {
   EXPECT_EQ(grid.cubes_drawn(), 2u);
 }
 
+// A scripted drag (--drag-region): the active sphere moves every frame, the frames are moving ones, the
+// selections run off the window's thread and --stats reports their times; the last selection, waited for
+// at the end, is where the sphere came to rest.
+TEST_F(Window, AScriptedDragReportsTheSelectionsTimes) {
+  VXL_REQUIRE_XVFB();
+  make_inputs();
+  const nlohmann::json j =
+      window_stats("--size 200x150 --include -40,-18,10,10 --drag-region 4,0,0 --frames 12 --context-opacity 0.1");
+  ASSERT_FALSE(j.is_null());
+  EXPECT_GE(j.at("moving_frames").get<int>(), 8);
+  EXPECT_GE(j.at("selections").get<int>(), 2);  // the first (at start) and at least one while dragging
+  EXPECT_GT(j.at("selection_median_ms").get<double>(), 0.0);
+  EXPECT_GE(j.at("selection_p95_ms").get<double>(), j.at("selection_median_ms").get<double>());
+  const test::CommandResult bad = run_voxview_in_xvfb(shell_quoted(vxl) + " --drag-region 1,0 --frames 2");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  const test::CommandResult none = run_voxview_in_xvfb(shell_quoted(vxl) + " --drag-region 1,0,0 --frames 2");
+  EXPECT_EQ(none.exit_code, 2) << none.output;
+  EXPECT_NE(none.output.find("--drag-region needs a region"), std::string::npos) << none.output;
+}
+
 // The window draws a command-line selection as the headless path does (focus and context, the context hidden
 // here): the same picture but for rasteriser details.
 TEST_F(Window, ASelectionLooksAsItDoesHeadless) {

@@ -56,7 +56,7 @@ FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint3
 }
 
 void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
-                       double frame_budget_ms, const StartupTimes& startup) {
+                       double frame_budget_ms, const StartupTimes& startup, const std::vector<double>& selection_ms) {
   const FrameSummary s = summarize_frames(frames, scene_level);
   nlohmann::json j;
   j["scene_level"] = scene_level;
@@ -75,6 +75,10 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
   j["refinement_pieces"] = s.pieces;
   j["piece_median_ms"] = s.piece_median_ms;
   j["piece_p95_ms"] = s.piece_p95_ms;
+  const auto [selection_median, selection_p95] = median_and_p95(selection_ms);
+  j["selections"] = selection_ms.size();
+  j["selection_median_ms"] = selection_median;
+  j["selection_p95_ms"] = selection_p95;
   nlohmann::json list = nlohmann::json::array();
   for (const FrameRecord& f : frames)
     list.push_back({{"level", f.level},

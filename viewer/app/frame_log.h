@@ -44,8 +44,10 @@ struct StartupTimes {
 
 FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint32_t scene_level);
 
-// Writes the summary, the budget and every frame as JSON to `path` (atomically). Throws vxl::Error (Output).
+// Writes the summary, the budget and every frame as JSON to `path` (atomically), and the selections' run
+// times (selection_worker.h: how long after a region moved its picture was ready). Throws vxl::Error (Output).
 void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
-                       double frame_budget_ms, const StartupTimes& startup = {});
+                       double frame_budget_ms, const StartupTimes& startup = {},
+                       const std::vector<double>& selection_ms = {});
 
 }  // namespace vxl::app

@@ -248,6 +248,14 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
   if (!(o.frame_budget_ms >= 0 && o.frame_budget_ms <= 1e6))
     usage_error("--frame-budget: expected milliseconds in [0, 1e6]");
   if (o.orbit_deg && !(std::abs(*o.orbit_deg) <= 360)) usage_error("--orbit: expected degrees in [-360, 360]");
+  if (!a.drag_region.empty()) {
+    if (a.drag_region.size() != 3 ||
+        !std::all_of(a.drag_region.begin(), a.drag_region.end(), [](double d) { return std::abs(d) <= 1000; }))
+      usage_error("--drag-region: expected DX,DY,DZ in mm, each in [-1000, 1000]");
+    if (o.include.empty() && o.exclude.empty() && o.ends_in.empty())
+      usage_error("--drag-region needs a region to drag (--include, --exclude or --ends-in)");
+    o.drag_region_mm = {a.drag_region[0], a.drag_region[1], a.drag_region[2]};
+  }
   check_outputs(o);
   return o;
 }

@@ -1,6 +1,7 @@
 // Everything `voxview` is told on its command line, shared by the headless and the window paths.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -50,7 +51,9 @@ struct ViewerOptions {
   double frame_budget_ms = 100;
   // Window, at rest: after full detail, draw the exact mode run by run where GL 4.3 is there (rest_refinement.h).
   bool exact_when_still = true;
-  std::optional<double> orbit_deg;        // window: turn the camera by this azimuth every frame (benchmarks)
+  std::optional<double> orbit_deg;  // window: turn the camera by this azimuth every frame (benchmarks)
+  // Window: move the active region by this offset (mm) every frame, a scripted drag (benchmarks).
+  std::optional<std::array<double, 3>> drag_region_mm;
   std::optional<std::string> stats_json;  // window: write each frame's level and time here on quitting
   // Window automation (tests, scripted screenshots): quit after N frames, saving a screenshot first.
   std::optional<int> frames;

@@ -209,11 +209,17 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
       "--orbit", a.options.orbit_deg,
       "window: turn the camera by this many degrees of azimuth every frame (a scripted orbit, with --frames, "
       "for benchmarks); the last frame is drawn at rest (with --until-refined the camera rests after --frames)");
+  cli.add_option("--drag-region", a.drag_region,
+                 "window: move the active region by DX,DY,DZ mm every frame (a scripted drag, with --frames, for "
+                 "benchmarks: --stats then has the selections' times); the picture takes each new selection when it "
+                 "is ready, the frames keep their budget")
+      ->delimiter(',')
+      ->expected(3);
   cli.add_option("--stats", a.options.stats_json,
                  "window: on quitting, write every frame's level of detail and time, when the first picture reached "
                  "the screen (first_on_screen_s, since the process started), when it was drawn and the first "
-                 "full-detail and exact pictures' times, the moving frames' and the refinement pieces' median and "
-                 "95th percentile to this JSON file");
+                 "full-detail and exact pictures' times, the moving frames', the refinement pieces' and the "
+                 "selections' median and 95th percentile to this JSON file");
   cli.add_option("--frames", a.options.frames, "window: quit after this many frames (for scripts and tests)")
       ->check(CLI::PositiveNumber);
   cli.add_flag("--until-refined", a.options.until_refined,

@@ -37,6 +37,7 @@
 #include "viewer/app/scene_detail.h"
 #include "viewer/app/scene_selection.h"
 #include "viewer/app/scene_source.h"
+#include "viewer/app/selection_worker.h"
 #include "viewer/app/ui_panel.h"
 #include "viewer/app/window_size.h"
 #include "viewer/platform/image_io.h"
@@ -155,7 +156,8 @@ struct PictureKey {
   RenderSettings settings;
   int width = 0, height = 0;
   bool grid = false, grid_all = false;
-  std::uint64_t selection = 0;  // the regions' revision the picture was drawn with
+  std::uint64_t selection = 0;  // the selection the picture was drawn with (its generation; the regions' shells
+                                // are in the settings)
 };
 bool same_picture(const PictureKey& a, const PictureKey& b) {
   return same_view(a.camera, b.camera) && a.settings == b.settings && a.width == b.width && a.height == b.height &&
@@ -188,7 +190,10 @@ class ViewerWindow {
   void move_focus_along(int axis, double mm);
   // Selects again when the regions changed since the last selection, and hands the focus and context to
   // every renderer (without regions: the files' own groups again).
-  void update_selection();
+  // Asks for a new selection when the regions changed and takes the newest finished one into the picture
+  // (selection_worker.h); with `wait`, the one the regions ask for now.
+  void update_selection(bool wait);
+  void apply_selection(std::optional<SceneSelection> selection);
   // Writes the selected streamlines of every file to a stamped .tck (a key or the panel).
   void save_selection();
 
@@ -227,11 +232,13 @@ class ViewerWindow {
   std::vector<const VxlFile*> files_;
   const Volume* volume_;
   RegionEditor regions_;
-  std::optional<SceneSelection> selection_;  // of the regions' revision `selection_revision_`
-  // Built with the first selection and kept, so that a region moved is re-selected from the voxels it touches.
-  std::vector<std::optional<VoxelVoxlines>> selection_indexes_;
-  std::optional<std::uint64_t> selection_revision_;
-  SceneDetail detail_;  // the level of detail drawn at rest, and the span size
+  std::optional<SceneSelection> selection_;          // the newest finished; the regions may have moved since
+  std::optional<std::uint64_t> selection_revision_;  // the regions' revision last asked for
+  std::optional<std::uint64_t> cleared_revision_;    // all regions removed at this revision: older selections are stale
+  std::uint64_t selection_generation_ = 0;           // counts the selections taken into the picture
+  SelectionWorker selection_worker_;
+  std::vector<double> selection_ms_;  // each selection's run time, for --stats
+  SceneDetail detail_;                // the level of detail drawn at rest, and the span size
   // The GPU memory budget every level's renderer shares: together they never take more.
   std::shared_ptr<GpuMemoryPool> gpu_memory_;
   // One renderer per level drawn, made on first use: the first picture's (coarse, so that it comes at once),
@@ -279,6 +286,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
       files_(pointers(files)),
       volume_(volume),
       regions_(std::move(regions)),
+      selection_worker_(files_),
       detail_(choose_scene_detail(files_, o.level, o.gpu_memory, o.span_texels)),
       gpu_memory_(std::make_shared<GpuMemoryPool>(detail_.budget)),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
@@ -294,7 +302,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
       for (std::uint32_t d = 0; d < segments.size(); ++d) segments[d] += f->level(i, d).segment_count;
   first_level_ = first_picture_level(segments, detail_.level);
   // The command line's selection first: its groups are those the options name.
-  update_selection();
+  update_selection(true);
   // Scene-wide facts (bounds, groups, value sets, voxel cubes) are the same at every level.
   Renderer& first = renderer_at(first_level_);
   grid_.emplace(first);
@@ -480,7 +488,7 @@ void ViewerWindow::move_focus_along(int axis, double mm) {
   regions_.move_active_by(offset);  // the active sphere moves with the focus (a dragged one from where it is)
 }
 
-void ViewerWindow::update_selection() {
+void ViewerWindow::update_selection(bool wait) {
   // The panel's list, every frame: which region is active changes without a new selection.
   stats_.regions.clear();
   for (std::size_t i = 0; i < regions_.regions().size(); ++i) {
@@ -488,29 +496,38 @@ void ViewerWindow::update_selection() {
     stats_.regions.push_back(
         {r.role_name(), r.argument(), r.streamlines, r.centre.has_value(), regions_.active() == i, r.radius});
   }
-  if (selection_revision_ == regions_.revision()) return;
-  selection_revision_ = regions_.revision();
-  try {
+  if (selection_revision_ != regions_.revision()) {
+    selection_revision_ = regions_.revision();
     if (regions_.empty()) {
-      selection_.reset();
-      stats_.selection.clear();
+      cleared_revision_ = regions_.revision();
+      if (selection_) apply_selection(std::nullopt);
     } else {
-      if (selection_indexes_.empty()) selection_indexes_ = build_selection_indexes(files_);
-      const auto t0 = std::chrono::steady_clock::now();
-      selection_ = select_in_scene(files_, regions_.criteria(), selection_indexes_);
-      regions_.set_counts(selection_->streamlines_per_region);
-      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      stats_.selection = std::to_string(selection_->selected) + " of " + std::to_string(selection_->total) +
-                         " streamlines selected (" + std::to_string(int(ms + 0.5)) + " ms)";
-      RenderSettings& s = state_.settings;
-      // Regions added in the window to a scene started without: the context faint, as --context-opacity's default.
-      if (s.find_style(SceneGroups::kContext) == nullptr)
-        s.style_of(SceneGroups::kContext).opacity = std::min(1.0f, 0.02f / s.opacity);
+      selection_worker_.request(regions_.revision(), regions_.criteria());
     }
-  } catch (const std::exception& e) {
-    set_error(e.what());
-    selection_.reset();
   }
+  std::optional<SelectionWorker::Done> done = selection_worker_.poll(wait);
+  if (!done || (cleared_revision_ && done->revision <= *cleared_revision_)) return;
+  if (!done->error.empty()) {
+    set_error(done->error);
+    apply_selection(std::nullopt);
+    return;
+  }
+  selection_ms_.push_back(done->ms);
+  // Counts only for the regions they were computed with: the list may have changed since.
+  if (done->revision == regions_.revision()) regions_.set_counts(done->selection->streamlines_per_region);
+  stats_.selection = std::to_string(done->selection->selected) + " of " + std::to_string(done->selection->total) +
+                     " streamlines selected (" + std::to_string(int(done->ms + 0.5)) + " ms)";
+  RenderSettings& s = state_.settings;
+  // Regions added in the window to a scene started without: the context faint, as --context-opacity's default.
+  if (s.find_style(SceneGroups::kContext) == nullptr)
+    s.style_of(SceneGroups::kContext).opacity = std::min(1.0f, 0.02f / s.opacity);
+  apply_selection(std::move(done->selection));
+}
+
+void ViewerWindow::apply_selection(std::optional<SceneSelection> selection) {
+  selection_ = std::move(selection);
+  if (!selection_) stats_.selection.clear();
+  ++selection_generation_;
   const SceneGroups groups = selection_ ? selection_->groups : SceneGroups(files_);
   for (auto& [level, r] : renderers_)
     if (r) r->set_groups(groups);
@@ -861,10 +878,15 @@ int ViewerWindow::run() {
     // setting changes, at the finest level that fits the frame budget; a script's last frame at the scene's
     // level. An unchanged one is refined at rest, a piece a frame (rest_refinement.h).
     const Camera& camera = controller_.camera();
-    update_selection();
+    // A scripted drag moves the active region every frame, as a mouse would.
+    const bool dragging = options_.drag_region_mm && !frames_done && regions_.active();
+    if (dragging) regions_.move_active_by(*options_.drag_region_mm);
+    // A script's window (--frames) waits for each selection, so that what it draws does not depend on timing;
+    // a scripted drag does not, as a user's drag does not.
+    update_selection(automated && !options_.drag_region_mm);
     state_.settings.regions = state_.show_regions ? regions_.shapes() : std::vector<RegionShape>{};
-    const PictureKey key{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all, regions_.revision()};
-    const bool moving = drawn_ && !closing && !same_view(drawn_->camera, camera);
+    const PictureKey key{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all, selection_generation_};
+    const bool moving = drawn_ && !closing && (!same_view(drawn_->camera, camera) || dragging);
     const bool changed = !drawn_ || !same_picture(*drawn_, key);
     const bool scripted_last = closing && frames_done && !options_.until_refined;
     bool drawn_now = false;  // the picture (and so what the panel should say) changed after the panel was built
@@ -927,7 +949,7 @@ int ViewerWindow::run() {
     if (closing) break;
   }
   if (options_.stats_json)
-    write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms, startup_);
+    write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms, startup_, selection_ms_);
   return 0;
 }
 

@@ -1,0 +1,51 @@
+#include "viewer/app/selection_worker.h"
+
+#include <chrono>
+#include <exception>
+
+namespace vxl::app {
+
+SelectionWorker::SelectionWorker(std::vector<const VxlFile*> files) : files_(std::move(files)) {}
+
+SelectionWorker::~SelectionWorker() {
+  if (running_.valid()) running_.wait();
+}
+
+void SelectionWorker::request(std::uint64_t revision, SelectionCriteria criteria) {
+  if (running_.valid())
+    waiting_.emplace(revision, std::move(criteria));
+  else
+    start(revision, std::move(criteria));
+}
+
+void SelectionWorker::start(std::uint64_t revision, SelectionCriteria criteria) {
+  running_ = std::async(std::launch::async, [this, revision, criteria = std::move(criteria)] {
+    Done done;
+    done.revision = revision;
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      if (indexes_.empty()) indexes_ = build_selection_indexes(files_);
+      done.selection = select_in_scene(files_, criteria, indexes_);
+    } catch (const std::exception& e) {
+      done.error = e.what();
+    }
+    done.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return done;
+  });
+}
+
+std::optional<SelectionWorker::Done> SelectionWorker::poll(bool wait) {
+  std::optional<Done> newest;
+  for (;;) {
+    if (!running_.valid()) {
+      if (!waiting_) return newest;
+      auto [revision, criteria] = std::move(*waiting_);
+      waiting_.reset();
+      start(revision, std::move(criteria));
+    }
+    if (!wait && running_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return newest;
+    newest = running_.get();
+  }
+}
+
+}  // namespace vxl::app
