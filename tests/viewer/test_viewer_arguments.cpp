@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include "converter/readers/source_formats.h"
 #include "format/error.h"
 #include "tests/test_support.h"
 #include "viewer/app/camera_file.h"
@@ -16,6 +17,7 @@
 #include "viewer/app/turntable.h"
 #include "viewer/app/viewer_arguments.h"
 #include "viewer/app/voxview_cli.h"
+#include "viewer/render/render_settings.h"
 
 namespace vxl {
 namespace {
@@ -405,13 +407,41 @@ TEST(VoxviewCli, ModesAndKeysComeFromTheirTables) {
   CLI::App cli{app::voxview_description("test")};
   app::declare_voxview_options(cli, a);
   const std::string help = cli.help();
-  EXPECT_NE(help.find("opaque | unsorted | additive | wboit | basic | axis | segsort | exact"), std::string::npos)
-      << help;
+  std::string modes;  // every mode of render_settings.cpp's table, in its order
+  for (const RenderModeInfo& m : render_modes()) modes += (modes.empty() ? "" : " | ") + std::string(m.name);
+  ASSERT_GE(render_modes().size(), 8u);
+  EXPECT_NE(help.find(modes), std::string::npos) << help;
   for (const app::KeyBinding& b : app::key_bindings())
     EXPECT_NE(help.find(std::string(b.keys) + ": " + b.description), std::string::npos) << b.keys;
 
   const char* argv[] = {"voxview", "a.vxl", "--mode", "fancy"};
   EXPECT_THROW(app::parse_voxview_command_line(cli, a, 4, argv), CLI::ValidationError);
+}
+
+// The text of `help` from `from` up to `to` (the next option's name), empty when `from` is missing.
+std::string help_part(const std::string& help, const std::string& from, const std::string& to) {
+  const std::size_t start = help.find(from);
+  if (start == std::string::npos) return {};
+  return help.substr(start, help.find(to, start + from.size()) - start);
+}
+
+TEST(VoxviewCli, SourceSuffixesAndStreamedFormatsComeFromTheReaderTable) {
+  ViewerArguments a;
+  CLI::App cli{app::voxview_description("test")};
+  app::declare_voxview_options(cli, a);
+  const std::string help = cli.help();
+  const std::string description = help_part(help, "voxview test", "Opening a .vxl");
+  const std::string files = help_part(help, "files", "--render");
+  const std::string memory_limit = help_part(help, "  --memory-limit SIZE", "  --gpu-memory");
+  ASSERT_FALSE(memory_limit.empty()) << help;
+  for (const SourceFormat& f : source_formats()) {
+    for (const char* suffix : f.suffixes) {
+      EXPECT_NE(description.find(suffix), std::string::npos) << suffix << " in " << description;
+      EXPECT_NE(files.find(suffix), std::string::npos) << suffix << " in " << files;
+    }
+    // Each format is named as streamed, or as refused under --memory-limit.
+    EXPECT_NE(memory_limit.find(f.name), std::string::npos) << f.name << " in " << memory_limit;
+  }
 }
 
 }  // namespace

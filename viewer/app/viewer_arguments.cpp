@@ -245,6 +245,11 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
     if (!o.gpu_memory || *o.gpu_memory == 0)
       usage_error("--gpu-memory '" + a.gpu_memory + "' is not a memory size (bytes, or K/M/G: 512M, 2G)");
   }
+  if (!a.memory_limit.empty()) {
+    const std::optional<std::uint64_t> limit = parse_memory_size(a.memory_limit);
+    if (!limit) usage_error("--memory-limit '" + a.memory_limit + "' is not a memory size (bytes, or K/M/G: 512M, 2G)");
+    o.memory_limit = *limit;
+  }
   if (!(o.frame_budget_ms >= 0 && o.frame_budget_ms <= 1e6))
     usage_error("--frame-budget: expected milliseconds in [0, 1e6]");
   if (o.orbit_deg && !(std::abs(*o.orbit_deg) <= 360)) usage_error("--orbit: expected degrees in [-360, 360]");

@@ -25,7 +25,8 @@ struct ViewerArguments {
   double slab = 0;
   std::string image_range, slices, focus, view;
   std::string size = "1024x1024";
-  std::string gpu_memory;  // --gpu-memory SIZE
+  std::string gpu_memory;    // --gpu-memory SIZE
+  std::string memory_limit;  // --memory-limit SIZE
   // With a selection: the focus's opacity (default --opacity) and the context's (0 hides it).
   std::optional<float> focus_opacity;
   float context_opacity = 0.02f;

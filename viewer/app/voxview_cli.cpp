@@ -43,7 +43,8 @@ std::string voxview_description(const std::string& version) {
          "voxview FILE... [--render OUT.png]: a window, or headless to PNG with --render.\n"
          "Opens a .vxl instantly (memory-mapped); a " +
          source_suffixes_text("/") +
-         " is converted in memory first.\n"
+         " is converted first, as 'voxlines convert' does (in memory, or streamed through a temporary\n"
+         ".vxl when it would not fit in memory or under --memory-limit).\n"
          "Opening a .vxl checks its structure (header, section table, section sizes, voxel table, names) in\n"
          "O(voxels) but not its checksums: damaged positions, orders or values are drawn as they are. --verify\n"
          "checks everything first, as 'voxlines verify' does.\n" +
@@ -52,10 +53,11 @@ std::string voxview_description(const std::string& version) {
 
 void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.name("voxview");
-  cli.add_option("files", a.options.inputs,
-                 "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx / .vtk / .vtp tractogram; several "
-                 "are shown together "
-                 "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
+  cli.add_option(
+         "files", a.options.inputs,
+         "a .vxl file, a .vxlz package, or a " + source_suffixes_text(" / ") +
+             " tractogram; several are shown together "
+             "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
       ->required();
   cli.add_option("--render", a.options.render_png,
                  "render headless (EGL, no display needed) to this picture and exit: PNG, or JPEG, TIFF or OpenEXR by "
@@ -178,9 +180,16 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                "before drawing, check every .vxl in full (every checksum and padding byte, every order, the streamline "
                "tables; reads the whole file, as 'voxlines verify') and refuse a damaged one (exit 3, naming the first "
                "problem); a .vxlz's unpacked file too (a package's own checksums are always checked)");
-  cli.add_option("--voxel-size", a.options.voxel_size, "voxel size in mm when converting a source file in memory")
+  cli.add_option("--voxel-size", a.options.voxel_size, "voxel size in mm when converting a source tractogram")
       ->default_val(10.0)
       ->check(CLI::PositiveNumber);
+  cli.add_option(
+         "--memory-limit", a.memory_limit,
+         "convert a source tractogram within SIZE of memory (bytes, or K/M/G: 512M, 2G), as 'voxlines convert "
+         "--memory-limit' does: streamed through a temporary .vxl in $TMPDIR (else /tmp), removed once mapped. " +
+             source_format_names_text("/", true) + " sources only (" + source_format_names_text("/", false) +
+             " are refused). Without it, a TCK too big for the available memory is streamed all the same")
+      ->type_name("SIZE");
   cli.add_option("--gpu-memory", a.gpu_memory,
                  "GPU memory the lines may take (bytes, or K/M/G: 512M, 2G): the finest level of detail that fits is "
                  "drawn (a file converted with levels keeps 1/8 of the streamlines per level, opacity compensated). "
