@@ -1,14 +1,7 @@
 #include "converter/source_to_vxl.h"
 
-#include <linux/magic.h>
-#include <stdlib.h>
-#include <sys/vfs.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <filesystem>
 
 #include "converter/memory_available.h"
@@ -17,6 +10,7 @@
 #include "converter/readers/read_tsf.h"
 #include "converter/readers/source_formats.h"
 #include "converter/streaming_convert.h"
+#include "converter/temporary_vxl.h"
 #include "format/error.h"
 
 namespace vxl {
@@ -51,28 +45,6 @@ void warn_each(const SourceConversion& c, const std::vector<std::string>& warnin
     for (const std::string& w : warnings) c.warn(w);
 }
 
-// A fresh, empty file "voxlines-XXXXXX-NAME.vxl" in `dir`: the name is this conversion's alone (mkstemps), and
-// the conversion's atomic output replaces the empty file when complete.
-std::string reserve_temporary_vxl(const std::string& input, const std::string& dir) {
-  std::string name = input;
-  while (name.size() > 1 && name.back() == '/') name.pop_back();  // a TRX directory given as "x.trx/"
-  std::string path =
-      (std::filesystem::path(dir) / ("voxlines-XXXXXX-" + std::filesystem::path(name).filename().string() + ".vxl"))
-          .string();
-  const int suffix = static_cast<int>(path.size() - path.rfind("XXXXXX") - 6);
-  const int fd = ::mkstemps(path.data(), suffix);
-  if (fd < 0)
-    throw Error(ErrorKind::Output, dir, std::nullopt,
-                std::string("cannot create a temporary .vxl for ") + input + ": " + std::strerror(errno));
-  ::close(fd);
-  return path;
-}
-
-bool on_tmpfs(const std::string& dir) {
-  struct statfs fs {};
-  return ::statfs(dir.c_str(), &fs) == 0 && fs.f_type == TMPFS_MAGIC;
-}
-
 }  // namespace
 
 SourceConversionReport convert_source(const std::string& input, const std::string& output, const SourceConversion& c) {
@@ -101,18 +73,10 @@ SourceConversionReport convert_source(const std::string& input, const std::strin
 }
 
 OpenedSource open_as_vxl(const std::string& input, const SourceConversion& c, const std::string& temporary_dir) {
-  const std::string dir = temporary_dir.empty() ? std::filesystem::temp_directory_path().string() : temporary_dir;
-  const std::string temporary = reserve_temporary_vxl(input, dir);
-  try {
-    SourceConversionReport report = convert_source(input, temporary, c);
-    VxlFile file = VxlFile::open(temporary);
-    std::filesystem::remove(temporary);  // the mapping keeps the data
-    return {std::move(file), std::move(report), temporary, on_tmpfs(dir)};
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    throw;
-  }
+  SourceConversionReport report;
+  TemporaryVxl t = open_through_temporary_vxl(
+      input, [&](const std::string& path) { report = convert_source(input, path, c); }, temporary_dir);
+  return {std::move(t.file), std::move(report), std::move(t.path), t.in_ram};
 }
 
 }  // namespace vxl

@@ -51,8 +51,8 @@ struct OpenedSource {
   bool temporary_in_ram = false;
 };
 
-// Converts `input` as convert_source does into a temporary .vxl in `temporary_dir` (empty: the system's
-// temporary folder, $TMPDIR or else /tmp) under a fresh name ("voxlines-XXXXXX-NAME.vxl"), maps it and
+// Converts `input` as convert_source does into a temporary .vxl in `temporary_dir` (temporary_vxl.h: empty is
+// the system's temporary folder, $TMPDIR or else /tmp; a fresh name "voxlines-XXXXXX-NAME.vxl"), maps it and
 // removes it at once: the mapping keeps the data, and nothing is left behind, also when the conversion or the
 // opening fails. A streamed conversion's .vxl lives in that folder's file system while it is mapped (its
 // pages can be evicted, unlike a conversion in memory): where /tmp is a RAM file system (tmpfs), set TMPDIR

@@ -100,6 +100,25 @@ TEST(SceneSource, NoTemporaryFileIsLeftWhenTheSourceIsTruncated) {
   }
 }
 
+TEST(SceneSource, APackageIsUnpackedThroughATemporaryFileThatIsRemoved) {
+  ScratchDir dir;
+  const std::string tck = synth_tck(dir, 500), vxl = dir.file("s.vxl"), vxlz = dir.file("s.vxlz");
+  ASSERT_EQ(test::run_cli("convert " + q(tck) + " " + q(vxl)).exit_code, 0);
+  ASSERT_EQ(test::run_cli("pack " + q(vxl) + " " + q(vxlz)).exit_code, 0);
+  const std::filesystem::path temporary = dir.path() / "tmp";
+  const TemporaryFolderAt in(temporary);
+  app::SceneSourceOptions options;
+  options.verify = true;
+  const app::OpenedScene opened = app::open_scene(vxlz, options);
+  EXPECT_FALSE(opened.conversion);
+  EXPECT_EQ(opened.file.meta().streamline_count, 500u);
+  EXPECT_TRUE(is_empty_folder(temporary));
+
+  std::filesystem::resize_file(vxlz, std::filesystem::file_size(vxlz) / 2);
+  EXPECT_THROW((void)app::open_scene(vxlz, options), Error);
+  EXPECT_TRUE(is_empty_folder(temporary)) << "a damaged package left a temporary file";
+}
+
 TEST(SceneSource, VoxviewTakesTheMemoryLimitAndSaysItStreamed) {
   ScratchDir dir;
   const std::string tck = synth_tck(dir, 4000);

@@ -1,11 +1,11 @@
 #include "viewer/app/scene_source.h"
 
-#include <unistd.h>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
 #include "converter/memory_size.h"
+#include "converter/temporary_vxl.h"
 #include "converter/unpack.h"
 #include "format/error.h"
 #include "format/vxl_verify.h"
@@ -25,19 +25,12 @@ void verify_or_refuse(const std::string& path, const std::string& shown) {
 
 // A package is unpacked into a temporary .vxl removed at once: the mapping keeps it alive, nothing is left.
 VxlFile open_package(const std::string& path, bool verify) {
-  std::filesystem::path temp =
-      std::filesystem::temp_directory_path() /
-      ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
-  unpack_vxlz(path, temp.string(), {});
-  try {
-    if (verify) verify_or_refuse(temp.string(), path);
-    VxlFile f = VxlFile::open(temp.string());
-    std::filesystem::remove(temp);
-    return f;
-  } catch (...) {
-    std::filesystem::remove(temp);
-    throw;
-  }
+  return open_through_temporary_vxl(path,
+                                    [&](const std::string& temporary) {
+                                      unpack_vxlz(path, temporary, {});
+                                      if (verify) verify_or_refuse(temporary, path);
+                                    })
+      .file;
 }
 
 // How the source was converted, and the command that converts it once so that it opens instantly.
