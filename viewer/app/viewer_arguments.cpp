@@ -180,9 +180,8 @@ void apply_view_and_size(const ViewerArguments& a, const std::string& size, View
   if (!a.view.empty()) {
     o.view = parse_view(a.view);
     if (!o.view)
-      usage_error("--view: unknown view '" + a.view +
-                  "' (expected axial, inferior, sagittal, right, coronal, posterior, or AZ,EL in degrees, the azimuth "
-                  "within +-1e6)");
+      usage_error("--view: unknown view '" + a.view + "' (expected " + view_names_text() +
+                  ", or AZ,EL in degrees, the azimuth within +-1e6)");
   }
   if (std::sscanf(size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 1 || o.height < 1 || o.width > 16384 ||
       o.height > 16384)

@@ -5,7 +5,9 @@
 #include "converter/readers/source_formats.h"
 #include "format/vxl_levels.h"
 #include "viewer/app/key_bindings.h"
+#include "viewer/platform/image_io.h"
 #include "viewer/render/background_color.h"
+#include "viewer/render/camera.h"
 #include "viewer/render/render_settings.h"
 
 namespace vxl::app {
@@ -60,8 +62,9 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
              "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
       ->required();
   cli.add_option("--render", a.options.render_png,
-                 "render headless (EGL, no display needed) to this picture and exit: PNG, or JPEG, TIFF or OpenEXR by "
-                 "the extension (.jpg, .tif, .exr)");
+                 "render headless (EGL, no display needed) to this picture and exit, in the format its extension "
+                 "names: " +
+                     picture_formats_text());
   cli.add_option("--turntable", a.options.turntable,
                  "with --render: N frames turning once around the vertical (superior) axis, written as OUT_000.png, "
                  "OUT_001.png, ... (frame i at azimuth + 360 i / N degrees; frame 0 looks from the --view direction; "
@@ -79,8 +82,7 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--opacity", a.opacity, "line opacity, 1 down to 0.001")
       ->default_val(0.3)
       ->check(CLI::Range(0.001, 1.0));
-  cli.add_option("--view", a.view,
-                 "axial, inferior, sagittal (left), right, coronal (anterior), posterior, or AZ,EL in degrees");
+  cli.add_option("--view", a.view, view_names_text() + ", or AZ,EL in degrees");
   cli.add_option("--size", a.size, "image or window size WxH")->default_val("1024x1024");
   cli.add_flag("--ortho", a.options.orthographic, "orthographic projection (default perspective)");
   cli.add_option(
@@ -88,7 +90,7 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
          "direction (|p1 - p0| as RGB), fixed (--fixed-color), scalar (a value set through --colormap) or group "
          "(one colour per TRX group, or per file when several are shown)")
       ->default_val("direction")
-      ->check(CLI::IsMember({"direction", "fixed", "scalar", "group"}));
+      ->check(CLI::IsMember(color_mode_names()));
   cli.add_option("--fixed-color", a.fixed_color, "the fixed colour, #RRGGBB (also for points without a value)")
       ->check([](const std::string& v) {
         return parse_hex_color(v) ? std::string() : "expected #RRGGBB, got '" + v + "'";
@@ -96,9 +98,13 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--scalar", a.scalar,
                  "the value set to colour by (a TSF's file name, a TRK scalar or property, a TRX dpv or dps name); "
                  "default: the first");
-  cli.add_option("--colormap", a.colormap, "grey, hot or viridis, for --color scalar")
+  cli.add_option("--colormap", a.colormap, join(colormap_names(), " | ") + ", for --color scalar")
       ->default_val("viridis")
-      ->check(CLI::IsMember({"grey", "gray", "hot", "viridis"}));
+      ->check([](const std::string& name) {
+        return parse_colormap(name)
+                   ? std::string()
+                   : "unknown colour map '" + name + "' (expected " + join(colormap_names(), ", ") + ")";
+      });
   cli.add_option("--range", a.range,
                  "MIN,MAX: the values at the colour map's ends (default: the set's minimum and maximum)");
   cli.add_option(
@@ -230,7 +236,7 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                "detail, then exact unless --no-exact-when-still), then quit")
       ->needs("--frames");
   cli.add_option("--screenshot", a.options.screenshot,
-                 "window: save the last frame to this picture before quitting (.png, .jpg, .tif or .exr)");
+                 "window: save the last frame to this picture before quitting: " + picture_formats_text());
 }
 
 void parse_voxview_command_line(CLI::App& cli, ViewerArguments& arguments, int argc, const char* const* argv) {
