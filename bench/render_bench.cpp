@@ -53,7 +53,9 @@ vxl::Camera turntable_camera(const vxl::Renderer& r, int step, int steps) {
 int run(int argc, char** argv) {
   std::vector<std::string> scenes;
   int size = 1024, frames = 5;
-  std::string modes_arg = "opaque,unsorted,additive,wboit,basic,axis,segsort,exact";
+  std::string every_mode;  // render_settings.h's table, the default of --modes
+  for (const std::string& name : vxl::render_mode_names()) every_mode += (every_mode.empty() ? "" : ",") + name;
+  std::string modes_arg = every_mode;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--scene" && i + 1 < argc)
@@ -72,8 +74,14 @@ int run(int argc, char** argv) {
   }
   std::vector<vxl::RenderMode> modes;
   std::stringstream ss(modes_arg);
-  for (std::string m; std::getline(ss, m, ',');)
-    if (auto mode = vxl::parse_render_mode(m)) modes.push_back(*mode);
+  for (std::string m; std::getline(ss, m, ',');) {
+    const auto mode = vxl::parse_render_mode(m);
+    if (!mode) {
+      std::fprintf(stderr, "render_bench: unknown mode '%s' (modes: %s)\n", m.c_str(), every_mode.c_str());
+      return 2;
+    }
+    modes.push_back(*mode);
+  }
 
   vxl::HeadlessGlContext context;
   std::printf("GL: %s %s; image %dx%d\n", context.version_string().c_str(), context.renderer().c_str(), size, size);

@@ -6,6 +6,7 @@
 
 #include "converter/command_line_typos.h"
 #include "converter/convert.h"
+#include "converter/readers/source_formats.h"
 #include "converter/synth.h"
 #include "tests/test_support.h"
 
@@ -58,6 +59,31 @@ TEST(CommandLine, TyposGetTheNearestName) {
   const test::CommandResult value = run_cli("convert a.tck b.vxl --levels 99");
   EXPECT_EQ(value.exit_code, 2);
   EXPECT_EQ(value.output.find("unknown option"), std::string::npos) << value.output;
+}
+
+// The text of `help` from `from` up to `to` (the next option's name), empty when `from` is missing.
+std::string help_part(const std::string& help, const std::string& from, const std::string& to) {
+  const std::size_t start = help.find(from);
+  if (start == std::string::npos) return {};
+  return help.substr(start, help.find(to, start + from.size()) - start);
+}
+
+TEST(CommandLine, ConvertHelpListsEverySourceOfTheReaderTable) {
+  const test::CommandResult r = run_cli("convert --help");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string description = help_part(r.output, "Convert a", "voxlines convert IN OUT.vxl");
+  const std::string output_dir = help_part(r.output, "  --output-dir DIR", "  --jobs N");
+  const std::string memory_limit = help_part(r.output, "  --memory-limit SIZE", "  --tsf");
+  ASSERT_FALSE(output_dir.empty() || memory_limit.empty()) << r.output;
+  for (const SourceFormat& f : source_formats()) {
+    EXPECT_NE(description.find(f.name), std::string::npos) << f.name << " in " << description;
+    for (const char* suffix : f.suffixes) {
+      EXPECT_NE(description.find(suffix), std::string::npos) << suffix << " in " << description;
+      EXPECT_NE(output_dir.find(suffix), std::string::npos) << suffix << " in " << output_dir;
+    }
+    // Each format is named as streamed, or as refused under --memory-limit.
+    EXPECT_NE(memory_limit.find(f.name), std::string::npos) << f.name << " in " << memory_limit;
+  }
 }
 
 }  // namespace

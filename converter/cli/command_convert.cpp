@@ -44,10 +44,10 @@ void add_convert_command(CLI::App& app, int& exit_code) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "convert",
-      "Convert a TCK / TRK (.trk.gz) / TRX / VTK / VTP tractogram to .vxl:\n"
-      "  voxlines convert IN OUT.vxl\n"
-      "  voxlines convert IN... --output-dir DIR [--jobs N]    (a cohort: DIR/NAME.vxl for each IN)");
+      "convert", "Convert a " + source_format_names_text(" / ") + " tractogram (" + source_suffixes_text(", ") +
+                     ") to .vxl:\n"
+                     "  voxlines convert IN OUT.vxl\n"
+                     "  voxlines convert IN... --output-dir DIR [--jobs N]    (a cohort: DIR/NAME.vxl for each IN)");
   cmd->add_option("files", opt->files,
                   "IN OUT.vxl: the source tractogram (" + source_descriptions_text() +
                       ") and the output (written atomically); with --output-dir: one or more sources")
@@ -99,9 +99,10 @@ void add_convert_command(CLI::App& app, int& exit_code) {
   cmd->add_option(
          "--memory-limit", opt->memory_limit,
          "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): reads the source several times and writes the "
-         "output in parts, byte-identical to a conversion without the limit. TCK sources only (TRK/TRX are "
-         "refused); a limit too small for the data is refused, naming what needs how much. With --output-dir "
-         "the limit is per file: --jobs N may use N times SIZE")
+         "output in parts, byte-identical to a conversion without the limit. " +
+             source_format_names_text("/", true) + " sources only (" + source_format_names_text("/", false) +
+             " are refused); a limit too small for the data is refused, naming what needs how much. With "
+             "--output-dir the limit is per file: --jobs N may use N times SIZE")
       ->type_name("SIZE")
       ->check(CLI::Validator(
           [](std::string& s) {

@@ -52,4 +52,11 @@ std::string source_suffixes_text(const std::string& separator) {
   return text;
 }
 
+std::string source_format_names_text(const std::string& separator, std::optional<bool> streamable) {
+  std::string text;
+  for (const SourceFormat& f : kFormats)
+    if (!streamable || f.streamable == *streamable) text += (text.empty() ? "" : separator) + std::string(f.name);
+  return text;
+}
+
 }  // namespace vxl

@@ -3,6 +3,7 @@
 // streaming converter, the cohort's output names and the viewer all look formats up here.
 #pragma once
 
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -36,5 +37,9 @@ std::string supported_sources_text();
 
 // Every suffix that chooses a reader, joined by `separator`: ".tck/.trk.gz/.trk/.trx/.vtk/.vtp" for help texts.
 std::string source_suffixes_text(const std::string& separator);
+
+// The formats' names joined by `separator` ("TCK / TRK / TRX / VTK / VTP"): all of them, or only those that
+// stream (`streamable` true) or only those that do not (false), for help texts.
+std::string source_format_names_text(const std::string& separator, std::optional<bool> streamable = std::nullopt);
 
 }  // namespace vxl

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include "converter/readers/source_formats.h"
 #include "format/error.h"
 #include "tests/test_support.h"
 #include "viewer/app/camera_file.h"
@@ -16,6 +17,8 @@
 #include "viewer/app/turntable.h"
 #include "viewer/app/viewer_arguments.h"
 #include "viewer/app/voxview_cli.h"
+#include "viewer/platform/image_io.h"
+#include "viewer/render/render_settings.h"
 
 namespace vxl {
 namespace {
@@ -405,13 +408,103 @@ TEST(VoxviewCli, ModesAndKeysComeFromTheirTables) {
   CLI::App cli{app::voxview_description("test")};
   app::declare_voxview_options(cli, a);
   const std::string help = cli.help();
-  EXPECT_NE(help.find("opaque | unsorted | additive | wboit | basic | axis | segsort | exact"), std::string::npos)
-      << help;
+  std::string modes;  // every mode of render_settings.cpp's table, in its order
+  for (const RenderModeInfo& m : render_modes()) modes += (modes.empty() ? "" : " | ") + std::string(m.name);
+  ASSERT_GE(render_modes().size(), 8u);
+  EXPECT_NE(help.find(modes), std::string::npos) << help;
   for (const app::KeyBinding& b : app::key_bindings())
     EXPECT_NE(help.find(std::string(b.keys) + ": " + b.description), std::string::npos) << b.keys;
 
   const char* argv[] = {"voxview", "a.vxl", "--mode", "fancy"};
   EXPECT_THROW(app::parse_voxview_command_line(cli, a, 4, argv), CLI::ValidationError);
+}
+
+// The text of `help` from `from` up to `to` (the next option's name), empty when `from` is missing.
+std::string help_part(const std::string& help, const std::string& from, const std::string& to) {
+  const std::size_t start = help.find(from);
+  if (start == std::string::npos) return {};
+  return help.substr(start, help.find(to, start + from.size()) - start);
+}
+
+TEST(VoxviewCli, SourceSuffixesAndStreamedFormatsComeFromTheReaderTable) {
+  ViewerArguments a;
+  CLI::App cli{app::voxview_description("test")};
+  app::declare_voxview_options(cli, a);
+  const std::string help = cli.help();
+  const std::string description = help_part(help, "voxview test", "Opening a .vxl");
+  const std::string files = help_part(help, "files", "--render");
+  const std::string memory_limit = help_part(help, "  --memory-limit SIZE", "  --gpu-memory");
+  ASSERT_FALSE(memory_limit.empty()) << help;
+  for (const SourceFormat& f : source_formats()) {
+    for (const char* suffix : f.suffixes) {
+      EXPECT_NE(description.find(suffix), std::string::npos) << suffix << " in " << description;
+      EXPECT_NE(files.find(suffix), std::string::npos) << suffix << " in " << files;
+    }
+    // Each format is named as streamed, or as refused under --memory-limit.
+    EXPECT_NE(memory_limit.find(f.name), std::string::npos) << f.name << " in " << memory_limit;
+  }
+}
+
+// Whether voxview's command line takes `args` (after "voxview a.vxl").
+bool accepts(const std::vector<std::string>& args) {
+  ViewerArguments a;
+  CLI::App cli{app::voxview_description("test")};
+  app::declare_voxview_options(cli, a);
+  std::vector<const char*> argv = {"voxview", "a.vxl"};
+  for (const std::string& arg : args) argv.push_back(arg.c_str());
+  try {
+    app::parse_voxview_command_line(cli, a, static_cast<int>(argv.size()), argv.data());
+    return true;
+  } catch (const CLI::ParseError&) {
+    return false;
+  }
+}
+
+TEST(VoxviewCli, OptionValueListsComeFromTheirTables) {
+  ASSERT_EQ(color_mode_names().size(), 4u);
+  for (const std::string& name : color_mode_names()) {
+    EXPECT_TRUE(accepts({"--color", name})) << name;
+    EXPECT_TRUE(parse_color_mode(name)) << name;
+  }
+  EXPECT_FALSE(accepts({"--color", "rainbow"}));
+  ASSERT_EQ(colormap_names().size(), 3u);
+  for (const std::string& name : colormap_names()) EXPECT_TRUE(accepts({"--colormap", name})) << name;
+  EXPECT_TRUE(accepts({"--colormap", "gray"}));
+  EXPECT_FALSE(accepts({"--colormap", "jet"}));
+
+  // Every extension the formats' text names is one picture_format_of knows, and the help gives that text.
+  const std::string formats = picture_formats_text();
+  int extensions = 0;
+  for (std::size_t at = formats.find('.'); at != std::string::npos; at = formats.find('.', at + 1)) {
+    const std::string extension = formats.substr(at, formats.find_first_of(",)", at) - at);
+    EXPECT_FALSE(picture_format_of("a" + extension).empty()) << extension;
+    ++extensions;
+  }
+  EXPECT_EQ(extensions, 6) << formats;
+  EXPECT_TRUE(picture_format_of("a.bmp").empty());
+  ViewerArguments a;
+  CLI::App cli{app::voxview_description("test")};
+  app::declare_voxview_options(cli, a);
+  const std::string help = cli.help();
+  EXPECT_NE(help_part(help, "  --render", "  --turntable").find(formats), std::string::npos) << help;
+  EXPECT_NE(help_part(help, "  --screenshot", "\n\n").find(formats), std::string::npos) << help;
+
+  // Every name the views' text lists, other names in brackets too, is a view --view takes.
+  const std::string views = view_names_text();
+  EXPECT_NE(help_part(help, "  --view", "  --size").find(views), std::string::npos) << help;
+  int named = 0;
+  for (std::size_t at = 0; at < views.size();) {
+    const std::size_t end = views.find_first_of(",()", at);
+    std::string name = views.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    while (!name.empty() && name.back() == ' ') name.pop_back();
+    if (!name.empty()) {
+      EXPECT_TRUE(parse_view(name)) << "'" << name << "' in " << views;
+      ++named;
+    }
+    at = end == std::string::npos ? views.size() : views.find_first_not_of(",() ", end);
+  }
+  EXPECT_EQ(named, 9) << views;
+  EXPECT_FALSE(parse_view("axil"));
 }
 
 }  // namespace

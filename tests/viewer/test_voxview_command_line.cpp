@@ -17,7 +17,8 @@ TEST(VoxviewCommandLine, TyposAndUnknownViewsSayWhatIsKnown) {
   const test::CommandResult view = test::run_program(
       VOXVIEW_CLI, test::q(dir.file("a.tck")) + " --render " + test::q(dir.file("a.png")) + " --view axil");
   EXPECT_EQ(view.exit_code, 2);
-  EXPECT_NE(view.output.find("unknown view 'axil' (expected axial,"), std::string::npos) << view.output;
+  EXPECT_NE(view.output.find("unknown view 'axil' (expected axial (superior), inferior,"), std::string::npos)
+      << view.output;
   EXPECT_EQ(view.output.find("<input>"), std::string::npos) << view.output;
 }
 

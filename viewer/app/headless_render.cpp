@@ -55,7 +55,7 @@ Camera initial_camera(std::span<const glm::dvec3> points, const ViewerOptions& o
 
 int run_headless(const ViewerOptions& o) {
   auto t0 = std::chrono::steady_clock::now();
-  const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
+  const std::vector<VxlFile> files = open_scenes(o.inputs, scene_source_options(o));
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);  // before any GL work: a bad image fails fast
   std::optional<SceneSelection> selection;            // before any GL work too: a bad region fails fast

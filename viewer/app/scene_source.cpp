@@ -1,13 +1,11 @@
 #include "viewer/app/scene_source.h"
 
-#include <unistd.h>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
-#include "converter/convert.h"
-#include "converter/readers/read_tractogram.h"
-#include "converter/readers/read_tsf.h"
+#include "converter/memory_size.h"
+#include "converter/temporary_vxl.h"
 #include "converter/unpack.h"
 #include "format/error.h"
 #include "format/vxl_verify.h"
@@ -25,67 +23,83 @@ void verify_or_refuse(const std::string& path, const std::string& shown) {
   throw Error(ErrorKind::Input, shown, std::nullopt, "--verify: the file is damaged or malformed: " + problem);
 }
 
+// A package is unpacked into a temporary .vxl removed at once: the mapping keeps it alive, nothing is left.
+VxlFile open_package(const std::string& path, bool verify) {
+  return open_through_temporary_vxl(path,
+                                    [&](const std::string& temporary) {
+                                      unpack_vxlz(path, temporary, {});
+                                      if (verify) verify_or_refuse(temporary, path);
+                                    })
+      .file;
+}
+
+// How the source was converted, and the command that converts it once so that it opens instantly.
+void print_convert_hint(const std::string& path, const SceneSourceOptions& options,
+                        const SourceConversionReport& report) {
+  std::string how = "in memory", options_text;
+  if (report.streamed) {
+    how = "streamed within " + format_memory_size(report.memory_limit) + " of memory (" +
+          std::to_string(report.summary.passes) + " passes over the source)";
+    if (options.memory_limit > 0) options_text += " --memory-limit " + memory_limit_argument(options.memory_limit);
+  }
+  if (options.voxel_size != 10.0) {
+    char size[64];
+    std::snprintf(size, sizeof size, " --voxel-size %g", options.voxel_size);
+    options_text += size;
+  }
+  for (const std::string& f : options.tsf) options_text += " --tsf '" + f + "'";
+  std::fprintf(stderr,
+               "voxview: converted %s %s. To reopen it instantly, convert once:\n"
+               "  voxlines convert '%s' '%s.vxl'%s\n",
+               path.c_str(), how.c_str(), path.c_str(), std::filesystem::path(path).stem().string().c_str(),
+               options_text.c_str());
+}
+
 }  // namespace
 
-VxlFile open_scene(const std::string& path, double voxel_size, const std::vector<std::string>& tsf, bool verify) {
+SceneSourceOptions scene_source_options(const ViewerOptions& o) {
+  return {o.voxel_size, o.tsf, o.verify, o.memory_limit};
+}
+
+OpenedScene open_scene(const std::string& path, const SceneSourceOptions& options) {
   std::string lower = path;
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (!tsf.empty() && (lower.ends_with(".vxl") || lower.ends_with(".vxlz")))
+  if (!options.tsf.empty() && (lower.ends_with(".vxl") || lower.ends_with(".vxlz")))
     throw Error(
         ErrorKind::Usage, path, std::nullopt,
         "--tsf adds values to a source tractogram converted in memory; a .vxl keeps the values it was converted "
         "with (voxlines convert IN.tck OUT.vxl --tsf FILE.tsf)");
   if (lower.ends_with(".vxl")) {
-    if (verify) verify_or_refuse(path, path);
-    return VxlFile::open(path);
+    if (options.verify) verify_or_refuse(path, path);
+    return {VxlFile::open(path), std::nullopt};
   }
-  if (lower.ends_with(".vxlz")) {
-    // A package is unpacked into an unlinked temporary .vxl: the mapping keeps it alive, nothing is left.
-    std::filesystem::path temp =
-        std::filesystem::temp_directory_path() /
-        ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
-    unpack_vxlz(path, temp.string(), {});
-    try {
-      if (verify) verify_or_refuse(temp.string(), path);
-      VxlFile f = VxlFile::open(temp.string());
-      std::filesystem::remove(temp);
-      return f;
-    } catch (...) {
-      std::filesystem::remove(temp);
-      throw;
-    }
-  }
+  if (lower.ends_with(".vxlz")) return {open_package(path, options.verify), std::nullopt};
 
-  Tractogram t = read_tractogram(path);
-  for (const std::string& f : tsf) attach_tsf(t, f);
-  for (const std::string& w : t.source.warnings)
+  SourceConversion conversion;
+  conversion.settings.voxel_size = options.voxel_size;
+  conversion.settings.memory_limit = options.memory_limit;
+  conversion.tsf = options.tsf;
+  conversion.warn = [&](const std::string& w) {
     std::fprintf(stderr, "voxview: warning: %s: %s\n", path.c_str(), w.c_str());
-  std::filesystem::path temp =
-      std::filesystem::temp_directory_path() /
-      ("voxview-" + std::to_string(::getpid()) + "-" + std::filesystem::path(path).filename().string() + ".vxl");
-  ConvertSettings settings;
-  settings.voxel_size = voxel_size;
-  for (const std::string& w : convert_tractogram(std::move(t), temp.string(), settings).warnings)
-    std::fprintf(stderr, "voxview: warning: %s: %s\n", path.c_str(), w.c_str());
-  VxlFile f = VxlFile::open(temp.string());
-  std::filesystem::remove(temp);  // the mapping keeps the data; nothing is left behind
-  std::string tsf_options;
-  for (const std::string& f : tsf) tsf_options += " --tsf '" + f + "'";
-  std::fprintf(stderr,
-               "voxview: converted %s in memory. To reopen it instantly, convert once:\n"
-               "  voxlines convert '%s' '%s.vxl'%s\n",
-               path.c_str(), path.c_str(), std::filesystem::path(path).stem().string().c_str(), tsf_options.c_str());
-  return f;
+  };
+  conversion.notice = [](const std::string& line) { std::fprintf(stderr, "voxview: %s\n", line.c_str()); };
+  OpenedSource opened = open_as_vxl(path, conversion);
+  print_convert_hint(path, options, opened.report);
+  if (opened.report.streamed && opened.temporary_in_ram)
+    std::fprintf(stderr,
+                 "voxview: note: the temporary .vxl is in a RAM file system (tmpfs, %s): it takes memory while "
+                 "shown; set TMPDIR to a folder on disk, or convert once as above\n",
+                 std::filesystem::path(opened.temporary_path).parent_path().c_str());
+  return {std::move(opened.file), std::move(opened.report)};
 }
 
-std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double voxel_size,
-                                 const std::vector<std::string>& tsf, bool verify) {
-  if (!tsf.empty() && paths.size() != 1)
+std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, const SceneSourceOptions& options) {
+  if (!options.tsf.empty() && paths.size() != 1)
     throw Error(ErrorKind::Usage, "", std::nullopt,
                 "--tsf needs a single input tractogram (it has one value per point of that file); convert each with "
                 "voxlines convert IN.tck OUT.vxl --tsf FILE.tsf and open the .vxl files together");
   std::vector<VxlFile> files;
-  for (const std::string& p : paths) files.push_back(open_scene(p, voxel_size, tsf, verify));
+  for (const std::string& p : paths) files.push_back(open_scene(p, options).file);
   return files;
 }
 

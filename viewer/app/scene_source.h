@@ -1,11 +1,16 @@
-// Opens what the user gave voxview: a .vxl is memory-mapped as is; a TCK/TRK/TRX source is converted in
-// memory first (into an unlinked temporary file that only the mapping keeps alive), with a hint on how
-// to convert once for fast reopening.
+// Opens what the user gave voxview: a .vxl is memory-mapped as is; a .vxlz is unpacked into a temporary
+// .vxl; a source tractogram (readers/source_formats.h) is converted as `voxlines convert` converts it
+// (converter/source_to_vxl.h: in memory, or streamed through the temporary file when it is larger than the
+// memory or --memory-limit) into a temporary .vxl that only the mapping keeps alive, with a hint on how to
+// convert once for fast reopening.
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "converter/source_to_vxl.h"
 #include "format/vxl_file.h"
 #include "viewer/app/viewer_options.h"
 
@@ -16,17 +21,32 @@ struct RenderSettings;
 
 namespace vxl::app {
 
-// `tsf`: MRtrix track scalar files to attach to a source tractogram (refused for a .vxl / .vxlz, whose values
-// were fixed at conversion). `verify`: before a .vxl is used, check it as `voxlines verify` does (every
-// checksum, padding byte, order and table; O(file)), and refuse it (vxl::Error, Input) naming the first
-// problem; a .vxlz's unpacked .vxl is checked the same way (the package's own checksums always are).
-// Without it a .vxl gets only open()'s O(voxels) checks (spec §7), which do not read the checksums.
-VxlFile open_scene(const std::string& path, double voxel_size_for_sources, const std::vector<std::string>& tsf = {},
-                   bool verify = false);
+struct SceneSourceOptions {
+  double voxel_size = 10.0;  // mm, for a source tractogram
+  // MRtrix track scalar files to attach to a source tractogram (refused for a .vxl / .vxlz, whose values were
+  // fixed at conversion).
+  std::vector<std::string> tsf;
+  // Before a .vxl is used, check it as `voxlines verify` does (every checksum, padding byte, order and table;
+  // O(file)), and refuse it (vxl::Error, Input) naming the first problem; a .vxlz's unpacked .vxl is checked
+  // the same way (the package's own checksums always are). Without it a .vxl gets only open()'s O(voxels)
+  // checks (spec §7), which do not read the checksums.
+  bool verify = false;
+  // --memory-limit: stream a source within this many bytes (as `voxlines convert --memory-limit`); 0: stream
+  // a TCK only when converting it in memory would not fit in the available memory.
+  std::uint64_t memory_limit = 0;
+};
+SceneSourceOptions scene_source_options(const ViewerOptions& options);
+
+struct OpenedScene {
+  VxlFile file;
+  std::optional<SourceConversionReport> conversion;  // for a source tractogram: how it was converted
+};
+
+// Opens one input. Throws vxl::Error.
+OpenedScene open_scene(const std::string& path, const SceneSourceOptions& options);
 
 // Opens every input of a scene (open_scene each; --tsf only with a single source input). Throws vxl::Error.
-std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, double voxel_size_for_sources,
-                                 const std::vector<std::string>& tsf, bool verify = false);
+std::vector<VxlFile> open_scenes(const std::vector<std::string>& paths, const SceneSourceOptions& options);
 std::vector<const VxlFile*> pointers(const std::vector<VxlFile>& files);
 
 // Refuses colour options the scene cannot honour, naming the file and what it has: --color scalar without

@@ -180,9 +180,8 @@ void apply_view_and_size(const ViewerArguments& a, const std::string& size, View
   if (!a.view.empty()) {
     o.view = parse_view(a.view);
     if (!o.view)
-      usage_error("--view: unknown view '" + a.view +
-                  "' (expected axial, inferior, sagittal, right, coronal, posterior, or AZ,EL in degrees, the azimuth "
-                  "within +-1e6)");
+      usage_error("--view: unknown view '" + a.view + "' (expected " + view_names_text() +
+                  ", or AZ,EL in degrees, the azimuth within +-1e6)");
   }
   if (std::sscanf(size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 1 || o.height < 1 || o.width > 16384 ||
       o.height > 16384)
@@ -244,6 +243,11 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
     o.gpu_memory = parse_memory_size(a.gpu_memory);
     if (!o.gpu_memory || *o.gpu_memory == 0)
       usage_error("--gpu-memory '" + a.gpu_memory + "' is not a memory size (bytes, or K/M/G: 512M, 2G)");
+  }
+  if (!a.memory_limit.empty()) {
+    const std::optional<std::uint64_t> limit = parse_memory_size(a.memory_limit);
+    if (!limit) usage_error("--memory-limit '" + a.memory_limit + "' is not a memory size (bytes, or K/M/G: 512M, 2G)");
+    o.memory_limit = *limit;
   }
   if (!(o.frame_budget_ms >= 0 && o.frame_budget_ms <= 1e6))
     usage_error("--frame-budget: expected milliseconds in [0, 1e6]");

@@ -22,7 +22,7 @@ struct ViewFileSettings {
 
 struct ViewerOptions {
   std::vector<std::string>
-      inputs;  // .vxl, or a source (readers/source_formats.h) converted in memory; several: one scene
+      inputs;  // .vxl, .vxlz, or a source (readers/source_formats.h) converted first; several: one scene
   // How the inputs are named in messages and titles: the first file's name, "+ N more" for the others.
   std::string inputs_name() const;
   std::optional<std::string> image;       // an anatomical NIfTI image shown as slices under the lines
@@ -36,7 +36,10 @@ struct ViewerOptions {
   bool orthographic = false;
   int width = 1024, height = 1024;
   bool size_given = false;   // by --size or a saved view: the window keeps it (else it fits the screen)
-  double voxel_size = 10.0;  // for in-memory conversion
+  double voxel_size = 10.0;  // for converting a source tractogram
+  // --memory-limit: a source tractogram is streamed within this many bytes (converter/source_to_vxl.h);
+  // 0: only a TCK too big for the available memory is.
+  std::uint64_t memory_limit = 0;
   // Level of detail (.vxl spec §5.12): the one --level names, else the finest within the GPU memory budget
   // (--gpu-memory, else a share of what the driver reports; scene_detail.h).
   std::optional<std::uint32_t> level;
@@ -45,7 +48,7 @@ struct ViewerOptions {
   // uploads and evicts (gpu_scene.h). None: chosen (scene_detail.h).
   std::optional<std::uint64_t> span_texels;
   bool verify = false;           // --verify: check every .vxl in full (as `voxlines verify`) before drawing
-  std::vector<std::string> tsf;  // per-point values for a .tck converted in memory
+  std::vector<std::string> tsf;  // per-point values for a source tractogram (converted in memory)
   // Window: while the camera moves, draw the finest level whose measured frame time fits this budget
   // (frame_budget.h); at rest, the scene's level. 0: no budget.
   double frame_budget_ms = 100;

@@ -5,7 +5,9 @@
 #include "converter/readers/source_formats.h"
 #include "format/vxl_levels.h"
 #include "viewer/app/key_bindings.h"
+#include "viewer/platform/image_io.h"
 #include "viewer/render/background_color.h"
+#include "viewer/render/camera.h"
 #include "viewer/render/render_settings.h"
 
 namespace vxl::app {
@@ -43,7 +45,8 @@ std::string voxview_description(const std::string& version) {
          "voxview FILE... [--render OUT.png]: a window, or headless to PNG with --render.\n"
          "Opens a .vxl instantly (memory-mapped); a " +
          source_suffixes_text("/") +
-         " is converted in memory first.\n"
+         " is converted first, as 'voxlines convert' does (in memory, or streamed through a temporary\n"
+         ".vxl when it would not fit in memory or under --memory-limit).\n"
          "Opening a .vxl checks its structure (header, section table, section sizes, voxel table, names) in\n"
          "O(voxels) but not its checksums: damaged positions, orders or values are drawn as they are. --verify\n"
          "checks everything first, as 'voxlines verify' does.\n" +
@@ -52,14 +55,16 @@ std::string voxview_description(const std::string& version) {
 
 void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.name("voxview");
-  cli.add_option("files", a.options.inputs,
-                 "a .vxl file, a .vxlz package, or a .tck / .trk / .trk.gz / .trx / .vtk / .vtp tractogram; several "
-                 "are shown together "
-                 "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
+  cli.add_option(
+         "files", a.options.inputs,
+         "a .vxl file, a .vxlz package, or a " + source_suffixes_text(" / ") +
+             " tractogram; several are shown together "
+             "(their voxels sorted back to front as one scene, one group per file for --color group and --group)")
       ->required();
   cli.add_option("--render", a.options.render_png,
-                 "render headless (EGL, no display needed) to this picture and exit: PNG, or JPEG, TIFF or OpenEXR by "
-                 "the extension (.jpg, .tif, .exr)");
+                 "render headless (EGL, no display needed) to this picture and exit, in the format its extension "
+                 "names: " +
+                     picture_formats_text());
   cli.add_option("--turntable", a.options.turntable,
                  "with --render: N frames turning once around the vertical (superior) axis, written as OUT_000.png, "
                  "OUT_001.png, ... (frame i at azimuth + 360 i / N degrees; frame 0 looks from the --view direction; "
@@ -77,8 +82,7 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--opacity", a.opacity, "line opacity, 1 down to 0.001")
       ->default_val(0.3)
       ->check(CLI::Range(0.001, 1.0));
-  cli.add_option("--view", a.view,
-                 "axial, inferior, sagittal (left), right, coronal (anterior), posterior, or AZ,EL in degrees");
+  cli.add_option("--view", a.view, view_names_text() + ", or AZ,EL in degrees");
   cli.add_option("--size", a.size, "image or window size WxH")->default_val("1024x1024");
   cli.add_flag("--ortho", a.options.orthographic, "orthographic projection (default perspective)");
   cli.add_option(
@@ -86,7 +90,7 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
          "direction (|p1 - p0| as RGB), fixed (--fixed-color), scalar (a value set through --colormap) or group "
          "(one colour per TRX group, or per file when several are shown)")
       ->default_val("direction")
-      ->check(CLI::IsMember({"direction", "fixed", "scalar", "group"}));
+      ->check(CLI::IsMember(color_mode_names()));
   cli.add_option("--fixed-color", a.fixed_color, "the fixed colour, #RRGGBB (also for points without a value)")
       ->check([](const std::string& v) {
         return parse_hex_color(v) ? std::string() : "expected #RRGGBB, got '" + v + "'";
@@ -94,9 +98,13 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--scalar", a.scalar,
                  "the value set to colour by (a TSF's file name, a TRK scalar or property, a TRX dpv or dps name); "
                  "default: the first");
-  cli.add_option("--colormap", a.colormap, "grey, hot or viridis, for --color scalar")
+  cli.add_option("--colormap", a.colormap, join(colormap_names(), " | ") + ", for --color scalar")
       ->default_val("viridis")
-      ->check(CLI::IsMember({"grey", "gray", "hot", "viridis"}));
+      ->check([](const std::string& name) {
+        return parse_colormap(name)
+                   ? std::string()
+                   : "unknown colour map '" + name + "' (expected " + join(colormap_names(), ", ") + ")";
+      });
   cli.add_option("--range", a.range,
                  "MIN,MAX: the values at the colour map's ends (default: the set's minimum and maximum)");
   cli.add_option(
@@ -178,9 +186,16 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                "before drawing, check every .vxl in full (every checksum and padding byte, every order, the streamline "
                "tables; reads the whole file, as 'voxlines verify') and refuse a damaged one (exit 3, naming the first "
                "problem); a .vxlz's unpacked file too (a package's own checksums are always checked)");
-  cli.add_option("--voxel-size", a.options.voxel_size, "voxel size in mm when converting a source file in memory")
+  cli.add_option("--voxel-size", a.options.voxel_size, "voxel size in mm when converting a source tractogram")
       ->default_val(10.0)
       ->check(CLI::PositiveNumber);
+  cli.add_option(
+         "--memory-limit", a.memory_limit,
+         "convert a source tractogram within SIZE of memory (bytes, or K/M/G: 512M, 2G), as 'voxlines convert "
+         "--memory-limit' does: streamed through a temporary .vxl in $TMPDIR (else /tmp), removed once mapped. " +
+             source_format_names_text("/", true) + " sources only (" + source_format_names_text("/", false) +
+             " are refused). Without it, a TCK too big for the available memory is streamed all the same")
+      ->type_name("SIZE");
   cli.add_option("--gpu-memory", a.gpu_memory,
                  "GPU memory the lines may take (bytes, or K/M/G: 512M, 2G): the finest level of detail that fits is "
                  "drawn (a file converted with levels keeps 1/8 of the streamlines per level, opacity compensated). "
@@ -227,7 +242,7 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                "detail, then exact unless --no-exact-when-still), then quit")
       ->needs("--frames");
   cli.add_option("--screenshot", a.options.screenshot,
-                 "window: save the last frame to this picture before quitting (.png, .jpg, .tif or .exr)");
+                 "window: save the last frame to this picture before quitting: " + picture_formats_text());
 }
 
 void parse_voxview_command_line(CLI::App& cli, ViewerArguments& arguments, int argc, const char* const* argv) {

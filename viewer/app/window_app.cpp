@@ -958,7 +958,7 @@ int ViewerWindow::run() {
 int run_window(const ViewerOptions& o) {
   const auto start = process_start();
   GlfwLibrary glfw;  // first: without a display, fail before any slow conversion
-  const std::vector<VxlFile> files = open_scenes(o.inputs, o.voxel_size, o.tsf, o.verify);
+  const std::vector<VxlFile> files = open_scenes(o.inputs, scene_source_options(o));
   std::optional<Volume> volume;
   if (o.image) volume = read_nifti_volume(*o.image);
   RegionEditor regions(o);  // parses the regions: a bad one fails before the window opens

@@ -126,17 +126,46 @@ void write_png(const std::string& path, int w, int h, const std::vector<std::uin
   write_image_as("png", path, w, h, rgba);
 }
 
+namespace {
+
+// The pictures voxview writes, in one table: OpenImageIO's format name, the name messages give, the extensions.
+struct PictureFormat {
+  const char* format;
+  const char* label;
+  std::vector<const char*> extensions;
+};
+const std::vector<PictureFormat>& picture_formats() {
+  static const std::vector<PictureFormat> formats = {{"png", "PNG", {".png"}},
+                                                     {"jpeg", "JPEG", {".jpg", ".jpeg"}},
+                                                     {"tiff", "TIFF", {".tif", ".tiff"}},
+                                                     {"openexr", "OpenEXR", {".exr"}}};
+  return formats;
+}
+
+}  // namespace
+
 std::string picture_format_of(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext.empty() || ext == ".png") return "png";
-  if (ext == ".jpg" || ext == ".jpeg") return "jpeg";
-  if (ext == ".tif" || ext == ".tiff") return "tiff";
-  if (ext == ".exr") return "openexr";
+  if (ext.empty()) return "png";
+  for (const PictureFormat& f : picture_formats())
+    for (const char* e : f.extensions)
+      if (ext == e) return f.format;
   return {};
 }
 
-const char* picture_formats_text() { return "PNG (.png), JPEG (.jpg, .jpeg), TIFF (.tif, .tiff) or OpenEXR (.exr)"; }
+std::string picture_formats_text() {
+  std::string text;
+  const auto& formats = picture_formats();
+  for (std::size_t i = 0; i < formats.size(); ++i) {
+    text += i == 0 ? "" : i + 1 == formats.size() ? " or " : ", ";
+    text += std::string(formats[i].label) + " (";
+    for (std::size_t k = 0; k < formats[i].extensions.size(); ++k)
+      text += std::string(k ? ", " : "") + formats[i].extensions[k];
+    text += ")";
+  }
+  return text;
+}
 
 void write_picture(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba) {
   const std::string format = picture_format_of(path);

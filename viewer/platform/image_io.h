@@ -33,8 +33,9 @@ inline void write_png(const std::string& path, const Image& img) { write_png(pat
 // (.jpg, .jpeg; no alpha: the alpha channel is dropped), "tiff" (.tif, .tiff) or "openexr" (.exr, half
 // floats); empty for any other.
 std::string picture_format_of(const std::string& path);
-// "PNG (.png), JPEG (.jpg, .jpeg), TIFF (.tif, .tiff) or OpenEXR (.exr)", for messages.
-const char* picture_formats_text();
+// "PNG (.png), JPEG (.jpg, .jpeg), TIFF (.tif, .tiff) or OpenEXR (.exr)", for messages and help texts, from the
+// same table as picture_format_of.
+std::string picture_formats_text();
 // As write_png, in the format the extension names. Throws vxl::Error (Usage) for an extension that names none.
 void write_picture(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba);
 

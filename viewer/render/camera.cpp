@@ -119,17 +119,31 @@ void Camera::frame_points_about(std::span<const glm::dvec3> points, const glm::d
   fit_points(*this, points, aspect, pivot);
 }
 
+namespace {
+
+// The standard views, in one table for parse_view and the texts that list them.
+struct NamedView {
+  const char* name;
+  const char* alias;  // the same view's other name, or null
+  double az, el;
+};
+constexpr NamedView kViews[] = {
+    {"axial", "superior", 180, 90}, {"inferior", nullptr, 0, -90}, {"sagittal", "left", -90, 0},
+    {"right", nullptr, 90, 0},      {"coronal", "anterior", 0, 0}, {"posterior", nullptr, 180, 0},
+};
+
+}  // namespace
+
+std::string view_names_text() {
+  std::string text;
+  for (const NamedView& v : kViews)
+    text += (text.empty() ? "" : ", ") + std::string(v.name) + (v.alias ? " (" + std::string(v.alias) + ")" : "");
+  return text;
+}
+
 std::optional<std::array<double, 2>> parse_view(const std::string& name) {
-  struct Named {
-    const char* name;
-    double az, el;
-  };
-  static const Named views[] = {
-      {"axial", 180, 90}, {"superior", 180, 90}, {"inferior", 0, -90}, {"sagittal", -90, 0},  {"left", -90, 0},
-      {"right", 90, 0},   {"coronal", 0, 0},     {"anterior", 0, 0},   {"posterior", 180, 0},
-  };
-  for (const Named& v : views)
-    if (name == v.name) return std::array<double, 2>{v.az, v.el};
+  for (const NamedView& v : kViews)
+    if (name == v.name || (v.alias && name == v.alias)) return std::array<double, 2>{v.az, v.el};
   auto comma = name.find(',');
   if (comma == std::string::npos) return std::nullopt;
   char* end = nullptr;

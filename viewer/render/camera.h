@@ -58,5 +58,7 @@ struct ViewLimits {
 // "axial"/"superior", "inferior", "sagittal"/"left", "right", "coronal"/"anterior", "posterior", or "AZ,EL" in degrees
 // (elevation clamped to [-90, 90]; an azimuth beyond ViewLimits is no view). Returns {azimuth, elevation}.
 std::optional<std::array<double, 2>> parse_view(const std::string& name);
+// The standard views' names, each other name in brackets: "axial (superior), inferior, sagittal (left), ...".
+std::string view_names_text();
 
 }  // namespace vxl

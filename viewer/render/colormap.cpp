@@ -64,6 +64,12 @@ const char* colormap_name(Colormap map) {
   return "?";
 }
 
+std::vector<std::string> colormap_names() {
+  std::vector<std::string> names;
+  for (const Named& n : kNames) names.emplace_back(n.name);
+  return names;
+}
+
 const std::array<glm::vec3, kColormapSamples>& colormap_samples(Colormap map) {
   static const auto grey = grey_table(), hot = hot_table();
   switch (map) {

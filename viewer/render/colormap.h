@@ -12,6 +12,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -21,6 +22,8 @@ enum class Colormap { Grey, Hot, Viridis };
 
 std::optional<Colormap> parse_colormap(const std::string& name);
 const char* colormap_name(Colormap map);
+// Every colour map's name ("grey", "hot", "viridis"), for help texts; parse_colormap also takes "gray".
+std::vector<std::string> colormap_names();
 
 inline constexpr int kColormapSamples = 33;
 const std::array<glm::vec3, kColormapSamples>& colormap_samples(Colormap map);

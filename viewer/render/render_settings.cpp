@@ -45,6 +45,12 @@ const char* color_mode_name(ColorMode mode) {
   return "?";
 }
 
+std::vector<std::string> color_mode_names() {
+  std::vector<std::string> names;
+  for (const ColorName& c : kColors) names.emplace_back(c.name);
+  return names;
+}
+
 std::optional<glm::vec3> parse_hex_color(const std::string& text) {
   if (text.size() != 7 || text[0] != '#') return std::nullopt;
   glm::vec3 c;

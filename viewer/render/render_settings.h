@@ -41,6 +41,8 @@ enum class ColorMode {
 };
 std::optional<ColorMode> parse_color_mode(const std::string& name);
 const char* color_mode_name(ColorMode mode);
+// Every colour mode's name, in the table's order ("direction", "fixed", "scalar", "group"), for help texts.
+std::vector<std::string> color_mode_names();
 
 // What the user changed about one group: its colour (else the palette's) and its opacity, a factor on
 // RenderSettings::opacity (0 hides the group).
