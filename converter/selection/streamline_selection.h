@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "converter/selection/region.h"
-#include "converter/selection/voxel_voxlines.h"
+#include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
 
 namespace vxl {

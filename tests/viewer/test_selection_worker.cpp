@@ -33,7 +33,7 @@ class SelectionWorkerTest : public ::testing::Test {
 
 TEST_F(SelectionWorkerTest, EachSelectionIsTheSynchronousOne) {
   const std::vector<const VxlFile*> files = {&*file};
-  SelectionWorker worker(files);
+  SelectionWorker worker(files, std::make_shared<VoxelVoxlinesCache>(files));
   for (int i = 0; i < 4; ++i) {
     const SelectionCriteria c = sphere_at(-30.0 + 20 * i, 12);
     worker.request(i + 1, c);
@@ -50,7 +50,7 @@ TEST_F(SelectionWorkerTest, EachSelectionIsTheSynchronousOne) {
 
 TEST_F(SelectionWorkerTest, TheNewestRequestWinsAndNothingIsLeftRunning) {
   const std::vector<const VxlFile*> files = {&*file};
-  SelectionWorker worker(files);
+  SelectionWorker worker(files, std::make_shared<VoxelVoxlinesCache>(files));
   // Requests faster than the worker runs them: the first starts at once, each later one replaces the one
   // waiting, so at most the first and the last run; the newest result is the last request's.
   for (int i = 0; i < 20; ++i) worker.request(i + 1, sphere_at(-40.0 + 4 * i, 10));
@@ -64,7 +64,7 @@ TEST_F(SelectionWorkerTest, TheNewestRequestWinsAndNothingIsLeftRunning) {
 
 TEST_F(SelectionWorkerTest, AFailureComesBackAsAnError) {
   const std::vector<const VxlFile*> files = {&*file};
-  SelectionWorker worker(files);
+  SelectionWorker worker(files, std::make_shared<VoxelVoxlinesCache>(files));
   SelectionCriteria c = sphere_at(0, 10);
   c.min_length = 100, c.max_length = 50;  // refused by the selection
   worker.request(1, c);

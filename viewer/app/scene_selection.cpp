@@ -3,11 +3,11 @@
 namespace vxl::app {
 
 SceneSelection select_in_scene(std::span<const VxlFile* const> files, const SelectionCriteria& criteria,
-                               std::span<const std::optional<VoxelVoxlines>> indexes) {
+                               VoxelVoxlinesCache* indexes) {
   SceneSelection out;
   for (std::size_t i = 0; i < files.size(); ++i) {
     const VxlFile* f = files[i];
-    const VoxelVoxlines* index = i < indexes.size() && indexes[i] ? &*indexes[i] : nullptr;
+    const VoxelVoxlines* index = indexes ? indexes->of(i) : nullptr;
     SelectionResult r = select_streamlines(*f, criteria, index);
     out.streamlines_per_region.resize(r.streamlines_per_region.size(), 0);
     for (std::size_t i = 0; i < r.streamlines_per_region.size(); ++i)
@@ -18,12 +18,6 @@ SceneSelection select_in_scene(std::span<const VxlFile* const> files, const Sele
   }
   out.groups = SceneGroups::selection(files, out.kept);
   return out;
-}
-
-std::vector<std::optional<VoxelVoxlines>> build_selection_indexes(std::span<const VxlFile* const> files) {
-  std::vector<std::optional<VoxelVoxlines>> indexes;
-  for (const VxlFile* f : files) indexes.push_back(VoxelVoxlines::build(*f));
-  return indexes;
 }
 
 }  // namespace vxl::app

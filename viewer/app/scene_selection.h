@@ -5,7 +5,6 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <span>
 #include <vector>
 
@@ -21,13 +20,9 @@ struct SceneSelection {
   std::uint64_t selected = 0, total = 0;
 };
 
-// `indexes`: empty, or one per file (VoxelVoxlines::build's, std::nullopt for a file too large for one),
-// for selections repeated as regions move: each then reads the voxels its regions touch, not every file's
-// whole voxline table.
+// `indexes` (one per file, or null), for selections repeated as regions move: each then reads the voxels
+// its regions touch, not every file's whole voxline table.
 SceneSelection select_in_scene(std::span<const VxlFile* const> files, const SelectionCriteria& criteria,
-                               std::span<const std::optional<VoxelVoxlines>> indexes = {});
-
-// The indexes select_in_scene takes, one per file.
-std::vector<std::optional<VoxelVoxlines>> build_selection_indexes(std::span<const VxlFile* const> files);
+                               VoxelVoxlinesCache* indexes = nullptr);
 
 }  // namespace vxl::app

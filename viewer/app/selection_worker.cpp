@@ -5,7 +5,8 @@
 
 namespace vxl::app {
 
-SelectionWorker::SelectionWorker(std::vector<const VxlFile*> files) : files_(std::move(files)) {}
+SelectionWorker::SelectionWorker(std::vector<const VxlFile*> files, std::shared_ptr<VoxelVoxlinesCache> indexes)
+    : files_(std::move(files)), indexes_(std::move(indexes)) {}
 
 SelectionWorker::~SelectionWorker() {
   if (running_.valid()) running_.wait();
@@ -24,8 +25,7 @@ void SelectionWorker::start(std::uint64_t revision, SelectionCriteria criteria) 
     done.revision = revision;
     const auto t0 = std::chrono::steady_clock::now();
     try {
-      if (indexes_.empty()) indexes_ = build_selection_indexes(files_);
-      done.selection = select_in_scene(files_, criteria, indexes_);
+      done.selection = select_in_scene(files_, criteria, indexes_.get());
     } catch (const std::exception& e) {
       done.error = e.what();
     }

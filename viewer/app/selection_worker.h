@@ -2,12 +2,13 @@
 // selection every frame, and one can take longer than a frame (hundreds of milliseconds on 10^7
 // streamlines where a region meets dense voxels), so the frames keep their budget and the picture takes
 // each selection when it is ready. The newest request wins: one runs at a time, and a request made while
-// it runs replaces any other still waiting. The first run builds the files' per-voxel indexes
-// (VoxelVoxlines), which every later one reuses.
+// it runs replaces any other still waiting. The files' per-voxel indexes (VoxelVoxlines) are built by the
+// first run that needs them, or by a renderer sharing the cache, and reused.
 #pragma once
 
 #include <cstdint>
 #include <future>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,7 +22,7 @@ class SelectionWorker {
  public:
   // The files must outlive the worker; they are only read (memory-mapped), so the worker's thread and the
   // window's may read them at once.
-  explicit SelectionWorker(std::vector<const VxlFile*> files);
+  explicit SelectionWorker(std::vector<const VxlFile*> files, std::shared_ptr<VoxelVoxlinesCache> indexes);
   SelectionWorker(const SelectionWorker&) = delete;
   SelectionWorker& operator=(const SelectionWorker&) = delete;
   ~SelectionWorker();  // waits for the run in progress
@@ -44,7 +45,7 @@ class SelectionWorker {
   void start(std::uint64_t revision, SelectionCriteria criteria);
 
   std::vector<const VxlFile*> files_;
-  std::vector<std::optional<VoxelVoxlines>> indexes_;  // built and read by the runs alone, one at a time
+  std::shared_ptr<VoxelVoxlinesCache> indexes_;
   std::future<Done> running_;
   std::optional<std::pair<std::uint64_t, SelectionCriteria>> waiting_;
 };

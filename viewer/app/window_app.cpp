@@ -236,6 +236,8 @@ class ViewerWindow {
   std::optional<std::uint64_t> selection_revision_;  // the regions' revision last asked for
   std::optional<std::uint64_t> cleared_revision_;    // all regions removed at this revision: older selections are stale
   std::uint64_t selection_generation_ = 0;           // counts the selections taken into the picture
+  // The files' per-voxel indexes, shared by the selections and the renderers (built once, on first use).
+  std::shared_ptr<VoxelVoxlinesCache> indexes_;
   SelectionWorker selection_worker_;
   std::vector<double> selection_ms_;  // each selection's run time, for --stats
   SceneDetail detail_;                // the level of detail drawn at rest, and the span size
@@ -286,7 +288,8 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
       files_(pointers(files)),
       volume_(volume),
       regions_(std::move(regions)),
-      selection_worker_(files_),
+      indexes_(std::make_shared<VoxelVoxlinesCache>(files_)),
+      selection_worker_(files_, indexes_),
       detail_(choose_scene_detail(files_, o.level, o.gpu_memory, o.span_texels)),
       gpu_memory_(std::make_shared<GpuMemoryPool>(detail_.budget)),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
@@ -648,6 +651,7 @@ Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
     // The first picture's level is uploaded whole at once; the others span by span as frames need them
     // (the refinement at rest spreads its level's upload over frames).
     r = std::make_unique<Renderer>(files_, detail_.span_texels, level, gpu_memory_, level == first_level_);
+    r->share_indexes(indexes_);
     if (volume_) r->set_volume(*volume_);
     if (selection_) r->set_groups(selection_->groups);
   }

@@ -112,7 +112,7 @@ std::uint64_t GpuScene::span_bytes(std::uint32_t c) const {
   std::uint64_t bytes = 4 * t.words() + 2 * t.order_entries();
   if (dataset_content_ == DatasetContent::StreamlineOrder) bytes += 4 * dataset_per_span_[c].size();
   if (dataset_content_ == DatasetContent::ViewOrder) bytes += 4 * t.segments;
-  if (t.file < attributes_.size() && !attributes_[t.file].empty()) bytes += 8 * t.vertices;
+  if (t.file < attributes_.size()) bytes += 8 * t.vertices;
   return bytes;
 }
 
@@ -147,21 +147,20 @@ void GpuScene::upload_extras(std::uint32_t ci) {
     g.dataset.create(GL_R32UI, dataset_per_span_[ci].data(), dataset_per_span_[ci].size() * 4);
   else  // the view order's entries are written every frame (upload_view_order)
     g.dataset.create(GL_R32UI, nullptr, dataset_content_ == DatasetContent::ViewOrder ? 4 * c.segments : 0);
-  const std::vector<std::uint32_t>* values = c.file < attributes_.size() ? &attributes_[c.file] : nullptr;
-  if (values == nullptr || values->empty()) {
+  if (c.file >= attributes_.size()) {
     g.attributes.create(GL_RG32UI, nullptr, 0);
     return;
   }
-  // Two words per vertex, each voxel's at its block's place in the span (scene_layout.h).
+  // Two words per vertex, each voxel's at its block's place in the span (scene_layout.h), made here so that
+  // only what is uploaded is made.
   const VxlFile& file = *files_[c.file];
   const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
   std::vector<std::uint32_t> padded(2 * c.vertices, 0);
-  for (std::uint32_t k = 0; k < c.voxel_count; ++k) {
+  parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned) {
     const VoxelDrawInfo& d = layout_.voxels()[c.voxel_first + k];
-    const VoxelEntry& v = file.voxels()[c.voxel_first + k - file_first];
-    std::copy_n(values->data() + 2 * v.vertex_first, 2 * std::uint64_t(d.vertex_count),
-                padded.data() + 2 * d.vertex_first);
-  }
+    voxel_attributes(file, c.voxel_first + k - file_first, attributes_[c.file], d.vertex_count,
+                     padded.data() + 2 * std::uint64_t(d.vertex_first));
+  });
   g.attributes.create(GL_RG32UI, padded.data(), padded.size() * 4);
 }
 
@@ -235,7 +234,7 @@ void GpuScene::release() {
   }
 }
 
-void GpuScene::upload_attributes(std::vector<std::vector<std::uint32_t>> per_file) {
+void GpuScene::upload_attributes(std::vector<AttributeSource> per_file) {
   attributes_ = std::move(per_file);
   upload_resident_again();
 }

@@ -24,6 +24,7 @@
 #include "viewer/render/gl_util.h"
 #include "viewer/render/gpu_memory_pool.h"
 #include "viewer/render/scene_layout.h"
+#include "viewer/render/vertex_attributes.h"
 
 namespace vxl {
 
@@ -69,10 +70,10 @@ class GpuScene {
   Residency make_resident(std::span<const std::uint32_t> needed,
                           double max_ms = std::numeric_limits<double>::infinity());
 
-  // Gives every span its vertices' share of its file's `per_file` entry (2 words per vertex of that file,
-  // vertex_attributes.h) as its attribute buffer; an empty vector empties them. Resident spans are uploaded
-  // again (their size changes).
-  void upload_attributes(std::vector<std::vector<std::uint32_t>> per_file);
+  // Gives every span an attribute buffer of 2 words per vertex made from its file's `per_file` entry
+  // (vertex_attributes.h) as the span is uploaded; an empty vector empties them. Resident spans are
+  // uploaded again (their size changes).
+  void upload_attributes(std::vector<AttributeSource> per_file);
 
   // Streamline-order draw ranges for the `unsorted` mode, built on first use (O(segments)), and again after
   // the view order replaced them; each span's dataset array joins its upload.
@@ -110,7 +111,7 @@ class GpuScene {
   std::vector<bool> resident_;
   std::vector<std::uint64_t> uploaded_bytes_;  // per resident span, as the pool counts it
   std::uint64_t gpu_bytes_ = 0;
-  std::vector<std::vector<std::uint32_t>> attributes_;  // per file, as upload_attributes got them
+  std::vector<AttributeSource> attributes_;  // per file, as upload_attributes got them; empty: none
   enum class DatasetContent { Nothing, StreamlineOrder, ViewOrder };
   DatasetContent dataset_content_ = DatasetContent::Nothing;
   // Switches the dataset buffers' content: the resident spans are uploaded again with it.

@@ -27,7 +27,8 @@ Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, 
                    std::shared_ptr<GpuMemoryPool> pool, bool eager)
     : files_(files.empty() ? throw Error(ErrorKind::Usage, "", std::nullopt, "Renderer: no files") : files),
       scene_(files_, max_texels, level, std::move(pool), eager),
-      groups_(files_) {
+      groups_(files_),
+      indexes_(std::make_shared<VoxelVoxlinesCache>(files_)) {
   const VxlFile& file = *files_.front();
   for (const VxlFile* f : files_)
     for (const ValueSets* sets : {&f->vertex_values(), &f->streamline_values()})
@@ -301,13 +302,18 @@ void Renderer::prepare_attributes(const RenderSettings& s) {
   for (std::size_t g = 0; g < groups.size(); ++g) want_groups |= s.group_color(groups[g].name, g).a != 1.0f;
   const std::string key = name.empty() && !want_groups ? "" : "value:" + name;
   if (key != attributes_key_) {
-    std::vector<std::vector<std::uint32_t>> per_file;
+    std::vector<AttributeSource> per_file;
     std::uint64_t first_streamline = 0;
     if (!key.empty())
-      for (const VxlFile* f : files_) {
-        per_file.push_back(vertex_attributes(*f, name.empty() ? ValueSource{} : find_value_set(*f, name),
-                                             static_cast<std::uint32_t>(first_streamline)));
-        first_streamline += f->meta().streamline_count;
+      for (std::size_t i = 0; i < files_.size(); ++i) {
+        const VoxelVoxlines* index = indexes_->of(i);
+        if (index == nullptr)
+          throw Error(ErrorKind::Unsupported, files_[i]->path(), std::nullopt,
+                      "colour or opacity by value or group needs the voxel index of voxlines, which holds fewer than "
+                      "2^32 streamlines and voxlines of fewer than 2^26 points");
+        per_file.push_back({name.empty() ? ValueSource{} : find_value_set(*files_[i], name),
+                            static_cast<std::uint32_t>(first_streamline), index});
+        first_streamline += files_[i]->meta().streamline_count;
       }
     scene_.upload_attributes(std::move(per_file));
     attributes_key_ = key;

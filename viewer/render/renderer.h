@@ -61,6 +61,10 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
+  // The files' per-voxel indexes (the vertices' streamlines for colour and opacity by group), shared with
+  // other users of the same files (the window's selections) so that they are built once.
+  void share_indexes(std::shared_ptr<VoxelVoxlinesCache> indexes) { indexes_ = std::move(indexes); }
+
   // Renders one frame into framebuffer `fbo` (0: the default one) of size width x height.
   // Throws std::runtime_error when the mode needs more than the context offers (exact on GL < 4.3).
   void draw(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
@@ -204,6 +208,7 @@ class Renderer {
   SceneGroups groups_;
   std::vector<std::string> value_set_names_;
   std::string attributes_key_;  // what the attribute buffers hold ("" : nothing)
+  std::shared_ptr<VoxelVoxlinesCache> indexes_;
   // One byte per streamline of the scene (the files' streamlines one after another): its group mod the
   // shader's group table. A new selection or grouping uploads this alone, not the per-vertex attributes.
   gl::TextureBuffer streamline_groups_;

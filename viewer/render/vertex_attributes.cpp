@@ -2,8 +2,10 @@
 
 #include <bit>
 #include <limits>
+#include <vector>
 
-#include "format/vxl_streamlines.h"
+#include "format/error.h"
+#include "format/vxl_levels.h"
 
 namespace vxl {
 
@@ -15,32 +17,45 @@ ValueSource find_value_set(const VxlFile& file, const std::string& name) {
   return {};
 }
 
-std::vector<std::uint32_t> vertex_attributes(const VxlFile& file, const ValueSource& source,
-                                             std::uint32_t first_streamline) {
-  const std::uint64_t v = file.meta().vertex_count;
-  std::vector<std::uint32_t> out(2 * v, 0);
-  if (source.kind == ValueSource::Kind::Vertex) {
-    const std::span<const float> values = file.vertex_values().values(source.set);
-    for (std::uint64_t i = 0; i < v; ++i) out[2 * i] = std::bit_cast<std::uint32_t>(values[i]);
-  } else {
-    const std::uint32_t none = std::bit_cast<std::uint32_t>(std::numeric_limits<float>::quiet_NaN());
-    for (std::uint64_t i = 0; i < v; ++i) out[2 * i] = none;
-  }
-  // Per-streamline values and numbers: every vertex of a voxline belongs to the streamline being walked.
-  const std::span<const float> per_streamline = source.kind == ValueSource::Kind::Streamline
-                                                    ? file.streamline_values().values(source.set)
+void voxel_attributes(const VxlFile& file, std::size_t voxel, const AttributeSource& source, std::uint32_t vertices,
+                      std::uint32_t* out) {
+  const VoxelEntry& v = file.voxels()[voxel];
+  const std::uint32_t none = std::bit_cast<std::uint32_t>(std::numeric_limits<float>::quiet_NaN());
+  for (std::uint32_t i = 0; i < vertices; ++i) out[2 * i] = none, out[2 * i + 1] = source.first_streamline;
+  const std::span<const float> per_vertex = source.values.kind == ValueSource::Kind::Vertex
+                                                ? file.vertex_values().values(source.values.set)
+                                                : std::span<const float>{};
+  const std::span<const float> per_streamline = source.values.kind == ValueSource::Kind::Streamline
+                                                    ? file.streamline_values().values(source.values.set)
                                                     : std::span<const float>{};
-  WalkCallbacks cb;
-  cb.voxline = [&](const VoxlineVisit& visit) {
-    const std::uint64_t end = visit.first_vertex + visit.own_points + (visit.connected ? 1 : 0);
-    const auto number = static_cast<std::uint32_t>(first_streamline + visit.streamline);
-    for (std::uint64_t i = visit.first_vertex; i < end; ++i) {
-      if (!per_streamline.empty()) out[2 * i] = std::bit_cast<std::uint32_t>(per_streamline[visit.streamline]);
+  if (!per_vertex.empty())
+    for (std::uint32_t i = 0; i < vertices; ++i)
+      out[2 * i] = std::bit_cast<std::uint32_t>(per_vertex[v.vertex_first + i]);
+
+  // The voxel's voxlines lie in its block by depth, deepest first, then in streamline order (spec §5.4):
+  // one cursor per depth, walked along the voxel's list.
+  const std::uint32_t levels = file.level_count();
+  const auto row = file.levels_of(voxel);
+  std::vector<std::uint64_t> cursor(levels), end(levels);
+  for (std::uint32_t d = 0; d < levels; ++d)
+    cursor[d] = depth_first_vertex(row, d), end[d] = depth_end_vertex(v, row, d);
+  for (const IndexedVoxline& e : source.index->of_voxel(voxel)) {
+    const std::uint32_t d = e.depth();
+    const std::uint64_t need = std::uint64_t(e.own()) + ((e.bits & IndexedVoxline::kLastOfStreamline) ? 0 : 1);
+    if (d >= levels || cursor[d] > end[d] || need > end[d] - cursor[d])
+      fail_input(file.path(), file.find_section(section_id("VOXT"))->offset + sizeof(VoxelEntry) * voxel,
+                 "the voxel's voxlines run past its vertex block (or a level's part of it)");
+    const std::uint64_t first = cursor[d];
+    cursor[d] += need;
+    if (first >= vertices) continue;  // beyond the prefix drawn
+    const std::uint32_t number = source.first_streamline + e.streamline;
+    const std::uint32_t value =
+        per_streamline.empty() ? none : std::bit_cast<std::uint32_t>(per_streamline[e.streamline]);
+    for (std::uint64_t i = first; i < std::min<std::uint64_t>(first + need, vertices); ++i) {
+      if (!per_streamline.empty()) out[2 * i] = value;
       out[2 * i + 1] = number;
     }
-  };
-  walk_streamlines(file, cb);
-  return out;
+  }
 }
 
 }  // namespace vxl

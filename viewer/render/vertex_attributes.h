@@ -1,15 +1,15 @@
 // What the line shader reads per vertex besides its position when colouring by value or by group: two
 // 32-bit words, (value as float bits, streamline number in the scene). The group of a streamline is not
 // here but in a table of one byte per streamline (Renderer), so that a new selection or grouping uploads
-// that table alone and the per-vertex words stay: built on the CPU only when a colour mode or a group's
-// opacity first needs them, from the file's value sets (VVAL as it is; SVAL and the streamline numbers
-// spread to the vertices by a walk of the voxline table, spec §5.6).
+// that table alone. The words are made voxel by voxel as a span is uploaded, so that their cost follows
+// what is drawn (a coarse level, the spans a GPU budget holds): each vertex's streamline comes from the
+// voxel's list of voxlines (VoxelVoxlines), values from VVAL as it is or SVAL through the streamline.
 #pragma once
 
 #include <cstdint>
 #include <string>
-#include <vector>
 
+#include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
 
 namespace vxl {
@@ -23,9 +23,17 @@ struct ValueSource {
 // The set called `name` in `file`, per-vertex sets first; Kind::None when it has none of that name.
 ValueSource find_value_set(const VxlFile& file, const std::string& name);
 
-// 2 * vertex_count words: per vertex the bits of its value (a NaN where `source` is None) and
-// `first_streamline` + the number of its streamline in the file.
-std::vector<std::uint32_t> vertex_attributes(const VxlFile& file, const ValueSource& source,
-                                             std::uint32_t first_streamline);
+// Where one file's words come from.
+struct AttributeSource {
+  ValueSource values;
+  std::uint32_t first_streamline = 0;    // the number of the file's streamline 0 in the scene
+  const VoxelVoxlines* index = nullptr;  // the file's
+};
+
+// The first `vertices` vertices of voxel `voxel`'s block (a level's prefix, or all of it), 2 words each,
+// into `out`: the bits of the value (a NaN where the source has none) and the streamline's number.
+// Throws vxl::Error (Input) naming the voxel's table entry when its voxlines run past its block.
+void voxel_attributes(const VxlFile& file, std::size_t voxel, const AttributeSource& source, std::uint32_t vertices,
+                      std::uint32_t* out);
 
 }  // namespace vxl

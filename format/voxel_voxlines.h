@@ -6,10 +6,12 @@
 // sequentially, never jumping back into VXLN or STRM: 8 bytes a voxline plus 8 a voxel, built once per
 // file in one pass over both tables (a counting sort) and reused by every query. The viewer builds it
 // when the first region appears, so that a region moved across a large file is re-selected from the
-// voxels it touches alone.
+// voxels it touches alone; its renderers find each vertex's streamline through it too.
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <vector>
@@ -47,6 +49,21 @@ class VoxelVoxlines {
  private:
   std::vector<std::uint64_t> first_;  // voxel_count + 1: where each voxel's list starts in entries_
   std::vector<IndexedVoxline> entries_;
+};
+
+// The indexes of several files, each built on first use, once, by whichever thread asks first (the
+// window's selection thread or its renderer); the others wait for it.
+class VoxelVoxlinesCache {
+ public:
+  explicit VoxelVoxlinesCache(std::vector<const VxlFile*> files);
+  // File `file`'s index; null when the file is too large for one. Rethrows the build's error (and builds
+  // again at the next call).
+  const VoxelVoxlines* of(std::size_t file);
+
+ private:
+  std::vector<const VxlFile*> files_;
+  std::unique_ptr<std::once_flag[]> once_;
+  std::vector<std::optional<VoxelVoxlines>> indexes_;
 };
 
 }  // namespace vxl

@@ -1,4 +1,4 @@
-#include "converter/selection/voxel_voxlines.h"
+#include "format/voxel_voxlines.h"
 
 #include <algorithm>
 #include <limits>
@@ -88,6 +88,14 @@ std::optional<VoxelVoxlines> VoxelVoxlines::build(const VxlFile& file, unsigned 
     }
   });
   return index;
+}
+
+VoxelVoxlinesCache::VoxelVoxlinesCache(std::vector<const VxlFile*> files)
+    : files_(std::move(files)), once_(new std::once_flag[files_.size()]), indexes_(files_.size()) {}
+
+const VoxelVoxlines* VoxelVoxlinesCache::of(std::size_t file) {
+  std::call_once(once_[file], [&] { indexes_[file] = VoxelVoxlines::build(*files_[file]); });
+  return indexes_[file] ? &*indexes_[file] : nullptr;
 }
 
 }  // namespace vxl

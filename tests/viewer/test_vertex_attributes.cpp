@@ -1,0 +1,87 @@
+// The line shader's per-vertex words (vertex_attributes.h), made voxel by voxel from the voxel's list of
+// voxlines: at every level's prefix they are what a walk of the whole voxline table gives (spec §5.6) — the
+// streamline's number in the scene, and its value from VVAL or SVAL.
+#include <bit>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "converter/convert.h"
+#include "converter/synth.h"
+#include "format/vxl_streamlines.h"
+#include "tests/hostile_vxl.h"
+#include "tests/test_support.h"
+#include "viewer/render/vertex_attributes.h"
+
+namespace vxl {
+namespace {
+
+// Per vertex, its streamline, from a walk of the voxline table in streamline order.
+std::vector<std::uint64_t> streamline_of_vertex(const VxlFile& f) {
+  std::vector<std::uint64_t> of(f.meta().vertex_count, ~0ull);
+  WalkCallbacks cb;
+  cb.voxline = [&](const VoxlineVisit& v) {
+    for (std::uint64_t i = v.first_vertex; i < v.first_vertex + v.own_points + (v.connected ? 1 : 0); ++i)
+      of[i] = v.streamline;
+  };
+  walk_streamlines(f, cb);
+  return of;
+}
+
+TEST(VertexAttributes, EveryLevelsPrefixHoldsTheStreamlinesTheWalkGives) {
+  test::ScratchDir dir;
+  SynthSettings synth;
+  synth.streamlines = 1500;
+  ConvertSettings c;
+  c.voxel_size = 6;
+  c.levels = 4;
+  c.threads = 2;
+  convert_tractogram(synthesize_tractogram(synth), dir.file("s.vxl"), c);
+  const VxlFile f = VxlFile::open(dir.file("s.vxl"));
+  ASSERT_GT(f.level_count(), 1u);
+  const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f, 2);
+  ASSERT_TRUE(index.has_value());
+  const std::vector<std::uint64_t> expected = streamline_of_vertex(f);
+  const AttributeSource source{{}, 1000, &*index};  // as the second file of a scene, after 1000 streamlines
+  std::uint64_t checked = 0;
+  for (std::size_t v = 0; v < f.voxels().size(); ++v)
+    for (std::uint32_t level = 0; level < f.level_count(); ++level) {
+      const std::uint32_t n = f.level(v, level).vertex_count;
+      std::vector<std::uint32_t> words(2 * std::size_t(n) + 2, 0xABCDEF01u);
+      voxel_attributes(f, v, source, n, words.data());
+      EXPECT_EQ(words[2 * n], 0xABCDEF01u) << "wrote past the prefix";
+      for (std::uint32_t i = 0; i < n; ++i) {
+        ASSERT_EQ(words[2 * i + 1], 1000 + expected[f.voxels()[v].vertex_first + i])
+            << "voxel " << v << " level " << level << " vertex " << i;
+        ASSERT_TRUE(std::isnan(std::bit_cast<float>(words[2 * i])));  // no value set asked for
+      }
+      checked += n;
+    }
+  EXPECT_GT(checked, f.meta().vertex_count);  // the coarse levels too
+}
+
+TEST(VertexAttributes, ValuesComeFromVvalAsTheyAreAndFromSvalThroughTheStreamline) {
+  test::ScratchDir dir;
+  const test::VxlBytes b = test::VxlBytes::make(dir.file("h.vxl"));
+  const VxlFile f = VxlFile::open(dir.file("h.vxl"));
+  const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f, 1);
+  ASSERT_TRUE(index.has_value());
+  const std::vector<std::uint64_t> streamline = streamline_of_vertex(f);
+  const ValueSource fa = find_value_set(f, "fa"), length = find_value_set(f, "length");
+  ASSERT_EQ(fa.kind, ValueSource::Kind::Vertex);
+  ASSERT_EQ(length.kind, ValueSource::Kind::Streamline);
+  for (std::size_t v = 0; v < f.voxels().size(); ++v) {
+    const VoxelEntry& e = f.voxels()[v];
+    std::vector<std::uint32_t> per_vertex(2 * e.vertex_count), per_streamline(2 * e.vertex_count);
+    voxel_attributes(f, v, {fa, 0, &*index}, e.vertex_count, per_vertex.data());
+    voxel_attributes(f, v, {length, 0, &*index}, e.vertex_count, per_streamline.data());
+    for (std::uint32_t i = 0; i < e.vertex_count; ++i) {
+      const std::uint64_t g = e.vertex_first + i;
+      EXPECT_EQ(std::bit_cast<float>(per_vertex[2 * i]), f.vertex_values().values(fa.set)[g]);
+      EXPECT_EQ(std::bit_cast<float>(per_streamline[2 * i]), f.streamline_values().values(length.set)[streamline[g]]);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace vxl
