@@ -3,6 +3,11 @@
 #include <chrono>
 #include <exception>
 
+#if defined(__linux__)
+#include <sys/resource.h>
+#include <unistd.h>
+#endif
+
 namespace vxl::app {
 
 SelectionWorker::SelectionWorker(std::vector<const VxlFile*> files, std::shared_ptr<VoxelVoxlinesCache> indexes)
@@ -21,6 +26,11 @@ void SelectionWorker::request(std::uint64_t revision, SelectionCriteria criteria
 
 void SelectionWorker::start(std::uint64_t revision, SelectionCriteria criteria) {
   running_ = std::async(std::launch::async, [this, revision, criteria = std::move(criteria)] {
+#if defined(__linux__)
+    // Below the window's thread (and the software rasteriser's, where there is no GPU), so that the frames
+    // keep their budget on a machine with few cores; the threads the selection starts inherit it.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
+#endif
     Done done;
     done.revision = revision;
     const auto t0 = std::chrono::steady_clock::now();
