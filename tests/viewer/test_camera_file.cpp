@@ -92,15 +92,26 @@ TEST(CameraFile, RoundTripsEveryFieldExactly) {
 }
 
 // A view with a selection keeps its regions; one without writes no "selection" key.
-TEST(CameraFile, TheSelectionsRegionsRoundTrip) {
+TEST(CameraFile, TheSelectionsRegionsAndTheirShellsRoundTrip) {
   SavedView a = unusual_view();
   a.include = {"-9,-23,-30,6", "box:0,0,0,1,1,1"};
   a.exclude = {"atlas.nii.gz:3"};
   a.ends_in = {"1,2,3,4"};
+  a.show_regions = true;
   const SavedView b = app::parse_view_json(app::view_json(a), "mem.json");
   EXPECT_EQ(b.include, a.include);
   EXPECT_EQ(b.exclude, a.exclude);
   EXPECT_EQ(b.ends_in, a.ends_in);
+  EXPECT_EQ(b.show_regions, std::optional<bool>(true));
+  // A file written before the key existed says nothing; a wrong type names the key.
+  EXPECT_FALSE(app::parse_view_json(R"({"voxview_view": 1, "selection": {"include": ["1,2,3,4"]}})", "old.json")
+                   .show_regions.has_value());
+  try {
+    app::parse_view_json(R"({"voxview_view": 1, "selection": {"show_regions": 1}})", "bad.json");
+    ADD_FAILURE() << "a number was taken for show_regions";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("selection.show_regions"), std::string::npos) << e.what();
+  }
   EXPECT_EQ(app::view_json(unusual_view()).find("selection"), std::string::npos);
   try {
     app::parse_view_json(R"({"voxview_view": 1, "selection": {"include": [3]}})", "bad.json");

@@ -168,7 +168,7 @@ TEST_F(FocusContext, VoxviewSelectsFromTheCommandLine) {
 }
 
 // A saved view keeps the selection: replayed without any region on the command line, the same picture.
-TEST_F(FocusContext, ASavedViewKeepsTheSelection) {
+TEST_F(FocusContext, ASavedViewKeepsTheSelectionAndItsShells) {
   make_scene(dir, crossing_lines(), 10.0, "lines.vxl");
   const std::string in = test::q(dir.file("lines.vxl"));
   const test::CommandResult save =
@@ -181,6 +181,24 @@ TEST_F(FocusContext, ASavedViewKeepsTheSelection) {
   ASSERT_EQ(replay.exit_code, 0) << replay.output;
   EXPECT_NE(replay.output.find("1 of 2 streamlines selected"), std::string::npos) << replay.output;
   EXPECT_EQ(test::slurp(dir.file("a.png")), test::slurp(dir.file("b.png")));
+
+  // With the shells drawn, the view says so and its replay draws them too; without, it does not.
+  const test::CommandResult shells =
+      test::run_program(VOXVIEW_CLI, in + " --render " + test::q(dir.file("c.png")) +
+                                         " --size 64x64 --include 0.5,20.5,-10,8 --show-regions --save-camera " +
+                                         test::q(dir.file("w.json")));
+  ASSERT_EQ(shells.exit_code, 0) << shells.output;
+  auto text = [&](const char* name) {
+    const std::vector<char> bytes = test::slurp(dir.file(name));
+    return std::string(bytes.begin(), bytes.end());
+  };
+  EXPECT_NE(text("w.json").find("\"show_regions\": true"), std::string::npos);
+  const test::CommandResult again = test::run_program(
+      VOXVIEW_CLI, in + " --render " + test::q(dir.file("d.png")) + " --camera " + test::q(dir.file("w.json")));
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(test::slurp(dir.file("c.png")), test::slurp(dir.file("d.png")));
+  EXPECT_NE(test::slurp(dir.file("c.png")), test::slurp(dir.file("a.png")));
+  EXPECT_NE(text("v.json").find("\"show_regions\": false"), std::string::npos);
 }
 
 }  // namespace

@@ -248,7 +248,10 @@ std::string view_json(const SavedView& v) {
                    {"slab_mm", s.clipping.slab_mm},
                    {"clip", clip}};
   if (!v.include.empty() || !v.exclude.empty() || !v.ends_in.empty())
-    j["selection"] = {{"include", v.include}, {"exclude", v.exclude}, {"ends_in", v.ends_in}};
+    j["selection"] = {{"include", v.include},
+                      {"exclude", v.exclude},
+                      {"ends_in", v.ends_in},
+                      {"show_regions", v.show_regions.value_or(false)}};
   return j.dump(2) + "\n";
 }
 
@@ -286,6 +289,10 @@ SavedView parse_view_json(const std::string& text, const std::string& path, cons
         r.fail(key, "an array of regions as voxlines select takes them (\"X,Y,Z,R\", \"box:...\", \"FILE.nii.gz\")");
       list->clear();
       for (const json& x : *regions) list->push_back(x.get<std::string>());
+    }
+    if (const json* shown = r.find("show_regions")) {
+      if (!shown->is_boolean()) r.fail("show_regions", "true or false");
+      v.show_regions = shown->get<bool>();
     }
   }
   return v;

@@ -15,12 +15,12 @@
 //                  "line_width": 1, "background": "black", "lighting": false, "orientation_labels": false,
 //                  "colorbar": false, "order_hysteresis": 0,
 //                  "slab_mm": 0, "clip": [{"plane": "-x,10", "enabled": true}]},
-//     "selection": {"include": ["-9,-23,-30,6"], "exclude": [], "ends_in": []}
+//     "selection": {"include": ["-9,-23,-30,6"], "exclude": [], "ends_in": [], "show_regions": true}
 //   }
 //
 // "background" takes what --background takes (a name, "#RRGGBB" or "R,G,B"; background_color.h).
 // "selection" (the regions of voxview --include, --exclude, --ends-in and of the window) is written only
-// when there are regions.
+// when there are regions; "show_regions": whether their shells were drawn (the window's B, --show-regions).
 //
 // Numbers are written with enough digits to read back the same double or float. On reading, a missing key
 // keeps its default (a hand-written file may give only what it changes) and unknown keys are ignored (a
@@ -44,6 +44,7 @@ struct SavedView {
   std::optional<std::array<int, 2>> size;  // width, height
   bool has_camera = true;                  // false: the file has no "camera", and the view is framed as without one
   std::vector<std::string> include, exclude, ends_in;  // the selection's regions, as voxlines select takes them
+  std::optional<bool> show_regions;                    // their shells drawn; none: not said (older files)
 };
 
 // A slab thickness that draws something: 0 (no slab), or within ViewLimits; and the range in words.

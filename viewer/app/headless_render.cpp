@@ -104,7 +104,7 @@ int run_headless(const ViewerOptions& o) {
   target.bind();
   if (o.save_camera)
     write_view(*o.save_camera, SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}, true, o.include,
-                                         o.exclude, o.ends_in});
+                                         o.exclude, o.ends_in, o.show_regions});
   const int frames = std::max(1, o.turntable);
   std::optional<PictureAnnotations> annotations;
   if (PictureAnnotations::wanted(o.settings)) annotations.emplace();

@@ -42,6 +42,9 @@ void apply_saved_view(const ViewerArguments& a, ViewerOptions& o, std::string& s
     o.include = saved.include;
     o.exclude = saved.exclude;
     o.ends_in = saved.ends_in;
+    // Their shells as they were drawn, unless the command line asks for them.
+    o.saved_show_regions = saved.show_regions;
+    if (saved.show_regions && !a.was_given("--show-regions")) o.show_regions = *saved.show_regions;
   }
   // What the file names and the command line does not replace is checked against the scene as the file's.
   ViewFileSettings& from_file = o.from_view_file;

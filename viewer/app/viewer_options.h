@@ -69,6 +69,8 @@ struct ViewerOptions {
   // Headless: draw the regions' spheres and boxes as translucent shells (region_shells.h). The window
   // shows them unless the user hides them (H, the panel).
   bool show_regions = false;
+  // A saved view's choice of shells (--camera): the window starts with it (else it shows them).
+  std::optional<bool> saved_show_regions;
   ViewFileSettings from_view_file;
 };
 

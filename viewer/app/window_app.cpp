@@ -297,6 +297,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
       startup_(startup),
       rest_(false, o.exact_when_still),
       controller_(Camera{}, 1.0) {
+  if (o.saved_show_regions) state_.show_regions = *o.saved_show_regions;  // as the saved view had them
   stats_.detail = describe_scene_detail(detail_, SceneLayout::coarsest_level(pointers(files)) + 1);
   if (!stats_.detail.empty()) std::fprintf(stderr, "voxview: %s\n", stats_.detail.c_str());
   std::vector<std::uint64_t> segments(SceneLayout::coarsest_level(files_) + 1, 0);
@@ -807,7 +808,8 @@ void ViewerWindow::save_screenshot(const std::string& path, int width, int heigh
 void ViewerWindow::save_view(int width, int height) {
   const std::string path = options_.save_camera.value_or(stamped_name("voxview-view-", ".json").string());
   try {
-    SavedView view{controller_.camera(), state_.settings, std::array<int, 2>{width, height}, true, {}, {}, {}};
+    SavedView view{controller_.camera(), state_.settings, std::array<int, 2>{width, height}, true, {}, {}, {},
+                   state_.show_regions};
     // Without regions the focus and context groups are gone: a view naming them would not replay.
     if (regions_.empty())
       std::erase_if(view.settings.group_styles, [](const GroupStyle& g) {
