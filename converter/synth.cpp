@@ -256,11 +256,15 @@ BundleSpec arched_curve(Rng& rng, V3 a, V3 b, double bend) {
   const V3 dir = (1.0 / len) * chord;
   const V3 u = random_unit(rng);
   const V3 side = normalized(u - dot(u, dir) * dir);
+  // One draw per statement: the operands of + are unsequenced, and GCC (right to left) and Clang (left to
+  // right) took the two draws of `a + ... + push * side + jitter` in opposite orders. This is GCC's order,
+  // the one the pinned outputs were made with.
+  for (int k = 1; k <= 2; ++k) {
+    const V3 jitter = random_perpendicular(rng, dir, 0.1 * len);
+    const double push = bend * len * rng.uniform(0.8, 1.0);
+    spec.p[k] = a + (k / 3.0) * chord + push * side + jitter;
+  }
   spec.p[0] = a;
-  spec.p[1] =
-      a + (1.0 / 3.0) * chord + (bend * len * rng.uniform(0.8, 1.0)) * side + random_perpendicular(rng, dir, 0.1 * len);
-  spec.p[2] =
-      a + (2.0 / 3.0) * chord + (bend * len * rng.uniform(0.8, 1.0)) * side + random_perpendicular(rng, dir, 0.1 * len);
   spec.p[3] = b;
   return spec;
 }

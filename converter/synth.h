@@ -19,7 +19,8 @@
 // geometry uses only + - * / and sqrt (IEEE correctly rounded) and our own log, so results are
 // bit-identical on any IEEE-754 platform as long as the compiler does not contract a*b+c into FMA
 // (GCC in ISO mode -std=c++20 does not; for Clang the source turns contraction off itself) and does not
-// use x87 excess precision (32-bit x86 without SSE2).
+// use x87 excess precision (32-bit x86 without SSE2). Two random draws never share one expression
+// (operands of + are unsequenced: GCC and Clang take them in opposite orders).
 //
 // Prefix property: streamline i depends only on (seed, i) (the bundle layout depends only on seed), so
 // the first K streamlines of a set of N >= K are exactly the K streamlines of a set of K.

@@ -24,6 +24,7 @@
 #include "format/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_verify.h"
+#include "tests/address_sanitizer.h"
 #include "tests/mrtrix_test_files.h"
 #include "tests/test_support.h"
 
@@ -484,7 +485,7 @@ TEST(StreamingConvert, AConversionKilledAtAnyMomentLeavesNoOutput) {
 // /proc/self/status (VmHWM): a parent's wait4() would also count this test process, which the child
 // was a copy of until exec().
 TEST(StreamingConvert, PeakResidentMemoryStaysUnderTheLimit) {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(VOXLINES_ADDRESS_SANITIZER)
   GTEST_SKIP() << "AddressSanitizer's shadow memory and quarantine make resident memory meaningless";
 #else
   ScratchDir dir;

@@ -352,7 +352,7 @@ TEST(Voxview, ColourSettingsFromAViewFileAreTheFilesErrors) {
     EXPECT_NE(r.output.find("v.json: " + message), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("in " + vxl), std::string::npos) << r.output;
   }
-  for (const std::string& option : {"--scalar fa", "--group CST=:0.5", "--color scalar"}) {
+  for (const std::string option : {"--scalar fa", "--group CST=:0.5", "--color scalar"}) {
     const auto r = test::run_program(VOXVIEW_CLI, test::q(vxl) + " " + option + " --render " + test::q(png));
     EXPECT_EQ(r.exit_code, 2) << option << ": " << r.output;
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <utility>
 
 namespace vxl::app {
 
@@ -18,7 +19,12 @@ const char* EditorRegion::role_name() const {
 
 RegionEditor::RegionEditor(const ViewerOptions& o) {
   auto add = [&](const std::vector<std::string>& texts, EditorRegion::Role role) {
-    for (const std::string& t : texts) regions_.push_back({role, t, std::nullopt, 0, 0});
+    for (const std::string& t : texts) {
+      EditorRegion r;
+      r.role = role;
+      r.text = t;
+      regions_.push_back(std::move(r));
+    }
   };
   add(o.include, EditorRegion::Role::Include);
   add(o.exclude, EditorRegion::Role::Exclude);
@@ -51,7 +57,11 @@ void RegionEditor::parse_all() {
 }
 
 void RegionEditor::add_sphere(const std::array<double, 3>& centre, double radius) {
-  regions_.push_back({EditorRegion::Role::Include, "", centre, radius, 0});
+  EditorRegion r;  // fields by name: a brace list would have to spell out every later member
+  r.role = EditorRegion::Role::Include;
+  r.centre = centre;
+  r.radius = radius;
+  regions_.push_back(std::move(r));
   parsed_.emplace_back();
   active_ = regions_.size() - 1;
   ++revision_;
