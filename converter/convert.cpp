@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <memory>
 
 #include "converter/position_packing.h"
 #include "converter/segment_orders.h"
@@ -135,10 +136,12 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   finish_value_sets(out.streamline_values());
   // Pass 2 writes all over these: fault them in first, in bulk (ORDR waits until the source is freed).
   // Packed positions are placed as floats first (orders are built from them), then packed into VERT.
-  std::vector<float> float_blocks(packed ? 3 * meta.vertex_count : 0);
-  const std::span<float> vertices = packed ? std::span<float>(float_blocks) : out.float_vertices();
-  for (std::span<std::uint8_t> s : {bytes_of(out.float_vertices()), bytes_of(out.packed_vertices()),
-                                    bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
+  // Not zeroed: every float is placed before it is read.
+  const std::size_t float_count = packed ? 3 * meta.vertex_count : 0;
+  std::unique_ptr<float[]> float_blocks = std::make_unique_for_overwrite<float[]>(float_count);
+  const std::span<float> vertices = packed ? std::span<float>(float_blocks.get(), float_count) : out.float_vertices();
+  for (std::span<std::uint8_t> s : {bytes_of(vertices), bytes_of(out.packed_vertices()), bytes_of(out.voxlines()),
+                                    bytes_of(out.streamline_first_voxline())})
     prefault_for_write(s, threads);
   VoxelBlocks blocks{out.voxels(), out.levels(), vertices, out.voxlines(), out.streamline_first_voxline(), {}};
   blocks.vertex_values = layout_value_sets(out.vertex_values(), point_set_names, meta.vertex_count);
@@ -151,7 +154,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   prefault_for_write(out.orders(), threads);
   build_orders_into(out.voxels(), out.levels(), levels, vertices, ends, order_set, out.orders(), threads,
                     settings.progress);
-  float_blocks = {};
+  float_blocks.reset();
   summary.orders_seconds = seconds_since(t0);
 
   if (settings.progress) settings.progress("writing", 0.0);

@@ -6,7 +6,7 @@
 // file, never a partial file at the output path).
 //
 // The data is either appended with write() or, when its size is known up front, filled in place through
-// map(): the caller writes straight into the page cache, with no intermediate buffer and no copy.
+// map(): the caller writes into memory of the file's size, which commit() writes past the page cache.
 #pragma once
 
 #include <cstddef>
@@ -34,10 +34,10 @@ class AtomicOutputFile {
   void pread(void* data, std::size_t size, std::uint64_t offset);
   std::uint64_t position() const { return position_; }
 
-  // Sizes the still empty file to `size` bytes and maps it read-write (MAP_SHARED). Every byte reads as
-  // zero until written. The disk space is reserved here where the file system allows it, so a full disk
-  // is an Error now rather than a SIGBUS while the mapping is filled. Call at most once, before any
-  // write(); the span stays valid until commit() or destruction.
+  // Sizes the still empty file to `size` bytes and returns `size` bytes of memory, all zero, that commit()
+  // writes to it (with O_DIRECT for its whole 4 KiB blocks where the file system allows it). The disk space
+  // is reserved here where the file system allows it, so a full disk is an Error now rather than at
+  // commit(). Call at most once, before any write(); the span stays valid until commit() or destruction.
   std::span<std::uint8_t> map(std::uint64_t size);
 
   // Sizes the still empty file to `size` bytes like map(), without mapping it: the caller then fills it
@@ -60,6 +60,7 @@ class AtomicOutputFile {
 
  private:
   [[noreturn]] void fail(const std::string& what) const;
+  void write_mapped();  // writes map()'s memory to the file
   void unmap() noexcept;
   std::string path_;
   std::string target_;     // path_, or where its symbolic links lead
