@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <future>
 
 #include "converter/segment_orders.h"
 #include "converter/voxel_size_auto.h"
@@ -148,6 +149,14 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   summary.voxelize_seconds = seconds_since(t0);
 
   t0 = Clock::now();
+  // What is final now goes to the disk while the orders are built (the write waits on the disk, not on a core).
+  std::future<void> written = std::async(std::launch::async, [&] {
+    for (std::span<std::uint8_t> s :
+         {bytes_of(out.voxels()), bytes_of(out.levels()), bytes_of(out.float_vertices()),
+          bytes_of(out.packed_vertices()), bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline()),
+          out.vertex_values(), out.streamline_values()})
+      out.write_now(s);
+  });
   prefault_for_write(out.orders(), threads);
   if (packed)
     build_orders_into_packed(out.voxels(), out.levels(), levels, out.packed_vertices(), order_set, out.orders(),
@@ -155,6 +164,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   else
     build_orders_into(out.voxels(), out.levels(), levels, out.float_vertices(), ends, order_set, out.orders(), threads,
                       settings.progress);
+  written.get();
   summary.orders_seconds = seconds_since(t0);
 
   if (settings.progress) settings.progress("writing", 0.0);

@@ -1,5 +1,6 @@
 #include "format/atomic_output.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -144,13 +145,28 @@ int AtomicOutputFile::direct_descriptor() {
   return direct_fd_;
 }
 
-void AtomicOutputFile::write_mapped() {
-  // Whole 4 KiB blocks past the page cache where the file system allows it (the mapping is page-aligned),
-  // the rest (and everything, where O_DIRECT is refused) through it.
-  constexpr std::uint64_t kBlock = 4096, kChunk = 64u << 20;
-  std::uint64_t done = 0;
+namespace {
+constexpr std::uint64_t kBlock = 4096;  // what O_DIRECT asks of offsets and sizes (the mapping is page-aligned)
+}  // namespace
+
+void AtomicOutputFile::write_at(int fd, const std::uint8_t* data, std::uint64_t size, std::uint64_t offset) {
+  while (size > 0) {
+    const ssize_t n = ::pwrite(fd, data, size, static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(std::string("write failed: ") + std::strerror(errno));
+    data += n;
+    size -= static_cast<std::uint64_t>(n);
+    offset += static_cast<std::uint64_t>(n);
+  }
+}
+
+void AtomicOutputFile::write_mapped_range(std::uint64_t begin, std::uint64_t end) {
+  // Whole blocks past the page cache where the file system allows it, the rest (and everything, where
+  // O_DIRECT is refused) through it.
+  constexpr std::uint64_t kChunk = 64u << 20;
+  std::uint64_t done = begin;
   if (const int direct = direct_descriptor(); direct >= 0) {
-    const std::uint64_t whole = map_size_ / kBlock * kBlock;
+    const std::uint64_t whole = end / kBlock * kBlock;
     while (done < whole) {
       const ssize_t n = ::pwrite(direct, map_ + done, std::min(kChunk, whole - done), static_cast<off_t>(done));
       if (n < 0 && errno == EINTR) continue;
@@ -159,9 +175,26 @@ void AtomicOutputFile::write_mapped() {
       done += static_cast<std::uint64_t>(n);
     }
   }
-  std::uint8_t* const map = std::exchange(map_, nullptr);  // pwrite() refuses a mapped file
-  pwrite(map + done, map_size_ - done, done);
-  map_ = map;
+  write_at(fd_, map_ + done, end - done, done);
+}
+
+void AtomicOutputFile::write_mapped_now(std::uint64_t offset, std::uint64_t size) {
+  if (map_ == nullptr || offset > map_size_ || size > map_size_ - offset)
+    fail("internal error: write_mapped_now() outside the mapped file");
+  const std::uint64_t begin = (offset + kBlock - 1) / kBlock * kBlock, end = (offset + size) / kBlock * kBlock;
+  if (begin >= end) return;
+  write_mapped_range(begin, end);
+  written_.emplace_back(begin, end);
+}
+
+void AtomicOutputFile::write_mapped() {
+  std::sort(written_.begin(), written_.end());
+  std::uint64_t at = 0;  // block-aligned: 0 or the end of a range written
+  for (const auto& [begin, end] : written_) {
+    if (begin > at) write_mapped_range(at, begin);
+    at = std::max(at, end);
+  }
+  if (at < map_size_) write_mapped_range(at, map_size_);
 }
 
 void AtomicOutputFile::commit() {

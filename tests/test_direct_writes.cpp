@@ -3,6 +3,7 @@
 // file system allows it, and without it. And a streaming conversion whose limit turns direct writes on
 // must still write the in-memory conversion's bytes, whether it holds VERT or writes it block by block.
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -98,6 +99,28 @@ TEST(DirectWrites, AMappedOutputOfAnySizeIsWrittenWholeAtCommit) {
     }
     EXPECT_TRUE(file_bytes(path) == expected) << size << " bytes";
   }
+}
+
+// Parts of a mapped output written early (write_mapped_now, as convert does with the sections that are final while
+// the orders are built: their whole blocks only), the rest at commit(): the file must still be the bytes, whatever
+// the parts' order, overlap and alignment.
+TEST(DirectWrites, AMappedOutputWrittenPartlyEarlyIsWrittenWholeAtCommit) {
+  ScratchDir dir;
+  std::mt19937 rng(11);
+  const std::uint64_t size = 40 * 4096 + 123;
+  std::vector<std::uint8_t> expected(size);
+  for (auto& b : expected) b = static_cast<std::uint8_t>(rng());
+  const std::vector<std::array<std::uint64_t, 2>> parts = {
+      {5 * 4096 + 7, 9000}, {0, 4095}, {30 * 4096, 10 * 4096 + 123}, {2 * 4096, 3 * 4096}, {6 * 4096, 100}};
+  const std::string path = dir.file("early.bin");
+  {
+    AtomicOutputFile out(path);
+    const std::span<std::uint8_t> bytes = out.map(size);
+    std::copy(expected.begin(), expected.end(), bytes.begin());
+    for (const auto& [offset, n] : parts) out.write_mapped_now(offset, n);
+    out.commit();
+  }
+  EXPECT_TRUE(file_bytes(path) == expected);
 }
 
 // All regions open at once and appended in a random interleaving (as the placing pass appends to the
