@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <future>
 
-#include "converter/position_packing.h"
 #include "converter/segment_orders.h"
 #include "converter/voxel_size_auto.h"
 #include "converter/voxel_table.h"
@@ -103,6 +103,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   vs.threads = threads;
   vs.levels = settings.levels;
   vs.progress = settings.progress;
+  vs.pack_positions = settings.positions == PositionEncoding::Packed;
   using Clock = std::chrono::steady_clock;
   auto seconds_since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   ConvertSummary summary;
@@ -134,24 +135,36 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   t.streamline_values.clear();
   finish_value_sets(out.streamline_values());
   // Pass 2 writes all over these: fault them in first, in bulk (ORDR waits until the source is freed).
-  // Packed positions are placed as floats first (orders are built from them), then packed into VERT.
-  std::vector<float> float_blocks(packed ? 3 * meta.vertex_count : 0);
-  const std::span<float> vertices = packed ? std::span<float>(float_blocks) : out.float_vertices();
+  // Packed positions are packed as they are placed (pass 1 found the voxels' bounds), and the orders are
+  // built from the words: no float copy of the blocks.
   for (std::span<std::uint8_t> s : {bytes_of(out.float_vertices()), bytes_of(out.packed_vertices()),
                                     bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
     prefault_for_write(s, threads);
-  VoxelBlocks blocks{out.voxels(), out.levels(), vertices, out.voxlines(), out.streamline_first_voxline(), {}};
+  VoxelBlocks blocks{
+      out.voxels(), out.levels(), out.float_vertices(), out.voxlines(), out.streamline_first_voxline(), {}};
+  if (packed) blocks.packed_vertices = out.packed_vertices();
   blocks.vertex_values = layout_value_sets(out.vertex_values(), point_set_names, meta.vertex_count);
   VoxlineEnds ends = place_vertices(std::move(plan), std::move(t), blocks);
   finish_value_sets(out.vertex_values());
-  if (packed) pack_vertex_blocks(out.voxels(), vertices, ends, out.packed_vertices(), threads);
   summary.voxelize_seconds = seconds_since(t0);
 
   t0 = Clock::now();
+  // What is final now goes to the disk while the orders are built (the write waits on the disk, not on a core).
+  std::future<void> written = std::async(std::launch::async, [&] {
+    for (std::span<std::uint8_t> s :
+         {bytes_of(out.voxels()), bytes_of(out.levels()), bytes_of(out.float_vertices()),
+          bytes_of(out.packed_vertices()), bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline()),
+          out.vertex_values(), out.streamline_values()})
+      out.write_now(s);
+  });
   prefault_for_write(out.orders(), threads);
-  build_orders_into(out.voxels(), out.levels(), levels, vertices, ends, order_set, out.orders(), threads,
-                    settings.progress);
-  float_blocks = {};
+  if (packed)
+    build_orders_into_packed(out.voxels(), out.levels(), levels, out.packed_vertices(), order_set, out.orders(),
+                             threads, settings.progress);
+  else
+    build_orders_into(out.voxels(), out.levels(), levels, out.float_vertices(), ends, order_set, out.orders(), threads,
+                      settings.progress);
+  written.get();
   summary.orders_seconds = seconds_since(t0);
 
   if (settings.progress) settings.progress("writing", 0.0);

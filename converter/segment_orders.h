@@ -109,6 +109,12 @@ void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const Level
                        std::uint32_t level_count, std::span<const float> vertices, const VoxlineEnds& ends,
                        const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,
                        const ProgressFn& progress);
+// The same from the packed blocks (VERT's words, their voxline-end bits set): the orders of the positions
+// the words decode to, which are what pack_block leaves in the float blocks, so the bytes are the same.
+void build_orders_into_packed(std::span<const VoxelEntry> voxels, std::span<const LevelEntry> levels,
+                              std::uint32_t level_count, std::span<const std::uint32_t> packed_vertices,
+                              const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,
+                              const ProgressFn& progress);
 
 // An upper bound of what build_orders_into allocates per worker thread (its sort buffers, growth
 // included) when no voxel has more than `max_vertices` vertices, for callers that budget memory.

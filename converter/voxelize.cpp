@@ -6,6 +6,7 @@
 
 #include "converter/voxel_table.h"
 #include "format/parallel.h"
+#include "format/vxl_positions.h"
 
 namespace vxl {
 
@@ -24,6 +25,7 @@ struct StreamlineRange {
   std::vector<float> synthetic_xyz;
   std::vector<double> synthetic_t;  // per synthetic point: where it lies on its step, for value interpolation
   detail::VoxelUse use;             // by local id
+  detail::VoxelBounds bounds;       // by local id, when packing
   detail::LocalVoxels table;        // global ids and cursors, by local id
   std::uint64_t voxline_base = 0;   // first global voxline of this range
   bool too_many_synthetic = false;
@@ -47,12 +49,44 @@ std::vector<std::uint64_t> split_by_points(const std::vector<std::uint64_t>& off
   return bounds;
 }
 
+// The voxels' tight bounds, from every range's (the same as set_tight_bounds finds over the placed blocks:
+// the bounds cover exactly the vertices place_voxline writes), and a packer for each voxel.
+void set_packers(std::span<VoxelEntry> voxels, std::vector<StreamlineRange>& ranges,
+                 std::vector<VertexPacker>& packers) {
+  detail::VoxelBounds bounds;
+  bounds.grow_to(voxels.size());
+  for (StreamlineRange& r : ranges) {
+    for (std::uint32_t local = 0; local < r.table.global_id.size(); ++local)
+      bounds.merge(r.table.global_id[local], r.bounds, local);
+    r.bounds = detail::VoxelBounds();
+  }
+  packers.reserve(voxels.size());
+  for (std::uint32_t g = 0; g < voxels.size(); ++g) {
+    bounds.set_tight_bounds(g, voxels[g]);
+    packers.emplace_back(voxels[g]);
+  }
+}
+
+// Places voxline j of `streamline` packed: its vertices as place_voxline gives them, quantised by the voxel's
+// packer into `words` (the last with its voxline-end bit). Returns the number of vertices.
+std::uint64_t place_packed(std::span<const TempVoxline> streamline, std::size_t j, const float* pts,
+                           const StreamlineRange& r, const VertexPacker& packer, std::vector<float>& voxline_xyz,
+                           std::uint32_t* words) {
+  voxline_xyz.resize(3 * (streamline[j].own() + 1));
+  const std::uint64_t used = detail::place_voxline(streamline, j, pts, r.synthetic_xyz.data(), voxline_xyz.data());
+  packer.words(voxline_xyz.data(), used, words);
+  words[used - 1] |= kPackedVoxlineEnd;
+  return used;
+}
+
 }  // namespace
 
 struct VoxelPlan::Work {
   unsigned threads = 1;
   std::uint32_t levels = 1;
   std::vector<StreamlineRange> ranges;
+  bool pack_positions = false;
+  std::vector<VertexPacker> packers;  // by voxel, when packing
 };
 
 VoxelPlan::VoxelPlan() : work_(std::make_unique<Work>()) {}
@@ -73,6 +107,7 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   VoxelPlan plan;
   plan.work_->threads = threads;
   plan.work_->levels = levels;
+  plan.work_->pack_positions = settings.pack_positions;
   MetaSection& m = plan.meta_;
   m.streamline_count = n_streamlines;
   m.point_count = n_points;
@@ -118,8 +153,13 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
     StreamlineRange& r = ranges[c];
     r.use = detail::VoxelUse(levels);
     r.use.grow_to(r.index.coords().size());
-    for (std::uint64_t k = 0; k + 1 < r.first_voxline.size(); ++k)
+    if (settings.pack_positions) r.bounds.grow_to(r.index.coords().size());
+    for (std::uint64_t k = 0; k + 1 < r.first_voxline.size(); ++k) {
       detail::count_voxel_use(r.streamline(k), streamline_depth(r.first_streamline + k, levels), r.use, path);
+      if (settings.pack_positions)
+        for (std::size_t j = 0; j < r.streamline(k).size(); ++j)
+          r.bounds.add_voxline(r.streamline(k), j, pts, r.synthetic_xyz.data());
+    }
   });
   if (settings.progress) settings.progress("voxelising", 1.0);
 
@@ -141,6 +181,7 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   }
   m.voxline_count = n_voxlines;
   m.synthetic_point_count = n_synthetic;
+  if (settings.pack_positions) set_packers(plan.voxels_, ranges, plan.work_->packers);
   return plan;
 }
 
@@ -150,7 +191,9 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
   const std::uint32_t levels = plan.work_->levels;
   std::vector<StreamlineRange>& ranges = plan.work_->ranges;
   const float* pts = t.positions.data();
-  if (out.voxels.size() != m.voxel_count || out.vertices.size() != 3 * m.vertex_count ||
+  const bool packing = plan.work_->pack_positions;
+  if (out.voxels.size() != m.voxel_count ||
+      (packing ? out.packed_vertices.size() != m.vertex_count : out.vertices.size() != 3 * m.vertex_count) ||
       out.voxlines.size() != m.voxline_count || out.streamline_first_voxline.size() != m.streamline_count + 1 ||
       out.levels.size() != plan.levels_.size())
     throw std::logic_error("place_vertices: the output spans do not have the sizes of the plan");
@@ -165,8 +208,10 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
       throw std::logic_error("place_vertices: value arrays do not have the sizes of the plan");
 
   // Pass 2: place vertices, fill the voxline and streamline tables.
+  const std::vector<VertexPacker>& packers = plan.work_->packers;
   parallel_for(ranges.size(), threads, [&](std::uint64_t c, unsigned) {
     StreamlineRange& r = ranges[c];
+    std::vector<float> voxline_xyz;  // one voxline's vertices on their way to being packed
     for (std::uint64_t k = 0; k + 1 < r.first_voxline.size(); ++k) {
       out.streamline_first_voxline[r.first_streamline + k] = r.voxline_base + r.first_voxline[k];
       const std::span<const TempVoxline> streamline = r.streamline(k);
@@ -174,8 +219,10 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
       for (std::size_t j = 0; j < streamline.size(); ++j) {
         const TempVoxline& v = streamline[j];
         std::uint64_t& cursor = r.table.cursor[std::size_t(v.voxel) * levels + depth];
-        const std::uint64_t used =
-            detail::place_voxline(streamline, j, pts, r.synthetic_xyz.data(), out.vertices.data() + 3 * cursor);
+        const std::uint64_t used = packing ? place_packed(streamline, j, pts, r, packers[r.table.global_id[v.voxel]],
+                                                          voxline_xyz, out.packed_vertices.data() + cursor)
+                                           : detail::place_voxline(streamline, j, pts, r.synthetic_xyz.data(),
+                                                                   out.vertices.data() + 3 * cursor);
         // Values travel with their points: a synthetic point's is interpolated where it lies on its step
         // (from source point src_first - 1 to src_first), a connecting vertex copies the next voxline's first.
         const bool connected = j + 1 < streamline.size();
@@ -206,6 +253,7 @@ VoxlineEnds place_vertices(VoxelPlan&& plan, Tractogram&& t, const VoxelBlocks& 
   t.point_values.clear();  // likewise their values
   t.point_values.shrink_to_fit();
 
+  if (packing) return ends;  // the tight bounds are set, every vertex packed
   // Tight bounds per voxel, in pieces of 4096 voxels.
   constexpr std::size_t kPiece = 4096;
   parallel_for((out.voxels.size() + kPiece - 1) / kPiece, threads, [&](std::uint64_t p, unsigned) {

@@ -39,6 +39,9 @@ struct VoxelizeSettings {
   // Refuse (with a suggested voxel size) when splitting long steps would add more than this many
   // points per source point: a guard against a voxel size far below the step length.
   double max_synthetic_per_point = 1.0;
+  // Packed positions (spec §5.4): pass 1 also finds each voxel's tight bounds, so that place_vertices packs
+  // every vertex as it places it (into VoxelBlocks::packed_vertices; no float copy of the blocks is held).
+  bool pack_positions = false;
 };
 
 // One bit per vertex, set when the vertex is the last of its voxline, so that no segment starts there
@@ -75,12 +78,13 @@ struct VoxelizedTractogram {
 struct VoxelBlocks {
   std::span<VoxelEntry> voxels;                       // voxel_count
   std::span<LevelEntry> levels;                       // voxel_count x (level_count - 1)
-  std::span<float> vertices;                          // 3 * vertex_count
+  std::span<float> vertices;                          // 3 * vertex_count; empty when packing
   std::span<VoxlineEntry> voxlines;                   // voxline_count
   std::span<std::uint64_t> streamline_first_voxline;  // streamline_count + 1
   // One per point value set of the tractogram, vertex_count each: the values spread like the positions
   // (spec §5.11). Empty when the tractogram has none.
   std::vector<std::span<float>> vertex_values;
+  std::span<std::uint32_t> packed_vertices;  // vertex_count when packing (then `vertices` is empty), else empty
 };
 
 // The result of pass 1: every streamline's voxlines and the voxel table.

@@ -43,7 +43,6 @@ class VertexPacker {
 
  private:
   std::uint32_t word(const float* xyz) const;
-  std::uint32_t quantise(int c, float x) const;
   float lo_[3], step_[3];
 };
 

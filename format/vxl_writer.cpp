@@ -156,6 +156,11 @@ void VxlWriter::set_meta(const MetaSection& meta) {
   std::memcpy(payload(kMeta).data(), &m, sizeof m);
 }
 
+void VxlWriter::write_now(std::span<const std::uint8_t> bytes) {
+  if (bytes.empty()) return;
+  out_.write_mapped_now(static_cast<std::uint64_t>(bytes.data() - file_.data()), bytes.size());
+}
+
 void VxlWriter::checksum_vertices_now() {
   SectionEntry& vert = *entry(kVert);  // required: always in the table
   vert.checksum = xxh3_64(file_.data() + vert.offset, vert.size);

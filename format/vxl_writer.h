@@ -116,6 +116,9 @@ class VxlWriter : public VxlSections {
   // hashes them beside its order building instead of at the end). The vertices must not change
   // afterwards; commit() then leaves VERT's checksum as it is.
   void checksum_vertices_now();
+  // Writes the whole 4 KiB blocks of `bytes` (a part of file()) to the disk now, e.g. on another thread while
+  // other sections are filled (AtomicOutputFile::write_mapped_now); they must be final.
+  void write_now(std::span<const std::uint8_t> bytes);
   // VVAL and SVAL payloads (vxl_value_sets.h: layout_value_sets, finish_value_sets); empty when absent.
   std::span<std::uint8_t> vertex_values() { return payload(kVval); }
   std::span<std::uint8_t> streamline_values() { return payload(kSval); }

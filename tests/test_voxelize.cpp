@@ -8,6 +8,7 @@
 #include "converter/segment_orders.h"
 #include "converter/voxelize.h"
 #include "format/error.h"
+#include "format/vxl_positions.h"
 #include "tests/test_support.h"
 
 namespace vxl {
@@ -105,6 +106,54 @@ TEST(Voxelize, ResultDoesNotDependOnTheThreadCount) {
   for (std::size_t i = 0; i < one.voxels.size(); ++i)
     EXPECT_EQ(0, std::memcmp(&one.voxels[i], &four.voxels[i], sizeof(VoxelEntry)));
   EXPECT_EQ(one.streamline_first_voxline, four.streamline_first_voxline);
+}
+
+// Packing while placing (pass 1 finds the tight bounds) must give what placing floats, then taking the tight
+// bounds from the blocks and packing them gives: the same voxel entries and the same words (end bits set
+// on each voxline's last vertex), with 1 and 3 threads and synthetic points at the faces.
+TEST(Voxelize, PackingWhilePlacingGivesTheWordsOfPackingThePlacedBlocks) {
+  Tractogram t;
+  for (int s = 0; s < 300; ++s) {
+    std::vector<float> pts;
+    for (int i = 0; i < 30; ++i) {
+      float a = 0.13f * i + 0.41f * s;
+      pts.insert(pts.end(), {25 * std::cos(a) - s % 5, 25 * std::sin(a), 0.7f * i - 0.02f * s});
+    }
+    t.add_streamline(pts.data(), 30);
+  }
+  for (unsigned threads : {1u, 3u}) {
+    VoxelizeSettings vs;
+    vs.voxel_size = 3.0;
+    vs.threads = threads;
+    vs.levels = 3;
+    Tractogram source = t;
+    VoxelizedTractogram floats = voxelize(std::move(source), vs);
+    std::vector<std::uint32_t> expected(floats.meta.vertex_count);
+    for (const VoxelEntry& v : floats.voxels) {
+      pack_block(v, floats.vertices.data() + 3 * v.vertex_first, v.vertex_count, expected.data() + v.vertex_first);
+      for (std::uint32_t k = 0; k < v.vertex_count; ++k)
+        if (floats.voxline_ends.test(v.vertex_first + k)) expected[v.vertex_first + k] |= kPackedVoxlineEnd;
+    }
+    ASSERT_GT(floats.meta.synthetic_point_count, 0u) << "the faces must be crossed by long steps";
+
+    vs.pack_positions = true;
+    Tractogram again = t;
+    VoxelPlan plan = plan_voxels(again, vs);
+    std::vector<VoxelEntry> voxels(plan.meta().voxel_count);
+    std::vector<LevelEntry> levels(plan.levels().size());
+    std::vector<VoxlineEntry> voxlines(plan.meta().voxline_count);
+    std::vector<std::uint64_t> first(plan.meta().streamline_count + 1);
+    std::vector<std::uint32_t> words(plan.meta().vertex_count);
+    VoxelBlocks blocks{voxels, levels, {}, voxlines, first, {}};
+    blocks.packed_vertices = words;
+    place_vertices(std::move(plan), std::move(again), blocks);
+    EXPECT_TRUE(words == expected) << threads << " threads";
+    ASSERT_EQ(voxels.size(), floats.voxels.size());
+    for (std::size_t i = 0; i < voxels.size(); ++i)
+      EXPECT_EQ(0, std::memcmp(&voxels[i], &floats.voxels[i], sizeof(VoxelEntry))) << "voxel " << i;
+    EXPECT_EQ(voxlines.size(), floats.voxlines.size());
+    EXPECT_EQ(first, floats.streamline_first_voxline);
+  }
 }
 
 TEST(Voxelize, TooSmallAVoxelIsRefusedWithASuggestion) {
