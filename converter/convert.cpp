@@ -141,7 +141,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
                                     bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
     prefault_for_write(s, threads);
   VoxelBlocks blocks{
-      out.voxels(), out.levels(), out.float_vertices(), out.voxlines(), out.streamline_first_voxline(), {}};
+      out.voxels(), out.levels(), out.float_vertices(), out.voxlines(), out.streamline_first_voxline(), {}, {}};
   if (packed) blocks.packed_vertices = out.packed_vertices();
   blocks.vertex_values = layout_value_sets(out.vertex_values(), point_set_names, meta.vertex_count);
   VoxlineEnds ends = place_vertices(std::move(plan), std::move(t), blocks);

@@ -275,7 +275,7 @@ VoxelizedTractogram voxelize(Tractogram&& t, const VoxelizeSettings& settings) {
   out.streamline_first_voxline.resize(out.meta.streamline_count + 1);
   out.voxline_ends =
       place_vertices(std::move(plan), std::move(t),
-                     {out.voxels, out.levels, out.vertices, out.voxlines, out.streamline_first_voxline, {}});
+                     {out.voxels, out.levels, out.vertices, out.voxlines, out.streamline_first_voxline, {}, {}});
   return out;
 }
 

@@ -144,7 +144,7 @@ TEST(Voxelize, PackingWhilePlacingGivesTheWordsOfPackingThePlacedBlocks) {
     std::vector<VoxlineEntry> voxlines(plan.meta().voxline_count);
     std::vector<std::uint64_t> first(plan.meta().streamline_count + 1);
     std::vector<std::uint32_t> words(plan.meta().vertex_count);
-    VoxelBlocks blocks{voxels, levels, {}, voxlines, first, {}};
+    VoxelBlocks blocks{voxels, levels, {}, voxlines, first, {}, {}};
     blocks.packed_vertices = words;
     place_vertices(std::move(plan), std::move(again), blocks);
     EXPECT_TRUE(words == expected) << threads << " threads";
