@@ -188,11 +188,10 @@ class ViewerWindow {
   void toggle_slices();
   void toggle_clip_plane(std::size_t i);
   void move_focus_along(int axis, double mm);
-  // Selects again when the regions changed since the last selection, and hands the focus and context to
-  // every renderer (without regions: the files' own groups again).
   // Asks for a new selection when the regions changed and takes the newest finished one into the picture
   // (selection_worker.h); with `wait`, the one the regions ask for now.
   void update_selection(bool wait);
+  // Hands the focus and context to every renderer (without a selection: the files' own groups again).
   void apply_selection(std::optional<SceneSelection> selection);
   // Writes the selected streamlines of every file to a stamped .tck (a key or the panel).
   void save_selection();
@@ -506,7 +505,12 @@ void ViewerWindow::update_selection(bool wait) {
       cleared_revision_ = regions_.revision();
       if (selection_) apply_selection(std::nullopt);
     } else {
-      selection_worker_.request(regions_.revision(), regions_.criteria());
+      try {
+        selection_worker_.request(regions_.revision(), regions_.criteria());
+      } catch (const std::exception& e) {  // a region that does not parse: said, and no selection
+        set_error(e.what());
+        if (selection_) apply_selection(std::nullopt);
+      }
     }
   }
   std::optional<SelectionWorker::Done> done = selection_worker_.poll(wait);
