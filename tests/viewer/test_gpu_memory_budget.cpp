@@ -8,6 +8,7 @@
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_metrics.h"
 #include "viewer/render/gpu_memory_pool.h"
+#include "viewer/render/view_queries.h"
 
 namespace vxl {
 namespace {
@@ -139,6 +140,21 @@ TEST_F(GpuMemoryBudget, TheBudgetIsNeverExceededAndTheNearestSpansComeFirst) {
   EXPECT_LE(pool->peak(), pool->budget());
   EXPECT_LE(r.gpu_bytes(), pool->budget());
   EXPECT_EQ(r.gpu_bytes(), pool->used());
+}
+
+TEST_F(GpuMemoryBudget, AViewsBytesAreKnownFromTheLayoutAlone) {
+  // view_queries.h works on the layout, before any renderer exists (the viewer's level choice).
+  const SceneLayout layout(*file_, kTexels, 0);
+  const VxlFile* const files[] = {&*file_};
+  const SceneBounds bounds = line_bounds(files);
+  const std::uint64_t whole = view_bytes(layout, view(), 1.0, bounds, {});
+  const std::uint64_t bottom = view_bytes(layout, view(), 1.0, bounds, near(true).clipping);
+  EXPECT_GT(bottom, 0u);
+  EXPECT_LT(bottom, whole) << "a slab near the bottom needs fewer spans than the whole view";
+  EXPECT_LE(whole, layout.upload_bytes());
+  Renderer r({&*file_}, kTexels, 0, std::make_shared<GpuMemoryPool>(0), false);
+  EXPECT_EQ(r.view_bytes(view(), 1.0, near(true).clipping), bottom) << "the renderer answers the same";
+  EXPECT_EQ(r.view_bytes(view(), 1.0), whole);
 }
 
 TEST_F(GpuMemoryBudget, EvictedSpansDrawTheSamePictureWhenUploadedAgain) {

@@ -17,6 +17,7 @@
 #include "viewer/render/segment_sort.h"
 #include "viewer/render/slice_renderer.h"
 #include "viewer/render/vertex_attributes.h"
+#include "viewer/render/view_queries.h"
 
 namespace vxl {
 
@@ -66,20 +67,9 @@ Renderer::~Renderer() {
   if (vao_) glDeleteVertexArrays(1, &vao_);
 }
 
-// The union of the files' bounds (a file without points does not count): {min, max}.
 std::pair<glm::dvec3, glm::dvec3> Renderer::bounds() const {
-  glm::dvec3 lo(0.0), hi(0.0);
-  bool any = false;
-  for (const VxlFile* f : files_) {
-    const MetaSection& m = f->meta();
-    if (m.point_count == 0) continue;
-    const glm::dvec3 a(m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]);
-    const glm::dvec3 b(m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]);
-    lo = any ? glm::min(lo, a) : a;
-    hi = any ? glm::max(hi, b) : b;
-    any = true;
-  }
-  return {lo, hi};
+  const SceneBounds b = line_bounds(files_);
+  return {b.min, b.max};
 }
 
 glm::dvec3 Renderer::scene_min() const { return slices_ ? glm::min(bounds_min(), slices_->ras_min()) : bounds_min(); }
@@ -113,32 +103,17 @@ std::array<float, 2> Renderer::slice_range(const RenderSettings& s) const {
 GLuint Renderer::slice_color_texture() const { return slices_drawn_ ? slices_->color_texture() : 0; }
 
 glm::dmat4 Renderer::projection(const Camera& camera, double aspect) const {
-  // Near and far planes hug the scene's bounding sphere (lines and image), for depth precision. The margin
-  // is a voxel, but never more than the scene's own size: every vertex lies inside the bounds, and a voxel
-  // far larger than the scene (--voxel-size 1e8) would put the near plane (far · 1e-4) beyond every line.
-  glm::dvec3 centre = (scene_min() + scene_max()) * 0.5;
-  const double half_diagonal = glm::length(scene_max() - scene_min()) * 0.5;
-  double radius = std::max(1.0, half_diagonal + std::min(scene_.layout().voxel_size(), std::max(1.0, half_diagonal)));
-  double along = glm::dot(centre - camera.eye(), camera.forward());
-  double far_mm = along + radius;
-  double near_mm = camera.orthographic ? along - radius : std::max(far_mm * 1e-4, along - radius);
-  return glm::dmat4(Camera(camera).projection(aspect, near_mm, std::max(far_mm, near_mm + 1.0)));
+  // Near and far planes hug the lines and the image.
+  return fitted_projection(camera, aspect, {scene_min(), scene_max()}, scene_.layout().voxel_size());
 }
 
 void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out,
                     const Clipping& clipping) const {
-  ViewParams view = make_view_params(camera.eye(), camera.forward(), camera.orthographic, projection(camera, aspect),
-                                     glm::dmat3(camera.view_rotation()));
-  for (const glm::dvec4& h : clip_half_spaces(clipping, camera)) view.clip.push_back(relative_to(h, view.eye));
-  plan_frame(scene_.layout(), view, order, out);
+  plan_view(scene_.layout(), camera, projection(camera, aspect), order, out, clipping);
 }
 
 std::uint64_t Renderer::view_bytes(const Camera& camera, double aspect, const Clipping& clipping) const {
-  FramePlan visible;
-  plan(camera, aspect, PlanOrder::Any, visible, clipping);
-  std::uint64_t bytes = 0;
-  for (std::uint32_t span : spans_nearest_first(visible)) bytes += scene_.layout().span_upload_bytes(span);
-  return bytes;
+  return vxl::view_bytes(scene_.layout(), camera, aspect, {scene_min(), scene_max()}, clipping);
 }
 
 void Renderer::plan_and_count(const Camera& camera, double aspect, PlanOrder order, FramePlan& out,
@@ -151,28 +126,15 @@ void Renderer::plan_and_count(const Camera& camera, double aspect, PlanOrder ord
   stats_.segments_drawn = out.segments_drawn;
 }
 
-// The spans a plan's voxels lie in, those of the nearest voxels first (a sorted plan is back to front).
-std::vector<std::uint32_t> Renderer::spans_nearest_first(const FramePlan& plan) const {
-  const SceneLayout& layout = scene_.layout();
-  std::vector<std::uint32_t> needed;
-  std::vector<bool> seen(layout.texture_spans().size(), false);
-  for (std::size_t i = plan.first.size(); i-- > 0;) {
-    const std::uint32_t span = layout.span_of_id(plan.first[i]);
-    if (!seen[span]) needed.push_back(span);
-    seen[span] = true;
-  }
-  return needed;
-}
-
 bool Renderer::upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms) {
   FramePlan nearest;
   plan(camera, aspect, PlanOrder::Nearest, nearest, clipping);
-  return !scene_.make_resident(spans_nearest_first(nearest), max_ms).out_of_time;
+  return !scene_.make_resident(spans_nearest_first(scene_.layout(), nearest), max_ms).out_of_time;
 }
 
 void Renderer::keep_resident(FramePlan& plan) {
   const SceneLayout& layout = scene_.layout();
-  const std::vector<std::uint32_t> needed = spans_nearest_first(plan);
+  const std::vector<std::uint32_t> needed = spans_nearest_first(layout, plan);
   stats_.voxels_waiting = 0;
   if (scene_.make_resident(needed).complete) return;
   // The budget holds only some: draw the voxels whose span is resident, in the plan's order.

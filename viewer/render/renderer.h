@@ -160,8 +160,6 @@ class Renderer {
   static void over_blending();
   // The depth and blend state of the opaque mode.
   static void opaque_blending();
-  // The spans a plan's voxels lie in, each once, those of the nearest voxels first.
-  std::vector<std::uint32_t> spans_nearest_first(const FramePlan& plan) const;
   // Makes the spans of the plan's voxels resident, the nearest first, and drops the voxels of those that
   // do not fit the budget.
   void keep_resident(FramePlan& plan);
