@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "bench/child_process.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxlz_draco.h"

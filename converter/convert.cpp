@@ -8,7 +8,7 @@
 #include "converter/segment_orders.h"
 #include "converter/voxel_size_auto.h"
 #include "converter/voxel_table.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_value_sets.h"
 #include "format/vxl_writer.h"
 

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <set>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 namespace {

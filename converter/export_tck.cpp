@@ -9,9 +9,9 @@
 #include "converter/export_groups.h"
 #include "converter/export_values.h"
 #include "converter/tck_writer.h"
-#include "format/error.h"
-#include "format/json_limits.h"
-#include "format/output_path.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
+#include "format/base/output_path.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {

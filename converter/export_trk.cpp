@@ -15,9 +15,9 @@
 #include "converter/export_trx.h"
 #include "converter/export_values.h"
 #include "converter/readers/trk_header.h"
-#include "format/atomic_output.h"
-#include "format/error.h"
-#include "format/json_limits.h"
+#include "format/base/atomic_output.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {

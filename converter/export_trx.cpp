@@ -10,9 +10,9 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/export_values.h"
-#include "format/error.h"
-#include "format/json_limits.h"
-#include "format/output_path.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
+#include "format/base/output_path.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {

@@ -2,7 +2,7 @@
 
 #include <charconv>
 
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {

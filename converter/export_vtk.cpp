@@ -6,8 +6,8 @@
 #include <limits>
 #include <vector>
 
-#include "format/atomic_output.h"
-#include "format/error.h"
+#include "format/base/atomic_output.h"
+#include "format/base/error.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {

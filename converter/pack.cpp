@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "converter/voxelize.h"
-#include "format/error.h"
-#include "format/json_limits.h"
-#include "format/parallel.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
+#include "format/base/parallel.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxlz_draco.h"
 #include "format/vxlz_package.h"

@@ -1,6 +1,6 @@
 #include "converter/position_packing.h"
 
-#include "format/parallel.h"
+#include "format/base/parallel.h"
 #include "format/vxl_positions.h"
 
 namespace vxl {

@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "format/error.h"
-#include "format/parallel.h"
+#include "format/base/error.h"
+#include "format/base/parallel.h"
 #include "format/vxl_positions.h"
 
 namespace vxl {

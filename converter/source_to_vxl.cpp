@@ -4,14 +4,14 @@
 #include <chrono>
 #include <filesystem>
 
-#include "converter/memory_available.h"
-#include "converter/memory_size.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "converter/readers/source_formats.h"
 #include "converter/streaming_convert.h"
 #include "converter/temporary_vxl.h"
-#include "format/error.h"
+#include "format/base/error.h"
+#include "format/base/memory_available.h"
+#include "format/base/memory_size.h"
 
 namespace vxl {
 namespace {

@@ -17,15 +17,15 @@
 #include <malloc.h>
 #endif
 
-#include "converter/memory_size.h"
 #include "converter/readers/source_formats.h"
 #include "converter/readers/tck_stream.h"
 #include "converter/segment_orders.h"
 #include "converter/voxel_size_auto.h"
 #include "converter/voxel_table.h"
 #include "converter/voxelize.h"
-#include "format/error.h"
-#include "format/parallel.h"
+#include "format/base/error.h"
+#include "format/base/memory_size.h"
+#include "format/base/parallel.h"
 #include "format/vxl_positions.h"
 #include "format/vxl_stream_writer.h"
 

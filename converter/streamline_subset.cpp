@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cassert>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 
@@ -38,14 +38,11 @@ SubsetCounts subset_counts(const VxlFile& file, const StreamlineSubset* subset) 
   const auto voxlines = file.voxlines();
   SubsetCounts c{subset->size(), 0};
   for (std::uint64_t s : subset->indices()) {
-    if (strm[s] > strm[s + 1] || strm[s + 1] > voxlines.size())
-      fail_input(file.path(), file.find_section(section_id("STRM"))->offset + 8 * (s + 1),
-                 "streamline table not non-decreasing");
+    file.check_streamline_run(s);
     for (std::uint64_t j = strm[s]; j < strm[s + 1]; ++j) {
       const std::uint32_t own = voxlines[j].count_flags & kVoxlineCountMask;
       const std::uint32_t skip = (voxlines[j].count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
-      if (own == 0)
-        fail_input(file.path(), file.find_section(section_id("VXLN"))->offset + 8 * j, "voxline with no points");
+      file.check_voxline(j);
       c.points += own - skip;
     }
   }

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "format/parallel.h"
+#include "format/base/parallel.h"
 
 #if defined(__linux__)
 #include <sys/mman.h>

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "format/atomic_output.h"
+#include "format/base/atomic_output.h"
 
 namespace vxl {
 

@@ -9,7 +9,7 @@
 #include <cstring>
 #include <filesystem>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 namespace {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 namespace {

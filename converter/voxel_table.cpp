@@ -4,7 +4,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl::detail {
 namespace {

@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "converter/voxel_table.h"
-#include "format/parallel.h"
+#include "format/base/parallel.h"
 #include "format/vxl_positions.h"
 
 namespace vxl {

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "converter/tractogram.h"
-#include "format/parallel.h"  // resolve_threads: the meaning of VoxelizeSettings::threads
+#include "format/base/parallel.h"  // resolve_threads: the meaning of VoxelizeSettings::threads
 #include "format/vxl_layout.h"
 #include "format/vxl_levels.h"
 

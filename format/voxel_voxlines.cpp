@@ -3,23 +3,14 @@
 #include <algorithm>
 #include <limits>
 
-#include "format/error.h"
-#include "format/parallel.h"
+#include "format/base/error.h"
+#include "format/base/parallel.h"
 #include "format/vxl_levels.h"
 
 namespace vxl {
 namespace {
 
 // STRM as spec §5.7 has it: from 0, non-decreasing, ending at the voxline count.
-void check_streamline_table(const VxlFile& file) {
-  const auto strm = file.streamline_first_voxline();
-  const std::uint64_t at = file.find_section(section_id("STRM"))->offset;
-  if (strm[0] != 0) fail_input(file.path(), at, "streamline table must start at voxline 0");
-  for (std::size_t s = 1; s < strm.size(); ++s)
-    if (strm[s] < strm[s - 1]) fail_input(file.path(), at + 8 * s, "streamline table not non-decreasing");
-  if (strm.back() != file.voxlines().size())
-    fail_input(file.path(), at + 8 * (strm.size() - 1), "streamline table must end at the voxline count");
-}
 
 }  // namespace
 
@@ -29,8 +20,7 @@ std::optional<VoxelVoxlines> VoxelVoxlines::build(const VxlFile& file, unsigned 
   const std::size_t voxel_count = file.voxels().size();
   const std::uint64_t n = file.meta().streamline_count;
   if (n > std::numeric_limits<std::uint32_t>::max()) return std::nullopt;
-  check_streamline_table(file);
-  const std::uint64_t vxln_at = file.find_section(section_id("VXLN"))->offset;
+  file.check_streamline_table();
   const std::uint32_t levels = file.level_count();
 
   // A counting sort in contiguous runs of streamlines, one count row per run, so that runs count and
@@ -50,9 +40,8 @@ std::optional<VoxelVoxlines> VoxelVoxlines::build(const VxlFile& file, unsigned 
     const auto [begin, end] = streamlines_of(c);
     for (std::uint64_t j = strm[begin]; j < strm[end]; ++j) {
       const VoxlineEntry& e = voxlines[j];
-      if (e.voxel >= voxel_count) fail_input(file.path(), vxln_at + 8 * j, "voxline refers to a voxel past the table");
+      file.check_voxline(j);
       const std::uint32_t own = e.count_flags & kVoxlineCountMask;
-      if (own == 0) fail_input(file.path(), vxln_at + 8 * j, "voxline with no points");
       if (own > IndexedVoxline::kCountMask) too_long = true;
       ++row[e.voxel];
     }

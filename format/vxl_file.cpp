@@ -4,9 +4,9 @@
 #include <cmath>
 #include <limits>
 
-#include "format/checked_count.h"
-#include "format/error.h"
-#include "format/utf8_check.h"
+#include "format/base/checked_count.h"
+#include "format/base/error.h"
+#include "format/base/utf8_check.h"
 #include "format/vxlz_layout.h"
 
 namespace vxl {
@@ -433,6 +433,25 @@ std::vector<StreamlineGroup> VxlFile::groups() const {
     out.push_back(std::move(gc));
   });
   return out;
+}
+
+void VxlFile::check_streamline_table() const {
+  for (std::uint64_t s = 0; s + 1 < strm_.size(); ++s) check_streamline_run(s);
+  if (strm_.back() != voxlines_.size()) fail_streamline_table(strm_.size() - 1);
+}
+
+void VxlFile::fail_streamline_table(std::uint64_t entry) const {
+  const std::uint64_t at = find_section(section_id("STRM"))->offset + 8 * entry;
+  if (entry == 0) fail_input(path(), at, "streamline table must start at voxline 0");
+  if (strm_[entry] < strm_[entry - 1]) fail_input(path(), at, "streamline table not non-decreasing");
+  if (strm_[entry] > voxlines_.size()) fail_input(path(), at, "streamline table points past the voxline table");
+  fail_input(path(), at, "streamline table must end at voxline_count");
+}
+
+void VxlFile::fail_voxline(std::uint64_t j) const {
+  const std::uint64_t at = find_section(section_id("VXLN"))->offset + 8 * j;
+  if (voxlines_[j].voxel >= voxels_.size()) fail_input(path(), at, "voxline refers to a voxel past the table");
+  fail_input(path(), at, "voxline with no points");
 }
 
 }  // namespace vxl

@@ -16,7 +16,7 @@
 #include <string_view>
 #include <vector>
 
-#include "format/mapped_file.h"
+#include "format/base/mapped_file.h"
 #include "format/streamline_group.h"
 #include "format/vxl_group_values.h"
 #include "format/vxl_layout.h"
@@ -100,6 +100,20 @@ class VxlFile {
   OrderView order(std::size_t voxel, std::uint32_t k, std::uint32_t level = 0) const;
   std::span<const VoxlineEntry> voxlines() const { return voxlines_; }
   std::span<const std::uint64_t> streamline_first_voxline() const { return strm_; }
+  // open() leaves STRM and VXLN unread (it stays O(voxels)): whoever walks them checks what it reads with
+  // these, so that a damaged table gets the same error, naming the same byte, whoever finds it.
+  // The whole streamline table: starts at voxline 0, never decreases, ends at the voxline count.
+  void check_streamline_table() const;
+  // Streamline s's run of voxlines, for a walker that reads some streamlines only.
+  void check_streamline_run(std::uint64_t s) const {
+    if ((s == 0 && strm_[0] != 0) || strm_[s + 1] < strm_[s] || strm_[s + 1] > voxlines_.size())
+      fail_streamline_table(s == 0 && strm_[0] != 0 ? 0 : s + 1);
+  }
+  // Voxline j: its voxel exists and it has points.
+  void check_voxline(std::uint64_t j) const {
+    const VoxlineEntry& e = voxlines_[j];
+    if (e.voxel >= voxels_.size() || (e.count_flags & kVoxlineCountMask) == 0) fail_voxline(j);
+  }
   std::string_view provenance_json() const { return provenance_; }
   // Where PROV starts in the file (0 when the file has none).
   std::uint64_t provenance_offset() const;
@@ -115,6 +129,8 @@ class VxlFile {
  private:
   explicit VxlFile(MappedFile file) : file_(std::move(file)) {}
   void validate();
+  [[noreturn]] void fail_streamline_table(std::uint64_t entry) const;
+  [[noreturn]] void fail_voxline(std::uint64_t j) const;
   void validate_header();
   void validate_section_table();
   void validate_meta_and_sizes();

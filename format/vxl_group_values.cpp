@@ -4,7 +4,7 @@
 #include <set>
 #include <utility>
 
-#include "format/utf8_check.h"
+#include "format/base/utf8_check.h"
 
 namespace vxl {
 namespace {

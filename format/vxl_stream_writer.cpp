@@ -7,7 +7,7 @@
 
 #include <unistd.h>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

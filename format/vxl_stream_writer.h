@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "format/atomic_output.h"
-#include "format/checksum.h"
-#include "format/direct_region_writer.h"
+#include "format/base/atomic_output.h"
+#include "format/base/checksum.h"
+#include "format/base/direct_region_writer.h"
 #include "format/vxl_layout.h"
 #include "format/vxl_writer.h"
 

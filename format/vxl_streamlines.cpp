@@ -4,7 +4,7 @@
 #include <cstring>
 #include <vector>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 
@@ -15,12 +15,9 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   auto voxlines = f.voxlines();
   auto strm = f.streamline_first_voxline();
   const bool packed = f.position_encoding() == PositionEncoding::Packed;
-  const std::uint64_t strm_at = f.find_section(section_id("STRM"))->offset;
   const std::uint64_t vxln_at = f.find_section(section_id("VXLN"))->offset;
 
-  if (strm[0] != 0) fail_input(p, strm_at, "streamline table must start at voxline 0");
-  if (strm[m.streamline_count] != m.voxline_count)
-    fail_input(p, strm_at + 8 * m.streamline_count, "streamline table must end at voxline_count");
+  f.check_streamline_table();
 
   // One cursor per voxel and depth: a voxel's block holds the voxlines of deeper streamlines first (spec
   // §5.4, §5.12), each depth's in streamline order.
@@ -47,8 +44,6 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   for (std::uint64_t s = 0; s < m.streamline_count; ++s) {
     const std::uint64_t first = strm[s], last = strm[s + 1];
     const std::uint32_t depth = streamline_depth(s, levels);
-    if (last < first || last > m.voxline_count)
-      fail_input(p, strm_at + 8 * (s + 1), "streamline table not non-decreasing");
     const bool read = !cb.read_points || cb.read_points(s);
     points.clear();
     float pending_connector[3];  // previous voxline's connecting vertex, when `connector_voxel` is set
@@ -56,11 +51,10 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
     for (std::uint64_t j = first; j < last; ++j) {
       const VoxlineEntry& e = voxlines[j];
       const std::uint64_t at = vxln_at + 8 * j;
-      if (e.voxel >= voxels.size()) fail_input(p, at, "voxline refers to a voxel past the table");
+      f.check_voxline(j);
       const std::uint32_t own = e.count_flags & kVoxlineCountMask;
       const bool synthetic_first = (e.count_flags & kVoxlineSyntheticFirst) != 0;
       const bool connected = j + 1 < last;
-      if (own == 0) fail_input(p, at, "voxline with no points");
       if (synthetic_first && j == first) fail_input(p, at, "a streamline cannot start with a synthetic point");
       std::uint64_t& here = cursor[e.voxel * levels + depth];
       const std::uint64_t end = cursor_end[e.voxel * levels + depth];

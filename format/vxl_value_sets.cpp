@@ -6,8 +6,8 @@
 #include <limits>
 #include <set>
 
-#include "format/error.h"
-#include "format/utf8_check.h"
+#include "format/base/error.h"
+#include "format/base/utf8_check.h"
 
 namespace vxl {
 

@@ -7,9 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "format/checksum.h"
-#include "format/error.h"
-#include "format/json_limits.h"
+#include "format/base/checksum.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 

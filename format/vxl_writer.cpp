@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
-#include "format/checksum.h"
-#include "format/parallel.h"
+#include "format/base/checksum.h"
+#include "format/base/parallel.h"
 #include "format/vxl_value_sets.h"
 
 namespace vxl {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "format/atomic_output.h"
+#include "format/base/atomic_output.h"
 #include "format/streamline_group.h"
 #include "format/vxl_group_values.h"
 #include "format/vxl_layout.h"

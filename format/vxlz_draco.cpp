@@ -9,7 +9,7 @@
 #include <draco/compression/point_cloud/point_cloud_decoder.h>
 #include <draco/point_cloud/point_cloud_builder.h>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 namespace {

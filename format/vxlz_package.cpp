@@ -5,10 +5,10 @@
 #include <cstring>
 #include <limits>
 
-#include "format/atomic_output.h"
-#include "format/checksum.h"
-#include "format/error.h"
-#include "format/parallel.h"
+#include "format/base/atomic_output.h"
+#include "format/base/checksum.h"
+#include "format/base/error.h"
+#include "format/base/parallel.h"
 #include "format/vxl_file.h"
 
 namespace vxl {

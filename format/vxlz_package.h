@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "format/mapped_file.h"
+#include "format/base/mapped_file.h"
 #include "format/vxl_layout.h"
 #include "format/vxlz_draco.h"
 #include "format/vxlz_layout.h"

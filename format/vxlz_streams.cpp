@@ -6,7 +6,7 @@
 
 #include <zlib.h>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

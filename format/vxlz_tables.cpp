@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 namespace {

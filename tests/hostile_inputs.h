@@ -18,7 +18,7 @@
 
 #include <gtest/gtest.h>
 
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/mrtrix_test_files.h"
 #include "tests/vtk_test_files.h"
 #include "tests/zip_writer.h"

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "format/checksum.h"
+#include "format/base/checksum.h"
 #include "format/vxl_layout.h"
 
 namespace vxl::test {

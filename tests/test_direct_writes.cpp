@@ -22,9 +22,9 @@
 #include "converter/streaming_convert.h"
 #include "converter/synth.h"
 #include "converter/tck_writer.h"
-#include "format/atomic_output.h"
-#include "format/direct_region_writer.h"
-#include "format/direct_write_queue.h"
+#include "format/base/atomic_output.h"
+#include "format/base/direct_region_writer.h"
+#include "format/base/direct_write_queue.h"
 #include "tests/test_support.h"
 
 namespace vxl {

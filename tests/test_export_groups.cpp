@@ -12,7 +12,7 @@
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "converter/synth.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 #include "tests/export_test_support.h"

@@ -17,7 +17,7 @@
 #include "converter/readers/read_tractogram.h"
 #include "converter/synth.h"
 #include "converter/tck_writer.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"

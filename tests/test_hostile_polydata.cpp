@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "converter/readers/read_tractogram.h"
-#include "format/checked_count.h"
-#include "format/error.h"
+#include "format/base/checked_count.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "tests/hostile_inputs.h"
 #include "tests/test_support.h"

@@ -14,7 +14,7 @@
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "converter/readers/tck_stream.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/hostile_inputs.h"
 #include "tests/nifti_test_files.h"
 #include "tests/test_support.h"

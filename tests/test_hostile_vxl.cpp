@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "converter/export_trx.h"
-#include "format/error.h"
-#include "format/utf8_check.h"
+#include "format/base/error.h"
+#include "format/base/utf8_check.h"
 #include "format/vxl_file.h"
 #include "format/vxl_value_sets.h"
 #include "tests/hostile_vxl.h"

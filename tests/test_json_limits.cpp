@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 
 #include "converter/readers/read_tractogram.h"
-#include "format/error.h"
-#include "format/json_limits.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
 #include "tests/hostile_inputs.h"
 #include "tests/hostile_vxl.h"
 #include "tests/test_support.h"

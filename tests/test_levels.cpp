@@ -17,7 +17,7 @@
 #include "converter/synth.h"
 #include "converter/tck_writer.h"
 #include "converter/unpack.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_streamlines.h"

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "converter/memory_available.h"
+#include "format/base/memory_available.h"
 #include "tests/test_support.h"
 
 namespace vxl {

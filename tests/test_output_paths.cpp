@@ -1,4 +1,4 @@
-// The output rule (format/output_path.h), for every writer of the converter: a FIFO, a device, a directory
+// The output rule (format/base/output_path.h), for every writer of the converter: a FIFO, a device, a directory
 // at OUT is refused (exit 5) and left as it was; a symbolic link is followed and kept; a missing folder is
 // an output error.
 #include <filesystem>
@@ -9,8 +9,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "format/error.h"
-#include "format/output_path.h"
+#include "format/base/error.h"
+#include "format/base/output_path.h"
 #include "tests/hostile_inputs.h"
 #include "tests/hostile_vxl.h"
 #include "tests/test_support.h"

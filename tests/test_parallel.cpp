@@ -1,4 +1,4 @@
-// format/parallel.h: every item runs once, on a named worker, and the first error reaches the caller.
+// format/base/parallel.h: every item runs once, on a named worker, and the first error reaches the caller.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -9,7 +9,7 @@
 #include <thread>
 #include <vector>
 
-#include "format/parallel.h"
+#include "format/base/parallel.h"
 
 namespace vxl {
 namespace {

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "converter/readers/volume_image.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/hostile_inputs.h"
 #include "tests/mif_test_files.h"
 #include "tests/nifti_test_files.h"

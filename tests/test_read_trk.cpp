@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "converter/readers/read_tractogram.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/test_support.h"
 
 namespace {

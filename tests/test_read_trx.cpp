@@ -16,8 +16,8 @@
 
 #include "converter/readers/float16.h"
 #include "converter/readers/read_tractogram.h"
-#include "format/checksum.h"
-#include "format/error.h"
+#include "format/base/checksum.h"
+#include "format/base/error.h"
 #include "tests/test_support.h"
 #include "tests/zip_writer.h"
 

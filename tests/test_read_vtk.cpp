@@ -9,7 +9,7 @@
 #include "converter/convert.h"
 #include "converter/export_vtk.h"
 #include "converter/readers/read_tractogram.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "tests/test_support.h"
 #include "tests/vtk_test_files.h"

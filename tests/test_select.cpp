@@ -23,7 +23,7 @@
 #include "converter/selection/selection_output.h"
 #include "converter/selection/streamline_selection.h"
 #include "converter/synth.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_verify.h"
 #include "tests/hostile_vxl.h"
 #include "tests/nifti_test_files.h"

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "converter/source_to_vxl.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/test_support.h"
 
 namespace vxl {

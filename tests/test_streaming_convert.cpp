@@ -15,13 +15,13 @@
 #include <unistd.h>
 
 #include "converter/convert.h"
-#include "converter/memory_size.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/tck_stream.h"
 #include "converter/streaming_convert.h"
 #include "converter/synth.h"
 #include "converter/tck_writer.h"
-#include "format/error.h"
+#include "format/base/error.h"
+#include "format/base/memory_size.h"
 #include "format/vxl_file.h"
 #include "format/vxl_verify.h"
 #include "tests/address_sanitizer.h"

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "converter/synth.h"
-#include "format/checksum.h"
+#include "format/base/checksum.h"
 
 namespace {
 

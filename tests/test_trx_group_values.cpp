@@ -22,7 +22,7 @@
 #include "converter/readers/read_tractogram.h"
 #include "converter/selection/selection_output.h"
 #include "converter/unpack.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_group_values.h"
 #include "format/vxl_verify.h"

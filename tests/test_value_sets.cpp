@@ -11,7 +11,7 @@
 #include "converter/convert.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"

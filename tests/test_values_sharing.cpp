@@ -17,7 +17,7 @@
 #include "converter/readers/read_tsf.h"
 #include "converter/synth.h"
 #include "converter/unpack.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_verify.h"
 #include "format/vxlz_package.h"

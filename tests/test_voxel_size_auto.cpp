@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/voxel_size_auto.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/mrtrix_test_files.h"
 #include "tests/test_support.h"
 

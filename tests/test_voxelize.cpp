@@ -7,7 +7,7 @@
 
 #include "converter/segment_orders.h"
 #include "converter/voxelize.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_positions.h"
 #include "tests/test_support.h"
 

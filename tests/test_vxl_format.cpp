@@ -7,7 +7,7 @@
 #include <iterator>
 
 #include "converter/convert.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"

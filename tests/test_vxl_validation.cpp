@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "converter/convert.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "tests/reseal_checksums.h"
 #include "tests/test_support.h"

@@ -12,10 +12,10 @@
 #include "converter/cli/convert_file.h"
 #include "converter/cli/progress_bar.h"
 #include "converter/convert.h"
-#include "converter/memory_size.h"
 #include "converter/readers/source_formats.h"
 #include "converter/segment_orders.h"
-#include "format/error.h"
+#include "format/base/error.h"
+#include "format/base/memory_size.h"
 
 namespace vxl::cli {
 namespace {
@@ -29,20 +29,107 @@ long long peak_resident_kib() {
   return -1;
 }
 
+struct ConvertOptions {
+  std::vector<std::string> files;
+  std::string output_dir;
+  unsigned jobs = 1;
+  ConvertSettings settings;
+  std::string memory_limit;
+  std::string voxel_size = "10";
+  bool verbose = false;
+  std::vector<std::string> tsf;
+};
+
+void add_voxel_size_option(CLI::App* cmd, std::string& voxel_size) {
+  cmd->add_option("--voxel-size", voxel_size,
+                  "voxel edge length in mm, or auto: chosen from the point count, extent and step length so that "
+                  "voxels stay under ~32k vertices (16-bit orders), at most 10 mm; `info` shows the choice")
+      ->type_name("MM|auto")
+      ->default_val("10")
+      ->check([](const std::string& text) -> std::string {
+        if (text == "auto") return {};
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !(v > 0) || !std::isfinite(v))
+          return "expected a positive number of mm or auto, got '" + text + "'";
+        return {};
+      });
+}
+
+void add_orders_option(CLI::App* cmd, std::string& orders) {
+  cmd->add_option("--orders", orders,
+                  "precomputed order set: axis (6 orders), axis+diag (14), or random:N (N pseudo-random directions "
+                  "per voxel, 2N orders, N in 1..64)")
+      ->default_val("axis")
+      ->check([](const std::string& name) -> std::string {
+        try {
+          parse_order_set(name);
+          return {};
+        } catch (const Error& e) {
+          return e.reason();
+        }
+      });
+}
+
+void add_memory_limit_option(CLI::App* cmd, std::string& memory_limit) {
+  cmd->add_option(
+         "--memory-limit", memory_limit,
+         "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): reads the source several times and writes the "
+         "output in parts, byte-identical to a conversion without the limit. " +
+             source_format_names_text("/", true) + " sources only (" + source_format_names_text("/", false) +
+             " are refused); a limit too small for the data is refused, naming what needs how much. With "
+             "--output-dir the limit is per file: --jobs N may use N times SIZE")
+      ->type_name("SIZE")
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            return parse_memory_size(s)
+                       ? std::string()
+                       : "'" + s + "' is not a memory size (a number of bytes, or of KiB/MiB/GiB with K/M/G: 512M, 2G)";
+          },
+          ""));
+}
+
+// One conversion (IN OUT.vxl) or a cohort (--output-dir); returns the exit code.
+int run_convert(ConvertOptions& o, bool cohort, bool jobs_given) {
+  if (!o.memory_limit.empty()) o.settings.memory_limit = *parse_memory_size(o.memory_limit);
+  o.settings.voxel_size_auto = o.voxel_size == "auto";
+  if (!o.settings.voxel_size_auto) o.settings.voxel_size = std::strtod(o.voxel_size.c_str(), nullptr);
+  if (cohort) {
+    CohortOptions c{o.files, o.output_dir, o.jobs, o.settings, o.tsf, o.verbose};
+    const int code = run_cohort(c);
+    if (o.verbose) std::printf("peak resident memory: %lld KiB\n", peak_resident_kib());
+    return code;
+  }
+  if (jobs_given) throw CLI::ValidationError("--jobs converts several files at once: it needs --output-dir DIR");
+  if (o.files.size() != 2)
+    throw CLI::ValidationError("convert takes IN OUT.vxl, or IN... --output-dir DIR (got " +
+                               std::to_string(o.files.size()) + " file names)");
+  const std::string& input = o.files[0];
+  const std::string& output = o.files[1];
+  // A .vxl under another name would pass for the other format (a TCK reader then fails on it).
+  std::string lower = output;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (!lower.ends_with(".vxl") && !std::filesystem::is_directory(output))  // a folder: the output rule's (exit 5)
+    throw Error(ErrorKind::Usage, output, std::nullopt,
+                "convert writes a .vxl file: name the output OUT.vxl (to write TCK, TRX or VTK from a .vxl use "
+                "`voxlines export IN.vxl OUT.tck`, or `voxlines select` for some of its streamlines)");
+  ProgressBar bar;
+  o.settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
+  bar.update("reading", 0.0);
+  const std::string report = convert_file(input, output, o.tsf, o.settings, o.verbose, [&](const std::string& w) {
+    bar.done();
+    std::fprintf(stderr, "voxlines: warning: %s: %s\n", input.c_str(), w.c_str());
+  });
+  bar.done();
+  std::fputs(report.c_str(), stdout);
+  if (o.verbose) std::printf("peak resident memory: %lld KiB\n", peak_resident_kib());
+  return 0;
+}
+
 }  // namespace
 
 void add_convert_command(CLI::App& app, int& exit_code) {
-  struct Options {
-    std::vector<std::string> files;
-    std::string output_dir;
-    unsigned jobs = 1;
-    ConvertSettings settings;
-    std::string memory_limit;
-    std::string voxel_size = "10";
-    bool verbose = false;
-    std::vector<std::string> tsf;
-  };
-  auto opt = std::make_shared<Options>();
+  auto opt = std::make_shared<ConvertOptions>();
   CLI::App* cmd = app.add_subcommand(
       "convert", "Convert a " + source_format_names_text(" / ") + " tractogram (" + source_suffixes_text(", ") +
                      ") to .vxl:\n"
@@ -66,51 +153,14 @@ void add_convert_command(CLI::App& app, int& exit_code) {
           ->type_name("N")
           ->default_val(1)
           ->check(CLI::Range(1u, 4096u));
-  cmd->add_option("--voxel-size", opt->voxel_size,
-                  "voxel edge length in mm, or auto: chosen from the point count, extent and step length so that "
-                  "voxels stay under ~32k vertices (16-bit orders), at most 10 mm; `info` shows the choice")
-      ->type_name("MM|auto")
-      ->default_val("10")
-      ->check([](const std::string& text) -> std::string {
-        if (text == "auto") return {};
-        char* end = nullptr;
-        const double v = std::strtod(text.c_str(), &end);
-        if (end == text.c_str() || *end != '\0' || !(v > 0) || !std::isfinite(v))
-          return "expected a positive number of mm or auto, got '" + text + "'";
-        return {};
-      });
+  add_voxel_size_option(cmd, opt->voxel_size);
   cmd->add_option("--threads", opt->settings.threads,
                   "worker threads in all (0: all cores); --jobs N shares them, each file getting threads / N")
       ->default_val(0);
-  cmd->add_option("--orders", opt->settings.orders,
-                  "precomputed order set: axis (6 orders), axis+diag (14), or random:N (N pseudo-random directions "
-                  "per voxel, 2N orders, N in 1..64)")
-      ->default_val("axis")
-      ->check([](const std::string& name) -> std::string {
-        try {
-          parse_order_set(name);
-          return {};
-        } catch (const Error& e) {
-          return e.reason();
-        }
-      });
+  add_orders_option(cmd, opt->settings.orders);
   add_positions_option(cmd, opt->settings.positions);
   add_levels_option(cmd, opt->settings.levels);
-  cmd->add_option(
-         "--memory-limit", opt->memory_limit,
-         "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): reads the source several times and writes the "
-         "output in parts, byte-identical to a conversion without the limit. " +
-             source_format_names_text("/", true) + " sources only (" + source_format_names_text("/", false) +
-             " are refused); a limit too small for the data is refused, naming what needs how much. With "
-             "--output-dir the limit is per file: --jobs N may use N times SIZE")
-      ->type_name("SIZE")
-      ->check(CLI::Validator(
-          [](std::string& s) {
-            return parse_memory_size(s)
-                       ? std::string()
-                       : "'" + s + "' is not a memory size (a number of bytes, or of KiB/MiB/GiB with K/M/G: 512M, 2G)";
-          },
-          ""));
+  add_memory_limit_option(cmd, opt->memory_limit);
   cmd->add_option("--tsf", opt->tsf,
                   "MRtrix track scalar file with one value per point of the input (repeatable); stored so that voxview "
                   "can colour by it (--color scalar). Refused with several inputs")
@@ -123,40 +173,7 @@ void add_convert_command(CLI::App& app, int& exit_code) {
       "Refused before any file is read: two inputs with the same NAME, --tsf with several inputs (2), an "
       "--output-dir that cannot be created or written into (5).");
   cmd->callback([opt, output_dir, jobs, &exit_code] {
-    if (!opt->memory_limit.empty()) opt->settings.memory_limit = *parse_memory_size(opt->memory_limit);
-    opt->settings.voxel_size_auto = opt->voxel_size == "auto";
-    if (!opt->settings.voxel_size_auto) opt->settings.voxel_size = std::strtod(opt->voxel_size.c_str(), nullptr);
-    if (output_dir->count() > 0) {
-      CohortOptions c{opt->files, opt->output_dir, opt->jobs, opt->settings, opt->tsf, opt->verbose};
-      exit_code = run_cohort(c);
-      if (opt->verbose) std::printf("peak resident memory: %lld KiB\n", peak_resident_kib());
-      return;
-    }
-    if (jobs->count() > 0)
-      throw CLI::ValidationError("--jobs converts several files at once: it needs --output-dir DIR");
-    if (opt->files.size() != 2)
-      throw CLI::ValidationError("convert takes IN OUT.vxl, or IN... --output-dir DIR (got " +
-                                 std::to_string(opt->files.size()) + " file names)");
-    const std::string& input = opt->files[0];
-    const std::string& output = opt->files[1];
-    // A .vxl under another name would pass for the other format (a TCK reader then fails on it).
-    std::string lower = output;
-    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (!lower.ends_with(".vxl") && !std::filesystem::is_directory(output))  // a folder: the output rule's (exit 5)
-      throw Error(ErrorKind::Usage, output, std::nullopt,
-                  "convert writes a .vxl file: name the output OUT.vxl (to write TCK, TRX or VTK from a .vxl use "
-                  "`voxlines export IN.vxl OUT.tck`, or `voxlines select` for some of its streamlines)");
-    ProgressBar bar;
-    opt->settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
-    bar.update("reading", 0.0);
-    const std::string report =
-        convert_file(input, output, opt->tsf, opt->settings, opt->verbose, [&](const std::string& w) {
-          bar.done();
-          std::fprintf(stderr, "voxlines: warning: %s: %s\n", input.c_str(), w.c_str());
-        });
-    bar.done();
-    std::fputs(report.c_str(), stdout);
-    if (opt->verbose) std::printf("peak resident memory: %lld KiB\n", peak_resident_kib());
+    exit_code = run_convert(*opt, output_dir->count() > 0, jobs->count() > 0);
   });
 }
 

@@ -8,7 +8,7 @@
 #include "converter/export_trk.h"
 #include "converter/export_trx.h"
 #include "converter/export_vtk.h"
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl::cli {
 namespace {

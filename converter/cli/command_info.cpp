@@ -7,7 +7,7 @@
 
 #include "converter/cli/commands.h"
 #include "converter/readers/float16.h"
-#include "format/json_limits.h"
+#include "format/base/json_limits.h"
 #include "format/vxl_file.h"
 
 namespace vxl::cli {

@@ -5,7 +5,7 @@
 #include "converter/cli/commands.h"
 #include "converter/selection/selection_output.h"
 #include "converter/selection/streamline_selection.h"
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl::cli {
 namespace {

@@ -18,8 +18,8 @@
 #include "converter/cli/convert_file.h"
 #include "converter/cli/progress_bar.h"
 #include "converter/readers/source_formats.h"
-#include "format/error.h"
-#include "format/parallel.h"
+#include "format/base/error.h"
+#include "format/base/parallel.h"
 
 namespace vxl::cli {
 namespace {

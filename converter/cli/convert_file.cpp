@@ -2,8 +2,8 @@
 
 #include <cstdio>
 
-#include "converter/memory_size.h"
 #include "converter/source_to_vxl.h"
+#include "format/base/memory_size.h"
 
 namespace vxl::cli {
 

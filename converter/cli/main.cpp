@@ -9,7 +9,7 @@
 
 #include "converter/cli/commands.h"
 #include "converter/command_line_typos.h"
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace {
 

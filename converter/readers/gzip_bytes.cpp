@@ -4,7 +4,7 @@
 #include <cstring>
 #include <new>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

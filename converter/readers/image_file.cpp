@@ -3,7 +3,7 @@
 #include <filesystem>
 
 #include "converter/readers/regular_file.h"
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 namespace {

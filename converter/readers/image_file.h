@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "converter/readers/gzip_bytes.h"
-#include "format/mapped_file.h"
+#include "format/base/mapped_file.h"
 
 namespace vxl {
 

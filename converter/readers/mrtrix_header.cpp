@@ -3,7 +3,7 @@
 #include <charconv>
 #include <string_view>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 namespace {

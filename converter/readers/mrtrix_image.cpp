@@ -11,8 +11,8 @@
 #include "converter/readers/mrtrix_header.h"
 #include "converter/readers/regular_file.h"
 #include "converter/readers/voxel_samples.h"
-#include "format/error.h"
-#include "format/mapped_file.h"
+#include "format/base/error.h"
+#include "format/base/mapped_file.h"
 
 namespace vxl {
 namespace {
@@ -142,6 +142,52 @@ Layout layout(const std::string& path, const std::optional<std::string>& text, s
   return l;
 }
 
+// The voxel-to-scanner matrix: scanner = R * (vox * index) + t, R and t the header's 'transform:' rows
+// (identity without them).
+std::array<double, 16> voxel_to_ras(const std::string& path, const MrtrixHeader& h, const std::vector<double>& vox) {
+  const std::size_t axes = vox.size();
+  std::array<double, 16> m{};
+  for (int r = 0; r < 3; ++r) m[5 * r] = 1.0;
+  if (h.fields.contains("transform")) {
+    const auto& rows = h.fields["transform"];
+    if (rows.size() != 3)
+      fail_input(path, std::nullopt,
+                 "MRtrix image header has " + std::to_string(rows.size()) + " 'transform:' rows, expected 3");
+    for (int r = 0; r < 3; ++r) {
+      const std::string row = rows[std::size_t(r)].get<std::string>();
+      const std::vector<double> v = numbers(path, "transform", row);
+      if (v.size() != 4) bad_field(path, "transform", row, "4 numbers per row");
+      for (int c = 0; c < 4; ++c) m[4 * r + c] = v[std::size_t(c)];
+    }
+  }
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m[4 * r + c] *= c < int(axes) ? vox[std::size_t(c)] : 1.0;
+  m[15] = 1.0;
+  check_voxel_to_ras(path, m, "the transform and vox");
+  return m;
+}
+
+// The sizes of the axes ('dim:'), whole numbers 1 to 2^31, at most kMaxAxes of them.
+std::vector<std::int64_t> dimensions(const std::string& path, const std::string& text) {
+  std::vector<std::int64_t> dim;
+  for (double d : numbers(path, "dim", text)) {
+    if (d < 1 || d > double(std::int64_t(1) << 31) || d != std::floor(d))
+      bad_field(path, "dim", text, "whole numbers 1 to 2^31");
+    dim.push_back(static_cast<std::int64_t>(d));
+  }
+  if (dim.size() > kMaxAxes) bad_field(path, "dim", text, "at most 16 axes");
+  return dim;
+}
+
+// 'scaling: OFFSET,MULTIPLIER' (value = offset + multiplier * stored); {0, 1} without it.
+std::pair<double, double> scaling(const std::string& path, const MrtrixHeader& h) {
+  const auto s = h.last("scaling");
+  if (!s) return {0.0, 1.0};
+  const std::vector<double> v = numbers(path, "scaling", *s);
+  if (v.size() != 2) bad_field(path, "scaling", *s, "OFFSET,MULTIPLIER");
+  return {v[0], v[1]};
+}
+
 }  // namespace
 
 VolumeImage read_mrtrix_image(const std::string& path, const ImageLimits& limits) {
@@ -168,13 +214,7 @@ VolumeImage read_mrtrix_image(const std::string& path, const ImageLimits& limits
     return *v;
   };
 
-  std::vector<std::int64_t> dim;
-  for (double d : numbers(path, "dim", field("dim"))) {
-    if (d < 1 || d > double(std::int64_t(1) << 31) || d != std::floor(d))
-      bad_field(path, "dim", field("dim"), "whole numbers 1 to 2^31");
-    dim.push_back(static_cast<std::int64_t>(d));
-  }
-  if (dim.size() > kMaxAxes) bad_field(path, "dim", field("dim"), "at most 16 axes");
+  const std::vector<std::int64_t> dim = dimensions(path, field("dim"));
   const std::vector<double> vox = numbers(path, "vox", field("vox"));
   if (vox.size() != dim.size()) bad_field(path, "vox", field("vox"), std::to_string(dim.size()) + " sizes, as dim");
   const Layout order = layout(path, h.last("layout"), dim.size());
@@ -184,32 +224,8 @@ VolumeImage read_mrtrix_image(const std::string& path, const ImageLimits& limits
   for (std::size_t a = 0; a < std::min<std::size_t>(3, axes); ++a) dims[a] = dim[a];
   check_image_size(path, dims, limits);
 
-  // scanner = R * (vox * index) + t
-  std::array<double, 16> m{};
-  for (int r = 0; r < 3; ++r) m[5 * r] = 1.0;
-  if (h.fields.contains("transform")) {
-    const auto& rows = h.fields["transform"];
-    if (rows.size() != 3)
-      fail_input(path, std::nullopt,
-                 "MRtrix image header has " + std::to_string(rows.size()) + " 'transform:' rows, expected 3");
-    for (int r = 0; r < 3; ++r) {
-      const std::string row = rows[std::size_t(r)].get<std::string>();
-      const std::vector<double> v = numbers(path, "transform", row);
-      if (v.size() != 4) bad_field(path, "transform", row, "4 numbers per row");
-      for (int c = 0; c < 4; ++c) m[4 * r + c] = v[std::size_t(c)];
-    }
-  }
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) m[4 * r + c] *= c < int(axes) ? vox[std::size_t(c)] : 1.0;
-  m[15] = 1.0;
-  check_voxel_to_ras(path, m, "the transform and vox");
-
-  double slope = 1.0, inter = 0.0;
-  if (const auto s = h.last("scaling")) {
-    const std::vector<double> v = numbers(path, "scaling", *s);
-    if (v.size() != 2) bad_field(path, "scaling", *s, "OFFSET,MULTIPLIER");
-    inter = v[0], slope = v[1];
-  }
+  const std::array<double, 16> m = voxel_to_ras(path, h, vox);
+  const auto [inter, slope] = scaling(path, h);
 
   // The file offset (in samples) of each axis' step, and of the last sample of the first volume.
   const std::size_t size = sample_bytes(type.type);

@@ -12,7 +12,7 @@
 
 #include "converter/readers/image_file.h"
 #include "converter/readers/voxel_samples.h"
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 namespace {

@@ -3,7 +3,7 @@
 
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/source_formats.h"
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

@@ -34,10 +34,10 @@
 #include "converter/readers/latin1.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/regular_file.h"
-#include "format/checksum.h"
-#include "format/error.h"
-#include "format/json_limits.h"
-#include "format/mapped_file.h"
+#include "format/base/checksum.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
+#include "format/base/mapped_file.h"
 
 namespace vxl {
 namespace {

@@ -8,9 +8,9 @@
 
 #include "converter/readers/mrtrix_header.h"
 #include "converter/readers/regular_file.h"
-#include "format/checksum.h"
-#include "format/error.h"
-#include "format/mapped_file.h"
+#include "format/base/checksum.h"
+#include "format/base/error.h"
+#include "format/base/mapped_file.h"
 
 namespace vxl {
 namespace {

@@ -13,9 +13,9 @@
 
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/vtk_polydata.h"
-#include "format/checked_count.h"
-#include "format/error.h"
-#include "format/mapped_file.h"
+#include "format/base/checked_count.h"
+#include "format/base/error.h"
+#include "format/base/mapped_file.h"
 
 namespace vxl {
 namespace {
@@ -31,7 +31,36 @@ class LegacyParser {
       : path_(path), data_(reinterpret_cast<const char*>(bytes.data()), bytes.size()) {}
 
   Tractogram parse() {
-    Tractogram t;
+    const std::string title = read_header();
+    while (skip_space() < data_.size()) {
+      const std::uint64_t key_at = pos_;
+      const std::string key = word();
+      if (key == "POINTS")
+        read_points(key_at);
+      else if (key == "LINES" || key == "VERTICES" || key == "POLYGONS" || key == "TRIANGLE_STRIPS")
+        read_cells(key, key_at);
+      else if (key == "POINT_DATA" || key == "CELL_DATA")
+        start_attributes(key);
+      else if (key == "METADATA")
+        skip_metadata();
+      else if (key == "FIELD")
+        read_field();
+      else if (key == "SCALARS" || key == "VECTORS" || key == "NORMALS" || key == "TENSORS" || key == "TENSORS6" ||
+               key == "TEXTURE_COORDINATES" || key == "COLOR_SCALARS" || key == "GLOBAL_IDS" || key == "PEDIGREE_IDS")
+        read_attribute(key, key_at);
+      else if (key == "LOOKUP_TABLE")
+        skip_lookup_table(key_at);
+      else
+        fail(key_at,
+             "unexpected keyword '" + key + "' (expected POINTS, LINES, POINT_DATA, CELL_DATA, FIELD or an attribute)");
+    }
+    check_sections();
+    return tractogram(title);
+  }
+
+ private:
+  // The first lines up to DATASET POLYDATA; returns the title (empty when the file has none).
+  std::string read_header() {
     const std::string first = line();
     if (!first.starts_with("# vtk DataFile Version")) fail(0, "expected '# vtk DataFile Version' on the first line");
     version_ = trim(first.substr(22));
@@ -52,155 +81,165 @@ class LegacyParser {
     if (dataset != "POLYDATA")
       fail_unsupported(path_, "DATASET " + dataset + ": only POLYDATA (streamlines as LINES) is read");
     end_line();
+    return title;
+  }
 
-    vtk::PolyData p;
-    bool have_points = false, have_lines = false;
-    std::string surface;  // POLYGONS or TRIANGLE_STRIPS seen
-    std::uint64_t verts = 0;
-    int section = 0;  // 0 dataset, 1 POINT_DATA, 2 CELL_DATA
-    std::uint64_t tuples = 0;
-    while (skip_space() < data_.size()) {
-      const std::uint64_t key_at = pos_;
-      const std::string key = word();
-      if (key == "POINTS") {
-        p.point_count = count();
-        points_type_ = word();
-        const Type type = parse_type(points_type_, key_at);
-        if (type.kind != 'f') fail(key_at, "POINTS must be float or double");
-        end_line();
-        p.points = numbers(checked_product(3, p.point_count, path_, key_at, "POINTS count"), type, "POINTS");
-        have_points = true;
-      } else if (key == "LINES" || key == "VERTICES" || key == "POLYGONS" || key == "TRIANGLE_STRIPS") {
-        std::vector<std::uint64_t> offsets{0};
-        std::vector<double> connectivity;
-        const std::uint64_t n = cells(offsets, connectivity, key_at, key);
-        p.cell_count = checked_sum(p.cell_count, n, path_, key_at, "the number of cells");
-        if (key == "LINES") {
-          if (have_lines) fail(key_at, "a second LINES section");
-          p.line_offsets = std::move(offsets);
-          p.line_connectivity = std::move(connectivity);
-          have_lines = true;
-        } else if (key == "VERTICES") {
-          verts = checked_sum(verts, n, path_, key_at, "the number of VERTICES cells");
-        } else if (n > 0) {
-          surface = key;
-        }
-      } else if (key == "POINT_DATA" || key == "CELL_DATA") {
-        section = key == "POINT_DATA" ? 1 : 2;
-        tuples = count();
-        end_line();
-      } else if (key == "METADATA") {
-        // Information keys, up to an empty line: nothing we use.
-        end_line();
-        while (pos_ < data_.size() && !trim(line()).empty()) {
-        }
-      } else if (key == "FIELD") {
-        word();  // the field's name
-        const std::uint64_t arrays = count();
-        end_line();
-        for (std::uint64_t k = 0; k < arrays; ++k) {
-          skip_space();
-          const std::uint64_t array_at = pos_;
-          vtk::DataArray a;
-          a.name = vtk::decode_name(word());
-          a.components = count();
-          const std::uint64_t n = count();
-          const Type type = parse_type(word(), array_at);
-          end_line();
-          if (a.components == 0) fail(array_at, "FIELD array '" + a.name + "' with 0 components");
-          if (n > data_.size() || (n > 0 && a.components > data_.size() / n))
-            fail(array_at, "FIELD array '" + a.name + "' larger than the file");
-          const std::uint64_t values = checked_product(a.components, n, path_, array_at, "FIELD array size");
-          if (type.kind == 's' || type.kind == 'b') {
-            skip_special(values, type);
-            if (section)
-              warnings_.push_back("array '" + a.name + "' holds " + (type.kind == 's' ? "strings" : "bits") +
-                                  "; skipped");
-            continue;
-          }
-          a.values = numbers(values, type, "FIELD array '" + a.name + "'");
-          if (section == 0) continue;  // dataset-level field data: not per point or cell
-          if (n != tuples)
-            fail(array_at, "FIELD array '" + a.name + "' has " + std::to_string(n) + " tuples; expected " +
-                               std::to_string(tuples));
-          (section == 1 ? p.point_data : p.cell_data).push_back(std::move(a));
-        }
-      } else if (key == "SCALARS" || key == "VECTORS" || key == "NORMALS" || key == "TENSORS" || key == "TENSORS6" ||
-                 key == "TEXTURE_COORDINATES" || key == "COLOR_SCALARS" || key == "GLOBAL_IDS" ||
-                 key == "PEDIGREE_IDS") {
-        if (section == 0) fail(key_at, key + " before POINT_DATA or CELL_DATA");
-        vtk::DataArray a;
-        a.name = vtk::decode_name(word());
-        Type type{'f', 4};
-        if (key == "COLOR_SCALARS") {
-          a.components = count();
-          type = binary_ ? Type{'u', 1} : Type{'f', 4};
-        } else if (key == "TEXTURE_COORDINATES") {
-          a.components = count();
-          type = parse_type(word(), key_at);
-        } else {
-          type = parse_type(word(), key_at);
-          a.components = key == "VECTORS" || key == "NORMALS" ? 3 : key == "TENSORS" ? 9 : key == "TENSORS6" ? 6 : 1;
-          if (key == "SCALARS" && !at_line_end()) a.components = count();
-        }
-        end_line();
-        if (a.components == 0 || a.components > data_.size() || (tuples > 0 && a.components > data_.size() / tuples))
-          fail(key_at, key + " '" + a.name + "' with an impossible number of components");
-        if (key == "SCALARS") {
-          // LOOKUP_TABLE name: always present in files VTK writes, optional in the specification.
-          const std::uint64_t save = pos_;
-          skip_space();
-          if (word() == "LOOKUP_TABLE") {
-            word();
-            end_line();
-          } else {
-            pos_ = save;
-          }
-        }
-        const std::uint64_t values = checked_product(a.components, tuples, path_, key_at, key + " size");
-        if (type.kind == 's' || type.kind == 'b') {
-          skip_special(values, type);
-          warnings_.push_back("array '" + a.name + "' holds " + std::string(type.kind == 's' ? "strings" : "bits") +
-                              "; skipped");
-          continue;
-        }
-        if (tuples > 0 && a.components > data_.size() / tuples)
-          fail(key_at, key + " '" + a.name + "' larger than the file");
-        a.values = numbers(values, type, key + " '" + a.name + "'");
-        if (key == "COLOR_SCALARS" && binary_)
-          for (double& v : a.values) v /= 255.0;  // as in ASCII files: 0 to 1
-        (section == 1 ? p.point_data : p.cell_data).push_back(std::move(a));
-      } else if (key == "LOOKUP_TABLE") {
-        word();
-        const std::uint64_t n = count();
-        end_line();
-        if (n > data_.size()) fail(key_at, "LOOKUP_TABLE larger than the file");
-        numbers(checked_product(4, n, path_, key_at, "LOOKUP_TABLE size"), binary_ ? Type{'u', 1} : Type{'f', 4},
-                "LOOKUP_TABLE");
-      } else {
-        fail(key_at,
-             "unexpected keyword '" + key + "' (expected POINTS, LINES, POINT_DATA, CELL_DATA, FIELD or an attribute)");
-      }
+  void read_points(std::uint64_t key_at) {
+    p_.point_count = count();
+    points_type_ = word();
+    const Type type = parse_type(points_type_, key_at);
+    if (type.kind != 'f') fail(key_at, "POINTS must be float or double");
+    end_line();
+    p_.points = numbers(checked_product(3, p_.point_count, path_, key_at, "POINTS count"), type, "POINTS");
+    have_points_ = true;
+  }
+
+  // LINES are the streamlines; VERTICES are counted (they come first in VTK's cell numbering); surface
+  // cells are noted and skipped.
+  void read_cells(const std::string& key, std::uint64_t key_at) {
+    std::vector<std::uint64_t> offsets{0};
+    std::vector<double> connectivity;
+    const std::uint64_t n = cells(offsets, connectivity, key_at, key);
+    p_.cell_count = checked_sum(p_.cell_count, n, path_, key_at, "the number of cells");
+    if (key == "LINES") {
+      if (have_lines_) fail(key_at, "a second LINES section");
+      p_.line_offsets = std::move(offsets);
+      p_.line_connectivity = std::move(connectivity);
+      have_lines_ = true;
+    } else if (key == "VERTICES") {
+      verts_ = checked_sum(verts_, n, path_, key_at, "the number of VERTICES cells");
+    } else if (n > 0) {
+      surface_ = key;
     }
+  }
 
-    if (!surface.empty() && !have_lines)
-      fail_unsupported(path_, "a surface mesh (" + surface + ", no LINES): only streamlines (LINES) are read");
-    if (!surface.empty()) warnings_.push_back(surface + " cells are not streamlines; skipped");
-    if (verts > 0) warnings_.push_back(std::to_string(verts) + " VERTICES cells are not streamlines; skipped");
-    if (!have_points && have_lines) fail(std::nullopt, "LINES without POINTS");
-    if (!have_lines && p.point_count > 0)
+  void start_attributes(const std::string& key) {
+    section_ = key == "POINT_DATA" ? Section::Points : Section::Cells;
+    tuples_ = count();
+    end_line();
+  }
+
+  // Information keys, up to an empty line: nothing we use.
+  void skip_metadata() {
+    end_line();
+    while (pos_ < data_.size() && !trim(line()).empty()) {
+    }
+  }
+
+  // The arrays of a section's attributes (or, before POINT_DATA and CELL_DATA, of the dataset: skipped).
+  std::vector<vtk::DataArray>& attributes() { return section_ == Section::Points ? p_.point_data : p_.cell_data; }
+
+  void read_field() {
+    word();  // the field's name
+    const std::uint64_t arrays = count();
+    end_line();
+    for (std::uint64_t k = 0; k < arrays; ++k) {
+      skip_space();
+      const std::uint64_t array_at = pos_;
+      vtk::DataArray a;
+      a.name = vtk::decode_name(word());
+      a.components = count();
+      const std::uint64_t n = count();
+      const Type type = parse_type(word(), array_at);
+      end_line();
+      if (a.components == 0) fail(array_at, "FIELD array '" + a.name + "' with 0 components");
+      if (n > data_.size() || (n > 0 && a.components > data_.size() / n))
+        fail(array_at, "FIELD array '" + a.name + "' larger than the file");
+      const std::uint64_t values = checked_product(a.components, n, path_, array_at, "FIELD array size");
+      if (type.kind == 's' || type.kind == 'b') {
+        skip_special(values, type);
+        if (section_ != Section::Dataset)
+          warnings_.push_back("array '" + a.name + "' holds " + (type.kind == 's' ? "strings" : "bits") + "; skipped");
+        continue;
+      }
+      a.values = numbers(values, type, "FIELD array '" + a.name + "'");
+      if (section_ == Section::Dataset) continue;  // dataset-level field data: not per point or cell
+      if (n != tuples_)
+        fail(array_at,
+             "FIELD array '" + a.name + "' has " + std::to_string(n) + " tuples; expected " + std::to_string(tuples_));
+      attributes().push_back(std::move(a));
+    }
+  }
+
+  // SCALARS, VECTORS, NORMALS, TENSORS, COLOR_SCALARS, ...: one array of the current section.
+  void read_attribute(const std::string& key, std::uint64_t key_at) {
+    if (section_ == Section::Dataset) fail(key_at, key + " before POINT_DATA or CELL_DATA");
+    vtk::DataArray a;
+    a.name = vtk::decode_name(word());
+    Type type{'f', 4};
+    if (key == "COLOR_SCALARS") {
+      a.components = count();
+      type = binary_ ? Type{'u', 1} : Type{'f', 4};
+    } else if (key == "TEXTURE_COORDINATES") {
+      a.components = count();
+      type = parse_type(word(), key_at);
+    } else {
+      type = parse_type(word(), key_at);
+      a.components = key == "VECTORS" || key == "NORMALS" ? 3 : key == "TENSORS" ? 9 : key == "TENSORS6" ? 6 : 1;
+      if (key == "SCALARS" && !at_line_end()) a.components = count();
+    }
+    end_line();
+    if (a.components == 0 || a.components > data_.size() || (tuples_ > 0 && a.components > data_.size() / tuples_))
+      fail(key_at, key + " '" + a.name + "' with an impossible number of components");
+    if (key == "SCALARS") skip_optional_lookup_table_name();
+    const std::uint64_t values = checked_product(a.components, tuples_, path_, key_at, key + " size");
+    if (type.kind == 's' || type.kind == 'b') {
+      skip_special(values, type);
+      warnings_.push_back("array '" + a.name + "' holds " + std::string(type.kind == 's' ? "strings" : "bits") +
+                          "; skipped");
+      return;
+    }
+    if (tuples_ > 0 && a.components > data_.size() / tuples_)
+      fail(key_at, key + " '" + a.name + "' larger than the file");
+    a.values = numbers(values, type, key + " '" + a.name + "'");
+    if (key == "COLOR_SCALARS" && binary_)
+      for (double& v : a.values) v /= 255.0;  // as in ASCII files: 0 to 1
+    attributes().push_back(std::move(a));
+  }
+
+  // LOOKUP_TABLE name after SCALARS: always present in files VTK writes, optional in the specification.
+  void skip_optional_lookup_table_name() {
+    const std::uint64_t save = pos_;
+    skip_space();
+    if (word() == "LOOKUP_TABLE") {
+      word();
+      end_line();
+    } else {
+      pos_ = save;
+    }
+  }
+
+  void skip_lookup_table(std::uint64_t key_at) {
+    word();
+    const std::uint64_t n = count();
+    end_line();
+    if (n > data_.size()) fail(key_at, "LOOKUP_TABLE larger than the file");
+    numbers(checked_product(4, n, path_, key_at, "LOOKUP_TABLE size"), binary_ ? Type{'u', 1} : Type{'f', 4},
+            "LOOKUP_TABLE");
+  }
+
+  // What the sections must add up to, once all are read.
+  void check_sections() {
+    if (!surface_.empty() && !have_lines_)
+      fail_unsupported(path_, "a surface mesh (" + surface_ + ", no LINES): only streamlines (LINES) are read");
+    if (!surface_.empty()) warnings_.push_back(surface_ + " cells are not streamlines; skipped");
+    if (verts_ > 0) warnings_.push_back(std::to_string(verts_) + " VERTICES cells are not streamlines; skipped");
+    if (!have_points_ && have_lines_) fail(std::nullopt, "LINES without POINTS");
+    if (!have_lines_ && p_.point_count > 0)
       fail_unsupported(path_,
-                       "POLYDATA without LINES: " + std::to_string(p.point_count) + " points but no streamlines");
-    for (const auto* arrays : {&p.point_data, &p.cell_data})
-      for (const vtk::DataArray& a : *arrays)
-        if (arrays == &p.cell_data && a.values.size() / a.components != p.cell_count)
-          fail(std::nullopt, "CELL_DATA for " + std::to_string(a.values.size() / a.components) +
-                                 " cells; the file has " + std::to_string(p.cell_count));
+                       "POLYDATA without LINES: " + std::to_string(p_.point_count) + " points but no streamlines");
+    for (const vtk::DataArray& a : p_.cell_data)
+      if (a.values.size() / a.components != p_.cell_count)
+        fail(std::nullopt, "CELL_DATA for " + std::to_string(a.values.size() / a.components) + " cells; the file has " +
+                               std::to_string(p_.cell_count));
+  }
 
+  Tractogram tractogram(const std::string& title) {
+    Tractogram t;
     // VTK numbers the cells vertices first, then lines, whatever order the sections come in.
-    p.cells_before_lines = verts;
+    p_.cells_before_lines = verts_;
     const bool lps = vtk::says_lps(title);
-    vtk::fill_tractogram(t, path_, p, lps);
+    vtk::fill_tractogram(t, path_, p_, lps);
     t.source.warnings.insert(t.source.warnings.end(), warnings_.begin(), warnings_.end());
     t.source.dtype = std::string(binary_ ? "BINARY " : "ASCII ") + points_type_;
     t.source.header = {{"version", version_},
@@ -210,7 +249,6 @@ class LegacyParser {
     return t;
   }
 
- private:
   [[noreturn]] void fail(std::optional<std::uint64_t> at, const std::string& what) const {
     fail_input(path_, at, what);
   }
@@ -417,6 +455,14 @@ class LegacyParser {
   bool binary_ = false;
   std::string version_, points_type_;
   std::vector<std::string> warnings_;
+  // What the sections read so far hold.
+  enum class Section { Dataset, Points, Cells };  // whose attributes come next
+  Section section_ = Section::Dataset;
+  std::uint64_t tuples_ = 0;  // of the current section
+  vtk::PolyData p_;
+  bool have_points_ = false, have_lines_ = false;
+  std::string surface_;  // POLYGONS or TRIANGLE_STRIPS seen
+  std::uint64_t verts_ = 0;
 };
 
 }  // namespace

@@ -23,9 +23,9 @@
 
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/vtk_polydata.h"
-#include "format/checked_count.h"
-#include "format/error.h"
-#include "format/mapped_file.h"
+#include "format/base/checked_count.h"
+#include "format/base/error.h"
+#include "format/base/mapped_file.h"
 
 namespace vxl {
 namespace {

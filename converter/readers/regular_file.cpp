@@ -2,7 +2,7 @@
 
 #include <sys/stat.h>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

@@ -15,7 +15,7 @@
 
 #include "converter/readers/mrtrix_header.h"
 #include "converter/tractogram.h"
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl::tck {
 

@@ -9,9 +9,9 @@
 #include <unistd.h>
 
 #include "converter/readers/regular_file.h"
-#include "format/checksum.h"
-#include "format/error.h"
-#include "format/regular_file.h"
+#include "format/base/checksum.h"
+#include "format/base/error.h"
+#include "format/base/regular_file.h"
 
 namespace vxl {
 namespace {

@@ -12,7 +12,7 @@
 
 #include "converter/readers/tck_format.h"
 #include "converter/tractogram.h"
-#include "format/mapped_file.h"
+#include "format/base/mapped_file.h"
 
 namespace vxl {
 

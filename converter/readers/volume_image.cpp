@@ -6,7 +6,7 @@
 
 #include "converter/readers/mrtrix_image.h"
 #include "converter/readers/nifti_image.h"
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 namespace {

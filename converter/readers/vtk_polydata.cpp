@@ -6,9 +6,9 @@
 #include <cstring>
 #include <set>
 
-#include "format/checked_count.h"
-#include "format/checksum.h"
-#include "format/error.h"
+#include "format/base/checked_count.h"
+#include "format/base/checksum.h"
+#include "format/base/error.h"
 
 namespace vxl::vtk {
 namespace {

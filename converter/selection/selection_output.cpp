@@ -10,8 +10,8 @@
 #include "converter/export_trx.h"
 #include "converter/export_values.h"
 #include "converter/export_vtk.h"
-#include "format/error.h"
-#include "format/json_limits.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {

@@ -7,9 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "format/error.h"
-#include "format/json_limits.h"
-#include "format/parallel.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
+#include "format/base/parallel.h"
 #include "format/vxl_positions.h"
 #include "format/vxl_streamlines.h"
 
@@ -112,7 +112,6 @@ struct HitSearch {
   std::span<const VoxlineEntry> voxlines = file.voxlines();
   std::span<const VoxelEntry> voxels = file.voxels();
   std::uint32_t levels = file.level_count();
-  std::uint64_t strm_at = file.find_section(section_id("STRM"))->offset;
   std::uint64_t vxln_at = file.find_section(section_id("VXLN"))->offset;
   std::vector<float> xyz = {};
 
@@ -176,22 +175,18 @@ std::vector<StreamlineHits> hits_by_scan(HitSearch& q, std::uint64_t& bytes_read
     if (q.voxel_regions.touching[i] != 0)
       for (std::uint32_t d = 0; d < q.levels; ++d)
         cursor[i * q.levels + d] = q.depth_start(i, d), end[i * q.levels + d] = q.depth_end(i, d);
-  if (q.strm[0] != 0) fail_input(q.file.path(), q.strm_at, "streamline table must start at voxline 0");
   std::vector<StreamlineHits> hits;
   for (std::uint64_t s = 0; s < n; ++s) {
     const std::uint64_t first = q.strm[s], last = q.strm[s + 1];
-    if (last < first || last > q.voxlines.size())
-      fail_input(q.file.path(), q.strm_at + 8 * (s + 1), "streamline table not non-decreasing");
+    q.file.check_streamline_run(s);
     Bits hit = 0;
     const std::uint32_t depth = streamline_depth(s, q.levels);
     for (std::uint64_t j = first; j < last; ++j) {
       const VoxlineEntry& e = q.voxlines[j];
-      if (e.voxel >= q.voxels.size())
-        fail_input(q.file.path(), q.vxln_at + 8 * j, "voxline refers to a voxel past the table");
+      q.file.check_voxline(j);
       if (q.voxel_regions.touching[e.voxel] == 0) continue;
       VoxlinePlace v{e.voxel, e.count_flags & kVoxlineCountMask, (e.count_flags & kVoxlineSyntheticFirst) != 0,
                      j == first, j + 1 < last};
-      if (v.own == 0) fail_input(q.file.path(), q.vxln_at + 8 * j, "voxline with no points");
       const std::size_t k = std::size_t(e.voxel) * q.levels + depth;
       if (!claim_vertices(v, cursor[k], end[k]))
         fail_input(q.file.path(), q.vxln_at + 8 * j,

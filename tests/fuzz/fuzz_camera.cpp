@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "format/error.h"
+#include "format/base/error.h"
 #include "viewer/app/camera_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 #include "converter/convert.h"
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl::fuzz {
 

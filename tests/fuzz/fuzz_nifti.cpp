@@ -6,7 +6,7 @@
 #include <cstdlib>
 
 #include "converter/readers/volume_image.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/fuzz/fuzz_input.h"
 
 namespace {

@@ -12,7 +12,7 @@
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/tck_stream.h"
 #include "converter/streaming_convert.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/fuzz/fuzz_input.h"
 
 namespace {

@@ -12,7 +12,7 @@
 
 #include "converter/convert.h"
 #include "converter/readers/read_tractogram.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/fuzz/fuzz_input.h"
 
 namespace {

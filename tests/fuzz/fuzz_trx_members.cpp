@@ -11,7 +11,7 @@
 
 #include "converter/convert.h"
 #include "converter/readers/read_tractogram.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/fuzz/fuzz_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "converter/export_tck.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"

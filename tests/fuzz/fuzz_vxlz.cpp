@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "converter/unpack.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_verify.h"
 #include "tests/fuzz/fuzz_input.h"
 #include "tests/reseal_checksums.h"

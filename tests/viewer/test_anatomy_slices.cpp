@@ -8,7 +8,7 @@
 #include <nifti2_io.h>
 
 #include "converter/readers/volume_image.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/anatomy/nifti_volume.h"
 

@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
-#include "format/error.h"
-#include "format/json_limits.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
 #include "tests/test_support.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/turntable.h"

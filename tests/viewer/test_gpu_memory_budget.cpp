@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "converter/synth.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_metrics.h"
 #include "viewer/render/gpu_memory_pool.h"

@@ -6,7 +6,7 @@
 #include <numeric>
 
 #include "converter/synth.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_metrics.h"
 #include "viewer/render/scene_layout.h"

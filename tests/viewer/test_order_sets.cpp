@@ -13,7 +13,7 @@
 #include "converter/convert.h"
 #include "converter/segment_orders.h"
 #include "converter/synth.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_verify.h"
 #include "tests/test_support.h"

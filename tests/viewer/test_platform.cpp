@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "format/error.h"
+#include "format/base/error.h"
 #include "viewer/platform/egl_context.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/offscreen_target.h"
@@ -529,7 +529,7 @@ TEST(PlatformImageIo, WriteFailuresLeaveNothingAndNameThePath) {
   EXPECT_TRUE(vxl::read_image(path).rgba == other.rgba);
 }
 
-// The output rule (format/output_path.h): a FIFO or a device is refused as an output error and left as it
+// The output rule (format/base/output_path.h): a FIFO or a device is refused as an output error and left as it
 // was, a symbolic link is followed and kept, a missing folder is an output error (voxview exit 5).
 TEST(PlatformImageIo, WritePngRefusesFifosAndDevicesAndFollowsLinks) {
   TempDir dir;

@@ -2,7 +2,7 @@
 // masks and boxes; adding, moving, resizing, switching and removing change the criteria and the revision.
 #include <gtest/gtest.h>
 
-#include "format/error.h"
+#include "format/base/error.h"
 #include "viewer/app/region_editor.h"
 
 namespace vxl::app {

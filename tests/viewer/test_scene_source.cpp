@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/test_support.h"
 #include "viewer/app/scene_source.h"
 

@@ -10,7 +10,7 @@
 #include <sys/stat.h>
 
 #include "converter/readers/source_formats.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "tests/test_support.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/key_bindings.h"

@@ -54,6 +54,22 @@ TEST(VoxviewVerify, RefusesADamagedChecksumThatOpenLetsThrough) {
   }
 }
 
+// A packed file's voxline-end bits are drawn as stored: one that disagrees with the voxel's order 0 is
+// refused when its voxel is uploaded (exit 3, naming the vertex and its byte), with or without --verify.
+TEST(VoxviewVerify, RefusesAVoxlineEndBitThatDisagreesWithTheOrders) {
+  ScratchDir dir;
+  VxlBytes b = VxlBytes::make(dir.file("h.vxl"));
+  ASSERT_EQ(VxlFile::open(dir.file("h.vxl")).position_encoding(), PositionEncoding::Packed);
+  b.flip(b.offset_of("VERT") + 3, 0x40);  // bit 30 of the first word, little-endian
+  b.write(dir.file("bad.vxl"));
+  const std::string png = dir.file("out.png");
+  const auto r = voxview(q(dir.file("bad.vxl")) + " --render " + q(png) + " --size 48x48");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("at byte " + std::to_string(b.offset_of("VERT"))), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("voxline-end bit disagrees with order 0"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(png));
+}
+
 TEST(VoxviewVerify, HelpSaysWhatOpenChecksAndWhatVerifyAdds) {
   const auto r = voxview("--help");
   EXPECT_EQ(r.exit_code, 0) << r.output;

@@ -9,9 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "format/atomic_output.h"
-#include "format/error.h"
-#include "format/json_limits.h"
+#include "format/base/atomic_output.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
 #include "viewer/render/background_color.h"
 
 namespace vxl::app {

@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "format/atomic_output.h"
+#include "format/base/atomic_output.h"
 
 namespace vxl::app {
 

@@ -6,7 +6,7 @@
 #include <memory>
 #include <optional>
 
-#include "converter/memory_size.h"
+#include "format/base/memory_size.h"
 #include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/picture_annotations.h"

@@ -5,9 +5,9 @@
 
 #include <epoxy/gl.h>
 
-#include "converter/memory_available.h"
-#include "converter/memory_size.h"
-#include "format/error.h"
+#include "format/base/error.h"
+#include "format/base/memory_available.h"
+#include "format/base/memory_size.h"
 #include "viewer/render/gpu_scene.h"
 #include "viewer/render/scene_layout.h"
 

@@ -4,10 +4,10 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "converter/memory_size.h"
 #include "converter/temporary_vxl.h"
 #include "converter/unpack.h"
-#include "format/error.h"
+#include "format/base/error.h"
+#include "format/base/memory_size.h"
 #include "format/vxl_verify.h"
 #include "viewer/render/renderer.h"
 

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "converter/memory_size.h"
-#include "format/error.h"
-#include "format/output_path.h"
+#include "format/base/error.h"
+#include "format/base/memory_size.h"
+#include "format/base/output_path.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/turntable.h"
 #include "viewer/platform/image_io.h"
@@ -214,7 +214,7 @@ void apply_selection(const ViewerArguments& a, ViewerOptions& o) {
 }
 
 // Every output path, before anything is read or drawn: a missing folder, a directory, a FIFO or a device
-// is refused now (exit 5) rather than after the rendering, and never replaced (format/output_path.h).
+// is refused now (exit 5) rather than after the rendering, and never replaced (format/base/output_path.h).
 void check_outputs(const ViewerOptions& o) {
   for (const auto* path : {&o.render_png, &o.screenshot})
     if (*path && picture_format_of(**path).empty())

@@ -39,7 +39,7 @@ struct ViewerArguments {
 // The options voxview runs with. Reads the saved view of `camera_file`, if any. Throws vxl::Error: Usage for
 // options that do not parse or do not go together, what read_view throws for a bad view file, and Output for
 // an output path (--render and its turntable frames, --save-camera, --stats, --screenshot) that cannot be
-// written or that format/output_path.h's rule refuses.
+// written or that format/base/output_path.h's rule refuses.
 ViewerOptions resolve_viewer_options(const ViewerArguments& arguments);
 
 }  // namespace vxl::app

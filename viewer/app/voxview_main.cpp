@@ -7,7 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "converter/command_line_typos.h"
-#include "format/error.h"
+#include "format/base/error.h"
 #include "viewer/app/headless_render.h"
 #include "viewer/app/viewer_arguments.h"
 #include "viewer/app/voxview_cli.h"

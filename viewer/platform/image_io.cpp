@@ -16,8 +16,8 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "format/error.h"
-#include "format/output_path.h"
+#include "format/base/error.h"
+#include "format/base/output_path.h"
 
 namespace vxl {
 

@@ -24,7 +24,7 @@ struct Image {
 // Writes an RGBA8 PNG (rows top-to-bottom, rgba.size() == w*h*4). Atomic: the image is written to a
 // temporary file in the same directory, flushed, then renamed over `path`; on failure the temporary
 // file is removed and `path` is untouched (no new or partial file there). `path` follows the output
-// rule of format/output_path.h (a device, FIFO or directory is refused, a symbolic link followed). Throws
+// rule of format/base/output_path.h (a device, FIFO or directory is refused, a symbolic link followed). Throws
 // vxl::Error (Output) naming `path` when it cannot be written, std::runtime_error for a malformed image.
 void write_png(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgba);
 inline void write_png(const std::string& path, const Image& img) { write_png(path, img.width, img.height, img.rgba); }

@@ -9,7 +9,7 @@
 #include <string>
 #include <utility>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

@@ -4,8 +4,8 @@
 #include <chrono>
 #include <cstring>
 
-#include "format/error.h"
-#include "format/parallel.h"
+#include "format/base/error.h"
+#include "format/base/parallel.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -17,8 +17,8 @@ std::uint64_t GpuScene::driver_limit() {
 }
 
 // Voxel i's part of its span: checks every order entry (open() does not: it would cost O(points) there),
-// finds the segment starts from order 0, and writes the packed words with the voxline-end bit where no
-// segment starts, the decoding info, its table entries and its orders at 16 bits (plus high halves).
+// finds the segment starts from order 0, checks the packed words' voxline-end bits against them (float32: sets
+// them where no segment starts), the decoding info, its table entries and its orders at 16 bits (plus high halves).
 void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t li, std::uint32_t index,
                             const TextureSpan& c, std::vector<std::uint32_t>& words, std::vector<std::uint16_t>& orders,
                             std::vector<std::uint8_t>& is_start, std::vector<float>& xyz) const {
@@ -54,14 +54,23 @@ void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t 
 
   std::uint32_t* block = words.data() + d.vertex_first;
   if (file.position_encoding() == PositionEncoding::Packed) {
+    // A packed file's voxline-end bits are the ones drawn (spec §5.4). This loop reads every word anyway, so
+    // it checks them against order 0: a file whose bits disagree is refused, not drawn with segments
+    // across voxlines.
     std::copy_n(file.packed_vertices().data() + v.vertex_first, counts.vertex_count, block);
+    for (std::uint32_t n = 0; n < counts.vertex_count; ++n)
+      if (((block[n] & kPackedVoxlineEnd) != 0) == (is_start[n] != 0) || (block[n] & kPackedReservedBit) != 0)
+        throw Error(ErrorKind::Input, file.path(),
+                    file.find_section(section_id("VERT"))->offset + 4 * (v.vertex_first + n),
+                    "packed vertex " + std::to_string(n) + " of voxel " + std::to_string(li) +
+                        ": voxline-end bit disagrees with order 0, or reserved bit set (run `voxlines verify`)");
   } else {
+    // float32 blocks carry no end bits: they come from order 0 (a vertex where no segment starts).
     xyz.resize(3 * std::uint64_t(counts.vertex_count));
     file.read_vertices(li, v.vertex_first, counts.vertex_count, xyz.data());
     pack_block(v, xyz.data(), counts.vertex_count, block);
+    for (std::uint32_t n = 0; n < counts.vertex_count; ++n) block[n] |= is_start[n] ? 0u : kPackedVoxlineEnd;
   }
-  for (std::uint32_t n = 0; n < counts.vertex_count; ++n)
-    block[n] = (block[n] & ~(kPackedVoxlineEnd | kPackedReservedBit)) | (is_start[n] ? 0u : kPackedVoxlineEnd);
 
   // Decoding info: lo and step per axis as the spec computes them (binary32), and the block's first word.
   std::uint32_t* info = words.data() + c.info_first() + 8ull * index;

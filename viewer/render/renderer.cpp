@@ -9,7 +9,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "format/error.h"
+#include "format/base/error.h"
 #include "viewer/render/exact_renderer.h"
 #include "viewer/render/line_lighting.h"
 #include "viewer/render/line_shaders.h"

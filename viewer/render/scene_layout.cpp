@@ -6,7 +6,7 @@
 #include <limits>
 #include <string>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

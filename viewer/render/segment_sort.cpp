@@ -4,8 +4,8 @@
 #include <limits>
 #include <string>
 
-#include "format/error.h"
-#include "format/parallel.h"
+#include "format/base/error.h"
+#include "format/base/parallel.h"
 
 namespace vxl {
 

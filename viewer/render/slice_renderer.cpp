@@ -6,7 +6,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "format/error.h"
+#include "format/base/error.h"
 #include "viewer/render/clip_planes.h"
 #include "viewer/render/line_shaders.h"
 

@@ -4,7 +4,7 @@
 #include <limits>
 #include <vector>
 
-#include "format/error.h"
+#include "format/base/error.h"
 #include "format/vxl_levels.h"
 
 namespace vxl {

@@ -1,8 +1,8 @@
-#include "format/direct_write_queue.h"
+#include "format/base/direct_write_queue.h"
 
 #include <utility>
 
-#include "format/direct_region_writer.h"
+#include "format/base/direct_region_writer.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "converter/memory_size.h"
+#include "format/base/memory_size.h"
 
 #include <cstdio>
 #include <limits>

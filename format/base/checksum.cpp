@@ -1,4 +1,4 @@
-#include "format/checksum.h"
+#include "format/base/checksum.h"
 
 #include <cstdio>
 

@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-#include "format/atomic_output.h"
+#include "format/base/atomic_output.h"
 
 namespace vxl {
 

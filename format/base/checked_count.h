@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

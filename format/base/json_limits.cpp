@@ -1,6 +1,6 @@
-#include "format/json_limits.h"
+#include "format/base/json_limits.h"
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

@@ -16,13 +16,13 @@
 #include <utility>
 #include <vector>
 
-#include "format/mapped_file.h"
+#include "format/base/mapped_file.h"
 
 namespace vxl {
 
 class AtomicOutputFile {
  public:
-  // Throws vxl::Error (Output) naming the path, also when format/output_path.h's rule refuses it.
+  // Throws vxl::Error (Output) naming the path, also when format/base/output_path.h's rule refuses it.
   explicit AtomicOutputFile(std::string path);
   ~AtomicOutputFile();  // discards the data (and any mapping) unless committed
   AtomicOutputFile(const AtomicOutputFile&) = delete;

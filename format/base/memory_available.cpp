@@ -1,11 +1,11 @@
-#include "converter/memory_available.h"
+#include "format/base/memory_available.h"
 
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
-#include "converter/memory_size.h"
+#include "format/base/memory_size.h"
 
 namespace vxl {
 namespace {

@@ -1,4 +1,4 @@
-#include "format/regular_file.h"
+#include "format/base/regular_file.h"
 
 #include <cerrno>
 #include <cstring>
@@ -6,7 +6,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

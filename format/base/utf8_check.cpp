@@ -1,4 +1,4 @@
-#include "format/utf8_check.h"
+#include "format/base/utf8_check.h"
 
 #include <iterator>
 

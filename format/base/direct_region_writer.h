@@ -13,8 +13,8 @@
 #include <memory>
 #include <span>
 
-#include "format/atomic_output.h"
-#include "format/direct_write_queue.h"
+#include "format/base/atomic_output.h"
+#include "format/base/direct_write_queue.h"
 
 namespace vxl {
 

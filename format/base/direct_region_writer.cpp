@@ -1,4 +1,4 @@
-#include "format/direct_region_writer.h"
+#include "format/base/direct_region_writer.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -9,7 +9,7 @@
 
 #include <unistd.h>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 

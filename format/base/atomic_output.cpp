@@ -1,4 +1,4 @@
-#include "format/atomic_output.h"
+#include "format/base/atomic_output.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -12,9 +12,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "format/error.h"
-#include "format/output_path.h"
-#include "format/parallel.h"
+#include "format/base/error.h"
+#include "format/base/output_path.h"
+#include "format/base/parallel.h"
 
 namespace vxl {
 

@@ -1,4 +1,4 @@
-#include "format/mapped_file.h"
+#include "format/base/mapped_file.h"
 
 #include <cerrno>
 #include <cstring>
@@ -8,8 +8,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "format/error.h"
-#include "format/regular_file.h"
+#include "format/base/error.h"
+#include "format/base/regular_file.h"
 
 namespace vxl {
 

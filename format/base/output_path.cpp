@@ -1,4 +1,4 @@
-#include "format/output_path.h"
+#include "format/base/output_path.h"
 
 #include <cerrno>
 #include <cstring>
@@ -6,7 +6,7 @@
 
 #include <sys/stat.h>
 
-#include "format/error.h"
+#include "format/base/error.h"
 
 namespace vxl {
 namespace {
