@@ -13,6 +13,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "viewer/render/line_shaders.h"
+#include "viewer/render/modes/pass_host.h"
 #include "viewer/render/renderer.h"
 
 namespace vxl {
@@ -66,7 +67,10 @@ float half_to_float(std::uint16_t h) {
 
 }  // namespace
 
-ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity) : lines_(lines) {
+ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity)
+    : ExactRenderer(lines.pass_host(), node_capacity) {}
+
+ExactRenderer::ExactRenderer(PassHost& host, std::uint64_t node_capacity) : host_(host) {
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
   glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -77,9 +81,7 @@ ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity) : lin
   glGetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
   std::uint64_t bytes = std::min<std::uint64_t>(static_cast<std::uint32_t>(max_block), 256ull << 20);
   capacity_ = node_capacity ? node_capacity : bytes / 16;
-  list_program_ =
-      gl::make_program(shaders::line_vertex(lines.bound_spans_, "#version 430 core"),
-                       shaders::line_fragment(kListFragment, "#version 430 core", lines.slices_ != nullptr));
+  list_program_ = host_.lines().make_program(kListFragment, "#version 430 core");
   clear_program_ = gl::make_compute_program(kClearCompute);
   blit_program_ = gl::make_program(shaders::kFullscreenVertex, kBlitFragment);
   glGenBuffers(1, &nodes_);
@@ -122,7 +124,7 @@ void ExactRenderer::begin(const Camera& camera, const RenderSettings& s, int wid
   camera_ = camera;
   settings_ = s;
   fbo_ = fbo;
-  lines_.plan_and_count(camera, double(width) / std::max(1, height), PlanOrder::Visibility, plan_, s.clipping);
+  host_.plan_and_count(FrameView{camera, s, width, height, fbo}, PlanOrder::Visibility, plan_);
   segments_before_.assign(plan_.count.size() + 1, 0);
   for (std::size_t v = 0; v < plan_.count.size(); ++v)
     segments_before_[v + 1] = segments_before_[v] + plan_.count[v] / 2;
@@ -142,7 +144,7 @@ double ExactRenderer::progress() const {
 std::size_t ExactRenderer::run_end(double max_segments) const {
   const std::size_t n = plan_.count.size();
   // Several grids: the voxels are not in a visibility order, so they are composited in one run.
-  if (!lines_.layout().one_grid()) return n;
+  if (!host_.scene().layout().one_grid()) return n;
   double budget = max_segments;
   if (per_segment_ > 0) budget = std::min(budget, 0.5 * double(capacity_) / per_segment_);
   if (!std::isfinite(budget)) return n;  // the first run of an unbounded frame measures the fragments
@@ -156,12 +158,11 @@ bool ExactRenderer::step(double max_ms) {
   const auto start = Clock::now();
   auto elapsed_ms = [&] { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); };
   // A window draws other things between steps: the state this pass needs is set again each time.
-  const double aspect = double(width_) / std::max(1, height_);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glViewport(0, 0, width_, height_);
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);
-  lines_.bind_line_program(list_program_, camera_, settings_, aspect);
+  host_.bind_lines(list_program_, FrameView{camera_, settings_, width_, height_, fbo_}, settings_);
   glUniform1ui(glGetUniformLocation(list_program_, "u_capacity"),
                static_cast<GLuint>(std::min<std::uint64_t>(capacity_, 0xFFFFFFFFu)));
 
@@ -169,7 +170,7 @@ bool ExactRenderer::step(double max_ms) {
   // next run's along every ray, so compositing run after run is exact. A run that overflows is
   // shortened and redone; one that cannot be (a single voxel, or several grids whose voxels overlap)
   // is split into bands of rows instead.
-  const bool depth_passes = lines_.layout().one_grid();
+  const bool depth_passes = host_.scene().layout().one_grid();
   const std::size_t n = plan_.count.size();
   while (next_ < n) {
     // Before anything is measured, a time-limited run assumes the line passes' rate (Renderer).
@@ -207,7 +208,7 @@ void ExactRenderer::show_image() {
   glBindTexture(GL_TEXTURE_2D, result_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, image_.data());
-  Renderer::enable_clip_distances(0);
+  LinePass::enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glViewport(0, 0, width_, height_);
   glUseProgram(blit_program_);
@@ -225,11 +226,11 @@ void ExactRenderer::start_image(const glm::vec3& background) {
   // The lines are composited over the opaque slices where there are some (their colour is the background
   // there); the list pass drops the fragments behind them.
   image_.resize(std::size_t(width_) * height_ * 4);
-  if (lines_.base_in_framebuffer()) {  // the region shells' back halves are drawn on it (renderer.h)
+  if (host_.base_in_framebuffer()) {  // the region shells' back halves are drawn on it (renderer.h)
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, width_, height_, GL_RGBA, GL_FLOAT, image_.data());
-  } else if (const GLuint slices = lines_.slice_color_texture()) {
+  } else if (const GLuint slices = host_.slice_color_texture()) {
     glBindTexture(GL_TEXTURE_2D, slices);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, image_.data());
@@ -256,8 +257,8 @@ std::uint64_t ExactRenderer::list_pass(std::size_t first_voxel, std::size_t end_
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_);
   const std::span<const std::int64_t> first(plan_.first);
   const std::span<const std::int32_t> count(plan_.count);
-  lines_.draw_plan(list_program_, first.subspan(first_voxel, end_voxel - first_voxel),
-                   count.subspan(first_voxel, end_voxel - first_voxel));
+  host_.lines().draw_plan(list_program_, first.subspan(first_voxel, end_voxel - first_voxel),
+                          count.subspan(first_voxel, end_voxel - first_voxel));
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
 
   // The counter counts every fragment, also those past the capacity that were not stored.

@@ -27,11 +27,15 @@
 
 namespace vxl {
 
+class PassHost;
 class Renderer;
 
 class ExactRenderer {
  public:
-  // node_capacity 0: as many 16-byte nodes as fit in min(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, 256 MiB).
+  // Draws with the host's line pass, plan and base (modes/pass_host.h). node_capacity 0: as many 16-byte
+  // nodes as fit in min(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, 256 MiB).
+  explicit ExactRenderer(PassHost& host, std::uint64_t node_capacity = 0);
+  // The same over `lines`' passes (Renderer::pass_host).
   explicit ExactRenderer(Renderer& lines, std::uint64_t node_capacity = 0);
   ~ExactRenderer();
   void draw(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
@@ -61,7 +65,7 @@ class ExactRenderer {
   // Composites the lists of rows [y0, y1) (holding `stored` nodes) over image_.
   void resolve_band(int y0, int y1, std::uint32_t stored);
 
-  Renderer& lines_;
+  PassHost& host_;
   std::uint64_t capacity_ = 0;
   GLuint list_program_ = 0, clear_program_ = 0, blit_program_ = 0;
   GLuint nodes_ = 0, counter_ = 0, heads_ = 0, result_ = 0;

@@ -1,7 +1,7 @@
 // The per-frame CPU work of the Voxlines method: drop voxels outside the view frustum (and outside the
 // slab and clip planes), sort the visible
 // voxels back to front, pick each voxel's nearest precomputed order (the paper's rule), and fill the
-// first/count arrays of the multi-draws (Renderer::draw_plan). No GL here.
+// first/count arrays of the multi-draws (LinePass::draw_plan). No GL here.
 #pragma once
 
 #include <array>

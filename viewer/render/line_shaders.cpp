@@ -5,18 +5,24 @@
 
 namespace vxl::shaders {
 
-std::string line_vertex(unsigned span_count, const char* version) {
-  std::string n = std::to_string(span_count);
-  std::string s = std::string(version) + "\n#define SPANS " + n + "\n#define CLIPS " +
-                  std::to_string(kMaxClipDistances) + "\n#define GROUPS " + std::to_string(kShaderGroups) +
-                  "\n#define SAMPLES " + std::to_string(kColormapSamples) + "\n";
+namespace {
+
+// The version line and the sizes the vertex shader is generated for.
+std::string vertex_defines(unsigned span_count, const char* version) {
+  return std::string(version) + "\n#define SPANS " + std::to_string(span_count) + "\n#define CLIPS " +
+         std::to_string(kMaxClipDistances) + "\n#define GROUPS " + std::to_string(kShaderGroups) +
+         "\n#define SAMPLES " + std::to_string(kColormapSamples) + "\n";
+}
+
+// Each span's samplers, and one function per buffer kind choosing the span's sampler (GLSL 3.30 cannot
+// index sampler arrays with a computed index).
+std::string span_fetchers(unsigned span_count) {
+  std::string s;
   for (unsigned c = 0; c < span_count; ++c) {
     std::string i = std::to_string(c);
     s += "uniform usamplerBuffer u_words" + i + ";\nuniform usamplerBuffer u_ord" + i +
          ";\nuniform usamplerBuffer u_dat" + i + ";\nuniform usamplerBuffer u_att" + i + ";\n";
   }
-  // One function per buffer kind, choosing the span's sampler (GLSL 3.30 cannot index sampler arrays
-  // with a computed index).
   s += "uvec4 fetch_words(int c, int t) {\n";
   for (unsigned c = 0; c < span_count; ++c)
     s += "  if (c == " + std::to_string(c) + ") return texelFetch(u_words" + std::to_string(c) + ", t);\n";
@@ -30,7 +36,11 @@ std::string line_vertex(unsigned span_count, const char* version) {
   for (unsigned c = 0; c < span_count; ++c)
     s += "  if (c == " + std::to_string(c) + ") return texelFetch(u_att" + std::to_string(c) + ", v).rg;\n";
   s += "  return uvec2(0u);\n}\n";
-  s += R"(
+  return s;
+}
+
+// The spans' layout uniforms and the packed position decoder.
+const char* const kSpanLayout = R"(
 // The spans' layout (scene_layout.h): S padded segments per slot, K slots, the first W entries of each
 // slot with high halves, V padded vertices, where the segment and vertex tables start (in words).
 uniform int u_span_base[SPANS];
@@ -48,7 +58,11 @@ vec3 decode(uint word, uvec4 lo_step, uvec4 rest) {
   vec3 step = uintBitsToFloat(uvec3(lo_step.w, rest.x, rest.y));
   return uintBitsToFloat(lo_step.xyz) + q * step;
 }
-uniform vec3 u_eye_hi;      // eye position split in two floats on the CPU (in double):
+)";
+
+// The vertex shader's uniforms and outputs.
+const char* const kVertexInterface =
+    R"(uniform vec3 u_eye_hi;      // eye position split in two floats on the CPU (in double):
 uniform vec3 u_eye_lo;      // p - eye = (p - hi) - lo keeps the source precision far from the origin
 uniform mat3 u_rotation;    // world -> eye
 uniform mat4 u_projection;
@@ -72,7 +86,10 @@ out float v_value;          // colour-map position, unclamped: mapped per fragme
 out float v_mapped;         // 1: colour from the map at v_value
 out float v_depth;          // distance along the view axis, mm
 
-void main() {
+)";
+
+// main(), first half: the virtual vertex id -> the span, the voxel and the segment's two ends.
+const char* const kVertexSegmentEnds = R"(void main() {
   int id = gl_VertexID;
   int c = 0;
   for (int k = 1; k < SPANS; ++k)
@@ -114,7 +131,10 @@ void main() {
   vec3 p = decode(fetch_word(c, v + end), lo_step, rest);
   vec3 q = decode(fetch_word(c, v + 1 - end), lo_step, rest);
   if (dropped) q = p;
-  vec3 rel = (p - u_eye_hi) - u_eye_lo;
+)";
+
+// main(), second half: clip distances, colour, opacity, value, lighting and position of the segment end.
+const char* const kVertexShading = R"(  vec3 rel = (p - u_eye_hi) - u_eye_lo;
   vec3 e = u_rotation * rel;
   for (int i = 0; i < CLIPS; ++i) gl_ClipDistance[i] = i < u_clip_count ? dot(u_clip[i].xyz, rel) + u_clip[i].w : 1.0;
   v_depth = -e.z;
@@ -154,7 +174,12 @@ void main() {
   gl_Position = hidden ? vec4(2.0, 2.0, 2.0, 1.0) : u_projection * vec4(e, 1.0);
 }
 )";
-  return s;
+
+}  // namespace
+
+std::string line_vertex(unsigned span_count, const char* version) {
+  return vertex_defines(span_count, version) + span_fetchers(span_count) + kSpanLayout + kVertexInterface +
+         kVertexSegmentEnds + kVertexShading;
 }
 
 std::string line_fragment(const char* body, const char* version, bool slice_test) {

@@ -26,9 +26,10 @@
 
 namespace vxl {
 
-class ExactRenderer;
+class LinePass;
+class ModePass;
+class PassHost;
 class RegionShells;
-class SegmentSorter;
 class SliceRenderer;
 struct Volume;
 
@@ -135,15 +136,17 @@ class Renderer {
   // nothing more can be uploaded for that view (all resident, or the budget holds no more).
   bool upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms);
 
- private:
-  // The exact mode is a part of the renderer kept in its own file: it draws with the line program.
-  friend class ExactRenderer;
+  // The renderer as its transparency modes see it (modes/pass_host.h): its line pass, scene, plan and base.
+  // For drawing a mode's pass over this renderer's scene (e.g. an ExactRenderer with a small node buffer).
+  PassHost& pass_host();
 
+ private:
+  class Host;  // the renderer as its modes' PassHost
   struct Pieces;
-  // The line passes' programs, with the slices' depth test only where there is a volume.
-  void make_line_programs();
   // The union of the files' bounds: {min, max}.
   std::pair<glm::dvec3, glm::dvec3> bounds() const;
+  // The pass that draws `mode` (modes/mode_pass.h), made on first use.
+  ModePass& pass(RenderMode mode);
   // What every mode does first: the per-vertex attributes, the slices (their depth hides lines behind them),
   // line width and a neutral blend and depth state.
   void start_frame(const Camera& camera, const RenderSettings& settings, int width, int height);
@@ -156,10 +159,6 @@ class Renderer {
   void draw_front_shells(const Pieces& pieces);
   // exact with shells: its base in `fbo` with the back halves drawn on it (base_in_framebuffer()).
   void shells_under_exact(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
-  // The blend state of the over-compositing modes (basic, axis; docs/rendering.md, pitfall 1).
-  static void over_blending();
-  // The depth and blend state of the opaque mode.
-  static void opaque_blending();
   // Makes the spans of the plan's voxels resident, the nearest first, and drops the voxels of those that
   // do not fit the budget.
   void keep_resident(FramePlan& plan);
@@ -167,50 +166,24 @@ class Renderer {
   void plan_and_count(const Camera& camera, double aspect, PlanOrder order, FramePlan& out, const Clipping& clipping);
   // Binds the line program's uniforms and textures for `camera`.
   void bind_line_program(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect) const;
-  // Draws the virtual-id ranges (first, count) in order with `program` (its other uniforms bound), binding
-  // the spans they lie in a few at a time.
-  void draw_plan(GLuint program, std::span<const std::int64_t> first, std::span<const std::int32_t> count) const;
-  // Binds spans `bound` to the program's span slots, their ids starting at `base` in this draw.
-  void bind_spans(GLuint program, std::span<const std::uint32_t> bound, std::span<const std::int64_t> base) const;
-  // Enables the first n of the line shader's clip distances and disables the others (passes without
-  // gl_ClipDistance must run with none enabled).
-  static void enable_clip_distances(int n);
-  // Uploads the per-vertex (value, streamline) attributes that `settings` needs when they changed, and
-  // the streamline groups' table when the groups changed.
-  void prepare_attributes(const RenderSettings& settings);
-  void upload_streamline_groups();
-  void draw_lines(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect, PlanOrder order);
-  void draw_dataset_order(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect);
-  // The segsort mode's lines: voxels sorted as axis sorts them, each voxel's segments sorted on the CPU for
-  // this view (segment_sort.h), uploaded into the dataset buffers and drawn from there.
-  void draw_segment_sorted(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect);
-  // A fullscreen pass of `program` reading the named 2D textures.
-  void composite(GLuint program, std::initializer_list<std::pair<const char*, GLuint>> textures) const;
+  // draw_piece() of a frame drawn in runs of the plan's voxels (PieceKind::Voxels).
+  void draw_voxel_piece(double max_ms);
 
   std::vector<const VxlFile*> files_;
   GpuScene scene_;
-  GLuint vao_ = 0;
-  unsigned bound_spans_ = 1;  // span slots of the line programs
-  GLuint over_program_ = 0, accum_program_ = 0, reveal_program_ = 0, additive_program_ = 0;
-  GLuint wboit_composite_ = 0, additive_composite_ = 0;
-  gl::RenderTarget wboit_target_, opaque_target_, additive_target_;
+  std::unique_ptr<LinePass> lines_;  // the line programs, attributes and draws every mode uses
+  std::unique_ptr<Host> host_;
+  std::vector<std::unique_ptr<ModePass>> passes_;  // by RenderMode, each made on first use
   FramePlan plan_;
   FrameStats stats_;
-  std::unique_ptr<ExactRenderer> exact_;
-  std::unique_ptr<Pieces> pieces_;                 // the frame begin_pieces() started, until draw() or the next begin
-  std::unique_ptr<SegmentSorter> segment_sorter_;  // made on first use
+  std::unique_ptr<Pieces> pieces_;  // the frame begin_pieces() started, until draw() or the next begin
   std::unique_ptr<SliceRenderer> slices_;
   std::unique_ptr<RegionShells> shells_;  // made when regions are first shown
   bool base_in_framebuffer_ = false;
   bool slices_drawn_ = false;  // this frame: the line shaders test against the slices' depth
   SceneGroups groups_;
   std::vector<std::string> value_set_names_;
-  std::string attributes_key_;  // what the attribute buffers hold ("" : nothing)
   std::shared_ptr<VoxelVoxlinesCache> indexes_;
-  // One byte per streamline of the scene (the files' streamlines one after another): its group mod the
-  // shader's group table. A new selection or grouping uploads this alone, not the per-vertex attributes.
-  gl::TextureBuffer streamline_groups_;
-  bool streamline_groups_stale_ = true;
 };
 
 }  // namespace vxl

@@ -4,7 +4,7 @@
 // The voxels of all files form one table (file 0's, then file 1's, ...), so that one frame plan sorts them
 // all together, back to front, interleaved across files. Voxels are grouped into texture spans (contiguous voxel
 // ranges of one file) small enough for the driver's texture-buffer limit; there may be any number of spans:
-// a draw binds a few at a time (Renderer::draw_plan). Each span holds, in four texture
+// a draw binds a few at a time (LinePass::draw_plan). Each span holds, in four texture
 // buffers (gpu_scene.h says how each is filled):
 //   words:   RGBA32UI, 4 words a texel: the packed positions (.vxl spec §5.4), each voxel's block starting at a
 //            multiple of kGroup words; then 8 words of decoding info per voxel; then one voxel index per kGroup

@@ -1,0 +1,253 @@
+#include "viewer/render/line_pass.h"
+
+#include <algorithm>
+#include <limits>
+#include <utility>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "format/base/error.h"
+#include "format/voxel_voxlines.h"
+#include "viewer/render/clip_planes.h"
+#include "viewer/render/colormap.h"
+#include "viewer/render/line_lighting.h"
+#include "viewer/render/line_shaders.h"
+#include "viewer/render/vertex_attributes.h"
+
+namespace vxl {
+
+LinePass::LinePass(GpuScene& scene, const std::vector<const VxlFile*>& files) : scene_(scene), files_(files) {
+  // A draw binds up to kMaxBoundSpans spans, as many as the vertex shader's texture units allow beside the
+  // streamline groups' table (GL 3.3 promises 16: three spans).
+  GLint units = 0;
+  glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
+  const std::size_t spans = std::max<std::size_t>(1, scene_.layout().texture_spans().size());
+  bound_spans_ = static_cast<unsigned>(std::min<std::size_t>(
+      {spans, kMaxBoundSpans, static_cast<std::size_t>(std::max(0, units - 1)) / kSamplersPerSpan}));
+  if (bound_spans_ == 0)
+    throw Error(ErrorKind::Unsupported, files_.front()->path(), std::nullopt,
+                "this GPU offers " + std::to_string(units) + " vertex-shader textures; the lines need " +
+                    std::to_string(kSamplersPerSpan + 1));
+  glGenVertexArrays(1, &vao_);
+  make_programs(false);
+}
+
+LinePass::~LinePass() {
+  for (GLuint p : {over_program_, accum_program_, reveal_program_, additive_program_})
+    if (p) glDeleteProgram(p);
+  streamline_groups_.destroy();
+  if (vao_) glDeleteVertexArrays(1, &vao_);
+}
+
+void LinePass::make_programs(bool slice_test) {
+  for (GLuint* p : {&over_program_, &accum_program_, &reveal_program_, &additive_program_})
+    if (*p) glDeleteProgram(std::exchange(*p, 0));
+  slice_test_ = slice_test;
+  const char* const version = "#version 330 core";
+  over_program_ = make_program(shaders::kLineOverFragment, version);
+  accum_program_ = make_program(shaders::kLineWboitAccumFragment, version);
+  reveal_program_ = make_program(shaders::kLineWboitRevealFragment, version);
+  additive_program_ = make_program(shaders::kLineAdditiveFragment, version);
+}
+
+GLuint LinePass::make_program(const char* fragment_body, const char* version) const {
+  return gl::make_program(shaders::line_vertex(bound_spans_, version),
+                          shaders::line_fragment(fragment_body, version, slice_test_));
+}
+
+void LinePass::prepare_attributes(const RenderSettings& s, const std::string& scalar, const SceneGroups& groups,
+                                  VoxelVoxlinesCache& indexes) {
+  const std::string name = s.color == ColorMode::Scalar ? scalar : std::string();
+  bool want_groups = s.color == ColorMode::Group;
+  const auto& all = groups.groups();
+  for (std::size_t g = 0; g < all.size(); ++g) want_groups |= s.group_color(all[g].name, g).a != 1.0f;
+  const std::string key = name.empty() && !want_groups ? "" : "value:" + name;
+  if (key != attributes_key_) {
+    std::vector<AttributeSource> per_file;
+    std::uint64_t first_streamline = 0;
+    if (!key.empty())
+      for (std::size_t i = 0; i < files_.size(); ++i) {
+        const VoxelVoxlines* index = indexes.of(i);
+        if (index == nullptr)
+          throw Error(ErrorKind::Unsupported, files_[i]->path(), std::nullopt,
+                      "colour or opacity by value or group needs the voxel index of voxlines, which holds fewer than "
+                      "2^32 streamlines and voxlines of fewer than 2^26 points");
+        per_file.push_back({name.empty() ? ValueSource{} : find_value_set(*files_[i], name),
+                            static_cast<std::uint32_t>(first_streamline), index});
+        first_streamline += files_[i]->meta().streamline_count;
+      }
+    scene_.upload_attributes(std::move(per_file));
+    attributes_key_ = key;
+  }
+  if (!key.empty() && streamline_groups_stale_) upload_streamline_groups(groups);
+}
+
+void LinePass::upload_streamline_groups(const SceneGroups& groups) {
+  std::uint64_t total = 0;
+  for (const VxlFile* f : files_) total += f->meta().streamline_count;
+  GLint max_texels = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+  if (total > static_cast<std::uint64_t>(std::max(0, max_texels)) || total > 0xFFFFFFFFu)
+    throw Error(ErrorKind::Unsupported, files_.front()->path(), std::nullopt,
+                "colour or opacity by group needs a table of " + std::to_string(total) +
+                    " streamlines; this GPU's buffer textures hold " + std::to_string(max_texels));
+  std::vector<std::uint8_t> table(std::max<std::uint64_t>(total, 1), 0);
+  std::uint64_t at = 0;
+  for (std::size_t i = 0; i < files_.size(); ++i) {
+    const std::uint64_t n = files_[i]->meta().streamline_count;
+    if (groups.uniform(i))
+      std::fill_n(table.begin() + at, n, std::uint8_t(groups.group_of(i, 0) % shaders::kShaderGroups));
+    else
+      for (std::uint64_t s = 0; s < n; ++s)
+        table[at + s] = std::uint8_t(groups.group_of(i, s) % shaders::kShaderGroups);
+    at += n;
+  }
+  streamline_groups_.destroy();
+  streamline_groups_.create(GL_R8UI, table.data(), table.size());
+  streamline_groups_stale_ = false;
+}
+
+void LinePass::bind(GLuint program, const LineUniforms& u) const {
+  const Camera& camera = u.camera;
+  const RenderSettings& s = u.settings;
+  glUseProgram(program);
+  const glm::dvec3 eye = camera.eye();
+  const glm::vec3 hi(eye);
+  const glm::vec3 lo(eye - glm::dvec3(hi));
+  glUniform3fv(glGetUniformLocation(program, "u_eye_hi"), 1, glm::value_ptr(hi));
+  glUniform3fv(glGetUniformLocation(program, "u_eye_lo"), 1, glm::value_ptr(lo));
+  const glm::mat3 rotation = camera.view_rotation();
+  glUniformMatrix3fv(glGetUniformLocation(program, "u_rotation"), 1, GL_FALSE, glm::value_ptr(rotation));
+  const glm::mat4 proj(u.projection);
+  glUniformMatrix4fv(glGetUniformLocation(program, "u_projection"), 1, GL_FALSE, glm::value_ptr(proj));
+  glUniform1i(glGetUniformLocation(program, "u_color_mode"), static_cast<int>(s.color));
+  glUniform3fv(glGetUniformLocation(program, "u_fixed_color"), 1, glm::value_ptr(s.fixed_color));
+  glUniform1i(glGetUniformLocation(program, "u_attributes"), attributes_key_.empty() ? 0 : 1);
+  glUniform3fv(glGetUniformLocation(program, "u_colormap"), kColormapSamples,
+               glm::value_ptr(colormap_samples(s.colormap)[0]));
+  glUniform2f(glGetUniformLocation(program, "u_range"), u.scalar_range[0], u.scalar_range[1]);
+  std::vector<glm::vec4> group(shaders::kShaderGroups, glm::vec4(1.0f));
+  const auto& groups = u.groups.groups();
+  for (std::size_t g = 0; g < groups.size() && g < group.size(); ++g) group[g] = s.group_color(groups[g].name, g);
+  glUniform4fv(glGetUniformLocation(program, "u_group"), shaders::kShaderGroups, glm::value_ptr(group[0]));
+  // A coarse level's segment stands for the 8^level segments it samples (.vxl spec §6.5).
+  const float opacity = SceneLayout::level_opacity(std::clamp(s.opacity, 0.001f, 1.0f), scene_.layout().level());
+  glUniform1f(glGetUniformLocation(program, "u_opacity"), opacity);
+  glUniform1i(glGetUniformLocation(program, "u_lighting"), s.lighting ? 1 : 0);
+  const glm::vec3 light = lighting::light_direction_eye();
+  glUniform3fv(glGetUniformLocation(program, "u_light"), 1, glm::value_ptr(light));
+  glUniform4f(glGetUniformLocation(program, "u_light_terms"), lighting::kAmbient, lighting::kDiffuse,
+              lighting::kSpecular, lighting::kShininess);
+  glUniform1i(glGetUniformLocation(program, "u_orthographic"), camera.orthographic ? 1 : 0);
+  std::vector<glm::vec4> clip;
+  for (const glm::dvec4& h : clip_half_spaces(s.clipping, camera)) clip.push_back(glm::vec4(relative_to(h, eye)));
+  const int clips = static_cast<int>(std::min<std::size_t>(clip.size(), kMaxClipDistances));
+  if (clips > 0) glUniform4fv(glGetUniformLocation(program, "u_clip"), clips, glm::value_ptr(clip[0]));
+  glUniform1i(glGetUniformLocation(program, "u_clip_count"), clips);
+  enable_clip_distances(clips);
+  // The streamline groups' table on the first unit after the spans', the slices' depth on the next (units
+  // of their own: two sampler types must not share one), bound even when unused.
+  const GLint groups_unit = static_cast<GLint>(kSamplersPerSpan * bound_spans_);
+  glActiveTexture(GL_TEXTURE0 + groups_unit);
+  glBindTexture(GL_TEXTURE_BUFFER, streamline_groups_.texture);
+  glUniform1i(glGetUniformLocation(program, "u_streamline_group"), groups_unit);
+  const GLint unit = groups_unit + 1;
+  glActiveTexture(GL_TEXTURE0 + unit);
+  glBindTexture(GL_TEXTURE_2D, u.slice_depth);
+  glUniform1i(glGetUniformLocation(program, "u_slice_depth"), unit);
+  glUniform1i(glGetUniformLocation(program, "u_slice_test"), u.slice_depth != 0 ? 1 : 0);
+  glActiveTexture(GL_TEXTURE0);
+}
+
+void LinePass::enable_clip_distances(int n) {
+  for (int i = 0; i < kMaxClipDistances; ++i) {
+    if (i < n)
+      glEnable(GL_CLIP_DISTANCE0 + i);
+    else
+      glDisable(GL_CLIP_DISTANCE0 + i);
+  }
+}
+
+void LinePass::bind_spans(GLuint program, std::span<const std::uint32_t> bound,
+                          std::span<const std::int64_t> base) const {
+  const auto& spans = scene_.layout().texture_spans();
+  // Per slot: where its ids start in this draw and how its buffers are laid out (scene_layout.h); a slot
+  // left empty starts past every id.
+  std::vector<std::pair<const char*, std::vector<GLint>>> fields = {
+      {"u_span_base", {}},     {"u_span_segments", {}},      {"u_span_slots", {}},        {"u_span_wide", {}},
+      {"u_span_vertices", {}}, {"u_span_segment_table", {}}, {"u_span_vertex_table", {}},
+  };
+  for (std::size_t slot = 0; slot < bound_spans_; ++slot) {
+    std::int64_t values[] = {std::numeric_limits<std::int32_t>::max(), 1, 1, 0, 0, 0, 0};
+    if (slot < bound.size()) {
+      const TextureSpan& c = spans[bound[slot]];
+      const std::int64_t used[] = {base[slot],
+                                   static_cast<std::int64_t>(std::max<std::uint64_t>(1, c.segments)),
+                                   c.slots,
+                                   static_cast<std::int64_t>(c.wide_segments),
+                                   static_cast<std::int64_t>(c.vertices),
+                                   static_cast<std::int64_t>(c.segment_table_first()),
+                                   static_cast<std::int64_t>(c.vertex_table_first())};
+      std::copy(std::begin(used), std::end(used), values);
+    }
+    for (std::size_t f = 0; f < fields.size(); ++f) fields[f].second.push_back(static_cast<GLint>(values[f]));
+  }
+  for (const auto& [name, values] : fields)
+    glUniform1iv(glGetUniformLocation(program, name), static_cast<GLsizei>(values.size()), values.data());
+  const char* names[kSamplersPerSpan] = {"u_words", "u_ord", "u_dat", "u_att"};
+  for (std::size_t slot = 0; slot < bound_spans_; ++slot) {
+    const GpuTextureSpan* g = slot < bound.size() ? &scene_.texture_spans()[bound[slot]] : nullptr;
+    const GLuint textures[kSamplersPerSpan] = {g ? g->words.texture : 0, g ? g->orders.texture : 0,
+                                               g ? g->dataset.texture : 0, g ? g->attributes.texture : 0};
+    for (int t = 0; t < kSamplersPerSpan; ++t) {
+      const GLint unit = static_cast<GLint>(kSamplersPerSpan * slot + t);
+      glActiveTexture(GL_TEXTURE0 + unit);
+      glBindTexture(GL_TEXTURE_BUFFER, textures[t]);
+      glUniform1i(glGetUniformLocation(program, (names[t] + std::to_string(slot)).c_str()), unit);
+    }
+  }
+  glActiveTexture(GL_TEXTURE0);
+}
+
+void LinePass::draw_plan(GLuint program, std::span<const std::int64_t> first,
+                         std::span<const std::int32_t> count) const {
+  if (first.empty()) return;
+  glBindVertexArray(vao_);
+  const SceneLayout& layout = scene_.layout();
+  const auto& spans = layout.texture_spans();
+  // Consecutive runs of the sequence, each over at most bound_spans_ spans whose ids, rebased one after
+  // another, stay below 2^31: one multi-draw each, in order, so blending sees the same sequence.
+  std::vector<std::uint32_t> bound;
+  std::vector<std::int64_t> base;
+  std::vector<GLint> run_first;
+  std::vector<GLsizei> run_count;
+  std::int64_t next_base = 0;
+  auto flush = [&] {
+    if (run_first.empty()) return;
+    bind_spans(program, bound, base);
+    glMultiDrawArrays(GL_LINES, run_first.data(), run_count.data(), static_cast<GLsizei>(run_first.size()));
+    bound.clear();
+    base.clear();
+    run_first.clear();
+    run_count.clear();
+    next_base = 0;
+  };
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    const std::uint32_t span = layout.span_of_id(first[i]);
+    std::size_t slot = std::find(bound.begin(), bound.end(), span) - bound.begin();
+    if (slot == bound.size()) {
+      const std::int64_t ids = static_cast<std::int64_t>(spans[span].virtual_ids());
+      if (bound.size() == bound_spans_ || next_base + ids > std::numeric_limits<std::int32_t>::max()) flush();
+      slot = bound.size();
+      bound.push_back(span);
+      base.push_back(next_base);
+      next_base += ids;
+    }
+    run_first.push_back(
+        static_cast<GLint>(first[i] - static_cast<std::int64_t>(spans[span].virtual_base) + base[slot]));
+    run_count.push_back(count[i]);
+  }
+  flush();
+}
+
+}  // namespace vxl
