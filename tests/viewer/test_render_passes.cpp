@@ -41,12 +41,12 @@ TEST(ModeTable, OnlyTheSortedModesDrawInPiecesOfVoxels) {
   RenderSettings s;
   s.order_hysteresis = 0.25f;
   FramePlan plan;
-  EXPECT_EQ(make_mode_pass(RenderMode::Opaque)->piece_order(s, plan), PlanOrder::Any);
-  EXPECT_EQ(make_mode_pass(RenderMode::Basic)->piece_order(s, plan), PlanOrder::Block);
+  EXPECT_EQ(make_mode_pass(RenderMode::Opaque)->plan_order(s, plan), PlanOrder::Any);
+  EXPECT_EQ(make_mode_pass(RenderMode::Basic)->plan_order(s, plan), PlanOrder::Block);
   EXPECT_EQ(plan.order_hysteresis, 0.0f) << "only the nearest-order pick keeps orders across frames";
-  EXPECT_EQ(make_mode_pass(RenderMode::Axis)->piece_order(s, plan), PlanOrder::Nearest);
+  EXPECT_EQ(make_mode_pass(RenderMode::Axis)->plan_order(s, plan), PlanOrder::Nearest);
   EXPECT_EQ(plan.order_hysteresis, 0.25f);
-  EXPECT_THROW(make_mode_pass(RenderMode::Wboit)->piece_order(s, plan), std::logic_error);
+  EXPECT_THROW(make_mode_pass(RenderMode::Wboit)->plan_order(s, plan), std::logic_error);
 }
 
 class LinePassSpans : public ::testing::Test {

@@ -267,7 +267,7 @@ void Renderer::begin_pieces(const Camera& camera, const RenderSettings& s, int w
   if (p.kind == PieceKind::Voxels) {
     start_frame(camera, s, width, height);
     clear_to_base(fbo, camera, s, width, height);
-    const PlanOrder order = p.pass->piece_order(s, plan_);
+    const PlanOrder order = p.pass->plan_order(s, plan_);
     plan_and_count(camera, double(width) / std::max(1, height), order, plan_, s.clipping);
     p.first = plan_.first;
     p.count = plan_.count;

@@ -4,7 +4,7 @@
 
 namespace vxl {
 
-PlanOrder ModePass::piece_order(const RenderSettings&, FramePlan&) const {
+PlanOrder ModePass::plan_order(const RenderSettings&, FramePlan&) const {
   throw std::logic_error(std::string("the ") + render_mode_name(mode()) + " mode is not drawn in runs of voxels");
 }
 

@@ -24,9 +24,10 @@ class ModePass {
   virtual void draw(PassHost& host, const FrameView& frame) = 0;
 
   virtual PieceKind piece_kind() const { return PieceKind::Whole; }
-  // PieceKind::Voxels: the plan's order (set up in `plan` as draw() does), and the GL state each piece sets
-  // again (a window draws other things between pieces).
-  virtual PlanOrder piece_order(const RenderSettings& settings, FramePlan& plan) const;
+  // PieceKind::Voxels: the order the mode plans its voxels in, with what that order keeps in `plan` set
+  // (axis: its order hysteresis), as draw() plans them; and the GL state each piece sets again (a window
+  // draws other things between pieces).
+  virtual PlanOrder plan_order(const RenderSettings& settings, FramePlan& plan) const;
   virtual void piece_state() const {}
   // PieceKind::Own: starts the frame (its base included), then draws it for about `max_ms` a step until
   // step() returns true; progress() is the share of the frame drawn.

@@ -16,7 +16,7 @@ class OpaquePass final : public ModePass {
     glDisable(GL_DEPTH_TEST);
   }
   PieceKind piece_kind() const override { return PieceKind::Voxels; }
-  PlanOrder piece_order(const RenderSettings&, FramePlan&) const override { return PlanOrder::Any; }
+  PlanOrder plan_order(const RenderSettings&, FramePlan&) const override { return PlanOrder::Any; }
   void piece_state() const override { opaque_blending(); }
 };
 

@@ -14,11 +14,11 @@ class OverPass final : public ModePass {
   void draw(PassHost& host, const FrameView& frame) override {
     host.clear_to_base(frame);
     over_blending();
-    const PlanOrder order = piece_order(frame.settings, host.frame_plan());
+    const PlanOrder order = plan_order(frame.settings, host.frame_plan());
     draw_planned_lines(host, frame, host.lines().over(), frame.settings, order);
   }
   PieceKind piece_kind() const override { return PieceKind::Voxels; }
-  PlanOrder piece_order(const RenderSettings& settings, FramePlan& plan) const override {
+  PlanOrder plan_order(const RenderSettings& settings, FramePlan& plan) const override {
     // Only the nearest-order pick keeps a voxel's order across frames (FramePlan::order_hysteresis).
     if (order_ == PlanOrder::Nearest) plan.order_hysteresis = settings.order_hysteresis;
     return order_;
