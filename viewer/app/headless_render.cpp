@@ -15,6 +15,7 @@
 #include "viewer/app/scene_selection.h"
 #include "viewer/app/scene_source.h"
 #include "viewer/app/turntable.h"
+#include "viewer/app/view_level.h"
 #include "viewer/platform/egl_context.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/offscreen_target.h"
@@ -74,28 +75,24 @@ int run_headless(const ViewerOptions& o) {
   const double aspect = double(o.width) / o.height;
   // The level whose whole copy fits the budget, or for one view (not a turntable, not --level) the finest
   // level whose visible part fits: a slab or a close view of a large scene is drawn in more detail.
-  std::unique_ptr<Renderer> renderer;
-  std::optional<Camera> camera;
+  LevelLayouts layouts(pointers(files), texels);
   const bool per_view = !detail.forced && o.turntable <= 1 && detail.level > 0;
-  for (std::uint32_t level = per_view ? 0 : detail.level;; ++level) {
-    renderer = std::make_unique<Renderer>(pointers(files), texels, level, gpu_memory);
-    if (volume) renderer->set_volume(*volume);
-    if (selection) renderer->set_groups(selection->groups);
-    if (!camera) camera = initial_camera(framing_points(renderer->layout()), o, aspect);
-    if (level >= detail.level) {
-      if (const std::string note = describe_scene_detail(detail, SceneLayout::coarsest_level(pointers(files)) + 1);
-          !note.empty())
-        std::fprintf(stderr, "voxview: %s\n", note.c_str());
-      break;
-    }
-    if (renderer->view_bytes(*camera, aspect, o.settings.clipping) <= detail.budget) {
-      std::fprintf(stderr,
-                   "voxview: drawing level %u: the visible part fits the GPU memory budget of %s (the whole scene "
-                   "needs level %u)\n",
-                   level, format_memory_size(detail.budget).c_str(), detail.level);
-      break;
-    }
-  }
+  const Camera camera = initial_camera(framing_points(layouts.at(per_view ? 0 : detail.level)), o, aspect);
+  const std::uint32_t level =
+      per_view ? level_for_view(layouts, detail, camera, aspect,
+                                scene_bounds(pointers(files), volume ? &*volume : nullptr), o.settings.clipping)
+               : detail.level;
+  if (level < detail.level)
+    std::fprintf(stderr,
+                 "voxview: drawing level %u: the visible part fits the GPU memory budget of %s (the whole scene "
+                 "needs level %u)\n",
+                 level, format_memory_size(detail.budget).c_str(), detail.level);
+  else if (const std::string note = describe_scene_detail(detail, SceneLayout::coarsest_level(pointers(files)) + 1);
+           !note.empty())
+    std::fprintf(stderr, "voxview: %s\n", note.c_str());
+  const auto renderer = std::make_unique<Renderer>(pointers(files), texels, level, gpu_memory);
+  if (volume) renderer->set_volume(*volume);
+  if (selection) renderer->set_groups(selection->groups);
   volume.reset();
   check_color_options(o.inputs_name(), *renderer, o.settings, o.from_view_file);
   RenderSettings settings = o.settings;
@@ -103,13 +100,13 @@ int run_headless(const ViewerOptions& o) {
   OffscreenTarget target(o.width, o.height);
   target.bind();
   if (o.save_camera)
-    write_view(*o.save_camera, SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}, true, o.include,
+    write_view(*o.save_camera, SavedView{camera, o.settings, std::array<int, 2>{o.width, o.height}, true, o.include,
                                          o.exclude, o.ends_in, o.show_regions});
   const int frames = std::max(1, o.turntable);
   std::optional<PictureAnnotations> annotations;
   if (PictureAnnotations::wanted(o.settings)) annotations.emplace();
   for (int i = 0; i < frames; ++i) {
-    const Camera frame_camera = turntable_camera(*camera, i, frames);
+    const Camera frame_camera = turntable_camera(camera, i, frames);
     renderer->draw(frame_camera, settings, o.width, o.height, target.framebuffer());
     if (annotations) {
       target.bind();

@@ -39,6 +39,7 @@
 #include "viewer/app/scene_source.h"
 #include "viewer/app/selection_worker.h"
 #include "viewer/app/ui_panel.h"
+#include "viewer/app/view_level.h"
 #include "viewer/app/window_size.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/offscreen_target.h"
@@ -242,6 +243,7 @@ class ViewerWindow {
   SceneDetail detail_;                // the level of detail drawn at rest, and the span size
   // The GPU memory budget every level's renderer shares: together they never take more.
   std::shared_ptr<GpuMemoryPool> gpu_memory_;
+  LevelLayouts layouts_;  // the scene's layout at each level, to measure views without a renderer
   // One renderer per level drawn, made on first use: the first picture's (coarse, so that it comes at once),
   // the scene's (at rest), and coarser ones while the camera moves.
   std::map<std::uint32_t, std::unique_ptr<Renderer>> renderers_;
@@ -291,6 +293,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
       selection_worker_(files_, indexes_),
       detail_(choose_scene_detail(files_, o.level, o.gpu_memory, o.span_texels)),
       gpu_memory_(std::make_shared<GpuMemoryPool>(detail_.budget)),
+      layouts_(files_, detail_.span_texels),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
       start_(start),
       startup_(startup),
@@ -743,11 +746,8 @@ void ViewerWindow::choose_rest_level(double aspect) {
 }
 
 std::uint32_t ViewerWindow::level_for_view(double aspect) {
-  if (detail_.forced) return detail_.level;
-  for (std::uint32_t level = 0; level < detail_.level; ++level)
-    if (renderer_at(level).view_bytes(controller_.camera(), aspect, state_.settings.clipping) <= detail_.budget)
-      return level;
-  return detail_.level;
+  return app::level_for_view(layouts_, detail_, controller_.camera(), aspect, scene_bounds(files_, volume_),
+                             state_.settings.clipping);
 }
 
 double ViewerWindow::refine(int width, int height, bool& completes) {
