@@ -21,7 +21,6 @@
 #include <GLFW/glfw3.h>
 
 #include "converter/selection/selection_output.h"
-#include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_controller.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/frame_budget.h"
@@ -39,7 +38,7 @@
 #include "viewer/app/scene_source.h"
 #include "viewer/app/selection_worker.h"
 #include "viewer/app/ui_panel.h"
-#include "viewer/app/view_level.h"
+#include "viewer/app/viewer_session.h"
 #include "viewer/app/window_size.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/offscreen_target.h"
@@ -169,11 +168,11 @@ bool same_picture(const PictureKey& a, const PictureKey& b) {
 // user pointer.
 class ViewerWindow {
  public:
-  // `volume` must outlive the window (coarse levels upload its slices when first drawn); `start`: when
-  // voxview started, for --stats.
+  // `session`: the scene, its level of detail already chosen (ViewerSession::choose_detail); its renderers
+  // go with the window, before the GL context. `start`: when voxview started, for --stats.
   // `regions`: the selection's regions (region_editor.h), edited in the window.
-  ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume, RegionEditor regions,
-               GLFWwindow* window, std::chrono::steady_clock::time_point start, StartupTimes startup);
+  ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession> session, RegionEditor regions, GLFWwindow* window,
+               std::chrono::steady_clock::time_point start, StartupTimes startup);
   int run();
 
  private:
@@ -229,24 +228,16 @@ class ViewerWindow {
 
   const ViewerOptions& options_;
   GLFWwindow* window_;
-  std::vector<const VxlFile*> files_;
-  const Volume* volume_;
+  std::unique_ptr<ViewerSession> session_;  // the files, the image, the level of detail, the renderers
+  const std::vector<const VxlFile*>& files_;
   RegionEditor regions_;
   std::optional<SceneSelection> selection_;          // the newest finished; the regions may have moved since
   std::optional<std::uint64_t> selection_revision_;  // the regions' revision last asked for
   std::optional<std::uint64_t> cleared_revision_;    // all regions removed at this revision: older selections are stale
   std::uint64_t selection_generation_ = 0;           // counts the selections taken into the picture
-  // The files' per-voxel indexes, shared by the selections and the renderers (built once, on first use).
-  std::shared_ptr<VoxelVoxlinesCache> indexes_;
   SelectionWorker selection_worker_;
   std::vector<double> selection_ms_;  // each selection's run time, for --stats
-  SceneDetail detail_;                // the level of detail drawn at rest, and the span size
-  // The GPU memory budget every level's renderer shares: together they never take more.
-  std::shared_ptr<GpuMemoryPool> gpu_memory_;
-  LevelLayouts layouts_;  // the scene's layout at each level, to measure views without a renderer
-  // One renderer per level drawn, made on first use: the first picture's (coarse, so that it comes at once),
-  // the scene's (at rest), and coarser ones while the camera moves.
-  std::map<std::uint32_t, std::unique_ptr<Renderer>> renderers_;
+  const SceneDetail& detail_;         // the level of detail drawn at rest, and the span size
   std::uint32_t first_level_ = 0;
   FrameBudget budget_;
   std::chrono::steady_clock::time_point start_;
@@ -281,26 +272,22 @@ class ViewerWindow {
   SliceSettings hidden_slices_;  // which slices I brings back
 };
 
-ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& files, const Volume* volume,
-                           RegionEditor regions, GLFWwindow* window, std::chrono::steady_clock::time_point start,
-                           StartupTimes startup)
+ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession> session, RegionEditor regions,
+                           GLFWwindow* window, std::chrono::steady_clock::time_point start, StartupTimes startup)
     : options_(o),
       window_(window),
-      files_(pointers(files)),
-      volume_(volume),
+      session_(std::move(session)),
+      files_(session_->files()),
       regions_(std::move(regions)),
-      indexes_(std::make_shared<VoxelVoxlinesCache>(files_)),
-      selection_worker_(files_, indexes_),
-      detail_(choose_scene_detail(files_, o.level, o.gpu_memory, o.span_texels)),
-      gpu_memory_(std::make_shared<GpuMemoryPool>(detail_.budget)),
-      layouts_(files_, detail_.span_texels),
+      selection_worker_(files_, session_->indexes()),
+      detail_(session_->detail()),
       budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
       start_(start),
       startup_(startup),
       rest_(false, o.exact_when_still),
       controller_(Camera{}, 1.0) {
   if (o.saved_show_regions) state_.show_regions = *o.saved_show_regions;  // as the saved view had them
-  stats_.detail = describe_scene_detail(detail_, SceneLayout::coarsest_level(pointers(files)) + 1);
+  stats_.detail = describe_scene_detail(detail_, session_->levels_in_files());
   if (!stats_.detail.empty()) std::fprintf(stderr, "voxview: %s\n", stats_.detail.c_str());
   std::vector<std::uint64_t> segments(SceneLayout::coarsest_level(files_) + 1, 0);
   for (const VxlFile* f : files_)
@@ -313,7 +300,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   Renderer& first = renderer_at(first_level_);
   grid_.emplace(first);
   controller_ = CameraController(Camera{}, std::max(1.0, glm::length(first.scene_max() - first.scene_min()) * 0.5));
-  stats_.has_image = volume != nullptr;
+  stats_.has_image = session_->image() != nullptr;
   check_color_options(o.inputs_name(), first, o.settings, o.from_view_file);
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
@@ -325,10 +312,10 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, const std::vector<VxlFile>& f
   drawn_mode_ = o.settings.mode;
   state_.orthographic = o.orthographic;
   stats_.title = std::filesystem::path(o.inputs.front()).filename().string();
-  if (files.size() > 1) stats_.title += " + " + std::to_string(files.size() - 1) + " more";
-  for (const VxlFile& f : files) {
-    stats_.voxels_total += f.meta().voxel_count;
-    stats_.segments_total += f.meta().segment_count;
+  if (files_.size() > 1) stats_.title += " + " + std::to_string(files_.size() - 1) + " more";
+  for (const VxlFile* f : files_) {
+    stats_.voxels_total += f->meta().voxel_count;
+    stats_.segments_total += f->meta().segment_count;
   }
   stats_.gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   stats_.gl_version = std::to_string(major) + "." + std::to_string(minor);
@@ -539,9 +526,8 @@ void ViewerWindow::apply_selection(std::optional<SceneSelection> selection) {
   selection_ = std::move(selection);
   if (!selection_) stats_.selection.clear();
   ++selection_generation_;
+  session_->set_groups(selection_ ? std::optional<SceneGroups>(selection_->groups) : std::nullopt);
   const SceneGroups groups = selection_ ? selection_->groups : SceneGroups(files_);
-  for (auto& [level, r] : renderers_)
-    if (r) r->set_groups(groups);
   stats_.groups.clear();
   for (const SceneGroup& g : groups.groups()) stats_.groups.emplace_back(g.name, g.streamlines);
   for (std::size_t i = 0; i < stats_.regions.size(); ++i)
@@ -654,16 +640,9 @@ void ViewerWindow::perform(KeyAction action, bool shift) {
 }
 
 Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
-  std::unique_ptr<Renderer>& r = renderers_[level];
-  if (!r) {
-    // The first picture's level is uploaded whole at once; the others span by span as frames need them
-    // (the refinement at rest spreads its level's upload over frames).
-    r = std::make_unique<Renderer>(files_, detail_.span_texels, level, gpu_memory_, level == first_level_);
-    r->share_indexes(indexes_);
-    if (volume_) r->set_volume(*volume_);
-    if (selection_) r->set_groups(selection_->groups);
-  }
-  return *r;
+  // The first picture's level is uploaded whole at once; the others span by span as frames need them
+  // (the refinement at rest spreads its level's upload over frames).
+  return session_->renderer_at(level, level == first_level_);
 }
 
 double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
@@ -746,8 +725,7 @@ void ViewerWindow::choose_rest_level(double aspect) {
 }
 
 std::uint32_t ViewerWindow::level_for_view(double aspect) {
-  return app::level_for_view(layouts_, detail_, controller_.camera(), aspect, scene_bounds(files_, volume_),
-                             state_.settings.clipping);
+  return session_->level_for_view(controller_.camera(), aspect, state_.settings.clipping);
 }
 
 double ViewerWindow::refine(int width, int height, bool& completes) {
@@ -967,15 +945,14 @@ int ViewerWindow::run() {
 
 int run_window(const ViewerOptions& o) {
   const auto start = process_start();
-  GlfwLibrary glfw;  // first: without a display, fail before any slow conversion
-  const std::vector<VxlFile> files = open_scenes(o.inputs, scene_source_options(o));
-  std::optional<Volume> volume;
-  if (o.image) volume = read_nifti_volume(*o.image);
-  RegionEditor regions(o);  // parses the regions: a bad one fails before the window opens
+  GlfwLibrary glfw;                                   // first: without a display, fail before any slow conversion
+  auto session = std::make_unique<ViewerSession>(o);  // a bad file or image fails before the window opens
+  RegionEditor regions(o);                            // parses the regions: a bad one fails there too
   WindowPtr window = open_window(o);
   StartupTimes startup;
   startup.window_open_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  ViewerWindow viewer(o, files, volume ? &*volume : nullptr, std::move(regions), window.get(), start, startup);
+  session->choose_detail(o);  // the driver's limits: the window's context is current
+  ViewerWindow viewer(o, std::move(session), std::move(regions), window.get(), start, startup);
   return viewer.run();
 }
 
