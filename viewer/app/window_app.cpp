@@ -98,14 +98,14 @@ WindowPtr open_window(const ViewerOptions& o) {
   return WindowPtr(w);
 }
 
-// The mode after `m` in render_modes(), skipping exact where the context cannot run it.
-RenderMode next_mode(RenderMode m, bool exact_available) {
+// The mode after `m` in render_modes(), skipping those that need OpenGL 4.3 where the context has less.
+RenderMode next_mode(RenderMode m, bool gl43) {
   const std::span<const RenderModeInfo> modes = render_modes();
   std::size_t i = static_cast<std::size_t>(
       std::find_if(modes.begin(), modes.end(), [m](const RenderModeInfo& info) { return info.mode == m; }) -
       modes.begin());
   do i = (i + 1) % modes.size();
-  while (modes[i].mode == RenderMode::Exact && !exact_available);
+  while (modes[i].needs_gl43 && !gl43);
   return modes[i].mode;
 }
 
@@ -649,8 +649,9 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
   Renderer& renderer = renderer_at(level);
   RenderSettings& s = state_.settings;
   if (s.mode != drawn_mode_) stats_.error.clear();  // a new choice of mode gets a fresh start
-  if (s.mode == RenderMode::Exact && !stats_.exact_available) {
-    set_error("the exact mode needs OpenGL 4.3; this context is " + stats_.gl_version + ": showing axis");
+  if (render_mode_info(s.mode).needs_gl43 && !stats_.exact_available) {
+    set_error(std::string("the ") + render_mode_name(s.mode) + " mode needs OpenGL 4.3; this context is " +
+              stats_.gl_version + ": showing axis");
     s.mode = RenderMode::Axis;
   }
   const auto t0 = std::chrono::steady_clock::now();
