@@ -29,6 +29,7 @@
 #include "viewer/app/headless_render.h"
 #include "viewer/app/key_bindings.h"
 #include "viewer/app/picture_annotations.h"
+#include "viewer/app/picture_scheduler.h"
 #include "viewer/app/process_clock.h"
 #include "viewer/app/region_drag.h"
 #include "viewer/app/region_editor.h"
@@ -202,15 +203,9 @@ class ViewerWindow {
   void set_error(const std::string& message);
   // Draws the scene whole at `level` of detail into scene_target_; returns the frame's time in ms.
   double draw_scene(int width, int height, std::uint32_t level);
-  // The finest level whose spans visible from the current view fit the GPU memory budget, at most the
-  // scene's level (--level: that level).
-  std::uint32_t level_for_view(double aspect);
-  // Chooses rest_level_ for the view on screen, once per picture drawn whole; when the picture already is at
-  // that level, the full-detail stage is complete at once.
-  void choose_rest_level(double aspect);
   // Draws the next piece of the refinement at rest (rest_refinement.h) into refine_target_; once the stage's
   // picture is complete it becomes scene_target_'s and `completes` is set. Returns the piece's time in ms.
-  double refine(int width, int height, bool& completes);
+  double refine(int width, int height, std::uint32_t level, bool& completes);
   // The grid overlay and the annotations (picture_annotations.h) over scene_target_'s picture, when they are on.
   void draw_overlays(const Renderer& renderer, int width, int height);
   // The panel's figures of a complete picture drawn by `renderer`.
@@ -239,17 +234,11 @@ class ViewerWindow {
   std::vector<double> selection_ms_;  // each selection's run time, for --stats
   const SceneDetail& detail_;         // the level of detail drawn at rest, and the span size
   std::uint32_t first_level_ = 0;
-  FrameBudget budget_;
   std::chrono::steady_clock::time_point start_;
-  std::vector<FrameRecord> frames_;  // for --stats
-  StartupTimes startup_;             // for --stats
-  std::optional<PictureKey> drawn_;  // what the picture on screen shows (none before the first)
-  RestRefinement rest_;
-  bool pieces_begun_ = false;      // the refinement's current stage has begun its pieces
-  std::uint32_t drawn_level_ = 0;  // the level of the picture on screen
-  // The level the refinement draws this view at: the finest whose visible part fits the GPU memory budget
-  // (the scene's level, or finer for a slab or a close view); none until the refinement has chosen it.
-  std::optional<std::uint32_t> rest_level_;
+  std::vector<FrameRecord> frames_;            // for --stats
+  StartupTimes startup_;                       // for --stats
+  std::optional<PictureKey> drawn_;            // what the picture on screen shows (none before the first)
+  std::optional<PictureScheduler> scheduler_;  // what each frame draws (made once the GL version is known)
   std::optional<GridOverlay> grid_;
   std::optional<PictureAnnotations> annotations_;  // made when first wanted
   // The scene is drawn here and blitted to the window: it blends in float like headless rendering, so
@@ -281,10 +270,8 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
       regions_(std::move(regions)),
       selection_worker_(files_, session_->indexes()),
       detail_(session_->detail()),
-      budget_(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
       start_(start),
       startup_(startup),
-      rest_(false, o.exact_when_still),
       controller_(Camera{}, 1.0) {
   if (o.saved_show_regions) state_.show_regions = *o.saved_show_regions;  // as the saved view had them
   stats_.detail = describe_scene_detail(detail_, session_->levels_in_files());
@@ -320,7 +307,9 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
   stats_.gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   stats_.gl_version = std::to_string(major) + "." + std::to_string(minor);
   stats_.exact_available = major * 10 + minor >= 43;
-  rest_ = RestRefinement(stats_.exact_available, o.exact_when_still);
+  scheduler_.emplace(FrameBudget(o.frame_budget_ms, detail_.level, SceneLayout::coarsest_level(files_)),
+                     RestRefinement(stats_.exact_available, o.exact_when_still), detail_.level, detail_.forced,
+                     first_level_);
   state_.exact_when_still = o.exact_when_still;
   stats_.frame_budget_ms = o.frame_budget_ms;
   stats_.max_line_width = std::clamp(widths[1], 1.0f, 16.0f);
@@ -658,7 +647,7 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
   const Camera& camera = controller_.camera();
   if (!scene_target_) scene_target_.emplace(width, height);
   if (scene_target_->width() != width || scene_target_->height() != height) scene_target_->resize(width, height);
-  pieces_begun_ = false;  // a whole picture abandons the refinement's pieces
+  scheduler_->abandon_pieces();  // a whole picture abandons the refinement's pieces
   const GLuint target = scene_target_->framebuffer();
   try {
     renderer.draw(camera, s, width, height, target);
@@ -716,31 +705,19 @@ void ViewerWindow::present(int width, int height) const {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-void ViewerWindow::choose_rest_level(double aspect) {
-  if (rest_level_) return;
-  rest_level_ = level_for_view(aspect);
-  if (rest_.stage() == RestStage::FullDetail && *rest_level_ == drawn_level_) {
-    rest_.stage_complete();  // the picture on screen is already this view's full detail
-    stats_.refinement = rest_.describe(0);
-  }
-}
-
-std::uint32_t ViewerWindow::level_for_view(double aspect) {
-  return session_->level_for_view(controller_.camera(), aspect, state_.settings.clipping);
-}
-
-double ViewerWindow::refine(int width, int height, bool& completes) {
+double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& completes) {
   const auto t0 = std::chrono::steady_clock::now();
-  Renderer& renderer = renderer_at(*rest_level_);
+  Renderer& renderer = renderer_at(level);
   if (!refine_target_) refine_target_.emplace(width, height);
   if (refine_target_->width() != width || refine_target_->height() != height) refine_target_->resize(width, height);
-  const bool exact_stage = rest_.stage() == RestStage::Exact;
+  RestRefinement& rest = scheduler_->rest();
+  const bool exact_stage = rest.stage() == RestStage::Exact;
   completes = false;
   try {
     // Each piece fits the frame budget, so that input waits no longer at rest than while moving.
     const double piece_ms =
         options_.frame_budget_ms > 0 ? options_.frame_budget_ms : std::numeric_limits<double>::infinity();
-    if (!pieces_begun_) {
+    if (!scheduler_->pieces_begun()) {
       // The level's spans this view needs come first, a piece's time at a time (the nearest first).
       if (!renderer.upload_for(controller_.camera(), double(width) / height, state_.settings.clipping, piece_ms)) {
         stats_.refinement = "uploading the scene's level";
@@ -748,34 +725,32 @@ double ViewerWindow::refine(int width, int height, bool& completes) {
         return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       }
       RenderSettings s = state_.settings;
-      s.mode = rest_.stage_mode();
+      s.mode = rest.stage_mode();
       renderer.begin_pieces(controller_.camera(), s, width, height, refine_target_->framebuffer());
-      pieces_begun_ = true;
+      scheduler_->begin_pieces();
     }
     completes = renderer.draw_piece(piece_ms);
   } catch (const std::exception& e) {
     // Exact out of node memory, say: keep the picture on screen and stop refining it.
-    set_error(std::string(exact_stage ? "exact when still" : render_mode_name(rest_.stage_mode())) + ": " + e.what() +
+    set_error(std::string(exact_stage ? "exact when still" : render_mode_name(rest.stage_mode())) + ": " + e.what() +
               (exact_stage ? ": turned off" : ": showing axis"));
     if (exact_stage) {
       state_.exact_when_still = false;
-      rest_.set_exact_when_still(false);
+      scheduler_->set_exact_when_still(false);
     } else {
       state_.settings.mode = RenderMode::Axis;  // as draw_scene does: the picture is drawn again in axis
     }
-    pieces_begun_ = false;
-    stats_.refinement = rest_.describe(0);
+    scheduler_->abandon_pieces();
+    stats_.refinement = rest.describe(0);
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   if (completes) {
     std::swap(scene_target_, refine_target_);
     draw_overlays(renderer, width, height);
-    show_frame_figures(renderer, *rest_level_);
-    drawn_level_ = *rest_level_;
-    rest_.stage_complete();
-    pieces_begun_ = false;
+    show_frame_figures(renderer, level);
   }
-  stats_.refinement = rest_.describe(completes ? 0 : renderer.pieces_progress());
+  scheduler_->piece_drawn(completes);
+  stats_.refinement = rest.describe(completes ? 0 : renderer.pieces_progress());
   glFinish();
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -827,7 +802,7 @@ int ViewerWindow::run() {
     // A script's frames are done after --frames; with --until-refined it then waits, at rest, for the
     // refinement to finish.
     const bool frames_done = automated && frame >= *options_.frames;
-    const bool refined = drawn_ && rest_.stage() == RestStage::Done;
+    const bool refined = drawn_ && scheduler_->rest().stage() == RestStage::Done;
     const bool closing = glfwWindowShouldClose(window_) || (frames_done && (!options_.until_refined || refined));
 
     // Render at the framebuffer's size (HiDPI), take input in window units.
@@ -856,10 +831,7 @@ int ViewerWindow::run() {
     if (requests.save_selection) save_selection();
     screenshot_requested_ |= requests.screenshot;
     save_view_requested_ |= requests.save_view;
-    if (state_.exact_when_still != rest_.exact_when_still()) {
-      rest_.set_exact_when_still(state_.exact_when_still);
-      pieces_begun_ = false;
-    }
+    scheduler_->set_exact_when_still(state_.exact_when_still);
     if (options_.orbit_deg && !frames_done)
       controller_.set_view(controller_.camera().azimuth_deg + *options_.orbit_deg, controller_.camera().elevation_deg);
 
@@ -879,33 +851,24 @@ int ViewerWindow::run() {
     const bool changed = !drawn_ || !same_picture(*drawn_, key);
     const bool scripted_last = closing && frames_done && !options_.until_refined;
     bool drawn_now = false;  // the picture (and so what the panel should say) changed after the panel was built
-    if (changed || scripted_last) {
-      const std::uint32_t level = scripted_last     ? detail_.level
-                                  : frames_.empty() ? first_level_
-                                                    : budget_.level_for(true);
-      const double ms = draw_scene(fb_w, fb_h, level);
-      budget_.record(level, ms);
-      // Full detail for any view only at level 0 (or the level --level forces); otherwise the refinement
-      // decides, once at rest, which level this view can have.
-      rest_.drawn_whole(state_.settings.mode, level == 0 || (detail_.forced && level == detail_.level));
-      drawn_level_ = level;
-      rest_level_.reset();
-      stats_.refinement = rest_.describe(0);
+    const PictureTask task = scheduler_->next(changed, scripted_last, closing, [&] {
+      return session_->level_for_view(camera, double(fb_w) / fb_h, state_.settings.clipping);
+    });
+    if (task.stage_skipped) stats_.refinement = scheduler_->rest().describe(0);
+    if (task.work == PictureWork::Whole) {
+      const double ms = draw_scene(fb_w, fb_h, task.level);
+      scheduler_->drawn_whole(state_.settings.mode, task.level, ms);
+      stats_.refinement = scheduler_->rest().describe(0);
       drawn_ = key;
-      frames_.push_back({level, moving, ms, seconds_since_start()});
+      frames_.push_back({task.level, moving, ms, seconds_since_start()});
+      drawn_now = true;
+    } else if (task.work == PictureWork::Piece) {
+      bool completes = false;
+      const double ms = refine(fb_w, fb_h, task.level, completes);
+      frames_.push_back({task.level, false, ms, seconds_since_start(), task.frame_work, completes});
       drawn_now = true;
     }
-    if (!changed && !scripted_last && !closing && rest_.stage() != RestStage::Done) {
-      choose_rest_level(double(fb_w) / fb_h);
-      if (rest_.stage() != RestStage::Done) {
-        const FrameWork work = rest_.stage() == RestStage::Exact ? FrameWork::ExactPiece : FrameWork::FullDetailPiece;
-        bool completes = false;
-        const double ms = refine(fb_w, fb_h, completes);
-        frames_.push_back({*rest_level_, false, ms, seconds_since_start(), work, completes});
-        drawn_now = true;
-      }
-    }
-    pacing.frame_ended(rest_.stage() != RestStage::Done, drawn_now);
+    pacing.frame_ended(scheduler_->rest().stage() != RestStage::Done, drawn_now);
     present(fb_w, fb_h);
     // Screenshots show the scene alone unless the user asked for the panel too; automated ones never do.
     if (closing && options_.screenshot) save_screenshot(*options_.screenshot, fb_w, fb_h);
