@@ -101,5 +101,20 @@ TEST(RenderModeTable, NamesParseBackInEnumOrder) {
   EXPECT_FALSE(parse_render_mode("fancy"));
 }
 
+// The per-mode facts the window, the refinement at rest and the panel read from the table.
+TEST(RenderModeTable, EachModesFactsAreInItsEntry) {
+  for (const RenderModeInfo& m : render_modes()) EXPECT_EQ(render_mode_info(m.mode).mode, m.mode);
+  for (const RenderModeInfo& m : render_modes()) {
+    EXPECT_EQ(m.needs_gl43, m.mode == RenderMode::Exact) << m.name;
+    EXPECT_EQ(m.refines_to_exact, m.mode == RenderMode::Basic || m.mode == RenderMode::Axis) << m.name;
+  }
+  EXPECT_EQ(render_mode_info(RenderMode::Axis).plan_order, PlanOrder::Nearest);
+  EXPECT_EQ(render_mode_info(RenderMode::Segsort).plan_order, PlanOrder::Nearest);
+  EXPECT_EQ(render_mode_info(RenderMode::Basic).plan_order, PlanOrder::Block);
+  EXPECT_EQ(render_mode_info(RenderMode::Exact).plan_order, PlanOrder::Visibility);
+  for (RenderMode m : {RenderMode::Opaque, RenderMode::Unsorted, RenderMode::Additive, RenderMode::Wboit})
+    EXPECT_EQ(render_mode_info(m).plan_order, PlanOrder::Any) << render_mode_name(m);
+}
+
 }  // namespace
 }  // namespace vxl

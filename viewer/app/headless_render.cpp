@@ -7,14 +7,13 @@
 #include <optional>
 
 #include "format/base/memory_size.h"
-#include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/picture_annotations.h"
 #include "viewer/app/region_editor.h"
-#include "viewer/app/scene_detail.h"
 #include "viewer/app/scene_selection.h"
 #include "viewer/app/scene_source.h"
 #include "viewer/app/turntable.h"
+#include "viewer/app/viewer_session.h"
 #include "viewer/platform/egl_context.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/offscreen_target.h"
@@ -55,61 +54,50 @@ Camera initial_camera(std::span<const glm::dvec3> points, const ViewerOptions& o
 
 int run_headless(const ViewerOptions& o) {
   auto t0 = std::chrono::steady_clock::now();
-  const std::vector<VxlFile> files = open_scenes(o.inputs, scene_source_options(o));
-  std::optional<Volume> volume;
-  if (o.image) volume = read_nifti_volume(*o.image);  // before any GL work: a bad image fails fast
-  std::optional<SceneSelection> selection;            // before any GL work too: a bad region fails fast
-  std::vector<RegionShape> shells;                    // drawn with --show-regions
+  // Made after the files are open, gone after the session's renderers: declared first, made later.
+  std::optional<HeadlessGlContext> context;
+  ViewerSession session(o);                 // before any GL work: a bad file or image fails fast
+  std::optional<SceneSelection> selection;  // before any GL work too: a bad region fails fast
+  std::vector<RegionShape> shells;          // drawn with --show-regions
   if (o.selecting()) {
     const RegionEditor regions(o);
-    selection = select_in_scene(pointers(files), regions.criteria());
+    selection = select_in_scene(session.files(), regions.criteria());
     if (o.show_regions) shells = regions.shapes();
     std::fprintf(stderr, "voxview: %llu of %llu streamlines selected (the focus; the others are context)\n",
                  (unsigned long long)selection->selected, (unsigned long long)selection->total);
   }
-  HeadlessGlContext context;
-  const SceneDetail detail = choose_scene_detail(pointers(files), o.level, o.gpu_memory, o.span_texels);
-  const std::uint64_t texels = detail.span_texels;
-  const auto gpu_memory = std::make_shared<GpuMemoryPool>(detail.budget);
+  context.emplace();
+  session.choose_detail(o);
+  const SceneDetail& detail = session.detail();
   const double aspect = double(o.width) / o.height;
   // The level whose whole copy fits the budget, or for one view (not a turntable, not --level) the finest
   // level whose visible part fits: a slab or a close view of a large scene is drawn in more detail.
-  std::unique_ptr<Renderer> renderer;
-  std::optional<Camera> camera;
   const bool per_view = !detail.forced && o.turntable <= 1 && detail.level > 0;
-  for (std::uint32_t level = per_view ? 0 : detail.level;; ++level) {
-    renderer = std::make_unique<Renderer>(pointers(files), texels, level, gpu_memory);
-    if (volume) renderer->set_volume(*volume);
-    if (selection) renderer->set_groups(selection->groups);
-    if (!camera) camera = initial_camera(framing_points(renderer->layout()), o, aspect);
-    if (level >= detail.level) {
-      if (const std::string note = describe_scene_detail(detail, SceneLayout::coarsest_level(pointers(files)) + 1);
-          !note.empty())
-        std::fprintf(stderr, "voxview: %s\n", note.c_str());
-      break;
-    }
-    if (renderer->view_bytes(*camera, aspect, o.settings.clipping) <= detail.budget) {
-      std::fprintf(stderr,
-                   "voxview: drawing level %u: the visible part fits the GPU memory budget of %s (the whole scene "
-                   "needs level %u)\n",
-                   level, format_memory_size(detail.budget).c_str(), detail.level);
-      break;
-    }
-  }
-  volume.reset();
+  const Camera camera = initial_camera(framing_points(session.layout_at(per_view ? 0 : detail.level)), o, aspect);
+  const std::uint32_t level = per_view ? session.level_for_view(camera, aspect, o.settings.clipping) : detail.level;
+  if (level < detail.level)
+    std::fprintf(stderr,
+                 "voxview: drawing level %u: the visible part fits the GPU memory budget of %s (the whole scene "
+                 "needs level %u)\n",
+                 level, format_memory_size(detail.budget).c_str(), detail.level);
+  else if (const std::string note = describe_scene_detail(detail, session.levels_in_files()); !note.empty())
+    std::fprintf(stderr, "voxview: %s\n", note.c_str());
+  if (selection) session.set_groups(selection->groups);
+  Renderer* const renderer = &session.renderer_at(level, true);
+  session.release_image();
   check_color_options(o.inputs_name(), *renderer, o.settings, o.from_view_file);
   RenderSettings settings = o.settings;
   settings.regions = shells;
   OffscreenTarget target(o.width, o.height);
   target.bind();
   if (o.save_camera)
-    write_view(*o.save_camera, SavedView{*camera, o.settings, std::array<int, 2>{o.width, o.height}, true, o.include,
+    write_view(*o.save_camera, SavedView{camera, o.settings, std::array<int, 2>{o.width, o.height}, true, o.include,
                                          o.exclude, o.ends_in, o.show_regions});
   const int frames = std::max(1, o.turntable);
   std::optional<PictureAnnotations> annotations;
   if (PictureAnnotations::wanted(o.settings)) annotations.emplace();
   for (int i = 0; i < frames; ++i) {
-    const Camera frame_camera = turntable_camera(*camera, i, frames);
+    const Camera frame_camera = turntable_camera(camera, i, frames);
     renderer->draw(frame_camera, settings, o.width, o.height, target.framebuffer());
     if (annotations) {
       target.bind();
@@ -123,7 +111,7 @@ int run_headless(const ViewerOptions& o) {
     std::printf("%s: %dx%d %s, %llu voxels and %llu segments drawn, %s after %.3f s (%s)\n", png.c_str(), o.width,
                 o.height, render_mode_name(o.settings.mode), (unsigned long long)s.voxels_drawn,
                 (unsigned long long)s.segments_drawn, i == 0 ? "first frame" : "frame", seconds,
-                context.renderer().c_str());
+                context->renderer().c_str());
   }
   if (o.save_camera) std::printf("view saved to %s\n", o.save_camera->c_str());
   return 0;

@@ -5,7 +5,7 @@
 namespace vxl::app {
 
 bool RestRefinement::wants_exact() const {
-  return exact_available_ && exact_when_still_ && (mode_ == RenderMode::Axis || mode_ == RenderMode::Basic);
+  return exact_available_ && exact_when_still_ && render_mode_info(mode_).refines_to_exact;
 }
 
 void RestRefinement::drawn_whole(RenderMode mode, bool full_detail) {
@@ -26,7 +26,8 @@ void RestRefinement::stage_complete() {
 
 void RestRefinement::set_exact_when_still(bool on) {
   exact_when_still_ = on;
-  if (mode_ == RenderMode::Exact) return;                   // the mode itself is exact: nothing to add or take back
+  // A mode without an exact stage (exact itself among them) has nothing to add or take back.
+  if (!render_mode_info(mode_).refines_to_exact) return;
   if (!on && exact_shown_) stage_ = RestStage::FullDetail;  // the exact picture is replaced by the mode's own
   if (!on && stage_ == RestStage::Exact) stage_ = RestStage::Done;
   if (on && stage_ == RestStage::Done && wants_exact()) stage_ = RestStage::Exact;

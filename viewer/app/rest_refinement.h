@@ -2,9 +2,9 @@
 // whole while the camera moved may be coarse (frame_budget.h): at rest it is redrawn at the scene's level in
 // pieces that each fit the frame budget (Renderer::begin_pieces), the coarse picture staying on screen until
 // the full one is complete, so that input is taken between pieces. Then, "exact when still": where the
-// context has OpenGL 4.3 and the mode is one the exact mode is the reference of (basic, axis), the picture
-// is drawn once more in the exact mode, run by run. A change of view or settings starts over. Pure logic:
-// which stage comes next; the window draws.
+// context has OpenGL 4.3 and the exact mode is the mode's reference (RenderModeInfo::refines_to_exact), the
+// picture is drawn once more in the exact mode, run by run. A change of view or settings starts over. Pure
+// logic: which stage comes next; the window draws.
 #pragma once
 
 #include <string>

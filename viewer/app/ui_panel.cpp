@@ -237,7 +237,7 @@ void look_controls(PanelState& state, const PanelStats& stats) {
     for (const RenderModeInfo& m : render_modes()) {
       const bool selected = m.mode == s.mode;
       std::string label = m.name;
-      if (m.mode == RenderMode::Exact && !stats.exact_available) label += " (needs GL 4.3)";
+      if (m.needs_gl43 && !stats.exact_available) label += " (needs GL 4.3)";
       if (ImGui::Selectable(label.c_str(), selected)) s.mode = m.mode;
       if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", m.description);
       if (selected) ImGui::SetItemDefaultFocus();

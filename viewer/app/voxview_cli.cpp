@@ -53,8 +53,10 @@ std::string voxview_description(const std::string& version) {
          controls_as_paragraph(110);
 }
 
-void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
-  cli.name("voxview");
+namespace {
+
+// The inputs, headless rendering and saved views.
+void declare_input_output(CLI::App& cli, ViewerArguments& a) {
   cli.add_option(
          "files", a.options.inputs,
          "a .vxl file, a .vxlz package, or a " + source_suffixes_text(" / ") +
@@ -76,6 +78,10 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--save-camera", a.options.save_camera,
                  "write the view (camera and settings) to this JSON file: headless after rendering, in the window on "
                  "V, the panel's Save view button, or on quitting after --frames");
+}
+
+// The transparency mode, the view and the colours.
+void declare_picture(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--mode", a.mode, join(render_mode_names(), " | "))
       ->default_val("axis")
       ->check(CLI::IsMember(render_mode_names()));
@@ -113,6 +119,10 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
          "it), repeatable")
       ->expected(1)
       ->take_all();
+}
+
+// The selection's regions and how focus and context are drawn.
+void declare_selection(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--include", a.options.include,
                  "select the streamlines that pass through this region (as `voxlines select`: X,Y,Z,R, "
                  "box:X0,Y0,Z0,X1,Y1,Z1, FILE.nii[.gz][:LABEL]); they are drawn as the focus, the others as "
@@ -140,6 +150,10 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                  "with a selection: the other streamlines' opacity (0 hides them)")
       ->default_val(0.02)
       ->check(CLI::Range(0.0, 1.0));
+}
+
+// Per-point values, lighting, line width, background and annotations.
+void declare_lines(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--tsf", a.options.tsf,
                  "a TSF file of per-point values for a .tck given as input (converted in memory), repeatable")
       ->expected(1)
@@ -158,6 +172,10 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
   cli.add_flag("--colorbar", a.colorbar,
                "with --color scalar: a colour bar at the right edge, the colour map from --range's minimum (bottom) "
                "to its maximum (top), with both numbers and the value set's name");
+}
+
+// The anatomical image, the focus point, the slab and the clip planes.
+void declare_image_and_clipping(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--image", a.options.image,
                  "an anatomical image (NIfTI-1 or -2, .nii or .nii.gz; MRtrix .mif, .mif.gz or .mih; e.g. a T1) shown "
                  "as opaque grey slices through the "
@@ -182,6 +200,10 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
          "clip plane AXIS,POS in RAS mm, up to 3: x,10 keeps x >= 10, -x,10 keeps x <= 10 (axes x y z, -x -y -z)")
       ->expected(1)
       ->take_all();
+}
+
+// Opening and converting the inputs, the GPU memory budget and the level of detail.
+void declare_loading(CLI::App& cli, ViewerArguments& a) {
   cli.add_flag("--verify", a.options.verify,
                "before drawing, check every .vxl in full (every checksum and padding byte, every order, the streamline "
                "tables; reads the whole file, as 'voxlines verify') and refuse a damaged one (exit 3, naming the first "
@@ -212,6 +234,10 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
                  "draw this level of detail (0: every streamline; level d keeps about 1/8^d of them), whatever the "
                  "GPU memory budget; at most the file's coarsest level")
       ->check(CLI::Range(0u, kMaxLevels - 1));
+}
+
+// The window's frame budget, refinement and scripting.
+void declare_window(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--frame-budget", a.options.frame_budget_ms,
                  "window: while the camera moves, draw the finest level of detail whose measured frame time fits this "
                  "many milliseconds; at rest, the level --gpu-memory allows (0: always that level)")
@@ -243,6 +269,20 @@ void declare_voxview_options(CLI::App& cli, ViewerArguments& a) {
       ->needs("--frames");
   cli.add_option("--screenshot", a.options.screenshot,
                  "window: save the last frame to this picture before quitting: " + picture_formats_text());
+}
+
+}  // namespace
+
+void declare_voxview_options(CLI::App& cli, ViewerArguments& arguments) {
+  cli.name("voxview");
+  // In the order --help lists them.
+  declare_input_output(cli, arguments);
+  declare_picture(cli, arguments);
+  declare_selection(cli, arguments);
+  declare_lines(cli, arguments);
+  declare_image_and_clipping(cli, arguments);
+  declare_loading(cli, arguments);
+  declare_window(cli, arguments);
 }
 
 void parse_voxview_command_line(CLI::App& cli, ViewerArguments& arguments, int argc, const char* const* argv) {

@@ -10,18 +10,26 @@
 namespace vxl {
 
 namespace {
+// Unsorted draws in the files' streamline order, not by voxel: its plan only culls (Any).
 constexpr RenderModeInfo kModes[] = {
-    {RenderMode::Opaque, "opaque", "depth-tested, no blending"},
-    {RenderMode::Unsorted, "unsorted", "blended in dataset (streamline) order, like TrackVis"},
+    {RenderMode::Opaque, "opaque", "depth-tested, no blending", false, PlanOrder::Any, false},
+    {RenderMode::Unsorted, "unsorted", "blended in dataset (streamline) order, like TrackVis", false, PlanOrder::Any,
+     false},
     {RenderMode::Additive, "additive",
-     "MRtrix-like: a depth-tested opaque pass and an additive pass, mixed by the opacity"},
-    {RenderMode::Wboit, "wboit", "weighted blended order-independent transparency (McGuire & Bavoil 2013)"},
-    {RenderMode::Basic, "basic", "voxels sorted back to front, segments in dataset order inside each voxel"},
-    {RenderMode::Axis, "axis", "voxels sorted back to front, each drawn in its nearest precomputed order (Voxlines)"},
+     "MRtrix-like: a depth-tested opaque pass and an additive pass, mixed by the opacity", false, PlanOrder::Any,
+     false},
+    {RenderMode::Wboit, "wboit", "weighted blended order-independent transparency (McGuire & Bavoil 2013)", false,
+     PlanOrder::Any, false},
+    {RenderMode::Basic, "basic", "voxels sorted back to front, segments in dataset order inside each voxel", false,
+     PlanOrder::Block, true},
+    {RenderMode::Axis, "axis", "voxels sorted back to front, each drawn in its nearest precomputed order (Voxlines)",
+     false, PlanOrder::Nearest, true},
     {RenderMode::Segsort, "segsort",
      "voxels sorted as axis, each voxel's segments sorted for the exact view on the CPU every frame: slow, a "
-     "reference for the orders"},
-    {RenderMode::Exact, "exact", "per-fragment sorted reference (needs OpenGL 4.3)"},
+     "reference for the orders",
+     false, PlanOrder::Nearest, false},
+    {RenderMode::Exact, "exact", "per-fragment sorted reference (needs OpenGL 4.3)", true, PlanOrder::Visibility,
+     false},
 };
 struct ColorName {
   ColorMode mode;
@@ -120,6 +128,8 @@ GroupStyle& RenderSettings::style_of(const std::string& name) {
 }
 
 std::span<const RenderModeInfo> render_modes() { return kModes; }
+
+const RenderModeInfo& render_mode_info(RenderMode mode) { return kModes[static_cast<std::size_t>(mode)]; }
 
 std::vector<std::string> render_mode_names() {
   std::vector<std::string> names;

@@ -12,6 +12,7 @@
 
 #include "viewer/render/clip_planes.h"
 #include "viewer/render/colormap.h"
+#include "viewer/render/frame_plan.h"
 #include "viewer/render/region_shapes.h"
 
 namespace vxl {
@@ -22,12 +23,21 @@ enum class RenderMode { Opaque, Unsorted, Additive, Wboit, Basic, Axis, Segsort,
 
 // The one list of the modes, in the order the panel shows them and M cycles through them: --mode, saved
 // views, the panel and the help all read it.
+// Each mode's facts live here, so that the window, the refinement at rest and the panel read them rather
+// than keep their own lists.
 struct RenderModeInfo {
   RenderMode mode;
   const char* name;         // as --mode and saved views spell it
   const char* description;  // one line
+  bool needs_gl43;          // runs only where the context has OpenGL 4.3 (elsewhere the window shows axis)
+  PlanOrder plan_order;     // how the frame plan orders the visible voxels (frame_plan.h)
+  // The exact mode is this mode's reference: at rest the window goes on to the exact picture ("exact when
+  // still", rest_refinement.h).
+  bool refines_to_exact;
 };
 std::span<const RenderModeInfo> render_modes();
+// The table's entry of `mode`.
+const RenderModeInfo& render_mode_info(RenderMode mode);
 std::vector<std::string> render_mode_names();
 
 std::optional<RenderMode> parse_render_mode(const std::string& name);

@@ -1,0 +1,88 @@
+// The scene voxview shows (viewer_session.h): one renderer per level, made once with the image and the
+// current groups, and a view's level measured on the layouts exactly as the renderers would measure it
+// (the lines' bounds joined with the image's box).
+#include "converter/synth.h"
+#include "tests/nifti_test_files.h"
+#include "tests/viewer/render_support.h"
+#include "viewer/app/viewer_session.h"
+
+namespace vxl::app {
+namespace {
+
+using test::gl_context;
+using test::ScratchDir;
+
+class ViewerSessionTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    gl_context();
+    SynthSettings synth;
+    synth.streamlines = 6000;
+    ConvertSettings s;
+    s.voxel_size = 10;
+    s.levels = 3;
+    convert_tractogram(synthesize_tractogram(synth), dir.file("scene.vxl"), s);
+    // An image reaching beyond the lines in +x: the projection's depth range covers it too.
+    const std::array<std::int64_t, 3> dims{8, 8, 8};
+    test::write_nifti_int16(dir.file("t1.nii"), dims, std::vector<std::int16_t>(8 * 8 * 8, 100),
+                            {25, 0, 0, -60, 0, 25, 0, -100, 0, 0, 25, -80});
+    options.inputs = {dir.file("scene.vxl")};
+    file.emplace(VxlFile::open(dir.file("scene.vxl")));
+    options.image = dir.file("t1.nii");
+    // Small spans, so that a slab touches only some of them.
+    options.span_texels = SceneLayout::largest_voxel_texels(std::vector<const VxlFile*>{&*file});
+  }
+  static Camera view() {
+    Camera c;
+    c.target = glm::dvec3(0, -15, 10);
+    c.distance = 200;
+    c.azimuth_deg = 30;
+    c.elevation_deg = 20;
+    return c;
+  }
+  ScratchDir dir;
+  ViewerOptions options;
+  std::optional<VxlFile> file;
+};
+
+TEST_F(ViewerSessionTest, RenderersAreMadeOncePerLevelWithTheImage) {
+  ViewerSession session(options);
+  ASSERT_NE(session.image(), nullptr);
+  session.choose_detail(options);
+  Renderer& coarse = session.renderer_at(1, false);
+  EXPECT_EQ(&session.renderer_at(1, false), &coarse);
+  EXPECT_NE(&session.renderer_at(0, false), &coarse);
+  EXPECT_EQ(coarse.layout().level(), 1u);
+  EXPECT_TRUE(coarse.has_volume());
+  EXPECT_EQ(session.bounds().min, coarse.scene_min()) << "the views are measured with the renderers' bounds";
+  EXPECT_EQ(session.bounds().max, coarse.scene_max());
+  EXPECT_GT(session.bounds().max.x, coarse.bounds_max().x) << "the image reaches beyond the lines";
+  EXPECT_EQ(session.levels_in_files(), 3u);
+}
+
+TEST_F(ViewerSessionTest, AViewsLevelIsTheOneItsRenderersWouldMeasure) {
+  const std::vector<const VxlFile*> files{&*file};
+  const std::uint64_t whole = SceneLayout(files, *options.span_texels, 0).upload_bytes();
+  Clipping slab;
+  slab.slab_mm = 6;
+  bool finer_than_the_scene = false;
+  for (int k = 1; k < 12; ++k) {
+    const std::uint64_t budget = whole * k / 12;
+    options.gpu_memory = budget;
+    ViewerSession session(options);
+    session.choose_detail(options);
+    const SceneDetail& d = session.detail();
+    std::uint32_t measured = d.level;  // as the window measured it before: with every level's renderer
+    for (std::uint32_t level = 0; level < d.level; ++level)
+      if (session.renderer_at(level, false).view_bytes(view(), 1.5, slab) <= d.budget) {
+        measured = level;
+        break;
+      }
+    EXPECT_EQ(session.level_for_view(view(), 1.5, slab), measured) << "budget " << budget;
+    finer_than_the_scene |= measured < d.level;
+  }
+  EXPECT_TRUE(finer_than_the_scene) << "the test needs a budget where the slab is drawn finer than the scene";
+}
+
+}  // namespace
+}  // namespace vxl::app

@@ -1,0 +1,46 @@
+#include "viewer/app/viewer_session.h"
+
+#include "viewer/anatomy/nifti_volume.h"
+#include "viewer/app/scene_source.h"
+#include "viewer/render/scene_layout.h"
+
+namespace vxl::app {
+
+ViewerSession::ViewerSession(const ViewerOptions& o)
+    : opened_(open_scenes(o.inputs, scene_source_options(o))),
+      files_(pointers(opened_)),
+      indexes_(std::make_shared<VoxelVoxlinesCache>(files_)) {
+  if (o.image) image_ = read_nifti_volume(*o.image);
+  bounds_ = scene_bounds(files_, image());
+}
+
+void ViewerSession::choose_detail(const ViewerOptions& o) {
+  detail_ = choose_scene_detail(files_, o.level, o.gpu_memory, o.span_texels);
+  gpu_memory_ = std::make_shared<GpuMemoryPool>(detail_->budget);
+  layouts_.emplace(files_, detail_->span_texels);
+}
+
+std::uint32_t ViewerSession::levels_in_files() const { return SceneLayout::coarsest_level(files_) + 1; }
+
+std::uint32_t ViewerSession::level_for_view(const Camera& camera, double aspect, const Clipping& clipping) {
+  return app::level_for_view(*layouts_, *detail_, camera, aspect, bounds_, clipping);
+}
+
+Renderer& ViewerSession::renderer_at(std::uint32_t level, bool eager) {
+  std::unique_ptr<Renderer>& r = renderers_[level];
+  if (!r) {
+    r = std::make_unique<Renderer>(files_, detail_->span_texels, level, gpu_memory_, eager);
+    r->share_indexes(indexes_);
+    if (image_) r->set_volume(*image_);
+    if (groups_) r->set_groups(*groups_);
+  }
+  return *r;
+}
+
+void ViewerSession::set_groups(const std::optional<SceneGroups>& groups) {
+  groups_ = groups;
+  const SceneGroups drawn = groups ? *groups : SceneGroups(files_);
+  for (auto& [level, r] : renderers_) r->set_groups(drawn);
+}
+
+}  // namespace vxl::app

@@ -1,0 +1,74 @@
+// One scene as voxview shows it, shared by the window and headless rendering: the files, the anatomical
+// image, the level of detail and GPU memory budget, the scene's layout per level (views measured without
+// GL, view_level.h) and the renderers per level, which share one GPU memory pool and the selection's groups.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "format/vxl_file.h"
+#include "viewer/app/scene_detail.h"
+#include "viewer/app/view_level.h"
+#include "viewer/app/viewer_options.h"
+#include "viewer/render/gpu_memory_pool.h"
+#include "viewer/render/renderer.h"
+#include "viewer/render/scene_groups.h"
+#include "viewer/render/volume.h"
+
+namespace vxl::app {
+
+class ViewerSession {
+ public:
+  // Opens the inputs (converting a source tractogram) and reads --image: a bad file or image fails here,
+  // before any GL work.
+  explicit ViewerSession(const ViewerOptions& options);
+  ViewerSession(const ViewerSession&) = delete;
+  ViewerSession& operator=(const ViewerSession&) = delete;
+
+  // Chooses the level of detail, the span size and the GPU memory budget (scene_detail.h) for the options'
+  // --level, --gpu-memory and --span-texels. Needs a current GL context (the driver's limits); before any
+  // layout, view or renderer.
+  void choose_detail(const ViewerOptions& options);
+  const SceneDetail& detail() const { return *detail_; }
+  // The levels the files hold (their coarsest level + 1), for messages.
+  std::uint32_t levels_in_files() const;
+
+  const std::vector<VxlFile>& opened() const { return opened_; }
+  const std::vector<const VxlFile*>& files() const { return files_; }
+  const Volume* image() const { return image_ ? &*image_ : nullptr; }
+  // Frees the image once every renderer that will draw it is made (headless draws with one).
+  void release_image() { image_.reset(); }
+
+  // The scene's layout at `level` (no GL), e.g. for the default framing.
+  const SceneLayout& layout_at(std::uint32_t level) { return layouts_->at(level); }
+  // What the renderers' projection covers: the lines' bounds joined with the image's box.
+  const SceneBounds& bounds() const { return bounds_; }
+  // The level `camera` with `clipping` is drawn at (view_level.h), measured with the renderer's bounds.
+  std::uint32_t level_for_view(const Camera& camera, double aspect, const Clipping& clipping);
+
+  // The renderer of `level`, made on first use with the image and the current groups; `eager`: it uploads
+  // its whole level at once when made (else span by span as frames need them).
+  Renderer& renderer_at(std::uint32_t level, bool eager);
+  // Every renderer's groups, now and when made later: a selection's focus and context, or (none) the files'
+  // own groups again.
+  void set_groups(const std::optional<SceneGroups>& groups);
+  // The files' per-voxel indexes, shared by the renderers and the selections (built once, on first use).
+  const std::shared_ptr<VoxelVoxlinesCache>& indexes() const { return indexes_; }
+
+ private:
+  std::vector<VxlFile> opened_;
+  std::vector<const VxlFile*> files_;
+  std::optional<Volume> image_;
+  SceneBounds bounds_;  // the lines joined with the image's box: what the renderer's projection covers
+  std::shared_ptr<VoxelVoxlinesCache> indexes_;
+  std::optional<SceneDetail> detail_;
+  std::shared_ptr<GpuMemoryPool> gpu_memory_;  // every level's renderer shares it: together they never take more
+  std::optional<LevelLayouts> layouts_;
+  std::map<std::uint32_t, std::unique_ptr<Renderer>> renderers_;
+  std::optional<SceneGroups> groups_;  // the selection's, when there is one
+};
+
+}  // namespace vxl::app

@@ -1,0 +1,148 @@
+// The window's viewer: one open window on one scene. Internal to the window's sources, which share it:
+// window_app.cpp (set-up, the frame loop, drawing, saving), window_input.cpp (mouse, keys and their
+// actions) and window_selection.cpp (the regions' selection).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#define GLFW_INCLUDE_NONE  // epoxy provides the GL declarations
+#include <GLFW/glfw3.h>
+
+#include "viewer/app/camera_controller.h"
+#include "viewer/app/frame_log.h"
+#include "viewer/app/key_bindings.h"
+#include "viewer/app/picture_annotations.h"
+#include "viewer/app/picture_scheduler.h"
+#include "viewer/app/region_editor.h"
+#include "viewer/app/scene_selection.h"
+#include "viewer/app/selection_worker.h"
+#include "viewer/app/ui_panel.h"
+#include "viewer/app/viewer_options.h"
+#include "viewer/app/viewer_session.h"
+#include "viewer/platform/offscreen_target.h"
+#include "viewer/render/grid_overlay.h"
+
+namespace vxl::app {
+
+// What a picture on screen depends on: when none of it changes, the window refines the picture instead of
+// drawing it again.
+struct PictureKey {
+  Camera camera;
+  RenderSettings settings;
+  int width = 0, height = 0;
+  bool grid = false, grid_all = false;
+  std::uint64_t selection = 0;  // the selection the picture was drawn with (its generation; the regions' shells
+                                // are in the settings)
+};
+// Whether two cameras show the same view (what the frame budget calls "not moving"), and two pictures.
+bool same_view(const Camera& a, const Camera& b);
+bool same_picture(const PictureKey& a, const PictureKey& b);
+
+// One open window on one scene: GL objects, camera, panel, input. Callbacks reach it through the GLFW
+// user pointer.
+class ViewerWindow {
+ public:
+  // `session`: the scene, its level of detail already chosen (ViewerSession::choose_detail); its renderers
+  // go with the window, before the GL context. `start`: when voxview started, for --stats.
+  // `regions`: the selection's regions (region_editor.h), edited in the window.
+  ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession> session, RegionEditor regions, GLFWwindow* window,
+               std::chrono::steady_clock::time_point start, StartupTimes startup);
+  int run();
+
+ private:
+  static ViewerWindow& of(GLFWwindow* w) { return *static_cast<ViewerWindow*>(glfwGetWindowUserPointer(w)); }
+  void on_mouse_button(int button, int action, int mods);
+  void on_cursor(double x, double y);
+  void begin_region_drag(double x, double y);
+  void on_scroll(double steps);
+  void on_key(int key, int action, int mods);
+  void on_char(unsigned codepoint);
+  // Carries out a key's action (key_bindings.h); `shift` makes a move 10 times larger.
+  void perform(KeyAction action, bool shift);
+  void toggle_slices();
+  void toggle_clip_plane(std::size_t i);
+  void move_focus_along(int axis, double mm);
+  // Asks for a new selection when the regions changed and takes the newest finished one into the picture
+  // (selection_worker.h); with `wait`, the one the regions ask for now.
+  void update_selection(bool wait);
+  // Hands the focus and context to every renderer (without a selection: the files' own groups again).
+  void apply_selection(std::optional<SceneSelection> selection);
+  // Writes the selected streamlines of every file to a stamped .tck (a key or the panel).
+  void save_selection();
+
+  Camera home_camera(double aspect, bool orthographic) const;
+  void reset_camera(double aspect);
+  double aspect() const;
+  void set_error(const std::string& message);
+  // Draws the scene whole at `level` of detail into scene_target_; returns the frame's time in ms.
+  double draw_scene(int width, int height, std::uint32_t level);
+  // Draws the next piece of the refinement at rest (rest_refinement.h) into refine_target_; once the stage's
+  // picture is complete it becomes scene_target_'s and `completes` is set. Returns the piece's time in ms.
+  double refine(int width, int height, std::uint32_t level, bool& completes);
+  // The grid overlay and the annotations (picture_annotations.h) over scene_target_'s picture, when they are on.
+  void draw_overlays(const Renderer& renderer, int width, int height);
+  // The panel's figures of a complete picture drawn by `renderer`.
+  void show_frame_figures(const Renderer& renderer, std::uint32_t level);
+  // scene_target_ into the window's back buffer.
+  void present(int width, int height) const;
+  double seconds_since_start() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  // The renderer of the scene's level, or of a coarser one (made on first use, for the frame budget).
+  Renderer& renderer_at(std::uint32_t level);
+  void save_screenshot(const std::string& path, int width, int height);
+  // save_screenshot to a stamped name in the current directory; a failure is shown, not thrown.
+  void save_stamped_screenshot(int width, int height);
+  // Writes the current view (camera, settings, size) to --save-camera's path or a stamped name.
+  void save_view(int width, int height);
+  // Builds the panel for this frame and carries out what it asks (`aspect`: the framebuffer's).
+  void build_panel(double aspect);
+  // Carries out the scheduler's task for the picture `key` describes; true when something was drawn.
+  bool draw_picture(const PictureTask& task, const PictureKey& key, bool moving);
+
+  const ViewerOptions& options_;
+  GLFWwindow* window_;
+  std::unique_ptr<ViewerSession> session_;  // the files, the image, the level of detail, the renderers
+  const std::vector<const VxlFile*>& files_;
+  RegionEditor regions_;
+  std::optional<SceneSelection> selection_;          // the newest finished; the regions may have moved since
+  std::optional<std::uint64_t> selection_revision_;  // the regions' revision last asked for
+  std::optional<std::uint64_t> cleared_revision_;    // all regions removed at this revision: older selections are stale
+  std::uint64_t selection_generation_ = 0;           // counts the selections taken into the picture
+  SelectionWorker selection_worker_;
+  std::vector<double> selection_ms_;  // each selection's run time, for --stats
+  const SceneDetail& detail_;         // the level of detail drawn at rest, and the span size
+  std::uint32_t first_level_ = 0;
+  std::chrono::steady_clock::time_point start_;
+  std::vector<FrameRecord> frames_;            // for --stats
+  StartupTimes startup_;                       // for --stats
+  std::optional<PictureKey> drawn_;            // what the picture on screen shows (none before the first)
+  std::optional<PictureScheduler> scheduler_;  // what each frame draws (made once the GL version is known)
+  std::optional<GridOverlay> grid_;
+  std::optional<PictureAnnotations> annotations_;  // made when first wanted
+  // The scene is drawn here and blitted to the window: it blends in float like headless rendering, so
+  // faint layers add up beyond 8-bit rounding and the window shows what --render writes.
+  std::optional<OffscreenTarget> scene_target_;
+  std::optional<OffscreenTarget> refine_target_;  // the refinement's picture until it is complete
+  CameraController controller_;
+  std::vector<glm::dvec3> framing_points_;  // what the home view fills the window with (scene_framing.h)
+  std::unique_ptr<UiPanel> panel_;          // created after our callbacks, which ImGui then chains to
+  PanelState state_;
+  PanelStats stats_;
+  int drag_button_ = -1;
+  bool dragging_region_ = false;   // Ctrl + left drag: the active sphere follows the cursor
+  glm::dvec2 region_cursor_{0.0};  // the cursor at the drag's last move
+  bool screenshot_requested_ = false;
+  bool save_view_requested_ = false;
+  RenderMode drawn_mode_ =
+      RenderMode::Axis;          // the mode of the last frame, to clear a mode's error once another is chosen
+  unsigned events_ = 0;          // input events seen, to keep drawing while something happens
+  SliceSettings hidden_slices_;  // which slices I brings back
+};
+
+}  // namespace vxl::app

@@ -1,0 +1,85 @@
+// The window's selection: the regions edited in the window, selected on a worker (selection_worker.h),
+// taken into the picture as focus and context, and written out on request.
+#include <algorithm>
+#include <cstdio>
+
+#include "converter/selection/selection_output.h"
+#include "viewer/app/glfw_window.h"
+#include "viewer/app/viewer_window.h"
+
+namespace vxl::app {
+
+void ViewerWindow::update_selection(bool wait) {
+  // The panel's list, every frame: which region is active changes without a new selection.
+  stats_.regions.clear();
+  for (std::size_t i = 0; i < regions_.regions().size(); ++i) {
+    const EditorRegion& r = regions_.regions()[i];
+    stats_.regions.push_back(
+        {r.role_name(), r.argument(), r.streamlines, r.centre.has_value(), regions_.active() == i, r.radius});
+  }
+  if (selection_revision_ != regions_.revision()) {
+    selection_revision_ = regions_.revision();
+    if (regions_.empty()) {
+      cleared_revision_ = regions_.revision();
+      if (selection_) apply_selection(std::nullopt);
+    } else {
+      try {
+        selection_worker_.request(regions_.revision(), regions_.criteria());
+      } catch (const std::exception& e) {  // a region that does not parse: said, and no selection
+        set_error(e.what());
+        if (selection_) apply_selection(std::nullopt);
+      }
+    }
+  }
+  std::optional<SelectionWorker::Done> done = selection_worker_.poll(wait);
+  if (!done || (cleared_revision_ && done->revision <= *cleared_revision_)) return;
+  if (!done->error.empty()) {
+    set_error(done->error);
+    apply_selection(std::nullopt);
+    return;
+  }
+  selection_ms_.push_back(done->ms);
+  // Counts only for the regions they were computed with: the list may have changed since.
+  if (done->revision == regions_.revision()) regions_.set_counts(done->selection->streamlines_per_region);
+  stats_.selection = std::to_string(done->selection->selected) + " of " + std::to_string(done->selection->total) +
+                     " streamlines selected (" + std::to_string(int(done->ms + 0.5)) + " ms)";
+  RenderSettings& s = state_.settings;
+  // Regions added in the window to a scene started without: the context faint, as --context-opacity's default.
+  if (s.find_style(SceneGroups::kContext) == nullptr)
+    s.style_of(SceneGroups::kContext).opacity = std::min(1.0f, 0.02f / s.opacity);
+  apply_selection(std::move(done->selection));
+}
+
+void ViewerWindow::apply_selection(std::optional<SceneSelection> selection) {
+  selection_ = std::move(selection);
+  if (!selection_) stats_.selection.clear();
+  ++selection_generation_;
+  session_->set_groups(selection_ ? std::optional<SceneGroups>(selection_->groups) : std::nullopt);
+  const SceneGroups groups = selection_ ? selection_->groups : SceneGroups(files_);
+  stats_.groups.clear();
+  for (const SceneGroup& g : groups.groups()) stats_.groups.emplace_back(g.name, g.streamlines);
+  for (std::size_t i = 0; i < stats_.regions.size(); ++i)
+    stats_.regions[i].streamlines = regions_.regions()[i].streamlines;
+}
+
+void ViewerWindow::save_selection() {
+  if (!selection_) {
+    set_error("no selection to save: add a region first (G)");
+    return;
+  }
+  for (std::size_t i = 0; i < files_.size(); ++i) {
+    const std::string path =
+        stamped_name("voxview-selection-", files_.size() > 1 ? "-" + std::to_string(i) + ".tck" : ".tck").string();
+    try {
+      write_selection(*files_[i], StreamlineSubset(files_[i]->meta().streamline_count, selection_->kept[i]), path, {},
+                      {});
+      stats_.status = "selection saved to " + path;
+      std::printf("voxview: %zu streamlines saved to %s\n", selection_->kept[i].size(), path.c_str());
+      std::fflush(stdout);
+    } catch (const std::exception& e) {
+      set_error(e.what());
+    }
+  }
+}
+
+}  // namespace vxl::app
