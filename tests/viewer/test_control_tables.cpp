@@ -109,7 +109,7 @@ TEST(RenderModeTable, EachModesFactsAreInItsEntry) {
     EXPECT_EQ(m.refines_to_exact, m.mode == RenderMode::Basic || m.mode == RenderMode::Axis) << m.name;
   }
   EXPECT_EQ(render_mode_info(RenderMode::Axis).plan_order, PlanOrder::Nearest);
-  EXPECT_EQ(render_mode_info(RenderMode::Segsort).plan_order, PlanOrder::Nearest);
+  EXPECT_EQ(render_mode_info(RenderMode::Segsort).plan_order, PlanOrder::Block);  // it sorts the segments itself
   EXPECT_EQ(render_mode_info(RenderMode::Basic).plan_order, PlanOrder::Block);
   EXPECT_EQ(render_mode_info(RenderMode::Exact).plan_order, PlanOrder::Visibility);
   for (RenderMode m : {RenderMode::Opaque, RenderMode::Unsorted, RenderMode::Additive, RenderMode::Wboit})

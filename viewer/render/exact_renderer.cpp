@@ -124,7 +124,7 @@ void ExactRenderer::begin(const Camera& camera, const RenderSettings& s, int wid
   camera_ = camera;
   settings_ = s;
   fbo_ = fbo;
-  host_.plan_and_count(FrameView{camera, s, width, height, fbo}, PlanOrder::Visibility, plan_);
+  host_.plan_and_count(FrameView{camera, s, width, height, fbo}, render_mode_info(RenderMode::Exact).plan_order, plan_);
   segments_before_.assign(plan_.count.size() + 1, 0);
   for (std::size_t v = 0; v < plan_.count.size(); ++v)
     segments_before_[v + 1] = segments_before_[v] + plan_.count[v] / 2;

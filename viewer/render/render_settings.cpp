@@ -27,7 +27,7 @@ constexpr RenderModeInfo kModes[] = {
     {RenderMode::Segsort, "segsort",
      "voxels sorted as axis, each voxel's segments sorted for the exact view on the CPU every frame: slow, a "
      "reference for the orders",
-     false, PlanOrder::Nearest, false},
+     false, PlanOrder::Block, false},
     {RenderMode::Exact, "exact", "per-fragment sorted reference (needs OpenGL 4.3)", true, PlanOrder::Visibility,
      false},
 };

@@ -30,7 +30,7 @@ struct RenderModeInfo {
   const char* name;         // as --mode and saved views spell it
   const char* description;  // one line
   bool needs_gl43;          // runs only where the context has OpenGL 4.3 (elsewhere the window shows axis)
-  PlanOrder plan_order;     // how the frame plan orders the visible voxels (frame_plan.h)
+  PlanOrder plan_order;     // how the frame plan orders the visible voxels (frame_plan.h); its pass plans so
   // The exact mode is this mode's reference: at rest the window goes on to the exact picture ("exact when
   // still", rest_refinement.h).
   bool refines_to_exact;

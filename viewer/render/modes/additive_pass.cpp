@@ -39,7 +39,7 @@ class AdditivePass final : public ModePass {
     glDepthFunc(GL_LESS);
     RenderSettings solid = s;
     solid.opacity = 1.0f;
-    draw_planned_lines(host, frame, lines.over(), solid, PlanOrder::Any);
+    draw_planned_lines(host, frame, lines.over(), solid, render_mode_info(mode()).plan_order);
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, additive_target_.fbo);
     glClearColor(0, 0, 0, 0);

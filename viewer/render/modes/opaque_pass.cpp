@@ -12,11 +12,11 @@ class OpaquePass final : public ModePass {
   void draw(PassHost& host, const FrameView& frame) override {
     host.clear_to_base(frame);
     opaque_blending();
-    draw_planned_lines(host, frame, host.lines().over(), frame.settings, PlanOrder::Any);
+    draw_planned_lines(host, frame, host.lines().over(), frame.settings, render_mode_info(mode()).plan_order);
     glDisable(GL_DEPTH_TEST);
   }
   PieceKind piece_kind() const override { return PieceKind::Voxels; }
-  PlanOrder plan_order(const RenderSettings&, FramePlan&) const override { return PlanOrder::Any; }
+  PlanOrder plan_order(const RenderSettings&, FramePlan&) const override { return render_mode_info(mode()).plan_order; }
   void piece_state() const override { opaque_blending(); }
 };
 

@@ -9,7 +9,7 @@ namespace {
 
 class OverPass final : public ModePass {
  public:
-  OverPass(RenderMode mode, PlanOrder order) : mode_(mode), order_(order) {}
+  explicit OverPass(RenderMode mode) : mode_(mode), order_(render_mode_info(mode).plan_order) {}
   RenderMode mode() const override { return mode_; }
   void draw(PassHost& host, const FrameView& frame) override {
     host.clear_to_base(frame);
@@ -35,7 +35,7 @@ class OverPass final : public ModePass {
 
 }  // namespace
 
-std::unique_ptr<ModePass> make_basic_pass() { return std::make_unique<OverPass>(RenderMode::Basic, PlanOrder::Block); }
-std::unique_ptr<ModePass> make_axis_pass() { return std::make_unique<OverPass>(RenderMode::Axis, PlanOrder::Nearest); }
+std::unique_ptr<ModePass> make_basic_pass() { return std::make_unique<OverPass>(RenderMode::Basic); }
+std::unique_ptr<ModePass> make_axis_pass() { return std::make_unique<OverPass>(RenderMode::Axis); }
 
 }  // namespace vxl

@@ -26,7 +26,7 @@ class SegsortPass final : public ModePass {
     GpuScene& scene = host.scene();
     scene.prepare_view_order();
     FramePlan& plan = host.frame_plan();
-    host.plan_and_count(frame, PlanOrder::Block, plan);
+    host.plan_and_count(frame, render_mode_info(RenderMode::Segsort).plan_order, plan);
     auto t0 = std::chrono::steady_clock::now();
     if (!sorter_) sorter_ = std::make_unique<SegmentSorter>(scene.layout(), host.scene_files());
     const Camera& camera = frame.camera;

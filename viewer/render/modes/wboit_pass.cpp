@@ -29,7 +29,7 @@ class WboitPass final : public ModePass {
     glClear(GL_COLOR_BUFFER_BIT);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
-    draw_planned_lines(host, frame, lines.wboit_accum(), frame.settings, PlanOrder::Any);
+    draw_planned_lines(host, frame, lines.wboit_accum(), frame.settings, render_mode_info(mode()).plan_order);
     glDrawBuffers(1, &reveal);
     glClearColor(1, 1, 1, 1);
     glClear(GL_COLOR_BUFFER_BIT);
