@@ -70,18 +70,16 @@ struct Case {
 
 // Fields by their spec offsets: header (§3), section entry (§4: id 0, flags 4, offset 8, size 16), META
 // (§5.1), voxel entry (§5.3: flags 12, vertex_first 40, vertex_count 48, segment_count 52, order_offset 56).
-std::vector<Case> cases() {
-  using u32 = std::uint32_t;
-  using u64 = std::uint64_t;
-  auto meta_u64 = [](int at, u64 v) { return [=](Bytes& f) { f.set<u64>(f.meta() + at, v); }; };
-  auto meta_add = [](int at, u64 d) {
-    return [=](Bytes& f) { f.set<u64>(f.meta() + at, f.get<u64>(f.meta() + at) + d); };
-  };
+using u32 = std::uint32_t;
+using u64 = std::uint64_t;
+
+// The header's magic and version, and packed positions (spec §3, §5.4).
+std::vector<Case> position_cases() {
   return {
       {"short", [](Bytes& f) { f.b.resize(40); }, "file too short for a .vxl header"},
       {"magic", [](Bytes& f) { f.b[0] ^= 0x20; }, "bad magic"},
       {"major", [](Bytes& f) { f.set<std::uint16_t>(8, 3); }, "major version 3", ErrorKind::Unsupported},
-      // Packed positions (the default the base file was converted with; spec §5.4).
+      // Packed positions (the default the base file was converted with).
       {"position_encoding", [](Bytes& f) { f.set<u32>(f.meta() + 152, 2); }, "unknown position encoding 2"},
       {"packed_in_version_1", [](Bytes& f) { f.set<std::uint16_t>(8, 1); }, "packed positions in a version 1 file"},
       {"tight_bounds_nan", [](Bytes& f) { f.set<float>(f.voxel(1) + 20, std::nanf("")); },
@@ -97,6 +95,12 @@ std::vector<Case> cases() {
          f.set<float>(f.voxel(0) + 36, 3e38f);
        },
        "voxel 0 tight bounds are not finite and ordered"},
+  };
+}
+
+// The header and the section table (spec §3, §4).
+std::vector<Case> header_and_table_cases() {
+  return {
       {"header_size", [](Bytes& f) { f.set<u32>(12, 72); }, "header_size must be 64"},
       {"file_size", [](Bytes& f) { f.set<u64>(16, f.b.size() + 64); }, "truncated or extended file"},
       {"table_offset", [](Bytes& f) { f.set<u64>(24, 128); }, "section table must start at byte 64"},
@@ -126,6 +130,16 @@ std::vector<Case> cases() {
          f.set<u32>(at + 4, 0);  // an optional unknown section: skipped, so DIRS is missing
        },
        "required section DIRS is missing"},
+  };
+}
+
+// META and the sizes it implies (spec §5.1).
+std::vector<Case> meta_cases() {
+  auto meta_u64 = [](int at, u64 v) { return [=](Bytes& f) { f.set<u64>(f.meta() + at, v); }; };
+  auto meta_add = [](int at, u64 d) {
+    return [=](Bytes& f) { f.set<u64>(f.meta() + at, f.get<u64>(f.meta() + at) + d); };
+  };
+  return {
       {"meta_size", [](Bytes& f) { f.set<u64>(f.entry_at("META") + 16, 192); }, "META must be 256 bytes"},
       {"voxel_size_zero", [](Bytes& f) { f.set<double>(f.meta() + 56, 0.0); },
        "voxel size must be finite and positive"},
@@ -146,6 +160,12 @@ std::vector<Case> cases() {
       {"strm_overflow", meta_u64(0, std::numeric_limits<u64>::max()), "section STRM size"},
       {"random_without_vdir", [](Bytes& f) { f.set<u32>(f.meta() + 100, static_cast<u32>(OrderSet::Random)); },
        "order set random needs a VDIR section"},
+  };
+}
+
+// The voxel table (spec §5.3).
+std::vector<Case> voxel_table_cases() {
+  return {
       {"coord_outside", [](Bytes& f) { f.set<std::int32_t>(f.voxel(0), f.get<std::int32_t>(f.meta() + 88)); },
        "voxel coordinate outside the grid"},
       {"coord_order",
@@ -182,7 +202,12 @@ std::vector<Case> cases() {
        "voxel blocks do not cover all vertices"},
       {"segment_sum", [](Bytes& f) { f.set<u32>(f.voxel(0) + 52, f.get<u32>(f.voxel(0) + 52) - 1); },
        "voxel segment counts do not add up to segment_count"},
-      // Levels of detail (spec §5.12; the base file has the default levels).
+  };
+}
+
+// Levels of detail (spec §5.12; the base file has the default levels).
+std::vector<Case> level_cases() {
+  return {
       {"level_count_1", [](Bytes& f) { f.set<u32>(f.meta() + 156, 1); }, "level count 1 must be 0 or 2..8"},
       {"level_count_9", [](Bytes& f) { f.set<u32>(f.meta() + 156, 9); }, "level count 9 must be 0 or 2..8"},
       {"lods_without_level_count", [](Bytes& f) { f.set<u32>(f.meta() + 156, 0); },
@@ -207,6 +232,13 @@ std::vector<Case> cases() {
        },
        "voxel 0 level 2 is not a prefix of level 1"},
   };
+}
+
+std::vector<Case> cases() {
+  std::vector<Case> all;
+  for (auto part : {position_cases, header_and_table_cases, meta_cases, voxel_table_cases, level_cases})
+    for (Case& c : part()) all.push_back(std::move(c));
+  return all;
 }
 
 class VxlValidation : public ::testing::TestWithParam<Case> {};
