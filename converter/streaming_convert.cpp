@@ -5,7 +5,6 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
-#include <future>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -17,7 +16,9 @@
 #include <malloc.h>
 #endif
 
-#include "converter/memory_size.h"
+#include "converter/pipeline/batch_reader.h"
+#include "converter/pipeline/conversion_plan.h"
+#include "converter/pipeline/memory_budget.h"
 #include "converter/readers/source_formats.h"
 #include "converter/readers/tck_stream.h"
 #include "converter/segment_orders.h"
@@ -38,42 +39,6 @@ using detail::TempVoxline;
 using detail::VoxelIndex;
 using Clock = std::chrono::steady_clock;
 
-constexpr std::uint64_t kMiB = 1ull << 20;
-// The program itself before any work: code, libraries, thread stacks, allocator slack (voxlines
-// measures about 7 MiB of resident memory at start; the rest is margin).
-constexpr std::uint64_t kBaselineBytes = 16 * kMiB;
-// The voxel table while it is built and used, at its peak (build_table): hash index (coordinates and
-// slots, with their growth: up to 40 bytes), counts per voxel (with growth: 32), tight bounds (with
-// growth: 48), sort order, global id, the table itself (64) and cursor (8) — 200 bytes, and a margin.
-constexpr std::uint64_t kPlanBytesPerVoxel = 240;
-// Each level of detail past the first adds counts per depth (32 with growth), a cursor (8), a LODS entry
-// (8) and the counts summed per voxel while the table is built (16).
-constexpr std::uint64_t plan_bytes_per_voxel(std::uint32_t levels) { return kPlanBytesPerVoxel + 64 * (levels - 1); }
-// Memory per point of a batch being read, at worst: two batches (one read while the other is processed),
-// each of whose positions may have twice the capacity in use.
-constexpr std::uint64_t kHeldBytesPerPoint = 2 * 2 * 3 * sizeof(float);
-// The output is written past the page cache (DirectRegionWriter: far cheaper on a virtual machine) under
-// limits of at least this much, staged this much per section.
-constexpr std::uint64_t kDirectWritesFromLimit = 256 * kMiB;
-constexpr std::uint64_t kDirectStagingBytes = 2 * kMiB;
-// With direct writes VERT is not held in memory when its blocks are few enough: each (voxel, level)
-// block is written through a staging of its own of this size (less where an eighth of the memory left
-// does not allow, but never under the minimum), then read back a chunk of voxels at a time for their
-// orders. Why: VERT is the conversion's largest buffer (2.3 GB for 10M streamlines), and on a virtual
-// machine whose host takes back the guest's free memory every fresh page costs about as much as
-// writing and reading it back past the page cache (measured: 2.7 s per GiB faulted in, against 2.9 GB/s
-// direct writes and 1.4-3 GB/s direct reads).
-constexpr std::uint64_t kBlockStagingBytes = 128 * 1024;
-constexpr std::uint64_t kMinBlockStagingBytes = 16 * 1024;
-// Spare stagings for the blocks' write queue (DirectWriteQueue): how far the writes may fall behind.
-constexpr std::uint64_t kSpareBlockStagings = 32;
-// Voxline and streamline table entries written at once.
-constexpr std::size_t kTableBufferEntries = 1 << 16;
-// The orders are built a run of voxels at a time, in a buffer of at most this size and an
-// eighth of the memory left (or of the largest voxel's orders, if more): large enough that each run keeps every
-// ordering thread busy.
-constexpr std::uint64_t kOrderChunkBytes = 256 * kMiB;
-
 // Where a batch is cut into two parts of about as many points each, for two threads: streamlines
 // [cut[0], cut[1]) and [cut[1], cut[2]).
 std::array<std::uint64_t, 3> two_parts(const Tractogram& b) {
@@ -84,48 +49,6 @@ std::array<std::uint64_t, 3> two_parts(const Tractogram& b) {
 }
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-// The memory the conversion holds, held against the limit.
-class Budget {
- public:
-  Budget(std::uint64_t limit, std::string path) : limit_(limit), path_(std::move(path)) {}
-  std::uint64_t used() const { return used_; }
-  std::uint64_t left() const { return used_ < limit_ ? limit_ - used_ : 0; }
-  // Takes `bytes` more, or throws Unsupported naming `what` (a singular noun phrase), what it needs and a
-  // limit that would do.
-  void take(std::uint64_t bytes, const std::string& what, const std::string& hint = "") {
-    if (bytes > left()) fail(bytes, used_, what, hint);
-    used_ += bytes;
-  }
-  // Follows a buffer that grows to `bytes`: takes its growth since `held`, which it updates. what() names it.
-  template <typename What>
-  void track(std::uint64_t bytes, std::uint64_t& held, What&& what, const std::string& hint = "") {
-    if (bytes <= held) return;
-    if (bytes - held > left()) fail(bytes, used_ - held, what(), hint);
-    used_ += bytes - held;
-    held = bytes;
-  }
-  // Gives back what a buffer followed by track() no longer holds once it is down to `bytes`.
-  void shrink(std::uint64_t bytes, std::uint64_t& held) {
-    if (bytes >= held) return;
-    used_ -= held - bytes;
-    held = bytes;
-  }
-  [[noreturn]] void fail(std::uint64_t needs, std::uint64_t others, const std::string& what,
-                         const std::string& hint = "") const {
-    // A quarter more than the sum, for what comes later.
-    throw Error(ErrorKind::Unsupported, path_, std::nullopt,
-                "--memory-limit " + format_memory_size(limit_) + " is too small: " + what + " needs " +
-                    format_memory_size(needs) +
-                    (others > 0 ? " on top of " + format_memory_size(others) + " already taken" : std::string()) +
-                    "; use --memory-limit " + memory_limit_argument((needs + others) / 4 * 5) + " or more" + hint);
-  }
-
- private:
-  std::uint64_t limit_;
-  std::uint64_t used_ = 0;
-  std::string path_;
-};
 
 // Where voxelize_streamline puts the voxlines of one streamline (or of several, one after the other).
 template <typename Index>
@@ -141,14 +64,6 @@ struct SinkOf {
 
 using Sink = SinkOf<VoxelIndex>;
 
-// A range of the voxel table, built in one pass.
-struct Range {
-  std::size_t first = 0, end = 0;  // voxels
-  std::uint64_t vertex_first = 0, vertex_end = 0;
-  std::uint32_t max_vertices = 0;
-  unsigned order_threads = 1;  // set by cut_ranges
-};
-
 class StreamingConversion {
  public:
   StreamingConversion(const std::string& source, const std::string& out, const ConvertSettings& settings,
@@ -163,40 +78,27 @@ class StreamingConversion {
   void scan();
   void plan();
   void build_table();
-  std::vector<Range> cut_ranges();
-  void build_range(const Range& r, std::size_t index, std::size_t count);
+  void build_range(const VoxelRange& r, std::size_t index, std::size_t count);
   struct PlanPart;
   void count_part(const Tractogram& b, std::uint64_t first, std::uint64_t begin, std::uint64_t end,
                   std::uint64_t points, std::uint64_t synthetic, std::uint64_t most_voxels, std::uint64_t other_voxels,
                   PlanPart& part) const;
   struct StagedPart;
   struct RangePlacement;
-  void place_range(const Range& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
+  void place_range(const VoxelRange& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
   void open_block_writers(RangePlacement& placing) const;
   void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
                   std::uint64_t end, StagedPart& part) const;
   void place_part(RangePlacement& placing, const StagedPart& part);
-  void write_orders(const Range& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
-  void write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> vertices,
+  void write_orders(const VoxelRange& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
+  void write_voxel_orders(const VoxelRange& r, std::size_t g, std::span<const std::uint8_t> vertices,
                           std::uint64_t vertices_first, VoxelOrderWriter& writer, VoxlineEnds& block_ends,
                           std::uint8_t* dst);
-  // The memory VERT's stagings take when written block by block: the write queue's spares and each
-  // (voxel, level) block's own (DirectRegionWriter::staging_size), as open_block_writers carves them.
-  std::uint64_t block_staging_total(std::uint64_t staging) const;
-  // The most VERT bytes of any run of consecutive voxels whose orders fit in a chunk (read back at once).
-  std::uint64_t largest_chunk_vertex_bytes() const;
   bool packed() const { return settings_.positions == PositionEncoding::Packed; }
   // Where voxel i's orders start in ORDR (i = voxel count: the payload's end).
-  std::uint64_t orders_start(std::size_t i) const {
-    return i < voxels_.size() ? voxels_[i].order_offset : order_bytes_;
-  }
-  // Memory per ordering thread besides its sort buffers: a float32 block's end bits.
-  std::uint64_t end_bits_bytes(std::uint32_t max_vertices) const { return packed() ? 0 : (max_vertices / 64 + 1) * 8; }
+  std::uint64_t orders_start(std::size_t i) const { return vxl::orders_start(voxels_, order_bytes_, i); }
   void write_rest();
   [[noreturn]] void fail_changed() const;
-  // Reads the source once, calling body(batch, index of its first streamline) per batch.
-  template <typename Body>
-  void each_batch(const std::string& stage, Body&& body);
   void report(const std::string& stage, double fraction) const {
     if (settings_.progress) settings_.progress(stage.c_str(), fraction);
   }
@@ -205,15 +107,12 @@ class StreamingConversion {
   ConvertSettings settings_;
   StreamingTuning tuning_;
   std::string voxel_size_choice_;  // --voxel-size auto's reason, once scan() has chosen
-  Budget budget_;
+  MemoryBudget budget_;
   OrderSetSpec order_set_;
   unsigned threads_ = 1;
   ConvertSummary summary_;
 
-  std::unique_ptr<TckStream> stream_;
-  Tractogram batches_[2];  // one processed while the next is read
-  std::uint64_t batch_items_ = 0, batch_held_ = 0, max_points_held_ = 0;
-  std::uint64_t longest_ = 0, longest_index_ = 0;  // the longest streamline seen (in points)
+  std::unique_ptr<BatchReader> reader_;
 
   // pass 1
   double lo_[3] = {INFINITY, INFINITY, INFINITY}, hi_[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -235,14 +134,11 @@ class StreamingConversion {
   // passes skip the streamlines that have no voxel in their range.
   std::vector<std::array<std::uint32_t, 2>> spans_;
   std::uint64_t order_bytes_ = 0;
-  std::uint64_t order_chunk_bytes_ = 0;
-  std::uint64_t direct_staging_ = 0;  // 0: the output is written through the page cache
-  std::uint64_t block_staging_ = 0;   // > 0: VERT is written block by block and read back, not held
+  ConversionPlan plan_;  // once the voxel table is built
   // Written block by block: one buffer for the blocks' staging while they are placed, then for the
   // orders' chunks and the vertices read back (fresh pages are dear: a buffer reused is not faulted in
   // again).
   std::unique_ptr<std::uint8_t, void (*)(void*)> pool_{nullptr, std::free};
-  std::uint64_t pool_bytes_ = 0, pool_chunk_bytes_ = 0, pool_read_back_bytes_ = 0;  // the orders' parts of pool_
   VoxlineEnds ends_;  // float32 positions: the voxline ends of the range being built
   std::unique_ptr<VxlStreamWriter> out_;
 };
@@ -263,13 +159,13 @@ struct StreamingConversion::StagedPart {
 
 // What one range's placing pass keeps between batches.
 struct StreamingConversion::RangePlacement {
-  RangePlacement(const Range& r, bool first_range, std::span<std::uint8_t> part_of_vert)
+  RangePlacement(const VoxelRange& r, bool first_range, std::span<std::uint8_t> part_of_vert)
       : range(r), tables(first_range), window(part_of_vert) {}
-  const Range& range;
+  const VoxelRange& range;
   bool tables;                        // the first range: also the voxline and streamline tables
   std::span<std::uint8_t> window;     // the range's part of VERT
   std::vector<VertexPacker> packers;  // by voxel - range.first (packed positions)
-  // Written block by block (block_staging_ > 0): a writer per (local voxel id, level), as cursor_, whose
+  // Written block by block (plan_.block_staging_bytes > 0): a writer per (local voxel id, level), as cursor_, whose
   // full stagings are written by `queue`'s thread.
   std::unique_ptr<DirectWriteQueue> queue;
   std::vector<std::unique_ptr<DirectRegionWriter>> blocks;
@@ -299,65 +195,16 @@ void StreamingConversion::check_source_type() const {
                                 std::string(match.format ? match.format->name : "other") + " sources without it");
 }
 
-template <typename Body>
-void StreamingConversion::each_batch(const std::string& stage, Body&& body) {
-  stream_->rewind();
-  ++summary_.passes;
-  report(stage, 0.0);
-  const double size = double(std::max<std::uint64_t>(1, stream_->file_size()));
-  const bool read_ahead = threads_ > 1;
-  std::uint64_t first = 0;
-  auto read = [&](int b) { return stream_->next(batches_[b], batch_items_, max_points_held_); };
-  auto check_overflow = [&](const Tractogram& b) {
-    if (stream_->overflowed())
-      budget_.fail(b.point_count() * kHeldBytesPerPoint, budget_.used() - batch_held_,
-                   "streamline " + std::to_string(first + b.streamline_count()) + ", of more than " +
-                       std::to_string(b.point_count() - b.offsets.back()) + " points, held whole while reading,");
-  };
-  int current = 0;
-  bool more = read(current);
-  check_overflow(batches_[current]);
-  while (more) {
-    const int other = 1 - current;
-    parallel_invoke(
-        read_ahead, [&] { body(static_cast<const Tractogram&>(batches_[current]), first); },
-        [&] { more = read(other); });
-    first += batches_[current].streamline_count();
-    current = other;
-    check_overflow(batches_[current]);
-    // Both batches keep their largest size; pass 1 finds it (later passes cut the same batches).
-    const std::uint64_t bytes =
-        (batches_[0].positions.capacity() + batches_[1].positions.capacity()) * sizeof(float) +
-        (batches_[0].offsets.capacity() + batches_[1].offsets.capacity()) * sizeof(std::uint64_t);
-    budget_.track(bytes, batch_held_, [&] {
-      return "reading two batches of streamlines, one holding streamline " + std::to_string(longest_index_) + " (" +
-             std::to_string(longest_) + " points) whole,";
-    });
-    report(stage, double(stream_->position()) / size);
-  }
-  report(stage, 1.0);
-}
-
 void StreamingConversion::open_stream() {
-  const std::uint64_t limit = settings_.memory_limit;
-  budget_.take(kBaselineBytes, "the program itself");
-  const std::uint64_t read_buffer = std::clamp<std::uint64_t>(limit / 64, 64 << 10, 4 * kMiB);
-  budget_.take(read_buffer, "the read buffer");
-  batch_items_ = std::clamp<std::uint64_t>(limit / 64 / 16, 1024, 1 << 20);
-  stream_ = std::make_unique<TckStream>(path_, std::max<std::uint64_t>(1, budget_.left() / 4), read_buffer);
-  max_points_held_ = budget_.left() / kHeldBytesPerPoint;
+  reader_ = std::make_unique<BatchReader>(path_, budget_, threads_, settings_.progress);
 }
 
 // Pass 1: what plan_voxels' bounds scan finds, and the source's checksum and warnings.
 void StreamingConversion::scan() {
   detail::BoundsScan bounds;
   std::uint64_t streamlines = 0, points = 0;
-  each_batch("reading", [&](const Tractogram& b, std::uint64_t first) {
-    for (std::uint64_t k = 0; k < b.streamline_count(); ++k)
-      if (b.offsets[k + 1] - b.offsets[k] > longest_) {
-        longest_ = b.offsets[k + 1] - b.offsets[k];
-        longest_index_ = first + k;
-      }
+  reader_->each_batch("reading", [&](const Tractogram& b, std::uint64_t first) {
+    reader_->note_longest(b, first);
     // In two parts on two threads, merged in order (a scan stops at a bad point; reading goes on for the
     // reader's errors).
     const std::array<std::uint64_t, 3> cut = two_parts(b);
@@ -401,11 +248,11 @@ void StreamingConversion::plan() {
       other{Sink(), detail::VoxelUse(settings_.levels), {}, 0, 0};
   PlanPart* parts[2] = {&main, &other};
   std::uint64_t voxlines = 0, synthetic = 0, points = 0;
-  each_batch("voxelising", [&](const Tractogram& b, std::uint64_t first) {
+  reader_->each_batch("voxelising", [&](const Tractogram& b, std::uint64_t first) {
     const std::array<std::uint64_t, 3> cut = two_parts(b);
     // The voxels the limit leaves room for in this batch, half to each part: a part that would need more
     // fails (no matter how many the other adds, so that the outcome does not depend on timing).
-    const std::uint64_t room = (plan_held_ + budget_.left()) / plan_bytes_per_voxel(settings_.levels);
+    const std::uint64_t room = (plan_held_ + budget_.left()) / voxel_table_bytes_per_voxel(settings_.levels);
     const std::uint64_t start = main.sink.index.coords().size();
     const std::uint64_t headroom = room > start ? room - start : 0;
     const std::uint64_t most[2] = {start + headroom / 2, headroom - headroom / 2};
@@ -433,9 +280,9 @@ void StreamingConversion::plan() {
       main.bounds.merge(i, other.bounds, j);
     }
     const std::uint64_t sinks = main.sink.bytes() + other.sink.bytes();
-    budget_.track(peak * plan_bytes_per_voxel(levels), plan_held_, [] { return std::string(); });
+    budget_.track(peak * voxel_table_bytes_per_voxel(levels), plan_held_, [] { return std::string(); });
     other = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0};
-    budget_.shrink(main.sink.index.coords().size() * plan_bytes_per_voxel(levels), plan_held_);
+    budget_.shrink(main.sink.index.coords().size() * voxel_table_bytes_per_voxel(levels), plan_held_);
     budget_.track(sinks, sink_held_, [] { return std::string("the voxline lists of two streamlines"); });
     points += b.point_count();
   });
@@ -454,7 +301,7 @@ void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, s
                                      std::uint64_t points, std::uint64_t synthetic, std::uint64_t most_voxels,
                                      std::uint64_t other_voxels, PlanPart& part) const {
   const float* pts = b.positions.data();
-  const std::uint64_t bytes_per_voxel = plan_bytes_per_voxel(settings_.levels);
+  const std::uint64_t bytes_per_voxel = voxel_table_bytes_per_voxel(settings_.levels);
   for (std::uint64_t k = begin; k < end; ++k) {
     part.sink.voxlines.clear();
     part.sink.synthetic_xyz.clear();
@@ -502,68 +349,12 @@ void StreamingConversion::build_table() {
   order_bytes_ = layout_orders(voxels_, levels_, settings_.levels, meta_.stored_order_count);
 }
 
-// Consecutive voxels, as many per range as fit in what the limit leaves: each range's vertices (packed:
-// 4 bytes each, the end bit inside; float32: 12 bytes and an end bit; written block by block: only the
-// float32 end bits) and its ordering threads' buffers.
-// The orders are not held per range: they are built and written a chunk of voxels at a time (the chunk
-// buffer is taken before this). An ordering thread's buffers grow with the largest voxel, so a range
-// orders with fewer threads when they would take more than a quarter of the room (the orders do not
-// depend on the thread count).
-std::vector<Range> StreamingConversion::cut_ranges() {
-  const std::uint64_t room = budget_.left();
-  auto per_thread = [&](const Range& r) {
-    return order_scratch_bytes(r.max_vertices) + end_bits_bytes(r.max_vertices);
-  };
-  auto order_threads = [&](const Range& r) {
-    return static_cast<unsigned>(std::clamp<std::uint64_t>(room / 4 / per_thread(r), 1, threads_));
-  };
-  auto cost = [&](const Range& r) {
-    const std::uint64_t v = r.vertex_end - r.vertex_first;
-    const std::uint64_t end_bits = packed() ? 0 : (v / 64 + 1) * 8;
-    const std::uint64_t held = block_staging_ > 0 ? end_bits : (packed() ? 4 : 12) * v + end_bits;
-    return held + order_threads(r) * per_thread(r);
-  };
-  auto alone = [&](std::size_t i) {
-    const VoxelEntry& v = voxels_[i];
-    Range r{i, i + 1, v.vertex_first, v.vertex_first + v.vertex_count, v.vertex_count};
-    if (cost(r) > room) {
-      budget_.take(cost(r),
-                   "voxel (" + std::to_string(v.coord[0]) + ", " + std::to_string(v.coord[1]) + ", " +
-                       std::to_string(v.coord[2]) + ") of " + std::to_string(v.vertex_count) +
-                       " vertices, with its sort buffers,",
-                   ", or a smaller --voxel-size");
-    }
-    return r;
-  };
-  std::vector<Range> ranges;
-  Range r;  // empty: the last one when there are no voxels (its pass still writes the tables)
-  for (std::size_t i = 0; i < voxels_.size(); ++i) {
-    if (r.first == r.end) {
-      r = alone(i);
-      continue;
-    }
-    Range grown = r;
-    grown.end = i + 1;
-    grown.vertex_end = voxels_[i].vertex_first + voxels_[i].vertex_count;
-    grown.max_vertices = std::max(grown.max_vertices, voxels_[i].vertex_count);
-    if (cost(grown) <= room) {
-      r = grown;
-    } else {
-      ranges.push_back(r);
-      r = alone(i);
-    }
-  }
-  ranges.push_back(r);
-  for (Range& each : ranges) each.order_threads = order_threads(each);
-  return ranges;
-}
-
 // Pass 2 + k: the blocks and orders of one range.
-void StreamingConversion::build_range(const Range& r, std::size_t index, std::size_t count) {
+void StreamingConversion::build_range(const VoxelRange& r, std::size_t index, std::size_t count) {
   const std::string of = " " + std::to_string(index + 1) + "/" + std::to_string(count);
   const bool tables = index == 0;
   const std::uint64_t range_vertices = r.vertex_end - r.vertex_first;
-  if (block_staging_ > 0) {  // VERT written block by block, then read back for the orders
+  if (plan_.block_staging_bytes > 0) {  // VERT written block by block, then read back for the orders
     place_range(r, tables, of, {});
     write_orders(r, {}, "ordering" + of);
     return;
@@ -580,11 +371,11 @@ void StreamingConversion::build_range(const Range& r, std::size_t index, std::si
 // writes the voxline and streamline tables. Each batch is cut in two parts that are voxelised and packed
 // on their own threads (stage_part: packing needs only the voxel, whose tight bounds came from pass 2),
 // then placed in streamline order (place_part), which is what fixes where each vertex goes.
-void StreamingConversion::place_range(const Range& r, bool tables, const std::string& of,
+void StreamingConversion::place_range(const VoxelRange& r, bool tables, const std::string& of,
                                       std::span<std::uint8_t> window) {
   auto t0 = Clock::now();
   RangePlacement placing(r, tables, window);
-  if (block_staging_ > 0) open_block_writers(placing);
+  if (plan_.block_staging_bytes > 0) open_block_writers(placing);
   if (packed()) {
     placing.packers.reserve(r.end - r.first);
     for (std::size_t g = r.first; g < r.end; ++g) placing.packers.emplace_back(voxels_[g]);
@@ -602,7 +393,7 @@ void StreamingConversion::place_range(const Range& r, bool tables, const std::st
   auto place_staged = [&](int set) {
     for (const StagedPart& part : placing.parts[set]) place_part(placing, part);
   };
-  each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
+  reader_->each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
     if (first + b.streamline_count() > spans_.size()) fail_changed();  // more streamlines than pass 1 saw
     const std::array<std::uint64_t, 3> cut = two_parts(b);
     // Item 0 places the earlier batch, so that its errors come first.
@@ -645,14 +436,15 @@ void StreamingConversion::place_range(const Range& r, bool tables, const std::st
 // A writer per (voxel, level) block of range r with vertices, from the block's first vertex (cursor_,
 // before any is placed) to its end.
 void StreamingConversion::open_block_writers(RangePlacement& placing) const {
-  const Range& r = placing.range;
+  const VoxelRange& r = placing.range;
   const std::uint32_t levels = settings_.levels;
   const std::uint64_t bytes = vertex_bytes(settings_.positions);
   placing.blocks.resize(cursor_.size());
   std::uint8_t* staging = pool_.get();  // the queue's spares, then each block's staging, one after another
   std::vector<std::uint8_t*> spares;
-  for (std::uint64_t k = 0; k < kSpareBlockStagings; ++k, staging += block_staging_) spares.push_back(staging);
-  placing.queue = out_->write_queue(std::move(spares), block_staging_);
+  for (std::uint64_t k = 0; k < kSpareBlockStagings; ++k, staging += plan_.block_staging_bytes)
+    spares.push_back(staging);
+  placing.queue = out_->write_queue(std::move(spares), plan_.block_staging_bytes);
   for (std::size_t local = 0; local < global_id_.size(); ++local) {
     const std::uint32_t g = global_id_[local];
     if (g < r.first || g >= r.end) continue;
@@ -661,11 +453,12 @@ void StreamingConversion::open_block_writers(RangePlacement& placing) const {
       const std::uint64_t end =
           voxels_[g].vertex_first + depth_end_vertex(voxels_[g], level_row(levels_, g, levels), d);
       if (end > first) {
-        const std::uint64_t size = DirectRegionWriter::staging_size((end - first) * bytes, block_staging_);
-        if (std::uint64_t(staging - pool_.get()) + size > pool_bytes_)
+        const std::uint64_t size = DirectRegionWriter::staging_size((end - first) * bytes, plan_.block_staging_bytes);
+        if (std::uint64_t(staging - pool_.get()) + size > plan_.pool_bytes)
           throw std::logic_error("StreamingConversion: the blocks' staging outgrows its pool");
-        placing.blocks[local * levels + d] = out_->region_writer(
-            VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, block_staging_, staging, placing.queue.get());
+        placing.blocks[local * levels + d] =
+            out_->region_writer(VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, plan_.block_staging_bytes,
+                                staging, placing.queue.get());
         staging += size;
       }
     }
@@ -676,7 +469,7 @@ void StreamingConversion::open_block_writers(RangePlacement& placing) const {
 // stages the vertices of their voxlines in range, packed (or as float32), in streamline order.
 void StreamingConversion::stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first,
                                      std::uint64_t begin, std::uint64_t end, StagedPart& part) const {
-  const Range& r = placing.range;
+  const VoxelRange& r = placing.range;
   part.begin = begin;
   part.end = end;
   part.source_first = first + begin;
@@ -734,7 +527,7 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
 // streamline's depth) and, for the first range, writes its voxline and streamline table entries.
 void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& part) {
   const std::uint64_t first = part.source_first;
-  const Range& r = placing.range;
+  const VoxelRange& r = placing.range;
   const std::uint32_t levels = settings_.levels;
   auto* const words = reinterpret_cast<std::uint32_t*>(placing.window.data());
   auto* const vertices = reinterpret_cast<float*>(placing.window.data());
@@ -797,7 +590,7 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
 // over the range's ordering threads), built in place in ORDR. The vertices are range r's part of VERT in
 // memory (`range_vertices`), or, when VERT was written block by block, read back a chunk at a time: the
 // next chunk's on another thread while this one is built.
-void StreamingConversion::write_orders(const Range& r, std::span<const std::uint8_t> range_vertices,
+void StreamingConversion::write_orders(const VoxelRange& r, std::span<const std::uint8_t> range_vertices,
                                        const std::string& stage) {
   // Per ordering thread, sized for the range's largest voxel once (fresh pages are dear; see above).
   std::vector<std::optional<VoxelOrderWriter>> writers(r.order_threads);
@@ -806,7 +599,7 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
   while (cuts.back() < r.end) {
     const std::size_t first = cuts.back();
     std::size_t end = first + 1;
-    while (end < r.end && orders_start(end + 1) - orders_start(first) <= order_chunk_bytes_) ++end;
+    while (end < r.end && orders_start(end + 1) - orders_start(first) <= plan_.order_chunk_bytes) ++end;
     cuts.push_back(end);
   }
   auto vertex_start = [&](std::size_t i) { return i < r.end ? voxels_[i].vertex_first : r.vertex_end; };
@@ -815,38 +608,42 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
   std::unique_ptr<std::uint8_t[]> own_chunks[2];
   std::uint8_t* chunks[2] = {};
   std::span<std::uint8_t> read_buffers[2];
-  if (block_staging_ > 0) {
+  if (plan_.block_staging_bytes > 0) {
     for (int b = 0; b < 2; ++b) {
-      chunks[b] = pool_.get() + b * pool_chunk_bytes_;
-      read_buffers[b] = {pool_.get() + 2 * pool_chunk_bytes_ + b * pool_read_back_bytes_, pool_read_back_bytes_};
+      chunks[b] = pool_.get() + b * plan_.pool_chunk_bytes;
+      read_buffers[b] = {pool_.get() + 2 * plan_.pool_chunk_bytes + b * plan_.pool_read_back_bytes,
+                         plan_.pool_read_back_bytes};
     }
   }
-  auto fetch = [&](std::size_t c) {
-    return std::async(block_staging_ > 0 ? std::launch::async : std::launch::deferred, [&, c] {
-      const std::uint64_t from = vertex_start(cuts[c]), to = vertex_start(cuts[c + 1]);
-      if (block_staging_ == 0)
-        return range_vertices.subspan((from - r.vertex_first) * vertex_size, (to - from) * vertex_size);
-      return out_->read_back(VxlStreamWriter::kVert, (to - from) * vertex_size, read_buffers[c % 2]);
-    });
+  // Chunk c's vertices: in memory, or read back (on another thread, while the chunk before is built).
+  auto vertices_of = [&](std::size_t c) {
+    const std::uint64_t from = vertex_start(cuts[c]), to = vertex_start(cuts[c + 1]);
+    if (plan_.block_staging_bytes == 0)
+      return range_vertices.subspan((from - r.vertex_first) * vertex_size, (to - from) * vertex_size);
+    return out_->read_back(VxlStreamWriter::kVert, (to - from) * vertex_size, read_buffers[c % 2]);
   };
+  auto fetch = [&](std::size_t c) {
+    return BackgroundTask<std::span<const std::uint8_t>>([&, c] { return vertices_of(c); });
+  };
+  const bool read_back = plan_.block_staging_bytes > 0;
   // With direct writes a chunk is written on its own thread while the next one is built (the write waits
   // on the disk, not the CPU); through the page cache it is written before the next one is built.
   // The buffers are taken once at the largest chunk's size and not cleared: the writers write every
   // byte of their voxels' orders, padding included. (Regrowing and zeroing them per chunk took 3 of the
   // 11 s of a 10M conversion's orders: fresh pages cost much on a virtual machine.)
   std::vector<std::size_t> by_size;  // a chunk's voxels
-  std::future<std::span<const std::uint8_t>> next_vertices;
-  if (cuts.size() > 1) next_vertices = fetch(0);
-  std::future<void> writing;
+  BackgroundTask<std::span<const std::uint8_t>> next_vertices;
+  if (read_back && cuts.size() > 1) next_vertices = fetch(0);
+  BackgroundTask<> writing;
   for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
     auto t0 = Clock::now();
     const std::size_t first = cuts[c], end = cuts[c + 1];
-    const std::span<const std::uint8_t> vertices = next_vertices.get();
-    if (c + 2 < cuts.size()) next_vertices = fetch(c + 1);
+    const std::span<const std::uint8_t> vertices = read_back ? next_vertices.get() : vertices_of(c);
+    if (read_back && c + 2 < cuts.size()) next_vertices = fetch(c + 1);
     const std::uint64_t base = orders_start(first);
-    const int b = direct_staging_ > 0 ? c % 2 : 0;
+    const int b = plan_.direct_staging_bytes > 0 ? c % 2 : 0;
     if (chunks[b] == nullptr) {
-      own_chunks[b] = std::make_unique_for_overwrite<std::uint8_t[]>(order_chunk_bytes_);
+      own_chunks[b] = std::make_unique_for_overwrite<std::uint8_t[]>(plan_.order_chunk_bytes);
       chunks[b] = own_chunks[b].get();
     }
     const std::span<std::uint8_t> chunk(chunks[b], orders_start(end) - base);
@@ -862,8 +659,8 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
                          chunk.data() + (voxels_[g].order_offset - base));
     });
     if (writing.valid()) writing.get();  // rethrows a failed write
-    if (direct_staging_ > 0)
-      writing = std::async(std::launch::async, [this, chunk] { out_->append(VxlStreamWriter::kOrdr, chunk); });
+    if (plan_.direct_staging_bytes > 0)
+      writing = BackgroundTask<>([this, chunk] { out_->append(VxlStreamWriter::kOrdr, chunk); });
     else
       out_->append(VxlStreamWriter::kOrdr, chunk);
     summary_.orders_seconds += seconds_since(t0);
@@ -875,7 +672,7 @@ void StreamingConversion::write_orders(const Range& r, std::span<const std::uint
 // Voxel g's orders at `dst`, from its block in `vertices` (the part of VERT from vertex
 // `vertices_first`): the orders sort the positions the file holds. A float32 block's voxline ends are
 // copied into `block_ends` (a packed block holds its own).
-void StreamingConversion::write_voxel_orders(const Range& r, std::size_t g, std::span<const std::uint8_t> vertices,
+void StreamingConversion::write_voxel_orders(const VoxelRange& r, std::size_t g, std::span<const std::uint8_t> vertices,
                                              std::uint64_t vertices_first, VoxelOrderWriter& writer,
                                              VoxlineEnds& block_ends, std::uint8_t* dst) {
   VoxelEntry v = voxels_[g];
@@ -892,32 +689,6 @@ void StreamingConversion::write_voxel_orders(const Range& r, std::size_t g, std:
     return;
   }
   writer.write_packed(v, row, reinterpret_cast<const std::uint32_t*>(vertices.data()) + at, dst);
-}
-
-std::uint64_t StreamingConversion::block_staging_total(std::uint64_t staging) const {
-  const std::uint32_t levels = settings_.levels;
-  const std::uint64_t bytes = vertex_bytes(settings_.positions);
-  std::uint64_t total = kSpareBlockStagings * staging;  // the write queue's spares
-  for (std::size_t g = 0; g < voxels_.size(); ++g) {
-    const std::span<const LevelEntry> row = level_row(levels_, g, levels);
-    for (std::uint32_t d = 0; d < levels; ++d) {  // as open_block_writers cuts them
-      const std::uint64_t first = depth_first_vertex(row, d), end = depth_end_vertex(voxels_[g], row, d);
-      if (end > first) total += DirectRegionWriter::staging_size((end - first) * bytes, staging);
-    }
-  }
-  return total;
-}
-
-std::uint64_t StreamingConversion::largest_chunk_vertex_bytes() const {
-  std::uint64_t most = 0;
-  std::size_t end = 0;  // the end of the longest chunk from `first`: never decreases as `first` grows
-  for (std::size_t first = 0; first < voxels_.size(); ++first) {
-    end = std::max(end, first + 1);
-    while (end < voxels_.size() && orders_start(end + 1) - orders_start(first) <= order_chunk_bytes_) ++end;
-    const VoxelEntry& last = voxels_[end - 1];
-    most = std::max(most, last.vertex_first + last.vertex_count - voxels_[first].vertex_first);
-  }
-  return most * vertex_bytes(settings_.positions);
 }
 
 void StreamingConversion::write_rest() {
@@ -957,61 +728,20 @@ ConvertSummary StreamingConversion::run() {
   plan();
   build_table();
   summary_.voxelize_seconds = seconds_since(t0);
-  budget_.take(kTableBufferEntries * (sizeof(VoxlineEntry) + sizeof(std::uint64_t)),
-               "the buffer of the voxline and streamline tables");
-  budget_.take(meta_.streamline_count * sizeof(spans_[0]), "the voxel span of every streamline");
+  plan_ = plan_conversion(budget_, {meta_, voxels_, levels_, settings_.levels, settings_.positions, order_bytes_,
+                                    threads_, reader_->plan().batch_streamlines, tuning_.order_chunk_bytes});
+  staged_held_ = plan_.staged_bytes;
   spans_.resize(meta_.streamline_count);
-  // The parts of two batches being placed (StagedPart), from what pass 2 counted per point: a voxline
-  // entry (24 bytes) per voxline, a voxline end (8) per streamline and a staged vertex per vertex, twice
-  // for the vectors' growth. A batch that needs more (a long streamline is held whole) takes the rest
-  // when it comes, while the limit allows.
-  {
-    const double points = double(std::max<std::uint64_t>(1, meta_.point_count));
-    const double vertices = double(meta_.point_count + meta_.synthetic_point_count + meta_.voxline_count);
-    const double per_point = (24.0 * double(meta_.voxline_count) + 8.0 * double(meta_.streamline_count) +
-                              double(vertex_bytes(settings_.positions)) * vertices) /
-                             points;
-    staged_held_ = static_cast<std::uint64_t>(2 * 2 * per_point * double(batch_items_));
-    budget_.take(staged_held_, "the voxlines of two batches being placed");
-  }
-  // Direct writes (the output bypasses the page cache) where the limit leaves room for their staging.
-  if (settings_.memory_limit >= kDirectWritesFromLimit) {
-    direct_staging_ = kDirectStagingBytes;
-    budget_.take(VxlStreamWriter::kCount * kDirectStagingBytes, "the staging of the output's direct writes");
-  }
-  order_chunk_bytes_ = std::min(
-      {tuning_.order_chunk_bytes > 0 ? tuning_.order_chunk_bytes : kOrderChunkBytes, order_bytes_, budget_.left() / 8});
-  for (std::size_t i = 0; i < voxels_.size(); ++i)
-    order_chunk_bytes_ = std::max(order_chunk_bytes_, orders_start(i + 1) - orders_start(i));
-  if (direct_staging_ > 0) {
-    // VERT block by block when the blocks' staging takes at most an eighth of what is left and the pool
-    // (that staging, then two orders chunks and two chunks' vertices read back) at most half.
-    constexpr std::uint64_t block = DirectRegionWriter::kBlock;
-    pool_chunk_bytes_ = (order_chunk_bytes_ + block - 1) / block * block;
-    pool_read_back_bytes_ = VxlStreamWriter::read_back_bytes(largest_chunk_vertex_bytes());
-    for (std::uint64_t staging = kBlockStagingBytes; staging >= kMinBlockStagingBytes && block_staging_ == 0;
-         staging /= 2) {
-      const std::uint64_t total = block_staging_total(staging);
-      if (total <= budget_.left() / 8 &&
-          std::max(total, 2 * (pool_chunk_bytes_ + pool_read_back_bytes_)) <= budget_.left() / 2)
-        block_staging_ = staging;
-    }
-  }
-  if (block_staging_ > 0) {
-    pool_bytes_ = std::max(block_staging_total(block_staging_), 2 * (pool_chunk_bytes_ + pool_read_back_bytes_));
-    budget_.take(pool_bytes_, "the vertex blocks being written, then the orders being built and their vertices");
-    void* p = std::aligned_alloc(DirectRegionWriter::kBlock, pool_bytes_);
+  if (plan_.block_staging_bytes > 0) {
+    void* p = std::aligned_alloc(DirectRegionWriter::kBlock, plan_.pool_bytes);
     if (p == nullptr) throw std::bad_alloc();
     pool_.reset(static_cast<std::uint8_t*>(p));
-  } else {
-    budget_.take(order_chunk_bytes_ * (direct_staging_ > 0 ? 2 : 1), "the part of the orders being written",
-                 ", or a smaller --voxel-size");
   }
-  std::vector<Range> ranges = cut_ranges();
+  const std::vector<VoxelRange>& ranges = plan_.ranges;
 
-  const std::string provenance = provenance_json(stream_->source(), settings_, threads_, voxel_size_choice_);
+  const std::string provenance = provenance_json(reader_->source(), settings_, threads_, voxel_size_choice_);
   out_ = std::make_unique<VxlStreamWriter>(out_path_, section_sizes(meta_, order_bytes_, provenance.size(), 0),
-                                           direct_staging_);
+                                           plan_.direct_staging_bytes);
   for (std::size_t k = 0; k < ranges.size(); ++k) {
     build_range(ranges[k], k, ranges.size());
 #if defined(__GLIBC__)
@@ -1028,10 +758,11 @@ ConvertSummary StreamingConversion::run() {
   report("writing", 1.0);
 
   summary_.take_counts(meta_);
+  summary_.passes = reader_->passes();
   summary_.partitions = ranges.size();
-  summary_.vertices_read_back = block_staging_ > 0;
-  for (const Range& r : ranges) summary_.partition_starts.push_back(r.first);
-  summary_.warnings = stream_->source().warnings;
+  summary_.vertices_read_back = plan_.block_staging_bytes > 0;
+  for (const VoxelRange& r : ranges) summary_.partition_starts.push_back(r.first);
+  summary_.warnings = reader_->source().warnings;
   return summary_;
 }
 
