@@ -4,8 +4,16 @@ namespace vxl {
 
 BatchReader::BatchReader(const std::string& path, MemoryBudget& budget, unsigned threads, ProgressFn progress)
     : budget_(budget), plan_(plan_reading(budget)), read_ahead_(threads > 1), progress_(std::move(progress)) {
-  stream_ = std::make_unique<TckStream>(path, plan_.window_bytes, plan_.read_buffer_bytes);
+  source_ = std::make_unique<TckBatchSource>(path, plan_);
 }
+
+BatchReader::BatchReader(std::unique_ptr<StreamlineSource> source, const ReadPlan& plan, MemoryBudget& budget,
+                         unsigned threads, ProgressFn progress)
+    : budget_(budget),
+      plan_(plan),
+      source_(std::move(source)),
+      read_ahead_(threads > 1),
+      progress_(std::move(progress)) {}
 
 void BatchReader::note_longest(const Tractogram& b, std::uint64_t first) {
   for (std::uint64_t k = 0; k < b.streamline_count(); ++k)
@@ -16,7 +24,7 @@ void BatchReader::note_longest(const Tractogram& b, std::uint64_t first) {
 }
 
 void BatchReader::check_overflow(const Tractogram& b, std::uint64_t first) const {
-  if (stream_->overflowed())
+  if (source_->overflowed())
     budget_.fail(b.point_count() * kHeldBytesPerPoint, budget_.used() - held_,
                  "streamline " + std::to_string(first + b.streamline_count()) + ", of more than " +
                      std::to_string(b.point_count() - b.offsets.back()) + " points, held whole while reading,");

@@ -1,6 +1,6 @@
-// A TCK source read pass after pass in bounded memory (streaming_convert.h): each pass hands out batches of
-// whole streamlines, the next batch read while the one before is processed, and counts what the two
-// batches hold against the memory budget.
+// A source read pass after pass in bounded memory (streaming_convert.h): each pass hands out the batches of
+// whole streamlines of a StreamlineSource, the next batch read while the one before is processed, and counts
+// what the two batches hold against the memory budget.
 #pragma once
 
 #include <cstdint>
@@ -9,7 +9,7 @@
 
 #include "converter/pipeline/conversion_plan.h"
 #include "converter/pipeline/memory_budget.h"
-#include "converter/readers/tck_stream.h"
+#include "converter/pipeline/streamline_source.h"
 #include "converter/tractogram.h"
 #include "converter/voxelize.h"
 #include "format/parallel.h"
@@ -18,12 +18,16 @@ namespace vxl {
 
 class BatchReader {
  public:
-  // Takes the program's own memory and the read buffer from `budget` (plan_reading), which must outlive
-  // the reader, and opens `path`. With more than one thread the next batch is read while one is processed.
+  // Reads the TCK file `path` (TckBatchSource): takes the program's own memory and the read buffer from
+  // `budget` (plan_reading), which must outlive the reader. With more than one thread the next batch is read
+  // while one is processed.
   BatchReader(const std::string& path, MemoryBudget& budget, unsigned threads, ProgressFn progress);
+  // Reads `source`, whose batches `plan` sized.
+  BatchReader(std::unique_ptr<StreamlineSource> source, const ReadPlan& plan, MemoryBudget& budget, unsigned threads,
+              ProgressFn progress);
 
   const ReadPlan& plan() const { return plan_; }
-  const SourceInfo& source() const { return stream_->source(); }
+  const SourceInfo& source() const { return source_->source(); }
   unsigned passes() const { return passes_; }  // each_batch calls so far
 
   // Reads the source once, calling body(batch, index of its first streamline) per batch; `stage` names the
@@ -45,7 +49,7 @@ class BatchReader {
 
   MemoryBudget& budget_;
   ReadPlan plan_;
-  std::unique_ptr<TckStream> stream_;
+  std::unique_ptr<StreamlineSource> source_;
   Tractogram batches_[2];                          // one processed while the next is read
   std::uint64_t held_ = 0;                         // what the two batches hold, as taken from the budget
   std::uint64_t longest_ = 0, longest_index_ = 0;  // the longest streamline noted (in points)
@@ -56,12 +60,11 @@ class BatchReader {
 
 template <typename Body>
 void BatchReader::each_batch(const std::string& stage, Body&& body) {
-  stream_->rewind();
+  source_->rewind();
   ++passes_;
   report(stage, 0.0);
-  const double size = double(std::max<std::uint64_t>(1, stream_->file_size()));
   std::uint64_t first = 0;
-  auto read = [&](int b) { return stream_->next(batches_[b], plan_.batch_streamlines, plan_.max_points_held); };
+  auto read = [&](int b) { return source_->next(batches_[b]); };
   int current = 0;
   bool more = read(current);
   check_overflow(batches_[current], first);
@@ -74,7 +77,7 @@ void BatchReader::each_batch(const std::string& stage, Body&& body) {
     current = other;
     check_overflow(batches_[current], first);
     track_batches();
-    report(stage, double(stream_->position()) / size);
+    report(stage, source_->progress());
   }
   report(stage, 1.0);
 }
