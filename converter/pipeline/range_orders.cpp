@@ -3,9 +3,11 @@
 #include "converter/pipeline/streaming_conversion.h"
 
 #include <algorithm>
+#include <array>
 #include <numeric>
 #include <optional>
 
+#include "converter/pipeline/chunk_vertices.h"
 #include "format/parallel.h"
 
 namespace vxl::streaming {
@@ -27,43 +29,35 @@ void StreamingConversion::write_orders(const VoxelRange& r, std::span<const std:
     cuts.push_back(end);
   }
   auto vertex_start = [&](std::size_t i) { return i < r.end ? table_.voxels[i].vertex_first : r.vertex_end; };
+  std::vector<std::uint64_t> chunk_bounds;
+  for (std::size_t cut : cuts) chunk_bounds.push_back(vertex_start(cut));
   const std::uint64_t vertex_size = vertex_bytes(job_.settings.positions);
   // The chunks' orders and the vertices read back: in pool_ after the blocks' staging is done with.
   std::unique_ptr<std::uint8_t[]> own_chunks[2];
   std::uint8_t* chunks[2] = {};
-  std::span<std::uint8_t> read_buffers[2];
+  std::optional<ChunkVertices> chunk_vertices;
   if (plan_.block_staging_bytes > 0) {
+    std::array<std::span<std::uint8_t>, 2> read_buffers;
     for (int b = 0; b < 2; ++b) {
       chunks[b] = pool_.get() + b * plan_.pool_chunk_bytes;
       read_buffers[b] = {pool_.get() + 2 * plan_.pool_chunk_bytes + b * plan_.pool_read_back_bytes,
                          plan_.pool_read_back_bytes};
     }
+    chunk_vertices.emplace(*out_, read_buffers, vertex_size, std::move(chunk_bounds));
+  } else {
+    chunk_vertices.emplace(range_vertices, r.vertex_first, vertex_size, std::move(chunk_bounds));
   }
-  // Chunk c's vertices: in memory, or read back (on another thread, while the chunk before is built).
-  auto vertices_of = [&](std::size_t c) {
-    const std::uint64_t from = vertex_start(cuts[c]), to = vertex_start(cuts[c + 1]);
-    if (plan_.block_staging_bytes == 0)
-      return range_vertices.subspan((from - r.vertex_first) * vertex_size, (to - from) * vertex_size);
-    return out_->read_back(VxlStreamWriter::kVert, (to - from) * vertex_size, read_buffers[c % 2]);
-  };
-  auto fetch = [&](std::size_t c) {
-    return BackgroundTask<std::span<const std::uint8_t>>([&, c] { return vertices_of(c); });
-  };
-  const bool read_back = plan_.block_staging_bytes > 0;
   // With direct writes a chunk is written on its own thread while the next one is built (the write waits
   // on the disk, not the CPU); through the page cache it is written before the next one is built.
   // The buffers are taken once at the largest chunk's size and not cleared: the writers write every
   // byte of their voxels' orders, padding included. (Regrowing and zeroing them per chunk took 3 of the
   // 11 s of a 10M conversion's orders: fresh pages cost much on a virtual machine.)
   std::vector<std::size_t> by_size;  // a chunk's voxels
-  BackgroundTask<std::span<const std::uint8_t>> next_vertices;
-  if (read_back && cuts.size() > 1) next_vertices = fetch(0);
   BackgroundTask<> writing;
   for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
     auto t0 = Clock::now();
     const std::size_t first = cuts[c], end = cuts[c + 1];
-    const std::span<const std::uint8_t> vertices = read_back ? next_vertices.get() : vertices_of(c);
-    if (read_back && c + 2 < cuts.size()) next_vertices = fetch(c + 1);
+    const std::span<const std::uint8_t> vertices = chunk_vertices->take(c);
     const std::uint64_t base = orders_start(first);
     const int b = plan_.direct_staging_bytes > 0 ? c % 2 : 0;
     if (chunks[b] == nullptr) {
