@@ -35,8 +35,7 @@ void StreamingConversion::build_range(const VoxelRange& r, std::size_t index, st
 void StreamingConversion::place_range(const VoxelRange& r, bool tables, const std::string& of,
                                       std::span<std::uint8_t> window) {
   auto t0 = Clock::now();
-  RangePlacement placing(r, tables, window);
-  if (plan_.block_staging_bytes > 0) open_block_writers(placing);
+  RangePlacement placing(r, tables, open_vertex_sink(r, window));
   if (packed()) {
     placing.packers.reserve(r.end - r.first);
     for (std::size_t g = r.first; g < r.end; ++g) placing.packers.emplace_back(table_.voxels[g]);
@@ -73,8 +72,7 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
     budget_.track(staged, staged_held_, [] { return std::string("the voxlines of two batches being placed"); });
   });
   if (!other_placed) place_staged(1 - staging);
-  if (placing.queue) placing.queue->finish();  // rethrows a failed write
-  placing.blocks.clear();  // each wrote its last bytes with its last append (checked below: all complete)
+  placing.sink.finish();  // rethrows a failed write (each block's completeness is checked below)
   if (placing.streamlines != table_.meta.streamline_count ||
       (tables && placing.voxline_index != table_.meta.voxline_count))
     fail_changed();
@@ -95,36 +93,24 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
   summary_.voxelize_seconds += seconds_since(t0);
 }
 
-// A writer per (voxel, level) block of range r with vertices, from the block's first vertex (table_.cursor,
-// before any is placed) to its end.
-void StreamingConversion::open_block_writers(RangePlacement& placing) const {
-  const VoxelRange& r = placing.range;
-  const std::uint32_t levels = job_.settings.levels;
+// Where range r's vertices go: `window` (its part of VERT), or, written block by block, a writer per
+// (voxel, level) block of the range with vertices, from the block's first vertex (table_.cursor, before any
+// is placed) to its end.
+VertexSink StreamingConversion::open_vertex_sink(const VoxelRange& r, std::span<std::uint8_t> window) const {
   const std::uint64_t bytes = vertex_bytes(job_.settings.positions);
-  placing.blocks.resize(table_.cursor.size());
-  std::uint8_t* staging = pool_.get();  // the queue's spares, then each block's staging, one after another
-  std::vector<std::uint8_t*> spares;
-  for (std::uint64_t k = 0; k < kSpareBlockStagings; ++k, staging += plan_.block_staging_bytes)
-    spares.push_back(staging);
-  placing.queue = out_->write_queue(std::move(spares), plan_.block_staging_bytes);
+  if (plan_.block_staging_bytes == 0) return VertexSink(window, bytes);
+  const std::uint32_t levels = job_.settings.levels;
+  std::vector<std::array<std::uint64_t, 2>> blocks(table_.cursor.size());  // {0, 0}: none in this range
   for (std::size_t local = 0; local < table_.global_id.size(); ++local) {
     const std::uint32_t g = table_.global_id[local];
     if (g < r.first || g >= r.end) continue;
-    for (std::uint32_t d = 0; d < levels; ++d) {
-      const std::uint64_t first = table_.cursor[local * levels + d];
-      const std::uint64_t end =
-          table_.voxels[g].vertex_first + depth_end_vertex(table_.voxels[g], level_row(table_.levels, g, levels), d);
-      if (end > first) {
-        const std::uint64_t size = DirectRegionWriter::staging_size((end - first) * bytes, plan_.block_staging_bytes);
-        if (std::uint64_t(staging - pool_.get()) + size > plan_.pool_bytes)
-          throw std::logic_error("StreamingConversion: the blocks' staging outgrows its pool");
-        placing.blocks[local * levels + d] =
-            out_->region_writer(VxlStreamWriter::kVert, first * bytes, (end - first) * bytes, plan_.block_staging_bytes,
-                                staging, placing.queue.get());
-        staging += size;
-      }
-    }
+    for (std::uint32_t d = 0; d < levels; ++d)
+      blocks[local * levels + d] = {
+          table_.cursor[local * levels + d],
+          table_.voxels[g].vertex_first + depth_end_vertex(table_.voxels[g], level_row(table_.levels, g, levels), d)};
   }
+  return VertexSink(*out_, blocks, bytes, plan_.block_staging_bytes, kSpareBlockStagings, pool_.get(),
+                    plan_.pool_bytes);
 }
 
 // On one thread: voxelises streamlines [begin, end) of batch b (numbered from `first` in the source) and
@@ -192,8 +178,6 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
   const std::uint64_t first = part.source_first;
   const VoxelRange& r = placing.range;
   const std::uint32_t levels = job_.settings.levels;
-  auto* const words = reinterpret_cast<std::uint32_t*>(placing.window.data());
-  auto* const vertices = reinterpret_cast<float*>(placing.window.data());
   std::uint64_t staged = 0;  // vertices of the part placed so far
   std::size_t start = 0;
   for (std::uint64_t k = 0; k < part.end - part.begin; ++k) {
@@ -232,16 +216,9 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
       if (cursor > block_end || used > block_end - cursor) fail_changed();
       const std::uint64_t at = cursor - r.vertex_first;
       if (!packed()) ends_.set(at + used - 1);
-      if (!placing.blocks.empty()) {
-        const auto* from = packed() ? reinterpret_cast<const std::uint8_t*>(part.words.data() + staged)
-                                    : reinterpret_cast<const std::uint8_t*>(part.xyz.data() + 3 * staged);
-        placing.blocks[std::size_t(v.voxel) * levels + depth]->append(
-            {from, used * vertex_bytes(job_.settings.positions)});
-      } else if (packed()) {
-        std::copy_n(part.words.data() + staged, used, words + at);
-      } else {
-        std::copy_n(part.xyz.data() + 3 * staged, 3 * used, vertices + 3 * at);
-      }
+      const auto* from = packed() ? reinterpret_cast<const std::uint8_t*>(part.words.data() + staged)
+                                  : reinterpret_cast<const std::uint8_t*>(part.xyz.data() + 3 * staged);
+      placing.sink.put(std::size_t(v.voxel) * levels + depth, at, from, used);
       staged += used;
       cursor += used;
     }

@@ -18,6 +18,7 @@
 #include "converter/pipeline/batch_reader.h"
 #include "converter/pipeline/conversion_plan.h"
 #include "converter/pipeline/memory_budget.h"
+#include "converter/pipeline/vertex_sink.h"
 #include "converter/position_packing.h"
 #include "converter/segment_orders.h"
 #include "converter/streaming_convert.h"
@@ -127,7 +128,7 @@ class StreamingConversion {
   struct StagedPart;
   struct RangePlacement;
   void place_range(const VoxelRange& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
-  void open_block_writers(RangePlacement& placing) const;
+  VertexSink open_vertex_sink(const VoxelRange& r, std::span<std::uint8_t> window) const;
   void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
                   std::uint64_t end, StagedPart& part) const;
   void place_part(RangePlacement& placing, const StagedPart& part);
@@ -177,16 +178,12 @@ struct StreamingConversion::StagedPart {
 
 // What one range's placing pass keeps between batches.
 struct StreamingConversion::RangePlacement {
-  RangePlacement(const VoxelRange& r, bool first_range, std::span<std::uint8_t> part_of_vert)
-      : range(r), tables(first_range), window(part_of_vert) {}
+  RangePlacement(const VoxelRange& r, bool first_range, VertexSink&& vertex_sink)
+      : range(r), tables(first_range), sink(std::move(vertex_sink)) {}
   const VoxelRange& range;
   bool tables;                        // the first range: also the voxline and streamline tables
-  std::span<std::uint8_t> window;     // the range's part of VERT
+  VertexSink sink;                    // where the range's vertices go (blocks by local voxel id * levels + level)
   std::vector<VertexPacker> packers;  // by voxel - range.first (packed positions)
-  // Written block by block (plan_.block_staging_bytes > 0): a writer per (local voxel id, level), as table_.cursor,
-  // whose full stagings are written by `queue`'s thread.
-  std::unique_ptr<DirectWriteQueue> queue;
-  std::vector<std::unique_ptr<DirectRegionWriter>> blocks;
   std::vector<VoxlineEntry> voxline_buffer;
   std::vector<std::uint64_t> streamline_buffer;
   std::uint64_t voxline_index = 0, streamlines = 0;
