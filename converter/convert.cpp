@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <future>
 
 #include "converter/segment_orders.h"
 #include "converter/voxel_size_auto.h"
 #include "converter/voxel_table.h"
 #include "format/base/error.h"
+#include "format/base/parallel.h"
 #include "format/vxl_value_sets.h"
 #include "format/vxl_writer.h"
 
@@ -47,6 +47,39 @@ std::span<std::uint8_t> bytes_of(std::span<T> s) {
   return {reinterpret_cast<std::uint8_t*>(s.data()), s.size_bytes()};
 }
 
+// Checks that t's value sets have a value per point or per streamline, keeps the first kMaxValueSets of
+// each kind and gives them names every reader of the file accepts (`verify`, `export`, voxview). Returns
+// the warnings of doing so, also added to t.source.warnings (PROV).
+std::vector<std::string> prepare_value_sets(Tractogram& t) {
+  for (const ValueSet& v : t.point_values)
+    if (v.values.size() != t.point_count())
+      throw Error(ErrorKind::Input, t.source.path, std::nullopt,
+                  "value set '" + v.name + "' has " + std::to_string(v.values.size()) + " values for " +
+                      std::to_string(t.point_count()) + " points");
+  for (const ValueSet& v : t.streamline_values)
+    if (v.values.size() != t.streamline_count())
+      throw Error(ErrorKind::Input, t.source.path, std::nullopt,
+                  "value set '" + v.name + "' has " + std::to_string(v.values.size()) + " values for " +
+                      std::to_string(t.streamline_count()) + " streamlines");
+  std::vector<std::string> warnings;
+  for (auto* sets : {&t.point_values, &t.streamline_values})
+    if (sets->size() > kMaxValueSets) {
+      warnings.push_back("only the first " + std::to_string(kMaxValueSets) + " of " + std::to_string(sets->size()) +
+                         (sets == &t.point_values ? " per-point" : " per-streamline") + " value sets are kept");
+      sets->resize(kMaxValueSets);
+    }
+  // Names every reader of the file accepts (`verify`, `export`, voxview): mapped here, said in a warning.
+  for (auto* sets : {&t.point_values, &t.streamline_values}) {
+    std::vector<std::string> names;
+    for (const ValueSet& v : *sets) names.push_back(v.name);
+    const std::vector<std::string> usable =
+        usable_value_set_names(names, sets == &t.point_values ? "point_values" : "streamline_values", warnings);
+    for (std::size_t k = 0; k < sets->size(); ++k) (*sets)[k].name = usable[k];
+  }
+  t.source.warnings.insert(t.source.warnings.end(), warnings.begin(), warnings.end());
+  return warnings;
+}
+
 }  // namespace
 
 ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, const ConvertSettings& given) {
@@ -64,33 +97,8 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
     settings.voxel_size = choice.size;
     voxel_size_choice = choice.reason;
   }
-  for (const ValueSet& v : t.point_values)
-    if (v.values.size() != t.point_count())
-      throw Error(ErrorKind::Input, t.source.path, std::nullopt,
-                  "value set '" + v.name + "' has " + std::to_string(v.values.size()) + " values for " +
-                      std::to_string(t.point_count()) + " points");
-  for (const ValueSet& v : t.streamline_values)
-    if (v.values.size() != t.streamline_count())
-      throw Error(ErrorKind::Input, t.source.path, std::nullopt,
-                  "value set '" + v.name + "' has " + std::to_string(v.values.size()) + " values for " +
-                      std::to_string(t.streamline_count()) + " streamlines");
   // Warnings of the conversion itself: in PROV with the reader's, and in the summary for the caller to show.
-  std::vector<std::string> warnings;
-  for (auto* sets : {&t.point_values, &t.streamline_values})
-    if (sets->size() > kMaxValueSets) {
-      warnings.push_back("only the first " + std::to_string(kMaxValueSets) + " of " + std::to_string(sets->size()) +
-                         (sets == &t.point_values ? " per-point" : " per-streamline") + " value sets are kept");
-      sets->resize(kMaxValueSets);
-    }
-  // Names every reader of the file accepts (`verify`, `export`, voxview): mapped here, said in a warning.
-  for (auto* sets : {&t.point_values, &t.streamline_values}) {
-    std::vector<std::string> names;
-    for (const ValueSet& v : *sets) names.push_back(v.name);
-    const std::vector<std::string> usable =
-        usable_value_set_names(names, sets == &t.point_values ? "point_values" : "streamline_values", warnings);
-    for (std::size_t k = 0; k < sets->size(); ++k) (*sets)[k].name = usable[k];
-  }
-  t.source.warnings.insert(t.source.warnings.end(), warnings.begin(), warnings.end());
+  std::vector<std::string> warnings = prepare_value_sets(t);
   // PROV and GRPS are known before any work: their sizes go into the plan of the output file.
   const std::string provenance = provenance_json(t.source, settings, threads, voxel_size_choice);
   std::vector<std::uint8_t> groups_bytes;
@@ -150,7 +158,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
 
   t0 = Clock::now();
   // What is final now goes to the disk while the orders are built (the write waits on the disk, not on a core).
-  std::future<void> written = std::async(std::launch::async, [&] {
+  BackgroundTask<> written([&] {
     for (std::span<std::uint8_t> s :
          {bytes_of(out.voxels()), bytes_of(out.levels()), bytes_of(out.float_vertices()),
           bytes_of(out.packed_vertices()), bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline()),

@@ -291,6 +291,57 @@ std::vector<std::uint8_t> unpacked_group_values(const VxlzFile& f, std::uint64_t
   return raw;
 }
 
+// What a package carries besides the positions and the tables: groups, their values and the value sets.
+struct PackageExtras {
+  std::vector<std::uint8_t> groups_bytes;        // GRPS's .vxl payload
+  std::vector<std::uint8_t> group_values_bytes;  // GDAT's
+  std::vector<NamedValues> point_values, streamline_values;
+};
+
+PackageExtras read_extras(const VxlzFile& f, unsigned threads) {
+  PackageExtras extras;
+  std::uint64_t group_count = 0;
+  if (f.has_section(section_id("GRPS"))) {
+    const std::vector<StreamlineGroup> groups =
+        decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count, f.context(section_id("GRPS")));
+    group_count = groups.size();
+    extras.groups_bytes = encode_groups(groups);
+  }
+  // GDAT travels as the .vxl payload (package spec §4.8): checked against the groups, written back as it came.
+  if (f.has_section(section_id("GDAT"))) extras.group_values_bytes = unpacked_group_values(f, group_count);
+
+  // Value sets (spec §4.7), checked against PACK's and META's counts before anything is inflated.
+  if (f.has_section(section_id("PVAL")))
+    extras.point_values = decode_value_section(f.section_payload(section_id("PVAL")), f.pack().point_count,
+                                               f.context(section_id("PVAL")), threads);
+  if (f.has_section(section_id("SVAL")))
+    extras.streamline_values = decode_value_section(f.section_payload(section_id("SVAL")), f.meta().streamline_count,
+                                                    f.context(section_id("SVAL")), threads);
+  return extras;
+}
+
+// Sets META's bounds from the voxels' tight bounds (package spec §7 step 1), and refuses what a damaged
+// package would make: a grid, or positions decoded outside their voxels, that open() refuses.
+void set_bounds_checked(MetaSection& meta, std::span<const VoxelEntry> voxels, const std::string& path) {
+  // The global bounds (step 1).
+  for (int c = 0; c < 3; ++c) {
+    meta.bounds_min[c] = meta.bounds_max[c] = 0;
+    for (std::size_t i = 0; i < voxels.size(); ++i) {
+      meta.bounds_min[c] =
+          i == 0 ? voxels[i].tight_min[c] : std::min<double>(meta.bounds_min[c], voxels[i].tight_min[c]);
+      meta.bounds_max[c] =
+          i == 0 ? voxels[i].tight_max[c] : std::max<double>(meta.bounds_max[c], voxels[i].tight_max[c]);
+    }
+  }
+  // A damaged package's grid, or positions it decodes outside their voxels, would make a file open() refuses.
+  check_grid_geometry(meta, path, std::nullopt);
+  for (std::size_t i = 0; i < voxels.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      if (!tight_bounds_in_place(meta, voxels[i], c))
+        fail_input(path, std::nullopt,
+                   "the positions decode outside their voxels: " + misplaced_voxel(meta, voxels[i], i, c));
+}
+
 }  // namespace
 
 UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
@@ -310,35 +361,16 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
     fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");
   Structure s = rebuild_structure(f, settings.levels);
   const std::string provenance = provenance_with_package(f);
-  std::vector<std::uint8_t> groups_bytes;
-  std::uint64_t group_count = 0;
-  if (f.has_section(section_id("GRPS"))) {
-    const std::vector<StreamlineGroup> groups =
-        decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count, f.context(section_id("GRPS")));
-    group_count = groups.size();
-    groups_bytes = encode_groups(groups);
-  }
-  // GDAT travels as the .vxl payload (package spec §4.8): checked against the groups, written back as it came.
-  std::vector<std::uint8_t> group_values_bytes;
-  if (f.has_section(section_id("GDAT"))) group_values_bytes = unpacked_group_values(f, group_count);
-
-  // Value sets (spec §4.7), checked against PACK's and META's counts before anything is inflated.
-  std::vector<NamedValues> point_values, streamline_values;
-  if (f.has_section(section_id("PVAL")))
-    point_values = decode_value_section(f.section_payload(section_id("PVAL")), f.pack().point_count,
-                                        f.context(section_id("PVAL")), threads);
-  if (f.has_section(section_id("SVAL")))
-    streamline_values = decode_value_section(f.section_payload(section_id("SVAL")), f.meta().streamline_count,
-                                             f.context(section_id("SVAL")), threads);
+  PackageExtras extras = read_extras(f, threads);
 
   MetaSection meta = f.meta();
   meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
   meta.level_count = s.level_count > 1 && meta.voxel_count > 0 ? s.level_count : 0;
   const bool packed = settings.positions == PositionEncoding::Packed;
-  VxlSectionSizes sizes = section_sizes(meta, s.order_bytes, provenance.size(), groups_bytes.size(),
-                                        static_cast<std::uint32_t>(point_values.size()),
-                                        static_cast<std::uint32_t>(streamline_values.size()));
-  sizes.group_values = group_values_bytes.size();
+  VxlSectionSizes sizes = section_sizes(meta, s.order_bytes, provenance.size(), extras.groups_bytes.size(),
+                                        static_cast<std::uint32_t>(extras.point_values.size()),
+                                        static_cast<std::uint32_t>(extras.streamline_values.size()));
+  sizes.group_values = extras.group_values_bytes.size();
   VxlWriter out(out_path, sizes);
   // Packed positions are decoded as floats first (tight bounds and orders come from them), then packed.
   std::vector<float> float_blocks(packed ? 3 * meta.vertex_count : 0);
@@ -394,23 +426,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   });
   progress("ordering", 1.0);
   float_blocks = {};
-  // The global bounds (step 1).
-  for (int c = 0; c < 3; ++c) {
-    meta.bounds_min[c] = meta.bounds_max[c] = 0;
-    for (std::size_t i = 0; i < voxels.size(); ++i) {
-      meta.bounds_min[c] =
-          i == 0 ? voxels[i].tight_min[c] : std::min<double>(meta.bounds_min[c], voxels[i].tight_min[c]);
-      meta.bounds_max[c] =
-          i == 0 ? voxels[i].tight_max[c] : std::max<double>(meta.bounds_max[c], voxels[i].tight_max[c]);
-    }
-  }
-  // A damaged package's grid, or positions it decodes outside their voxels, would make a file open() refuses.
-  check_grid_geometry(meta, f.path(), std::nullopt);
-  for (std::size_t i = 0; i < voxels.size(); ++i)
-    for (int c = 0; c < 3; ++c)
-      if (!tight_bounds_in_place(meta, voxels[i], c))
-        fail_input(f.path(), std::nullopt,
-                   "the positions decode outside their voxels: " + misplaced_voxel(meta, voxels[i], i, c));
+  set_bounds_checked(meta, voxels, f.path());
   summary.orders_seconds = seconds_since(t0);
 
   t0 = Clock::now();
@@ -420,11 +436,12 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   std::copy(s.voxlines.begin(), s.voxlines.end(), out.voxlines().begin());
   std::copy(s.strm.begin(), s.strm.end(), out.streamline_first_voxline().begin());
   std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
-  std::copy(groups_bytes.begin(), groups_bytes.end(), out.groups().begin());
-  std::copy(group_values_bytes.begin(), group_values_bytes.end(), out.group_values().begin());
-  if (!point_values.empty()) write_point_values(s, point_values, out.vertex_values(), meta.vertex_count, threads);
-  if (!streamline_values.empty())
-    write_streamline_values(streamline_values, out.streamline_values(), meta.streamline_count);
+  std::copy(extras.groups_bytes.begin(), extras.groups_bytes.end(), out.groups().begin());
+  std::copy(extras.group_values_bytes.begin(), extras.group_values_bytes.end(), out.group_values().begin());
+  if (!extras.point_values.empty())
+    write_point_values(s, extras.point_values, out.vertex_values(), meta.vertex_count, threads);
+  if (!extras.streamline_values.empty())
+    write_streamline_values(extras.streamline_values, out.streamline_values(), meta.streamline_count);
   out.commit(threads);
   summary.write_seconds = seconds_since(t0);
   progress("writing", 1.0);
@@ -434,8 +451,8 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   summary.voxels = meta.voxel_count;
   summary.pack = f.pack();
   summary.repack_error_bound = *std::max_element(repack_bound.begin(), repack_bound.end());
-  summary.point_value_sets = static_cast<std::uint32_t>(point_values.size());
-  summary.streamline_value_sets = static_cast<std::uint32_t>(streamline_values.size());
+  summary.point_value_sets = static_cast<std::uint32_t>(extras.point_values.size());
+  summary.streamline_value_sets = static_cast<std::uint32_t>(extras.streamline_values.size());
   return summary;
 }
 

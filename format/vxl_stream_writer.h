@@ -9,7 +9,6 @@
 #pragma once
 
 #include <cstdint>
-#include <future>
 #include <memory>
 #include <span>
 #include <string>
@@ -18,6 +17,7 @@
 #include "format/base/atomic_output.h"
 #include "format/base/checksum.h"
 #include "format/base/direct_region_writer.h"
+#include "format/base/parallel.h"
 #include "format/vxl_layout.h"
 #include "format/vxl_writer.h"
 
@@ -54,7 +54,7 @@ class VxlStreamWriter : public VxlSections {
     if (!regions_.empty()) {
       const std::span<std::uint8_t> buffer = fill_buffer(section, size, threads);
       fill(buffer);
-      std::future<void> writing = std::async(std::launch::async, [&] { append(section, buffer); });
+      BackgroundTask<> writing([&] { append(section, buffer); });
       then(std::span<const std::uint8_t>(buffer));  // on a throw, `writing` waits for the write first
       writing.get();
       return;

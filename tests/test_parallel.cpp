@@ -95,5 +95,54 @@ TEST(Parallel, InvokeRunsBothAndRethrows) {
   }
 }
 
+TEST(BackgroundTask, RunsOnAnotherThreadWhileTheCallerGoesOn) {
+  std::atomic<bool> caller_went_on{false};
+  const std::thread::id caller = std::this_thread::get_id();
+  BackgroundTask<std::thread::id> task([&] {
+    // Returns only once the caller has gone on past the task's start: the task must not run inline.
+    while (!caller_went_on) std::this_thread::yield();
+    return std::this_thread::get_id();
+  });
+  EXPECT_TRUE(task.valid());
+  caller_went_on = true;
+  EXPECT_NE(task.get(), caller);
+  EXPECT_FALSE(task.valid()) << "get() empties the task";
+}
+
+TEST(BackgroundTask, GetRethrowsTheTasksExceptionOnTheCaller) {
+  BackgroundTask<> failing([] { throw std::runtime_error("written badly"); });
+  try {
+    failing.get();
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "written badly");
+  }
+  BackgroundTask<int> value([]() -> int { throw std::logic_error("no value"); });
+  EXPECT_THROW(value.get(), std::logic_error);
+}
+
+TEST(BackgroundTask, ADestroyedOrReplacedTaskIsWaitedFor) {
+  std::atomic<int> finished{0};
+  auto slow = [&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ++finished;
+  };
+  { BackgroundTask<> task(slow); }
+  EXPECT_EQ(finished.load(), 1) << "the destructor returned before the task finished";
+  BackgroundTask<> task(slow);
+  task = BackgroundTask<>(slow);  // waits for the first before taking the second
+  EXPECT_GE(finished.load(), 2);
+  task.get();
+  EXPECT_EQ(finished.load(), 3);
+  BackgroundTask<> ignored([] { throw std::runtime_error("dropped"); });  // joined, not rethrown, when destroyed
+}
+
+TEST(BackgroundTask, MovingATaskKeepsItsResult) {
+  BackgroundTask<std::vector<int>> task([] { return std::vector<int>{1, 2, 3}; });
+  BackgroundTask<std::vector<int>> moved = std::move(task);
+  EXPECT_FALSE(task.valid());  // NOLINT(bugprone-use-after-move): a moved-from task is empty
+  EXPECT_EQ(moved.get(), (std::vector<int>{1, 2, 3}));
+}
+
 }  // namespace
 }  // namespace vxl

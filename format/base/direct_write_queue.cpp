@@ -9,7 +9,7 @@ namespace vxl {
 DirectWriteQueue::DirectWriteQueue(AtomicOutputFile& out, int direct_fd, std::vector<std::uint8_t*> spares,
                                    std::uint64_t buffer_bytes)
     : out_(out), direct_fd_(direct_fd), buffer_bytes_(buffer_bytes), spares_(std::move(spares)) {
-  writer_ = std::thread([this] { run(); });
+  writer_ = BackgroundTask<>([this] { run(); });
 }
 
 DirectWriteQueue::~DirectWriteQueue() {
@@ -18,7 +18,7 @@ DirectWriteQueue::~DirectWriteQueue() {
     stopping_ = true;
   }
   changed_.notify_all();
-  writer_.join();  // the writer drains the queue first
+  // writer_'s destructor joins it: the writer drains the queue first.
 }
 
 std::uint8_t* DirectWriteQueue::submit(std::uint8_t* buffer, std::uint64_t size, std::uint64_t offset, bool recycle,

@@ -12,10 +12,10 @@
 #include <deque>
 #include <exception>
 #include <mutex>
-#include <thread>
 #include <vector>
 
 #include "format/base/atomic_output.h"
+#include "format/base/parallel.h"
 
 namespace vxl {
 
@@ -57,7 +57,7 @@ class DirectWriteQueue {
   std::size_t writing_ = 0;  // jobs taken by the writer and not yet done
   bool stopping_ = false;
   std::exception_ptr failure_;
-  std::thread writer_;  // last: started once the rest is set up
+  BackgroundTask<> writer_;  // last: started once the rest is set up, joined first
 };
 
 }  // namespace vxl

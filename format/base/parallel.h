@@ -5,9 +5,10 @@
 // every thread has joined (items already running finish; later exceptions are dropped).
 //
 // Threads are started per call, not kept in a pool: every call here runs for milliseconds to seconds,
-// so the start-up (tens of microseconds) does not show, and nothing outlives the call. (Work that overlaps
-// with a loop rather than splitting one — the streaming converter's next batch, the direct-write queue —
-// runs on its own thread, std::async or one std::thread, owned by the object that needs it.)
+// so the start-up (tens of microseconds) does not show, and nothing outlives the call. Work that overlaps
+// with other work rather than splitting it — sections written while the orders are built, the next chunk
+// of vertices read back, the direct-write queue — runs as a BackgroundTask owned by the object that
+// needs it: the converter and the format library start no thread elsewhere.
 // Lives in format/, the library every other one links, so that all of them can use it.
 #pragma once
 
@@ -15,8 +16,12 @@
 #include <atomic>
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace vxl {
@@ -86,5 +91,56 @@ void parallel_invoke(bool concurrent, A&& a, B&& b) {
       b();
   });
 }
+
+// Runs fn() on a thread of its own while the caller goes on; get() waits for it and returns its result
+// or rethrows its exception on the caller's thread. A task not waited for is joined by its destructor
+// (its exception dropped): nothing outlives the owner. An empty task (default-constructed, moved from,
+// or after get()) is not valid().
+template <typename T = void>
+class BackgroundTask {
+ public:
+  BackgroundTask() = default;
+  template <typename Fn>
+  explicit BackgroundTask(Fn&& fn) : state_(std::make_unique<State>()) {
+    thread_ = std::thread([state = state_.get(), fn = std::forward<Fn>(fn)]() mutable {
+      try {
+        if constexpr (std::is_void_v<T>)
+          fn();
+        else
+          state->value.emplace(fn());
+      } catch (...) {
+        state->error = std::current_exception();
+      }
+    });
+  }
+  BackgroundTask(BackgroundTask&&) noexcept = default;
+  BackgroundTask& operator=(BackgroundTask&& other) noexcept {
+    join();
+    thread_ = std::move(other.thread_);
+    state_ = std::move(other.state_);
+    return *this;
+  }
+  ~BackgroundTask() { join(); }
+
+  bool valid() const { return state_ != nullptr; }
+  T get() {
+    join();
+    const std::unique_ptr<State> state = std::move(state_);
+    if (state->error) std::rethrow_exception(state->error);
+    if constexpr (!std::is_void_v<T>) return std::move(*state->value);
+  }
+
+ private:
+  struct Empty {};
+  struct State {
+    std::conditional_t<std::is_void_v<T>, Empty, std::optional<T>> value;
+    std::exception_ptr error;
+  };
+  void join() {
+    if (thread_.joinable()) thread_.join();
+  }
+  std::thread thread_;
+  std::unique_ptr<State> state_;  // apart from the task, so that moving the task does not move it
+};
 
 }  // namespace vxl

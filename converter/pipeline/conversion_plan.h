@@ -1,0 +1,90 @@
+// How a conversion within a memory limit (streaming_convert.h) is split, worked out from the limit and the
+// counts of the passes before: how large a batch of streamlines is read at a time, how the output is
+// written (through the page cache, past it, or VERT block by block and read back), how large a chunk of
+// orders is built at a time and which ranges of voxels are built in one pass each. Pure arithmetic on a
+// MemoryBudget: no I/O, so that the split can be tested without a source or an output. A limit too small
+// for a part is refused here (MemoryBudget::fail) before any of the work it sizes is done.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "converter/pipeline/memory_budget.h"
+#include "format/vxl_layout.h"
+#include "format/vxl_levels.h"
+#include "format/vxl_positions.h"
+
+namespace vxl {
+
+// Voxline and streamline table entries written at once.
+inline constexpr std::size_t kTableBufferEntries = 1 << 16;
+// Spare stagings for the blocks' write queue (DirectWriteQueue): how far the writes may fall behind.
+inline constexpr std::uint64_t kSpareBlockStagings = 32;
+// Memory per point of a batch being read, at worst: two batches (one read while the other is processed),
+// each of whose positions may have twice the capacity in use.
+inline constexpr std::uint64_t kHeldBytesPerPoint = 2 * 2 * 3 * sizeof(float);
+// The output is written past the page cache (DirectRegionWriter) under limits of at least this much.
+inline constexpr std::uint64_t kDirectWritesFromLimit = 256ull << 20;
+
+// The voxel table's bytes per voxel while it is built, with `levels` levels of detail.
+std::uint64_t voxel_table_bytes_per_voxel(std::uint32_t levels);
+
+// How the source is read, from the limit alone (before anything is read).
+struct ReadPlan {
+  std::uint64_t read_buffer_bytes = 0;
+  std::uint64_t batch_streamlines = 0;  // streamlines per batch (a batch holds whole streamlines)
+  std::uint64_t window_bytes = 0;       // the mapped part of the source
+  std::uint64_t max_points_held = 0;    // points a batch may hold (a longer streamline is refused)
+};
+// Takes the program's own memory and the read buffer from `budget`.
+ReadPlan plan_reading(MemoryBudget& budget);
+
+// Consecutive voxels built in one pass over the source.
+struct VoxelRange {
+  std::size_t first = 0, end = 0;  // voxels
+  std::uint64_t vertex_first = 0, vertex_end = 0;
+  std::uint32_t max_vertices = 0;  // of its largest voxel
+  unsigned order_threads = 1;      // threads building its orders (fewer where their buffers do not fit)
+};
+
+// What the voxel table fixed, for plan_conversion.
+struct ConversionCounts {
+  const MetaSection& meta;             // streamline, point, synthetic point and voxline counts
+  std::span<const VoxelEntry> voxels;  // laid out: vertex_first, vertex_count and order_offset set
+  std::span<const LevelEntry> levels;  // LODS, voxel-major (empty with one level)
+  std::uint32_t level_count = 1;
+  PositionEncoding positions = PositionEncoding::Packed;
+  std::uint64_t order_bytes = 0;          // ORDR's payload
+  unsigned threads = 1;                   // resolved
+  std::uint64_t batch_streamlines = 0;    // ReadPlan::batch_streamlines
+  std::uint64_t order_chunk_request = 0;  // StreamingTuning::order_chunk_bytes (0: derived)
+};
+
+struct ConversionPlan {
+  std::uint64_t staged_bytes = 0;          // two batches' staged voxlines, as first taken (they may grow)
+  std::uint64_t direct_staging_bytes = 0;  // per section; 0: the output is written through the page cache
+  std::uint64_t order_chunk_bytes = 0;     // orders built and written at once (at least the largest voxel's)
+  // > 0: VERT is written block by block through stagings of this size and read back for the orders.
+  std::uint64_t block_staging_bytes = 0;
+  // Written block by block: one buffer for the blocks' stagings while they are placed, then two orders
+  // chunks (pool_chunk_bytes each) and two chunks' vertices read back (pool_read_back_bytes each).
+  std::uint64_t pool_bytes = 0, pool_chunk_bytes = 0, pool_read_back_bytes = 0;
+  std::vector<VoxelRange> ranges;  // at least one (with no voxels: one empty range, which writes the tables)
+};
+
+// Takes from `budget`, in this order: the tables' buffers, every streamline's voxel span, two batches'
+// staged voxlines, the direct writes' staging, the pool or the orders chunks, and each range's vertices
+// and sort buffers (the largest range's: ranges are cut to fit in what is left).
+ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& counts);
+
+// Where voxel i's orders start in ORDR (i = voxel count: the payload's end).
+inline std::uint64_t orders_start(std::span<const VoxelEntry> voxels, std::uint64_t order_bytes, std::size_t i) {
+  return i < voxels.size() ? voxels[i].order_offset : order_bytes;
+}
+
+// The memory VERT's stagings take when written block by block with stagings of `staging` bytes: the write
+// queue's spares and each (voxel, level) block's own (DirectRegionWriter::staging_size).
+std::uint64_t block_staging_total(const ConversionCounts& counts, std::uint64_t staging);
+
+}  // namespace vxl

@@ -1,0 +1,20 @@
+#include "converter/pipeline/memory_budget.h"
+
+#include <optional>
+
+#include "format/base/error.h"
+#include "format/base/memory_size.h"
+
+namespace vxl {
+
+void MemoryBudget::fail(std::uint64_t needs, std::uint64_t others, const std::string& what,
+                        const std::string& hint) const {
+  // A quarter more than the sum, for what comes later.
+  throw Error(ErrorKind::Unsupported, path_, std::nullopt,
+              "--memory-limit " + format_memory_size(limit_) + " is too small: " + what + " needs " +
+                  format_memory_size(needs) +
+                  (others > 0 ? " on top of " + format_memory_size(others) + " already taken" : std::string()) +
+                  "; use --memory-limit " + memory_limit_argument((needs + others) / 4 * 5) + " or more" + hint);
+}
+
+}  // namespace vxl

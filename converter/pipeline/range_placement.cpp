@@ -1,0 +1,230 @@
+// The streaming conversion's pass per range of voxels: the range's vertices placed into VERT (mapped, or
+// written block by block through stagings), and the voxline and streamline tables with the first range
+// (streaming_conversion.h).
+#include "converter/pipeline/streaming_conversion.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "format/base/parallel.h"
+
+namespace vxl::streaming {
+
+// Pass 2 + k: the blocks and orders of one range.
+void StreamingConversion::build_range(const VoxelRange& r, std::size_t index, std::size_t count) {
+  const std::string of = " " + std::to_string(index + 1) + "/" + std::to_string(count);
+  const bool tables = index == 0;
+  const std::uint64_t range_vertices = r.vertex_end - r.vertex_first;
+  if (plan_.block_staging_bytes > 0) {  // VERT written block by block, then read back for the orders
+    place_range(r, tables, of, {});
+    write_orders(r, {}, "ordering" + of);
+    return;
+  }
+  // The range's vertices are placed straight into the output (a mapping of its part of VERT); the
+  // orders are built from them there before it is unmapped.
+  out_->append_in_place(
+      VxlStreamWriter::kVert, range_vertices * vertex_bytes(job_.settings.positions), job_.threads,
+      [&](std::span<std::uint8_t> window) { place_range(r, tables, of, window); },
+      [&](std::span<const std::uint8_t> window) { write_orders(r, window, "ordering" + of); });
+}
+
+// Pass 2 + k, reading: places range r's vertices in `window` (its part of VERT); the first range also
+// writes the voxline and streamline tables. Each batch is cut in two parts that are voxelised and packed
+// on their own threads (stage_part: packing needs only the voxel, whose tight bounds came from pass 2),
+// then placed in streamline order (place_part), which is what fixes where each vertex goes.
+void StreamingConversion::place_range(const VoxelRange& r, bool tables, const std::string& of,
+                                      std::span<std::uint8_t> window) {
+  auto t0 = Clock::now();
+  RangePlacement placing(r, tables, open_vertex_sink(r, window));
+  if (packed()) {
+    placing.packers.reserve(r.end - r.first);
+    for (std::size_t g = r.first; g < r.end; ++g) placing.packers.emplace_back(table_.voxels[g]);
+  } else {
+    ends_ = VoxlineEnds(r.vertex_end - r.vertex_first);
+  }
+  if (tables) {
+    placing.voxline_buffer.reserve(kTableBufferEntries);
+    placing.streamline_buffer.reserve(kTableBufferEntries);
+  }
+  // Batch k is staged in two parts on two threads while batch k - 1, staged before, is placed on a third:
+  // placing (in streamline order) is the serial part of the pass.
+  int staging = 0;           // the set of parts the current batch is staged in
+  bool other_placed = true;  // whether the other set's parts are placed
+  auto place_staged = [&](int set) {
+    for (const StagedPart& part : placing.parts[set]) place_part(placing, part);
+  };
+  reader_->each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
+    if (first + b.streamline_count() > table_.spans.size()) fail_changed();  // more streamlines than pass 1 saw
+    const std::array<std::uint64_t, 3> cut = two_parts(b);
+    // Item 0 places the earlier batch, so that its errors come first.
+    parallel_for_first_error_in_order(3, job_.threads > 1 ? 3 : 1, [&](std::uint64_t item, unsigned) {
+      if (item == 0) {
+        if (!other_placed) place_staged(1 - staging);
+        return;
+      }
+      stage_part(placing, b, first, cut[item - 1], cut[item], placing.parts[staging][item - 1]);
+    });
+    other_placed = false;
+    staging = 1 - staging;
+    std::uint64_t staged = 0;
+    for (const auto& set : placing.parts)
+      for (const StagedPart& part : set) staged += part.bytes();
+    budget_.track(staged, staged_held_, [] { return std::string("the voxlines of two batches being placed"); });
+  });
+  if (!other_placed) place_staged(1 - staging);
+  placing.sink.finish();  // rethrows a failed write (each block's completeness is checked below)
+  if (placing.streamlines != table_.meta.streamline_count ||
+      (tables && placing.voxline_index != table_.meta.voxline_count))
+    fail_changed();
+  const std::uint32_t levels = job_.settings.levels;
+  for (std::size_t local = 0; local < table_.global_id.size(); ++local) {
+    const std::uint32_t g = table_.global_id[local];
+    if (g < r.first || g >= r.end) continue;
+    for (std::uint32_t d = 0; d < levels; ++d)
+      if (table_.cursor[local * levels + d] !=
+          table_.voxels[g].vertex_first + depth_end_vertex(table_.voxels[g], level_row(table_.levels, g, levels), d))
+        fail_changed();
+  }
+  if (tables) {
+    placing.streamline_buffer.push_back(placing.voxline_index);
+    out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, placing.streamline_buffer);
+    out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, placing.voxline_buffer);
+  }
+  summary_.voxelize_seconds += seconds_since(t0);
+}
+
+// Where range r's vertices go: `window` (its part of VERT), or, written block by block, a writer per
+// (voxel, level) block of the range with vertices, from the block's first vertex (table_.cursor, before any
+// is placed) to its end.
+VertexSink StreamingConversion::open_vertex_sink(const VoxelRange& r, std::span<std::uint8_t> window) const {
+  const std::uint64_t bytes = vertex_bytes(job_.settings.positions);
+  if (plan_.block_staging_bytes == 0) return VertexSink(window, bytes);
+  const std::uint32_t levels = job_.settings.levels;
+  std::vector<std::array<std::uint64_t, 2>> blocks(table_.cursor.size());  // {0, 0}: none in this range
+  for (std::size_t local = 0; local < table_.global_id.size(); ++local) {
+    const std::uint32_t g = table_.global_id[local];
+    if (g < r.first || g >= r.end) continue;
+    for (std::uint32_t d = 0; d < levels; ++d)
+      blocks[local * levels + d] = {
+          table_.cursor[local * levels + d],
+          table_.voxels[g].vertex_first + depth_end_vertex(table_.voxels[g], level_row(table_.levels, g, levels), d)};
+  }
+  return VertexSink(*out_, blocks, bytes, plan_.block_staging_bytes, kSpareBlockStagings, pool_.get(),
+                    plan_.pool_bytes);
+}
+
+// On one thread: voxelises streamlines [begin, end) of batch b (numbered from `first` in the source) and
+// stages the vertices of their voxlines in range, packed (or as float32), in streamline order.
+void StreamingConversion::stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first,
+                                     std::uint64_t begin, std::uint64_t end, StagedPart& part) const {
+  const VoxelRange& r = placing.range;
+  part.begin = begin;
+  part.end = end;
+  part.source_first = first + begin;
+  part.sink.index.index = &table_.sink.index;
+  part.sink.voxlines.clear();
+  part.sink.synthetic_xyz.clear();
+  part.voxline_ends.clear();
+  part.words.clear();
+  part.xyz.clear();
+  const float* pts = b.positions.data();
+  std::vector<float> voxline_xyz;  // one voxline's vertices on their way to being packed
+  part.sink.too_many_synthetic = false;
+  for (std::uint64_t k = begin; k < end; ++k) {
+    const std::size_t start = part.sink.voxlines.size();
+    if (!placing.tables) {
+      const std::array<std::uint32_t, 2>& span = table_.spans[first + k];
+      if (span[1] < r.first || span[0] >= r.end) {  // no voxel in this range (or none at all)
+        part.voxline_ends.push_back(start);
+        continue;
+      }
+    }
+    detail::voxelize_streamline(table_.grid, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], part.sink,
+                                table_.synthetic_limit);
+    if (part.sink.too_many_synthetic) fail_changed();
+    part.voxline_ends.push_back(part.sink.voxlines.size());
+    const std::span<const TempVoxline> streamline(part.sink.voxlines.data() + start, part.sink.voxlines.size() - start);
+    for (std::size_t j = 0; j < streamline.size(); ++j) {
+      const TempVoxline& v = streamline[j];
+      if (v.voxel >= table_.global_id.size()) fail_changed();  // a voxel pass 2 did not see
+      const std::uint32_t g = table_.global_id[v.voxel];
+      if (g < r.first || g >= r.end) continue;
+      const std::uint64_t used = v.own() + (j + 1 < streamline.size() ? 1 : 0);
+      if (!packed()) {
+        const std::size_t at = part.xyz.size();
+        part.xyz.resize(at + 3 * used);
+        detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), part.xyz.data() + at);
+        continue;
+      }
+      voxline_xyz.resize(3 * used);
+      detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), voxline_xyz.data());
+      // A vertex outside the bounds pass 2 found would be clamped: the source changed.
+      const VoxelEntry& voxel = table_.voxels[g];
+      for (std::uint64_t e = 0; e < used; ++e)
+        for (int c = 0; c < 3; ++c)
+          if (!(voxline_xyz[3 * e + c] >= voxel.tight_min[c] && voxline_xyz[3 * e + c] <= voxel.tight_max[c]))
+            fail_changed();
+      const std::size_t at = part.words.size();
+      part.words.resize(at + used);
+      placing.packers[g - r.first].words(voxline_xyz.data(), used, part.words.data() + at);
+      part.words[at + used - 1] |= kPackedVoxlineEnd;
+    }
+  }
+}
+
+// In streamline order: copies a staged part's vertices to their blocks (each voxel's next place for the
+// streamline's depth) and, for the first range, writes its voxline and streamline table entries.
+void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& part) {
+  const std::uint64_t first = part.source_first;
+  const VoxelRange& r = placing.range;
+  const std::uint32_t levels = job_.settings.levels;
+  std::uint64_t staged = 0;  // vertices of the part placed so far
+  std::size_t start = 0;
+  for (std::uint64_t k = 0; k < part.end - part.begin; ++k) {
+    const std::size_t end = part.voxline_ends[k];
+    const std::span<const TempVoxline> streamline(part.sink.voxlines.data() + start, end - start);
+    start = end;
+    std::array<std::uint32_t, 2>& span = table_.spans[first + k];
+    if (placing.tables) {
+      span = {std::numeric_limits<std::uint32_t>::max(), 0};
+      placing.streamline_buffer.push_back(placing.voxline_index);
+      if (placing.streamline_buffer.size() == kTableBufferEntries) {
+        out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, placing.streamline_buffer);
+        placing.streamline_buffer.clear();
+      }
+    } else if (span[1] < r.first || span[0] >= r.end) {
+      continue;
+    }
+    const std::uint32_t depth = streamline_depth(first + k, levels);
+    for (std::size_t j = 0; j < streamline.size(); ++j) {
+      const TempVoxline& v = streamline[j];
+      const std::uint32_t g = table_.global_id[v.voxel];  // checked by stage_part
+      const std::uint32_t own = v.own();
+      if (placing.tables) {
+        span = {std::min(span[0], g), std::max(span[1], g)};
+        placing.voxline_buffer.push_back({g, own | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)});
+        if (placing.voxline_buffer.size() == kTableBufferEntries) {
+          out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, placing.voxline_buffer);
+          placing.voxline_buffer.clear();
+        }
+      }
+      if (g < r.first || g >= r.end) continue;
+      const std::uint64_t used = own + (j + 1 < streamline.size() ? 1 : 0);
+      std::uint64_t& cursor = table_.cursor[std::size_t(v.voxel) * levels + depth];
+      const std::uint64_t block_end = table_.voxels[g].vertex_first +
+                                      depth_end_vertex(table_.voxels[g], level_row(table_.levels, g, levels), depth);
+      if (cursor > block_end || used > block_end - cursor) fail_changed();
+      const std::uint64_t at = cursor - r.vertex_first;
+      if (!packed()) ends_.set(at + used - 1);
+      const auto* from = packed() ? reinterpret_cast<const std::uint8_t*>(part.words.data() + staged)
+                                  : reinterpret_cast<const std::uint8_t*>(part.xyz.data() + 3 * staged);
+      placing.sink.put(std::size_t(v.voxel) * levels + depth, at, from, used);
+      staged += used;
+      cursor += used;
+    }
+    placing.voxline_index += streamline.size();
+  }
+  placing.streamlines += part.end - part.begin;
+}
+
+}  // namespace vxl::streaming

@@ -1,0 +1,201 @@
+// The conversion within a memory limit (streaming_convert.h), in stages that share this class: the scan and
+// the voxel counts (voxel_counting.cpp), the plan (conversion_plan.h), each range's placing pass
+// (range_placement.cpp) and its orders (range_orders.cpp); streaming_convert.cpp runs them. Internal to
+// those files.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "converter/convert.h"
+#include "converter/pipeline/batch_reader.h"
+#include "converter/pipeline/conversion_plan.h"
+#include "converter/pipeline/memory_budget.h"
+#include "converter/pipeline/vertex_sink.h"
+#include "converter/position_packing.h"
+#include "converter/segment_orders.h"
+#include "converter/streaming_convert.h"
+#include "converter/voxel_table.h"
+#include "converter/voxelize.h"
+#include "converter/voxelize_streamline.h"
+#include "format/base/direct_region_writer.h"
+#include "format/base/direct_write_queue.h"
+#include "format/vxl_positions.h"
+#include "format/vxl_stream_writer.h"
+
+namespace vxl::streaming {
+
+using detail::Grid;
+using detail::kNoSynthetic;
+using detail::TempVoxline;
+using detail::VoxelIndex;
+using Clock = std::chrono::steady_clock;
+
+// Where a batch is cut into two parts of about as many points each, for two threads: streamlines
+// [cut[0], cut[1]) and [cut[1], cut[2]).
+inline std::array<std::uint64_t, 3> two_parts(const Tractogram& b) {
+  const std::uint64_t n = b.streamline_count();
+  const std::uint64_t half =
+      std::upper_bound(b.offsets.begin(), b.offsets.end(), b.point_count() / 2) - b.offsets.begin() - 1;
+  return {0, std::min(half, n), n};
+}
+
+inline double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// Where voxelize_streamline puts the voxlines of one streamline (or of several, one after the other).
+template <typename Index>
+struct SinkOf {
+  Index index;
+  std::vector<TempVoxline> voxlines;
+  std::vector<float> synthetic_xyz;
+  bool too_many_synthetic = false;
+  std::uint64_t bytes() const {
+    return voxlines.capacity() * sizeof(TempVoxline) + synthetic_xyz.capacity() * sizeof(float);
+  }
+};
+
+using Sink = SinkOf<VoxelIndex>;
+
+// What the conversion was asked to do.
+struct StreamingJob {
+  std::string path, out_path;
+  ConvertSettings settings;  // its voxel_size chosen by the scan under --voxel-size auto
+  StreamingTuning tuning;
+  OrderSetSpec order_set;
+  unsigned threads = 1;           // resolved
+  std::string voxel_size_choice;  // --voxel-size auto's reason, once the scan has chosen
+};
+
+// What pass 1 found: the bounds of every point and the longest step (squared).
+struct SourceScan {
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  double longest_step2 = 0;
+};
+
+// Pass 2's counts and tight bounds per voxel (by local id), until build_table makes the voxel table of them.
+struct CountingState {
+  detail::VoxelUse use;
+  detail::VoxelBounds bounds;
+  std::uint64_t sink_held = 0, table_held = 0;  // as taken from the budget
+};
+
+// The voxel table, and what maps the source's voxels and streamlines onto it, from pass 2 on.
+struct StreamedVoxelTable {
+  MetaSection meta{};
+  Grid grid{};
+  std::uint64_t synthetic_limit = 0;     // points added at voxel faces, at most
+  Sink sink;                             // the source's voxel index (local ids)
+  std::vector<std::uint32_t> global_id;  // local id -> voxel index
+  std::vector<VoxelEntry> voxels;
+  std::vector<LevelEntry> levels;  // LODS, voxel-major
+  // By (local id * levels + depth): the next vertex of its voxel to place for that depth (global index).
+  std::vector<std::uint64_t> cursor;
+  std::uint64_t order_bytes = 0;
+  // Per streamline: its lowest and highest voxel index (set by the first range's pass), so that later
+  // passes skip the streamlines that have no voxel in their range.
+  std::vector<std::array<std::uint32_t, 2>> spans;
+};
+
+// One conversion within a memory limit: run() reads the source with a BatchReader, scans it (scan), counts
+// its voxels (count_voxels) into the voxel table (build_table), plans the rest (plan_conversion), then
+// builds each range (build_range: place_range, then write_orders) and writes the tables (write_rest).
+class StreamingConversion {
+ public:
+  StreamingConversion(const std::string& source, const std::string& out, const ConvertSettings& settings,
+                      const StreamingTuning& tuning)
+      : job_{source, out, settings, tuning, {}, 1, {}}, budget_(settings.memory_limit, source) {}
+
+  ConvertSummary run();
+
+ private:
+  void check_source_type() const;
+  void open_stream();
+  void scan();
+  void count_voxels();
+  void build_table();
+  void build_range(const VoxelRange& r, std::size_t index, std::size_t count);
+  struct PlanPart;
+  void count_part(const Tractogram& b, std::uint64_t first, std::uint64_t begin, std::uint64_t end,
+                  std::uint64_t points, std::uint64_t synthetic, std::uint64_t most_voxels, std::uint64_t other_voxels,
+                  PlanPart& part) const;
+  struct StagedPart;
+  struct RangePlacement;
+  void place_range(const VoxelRange& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
+  VertexSink open_vertex_sink(const VoxelRange& r, std::span<std::uint8_t> window) const;
+  void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
+                  std::uint64_t end, StagedPart& part) const;
+  void place_part(RangePlacement& placing, const StagedPart& part);
+  void write_orders(const VoxelRange& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
+  void write_voxel_orders(const VoxelRange& r, std::size_t g, std::span<const std::uint8_t> vertices,
+                          std::uint64_t vertices_first, VoxelOrderWriter& writer, VoxlineEnds& block_ends,
+                          std::uint8_t* dst);
+  bool packed() const { return job_.settings.positions == PositionEncoding::Packed; }
+  // Where voxel i's orders start in ORDR (i = voxel count: the payload's end).
+  std::uint64_t orders_start(std::size_t i) const { return vxl::orders_start(table_.voxels, table_.order_bytes, i); }
+  void write_rest();
+  [[noreturn]] void fail_changed() const;
+  void report(const std::string& stage, double fraction) const {
+    if (job_.settings.progress) job_.settings.progress(stage.c_str(), fraction);
+  }
+
+  StreamingJob job_;
+  MemoryBudget budget_;
+  ConvertSummary summary_;
+  std::unique_ptr<BatchReader> reader_;
+  SourceScan scan_;                // pass 1
+  CountingState counting_;         // pass 2, until the table is built
+  StreamedVoxelTable table_;       // pass 2 on
+  ConversionPlan plan_;            // once the voxel table is built
+  std::uint64_t staged_held_ = 0;  // the staged parts of two batches, as taken from the budget
+  // Written block by block: one buffer for the blocks' staging while they are placed, then for the
+  // orders' chunks and the vertices read back (fresh pages are dear: a buffer reused is not faulted in
+  // again).
+  std::unique_ptr<std::uint8_t, void (*)(void*)> pool_{nullptr, std::free};
+  VoxlineEnds ends_;  // float32 positions: the voxline ends of the range being built
+  std::unique_ptr<VxlStreamWriter> out_;
+};
+
+// Part of a batch voxelised on its own thread (stage_part), waiting to be placed in order.
+struct StreamingConversion::StagedPart {
+  std::uint64_t begin = 0, end = 0;       // streamlines of the batch
+  std::uint64_t source_first = 0;         // the index of streamline `begin` in the source
+  SinkOf<detail::SharedVoxelIndex> sink;  // every voxline of the part, in order
+  std::vector<std::size_t> voxline_ends;  // per streamline: the end of its voxlines in sink.voxlines
+  std::vector<std::uint32_t> words;       // packed: the vertices of the voxlines in range, in order
+  std::vector<float> xyz;                 // float32: the same
+  std::uint64_t bytes() const {
+    return sink.bytes() + voxline_ends.capacity() * sizeof(std::size_t) + words.capacity() * sizeof(std::uint32_t) +
+           xyz.capacity() * sizeof(float);
+  }
+};
+
+// What one range's placing pass keeps between batches.
+struct StreamingConversion::RangePlacement {
+  RangePlacement(const VoxelRange& r, bool first_range, VertexSink&& vertex_sink)
+      : range(r), tables(first_range), sink(std::move(vertex_sink)) {}
+  const VoxelRange& range;
+  bool tables;                        // the first range: also the voxline and streamline tables
+  VertexSink sink;                    // where the range's vertices go (blocks by local voxel id * levels + level)
+  std::vector<VertexPacker> packers;  // by voxel - range.first (packed positions)
+  std::vector<VoxlineEntry> voxline_buffer;
+  std::vector<std::uint64_t> streamline_buffer;
+  std::uint64_t voxline_index = 0, streamlines = 0;
+  StagedPart parts[2][2];  // two sets of two parts: one being staged, one being placed
+};
+
+// Part of a batch counted on its own thread in pass 2 (count_part).
+struct StreamingConversion::PlanPart {
+  Sink sink;
+  detail::VoxelUse use;
+  detail::VoxelBounds bounds;
+  std::uint64_t voxlines = 0, synthetic = 0;  // in the batch being counted
+};
+
+}  // namespace vxl::streaming

@@ -1,0 +1,168 @@
+// The streaming conversion's first two passes: the scan (bounds, checksum, warnings) and the counts and
+// tight bounds per voxel, then the voxel table made of them (streaming_conversion.h).
+#include "converter/pipeline/streaming_conversion.h"
+
+#include <algorithm>
+#include <utility>
+
+#include "converter/voxel_size_auto.h"
+#include "format/base/parallel.h"
+
+namespace vxl::streaming {
+
+// Pass 1: what plan_voxels' bounds scan finds, and the source's checksum and warnings.
+void StreamingConversion::scan() {
+  detail::BoundsScan bounds;
+  std::uint64_t streamlines = 0, points = 0;
+  reader_->each_batch("reading", [&](const Tractogram& b, std::uint64_t first) {
+    reader_->note_longest(b, first);
+    // In two parts on two threads, merged in order (a scan stops at a bad point; reading goes on for the
+    // reader's errors).
+    const std::array<std::uint64_t, 3> cut = two_parts(b);
+    detail::BoundsScan parts[2];
+    parallel_for(2, job_.threads > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
+      parts[p].add(b.positions.data(), b.offsets.data(), cut[p], cut[p + 1], first);
+    });
+    for (const detail::BoundsScan& part : parts) bounds.merge(part);
+    streamlines += b.streamline_count();
+    points += b.point_count();
+  });
+  bounds.check(job_.path);
+  for (int c = 0; c < 3; ++c) {
+    scan_.lo[c] = bounds.lo[c];
+    scan_.hi[c] = bounds.hi[c];
+  }
+  scan_.longest_step2 = bounds.longest_step2;
+  table_.meta.streamline_count = streamlines;
+  table_.meta.point_count = points;
+  if (job_.settings.voxel_size_auto) {
+    const VoxelSizeChoice choice = choose_voxel_size(points, scan_.lo, scan_.hi, bounds.rms_step(), job_.path);
+    job_.settings.voxel_size = choice.size;
+    job_.voxel_size_choice = choice.reason;
+  }
+  table_.meta.voxel_size = job_.settings.voxel_size;
+}
+
+// Pass 2: the vertex and segment counts and the tight bounds per voxel (plan_voxels' pass 1), kept per
+// voxel only. Each batch is cut in two parts counted on two threads: the first into the source's voxel
+// index (table_.sink, counting_.use, counting_.bounds), the second into a part of its own (PlanPart), merged into it
+// after the batch — the counts and bounds do not depend on the order streamlines are counted in.
+void StreamingConversion::count_voxels() {
+  counting_.use = detail::VoxelUse(job_.settings.levels);
+  if (table_.meta.point_count == 0) return;  // no voxels (plan_voxels returns early too)
+  table_.grid = detail::set_grid(table_.meta, scan_.lo, scan_.hi, job_.path);
+  // plan_voxels' limit on added points, applied to the whole source (plan_voxels applies it per
+  // thread's range: the two can differ only in whether a borderline source is refused).
+  table_.synthetic_limit =
+      static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(table_.meta.point_count)) + 4096;
+  PlanPart main{std::move(table_.sink), std::move(counting_.use), std::move(counting_.bounds), 0, 0},
+      other{Sink(), detail::VoxelUse(job_.settings.levels), {}, 0, 0};
+  PlanPart* parts[2] = {&main, &other};
+  std::uint64_t voxlines = 0, synthetic = 0, points = 0;
+  reader_->each_batch("voxelising", [&](const Tractogram& b, std::uint64_t first) {
+    const std::array<std::uint64_t, 3> cut = two_parts(b);
+    // The voxels the limit leaves room for in this batch, half to each part: a part that would need more
+    // fails (no matter how many the other adds, so that the outcome does not depend on timing).
+    const std::uint64_t room =
+        (counting_.table_held + budget_.left()) / voxel_table_bytes_per_voxel(job_.settings.levels);
+    const std::uint64_t start = main.sink.index.coords().size();
+    const std::uint64_t headroom = room > start ? room - start : 0;
+    const std::uint64_t most[2] = {start + headroom / 2, headroom - headroom / 2};
+    parallel_for_first_error_in_order(2, job_.threads > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
+      count_part(b, first, cut[p], cut[p + 1], points, synthetic, most[p], p == 0 ? 0 : start, *parts[p]);
+    });
+    for (PlanPart* part : parts) {
+      voxlines += std::exchange(part->voxlines, 0);
+      synthetic += std::exchange(part->synthetic, 0);
+    }
+    if (synthetic > table_.synthetic_limit)
+      detail::fail_too_many_synthetic(job_.path, table_.meta.voxel_size, scan_.longest_step2);
+    // Both parts' tables at their largest (within the limit, by the parts' shares); then the second
+    // part's voxels into the first's index.
+    const std::vector<detail::Coord>& coords = other.sink.index.coords();
+    const std::uint64_t peak = main.sink.index.coords().size() + coords.size();
+    const std::uint32_t levels = job_.settings.levels;
+    for (std::uint32_t j = 0; j < coords.size(); ++j) {
+      const std::uint32_t i = main.sink.index.find_or_insert(coords[j]);
+      main.use.grow_to(main.sink.index.coords().size());
+      main.bounds.grow_to(main.sink.index.coords().size());
+      for (std::uint32_t d = 0; d < levels; ++d) {
+        main.use.vertices[std::size_t(i) * levels + d] += other.use.vertices[std::size_t(j) * levels + d];
+        main.use.segments[std::size_t(i) * levels + d] += other.use.segments[std::size_t(j) * levels + d];
+      }
+      main.bounds.merge(i, other.bounds, j);
+    }
+    const std::uint64_t sinks = main.sink.bytes() + other.sink.bytes();
+    budget_.track(peak * voxel_table_bytes_per_voxel(levels), counting_.table_held, [] { return std::string(); });
+    other = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0};
+    budget_.shrink(main.sink.index.coords().size() * voxel_table_bytes_per_voxel(levels), counting_.table_held);
+    budget_.track(sinks, counting_.sink_held, [] { return std::string("the voxline lists of two streamlines"); });
+    points += b.point_count();
+  });
+  table_.sink = std::move(main.sink);
+  counting_.use = std::move(main.use);
+  counting_.bounds = std::move(main.bounds);
+  table_.meta.voxline_count = voxlines;
+  table_.meta.synthetic_point_count = synthetic;
+}
+
+// On one thread: counts streamlines [begin, end) of batch b (numbered from `first`) into `part`, whose
+// index may grow to `most_voxels` (its share of the limit; checked after every streamline, so that a table
+// outgrowing the limit is caught before it goes far past it); `other_voxels` are the other part's at the
+// batch's start, for the message. `points` and `synthetic` are those of the batches before.
+void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, std::uint64_t begin, std::uint64_t end,
+                                     std::uint64_t points, std::uint64_t synthetic, std::uint64_t most_voxels,
+                                     std::uint64_t other_voxels, PlanPart& part) const {
+  const float* pts = b.positions.data();
+  const std::uint64_t bytes_per_voxel = voxel_table_bytes_per_voxel(job_.settings.levels);
+  for (std::uint64_t k = begin; k < end; ++k) {
+    part.sink.voxlines.clear();
+    part.sink.synthetic_xyz.clear();
+    detail::voxelize_streamline(table_.grid, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], part.sink,
+                                table_.synthetic_limit - std::min(table_.synthetic_limit, synthetic + part.synthetic));
+    if (part.sink.too_many_synthetic)
+      detail::fail_too_many_synthetic(job_.path, table_.meta.voxel_size, scan_.longest_step2);
+    part.synthetic += part.sink.synthetic_xyz.size() / 3;
+    const std::size_t n_local = part.sink.index.coords().size();
+    part.use.grow_to(n_local);
+    detail::count_voxel_use(part.sink.voxlines, streamline_depth(first + k, job_.settings.levels), part.use, job_.path);
+    part.bounds.grow_to(n_local);
+    for (std::size_t j = 0; j < part.sink.voxlines.size(); ++j)
+      part.bounds.add_voxline(part.sink.voxlines, j, pts, part.sink.synthetic_xyz.data());
+    part.voxlines += part.sink.voxlines.size();
+    if (n_local > most_voxels) {
+      const std::uint64_t voxels = n_local + other_voxels;
+      // Voxels turn up ever more slowly: extrapolating from the points read so far overestimates.
+      const std::uint64_t read = points + b.offsets[k + 1];
+      const std::uint64_t all =
+          static_cast<std::uint64_t>(double(voxels) * double(table_.meta.point_count) / double(read));
+      budget_.fail(all * bytes_per_voxel, budget_.used() - counting_.table_held,
+                   "the voxel table (" + std::to_string(voxels) + " voxels after " + std::to_string(read) + " of " +
+                       std::to_string(table_.meta.point_count) + " points; about " + std::to_string(all) +
+                       " in all, extrapolated)",
+                   ", or a larger --voxel-size");
+    }
+  }
+}
+
+// The voxel table sorted by (z, y, x), as plan_voxels and layout_orders make it.
+void StreamingConversion::build_table() {
+  detail::LocalVoxels table{&table_.sink.index.coords(), &counting_.use, {}, {}};
+  counting_.use.grow_to(table_.sink.index.coords().size());
+  detail::VoxelTable built = detail::build_voxel_table({&table, 1}, job_.settings.levels, table_.meta, job_.path);
+  table_.voxels = std::move(built.voxels);
+  table_.levels = std::move(built.levels);
+  counting_.use = detail::VoxelUse(job_.settings.levels);
+  table_.global_id = std::move(table.global_id);
+  table_.cursor = std::move(table.cursor);
+  for (std::uint32_t local = 0; local < table_.global_id.size(); ++local)
+    counting_.bounds.set_tight_bounds(local, table_.voxels[table_.global_id[local]]);
+  counting_.bounds = detail::VoxelBounds();
+  table_.meta.stored_order_count = static_cast<std::uint32_t>(job_.order_set.directions.size());
+  table_.meta.order_set = static_cast<std::uint32_t>(job_.order_set.kind);
+  table_.meta.position_encoding = static_cast<std::uint32_t>(job_.settings.positions);
+  table_.order_bytes =
+      layout_orders(table_.voxels, table_.levels, job_.settings.levels, table_.meta.stored_order_count);
+}
+
+}  // namespace vxl::streaming
