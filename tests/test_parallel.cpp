@@ -137,6 +137,23 @@ TEST(BackgroundTask, ADestroyedOrReplacedTaskIsWaitedFor) {
   BackgroundTask<> ignored([] { throw std::runtime_error("dropped"); });  // joined, not rethrown, when destroyed
 }
 
+// ready() answers without waiting: false while the task runs, true once get() would return at once.
+TEST(BackgroundTask, ReadySaysWithoutWaitingWhetherTheResultIsThere) {
+  std::atomic<bool> release{false};
+  BackgroundTask<int> task([&] {
+    while (!release.load()) std::this_thread::yield();
+    return 7;
+  });
+  EXPECT_TRUE(task.valid());
+  EXPECT_FALSE(task.ready()) << "the task waits for the release";
+  release = true;
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!task.ready() && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) std::this_thread::yield();
+  ASSERT_TRUE(task.ready());
+  EXPECT_EQ(task.get(), 7);
+  EXPECT_FALSE(task.ready()) << "an empty task has nothing to give";
+}
+
 TEST(BackgroundTask, MovingATaskKeepsItsResult) {
   BackgroundTask<std::vector<int>> task([] { return std::vector<int>{1, 2, 3}; });
   BackgroundTask<std::vector<int>> moved = std::move(task);

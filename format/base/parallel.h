@@ -95,7 +95,7 @@ void parallel_invoke(bool concurrent, A&& a, B&& b) {
 // Runs fn() on a thread of its own while the caller goes on; get() waits for it and returns its result
 // or rethrows its exception on the caller's thread. A task not waited for is joined by its destructor
 // (its exception dropped): nothing outlives the owner. An empty task (default-constructed, moved from,
-// or after get()) is not valid().
+// or after get()) is not valid(); ready() says, without waiting, whether get() would return at once.
 template <typename T = void>
 class BackgroundTask {
  public:
@@ -111,6 +111,7 @@ class BackgroundTask {
       } catch (...) {
         state->error = std::current_exception();
       }
+      state->finished.store(true, std::memory_order_release);
     });
   }
   BackgroundTask(BackgroundTask&&) noexcept = default;
@@ -123,6 +124,7 @@ class BackgroundTask {
   ~BackgroundTask() { join(); }
 
   bool valid() const { return state_ != nullptr; }
+  bool ready() const { return state_ && state_->finished.load(std::memory_order_acquire); }
   T get() {
     join();
     const std::unique_ptr<State> state = std::move(state_);
@@ -135,6 +137,7 @@ class BackgroundTask {
   struct State {
     std::conditional_t<std::is_void_v<T>, Empty, std::optional<T>> value;
     std::exception_ptr error;
+    std::atomic<bool> finished{false};
   };
   void join() {
     if (thread_.joinable()) thread_.join();

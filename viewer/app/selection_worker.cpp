@@ -13,9 +13,8 @@ namespace vxl::app {
 SelectionWorker::SelectionWorker(std::vector<const VxlFile*> files, std::shared_ptr<VoxelVoxlinesCache> indexes)
     : files_(std::move(files)), indexes_(std::move(indexes)) {}
 
-SelectionWorker::~SelectionWorker() {
-  if (running_.valid()) running_.wait();
-}
+// running_'s destructor waits for a selection still running.
+SelectionWorker::~SelectionWorker() = default;
 
 void SelectionWorker::request(std::uint64_t revision, SelectionCriteria criteria) {
   if (running_.valid())
@@ -25,7 +24,7 @@ void SelectionWorker::request(std::uint64_t revision, SelectionCriteria criteria
 }
 
 void SelectionWorker::start(std::uint64_t revision, SelectionCriteria criteria) {
-  running_ = std::async(std::launch::async, [this, revision, criteria = std::move(criteria)] {
+  running_ = BackgroundTask<Done>([this, revision, criteria = std::move(criteria)] {
 #if defined(__linux__)
     // Below the window's thread (and the software rasteriser's, where there is no GPU), so that the frames
     // keep their budget on a machine with few cores; the threads the selection starts inherit it.
@@ -53,7 +52,7 @@ std::optional<SelectionWorker::Done> SelectionWorker::poll(bool wait) {
       waiting_.reset();
       start(revision, std::move(criteria));
     }
-    if (!wait && running_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return newest;
+    if (!wait && !running_.ready()) return newest;
     newest = running_.get();
   }
 }

@@ -7,13 +7,13 @@
 #pragma once
 
 #include <cstdint>
-#include <future>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "converter/selection/streamline_selection.h"
+#include "format/base/parallel.h"
 #include "viewer/app/scene_selection.h"
 
 namespace vxl::app {
@@ -46,7 +46,7 @@ class SelectionWorker {
 
   std::vector<const VxlFile*> files_;
   std::shared_ptr<VoxelVoxlinesCache> indexes_;
-  std::future<Done> running_;
+  BackgroundTask<Done> running_;
   std::optional<std::pair<std::uint64_t, SelectionCriteria>> waiting_;
 };
 
