@@ -28,12 +28,11 @@
 #include <string>
 #include <vector>
 
-#include <zip.h>
-
 #include "converter/readers/float16.h"
 #include "converter/readers/latin1.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/regular_file.h"
+#include "converter/readers/trx_members.h"
 #include "format/base/checksum.h"
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
@@ -42,166 +41,8 @@
 namespace vxl {
 namespace {
 
-// ---- member access: the same interface over a zip archive and a directory ----
-
-// One member's bytes, either copied out of the archive or memory-mapped from the directory.
-class Blob {
- public:
-  explicit Blob(std::vector<std::uint8_t> owned) : owned_(std::move(owned)) {}
-  explicit Blob(MappedFile mapped) : mapped_(std::move(mapped)) {}
-  std::span<const std::uint8_t> bytes() const {
-    if (mapped_) return mapped_->bytes();
-    return {owned_.data(), owned_.size()};
-  }
-
- private:
-  std::vector<std::uint8_t> owned_;
-  std::optional<MappedFile> mapped_;
-};
-
-class Members {
- public:
-  virtual ~Members() = default;
-  // Regular-file members, by relative path with '/' separators, mapped to their index for read().
-  const std::map<std::string, std::uint64_t>& names() const { return names_; }
-  bool has(const std::string& name) const { return names_.count(name) != 0; }
-  // The member's size as the archive's directory (or the file system) says, before reading it.
-  virtual std::uint64_t declared_size(const std::string& name) const = 0;
-  // The member's bytes. Refuses, naming the member, one that declares or holds more than `max_bytes`:
-  // `why` says where that bound comes from (header.json's counts fix every member's size), and no more
-  // than max_bytes + 1 are ever inflated.
-  virtual Blob read(const std::string& name, std::uint64_t max_bytes, const std::string& why) const = 0;
-
- protected:
-  std::map<std::string, std::uint64_t> names_;
-};
-
-class ZipMembers : public Members {
- public:
-  // `bytes` must outlive this object (it is the caller's mapping of the archive).
-  ZipMembers(const std::string& path, std::span<const std::uint8_t> bytes) : path_(path) {
-    zip_error_t error;
-    zip_error_init(&error);
-    zip_source_t* src = zip_source_buffer_create(bytes.data(), bytes.size(), 0, &error);
-    if (src == nullptr) fail(error);
-    zip_t* archive = zip_open_from_source(src, ZIP_RDONLY, &error);
-    if (archive == nullptr) {
-      zip_source_free(src);
-      fail(error);
-    }
-    zip_error_fini(&error);
-    archive_.reset(archive);
-    const zip_int64_t n = zip_get_num_entries(archive, 0);
-    for (zip_int64_t i = 0; i < n; ++i) {
-      // libzip hands out names as UTF-8 (it converts legacy CP437 names).
-      const char* name = zip_get_name(archive, static_cast<zip_uint64_t>(i), 0);
-      if (name == nullptr) continue;
-      std::string s = name;
-      if (s.empty() || s.back() == '/') continue;  // directory entries carry no data
-      if (!names_.emplace(s, static_cast<std::uint64_t>(i)).second)
-        fail_input(path_, std::nullopt, "member " + s + " appears twice in the zip archive");
-    }
-  }
-  std::uint64_t declared_size(const std::string& name) const override { return stat(name).size; }
-  Blob read(const std::string& name, std::uint64_t max_bytes, const std::string& why) const override {
-    zip_t* archive = archive_.get();
-    const zip_stat_t st = stat(name);
-    if (st.size > max_bytes)
-      fail_input(path_, std::nullopt,
-                 name + ": its zip entry declares " + std::to_string(st.size) + " bytes, more than the " +
-                     std::to_string(max_bytes) + " " + why);
-    // What the compressed bytes can inflate to at most: deflate's best ratio is 1032:1, stored is 1:1.
-    if ((st.valid & ZIP_STAT_COMP_SIZE) && (st.valid & ZIP_STAT_COMP_METHOD)) {
-      const zip_uint64_t most = st.comp_method == ZIP_CM_STORE     ? st.comp_size
-                                : st.comp_method == ZIP_CM_DEFLATE ? st.comp_size * 1032 + 1024
-                                                                   : ~zip_uint64_t{0};
-      if (st.size > most)
-        fail_input(path_, std::nullopt,
-                   name + ": its zip entry declares " + std::to_string(st.size) + " bytes, more than its " +
-                       std::to_string(st.comp_size) + " compressed bytes can hold");
-    }
-    zip_file_t* f = zip_fopen_index(archive, names_.at(name), 0);
-    if (f == nullptr) fail_input(path_, std::nullopt, name + ": cannot open the zip entry: " + zip_strerror(archive));
-    // Bounded above: the whole declared size is known to be justified, so it is allocated at once. One byte
-    // beyond it is asked for to catch an entry that inflates to more than it declares.
-    std::vector<std::uint8_t> out(static_cast<std::size_t>(st.size) + 1);
-    std::uint64_t have = 0;
-    while (have < out.size()) {
-      const zip_int64_t got = zip_fread(f, out.data() + have, out.size() - have);
-      if (got < 0) {
-        std::string msg = zip_file_strerror(f);
-        zip_fclose(f);
-        fail_input(path_, std::nullopt, name + ": corrupt zip entry: " + msg);
-      }
-      if (got == 0) break;
-      have += static_cast<std::uint64_t>(got);
-    }
-    zip_fclose(f);
-    if (have > st.size)
-      fail_input(path_, std::nullopt,
-                 name + ": zip entry inflates to more than the " + std::to_string(st.size) +
-                     " bytes its directory entry declares");
-    out.resize(have);
-    if (out.size() != st.size)
-      fail_input(path_, std::nullopt,
-                 name + ": zip entry holds " + std::to_string(out.size()) + " bytes but its directory entry says " +
-                     std::to_string(st.size));
-    return Blob(std::move(out));
-  }
-
- private:
-  zip_stat_t stat(const std::string& name) const {
-    zip_stat_t st;
-    zip_stat_init(&st);
-    if (zip_stat_index(archive_.get(), names_.at(name), 0, &st) != 0 || (st.valid & ZIP_STAT_SIZE) == 0)
-      fail_input(path_, std::nullopt, name + ": cannot read the zip entry: " + zip_strerror(archive_.get()));
-    return st;
-  }
-
-  [[noreturn]] void fail(zip_error_t& error) {
-    std::string msg = zip_error_strerror(&error);
-    zip_error_fini(&error);
-    fail_input(path_, std::nullopt, "not a readable TRX zip archive: " + msg);
-  }
-
-  struct Discard {
-    void operator()(zip_t* z) const { zip_discard(z); }
-  };
-  std::string path_;
-  std::unique_ptr<zip_t, Discard> archive_;
-};
-
-class DirMembers : public Members {
- public:
-  explicit DirMembers(const std::string& path) : root_(path) {
-    std::error_code ec;
-    std::filesystem::recursive_directory_iterator it(root_, ec), end;
-    if (ec) fail_input(path, std::nullopt, "cannot list the TRX directory: " + ec.message());
-    for (; it != end; it.increment(ec)) {
-      if (ec) fail_input(path, std::nullopt, "cannot list the TRX directory: " + ec.message());
-      if (!it->is_regular_file()) continue;
-      names_.emplace(std::filesystem::relative(it->path(), root_).generic_string(), 0);
-    }
-    if (ec) fail_input(path, std::nullopt, "cannot list the TRX directory: " + ec.message());
-  }
-  std::uint64_t declared_size(const std::string& name) const override {
-    std::error_code ec;
-    const std::uint64_t size = std::filesystem::file_size(root_ / name, ec);
-    if (ec) fail_input(root_.string(), std::nullopt, name + ": cannot stat: " + ec.message());
-    return size;
-  }
-  Blob read(const std::string& name, std::uint64_t max_bytes, const std::string& why) const override {
-    MappedFile file((root_ / name).string());  // mapped, not read: its size costs no memory yet
-    if (file.size() > max_bytes)
-      fail_input(root_.string(), std::nullopt,
-                 name + ": holds " + std::to_string(file.size()) + " bytes, more than the " +
-                     std::to_string(max_bytes) + " " + why);
-    return Blob(std::move(file));
-  }
-
- private:
-  std::filesystem::path root_;
-};
+using trx::Blob;
+using trx::Members;
 
 // ---- little-endian loads ----
 
@@ -585,7 +426,7 @@ Tractogram read_trx(const std::string& path) {
   std::unique_ptr<Members> members;
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
-    members = std::make_unique<DirMembers>(path);
+    members = trx::dir_members(path);
     // Directory provenance: the member files' bytes in byte-wise order of their relative paths
     // (std::string compares as unsigned bytes), so the hash does not depend on listing order.
     Xxh3_128Stream hash;
@@ -599,7 +440,7 @@ Tractogram read_trx(const std::string& path) {
     zip_file.emplace(path);
     t.source.bytes = zip_file->size();
     t.source.xxh3_128 = xxh3_128_hex(zip_file->data(), zip_file->size());
-    members = std::make_unique<ZipMembers>(path, zip_file->bytes());
+    members = trx::zip_members(path, zip_file->bytes());
   }
 
   // header.json
