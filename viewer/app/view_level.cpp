@@ -8,15 +8,6 @@ const SceneLayout& LevelLayouts::at(std::uint32_t level) {
   return *layout;
 }
 
-SceneBounds scene_bounds(std::span<const VxlFile* const> files, const Volume* volume) {
-  SceneBounds b = line_bounds(files);
-  if (volume) {
-    b.min = glm::min(b.min, volume->ras_min());
-    b.max = glm::max(b.max, volume->ras_max());
-  }
-  return b;
-}
-
 std::uint32_t level_for_view(LevelLayouts& layouts, const SceneDetail& detail, const Camera& camera, double aspect,
                              const SceneBounds& bounds, const Clipping& clipping) {
   if (detail.forced) return detail.level;

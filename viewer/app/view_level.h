@@ -32,10 +32,6 @@ class LevelLayouts {
   std::map<std::uint32_t, std::unique_ptr<SceneLayout>> layouts_;
 };
 
-// What the renderer's projection covers: the lines' bounds joined with the anatomical image's box (when
-// there is one), so that a view measured here is the view the renderer draws.
-SceneBounds scene_bounds(std::span<const VxlFile* const> files, const Volume* volume);
-
 // The finest level, from full detail up to the scene's (detail.level), whose spans visible from `camera`
 // with `clipping` fit detail.budget; the scene's level when none finer fits or when --level forced it.
 std::uint32_t level_for_view(LevelLayouts& layouts, const SceneDetail& detail, const Camera& camera, double aspect,

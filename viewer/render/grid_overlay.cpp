@@ -7,6 +7,7 @@
 
 #include "viewer/render/camera.h"
 #include "viewer/render/renderer.h"
+#include "viewer/render/view_queries.h"
 
 namespace vxl {
 
@@ -123,11 +124,8 @@ void GridOverlay::draw(const Renderer& renderer, const Camera& camera, double as
   // Near/far planes of our own: outlines reach up to a voxel beyond the tight bounds the renderer fits its
   // planes to. Depth is not tested, so only clipping matters.
   const glm::dvec3 lo = renderer.bounds_min(), hi = renderer.bounds_max();
-  const double radius = glm::length(hi - lo) * 0.5 + 2.0 * layout.voxel_size();
-  const double along = glm::dot((lo + hi) * 0.5 - camera.eye(), camera.forward());
-  const double far_mm = along + radius;
-  const double near_mm = camera.orthographic ? along - radius : std::max(far_mm * 1e-4, along - radius);
-  const glm::mat4 projection = camera.projection(aspect, near_mm, std::max(far_mm, near_mm + 1.0));
+  const glm::mat4 projection(
+      projection_around(camera, aspect, (lo + hi) * 0.5, glm::length(hi - lo) * 0.5 + 2.0 * layout.voxel_size()));
   const glm::mat3 rotation = camera.view_rotation();
 
   glUseProgram(program_);

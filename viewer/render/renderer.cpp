@@ -52,6 +52,8 @@ Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels, std::uint32_t 
 Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level,
                    std::shared_ptr<GpuMemoryPool> pool, bool eager)
     : files_(files.empty() ? throw Error(ErrorKind::Usage, "", std::nullopt, "Renderer: no files") : files),
+      line_bounds_(line_bounds(files_)),
+      scene_bounds_(line_bounds_),
       scene_(files_, max_texels, level, std::move(pool), eager),
       groups_(files_),
       indexes_(std::make_shared<VoxelVoxlinesCache>(files_)) {
@@ -79,16 +81,9 @@ ModePass& Renderer::pass(RenderMode mode) {
   return *p;
 }
 
-std::pair<glm::dvec3, glm::dvec3> Renderer::bounds() const {
-  const SceneBounds b = line_bounds(files_);
-  return {b.min, b.max};
-}
-
-glm::dvec3 Renderer::scene_min() const { return slices_ ? glm::min(bounds_min(), slices_->ras_min()) : bounds_min(); }
-glm::dvec3 Renderer::scene_max() const { return slices_ ? glm::max(bounds_max(), slices_->ras_max()) : bounds_max(); }
-
 void Renderer::set_volume(const Volume& volume) {
   slices_ = std::make_unique<SliceRenderer>(volume);
+  scene_bounds_ = scene_bounds(files_, &volume);
   // The line programs now test against the slices' depth; the modes' own programs (exact's list program)
   // are made again on first use.
   lines_->make_programs(true);
@@ -104,7 +99,7 @@ GLuint Renderer::slice_color_texture() const { return slices_drawn_ ? slices_->c
 
 glm::dmat4 Renderer::projection(const Camera& camera, double aspect) const {
   // Near and far planes hug the lines and the image.
-  return fitted_projection(camera, aspect, {scene_min(), scene_max()}, scene_.layout().voxel_size());
+  return fitted_projection(camera, aspect, scene_bounds_, scene_.layout().voxel_size());
 }
 
 void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FramePlan& out,
@@ -113,7 +108,7 @@ void Renderer::plan(const Camera& camera, double aspect, PlanOrder order, FrameP
 }
 
 std::uint64_t Renderer::view_bytes(const Camera& camera, double aspect, const Clipping& clipping) const {
-  return vxl::view_bytes(scene_.layout(), camera, aspect, {scene_min(), scene_max()}, clipping);
+  return vxl::view_bytes(scene_.layout(), camera, aspect, scene_bounds_, clipping);
 }
 
 void Renderer::plan_and_count(const Camera& camera, double aspect, PlanOrder order, FramePlan& out,

@@ -23,6 +23,7 @@
 #include "viewer/render/region_shapes.h"
 #include "viewer/render/render_settings.h"
 #include "viewer/render/scene_groups.h"
+#include "viewer/render/view_queries.h"
 
 namespace vxl {
 
@@ -115,12 +116,12 @@ class Renderer {
   void prepare(RenderMode mode);
   const VxlFile& file() const { return *files_.front(); }  // the first
   const std::vector<const VxlFile*>& files() const { return files_; }
-  glm::dvec3 bounds_min() const { return bounds().first; }
-  glm::dvec3 bounds_max() const { return bounds().second; }
+  glm::dvec3 bounds_min() const { return line_bounds_.min; }
+  glm::dvec3 bounds_max() const { return line_bounds_.max; }
   // The lines' bounds joined with the image's box (when there is one): what the depth range covers (the
   // camera frames the lines).
-  glm::dvec3 scene_min() const;
-  glm::dvec3 scene_max() const;
+  glm::dvec3 scene_min() const { return scene_bounds_.min; }
+  glm::dvec3 scene_max() const { return scene_bounds_.max; }
 
   // The projection the renderer uses for `camera` (near/far planes fitted to the scene bounds).
   glm::dmat4 projection(const Camera& camera, double aspect) const;
@@ -143,8 +144,6 @@ class Renderer {
  private:
   class Host;  // the renderer as its modes' PassHost
   struct Pieces;
-  // The union of the files' bounds: {min, max}.
-  std::pair<glm::dvec3, glm::dvec3> bounds() const;
   // The pass that draws `mode` (modes/mode_pass.h), made on first use.
   ModePass& pass(RenderMode mode);
   // What every mode does first: the per-vertex attributes, the slices (their depth hides lines behind them),
@@ -170,6 +169,8 @@ class Renderer {
   void draw_voxel_piece(double max_ms);
 
   std::vector<const VxlFile*> files_;
+  SceneBounds line_bounds_;   // the files' (view_queries.h)
+  SceneBounds scene_bounds_;  // the same joined with the image's box: what the projection covers
   GpuScene scene_;
   std::unique_ptr<LinePass> lines_;  // the line programs, attributes and draws every mode uses
   std::unique_ptr<Host> host_;

@@ -21,13 +21,25 @@ SceneBounds line_bounds(std::span<const VxlFile* const> files) {
   return b;
 }
 
+SceneBounds scene_bounds(std::span<const VxlFile* const> files, const Volume* volume) {
+  SceneBounds b = line_bounds(files);
+  if (volume) {
+    b.min = glm::min(b.min, volume->ras_min());
+    b.max = glm::max(b.max, volume->ras_max());
+  }
+  return b;
+}
+
 glm::dmat4 fitted_projection(const Camera& camera, double aspect, const SceneBounds& scene, double voxel_size) {
   // The margin is a voxel, but never more than the scene's own size: every vertex lies inside the bounds,
   // and a voxel far larger than the scene (--voxel-size 1e8) would put the near plane (far · 1e-4) beyond
   // every line.
-  const glm::dvec3 centre = (scene.min + scene.max) * 0.5;
   const double half_diagonal = glm::length(scene.max - scene.min) * 0.5;
   const double radius = std::max(1.0, half_diagonal + std::min(voxel_size, std::max(1.0, half_diagonal)));
+  return projection_around(camera, aspect, (scene.min + scene.max) * 0.5, radius);
+}
+
+glm::dmat4 projection_around(const Camera& camera, double aspect, const glm::dvec3& centre, double radius) {
   const double along = glm::dot(centre - camera.eye(), camera.forward());
   const double far_mm = along + radius;
   const double near_mm = camera.orthographic ? along - radius : std::max(far_mm * 1e-4, along - radius);

@@ -14,6 +14,7 @@
 #include "viewer/render/clip_planes.h"
 #include "viewer/render/frame_plan.h"
 #include "viewer/render/scene_layout.h"
+#include "viewer/render/volume.h"
 
 namespace vxl {
 
@@ -25,9 +26,14 @@ struct SceneBounds {
 
 // The union of the files' line bounds (a file without points does not count); all zero when none has points.
 SceneBounds line_bounds(std::span<const VxlFile* const> files);
+// What the renderer's projection covers: the lines' bounds joined with the anatomical image's box (none: the
+// lines alone).
+SceneBounds scene_bounds(std::span<const VxlFile* const> files, const Volume* volume);
 
-// The projection of `camera` with near and far planes hugging `scene`'s bounding sphere, for depth precision.
-// voxel_size: the scene's voxel size, the margin (never more than the scene's own size).
+// The projection of `camera` with near and far planes on the sphere (centre, radius), for depth precision.
+glm::dmat4 projection_around(const Camera& camera, double aspect, const glm::dvec3& centre, double radius);
+// The projection of `camera` with near and far planes hugging `scene`'s bounding sphere. voxel_size: the
+// scene's voxel size, the margin (never more than the scene's own size).
 glm::dmat4 fitted_projection(const Camera& camera, double aspect, const SceneBounds& scene, double voxel_size);
 
 // The frame plan of `camera` with `projection`: voxels outside the frustum or the slab / clip planes of
