@@ -142,7 +142,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
     std::copy(t.streamline_values[k].values.begin(), t.streamline_values[k].values.end(), streamline_arrays[k].begin());
   t.streamline_values.clear();
   finish_value_sets(out.streamline_values());
-  // Pass 2 writes all over these: fault them in first, in bulk (ORDR waits until the source is freed).
+  // Pass 2 writes all over these: fault them in first, in bulk (ORDB waits until the source is freed).
   // Packed positions are packed as they are placed (pass 1 found the voxels' bounds), and the orders are
   // built from the words: no float copy of the blocks.
   for (std::span<std::uint8_t> s : {bytes_of(out.float_vertices()), bytes_of(out.packed_vertices()),

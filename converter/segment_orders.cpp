@@ -154,35 +154,24 @@ void radix_sort_bits(std::vector<Item>& items, std::vector<Item>& scratch, std::
   }
 }
 
-// Writes block-local indices as `width`-byte little-endian entries (spec §5.5).
+// Writes block-local indices as `bits`-bit entries from the lowest bit of dst on (spec §5.5 ORDB), four
+// bytes at a time; the last bytes alone, so nothing past the array's order_array_bytes is touched.
 template <typename Local>
-std::uint8_t* put_entries(std::uint8_t* dst, std::uint32_t width, std::size_t n, Local&& local) {
-  switch (width) {
-    case 2:
-      for (std::size_t i = 0; i < n; ++i, dst += 2) {
-        std::uint16_t e = static_cast<std::uint16_t>(local(i));
-        std::memcpy(dst, &e, 2);
-      }
-      break;
-    case 3:
-      // Four bytes at a time, each store's top byte overwritten by the next entry; the last entry
-      // stores its three bytes alone, so nothing past the array is touched.
-      for (std::size_t i = 0; i + 1 < n; ++i, dst += 3) {
-        std::uint32_t e = local(i);
-        std::memcpy(dst, &e, 4);
-      }
-      if (n > 0) {
-        std::uint32_t e = local(n - 1);
-        std::memcpy(dst, &e, 3);
-        dst += 3;
-      }
-      break;
-    default:
-      for (std::size_t i = 0; i < n; ++i, dst += 4) {
-        std::uint32_t e = local(i);
-        std::memcpy(dst, &e, 4);
-      }
+std::uint8_t* put_entries(std::uint8_t* dst, std::uint32_t bits, std::size_t n, Local&& local) {
+  std::uint64_t pending = 0;  // bits not yet stored, lowest first
+  std::uint32_t filled = 0;   // < 32 between entries
+  for (std::size_t i = 0; i < n; ++i) {
+    pending |= std::uint64_t(local(i)) << filled;
+    filled += bits;
+    if (filled >= 32) {
+      const auto word = static_cast<std::uint32_t>(pending);
+      std::memcpy(dst, &word, 4);
+      dst += 4;
+      pending >>= 32;
+      filled -= 32;
+    }
   }
+  for (; filled > 0; filled = filled > 8 ? filled - 8 : 0, pending >>= 8) *dst++ = static_cast<std::uint8_t>(pending);
   return dst;
 }
 
@@ -204,10 +193,10 @@ struct SortScratch {
 // Writes the order of one voxel's segments (block-local `starts`, ascending) by ascending `s.keys`
 // (which differ in the bits of `varying`), ties by ascending index, to `dst`; returns the end of what
 // it wrote.
-std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint32_t vertex_count, std::uint32_t width,
-                            std::uint64_t varying, SortScratch& s, std::uint8_t* dst) {
+std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint32_t vertex_count,
+                            std::uint32_t entry_bits, std::uint64_t varying, SortScratch& s, std::uint8_t* dst) {
   const std::size_t n = starts.size();
-  if (n < 2 || varying == 0) return put_entries(dst, width, n, [&](std::size_t i) { return starts[i]; });
+  if (n < 2 || varying == 0) return put_entries(dst, entry_bits, n, [&](std::size_t i) { return starts[i]; });
 
   // All keys share the bits above the highest varying bit and below the lowest, so the varying field
   // alone orders them. Packed above the block-local index it makes one 8-byte item per segment, half
@@ -221,7 +210,7 @@ std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint3
     radix_sort_bits(
         s.keys, s.packed_tmp, s.counts, [](std::uint64_t x) { return x; }, index_bits, bits);
     const std::uint64_t index_mask = (1ull << index_bits) - 1;
-    return put_entries(dst, width, n,
+    return put_entries(dst, entry_bits, n,
                        [&](std::size_t i) { return static_cast<std::uint32_t>(s.keys[i] & index_mask); });
   }
   s.keyed.reserve(s.max_vertices);
@@ -230,7 +219,7 @@ std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint3
   for (std::size_t i = 0; i < n; ++i) s.keyed[i] = {s.keys[i], starts[i]};
   radix_sort_bits(
       s.keyed, s.keyed_tmp, s.counts, [](const KeyedSegment& k) { return k.key; }, low, bits);
-  return put_entries(dst, width, n, [&](std::size_t i) { return s.keyed[i].local; });
+  return put_entries(dst, entry_bits, n, [&](std::size_t i) { return s.keyed[i].local; });
 }
 
 }  // namespace
@@ -269,7 +258,7 @@ std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::span<const LevelE
     VoxelEntry& v = voxels[i];
     v.flags = order_width_code(v.vertex_count);
     v.order_offset = total;
-    total += voxel_all_orders_size(v, level_row(levels, i, level_count), stored_orders);
+    total += voxel_all_orders_size(v, level_row(levels, i, level_count), stored_orders, OrderPacking::Bits);
   }
   return total;
 }
@@ -347,7 +336,7 @@ void VoxelOrderWriter::write_levels(const VoxelEntry& v, std::span<const LevelEn
   const std::uint32_t k = static_cast<std::uint32_t>(directions_.size());
   for (std::uint32_t level = 0; level <= row.size(); ++level) {
     const LevelEntry counts = voxel_level(v, row, level);
-    std::uint8_t* const level_end = dst + level_orders_size(counts, k);
+    std::uint8_t* const level_end = dst + level_orders_size(counts, k, OrderPacking::Bits);
     if (counts.segment_count > 0) dst = write_level(counts, block, dst);
     std::fill(dst, level_end, std::uint8_t{0});  // the padding to 4 bytes
     dst = level_end;
@@ -368,7 +357,7 @@ std::uint8_t* VoxelOrderWriter::write_level(const LevelEntry& level, const Block
   }
   starts.resize(n_starts);
   if (n_starts != level.segment_count) throw std::logic_error("VoxelOrderWriter: level segment count mismatch");
-  const std::uint32_t width = order_entry_width(level.vertex_count);
+  const std::uint32_t bits = order_entry_bits(level.vertex_count, OrderPacking::Bits);
   for (std::size_t k = 0; k < directions_.size(); ++k) {
     scratch.keys.resize(starts.size());
     const auto& d = directions_[k];
@@ -388,7 +377,7 @@ std::uint8_t* VoxelOrderWriter::write_level(const LevelEntry& level, const Block
       all_or |= bits;
       all_and &= bits;
     }
-    dst = sort_segments(starts, level.vertex_count, width, all_or ^ all_and, scratch, dst);
+    dst = sort_segments(starts, level.vertex_count, bits, all_or ^ all_and, scratch, dst);
   }
   return dst;
 }

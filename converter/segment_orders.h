@@ -57,7 +57,7 @@ inline std::span<const LevelEntry> level_row(std::span<const LevelEntry> levels,
 }
 
 // Sets every voxel's flags (order entry width) and order_offset for K = `stored_orders` and every level
-// of `levels` (voxel_count x (level_count - 1)); returns the size of the ORDR payload, so that it can be
+// of `levels` (voxel_count x (level_count - 1)); returns the size of the ORDB payload, so that it can be
 // allocated before the orders are built.
 std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::span<const LevelEntry> levels, std::uint32_t level_count,
                             std::uint32_t stored_orders);
@@ -75,7 +75,7 @@ class VoxelOrderWriter {
   VoxelOrderWriter(VoxelOrderWriter&&) noexcept;
 
   // Sorts voxel `v`'s segments (the vertices of its block that do not end a voxline in `ends`) for every
-  // direction of the set and writes its K orders at `dst` (the ORDR payload plus v.order_offset; the
+  // direction of the set and writes its K orders at `dst` (the ORDB payload plus v.order_offset; the
   // voxel's flags and order_offset as layout_orders set them), then those of each coarser level in `row`
   // (its LODS entries) after them. Every byte of the voxel's orders is written, the padding (zero)
   // included, so `dst` need not be cleared.
@@ -103,7 +103,7 @@ class VoxelOrderWriter {
   std::unique_ptr<Scratch> scratch_;
 };
 
-// Sorts every voxel's segments for every direction of `set` into `orders`, the ORDR payload laid out
+// Sorts every voxel's segments for every direction of `set` into `orders`, the ORDB payload laid out
 // by layout_orders (its padding bytes zeroed).
 void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const LevelEntry> levels,
                        std::uint32_t level_count, std::span<const float> vertices, const VoxlineEnds& ends,
@@ -123,7 +123,7 @@ std::uint64_t order_scratch_bytes(std::uint32_t max_vertices);
 struct BuiltOrders {
   std::vector<DirectionEntry> directions;
   std::vector<DirectionEntry> voxel_directions;  // the VDIR payload; empty unless the set is random
-  std::vector<std::uint8_t> bytes;               // the ORDR payload
+  std::vector<std::uint8_t> bytes;               // the ORDB payload
 };
 
 // All of the above in memory: sets the voxels' flags and order_offset and the meta's order fields.

@@ -398,7 +398,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   OrderSetSpec set;
   set.kind = static_cast<OrderSet>(meta.order_set);
   for (const DirectionEntry& d : f.directions()) set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
-  // ORDR and the sections after it (VXLN, STRM, PROV, GRPS), which are filled after the orders: one
+  // ORDB and the sections after it (VXLN, STRM, PROV, GRPS), which are filled after the orders: one
   // populate for all, instead of a fault per page for the voxline table's 8 bytes per voxline.
   prefault_for_write(out.file().subspan(static_cast<std::size_t>(out.orders().data() - out.file().data())), threads);
   std::span<VoxelEntry> voxels = out.voxels();

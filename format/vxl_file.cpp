@@ -44,11 +44,15 @@ OrderView VxlFile::order(std::size_t voxel, std::uint32_t k, std::uint32_t level
   const VoxelEntry& v = voxels_[voxel];
   const LevelEntry counts = this->level(voxel, level);
   OrderView o;
-  o.width = order_entry_width(counts.vertex_count);
+  o.bits = order_entry_bits(counts.vertex_count, order_packing_);
   o.count = counts.segment_count;
-  o.data = orders_.data() + level_orders_offset(v, levels_of(voxel), level, meta_.stored_order_count) +
-           std::uint64_t(k) * counts.segment_count * o.width;
+  o.data = orders_.data() + level_orders_offset(v, levels_of(voxel), level, meta_.stored_order_count, order_packing_) +
+           k * order_array_bytes(counts.segment_count, o.bits);
   return o;
+}
+
+std::uint64_t VxlFile::orders_offset() const {
+  return find_section(section_id(order_packing_ == OrderPacking::Bits ? "ORDB" : "ORDR"))->offset;
 }
 
 void VxlFile::read_vertices(std::size_t voxel, std::uint64_t first, std::uint64_t count, float* xyz) const {
@@ -149,11 +153,11 @@ void VxlFile::validate_section_table() {
     previous_end = e.offset + e.size;
     // The sections a reader must understand to draw the file right (spec §4): they carry the required flag,
     // or an older reader that skipped them (LODS, VDIR) would draw garbage without a word.
-    static const std::uint32_t required[] = {section_id("META"), section_id("DIRS"), section_id("VOXT"),
-                                             section_id("LODS"), section_id("VERT"), section_id("ORDR"),
-                                             section_id("VXLN"), section_id("STRM"), section_id("VDIR")};
+    static const std::uint32_t required[] = {
+        section_id("META"), section_id("DIRS"), section_id("VOXT"), section_id("LODS"), section_id("VERT"),
+        section_id("ORDR"), section_id("ORDB"), section_id("VXLN"), section_id("STRM"), section_id("VDIR")};
     static const std::uint32_t optional[] = {section_id("PROV"), section_id("GRPS"), section_id("VVAL"),
-                                             section_id("SVAL"), section_id("GDAT")};
+                                             section_id("SVAL"), section_id("GDAT"), section_id("VXIX")};
     const bool is_required = std::find(std::begin(required), std::end(required), id) != std::end(required);
     const bool is_optional = std::find(std::begin(optional), std::end(optional), id) != std::end(optional);
     if (is_required && !(e.flags & kSectionRequired))
@@ -243,7 +247,15 @@ void VxlFile::validate_meta_and_sizes() {
                                                ? std::nullopt
                                                : count_product(m.streamline_count + 1, 8);
   auto strm = expect_size("STRM", strm_size, "(streamline_count + 1) × 8");
-  orders_ = section("ORDR", true);
+  // The orders: ORDB (bit-packed) since 1.4 / 2.3, ORDR before; exactly one of them (§5.5).
+  const bool bit_orders = find_section(section_id("ORDB")) != nullptr;
+  if (bit_orders == (find_section(section_id("ORDR")) != nullptr))
+    fail_input(p, 64,
+               bit_orders ? "both ORDR and ORDB sections: a file holds one of them"
+                          : "required section ORDB (or ORDR) is missing");
+  order_packing_ = bit_orders ? OrderPacking::Bits : OrderPacking::Bytes;
+  orders_ = section(bit_orders ? "ORDB" : "ORDR", true);
+  validate_voxel_index(section("VXIX", false));
   // Per-voxel directions: present exactly when the order set is random (§5.10).
   const bool random_set = m.order_set == static_cast<std::uint32_t>(OrderSet::Random);
   if (random_set != (find_section(section_id("VDIR")) != nullptr))
@@ -327,6 +339,30 @@ void check_grid_geometry(const MetaSection& m, const std::string& p, std::option
   }
 }
 
+// VXIX (§5.14), O(voxels): its size from the counts, and voxel lists that start at 0, never shrink and end at
+// the voxline count, so that a list never reads past the entries. The entries themselves are checked by
+// their users (streamline below the count, voxlines within the block), as VXLN's are.
+void VxlFile::validate_voxel_index(std::span<const std::uint8_t> vxix) {
+  if (vxix.data() == nullptr) return;
+  const std::string& p = file_.path();
+  const std::uint64_t at = find_section(section_id("VXIX"))->offset;
+  const std::optional<std::uint64_t> lists = count_product(meta_.voxline_count, 8);
+  const std::optional<std::uint64_t> expected = lists ? count_sum(8 * (meta_.voxel_count + 1ull), *lists) : lists;
+  if (!expected || vxix.size() != *expected)
+    fail_input(p, at,
+               "section VXIX size " + std::to_string(vxix.size()) +
+                   " does not match (voxel_count + 1) × 8 + voxline_count × 8");
+  if (meta_.streamline_count > std::numeric_limits<std::uint32_t>::max())
+    fail_input(p, at, "section VXIX in a file of 2^32 streamlines or more (its entries number them in 32 bits)");
+  const auto* first = reinterpret_cast<const std::uint64_t*>(vxix.data());
+  for (std::uint64_t i = 0; i <= meta_.voxel_count; ++i)
+    if ((i == 0 && first[0] != 0) || (i > 0 && first[i] < first[i - 1]) ||
+        (i == meta_.voxel_count && first[i] != meta_.voxline_count))
+      fail_input(p, at + 8 * i, "VXIX voxel list starts must rise from 0 to the voxline count");
+  voxel_index_first_ = {first, meta_.voxel_count + 1ull};
+  voxel_index_entries_ = {reinterpret_cast<const IndexedVoxline*>(first + meta_.voxel_count + 1), meta_.voxline_count};
+}
+
 void VxlFile::validate_voxel_table() {
   const std::string& p = file_.path();
   const MetaSection& m = meta_;
@@ -372,9 +408,11 @@ void VxlFile::validate_voxel_table() {
                    "voxel " + std::to_string(i) + " level " + std::to_string(d + 1) + " is not a prefix of level " +
                        std::to_string(d) + " with fewer segments than vertices");
     }
-    std::uint64_t bytes = voxel_all_orders_size(v, row, m.stored_order_count);
+    std::uint64_t bytes = voxel_all_orders_size(v, row, m.stored_order_count, order_packing_);
     if (v.order_offset > orders_.size() || bytes > orders_.size() - v.order_offset)
-      fail_input(p, at + 56, "voxel orders run past the ORDR section");
+      fail_input(p, at + 56,
+                 std::string("voxel orders run past the ") + (order_packing_ == OrderPacking::Bits ? "ORDB" : "ORDR") +
+                     " section");
     min_order_offset = v.order_offset + bytes;
     segments += v.segment_count;
   }

@@ -7,6 +7,7 @@
 // renderer's upload), because checking them here would cost O(points).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <functional>
@@ -26,15 +27,19 @@
 
 namespace vxl {
 
-// One stored order of one voxel: n block-local vertex indices of 2, 3 or 4 bytes (little-endian).
+// One stored order of one voxel: n block-local vertex indices of `bits` bits each, packed from the first byte's
+// lowest bit up (little-endian; an ORDR file's 2, 3 or 4 bytes are the same with 16, 24 or 32 bits).
 struct OrderView {
   const std::uint8_t* data = nullptr;
   std::uint32_t count = 0;
-  std::uint32_t width = 2;
+  std::uint32_t bits = 16;
   std::uint32_t operator[](std::uint32_t i) const {
-    std::uint32_t v = 0;
-    std::memcpy(&v, data + std::uint64_t(width) * i, width);
-    return v;
+    const std::uint64_t bit = std::uint64_t(bits) * i;
+    const std::uint64_t byte = bit >> 3, size = order_array_bytes(count, bits);
+    // Up to 39 bits from `byte` on; never a byte past the array, which may end the section.
+    std::uint64_t word = 0;
+    std::memcpy(&word, data + byte, std::min<std::uint64_t>(8, size - byte));
+    return static_cast<std::uint32_t>((word >> (bit & 7)) & ((std::uint64_t(1) << bits) - 1));
   }
 };
 
@@ -95,7 +100,10 @@ class VxlFile {
   void read_vertices(std::size_t voxel, std::uint64_t first, std::uint64_t count, float* xyz) const;
   // Every vertex, decoded (3 * vertex_count floats): for tools and tests; the viewer reads by voxel.
   std::vector<float> all_vertices() const;
+  // The orders' payload (ORDB, or ORDR in files before 1.4 / 2.3), how it stores entries and where it starts.
   std::span<const std::uint8_t> order_bytes() const { return orders_; }
+  OrderPacking order_packing() const { return order_packing_; }
+  std::uint64_t orders_offset() const;
   // Stored order k of voxel `voxel` at level `level` (0: full detail).
   OrderView order(std::size_t voxel, std::uint32_t k, std::uint32_t level = 0) const;
   std::span<const VoxlineEntry> voxlines() const { return voxlines_; }
@@ -114,6 +122,11 @@ class VxlFile {
     const VoxlineEntry& e = voxlines_[j];
     if (e.voxel >= voxels_.size() || (e.count_flags & kVoxlineCountMask) == 0) fail_voxline(j);
   }
+  // VXIX (spec §5.14), empty when the file has none: per voxel, where its list of voxlines starts
+  // (voxel_count + 1 entries; open() has checked that they rise to the voxline count), then the lists'
+  // entries (format/voxel_voxlines.h reads them; their contents are checked by whoever uses them).
+  std::span<const std::uint64_t> voxel_index_first() const { return voxel_index_first_; }
+  std::span<const IndexedVoxline> voxel_index_entries() const { return voxel_index_entries_; }
   std::string_view provenance_json() const { return provenance_; }
   // Where PROV starts in the file (0 when the file has none).
   std::uint64_t provenance_offset() const;
@@ -135,6 +148,7 @@ class VxlFile {
   void validate_section_table();
   void validate_meta_and_sizes();
   void validate_voxel_table();
+  void validate_voxel_index(std::span<const std::uint8_t> vxix);
   // Walks GRPS (spec §5.9) checking its structure and names (valid UTF-8, no NUL) but not the members:
   // O(groups). `visit` gets each group's name and where its `count` members start in the section.
   void walk_groups(
@@ -151,7 +165,10 @@ class VxlFile {
   std::span<const float> float_vertices_;
   std::span<const std::uint32_t> packed_vertices_;
   std::span<const std::uint8_t> orders_;
+  OrderPacking order_packing_ = OrderPacking::Bits;
   std::span<const VoxlineEntry> voxlines_;
+  std::span<const std::uint64_t> voxel_index_first_;
+  std::span<const IndexedVoxline> voxel_index_entries_;
   std::span<const std::uint64_t> strm_;
   std::string_view provenance_;
   std::span<const std::uint8_t> groups_;

@@ -1,4 +1,4 @@
-// On-disk structures of the .vxl format, versions 1.0 to 2.1 (spec/vxl-format.md is the reference; section
+// On-disk structures of the .vxl format, versions 1.0 to 2.3 (spec/vxl-format.md is the reference; section
 // numbers below point into it). All little-endian; every struct's layout is pinned by static_asserts so
 // a file can be used in place after mmap.
 #pragma once
@@ -25,6 +25,10 @@ inline constexpr std::uint16_t kVxlVersionMinorLevels = 1;
 // Files with values per group (GDAT, spec §5.13) are 1.3 when they would otherwise be 1.x, 2.2 when 2.x.
 inline constexpr std::uint16_t kVxlVersionMinorGroupValues1 = 3;
 inline constexpr std::uint16_t kVxlVersionMinorGroupValues2 = 2;
+// Files whose orders are bit-packed (ORDB instead of ORDR, spec §5.5), with or without the voxel index
+// (VXIX, spec §5.14), are 1.4 when they would otherwise be 1.x, 2.3 when 2.x.
+inline constexpr std::uint16_t kVxlVersionMinorBitOrders1 = 4;
+inline constexpr std::uint16_t kVxlVersionMinorBitOrders2 = 3;
 inline constexpr std::uint64_t kVxlAlignment = 64;
 inline constexpr std::uint32_t kVxlMaxSections = 64;
 inline constexpr std::uint32_t kVxlMaxStoredOrders = 64;
@@ -116,11 +120,25 @@ static_assert(sizeof(VoxelEntry) == 64);
 static_assert(offsetof(VoxelEntry, vertex_first) == 40);
 inline constexpr std::uint32_t kVoxelOrderWidthMask = 3u;
 
-// Bytes per order entry for a voxel of this many vertices (spec §5.5), and its flags code.
+// Bytes per order entry of an ORDR section for a voxel of this many vertices (spec §5.5), and its flags code
+// (the same in every file: the renderer uploads entries of voxels in the u16 class at 16 bits).
 constexpr std::uint32_t order_entry_width(std::uint32_t vertex_count) {
   return vertex_count <= kU16OrderMaxVertices ? 2 : vertex_count <= kU24OrderMaxVertices ? 3 : 4;
 }
 constexpr std::uint32_t order_width_code(std::uint32_t vertex_count) { return order_entry_width(vertex_count) - 2; }
+
+// How a file stores its order entries (spec §5.5): whole bytes (ORDR, files before 1.4 / 2.3) or as few bits
+// as the block needs (ORDB).
+enum class OrderPacking : std::uint8_t { Bytes, Bits };
+
+// Bits per order entry of a block (or level prefix) of `vertex_count` vertices: entries are below
+// vertex_count − 1, so ORDB stores the bits of vertex_count − 1 (at least one).
+constexpr std::uint32_t order_entry_bits(std::uint32_t vertex_count, OrderPacking packing) {
+  if (packing == OrderPacking::Bytes) return 8 * order_entry_width(vertex_count);
+  return vertex_count <= 2 ? 1u : static_cast<std::uint32_t>(std::bit_width(vertex_count - 1));
+}
+// Bytes of one order array of `count` entries of `bits` bits; each array starts on a byte.
+constexpr std::uint64_t order_array_bytes(std::uint64_t count, std::uint32_t bits) { return (count * bits + 7) / 8; }
 
 // §5.6
 struct VoxlineEntry {
@@ -131,11 +149,26 @@ static_assert(sizeof(VoxlineEntry) == 8);
 inline constexpr std::uint32_t kVoxlineSyntheticFirst = 0x80000000u;
 inline constexpr std::uint32_t kVoxlineCountMask = 0x7FFFFFFFu;
 
+// §5.14: one entry of a voxel's list of voxlines in VXIX.
+struct IndexedVoxline {
+  std::uint32_t streamline;
+  std::uint32_t bits;  // own point count (bits 0–25), flags (26–28), depth of the streamline (29–31)
+
+  static constexpr std::uint32_t kCountMask = (1u << 26) - 1;
+  static constexpr std::uint32_t kSyntheticFirst = 1u << 26;     // its first own point is synthetic (spec §6.3)
+  static constexpr std::uint32_t kFirstOfStreamline = 1u << 27;  // the streamline's first voxline
+  static constexpr std::uint32_t kLastOfStreamline = 1u << 28;   // no connecting vertex follows it
+  std::uint32_t own() const { return bits & kCountMask; }
+  std::uint32_t depth() const { return bits >> 29; }
+};
+static_assert(sizeof(IndexedVoxline) == 8);
+
 constexpr std::uint64_t align_up(std::uint64_t x, std::uint64_t a) { return (x + a - 1) / a * a; }
 
 // Bytes taken by one voxel's K orders of n segments, including the padding to 4 bytes (§5.5).
-constexpr std::uint64_t voxel_orders_size(std::uint32_t vertex_count, std::uint32_t segment_count, std::uint32_t k) {
-  return align_up(std::uint64_t(segment_count) * k * order_entry_width(vertex_count), 4);
+constexpr std::uint64_t voxel_orders_size(std::uint32_t vertex_count, std::uint32_t segment_count, std::uint32_t k,
+                                          OrderPacking packing) {
+  return align_up(k * order_array_bytes(segment_count, order_entry_bits(vertex_count, packing)), 4);
 }
 
 }  // namespace vxl

@@ -59,22 +59,23 @@ inline std::uint32_t depth_end_vertex(const VoxelEntry& v, std::span<const Level
 }
 
 // Bytes of one level's K orders, padded to 4 (spec §5.5): entries are as wide as the level's prefix needs.
-constexpr std::uint64_t level_orders_size(const LevelEntry& level, std::uint32_t k) {
-  return voxel_orders_size(level.vertex_count, level.segment_count, k);
+constexpr std::uint64_t level_orders_size(const LevelEntry& level, std::uint32_t k, OrderPacking packing) {
+  return voxel_orders_size(level.vertex_count, level.segment_count, k, packing);
 }
 
 // Where level `level`'s orders start, from the voxel's order_offset: after the finer levels' orders.
 inline std::uint64_t level_orders_offset(const VoxelEntry& v, std::span<const LevelEntry> row, std::uint32_t level,
-                                         std::uint32_t k) {
+                                         std::uint32_t k, OrderPacking packing) {
   std::uint64_t offset = v.order_offset;
-  for (std::uint32_t d = 0; d < level; ++d) offset += level_orders_size(voxel_level(v, row, d), k);
+  for (std::uint32_t d = 0; d < level; ++d) offset += level_orders_size(voxel_level(v, row, d), k, packing);
   return offset;
 }
 
 // All of a voxel's orders, every level.
-inline std::uint64_t voxel_all_orders_size(const VoxelEntry& v, std::span<const LevelEntry> row, std::uint32_t k) {
-  std::uint64_t bytes = level_orders_size(voxel_level(v, row, 0), k);
-  for (const LevelEntry& e : row) bytes += level_orders_size(e, k);
+inline std::uint64_t voxel_all_orders_size(const VoxelEntry& v, std::span<const LevelEntry> row, std::uint32_t k,
+                                           OrderPacking packing) {
+  std::uint64_t bytes = level_orders_size(voxel_level(v, row, 0), k, packing);
+  for (const LevelEntry& e : row) bytes += level_orders_size(e, k, packing);
   return bytes;
 }
 

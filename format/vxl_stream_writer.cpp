@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "format/base/error.h"
+#include "format/voxel_voxlines.h"
 
 namespace vxl {
 
@@ -131,6 +132,25 @@ void VxlStreamWriter::append_meta(const MetaSection& meta) {
   MetaSection m = meta;
   std::memset(m.reserved, 0, sizeof m.reserved);
   append(kMeta, {reinterpret_cast<const std::uint8_t*>(&m), sizeof m});
+}
+
+void VxlStreamWriter::append_voxel_index(std::uint32_t level_count, unsigned threads) {
+  const std::size_t x = entry_[kVxix], l = entry_[kVxln], s = entry_[kStrm];
+  if (x >= table_.size()) return;
+  if (written_[l] != table_[l].size || written_[s] != table_[s].size || written_[x] != 0)
+    throw std::logic_error("VxlStreamWriter::append_voxel_index: VXLN or STRM incomplete, or VXIX begun");
+  // Both are on the disk already (a direct region writes its last bytes with its last append).
+  auto read = [&](std::size_t i) {
+    return table_[i].size > 0 ? out_.map_window(table_[i].offset, table_[i].size) : FileWindow();
+  };
+  const FileWindow strm = read(s), vxln = read(l);
+  FileWindow window = out_.map_window(table_[x].offset, table_[x].size);
+  fill_voxel_index_payload(window.bytes(),
+                           {reinterpret_cast<const std::uint64_t*>(strm.bytes().data()), strm.bytes().size() / 8},
+                           {reinterpret_cast<const VoxlineEntry*>(vxln.bytes().data()), vxln.bytes().size() / 8},
+                           level_count, threads, out_.path());
+  checksums_[x]->update(window.bytes().data(), window.bytes().size());
+  written_[x] = table_[x].size;
 }
 
 void VxlStreamWriter::commit() {

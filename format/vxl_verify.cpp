@@ -10,6 +10,7 @@
 #include "format/base/checksum.h"
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
+#include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 
@@ -73,7 +74,7 @@ void check_meta_and_dirs(const VxlFile& f) {
 // voxel's own direction (VDIR) or the shared one (DIRS).
 void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_start) {
   const std::string& p = f.path();
-  const std::uint64_t ordr_at = f.find_section(section_id("ORDR"))->offset;
+  const std::uint64_t ordr_at = f.orders_offset();
   auto voxels = f.voxels();
   const std::uint64_t vert_at = f.find_section(section_id("VERT"))->offset;
   auto packed = f.packed_vertices();
@@ -94,7 +95,8 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
     // Each level: its segment count, and K orders of the segments in its prefix of the block (§5.12).
     for (std::uint32_t level = 0; level < f.level_count(); ++level) {
       const LevelEntry counts = f.level(i, level);
-      const std::uint64_t at = ordr_at + level_orders_offset(v, f.levels_of(i), level, f.meta().stored_order_count);
+      const std::uint64_t at =
+          ordr_at + level_orders_offset(v, f.levels_of(i), level, f.meta().stored_order_count, f.order_packing());
       const std::string what = "voxel " + std::to_string(i) + (level > 0 ? " level " + std::to_string(level) : "");
       std::uint64_t starts = 0;
       for (std::uint32_t e = 0; e < counts.vertex_count; ++e) starts += is_segment_start[v.vertex_first + e];
@@ -120,7 +122,17 @@ void check_orders(const VxlFile& f, const std::vector<std::uint8_t>& is_segment_
           previous_key = key;
           previous_entry = e;
         }
+        // ORDB: the bits after the last entry, up to the array's last byte, are zero (§5.5).
+        const std::uint64_t used = std::uint64_t(o.count) * o.bits;
+        if (used % 8 != 0 && (o.data[used / 8] >> (used % 8)) != 0)
+          fail_input(p, at, what + " order " + std::to_string(k) + " has bits set after its last entry");
       }
+      // And the level's padding to 4 bytes.
+      const std::uint32_t bits = order_entry_bits(counts.vertex_count, f.order_packing());
+      const std::uint64_t arrays = f.meta().stored_order_count * order_array_bytes(counts.segment_count, bits);
+      const std::uint64_t padded = level_orders_size(counts, f.meta().stored_order_count, f.order_packing());
+      if (!all_zero(f.bytes().data() + at + arrays, padded - arrays))
+        fail_input(p, at + arrays, what + " order padding is not zero");
     }
   }
 }
@@ -161,6 +173,26 @@ void check_value_sets(const VxlFile& f, const ValueSets& sets, const char (&id)[
     fail_input(p, at + entries_end, std::string(id) + " padding before the arrays is not zero");
 }
 
+// VXIX (§5.14): exactly the lists built from VXLN and STRM.
+void check_voxel_index(const VxlFile& f) {
+  if (f.voxel_index_first().empty()) return;
+  const std::optional<VoxelVoxlines> built = VoxelVoxlines::build(f);
+  const std::uint64_t at = f.find_section(section_id("VXIX"))->offset;
+  if (!built) fail_input(f.path(), at, "VXIX in a file whose voxlines an index cannot hold (2^26 points or more)");
+  for (std::size_t i = 0; i < f.voxels().size(); ++i) {
+    const auto stored = f.voxel_index_entries().subspan(f.voxel_index_first()[i],
+                                                        f.voxel_index_first()[i + 1] - f.voxel_index_first()[i]);
+    const auto expected = built->of_voxel(i);
+    if (stored.size() != expected.size())
+      fail_input(f.path(), at + 8 * i, "VXIX list of voxel " + std::to_string(i) + " does not hold its voxlines");
+    for (std::size_t k = 0; k < stored.size(); ++k)
+      if (stored[k].streamline != expected[k].streamline || stored[k].bits != expected[k].bits)
+        fail_input(
+            f.path(), at + 8 * (f.voxels().size() + 1 + f.voxel_index_first()[i] + k),
+            "VXIX entry " + std::to_string(k) + " of voxel " + std::to_string(i) + " differs from the voxline table");
+  }
+}
+
 }  // namespace
 
 VerifyResult verify_vxl(const std::string& path) {
@@ -178,6 +210,7 @@ VerifyResult verify_vxl(const std::string& path) {
     };
     walk_streamlines(f, cb);
     check_orders(f, is_segment_start);
+    check_voxel_index(f);
     if (!f.provenance_json().empty() &&
         (parse_json(f.provenance_json(), path, f.provenance_offset(), "provenance").is_discarded()))
       fail_input(path, f.provenance_offset(), "provenance is not valid JSON");

@@ -5,6 +5,7 @@
 
 #include "format/base/checksum.h"
 #include "format/base/parallel.h"
+#include "format/voxel_voxlines.h"
 #include "format/vxl_value_sets.h"
 
 namespace vxl {
@@ -44,6 +45,7 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
   s.streamlines = (m.streamline_count + 1) * sizeof(std::uint64_t);
   s.provenance = provenance_bytes;
   s.groups = group_bytes;
+  s.voxel_index = voxel_index_bytes(m);
   s.vertex_values = value_sets_bytes(vertex_value_sets, m.vertex_count);
   s.streamline_values = value_sets_bytes(streamline_value_sets, m.streamline_count);
   return s;
@@ -66,9 +68,12 @@ VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
       // Required: a reader that ignored it would misread the orders of every voxel but the first level's.
       {"LODS", kSectionRequired, sizes.levels, sizes.levels > 0},
       {"VERT", kSectionRequired, sizes.vertices, true},
-      {"ORDR", kSectionRequired, sizes.orders, true},
+      // Bit-packed orders (spec §5.5) under a new id: a reader of ORDR's whole-byte entries refuses the file.
+      {"ORDB", kSectionRequired, sizes.orders, true},
       {"VXLN", kSectionRequired, sizes.voxlines, true},
       {"STRM", kSectionRequired, sizes.streamlines, true},
+      // Optional: a reader without it builds the same lists from VXLN and STRM (spec §5.14).
+      {"VXIX", 0, sizes.voxel_index, sizes.voxel_index > 0},
       {"PROV", 0, sizes.provenance, true},
       {"GRPS", 0, sizes.groups, sizes.groups > 0},
       // Optional: a reader that does not know them still draws the picture, in the other colour modes.
@@ -112,13 +117,19 @@ std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, 
   });
   const bool has_group_values =
       std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "GDAT", 4) == 0; });
+  const bool has_bit_orders =
+      std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "ORDB", 4) == 0; });
   if (h.version_major == kVxlVersionMajorPackedPositions)
-    h.version_minor = has_group_values ? kVxlVersionMinorGroupValues2 : has_levels ? kVxlVersionMinorLevels : 0;
+    h.version_minor = has_bit_orders     ? kVxlVersionMinorBitOrders2
+                      : has_group_values ? kVxlVersionMinorGroupValues2
+                      : has_levels       ? kVxlVersionMinorLevels
+                                         : 0;
   else
-    h.version_minor = has_group_values ? kVxlVersionMinorGroupValues1
-                      : has_values     ? kVxlVersionMinorValueSets
-                      : has_vdir       ? kVxlVersionMinorVoxelDirections
-                                       : kVxlVersionMinor;
+    h.version_minor = has_bit_orders     ? kVxlVersionMinorBitOrders1
+                      : has_group_values ? kVxlVersionMinorGroupValues1
+                      : has_values       ? kVxlVersionMinorValueSets
+                      : has_vdir         ? kVxlVersionMinorVoxelDirections
+                                         : kVxlVersionMinor;
   h.header_size = sizeof(FileHeader);
   h.file_size = file_size;
   h.section_table_offset = sizeof(FileHeader);
@@ -133,7 +144,8 @@ std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, 
   return bytes;
 }
 
-VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path), positions_(sizes.positions) {
+VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes)
+    : out_(path), path_(path), positions_(sizes.positions) {
   VxlLayout layout = plan_vxl_layout(sizes);
   table_ = std::move(layout.table);
   file_ = out_.map(layout.file_size);
@@ -168,6 +180,11 @@ void VxlWriter::checksum_vertices_now() {
 }
 
 void VxlWriter::commit(unsigned threads) {
+  if (const std::span<std::uint8_t> vxix = payload(kVxix); !vxix.empty()) {
+    MetaSection meta;
+    std::memcpy(&meta, payload(kMeta).data(), sizeof meta);
+    fill_voxel_index_payload(vxix, streamline_first_voxline(), voxlines(), meta.level_count, threads, path_);
+  }
   // Largest payloads first, so that the big ones (VERT, ORDR) run side by side.
   std::vector<std::size_t> by_size;
   const SectionEntry* vert = entry(kVert);
@@ -184,47 +201,6 @@ void VxlWriter::commit(unsigned threads) {
   std::memcpy(file_.data(), header.data(), header.size());
   file_ = {};
   out_.commit();
-}
-
-void write_vxl(const std::string& path, const VxlContent& c) {
-  std::vector<std::uint8_t> groups_bytes;
-  if (!c.groups.empty()) groups_bytes = encode_groups(c.groups);
-  std::vector<std::uint8_t> group_values_bytes;
-  if (!c.group_values.empty()) group_values_bytes = encode_group_values(c.group_values);
-  VxlSectionSizes sizes;
-  sizes.directions = c.directions.size_bytes();
-  if (c.meta.order_set == static_cast<std::uint32_t>(OrderSet::Random))
-    sizes.voxel_directions = c.voxel_directions.size_bytes();
-  sizes.voxels = c.voxels.size_bytes();
-  sizes.levels = c.levels.size_bytes();
-  sizes.positions = static_cast<PositionEncoding>(c.meta.position_encoding);
-  sizes.vertices =
-      sizes.positions == PositionEncoding::Packed ? c.packed_vertices.size_bytes() : c.vertices.size_bytes();
-  sizes.orders = c.orders.size_bytes();
-  sizes.voxlines = c.voxlines.size_bytes();
-  sizes.streamlines = c.streamline_first_voxline.size_bytes();
-  sizes.provenance = c.provenance_json.size();
-  sizes.groups = groups_bytes.size();
-  sizes.group_values = group_values_bytes.size();
-
-  VxlWriter w(path, sizes);
-  auto copy = [](auto dst, const void* src) {
-    if (!dst.empty()) std::memcpy(dst.data(), src, dst.size_bytes());
-  };
-  w.set_meta(c.meta);
-  copy(w.directions(), c.directions.data());
-  copy(w.voxel_directions(), c.voxel_directions.data());
-  copy(w.voxels(), c.voxels.data());
-  copy(w.levels(), c.levels.data());
-  copy(w.float_vertices(), c.vertices.data());
-  copy(w.packed_vertices(), c.packed_vertices.data());
-  copy(w.orders(), c.orders.data());
-  copy(w.voxlines(), c.voxlines.data());
-  copy(w.streamline_first_voxline(), c.streamline_first_voxline.data());
-  copy(w.provenance(), c.provenance_json.data());
-  copy(w.groups(), groups_bytes.data());
-  copy(w.group_values(), group_values_bytes.data());
-  w.commit();
 }
 
 }  // namespace vxl

@@ -30,6 +30,7 @@ struct VxlSectionSizes {
   std::uint64_t groups = 0;                                // 0: no GRPS section
   std::uint64_t group_values = 0;                          // GDAT (spec §5.13); 0: absent
   std::uint64_t vertex_values = 0, streamline_values = 0;  // VVAL, SVAL (spec §5.11); 0: absent
+  std::uint64_t voxel_index = 0;                           // VXIX (spec §5.14); 0: absent
   PositionEncoding positions = PositionEncoding::Float32;  // how VERT holds them (spec §5.4); sets the version
 };
 
@@ -51,13 +52,14 @@ struct VxlLayout {
 VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes);
 
 // The bytes of the header and the section table (spec §3, §4), once every checksum in `table` is set.
-// The version is the lowest that holds what is written (spec §10): 2.1 with LODS, else 2.0 with packed
-// positions, else 1.2 with VVAL or SVAL, else 1.1 with VDIR, else 1.0.
+// The version is the lowest that holds what is written (spec §10): major 2 with packed positions or LODS,
+// else 1; minor 3 (2.x) or 4 (1.x) with ORDB, else the older rules (GDAT, LODS, VVAL/SVAL, VDIR).
 std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size,
                                            PositionEncoding positions);
 
-// The sections the writers fill, in file order (spec §4), and their ids; VDIR, LODS, GRPS, VVAL, SVAL and GDAT are
-// optional. One list for both writers (VxlWriter, VxlStreamWriter), so that they lay out a file alike.
+// The sections the writers fill, in file order (spec §4), and their ids; VDIR, LODS, VXIX, GRPS, VVAL, SVAL and
+// GDAT are optional. The writers fill VXIX themselves from VXLN and STRM (fill_voxel_index). One list for both writers
+// (VxlWriter, VxlStreamWriter), so that they lay out a file alike.
 struct VxlSections {
   enum Index : std::size_t {
     kMeta,
@@ -66,9 +68,10 @@ struct VxlSections {
     kVoxt,
     kLods,
     kVert,
-    kOrdr,
+    kOrdb,
     kVxln,
     kStrm,
+    kVxix,
     kProv,
     kGrps,
     kVval,
@@ -76,8 +79,8 @@ struct VxlSections {
     kGdat,
     kCount
   };
-  static constexpr const char* kIds[kCount] = {"META", "DIRS", "VDIR", "VOXT", "LODS", "VERT", "ORDR",
-                                               "VXLN", "STRM", "PROV", "GRPS", "VVAL", "SVAL", "GDAT"};
+  static constexpr const char* kIds[kCount] = {"META", "DIRS", "VDIR", "VOXT", "LODS", "VERT", "ORDB", "VXLN",
+                                               "STRM", "VXIX", "PROV", "GRPS", "VVAL", "SVAL", "GDAT"};
 };
 
 class VxlWriter : public VxlSections {
@@ -104,7 +107,7 @@ class VxlWriter : public VxlSections {
   std::span<std::uint32_t> packed_vertices() {
     return positions_ == PositionEncoding::Packed ? typed<std::uint32_t>(kVert) : std::span<std::uint32_t>{};
   }
-  std::span<std::uint8_t> orders() { return payload(kOrdr); }
+  std::span<std::uint8_t> orders() { return payload(kOrdb); }
   std::span<VoxlineEntry> voxlines() { return typed<VoxlineEntry>(kVxln); }
   std::span<std::uint64_t> streamline_first_voxline() { return typed<std::uint64_t>(kStrm); }
   std::span<std::uint8_t> provenance() { return payload(kProv); }
@@ -124,8 +127,9 @@ class VxlWriter : public VxlSections {
   std::span<std::uint8_t> streamline_values() { return payload(kSval); }
   std::span<std::uint8_t> group_values() { return payload(kGdat); }  // empty when there is no GDAT section
 
-  // Checksums every payload (sections spread over up to `threads` threads; 0: all hardware threads),
-  // writes the section table and the header, unmaps and links the file into place. The spans above
+  // Fills VXIX from VXLN, STRM and META (which must be final), checksums every payload (sections spread over
+  // up to `threads` threads; 0: all hardware threads), writes the section table and the header, unmaps and
+  // links the file into place. The spans above
   // are invalid afterwards. Without commit() the destructor discards the file.
   void commit(unsigned threads = 0);
 
@@ -139,33 +143,12 @@ class VxlWriter : public VxlSections {
   }
 
   AtomicOutputFile out_;
+  std::string path_;                 // for the errors of commit()
   std::vector<SectionEntry> table_;  // in Index order, optional sections only when present
   PositionEncoding positions_;
   bool vertices_checksummed_ = false;
   std::span<std::uint8_t> file_;
 };
-
-// Everything a .vxl holds, in memory. The caller fills `meta` (counts must match the spans; reserved
-// bytes are zeroed by the writer) and guarantees the invariants of spec §5 (the reader re-checks them).
-// VERT is `vertices` when meta.position_encoding is float32, else `packed_vertices`.
-struct VxlContent {
-  MetaSection meta{};
-  std::span<const DirectionEntry> directions;
-  std::span<const DirectionEntry> voxel_directions;  // VDIR, written when meta.order_set is random
-  std::span<const VoxelEntry> voxels;
-  std::span<const LevelEntry> levels;              // LODS, voxel_count x (level_count - 1)
-  std::span<const float> vertices;                 // 3 * vertex_count
-  std::span<const std::uint32_t> packed_vertices;  // vertex_count
-  std::span<const std::uint8_t> orders;
-  std::span<const VoxlineEntry> voxlines;
-  std::span<const std::uint64_t> streamline_first_voxline;  // N + 1
-  std::string provenance_json;
-  std::span<const StreamlineGroup> groups;    // GRPS is written only when non-empty
-  std::span<const GroupValues> group_values;  // GDAT is written only when non-empty
-};
-
-// Writes in-memory content through VxlWriter. Throws vxl::Error (Output) naming the path.
-void write_vxl(const std::string& path, const VxlContent& content);
 
 // The GRPS payload (spec §5.9), exposed for tests.
 std::vector<std::uint8_t> encode_groups(std::span<const StreamlineGroup> groups);

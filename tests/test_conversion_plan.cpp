@@ -157,7 +157,7 @@ TEST(ConversionPlan, TheOrderChunkFollowsTheRequestButHoldsTheLargestVoxel) {
   EXPECT_EQ(plan_conversion(a, t.counts(PositionEncoding::Packed, 4, 1)).order_chunk_bytes, largest);
   MemoryBudget b(200 * kMiB, "source.tck");
   EXPECT_EQ(plan_conversion(b, t.counts(PositionEncoding::Packed, 4, 4 * kMiB)).order_chunk_bytes, t.order_bytes)
-      << "never more than the whole ORDR payload";
+      << "never more than the whole ORDB payload";
 }
 
 TEST(ConversionPlan, NoVoxelsMakeOneEmptyRangeThatWritesTheTables) {

@@ -193,8 +193,8 @@ TEST(Extremes, CountsAndOffsetsAreSixtyFourBitBeyondTwoToTheThirtyTwo) {
   v[0].segment_count = v[1].segment_count = 1;
   v[0].flags = order_width_code(v[0].vertex_count);
   v[1].flags = order_width_code(v[1].vertex_count);
-  v[1].order_offset = voxel_orders_size(v[0].vertex_count, 1, 3);
-  const std::uint64_t ordr = v[1].order_offset + voxel_orders_size(v[1].vertex_count, 1, 3);
+  v[1].order_offset = voxel_orders_size(v[0].vertex_count, 1, 3, OrderPacking::Bytes);
+  const std::uint64_t ordr = v[1].order_offset + voxel_orders_size(v[1].vertex_count, 1, 3, OrderPacking::Bytes);
   DirectionEntry dirs[3] = {{{1, 0, 0}, 0}, {{0, 1, 0}, 0}, {{0, 0, 1}, 0}};
   struct Part {
     const char* id;
@@ -240,8 +240,8 @@ TEST(Extremes, CountsAndOffsetsAreSixtyFourBitBeyondTwoToTheThirtyTwo) {
   EXPECT_GT(f.meta().vertex_count, std::uint64_t(1) << 32);
   EXPECT_EQ(f.float_vertices().size(), 3 * vertices);
   EXPECT_EQ(f.voxels()[1].vertex_first, first_count);
-  EXPECT_EQ(f.order(1, 2).width, 2u);
-  EXPECT_EQ(f.order(0, 0).width, 4u);
+  EXPECT_EQ(f.order(1, 2).bits, 16u);
+  EXPECT_EQ(f.order(0, 0).bits, 32u);
   // The last vertex is addressable (a hole reads as zeros).
   EXPECT_EQ(f.float_vertices()[3 * vertices - 1], 0.0f);
 }

@@ -10,8 +10,10 @@
 
 #include "converter/readers/read_tractogram.h"
 #include "converter/streaming_convert.h"
+#include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
+#include "format/vxl_verify.h"
 #include "format/vxlz_package.h"
 #include "tests/test_support.h"
 
@@ -155,6 +157,52 @@ TEST(GoldenBytes, TheUnpackedFileDecodesWithinThePackagesBoundAndARepack) {
   EXPECT_EQ(package.meta().point_count, 418u);
   // The package's stated bound (against the packed file) plus the packed file's own and the re-pack's.
   expect_coordinates(decode_vxl(golden("unpacked.vxl")), package.pack().error_bound + 2 * 0.0045);
+}
+
+// A file of version 2.1 (frozen: whole-byte orders in ORDR, no VXIX) still opens and verifies, and reads as the
+// same orders, points and voxel lists as the pinned input's file of today.
+TEST(GoldenBytes, AFileOfVersion21ReadsAsTheCurrentOne) {
+  const VxlFile old_file = VxlFile::open(golden("packed-2.1.vxl")), now = VxlFile::open(golden("packed.vxl"));
+  EXPECT_EQ(old_file.header().version_major, 2);
+  EXPECT_EQ(old_file.header().version_minor, 1);
+  EXPECT_EQ(now.header().version_minor, 3);
+  EXPECT_EQ(old_file.order_packing(), OrderPacking::Bytes);
+  EXPECT_EQ(now.order_packing(), OrderPacking::Bits);
+  EXPECT_LT(now.order_bytes().size(), old_file.order_bytes().size());
+  EXPECT_TRUE(old_file.voxel_index_first().empty());
+  ASSERT_FALSE(now.voxel_index_first().empty());
+  EXPECT_TRUE(verify_vxl(golden("packed-2.1.vxl")).valid) << verify_vxl(golden("packed-2.1.vxl")).problem;
+  EXPECT_TRUE(verify_vxl(golden("packed.vxl")).valid) << verify_vxl(golden("packed.vxl")).problem;
+
+  ASSERT_EQ(old_file.voxels().size(), now.voxels().size());
+  ASSERT_EQ(old_file.level_count(), now.level_count());
+  std::uint64_t entries = 0;
+  for (std::size_t i = 0; i < now.voxels().size(); ++i)
+    for (std::uint32_t level = 0; level < now.level_count(); ++level)
+      for (std::uint32_t k = 0; k < now.meta().stored_order_count; ++k) {
+        const OrderView a = old_file.order(i, k, level), b = now.order(i, k, level);
+        ASSERT_EQ(a.count, b.count);
+        EXPECT_EQ(a.bits % 8, 0u);
+        EXPECT_LE(b.bits, a.bits);
+        for (std::uint32_t n = 0; n < a.count; ++n, ++entries)
+          ASSERT_EQ(a[n], b[n]) << "voxel " << i << " level " << level << " order " << k << " entry " << n;
+      }
+  EXPECT_GT(entries, 400u);
+  EXPECT_EQ(decode_vxl(golden("packed-2.1.vxl")).xyz, decode_vxl(golden("packed.vxl")).xyz);
+
+  // The lists built from the old file's tables are the ones the new file carries.
+  const std::optional<VoxelVoxlines> built = VoxelVoxlines::of_file(old_file), mapped = VoxelVoxlines::of_file(now);
+  ASSERT_TRUE(built && mapped);
+  EXPECT_FALSE(built->from_file());
+  EXPECT_TRUE(mapped->from_file());
+  for (std::size_t i = 0; i < now.voxels().size(); ++i) {
+    const auto a = built->of_voxel(i), b = mapped->of_voxel(i);
+    ASSERT_EQ(a.size(), b.size()) << "voxel " << i;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      EXPECT_EQ(a[k].streamline, b[k].streamline);
+      EXPECT_EQ(a[k].bits, b[k].bits);
+    }
+  }
 }
 
 }  // namespace

@@ -222,9 +222,88 @@ TEST(HostileVxl, MetaFieldsThatContradictTheSectionsAreRefusedOnOpen) {
            "stored order count 3 for order set 1 (it stores 7)"},
           {"levels not marked required", [&](VxlBytes& b) { put_u32(b, b.entry_at("LODS") + 4, 0); },
            "section LODS must carry the required flag"},
-          {"orders not marked required", [&](VxlBytes& b) { put_u32(b, b.entry_at("ORDR") + 4, 0); },
-           "section ORDR must carry the required flag"},
+          {"orders not marked required", [&](VxlBytes& b) { put_u32(b, b.entry_at("ORDB") + 4, 0); },
+           "section ORDB must carry the required flag"},
       });
+}
+
+// The voxel index (VXIX, spec §5.14): list starts that do not rise to the voxline count, or a size for other
+// counts, are refused on open (O(voxels)); a section that is both ORDR and ORDB, or neither, too.
+TEST(HostileVxl, AVoxelIndexOrOrdersThatDoNotFitTheCountsAreRefusedOnOpen) {
+  ScratchDir dir;
+  const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
+  const SectionEntry vxix = valid.entry("VXIX");
+  auto put_u64 = [](VxlBytes& b, std::uint64_t at, std::uint64_t v) { std::memcpy(b.bytes.data() + at, &v, 8); };
+  expect_refused_on_open(
+      dir, valid,
+      {
+          {"first list start not 0", [&](VxlBytes& b) { put_u64(b, vxix.offset, 1); },
+           "VXIX voxel list starts must rise from 0 to the voxline count"},
+          {"list starts decreasing", [&](VxlBytes& b) { put_u64(b, vxix.offset + 8, 1ull << 40); },
+           "VXIX voxel list starts must rise from 0 to the voxline count"},
+          {"size for other counts", [&](VxlBytes& b) { put_u64(b, b.entry_at("VXIX") + 16, vxix.size - 8); },
+           "section VXIX size"},
+          {"orders under the former id too",
+           [&](VxlBytes& b) {
+             std::memcpy(b.bytes.data() + b.entry_at("VXIX"), "ORDR", 4);
+             const std::uint32_t required = kSectionRequired;
+             std::memcpy(b.bytes.data() + b.entry_at("ORDR") + 4, &required, 4);
+           },
+           "both ORDR and ORDB sections"},
+      });
+}
+
+// What open() does not read, the users of an entry check: a VXIX entry naming a streamline past the count, or
+// more points than the voxel's block holds, is refused by `select` (exit 3), never read past a table; `verify`
+// finds every such change, and bits set after an order's last entry.
+TEST(HostileVxl, VoxelIndexEntriesAndOrderBitsThatLieAreRefusedWhereUsed) {
+  ScratchDir dir;
+  const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
+  const VxlFile f = VxlFile::open(dir.file("h.vxl"));
+  const SectionEntry vxix = valid.entry("VXIX");
+  const std::uint64_t entries = vxix.offset + 8 * (f.voxels().size() + 1);
+  struct Case {
+    const char* name;
+    std::uint64_t at;
+    std::uint32_t value;
+    const char* select_message;  // null: `select` may read it as it is (verify still refuses)
+    const char* verify_message;
+  };
+  const Case cases[] = {
+      {"streamline past the count", entries, 1u << 30, "names a streamline past the streamline count",
+       "differs from the voxline table"},
+      {"more points than the block", entries + 4,
+       (f.voxel_index_entries()[0].bits & ~IndexedVoxline::kCountMask) | 1000000,
+       "the voxel's voxlines run past its vertex block", "differs from the voxline table"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    VxlBytes b = valid;
+    std::memcpy(b.bytes.data() + c.at, &c.value, 4);
+    b.reseal();
+    b.write(dir.file("bad.vxl"));
+    const auto r = test::run_cli("select " + q(dir.file("bad.vxl")) + " " + q(dir.file("out.tck")) +
+                                 " --include box:-1000,-1000,-1000,1000,1000,1000");
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find(c.select_message), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("out.tck")));
+    const auto v = test::run_cli("verify " + q(dir.file("bad.vxl")));
+    EXPECT_EQ(v.exit_code, 1) << v.output;
+    EXPECT_NE(v.output.find(c.verify_message), std::string::npos) << v.output;
+  }
+  // A bit set after the last entry of the first order that does not end on a byte.
+  OrderView o;
+  for (std::size_t i = 0; i < f.voxels().size() && (o.data == nullptr || o.count * o.bits % 8 == 0); ++i)
+    o = f.order(i, 0);
+  const std::uint64_t used = std::uint64_t(o.count) * o.bits;
+  ASSERT_NE(used % 8, 0u) << "every order ends on a byte";
+  VxlBytes b = valid;
+  b.bytes[static_cast<std::size_t>(o.data - f.bytes().data()) + used / 8] |= static_cast<char>(0x80);
+  b.reseal();
+  b.write(dir.file("bits.vxl"));
+  const auto v = test::run_cli("verify " + q(dir.file("bits.vxl")));
+  EXPECT_EQ(v.exit_code, 1) << v.output;
+  EXPECT_NE(v.output.find("has bits set after its last entry"), std::string::npos) << v.output;
 }
 
 // PROV is any JSON to open(): fields of the wrong type made `info` exit 70 (type_error 302/306) and

@@ -80,7 +80,7 @@ TEST(Levels, EachLevelIsAPrefixHoldingItsStreamlines) {
   const VxlFile f = VxlFile::open(out);
   ASSERT_EQ(f.level_count(), 4u);
   EXPECT_EQ(f.header().version_major, 2);
-  EXPECT_EQ(f.header().version_minor, 1);
+  EXPECT_EQ(f.header().version_minor, 3);  // bit-packed orders (spec §10)
 
   std::uint64_t checked = 0, streamline = 0;
   const auto strm = f.streamline_first_voxline();
@@ -130,7 +130,7 @@ TEST(Levels, LevelOrdersAreTheFullOrdersRestrictedToTheLevel) {
       for (std::uint32_t k = 0; k < f.meta().stored_order_count; ++k) {
         const OrderView full = f.order(i, k, 0), coarse = f.order(i, k, d);
         ASSERT_EQ(coarse.count, level.segment_count);
-        EXPECT_EQ(coarse.width, order_entry_width(level.vertex_count));
+        EXPECT_EQ(coarse.bits, order_entry_bits(level.vertex_count, OrderPacking::Bits));
         std::vector<std::uint32_t> expected, got;
         for (std::uint32_t n = 0; n < full.count; ++n)
           if (full[n] < level.vertex_count) expected.push_back(full[n]);
@@ -142,7 +142,7 @@ TEST(Levels, LevelOrdersAreTheFullOrdersRestrictedToTheLevel) {
   EXPECT_GT(compared, 1000u);
 }
 
-TEST(Levels, OneLevelWritesNoLodsAndTheFormerVersion) {
+TEST(Levels, OneLevelWritesNoLods) {
   ScratchDir dir;
   ConvertSettings settings;
   settings.levels = 1;
@@ -152,7 +152,7 @@ TEST(Levels, OneLevelWritesNoLodsAndTheFormerVersion) {
   EXPECT_EQ(f.meta().level_count, 0u);
   EXPECT_EQ(f.find_section(section_id("LODS")), nullptr);
   EXPECT_EQ(f.header().version_major, 2);  // packed positions
-  EXPECT_EQ(f.header().version_minor, 0);
+  EXPECT_EQ(f.header().version_minor, 3);  // bit-packed orders, with or without levels (spec §10)
   EXPECT_TRUE(verify_vxl(dir.file("one.vxl")).valid);
   EXPECT_THROW(convert_tractogram(synth(10), dir.file("nine.vxl"),
                                   [] {
@@ -196,7 +196,8 @@ TEST(Levels, StreamedAndUnpackedFilesHaveTheSameLevels) {
   ASSERT_EQ(memory.level_count(), kDefaultLevels);
   EXPECT_FALSE(section_bytes(memory, "LODS").empty());
   EXPECT_EQ(section_bytes(memory, "LODS"), section_bytes(streamed, "LODS"));
-  EXPECT_EQ(section_bytes(memory, "ORDR"), section_bytes(streamed, "ORDR"));
+  EXPECT_EQ(section_bytes(memory, "ORDB"), section_bytes(streamed, "ORDB"));
+  EXPECT_EQ(section_bytes(memory, "VXIX"), section_bytes(streamed, "VXIX"));
 
   PackSettings pack;
   pack.threads = 2;
@@ -226,17 +227,25 @@ TEST(Levels, VerifyRefusesACoarseOrderOutOfSort) {
   convert_tractogram(synth(6000), out, exact_settings(3));
   std::vector<char> bytes = test::slurp(out);
   std::uint64_t at = 0;
+  std::uint32_t bits = 0, first = 0, second = 0;
   {
     const VxlFile f = VxlFile::open(out);
     for (std::size_t i = 0; i < f.voxels().size() && at == 0; ++i) {
       const OrderView o = f.order(i, 0, 1);
-      if (o.count >= 2 && o.width == 2) at = static_cast<std::uint64_t>(o.data - f.bytes().data());
+      if (o.count >= 2)
+        at = static_cast<std::uint64_t>(o.data - f.bytes().data()), bits = o.bits, first = o[0], second = o[1];
     }
     ASSERT_NE(at, 0u) << "no voxel with two level-1 segments";
   }
-  // Swap the first two (2-byte) entries of that order: distinct segments, so no longer in sort order.
-  std::swap_ranges(bytes.begin() + static_cast<std::ptrdiff_t>(at), bytes.begin() + static_cast<std::ptrdiff_t>(at + 2),
-                   bytes.begin() + static_cast<std::ptrdiff_t>(at + 2));
+  // Swap the first two entries of that order (bit-packed, spec §5.5): distinct segments, so no longer in sort order.
+  auto put = [&](std::uint64_t bit, std::uint32_t value) {
+    for (std::uint32_t b = 0; b < bits; ++b, ++bit) {
+      char& byte = bytes[at + bit / 8];
+      byte = static_cast<char>((byte & ~(1 << (bit % 8))) | (((value >> b) & 1) << (bit % 8)));
+    }
+  };
+  put(0, second);
+  put(bits, first);
   test::reseal_checksums(bytes.data(), bytes.size());
   std::ofstream(dir.file("bad.vxl"), std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   const VerifyResult r = verify_vxl(dir.file("bad.vxl"));

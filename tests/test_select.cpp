@@ -179,10 +179,14 @@ TEST_F(Selection, RandomSpheresBoxesAndMasksMatchTheBruteForceReference) {
       c.invert = trial % 9 == 6;
       const SelectionResult r = select_streamlines(f, c);
       ASSERT_EQ(r.streamlines, brute_force(*source_, c)) << file << " trial " << trial;
-      // Through the per-voxel index: the same streamlines, the same count per region.
-      const SelectionResult indexed = select_streamlines(f, c, &*index.at(file));
+      // Through an index built from the tables, and by the scan of the voxline table: the same streamlines, the
+      // same count per region as through the file's own index.
+      const SelectionResult indexed = select_streamlines(f, c, &*index.at(file)),
+                            scan = select_streamlines(f, c, nullptr, SelectionPath::ScanTable);
       ASSERT_EQ(indexed.streamlines, r.streamlines) << file << " trial " << trial;
       ASSERT_EQ(indexed.streamlines_per_region, r.streamlines_per_region) << file << " trial " << trial;
+      ASSERT_EQ(scan.streamlines, r.streamlines) << file << " trial " << trial;
+      ASSERT_EQ(scan.streamlines_per_region, r.streamlines_per_region) << file << " trial " << trial;
       nonempty += !r.streamlines.empty() && r.streamlines.size() < source_->streamline_count();
       ++cases;
     }
@@ -275,7 +279,9 @@ TEST(SelectionIndex, ListsEveryVoxlineOnceAndSelectsWhatTheScanSelects) {
     c.include.push_back(sphere(v.tight_min[0], v.tight_max[1], v.tight_min[2], radius(rng)));
     if (trial % 3 == 0) c.ends_in.push_back(sphere(v.tight_max[0], v.tight_min[1], v.tight_max[2], 15));
     if (trial % 4 == 1) c.exclude.push_back(sphere(v.tight_max[0], v.tight_max[1], v.tight_max[2], 6));
-    const SelectionResult scan = select_streamlines(f, c), indexed = select_streamlines(f, c, &*index);
+    const SelectionResult scan = select_streamlines(f, c, nullptr, SelectionPath::ScanTable),
+                          indexed = select_streamlines(f, c, &*index), from_file = select_streamlines(f, c);
+    ASSERT_EQ(from_file.streamlines, scan.streamlines) << "trial " << trial;
     ASSERT_EQ(indexed.streamlines, scan.streamlines) << "trial " << trial;
     ASSERT_EQ(indexed.streamlines_per_region, scan.streamlines_per_region) << "trial " << trial;
     cut += !scan.streamlines.empty() && scan.streamlines.size() < 3000;
@@ -285,7 +291,8 @@ TEST(SelectionIndex, ListsEveryVoxlineOnceAndSelectsWhatTheScanSelects) {
   const VoxelEntry& v = f.voxels()[f.voxels().size() / 2];
   SelectionCriteria small;
   small.include.push_back(sphere(v.tight_min[0] + 1, v.tight_min[1] + 1, v.tight_min[2] + 1, 2));
-  const SelectionResult scan = select_streamlines(f, small), indexed = select_streamlines(f, small, &*index);
+  const SelectionResult scan = select_streamlines(f, small, nullptr, SelectionPath::ScanTable),
+                        indexed = select_streamlines(f, small, &*index);
   EXPECT_EQ(indexed.streamlines, scan.streamlines);
   const std::uint64_t always = f.voxels().size_bytes();  // both look at every voxel's bounds
   EXPECT_LT(indexed.bytes_read - always - indexed.points_tested * 4,
@@ -328,7 +335,7 @@ TEST(SelectionIndex, TablesThatDoNotHoldTogetherAreRefused) {
       }
       return false;
     };
-    EXPECT_TRUE(refused([&] { select_streamlines(f, everywhere); }));
+    EXPECT_TRUE(refused([&] { select_streamlines(f, everywhere, nullptr, SelectionPath::ScanTable); }));
     std::optional<VoxelVoxlines> index;
     if (!refused([&] { index = VoxelVoxlines::build(f, 2); })) {
       ASSERT_TRUE(index.has_value());

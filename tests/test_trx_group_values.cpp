@@ -318,8 +318,8 @@ TEST(GdatSection, FilesWithoutGroupValuesHaveNoSection) {
   EXPECT_EQ(f.groups().size(), 2u);
 }
 
-// The version a file with GDAT carries (spec §10): 2.2 with packed positions or levels, 1.3 otherwise; a
-// package with it is 2.2. Files without it keep the version they had before GDAT existed.
+// The version a file with GDAT carries (spec §10): every file written now has bit-packed orders (2.3 with packed
+// positions or levels, 1.4 otherwise), which holds GDAT too; a package with it is 2.2, one without 2.0.
 TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
   ScratchDir dir;
   test::write_zip(dir.file("a.trx"), trx_members());
@@ -333,12 +333,12 @@ TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
     return std::to_string(v[0]) + "." + std::to_string(v[1]);
   };
   convert_tractogram(read_trx(dir.file("a.trx")), dir.file("packed.vxl"), ConvertSettings{});
-  EXPECT_EQ(version_of(VxlFile::open(dir.file("packed.vxl")).header()), "2.2");
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("packed.vxl")).header()), "2.3");
   ConvertSettings plain;
   plain.positions = PositionEncoding::Float32;
   plain.levels = 1;
   convert_tractogram(read_trx(dir.file("a.trx")), dir.file("plain.vxl"), plain);
-  EXPECT_EQ(version_of(VxlFile::open(dir.file("plain.vxl")).header()), "1.3");
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("plain.vxl")).header()), "1.4");
   pack_vxl(VxlFile::open(dir.file("packed.vxl")), dir.file("a.vxlz"), PackSettings{});
   EXPECT_EQ(package_version_of(dir.file("a.vxlz")), "2.2");
 
@@ -346,9 +346,9 @@ TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
   std::erase_if(members, [](const auto& m) { return m.first.starts_with("dpg/"); });
   test::write_zip(dir.file("b.trx"), members);
   convert_tractogram(read_trx(dir.file("b.trx")), dir.file("b.vxl"), ConvertSettings{});
-  EXPECT_EQ(version_of(VxlFile::open(dir.file("b.vxl")).header()), "2.1");
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("b.vxl")).header()), "2.3");
   convert_tractogram(read_trx(dir.file("b.trx")), dir.file("b_plain.vxl"), plain);
-  EXPECT_EQ(version_of(VxlFile::open(dir.file("b_plain.vxl")).header()), "1.0");
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("b_plain.vxl")).header()), "1.4");
   pack_vxl(VxlFile::open(dir.file("b.vxl")), dir.file("b.vxlz"), PackSettings{});
   EXPECT_EQ(package_version_of(dir.file("b.vxlz")), "2.0");
 }

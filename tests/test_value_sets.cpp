@@ -146,13 +146,13 @@ TEST(ValueSets, PointValuesFollowTheirPointsIntoTheVertexBlocks) {
   ConvertSettings settings;
   settings.voxel_size = 2;
   settings.positions = PositionEncoding::Float32;  // the values are checked against exact positions
-  settings.levels = 1;                             // one level: the 1.x version rules apply
+  settings.levels = 1;                             // one level: major version 1
   convert_tractogram(std::move(t), dir.file("v.vxl"), settings);
   VerifyResult verified = verify_vxl(dir.file("v.vxl"));
   ASSERT_TRUE(verified.valid) << verified.problem;
 
   VxlFile f = VxlFile::open(dir.file("v.vxl"));
-  EXPECT_EQ(f.header().version_minor, 2);
+  EXPECT_EQ(f.header().version_minor, 4);  // 1.4: bit-packed orders (spec §10)
   EXPECT_GT(f.meta().synthetic_point_count, 5u);
   const ValueSets& vv = f.vertex_values();
   ASSERT_EQ(vv.size(), 2u);
@@ -185,13 +185,13 @@ TEST(ValueSets, PointValuesFollowTheirPointsIntoTheVertexBlocks) {
   EXPECT_EQ(sv.name(0), "length");
   EXPECT_EQ(std::vector<float>(sv.values(0).begin(), sv.values(0).end()), (std::vector<float>{16.5f, 0.5f}));
 
-  // Without values nothing changes: no sections, version 1.0.
+  // Without values: no value sections, the same version.
   ConvertSettings exact;
   exact.positions = PositionEncoding::Float32;
   exact.levels = 1;
   convert_tractogram(five_points(), dir.file("plain.vxl"), exact);
   VxlFile plain = VxlFile::open(dir.file("plain.vxl"));
-  EXPECT_EQ(plain.header().version_minor, 0);
+  EXPECT_EQ(plain.header().version_minor, 4);
   EXPECT_TRUE(plain.vertex_values().empty());
   EXPECT_EQ(plain.find_section(section_id("VVAL")), nullptr);
 }

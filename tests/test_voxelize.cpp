@@ -8,6 +8,7 @@
 #include "converter/segment_orders.h"
 #include "converter/voxelize.h"
 #include "format/base/error.h"
+#include "format/vxl_file.h"
 #include "format/vxl_positions.h"
 #include "tests/test_support.h"
 
@@ -191,18 +192,22 @@ TEST(SegmentOrders, AxisOrdersSortByMidpointWithStableTies) {
   ASSERT_EQ(vt.voxels.size(), 1u);
   BuiltOrders o = build_orders(vt, parse_order_set("axis"), 1, {});
   ASSERT_EQ(o.directions.size(), 3u);
-  const auto* e = reinterpret_cast<const std::uint16_t*>(o.bytes.data() + vt.voxels[0].order_offset);
+  // Six vertices: entries of 3 bits (the bit width of 5), each array of 3 entries in 2 bytes (spec §5.5).
+  ASSERT_EQ(o.bytes.size(), 8u);
+  const OrderView x{o.bytes.data() + vt.voxels[0].order_offset, 3, 3}, y{x.data + 2, 3, 3};
   // blocks: [4,6] at 0-1, [0,2] at 2-3, [2,4] at 4-5; +X order: midpoints 1, 3, 5 -> starts 2, 4, 0
-  EXPECT_EQ(e[0], 2);
-  EXPECT_EQ(e[1], 4);
-  EXPECT_EQ(e[2], 0);
+  EXPECT_EQ(x[0], 2u);
+  EXPECT_EQ(x[1], 4u);
+  EXPECT_EQ(x[2], 0u);
+  EXPECT_EQ(x.data[0], 2 | 4 << 3 | (0 << 6)) << "entries packed from the lowest bit up";
   // +Y: all keys equal -> ascending local index
-  EXPECT_EQ(e[3], 0);
-  EXPECT_EQ(e[4], 2);
-  EXPECT_EQ(e[5], 4);
+  EXPECT_EQ(y[0], 0u);
+  EXPECT_EQ(y[1], 2u);
+  EXPECT_EQ(y[2], 4u);
+  EXPECT_EQ(x.data[1] >> 1, 0) << "the bits after an array's last entry are zero";
 }
 
-TEST(SegmentOrders, TwentyFourBitEntriesAboveU16Range) {
+TEST(SegmentOrders, SeventeenBitEntriesAboveU16Range) {
   std::vector<float> pts;
   for (int i = 0; i < 70000; ++i)
     pts.insert(pts.end(), {float(i % 5) * 0.1f, float((i * 7) % 9) * 0.1f, float(i % 3) * 0.1f});
@@ -210,11 +215,17 @@ TEST(SegmentOrders, TwentyFourBitEntriesAboveU16Range) {
   t.add_streamline(pts.data(), 70000);
   auto vt = run(std::move(t));
   BuiltOrders o = build_orders(vt, parse_order_set("axis"), 2, {});
-  EXPECT_EQ(vt.voxels[0].flags, 1u);  // 24-bit entries
-  EXPECT_EQ(o.bytes.size(), align_up(3u * 69999u * 3u, 4));
-  const std::uint8_t* e = o.bytes.data();
-  std::uint32_t first = e[0] | e[1] << 8 | e[2] << 16;
-  EXPECT_LT(first, 69999u);
+  EXPECT_EQ(vt.voxels[0].flags, 1u);                   // beyond 16 bits: the renderer uploads high halves
+  const std::uint64_t array = (69999u * 17u + 7) / 8;  // 17 bits: the bit width of 69 999
+  EXPECT_EQ(o.bytes.size(), align_up(3 * array, 4));
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    const OrderView order{o.bytes.data() + k * array, 69999, 17};
+    std::vector<std::uint8_t> seen(69999, 0);
+    for (std::uint32_t n = 0; n < order.count; ++n) {
+      ASSERT_LT(order[n], 69999u) << "order " << k << " entry " << n;
+      ASSERT_EQ(seen[order[n]]++, 0) << "order " << k << " entry " << n << " repeats " << order[n];
+    }
+  }
 }
 
 TEST(SegmentOrders, UnknownOrderSetIsAUsageError) {

@@ -192,7 +192,7 @@ std::vector<Case> voxel_table_cases() {
       {"order_offset", [](Bytes& f) { f.set<u64>(f.voxel(1) + 56, f.get<u64>(f.voxel(1) + 56) + 2); },
        "order offset not a multiple of 4 or decreasing"},
       {"orders_past_end", [](Bytes& f) { f.set<u64>(f.voxel(f.voxel_count() - 1) + 56, u64(1) << 40); },
-       "voxel orders run past the ORDR section"},
+       "voxel orders run past the ORDB section"},
       {"blocks_short",
        [](Bytes& f) {
          const u64 last = f.voxel(f.voxel_count() - 1);

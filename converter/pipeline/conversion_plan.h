@@ -55,7 +55,7 @@ struct ConversionCounts {
   std::span<const LevelEntry> levels;  // LODS, voxel-major (empty with one level)
   std::uint32_t level_count = 1;
   PositionEncoding positions = PositionEncoding::Packed;
-  std::uint64_t order_bytes = 0;          // ORDR's payload
+  std::uint64_t order_bytes = 0;          // ORDB's payload
   unsigned threads = 1;                   // resolved
   std::uint64_t batch_streamlines = 0;    // ReadPlan::batch_streamlines
   std::uint64_t order_chunk_request = 0;  // StreamingTuning::order_chunk_bytes (0: derived)
@@ -78,7 +78,7 @@ struct ConversionPlan {
 // and sort buffers (the largest range's: ranges are cut to fit in what is left).
 ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& counts);
 
-// Where voxel i's orders start in ORDR (i = voxel count: the payload's end).
+// Where voxel i's orders start in ORDB (i = voxel count: the payload's end).
 inline std::uint64_t orders_start(std::span<const VoxelEntry> voxels, std::uint64_t order_bytes, std::size_t i) {
   return i < voxels.size() ? voxels[i].order_offset : order_bytes;
 }

@@ -13,7 +13,7 @@
 namespace vxl::streaming {
 
 // The orders of range r's voxels, a chunk of consecutive voxels at a time (each chunk's voxels spread
-// over the range's ordering threads), built in place in ORDR. The vertices are range r's part of VERT in
+// over the range's ordering threads), built in place in ORDB. The vertices are range r's part of VERT in
 // memory (`range_vertices`), or, when VERT was written block by block, read back a chunk at a time: the
 // next chunk's on another thread while this one is built.
 void StreamingConversion::write_orders(const VoxelRange& r, std::span<const std::uint8_t> range_vertices,
@@ -79,9 +79,9 @@ void StreamingConversion::write_orders(const VoxelRange& r, std::span<const std:
     });
     if (writing.valid()) writing.get();  // rethrows a failed write
     if (plan_.direct_staging_bytes > 0)
-      writing = BackgroundTask<>([this, chunk] { out_->append(VxlStreamWriter::kOrdr, chunk); });
+      writing = BackgroundTask<>([this, chunk] { out_->append(VxlStreamWriter::kOrdb, chunk); });
     else
-      out_->append(VxlStreamWriter::kOrdr, chunk);
+      out_->append(VxlStreamWriter::kOrdb, chunk);
     summary_.orders_seconds += seconds_since(t0);
     report(stage, double(end - r.first) / double(std::max<std::size_t>(1, r.end - r.first)));
   }

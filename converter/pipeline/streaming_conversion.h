@@ -137,7 +137,7 @@ class StreamingConversion {
                           std::uint64_t vertices_first, VoxelOrderWriter& writer, VoxlineEnds& block_ends,
                           std::uint8_t* dst);
   bool packed() const { return job_.settings.positions == PositionEncoding::Packed; }
-  // Where voxel i's orders start in ORDR (i = voxel count: the payload's end).
+  // Where voxel i's orders start in ORDB (i = voxel count: the payload's end).
   std::uint64_t orders_start(std::size_t i) const { return vxl::orders_start(table_.voxels, table_.order_bytes, i); }
   void write_rest();
   [[noreturn]] void fail_changed() const;

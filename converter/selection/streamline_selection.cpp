@@ -223,6 +223,9 @@ std::vector<StreamlineHits> hits_by_index(HitSearch& q, const VoxelVoxlines& ind
       if (e.depth() >= q.levels || !claim_vertices(v, cursor[e.depth()], end[e.depth()]))
         fail_input(q.file.path(), voxt_at + sizeof(VoxelEntry) * voxel,
                    "the voxel's voxlines run past its vertex block (or a level's part of it)");
+      if (e.streamline >= q.strm.size() - 1)  // from the file's VXIX, unchecked until now
+        fail_input(q.file.path(), q.file.find_section(section_id("VXIX"))->offset,
+                   "voxel " + std::to_string(voxel) + "'s list names a streamline past the streamline count");
       if (const Bits hit = search.test_voxline(v, ~Bits(0)); hit != 0) per_voxel[k].push_back({e.streamline, hit});
     }
   });
@@ -254,7 +257,8 @@ double length_limit_margin(const VxlFile& file) {
   return (downsample && *downsample > 0 ? 0.5 / *downsample : 0.1) * *step;
 }
 
-SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria, const VoxelVoxlines* index) {
+SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria, const VoxelVoxlines* index,
+                                   SelectionPath path) {
   if (criteria.min_length && criteria.max_length && *criteria.min_length > *criteria.max_length)
     throw Error(ErrorKind::Usage, "--min-length", std::nullopt, "the minimum length is above the maximum length");
   const RegionTable table(criteria);
@@ -263,6 +267,14 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
   const VoxelRegions voxel_regions = regions_per_voxel(file, table, result.voxels_touched);
   result.bytes_read = file.voxels().size_bytes();
   HitSearch search{file, table, voxel_regions};
+  // The file's own index costs nothing to use; one is built only by callers that keep it (the viewer).
+  std::optional<VoxelVoxlines> file_index;
+  if (path == SelectionPath::ScanTable) {
+    index = nullptr;
+  } else if (!index && !file.voxel_index_first().empty()) {
+    file_index = VoxelVoxlines::of_file(file);
+    index = file_index ? &*file_index : nullptr;
+  }
   const std::vector<StreamlineHits> hits =
       index ? hits_by_index(search, *index, result.bytes_read) : hits_by_scan(search, result.bytes_read);
   result.points_tested = search.points_tested;

@@ -14,10 +14,11 @@
 // tckedit on the source file.
 //
 // The voxel grid is the index: a region is tested only against the voxlines of the voxels whose bounds it
-// may touch. Without a VoxelVoxlines index the streamlines crossing them are found by walking the voxline
-// table (8 bytes a voxline, about a tenth of the source's bytes); with one, from those voxels' lists alone,
-// so that the cost follows the regions, not the file. Length limits read the points of the streamlines
-// that pass the regions (all of them when there is no include region), through the whole voxline table.
+// may touch. With a VoxelVoxlines index (the file's VXIX, or one given) the streamlines crossing them are
+// found from those voxels' lists alone, so that the cost follows the regions, not the file; without one
+// (older files), by walking the voxline table (8 bytes a voxline, about a tenth of the source's bytes).
+// Length limits read the points of the streamlines that pass the regions (all of them when there is no
+// include region), through the whole voxline table.
 #pragma once
 
 #include <cstdint>
@@ -51,13 +52,17 @@ struct SelectionResult {
 // At most this many regions in one selection (one bit each per streamline being tested).
 inline constexpr std::size_t kMaxRegions = 64;
 
+// Where the streamlines crossing the touched voxels are found: through an index when there is one (given, or
+// the file's VXIX), or always by walking the voxline table (tests and the benchmark compare both).
+enum class SelectionPath { Fastest, ScanTable };
+
 // How far tckedit widens length limits for this file's source (0 when its header has no step_size).
 double length_limit_margin(const VxlFile& file);
 
 // Throws vxl::Error: Usage for more than kMaxRegions regions or min_length > max_length, Input for a .vxl
-// whose tables do not hold together. `index`, when given, must be VoxelVoxlines::build(file)'s: the
-// result is the same with or without it.
+// whose tables do not hold together. `index`, when given, must be VoxelVoxlines::of_file(file)'s: the
+// result is the same with or without it (without it, the file's VXIX is used when it has one), and by either path.
 SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria,
-                                   const VoxelVoxlines* index = nullptr);
+                                   const VoxelVoxlines* index = nullptr, SelectionPath path = SelectionPath::Fastest);
 
 }  // namespace vxl

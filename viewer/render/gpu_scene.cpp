@@ -27,8 +27,9 @@ void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t 
   // The scene's level of the voxel: a prefix of its block and that level's orders (.vxl spec §5.12).
   const std::uint32_t level = layout_.files()[c.file].level;
   const LevelEntry counts = file.level(li, level);
-  const std::uint64_t ordr_at = file.find_section(section_id("ORDR"))->offset +
-                                level_orders_offset(v, file.levels_of(li), level, file.meta().stored_order_count);
+  const std::uint64_t ordr_at =
+      file.orders_offset() +
+      level_orders_offset(v, file.levels_of(li), level, file.meta().stored_order_count, file.order_packing());
   is_start.assign(counts.vertex_count, 0);
   const bool wide = counts.vertex_count > kU16OrderMaxVertices;
   for (std::uint32_t k = 0; k < c.slots; ++k) {

@@ -45,6 +45,9 @@ void voxel_attributes(const VxlFile& file, std::size_t voxel, const AttributeSou
     if (d >= levels || cursor[d] > end[d] || need > end[d] - cursor[d])
       fail_input(file.path(), file.find_section(section_id("VOXT"))->offset + sizeof(VoxelEntry) * voxel,
                  "the voxel's voxlines run past its vertex block (or a level's part of it)");
+    if (e.streamline >= file.meta().streamline_count)  // from the file's VXIX, unchecked until now
+      fail_input(file.path(), file.find_section(section_id("VXIX"))->offset,
+                 "voxel " + std::to_string(voxel) + "'s list names a streamline past the streamline count");
     const std::uint64_t first = cursor[d];
     cursor[d] += need;
     if (first >= vertices) continue;  // beyond the prefix drawn
