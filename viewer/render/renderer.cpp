@@ -341,9 +341,8 @@ void Renderer::draw_front_shells(const Pieces& p) {
 void Renderer::draw_shells(ShellHalf half, const Camera& camera, const RenderSettings& s, int width, int height) {
   if (s.regions.empty()) return;
   if (!shells_) shells_ = std::make_unique<RegionShells>();
-  LinePass::enable_clip_distances(0);
   shells_->draw(camera, projection(camera, double(width) / std::max(1, height)), s.regions, half,
-                slices_drawn_ ? slices_->depth_texture() : 0);
+                slices_drawn_ ? slices_->depth_texture() : 0, clip_half_spaces(s.clipping, camera));
 }
 
 void Renderer::shells_under_exact(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
