@@ -220,8 +220,10 @@ void declare_loading(CLI::App& cli, ViewerArguments& a) {
       ->type_name("SIZE");
   cli.add_option("--gpu-memory", a.gpu_memory,
                  "GPU memory the lines may take (bytes, or K/M/G: 512M, 2G): the finest level of detail that fits is "
-                 "drawn (a file converted with levels keeps 1/8 of the streamlines per level, opacity compensated). "
-                 "Default: half the free memory the driver reports, or a quarter of the available RAM on a driver "
+                 "drawn (a file converted with levels keeps 1/8 of the streamlines per level, opacity compensated); "
+                 "with a selection, --render draws the focus at full detail first and the context at the level that "
+                 "fits the rest. Default: half the free memory the driver reports, or a quarter of the available RAM "
+                 "on a driver "
                  "that reports none (Mesa llvmpipe)")
       ->type_name("SIZE");
   cli.add_option("--span-texels", a.options.span_texels,

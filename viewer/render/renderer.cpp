@@ -50,11 +50,11 @@ Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels, std::uint32_t 
     : Renderer(std::vector<const VxlFile*>{&file}, max_texels, level) {}
 
 Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level,
-                   std::shared_ptr<GpuMemoryPool> pool, bool eager)
+                   std::shared_ptr<GpuMemoryPool> pool, bool eager, const std::vector<std::uint32_t>& file_levels)
     : files_(files.empty() ? throw Error(ErrorKind::Usage, "", std::nullopt, "Renderer: no files") : files),
       line_bounds_(line_bounds(files_)),
       scene_bounds_(line_bounds_),
-      scene_(files_, max_texels, level, std::move(pool), eager),
+      scene_(files_, max_texels, level, std::move(pool), eager, file_levels),
       groups_(files_),
       indexes_(std::make_shared<VoxelVoxlinesCache>(files_)) {
   for (const VxlFile* f : files_)
