@@ -38,15 +38,18 @@ Renderer& ViewerSession::renderer_at(std::uint32_t level, bool eager) {
 }
 
 void ViewerSession::set_focus(const std::vector<std::vector<std::uint64_t>>& kept) {
-  focus_renderers_.clear();
-  focus_layout_.reset();
-  focus_.reset();
-  focus_kept_ = kept;
   bool any = false;
   for (const auto& k : kept) any |= !k.empty();
-  if (!any) return;
-  focus_ = std::make_unique<FocusCopy>(files_, kept);
-  focus_layout_.emplace(focus_->files(), detail_->span_texels, 0);
+  set_focus(kept, any ? std::make_shared<const FocusCopy>(files_, kept) : nullptr);
+}
+
+void ViewerSession::set_focus(const std::vector<std::vector<std::uint64_t>>& kept,
+                              std::shared_ptr<const FocusCopy> copy) {
+  focus_renderers_.clear();  // before the copy they draw
+  focus_layout_.reset();
+  focus_ = std::move(copy);
+  focus_kept_ = kept;
+  if (focus_ && !focus_->files().empty()) focus_layout_.emplace(focus_->files(), detail_->span_texels, 0);
 }
 
 std::optional<FocusFirstLevels> ViewerSession::focus_first_levels(const LayoutBytes& bytes) {

@@ -60,6 +60,9 @@ class ViewerSession {
   // streamlines), made here without GL, replacing an earlier one and its renderers; none when nothing is
   // selected. Throws vxl::Error when the copy cannot be written.
   void set_focus(const std::vector<std::vector<std::uint64_t>>& kept);
+  // The same with a copy of `kept` made elsewhere (the window's, off its thread); null: no focus copy.
+  void set_focus(const std::vector<std::vector<std::uint64_t>>& kept, std::shared_ptr<const FocusCopy> copy);
+  bool has_focus() const { return focus_layout_.has_value(); }
   // The focus's and the context's levels for `bytes` (view_level.h); nullopt without a focus, or when it
   // does not fit beside the context: then the scene is drawn at one level.
   std::optional<FocusFirstLevels> focus_first_levels(const LayoutBytes& bytes);
@@ -81,7 +84,7 @@ class ViewerSession {
   std::map<std::uint32_t, std::unique_ptr<Renderer>> renderers_;
   std::optional<SceneGroups> groups_;  // the selection's, when there is one
   // Focus first: the copy (outliving its renderers), its layout at full detail, its selection.
-  std::unique_ptr<FocusCopy> focus_;
+  std::shared_ptr<const FocusCopy> focus_;
   std::optional<SceneLayout> focus_layout_;
   std::vector<std::vector<std::uint64_t>> focus_kept_;
   std::map<std::uint32_t, std::unique_ptr<Renderer>> focus_renderers_;
