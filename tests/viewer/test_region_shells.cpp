@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "tests/viewer/render_support.h"
+#include "viewer/render/clip_planes.h"
 #include "viewer/render/region_shapes.h"
 #include "viewer/render/volume.h"
 
@@ -135,6 +136,41 @@ TEST_F(RegionShells, TheSlicesHideTheBackHalf) {
     EXPECT_NEAR(grey, 127.5, 2);
     expect_pixel(img, column_of(0.5), row_of(5.5), over(glm::dvec3(grey), green, off_centre),
                  "the front half over the slice");
+  }
+}
+
+// The slab and clip planes cut the shells where they cut the lines: a shell pixel on the cut-away side is
+// the background, one on the kept side is still tinted.
+TEST_F(RegionShells, TheClipPlanesAndTheSlabCutTheShells) {
+  const VxlFile scene = make_scene(dir, one_line(), 10.0);
+  Renderer r({&scene});
+  const glm::vec3 green = region_shell_color(RegionShape::Role::Include);
+  const double off_centre = region_shell_alpha(static_cast<float>(std::sqrt(0.75)), true);
+  const glm::dvec3 both_halves = over(over({0, 0, 0}, green, off_centre), green, off_centre);
+  for (RenderMode mode : {RenderMode::Opaque, RenderMode::Axis, RenderMode::Exact}) {
+    SCOPED_TRACE(render_mode_name(mode));
+    RenderSettings s = red_line(mode);
+    s.regions = {sphere()};
+    s.clipping.planes = {*parse_axis_clip("x,0")};  // keeps x >= 0
+    const Image planed = render_image(r, top_view(), s, 64, 64);
+    expect_pixel(planed, column_of(-1.5), row_of(5.5), {0, 0, 0}, "the shell beyond the plane");
+    expect_pixel(planed, column_of(-1.5), row_of(0.5), {0, 0, 0}, "the line beyond the plane");
+    expect_pixel(planed, column_of(0.5), row_of(5.5), both_halves, "the shell on the kept side");
+    // A slab |z| <= 3 around the target keeps neither half near the sphere's centre (|z| > 8 there), and
+    // both 9.8 mm from it (|z| < 2).
+    s.clipping.planes.clear();
+    s.clipping.slab_mm = 6;
+    const Image slab = render_image(r, top_view(), s, 64, 64);
+    expect_pixel(slab, column_of(0.5), row_of(5.5), {0, 0, 0}, "the shell outside the slab");
+    int inner = 0, rim = 0;  // shell pixels whose centre lies within 8 mm of the sphere's axis, and beyond
+    for (int y = 0; y < 64; ++y)
+      for (int x = 0; x < 64; ++x) {
+        if (slab.pixel(x, y)[1] == 0) continue;
+        const double dx = x - 31.0 - 0.5, dy = 31.0 - y - 0.5;  // the pixel's centre from (0.5, 0.5)
+        (dx * dx + dy * dy < 64 ? inner : rim) += 1;
+      }
+    EXPECT_EQ(inner, 0) << "the shell outside the slab";
+    EXPECT_GT(rim, 0) << "the shell's rim inside the slab";
   }
 }
 

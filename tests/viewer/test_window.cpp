@@ -296,6 +296,42 @@ TEST_F(Window, AtRestAThinSlabIsRefinedToFullDetailUnderABudgetForLevelOne) {
   EXPECT_LT(compare_images(a, b).differing_pixels, 200u * 150u / 100u) << "the window's picture at rest is headless'";
 }
 
+// Focus first in the window: under a GPU memory budget that holds only level 1 of the whole scene, the
+// selection's focus is drawn at full detail (its copy, written off the window's thread) and the context at
+// level 1, as headless draws it; --stats says so per frame (focus_level).
+TEST_F(Window, UnderABudgetTheFocusIsDrawnAtFullDetailAsHeadless) {
+  VXL_REQUIRE_XVFB();
+  make_inputs(6000);
+  const VxlFile f = VxlFile::open(vxl);
+  const std::vector<const VxlFile*> files = {&f};
+  const std::uint64_t texels = std::max<std::uint64_t>(4096, SceneLayout::largest_voxel_texels(files));
+  const std::vector<float> points = f.all_vertices();
+  const std::size_t middle = points.size() / 6 * 3;  // a point of some streamline: a sphere there selects a bundle
+  const std::string sphere = std::to_string(points[middle]) + "," + std::to_string(points[middle + 1]) + "," +
+                             std::to_string(points[middle + 2]) + ",8";
+  const std::string args = " --size 200x150 --view axial --span-texels 4096 --gpu-memory " +
+                           std::to_string(SceneLayout(files, texels, 1).upload_bytes()) + " --include=" + sphere +
+                           " --context-opacity 0.1 --focus-opacity 1 --color group --group selected=#ff0000";
+  const std::string png = dir.file("window.png"), reference = dir.file("headless.png");
+  const nlohmann::json j =
+      window_stats(args + " --frames 3 --until-refined --no-exact-when-still --screenshot " + shell_quoted(png));
+  ASSERT_FALSE(j.is_null());
+  EXPECT_EQ(j.at("scene_level"), 1);
+  const auto& last = j.at("frames").back();
+  EXPECT_GE(last.at("level"), 1) << "the context below full detail";
+  ASSERT_TRUE(last.contains("focus_level")) << j.dump();
+  EXPECT_EQ(last.at("focus_level"), 0);
+  CommandResult h =
+      run_shell(shell_quoted(VOXVIEW_CLI) + " " + shell_quoted(vxl) + args + " --render " + shell_quoted(reference));
+  ASSERT_EQ(h.exit_code, 0) << h.output;
+  EXPECT_NE(h.output.find("focus at level 0 and context at level " + std::to_string(int(last.at("level")))),
+            std::string::npos)
+      << h.output;
+  const Image a = read_image(png), b = read_image(reference);
+  ASSERT_GT(lit_pixels(b), 200 * 150 / 100);
+  EXPECT_LT(compare_images(a, b).differing_pixels, 200u * 150u / 100u) << "the window's picture is headless'";
+}
+
 TEST_F(Window, OpensATckDirectly) {
   VXL_REQUIRE_XVFB();
   make_inputs();

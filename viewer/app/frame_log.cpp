@@ -80,13 +80,15 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
   j["selection_median_ms"] = selection_median;
   j["selection_p95_ms"] = selection_p95;
   nlohmann::json list = nlohmann::json::array();
-  for (const FrameRecord& f : frames)
+  for (const FrameRecord& f : frames) {
     list.push_back({{"level", f.level},
                     {"moving", f.moving},
                     {"work", work_name(f.work)},
                     {"completes", f.completes},
                     {"ms", f.ms},
                     {"since_start_s", f.since_start_s}});
+    if (f.focus_first) list.back()["focus_level"] = 0;  // focus first: `level` is the context's
+  }
   j["frames"] = list;
   const std::string text = j.dump(2) + "\n";
   AtomicOutputFile out(path);

@@ -24,7 +24,8 @@ struct FrameRecord {
   double ms = 0;             // drawing the frame, GPU work included
   double since_start_s = 0;  // when it was on screen
   FrameWork work = FrameWork::Whole;
-  bool completes = true;  // the picture it drew is complete and on screen (a piece: only the last one's)
+  bool completes = true;     // the picture it drew is complete and on screen (a piece: only the last one's)
+  bool focus_first = false;  // the focus drawn at level 0 from its copy, the context at `level`
 };
 
 struct FrameSummary {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "format/base/memory_size.h"
 #include "viewer/app/camera_file.h"
@@ -75,7 +76,26 @@ int run_headless(const ViewerOptions& o) {
   const bool per_view = !detail.forced && o.turntable <= 1 && detail.level > 0;
   const Camera camera = initial_camera(framing_points(session.layout_at(per_view ? 0 : detail.level)), o, aspect);
   const std::uint32_t level = per_view ? session.level_for_view(camera, aspect, o.settings.clipping) : detail.level;
-  if (level < detail.level)
+  // Focus first: when the budget forces the scene coarser, the selection's full-detail copy takes the budget
+  // first and the context the finest level that fits what is left (view_level.h).
+  std::optional<FocusFirstLevels> focus_first;
+  if (selection && level > 0 && !detail.forced) {
+    try {
+      session.set_focus(selection->kept);
+      focus_first = session.focus_first_levels(
+          per_view ? visible_bytes(camera, aspect, session.bounds(), o.settings.clipping)
+                   : LayoutBytes([](const SceneLayout& layout) { return layout.upload_bytes(); }));
+    } catch (const std::exception& e) {  // the copy could not be written: drawn at one level, as before
+      std::fprintf(stderr, "voxview: the focus is drawn with the context: %s\n", e.what());
+    }
+  }
+  if (focus_first)
+    std::fprintf(stderr,
+                 "voxview: focus first: the %llu selected streamlines at full detail (level 0, %s of GPU memory), "
+                 "the context at level %u in the rest of the GPU memory budget of %s (one level for both: %u)\n",
+                 (unsigned long long)selection->selected, format_memory_size(focus_first->focus_bytes).c_str(),
+                 focus_first->context, format_memory_size(detail.budget).c_str(), level);
+  else if (level < detail.level)
     std::fprintf(stderr,
                  "voxview: drawing level %u: the visible part fits the GPU memory budget of %s (the whole scene "
                  "needs level %u)\n",
@@ -83,7 +103,8 @@ int run_headless(const ViewerOptions& o) {
   else if (const std::string note = describe_scene_detail(detail, session.levels_in_files()); !note.empty())
     std::fprintf(stderr, "voxview: %s\n", note.c_str());
   if (selection) session.set_groups(selection->groups);
-  Renderer* const renderer = &session.renderer_at(level, true);
+  Renderer* const renderer =
+      focus_first ? &session.focus_first_renderer(focus_first->context, true) : &session.renderer_at(level, true);
   session.release_image();
   check_color_options(o.inputs_name(), *renderer, o.settings, o.from_view_file);
   RenderSettings settings = o.settings;
@@ -108,9 +129,11 @@ int run_headless(const ViewerOptions& o) {
     const std::string png = o.turntable ? turntable_frame_path(*o.render_png, i, frames) : *o.render_png;
     write_picture(png, o.width, o.height, rgba);
     const FrameStats& s = renderer->stats();
-    std::printf("%s: %dx%d %s, %llu voxels and %llu segments drawn, %s after %.3f s (%s)\n", png.c_str(), o.width,
+    const std::string levels =
+        focus_first ? ", focus at level 0 and context at level " + std::to_string(focus_first->context) : "";
+    std::printf("%s: %dx%d %s, %llu voxels and %llu segments drawn%s, %s after %.3f s (%s)\n", png.c_str(), o.width,
                 o.height, render_mode_name(o.settings.mode), (unsigned long long)s.voxels_drawn,
-                (unsigned long long)s.segments_drawn, i == 0 ? "first frame" : "frame", seconds,
+                (unsigned long long)s.segments_drawn, levels.c_str(), i == 0 ? "first frame" : "frame", seconds,
                 context->renderer().c_str());
   }
   if (o.save_camera) std::printf("view saved to %s\n", o.save_camera->c_str());

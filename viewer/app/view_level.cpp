@@ -16,4 +16,18 @@ std::uint32_t level_for_view(LevelLayouts& layouts, const SceneDetail& detail, c
   return detail.level;
 }
 
+std::optional<FocusFirstLevels> focus_first_levels(LevelLayouts& context, const SceneLayout& focus,
+                                                   const SceneDetail& detail, const LayoutBytes& bytes) {
+  if (detail.forced) return std::nullopt;
+  const std::uint64_t focus_bytes = bytes(focus);
+  if (focus_bytes > detail.budget) return std::nullopt;
+  for (std::uint32_t level = 0; level <= context.coarsest(); ++level)
+    if (bytes(context.at(level)) <= detail.budget - focus_bytes) return FocusFirstLevels{level, focus_bytes};
+  return std::nullopt;
+}
+
+LayoutBytes visible_bytes(const Camera& camera, double aspect, const SceneBounds& bounds, const Clipping& clipping) {
+  return [=](const SceneLayout& layout) { return view_bytes(layout, camera, aspect, bounds, clipping); };
+}
+
 }  // namespace vxl::app

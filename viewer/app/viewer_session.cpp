@@ -37,6 +37,41 @@ Renderer& ViewerSession::renderer_at(std::uint32_t level, bool eager) {
   return *r;
 }
 
+void ViewerSession::set_focus(const std::vector<std::vector<std::uint64_t>>& kept) {
+  bool any = false;
+  for (const auto& k : kept) any |= !k.empty();
+  set_focus(kept, any ? std::make_shared<const FocusCopy>(files_, kept) : nullptr);
+}
+
+void ViewerSession::set_focus(const std::vector<std::vector<std::uint64_t>>& kept,
+                              std::shared_ptr<const FocusCopy> copy) {
+  focus_renderers_.clear();  // before the copy they draw
+  focus_layout_.reset();
+  focus_ = std::move(copy);
+  focus_kept_ = kept;
+  if (focus_ && !focus_->files().empty()) focus_layout_.emplace(focus_->files(), detail_->span_texels, 0);
+}
+
+std::optional<FocusFirstLevels> ViewerSession::focus_first_levels(const LayoutBytes& bytes) {
+  if (!focus_layout_) return std::nullopt;
+  return app::focus_first_levels(*layouts_, *focus_layout_, *detail_, bytes);
+}
+
+Renderer& ViewerSession::focus_first_renderer(std::uint32_t context_level, bool eager) {
+  std::unique_ptr<Renderer>& r = focus_renderers_[context_level];
+  if (!r) {
+    std::vector<const VxlFile*> all = files_;
+    all.insert(all.end(), focus_->files().begin(), focus_->files().end());
+    std::vector<std::uint32_t> levels(files_.size(), context_level);
+    levels.resize(all.size(), 0);  // the focus's copies at full detail
+    // Its own per-voxel indexes: the session's cover the context's files only.
+    r = std::make_unique<Renderer>(all, detail_->span_texels, context_level, gpu_memory_, eager, levels);
+    if (image_) r->set_volume(*image_);
+    r->set_groups(SceneGroups::focus_first(all, files_.size(), focus_kept_));
+  }
+  return *r;
+}
+
 void ViewerSession::set_groups(const std::optional<SceneGroups>& groups) {
   groups_ = groups;
   const SceneGroups drawn = groups ? *groups : SceneGroups(files_);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "format/vxl_file.h"
+#include "viewer/app/focus_copy.h"
 #include "viewer/app/scene_detail.h"
 #include "viewer/app/view_level.h"
 #include "viewer/app/viewer_options.h"
@@ -55,6 +56,19 @@ class ViewerSession {
   // Every renderer's groups, now and when made later: a selection's focus and context, or (none) the files'
   // own groups again.
   void set_groups(const std::optional<SceneGroups>& groups);
+  // Focus first (view_level.h): the selection's full-detail copy (focus_copy.h; kept: per file, its selected
+  // streamlines), made here without GL, replacing an earlier one and its renderers; none when nothing is
+  // selected. Throws vxl::Error when the copy cannot be written.
+  void set_focus(const std::vector<std::vector<std::uint64_t>>& kept);
+  // The same with a copy of `kept` made elsewhere (the window's, off its thread); null: no focus copy.
+  void set_focus(const std::vector<std::vector<std::uint64_t>>& kept, std::shared_ptr<const FocusCopy> copy);
+  bool has_focus() const { return focus_layout_.has_value(); }
+  // The focus's and the context's levels for `bytes` (view_level.h); nullopt without a focus, or when it
+  // does not fit beside the context: then the scene is drawn at one level.
+  std::optional<FocusFirstLevels> focus_first_levels(const LayoutBytes& bytes);
+  // The renderer of the context's files at `context_level` and the focus's copy at full detail, one scene
+  // (its groups: SceneGroups::focus_first), made on first use like renderer_at. Needs set_focus.
+  Renderer& focus_first_renderer(std::uint32_t context_level, bool eager);
   // The files' per-voxel indexes, shared by the renderers and the selections (built once, on first use).
   const std::shared_ptr<VoxelVoxlinesCache>& indexes() const { return indexes_; }
 
@@ -69,6 +83,11 @@ class ViewerSession {
   std::optional<LevelLayouts> layouts_;
   std::map<std::uint32_t, std::unique_ptr<Renderer>> renderers_;
   std::optional<SceneGroups> groups_;  // the selection's, when there is one
+  // Focus first: the copy (outliving its renderers), its layout at full detail, its selection.
+  std::shared_ptr<const FocusCopy> focus_;
+  std::optional<SceneLayout> focus_layout_;
+  std::vector<std::vector<std::uint64_t>> focus_kept_;
+  std::map<std::uint32_t, std::unique_ptr<Renderer>> focus_renderers_;
 };
 
 }  // namespace vxl::app

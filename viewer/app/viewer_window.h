@@ -14,6 +14,7 @@
 #include <GLFW/glfw3.h>
 
 #include "viewer/app/camera_controller.h"
+#include "viewer/app/focus_copy_worker.h"
 #include "viewer/app/frame_log.h"
 #include "viewer/app/key_bindings.h"
 #include "viewer/app/picture_annotations.h"
@@ -70,8 +71,13 @@ class ViewerWindow {
   // Asks for a new selection when the regions changed and takes the newest finished one into the picture
   // (selection_worker.h); with `wait`, the one the regions ask for now.
   void update_selection(bool wait);
-  // Hands the focus and context to every renderer (without a selection: the files' own groups again).
+  // Hands the focus and context to every renderer (without a selection: the files' own groups again), and
+  // asks for the selection's focus copy (focus first, focus_copy_worker.h).
   void apply_selection(std::optional<SceneSelection> selection);
+  // Takes the newest focus copy of the current selection into the picture; with `wait`, the one asked for.
+  void update_focus_copy(bool wait);
+  // Whether a picture at `level` draws the focus from its full-detail copy (focus first).
+  bool focus_first_at(std::uint32_t level) const { return level > 0 && session_->has_focus(); }
   // Writes the selected streamlines of every file to a stamped .tck (a key or the panel).
   void save_selection();
 
@@ -115,6 +121,10 @@ class ViewerWindow {
   std::optional<std::uint64_t> cleared_revision_;    // all regions removed at this revision: older selections are stale
   std::uint64_t selection_generation_ = 0;           // counts the selections taken into the picture
   SelectionWorker selection_worker_;
+  // Focus first: copies of the selection for pictures coarser than full detail (none with --level, or
+  // when the files hold no coarser level).
+  bool focus_first_wanted_ = false;
+  FocusCopyWorker focus_copies_;
   std::vector<double> selection_ms_;  // each selection's run time, for --stats
   const SceneDetail& detail_;         // the level of detail drawn at rest, and the span size
   std::uint32_t first_level_ = 0;

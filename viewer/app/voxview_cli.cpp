@@ -220,8 +220,10 @@ void declare_loading(CLI::App& cli, ViewerArguments& a) {
       ->type_name("SIZE");
   cli.add_option("--gpu-memory", a.gpu_memory,
                  "GPU memory the lines may take (bytes, or K/M/G: 512M, 2G): the finest level of detail that fits is "
-                 "drawn (a file converted with levels keeps 1/8 of the streamlines per level, opacity compensated). "
-                 "Default: half the free memory the driver reports, or a quarter of the available RAM on a driver "
+                 "drawn (a file converted with levels keeps 1/8 of the streamlines per level, opacity compensated); "
+                 "with a selection, the focus is drawn at full detail first and the context at the level that "
+                 "fits the rest. Default: half the free memory the driver reports, or a quarter of the available RAM "
+                 "on a driver "
                  "that reports none (Mesa llvmpipe)")
       ->type_name("SIZE");
   cli.add_option("--span-texels", a.options.span_texels,
@@ -257,7 +259,8 @@ void declare_window(CLI::App& cli, ViewerArguments& a) {
       ->delimiter(',')
       ->expected(3);
   cli.add_option("--stats", a.options.stats_json,
-                 "window: on quitting, write every frame's level of detail and time, when the first picture reached "
+                 "window: on quitting, write every frame's level of detail (with focus_level 0 where the focus was "
+                 "drawn first, at full detail) and time, when the first picture reached "
                  "the screen (first_on_screen_s, since the process started), when it was drawn and the first "
                  "full-detail and exact pictures' times, the moving frames', the refinement pieces' and the "
                  "selections' median and 95th percentile to this JSON file");

@@ -47,6 +47,8 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
       files_(session_->files()),
       regions_(std::move(regions)),
       selection_worker_(files_, session_->indexes()),
+      focus_first_wanted_(!session_->detail().forced && SceneLayout::coarsest_level(session_->files()) > 0),
+      focus_copies_(files_),
       detail_(session_->detail()),
       start_(start),
       startup_(startup),
@@ -98,7 +100,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
   }
   if (o.settings.clipping.slab_mm > 0) state_.slab_thickness = o.settings.clipping.slab_mm;
 
-  framing_points_ = framing_points(first.layout());
+  framing_points_ = framing_points(session_->layout_at(first_level_));  // the files', without a focus copy
   controller_.set_home(home_camera(aspect(), o.orthographic));
   controller_.reset();
 
@@ -139,6 +141,8 @@ void ViewerWindow::set_error(const std::string& message) {
 }
 
 Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
+  // Focus first: below full detail, the context at `level` and the focus from its full-detail copy.
+  if (focus_first_at(level)) return session_->focus_first_renderer(level, false);
   // The first picture's level is uploaded whole at once; the others span by span as frames need them
   // (the refinement at rest spreads its level's upload over frames).
   return session_->renderer_at(level, level == first_level_);
@@ -206,6 +210,9 @@ void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t le
                        : level < detail_.level
                            ? "level " + std::to_string(level) + ": the visible part fits the GPU memory budget"
                            : "";
+  if (focus_first_at(level))
+    stats_.frame_level = "focus at full detail, context at level " + std::to_string(level) +
+                         (level > detail_.level ? " while the camera moves" : "");
 }
 
 void ViewerWindow::present(int width, int height) const {
@@ -334,12 +341,14 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
     stats_.refinement = scheduler_->rest().describe(0);
     drawn_ = key;
     frames_.push_back({task.level, moving, ms, seconds_since_start()});
+    frames_.back().focus_first = focus_first_at(task.level);
     return true;
   }
   if (task.work == PictureWork::Piece) {
     bool completes = false;
     const double ms = refine(key.width, key.height, task.level, completes);
     frames_.push_back({task.level, false, ms, seconds_since_start(), task.frame_work, completes});
+    frames_.back().focus_first = focus_first_at(task.level);
     return true;
   }
   return false;
@@ -386,6 +395,7 @@ int ViewerWindow::run() {
     // A script's window (--frames) waits for each selection, so that what it draws does not depend on timing;
     // a scripted drag does not, as a user's drag does not.
     update_selection(automated && !options_.drag_region_mm);
+    update_focus_copy(automated && !options_.drag_region_mm);
     state_.settings.regions = state_.show_regions ? regions_.shapes() : std::vector<RegionShape>{};
     const PictureKey key{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all, selection_generation_};
     const bool moving = drawn_ && !closing && (!same_view(drawn_->camera, camera) || dragging);
@@ -393,9 +403,19 @@ int ViewerWindow::run() {
     const bool scripted_last = closing && frames_done && !options_.until_refined;
     // The picture (and so what the panel should say) changed after the panel was built.
     const bool drawn_now = draw_picture(
-        scheduler_->next(
-            changed, scripted_last, closing,
-            [&] { return session_->level_for_view(camera, double(fb_w) / fb_h, state_.settings.clipping); }),
+        scheduler_->next(changed, scripted_last, closing,
+                         [&] {
+                           const double aspect = double(fb_w) / fb_h;
+                           if (session_->has_focus()) {
+                             // Focus first: the copy's visible bytes first, the context at the level that fits the
+                             // rest; a copy that does not fit beside it is dropped (one level for all, as without it).
+                             if (const std::optional<FocusFirstLevels> f = session_->focus_first_levels(
+                                     visible_bytes(camera, aspect, session_->bounds(), state_.settings.clipping)))
+                               return f->context;
+                             session_->set_focus({}, nullptr);
+                           }
+                           return session_->level_for_view(camera, aspect, state_.settings.clipping);
+                         }),
         key, moving);
     pacing.frame_ended(scheduler_->rest().stage() != RestStage::Done, drawn_now);
     present(fb_w, fb_h);

@@ -55,11 +55,28 @@ void ViewerWindow::apply_selection(std::optional<SceneSelection> selection) {
   if (!selection_) stats_.selection.clear();
   ++selection_generation_;
   session_->set_groups(selection_ ? std::optional<SceneGroups>(selection_->groups) : std::nullopt);
+  // Focus first: the old copy held the old selection; the new one's comes from the worker.
+  if (session_->has_focus()) session_->set_focus({}, nullptr);
+  focus_copies_.cancel_waiting();
+  // Not while a newer selection runs (a drag): its copy would be stale before it is done.
+  if (selection_ && focus_first_wanted_ && selection_->selected > 0 && !selection_worker_.busy())
+    focus_copies_.request(selection_generation_, selection_->kept);
   const SceneGroups groups = selection_ ? selection_->groups : SceneGroups(files_);
   stats_.groups.clear();
   for (const SceneGroup& g : groups.groups()) stats_.groups.emplace_back(g.name, g.streamlines);
   for (std::size_t i = 0; i < stats_.regions.size(); ++i)
     stats_.regions[i].streamlines = regions_.regions()[i].streamlines;
+}
+
+void ViewerWindow::update_focus_copy(bool wait) {
+  std::optional<FocusCopyWorker::Done> done = focus_copies_.poll(wait);
+  if (!done || !selection_ || done->generation != selection_generation_) return;  // a selection since
+  if (!done->copy) {
+    set_error("the focus is drawn with the context: " + done->error);
+    return;
+  }
+  session_->set_focus(selection_->kept, done->copy);
+  ++selection_generation_;  // the picture changes: drawn again, the focus at full detail
 }
 
 void ViewerWindow::save_selection() {

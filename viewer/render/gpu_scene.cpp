@@ -89,10 +89,20 @@ void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t 
     words[c.vertex_table_first() + g] = index;
 }
 
+namespace {
+
+SceneLayout scene_layout(const std::vector<const VxlFile*>& files, std::uint64_t max_texels, std::uint32_t level,
+                         const std::vector<std::uint32_t>& file_levels) {
+  if (file_levels.empty()) return SceneLayout(files, max_texels, level);
+  return SceneLayout(files, max_texels, file_levels);
+}
+
+}  // namespace
+
 GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level,
-                   std::shared_ptr<GpuMemoryPool> pool, bool eager)
+                   std::shared_ptr<GpuMemoryPool> pool, bool eager, const std::vector<std::uint32_t>& file_levels)
     : files_(std::move(files)),
-      layout_(files_, max_texels ? max_texels : driver_limit(), level),
+      layout_(scene_layout(files_, max_texels ? max_texels : driver_limit(), level, file_levels)),
       pool_(pool ? std::move(pool) : std::make_shared<GpuMemoryPool>()),
       spans_(layout_.texture_spans().size()),
       resident_(layout_.texture_spans().size(), false),

@@ -42,8 +42,10 @@ class GpuScene {
   // of detail uploaded (scene_layout.h). pool: the budget shared with other scenes (none: no budget). The
   // files must outlive the scene.
   // eager: upload the whole scene now when it fits the pool's free room (else spans come as frames need them).
+  // file_levels: when not empty, each file's own level instead of `level` (SceneLayout's per-file levels).
   GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0, std::uint32_t level = 0,
-           std::shared_ptr<GpuMemoryPool> pool = nullptr, bool eager = true);
+           std::shared_ptr<GpuMemoryPool> pool = nullptr, bool eager = true,
+           const std::vector<std::uint32_t>& file_levels = {});
   GpuScene(const VxlFile& file, std::uint64_t max_texels = 0, std::uint32_t level = 0)
       : GpuScene(std::vector<const VxlFile*>{&file}, max_texels, level) {}
   // The driver's GL_MAX_TEXTURE_BUFFER_SIZE (needs a current context).

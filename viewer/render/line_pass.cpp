@@ -15,6 +15,20 @@
 #include "viewer/render/vertex_attributes.h"
 
 namespace vxl {
+namespace {
+
+// The level each group is drawn at: the finest of the files it fills alone (a focus copy), else the scene's.
+std::vector<std::uint32_t> group_levels(const SceneGroups& groups, const SceneLayout& layout) {
+  std::vector<std::uint32_t> levels(groups.groups().size(), layout.level());
+  for (std::size_t i = 0; i < layout.files().size(); ++i)
+    if (groups.uniform(i)) {
+      std::uint32_t& level = levels[groups.group_of(i, 0)];
+      level = std::min(level, layout.files()[i].level);
+    }
+  return levels;
+}
+
+}  // namespace
 
 LinePass::LinePass(GpuScene& scene, const std::vector<const VxlFile*>& files) : scene_(scene), files_(files) {
   // A draw binds up to kMaxBoundSpans spans, as many as the vertex shader's texture units allow beside the
@@ -60,7 +74,7 @@ void LinePass::prepare_attributes(const RenderSettings& s, const std::string& sc
   const std::string name = s.color == ColorMode::Scalar ? scalar : std::string();
   bool want_groups = s.color == ColorMode::Group;
   const auto& all = groups.groups();
-  for (std::size_t g = 0; g < all.size(); ++g) want_groups |= s.group_color(all[g].name, g).a != 1.0f;
+  for (std::size_t g = 0; g < all.size(); ++g) want_groups |= s.group_color(all[g].name, g).a != 1.0f || all[g].hidden;
   const std::string key = name.empty() && !want_groups ? "" : "value:" + name;
   if (key != attributes_key_) {
     std::vector<AttributeSource> per_file;
@@ -129,9 +143,19 @@ void LinePass::bind(GLuint program, const LineUniforms& u) const {
   std::vector<glm::vec4> group(shaders::kShaderGroups, glm::vec4(1.0f));
   const auto& groups = u.groups.groups();
   for (std::size_t g = 0; g < groups.size() && g < group.size(); ++g) group[g] = s.group_color(groups[g].name, g);
-  glUniform4fv(glGetUniformLocation(program, "u_group"), shaders::kShaderGroups, glm::value_ptr(group[0]));
+  for (std::size_t g = 0; g < groups.size() && g < group.size(); ++g)
+    if (groups[g].hidden) group[g].a = 0.0f;
   // A coarse level's segment stands for the 8^level segments it samples (.vxl spec §6.5).
   const float opacity = SceneLayout::level_opacity(std::clamp(s.opacity, 0.001f, 1.0f), scene_.layout().level());
+  if (!scene_.layout().one_level()) {
+    // Files at several levels (a focus copy at full detail): a group drawn from finer files than the scene's
+    // level gets its own compensation, as a factor on u_opacity.
+    const std::vector<std::uint32_t> levels = group_levels(u.groups, scene_.layout());
+    for (std::size_t g = 0; g < levels.size() && g < group.size(); ++g)
+      if (levels[g] != scene_.layout().level())
+        group[g].a *= SceneLayout::level_opacity(std::clamp(s.opacity, 0.001f, 1.0f), levels[g]) / opacity;
+  }
+  glUniform4fv(glGetUniformLocation(program, "u_group"), shaders::kShaderGroups, glm::value_ptr(group[0]));
   glUniform1f(glGetUniformLocation(program, "u_opacity"), opacity);
   glUniform1i(glGetUniformLocation(program, "u_lighting"), s.lighting ? 1 : 0);
   const glm::vec3 light = lighting::light_direction_eye();

@@ -3,13 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include <glm/gtc/type_ptr.hpp>
 
 namespace vxl {
 namespace {
 
-const char* const kShellVertex = R"(#version 330 core
+// The slab and clip planes cut the shells exactly as they cut the lines (line_shaders.cpp).
+const std::string kShellVertex = "#version 330 core\n#define CLIPS " + std::to_string(kMaxClipDistances) + R"(
 layout(location = 0) in vec3 a_position;  // on the unit sphere, or the cube [-1, 1]^3
 layout(location = 1) in vec3 a_normal;
 uniform vec3 u_centre;  // eye-relative (subtracted in double on the CPU)
@@ -18,12 +20,16 @@ uniform mat3 u_rotation;
 uniform mat4 u_projection;
 uniform int u_orthographic;
 uniform vec3 u_forward;
+uniform vec4 u_clip[CLIPS];  // camera-relative half-spaces: dot(n, p - eye) + d >= 0 is kept
+uniform int u_clip_count;
 out vec3 v_normal;
 out vec3 v_view;  // from the eye towards the surface
+out float gl_ClipDistance[CLIPS];
 void main() {
   vec3 rel = u_centre + a_position * u_scale;
   v_normal = a_normal;
   v_view = u_orthographic != 0 ? u_forward : rel;
+  for (int i = 0; i < CLIPS; ++i) gl_ClipDistance[i] = i < u_clip_count ? dot(u_clip[i].xyz, rel) + u_clip[i].w : 1.0;
   gl_Position = u_projection * vec4(u_rotation * rel, 1.0);
 }
 )";
@@ -80,7 +86,7 @@ void add_box(std::vector<glm::vec3>& v) {
 }  // namespace
 
 RegionShells::RegionShells() {
-  program_ = gl::make_program(kShellVertex, kShellFragment);
+  program_ = gl::make_program(kShellVertex.c_str(), kShellFragment);
   std::vector<glm::vec3> vertices;
   add_sphere(vertices);
   sphere_count_ = static_cast<GLint>(vertices.size() / 2);
@@ -109,7 +115,7 @@ RegionShells::~RegionShells() {
 }
 
 void RegionShells::draw(const Camera& camera, const glm::dmat4& projection, const std::vector<RegionShape>& shapes,
-                        ShellHalf half, GLuint slice_depth) {
+                        ShellHalf half, GLuint slice_depth, const std::vector<glm::dvec4>& clip) {
   if (shapes.empty()) return;
   const glm::dvec3 eye = camera.eye();
   auto centre = [](const RegionShape& s) {
@@ -130,6 +136,17 @@ void RegionShells::draw(const Camera& camera, const glm::dmat4& projection, cons
   glUniform1i(glGetUniformLocation(program_, "u_orthographic"), camera.orthographic ? 1 : 0);
   glUniform3fv(glGetUniformLocation(program_, "u_forward"), 1, glm::value_ptr(forward));
   glUniform1i(glGetUniformLocation(program_, "u_front"), half == ShellHalf::Front ? 1 : 0);
+  std::vector<glm::vec4> planes;
+  for (const glm::dvec4& h : clip) planes.push_back(glm::vec4(relative_to(h, eye)));
+  const int clips = static_cast<int>(std::min<std::size_t>(planes.size(), kMaxClipDistances));
+  if (clips > 0) glUniform4fv(glGetUniformLocation(program_, "u_clip"), clips, glm::value_ptr(planes[0]));
+  glUniform1i(glGetUniformLocation(program_, "u_clip_count"), clips);
+  for (int i = 0; i < kMaxClipDistances; ++i) {
+    if (i < clips)
+      glEnable(GL_CLIP_DISTANCE0 + i);
+    else
+      glDisable(GL_CLIP_DISTANCE0 + i);
+  }
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, slice_depth);
   glUniform1i(glGetUniformLocation(program_, "u_slice_depth"), 0);
@@ -158,6 +175,7 @@ void RegionShells::draw(const Camera& camera, const glm::dmat4& projection, cons
   glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
   glDisable(GL_BLEND);
+  for (int i = 0; i < clips; ++i) glDisable(GL_CLIP_DISTANCE0 + i);
   glBindVertexArray(0);
 }
 

@@ -50,11 +50,11 @@ Renderer::Renderer(const VxlFile& file, std::uint64_t max_texels, std::uint32_t 
     : Renderer(std::vector<const VxlFile*>{&file}, max_texels, level) {}
 
 Renderer::Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels, std::uint32_t level,
-                   std::shared_ptr<GpuMemoryPool> pool, bool eager)
+                   std::shared_ptr<GpuMemoryPool> pool, bool eager, const std::vector<std::uint32_t>& file_levels)
     : files_(files.empty() ? throw Error(ErrorKind::Usage, "", std::nullopt, "Renderer: no files") : files),
       line_bounds_(line_bounds(files_)),
       scene_bounds_(line_bounds_),
-      scene_(files_, max_texels, level, std::move(pool), eager),
+      scene_(files_, max_texels, level, std::move(pool), eager, file_levels),
       groups_(files_),
       indexes_(std::make_shared<VoxelVoxlinesCache>(files_)) {
   for (const VxlFile* f : files_)
@@ -341,9 +341,8 @@ void Renderer::draw_front_shells(const Pieces& p) {
 void Renderer::draw_shells(ShellHalf half, const Camera& camera, const RenderSettings& s, int width, int height) {
   if (s.regions.empty()) return;
   if (!shells_) shells_ = std::make_unique<RegionShells>();
-  LinePass::enable_clip_distances(0);
   shells_->draw(camera, projection(camera, double(width) / std::max(1, height)), s.regions, half,
-                slices_drawn_ ? slices_->depth_texture() : 0);
+                slices_drawn_ ? slices_->depth_texture() : 0, clip_half_spaces(s.clipping, camera));
 }
 
 void Renderer::shells_under_exact(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {

@@ -57,8 +57,12 @@ class Renderer {
   // budget). A frame draws the visible voxels whose span the budget holds, the nearest first.
   // eager: upload the whole scene when made, if it fits the pool's free room; else spans come as frames (or
   // upload_for) need them.
+  // file_levels: when not empty, each file's own level instead of `level` (a selection's focus copy at full
+  // detail beside the context at a coarser one: viewer_session.h); each group's opacity is then compensated
+  // for the level of the files it is drawn from (LinePass::bind).
   explicit Renderer(std::vector<const VxlFile*> files, std::uint64_t max_texels = 0, std::uint32_t level = 0,
-                    std::shared_ptr<GpuMemoryPool> pool = nullptr, bool eager = true);
+                    std::shared_ptr<GpuMemoryPool> pool = nullptr, bool eager = true,
+                    const std::vector<std::uint32_t>& file_levels = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;

@@ -57,6 +57,19 @@ SceneGroups SceneGroups::selection(std::span<const VxlFile* const> files,
   return out;
 }
 
+SceneGroups SceneGroups::focus_first(std::span<const VxlFile* const> files, std::size_t context_files,
+                                     const std::vector<std::vector<std::uint64_t>>& kept) {
+  SceneGroups out = selection(files.first(context_files), kept);
+  out.groups_.push_back({kSelectedInContext, out.groups_[0].streamlines, true});
+  for (std::size_t i = 0; i < context_files; ++i)
+    for (std::uint64_t s : kept[i]) out.files_[i].of_streamline[s] = 2;
+  out.files_.resize(files.size());  // the copies: every streamline selected (constant group 0)
+  out.groups_[0].streamlines = 0;
+  for (std::size_t i = context_files; i < files.size(); ++i)
+    out.groups_[0].streamlines += files[i]->meta().streamline_count;
+  return out;
+}
+
 int SceneGroups::find(const std::string& name) const {
   for (std::size_t g = 0; g < groups_.size(); ++g)
     if (groups_[g].name == name) return static_cast<int>(g);

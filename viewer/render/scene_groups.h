@@ -6,7 +6,10 @@
 //   one file without groups        one group, named after the file;
 //   a selection (voxlines select's rules, one kept list per file)
 //                                  two groups, "selected" (the focus) and "context" (every other streamline),
-//                                  whatever the files' own groups.
+//                                  whatever the files' own groups;
+//   a selection drawn focus first  the same two, the focus drawn from its own full-detail files (the
+//                                  scene's last files, viewer_session.h), and a third, hidden group: the
+//                                  selected streamlines in the context's files, drawn once only.
 //
 // Group g gets palette colour g (matplotlib's tab10, repeating) unless the user chose one.
 #pragma once
@@ -25,6 +28,7 @@ namespace vxl {
 struct SceneGroup {
   std::string name;
   std::uint64_t streamlines = 0;
+  bool hidden = false;  // never drawn, whatever its style (drawn from another file instead)
 };
 
 class SceneGroups {
@@ -35,8 +39,14 @@ class SceneGroups {
   // The focus and context of a selection: `kept[i]` lists file i's selected streamlines (increasing).
   static SceneGroups selection(std::span<const VxlFile* const> files,
                                const std::vector<std::vector<std::uint64_t>>& kept);
+  // The focus drawn first (at full detail): files[0, context_files) are the scene's own files at the context's
+  // level, files[context_files, ...) the selection's full-detail copies, one per file with a selected
+  // streamline, in file order (all of theirs selected).
+  static SceneGroups focus_first(std::span<const VxlFile* const> files, std::size_t context_files,
+                                 const std::vector<std::vector<std::uint64_t>>& kept);
   static constexpr const char* kSelected = "selected";
   static constexpr const char* kContext = "context";
+  static constexpr const char* kSelectedInContext = "selected (drawn from its full-detail copy)";
 
   const std::vector<SceneGroup>& groups() const { return groups_; }
   std::uint32_t group_of(std::size_t file, std::uint64_t streamline) const {

@@ -91,8 +91,27 @@ float SceneLayout::level_opacity(float opacity, std::uint32_t level) {
   return static_cast<float>(1.0 - std::pow(1.0 - double(opacity), std::pow(double(kLevelRatio), double(level))));
 }
 
-SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels, std::uint32_t level)
-    : level_(std::min(level, coarsest_level(files))) {
+SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels, std::uint32_t level) {
+  const std::vector<std::uint32_t> same(files.size(), std::min(level, coarsest_level(files)));
+  lay_out(files, max_texels, same);
+}
+
+SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels,
+                         std::span<const std::uint32_t> file_levels) {
+  std::vector<std::uint32_t> levels(files.size(), 0);
+  for (std::size_t i = 0; i < files.size(); ++i)
+    levels[i] = std::min(i < file_levels.size() ? file_levels[i] : 0u, files[i]->level_count() - 1);
+  lay_out(files, max_texels, levels);
+}
+
+bool SceneLayout::one_level() const {
+  return std::all_of(files_.begin(), files_.end(), [&](const FileLayout& f) { return f.level == level_; });
+}
+
+void SceneLayout::lay_out(std::span<const VxlFile* const> files, std::uint64_t max_texels,
+                          std::span<const std::uint32_t> file_levels) {
+  level_ = 0;
+  for (std::uint32_t l : file_levels) level_ = std::max(level_, l);
   std::uint64_t total_voxels = 0;
   for (const VxlFile* f : files) total_voxels += f->meta().voxel_count;
   if (total_voxels > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
@@ -115,9 +134,9 @@ SceneLayout::SceneLayout(std::span<const VxlFile* const> files, std::uint64_t ma
     if (fi > 0 && !same_grid(files[0]->meta(), m)) one_grid_ = false;
     const std::uint32_t slots = fl.stored_orders;
     auto padded = [](std::uint64_t n) { return (n + kGroup - 1) / kGroup * kGroup; };
-    fl.level = level_;
+    fl.level = file_levels[fi];
     auto wide = [](const LevelEntry& e) { return e.vertex_count > kU16OrderMaxVertices; };
-    auto counts = [&](std::uint32_t local) { return file.level(local, level_); };
+    auto counts = [&](std::uint32_t local) { return file.level(local, fl.level); };
     // Both buffers of a span within the limit: its words (4 a texel) and its order entries; and its ids
     // within one draw's.
     auto fits = [&](const TextureSpan& c) {

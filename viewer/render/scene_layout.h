@@ -87,6 +87,11 @@ class SceneLayout {
   // fit a span.
   SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels, std::uint32_t level = 0);
   SceneLayout(const VxlFile& file, std::uint64_t max_texels, std::uint32_t level = 0);
+  // Each file at its own level (file_levels[i], at most that file's coarsest): a selection's focus copy at
+  // full detail beside the context's files at a coarser level (viewer_session.h). level() is then the
+  // coarsest of them.
+  SceneLayout(std::span<const VxlFile* const> files, std::uint64_t max_texels,
+              std::span<const std::uint32_t> file_levels);
 
   // The texels the largest voxel's span takes at full detail: the smallest max_texels every level fits.
   static std::uint64_t largest_voxel_texels(std::span<const VxlFile* const> files);
@@ -101,8 +106,8 @@ class SceneLayout {
   std::uint64_t upload_bytes() const;
   // The same for one span.
   std::uint64_t span_upload_bytes(std::uint32_t span) const;
-  // The level the scene is drawn at, and the opacity that makes a segment of it stand for the 8^level
-  // segments of full detail it samples (.vxl spec §6.5): 1 - (1 - opacity)^(8^level).
+  // The level the scene is drawn at (the coarsest file's), and the opacity that makes a segment of it stand for the
+  // 8^level segments of full detail it samples (.vxl spec §6.5): 1 - (1 - opacity)^(8^level).
   std::uint32_t level() const { return level_; }
   static float level_opacity(float opacity, std::uint32_t level);
 
@@ -124,6 +129,8 @@ class SceneLayout {
   const std::vector<VoxelDrawInfo>& voxels() const { return voxels_; }
   const std::vector<TextureSpan>& texture_spans() const { return spans_; }
   const std::vector<FileLayout>& files() const { return files_; }
+  // Whether every file is drawn at level().
+  bool one_level() const;
   // The file a scene voxel belongs to, and its index in that file's voxel table.
   std::uint32_t file_of(std::uint32_t voxel) const { return spans_[voxels_[voxel].span].file; }
   std::uint32_t local_voxel(std::uint32_t voxel) const { return voxel - files_[file_of(voxel)].voxel_first; }
@@ -157,6 +164,8 @@ class SceneLayout {
   }
 
  private:
+  void lay_out(std::span<const VxlFile* const> files, std::uint64_t max_texels,
+               std::span<const std::uint32_t> file_levels);
   std::vector<FileLayout> files_;
   std::vector<VoxelDrawInfo> voxels_;
   std::vector<TextureSpan> spans_;
