@@ -24,8 +24,7 @@ std::string format_mm(double v) {
 
 [[noreturn]] void fail_long_voxline(const std::string& path) {
   throw Error(ErrorKind::Unsupported, path, std::nullopt,
-              "a voxline of 2^26 points or more in one voxel (the voxel index counts 26 bits); use a smaller "
-              "--voxel-size");
+              "a voxline of more than 2^31-1 points; use a smaller --voxel-size");
 }
 
 }  // namespace
@@ -125,7 +124,7 @@ void count_voxel_use(std::span<const TempVoxline> streamline, std::uint32_t dept
   for (std::size_t j = 0; j < streamline.size(); ++j) {
     const TempVoxline& v = streamline[j];
     const std::uint64_t own = v.own();
-    if (own > IndexedVoxline::kCountMask) fail_long_voxline(path);
+    if (own > kVoxlineCountMask) fail_long_voxline(path);
     const std::uint64_t used = own + (j + 1 < streamline.size() ? 1 : 0);  // + the connecting vertex
     use.vertices[std::size_t(v.voxel) * use.levels + depth] += used;
     use.segments[std::size_t(v.voxel) * use.levels + depth] += used - 1;

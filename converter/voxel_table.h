@@ -65,7 +65,7 @@ struct VoxelUse {
 
 // Adds one streamline's voxlines (all of them, in order) to `use`, at the streamline's depth: each
 // voxline's own points plus, but for the last, the connecting vertex. Throws Unsupported for a voxline
-// longer than spec §9 allows (2^26 − 1 own points, what a VXIX entry counts).
+// longer than spec §9 allows.
 void count_voxel_use(std::span<const TempVoxline> streamline, std::uint32_t depth, VoxelUse& use,
                      const std::string& path);
 

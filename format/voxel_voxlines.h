@@ -1,9 +1,10 @@
 // The inverse of a .vxl's voxline table: for every voxel, the voxlines that pass through it, in streamline
 // order. VXLN is in streamline order (spec §5.6), so without this a query about a few voxels must walk
 // the whole table to learn which streamlines cross them; with it, the cost of a query is the voxlines of
-// the voxels it touches, read in order beside the voxel's vertex block. Each entry carries what a query
-// needs of its voxline (streamline, point count, flags, depth), so that a voxel's list is read
-// sequentially, never jumping back into VXLN or STRM: 8 bytes a voxline plus 8 a voxel.
+// the voxels it touches, read in order beside the voxel's vertex block. An entry is 4 bytes: its streamline
+// and three flags. Where its points lie in the block follows from the block itself (place_voxel_voxlines:
+// the voxline ends of spec §5.4 and the depth of spec §6.5), so the list is read sequentially, never jumping
+// back into VXLN or STRM.
 //
 // Files since 1.4 / 2.3 carry it (VXIX, spec §5.14): the writers fill it from their tables at the end
 // (fill_voxel_index), and a reader maps it. For an older file it is built once, in one pass over VXLN and
@@ -23,19 +24,16 @@
 
 namespace vxl {
 
-// VXIX's payload size for a file of these counts; 0 when it cannot have one (2^32 streamlines or more).
+// VXIX's payload size for a file of these counts; 0 when it cannot have one (more than 2^29 streamlines).
 std::uint64_t voxel_index_bytes(const MetaSection& meta);
 
 // Fills a VXIX payload (`first`: voxel_count + 1 list starts, then `entries`: one per voxline) from a
-// writer's own tables, STRM and VXLN, with `level_count` levels of detail. Throws vxl::Error (Unsupported,
-// naming `path`) for a voxline of 2^26 own points or more, which an entry cannot count.
+// writer's own tables, STRM and VXLN.
 void fill_voxel_index(std::span<const std::uint64_t> strm, std::span<const VoxlineEntry> voxlines,
-                      std::uint32_t level_count, std::span<std::uint64_t> first, std::span<IndexedVoxline> entries,
-                      unsigned threads, const std::string& path);
+                      std::span<std::uint64_t> first, std::span<IndexedVoxline> entries, unsigned threads);
 // The same into a whole VXIX payload of voxel_index_bytes() (8-byte aligned), as the writers hold it.
 void fill_voxel_index_payload(std::span<std::uint8_t> payload, std::span<const std::uint64_t> strm,
-                              std::span<const VoxlineEntry> voxlines, std::uint32_t level_count, unsigned threads,
-                              const std::string& path);
+                              std::span<const VoxlineEntry> voxlines, unsigned threads);
 
 class VoxelVoxlines {
  public:
@@ -43,17 +41,16 @@ class VoxelVoxlines {
   VoxelVoxlines& operator=(VoxelVoxlines&&) noexcept = default;
   VoxelVoxlines(const VoxelVoxlines&) = delete;
   VoxelVoxlines& operator=(const VoxelVoxlines&) = delete;
+
   // The file's VXIX when it has one (nothing is read), else built from STRM and VXLN. Throws vxl::Error
   // (Input) naming the file and the byte offset when STRM or VXLN do not hold together (spec §5.6, §5.7).
-  // std::nullopt for a file without VXIX that this index cannot hold: 2^32 streamlines or more, or a
-  // voxline of 2^26 points or more.
+  // std::nullopt for a file without VXIX of more than 2^29 streamlines.
   static std::optional<VoxelVoxlines> of_file(const VxlFile& file, unsigned threads = 0);
   // Always built from STRM and VXLN (`voxlines verify` compares it with VXIX).
   static std::optional<VoxelVoxlines> build(const VxlFile& file, unsigned threads = 0);
 
-  // The voxlines of voxel `voxel`, in streamline order. From a file's VXIX their streamline numbers and counts
-  // are as the file says: a user checks the numbers against the streamline count and the counts against the
-  // voxel's block.
+  // The voxlines of voxel `voxel`, in streamline order. From a file's VXIX their streamline numbers are as the
+  // file says: place_voxel_voxlines checks them.
   std::span<const IndexedVoxline> of_voxel(std::size_t voxel) const {
     return {entries_.data() + first_[voxel], entries_.data() + first_[voxel + 1]};
   }
@@ -68,6 +65,25 @@ class VoxelVoxlines {
   std::vector<std::uint64_t> owned_first_;  // when built
   std::vector<IndexedVoxline> owned_entries_;
 };
+
+// One voxline of a voxel's list, placed in the voxel's block.
+struct PlacedVoxline {
+  std::uint32_t streamline = 0;
+  std::uint32_t own = 0;           // its own points (spec §5.6)
+  std::uint64_t first_vertex = 0;  // global index of the first of them
+  std::uint32_t depth = 0;         // of its streamline (spec §6.5)
+  bool synthetic_first = false, first_of_streamline = false, last_of_streamline = false;
+  // Its vertices in the block: the own points and, unless it ends its streamline, the connecting vertex.
+  std::uint32_t vertices() const { return own + (last_of_streamline ? 0 : 1); }
+};
+
+// Places voxel `voxel`'s list in its block, in list order, as spec §5.14 says: a voxline of depth d starts at
+// that depth's cursor (spec §5.6, §5.12) and ends at the first voxline end from there (the packed words' end
+// bit; with float32 positions, a vertex where no segment of order 0 starts). `ends` is scratch. Throws
+// vxl::Error (Input) naming the file when the list and the block disagree: a streamline past the count, a
+// voxline past its depth's part of the block.
+void place_voxel_voxlines(const VxlFile& file, const VoxelVoxlines& index, std::size_t voxel,
+                          std::vector<std::uint8_t>& ends, std::vector<PlacedVoxline>& out);
 
 // The indexes of several files, each built on first use, once, by whichever thread asks first (the
 // window's selection thread or its renderer); the others wait for it.

@@ -346,14 +346,14 @@ void VxlFile::validate_voxel_index(std::span<const std::uint8_t> vxix) {
   if (vxix.data() == nullptr) return;
   const std::string& p = file_.path();
   const std::uint64_t at = find_section(section_id("VXIX"))->offset;
-  const std::optional<std::uint64_t> lists = count_product(meta_.voxline_count, 8);
+  const std::optional<std::uint64_t> lists = count_product(meta_.voxline_count, sizeof(IndexedVoxline));
   const std::optional<std::uint64_t> expected = lists ? count_sum(8 * (meta_.voxel_count + 1ull), *lists) : lists;
   if (!expected || vxix.size() != *expected)
     fail_input(p, at,
                "section VXIX size " + std::to_string(vxix.size()) +
-                   " does not match (voxel_count + 1) × 8 + voxline_count × 8");
-  if (meta_.streamline_count > std::numeric_limits<std::uint32_t>::max())
-    fail_input(p, at, "section VXIX in a file of 2^32 streamlines or more (its entries number them in 32 bits)");
+                   " does not match (voxel_count + 1) × 8 + voxline_count × 4");
+  if (meta_.streamline_count > IndexedVoxline::kStreamlineMask + 1ull)
+    fail_input(p, at, "section VXIX in a file of more than 2^29 streamlines (its entries number them in 29 bits)");
   const auto* first = reinterpret_cast<const std::uint64_t*>(vxix.data());
   for (std::uint64_t i = 0; i <= meta_.voxel_count; ++i)
     if ((i == 0 && first[0] != 0) || (i > 0 && first[i] < first[i - 1]) ||

@@ -149,19 +149,18 @@ static_assert(sizeof(VoxlineEntry) == 8);
 inline constexpr std::uint32_t kVoxlineSyntheticFirst = 0x80000000u;
 inline constexpr std::uint32_t kVoxlineCountMask = 0x7FFFFFFFu;
 
-// §5.14: one entry of a voxel's list of voxlines in VXIX.
+// §5.14: one entry of a voxel's list of voxlines in VXIX: its streamline and three flags. Its points are found in
+// the block (format/voxel_voxlines.h: the voxline ends, the depth from the streamline).
 struct IndexedVoxline {
-  std::uint32_t streamline;
-  std::uint32_t bits;  // own point count (bits 0–25), flags (26–28), depth of the streamline (29–31)
+  std::uint32_t word;
 
-  static constexpr std::uint32_t kCountMask = (1u << 26) - 1;
-  static constexpr std::uint32_t kSyntheticFirst = 1u << 26;     // its first own point is synthetic (spec §6.3)
-  static constexpr std::uint32_t kFirstOfStreamline = 1u << 27;  // the streamline's first voxline
-  static constexpr std::uint32_t kLastOfStreamline = 1u << 28;   // no connecting vertex follows it
-  std::uint32_t own() const { return bits & kCountMask; }
-  std::uint32_t depth() const { return bits >> 29; }
+  static constexpr std::uint32_t kStreamlineMask = (1u << 29) - 1;  // bits 0–28
+  static constexpr std::uint32_t kSyntheticFirst = 1u << 29;        // its first own point is synthetic (spec §6.3)
+  static constexpr std::uint32_t kFirstOfStreamline = 1u << 30;     // the streamline's first voxline
+  static constexpr std::uint32_t kLastOfStreamline = 1u << 31;      // no connecting vertex follows it
+  std::uint32_t streamline() const { return word & kStreamlineMask; }
 };
-static_assert(sizeof(IndexedVoxline) == 8);
+static_assert(sizeof(IndexedVoxline) == 4);
 
 constexpr std::uint64_t align_up(std::uint64_t x, std::uint64_t a) { return (x + a - 1) / a * a; }
 

@@ -134,7 +134,7 @@ void VxlStreamWriter::append_meta(const MetaSection& meta) {
   append(kMeta, {reinterpret_cast<const std::uint8_t*>(&m), sizeof m});
 }
 
-void VxlStreamWriter::append_voxel_index(std::uint32_t level_count, unsigned threads) {
+void VxlStreamWriter::append_voxel_index(unsigned threads) {
   const std::size_t x = entry_[kVxix], l = entry_[kVxln], s = entry_[kStrm];
   if (x >= table_.size()) return;
   if (written_[l] != table_[l].size || written_[s] != table_[s].size || written_[x] != 0)
@@ -145,10 +145,9 @@ void VxlStreamWriter::append_voxel_index(std::uint32_t level_count, unsigned thr
   };
   const FileWindow strm = read(s), vxln = read(l);
   FileWindow window = out_.map_window(table_[x].offset, table_[x].size);
-  fill_voxel_index_payload(window.bytes(),
-                           {reinterpret_cast<const std::uint64_t*>(strm.bytes().data()), strm.bytes().size() / 8},
-                           {reinterpret_cast<const VoxlineEntry*>(vxln.bytes().data()), vxln.bytes().size() / 8},
-                           level_count, threads, out_.path());
+  fill_voxel_index_payload(
+      window.bytes(), {reinterpret_cast<const std::uint64_t*>(strm.bytes().data()), strm.bytes().size() / 8},
+      {reinterpret_cast<const VoxlineEntry*>(vxln.bytes().data()), vxln.bytes().size() / 8}, threads);
   checksums_[x]->update(window.bytes().data(), window.bytes().size());
   written_[x] = table_[x].size;
 }

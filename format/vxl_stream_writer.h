@@ -87,8 +87,8 @@ class VxlStreamWriter : public VxlSections {
 
   // Appends VXIX (spec §5.14), when the file has one, from VXLN and STRM, which must be complete: read back
   // through mappings of the output and filled in place (the lists are written out of order), so that it
-  // needs no buffer of its size. `level_count`: META's. Throws vxl::Error as fill_voxel_index does.
-  void append_voxel_index(std::uint32_t level_count, unsigned threads);
+  // needs no buffer of its size.
+  void append_voxel_index(unsigned threads);
 
   // Throws std::logic_error unless every payload has been appended in full; then writes the table and
   // the header and links the file into place. Without commit() the destructor discards the file.

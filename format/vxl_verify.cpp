@@ -178,7 +178,7 @@ void check_voxel_index(const VxlFile& f) {
   if (f.voxel_index_first().empty()) return;
   const std::optional<VoxelVoxlines> built = VoxelVoxlines::build(f);
   const std::uint64_t at = f.find_section(section_id("VXIX"))->offset;
-  if (!built) fail_input(f.path(), at, "VXIX in a file whose voxlines an index cannot hold (2^26 points or more)");
+  if (!built) fail_input(f.path(), at, "VXIX in a file of more than 2^29 streamlines");
   for (std::size_t i = 0; i < f.voxels().size(); ++i) {
     const auto stored = f.voxel_index_entries().subspan(f.voxel_index_first()[i],
                                                         f.voxel_index_first()[i + 1] - f.voxel_index_first()[i]);
@@ -186,9 +186,9 @@ void check_voxel_index(const VxlFile& f) {
     if (stored.size() != expected.size())
       fail_input(f.path(), at + 8 * i, "VXIX list of voxel " + std::to_string(i) + " does not hold its voxlines");
     for (std::size_t k = 0; k < stored.size(); ++k)
-      if (stored[k].streamline != expected[k].streamline || stored[k].bits != expected[k].bits)
+      if (stored[k].word != expected[k].word)
         fail_input(
-            f.path(), at + 8 * (f.voxels().size() + 1 + f.voxel_index_first()[i] + k),
+            f.path(), at + 8 * (f.voxels().size() + 1) + 4 * (f.voxel_index_first()[i] + k),
             "VXIX entry " + std::to_string(k) + " of voxel " + std::to_string(i) + " differs from the voxline table");
   }
 }

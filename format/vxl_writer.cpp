@@ -144,8 +144,7 @@ std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, 
   return bytes;
 }
 
-VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes)
-    : out_(path), path_(path), positions_(sizes.positions) {
+VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path), positions_(sizes.positions) {
   VxlLayout layout = plan_vxl_layout(sizes);
   table_ = std::move(layout.table);
   file_ = out_.map(layout.file_size);
@@ -180,11 +179,8 @@ void VxlWriter::checksum_vertices_now() {
 }
 
 void VxlWriter::commit(unsigned threads) {
-  if (const std::span<std::uint8_t> vxix = payload(kVxix); !vxix.empty()) {
-    MetaSection meta;
-    std::memcpy(&meta, payload(kMeta).data(), sizeof meta);
-    fill_voxel_index_payload(vxix, streamline_first_voxline(), voxlines(), meta.level_count, threads, path_);
-  }
+  if (const std::span<std::uint8_t> vxix = payload(kVxix); !vxix.empty())
+    fill_voxel_index_payload(vxix, streamline_first_voxline(), voxlines(), threads);
   // Largest payloads first, so that the big ones (VERT, ORDR) run side by side.
   std::vector<std::size_t> by_size;
   const SectionEntry* vert = entry(kVert);

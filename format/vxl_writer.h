@@ -127,7 +127,7 @@ class VxlWriter : public VxlSections {
   std::span<std::uint8_t> streamline_values() { return payload(kSval); }
   std::span<std::uint8_t> group_values() { return payload(kGdat); }  // empty when there is no GDAT section
 
-  // Fills VXIX from VXLN, STRM and META (which must be final), checksums every payload (sections spread over
+  // Fills VXIX from VXLN and STRM (which must be final), checksums every payload (sections spread over
   // up to `threads` threads; 0: all hardware threads), writes the section table and the header, unmaps and
   // links the file into place. The spans above
   // are invalid afterwards. Without commit() the destructor discards the file.
@@ -143,7 +143,6 @@ class VxlWriter : public VxlSections {
   }
 
   AtomicOutputFile out_;
-  std::string path_;                 // for the errors of commit()
   std::vector<SectionEntry> table_;  // in Index order, optional sections only when present
   PositionEncoding positions_;
   bool vertices_checksummed_ = false;

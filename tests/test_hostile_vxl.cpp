@@ -266,15 +266,22 @@ TEST(HostileVxl, VoxelIndexEntriesAndOrderBitsThatLieAreRefusedWhereUsed) {
     const char* name;
     std::uint64_t at;
     std::uint32_t value;
-    const char* select_message;  // null: `select` may read it as it is (verify still refuses)
+    const char* select_message;
     const char* verify_message;
   };
+  // The first voxline end of voxel 0's block, cleared: its depth's voxlines no longer fit their part of the block.
+  const std::uint64_t vert = valid.entry("VERT").offset + 4 * f.voxels()[0].vertex_first;
+  std::uint32_t end_word = 0;
+  std::uint64_t end_at = 0;
+  for (std::uint32_t i = 0; i < f.voxels()[0].vertex_count && end_at == 0; ++i)
+    if (const std::uint32_t w = f.packed_vertices()[f.voxels()[0].vertex_first + i]; w & kPackedVoxlineEnd)
+      end_at = vert + 4 * i, end_word = w & ~kPackedVoxlineEnd;
+  ASSERT_NE(end_at, 0u);
   const Case cases[] = {
-      {"streamline past the count", entries, 1u << 30, "names a streamline past the streamline count",
-       "differs from the voxline table"},
-      {"more points than the block", entries + 4,
-       (f.voxel_index_entries()[0].bits & ~IndexedVoxline::kCountMask) | 1000000,
-       "the voxel's voxlines run past its vertex block", "differs from the voxline table"},
+      {"streamline past the count", entries, IndexedVoxline::kStreamlineMask,
+       "names a streamline past the streamline count", "differs from the voxline table"},
+      {"a voxline end cleared", end_at, end_word, "the voxel's voxlines run past its vertex block",
+       "voxline-end bit wrong"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);

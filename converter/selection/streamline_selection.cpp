@@ -199,40 +199,38 @@ std::vector<StreamlineHits> hits_by_scan(HitSearch& q, std::uint64_t& bytes_read
   return hits;
 }
 
-// Only the voxels the regions may touch, through their lists (VoxelVoxlines): a voxel's list is in
-// streamline order, the order of its block's voxlines within a depth, so its cursors are walked as the
-// scan walks them, and the list, read in order, is all a voxline costs. Voxels are independent here, so
-// they are searched side by side (the hits sorted afterwards; the first error in voxel order reported).
+// Only the voxels the regions may touch, through their lists (VoxelVoxlines): a voxel's list, placed in its
+// block (place_voxel_voxlines), is all a voxline costs. Voxels are independent here, so they are searched side
+// by side (the hits sorted afterwards; the first error in voxel order reported).
 std::vector<StreamlineHits> hits_by_index(HitSearch& q, const VoxelVoxlines& index, std::uint64_t& bytes_read) {
   std::vector<std::uint32_t> touched;
   for (std::size_t voxel = 0; voxel < q.voxels.size(); ++voxel)
     if (q.voxel_regions.touching[voxel] != 0) touched.push_back(std::uint32_t(voxel));
-  const std::uint64_t voxt_at = q.file.find_section(section_id("VOXT"))->offset;
   std::vector<std::vector<StreamlineHits>> per_voxel(touched.size());
+  struct Scratch {
+    std::vector<std::uint8_t> ends;
+    std::vector<PlacedVoxline> placed;
+  };
   std::vector<HitSearch> per_thread(resolve_threads(0), q);
+  std::vector<Scratch> scratch(per_thread.size());
   parallel_for_first_error_in_order(touched.size(), 0, [&](std::uint64_t k, unsigned t) {
     HitSearch& search = per_thread[t];
     const std::uint32_t voxel = touched[k];
-    std::vector<std::uint64_t> cursor(q.levels), end(q.levels);
-    for (std::uint32_t d = 0; d < q.levels; ++d)
-      cursor[d] = search.depth_start(voxel, d), end[d] = search.depth_end(voxel, d);
-    for (const IndexedVoxline& e : index.of_voxel(voxel)) {
-      VoxlinePlace v{voxel, e.own(), (e.bits & IndexedVoxline::kSyntheticFirst) != 0,
-                     (e.bits & IndexedVoxline::kFirstOfStreamline) != 0,
-                     (e.bits & IndexedVoxline::kLastOfStreamline) == 0};
-      if (e.depth() >= q.levels || !claim_vertices(v, cursor[e.depth()], end[e.depth()]))
-        fail_input(q.file.path(), voxt_at + sizeof(VoxelEntry) * voxel,
-                   "the voxel's voxlines run past its vertex block (or a level's part of it)");
-      if (e.streamline >= q.strm.size() - 1)  // from the file's VXIX, unchecked until now
-        fail_input(q.file.path(), q.file.find_section(section_id("VXIX"))->offset,
-                   "voxel " + std::to_string(voxel) + "'s list names a streamline past the streamline count");
-      if (const Bits hit = search.test_voxline(v, ~Bits(0)); hit != 0) per_voxel[k].push_back({e.streamline, hit});
+    place_voxel_voxlines(q.file, index, voxel, scratch[t].ends, scratch[t].placed);
+    for (const PlacedVoxline& p : scratch[t].placed) {
+      VoxlinePlace v{voxel, p.own, p.synthetic_first, p.first_of_streamline, !p.last_of_streamline, p.first_vertex};
+      if (const Bits hit = search.test_voxline(v, ~Bits(0)); hit != 0) per_voxel[k].push_back({p.streamline, hit});
     }
   });
   std::vector<StreamlineHits> hits;
   for (std::size_t k = 0; k < touched.size(); ++k) {
     hits.insert(hits.end(), per_voxel[k].begin(), per_voxel[k].end());
-    bytes_read += index.of_voxel(touched[k]).size_bytes();
+    // The list, and the block's voxline ends: its packed words (float32: order 0), read whole.
+    const VoxelEntry& v = q.voxels[touched[k]];
+    bytes_read += index.of_voxel(touched[k]).size_bytes() +
+                  (q.file.position_encoding() == PositionEncoding::Packed
+                       ? 4ull * v.vertex_count
+                       : order_array_bytes(v.segment_count, q.file.order(touched[k], 0).bits));
   }
   for (const HitSearch& search : per_thread) q.points_tested += search.points_tested;
   // One entry per streamline, in streamline order, as the scan gives them.

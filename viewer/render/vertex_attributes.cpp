@@ -32,29 +32,18 @@ void voxel_attributes(const VxlFile& file, std::size_t voxel, const AttributeSou
     for (std::uint32_t i = 0; i < vertices; ++i)
       out[2 * i] = std::bit_cast<std::uint32_t>(per_vertex[v.vertex_first + i]);
 
-  // The voxel's voxlines lie in its block by depth, deepest first, then in streamline order (spec §5.4):
-  // one cursor per depth, walked along the voxel's list.
-  const std::uint32_t levels = file.level_count();
-  const auto row = file.levels_of(voxel);
-  std::vector<std::uint64_t> cursor(levels), end(levels);
-  for (std::uint32_t d = 0; d < levels; ++d)
-    cursor[d] = depth_first_vertex(row, d), end[d] = depth_end_vertex(v, row, d);
-  for (const IndexedVoxline& e : source.index->of_voxel(voxel)) {
-    const std::uint32_t d = e.depth();
-    const std::uint64_t need = std::uint64_t(e.own()) + ((e.bits & IndexedVoxline::kLastOfStreamline) ? 0 : 1);
-    if (d >= levels || cursor[d] > end[d] || need > end[d] - cursor[d])
-      fail_input(file.path(), file.find_section(section_id("VOXT"))->offset + sizeof(VoxelEntry) * voxel,
-                 "the voxel's voxlines run past its vertex block (or a level's part of it)");
-    if (e.streamline >= file.meta().streamline_count)  // from the file's VXIX, unchecked until now
-      fail_input(file.path(), file.find_section(section_id("VXIX"))->offset,
-                 "voxel " + std::to_string(voxel) + "'s list names a streamline past the streamline count");
-    const std::uint64_t first = cursor[d];
-    cursor[d] += need;
+  // The voxel's voxlines, placed in its block through its list (spec §5.14); the scratch is kept for the
+  // thread's next voxel.
+  thread_local std::vector<std::uint8_t> ends;
+  thread_local std::vector<PlacedVoxline> placed;
+  place_voxel_voxlines(file, *source.index, voxel, ends, placed);
+  for (const PlacedVoxline& p : placed) {
+    const std::uint64_t first = p.first_vertex - v.vertex_first;
     if (first >= vertices) continue;  // beyond the prefix drawn
-    const std::uint32_t number = source.first_streamline + e.streamline;
+    const std::uint32_t number = source.first_streamline + p.streamline;
     const std::uint32_t value =
-        per_streamline.empty() ? none : std::bit_cast<std::uint32_t>(per_streamline[e.streamline]);
-    for (std::uint64_t i = first; i < std::min<std::uint64_t>(first + need, vertices); ++i) {
+        per_streamline.empty() ? none : std::bit_cast<std::uint32_t>(per_streamline[p.streamline]);
+    for (std::uint64_t i = first; i < std::min<std::uint64_t>(first + p.vertices(), vertices); ++i) {
       if (!per_streamline.empty()) out[2 * i] = value;
       out[2 * i + 1] = number;
     }
