@@ -94,7 +94,7 @@ ConvertSummary StreamingConversion::run() {
   report("writing", 0.0);
   t0 = Clock::now();
   write_rest();
-  out_->append_voxel_index(job_.threads);
+  out_->append_voxel_index();
   out_->append(VxlStreamWriter::kProv, {reinterpret_cast<const std::uint8_t*>(provenance.data()), provenance.size()});
   out_->commit();
   summary_.write_seconds += seconds_since(t0);

@@ -2,65 +2,45 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <limits>
 
 #include "format/base/error.h"
-#include "format/base/parallel.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
 
 namespace vxl {
 namespace {
 
-// A counting sort of VXLN by voxel in contiguous runs of streamlines, one count row per run, so that runs
-// count and scatter side by side and each voxel's list still comes out in streamline order. Fewer runs when
-// the rows would outweigh the table (many voxels, few voxlines). check(j) sees voxline j before it is counted.
-template <typename CheckVoxline>
-void fill_lists(std::span<const std::uint64_t> strm, std::span<const VoxlineEntry> voxlines,
-                std::span<std::uint64_t> first, std::span<IndexedVoxline> entries, unsigned threads,
-                CheckVoxline&& check) {
-  const std::size_t voxel_count = first.size() - 1;
-  const std::uint64_t n = strm.size() - 1;
-  const std::uint64_t runs =
-      std::clamp<std::uint64_t>(voxlines.size() / (4 * voxel_count + 1), 1, std::max<std::uint64_t>(n, 1));
-  const std::uint64_t chunks = std::min<std::uint64_t>(runs, resolve_threads(threads));
-  const std::uint64_t per_chunk = (n + chunks - 1) / chunks;
-  auto streamlines_of = [&](std::uint64_t c) {
-    return std::pair(std::min(c * per_chunk, n), std::min((c + 1) * per_chunk, n));
-  };
-  std::vector<std::uint64_t> at(chunks * voxel_count, 0);
-  parallel_for_first_error_in_order(chunks, threads, [&](std::uint64_t c, unsigned) {
-    std::uint64_t* row = &at[c * voxel_count];
-    const auto [begin, end] = streamlines_of(c);
-    for (std::uint64_t j = strm[begin]; j < strm[end]; ++j) {
-      check(j);
-      ++row[voxlines[j].voxel];
-    }
-  });
+constexpr std::uint64_t kPartEntries = 1 << 20;  // table entries read at a time: 8 MB
 
-  std::uint64_t total = 0;
-  for (std::size_t v = 0; v < voxel_count; ++v) {
-    first[v] = total;
-    for (std::uint64_t c = 0; c < chunks; ++c) {
-      const std::uint64_t count = at[c * voxel_count + v];
-      at[c * voxel_count + v] = total;  // becomes where run c writes voxel v's next voxline
-      total += count;
+// STRM read in order, a part at a time: at(s) for s that never decreases.
+class StreamlineTableReader {
+ public:
+  StreamlineTableReader(const VoxelIndexIo& io, std::uint64_t entries) : io_(io), entries_(entries) {}
+  std::uint64_t at(std::uint64_t s) {
+    if (s < first_ || s >= first_ + part_.size()) {
+      first_ = s;
+      part_.resize(std::min(kPartEntries, entries_ - s));
+      io_.read_streamline_table(first_, part_);
     }
+    return part_[s - first_];
   }
-  first[voxel_count] = total;
-  parallel_for(chunks, threads, [&](std::uint64_t c, unsigned) {
-    std::uint64_t* row = &at[c * voxel_count];
-    const auto [begin, end] = streamlines_of(c);
-    for (std::uint64_t s = begin; s < end; ++s)
-      for (std::uint64_t j = strm[s]; j < strm[s + 1]; ++j) {
-        const VoxlineEntry& e = voxlines[j];
-        std::uint32_t word = static_cast<std::uint32_t>(s);
-        if (e.count_flags & kVoxlineSyntheticFirst) word |= IndexedVoxline::kSyntheticFirst;
-        if (j == strm[s]) word |= IndexedVoxline::kFirstOfStreamline;
-        if (j + 1 == strm[s + 1]) word |= IndexedVoxline::kLastOfStreamline;
-        entries[row[e.voxel]++] = {word};
-      }
-  });
+
+ private:
+  const VoxelIndexIo& io_;
+  std::uint64_t entries_, first_ = 0;
+  std::vector<std::uint64_t> part_;
+};
+
+// Calls visit(j, e) for every voxline in order, reading VXLN a part at a time.
+template <typename Visit>
+void each_voxline(const VoxelIndexIo& io, std::uint64_t voxline_count, std::vector<VoxlineEntry>& part, Visit&& visit) {
+  for (std::uint64_t first = 0; first < voxline_count; first += part.size()) {
+    part.resize(std::min(kPartEntries, voxline_count - first));
+    io.read_voxlines(first, part);
+    for (std::size_t k = 0; k < part.size(); ++k) visit(first + k, part[k]);
+  }
 }
 
 }  // namespace
@@ -70,43 +50,100 @@ std::uint64_t voxel_index_bytes(const MetaSection& meta) {
   return 8 * (std::uint64_t(meta.voxel_count) + 1) + sizeof(IndexedVoxline) * meta.voxline_count;
 }
 
-void fill_voxel_index(std::span<const std::uint64_t> strm, std::span<const VoxlineEntry> voxlines,
-                      std::span<std::uint64_t> first, std::span<IndexedVoxline> entries, unsigned threads) {
-  if (first.empty() || strm.empty() || entries.size() != voxlines.size() ||
-      strm.size() - 1 > IndexedVoxline::kStreamlineMask + 1ull)
-    throw std::logic_error("fill_voxel_index: payload sized for other counts");
-  const std::size_t voxel_count = first.size() - 1;
-  fill_lists(strm, voxlines, first, entries, threads, [&](std::uint64_t j) {
-    if (voxlines[j].voxel >= voxel_count) throw std::logic_error("fill_voxel_index: voxline in no voxel");
+void fill_voxel_index(std::uint64_t voxel_count, std::uint64_t voxline_count, std::uint64_t streamline_count,
+                      const VoxelIndexIo& io, std::uint64_t buffer_bytes) {
+  if (streamline_count > IndexedVoxline::kStreamlineMask + 1ull)
+    throw std::logic_error("fill_voxel_index: more streamlines than an entry numbers");
+  // Pass 1: each voxel's list size, then where each list starts (the payload's first part).
+  std::vector<std::uint64_t> first(voxel_count + 1, 0);
+  std::vector<VoxlineEntry> part;
+  each_voxline(io, voxline_count, part, [&](std::uint64_t j, const VoxlineEntry& e) {
+    if (io.check) io.check(j, e);
+    if (e.voxel >= voxel_count) throw std::logic_error("fill_voxel_index: a voxline in no voxel");
+    ++first[e.voxel + 1];
   });
+  for (std::uint64_t v = 0; v < voxel_count; ++v) first[v + 1] += first[v];
+  io.write({reinterpret_cast<const std::uint8_t*>(first.data()), first.size() * 8});
+
+  // Then the lists, a range of voxels per pass, each written in place in a buffer by a counting sort.
+  const std::uint64_t buffer_entries =
+      io.in_place.empty() ? std::max<std::uint64_t>(1, buffer_bytes / sizeof(IndexedVoxline)) : voxline_count;
+  std::vector<IndexedVoxline> buffer;
+  std::vector<std::uint64_t> cursor;
+  for (std::uint64_t begin = 0; begin < voxel_count;) {
+    std::uint64_t end = begin + 1;
+    while (end < voxel_count && first[end + 1] - first[begin] <= buffer_entries) ++end;
+    std::span<IndexedVoxline> lists = io.in_place;
+    if (lists.empty()) {
+      buffer.resize(first[end] - first[begin]);
+      lists = buffer;
+    }
+    cursor.assign(first.begin() + static_cast<std::ptrdiff_t>(begin), first.begin() + static_cast<std::ptrdiff_t>(end));
+    StreamlineTableReader strm(io, streamline_count + 1);
+    std::uint64_t s = 0;
+    each_voxline(io, voxline_count, part, [&](std::uint64_t j, const VoxlineEntry& e) {
+      while (strm.at(s + 1) <= j) ++s;  // the streamline voxline j belongs to (STRM checked by the caller)
+      if (e.voxel < begin || e.voxel >= end) return;
+      std::uint32_t word = static_cast<std::uint32_t>(s);
+      if (e.count_flags & kVoxlineSyntheticFirst) word |= IndexedVoxline::kSyntheticFirst;
+      if (j == strm.at(s)) word |= IndexedVoxline::kFirstOfStreamline;
+      if (j + 1 == strm.at(s + 1)) word |= IndexedVoxline::kLastOfStreamline;
+      lists[cursor[e.voxel - begin]++ - first[begin]] = {word};
+    });
+    if (io.in_place.empty())
+      io.write({reinterpret_cast<const std::uint8_t*>(lists.data()), lists.size() * sizeof(IndexedVoxline)});
+    begin = end;
+  }
 }
+
+namespace {
+
+// Reads from tables in memory (a writer's own, or a mapped file's).
+VoxelIndexIo tables_in_memory(std::span<const std::uint64_t> strm, std::span<const VoxlineEntry> voxlines) {
+  VoxelIndexIo io;
+  io.read_voxlines = [voxlines](std::uint64_t first, std::span<VoxlineEntry> out) {
+    std::copy_n(voxlines.begin() + static_cast<std::ptrdiff_t>(first), out.size(), out.begin());
+  };
+  io.read_streamline_table = [strm](std::uint64_t first, std::span<std::uint64_t> out) {
+    std::copy_n(strm.begin() + static_cast<std::ptrdiff_t>(first), out.size(), out.begin());
+  };
+  return io;
+}
+
+}  // namespace
 
 void fill_voxel_index_payload(std::span<std::uint8_t> payload, std::span<const std::uint64_t> strm,
-                              std::span<const VoxlineEntry> voxlines, unsigned threads) {
+                              std::span<const VoxlineEntry> voxlines) {
   const std::uint64_t lists = sizeof(IndexedVoxline) * voxlines.size();
-  if (payload.size() < lists + 8 || (payload.size() - lists) % 8 != 0)
+  if (strm.empty() || payload.size() < lists + 8 || (payload.size() - lists) % 8 != 0)
     throw std::logic_error("fill_voxel_index_payload: payload sized for other counts");
-  auto* first = reinterpret_cast<std::uint64_t*>(payload.data());  // payloads are 64-byte aligned
-  const std::uint64_t first_count = (payload.size() - lists) / 8;
-  fill_voxel_index(strm, voxlines, {first, first_count},
-                   {reinterpret_cast<IndexedVoxline*>(first + first_count), voxlines.size()}, threads);
+  const std::uint64_t starts = payload.size() - lists;
+  VoxelIndexIo io = tables_in_memory(strm, voxlines);
+  io.write = [&](std::span<const std::uint8_t> bytes) { std::copy(bytes.begin(), bytes.end(), payload.begin()); };
+  io.in_place = {reinterpret_cast<IndexedVoxline*>(payload.data() + starts), voxlines.size()};  // 64-byte aligned
+  fill_voxel_index(starts / 8 - 1, voxlines.size(), strm.size() - 1, io, lists);
 }
 
-std::optional<VoxelVoxlines> VoxelVoxlines::build(const VxlFile& file, unsigned threads) {
+std::optional<VoxelVoxlines> VoxelVoxlines::build(const VxlFile& file) {
   if (file.meta().streamline_count > IndexedVoxline::kStreamlineMask + 1ull) return std::nullopt;
   file.check_streamline_table();
   VoxelVoxlines index;
-  index.owned_first_.assign(file.voxels().size() + 1, 0);
+  index.owned_first_.resize(file.voxels().size() + 1);
   index.owned_entries_.resize(file.voxlines().size());
-  fill_lists(file.streamline_first_voxline(), file.voxlines(), index.owned_first_, index.owned_entries_, threads,
-             [&](std::uint64_t j) { file.check_voxline(j); });
+  VoxelIndexIo io = tables_in_memory(file.streamline_first_voxline(), file.voxlines());
+  io.write = [&](std::span<const std::uint8_t> bytes) {
+    std::memcpy(index.owned_first_.data(), bytes.data(), bytes.size());
+  };
+  io.check = [&](std::uint64_t j, const VoxlineEntry&) { file.check_voxline(j); };
+  io.in_place = index.owned_entries_;
+  fill_voxel_index(file.voxels().size(), file.voxlines().size(), file.meta().streamline_count, io, 0);
   index.first_ = index.owned_first_;
   index.entries_ = index.owned_entries_;
   return index;
 }
 
-std::optional<VoxelVoxlines> VoxelVoxlines::of_file(const VxlFile& file, unsigned threads) {
-  if (file.voxel_index_first().empty()) return build(file, threads);
+std::optional<VoxelVoxlines> VoxelVoxlines::of_file(const VxlFile& file) {
+  if (file.voxel_index_first().empty()) return build(file);
   VoxelVoxlines index;
   index.first_ = file.voxel_index_first();
   index.entries_ = file.voxel_index_entries();

@@ -7,12 +7,13 @@
 // back into VXLN or STRM.
 //
 // Files since 1.4 / 2.3 carry it (VXIX, spec §5.14): the writers fill it from their tables at the end
-// (fill_voxel_index), and a reader maps it. For an older file it is built once, in one pass over VXLN and
-// STRM (a counting sort), when the first query needs it. The viewer's renderers find each vertex's
+// (fill_voxel_index), and a reader maps it. For an older file the same lists are built once, in memory, when
+// the first query needs them. The viewer's renderers find each vertex's
 // streamline through it too.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -27,13 +28,29 @@ namespace vxl {
 // VXIX's payload size for a file of these counts; 0 when it cannot have one (more than 2^29 streamlines).
 std::uint64_t voxel_index_bytes(const MetaSection& meta);
 
-// Fills a VXIX payload (`first`: voxel_count + 1 list starts, then `entries`: one per voxline) from a
-// writer's own tables, STRM and VXLN.
-void fill_voxel_index(std::span<const std::uint64_t> strm, std::span<const VoxlineEntry> voxlines,
-                      std::span<std::uint64_t> first, std::span<IndexedVoxline> entries, unsigned threads);
-// The same into a whole VXIX payload of voxel_index_bytes() (8-byte aligned), as the writers hold it.
+// How fill_voxel_index reads the tables and writes the payload: a part at a time, so that a streamed conversion
+// fills the index through bounded buffers rather than mappings of whole tables.
+struct VoxelIndexIo {
+  // VXLN entries [first, first + out.size()) and STRM entries [first, first + out.size()).
+  std::function<void(std::uint64_t first, std::span<VoxlineEntry> out)> read_voxlines;
+  std::function<void(std::uint64_t first, std::span<std::uint64_t> out)> read_streamline_table;
+  // The payload's next bytes: called in payload order, each part following the last.
+  std::function<void(std::span<const std::uint8_t> bytes)> write;
+  // Sees voxline j before it is counted; throws for one that is damaged. Empty: the voxel must be in range.
+  std::function<void(std::uint64_t j, const VoxlineEntry& e)> check;
+  // Where the lists go when they are in memory already (voxline_count entries): sorted straight into it in one
+  // range, and write() is given the list starts only.
+  std::span<IndexedVoxline> in_place;
+};
+
+// Fills a VXIX payload (spec §5.14) for a file of these counts from its STRM and VXLN, which must hold together:
+// one pass to count each voxel's voxlines, then one per range of voxels whose lists fit `buffer_bytes` (a voxel
+// larger than that alone). Each pass reads both tables in order, in parts of about 8 MB.
+void fill_voxel_index(std::uint64_t voxel_count, std::uint64_t voxline_count, std::uint64_t streamline_count,
+                      const VoxelIndexIo& io, std::uint64_t buffer_bytes);
+// The same from tables in memory into a whole payload of voxel_index_bytes(), in one range.
 void fill_voxel_index_payload(std::span<std::uint8_t> payload, std::span<const std::uint64_t> strm,
-                              std::span<const VoxlineEntry> voxlines, unsigned threads);
+                              std::span<const VoxlineEntry> voxlines);
 
 class VoxelVoxlines {
  public:
@@ -45,9 +62,9 @@ class VoxelVoxlines {
   // The file's VXIX when it has one (nothing is read), else built from STRM and VXLN. Throws vxl::Error
   // (Input) naming the file and the byte offset when STRM or VXLN do not hold together (spec §5.6, §5.7).
   // std::nullopt for a file without VXIX of more than 2^29 streamlines.
-  static std::optional<VoxelVoxlines> of_file(const VxlFile& file, unsigned threads = 0);
+  static std::optional<VoxelVoxlines> of_file(const VxlFile& file);
   // Always built from STRM and VXLN (`voxlines verify` compares it with VXIX).
-  static std::optional<VoxelVoxlines> build(const VxlFile& file, unsigned threads = 0);
+  static std::optional<VoxelVoxlines> build(const VxlFile& file);
 
   // The voxlines of voxel `voxel`, in streamline order. From a file's VXIX their streamline numbers are as the
   // file says: place_voxel_voxlines checks them.

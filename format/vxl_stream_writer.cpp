@@ -134,22 +134,24 @@ void VxlStreamWriter::append_meta(const MetaSection& meta) {
   append(kMeta, {reinterpret_cast<const std::uint8_t*>(&m), sizeof m});
 }
 
-void VxlStreamWriter::append_voxel_index(unsigned threads) {
+void VxlStreamWriter::append_voxel_index() {
   const std::size_t x = entry_[kVxix], l = entry_[kVxln], s = entry_[kStrm];
   if (x >= table_.size()) return;
   if (written_[l] != table_[l].size || written_[s] != table_[s].size || written_[x] != 0)
     throw std::logic_error("VxlStreamWriter::append_voxel_index: VXLN or STRM incomplete, or VXIX begun");
-  // Both are on the disk already (a direct region writes its last bytes with its last append).
-  auto read = [&](std::size_t i) {
-    return table_[i].size > 0 ? out_.map_window(table_[i].offset, table_[i].size) : FileWindow();
+  // Both are on the disk already (a direct region writes its last bytes with its last append): read back a part
+  // at a time, so that the index costs its buffer and not mappings of the whole tables.
+  VoxelIndexIo io;
+  io.read_voxlines = [&](std::uint64_t first, std::span<VoxlineEntry> out) {
+    out_.pread(out.data(), out.size_bytes(), table_[l].offset + first * sizeof(VoxlineEntry));
   };
-  const FileWindow strm = read(s), vxln = read(l);
-  FileWindow window = out_.map_window(table_[x].offset, table_[x].size);
-  fill_voxel_index_payload(
-      window.bytes(), {reinterpret_cast<const std::uint64_t*>(strm.bytes().data()), strm.bytes().size() / 8},
-      {reinterpret_cast<const VoxlineEntry*>(vxln.bytes().data()), vxln.bytes().size() / 8}, threads);
-  checksums_[x]->update(window.bytes().data(), window.bytes().size());
-  written_[x] = table_[x].size;
+  io.read_streamline_table = [&](std::uint64_t first, std::span<std::uint64_t> out) {
+    out_.pread(out.data(), out.size_bytes(), table_[s].offset + first * 8);
+  };
+  io.write = [&](std::span<const std::uint8_t> bytes) { append(kVxix, bytes); };
+  const std::uint64_t voxlines = table_[l].size / sizeof(VoxlineEntry), streamlines = table_[s].size / 8 - 1;
+  const std::uint64_t voxels = (table_[x].size - voxlines * sizeof(IndexedVoxline)) / 8 - 1;
+  fill_voxel_index(voxels, voxlines, streamlines, io, kVoxelIndexBufferBytes);
 }
 
 void VxlStreamWriter::commit() {

@@ -85,10 +85,11 @@ class VxlStreamWriter : public VxlSections {
     return entry_[section] < table_.size() ? written_[entry_[section]] : 0;
   }
 
-  // Appends VXIX (spec §5.14), when the file has one, from VXLN and STRM, which must be complete: read back
-  // through mappings of the output and filled in place (the lists are written out of order), so that it
-  // needs no buffer of its size.
-  void append_voxel_index(unsigned threads);
+  // Appends VXIX (spec §5.14), when the file has one, from VXLN and STRM, which must be complete: read back a
+  // part at a time, the lists sorted in a buffer of kVoxelIndexBufferBytes, one pass over both tables per
+  // buffer full (three on a 10M-streamline set).
+  void append_voxel_index();
+  static constexpr std::uint64_t kVoxelIndexBufferBytes = 128ull << 20;
 
   // Throws std::logic_error unless every payload has been appended in full; then writes the table and
   // the header and links the file into place. Without commit() the destructor discards the file.

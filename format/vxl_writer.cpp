@@ -180,7 +180,7 @@ void VxlWriter::checksum_vertices_now() {
 
 void VxlWriter::commit(unsigned threads) {
   if (const std::span<std::uint8_t> vxix = payload(kVxix); !vxix.empty())
-    fill_voxel_index_payload(vxix, streamline_first_voxline(), voxlines(), threads);
+    fill_voxel_index_payload(vxix, streamline_first_voxline(), voxlines());
   // Largest payloads first, so that the big ones (VERT, ORDR) run side by side.
   std::vector<std::size_t> by_size;
   const SectionEntry* vert = entry(kVert);

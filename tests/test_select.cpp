@@ -166,7 +166,7 @@ TEST_F(Selection, RandomSpheresBoxesAndMasksMatchTheBruteForceReference) {
   std::map<std::string, std::optional<VoxelVoxlines>> index;
   for (const char* file : {"f32.vxl", "f32_4mm.vxl"}) {
     const VxlFile f = VxlFile::open(dir_->file(file));
-    index[file] = VoxelVoxlines::build(f, 2);
+    index[file] = VoxelVoxlines::build(f);
     ASSERT_TRUE(index[file].has_value());
     for (int trial = 0; trial < 40; ++trial) {
       SelectionCriteria c;
@@ -249,7 +249,7 @@ TEST(SelectionIndex, ListsEveryVoxlineOnceAndSelectsWhatTheScanSelects) {
   convert_tractogram(synth(3000, 5), dir.file("p.vxl"), packed);
   const VxlFile f = VxlFile::open(dir.file("p.vxl"));
   ASSERT_GT(f.level_count(), 1u);
-  const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f, 2);
+  const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f);
   ASSERT_TRUE(index.has_value());
   // The expected lists, from a walk of VXLN in streamline order (spec §5.6, §5.7, §6.5).
   std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> expected(f.voxels().size());
@@ -300,6 +300,40 @@ TEST(SelectionIndex, ListsEveryVoxlineOnceAndSelectsWhatTheScanSelects) {
             (scan.bytes_read - always - scan.points_tested * 4) / 4);
 }
 
+// A streamed conversion fills the index a range of voxels at a time (fill_voxel_index through a bounded buffer):
+// with buffers of one list entry up to the whole index, the payload is the one filled in memory in one range.
+TEST(SelectionIndex, FilledInPartsItIsTheSameIndex) {
+  ScratchDir dir;
+  convert_tractogram(synth(3000, 5), dir.file("p.vxl"), settings(PositionEncoding::Packed, 4.0));
+  const VxlFile f = VxlFile::open(dir.file("p.vxl"));
+  const auto strm = f.streamline_first_voxline();
+  const auto voxlines = f.voxlines();
+  std::vector<std::uint8_t> whole(voxel_index_bytes(f.meta()));
+  ASSERT_GT(whole.size(), 0u);
+  fill_voxel_index_payload(whole, strm, voxlines);
+  const auto* stored = reinterpret_cast<const std::uint8_t*>(f.voxel_index_first().data());
+  EXPECT_TRUE(std::equal(whole.begin(), whole.end(), stored)) << "the file's VXIX is the one filled in memory";
+  for (const std::uint64_t buffer : {std::uint64_t(4), std::uint64_t(4096), std::uint64_t(1) << 16}) {
+    SCOPED_TRACE(buffer);
+    std::vector<std::uint8_t> parts;
+    int writes = 0;
+    VoxelIndexIo io;
+    io.read_voxlines = [&](std::uint64_t first, std::span<VoxlineEntry> out) {
+      std::copy_n(voxlines.begin() + static_cast<std::ptrdiff_t>(first), out.size(), out.begin());
+    };
+    io.read_streamline_table = [&](std::uint64_t first, std::span<std::uint64_t> out) {
+      std::copy_n(strm.begin() + static_cast<std::ptrdiff_t>(first), out.size(), out.begin());
+    };
+    io.write = [&](std::span<const std::uint8_t> bytes) {
+      parts.insert(parts.end(), bytes.begin(), bytes.end());
+      ++writes;
+    };
+    fill_voxel_index(f.voxels().size(), voxlines.size(), strm.size() - 1, io, buffer);
+    EXPECT_EQ(parts, whole);
+    if (buffer == 4) EXPECT_EQ(writes, 1 + static_cast<int>(f.voxels().size())) << "one range per voxel";
+  }
+}
+
 // Voxline and streamline tables that do not hold together, checksums resealed so that only the structure
 // can tell: building the index, and selecting with or without it, is refused naming the file (Input) —
 // never a read past a table. An index holds no point counts (the block says where a voxline ends), so a count
@@ -342,7 +376,7 @@ TEST(SelectionIndex, TablesThatDoNotHoldTogetherAreRefused) {
     };
     EXPECT_TRUE(refused([&] { select_streamlines(f, everywhere, nullptr, SelectionPath::ScanTable); }));
     std::optional<VoxelVoxlines> index;
-    if (!refused([&] { index = VoxelVoxlines::build(f, 2); })) {
+    if (!refused([&] { index = VoxelVoxlines::build(f); })) {
       ASSERT_TRUE(index.has_value());
       if (d.in_the_index)
         EXPECT_TRUE(refused([&] { select_streamlines(f, everywhere, &*index); }));

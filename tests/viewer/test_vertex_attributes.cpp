@@ -39,7 +39,7 @@ TEST(VertexAttributes, EveryLevelsPrefixHoldsTheStreamlinesTheWalkGives) {
   convert_tractogram(synthesize_tractogram(synth), dir.file("s.vxl"), c);
   const VxlFile f = VxlFile::open(dir.file("s.vxl"));
   ASSERT_GT(f.level_count(), 1u);
-  const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f, 2);
+  const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f);
   ASSERT_TRUE(index.has_value());
   const std::vector<std::uint64_t> expected = streamline_of_vertex(f);
   const AttributeSource source{{}, 1000, &*index};  // as the second file of a scene, after 1000 streamlines
@@ -64,7 +64,7 @@ TEST(VertexAttributes, ValuesComeFromVvalAsTheyAreAndFromSvalThroughTheStreamlin
   test::ScratchDir dir;
   const test::VxlBytes b = test::VxlBytes::make(dir.file("h.vxl"));
   const VxlFile f = VxlFile::open(dir.file("h.vxl"));
-  const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f, 1);
+  const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f);
   ASSERT_TRUE(index.has_value());
   const std::vector<std::uint64_t> streamline = streamline_of_vertex(f);
   const ValueSource fa = find_value_set(f, "fa"), length = find_value_set(f, "length");
