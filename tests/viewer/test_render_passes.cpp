@@ -6,6 +6,7 @@
 #include "converter/synth.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_metrics.h"
+#include "viewer/render/clip_uniforms.h"
 #include "viewer/render/line_pass.h"
 #include "viewer/render/modes/blend_states.h"
 #include "viewer/render/modes/mode_pass.h"
@@ -84,7 +85,7 @@ Image draw_through_line_pass(const VxlFile& f, std::uint64_t max_texels, std::si
   lines.draw_plan(lines.over(), plan.first, plan.count);
   glFinish();
   EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
-  LinePass::enable_clip_distances(0);
+  enable_clip_distances(0);
   return Image{96, 96, target.read_rgba()};
 }
 

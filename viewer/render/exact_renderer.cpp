@@ -12,6 +12,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "viewer/render/clip_uniforms.h"
 #include "viewer/render/line_shaders.h"
 #include "viewer/render/modes/pass_host.h"
 #include "viewer/render/renderer.h"
@@ -208,7 +209,7 @@ void ExactRenderer::show_image() {
   glBindTexture(GL_TEXTURE_2D, result_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, image_.data());
-  LinePass::enable_clip_distances(0);
+  enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glViewport(0, 0, width_, height_);
   glUseProgram(blit_program_);

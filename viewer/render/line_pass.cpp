@@ -9,6 +9,7 @@
 #include "format/base/error.h"
 #include "format/voxel_voxlines.h"
 #include "viewer/render/clip_planes.h"
+#include "viewer/render/clip_uniforms.h"
 #include "viewer/render/colormap.h"
 #include "viewer/render/line_lighting.h"
 #include "viewer/render/line_shaders.h"
@@ -163,12 +164,7 @@ void LinePass::bind(GLuint program, const LineUniforms& u) const {
   glUniform4f(glGetUniformLocation(program, "u_light_terms"), lighting::kAmbient, lighting::kDiffuse,
               lighting::kSpecular, lighting::kShininess);
   glUniform1i(glGetUniformLocation(program, "u_orthographic"), camera.orthographic ? 1 : 0);
-  std::vector<glm::vec4> clip;
-  for (const glm::dvec4& h : clip_half_spaces(s.clipping, camera)) clip.push_back(glm::vec4(relative_to(h, eye)));
-  const int clips = static_cast<int>(std::min<std::size_t>(clip.size(), kMaxClipDistances));
-  if (clips > 0) glUniform4fv(glGetUniformLocation(program, "u_clip"), clips, glm::value_ptr(clip[0]));
-  glUniform1i(glGetUniformLocation(program, "u_clip_count"), clips);
-  enable_clip_distances(clips);
+  bind_clip_half_spaces(program, clip_half_spaces(s.clipping, camera), eye);
   // The streamline groups' table on the first unit after the spans', the slices' depth on the next (units
   // of their own: two sampler types must not share one), bound even when unused.
   const GLint groups_unit = static_cast<GLint>(kSamplersPerSpan * bound_spans_);
@@ -181,15 +177,6 @@ void LinePass::bind(GLuint program, const LineUniforms& u) const {
   glUniform1i(glGetUniformLocation(program, "u_slice_depth"), unit);
   glUniform1i(glGetUniformLocation(program, "u_slice_test"), u.slice_depth != 0 ? 1 : 0);
   glActiveTexture(GL_TEXTURE0);
-}
-
-void LinePass::enable_clip_distances(int n) {
-  for (int i = 0; i < kMaxClipDistances; ++i) {
-    if (i < n)
-      glEnable(GL_CLIP_DISTANCE0 + i);
-    else
-      glDisable(GL_CLIP_DISTANCE0 + i);
-  }
 }
 
 void LinePass::bind_spans(GLuint program, std::span<const std::uint32_t> bound,

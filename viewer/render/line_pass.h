@@ -76,7 +76,6 @@ class LinePass {
   void bind_spans(GLuint program, std::span<const std::uint32_t> bound, std::span<const std::int64_t> base) const;
   // Enables the first n of the line shader's clip distances and disables the others (passes without
   // gl_ClipDistance must run with none enabled).
-  static void enable_clip_distances(int n);
 
  private:
   void upload_streamline_groups(const SceneGroups& groups);

@@ -1,4 +1,5 @@
 #include "viewer/render/region_shells.h"
+#include "viewer/render/clip_uniforms.h"
 
 #include <algorithm>
 #include <cmath>
@@ -136,17 +137,7 @@ void RegionShells::draw(const Camera& camera, const glm::dmat4& projection, cons
   glUniform1i(glGetUniformLocation(program_, "u_orthographic"), camera.orthographic ? 1 : 0);
   glUniform3fv(glGetUniformLocation(program_, "u_forward"), 1, glm::value_ptr(forward));
   glUniform1i(glGetUniformLocation(program_, "u_front"), half == ShellHalf::Front ? 1 : 0);
-  std::vector<glm::vec4> planes;
-  for (const glm::dvec4& h : clip) planes.push_back(glm::vec4(relative_to(h, eye)));
-  const int clips = static_cast<int>(std::min<std::size_t>(planes.size(), kMaxClipDistances));
-  if (clips > 0) glUniform4fv(glGetUniformLocation(program_, "u_clip"), clips, glm::value_ptr(planes[0]));
-  glUniform1i(glGetUniformLocation(program_, "u_clip_count"), clips);
-  for (int i = 0; i < kMaxClipDistances; ++i) {
-    if (i < clips)
-      glEnable(GL_CLIP_DISTANCE0 + i);
-    else
-      glDisable(GL_CLIP_DISTANCE0 + i);
-  }
+  bind_clip_half_spaces(program_, clip, eye);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, slice_depth);
   glUniform1i(glGetUniformLocation(program_, "u_slice_depth"), 0);
@@ -175,7 +166,7 @@ void RegionShells::draw(const Camera& camera, const glm::dmat4& projection, cons
   glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
   glDisable(GL_BLEND);
-  for (int i = 0; i < clips; ++i) glDisable(GL_CLIP_DISTANCE0 + i);
+  enable_clip_distances(0);
   glBindVertexArray(0);
 }
 

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "format/base/error.h"
+#include "viewer/render/clip_uniforms.h"
 #include "viewer/render/line_pass.h"
 #include "viewer/render/modes/mode_pass.h"
 #include "viewer/render/region_shells.h"
@@ -230,7 +231,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
   mode.draw(*host_, FrameView{camera, s, width, height, fbo});
   draw_shells(ShellHalf::Front, camera, s, width, height);
   glDisable(GL_BLEND);
-  LinePass::enable_clip_distances(0);
+  enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
 }
 
@@ -290,7 +291,7 @@ bool Renderer::draw_piece(double max_ms) {
       pieces_->done = pieces_->pass->step(max_ms);
       if (pieces_->done) draw_front_shells(*pieces_);
       glDisable(GL_BLEND);
-      LinePass::enable_clip_distances(0);
+      enable_clip_distances(0);
       break;
     case PieceKind::Voxels: draw_voxel_piece(max_ms); break;
   }
@@ -329,7 +330,7 @@ void Renderer::draw_voxel_piece(double max_ms) {
   if (p.done) draw_front_shells(p);
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);
-  LinePass::enable_clip_distances(0);
+  enable_clip_distances(0);
 }
 
 void Renderer::draw_front_shells(const Pieces& p) {

@@ -8,6 +8,7 @@
 
 #include "format/base/error.h"
 #include "viewer/render/clip_planes.h"
+#include "viewer/render/clip_uniforms.h"
 #include "viewer/render/line_shaders.h"
 
 namespace vxl {
@@ -124,17 +125,7 @@ void SliceRenderer::draw(const Camera& camera, const glm::dmat4& projection, con
   glUniform3f(glGetUniformLocation(program_, "u_dims"), float(dims_[0]), float(dims_[1]), float(dims_[2]));
   const std::array<float, 2> r = range(s);
   glUniform2f(glGetUniformLocation(program_, "u_range"), r[0], r[1]);
-  std::vector<glm::vec4> planes;
-  for (const glm::dvec4& h : clip) planes.push_back(glm::vec4(relative_to(h, eye)));
-  const int clips = static_cast<int>(std::min<std::size_t>(planes.size(), kMaxClipDistances));
-  if (clips > 0) glUniform4fv(glGetUniformLocation(program_, "u_clip"), clips, glm::value_ptr(planes[0]));
-  glUniform1i(glGetUniformLocation(program_, "u_clip_count"), clips);
-  for (int i = 0; i < kMaxClipDistances; ++i) {
-    if (i < clips)
-      glEnable(GL_CLIP_DISTANCE0 + i);
-    else
-      glDisable(GL_CLIP_DISTANCE0 + i);
-  }
+  bind_clip_half_spaces(program_, clip, eye);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_3D, texture_);
   glUniform1i(glGetUniformLocation(program_, "u_volume"), 0);
@@ -174,7 +165,7 @@ void SliceRenderer::draw(const Camera& camera, const glm::dmat4& projection, con
   }
   glBindTexture(GL_TEXTURE_3D, 0);
   glDisable(GL_DEPTH_TEST);
-  for (int i = 0; i < kMaxClipDistances; ++i) glDisable(GL_CLIP_DISTANCE0 + i);
+  enable_clip_distances(0);
 }
 
 void SliceRenderer::copy_color() const {

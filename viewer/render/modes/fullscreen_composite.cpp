@@ -1,12 +1,13 @@
 #include "viewer/render/modes/fullscreen_composite.h"
 
+#include "viewer/render/clip_uniforms.h"
 #include "viewer/render/line_pass.h"
 
 namespace vxl {
 
 void draw_fullscreen_composite(GLuint program, GLuint vao,
                                std::initializer_list<std::pair<const char*, GLuint>> textures) {
-  LinePass::enable_clip_distances(0);  // the composite writes no gl_ClipDistance
+  enable_clip_distances(0);  // the composite writes no gl_ClipDistance
   glUseProgram(program);
   GLint unit = 0;
   for (const auto& [name, texture] : textures) {
