@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
     if (index->from_file())
       std::printf("index: the file's VXIX, mapped in %.3f ms (nothing built)\n", build_ms);
     else
-      std::printf("index build (a file without VXIX): %.0f ms, %.1f MB (8 bytes a voxline, 8 a voxel)\n", build_ms,
+      std::printf("index build (a file without VXIX): %.0f ms, %.1f MB (4 bytes a voxline, 8 a voxel)\n", build_ms,
                   index->bytes() / 1e6);
 
     // The per-vertex words of every voxel at full detail: what uploading the whole scene makes once.
