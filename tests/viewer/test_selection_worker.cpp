@@ -1,6 +1,6 @@
-// The window's selections off its thread (selection_worker.h): each finished selection is the one the
-// synchronous path gives for the same regions, the newest request wins over those still waiting, and a
-// failure comes back as an error, not an exception on the window's thread.
+// The window's selections off its thread (selection_worker.h, newest_request_worker.h): each finished selection is the
+// one the synchronous path gives for the same regions, the newest request wins over those still waiting, and a failure
+// comes back as an error, not an exception on the window's thread.
 #include <gtest/gtest.h>
 
 #include "converter/convert.h"
@@ -39,11 +39,11 @@ TEST_F(SelectionWorkerTest, EachSelectionIsTheSynchronousOne) {
     worker.request(i + 1, c);
     const std::optional<SelectionWorker::Done> done = worker.poll(true);
     ASSERT_TRUE(done.has_value());
-    ASSERT_TRUE(done->selection.has_value()) << done->error;
-    EXPECT_EQ(done->revision, std::uint64_t(i + 1));
+    ASSERT_TRUE(done->result.has_value()) << done->error;
+    EXPECT_EQ(done->number, std::uint64_t(i + 1));
     const SceneSelection expected = select_in_scene(files, c);
-    EXPECT_EQ(done->selection->kept, expected.kept);
-    EXPECT_EQ(done->selection->streamlines_per_region, expected.streamlines_per_region);
+    EXPECT_EQ(done->result->kept, expected.kept);
+    EXPECT_EQ(done->result->streamlines_per_region, expected.streamlines_per_region);
     EXPECT_FALSE(worker.busy());
   }
 }
@@ -56,8 +56,8 @@ TEST_F(SelectionWorkerTest, TheNewestRequestWinsAndNothingIsLeftRunning) {
   for (int i = 0; i < 20; ++i) worker.request(i + 1, sphere_at(-40.0 + 4 * i, 10));
   const std::optional<SelectionWorker::Done> done = worker.poll(true);
   ASSERT_TRUE(done.has_value());
-  EXPECT_EQ(done->revision, 20u);
-  EXPECT_EQ(done->selection->kept, select_in_scene(files, sphere_at(-40.0 + 4 * 19, 10)).kept);
+  EXPECT_EQ(done->number, 20u);
+  EXPECT_EQ(done->result->kept, select_in_scene(files, sphere_at(-40.0 + 4 * 19, 10)).kept);
   EXPECT_FALSE(worker.busy());
   EXPECT_FALSE(worker.poll(true).has_value());  // nothing new since
 }
@@ -70,7 +70,7 @@ TEST_F(SelectionWorkerTest, AFailureComesBackAsAnError) {
   worker.request(1, c);
   const std::optional<SelectionWorker::Done> done = worker.poll(true);
   ASSERT_TRUE(done.has_value());
-  EXPECT_FALSE(done->selection.has_value());
+  EXPECT_FALSE(done->result.has_value());
   EXPECT_NE(done->error.find("minimum length"), std::string::npos) << done->error;
 }
 

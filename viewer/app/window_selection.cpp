@@ -32,7 +32,7 @@ void ViewerWindow::update_selection(bool wait) {
     }
   }
   std::optional<SelectionWorker::Done> done = selection_worker_.poll(wait);
-  if (!done || (cleared_revision_ && done->revision <= *cleared_revision_)) return;
+  if (!done || (cleared_revision_ && done->number <= *cleared_revision_)) return;
   if (!done->error.empty()) {
     set_error(done->error);
     apply_selection(std::nullopt);
@@ -40,14 +40,14 @@ void ViewerWindow::update_selection(bool wait) {
   }
   selection_ms_.push_back(done->ms);
   // Counts only for the regions they were computed with: the list may have changed since.
-  if (done->revision == regions_.revision()) regions_.set_counts(done->selection->streamlines_per_region);
-  stats_.selection = std::to_string(done->selection->selected) + " of " + std::to_string(done->selection->total) +
+  if (done->number == regions_.revision()) regions_.set_counts(done->result->streamlines_per_region);
+  stats_.selection = std::to_string(done->result->selected) + " of " + std::to_string(done->result->total) +
                      " streamlines selected (" + std::to_string(int(done->ms + 0.5)) + " ms)";
   RenderSettings& s = state_.settings;
   // Regions added in the window to a scene started without: the context faint, as --context-opacity's default.
   if (s.find_style(SceneGroups::kContext) == nullptr)
     s.style_of(SceneGroups::kContext).opacity = std::min(1.0f, 0.02f / s.opacity);
-  apply_selection(std::move(done->selection));
+  apply_selection(std::move(done->result));
 }
 
 void ViewerWindow::apply_selection(std::optional<SceneSelection> selection) {
@@ -70,12 +70,12 @@ void ViewerWindow::apply_selection(std::optional<SceneSelection> selection) {
 
 void ViewerWindow::update_focus_copy(bool wait) {
   std::optional<FocusCopyWorker::Done> done = focus_copies_.poll(wait);
-  if (!done || !selection_ || done->generation != selection_generation_) return;  // a selection since
-  if (!done->copy) {
+  if (!done || !selection_ || done->number != selection_generation_) return;  // a selection since
+  if (!done->result) {
     set_error("the focus is drawn with the context: " + done->error);
     return;
   }
-  session_->set_focus(selection_->kept, done->copy);
+  session_->set_focus(selection_->kept, *done->result);
   ++selection_generation_;  // the picture changes: drawn again, the focus at full detail
 }
 
