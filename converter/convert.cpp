@@ -148,6 +148,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   for (std::span<std::uint8_t> s : {bytes_of(out.float_vertices()), bytes_of(out.packed_vertices()),
                                     bytes_of(out.voxlines()), bytes_of(out.streamline_first_voxline())})
     prefault_for_write(s, threads);
+  std::copy(plan.streamline_lengths().begin(), plan.streamline_lengths().end(), out.streamline_lengths().begin());
   VoxelBlocks blocks{
       out.voxels(), out.levels(), out.float_vertices(), out.voxlines(), out.streamline_first_voxline(), {}, {}};
   if (packed) blocks.packed_vertices = out.packed_vertices();

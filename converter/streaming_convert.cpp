@@ -95,6 +95,7 @@ ConvertSummary StreamingConversion::run() {
   t0 = Clock::now();
   write_rest();
   out_->append_voxel_index();
+  if (!scan_.lengths.empty()) out_->append_items<float>(VxlStreamWriter::kSlen, scan_.lengths);
   out_->append(VxlStreamWriter::kProv, {reinterpret_cast<const std::uint8_t*>(provenance.data()), provenance.size()});
   out_->commit();
   summary_.write_seconds += seconds_since(t0);

@@ -15,6 +15,7 @@
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
 #include "format/base/parallel.h"
+#include "format/streamline_length.h"
 #include "format/vxl_file.h"
 #include "format/vxl_group_values.h"
 #include "format/vxl_value_sets.h"
@@ -342,6 +343,26 @@ void set_bounds_checked(MetaSection& meta, std::span<const VoxelEntry> voxels, c
                    "the positions decode outside their voxels: " + misplaced_voxel(meta, voxels[i], i, c));
 }
 
+// Each streamline's length (SLEN, spec §5.15) from the decoded points, synthetic face points left out: the
+// package's positions are the source of the file written.
+void measure_streamlines(const Structure& s, std::span<const float> vertices, std::span<float> lengths,
+                         unsigned threads) {
+  const std::uint64_t n = lengths.size(), parts = std::min<std::uint64_t>(n, 64ull * threads);
+  parallel_for(parts, threads, [&](std::uint64_t part, unsigned) {
+    std::vector<float> xyz;
+    for (std::uint64_t k = n * part / parts; k < n * (part + 1) / parts; ++k) {
+      xyz.clear();
+      for (std::uint64_t j = s.strm[k]; j < s.strm[k + 1]; ++j) {
+        const std::uint32_t own = s.voxlines[j].count_flags & kVoxlineCountMask;
+        const std::uint32_t from = (s.voxlines[j].count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
+        const float* first = vertices.data() + 3 * s.first_vertex(j);
+        xyz.insert(xyz.end(), first + 3 * from, first + 3 * std::max(own, from));
+      }
+      lengths[k] = stored_length_of(xyz);
+    }
+  });
+}
+
 }  // namespace
 
 UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
@@ -390,6 +411,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
       ++done;
   });
 
+  measure_streamlines(s, vertices, out.streamline_lengths(), threads);
   summary.decode_seconds = seconds_since(t0);
 
   // Per voxel, while its block is in cache: its tight bounds from the decoded vertices (spec §7 step 3),

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "format/base/error.h"
+#include "format/streamline_length.h"
 
 namespace vxl::detail {
 namespace {
@@ -30,7 +31,7 @@ std::string format_mm(double v) {
 }  // namespace
 
 void BoundsScan::add(const float* pts, const std::uint64_t* offsets, std::uint64_t first, std::uint64_t end,
-                     std::uint64_t index_base) {
+                     std::uint64_t index_base, float* lengths) {
   // Locals, not the fields: the compiler cannot tell that `this` does not alias the points.
   float l[3] = {lo[0], lo[1], lo[2]}, h[3] = {hi[0], hi[1], hi[2]};
   double step2 = longest_step2;
@@ -55,6 +56,8 @@ void BoundsScan::add(const float* pts, const std::uint64_t* offsets, std::uint64
         ++step_count;
       }
     }
+    // While its points are in cache (a streamline with a bad point fails the conversion: its length is moot).
+    if (lengths) lengths[k] = stored_length_of({pts + 3 * offsets[k], std::size_t(3 * (offsets[k + 1] - offsets[k]))});
   }
   std::copy(l, l + 3, lo);
   std::copy(h, h + 3, hi);

@@ -40,8 +40,10 @@ struct BoundsScan {
   std::uint64_t bad_streamline = kNone, bad_point = 0;  // the first non-finite point
 
   // Streamlines [first, end) of `offsets` (points xyz in `pts`), numbered from `index_base` in messages.
+  // With `lengths`, also stores streamline k's length (stored_length_of, format/streamline_length.h) at
+  // lengths[k] for each streamline scanned.
   void add(const float* pts, const std::uint64_t* offsets, std::uint64_t first, std::uint64_t end,
-           std::uint64_t index_base);
+           std::uint64_t index_base, float* lengths = nullptr);
   // Folds in a scan of later streamlines.
   void merge(const BoundsScan& later);
   // Throws Input for the first non-finite point, if any.

@@ -116,8 +116,10 @@ VoxelPlan plan_voxels(const Tractogram& t, const VoxelizeSettings& settings) {
   // The same streamline ranges serve the bounds scan and pass 1.
   const std::vector<std::uint64_t> bounds = split_by_points(t.offsets, threads);
   std::vector<detail::BoundsScan> parts(bounds.size() - 1);
-  parallel_for(parts.size(), threads,
-               [&](std::uint64_t c, unsigned) { parts[c].add(pts, t.offsets.data(), bounds[c], bounds[c + 1], 0); });
+  plan.lengths_.resize(n_streamlines);
+  parallel_for(parts.size(), threads, [&](std::uint64_t c, unsigned) {
+    parts[c].add(pts, t.offsets.data(), bounds[c], bounds[c + 1], 0, plan.lengths_.data());
+  });
   detail::BoundsScan scan;
   for (const detail::BoundsScan& part : parts) scan.merge(part);  // in streamline order: the first bad point wins
   scan.check(path);

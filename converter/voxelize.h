@@ -101,6 +101,8 @@ class VoxelPlan {
   std::span<VoxelEntry> voxels() { return voxels_; }
   // The level prefixes of each voxel (spec §5.12), voxel-major.
   std::span<const LevelEntry> levels() const { return levels_; }
+  // Each streamline's length (SLEN, spec §5.15), measured by the bounds scan from the source points.
+  std::span<const float> streamline_lengths() const { return lengths_; }
 
  private:
   struct Work;  // the per-thread voxlines (voxelize.cpp)
@@ -112,6 +114,7 @@ class VoxelPlan {
   MetaSection meta_{};
   std::vector<VoxelEntry> voxels_;
   std::vector<LevelEntry> levels_;
+  std::vector<float> lengths_;
 };
 
 // Pass 1. Throws vxl::Error: Input for a non-finite coordinate, Unsupported (with a suggestion) when a

@@ -157,7 +157,8 @@ void VxlFile::validate_section_table() {
         section_id("META"), section_id("DIRS"), section_id("VOXT"), section_id("LODS"), section_id("VERT"),
         section_id("ORDR"), section_id("ORDB"), section_id("VXLN"), section_id("STRM"), section_id("VDIR")};
     static const std::uint32_t optional[] = {section_id("PROV"), section_id("GRPS"), section_id("VVAL"),
-                                             section_id("SVAL"), section_id("GDAT"), section_id("VXIX")};
+                                             section_id("SVAL"), section_id("GDAT"), section_id("VXIX"),
+                                             section_id("SLEN")};
     const bool is_required = std::find(std::begin(required), std::end(required), id) != std::end(required);
     const bool is_optional = std::find(std::begin(optional), std::end(optional), id) != std::end(optional);
     if (is_required && !(e.flags & kSectionRequired))
@@ -256,6 +257,10 @@ void VxlFile::validate_meta_and_sizes() {
   order_packing_ = bit_orders ? OrderPacking::Bits : OrderPacking::Bytes;
   orders_ = section(bit_orders ? "ORDB" : "ORDR", true);
   validate_voxel_index(section("VXIX", false));
+  if (find_section(section_id("SLEN")) != nullptr) {
+    auto slen = expect_size("SLEN", count_product(m.streamline_count, sizeof(float)), "streamline_count × 4");
+    streamline_lengths_ = {reinterpret_cast<const float*>(slen.data()), slen.size() / sizeof(float)};
+  }
   // Per-voxel directions: present exactly when the order set is random (§5.10).
   const bool random_set = m.order_set == static_cast<std::uint32_t>(OrderSet::Random);
   if (random_set != (find_section(section_id("VDIR")) != nullptr))

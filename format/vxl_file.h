@@ -127,6 +127,9 @@ class VxlFile {
   // entries (format/voxel_voxlines.h reads them; their contents are checked by whoever uses them).
   std::span<const std::uint64_t> voxel_index_first() const { return voxel_index_first_; }
   std::span<const IndexedVoxline> voxel_index_entries() const { return voxel_index_entries_; }
+  // SLEN (spec §5.15), empty when the file has none: each streamline's length in mm (open() has checked the
+  // size only: a user checks the values it reads, as format/streamline_length.h's stored_length does).
+  std::span<const float> streamline_lengths() const { return streamline_lengths_; }
   std::string_view provenance_json() const { return provenance_; }
   // Where PROV starts in the file (0 when the file has none).
   std::uint64_t provenance_offset() const;
@@ -169,6 +172,7 @@ class VxlFile {
   std::span<const VoxlineEntry> voxlines_;
   std::span<const std::uint64_t> voxel_index_first_;
   std::span<const IndexedVoxline> voxel_index_entries_;
+  std::span<const float> streamline_lengths_;
   std::span<const std::uint64_t> strm_;
   std::string_view provenance_;
   std::span<const std::uint8_t> groups_;

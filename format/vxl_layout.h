@@ -1,4 +1,4 @@
-// On-disk structures of the .vxl format, versions 1.0 to 2.3 (spec/vxl-format.md is the reference; section
+// On-disk structures of the .vxl format, versions 1.0 to 2.4 (spec/vxl-format.md is the reference; section
 // numbers below point into it). All little-endian; every struct's layout is pinned by static_asserts so
 // a file can be used in place after mmap.
 #pragma once
@@ -29,6 +29,9 @@ inline constexpr std::uint16_t kVxlVersionMinorGroupValues2 = 2;
 // (VXIX, spec §5.14), are 1.4 when they would otherwise be 1.x, 2.3 when 2.x.
 inline constexpr std::uint16_t kVxlVersionMinorBitOrders1 = 4;
 inline constexpr std::uint16_t kVxlVersionMinorBitOrders2 = 3;
+// Files with per-streamline lengths (SLEN, spec §5.15) are 1.5 when they would otherwise be 1.x, 2.4 when 2.x.
+inline constexpr std::uint16_t kVxlVersionMinorLengths1 = 5;
+inline constexpr std::uint16_t kVxlVersionMinorLengths2 = 4;
 inline constexpr std::uint64_t kVxlAlignment = 64;
 inline constexpr std::uint32_t kVxlMaxSections = 64;
 inline constexpr std::uint32_t kVxlMaxStoredOrders = 64;

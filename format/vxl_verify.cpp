@@ -10,6 +10,7 @@
 #include "format/base/checksum.h"
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
+#include "format/streamline_length.h"
 #include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
@@ -193,6 +194,31 @@ void check_voxel_index(const VxlFile& f) {
   }
 }
 
+// SLEN (§5.15): each length against the stored points' length, equal to the bit with float32 positions (they are
+// the source points); with packed positions within what moving each point by the file's bound can change.
+class LengthCheck {
+ public:
+  explicit LengthCheck(const VxlFile& f) : f_(f) {
+    if (f.position_encoding() != PositionEncoding::Packed) return;
+    for (const VoxelEntry& v : f.voxels()) bound_ = std::max(bound_, packed_error_bound(v));
+  }
+  void operator()(std::uint64_t s, std::span<const float> xyz) const {
+    const double stored = stored_length(f_, s), measured = polyline_length(xyz);
+    const double segments = xyz.size() / 3 > 1 ? double(xyz.size() / 3 - 1) : 0.0;
+    const bool holds = bound_ == 0 ? float(measured) == float(stored)
+                                   : std::abs(stored - measured) <=
+                                         2 * std::sqrt(3.0) * bound_ * segments + 1e-6 * std::max(1.0, measured);
+    if (!holds)
+      fail_input(f_.path(), f_.find_section(section_id("SLEN"))->offset + 4 * s,
+                 "SLEN length of streamline " + std::to_string(s) + " (" + std::to_string(stored) +
+                     " mm) differs from its points' (" + std::to_string(measured) + " mm)");
+  }
+
+ private:
+  const VxlFile& f_;
+  double bound_ = 0;  // per axis, the largest of the voxels' packing bounds
+};
+
 }  // namespace
 
 VerifyResult verify_vxl(const std::string& path) {
@@ -208,6 +234,7 @@ VerifyResult verify_vxl(const std::string& path) {
       const std::uint64_t n = v.own_points + (v.connected ? 1 : 0);
       for (std::uint64_t i = 0; i + 1 < n; ++i) is_segment_start[v.first_vertex + i] = 1;
     };
+    if (!f.streamline_lengths().empty()) cb.streamline = LengthCheck(f);
     walk_streamlines(f, cb);
     check_orders(f, is_segment_start);
     check_voxel_index(f);

@@ -46,6 +46,7 @@ VxlSectionSizes section_sizes(const MetaSection& m, std::uint64_t order_bytes, s
   s.provenance = provenance_bytes;
   s.groups = group_bytes;
   s.voxel_index = voxel_index_bytes(m);
+  s.streamline_lengths = m.streamline_count * sizeof(float);
   s.vertex_values = value_sets_bytes(vertex_value_sets, m.vertex_count);
   s.streamline_values = value_sets_bytes(streamline_value_sets, m.streamline_count);
   return s;
@@ -74,6 +75,8 @@ VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes) {
       {"STRM", kSectionRequired, sizes.streamlines, true},
       // Optional: a reader without it builds the same lists from VXLN and STRM (spec §5.14).
       {"VXIX", 0, sizes.voxel_index, sizes.voxel_index > 0},
+      // Optional: a reader without it measures the streamlines from their points (spec §5.15).
+      {"SLEN", 0, sizes.streamline_lengths, sizes.streamline_lengths > 0},
       {"PROV", 0, sizes.provenance, true},
       {"GRPS", 0, sizes.groups, sizes.groups > 0},
       // Optional: a reader that does not know them still draws the picture, in the other colour modes.
@@ -119,13 +122,17 @@ std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, 
       std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "GDAT", 4) == 0; });
   const bool has_bit_orders =
       std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "ORDB", 4) == 0; });
+  const bool has_lengths =
+      std::any_of(table.begin(), table.end(), [](const SectionEntry& e) { return std::memcmp(e.id, "SLEN", 4) == 0; });
   if (h.version_major == kVxlVersionMajorPackedPositions)
-    h.version_minor = has_bit_orders     ? kVxlVersionMinorBitOrders2
+    h.version_minor = has_lengths        ? kVxlVersionMinorLengths2
+                      : has_bit_orders   ? kVxlVersionMinorBitOrders2
                       : has_group_values ? kVxlVersionMinorGroupValues2
                       : has_levels       ? kVxlVersionMinorLevels
                                          : 0;
   else
-    h.version_minor = has_bit_orders     ? kVxlVersionMinorBitOrders1
+    h.version_minor = has_lengths        ? kVxlVersionMinorLengths1
+                      : has_bit_orders   ? kVxlVersionMinorBitOrders1
                       : has_group_values ? kVxlVersionMinorGroupValues1
                       : has_values       ? kVxlVersionMinorValueSets
                       : has_vdir         ? kVxlVersionMinorVoxelDirections

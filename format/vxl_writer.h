@@ -31,6 +31,7 @@ struct VxlSectionSizes {
   std::uint64_t group_values = 0;                          // GDAT (spec §5.13); 0: absent
   std::uint64_t vertex_values = 0, streamline_values = 0;  // VVAL, SVAL (spec §5.11); 0: absent
   std::uint64_t voxel_index = 0;                           // VXIX (spec §5.14); 0: absent
+  std::uint64_t streamline_lengths = 0;                    // SLEN (spec §5.15); 0: absent (no streamlines)
   PositionEncoding positions = PositionEncoding::Float32;  // how VERT holds them (spec §5.4); sets the version
 };
 
@@ -53,13 +54,14 @@ VxlLayout plan_vxl_layout(const VxlSectionSizes& sizes);
 
 // The bytes of the header and the section table (spec §3, §4), once every checksum in `table` is set.
 // The version is the lowest that holds what is written (spec §10): major 2 with packed positions or LODS,
-// else 1; minor 3 (2.x) or 4 (1.x) with ORDB, else the older rules (GDAT, LODS, VVAL/SVAL, VDIR).
+// else 1; minor 4 (2.x) or 5 (1.x) with SLEN, 3 or 4 with ORDB, else the older rules (GDAT, LODS, VVAL/SVAL,
+// VDIR).
 std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, std::uint64_t file_size,
                                            PositionEncoding positions);
 
-// The sections the writers fill, in file order (spec §4), and their ids; VDIR, LODS, VXIX, GRPS, VVAL, SVAL and
-// GDAT are optional. The writers fill VXIX themselves from VXLN and STRM (fill_voxel_index). One list for both writers
-// (VxlWriter, VxlStreamWriter), so that they lay out a file alike.
+// The sections the writers fill, in file order (spec §4), and their ids; VDIR, LODS, VXIX, SLEN, GRPS, VVAL, SVAL
+// and GDAT are optional. The writers fill VXIX themselves from VXLN and STRM (fill_voxel_index). One list for both
+// writers (VxlWriter, VxlStreamWriter), so that they lay out a file alike.
 struct VxlSections {
   enum Index : std::size_t {
     kMeta,
@@ -72,6 +74,7 @@ struct VxlSections {
     kVxln,
     kStrm,
     kVxix,
+    kSlen,
     kProv,
     kGrps,
     kVval,
@@ -80,7 +83,7 @@ struct VxlSections {
     kCount
   };
   static constexpr const char* kIds[kCount] = {"META", "DIRS", "VDIR", "VOXT", "LODS", "VERT", "ORDB", "VXLN",
-                                               "STRM", "VXIX", "PROV", "GRPS", "VVAL", "SVAL", "GDAT"};
+                                               "STRM", "VXIX", "SLEN", "PROV", "GRPS", "VVAL", "SVAL", "GDAT"};
 };
 
 class VxlWriter : public VxlSections {
@@ -110,6 +113,8 @@ class VxlWriter : public VxlSections {
   std::span<std::uint8_t> orders() { return payload(kOrdb); }
   std::span<VoxlineEntry> voxlines() { return typed<VoxlineEntry>(kVxln); }
   std::span<std::uint64_t> streamline_first_voxline() { return typed<std::uint64_t>(kStrm); }
+  // SLEN: each streamline's length (format/streamline_length.h); empty when the file has no streamlines.
+  std::span<float> streamline_lengths() { return typed<float>(kSlen); }
   std::span<std::uint8_t> provenance() { return payload(kProv); }
   std::span<std::uint8_t> groups() { return payload(kGrps); }  // empty when there is no GRPS section
   // The whole mapped file (header and table still unwritten), for prefaulting several payloads at once.

@@ -159,18 +159,37 @@ TEST(GoldenBytes, TheUnpackedFileDecodesWithinThePackagesBoundAndARepack) {
   expect_coordinates(decode_vxl(golden("unpacked.vxl")), package.pack().error_bound + 2 * 0.0045);
 }
 
+// The lengths (SLEN) are the pinned input's, measured here independently (std::hypot per segment): the same in
+// the packed and the float32 file, since both come from the source points, not from the packed ones.
+TEST(GoldenBytes, TheLengthsAreTheInputsOwn) {
+  const Streamlines input = pinned_input();
+  const VxlFile packed = VxlFile::open(golden("packed.vxl")), float32 = VxlFile::open(golden("float32.vxl"));
+  ASSERT_EQ(packed.streamline_lengths().size(), input.xyz.size());
+  ASSERT_EQ(float32.streamline_lengths().size(), input.xyz.size());
+  for (std::size_t s = 0; s < input.xyz.size(); ++s) {
+    const std::vector<float>& p = input.xyz[s];
+    double length = 0;
+    for (std::size_t i = 3; i < p.size(); i += 3)
+      length += std::hypot(double(p[i]) - p[i - 3], double(p[i + 1]) - p[i - 2], double(p[i + 2]) - p[i - 1]);
+    EXPECT_GT(length, 10.0) << "streamline " << s;
+    EXPECT_NEAR(packed.streamline_lengths()[s], length, 1e-6 * length) << "streamline " << s;
+    EXPECT_EQ(packed.streamline_lengths()[s], float32.streamline_lengths()[s]) << "streamline " << s;
+  }
+}
+
 // A file of version 2.1 (frozen: whole-byte orders in ORDR, no VXIX) still opens and verifies, and reads as the
 // same orders, points and voxel lists as the pinned input's file of today.
 TEST(GoldenBytes, AFileOfVersion21ReadsAsTheCurrentOne) {
   const VxlFile old_file = VxlFile::open(golden("packed-2.1.vxl")), now = VxlFile::open(golden("packed.vxl"));
   EXPECT_EQ(old_file.header().version_major, 2);
   EXPECT_EQ(old_file.header().version_minor, 1);
-  EXPECT_EQ(now.header().version_minor, 3);
+  EXPECT_EQ(now.header().version_minor, 4);
   EXPECT_EQ(old_file.order_packing(), OrderPacking::Bytes);
   EXPECT_EQ(now.order_packing(), OrderPacking::Bits);
   EXPECT_LT(now.order_bytes().size(), old_file.order_bytes().size());
   EXPECT_TRUE(old_file.voxel_index_first().empty());
   ASSERT_FALSE(now.voxel_index_first().empty());
+  EXPECT_TRUE(old_file.streamline_lengths().empty());
   EXPECT_TRUE(verify_vxl(golden("packed-2.1.vxl")).valid) << verify_vxl(golden("packed-2.1.vxl")).problem;
   EXPECT_TRUE(verify_vxl(golden("packed.vxl")).valid) << verify_vxl(golden("packed.vxl")).problem;
 

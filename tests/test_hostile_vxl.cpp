@@ -313,6 +313,53 @@ TEST(HostileVxl, VoxelIndexEntriesAndOrderBitsThatLieAreRefusedWhereUsed) {
   EXPECT_NE(v.output.find("has bits set after its last entry"), std::string::npos) << v.output;
 }
 
+// The streamline lengths (SLEN, spec §5.15): a size for other counts is refused on open; a length that is not a
+// finite number ≥ 0 is refused by `select` where it is read (exit 3, naming the byte) and by `verify`; a finite
+// length that is not its points' is found by `verify`.
+TEST(HostileVxl, StreamlineLengthsThatDoNotFitOrLieAreRefused) {
+  ScratchDir dir;
+  const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
+  const SectionEntry slen = valid.entry("SLEN");
+  const std::uint64_t streamlines = VxlFile::open(dir.file("h.vxl")).meta().streamline_count;
+  ASSERT_EQ(slen.size, 4 * streamlines);
+  expect_refused_on_open(dir, valid,
+                         {{"size for other counts",
+                           [&](VxlBytes& b) {
+                             const std::uint64_t smaller = slen.size - 4;
+                             std::memcpy(b.bytes.data() + b.entry_at("SLEN") + 16, &smaller, 8);
+                           },
+                           "section SLEN size"}});
+  struct Case {
+    const char* name;
+    float value;
+    bool select_refuses;
+    const char* verify_message;
+  };
+  const Case cases[] = {{"NaN", NAN, true, "is not a finite number"},
+                        {"negative", -1.0f, true, "is not a finite number"},
+                        {"a thousand times longer", 1000.0f * 150.0f, false, "differs from its points'"}};
+  const std::uint64_t last = streamlines - 1;
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    VxlBytes b = valid;
+    std::memcpy(b.bytes.data() + slen.offset + 4 * last, &c.value, 4);
+    b.reseal();
+    b.write(dir.file("bad.vxl"));
+    const auto r = test::run_cli("select " + q(dir.file("bad.vxl")) + " " + q(dir.file("out.tck")) + " --min-length 1");
+    if (c.select_refuses) {
+      EXPECT_EQ(r.exit_code, 3) << r.output;
+      EXPECT_NE(r.output.find("byte " + std::to_string(slen.offset + 4 * last)), std::string::npos) << r.output;
+      EXPECT_FALSE(std::filesystem::exists(dir.file("out.tck")));
+    } else {
+      EXPECT_EQ(r.exit_code, 0) << r.output;
+      std::filesystem::remove(dir.file("out.tck"));
+    }
+    const auto v = test::run_cli("verify " + q(dir.file("bad.vxl")));
+    EXPECT_EQ(v.exit_code, 1) << v.output;
+    EXPECT_NE(v.output.find(c.verify_message), std::string::npos) << v.output;
+  }
+}
+
 // PROV is any JSON to open(): fields of the wrong type made `info` exit 70 (type_error 302/306) and
 // `export x.trx` too. They are ignored now, as missing fields are.
 TEST(HostileVxl, ProvenanceOfTheWrongTypesIsIgnored) {

@@ -80,7 +80,7 @@ TEST(Levels, EachLevelIsAPrefixHoldingItsStreamlines) {
   const VxlFile f = VxlFile::open(out);
   ASSERT_EQ(f.level_count(), 4u);
   EXPECT_EQ(f.header().version_major, 2);
-  EXPECT_EQ(f.header().version_minor, 3);  // bit-packed orders (spec §10)
+  EXPECT_EQ(f.header().version_minor, 4);  // streamline lengths (spec §10)
 
   std::uint64_t checked = 0, streamline = 0;
   const auto strm = f.streamline_first_voxline();
@@ -152,7 +152,7 @@ TEST(Levels, OneLevelWritesNoLods) {
   EXPECT_EQ(f.meta().level_count, 0u);
   EXPECT_EQ(f.find_section(section_id("LODS")), nullptr);
   EXPECT_EQ(f.header().version_major, 2);  // packed positions
-  EXPECT_EQ(f.header().version_minor, 3);  // bit-packed orders, with or without levels (spec §10)
+  EXPECT_EQ(f.header().version_minor, 4);  // streamline lengths, with or without levels (spec §10)
   EXPECT_TRUE(verify_vxl(dir.file("one.vxl")).valid);
   EXPECT_THROW(convert_tractogram(synth(10), dir.file("nine.vxl"),
                                   [] {
@@ -198,6 +198,8 @@ TEST(Levels, StreamedAndUnpackedFilesHaveTheSameLevels) {
   EXPECT_EQ(section_bytes(memory, "LODS"), section_bytes(streamed, "LODS"));
   EXPECT_EQ(section_bytes(memory, "ORDB"), section_bytes(streamed, "ORDB"));
   EXPECT_EQ(section_bytes(memory, "VXIX"), section_bytes(streamed, "VXIX"));
+  EXPECT_EQ(section_bytes(memory, "SLEN").size(), 4u * 3000);
+  EXPECT_EQ(section_bytes(memory, "SLEN"), section_bytes(streamed, "SLEN"));
 
   PackSettings pack;
   pack.threads = 2;

@@ -209,6 +209,32 @@ TEST_F(Selection, ExcludeOnlyEndsOnlyAndLengthOnlyMatchTheReference) {
   }
 }
 
+// Length limits on a file with packed positions are the source's exactly (SLEN holds the source points'
+// lengths), as is every walk of the points with float32 positions; the walk over packed points is within the bound.
+TEST_F(Selection, LengthLimitsOnAPackedFileAreTheSourcesExactly) {
+  Tractogram copy = *source_;
+  convert_tractogram(std::move(copy), dir_->file("packed.vxl"), settings(PositionEncoding::Packed));
+  const VxlFile packed = VxlFile::open(dir_->file("packed.vxl")), f32 = VxlFile::open(dir_->file("f32.vxl"));
+  ASSERT_FALSE(packed.streamline_lengths().empty());
+  EXPECT_TRUE(std::equal(packed.streamline_lengths().begin(), packed.streamline_lengths().end(),
+                         f32.streamline_lengths().begin(), f32.streamline_lengths().end()));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> limit(20, 160);
+  int cut = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    SelectionCriteria c;
+    const double a = limit(rng), b = limit(rng);
+    if (trial % 3 != 1) c.min_length = std::min(a, b);
+    if (trial % 3 != 2) c.max_length = std::max(a, b);
+    const SelectionResult r = select_streamlines(packed, c);
+    ASSERT_EQ(r.streamlines, brute_force(*source_, c)) << "trial " << trial;
+    EXPECT_EQ(r.bytes_read, packed.voxels().size_bytes() + 4 * r.streamlines_measured) << "lengths only";
+    ASSERT_EQ(select_streamlines(f32, c, nullptr, SelectionPath::ScanTable).streamlines, r.streamlines);
+    cut += !r.streamlines.empty() && r.streamlines.size() < source_->streamline_count();
+  }
+  EXPECT_GT(cut, 10);
+}
+
 TEST_F(Selection, RegionsOutsideEverythingOrHoldingEverything) {
   const VxlFile f = VxlFile::open(dir_->file("f32.vxl"));
   SelectionCriteria outside;

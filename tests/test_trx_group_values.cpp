@@ -318,8 +318,8 @@ TEST(GdatSection, FilesWithoutGroupValuesHaveNoSection) {
   EXPECT_EQ(f.groups().size(), 2u);
 }
 
-// The version a file with GDAT carries (spec §10): every file written now has bit-packed orders (2.3 with packed
-// positions or levels, 1.4 otherwise), which holds GDAT too; a package with it is 2.2, one without 2.0.
+// The version a file with GDAT carries (spec §10): every file written now has streamline lengths (2.4 with packed
+// positions or levels, 1.5 otherwise), which holds GDAT too; a package with it is 2.2, one without 2.0.
 TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
   ScratchDir dir;
   test::write_zip(dir.file("a.trx"), trx_members());
@@ -333,12 +333,12 @@ TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
     return std::to_string(v[0]) + "." + std::to_string(v[1]);
   };
   convert_tractogram(read_trx(dir.file("a.trx")), dir.file("packed.vxl"), ConvertSettings{});
-  EXPECT_EQ(version_of(VxlFile::open(dir.file("packed.vxl")).header()), "2.3");
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("packed.vxl")).header()), "2.4");
   ConvertSettings plain;
   plain.positions = PositionEncoding::Float32;
   plain.levels = 1;
   convert_tractogram(read_trx(dir.file("a.trx")), dir.file("plain.vxl"), plain);
-  EXPECT_EQ(version_of(VxlFile::open(dir.file("plain.vxl")).header()), "1.4");
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("plain.vxl")).header()), "1.5");
   pack_vxl(VxlFile::open(dir.file("packed.vxl")), dir.file("a.vxlz"), PackSettings{});
   EXPECT_EQ(package_version_of(dir.file("a.vxlz")), "2.2");
 
@@ -346,9 +346,9 @@ TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
   std::erase_if(members, [](const auto& m) { return m.first.starts_with("dpg/"); });
   test::write_zip(dir.file("b.trx"), members);
   convert_tractogram(read_trx(dir.file("b.trx")), dir.file("b.vxl"), ConvertSettings{});
-  EXPECT_EQ(version_of(VxlFile::open(dir.file("b.vxl")).header()), "2.3");
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("b.vxl")).header()), "2.4");
   convert_tractogram(read_trx(dir.file("b.trx")), dir.file("b_plain.vxl"), plain);
-  EXPECT_EQ(version_of(VxlFile::open(dir.file("b_plain.vxl")).header()), "1.4");
+  EXPECT_EQ(version_of(VxlFile::open(dir.file("b_plain.vxl")).header()), "1.5");
   pack_vxl(VxlFile::open(dir.file("b.vxl")), dir.file("b.vxlz"), PackSettings{});
   EXPECT_EQ(package_version_of(dir.file("b.vxlz")), "2.0");
 }

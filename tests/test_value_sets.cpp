@@ -152,7 +152,7 @@ TEST(ValueSets, PointValuesFollowTheirPointsIntoTheVertexBlocks) {
   ASSERT_TRUE(verified.valid) << verified.problem;
 
   VxlFile f = VxlFile::open(dir.file("v.vxl"));
-  EXPECT_EQ(f.header().version_minor, 4);  // 1.4: bit-packed orders (spec §10)
+  EXPECT_EQ(f.header().version_minor, 5);  // 1.5: streamline lengths (spec §10)
   EXPECT_GT(f.meta().synthetic_point_count, 5u);
   const ValueSets& vv = f.vertex_values();
   ASSERT_EQ(vv.size(), 2u);
@@ -191,7 +191,7 @@ TEST(ValueSets, PointValuesFollowTheirPointsIntoTheVertexBlocks) {
   exact.levels = 1;
   convert_tractogram(five_points(), dir.file("plain.vxl"), exact);
   VxlFile plain = VxlFile::open(dir.file("plain.vxl"));
-  EXPECT_EQ(plain.header().version_minor, 4);
+  EXPECT_EQ(plain.header().version_minor, 5);
   EXPECT_TRUE(plain.vertex_values().empty());
   EXPECT_EQ(plain.find_section(section_id("VVAL")), nullptr);
 }

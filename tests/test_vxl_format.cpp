@@ -77,9 +77,9 @@ TEST_P(VxlFormat, RoundTripThroughTheWalk) {
   ASSERT_TRUE(r.valid) << r.problem;
   VxlFile f = VxlFile::open(path());
   const bool packed = GetParam() == PositionEncoding::Packed;
-  // The lowest version that holds the file (spec §10): bit-packed orders and levels of detail (the default), 2.3.
+  // The lowest version that holds the file (spec §10): streamline lengths and levels of detail (the default), 2.4.
   EXPECT_EQ(f.header().version_major, 2);
-  EXPECT_EQ(f.header().version_minor, 3);
+  EXPECT_EQ(f.header().version_minor, 4);
   EXPECT_GT(f.level_count(), 1u);
   EXPECT_EQ(f.position_encoding(), GetParam());
   EXPECT_EQ(f.find_section(section_id("VERT"))->size, f.meta().vertex_count * (packed ? 4 : 12));

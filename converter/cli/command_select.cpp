@@ -46,7 +46,8 @@ void add_select_command(CLI::App& app) {
       "(its non-zero voxels: the voxel nearest to the point) or FILE.nii[.gz]:LABEL (one label of a parcellation).\n"
       "Points are those the .vxl stores: bit for bit the source's with --positions float32; with packed positions\n"
       "(the default) within the bound `voxlines info` prints, so a streamline whose deciding point lies that close\n"
-      "to a region's surface may be decided differently from tckedit on the source.");
+      "to a region's surface may be decided differently from tckedit on the source. Lengths are the source's in\n"
+      "either case (measured when converting; files of format 2.3 and older have their points measured).");
   cmd->add_option("input", opt->input, ".vxl file")->required();
   cmd->add_option("output", opt->output,
                   "the selected streamlines, in source order: .tck (with --tsf: one per-point value set), .trx "
@@ -59,7 +60,9 @@ void add_select_command(CLI::App& app) {
                   "a region holding the first or the last point of every kept streamline (repeatable; tckedit's "
                   "-include with -ends_only)")
       ->type_name("ROI");
-  cmd->add_option("--min-length", opt->min_length, "keep streamlines at least this long (mm)")->type_name("MM");
+  cmd->add_option("--min-length", opt->min_length,
+                  "keep streamlines at least this long (mm; the sum of the segments, as tckedit measures it)")
+      ->type_name("MM");
   cmd->add_option("--max-length", opt->max_length, "keep streamlines at most this long (mm)")->type_name("MM");
   cmd->add_flag("--invert", opt->invert, "keep exactly the streamlines the criteria reject (tckedit's -inverse)");
   cmd->add_flag("--count", opt->count, "print only the number of selected streamlines (no output file)");

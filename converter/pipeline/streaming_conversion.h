@@ -73,10 +73,13 @@ struct StreamingJob {
   std::string voxel_size_choice;  // --voxel-size auto's reason, once the scan has chosen
 };
 
-// What pass 1 found: the bounds of every point and the longest step (squared).
+// What pass 1 found: the bounds of every point, the longest step (squared) and each streamline's length
+// (SLEN, written at the end; 4 bytes a streamline, held against the memory limit).
 struct SourceScan {
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   double longest_step2 = 0;
+  std::vector<float> lengths;
+  std::uint64_t lengths_held = 0;  // as taken from the budget
 };
 
 // Pass 2's counts and tight bounds per voxel (by local id), until build_table makes the voxel table of them.

@@ -16,12 +16,15 @@ void StreamingConversion::scan() {
   std::uint64_t streamlines = 0, points = 0;
   reader_->each_batch("reading", [&](const Tractogram& b, std::uint64_t first) {
     reader_->note_longest(b, first);
+    std::vector<float>& lengths = scan_.lengths;
+    lengths.resize(first + b.streamline_count());
+    budget_.track(lengths.capacity() * sizeof(float), scan_.lengths_held, [] { return "the streamlines' lengths"; });
     // In two parts on two threads, merged in order (a scan stops at a bad point; reading goes on for the
     // reader's errors).
     const std::array<std::uint64_t, 3> cut = two_parts(b);
     detail::BoundsScan parts[2];
     parallel_for(2, job_.threads > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
-      parts[p].add(b.positions.data(), b.offsets.data(), cut[p], cut[p + 1], first);
+      parts[p].add(b.positions.data(), b.offsets.data(), cut[p], cut[p + 1], first, lengths.data() + first);
     });
     for (const detail::BoundsScan& part : parts) bounds.merge(part);
     streamlines += b.streamline_count();

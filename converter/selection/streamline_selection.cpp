@@ -10,6 +10,7 @@
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
 #include "format/base/parallel.h"
+#include "format/streamline_length.h"
 #include "format/vxl_positions.h"
 #include "format/vxl_streamlines.h"
 
@@ -61,16 +62,6 @@ VoxelRegions regions_per_voxel(const VxlFile& file, const RegionTable& table, st
     touched += out.touching[i] != 0;
   }
   return out;
-}
-
-double polyline_length(std::span<const float> xyz) {
-  double length = 0;
-  for (std::size_t i = 3; i + 2 < xyz.size(); i += 3) {
-    const double dx = double(xyz[i]) - xyz[i - 3], dy = double(xyz[i + 1]) - xyz[i - 2],
-                 dz = double(xyz[i + 2]) - xyz[i - 1];
-    length += std::sqrt(dx * dx + dy * dy + dz * dz);
-  }
-  return length;
 }
 
 // A number from the source header kept in PROV (a TCK's "key: value" lines are arrays of strings there).
@@ -287,20 +278,30 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
   const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
   result.bytes_read += result.points_tested * vertex_bytes;
 
-  // Length limits: the points of the streamlines still in.
+  // Length limits, for the streamlines still in: their lengths from SLEN (4 bytes each), or measured from their
+  // points through the whole voxline table (files without SLEN; and the table-walking path, so that tests
+  // compare the two).
   if (criteria.min_length || criteria.max_length) {
     const double margin = length_limit_margin(file);
-    WalkCallbacks lengths;
-    lengths.read_points = [&](std::uint64_t s) { return passes[s] != 0; };
-    lengths.streamline = [&](std::uint64_t s, std::span<const float> points) {
+    auto apply = [&](std::uint64_t s, double length) {
       ++result.streamlines_measured;
-      result.bytes_read += points.size() / 3 * vertex_bytes;
-      const double length = polyline_length(points);
       if ((criteria.min_length && length < *criteria.min_length - margin) ||
           (criteria.max_length && length > *criteria.max_length + margin))
         passes[s] = 0;
     };
-    walk_streamlines(file, lengths);
+    if (!file.streamline_lengths().empty() && path == SelectionPath::Fastest) {
+      for (std::uint64_t s = 0; s < n; ++s)
+        if (passes[s] != 0) apply(s, stored_length(file, s));
+      result.bytes_read += 4 * result.streamlines_measured;
+    } else {
+      WalkCallbacks lengths;
+      lengths.read_points = [&](std::uint64_t s) { return passes[s] != 0; };
+      lengths.streamline = [&](std::uint64_t s, std::span<const float> points) {
+        result.bytes_read += points.size() / 3 * vertex_bytes;
+        apply(s, double(stored_length_of(points)));
+      };
+      walk_streamlines(file, lengths);
+    }
   }
   for (std::uint64_t s = 0; s < n; ++s)
     if ((passes[s] != 0) != criteria.invert) result.streamlines.push_back(s);

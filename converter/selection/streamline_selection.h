@@ -11,14 +11,15 @@
 // Points are the source points as the .vxl stores them (synthetic face points are not tested): bit for bit
 // the source's with --positions float32, within the file's packed bound otherwise, so that a streamline
 // whose deciding point lies within that bound of a region's surface may be decided differently from
-// tckedit on the source file.
+// tckedit on the source file. Lengths are the source points' (SLEN), bit for bit what the converter measured.
 //
 // The voxel grid is the index: a region is tested only against the voxlines of the voxels whose bounds it
 // may touch. With a VoxelVoxlines index (the file's VXIX, or one given) the streamlines crossing them are
 // found from those voxels' lists alone, so that the cost follows the regions, not the file; without one
 // (older files), by walking the voxline table (8 bytes a voxline, about a tenth of the source's bytes).
-// Length limits read the points of the streamlines that pass the regions (all of them when there is no
-// include region), through the whole voxline table.
+// Length limits read the lengths of the streamlines that pass the regions from the file's SLEN (4 bytes a
+// streamline; their source points' lengths, format/streamline_length.h); files without SLEN have their
+// points read instead, through the whole voxline table.
 #pragma once
 
 #include <cstdint>
@@ -53,7 +54,8 @@ struct SelectionResult {
 inline constexpr std::size_t kMaxRegions = 64;
 
 // Where the streamlines crossing the touched voxels are found: through an index when there is one (given, or
-// the file's VXIX), or always by walking the voxline table (tests and the benchmark compare both).
+// the file's VXIX) and lengths in SLEN, or always by walking the voxline table, lengths measured from the stored
+// points (tests and the benchmark compare both).
 enum class SelectionPath { Fastest, ScanTable };
 
 // How far tckedit widens length limits for this file's source (0 when its header has no step_size).

@@ -232,13 +232,13 @@ TEST(OrderSets, RandomFilesCarryRequiredPerVoxelDirectionsAndVerify) {
   ScratchDir dir;
   VxlFile axis = convert_synth(dir, "axis", 10.0, "axis.vxl");
   EXPECT_EQ(axis.header().version_major, 2);  // levels of detail (the default)
-  EXPECT_EQ(axis.header().version_minor, 3);
+  EXPECT_EQ(axis.header().version_minor, 4);
   EXPECT_EQ(axis.find_section(section_id("VDIR")), nullptr);
   EXPECT_TRUE(axis.voxel_directions().empty());
 
   VxlFile r = convert_synth(dir, "random:8", 10.0, "random.vxl");
-  EXPECT_EQ(r.header().version_major, 2);  // 2.3 holds VDIR too (1.4 with float32 positions and one level)
-  EXPECT_EQ(r.header().version_minor, 3);
+  EXPECT_EQ(r.header().version_major, 2);  // 2.4 holds VDIR too (1.5 with float32 positions and one level)
+  EXPECT_EQ(r.header().version_minor, 4);
   EXPECT_EQ(r.meta().order_set, static_cast<std::uint32_t>(OrderSet::Random));
   EXPECT_EQ(r.meta().stored_order_count, 8u);
   const SectionEntry* vdir = r.find_section(section_id("VDIR"));

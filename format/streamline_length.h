@@ -1,0 +1,25 @@
+// The length of a streamline as SLEN stores it (spec §5.15) and as a selection's --min-length/--max-length
+// measure it (MRtrix tckedit's rule): the sum of its segments' Euclidean lengths. One definition, compiled
+// once (without fused multiply-add), so that the converter's lengths, verify's and a reader's of a file
+// without SLEN agree to the bit.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "format/vxl_file.h"
+
+namespace vxl {
+
+// The polyline's length in mm: each segment's length from its float32 end points in double, summed in
+// order in double (0 for fewer than two points).
+double polyline_length(std::span<const float> xyz);
+
+// The length SLEN stores for those points: polyline_length rounded to float32.
+inline float stored_length_of(std::span<const float> xyz) { return static_cast<float>(polyline_length(xyz)); }
+
+// Streamline s's length from the file's SLEN, which it must have: throws vxl::Error (Input, naming the file and
+// the byte) for a value that is not a finite number ≥ 0.
+double stored_length(const VxlFile& file, std::uint64_t streamline);
+
+}  // namespace vxl
