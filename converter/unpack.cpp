@@ -437,12 +437,16 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
     }
     VoxelEntry& v = voxels[item - 1];
     detail::set_tight_bounds({&v, 1}, vertices.data(), 0);
+    const std::span<const LevelEntry> row = level_row(s.levels, item - 1, s.level_count);
+    std::uint8_t* orders = out.orders().data() + v.order_offset;
+    // Orders from what the file holds, as every conversion builds them: the packed words, or the floats.
     if (packed) {
       pack_vertex_blocks({&v, 1}, vertices, ends, out.packed_vertices(), 1);
       repack_bound[t] = std::max(repack_bound[t], packed_error_bound(v));
+      writers[t].write_packed(v, row, out.packed_vertices().data() + v.vertex_first, orders);
+    } else {
+      writers[t].write(v, row, vertices, ends, orders);
     }
-    writers[t].write(v, level_row(s.levels, item - 1, s.level_count), vertices, ends,
-                     out.orders().data() + v.order_offset);
     const std::uint64_t d = ++ordered;
     if (t == 0 && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
   });
