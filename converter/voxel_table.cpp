@@ -28,6 +28,25 @@ std::string format_mm(double v) {
               "a voxline of more than 2^31-1 points; use a smaller --voxel-size");
 }
 
+// The one way both find tight bounds: widen [lo, hi] to `count` points (xyz). Callers keep lo and hi in
+// locals: stored through pointers, the compiler would have to assume they alias the points and store them
+// back after every point.
+inline void widen(float lo[3], float hi[3], const float* xyz, std::uint64_t count) {
+  for (std::uint64_t k = 0; k < count; ++k)
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], xyz[3 * k + c]);
+      hi[c] = std::max(hi[c], xyz[3 * k + c]);
+    }
+}
+
+// ... and store them: a zero bound as +0 whichever zero came first (-0 + 0 = +0).
+inline void store_tight_bounds(const float lo[3], const float hi[3], VoxelEntry& v) {
+  for (int c = 0; c < 3; ++c) {
+    v.tight_min[c] = lo[c] + 0.0f;
+    v.tight_max[c] = hi[c] + 0.0f;
+  }
+}
+
 }  // namespace
 
 void BoundsScan::add(const float* pts, const std::uint64_t* offsets, std::uint64_t first, std::uint64_t end,
@@ -218,18 +237,9 @@ VoxelTable build_voxel_table(std::span<LocalVoxels> indexes, std::uint32_t level
 void set_tight_bounds(std::span<VoxelEntry> voxels, const float* vertices, std::uint64_t vertex_base) {
   for (VoxelEntry& v : voxels) {
     const float* p = vertices + 3 * (v.vertex_first - vertex_base);
-    // In locals: the entry may live in the same mapping as the vertices (unpack), and the compiler would
-    // otherwise store it back after every vertex.
     float lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
-    for (std::uint64_t k = 1; k < v.vertex_count; ++k)
-      for (int c = 0; c < 3; ++c) {
-        lo[c] = std::min(lo[c], p[3 * k + c]);
-        hi[c] = std::max(hi[c], p[3 * k + c]);
-      }
-    for (int c = 0; c < 3; ++c) {
-      v.tight_min[c] = lo[c] + 0.0f;  // -0 + 0 = +0
-      v.tight_max[c] = hi[c] + 0.0f;
-    }
+    widen(lo, hi, p + 3, v.vertex_count > 0 ? v.vertex_count - 1 : 0);
+    store_tight_bounds(lo, hi, v);
   }
 }
 
@@ -242,13 +252,8 @@ void VoxelBounds::grow_to(std::size_t voxels) {
 void VoxelBounds::add(std::uint32_t local, const float* xyz, std::uint64_t count) {
   float* const lo_out = lo_.data() + 3 * std::size_t(local);
   float* const hi_out = hi_.data() + 3 * std::size_t(local);
-  // In locals: stored through the pointers the compiler would have to assume they alias xyz.
   float lo[3] = {lo_out[0], lo_out[1], lo_out[2]}, hi[3] = {hi_out[0], hi_out[1], hi_out[2]};
-  for (std::uint64_t k = 0; k < count; ++k)
-    for (int c = 0; c < 3; ++c) {
-      lo[c] = std::min(lo[c], xyz[3 * k + c]);
-      hi[c] = std::max(hi[c], xyz[3 * k + c]);
-    }
+  widen(lo, hi, xyz, count);
   std::copy(lo, lo + 3, lo_out);
   std::copy(hi, hi + 3, hi_out);
 }
@@ -266,10 +271,7 @@ void VoxelBounds::merge(std::uint32_t local, const VoxelBounds& other, std::uint
 }
 
 void VoxelBounds::set_tight_bounds(std::uint32_t local, VoxelEntry& v) const {
-  for (int c = 0; c < 3; ++c) {
-    v.tight_min[c] = lo_[3 * std::size_t(local) + c] + 0.0f;
-    v.tight_max[c] = hi_[3 * std::size_t(local) + c] + 0.0f;
-  }
+  store_tight_bounds(lo_.data() + 3 * std::size_t(local), hi_.data() + 3 * std::size_t(local), v);
 }
 
 }  // namespace vxl::detail
