@@ -10,6 +10,7 @@
 
 #include "tests/test_support.h"
 #include "tests/viewer/render_support.h"
+#include "viewer/app/focus_copy.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/image_metrics.h"
 #include "viewer/render/grid_overlay.h"
@@ -440,6 +441,38 @@ TEST_F(WindowGridOverlay, DrawnScopeKeepsOnlyTheVoxelsInView) {
   wide.ortho_height = 300;
   overlay_image(r, grid, wide, GridOverlay::Scope::Drawn);
   EXPECT_EQ(grid.cubes_drawn(), 2u);
+}
+
+// Focus first draws a full-detail copy of the selection beside the input, in the same renderer
+// (ViewerSession::focus_first_renderer). The overlay shows the voxels of the file the user opened: the copy's
+// voxels (a cube on its own grid, whose origin is the selected streamline's corner) add no outline, in either
+// scope, and the picture is the one without the copy.
+TEST_F(WindowGridOverlay, OutlinesTheInputsVoxelsNotThoseOfTheFocusCopy) {
+  Tractogram t;
+  const float first[] = {1, 1, 0, 9, 5, 0}, selected[] = {4, 4, 0, 9, 8, 0};
+  t.add_streamline(first, 2);
+  t.add_streamline(selected, 2);
+  t.source.path = "two_in_one_voxel";
+  VxlFile f = test::make_scene(dir, std::move(t), 10.0);
+  const app::FocusCopy copy(std::vector<const VxlFile*>{&f}, {{1}});
+  ASSERT_EQ(copy.files().size(), 1u);
+  Renderer input(f);
+  Renderer focus_first({&f, copy.files()[0]}, 0, 0, nullptr, true, {0, 0});
+  GridOverlay grid(input);
+  for (const GridOverlay::Scope scope : {GridOverlay::Scope::Drawn, GridOverlay::Scope::All}) {
+    const Image expected = overlay_image(input, grid, above_first_voxel(0.0), scope);
+    const std::uint64_t cubes = grid.cubes_drawn();
+    EXPECT_EQ(cubes, 1u);
+    const Image with_copy = overlay_image(focus_first, grid, above_first_voxel(0.0), scope);
+    EXPECT_EQ(grid.cubes_drawn(), cubes) << "scope " << int(scope);
+    EXPECT_EQ(compare_images(with_copy, expected).differing_pixels, 0u) << "scope " << int(scope);
+  }
+  // The copy is in the renderer's plan and on another grid: an overlay of every file it draws outlines it.
+  GridOverlay every(focus_first);
+  const Image both = overlay_image(focus_first, every, above_first_voxel(0.0), GridOverlay::Scope::Drawn);
+  EXPECT_EQ(every.cubes_drawn(), 2u);
+  EXPECT_GT(test::lit_pixels(both),
+            test::lit_pixels(overlay_image(input, grid, above_first_voxel(0.0), GridOverlay::Scope::Drawn)));
 }
 
 // A scripted drag (--drag-region): the active sphere moves every frame, the frames are moving ones, the

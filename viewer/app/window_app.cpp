@@ -65,7 +65,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
   update_selection(true);
   // Scene-wide facts (bounds, groups, value sets, voxel cubes) are the same at every level.
   Renderer& first = renderer_at(first_level_);
-  grid_.emplace(first);
+  grid_.emplace(std::span<const VxlFile* const>(files_));  // the files opened: not a focus copy drawn beside them
   controller_ = CameraController(Camera{}, std::max(1.0, glm::length(first.scene_max() - first.scene_min()) * 0.5));
   stats_.has_image = session_->image() != nullptr;
   check_color_options(o.inputs_name(), first, o.settings, o.from_view_file);
