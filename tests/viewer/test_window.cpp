@@ -333,6 +333,50 @@ TEST_F(Window, UnderABudgetTheFocusIsDrawnAtFullDetailAsHeadless) {
   EXPECT_LT(compare_images(a, b).differing_pixels, 200u * 150u / 100u) << "the window's picture is headless'";
 }
 
+// A scripted drag under the same budget: after its last step the window waits, drawing frames, for the last
+// position's selection and its focus copy (both made off the window's thread), then draws its last picture with
+// the focus at full detail, as a window started with the sphere at that position draws it; --stats says that it
+// waited and how long.
+TEST_F(Window, AScriptedDragUnderABudgetEndsWithTheFocusCopyOfItsLastPosition) {
+  VXL_REQUIRE_XVFB();
+  make_inputs(6000);
+  const VxlFile f = VxlFile::open(vxl);
+  const std::vector<const VxlFile*> files = {&f};
+  const std::uint64_t texels = std::max<std::uint64_t>(4096, SceneLayout::largest_voxel_texels(files));
+  const std::vector<float> points = f.all_vertices();
+  const std::size_t middle = points.size() / 6 * 3;
+  auto sphere_at = [&](double dx) {
+    return std::to_string(points[middle] + dx) + "," + std::to_string(points[middle + 1]) + "," +
+           std::to_string(points[middle + 2]) + ",8";
+  };
+  const std::string args = " --size 200x150 --view axial --span-texels 4096 --gpu-memory " +
+                           std::to_string(SceneLayout(files, texels, 1).upload_bytes()) +
+                           " --context-opacity 0 --focus-opacity 1 --color group --group selected=#ff0000";
+  // --frames 6 moves the sphere on frames 1 to 5: 5 steps of 2 mm along x.
+  const std::string dragged = dir.file("dragged.png"), still = dir.file("still.png");
+  const nlohmann::json j = window_stats(args + " --include=" + sphere_at(0) +
+                                        " --drag-region 2,0,0 --frames 6 --screenshot " + shell_quoted(dragged));
+  ASSERT_FALSE(j.is_null());
+  EXPECT_EQ(j.at("scene_level"), 1);
+  const auto& last = j.at("frames").back();
+  EXPECT_EQ(last.at("level"), 1);
+  ASSERT_TRUE(last.contains("focus_level")) << "the last picture without the focus copy: " << j.dump();
+  EXPECT_EQ(last.at("focus_level"), 0);
+  ASSERT_TRUE(j.contains("drag_end_wait")) << j.dump();
+  const auto& wait = j.at("drag_end_wait");
+  EXPECT_TRUE(wait.at("waited").get<bool>()) << "the copy takes longer than a frame";
+  EXPECT_GT(wait.at("ms").get<double>(), 0.0);
+  EXPECT_FALSE(wait.at("timed_out").get<bool>());
+  CommandResult r = run_voxview_in_xvfb(shell_quoted(vxl) + args + " --include=" + sphere_at(10) +
+                                        " --frames 3 --screenshot " + shell_quoted(still));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Image a = read_image(dragged), b = read_image(still);
+  ASSERT_GT(lit_pixels(b), 200 * 150 / 200);
+  // Without the wait the last picture draws the focus at level 1: about 40 % of its pixels differ.
+  EXPECT_LT(compare_images(a, b).differing_pixels, 200u * 150u / 1000u)
+      << "the drag's last picture is the focus of its last position at full detail (of " << lit_pixels(b) << ")";
+}
+
 TEST_F(Window, OpensATckDirectly) {
   VXL_REQUIRE_XVFB();
   make_inputs();
