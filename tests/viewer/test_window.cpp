@@ -10,6 +10,7 @@
 
 #include "tests/test_support.h"
 #include "tests/viewer/render_support.h"
+#include "viewer/app/focus_copy.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/platform/image_metrics.h"
 #include "viewer/render/grid_overlay.h"
@@ -332,6 +333,50 @@ TEST_F(Window, UnderABudgetTheFocusIsDrawnAtFullDetailAsHeadless) {
   EXPECT_LT(compare_images(a, b).differing_pixels, 200u * 150u / 100u) << "the window's picture is headless'";
 }
 
+// A scripted drag under the same budget: after its last step the window waits, drawing frames, for the last
+// position's selection and its focus copy (both made off the window's thread), then draws its last picture with
+// the focus at full detail, as a window started with the sphere at that position draws it; --stats says that it
+// waited and how long.
+TEST_F(Window, AScriptedDragUnderABudgetEndsWithTheFocusCopyOfItsLastPosition) {
+  VXL_REQUIRE_XVFB();
+  make_inputs(6000);
+  const VxlFile f = VxlFile::open(vxl);
+  const std::vector<const VxlFile*> files = {&f};
+  const std::uint64_t texels = std::max<std::uint64_t>(4096, SceneLayout::largest_voxel_texels(files));
+  const std::vector<float> points = f.all_vertices();
+  const std::size_t middle = points.size() / 6 * 3;
+  auto sphere_at = [&](double dx) {
+    return std::to_string(points[middle] + dx) + "," + std::to_string(points[middle + 1]) + "," +
+           std::to_string(points[middle + 2]) + ",8";
+  };
+  const std::string args = " --size 200x150 --view axial --span-texels 4096 --gpu-memory " +
+                           std::to_string(SceneLayout(files, texels, 1).upload_bytes()) +
+                           " --context-opacity 0 --focus-opacity 1 --color group --group selected=#ff0000";
+  // --frames 6 moves the sphere on frames 1 to 5: 5 steps of 2 mm along x.
+  const std::string dragged = dir.file("dragged.png"), still = dir.file("still.png");
+  const nlohmann::json j = window_stats(args + " --include=" + sphere_at(0) +
+                                        " --drag-region 2,0,0 --frames 6 --screenshot " + shell_quoted(dragged));
+  ASSERT_FALSE(j.is_null());
+  EXPECT_EQ(j.at("scene_level"), 1);
+  const auto& last = j.at("frames").back();
+  EXPECT_EQ(last.at("level"), 1);
+  ASSERT_TRUE(last.contains("focus_level")) << "the last picture without the focus copy: " << j.dump();
+  EXPECT_EQ(last.at("focus_level"), 0);
+  ASSERT_TRUE(j.contains("drag_end_wait")) << j.dump();
+  const auto& wait = j.at("drag_end_wait");
+  EXPECT_TRUE(wait.at("waited").get<bool>()) << "the copy takes longer than a frame";
+  EXPECT_GT(wait.at("ms").get<double>(), 0.0);
+  EXPECT_FALSE(wait.at("timed_out").get<bool>());
+  CommandResult r = run_voxview_in_xvfb(shell_quoted(vxl) + args + " --include=" + sphere_at(10) +
+                                        " --frames 3 --screenshot " + shell_quoted(still));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Image a = read_image(dragged), b = read_image(still);
+  ASSERT_GT(lit_pixels(b), 200 * 150 / 200);
+  // Without the wait the last picture draws the focus at level 1: about 40 % of its pixels differ.
+  EXPECT_LT(compare_images(a, b).differing_pixels, 200u * 150u / 1000u)
+      << "the drag's last picture is the focus of its last position at full detail (of " << lit_pixels(b) << ")";
+}
+
 TEST_F(Window, OpensATckDirectly) {
   VXL_REQUIRE_XVFB();
   make_inputs();
@@ -440,6 +485,38 @@ TEST_F(WindowGridOverlay, DrawnScopeKeepsOnlyTheVoxelsInView) {
   wide.ortho_height = 300;
   overlay_image(r, grid, wide, GridOverlay::Scope::Drawn);
   EXPECT_EQ(grid.cubes_drawn(), 2u);
+}
+
+// Focus first draws a full-detail copy of the selection beside the input, in the same renderer
+// (ViewerSession::focus_first_renderer). The overlay shows the voxels of the file the user opened: the copy's
+// voxels (a cube on its own grid, whose origin is the selected streamline's corner) add no outline, in either
+// scope, and the picture is the one without the copy.
+TEST_F(WindowGridOverlay, OutlinesTheInputsVoxelsNotThoseOfTheFocusCopy) {
+  Tractogram t;
+  const float first[] = {1, 1, 0, 9, 5, 0}, selected[] = {4, 4, 0, 9, 8, 0};
+  t.add_streamline(first, 2);
+  t.add_streamline(selected, 2);
+  t.source.path = "two_in_one_voxel";
+  VxlFile f = test::make_scene(dir, std::move(t), 10.0);
+  const app::FocusCopy copy(std::vector<const VxlFile*>{&f}, {{1}});
+  ASSERT_EQ(copy.files().size(), 1u);
+  Renderer input(f);
+  Renderer focus_first({&f, copy.files()[0]}, 0, 0, nullptr, true, {0, 0});
+  GridOverlay grid(input);
+  for (const GridOverlay::Scope scope : {GridOverlay::Scope::Drawn, GridOverlay::Scope::All}) {
+    const Image expected = overlay_image(input, grid, above_first_voxel(0.0), scope);
+    const std::uint64_t cubes = grid.cubes_drawn();
+    EXPECT_EQ(cubes, 1u);
+    const Image with_copy = overlay_image(focus_first, grid, above_first_voxel(0.0), scope);
+    EXPECT_EQ(grid.cubes_drawn(), cubes) << "scope " << int(scope);
+    EXPECT_EQ(compare_images(with_copy, expected).differing_pixels, 0u) << "scope " << int(scope);
+  }
+  // The copy is in the renderer's plan and on another grid: an overlay of every file it draws outlines it.
+  GridOverlay every(focus_first);
+  const Image both = overlay_image(focus_first, every, above_first_voxel(0.0), GridOverlay::Scope::Drawn);
+  EXPECT_EQ(every.cubes_drawn(), 2u);
+  EXPECT_GT(test::lit_pixels(both),
+            test::lit_pixels(overlay_image(input, grid, above_first_voxel(0.0), GridOverlay::Scope::Drawn)));
 }
 
 // A scripted drag (--drag-region): the active sphere moves every frame, the frames are moving ones, the

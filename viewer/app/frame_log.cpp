@@ -56,7 +56,8 @@ FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint3
 }
 
 void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
-                       double frame_budget_ms, const StartupTimes& startup, const std::vector<double>& selection_ms) {
+                       double frame_budget_ms, const StartupTimes& startup, const std::vector<double>& selection_ms,
+                       const std::optional<DragEndWait>& drag_end) {
   const FrameSummary s = summarize_frames(frames, scene_level);
   nlohmann::json j;
   j["scene_level"] = scene_level;
@@ -79,6 +80,8 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
   j["selections"] = selection_ms.size();
   j["selection_median_ms"] = selection_median;
   j["selection_p95_ms"] = selection_p95;
+  if (drag_end)
+    j["drag_end_wait"] = {{"waited", drag_end->waited}, {"ms", drag_end->ms}, {"timed_out", drag_end->timed_out}};
   nlohmann::json list = nlohmann::json::array();
   for (const FrameRecord& f : frames) {
     list.push_back({{"level", f.level},

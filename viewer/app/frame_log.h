@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,12 +44,23 @@ struct StartupTimes {
   double first_on_screen_s = -1;  // the buffer swap that shows the first drawn picture has completed
 };
 
+// The end of a scripted drag (--drag-region with --frames): its last position's selection and focus copy are
+// made off the window's thread, so after the last step the window keeps drawing frames until they are in the
+// picture (or a time limit passes), then draws the last picture.
+struct DragEndWait {
+  bool waited = false;     // the selection or the focus copy was still being made after the last step
+  double ms = 0;           // how long the window waited for them
+  bool timed_out = false;  // the limit passed first: the last picture may not show them
+};
+
 FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint32_t scene_level);
 
 // Writes the summary, the budget and every frame as JSON to `path` (atomically), and the selections' run
-// times (selection_worker.h: how long after a region moved its picture was ready). Throws vxl::Error (Output).
+// times (selection_worker.h: how long after a region moved its picture was ready), and for a scripted drag how
+// its end waited. Throws vxl::Error (Output).
 void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
                        double frame_budget_ms, const StartupTimes& startup = {},
-                       const std::vector<double>& selection_ms = {});
+                       const std::vector<double>& selection_ms = {},
+                       const std::optional<DragEndWait>& drag_end = std::nullopt);
 
 }  // namespace vxl::app

@@ -76,6 +76,10 @@ class ViewerWindow {
   void apply_selection(std::optional<SceneSelection> selection);
   // Takes the newest focus copy of the current selection into the picture; with `wait`, the one asked for.
   void update_focus_copy(bool wait);
+  // A scripted drag's end (--drag-region, after --frames): whether the last position's selection and focus copy
+  // are in the picture, or the wait for them has reached its limit (then said). The first call starts the wait;
+  // the frames go on meanwhile, so the window stays responsive. Records the wait for --stats.
+  bool drag_end_settled();
   // Whether a picture at `level` draws the focus from its full-detail copy (focus first).
   bool focus_first_at(std::uint32_t level) const { return level > 0 && session_->has_focus(); }
   // Writes the selected streamlines of every file to a stamped .tck (a key or the panel).
@@ -126,7 +130,12 @@ class ViewerWindow {
   bool focus_first_wanted_ = false;
   FocusCopyWorker focus_copies_;
   std::vector<double> selection_ms_;  // each selection's run time, for --stats
-  const SceneDetail& detail_;         // the level of detail drawn at rest, and the span size
+  // A scripted drag's end waits at most this long for its selection and focus copy (a large selection's copy
+  // takes seconds on two cores).
+  static constexpr std::chrono::seconds kDragEndWaitLimit{60};
+  std::optional<std::chrono::steady_clock::time_point> drag_end_since_;  // the drag's frames done
+  std::optional<DragEndWait> drag_end_;                                  // the wait over, for --stats
+  const SceneDetail& detail_;  // the level of detail drawn at rest, and the span size
   std::uint32_t first_level_ = 0;
   std::chrono::steady_clock::time_point start_;
   std::vector<FrameRecord> frames_;            // for --stats

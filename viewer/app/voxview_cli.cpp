@@ -255,7 +255,8 @@ void declare_window(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--drag-region", a.drag_region,
                  "window: move the active region by DX,DY,DZ mm every frame (a scripted drag, with --frames, for "
                  "benchmarks: --stats then has the selections' times); the picture takes each new selection when it "
-                 "is ready, the frames keep their budget")
+                 "is ready, the frames keep their budget; after the frames it draws frames until the last "
+                 "position's selection and focus copy are in the picture (at most 60 s; --stats: drag_end_wait)")
       ->delimiter(',')
       ->expected(3);
   cli.add_option("--stats", a.options.stats_json,

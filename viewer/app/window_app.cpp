@@ -65,7 +65,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
   update_selection(true);
   // Scene-wide facts (bounds, groups, value sets, voxel cubes) are the same at every level.
   Renderer& first = renderer_at(first_level_);
-  grid_.emplace(first);
+  grid_.emplace(std::span<const VxlFile* const>(files_));  // the files opened: not a focus copy drawn beside them
   controller_ = CameraController(Camera{}, std::max(1.0, glm::length(first.scene_max() - first.scene_min()) * 0.5));
   stats_.has_image = session_->image() != nullptr;
   check_color_options(o.inputs_name(), first, o.settings, o.from_view_file);
@@ -357,19 +357,26 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
 int ViewerWindow::run() {
   const bool automated = options_.frames.has_value();
   FramePacing pacing;
+  bool idle_at_drag_end = false;  // a scripted drag's end waits and the last frame drew nothing
   for (long frame = 1;; ++frame) {
     const unsigned seen = events_;
-    if (automated || !pacing.may_wait()) {
+    if (idle_at_drag_end) {
+      // Not a busy loop: the selection and the copy run on the cores below the window's priority.
+      glfwWaitEventsTimeout(0.005);
+    } else if (automated || !pacing.may_wait()) {
       glfwPollEvents();
     } else {
       glfwWaitEvents();  // nothing moves by itself: sleep until the user does something
     }
     pacing.frame_started(events_ != seen);
-    // A script's frames are done after --frames; with --until-refined it then waits, at rest, for the
-    // refinement to finish.
+    // A script's frames are done after --frames; a scripted drag then waits, drawing frames, for its last
+    // position's selection and focus copy (they come off the window's thread), so that its last picture and
+    // --stats show them; with --until-refined it then waits, at rest, for the refinement to finish.
     const bool frames_done = automated && frame >= *options_.frames;
+    const bool settled = !frames_done || !options_.drag_region_mm || drag_end_settled();
     const bool refined = drawn_ && scheduler_->rest().stage() == RestStage::Done;
-    const bool closing = glfwWindowShouldClose(window_) || (frames_done && (!options_.until_refined || refined));
+    const bool closing =
+        glfwWindowShouldClose(window_) || (frames_done && settled && (!options_.until_refined || refined));
 
     // Render at the framebuffer's size (HiDPI), take input in window units.
     int fb_w = 0, fb_h = 0, win_h = 0;
@@ -393,7 +400,7 @@ int ViewerWindow::run() {
     const bool dragging = options_.drag_region_mm && !frames_done && regions_.active();
     if (dragging) regions_.move_active_by(*options_.drag_region_mm);
     // A script's window (--frames) waits for each selection, so that what it draws does not depend on timing;
-    // a scripted drag does not, as a user's drag does not.
+    // a scripted drag does not, as a user's drag does not (its end waits above, frame by frame).
     update_selection(automated && !options_.drag_region_mm);
     update_focus_copy(automated && !options_.drag_region_mm);
     state_.settings.regions = state_.show_regions ? regions_.shapes() : std::vector<RegionShape>{};
@@ -418,6 +425,7 @@ int ViewerWindow::run() {
                          }),
         key, moving);
     pacing.frame_ended(scheduler_->rest().stage() != RestStage::Done, drawn_now);
+    idle_at_drag_end = frames_done && !settled && !drawn_now;
     present(fb_w, fb_h);
     // Screenshots show the scene alone unless the user asked for the panel too; automated ones never do.
     if (closing && options_.screenshot) save_screenshot(*options_.screenshot, fb_w, fb_h);
@@ -438,7 +446,8 @@ int ViewerWindow::run() {
     if (closing) break;
   }
   if (options_.stats_json)
-    write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms, startup_, selection_ms_);
+    write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms, startup_, selection_ms_,
+                      drag_end_);
   return 0;
 }
 

@@ -1,7 +1,10 @@
 // The window's selection: the regions edited in the window, selected on a worker (selection_worker.h),
-// taken into the picture as focus and context, and written out on request.
+// taken into the picture as focus and context (with focus first's copy, focus_copy_worker.h), waited for at a
+// scripted drag's end, and written out on request.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <string>
 
 #include "converter/selection/selection_output.h"
 #include "viewer/app/glfw_window.h"
@@ -77,6 +80,24 @@ void ViewerWindow::update_focus_copy(bool wait) {
   }
   session_->set_focus(selection_->kept, *done->result);
   ++selection_generation_;  // the picture changes: drawn again, the focus at full detail
+}
+
+bool ViewerWindow::drag_end_settled() {
+  if (drag_end_) return true;
+  const auto now = std::chrono::steady_clock::now();
+  if (!drag_end_since_) drag_end_since_ = now;
+  // busy(): asked for and not yet taken into the picture (a finished one is taken by the next poll). The copy
+  // only matters when the last picture, drawn at the scene's level, is coarser than full detail.
+  const bool pending = selection_revision_ != regions_.revision() || selection_worker_.busy() ||
+                       (detail_.level > 0 && focus_copies_.busy());
+  const bool timed_out = pending && now - *drag_end_since_ >= kDragEndWaitLimit;
+  if (pending && !timed_out) return false;
+  drag_end_ = DragEndWait{now != *drag_end_since_,
+                          std::chrono::duration<double, std::milli>(now - *drag_end_since_).count(), timed_out};
+  if (timed_out)
+    set_error("the drag's last selection or focus copy was not ready after " +
+              std::to_string(kDragEndWaitLimit.count()) + " s: the last picture may not show it");
+  return true;
 }
 
 void ViewerWindow::save_selection() {

@@ -53,7 +53,9 @@ std::vector<float> cube_edges() {
 
 }  // namespace
 
-GridOverlay::GridOverlay(const Renderer& renderer) {
+GridOverlay::GridOverlay(const Renderer& renderer) : GridOverlay(std::span<const VxlFile* const>(renderer.files())) {}
+
+GridOverlay::GridOverlay(std::span<const VxlFile* const> files) : files_(files.begin(), files.end()) {
   program_ = gl::make_program(kVertex, kFragment);
   glGenVertexArrays(1, &vao_);
   glBindVertexArray(vao_);
@@ -67,11 +69,13 @@ GridOverlay::GridOverlay(const Renderer& renderer) {
   glEnableVertexAttribArray(1);
   glVertexAttribDivisor(1, 1);
 
-  // Every voxel's coordinate, straight from the voxel tables (file after file, as in the scene): uploaded
-  // once for the "all" scope.
+  // Every voxel's coordinate, straight from the voxel tables (file after file): uploaded once for the "all"
+  // scope.
   std::vector<glm::ivec3> all;
-  for (const VxlFile* f : renderer.files())
+  for (const VxlFile* f : files_) {
+    all_first_.push_back(all.size());
     for (const VoxelEntry& e : f->voxels()) all.emplace_back(e.coord[0], e.coord[1], e.coord[2]);
+  }
   voxel_count_ = all.size();
   glGenBuffers(1, &all_instances_);
   glBindBuffer(GL_ARRAY_BUFFER, all_instances_);
@@ -79,6 +83,12 @@ GridOverlay::GridOverlay(const Renderer& renderer) {
   glGenBuffers(1, &drawn_instances_);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
   glBindVertexArray(0);
+}
+
+std::optional<std::size_t> GridOverlay::index_of(const VxlFile* file) const {
+  const auto it = std::find(files_.begin(), files_.end(), file);
+  if (it == files_.end()) return std::nullopt;
+  return static_cast<std::size_t>(it - files_.begin());
 }
 
 GridOverlay::~GridOverlay() {
@@ -91,16 +101,18 @@ GridOverlay::~GridOverlay() {
 void GridOverlay::draw(const Renderer& renderer, const Camera& camera, double aspect, Scope scope,
                        const glm::vec4& colour, const Clipping& clipping) {
   const SceneLayout& layout = renderer.layout();
-  const auto& files = layout.files();
-  // Per file: the first instance and the count in the instance buffer (each file has its own grid).
-  std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges;
+  // Per overlay file: the first instance and the count in the instance buffer (each file has its own grid).
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges(files_.size(), {0, 0});
   GLuint instances = all_instances_;
   cubes_drawn_ = voxel_count_;
   if (scope == Scope::Drawn) {
-    // The same cull as the frame; the sort does not matter for outlines. Grouped by file.
+    // The same cull as the frame; the sort does not matter for outlines. Grouped by file; the renderer's files
+    // that are not the overlay's (a focus copy) are left out.
     renderer.plan(camera, aspect, PlanOrder::Any, plan_, clipping);
     drawn_coords_.clear();
-    for (std::uint32_t fi = 0; fi < files.size(); ++fi) {
+    for (std::uint32_t fi = 0; fi < renderer.files().size(); ++fi) {
+      const std::optional<std::size_t> mine = index_of(renderer.files()[fi]);
+      if (!mine) continue;
       const std::uint64_t first = drawn_coords_.size();
       const auto voxels = renderer.files()[fi]->voxels();
       for (const auto& [key, i] : plan_.sort_keys)
@@ -108,7 +120,7 @@ void GridOverlay::draw(const Renderer& renderer, const Camera& camera, double as
           const VoxelEntry& e = voxels[layout.local_voxel(i)];
           drawn_coords_.emplace_back(e.coord[0], e.coord[1], e.coord[2]);
         }
-      ranges.emplace_back(first, drawn_coords_.size() - first);
+      ranges[*mine] = {first, drawn_coords_.size() - first};
     }
     glBindBuffer(GL_ARRAY_BUFFER, drawn_instances_);
     // Orphan and refill: a fresh store each frame avoids waiting on the previous frame's draw.
@@ -117,7 +129,7 @@ void GridOverlay::draw(const Renderer& renderer, const Camera& camera, double as
     instances = drawn_instances_;
     cubes_drawn_ = drawn_coords_.size();
   } else {
-    for (const FileLayout& f : files) ranges.emplace_back(f.voxel_first, f.voxel_count);
+    for (std::size_t i = 0; i < files_.size(); ++i) ranges[i] = {all_first_[i], files_[i]->voxels().size()};
   }
   if (cubes_drawn_ == 0) return;
 
@@ -140,7 +152,7 @@ void GridOverlay::draw(const Renderer& renderer, const Camera& camera, double as
   for (std::size_t fi = 0; fi < ranges.size(); ++fi) {
     const auto [first, count] = ranges[fi];
     if (count == 0) continue;
-    const MetaSection& m = renderer.files()[fi]->meta();
+    const MetaSection& m = files_[fi]->meta();
     // The eye in this file's grid units, split in double into an integer cell and a fraction.
     const glm::dvec3 g =
         (camera.eye() - glm::dvec3(m.grid_origin[0], m.grid_origin[1], m.grid_origin[2])) / m.voxel_size;
