@@ -44,5 +44,21 @@ TEST(FramePacing, ThePieceThatCompletesTheRefinementIsFollowedByAFrameThatShowsI
   EXPECT_TRUE(pacing.may_wait());
 }
 
+// A selection or focus copy made off the window's thread sends no event when it is done: an idle window must not
+// sleep until the next input while one is in flight, or the picture would wait for the user to move.
+TEST(FramePacing, AnIdleWindowLooksAgainWhileWorkIsInFlight) {
+  FramePacing pacing;
+  for (int i = 0; i < 3; ++i) {
+    pacing.frame_started(false);
+    pacing.frame_ended(false, false);
+  }
+  ASSERT_TRUE(pacing.may_wait());
+  EXPECT_EQ(pacing.next_wait(false, false), FramePacing::Wait::UntilInput);
+  EXPECT_EQ(pacing.next_wait(false, true), FramePacing::Wait::Briefly);
+  EXPECT_EQ(pacing.next_wait(true, true), FramePacing::Wait::None);  // a script never waits
+  pacing.frame_started(true);                                        // input: frames follow at once
+  EXPECT_EQ(pacing.next_wait(false, true), FramePacing::Wait::None);
+}
+
 }  // namespace
 }  // namespace vxl::app

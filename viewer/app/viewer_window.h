@@ -80,6 +80,12 @@ class ViewerWindow {
   // are in the picture, or the wait for them has reached its limit (then said). The first call starts the wait;
   // the frames go on meanwhile, so the window stays responsive. Records the wait for --stats.
   bool drag_end_settled();
+  // Whether a selection or a focus copy is being made or waits to be taken into the picture: an idle window then
+  // looks for it every kWorkPollSeconds instead of sleeping until the next input (FramePacing::next_wait).
+  bool work_in_flight() const {
+    return selection_revision_ != regions_.revision() || selection_worker_.busy() || focus_copies_.busy();
+  }
+  static constexpr double kWorkPollSeconds = 0.02;
   // Whether a picture at `level` draws the focus from its full-detail copy (focus first).
   bool focus_first_at(std::uint32_t level) const { return level > 0 && session_->has_focus(); }
   // Writes the selected streamlines of every file to a stamped .tck (a key or the panel).

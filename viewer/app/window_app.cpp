@@ -363,10 +363,13 @@ int ViewerWindow::run() {
     if (idle_at_drag_end) {
       // Not a busy loop: the selection and the copy run on the cores below the window's priority.
       glfwWaitEventsTimeout(0.005);
-    } else if (automated || !pacing.may_wait()) {
-      glfwPollEvents();
     } else {
-      glfwWaitEvents();  // nothing moves by itself: sleep until the user does something
+      switch (pacing.next_wait(automated, work_in_flight())) {
+        case FramePacing::Wait::None: glfwPollEvents(); break;
+        // Nothing wakes the window when a selection or a focus copy is done: it looks again in a while.
+        case FramePacing::Wait::Briefly: glfwWaitEventsTimeout(kWorkPollSeconds); break;
+        case FramePacing::Wait::UntilInput: glfwWaitEvents(); break;  // nothing moves by itself
+      }
     }
     pacing.frame_started(events_ != seen);
     // A script's frames are done after --frames; a scripted drag then waits, drawing frames, for its last
