@@ -94,7 +94,8 @@ ConvertSummary StreamingConversion::run() {
   report("writing", 0.0);
   t0 = Clock::now();
   write_rest();
-  out_->append_voxel_index();
+  pool_.reset();  // the voxel index's buffer takes the memory the ranges and the pool gave back
+  out_->append_voxel_index(plan_.voxel_index_buffer_bytes);
   out_->append(VxlStreamWriter::kProv, {reinterpret_cast<const std::uint8_t*>(provenance.data()), provenance.size()});
   out_->commit();
   summary_.write_seconds += seconds_since(t0);

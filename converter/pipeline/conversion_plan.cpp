@@ -6,6 +6,7 @@
 
 #include "converter/segment_orders.h"
 #include "format/base/direct_region_writer.h"
+#include "format/voxel_voxlines.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_stream_writer.h"
 
@@ -181,6 +182,30 @@ std::uint64_t block_staging_total(const ConversionCounts& c, std::uint64_t stagi
   return total;
 }
 
+std::uint64_t plan_voxel_index(const MemoryBudget& budget, std::uint64_t room, const ConversionCounts& counts) {
+  const std::uint64_t lists = counts.meta.voxline_count * sizeof(IndexedVoxline);
+  const std::uint64_t starts = 8 * (counts.voxels.size() + 1);
+  // The tables' parts being read: VXLN (8 bytes an entry) and STRM (8), up to kVoxelIndexPartEntries each.
+  const std::uint64_t parts = 8 * std::min(kVoxelIndexPartEntries, counts.meta.voxline_count) +
+                              8 * std::min(kVoxelIndexPartEntries, counts.meta.streamline_count + 1);
+  std::uint64_t largest = 0;  // the largest voxel's list, at most: a voxline has at least one vertex
+  std::size_t largest_at = 0;
+  for (std::size_t i = 0; i < counts.voxels.size(); ++i)
+    if (counts.voxels[i].vertex_count > largest) largest = counts.voxels[i].vertex_count, largest_at = i;
+  largest = std::min(lists, largest * sizeof(IndexedVoxline));
+  if (largest + starts > room) {
+    const VoxelEntry& v = counts.voxels[largest_at];
+    budget.fail(largest + starts, budget.limit() - std::min(budget.limit(), room),
+                "the voxel index's list of voxel (" + std::to_string(v.coord[0]) + ", " + std::to_string(v.coord[1]) +
+                    ", " + std::to_string(v.coord[2]) + ")",
+                ", or a smaller --voxel-size");
+  }
+  // The largest list goes first: the tables' parts are small beside it, and a limit that fits the ranges
+  // fits it.
+  const std::uint64_t free = room - starts;
+  return std::max(largest, std::min(lists, free > parts ? free - parts : 0));
+}
+
 ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& counts) {
   ConversionPlan plan;
   budget.take(kTableBufferEntries * (sizeof(VoxlineEntry) + sizeof(std::uint64_t)),
@@ -199,6 +224,8 @@ ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& cou
   for (std::size_t i = 0; i < counts.voxels.size(); ++i)
     plan.order_chunk_bytes = std::max(plan.order_chunk_bytes, orders_start(counts.voxels, counts.order_bytes, i + 1) -
                                                                   orders_start(counts.voxels, counts.order_bytes, i));
+  // What the pool, the orders' chunks and the ranges take is given back before the write stage.
+  const std::uint64_t room_at_write = budget.left();
   if (plan.direct_staging_bytes > 0) plan_block_staging(budget, counts, plan);
   if (plan.block_staging_bytes > 0)
     budget.take(plan.pool_bytes, "the vertex blocks being written, then the orders being built and their vertices");
@@ -206,6 +233,7 @@ ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& cou
     budget.take(plan.order_chunk_bytes * (plan.direct_staging_bytes > 0 ? 2 : 1),
                 "the part of the orders being written", ", or a smaller --voxel-size");
   plan.ranges = cut_ranges(budget, counts, plan.block_staging_bytes > 0);
+  plan.voxel_index_buffer_bytes = plan_voxel_index(budget, room_at_write, counts);
   return plan;
 }
 
