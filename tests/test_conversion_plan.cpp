@@ -208,6 +208,25 @@ TEST(ConversionPlan, AVoxelIndexListTooLargeForWhatIsLeftIsNamed) {
   }
 }
 
+TEST(ConversionPlan, VoxelRunsAreKeptOnlyBesideThePlanAndItsLargestRange) {
+  const Table t(std::vector<std::uint32_t>(500, 1000));
+  MemoryBudget budget(200 * kMiB, "source.tck");
+  const ConversionPlan plan = plan_conversion(budget, t.counts());
+  ASSERT_EQ(plan.ranges.size(), 1u);
+  EXPECT_GT(plan.ranges[0].bytes, (plan.ranges[0].vertex_end - plan.ranges[0].vertex_first) * 4);
+  const std::uint64_t used = budget.used(), room = budget.left() - plan.ranges[0].bytes;
+  EXPECT_FALSE(plan_voxel_runs(budget, plan, room + 1));
+  EXPECT_EQ(budget.used(), used) << "runs that do not fit take nothing";
+  EXPECT_TRUE(plan_voxel_runs(budget, plan, room));
+  EXPECT_EQ(budget.used(), used + room);
+  // Ranges cut to use what is left leave no room for them.
+  MemoryBudget tight(12 * kMiB, "source.tck");
+  const Table large(std::vector<std::uint32_t>(2000, 3000));
+  const ConversionPlan cut = plan_conversion(tight, large.counts());
+  ASSERT_GT(cut.ranges.size(), 2u);
+  EXPECT_FALSE(plan_voxel_runs(tight, cut, 8 * kMiB));
+}
+
 TEST(ConversionPlan, TheSameCountsGiveTheSamePlan) {
   const Table t(std::vector<std::uint32_t>(1500, 2500));
   MemoryBudget a(20 * kMiB, "source.tck"), b(20 * kMiB, "source.tck");

@@ -100,7 +100,7 @@ void plan_block_staging(const MemoryBudget& budget, const ConversionCounts& coun
 // orders with fewer threads when they would take more than a quarter of the room (the orders do not
 // depend on the thread count).
 std::vector<VoxelRange> cut_ranges(MemoryBudget& budget, const ConversionCounts& c, bool block_staging) {
-  const std::uint64_t room = budget.left();
+  const std::uint64_t room = c.range_request > 0 ? std::min(c.range_request, budget.left()) : budget.left();
   auto per_thread = [&](const VoxelRange& r) {
     return order_scratch_bytes(r.max_vertices) + end_bits_bytes(c, r.max_vertices);
   };
@@ -116,7 +116,7 @@ std::vector<VoxelRange> cut_ranges(MemoryBudget& budget, const ConversionCounts&
   auto alone = [&](std::size_t i) {
     const VoxelEntry& v = c.voxels[i];
     VoxelRange r{i, i + 1, v.vertex_first, v.vertex_first + v.vertex_count, v.vertex_count};
-    if (cost(r) > room) {
+    if (cost(r) > budget.left()) {  // refused
       budget.take(cost(r),
                   "voxel (" + std::to_string(v.coord[0]) + ", " + std::to_string(v.coord[1]) + ", " +
                       std::to_string(v.coord[2]) + ") of " + std::to_string(v.vertex_count) +
@@ -144,7 +144,10 @@ std::vector<VoxelRange> cut_ranges(MemoryBudget& budget, const ConversionCounts&
     }
   }
   ranges.push_back(r);
-  for (VoxelRange& each : ranges) each.order_threads = order_threads(each);
+  for (VoxelRange& each : ranges) {
+    each.order_threads = order_threads(each);
+    each.bytes = cost(each);
+  }
   return ranges;
 }
 
@@ -180,6 +183,14 @@ std::uint64_t block_staging_total(const ConversionCounts& c, std::uint64_t stagi
     }
   }
   return total;
+}
+
+bool plan_voxel_runs(MemoryBudget& budget, const ConversionPlan& plan, std::uint64_t runs_bytes) {
+  std::uint64_t largest = 0;
+  for (const VoxelRange& r : plan.ranges) largest = std::max(largest, r.bytes);
+  if (budget.left() < largest || runs_bytes > budget.left() - largest) return false;
+  budget.take(runs_bytes, "the voxel runs");
+  return true;
 }
 
 std::uint64_t plan_voxel_index(const MemoryBudget& budget, std::uint64_t room, const ConversionCounts& counts) {

@@ -46,6 +46,7 @@ struct VoxelRange {
   std::uint64_t vertex_first = 0, vertex_end = 0;
   std::uint32_t max_vertices = 0;  // of its largest voxel
   unsigned order_threads = 1;      // threads building its orders (fewer where their buffers do not fit)
+  std::uint64_t bytes = 0;         // what building it holds besides what plan_conversion took: vertices, sorts
 };
 
 // What the voxel table fixed, for plan_conversion.
@@ -59,6 +60,7 @@ struct ConversionCounts {
   unsigned threads = 1;                   // resolved
   std::uint64_t batch_streamlines = 0;    // ReadPlan::batch_streamlines
   std::uint64_t order_chunk_request = 0;  // StreamingTuning::order_chunk_bytes (0: derived)
+  std::uint64_t range_request = 0;        // StreamingTuning::range_bytes (0: what the limit leaves)
 };
 
 struct ConversionPlan {
@@ -82,6 +84,11 @@ struct ConversionPlan {
 // comes after the ranges, in the memory they give back: plan_voxel_index, from what is left before the
 // pool and the ranges are taken.
 ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& counts);
+
+// Whether the voxel runs the counting pass recorded (`runs_bytes`: every streamline's voxlines, so that the
+// placing passes need not voxelise again) are kept: when they fit beside what `plan` took from `budget` and
+// its largest range. Then they are taken from `budget`.
+bool plan_voxel_runs(MemoryBudget& budget, const ConversionPlan& plan, std::uint64_t runs_bytes);
 
 // The voxel index's buffer at the write stage, when `room` is what the limit leaves then (the ranges, the
 // pool and the orders' chunks given back): every voxel's list at once (4 bytes a voxline) when they fit,

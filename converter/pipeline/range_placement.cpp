@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 
 #include "format/base/parallel.h"
 
@@ -130,18 +131,37 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
   const float* pts = b.positions.data();
   std::vector<float> voxline_xyz;  // one voxline's vertices on their way to being packed
   part.sink.too_many_synthetic = false;
+  // The part's voxel runs, when pass 2 kept them (the same batches, cut the same way).
+  std::uint64_t run = 0;
+  if (table_.runs_kept && begin < end) {
+    const std::optional<std::uint64_t> at = table_.runs.part_start(first + begin);
+    if (!at) fail_changed();
+    run = *at;
+  }
   for (std::uint64_t k = begin; k < end; ++k) {
     const std::size_t start = part.sink.voxlines.size();
+    const std::uint64_t points = b.offsets[k + 1] - b.offsets[k];
+    const bool by_runs = table_.runs_kept && points > 0 &&
+                         (run >= table_.runs.size() || table_.runs[run].voxel != VoxelRuns::kVoxelisedAgain);
     if (!placing.tables) {
       const std::array<std::uint32_t, 2>& span = table_.spans[first + k];
       if (span[1] < r.first || span[0] >= r.end) {  // no voxel in this range (or none at all)
+        if (by_runs)
+          cut_by_runs(b.offsets[k], points, run, part.sink.voxlines);
+        else if (table_.runs_kept && points > 0)
+          ++run;  // kVoxelisedAgain
+        part.sink.voxlines.resize(start);
         part.voxline_ends.push_back(start);
         continue;
       }
     }
-    detail::voxelize_streamline(table_.grid, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], part.sink,
-                                table_.synthetic_limit);
-    if (part.sink.too_many_synthetic) fail_changed();
+    if (by_runs) {
+      cut_by_runs(b.offsets[k], points, run, part.sink.voxlines);
+    } else {
+      if (table_.runs_kept && points > 0) ++run;  // kVoxelisedAgain
+      detail::voxelize_streamline(table_.grid, pts, b.offsets[k], points, part.sink, table_.synthetic_limit);
+      if (part.sink.too_many_synthetic) fail_changed();
+    }
     part.voxline_ends.push_back(part.sink.voxlines.size());
     const std::span<const TempVoxline> streamline(part.sink.voxlines.data() + start, part.sink.voxlines.size() - start);
     for (std::size_t j = 0; j < streamline.size(); ++j) {
@@ -169,6 +189,20 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
       placing.packers[g - r.first].words(voxline_xyz.data(), used, part.words.data() + at);
       part.words[at + used - 1] |= kPackedVoxlineEnd;
     }
+  }
+}
+
+// Appends the voxlines of the streamline of `points` source points from `first_point` to `out`, as pass 2 found
+// them: voxel runs from `run` on, which it advances past them.
+void StreamingConversion::cut_by_runs(std::uint64_t first_point, std::uint64_t points, std::uint64_t& run,
+                                      std::vector<TempVoxline>& out) const {
+  const std::uint64_t end = first_point + points;
+  for (std::uint64_t at = first_point; at < end;) {
+    if (run >= table_.runs.size()) fail_changed();
+    const VoxelRun v = table_.runs[run++];
+    if (v.voxel == VoxelRuns::kVoxelisedAgain || v.points == 0 || v.points > end - at) fail_changed();
+    out.push_back({v.voxel, v.points, at, kNoSynthetic});
+    at += v.points;
   }
 }
 
