@@ -141,7 +141,7 @@ class StreamingConversion {
   VertexSink open_vertex_sink(const VoxelRange& r, std::span<std::uint8_t> window) const;
   void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
                   std::uint64_t end, StagedPart& part) const;
-  void place_part(RangePlacement& placing, const StagedPart& part);
+  void place_part(RangePlacement& placing, const StagedPart& part, int half);
   void cut_by_runs(std::uint64_t first_point, std::uint64_t points, std::uint64_t& run,
                    std::vector<TempVoxline>& out) const;
   void write_orders(const VoxelRange& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
@@ -199,6 +199,7 @@ struct StreamingConversion::RangePlacement {
   std::vector<VoxlineEntry> voxline_buffer;
   std::vector<std::uint64_t> streamline_buffer;
   std::uint64_t voxline_index = 0, streamlines = 0;
+  std::size_t split = 0;   // the first voxel of the second placing half (range.end: placed whole)
   StagedPart parts[2][2];  // two sets of two parts: one being staged, one being placed
 };
 
