@@ -208,6 +208,14 @@ TEST(ConversionPlan, AVoxelIndexListTooLargeForWhatIsLeftIsNamed) {
   }
 }
 
+TEST(ConversionPlan, AFileWithoutAVoxelIndexNeedsNoBufferForIt) {
+  Table t({100, 200, 3'000'000, 100});
+  t.meta.voxline_count = 3'000'000;
+  t.meta.streamline_count = (1ull << 29) + 1;  // more than a voxel index entry numbers
+  const MemoryBudget budget(64 * kMiB, "source.tck");
+  EXPECT_EQ(plan_voxel_index(budget, 4 * kMiB, t.counts()), 0u);
+}
+
 TEST(ConversionPlan, VoxelRunsAreKeptOnlyBesideThePlanAndItsLargestRange) {
   const Table t(std::vector<std::uint32_t>(500, 1000));
   MemoryBudget budget(200 * kMiB, "source.tck");

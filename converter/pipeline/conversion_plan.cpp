@@ -194,6 +194,7 @@ bool plan_voxel_runs(MemoryBudget& budget, const ConversionPlan& plan, std::uint
 }
 
 std::uint64_t plan_voxel_index(const MemoryBudget& budget, std::uint64_t room, const ConversionCounts& counts) {
+  if (voxel_index_bytes(counts.meta) == 0) return 0;  // no voxel index: too many streamlines for its entries
   const std::uint64_t lists = counts.meta.voxline_count * sizeof(IndexedVoxline);
   const std::uint64_t starts = 8 * (counts.voxels.size() + 1);
   // The tables' parts being read: VXLN (8 bytes an entry) and STRM (8), up to kVoxelIndexPartEntries each.

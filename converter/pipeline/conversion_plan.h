@@ -95,7 +95,7 @@ bool plan_voxel_runs(MemoryBudget& budget, const ConversionPlan& plan, std::uint
 // else as many as fit beside the list starts (8 bytes a voxel) and the tables' parts being read
 // (kVoxelIndexPartEntries of each), but never fewer than the largest voxel's list, whose length is at most
 // its vertex count. Throws Unsupported (MemoryBudget::fail) when `room` does not hold that list and the
-// starts.
+// starts. 0 when the file has no voxel index (more streamlines than its entries number).
 std::uint64_t plan_voxel_index(const MemoryBudget& budget, std::uint64_t room, const ConversionCounts& counts);
 
 // Where voxel i's orders start in ORDB (i = voxel count: the payload's end).
