@@ -35,6 +35,9 @@ struct ConvertSummary {
   std::uint64_t partitions = 1;                 // voxel ranges whose blocks and orders were built one after another
   std::vector<std::uint64_t> partition_starts;  // convert_streaming only: the first voxel of each range
   bool vertices_read_back = false;              // convert_streaming only: VERT written block by block, not held
+  // convert_streaming only: the placing passes cut the streamlines by the voxel runs the counting pass kept
+  // (false: they voxelised again, the limit leaving no room for the runs).
+  bool voxelised_once = false;
   // convert_streaming: the source's; convert_tractogram: the conversion's own (the reader's are in the
   // Tractogram, for its caller to show).
   std::vector<std::string> warnings;

@@ -68,9 +68,17 @@ ConvertSummary StreamingConversion::run() {
   count_voxels();
   build_table();
   summary_.voxelize_seconds = seconds_since(t0);
+  // Planned without the voxel runs, which are kept for the placing passes only where the plan leaves room.
+  budget_.shrink(0, table_.runs_held);
   plan_ = plan_conversion(
-      budget_, {table_.meta, table_.voxels, table_.levels, job_.settings.levels, job_.settings.positions,
-                table_.order_bytes, job_.threads, reader_->plan().batch_streamlines, job_.tuning.order_chunk_bytes});
+      budget_,
+      {table_.meta, table_.voxels, table_.levels, job_.settings.levels, job_.settings.positions, table_.order_bytes,
+       job_.threads, reader_->plan().batch_streamlines, job_.tuning.order_chunk_bytes, job_.tuning.range_bytes});
+  table_.runs_kept = counting_.recording_runs && plan_voxel_runs(budget_, plan_, table_.runs.bytes());
+  if (table_.runs_kept)
+    table_.runs_held = table_.runs.bytes();
+  else
+    table_.runs.clear();
   staged_held_ = plan_.staged_bytes;
   table_.spans.resize(table_.meta.streamline_count);
   if (plan_.block_staging_bytes > 0) {
@@ -91,10 +99,15 @@ ConvertSummary StreamingConversion::run() {
 #endif
   }
 
+  summary_.voxelised_once = table_.runs_kept;
+  table_.runs.clear();
+  budget_.shrink(0, table_.runs_held);
+
   report("writing", 0.0);
   t0 = Clock::now();
   write_rest();
-  out_->append_voxel_index();
+  pool_.reset();  // the voxel index's buffer takes the memory the ranges and the pool gave back
+  out_->append_voxel_index(plan_.voxel_index_buffer_bytes);
   if (!scan_.lengths.empty()) out_->append_items<float>(VxlStreamWriter::kSlen, scan_.lengths);
   out_->append(VxlStreamWriter::kProv, {reinterpret_cast<const std::uint8_t*>(provenance.data()), provenance.size()});
   out_->commit();

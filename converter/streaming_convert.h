@@ -43,6 +43,7 @@ ConvertSummary convert_streaming(const std::string& source_path, const std::stri
 // only large data would) and benchmarks; 0 keeps the derived value. The output does not depend on them.
 struct StreamingTuning {
   std::uint64_t order_chunk_bytes = 0;  // orders built and written this much at a time (or one voxel)
+  std::uint64_t range_bytes = 0;        // ranges of voxels cut to hold at most this much (or one voxel; 0: the limit)
 };
 ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
                                  const ConvertSettings& settings, const StreamingTuning& tuning);

@@ -12,8 +12,6 @@
 namespace vxl {
 namespace {
 
-constexpr std::uint64_t kPartEntries = 1 << 20;  // table entries read at a time: 8 MB
-
 // STRM read in order, a part at a time: at(s) for s that never decreases.
 class StreamlineTableReader {
  public:
@@ -21,7 +19,7 @@ class StreamlineTableReader {
   std::uint64_t at(std::uint64_t s) {
     if (s < first_ || s >= first_ + part_.size()) {
       first_ = s;
-      part_.resize(std::min(kPartEntries, entries_ - s));
+      part_.resize(std::min(kVoxelIndexPartEntries, entries_ - s));
       io_.read_streamline_table(first_, part_);
     }
     return part_[s - first_];
@@ -37,7 +35,7 @@ class StreamlineTableReader {
 template <typename Visit>
 void each_voxline(const VoxelIndexIo& io, std::uint64_t voxline_count, std::vector<VoxlineEntry>& part, Visit&& visit) {
   for (std::uint64_t first = 0; first < voxline_count; first += part.size()) {
-    part.resize(std::min(kPartEntries, voxline_count - first));
+    part.resize(std::min(kVoxelIndexPartEntries, voxline_count - first));
     io.read_voxlines(first, part);
     for (std::size_t k = 0; k < part.size(); ++k) visit(first + k, part[k]);
   }

@@ -43,6 +43,9 @@ struct VoxelIndexIo {
   std::span<IndexedVoxline> in_place;
 };
 
+// Entries of VXLN and of STRM that fill_voxel_index reads at a time (8 MB each).
+inline constexpr std::uint64_t kVoxelIndexPartEntries = 1 << 20;
+
 // Fills a VXIX payload (spec §5.14) for a file of these counts from its STRM and VXLN, which must hold together:
 // one pass to count each voxel's voxlines, then one per range of voxels whose lists fit `buffer_bytes` (a voxel
 // larger than that alone). Each pass reads both tables in order, in parts of about 8 MB.

@@ -134,7 +134,7 @@ void VxlStreamWriter::append_meta(const MetaSection& meta) {
   append(kMeta, {reinterpret_cast<const std::uint8_t*>(&m), sizeof m});
 }
 
-void VxlStreamWriter::append_voxel_index() {
+void VxlStreamWriter::append_voxel_index(std::uint64_t buffer_bytes) {
   const std::size_t x = entry_[kVxix], l = entry_[kVxln], s = entry_[kStrm];
   if (x >= table_.size()) return;
   if (written_[l] != table_[l].size || written_[s] != table_[s].size || written_[x] != 0)
@@ -151,7 +151,7 @@ void VxlStreamWriter::append_voxel_index() {
   io.write = [&](std::span<const std::uint8_t> bytes) { append(kVxix, bytes); };
   const std::uint64_t voxlines = table_[l].size / sizeof(VoxlineEntry), streamlines = table_[s].size / 8 - 1;
   const std::uint64_t voxels = (table_[x].size - voxlines * sizeof(IndexedVoxline)) / 8 - 1;
-  fill_voxel_index(voxels, voxlines, streamlines, io, kVoxelIndexBufferBytes);
+  fill_voxel_index(voxels, voxlines, streamlines, io, buffer_bytes);
 }
 
 void VxlStreamWriter::commit() {

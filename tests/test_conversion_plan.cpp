@@ -168,6 +168,73 @@ TEST(ConversionPlan, NoVoxelsMakeOneEmptyRangeThatWritesTheTables) {
   EXPECT_EQ(plan.ranges[0].first, plan.ranges[0].end);
 }
 
+TEST(ConversionPlan, TheVoxelIndexIsSortedInOnePassWhenItsListsFit) {
+  const Table t(std::vector<std::uint32_t>(300, 5000));
+  for (std::uint64_t limit : {200 * kMiB, 512 * kMiB}) {  // written through the page cache, and block by block
+    MemoryBudget budget(limit, "source.tck");
+    const ConversionPlan plan = plan_conversion(budget, t.counts());
+    EXPECT_EQ(plan.voxel_index_buffer_bytes, t.meta.voxline_count * 4) << limit;
+  }
+}
+
+TEST(ConversionPlan, TheVoxelIndexBufferIsWhatTheWriteStageLeaves) {
+  Table t(std::vector<std::uint32_t>(1000, 40'000));
+  t.meta.voxline_count = 10'000'000;  // lists of 40 MB
+  const MemoryBudget budget(1024 * kMiB, "source.tck");
+  const std::uint64_t lists = t.meta.voxline_count * 4, largest = 40'000 * 4;
+  const std::uint64_t small = plan_voxel_index(budget, 12 * kMiB, t.counts());
+  EXPECT_GE(small, largest);
+  EXPECT_LT(small, 12 * kMiB) << "beside the list starts and the tables' parts";
+  const std::uint64_t larger = plan_voxel_index(budget, 32 * kMiB, t.counts());
+  EXPECT_GT(larger, small);
+  EXPECT_LT(larger, lists);
+  EXPECT_EQ(plan_voxel_index(budget, 100 * kMiB, t.counts()), lists);
+  // A room for the largest list but not for the tables' parts beside it: the largest list alone.
+  EXPECT_EQ(plan_voxel_index(budget, largest + 8 * 1001 + 1000, t.counts()), largest);
+}
+
+TEST(ConversionPlan, AVoxelIndexListTooLargeForWhatIsLeftIsNamed) {
+  Table t({100, 200, 3'000'000, 100});
+  t.meta.voxline_count = 3'000'000;
+  t.voxels[2].coord[1] = 7;
+  const MemoryBudget budget(64 * kMiB, "source.tck");
+  try {
+    plan_voxel_index(budget, 4 * kMiB, t.counts());
+    FAIL() << "a list of 12 MB fit in 4 MiB";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the voxel index's list of voxel (2, 7, 0)"), std::string::npos) << what;
+  }
+}
+
+TEST(ConversionPlan, AFileWithoutAVoxelIndexNeedsNoBufferForIt) {
+  Table t({100, 200, 3'000'000, 100});
+  t.meta.voxline_count = 3'000'000;
+  t.meta.streamline_count = (1ull << 29) + 1;  // more than a voxel index entry numbers
+  const MemoryBudget budget(64 * kMiB, "source.tck");
+  EXPECT_EQ(plan_voxel_index(budget, 4 * kMiB, t.counts()), 0u);
+}
+
+TEST(ConversionPlan, VoxelRunsAreKeptOnlyBesideThePlanAndItsLargestRange) {
+  const Table t(std::vector<std::uint32_t>(500, 1000));
+  MemoryBudget budget(200 * kMiB, "source.tck");
+  const ConversionPlan plan = plan_conversion(budget, t.counts());
+  ASSERT_EQ(plan.ranges.size(), 1u);
+  EXPECT_GT(plan.ranges[0].bytes, (plan.ranges[0].vertex_end - plan.ranges[0].vertex_first) * 4);
+  const std::uint64_t used = budget.used(), room = budget.left() - plan.ranges[0].bytes;
+  EXPECT_FALSE(plan_voxel_runs(budget, plan, room + 1));
+  EXPECT_EQ(budget.used(), used) << "runs that do not fit take nothing";
+  EXPECT_TRUE(plan_voxel_runs(budget, plan, room));
+  EXPECT_EQ(budget.used(), used + room);
+  // Ranges cut to use what is left leave no room for them.
+  MemoryBudget tight(12 * kMiB, "source.tck");
+  const Table large(std::vector<std::uint32_t>(2000, 3000));
+  const ConversionPlan cut = plan_conversion(tight, large.counts());
+  ASSERT_GT(cut.ranges.size(), 2u);
+  EXPECT_FALSE(plan_voxel_runs(tight, cut, 8 * kMiB));
+}
+
 TEST(ConversionPlan, TheSameCountsGiveTheSamePlan) {
   const Table t(std::vector<std::uint32_t>(1500, 2500));
   MemoryBudget a(20 * kMiB, "source.tck"), b(20 * kMiB, "source.tck");
@@ -175,6 +242,7 @@ TEST(ConversionPlan, TheSameCountsGiveTheSamePlan) {
   ASSERT_EQ(x.ranges.size(), y.ranges.size());
   for (std::size_t k = 0; k < x.ranges.size(); ++k) EXPECT_EQ(x.ranges[k].end, y.ranges[k].end);
   EXPECT_EQ(a.used(), b.used());
+  EXPECT_EQ(x.voxel_index_buffer_bytes, y.voxel_index_buffer_bytes);
 }
 
 }  // namespace

@@ -244,6 +244,46 @@ TEST(StreamingConvert, LongStepsAndDiagonalOrdersAreIdentical) {
   EXPECT_GE(r.partitions, 2u);
 }
 
+// The placing passes cut the streamlines by the voxel runs the counting pass kept where the limit leaves
+// room for them, and voxelise again where it does not: the same bytes either way, in one range or several,
+// with points added at voxel faces (whose streamlines are voxelised again) or without.
+TEST(StreamingConvert, VoxelRunsAreKeptWhereTheyFitAndTheBytesAreTheSame) {
+  ScratchDir dir;
+  const std::string tck = dir.file("in.tck");
+  write_synth_tck(tck, 12000);
+  ConvertSummary s = expect_identical(dir, tck, settings_for(10.0), 256 * kMiB);
+  EXPECT_TRUE(s.voxelised_once);
+  EXPECT_EQ(s.partitions, 1u);
+  s = expect_identical(dir, tck, settings_for(10.0), 21 * kMiB);  // several ranges, no room for the runs
+  EXPECT_FALSE(s.voxelised_once);
+  EXPECT_GE(s.partitions, 3u);
+  // Several ranges beside the runs: streamlines with no voxel in a range are skipped past their runs (under
+  // 256 MiB, so that a range holds its vertices and the request cuts it).
+  ConvertSettings settings = settings_for(10.0);
+  settings.memory_limit = 200 * kMiB;
+  StreamingTuning small_ranges;
+  small_ranges.range_bytes = 1 * kMiB;
+  const std::string whole = dir.file("whole.vxl"), ranged = dir.file("ranged.vxl");
+  s = convert_streaming(tck, ranged, settings, small_ranges);
+  EXPECT_TRUE(s.voxelised_once);
+  EXPECT_GE(s.partitions, 3u);
+  EXPECT_TRUE(file_bytes(whole) == file_bytes(ranged));
+  EXPECT_GT(streamlines_across_ranges(ranged, s.partition_starts), 1000u);
+  // 1 mm voxels: points added at voxel faces, their streamlines voxelised again in the placing pass.
+  write_synth_tck(tck, 2000, 7);
+  ConvertSettings fine = settings_for(1.0);
+  fine.levels = 1;
+  s = expect_identical(dir, tck, fine, 256 * kMiB);
+  EXPECT_TRUE(s.voxelised_once);
+  EXPECT_GT(s.synthetic_points, 100u);
+  settings = fine;
+  settings.memory_limit = 200 * kMiB;
+  s = convert_streaming(tck, ranged, settings, small_ranges);
+  EXPECT_TRUE(s.voxelised_once);
+  EXPECT_GE(s.partitions, 2u);
+  EXPECT_TRUE(file_bytes(whole) == file_bytes(ranged));
+}
+
 // Float64 big-endian source, an empty streamline, no Inf terminator: the provenance (checksum, header,
 // warnings) must come out the same too.
 TEST(StreamingConvert, HandMadeSourceWithWarningsIsIdentical) {

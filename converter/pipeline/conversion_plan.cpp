@@ -6,6 +6,7 @@
 
 #include "converter/segment_orders.h"
 #include "format/base/direct_region_writer.h"
+#include "format/voxel_voxlines.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_stream_writer.h"
 
@@ -99,7 +100,7 @@ void plan_block_staging(const MemoryBudget& budget, const ConversionCounts& coun
 // orders with fewer threads when they would take more than a quarter of the room (the orders do not
 // depend on the thread count).
 std::vector<VoxelRange> cut_ranges(MemoryBudget& budget, const ConversionCounts& c, bool block_staging) {
-  const std::uint64_t room = budget.left();
+  const std::uint64_t room = c.range_request > 0 ? std::min(c.range_request, budget.left()) : budget.left();
   auto per_thread = [&](const VoxelRange& r) {
     return order_scratch_bytes(r.max_vertices) + end_bits_bytes(c, r.max_vertices);
   };
@@ -115,7 +116,7 @@ std::vector<VoxelRange> cut_ranges(MemoryBudget& budget, const ConversionCounts&
   auto alone = [&](std::size_t i) {
     const VoxelEntry& v = c.voxels[i];
     VoxelRange r{i, i + 1, v.vertex_first, v.vertex_first + v.vertex_count, v.vertex_count};
-    if (cost(r) > room) {
+    if (cost(r) > budget.left()) {  // refused
       budget.take(cost(r),
                   "voxel (" + std::to_string(v.coord[0]) + ", " + std::to_string(v.coord[1]) + ", " +
                       std::to_string(v.coord[2]) + ") of " + std::to_string(v.vertex_count) +
@@ -143,7 +144,10 @@ std::vector<VoxelRange> cut_ranges(MemoryBudget& budget, const ConversionCounts&
     }
   }
   ranges.push_back(r);
-  for (VoxelRange& each : ranges) each.order_threads = order_threads(each);
+  for (VoxelRange& each : ranges) {
+    each.order_threads = order_threads(each);
+    each.bytes = cost(each);
+  }
   return ranges;
 }
 
@@ -181,6 +185,39 @@ std::uint64_t block_staging_total(const ConversionCounts& c, std::uint64_t stagi
   return total;
 }
 
+bool plan_voxel_runs(MemoryBudget& budget, const ConversionPlan& plan, std::uint64_t runs_bytes) {
+  std::uint64_t largest = 0;
+  for (const VoxelRange& r : plan.ranges) largest = std::max(largest, r.bytes);
+  if (budget.left() < largest || runs_bytes > budget.left() - largest) return false;
+  budget.take(runs_bytes, "the voxel runs");
+  return true;
+}
+
+std::uint64_t plan_voxel_index(const MemoryBudget& budget, std::uint64_t room, const ConversionCounts& counts) {
+  if (voxel_index_bytes(counts.meta) == 0) return 0;  // no voxel index: too many streamlines for its entries
+  const std::uint64_t lists = counts.meta.voxline_count * sizeof(IndexedVoxline);
+  const std::uint64_t starts = 8 * (counts.voxels.size() + 1);
+  // The tables' parts being read: VXLN (8 bytes an entry) and STRM (8), up to kVoxelIndexPartEntries each.
+  const std::uint64_t parts = 8 * std::min(kVoxelIndexPartEntries, counts.meta.voxline_count) +
+                              8 * std::min(kVoxelIndexPartEntries, counts.meta.streamline_count + 1);
+  std::uint64_t largest = 0;  // the largest voxel's list, at most: a voxline has at least one vertex
+  std::size_t largest_at = 0;
+  for (std::size_t i = 0; i < counts.voxels.size(); ++i)
+    if (counts.voxels[i].vertex_count > largest) largest = counts.voxels[i].vertex_count, largest_at = i;
+  largest = std::min(lists, largest * sizeof(IndexedVoxline));
+  if (largest + starts > room) {
+    const VoxelEntry& v = counts.voxels[largest_at];
+    budget.fail(largest + starts, budget.limit() - std::min(budget.limit(), room),
+                "the voxel index's list of voxel (" + std::to_string(v.coord[0]) + ", " + std::to_string(v.coord[1]) +
+                    ", " + std::to_string(v.coord[2]) + ")",
+                ", or a smaller --voxel-size");
+  }
+  // The largest list goes first: the tables' parts are small beside it, and a limit that fits the ranges
+  // fits it.
+  const std::uint64_t free = room - starts;
+  return std::max(largest, std::min(lists, free > parts ? free - parts : 0));
+}
+
 ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& counts) {
   ConversionPlan plan;
   budget.take(kTableBufferEntries * (sizeof(VoxlineEntry) + sizeof(std::uint64_t)),
@@ -199,6 +236,8 @@ ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& cou
   for (std::size_t i = 0; i < counts.voxels.size(); ++i)
     plan.order_chunk_bytes = std::max(plan.order_chunk_bytes, orders_start(counts.voxels, counts.order_bytes, i + 1) -
                                                                   orders_start(counts.voxels, counts.order_bytes, i));
+  // What the pool, the orders' chunks and the ranges take is given back before the write stage.
+  const std::uint64_t room_at_write = budget.left();
   if (plan.direct_staging_bytes > 0) plan_block_staging(budget, counts, plan);
   if (plan.block_staging_bytes > 0)
     budget.take(plan.pool_bytes, "the vertex blocks being written, then the orders being built and their vertices");
@@ -206,6 +245,7 @@ ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& cou
     budget.take(plan.order_chunk_bytes * (plan.direct_staging_bytes > 0 ? 2 : 1),
                 "the part of the orders being written", ", or a smaller --voxel-size");
   plan.ranges = cut_ranges(budget, counts, plan.block_staging_bytes > 0);
+  plan.voxel_index_buffer_bytes = plan_voxel_index(budget, room_at_write, counts);
   return plan;
 }
 

@@ -46,6 +46,7 @@ struct VoxelRange {
   std::uint64_t vertex_first = 0, vertex_end = 0;
   std::uint32_t max_vertices = 0;  // of its largest voxel
   unsigned order_threads = 1;      // threads building its orders (fewer where their buffers do not fit)
+  std::uint64_t bytes = 0;         // what building it holds besides what plan_conversion took: vertices, sorts
 };
 
 // What the voxel table fixed, for plan_conversion.
@@ -59,6 +60,7 @@ struct ConversionCounts {
   unsigned threads = 1;                   // resolved
   std::uint64_t batch_streamlines = 0;    // ReadPlan::batch_streamlines
   std::uint64_t order_chunk_request = 0;  // StreamingTuning::order_chunk_bytes (0: derived)
+  std::uint64_t range_request = 0;        // StreamingTuning::range_bytes (0: what the limit leaves)
 };
 
 struct ConversionPlan {
@@ -71,12 +73,30 @@ struct ConversionPlan {
   // chunks (pool_chunk_bytes each) and two chunks' vertices read back (pool_read_back_bytes each).
   std::uint64_t pool_bytes = 0, pool_chunk_bytes = 0, pool_read_back_bytes = 0;
   std::vector<VoxelRange> ranges;  // at least one (with no voxels: one empty range, which writes the tables)
+  // The write stage's voxel index (VxlStreamWriter::append_voxel_index): the lists sorted at once, one pass
+  // over VXLN and STRM per buffer full (plan_voxel_index).
+  std::uint64_t voxel_index_buffer_bytes = 0;
 };
 
 // Takes from `budget`, in this order: the tables' buffers, every streamline's voxel span, two batches'
 // staged voxlines, the direct writes' staging, the pool or the orders chunks, and each range's vertices
-// and sort buffers (the largest range's: ranges are cut to fit in what is left).
+// and sort buffers (the largest range's: ranges are cut to fit in what is left). The voxel index's buffer
+// comes after the ranges, in the memory they give back: plan_voxel_index, from what is left before the
+// pool and the ranges are taken.
 ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& counts);
+
+// Whether the voxel runs the counting pass recorded (`runs_bytes`: every streamline's voxlines, so that the
+// placing passes need not voxelise again) are kept: when they fit beside what `plan` took from `budget` and
+// its largest range. Then they are taken from `budget`.
+bool plan_voxel_runs(MemoryBudget& budget, const ConversionPlan& plan, std::uint64_t runs_bytes);
+
+// The voxel index's buffer at the write stage, when `room` is what the limit leaves then (the ranges, the
+// pool and the orders' chunks given back): every voxel's list at once (4 bytes a voxline) when they fit,
+// else as many as fit beside the list starts (8 bytes a voxel) and the tables' parts being read
+// (kVoxelIndexPartEntries of each), but never fewer than the largest voxel's list, whose length is at most
+// its vertex count. Throws Unsupported (MemoryBudget::fail) when `room` does not hold that list and the
+// starts. 0 when the file has no voxel index (more streamlines than its entries number).
+std::uint64_t plan_voxel_index(const MemoryBudget& budget, std::uint64_t room, const ConversionCounts& counts);
 
 // Where voxel i's orders start in ORDB (i = voxel count: the payload's end).
 inline std::uint64_t orders_start(std::span<const VoxelEntry> voxels, std::uint64_t order_bytes, std::size_t i) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 
 #include "format/base/parallel.h"
 
@@ -46,23 +47,38 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
     placing.voxline_buffer.reserve(kTableBufferEntries);
     placing.streamline_buffer.reserve(kTableBufferEntries);
   }
-  // Batch k is staged in two parts on two threads while batch k - 1, staged before, is placed on a third:
-  // placing (in streamline order) is the serial part of the pass.
+  // Batch k is staged in two parts while batch k - 1, staged before, is placed in streamline order. With packed
+  // positions the placing is split too, at a voxel that halves the range's vertices: each half places the
+  // voxlines of its own voxels (their blocks are apart), the first also writes the tables. Four items then
+  // share the threads as they come free; float32 positions place on a third thread of their own (their
+  // voxline ends are bits that neighbouring blocks share).
+  placing.split = r.end;
+  if (packed() && job_.threads > 1 && r.end - r.first > 1) {
+    const std::uint64_t middle = r.vertex_first + (r.vertex_end - r.vertex_first) / 2;
+    const auto voxels = std::span<const VoxelEntry>(table_.voxels).subspan(r.first + 1, r.end - r.first - 1);
+    placing.split =
+        r.first + 1 +
+        static_cast<std::size_t>(std::partition_point(voxels.begin(), voxels.end(),
+                                                      [&](const VoxelEntry& v) { return v.vertex_first < middle; }) -
+                                 voxels.begin());
+  }
+  const bool split = placing.split < r.end;
+  const unsigned threads = job_.threads <= 1 ? 1 : split ? std::min(job_.threads, 4u) : 3;
   int staging = 0;           // the set of parts the current batch is staged in
   bool other_placed = true;  // whether the other set's parts are placed
-  auto place_staged = [&](int set) {
-    for (const StagedPart& part : placing.parts[set]) place_part(placing, part);
+  auto place_staged = [&](int set, int half) {
+    for (const StagedPart& part : placing.parts[set]) place_part(placing, part, half);
   };
   reader_->each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
     if (first + b.streamline_count() > table_.spans.size()) fail_changed();  // more streamlines than pass 1 saw
     const std::array<std::uint64_t, 3> cut = two_parts(b);
-    // Item 0 places the earlier batch, so that its errors come first.
-    parallel_for_first_error_in_order(3, job_.threads > 1 ? 3 : 1, [&](std::uint64_t item, unsigned) {
-      if (item == 0) {
-        if (!other_placed) place_staged(1 - staging);
+    // Items 0 and 1 place the earlier batch, so that its errors come first.
+    parallel_for_first_error_in_order(4, threads, [&](std::uint64_t item, unsigned) {
+      if (item < 2) {
+        if (!other_placed && (item == 0 || split)) place_staged(1 - staging, static_cast<int>(item));
         return;
       }
-      stage_part(placing, b, first, cut[item - 1], cut[item], placing.parts[staging][item - 1]);
+      stage_part(placing, b, first, cut[item - 2], cut[item - 1], placing.parts[staging][item - 2]);
     });
     other_placed = false;
     staging = 1 - staging;
@@ -71,7 +87,10 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
       for (const StagedPart& part : set) staged += part.bytes();
     budget_.track(staged, staged_held_, [] { return std::string("the voxlines of two batches being placed"); });
   });
-  if (!other_placed) place_staged(1 - staging);
+  if (!other_placed) {
+    place_staged(1 - staging, 0);
+    if (split) place_staged(1 - staging, 1);
+  }
   placing.sink.finish();  // rethrows a failed write (each block's completeness is checked below)
   if (placing.streamlines != table_.meta.streamline_count ||
       (tables && placing.voxline_index != table_.meta.voxline_count))
@@ -130,18 +149,37 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
   const float* pts = b.positions.data();
   std::vector<float> voxline_xyz;  // one voxline's vertices on their way to being packed
   part.sink.too_many_synthetic = false;
+  // The part's voxel runs, when pass 2 kept them (the same batches, cut the same way).
+  std::uint64_t run = 0;
+  if (table_.runs_kept && begin < end) {
+    const std::optional<std::uint64_t> at = table_.runs.part_start(first + begin);
+    if (!at) fail_changed();
+    run = *at;
+  }
   for (std::uint64_t k = begin; k < end; ++k) {
     const std::size_t start = part.sink.voxlines.size();
+    const std::uint64_t points = b.offsets[k + 1] - b.offsets[k];
+    const bool by_runs = table_.runs_kept && points > 0 &&
+                         (run >= table_.runs.size() || table_.runs[run].voxel != VoxelRuns::kVoxelisedAgain);
     if (!placing.tables) {
       const std::array<std::uint32_t, 2>& span = table_.spans[first + k];
       if (span[1] < r.first || span[0] >= r.end) {  // no voxel in this range (or none at all)
+        if (by_runs)
+          cut_by_runs(b.offsets[k], points, run, part.sink.voxlines);
+        else if (table_.runs_kept && points > 0)
+          ++run;  // kVoxelisedAgain
+        part.sink.voxlines.resize(start);
         part.voxline_ends.push_back(start);
         continue;
       }
     }
-    detail::voxelize_streamline(table_.grid, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], part.sink,
-                                table_.synthetic_limit);
-    if (part.sink.too_many_synthetic) fail_changed();
+    if (by_runs) {
+      cut_by_runs(b.offsets[k], points, run, part.sink.voxlines);
+    } else {
+      if (table_.runs_kept && points > 0) ++run;  // kVoxelisedAgain
+      detail::voxelize_streamline(table_.grid, pts, b.offsets[k], points, part.sink, table_.synthetic_limit);
+      if (part.sink.too_many_synthetic) fail_changed();
+    }
     part.voxline_ends.push_back(part.sink.voxlines.size());
     const std::span<const TempVoxline> streamline(part.sink.voxlines.data() + start, part.sink.voxlines.size() - start);
     for (std::size_t j = 0; j < streamline.size(); ++j) {
@@ -172,27 +210,44 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
   }
 }
 
+// Appends the voxlines of the streamline of `points` source points from `first_point` to `out`, as pass 2 found
+// them: voxel runs from `run` on, which it advances past them.
+void StreamingConversion::cut_by_runs(std::uint64_t first_point, std::uint64_t points, std::uint64_t& run,
+                                      std::vector<TempVoxline>& out) const {
+  const std::uint64_t end = first_point + points;
+  for (std::uint64_t at = first_point; at < end;) {
+    if (run >= table_.runs.size()) fail_changed();
+    const VoxelRun v = table_.runs[run++];
+    if (v.voxel == VoxelRuns::kVoxelisedAgain || v.points == 0 || v.points > end - at) fail_changed();
+    out.push_back({v.voxel, v.points, at, kNoSynthetic});
+    at += v.points;
+  }
+}
+
 // In streamline order: copies a staged part's vertices to their blocks (each voxel's next place for the
-// streamline's depth) and, for the first range, writes its voxline and streamline table entries.
-void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& part) {
+// streamline's depth) — those of the voxels of half `half` of the range (split at placing.split) — and, for
+// the first range's first half, writes its voxline and streamline table entries.
+void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& part, int half) {
   const std::uint64_t first = part.source_first;
   const VoxelRange& r = placing.range;
+  const std::size_t lo = half == 0 ? r.first : placing.split, hi = half == 0 ? placing.split : r.end;
+  const bool tables = placing.tables && half == 0;
   const std::uint32_t levels = job_.settings.levels;
-  std::uint64_t staged = 0;  // vertices of the part placed so far
+  std::uint64_t staged = 0;  // vertices of the part passed so far
   std::size_t start = 0;
   for (std::uint64_t k = 0; k < part.end - part.begin; ++k) {
     const std::size_t end = part.voxline_ends[k];
     const std::span<const TempVoxline> streamline(part.sink.voxlines.data() + start, end - start);
     start = end;
     std::array<std::uint32_t, 2>& span = table_.spans[first + k];
-    if (placing.tables) {
+    if (tables) {
       span = {std::numeric_limits<std::uint32_t>::max(), 0};
       placing.streamline_buffer.push_back(placing.voxline_index);
       if (placing.streamline_buffer.size() == kTableBufferEntries) {
         out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, placing.streamline_buffer);
         placing.streamline_buffer.clear();
       }
-    } else if (span[1] < r.first || span[0] >= r.end) {
+    } else if (!placing.tables && (span[1] < r.first || span[0] >= r.end)) {
       continue;
     }
     const std::uint32_t depth = streamline_depth(first + k, levels);
@@ -200,7 +255,7 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
       const TempVoxline& v = streamline[j];
       const std::uint32_t g = table_.global_id[v.voxel];  // checked by stage_part
       const std::uint32_t own = v.own();
-      if (placing.tables) {
+      if (tables) {
         span = {std::min(span[0], g), std::max(span[1], g)};
         placing.voxline_buffer.push_back({g, own | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)});
         if (placing.voxline_buffer.size() == kTableBufferEntries) {
@@ -210,6 +265,10 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
       }
       if (g < r.first || g >= r.end) continue;
       const std::uint64_t used = own + (j + 1 < streamline.size() ? 1 : 0);
+      if (g < lo || g >= hi) {  // the other half's
+        staged += used;
+        continue;
+      }
       std::uint64_t& cursor = table_.cursor[std::size_t(v.voxel) * levels + depth];
       const std::uint64_t block_end = table_.voxels[g].vertex_first +
                                       depth_end_vertex(table_.voxels[g], level_row(table_.levels, g, levels), depth);
@@ -222,9 +281,9 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
       staged += used;
       cursor += used;
     }
-    placing.voxline_index += streamline.size();
+    if (half == 0) placing.voxline_index += streamline.size();
   }
-  placing.streamlines += part.end - part.begin;
+  if (half == 0) placing.streamlines += part.end - part.begin;
 }
 
 }  // namespace vxl::streaming

@@ -19,6 +19,7 @@
 #include "converter/pipeline/conversion_plan.h"
 #include "converter/pipeline/memory_budget.h"
 #include "converter/pipeline/vertex_sink.h"
+#include "converter/pipeline/voxel_runs.h"
 #include "converter/position_packing.h"
 #include "converter/segment_orders.h"
 #include "converter/streaming_convert.h"
@@ -87,6 +88,7 @@ struct CountingState {
   detail::VoxelUse use;
   detail::VoxelBounds bounds;
   std::uint64_t sink_held = 0, table_held = 0;  // as taken from the budget
+  bool recording_runs = true;                   // into StreamedVoxelTable::runs, until the budget wants their memory
 };
 
 // The voxel table, and what maps the source's voxels and streamlines onto it, from pass 2 on.
@@ -104,6 +106,11 @@ struct StreamedVoxelTable {
   // Per streamline: its lowest and highest voxel index (set by the first range's pass), so that later
   // passes skip the streamlines that have no voxel in their range.
   std::vector<std::array<std::uint32_t, 2>> spans;
+  // Every streamline's voxlines as pass 2 found them (empty when the limit leaves no room for them: the
+  // placing passes voxelise again), and what the budget counts of them.
+  VoxelRuns runs;
+  std::uint64_t runs_held = 0;
+  bool runs_kept = false;  // for the placing passes
 };
 
 // One conversion within a memory limit: run() reads the source with a BatchReader, scans it (scan), counts
@@ -122,9 +129,12 @@ class StreamingConversion {
   void open_stream();
   void scan();
   void count_voxels();
+  struct PlanPart;
+  void record_runs(std::uint64_t first, const std::array<std::uint64_t, 3>& cut, PlanPart& main, PlanPart& other,
+                   std::span<const std::uint32_t> other_ids);
+  void drop_runs();
   void build_table();
   void build_range(const VoxelRange& r, std::size_t index, std::size_t count);
-  struct PlanPart;
   void count_part(const Tractogram& b, std::uint64_t first, std::uint64_t begin, std::uint64_t end,
                   std::uint64_t points, std::uint64_t synthetic, std::uint64_t most_voxels, std::uint64_t other_voxels,
                   PlanPart& part) const;
@@ -134,7 +144,9 @@ class StreamingConversion {
   VertexSink open_vertex_sink(const VoxelRange& r, std::span<std::uint8_t> window) const;
   void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
                   std::uint64_t end, StagedPart& part) const;
-  void place_part(RangePlacement& placing, const StagedPart& part);
+  void place_part(RangePlacement& placing, const StagedPart& part, int half);
+  void cut_by_runs(std::uint64_t first_point, std::uint64_t points, std::uint64_t& run,
+                   std::vector<TempVoxline>& out) const;
   void write_orders(const VoxelRange& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
   void write_voxel_orders(const VoxelRange& r, std::size_t g, std::span<const std::uint8_t> vertices,
                           std::uint64_t vertices_first, VoxelOrderWriter& writer, VoxlineEnds& block_ends,
@@ -190,6 +202,7 @@ struct StreamingConversion::RangePlacement {
   std::vector<VoxlineEntry> voxline_buffer;
   std::vector<std::uint64_t> streamline_buffer;
   std::uint64_t voxline_index = 0, streamlines = 0;
+  std::size_t split = 0;   // the first voxel of the second placing half (range.end: placed whole)
   StagedPart parts[2][2];  // two sets of two parts: one being staged, one being placed
 };
 
@@ -199,6 +212,7 @@ struct StreamingConversion::PlanPart {
   detail::VoxelUse use;
   detail::VoxelBounds bounds;
   std::uint64_t voxlines = 0, synthetic = 0;  // in the batch being counted
+  std::vector<VoxelRun> runs;                 // of the batch being counted (local ids of `sink`'s index)
 };
 
 }  // namespace vxl::streaming

@@ -52,22 +52,26 @@ void StreamingConversion::scan() {
 // after the batch — the counts and bounds do not depend on the order streamlines are counted in.
 void StreamingConversion::count_voxels() {
   counting_.use = detail::VoxelUse(job_.settings.levels);
-  if (table_.meta.point_count == 0) return;  // no voxels (plan_voxels returns early too)
+  if (table_.meta.point_count == 0) {  // no voxels (plan_voxels returns early too)
+    counting_.recording_runs = false;
+    return;
+  }
   table_.grid = detail::set_grid(table_.meta, scan_.lo, scan_.hi, job_.path);
   // plan_voxels' limit on added points, applied to the whole source (plan_voxels applies it per
   // thread's range: the two can differ only in whether a borderline source is refused).
   table_.synthetic_limit =
       static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(table_.meta.point_count)) + 4096;
-  PlanPart main{std::move(table_.sink), std::move(counting_.use), std::move(counting_.bounds), 0, 0},
-      other{Sink(), detail::VoxelUse(job_.settings.levels), {}, 0, 0};
+  PlanPart main{std::move(table_.sink), std::move(counting_.use), std::move(counting_.bounds), 0, 0, {}},
+      other{Sink(), detail::VoxelUse(job_.settings.levels), {}, 0, 0, {}};
   PlanPart* parts[2] = {&main, &other};
   std::uint64_t voxlines = 0, synthetic = 0, points = 0;
   reader_->each_batch("voxelising", [&](const Tractogram& b, std::uint64_t first) {
     const std::array<std::uint64_t, 3> cut = two_parts(b);
     // The voxels the limit leaves room for in this batch, half to each part: a part that would need more
     // fails (no matter how many the other adds, so that the outcome does not depend on timing).
+    // (The runs give their memory back when the table needs it.)
     const std::uint64_t room =
-        (counting_.table_held + budget_.left()) / voxel_table_bytes_per_voxel(job_.settings.levels);
+        (counting_.table_held + table_.runs_held + budget_.left()) / voxel_table_bytes_per_voxel(job_.settings.levels);
     const std::uint64_t start = main.sink.index.coords().size();
     const std::uint64_t headroom = room > start ? room - start : 0;
     const std::uint64_t most[2] = {start + headroom / 2, headroom - headroom / 2};
@@ -85,8 +89,9 @@ void StreamingConversion::count_voxels() {
     const std::vector<detail::Coord>& coords = other.sink.index.coords();
     const std::uint64_t peak = main.sink.index.coords().size() + coords.size();
     const std::uint32_t levels = job_.settings.levels;
+    std::vector<std::uint32_t> other_ids(coords.size());  // the second part's local ids in the first's index
     for (std::uint32_t j = 0; j < coords.size(); ++j) {
-      const std::uint32_t i = main.sink.index.find_or_insert(coords[j]);
+      const std::uint32_t i = other_ids[j] = main.sink.index.find_or_insert(coords[j]);
       main.use.grow_to(main.sink.index.coords().size());
       main.bounds.grow_to(main.sink.index.coords().size());
       for (std::uint32_t d = 0; d < levels; ++d) {
@@ -96,8 +101,11 @@ void StreamingConversion::count_voxels() {
       main.bounds.merge(i, other.bounds, j);
     }
     const std::uint64_t sinks = main.sink.bytes() + other.sink.bytes();
-    budget_.track(peak * voxel_table_bytes_per_voxel(levels), counting_.table_held, [] { return std::string(); });
-    other = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0};
+    if (counting_.recording_runs) record_runs(first, cut, main, other, other_ids);
+    const std::uint64_t table_peak = peak * voxel_table_bytes_per_voxel(levels);
+    if (table_peak > counting_.table_held && table_peak - counting_.table_held + sinks > budget_.left()) drop_runs();
+    budget_.track(table_peak, counting_.table_held, [] { return std::string(); });
+    other = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0, {}};
     budget_.shrink(main.sink.index.coords().size() * voxel_table_bytes_per_voxel(levels), counting_.table_held);
     budget_.track(sinks, counting_.sink_held, [] { return std::string("the voxline lists of two streamlines"); });
     points += b.point_count();
@@ -107,6 +115,31 @@ void StreamingConversion::count_voxels() {
   counting_.bounds = std::move(main.bounds);
   table_.meta.voxline_count = voxlines;
   table_.meta.synthetic_point_count = synthetic;
+}
+
+// Appends the batch's runs to table_.runs, the second part's with the first part's local ids, while they
+// take at most half of what the limit leaves (the rest is the voxel table's and the plan's).
+void StreamingConversion::record_runs(std::uint64_t first, const std::array<std::uint64_t, 3>& cut, PlanPart& main,
+                                      PlanPart& other, std::span<const std::uint32_t> other_ids) {
+  VoxelRuns& runs = table_.runs;
+  runs.start_part(first + cut[0]);
+  runs.append(main.runs);
+  main.runs.clear();
+  runs.start_part(first + cut[1]);
+  for (VoxelRun& r : other.runs)
+    if (r.voxel != VoxelRuns::kVoxelisedAgain) r.voxel = other_ids[r.voxel];
+  runs.append(other.runs);
+  if (runs.bytes() > table_.runs_held && runs.bytes() - table_.runs_held > budget_.left() / 2)
+    drop_runs();
+  else
+    budget_.track(runs.bytes(), table_.runs_held, [] { return std::string("the voxel runs"); });
+}
+
+// Stops recording the runs and gives back their memory: the placing passes voxelise again.
+void StreamingConversion::drop_runs() {
+  counting_.recording_runs = false;
+  table_.runs.clear();
+  budget_.shrink(0, table_.runs_held);
 }
 
 // On one thread: counts streamlines [begin, end) of batch b (numbered from `first`) into `part`, whose
@@ -126,6 +159,12 @@ void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, s
     if (part.sink.too_many_synthetic)
       detail::fail_too_many_synthetic(job_.path, table_.meta.voxel_size, scan_.longest_step2);
     part.synthetic += part.sink.synthetic_xyz.size() / 3;
+    if (counting_.recording_runs) {
+      if (!part.sink.synthetic_xyz.empty())
+        part.runs.push_back({VoxelRuns::kVoxelisedAgain, 0});
+      else
+        for (const TempVoxline& v : part.sink.voxlines) part.runs.push_back({v.voxel, v.src_count});
+    }
     const std::size_t n_local = part.sink.index.coords().size();
     part.use.grow_to(n_local);
     detail::count_voxel_use(part.sink.voxlines, streamline_depth(first + k, job_.settings.levels), part.use, job_.path);
@@ -139,7 +178,7 @@ void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, s
       const std::uint64_t read = points + b.offsets[k + 1];
       const std::uint64_t all =
           static_cast<std::uint64_t>(double(voxels) * double(table_.meta.point_count) / double(read));
-      budget_.fail(all * bytes_per_voxel, budget_.used() - counting_.table_held,
+      budget_.fail(all * bytes_per_voxel, budget_.used() - counting_.table_held - table_.runs_held,
                    "the voxel table (" + std::to_string(voxels) + " voxels after " + std::to_string(read) + " of " +
                        std::to_string(table_.meta.point_count) + " points; about " + std::to_string(all) +
                        " in all, extrapolated)",

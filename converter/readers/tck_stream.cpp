@@ -58,6 +58,7 @@ TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, st
   source_.header = header_.fields;
   triplet_bytes_ = header_.datatype.starts_with("Float64") ? 24 : 12;
   window_bytes_ = std::max<std::uint64_t>(1, read_buffer_bytes / triplet_bytes_) * triplet_bytes_;
+  window_ = std::make_unique_for_overwrite<std::uint8_t[]>(window_bytes_);
   ::posix_fadvise(fd_, 0, 0, POSIX_FADV_SEQUENTIAL);  // a hint: read ahead further
   rewind();
 }
@@ -87,7 +88,6 @@ void TckStream::check_unchanged() const {
 
 void TckStream::rewind() {
   check_unchanged();
-  window_ = FileWindow();
   buffer_used_ = buffer_size_ = 0;
   read_end_ = header_.data_offset;
   state_ = {};
@@ -105,11 +105,12 @@ void TckStream::rewind() {
 bool TckStream::fill_buffer() {
   if (read_end_ >= source_.bytes) return false;
   std::uint64_t n = std::min<std::uint64_t>(window_bytes_, source_.bytes - read_end_);
-  window_ = FileWindow();  // unmapped before the next part is mapped: one part resident at a time
-  window_ = FileWindow(fd_, path_, read_end_, n);
-  // Read the next part while this one is decoded (a hint: mapping it populates synchronously).
+  // Read into one buffer, not mapped: a copy from the page cache costs less than mapping each part anew (page
+  // tables filled and torn down per part).
+  read_at(read_end_, window_.get(), n);
+  // Read the next part while this one is decoded (a hint: the read above waits).
   ::posix_fadvise(fd_, static_cast<off_t>(read_end_ + n), static_cast<off_t>(window_bytes_), POSIX_FADV_WILLNEED);
-  if (hash_) hash_->update(window_.data(), n);
+  if (hash_) hash_->update(window_.get(), n);
   read_end_ += n;
   buffer_size_ = n;
   buffer_used_ = 0;
@@ -124,7 +125,7 @@ bool TckStream::next(Tractogram& batch, std::uint64_t max_points, std::uint64_t 
   for (;;) {
     const std::uint64_t whole = (buffer_size_ - buffer_used_) / triplet_bytes_;
     if (whole > 0) {
-      const std::uint8_t* p = window_.data() + buffer_used_;
+      const std::uint8_t* p = window_.get() + buffer_used_;
       const std::uint64_t offset = read_end_ - buffer_size_ + buffer_used_;
       const std::uint64_t used = visit_mrtrix_datatype(datatype_, [&]<typename Real, bool kBigEndian>() {
         return tck::decode<Real, kBigEndian>(path_, p, whole, offset, batch, state_, stop);

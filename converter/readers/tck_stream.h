@@ -1,7 +1,7 @@
 // A TCK file read in bounded memory, a batch of whole streamlines at a time, in as many passes as the
 // caller needs (voxlines convert --memory-limit). It yields exactly what read_tck reads — the same
-// points, streamlines, provenance and warnings (tck_format.h holds the shared pieces) — but through
-// one mapped part of the file at a time (FileWindow), so the file adds at most one part to this
+// points, streamlines, provenance and warnings (tck_format.h holds the shared pieces) — but one part of
+// the file at a time, read into a buffer of that size, so the file adds at most one part to this
 // process's resident memory.
 #pragma once
 
@@ -12,7 +12,6 @@
 
 #include "converter/readers/tck_format.h"
 #include "converter/tractogram.h"
-#include "format/base/mapped_file.h"
 
 namespace vxl {
 
@@ -60,8 +59,8 @@ class TckStream {
   SourceInfo source_;
   std::uint32_t triplet_bytes_ = 12;
   std::int64_t mtime_ns_ = 0;
-  std::uint64_t window_bytes_ = 0;  // the size of each part of the file mapped (a whole number of triplets)
-  FileWindow window_;               // the part being decoded
+  std::uint64_t window_bytes_ = 0;          // the size of each part of the file read (a whole number of triplets)
+  std::unique_ptr<std::uint8_t[]> window_;  // the part being decoded
   std::uint64_t buffer_used_ = 0, buffer_size_ = 0;  // consumed / valid bytes of window_
   std::uint64_t read_end_ = 0;                       // file offset just after window_'s valid bytes
   tck::DecodeState state_;
