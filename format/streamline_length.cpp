@@ -19,7 +19,7 @@ double polyline_length(std::span<const float> xyz) {
 
 double stored_length(const VxlFile& file, std::uint64_t streamline) {
   const float length = file.streamline_lengths()[streamline];
-  if (!(std::isfinite(length) && length >= 0))
+  if (!std::isfinite(length) || std::signbit(length))  // no writer stores -0 either
     fail_input(file.path(), file.find_section(section_id("SLEN"))->offset + 4 * streamline,
                "SLEN length of streamline " + std::to_string(streamline) + " is not a finite number ≥ 0");
   return length;

@@ -1,7 +1,7 @@
 // The length of a streamline as SLEN stores it (spec §5.15) and as a selection's --min-length/--max-length
-// measure it (MRtrix tckedit's rule): the sum of its segments' Euclidean lengths. One definition, compiled
-// once (without fused multiply-add), so that the converter's lengths, verify's and a reader's of a file
-// without SLEN agree to the bit.
+// measure it: the sum of its segments' Euclidean lengths, as MRtrix tckedit measures it (up to its rounding). One
+// definition, compiled once (without fused multiply-add), so that the converter's lengths, verify's and a reader's of a
+// file without SLEN agree to the bit.
 #pragma once
 
 #include <cstdint>
@@ -19,7 +19,7 @@ double polyline_length(std::span<const float> xyz);
 inline float stored_length_of(std::span<const float> xyz) { return static_cast<float>(polyline_length(xyz)); }
 
 // Streamline s's length from the file's SLEN, which it must have: throws vxl::Error (Input, naming the file and
-// the byte) for a value that is not a finite number ≥ 0.
+// the byte) for a value that is not finite or has its sign bit set (-0 included).
 double stored_length(const VxlFile& file, std::uint64_t streamline);
 
 }  // namespace vxl

@@ -72,7 +72,7 @@ TEST(ConversionPlan, ReadingTakesTheProgramAndTheReadBufferAndSizesTheBatches) {
     EXPECT_EQ(budget.used(), 16 * kMiB + plan.read_buffer_bytes);
     EXPECT_GE(plan.batch_streamlines, 1024u);
     EXPECT_LE(plan.batch_streamlines, 1u << 20);
-    EXPECT_EQ(plan.window_bytes, budget.left() / 4);
+    EXPECT_EQ(plan.max_header_bytes, budget.left() / 4);
     EXPECT_EQ(plan.max_points_held, budget.left() / kHeldBytesPerPoint);
   }
   MemoryBudget larger(512 * kMiB, "source.tck"), smaller(64 * kMiB, "source.tck");

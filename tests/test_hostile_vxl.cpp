@@ -337,6 +337,7 @@ TEST(HostileVxl, StreamlineLengthsThatDoNotFitOrLieAreRefused) {
   };
   const Case cases[] = {{"NaN", NAN, true, "is not a finite number"},
                         {"negative", -1.0f, true, "is not a finite number"},
+                        {"minus zero", -0.0f, true, "is not a finite number"},
                         {"a thousand times longer", 1000.0f * 150.0f, false, "differs from its points'"}};
   const std::uint64_t last = streamlines - 1;
   for (const Case& c : cases) {

@@ -166,7 +166,7 @@ ReadPlan plan_reading(MemoryBudget& budget) {
   plan.read_buffer_bytes = std::clamp<std::uint64_t>(limit / 64, 64 << 10, 4 * kMiB);
   budget.take(plan.read_buffer_bytes, "the read buffer");
   plan.batch_streamlines = std::clamp<std::uint64_t>(limit / 64 / 16, 1024, 1 << 20);
-  plan.window_bytes = std::max<std::uint64_t>(1, budget.left() / 4);
+  plan.max_header_bytes = std::max<std::uint64_t>(1, budget.left() / 4);
   plan.max_points_held = budget.left() / kHeldBytesPerPoint;
   return plan;
 }
@@ -212,8 +212,8 @@ std::uint64_t plan_voxel_index(const MemoryBudget& budget, std::uint64_t room, c
                     ", " + std::to_string(v.coord[2]) + ")",
                 ", or a smaller --voxel-size");
   }
-  // The largest list goes first: the tables' parts are small beside it, and a limit that fits the ranges
-  // fits it.
+  // The largest list goes first: where the room holds it but not also the tables' parts being read (at most
+  // 16 MB), those go past the limit, rather than refusing a limit that fits every range.
   const std::uint64_t free = room - starts;
   return std::max(largest, std::min(lists, free > parts ? free - parts : 0));
 }

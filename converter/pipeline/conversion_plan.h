@@ -34,7 +34,7 @@ std::uint64_t voxel_table_bytes_per_voxel(std::uint32_t levels);
 struct ReadPlan {
   std::uint64_t read_buffer_bytes = 0;
   std::uint64_t batch_streamlines = 0;  // streamlines per batch (a batch holds whole streamlines)
-  std::uint64_t window_bytes = 0;       // the mapped part of the source
+  std::uint64_t max_header_bytes = 0;   // the longest TCK header read
   std::uint64_t max_points_held = 0;    // points a batch may hold (a longer streamline is refused)
 };
 // Takes the program's own memory and the read buffer from `budget`.

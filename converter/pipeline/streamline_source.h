@@ -28,11 +28,11 @@ class StreamlineSource {
   virtual bool overflowed() const { return false; }
 };
 
-// A TCK file, a mapped part at a time (TckStream), in batches sized by `plan` (plan_reading).
+// A TCK file, a part at a time read into one buffer (TckStream), in batches sized by `plan` (plan_reading).
 class TckBatchSource final : public StreamlineSource {
  public:
   TckBatchSource(const std::string& path, const ReadPlan& plan)
-      : stream_(path, plan.window_bytes, plan.read_buffer_bytes),
+      : stream_(path, plan.max_header_bytes, plan.read_buffer_bytes),
         batch_streamlines_(plan.batch_streamlines),
         max_points_held_(plan.max_points_held) {}
   const SourceInfo& source() const override { return stream_.source(); }

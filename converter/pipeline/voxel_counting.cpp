@@ -17,8 +17,13 @@ void StreamingConversion::scan() {
   reader_->each_batch("reading", [&](const Tractogram& b, std::uint64_t first) {
     reader_->note_longest(b, first);
     std::vector<float>& lengths = scan_.lengths;
-    lengths.resize(first + b.streamline_count());
-    budget_.track(lengths.capacity() * sizeof(float), scan_.lengths_held, [] { return "the streamlines' lengths"; });
+    const std::uint64_t need = first + b.streamline_count();
+    if (need > lengths.capacity()) {  // taken from the limit before it is allocated
+      const std::uint64_t grown = std::max<std::uint64_t>(need, 2 * lengths.capacity());
+      budget_.track(grown * sizeof(float), scan_.lengths_held, [] { return "the streamlines' lengths"; });
+      lengths.reserve(grown);
+    }
+    lengths.resize(need);
     // In two parts on two threads, merged in order (a scan stops at a bad point; reading goes on for the
     // reader's errors).
     const std::array<std::uint64_t, 3> cut = two_parts(b);
@@ -103,7 +108,10 @@ void StreamingConversion::count_voxels() {
     const std::uint64_t sinks = main.sink.bytes() + other.sink.bytes();
     if (counting_.recording_runs) record_runs(first, cut, main, other, other_ids);
     const std::uint64_t table_peak = peak * voxel_table_bytes_per_voxel(levels);
-    if (table_peak > counting_.table_held && table_peak - counting_.table_held + sinks > budget_.left()) drop_runs();
+    if (table_peak > counting_.table_held && table_peak - counting_.table_held + sinks > budget_.left()) {
+      drop_runs();
+      main.runs = {};
+    }
     budget_.track(table_peak, counting_.table_held, [] { return std::string(); });
     other = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0, {}};
     budget_.shrink(main.sink.index.coords().size() * voxel_table_bytes_per_voxel(levels), counting_.table_held);
@@ -118,10 +126,12 @@ void StreamingConversion::count_voxels() {
 }
 
 // Appends the batch's runs to table_.runs, the second part's with the first part's local ids, while they
-// take at most half of what the limit leaves (the rest is the voxel table's and the plan's).
+// take at most half of what the limit leaves (the rest is the voxel table's and the plan's). The parts' own
+// lists of the batch's runs count with them (the first part's keeps its memory from batch to batch).
 void StreamingConversion::record_runs(std::uint64_t first, const std::array<std::uint64_t, 3>& cut, PlanPart& main,
                                       PlanPart& other, std::span<const std::uint32_t> other_ids) {
   VoxelRuns& runs = table_.runs;
+  const std::uint64_t batch_lists = (main.runs.capacity() + other.runs.capacity()) * sizeof(VoxelRun);
   runs.start_part(first + cut[0]);
   runs.append(main.runs);
   main.runs.clear();
@@ -129,10 +139,13 @@ void StreamingConversion::record_runs(std::uint64_t first, const std::array<std:
   for (VoxelRun& r : other.runs)
     if (r.voxel != VoxelRuns::kVoxelisedAgain) r.voxel = other_ids[r.voxel];
   runs.append(other.runs);
-  if (runs.bytes() > table_.runs_held && runs.bytes() - table_.runs_held > budget_.left() / 2)
+  const std::uint64_t held = runs.bytes() + batch_lists;
+  if (held > table_.runs_held && held - table_.runs_held > budget_.left() / 2) {
     drop_runs();
-  else
-    budget_.track(runs.bytes(), table_.runs_held, [] { return std::string("the voxel runs"); });
+    main.runs = {};
+  } else {
+    budget_.track(held, table_.runs_held, [] { return std::string("the voxel runs"); });
+  }
 }
 
 // Stops recording the runs and gives back their memory: the placing passes voxelise again.

@@ -17,7 +17,7 @@ namespace vxl::streaming {
 
 struct VoxelRun {
   std::uint32_t voxel;   // local id, or VoxelRuns::kVoxelisedAgain
-  std::uint32_t points;  // source points (at least one); a kVoxelisedAgain entry: the streamline's
+  std::uint32_t points;  // source points (at least one); 0 in a kVoxelisedAgain entry
 };
 
 class VoxelRuns {

@@ -48,19 +48,19 @@ TckStream::TckStream(const std::string& path, std::uint64_t max_header_bytes, st
       want = std::min({source_.bytes, max_header_bytes, want * 4});
     }
     datatype_ = mrtrix_datatype(path, header_.datatype, kTckFile);
-  } catch (...) {
+    source_.path = path;
+    source_.format = "tck";
+    source_.dtype = header_.datatype;
+    source_.header = header_.fields;
+    triplet_bytes_ = header_.datatype.starts_with("Float64") ? 24 : 12;
+    window_bytes_ = std::max<std::uint64_t>(1, read_buffer_bytes / triplet_bytes_) * triplet_bytes_;
+    window_ = std::make_unique_for_overwrite<std::uint8_t[]>(window_bytes_);
+    ::posix_fadvise(fd_, 0, 0, POSIX_FADV_SEQUENTIAL);  // a hint: read ahead further
+    rewind();
+  } catch (...) {  // the destructor does not run for a constructor that throws
     ::close(fd_);
     throw;
   }
-  source_.path = path;
-  source_.format = "tck";
-  source_.dtype = header_.datatype;
-  source_.header = header_.fields;
-  triplet_bytes_ = header_.datatype.starts_with("Float64") ? 24 : 12;
-  window_bytes_ = std::max<std::uint64_t>(1, read_buffer_bytes / triplet_bytes_) * triplet_bytes_;
-  window_ = std::make_unique_for_overwrite<std::uint8_t[]>(window_bytes_);
-  ::posix_fadvise(fd_, 0, 0, POSIX_FADV_SEQUENTIAL);  // a hint: read ahead further
-  rewind();
 }
 
 TckStream::~TckStream() {
