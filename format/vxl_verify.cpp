@@ -198,16 +198,16 @@ void check_voxel_index(const VxlFile& f) {
 // the source points); with packed positions within what moving each point by the file's bound can change.
 class LengthCheck {
  public:
-  explicit LengthCheck(const VxlFile& f) : f_(f) {
-    if (f.position_encoding() != PositionEncoding::Packed) return;
-    for (const VoxelEntry& v : f.voxels()) bound_ = std::max(bound_, packed_error_bound(v));
+  explicit LengthCheck(const VxlFile& f) : f_(f), packed_(f.position_encoding() == PositionEncoding::Packed) {
+    if (packed_)
+      for (const VoxelEntry& v : f.voxels()) bound_ = std::max(bound_, packed_error_bound(v));
   }
   void operator()(std::uint64_t s, std::span<const float> xyz) const {
     const double stored = stored_length(f_, s), measured = polyline_length(xyz);
     const double segments = xyz.size() / 3 > 1 ? double(xyz.size() / 3 - 1) : 0.0;
-    const bool holds = bound_ == 0 ? float(measured) == float(stored)
-                                   : std::abs(stored - measured) <=
-                                         2 * std::sqrt(3.0) * bound_ * segments + 1e-6 * std::max(1.0, measured);
+    const bool holds = !packed_ ? float(measured) == float(stored)
+                                : std::abs(stored - measured) <=
+                                      2 * std::sqrt(3.0) * bound_ * segments + 1e-6 * std::max(1.0, measured);
     if (!holds)
       fail_input(f_.path(), f_.find_section(section_id("SLEN"))->offset + 4 * s,
                  "SLEN length of streamline " + std::to_string(s) + " (" + std::to_string(stored) +
@@ -216,6 +216,7 @@ class LengthCheck {
 
  private:
   const VxlFile& f_;
+  bool packed_;
   double bound_ = 0;  // per axis, the largest of the voxels' packing bounds
 };
 

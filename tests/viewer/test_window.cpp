@@ -1,6 +1,7 @@
 // The interactive `voxview FILE` window, driven by its automation options (--frames, --screenshot) under a
 // virtual X server (xvfb-run; skipped where it is not installed), and the window's voxel-grid overlay,
 // drawn headless.
+#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -71,6 +72,28 @@ class Window : public ::testing::Test {
     ASSERT_EQ(synth.exit_code, 0) << synth.output;
     CommandResult convert = test::run_cli("convert --voxel-size 10 " + shell_quoted(tck) + " " + shell_quoted(vxl));
     ASSERT_EQ(convert.exit_code, 0) << convert.output;
+  }
+
+  // Focus first's scene: 6000 streamlines under a GPU memory budget that holds only level 1 of the whole scene
+  // (`args`: the window size, view and budget), and a sphere of 8 mm at a point of some streamline, moved `dx` mm
+  // along x (at dx = 0 it selects a bundle).
+  struct BudgetScene {
+    std::string args;
+    std::array<float, 3> point;
+    std::string sphere_at(double dx) const {
+      return std::to_string(point[0] + dx) + "," + std::to_string(point[1]) + "," + std::to_string(point[2]) + ",8";
+    }
+  };
+  BudgetScene budget_scene() {
+    make_inputs(6000);
+    const VxlFile f = VxlFile::open(vxl);
+    const std::vector<const VxlFile*> files = {&f};
+    const std::uint64_t texels = std::max<std::uint64_t>(4096, SceneLayout::largest_voxel_texels(files));
+    const std::vector<float> points = f.all_vertices();
+    const std::size_t middle = points.size() / 6 * 3;
+    return {" --size 200x150 --view axial --span-texels 4096 --gpu-memory " +
+                std::to_string(SceneLayout(files, texels, 1).upload_bytes()),
+            {points[middle], points[middle + 1], points[middle + 2]}};
   }
 
   // Runs the window on the .vxl with `args` and --stats; returns what it wrote (null when it wrote nothing).
@@ -302,16 +325,8 @@ TEST_F(Window, AtRestAThinSlabIsRefinedToFullDetailUnderABudgetForLevelOne) {
 // level 1, as headless draws it; --stats says so per frame (focus_level).
 TEST_F(Window, UnderABudgetTheFocusIsDrawnAtFullDetailAsHeadless) {
   VXL_REQUIRE_XVFB();
-  make_inputs(6000);
-  const VxlFile f = VxlFile::open(vxl);
-  const std::vector<const VxlFile*> files = {&f};
-  const std::uint64_t texels = std::max<std::uint64_t>(4096, SceneLayout::largest_voxel_texels(files));
-  const std::vector<float> points = f.all_vertices();
-  const std::size_t middle = points.size() / 6 * 3;  // a point of some streamline: a sphere there selects a bundle
-  const std::string sphere = std::to_string(points[middle]) + "," + std::to_string(points[middle + 1]) + "," +
-                             std::to_string(points[middle + 2]) + ",8";
-  const std::string args = " --size 200x150 --view axial --span-texels 4096 --gpu-memory " +
-                           std::to_string(SceneLayout(files, texels, 1).upload_bytes()) + " --include=" + sphere +
+  const BudgetScene scene = budget_scene();
+  const std::string args = scene.args + " --include=" + scene.sphere_at(0) +
                            " --context-opacity 0.1 --focus-opacity 1 --color group --group selected=#ff0000";
   const std::string png = dir.file("window.png"), reference = dir.file("headless.png");
   const nlohmann::json j =
@@ -339,22 +354,11 @@ TEST_F(Window, UnderABudgetTheFocusIsDrawnAtFullDetailAsHeadless) {
 // waited and how long.
 TEST_F(Window, AScriptedDragUnderABudgetEndsWithTheFocusCopyOfItsLastPosition) {
   VXL_REQUIRE_XVFB();
-  make_inputs(6000);
-  const VxlFile f = VxlFile::open(vxl);
-  const std::vector<const VxlFile*> files = {&f};
-  const std::uint64_t texels = std::max<std::uint64_t>(4096, SceneLayout::largest_voxel_texels(files));
-  const std::vector<float> points = f.all_vertices();
-  const std::size_t middle = points.size() / 6 * 3;
-  auto sphere_at = [&](double dx) {
-    return std::to_string(points[middle] + dx) + "," + std::to_string(points[middle + 1]) + "," +
-           std::to_string(points[middle + 2]) + ",8";
-  };
-  const std::string args = " --size 200x150 --view axial --span-texels 4096 --gpu-memory " +
-                           std::to_string(SceneLayout(files, texels, 1).upload_bytes()) +
-                           " --context-opacity 0 --focus-opacity 1 --color group --group selected=#ff0000";
+  const BudgetScene scene = budget_scene();
+  const std::string args = scene.args + " --context-opacity 0 --focus-opacity 1 --color group --group selected=#ff0000";
   // --frames 6 moves the sphere on frames 1 to 5: 5 steps of 2 mm along x.
   const std::string dragged = dir.file("dragged.png"), still = dir.file("still.png");
-  const nlohmann::json j = window_stats(args + " --include=" + sphere_at(0) +
+  const nlohmann::json j = window_stats(args + " --include=" + scene.sphere_at(0) +
                                         " --drag-region 2,0,0 --frames 6 --screenshot " + shell_quoted(dragged));
   ASSERT_FALSE(j.is_null());
   EXPECT_EQ(j.at("scene_level"), 1);
@@ -367,7 +371,7 @@ TEST_F(Window, AScriptedDragUnderABudgetEndsWithTheFocusCopyOfItsLastPosition) {
   EXPECT_TRUE(wait.at("waited").get<bool>()) << "the copy takes longer than a frame";
   EXPECT_GT(wait.at("ms").get<double>(), 0.0);
   EXPECT_FALSE(wait.at("timed_out").get<bool>());
-  CommandResult r = run_voxview_in_xvfb(shell_quoted(vxl) + args + " --include=" + sphere_at(10) +
+  CommandResult r = run_voxview_in_xvfb(shell_quoted(vxl) + args + " --include=" + scene.sphere_at(10) +
                                         " --frames 3 --screenshot " + shell_quoted(still));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Image a = read_image(dragged), b = read_image(still);
