@@ -1,9 +1,13 @@
 #include "converter/pipeline/batch_reader.h"
 
+#include <algorithm>
+
 namespace vxl {
 
 BatchReader::BatchReader(const std::string& path, MemoryBudget& budget, unsigned threads, ProgressFn progress)
-    : budget_(budget), plan_(plan_reading(budget)), read_ahead_(threads > 1), progress_(std::move(progress)) {
+    : budget_(budget), plan_(plan_reading(budget)), threads_(std::max(1u, threads)),
+      read_ahead_(threads > 1),
+      progress_(std::move(progress)) {
   source_ = std::make_unique<TckBatchSource>(path, plan_);
 }
 
@@ -12,6 +16,7 @@ BatchReader::BatchReader(std::unique_ptr<StreamlineSource> source, const ReadPla
     : budget_(budget),
       plan_(plan),
       source_(std::move(source)),
+      threads_(std::max(1u, threads)),
       read_ahead_(threads > 1),
       progress_(std::move(progress)) {}
 

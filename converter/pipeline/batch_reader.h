@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <exception>
 #include <memory>
 #include <string>
 
@@ -30,11 +31,23 @@ class BatchReader {
   const SourceInfo& source() const { return source_->source(); }
   unsigned passes() const { return passes_; }  // each_batch calls so far
 
-  // Reads the source once, calling body(batch, index of its first streamline) per batch; `stage` names the
-  // pass in the progress reports. Throws as the budget does when a streamline is too long to hold whole or
-  // the two batches outgrow what is left.
+  // Reads the source once, batch by batch; `stage` names the pass in the progress reports. Per batch (its
+  // first streamline's index in the source is `first`): prepare(batch, first) on the calling thread, then
+  // part(batch, first, p) for every p in [0, parts) on the reader's threads while the next batch is read
+  // beside them, then finish(batch, first) on the calling thread. The read is one more item for the same
+  // threads, not a thread of its own: the parts fill the cores around it, so that cutting a batch in a
+  // few parts keeps every core busy even when the read and the parts take unequal times. An error of a
+  // part comes before one of the read (which is further on in the file), the lowest part's first. Throws
+  // as the budget does when a streamline is too long to hold whole or the two batches outgrow what is left.
+  template <typename Prepare, typename Part, typename Finish>
+  void each_batch(const std::string& stage, std::uint64_t parts, Prepare&& prepare, Part&& part, Finish&& finish);
+  // The same with the whole batch as one part: body(batch, first).
   template <typename Body>
-  void each_batch(const std::string& stage, Body&& body);
+  void each_batch(const std::string& stage, Body&& body) {
+    const auto none = [](const Tractogram&, std::uint64_t) {};
+    each_batch(
+        stage, 1, none, [&](const Tractogram& b, std::uint64_t first, std::uint64_t) { body(b, first); }, none);
+  }
 
   // Notes the longest streamline of batch b (numbered from `first`), for the message of a budget exceeded
   // by the batches: pass 1 calls it for every batch.
@@ -53,27 +66,43 @@ class BatchReader {
   Tractogram batches_[2];                          // one processed while the next is read
   std::uint64_t held_ = 0;                         // what the two batches hold, as taken from the budget
   std::uint64_t longest_ = 0, longest_index_ = 0;  // the longest streamline noted (in points)
-  bool read_ahead_ = false;
+  unsigned threads_ = 1;
+  bool read_ahead_ = false;  // threads_ > 1
   unsigned passes_ = 0;
   ProgressFn progress_;
 };
 
-template <typename Body>
-void BatchReader::each_batch(const std::string& stage, Body&& body) {
+template <typename Prepare, typename Part, typename Finish>
+void BatchReader::each_batch(const std::string& stage, std::uint64_t parts, Prepare&& prepare, Part&& part,
+                             Finish&& finish) {
   source_->rewind();
   ++passes_;
   report(stage, 0.0);
   std::uint64_t first = 0;
-  auto read = [&](int b) { return source_->next(batches_[b]); };
   int current = 0;
-  bool more = read(current);
+  bool more = source_->next(batches_[current]);
   check_overflow(batches_[current], first);
   while (more) {
     const int other = 1 - current;
-    parallel_invoke(
-        read_ahead_, [&] { body(static_cast<const Tractogram&>(batches_[current]), first); },
-        [&] { more = read(other); });
-    first += batches_[current].streamline_count();
+    const Tractogram& batch = batches_[current];
+    prepare(batch, first);
+    std::exception_ptr read_error;
+    const auto read_next = [&] {
+      try {
+        more = source_->next(batches_[other]);
+      } catch (...) {
+        read_error = std::current_exception();
+      }
+    };
+    // Item 0, handed out first, reads the next batch; items 1.. are the parts.
+    parallel_for_first_error_in_order(parts + (read_ahead_ ? 1 : 0), threads_, [&](std::uint64_t item, unsigned) {
+      if (read_ahead_ && item == 0) return read_next();
+      part(batch, first, item - (read_ahead_ ? 1 : 0));
+    });
+    finish(batch, first);
+    if (!read_ahead_) read_next();
+    if (read_error) std::rethrow_exception(read_error);
+    first += batch.streamline_count();
     current = other;
     check_overflow(batches_[current], first);
     track_batches();

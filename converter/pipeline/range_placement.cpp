@@ -30,8 +30,8 @@ void StreamingConversion::build_range(const VoxelRange& r, std::size_t index, st
 }
 
 // Pass 2 + k, reading: places range r's vertices in `window` (its part of VERT); the first range also
-// writes the voxline and streamline tables. Each batch is cut in two parts that are voxelised and packed
-// on their own threads (stage_part: packing needs only the voxel, whose tight bounds came from pass 2),
+// writes the voxline and streamline tables. Each batch is cut in parts that are voxelised and packed
+// side by side (stage_part: packing needs only the voxel, whose tight bounds came from pass 2),
 // then placed in streamline order (place_part), which is what fixes where each vertex goes.
 void StreamingConversion::place_range(const VoxelRange& r, bool tables, const std::string& of,
                                       std::span<std::uint8_t> window) {
@@ -47,11 +47,11 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
     placing.voxline_buffer.reserve(kTableBufferEntries);
     placing.streamline_buffer.reserve(kTableBufferEntries);
   }
-  // Batch k is staged in two parts while batch k - 1, staged before, is placed in streamline order. With packed
-  // positions the placing is split too, at a voxel that halves the range's vertices: each half places the
-  // voxlines of its own voxels (their blocks are apart), the first also writes the tables. Four items then
-  // share the threads as they come free; float32 positions place on a third thread of their own (their
-  // voxline ends are bits that neighbouring blocks share).
+  // Batch k is staged in parts (cut_batch) while batch k - 1, staged before, is placed in streamline order.
+  // With packed positions the placing is split too, at a voxel that halves the range's vertices: each half
+  // places the voxlines of its own voxels (their blocks are apart), the first also writes the tables. The
+  // items share the reader's threads as they come free; float32 positions place in one item (their voxline
+  // ends are bits that neighbouring blocks share).
   placing.split = r.end;
   if (packed() && job_.threads > 1 && r.end - r.first > 1) {
     const std::uint64_t middle = r.vertex_first + (r.vertex_end - r.vertex_first) / 2;
@@ -63,30 +63,33 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
                                  voxels.begin());
   }
   const bool split = placing.split < r.end;
-  const unsigned threads = job_.threads <= 1 ? 1 : split ? std::min(job_.threads, 4u) : 3;
   int staging = 0;           // the set of parts the current batch is staged in
   bool other_placed = true;  // whether the other set's parts are placed
   auto place_staged = [&](int set, int half) {
     for (const StagedPart& part : placing.parts[set]) place_part(placing, part, half);
   };
-  reader_->each_batch("placing" + of, [&](const Tractogram& b, std::uint64_t first) {
-    if (first + b.streamline_count() > table_.spans.size()) fail_changed();  // more streamlines than pass 1 saw
-    const std::array<std::uint64_t, 3> cut = two_parts(b);
-    // Items 0 and 1 place the earlier batch, so that its errors come first.
-    parallel_for_first_error_in_order(4, threads, [&](std::uint64_t item, unsigned) {
-      if (item < 2) {
-        if (!other_placed && (item == 0 || split)) place_staged(1 - staging, static_cast<int>(item));
-        return;
-      }
-      stage_part(placing, b, first, cut[item - 2], cut[item - 1], placing.parts[staging][item - 2]);
-    });
+  BatchCut cut{};
+  const auto prepare = [&](const Tractogram& b, std::uint64_t first) {
+    if (first + b.streamline_count() > table_.spans.size()) fail_changed();  // more streamlines than pass 2 saw
+    cut = cut_batch(b);
+  };
+  // Items 0 and 1 place the earlier batch (its halves), so that its errors come first; then the parts.
+  const auto item = [&](const Tractogram& b, std::uint64_t first, std::uint64_t i) {
+    if (i < 2) {
+      if (!other_placed && (i == 0 || split)) place_staged(1 - staging, static_cast<int>(i));
+      return;
+    }
+    stage_part(placing, b, first, cut[i - 2], cut[i - 1], placing.parts[staging][i - 2]);
+  };
+  const auto finish = [&](const Tractogram&, std::uint64_t) {
     other_placed = false;
     staging = 1 - staging;
     std::uint64_t staged = 0;
     for (const auto& set : placing.parts)
       for (const StagedPart& part : set) staged += part.bytes();
     budget_.track(staged, staged_held_, [] { return std::string("the voxlines of two batches being placed"); });
-  });
+  };
+  reader_->each_batch("placing" + of, 2 + kBatchParts, prepare, item, finish);
   if (!other_placed) {
     place_staged(1 - staging, 0);
     if (split) place_staged(1 - staging, 1);

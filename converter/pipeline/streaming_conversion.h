@@ -4,6 +4,7 @@
 // those files.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -39,13 +40,22 @@ using detail::TempVoxline;
 using detail::VoxelIndex;
 using Clock = std::chrono::steady_clock;
 
-// Where a batch is cut into two parts of about as many points each, for two threads: streamlines
-// [cut[0], cut[1]) and [cut[1], cut[2]).
-inline std::array<std::uint64_t, 3> two_parts(const Tractogram& b) {
-  const std::uint64_t n = b.streamline_count();
-  const std::uint64_t half =
-      std::upper_bound(b.offsets.begin(), b.offsets.end(), b.point_count() / 2) - b.offsets.begin() - 1;
-  return {0, std::min(half, n), n};
+// The parts a batch is cut in, of about as many points each, for the reader's threads (BatchReader::
+// each_batch). More parts than two cores keep both busy beside the read; the counting and the placing
+// passes cut alike (the placing passes find the counting pass's voxel runs by the parts' first streamlines).
+inline constexpr std::size_t kBatchParts = 3;
+using BatchCut = std::array<std::uint64_t, kBatchParts + 1>;  // part p: streamlines [cut[p], cut[p + 1])
+
+inline BatchCut cut_batch(const Tractogram& b) {
+  const std::uint64_t n = b.streamline_count(), points = b.point_count();
+  BatchCut cut{};
+  for (std::size_t p = 1; p < kBatchParts; ++p) {
+    const std::uint64_t at =
+        std::upper_bound(b.offsets.begin(), b.offsets.end(), points / kBatchParts * p) - b.offsets.begin() - 1;
+    cut[p] = std::clamp(at, cut[p - 1], n);
+  }
+  cut[kBatchParts] = n;
+  return cut;
 }
 
 inline double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
@@ -130,8 +140,9 @@ class StreamingConversion {
   void scan();
   void count_voxels();
   struct PlanPart;
-  void record_runs(std::uint64_t first, const std::array<std::uint64_t, 3>& cut, PlanPart& main, PlanPart& other,
-                   std::span<const std::uint32_t> other_ids);
+  std::vector<std::uint32_t> fold_into_first(PlanPart& main, const PlanPart& other) const;
+  void record_runs(std::uint64_t first, const BatchCut& cut, std::span<PlanPart, kBatchParts> parts,
+                   std::span<const std::vector<std::uint32_t>, kBatchParts> local_ids);
   void drop_runs();
   void build_table();
   void build_range(const VoxelRange& r, std::size_t index, std::size_t count);
@@ -203,7 +214,7 @@ struct StreamingConversion::RangePlacement {
   std::vector<std::uint64_t> streamline_buffer;
   std::uint64_t voxline_index = 0, streamlines = 0;
   std::size_t split = 0;   // the first voxel of the second placing half (range.end: placed whole)
-  StagedPart parts[2][2];  // two sets of two parts: one being staged, one being placed
+  std::array<StagedPart, kBatchParts> parts[2];  // two sets of a batch's parts: one being staged, one being placed
 };
 
 // Part of a batch counted on its own thread in pass 2 (count_part).

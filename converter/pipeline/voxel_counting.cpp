@@ -3,6 +3,7 @@
 #include "converter/pipeline/streaming_conversion.h"
 
 #include <algorithm>
+#include <array>
 #include <utility>
 
 #include "converter/voxel_size_auto.h"
@@ -14,7 +15,9 @@ namespace vxl::streaming {
 void StreamingConversion::scan() {
   detail::BoundsScan bounds;
   std::uint64_t streamlines = 0, points = 0;
-  reader_->each_batch("reading", [&](const Tractogram& b, std::uint64_t first) {
+  BatchCut cut{};
+  std::array<detail::BoundsScan, kBatchParts> parts;
+  const auto prepare = [&](const Tractogram& b, std::uint64_t first) {
     reader_->note_longest(b, first);
     std::vector<float>& lengths = scan_.lengths;
     const std::uint64_t need = first + b.streamline_count();
@@ -24,17 +27,19 @@ void StreamingConversion::scan() {
       lengths.reserve(grown);
     }
     lengths.resize(need);
-    // In two parts on two threads, merged in order (a scan stops at a bad point; reading goes on for the
-    // reader's errors).
-    const std::array<std::uint64_t, 3> cut = two_parts(b);
-    detail::BoundsScan parts[2];
-    parallel_for(2, job_.threads > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
-      parts[p].add(b.positions.data(), b.offsets.data(), cut[p], cut[p + 1], first, lengths.data() + first);
-    });
+    cut = cut_batch(b);
+    parts.fill(detail::BoundsScan());
+  };
+  // The parts are merged in order (a scan stops at a bad point; reading goes on for the reader's errors).
+  const auto scan_part = [&](const Tractogram& b, std::uint64_t first, std::uint64_t p) {
+    parts[p].add(b.positions.data(), b.offsets.data(), cut[p], cut[p + 1], first, scan_.lengths.data() + first);
+  };
+  const auto finish = [&](const Tractogram& b, std::uint64_t) {
     for (const detail::BoundsScan& part : parts) bounds.merge(part);
     streamlines += b.streamline_count();
     points += b.point_count();
-  });
+  };
+  reader_->each_batch("reading", kBatchParts, prepare, scan_part, finish);
   bounds.check(job_.path);
   for (int c = 0; c < 3; ++c) {
     scan_.lo[c] = bounds.lo[c];
@@ -52,9 +57,9 @@ void StreamingConversion::scan() {
 }
 
 // Pass 2: the vertex and segment counts and the tight bounds per voxel (plan_voxels' pass 1), kept per
-// voxel only. Each batch is cut in two parts counted on two threads: the first into the source's voxel
-// index (table_.sink, counting_.use, counting_.bounds), the second into a part of its own (PlanPart), merged into it
-// after the batch — the counts and bounds do not depend on the order streamlines are counted in.
+// voxel only. Each batch is cut in parts (cut_batch) counted side by side: the first into the source's voxel
+// index (table_.sink, counting_.use, counting_.bounds), the others into indexes of their own (PlanPart),
+// folded into it after the batch — the counts and bounds do not depend on the order streamlines are counted in.
 void StreamingConversion::count_voxels() {
   counting_.use = detail::VoxelUse(job_.settings.levels);
   if (table_.meta.point_count == 0) {  // no voxels (plan_voxels returns early too)
@@ -66,58 +71,61 @@ void StreamingConversion::count_voxels() {
   // thread's range: the two can differ only in whether a borderline source is refused).
   table_.synthetic_limit =
       static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(table_.meta.point_count)) + 4096;
-  PlanPart main{std::move(table_.sink), std::move(counting_.use), std::move(counting_.bounds), 0, 0, {}},
-      other{Sink(), detail::VoxelUse(job_.settings.levels), {}, 0, 0, {}};
-  PlanPart* parts[2] = {&main, &other};
+  const std::uint32_t levels = job_.settings.levels;
+  // Part 0 counts into the source's voxel index; the others into indexes of their own, folded into it
+  // after each batch.
+  std::array<PlanPart, kBatchParts> parts;
+  parts[0] = PlanPart{std::move(table_.sink), std::move(counting_.use), std::move(counting_.bounds), 0, 0, {}};
+  for (std::size_t p = 1; p < kBatchParts; ++p) parts[p] = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0, {}};
+  PlanPart& main = parts[0];
   std::uint64_t voxlines = 0, synthetic = 0, points = 0;
-  reader_->each_batch("voxelising", [&](const Tractogram& b, std::uint64_t first) {
-    const std::array<std::uint64_t, 3> cut = two_parts(b);
-    // The voxels the limit leaves room for in this batch, half to each part: a part that would need more
-    // fails (no matter how many the other adds, so that the outcome does not depend on timing).
+  BatchCut cut{};
+  std::array<std::uint64_t, kBatchParts> most{};
+  std::uint64_t start = 0;
+  const auto prepare = [&](const Tractogram& b, std::uint64_t) {
+    cut = cut_batch(b);
+    // The voxels the limit leaves room for in this batch, shared among the parts: a part that would need
+    // more fails (no matter how many the others add, so that the outcome does not depend on timing).
     // (The runs give their memory back when the table needs it.)
     const std::uint64_t room =
-        (counting_.table_held + table_.runs_held + budget_.left()) / voxel_table_bytes_per_voxel(job_.settings.levels);
-    const std::uint64_t start = main.sink.index.coords().size();
+        (counting_.table_held + table_.runs_held + budget_.left()) / voxel_table_bytes_per_voxel(levels);
+    start = main.sink.index.coords().size();
     const std::uint64_t headroom = room > start ? room - start : 0;
-    const std::uint64_t most[2] = {start + headroom / 2, headroom - headroom / 2};
-    parallel_for_first_error_in_order(2, job_.threads > 1 ? 2 : 1, [&](std::uint64_t p, unsigned) {
-      count_part(b, first, cut[p], cut[p + 1], points, synthetic, most[p], p == 0 ? 0 : start, *parts[p]);
-    });
-    for (PlanPart* part : parts) {
-      voxlines += std::exchange(part->voxlines, 0);
-      synthetic += std::exchange(part->synthetic, 0);
+    for (std::size_t p = 0; p < kBatchParts; ++p) most[p] = headroom / kBatchParts;
+    most[0] += start + headroom % kBatchParts;
+  };
+  const auto count = [&](const Tractogram& b, std::uint64_t first, std::uint64_t p) {
+    count_part(b, first, cut[p], cut[p + 1], points, synthetic, most[p], p == 0 ? 0 : start, parts[p]);
+  };
+  const auto finish = [&](const Tractogram& b, std::uint64_t first) {
+    for (PlanPart& part : parts) {
+      voxlines += std::exchange(part.voxlines, 0);
+      synthetic += std::exchange(part.synthetic, 0);
     }
     if (synthetic > table_.synthetic_limit)
       detail::fail_too_many_synthetic(job_.path, table_.meta.voxel_size, scan_.longest_step2);
-    // Both parts' tables at their largest (within the limit, by the parts' shares); then the second
-    // part's voxels into the first's index.
-    const std::vector<detail::Coord>& coords = other.sink.index.coords();
-    const std::uint64_t peak = main.sink.index.coords().size() + coords.size();
-    const std::uint32_t levels = job_.settings.levels;
-    std::vector<std::uint32_t> other_ids(coords.size());  // the second part's local ids in the first's index
-    for (std::uint32_t j = 0; j < coords.size(); ++j) {
-      const std::uint32_t i = other_ids[j] = main.sink.index.find_or_insert(coords[j]);
-      main.use.grow_to(main.sink.index.coords().size());
-      main.bounds.grow_to(main.sink.index.coords().size());
-      for (std::uint32_t d = 0; d < levels; ++d) {
-        main.use.vertices[std::size_t(i) * levels + d] += other.use.vertices[std::size_t(j) * levels + d];
-        main.use.segments[std::size_t(i) * levels + d] += other.use.segments[std::size_t(j) * levels + d];
-      }
-      main.bounds.merge(i, other.bounds, j);
+    // Every part's table at its largest (within the limit, by the parts' shares); then the other parts'
+    // voxels into the first's index.
+    std::uint64_t peak = 0, sinks = 0;
+    for (const PlanPart& part : parts) {
+      peak += part.sink.index.coords().size();
+      sinks += part.sink.bytes();
     }
-    const std::uint64_t sinks = main.sink.bytes() + other.sink.bytes();
-    if (counting_.recording_runs) record_runs(first, cut, main, other, other_ids);
+    std::array<std::vector<std::uint32_t>, kBatchParts> local_ids;  // part p's local ids in the first's index
+    for (std::size_t p = 1; p < kBatchParts; ++p) local_ids[p] = fold_into_first(main, parts[p]);
+    if (counting_.recording_runs) record_runs(first, cut, parts, local_ids);
     const std::uint64_t table_peak = peak * voxel_table_bytes_per_voxel(levels);
     if (table_peak > counting_.table_held && table_peak - counting_.table_held + sinks > budget_.left()) {
       drop_runs();
       main.runs = {};
     }
     budget_.track(table_peak, counting_.table_held, [] { return std::string(); });
-    other = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0, {}};
+    for (std::size_t p = 1; p < kBatchParts; ++p) parts[p] = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0, {}};
     budget_.shrink(main.sink.index.coords().size() * voxel_table_bytes_per_voxel(levels), counting_.table_held);
-    budget_.track(sinks, counting_.sink_held, [] { return std::string("the voxline lists of two streamlines"); });
+    budget_.track(sinks, counting_.sink_held, [] { return std::string("the voxline lists of the batch's parts"); });
     points += b.point_count();
-  });
+  };
+  reader_->each_batch("voxelising", kBatchParts, prepare, count, finish);
   table_.sink = std::move(main.sink);
   counting_.use = std::move(main.use);
   counting_.bounds = std::move(main.bounds);
@@ -125,24 +133,45 @@ void StreamingConversion::count_voxels() {
   table_.meta.synthetic_point_count = synthetic;
 }
 
-// Appends the batch's runs to table_.runs, the second part's with the first part's local ids, while they
-// take at most half of what the limit leaves (the rest is the voxel table's and the plan's). The parts' own
-// lists of the batch's runs count with them (the first part's keeps its memory from batch to batch).
-void StreamingConversion::record_runs(std::uint64_t first, const std::array<std::uint64_t, 3>& cut, PlanPart& main,
-                                      PlanPart& other, std::span<const std::uint32_t> other_ids) {
+// Folds `other`'s voxels, counts and bounds into `main`'s; returns each of its local ids' id in main's index.
+std::vector<std::uint32_t> StreamingConversion::fold_into_first(PlanPart& main, const PlanPart& other) const {
+  const std::uint32_t levels = job_.settings.levels;
+  const std::vector<detail::Coord>& coords = other.sink.index.coords();
+  std::vector<std::uint32_t> ids(coords.size());
+  for (std::uint32_t j = 0; j < coords.size(); ++j) {
+    const std::uint32_t i = ids[j] = main.sink.index.find_or_insert(coords[j]);
+    main.use.grow_to(main.sink.index.coords().size());
+    main.bounds.grow_to(main.sink.index.coords().size());
+    for (std::uint32_t d = 0; d < levels; ++d) {
+      main.use.vertices[std::size_t(i) * levels + d] += other.use.vertices[std::size_t(j) * levels + d];
+      main.use.segments[std::size_t(i) * levels + d] += other.use.segments[std::size_t(j) * levels + d];
+    }
+    main.bounds.merge(i, other.bounds, j);
+  }
+  return ids;
+}
+
+// Appends the batch's runs to table_.runs, part by part (each part's from its first streamline on, those of
+// parts past the first with the first part's local ids, `local_ids`), while they take at most half of what
+// the limit leaves (the rest is the voxel table's and the plan's). The parts' own lists of the batch's runs
+// count with them (the first part's keeps its memory from batch to batch).
+void StreamingConversion::record_runs(std::uint64_t first, const BatchCut& cut, std::span<PlanPart, kBatchParts> parts,
+                                      std::span<const std::vector<std::uint32_t>, kBatchParts> local_ids) {
   VoxelRuns& runs = table_.runs;
-  const std::uint64_t batch_lists = (main.runs.capacity() + other.runs.capacity()) * sizeof(VoxelRun);
-  runs.start_part(first + cut[0]);
-  runs.append(main.runs);
-  main.runs.clear();
-  runs.start_part(first + cut[1]);
-  for (VoxelRun& r : other.runs)
-    if (r.voxel != VoxelRuns::kVoxelisedAgain) r.voxel = other_ids[r.voxel];
-  runs.append(other.runs);
+  std::uint64_t batch_lists = 0;
+  for (const PlanPart& part : parts) batch_lists += part.runs.capacity() * sizeof(VoxelRun);
+  for (std::size_t p = 0; p < kBatchParts; ++p) {
+    runs.start_part(first + cut[p]);
+    if (p > 0)
+      for (VoxelRun& r : parts[p].runs)
+        if (r.voxel != VoxelRuns::kVoxelisedAgain) r.voxel = local_ids[p][r.voxel];
+    runs.append(parts[p].runs);
+  }
+  parts[0].runs.clear();
   const std::uint64_t held = runs.bytes() + batch_lists;
   if (held > table_.runs_held && held - table_.runs_held > budget_.left() / 2) {
     drop_runs();
-    main.runs = {};
+    parts[0].runs = {};
   } else {
     budget_.track(held, table_.runs_held, [] { return std::string("the voxel runs"); });
   }
@@ -157,8 +186,8 @@ void StreamingConversion::drop_runs() {
 
 // On one thread: counts streamlines [begin, end) of batch b (numbered from `first`) into `part`, whose
 // index may grow to `most_voxels` (its share of the limit; checked after every streamline, so that a table
-// outgrowing the limit is caught before it goes far past it); `other_voxels` are the other part's at the
-// batch's start, for the message. `points` and `synthetic` are those of the batches before.
+// outgrowing the limit is caught before it goes far past it); `other_voxels` are the first part's at the
+// batch's start (for the others' message). `points` and `synthetic` are those of the batches before.
 void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, std::uint64_t begin, std::uint64_t end,
                                      std::uint64_t points, std::uint64_t synthetic, std::uint64_t most_voxels,
                                      std::uint64_t other_voxels, PlanPart& part) const {
