@@ -5,7 +5,9 @@
 namespace vxl {
 
 BatchReader::BatchReader(const std::string& path, MemoryBudget& budget, unsigned threads, ProgressFn progress)
-    : budget_(budget), plan_(plan_reading(budget)), threads_(std::max(1u, threads)),
+    : budget_(budget),
+      plan_(plan_reading(budget)),
+      threads_(std::max(1u, threads)),
       read_ahead_(threads > 1),
       progress_(std::move(progress)) {
   source_ = std::make_unique<TckBatchSource>(path, plan_);

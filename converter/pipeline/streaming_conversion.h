@@ -213,7 +213,7 @@ struct StreamingConversion::RangePlacement {
   std::vector<VoxlineEntry> voxline_buffer;
   std::vector<std::uint64_t> streamline_buffer;
   std::uint64_t voxline_index = 0, streamlines = 0;
-  std::size_t split = 0;   // the first voxel of the second placing half (range.end: placed whole)
+  std::size_t split = 0;                         // the first voxel of the second placing half (range.end: placed whole)
   std::array<StagedPart, kBatchParts> parts[2];  // two sets of a batch's parts: one being staged, one being placed
 };
 
