@@ -108,10 +108,17 @@ std::uint64_t sortable_bits(double d) {
 // (10 mm voxels, ~60k segments, keys of 21-28 bits) sorts in 2 passes of up to 14 bits instead of 3 of up
 // to 11, and its orders took 1.27 instead of 1.54 s of CPU. Each pass also walks all its buckets, so small
 // voxels keep narrow digits.
+//
+// Past about 2M items (16 MB, more than the caches hold) every pass goes to main memory, and 14-bit digits
+// scatter each pass over 16k places at once: 11-bit ones, though they may take a pass more, sorted the
+// largest voxels of the 10M synthetic set (up to 7.7M segments) about 5 % faster.
 constexpr int kMinDigitBits = 8, kMaxDigitBits = 14;
 constexpr int kMaxPasses = (64 + kMinDigitBits - 1) / kMinDigitBits;
+constexpr std::size_t kUncachedItems = std::size_t(1) << 21;
+constexpr int kUncachedDigitBits = 11;
 int digit_bits(std::size_t n) {
-  return std::clamp(static_cast<int>(std::bit_width(n)) - 2, kMinDigitBits, kMaxDigitBits);
+  const int bits = std::clamp(static_cast<int>(std::bit_width(n)) - 2, kMinDigitBits, kMaxDigitBits);
+  return n > kUncachedItems ? std::min(bits, kUncachedDigitBits) : bits;
 }
 
 // One read of the items fills every pass's histogram (P known at compile time, so the loop unrolls).
