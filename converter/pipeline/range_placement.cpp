@@ -37,6 +37,7 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
                                       std::span<std::uint8_t> window) {
   auto t0 = Clock::now();
   RangePlacement placing(r, tables, open_vertex_sink(r, window));
+  placing.block_end = block_ends(r);
   if (packed()) {
     placing.packers.reserve(r.end - r.first);
     for (std::size_t g = r.first; g < r.end; ++g) placing.packers.emplace_back(table_.voxels[g]);
@@ -103,9 +104,7 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
     const std::uint32_t g = table_.global_id[local];
     if (g < r.first || g >= r.end) continue;
     for (std::uint32_t d = 0; d < levels; ++d)
-      if (table_.cursor[local * levels + d] !=
-          table_.voxels[g].vertex_first + depth_end_vertex(table_.voxels[g], level_row(table_.levels, g, levels), d))
-        fail_changed();
+      if (table_.cursor[local * levels + d] != placing.block_end[local * levels + d]) fail_changed();
   }
   if (tables) {
     placing.streamline_buffer.push_back(placing.voxline_index);
@@ -115,40 +114,54 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
   summary_.voxelize_seconds += seconds_since(t0);
 }
 
+// By (local id * levels + depth): where the block of each voxel of range r ends (its last vertex + 1); 0 for
+// the voxels of other ranges.
+std::vector<std::uint64_t> StreamingConversion::block_ends(const VoxelRange& r) const {
+  const std::uint32_t levels = job_.settings.levels;
+  std::vector<std::uint64_t> ends(table_.cursor.size(), 0);
+  for (std::size_t local = 0; local < table_.global_id.size(); ++local) {
+    const std::uint32_t g = table_.global_id[local];
+    if (g < r.first || g >= r.end) continue;
+    for (std::uint32_t d = 0; d < levels; ++d)
+      ends[local * levels + d] =
+          table_.voxels[g].vertex_first + depth_end_vertex(table_.voxels[g], level_row(table_.levels, g, levels), d);
+  }
+  return ends;
+}
+
 // Where range r's vertices go: `window` (its part of VERT), or, written block by block, a writer per
 // (voxel, level) block of the range with vertices, from the block's first vertex (table_.cursor, before any
 // is placed) to its end.
 VertexSink StreamingConversion::open_vertex_sink(const VoxelRange& r, std::span<std::uint8_t> window) const {
   const std::uint64_t bytes = vertex_bytes(job_.settings.positions);
   if (plan_.block_staging_bytes == 0) return VertexSink(window, bytes);
-  const std::uint32_t levels = job_.settings.levels;
+  const std::vector<std::uint64_t> ends = block_ends(r);
   std::vector<std::array<std::uint64_t, 2>> blocks(table_.cursor.size());  // {0, 0}: none in this range
-  for (std::size_t local = 0; local < table_.global_id.size(); ++local) {
-    const std::uint32_t g = table_.global_id[local];
-    if (g < r.first || g >= r.end) continue;
-    for (std::uint32_t d = 0; d < levels; ++d)
-      blocks[local * levels + d] = {
-          table_.cursor[local * levels + d],
-          table_.voxels[g].vertex_first + depth_end_vertex(table_.voxels[g], level_row(table_.levels, g, levels), d)};
-  }
+  for (std::size_t k = 0; k < blocks.size(); ++k)
+    if (ends[k] > 0) blocks[k] = {table_.cursor[k], ends[k]};
   return VertexSink(*out_, blocks, bytes, plan_.block_staging_bytes, kSpareBlockStagings, pool_.get(),
                     plan_.pool_bytes);
 }
 
 // On one thread: voxelises streamlines [begin, end) of batch b (numbered from `first` in the source) and
-// stages the vertices of their voxlines in range, packed (or as float32), in streamline order.
+// stages the vertices of their voxlines in range, packed (or as float32), in streamline order, for the
+// placing half of their voxel; in the first range also every voxline's table entry and each streamline's span.
 void StreamingConversion::stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first,
                                      std::uint64_t begin, std::uint64_t end, StagedPart& part) const {
   const VoxelRange& r = placing.range;
+  const std::uint32_t levels = job_.settings.levels;
   part.begin = begin;
   part.end = end;
   part.source_first = first + begin;
   part.sink.index.index = &table_.sink.index;
-  part.sink.voxlines.clear();
-  part.sink.synthetic_xyz.clear();
-  part.voxline_ends.clear();
-  part.words.clear();
-  part.xyz.clear();
+  for (int h = 0; h < 2; ++h) {
+    part.voxlines[h].clear();
+    part.words[h].clear();
+    part.xyz[h].clear();
+  }
+  part.table_entries.clear();
+  part.streamline_voxlines.clear();
+  part.spans.clear();
   const float* pts = b.positions.data();
   std::vector<float> voxline_xyz;  // one voxline's vertices on their way to being packed
   part.sink.too_many_synthetic = false;
@@ -160,7 +173,8 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
     run = *at;
   }
   for (std::uint64_t k = begin; k < end; ++k) {
-    const std::size_t start = part.sink.voxlines.size();
+    part.sink.voxlines.clear();
+    part.sink.synthetic_xyz.clear();
     const std::uint64_t points = b.offsets[k + 1] - b.offsets[k];
     const bool by_runs = table_.runs_kept && points > 0 &&
                          (run >= table_.runs.size() || table_.runs[run].voxel != VoxelRuns::kVoxelisedAgain);
@@ -171,8 +185,6 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
           cut_by_runs(b.offsets[k], points, run, part.sink.voxlines);
         else if (table_.runs_kept && points > 0)
           ++run;  // kVoxelisedAgain
-        part.sink.voxlines.resize(start);
-        part.voxline_ends.push_back(start);
         continue;
       }
     }
@@ -183,18 +195,26 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
       detail::voxelize_streamline(table_.grid, pts, b.offsets[k], points, part.sink, table_.synthetic_limit);
       if (part.sink.too_many_synthetic) fail_changed();
     }
-    part.voxline_ends.push_back(part.sink.voxlines.size());
-    const std::span<const TempVoxline> streamline(part.sink.voxlines.data() + start, part.sink.voxlines.size() - start);
+    const std::span<const TempVoxline> streamline(part.sink.voxlines);
+    const std::uint32_t depth = streamline_depth(first + k, levels);
+    std::array<std::uint32_t, 2> span = {std::numeric_limits<std::uint32_t>::max(), 0};
     for (std::size_t j = 0; j < streamline.size(); ++j) {
       const TempVoxline& v = streamline[j];
       if (v.voxel >= table_.global_id.size()) fail_changed();  // a voxel pass 2 did not see
       const std::uint32_t g = table_.global_id[v.voxel];
+      if (placing.tables) {
+        span = {std::min(span[0], g), std::max(span[1], g)};
+        part.table_entries.push_back({g, v.own() | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)});
+      }
       if (g < r.first || g >= r.end) continue;
       const std::uint64_t used = v.own() + (j + 1 < streamline.size() ? 1 : 0);
+      const int half = g < placing.split ? 0 : 1;
+      part.voxlines[half].push_back({v.voxel, static_cast<std::uint32_t>(used), depth});
       if (!packed()) {
-        const std::size_t at = part.xyz.size();
-        part.xyz.resize(at + 3 * used);
-        detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), part.xyz.data() + at);
+        std::vector<float>& xyz = part.xyz[half];
+        const std::size_t at = xyz.size();
+        xyz.resize(at + 3 * used);
+        detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), xyz.data() + at);
         continue;
       }
       voxline_xyz.resize(3 * used);
@@ -205,10 +225,15 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
         for (int c = 0; c < 3; ++c)
           if (!(voxline_xyz[3 * e + c] >= voxel.tight_min[c] && voxline_xyz[3 * e + c] <= voxel.tight_max[c]))
             fail_changed();
-      const std::size_t at = part.words.size();
-      part.words.resize(at + used);
-      placing.packers[g - r.first].words(voxline_xyz.data(), used, part.words.data() + at);
-      part.words[at + used - 1] |= kPackedVoxlineEnd;
+      std::vector<std::uint32_t>& words = part.words[half];
+      const std::size_t at = words.size();
+      words.resize(at + used);
+      placing.packers[g - r.first].words(voxline_xyz.data(), used, words.data() + at);
+      words[at + used - 1] |= kPackedVoxlineEnd;
+    }
+    if (placing.tables) {
+      part.streamline_voxlines.push_back(static_cast<std::uint32_t>(streamline.size()));
+      part.spans.push_back(span);
     }
   }
 }
@@ -227,64 +252,42 @@ void StreamingConversion::cut_by_runs(std::uint64_t first_point, std::uint64_t p
   }
 }
 
-// In streamline order: copies a staged part's vertices to their blocks (each voxel's next place for the
-// streamline's depth) — those of the voxels of half `half` of the range (split at placing.split) — and, for
-// the first range's first half, writes its voxline and streamline table entries.
+// In streamline order: copies the vertices a part staged for half `half` of the range (split at
+// placing.split) to their blocks (each voxel's next place for the streamline's depth) and, for the first
+// range's first half, writes the part's voxline and streamline table entries and keeps its streamlines' spans.
 void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& part, int half) {
-  const std::uint64_t first = part.source_first;
   const VoxelRange& r = placing.range;
-  const std::size_t lo = half == 0 ? r.first : placing.split, hi = half == 0 ? placing.split : r.end;
-  const bool tables = placing.tables && half == 0;
   const std::uint32_t levels = job_.settings.levels;
-  std::uint64_t staged = 0;  // vertices of the part passed so far
-  std::size_t start = 0;
-  for (std::uint64_t k = 0; k < part.end - part.begin; ++k) {
-    const std::size_t end = part.voxline_ends[k];
-    const std::span<const TempVoxline> streamline(part.sink.voxlines.data() + start, end - start);
-    start = end;
-    std::array<std::uint32_t, 2>& span = table_.spans[first + k];
-    if (tables) {
-      span = {std::numeric_limits<std::uint32_t>::max(), 0};
+  if (placing.tables && half == 0) {
+    for (std::size_t k = 0; k < part.streamline_voxlines.size(); ++k) {
+      table_.spans[part.source_first + k] = part.spans[k];
       placing.streamline_buffer.push_back(placing.voxline_index);
+      placing.voxline_index += part.streamline_voxlines[k];
       if (placing.streamline_buffer.size() == kTableBufferEntries) {
         out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, placing.streamline_buffer);
         placing.streamline_buffer.clear();
       }
-    } else if (!placing.tables && (span[1] < r.first || span[0] >= r.end)) {
-      continue;
     }
-    const std::uint32_t depth = streamline_depth(first + k, levels);
-    for (std::size_t j = 0; j < streamline.size(); ++j) {
-      const TempVoxline& v = streamline[j];
-      const std::uint32_t g = table_.global_id[v.voxel];  // checked by stage_part
-      const std::uint32_t own = v.own();
-      if (tables) {
-        span = {std::min(span[0], g), std::max(span[1], g)};
-        placing.voxline_buffer.push_back({g, own | (v.synthetic != kNoSynthetic ? kVoxlineSyntheticFirst : 0u)});
-        if (placing.voxline_buffer.size() == kTableBufferEntries) {
-          out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, placing.voxline_buffer);
-          placing.voxline_buffer.clear();
-        }
+    for (const VoxlineEntry& e : part.table_entries) {
+      placing.voxline_buffer.push_back(e);
+      if (placing.voxline_buffer.size() == kTableBufferEntries) {
+        out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, placing.voxline_buffer);
+        placing.voxline_buffer.clear();
       }
-      if (g < r.first || g >= r.end) continue;
-      const std::uint64_t used = own + (j + 1 < streamline.size() ? 1 : 0);
-      if (g < lo || g >= hi) {  // the other half's
-        staged += used;
-        continue;
-      }
-      std::uint64_t& cursor = table_.cursor[std::size_t(v.voxel) * levels + depth];
-      const std::uint64_t block_end = table_.voxels[g].vertex_first +
-                                      depth_end_vertex(table_.voxels[g], level_row(table_.levels, g, levels), depth);
-      if (cursor > block_end || used > block_end - cursor) fail_changed();
-      const std::uint64_t at = cursor - r.vertex_first;
-      if (!packed()) ends_.set(at + used - 1);
-      const auto* from = packed() ? reinterpret_cast<const std::uint8_t*>(part.words.data() + staged)
-                                  : reinterpret_cast<const std::uint8_t*>(part.xyz.data() + 3 * staged);
-      placing.sink.put(std::size_t(v.voxel) * levels + depth, at, from, used);
-      staged += used;
-      cursor += used;
     }
-    if (half == 0) placing.voxline_index += streamline.size();
+  }
+  const std::uint64_t bytes = vertex_bytes(job_.settings.positions);
+  const auto* from = packed() ? reinterpret_cast<const std::uint8_t*>(part.words[half].data())
+                              : reinterpret_cast<const std::uint8_t*>(part.xyz[half].data());
+  for (const StagedVoxline& v : part.voxlines[half]) {
+    const std::size_t block = std::size_t(v.voxel) * levels + v.depth;
+    std::uint64_t& cursor = table_.cursor[block];
+    if (cursor > placing.block_end[block] || v.count > placing.block_end[block] - cursor) fail_changed();
+    const std::uint64_t at = cursor - r.vertex_first;
+    if (!packed()) ends_.set(at + v.count - 1);
+    placing.sink.put(block, at, from, v.count);
+    from += v.count * bytes;
+    cursor += v.count;
   }
   if (half == 0) placing.streamlines += part.end - part.begin;
 }

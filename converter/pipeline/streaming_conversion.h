@@ -152,6 +152,7 @@ class StreamingConversion {
   struct StagedPart;
   struct RangePlacement;
   void place_range(const VoxelRange& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
+  std::vector<std::uint64_t> block_ends(const VoxelRange& r) const;
   VertexSink open_vertex_sink(const VoxelRange& r, std::span<std::uint8_t> window) const;
   void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
                   std::uint64_t end, StagedPart& part) const;
@@ -188,17 +189,34 @@ class StreamingConversion {
   std::unique_ptr<VxlStreamWriter> out_;
 };
 
-// Part of a batch voxelised on its own thread (stage_part), waiting to be placed in order.
+// One voxline's vertices staged for a placing half: its (voxel, level) block and how many vertices.
+struct StagedVoxline {
+  std::uint32_t voxel;  // local id
+  std::uint32_t count;
+  std::uint32_t depth;
+};
+
+// Part of a batch voxelised on its own thread (stage_part), waiting to be placed in order: what each placing
+// half places, in streamline order, and (first range) the part's table entries.
 struct StreamingConversion::StagedPart {
-  std::uint64_t begin = 0, end = 0;       // streamlines of the batch
-  std::uint64_t source_first = 0;         // the index of streamline `begin` in the source
-  SinkOf<detail::SharedVoxelIndex> sink;  // every voxline of the part, in order
-  std::vector<std::size_t> voxline_ends;  // per streamline: the end of its voxlines in sink.voxlines
-  std::vector<std::uint32_t> words;       // packed: the vertices of the voxlines in range, in order
-  std::vector<float> xyz;                 // float32: the same
+  std::uint64_t begin = 0, end = 0;                    // streamlines of the batch
+  std::uint64_t source_first = 0;                      // the index of streamline `begin` in the source
+  SinkOf<detail::SharedVoxelIndex> sink;               // the voxlines of the streamline being staged
+  std::array<std::vector<StagedVoxline>, 2> voxlines;  // per half: the voxlines in range, in order
+  std::array<std::vector<std::uint32_t>, 2> words;     // packed: per half, those voxlines' vertices in order
+  std::array<std::vector<float>, 2> xyz;               // float32: the same
+  // First range: every voxline's VXLN entry and each streamline's voxline count and lowest and highest voxel.
+  std::vector<VoxlineEntry> table_entries;
+  std::vector<std::uint32_t> streamline_voxlines;
+  std::vector<std::array<std::uint32_t, 2>> spans;
   std::uint64_t bytes() const {
-    return sink.bytes() + voxline_ends.capacity() * sizeof(std::size_t) + words.capacity() * sizeof(std::uint32_t) +
-           xyz.capacity() * sizeof(float);
+    std::uint64_t b = sink.bytes() + table_entries.capacity() * sizeof(VoxlineEntry) +
+                      streamline_voxlines.capacity() * sizeof(std::uint32_t) +
+                      spans.capacity() * sizeof(std::array<std::uint32_t, 2>);
+    for (int h = 0; h < 2; ++h)
+      b += voxlines[h].capacity() * sizeof(StagedVoxline) + words[h].capacity() * sizeof(std::uint32_t) +
+           xyz[h].capacity() * sizeof(float);
+    return b;
   }
 };
 
@@ -213,7 +231,9 @@ struct StreamingConversion::RangePlacement {
   std::vector<VoxlineEntry> voxline_buffer;
   std::vector<std::uint64_t> streamline_buffer;
   std::uint64_t voxline_index = 0, streamlines = 0;
-  std::size_t split = 0;                         // the first voxel of the second placing half (range.end: placed whole)
+  std::size_t split = 0;  // the first voxel of the second placing half (range.end: placed whole)
+  // By (local id * levels + depth), for the range's voxels: where the block ends (its last vertex + 1).
+  std::vector<std::uint64_t> block_end;
   std::array<StagedPart, kBatchParts> parts[2];  // two sets of a batch's parts: one being staged, one being placed
 };
 
