@@ -15,10 +15,10 @@
 // written through a small staging of its own as it is placed, and read back a chunk at a time for the
 // orders (one range, 3 passes for any size of source).
 //
-// Every pass cuts its batches in two parts for two threads (the placing pass places in streamline order,
-// one batch behind). What stays in memory: the voxel table (about 240 bytes per voxel), each streamline's
-// length (4 bytes), its voxel runs where they fit (8 bytes a voxline: the placing passes then do not voxelise
-// again), one part of the source read into a buffer and two batches of whole streamlines, two batches' staged
+// Every pass cuts its batches in parts that share the threads with the next batch's read (the placing pass
+// places in streamline order, one batch behind). What stays in memory: the voxel table (about 240 bytes per voxel),
+// each streamline's length (4 bytes), its voxel runs where they fit (8 bytes a voxline: the placing passes then do not
+// voxelise again), one part of the source read into a buffer and two batches of whole streamlines, two batches' staged
 // voxlines, one range's blocks (or, written block by block, their stagings and then two chunks of them read
 // back), an orders chunk or two and the sort buffers; at the end, the voxel index's buffer. The source is read
 // a part at a time (pread); the output is

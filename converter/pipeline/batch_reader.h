@@ -34,11 +34,12 @@ class BatchReader {
   // Reads the source once, batch by batch; `stage` names the pass in the progress reports. Per batch (its
   // first streamline's index in the source is `first`): prepare(batch, first) on the calling thread, then
   // part(batch, first, p) for every p in [0, parts) on the reader's threads while the next batch is read
-  // beside them, then finish(batch, first) on the calling thread. The read is one more item for the same
-  // threads, not a thread of its own: the parts fill the cores around it, so that cutting a batch in a
-  // few parts keeps every core busy even when the read and the parts take unequal times. An error of a
-  // part comes before one of the read (which is further on in the file), the lowest part's first. Throws
-  // as the budget does when a streamline is too long to hold whole or the two batches outgrow what is left.
+  // beside them, then finish(batch, first) on the calling thread (with one thread, the read comes after
+  // finish). The read is one more item for the same threads, not a thread of its own: the parts fill the
+  // cores around it, so that cutting a batch in a few parts keeps every core busy even when the read and
+  // the parts take unequal times. An error of a part comes before one of the read (which is further on in
+  // the file), the lowest part's first. Throws as the budget does when a streamline is too long to hold
+  // whole or the two batches outgrow what is left.
   template <typename Prepare, typename Part, typename Finish>
   void each_batch(const std::string& stage, std::uint64_t parts, Prepare&& prepare, Part&& part, Finish&& finish);
   // The same with the whole batch as one part: body(batch, first).

@@ -61,9 +61,10 @@ std::uint64_t largest_chunk_vertex_bytes(const ConversionCounts& c, std::uint64_
   return most * vertex_bytes(c.positions);
 }
 
-// The parts of two batches being placed, from what pass 2 counted per point: a voxline entry (24 bytes)
-// per voxline, a voxline end (8) per streamline and a staged vertex per vertex, twice for the vectors'
-// growth. A batch that needs more (a long streamline is held whole) takes the rest when it comes.
+// The parts of two batches being placed, from what pass 2 counted per point: 24 bytes per voxline (its staged
+// entry, 12, and in the first range its table entry, 8), 8 per streamline (in the first range its voxline
+// count and span take 12: the voxlines' share covers the rest) and a staged vertex per vertex, twice for the
+// vectors' growth. A batch that needs more (a long streamline is held whole) takes the rest when it comes.
 std::uint64_t staged_batches_bytes(const ConversionCounts& c) {
   const MetaSection& meta = c.meta;
   const double points = double(std::max<std::uint64_t>(1, meta.point_count));

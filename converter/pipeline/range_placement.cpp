@@ -36,8 +36,9 @@ void StreamingConversion::build_range(const VoxelRange& r, std::size_t index, st
 void StreamingConversion::place_range(const VoxelRange& r, bool tables, const std::string& of,
                                       std::span<std::uint8_t> window) {
   auto t0 = Clock::now();
-  RangePlacement placing(r, tables, open_vertex_sink(r, window));
-  placing.block_end = block_ends(r);
+  std::vector<std::uint64_t> ends = block_ends(r);
+  RangePlacement placing(r, tables, open_vertex_sink(window, ends));
+  placing.block_end = std::move(ends);
   if (packed()) {
     placing.packers.reserve(r.end - r.first);
     for (std::size_t g = r.first; g < r.end; ++g) placing.packers.emplace_back(table_.voxels[g]);
@@ -71,10 +72,10 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
   };
   BatchCut cut{};
   const auto prepare = [&](const Tractogram& b, std::uint64_t first) {
-    if (first + b.streamline_count() > table_.spans.size()) fail_changed();  // more streamlines than pass 2 saw
+    if (first + b.streamline_count() > table_.spans.size()) fail_changed();  // more streamlines than pass 1 counted
     cut = cut_batch(b);
   };
-  // Items 0 and 1 place the earlier batch (its halves), so that its errors come first; then the parts.
+  // Parts 0 and 1 place the earlier batch (its halves), so that its errors come first; then the staging parts.
   const auto item = [&](const Tractogram& b, std::uint64_t first, std::uint64_t i) {
     if (i < 2) {
       if (!other_placed && (i == 0 || split)) place_staged(1 - staging, static_cast<int>(i));
@@ -129,13 +130,13 @@ std::vector<std::uint64_t> StreamingConversion::block_ends(const VoxelRange& r) 
   return ends;
 }
 
-// Where range r's vertices go: `window` (its part of VERT), or, written block by block, a writer per
+// Where a range's vertices go: `window` (its part of VERT), or, written block by block, a writer per
 // (voxel, level) block of the range with vertices, from the block's first vertex (table_.cursor, before any
-// is placed) to its end.
-VertexSink StreamingConversion::open_vertex_sink(const VoxelRange& r, std::span<std::uint8_t> window) const {
+// is placed) to its end (`ends`, block_ends).
+VertexSink StreamingConversion::open_vertex_sink(std::span<std::uint8_t> window,
+                                                 std::span<const std::uint64_t> ends) const {
   const std::uint64_t bytes = vertex_bytes(job_.settings.positions);
   if (plan_.block_staging_bytes == 0) return VertexSink(window, bytes);
-  const std::vector<std::uint64_t> ends = block_ends(r);
   std::vector<std::array<std::uint64_t, 2>> blocks(table_.cursor.size());  // {0, 0}: none in this range
   for (std::size_t k = 0; k < blocks.size(); ++k)
     if (ends[k] > 0) blocks[k] = {table_.cursor[k], ends[k]};

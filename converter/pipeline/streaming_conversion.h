@@ -153,7 +153,7 @@ class StreamingConversion {
   struct RangePlacement;
   void place_range(const VoxelRange& r, bool tables, const std::string& of, std::span<std::uint8_t> window);
   std::vector<std::uint64_t> block_ends(const VoxelRange& r) const;
-  VertexSink open_vertex_sink(const VoxelRange& r, std::span<std::uint8_t> window) const;
+  VertexSink open_vertex_sink(std::span<std::uint8_t> window, std::span<const std::uint64_t> ends) const;
   void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
                   std::uint64_t end, StagedPart& part) const;
   void place_part(RangePlacement& placing, const StagedPart& part, int half);

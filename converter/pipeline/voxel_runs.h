@@ -3,7 +3,7 @@
 // voxel (the source's local id) and its source points, 8 bytes, in blocks that never move (no copy as the
 // list grows). A streamline with points added at voxel faces is one entry, kVoxelisedAgain: the placing pass
 // voxelises it again (the added points are not kept). Where each part of a batch starts is kept too: the
-// placing pass reads the same batches, cut the same way, on two threads.
+// placing pass reads the same batches, cut the same way (cut_batch).
 #pragma once
 
 #include <cstdint>
