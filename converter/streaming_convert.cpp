@@ -106,8 +106,15 @@ ConvertSummary StreamingConversion::run() {
   report("writing", 0.0);
   t0 = Clock::now();
   write_rest();
-  pool_.reset();  // the voxel index's buffer takes the memory the ranges and the pool gave back
-  out_->append_voxel_index(plan_.voxel_index_buffer_bytes);
+  // The voxel index's buffer takes the memory the ranges and the pool gave back: the pool itself where it is
+  // large enough (its pages are in memory already; fresh ones cost more than the sorting on some machines).
+  std::span<std::uint8_t> index_buffer;
+  if (pool_ && plan_.pool_bytes >= plan_.voxel_index_buffer_bytes)
+    index_buffer = {pool_.get(), plan_.voxel_index_buffer_bytes};
+  else
+    pool_.reset();
+  out_->append_voxel_index(plan_.voxel_index_buffer_bytes, index_buffer);
+  pool_.reset();
   if (!scan_.lengths.empty()) out_->append_items<float>(VxlStreamWriter::kSlen, scan_.lengths);
   out_->append(VxlStreamWriter::kProv, {reinterpret_cast<const std::uint8_t*>(provenance.data()), provenance.size()});
   out_->commit();

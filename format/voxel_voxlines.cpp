@@ -65,14 +65,19 @@ void fill_voxel_index(std::uint64_t voxel_count, std::uint64_t voxline_count, st
 
   // Then the lists, a range of voxels per pass, each written in place in a buffer by a counting sort.
   const std::uint64_t buffer_entries =
-      io.in_place.empty() ? std::max<std::uint64_t>(1, buffer_bytes / sizeof(IndexedVoxline)) : voxline_count;
+      !io.in_place.empty() ? voxline_count
+      : io.buffer.empty()
+          ? std::max<std::uint64_t>(1, buffer_bytes / sizeof(IndexedVoxline))
+          : std::max<std::uint64_t>(1, std::min(buffer_bytes, io.buffer.size_bytes()) / sizeof(IndexedVoxline));
   std::vector<IndexedVoxline> buffer;
   std::vector<std::uint64_t> cursor;
   for (std::uint64_t begin = 0; begin < voxel_count;) {
     std::uint64_t end = begin + 1;
     while (end < voxel_count && first[end + 1] - first[begin] <= buffer_entries) ++end;
     std::span<IndexedVoxline> lists = io.in_place;
-    if (lists.empty()) {
+    if (lists.empty() && first[end] - first[begin] <= io.buffer.size()) {
+      lists = io.buffer.first(first[end] - first[begin]);
+    } else if (lists.empty()) {
       buffer.resize(first[end] - first[begin]);
       lists = buffer;
     }

@@ -41,6 +41,9 @@ struct VoxelIndexIo {
   // Where the lists go when they are in memory already (voxline_count entries): sorted straight into it in one
   // range, and write() is given the list starts only.
   std::span<IndexedVoxline> in_place;
+  // Memory of the caller's to sort the lists in, a range of voxels at a time (at most buffer_bytes of it), when
+  // not in place; a voxel whose list alone is larger gets a buffer of its own. Empty: one is allocated.
+  std::span<IndexedVoxline> buffer;
 };
 
 // Entries of VXLN and of STRM that fill_voxel_index reads at a time (8 MB each).

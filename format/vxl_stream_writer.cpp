@@ -134,7 +134,7 @@ void VxlStreamWriter::append_meta(const MetaSection& meta) {
   append(kMeta, {reinterpret_cast<const std::uint8_t*>(&m), sizeof m});
 }
 
-void VxlStreamWriter::append_voxel_index(std::uint64_t buffer_bytes) {
+void VxlStreamWriter::append_voxel_index(std::uint64_t buffer_bytes, std::span<std::uint8_t> scratch) {
   const std::size_t x = entry_[kVxix], l = entry_[kVxln], s = entry_[kStrm];
   if (x >= table_.size()) return;
   if (written_[l] != table_[l].size || written_[s] != table_[s].size || written_[x] != 0)
@@ -149,6 +149,8 @@ void VxlStreamWriter::append_voxel_index(std::uint64_t buffer_bytes) {
     out_.pread(out.data(), out.size_bytes(), table_[s].offset + first * 8);
   };
   io.write = [&](std::span<const std::uint8_t> bytes) { append(kVxix, bytes); };
+  if (reinterpret_cast<std::uintptr_t>(scratch.data()) % alignof(IndexedVoxline) == 0)
+    io.buffer = {reinterpret_cast<IndexedVoxline*>(scratch.data()), scratch.size() / sizeof(IndexedVoxline)};
   const std::uint64_t voxlines = table_[l].size / sizeof(VoxlineEntry), streamlines = table_[s].size / 8 - 1;
   const std::uint64_t voxels = (table_[x].size - voxlines * sizeof(IndexedVoxline)) / 8 - 1;
   fill_voxel_index(voxels, voxlines, streamlines, io, buffer_bytes);

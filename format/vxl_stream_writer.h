@@ -87,8 +87,9 @@ class VxlStreamWriter : public VxlSections {
 
   // Appends VXIX (spec §5.14), when the file has one, from VXLN and STRM, which must be complete: read back a
   // part at a time, the lists sorted in a buffer of up to `buffer_bytes` (a voxel's list larger than that
-  // alone), one pass over both tables per buffer full besides the one that counts the lists.
-  void append_voxel_index(std::uint64_t buffer_bytes);
+  // alone), one pass over both tables per buffer full besides the one that counts the lists. `scratch`, where
+  // given, is the caller's memory for that buffer (4-byte aligned).
+  void append_voxel_index(std::uint64_t buffer_bytes, std::span<std::uint8_t> scratch = {});
 
   // Throws std::logic_error unless every payload has been appended in full; then writes the table and
   // the header and links the file into place. Without commit() the destructor discards the file.

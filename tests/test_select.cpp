@@ -327,7 +327,8 @@ TEST(SelectionIndex, ListsEveryVoxlineOnceAndSelectsWhatTheScanSelects) {
 }
 
 // A streamed conversion fills the index a range of voxels at a time (fill_voxel_index through a bounded buffer):
-// with buffers of one list entry up to the whole index, the payload is the one filled in memory in one range.
+// with buffers of one list entry up to the whole index, allocated or the caller's, the payload is the one filled in
+// memory in one range.
 TEST(SelectionIndex, FilledInPartsItIsTheSameIndex) {
   ScratchDir dir;
   convert_tractogram(synth(3000, 5), dir.file("p.vxl"), settings(PositionEncoding::Packed, 4.0));
@@ -339,24 +340,34 @@ TEST(SelectionIndex, FilledInPartsItIsTheSameIndex) {
   fill_voxel_index_payload(whole, strm, voxlines);
   const auto* stored = reinterpret_cast<const std::uint8_t*>(f.voxel_index_first().data());
   EXPECT_TRUE(std::equal(whole.begin(), whole.end(), stored)) << "the file's VXIX is the one filled in memory";
+  // Each buffer allocated, or given by the caller (its size then limits the range, not buffer_bytes).
   for (const std::uint64_t buffer : {std::uint64_t(4), std::uint64_t(4096), std::uint64_t(1) << 16}) {
-    SCOPED_TRACE(buffer);
-    std::vector<std::uint8_t> parts;
-    int writes = 0;
-    VoxelIndexIo io;
-    io.read_voxlines = [&](std::uint64_t first, std::span<VoxlineEntry> out) {
-      std::copy_n(voxlines.begin() + static_cast<std::ptrdiff_t>(first), out.size(), out.begin());
-    };
-    io.read_streamline_table = [&](std::uint64_t first, std::span<std::uint64_t> out) {
-      std::copy_n(strm.begin() + static_cast<std::ptrdiff_t>(first), out.size(), out.begin());
-    };
-    io.write = [&](std::span<const std::uint8_t> bytes) {
-      parts.insert(parts.end(), bytes.begin(), bytes.end());
-      ++writes;
-    };
-    fill_voxel_index(f.voxels().size(), voxlines.size(), strm.size() - 1, io, buffer);
-    EXPECT_EQ(parts, whole);
-    if (buffer == 4) EXPECT_EQ(writes, 1 + static_cast<int>(f.voxels().size())) << "one range per voxel";
+    for (const bool given : {false, true}) {
+      SCOPED_TRACE(testing::Message() << buffer << (given ? " bytes given" : " bytes allocated"));
+      std::vector<std::uint8_t> parts;
+      int writes = 0;
+      std::vector<IndexedVoxline> caller_memory(buffer / sizeof(IndexedVoxline));
+      VoxelIndexIo io;
+      if (given) io.buffer = caller_memory;
+      io.read_voxlines = [&](std::uint64_t first, std::span<VoxlineEntry> out) {
+        std::copy_n(voxlines.begin() + static_cast<std::ptrdiff_t>(first), out.size(), out.begin());
+      };
+      io.read_streamline_table = [&](std::uint64_t first, std::span<std::uint64_t> out) {
+        std::copy_n(strm.begin() + static_cast<std::ptrdiff_t>(first), out.size(), out.begin());
+      };
+      io.write = [&](std::span<const std::uint8_t> bytes) {
+        parts.insert(parts.end(), bytes.begin(), bytes.end());
+        ++writes;
+      };
+      fill_voxel_index(f.voxels().size(), voxlines.size(), strm.size() - 1, io, given ? ~std::uint64_t(0) : buffer);
+      EXPECT_EQ(parts, whole);
+      if (buffer == 4) {
+        EXPECT_EQ(writes, 1 + static_cast<int>(f.voxels().size())) << "one range per voxel";
+      }
+      if (buffer == 4096) {
+        EXPECT_GT(writes, 2) << "more than one range";
+      }
+    }
   }
 }
 
