@@ -456,6 +456,49 @@ TEST(StreamingConvert, ASourceThatChangesBetweenPassesIsAnInputError) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+// The same when the change keeps the file's size and time (points rewritten in place, the time set back): the
+// placing pass finds vertices outside the bounds the counting pass found, with either position encoding.
+TEST(StreamingConvert, PointsRewrittenBetweenPassesWithTheTimeKeptAreAnInputError) {
+  for (const PositionEncoding positions : {PositionEncoding::Packed, PositionEncoding::Float32}) {
+    SCOPED_TRACE(position_encoding_name(positions));
+    ScratchDir dir;
+    const std::string tck = dir.file("in.tck"), out = dir.file("out.vxl");
+    write_synth_tck(tck, 500);
+    ConvertSettings settings = settings_for(10.0);
+    settings.positions = positions;
+    settings.memory_limit = 64 * kMiB;
+    bool changed = false;
+    settings.progress = [&](const char* stage, double) {
+      if (changed || std::string(stage).rfind("placing", 0) != 0) return;
+      const auto time = std::filesystem::last_write_time(tck);
+      std::fstream f(tck, std::ios::in | std::ios::out | std::ios::binary);
+      std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+      const std::size_t data = std::stoul(bytes.substr(bytes.find("file: . ") + 8));
+      for (std::size_t at = data; at + 12 <= bytes.size(); at += 12) {  // every point 30 mm along x
+        float x;
+        std::memcpy(&x, bytes.data() + at, 4);
+        if (!std::isfinite(x)) continue;
+        x += 30.0f;
+        std::memcpy(bytes.data() + at, &x, 4);
+      }
+      f.seekp(0);
+      f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+      f.close();
+      std::filesystem::last_write_time(tck, time);
+      changed = true;
+    };
+    try {
+      convert_streaming(tck, out, settings);
+      ADD_FAILURE() << "converted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input);
+      EXPECT_NE(std::string(e.what()).find("changed"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(changed);
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+}
+
 TEST(StreamingConvert, MemorySizesParse) {
   EXPECT_EQ(parse_memory_size("1048576"), 1048576u);
   EXPECT_EQ(parse_memory_size("64K"), 64u << 10);

@@ -211,21 +211,24 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
       const std::uint64_t used = v.own() + (j + 1 < streamline.size() ? 1 : 0);
       const int half = g < placing.split ? 0 : 1;
       part.voxlines[half].push_back({v.voxel, static_cast<std::uint32_t>(used), depth});
-      if (!packed()) {
-        std::vector<float>& xyz = part.xyz[half];
-        const std::size_t at = xyz.size();
-        xyz.resize(at + 3 * used);
-        detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), xyz.data() + at);
-        continue;
+      // Float32 vertices go straight to their half's array; packed ones through voxline_xyz.
+      float* xyz = voxline_xyz.data();
+      if (packed()) {
+        voxline_xyz.resize(3 * used);
+        xyz = voxline_xyz.data();
+      } else {
+        const std::size_t at = part.xyz[half].size();
+        part.xyz[half].resize(at + 3 * used);
+        xyz = part.xyz[half].data() + at;
       }
-      voxline_xyz.resize(3 * used);
-      detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), voxline_xyz.data());
-      // A vertex outside the bounds pass 2 found would be clamped: the source changed.
+      detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), xyz);
+      // A vertex outside the bounds pass 2 found (packed: it would be clamped) means the source changed, also
+      // where its size and time did not.
       const VoxelEntry& voxel = table_.voxels[g];
       for (std::uint64_t e = 0; e < used; ++e)
         for (int c = 0; c < 3; ++c)
-          if (!(voxline_xyz[3 * e + c] >= voxel.tight_min[c] && voxline_xyz[3 * e + c] <= voxel.tight_max[c]))
-            fail_changed();
+          if (!(xyz[3 * e + c] >= voxel.tight_min[c] && xyz[3 * e + c] <= voxel.tight_max[c])) fail_changed();
+      if (!packed()) continue;
       std::vector<std::uint32_t>& words = part.words[half];
       const std::size_t at = words.size();
       words.resize(at + used);
