@@ -112,7 +112,7 @@ std::uint64_t sortable_bits(double d) {
 // Past about 2M items (16 MB, more than the caches hold) every pass goes to main memory, and 14-bit digits
 // scatter each pass over 16k places at once: where the keys need more than one pass anyway, 11-bit digits,
 // though they may take a pass more, sorted the largest voxels of the 10M synthetic set (up to 7.7M
-// segments, keys of 21-39 bits) about 5 % faster.
+// segments, keys of 21-39 bits) 3-5 % faster.
 constexpr int kMinDigitBits = 8, kMaxDigitBits = 14;
 constexpr int kMaxPasses = (64 + kMinDigitBits - 1) / kMinDigitBits;
 constexpr std::size_t kUncachedItems = std::size_t(1) << 21;

@@ -149,8 +149,9 @@ void VxlStreamWriter::append_voxel_index(std::uint64_t buffer_bytes, std::span<s
     out_.pread(out.data(), out.size_bytes(), table_[s].offset + first * 8);
   };
   io.write = [&](std::span<const std::uint8_t> bytes) { append(kVxix, bytes); };
-  if (reinterpret_cast<std::uintptr_t>(scratch.data()) % alignof(IndexedVoxline) == 0)
-    io.buffer = {reinterpret_cast<IndexedVoxline*>(scratch.data()), scratch.size() / sizeof(IndexedVoxline)};
+  if (reinterpret_cast<std::uintptr_t>(scratch.data()) % alignof(IndexedVoxline) != 0)
+    throw std::logic_error("VxlStreamWriter::append_voxel_index: scratch not 4-byte aligned");
+  io.buffer = {reinterpret_cast<IndexedVoxline*>(scratch.data()), scratch.size() / sizeof(IndexedVoxline)};
   const std::uint64_t voxlines = table_[l].size / sizeof(VoxlineEntry), streamlines = table_[s].size / 8 - 1;
   const std::uint64_t voxels = (table_[x].size - voxlines * sizeof(IndexedVoxline)) / 8 - 1;
   fill_voxel_index(voxels, voxlines, streamlines, io, buffer_bytes);

@@ -212,15 +212,10 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
       const int half = g < placing.split ? 0 : 1;
       part.voxlines[half].push_back({v.voxel, static_cast<std::uint32_t>(used), depth});
       // Float32 vertices go straight to their half's array; packed ones through voxline_xyz.
-      float* xyz = voxline_xyz.data();
-      if (packed()) {
-        voxline_xyz.resize(3 * used);
-        xyz = voxline_xyz.data();
-      } else {
-        const std::size_t at = part.xyz[half].size();
-        part.xyz[half].resize(at + 3 * used);
-        xyz = part.xyz[half].data() + at;
-      }
+      std::vector<float>& staged = packed() ? voxline_xyz : part.xyz[half];
+      const std::size_t staged_at = packed() ? 0 : staged.size();
+      staged.resize(staged_at + 3 * used);
+      float* const xyz = staged.data() + staged_at;
       detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), xyz);
       // A vertex outside the bounds pass 2 found (packed: it would be clamped) means the source changed, also
       // where its size and time did not.

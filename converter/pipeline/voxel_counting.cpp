@@ -74,9 +74,10 @@ void StreamingConversion::count_voxels() {
   const std::uint32_t levels = job_.settings.levels;
   // Part 0 counts into the source's voxel index; the others into indexes of their own, folded into it
   // after each batch.
+  const auto empty_part = [&] { return PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0, {}}; };
   std::array<PlanPart, kBatchParts> parts;
   parts[0] = PlanPart{std::move(table_.sink), std::move(counting_.use), std::move(counting_.bounds), 0, 0, {}};
-  for (std::size_t p = 1; p < kBatchParts; ++p) parts[p] = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0, {}};
+  for (std::size_t p = 1; p < kBatchParts; ++p) parts[p] = empty_part();
   PlanPart& main = parts[0];
   std::uint64_t voxlines = 0, synthetic = 0, points = 0;
   BatchCut cut{};
@@ -120,7 +121,7 @@ void StreamingConversion::count_voxels() {
       main.runs = {};
     }
     budget_.track(table_peak, counting_.table_held, [] { return std::string(); });
-    for (std::size_t p = 1; p < kBatchParts; ++p) parts[p] = PlanPart{Sink(), detail::VoxelUse(levels), {}, 0, 0, {}};
+    for (std::size_t p = 1; p < kBatchParts; ++p) parts[p] = empty_part();
     budget_.shrink(main.sink.index.coords().size() * voxel_table_bytes_per_voxel(levels), counting_.table_held);
     budget_.track(sinks, counting_.sink_held, [] { return std::string("the voxline lists of the batch's parts"); });
     points += b.point_count();
