@@ -2,14 +2,14 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <cmath>
-#include <cstring>
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 
+#include "converter/segment_sort.h"
 #include "format/base/error.h"
 #include "format/base/parallel.h"
 #include "format/vxl_positions.h"
@@ -87,149 +87,6 @@ std::array<float, 3> uniform_direction(SplitMix64& g) {
   }
 }
 
-// Order-preserving map of a double (not NaN) to an unsigned integer: its sign and magnitude as a two's
-// complement integer, offset by 2^63. Unlike flipping every bit of negative numbers, this keeps the zero
-// low mantissa bits of a sum of two floats zero for both signs, so that the keys of a voxel that
-// straddles 0 still vary in few enough bits for sort_segments to pack them with their index.
-std::uint64_t sortable_bits(double d) {
-  std::uint64_t u;
-  std::memcpy(&u, &d, 8);
-  const std::uint64_t negative = 0 - (u >> 63);  // all ones for a negative number (no branch: signs mix)
-  const std::uint64_t magnitude = u & 0x7FFFFFFFFFFFFFFFull;
-  return ((magnitude ^ negative) - negative) ^ 0x8000000000000000ull;  // -0 and +0 map alike
-}
-
-// Stable LSD radix sort of `items` by the bits [first_bit, first_bit + bits) of key(item), in as few
-// passes of at most digit_bits(n, bits) bits as cover them; passes whose digit is the same for every item are
-// skipped. Items arrive in ascending block-local index, so stability gives the spec's tie rule
-// (ascending index) for free.
-//
-// Fewer, wider passes win while the buckets stay few next to the items: a voxel of the 1M synthetic set
-// (10 mm voxels, ~60k segments, keys of 21-28 bits) sorts in 2 passes of up to 14 bits instead of 3 of up
-// to 11, and its orders took 1.27 instead of 1.54 s of CPU. Each pass also walks all its buckets, so small
-// voxels keep narrow digits.
-//
-// Past about 2M items (16 MB, more than the caches hold) every pass goes to main memory, and 14-bit digits
-// scatter each pass over 16k places at once: where the keys need more than one pass anyway, 11-bit digits,
-// though they may take a pass more, sorted the largest voxels of the 10M synthetic set (up to 7.7M
-// segments, keys of 21-39 bits) 3-5 % faster.
-constexpr int kMinDigitBits = 8, kMaxDigitBits = 14;
-constexpr int kMaxPasses = (64 + kMinDigitBits - 1) / kMinDigitBits;
-constexpr std::size_t kUncachedItems = std::size_t(1) << 21;
-constexpr int kUncachedDigitBits = 11;
-int digit_bits(std::size_t n, int key_bits) {
-  const int bits = std::clamp(static_cast<int>(std::bit_width(n)) - 2, kMinDigitBits, kMaxDigitBits);
-  return n > kUncachedItems && key_bits > bits ? std::min(bits, kUncachedDigitBits) : bits;
-}
-
-// One read of the items fills every pass's histogram (P known at compile time, so the loop unrolls).
-template <int P, typename Item, typename Key>
-void histograms(const std::vector<Item>& items, std::uint32_t* count, Key key, int first_bit, int digit) {
-  const std::uint64_t mask = (1ull << digit) - 1;
-  for (const Item& x : items) {
-    const std::uint64_t k = key(x) >> first_bit;
-    for (int p = 0; p < P; ++p) ++count[(std::size_t(p) << digit) + ((k >> (p * digit)) & mask)];
-  }
-}
-
-template <typename Item, typename Key>
-void radix_sort_bits(std::vector<Item>& items, std::vector<Item>& scratch, std::vector<std::uint32_t>& count, Key key,
-                     int first_bit, int bits) {
-  const std::size_t n = items.size();
-  const int passes = (bits + digit_bits(n, bits) - 1) / digit_bits(n, bits);
-  const int digit = (bits + passes - 1) / passes;
-  const std::uint64_t mask = (1ull << digit) - 1;
-  count.assign(std::size_t(passes) << digit, 0u);
-  switch (passes) {
-    case 1: histograms<1>(items, count.data(), key, first_bit, digit); break;
-    case 2: histograms<2>(items, count.data(), key, first_bit, digit); break;
-    case 3: histograms<3>(items, count.data(), key, first_bit, digit); break;
-    case 4: histograms<4>(items, count.data(), key, first_bit, digit); break;
-    case 5: histograms<5>(items, count.data(), key, first_bit, digit); break;
-    case 6: histograms<6>(items, count.data(), key, first_bit, digit); break;
-    case 7: histograms<7>(items, count.data(), key, first_bit, digit); break;
-    default: static_assert(kMaxPasses == 8); histograms<8>(items, count.data(), key, first_bit, digit);
-  }
-  scratch.resize(n);
-  for (int p = 0; p < passes; ++p) {
-    std::uint32_t* c = count.data() + (std::size_t(p) << digit);
-    const int shift = first_bit + p * digit;
-    if (c[(key(items[0]) >> shift) & mask] == n) continue;  // one bucket holds everything: nothing moves
-    std::uint32_t sum = 0;
-    for (std::size_t b = 0; b <= mask; ++b) sum += std::exchange(c[b], sum);
-    for (const Item& x : items) scratch[c[(key(x) >> shift) & mask]++] = x;
-    items.swap(scratch);
-  }
-}
-
-// Writes block-local indices as `bits`-bit entries from the lowest bit of dst on (spec §5.5 ORDB), four
-// bytes at a time; the last bytes alone, so nothing past the array's order_array_bytes is touched.
-template <typename Local>
-std::uint8_t* put_entries(std::uint8_t* dst, std::uint32_t bits, std::size_t n, Local&& local) {
-  std::uint64_t pending = 0;  // bits not yet stored, lowest first
-  std::uint32_t filled = 0;   // < 32 between entries
-  for (std::size_t i = 0; i < n; ++i) {
-    pending |= std::uint64_t(local(i)) << filled;
-    filled += bits;
-    if (filled >= 32) {
-      const auto word = static_cast<std::uint32_t>(pending);
-      std::memcpy(dst, &word, 4);
-      dst += 4;
-      pending >>= 32;
-      filled -= 32;
-    }
-  }
-  for (; filled > 0; filled = filled > 8 ? filled - 8 : 0, pending >>= 8) *dst++ = static_cast<std::uint8_t>(pending);
-  return dst;
-}
-
-// A segment whose key varies in too many bits to share 64 bits with its index.
-struct KeyedSegment {
-  std::uint64_t key;
-  std::uint32_t local;
-};
-
-// Per worker thread. Reserved for the largest voxel up front (keyed on first use), so that these never
-// grow past it: order_scratch_bytes() is a bound that callers budget with.
-struct SortScratch {
-  std::uint32_t max_vertices = 0;
-  std::vector<std::uint64_t> keys, packed_tmp;  // keys: packed with the index in place where they fit
-  std::vector<KeyedSegment> keyed, keyed_tmp;
-  std::vector<std::uint32_t> counts;
-};
-
-// Writes the order of one voxel's segments (block-local `starts`, ascending) by ascending `s.keys`
-// (which differ in the bits of `varying`), ties by ascending index, to `dst`; returns the end of what
-// it wrote.
-std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint32_t vertex_count,
-                            std::uint32_t entry_bits, std::uint64_t varying, SortScratch& s, std::uint8_t* dst) {
-  const std::size_t n = starts.size();
-  if (n < 2 || varying == 0) return put_entries(dst, entry_bits, n, [&](std::size_t i) { return starts[i]; });
-
-  // All keys share the bits above the highest varying bit and below the lowest, so the varying field
-  // alone orders them. Packed above the block-local index it makes one 8-byte item per segment, half
-  // the traffic of key + index. The field is typically 3 bytes of mantissa (sums of two floats).
-  const int low = std::countr_zero(varying), bits = 64 - std::countl_zero(varying) - low;
-  const int index_bits = std::bit_width(vertex_count - 1);  // vertex_count >= 2 here
-  if (bits + index_bits <= 64) {
-    // In place: one array less to fill and to keep in cache (the largest voxels' do not fit).
-    const std::uint64_t field = (1ull << bits) - 1;  // bits < 64 here
-    for (std::size_t i = 0; i < n; ++i) s.keys[i] = ((s.keys[i] >> low) & field) << index_bits | starts[i];
-    radix_sort_bits(
-        s.keys, s.packed_tmp, s.counts, [](std::uint64_t x) { return x; }, index_bits, bits);
-    const std::uint64_t index_mask = (1ull << index_bits) - 1;
-    return put_entries(dst, entry_bits, n,
-                       [&](std::size_t i) { return static_cast<std::uint32_t>(s.keys[i] & index_mask); });
-  }
-  s.keyed.reserve(s.max_vertices);
-  s.keyed_tmp.reserve(s.max_vertices);
-  s.keyed.resize(n);
-  for (std::size_t i = 0; i < n; ++i) s.keyed[i] = {s.keys[i], starts[i]};
-  radix_sort_bits(
-      s.keyed, s.keyed_tmp, s.counts, [](const KeyedSegment& k) { return k.key; }, low, bits);
-  return put_entries(dst, entry_bits, n, [&](std::size_t i) { return s.keyed[i].local; });
-}
-
 }  // namespace
 
 std::vector<DirectionEntry> order_directions(const OrderSetSpec& set) {
@@ -276,14 +133,15 @@ std::uint64_t layout_orders(std::span<VoxelEntry> voxels, std::span<const LevelE
 struct PackedBlock {
   const std::uint32_t* words;
   std::array<std::array<float, kPackedSteps + 1>, 3> decoded;
+  std::array<detail::QuantumSumKeys, 3> sums;  // by axis
   float axis(std::uint32_t e, int c) const { return decoded[c][(words[e] >> (10 * c)) & kPackedAxisMask]; }
   bool ends_voxline(std::uint32_t e) const { return (words[e] & kPackedVoxlineEnd) != 0; }
 };
 
 struct VoxelOrderWriter::Scratch {
   std::vector<std::uint32_t> starts;
-  SortScratch sort;
-  PackedBlock packed;  // write_packed's table, 12 KiB: here rather than on the stack or per voxel
+  detail::SortScratch sort;
+  PackedBlock packed;  // write_packed's tables, 85 KiB: here rather than on the stack or per voxel
 };
 
 VoxelOrderWriter::VoxelOrderWriter(const OrderSetSpec& set, std::uint32_t max_vertices)
@@ -291,7 +149,7 @@ VoxelOrderWriter::VoxelOrderWriter(const OrderSetSpec& set, std::uint32_t max_ve
       directions_(set.directions.size()),
       axis_of_(set.directions.size(), -1),
       scratch_(std::make_unique<Scratch>()) {
-  SortScratch& s = scratch_->sort;
+  detail::SortScratch& s = scratch_->sort;
   s.max_vertices = max_vertices;
   for (auto* v : {&s.keys, &s.packed_tmp}) v->reserve(max_vertices);
   scratch_->starts.reserve(max_vertices);
@@ -332,8 +190,10 @@ void VoxelOrderWriter::write_packed(const VoxelEntry& v, std::span<const LevelEn
   PackedBlock& block = scratch_->packed;
   block.words = words;
   const VertexPacker packer(v);
-  for (int c = 0; c < 3; ++c)
+  for (int c = 0; c < 3; ++c) {
     for (std::uint32_t q = 0; q <= kPackedSteps; ++q) block.decoded[c][q] = packer.decode_axis(c, q);
+    block.sums[c].prepare(block.decoded[c]);
+  }
   write_levels(v, row, block, dst);
 }
 
@@ -354,7 +214,7 @@ void VoxelOrderWriter::write_levels(const VoxelEntry& v, std::span<const LevelEn
 template <typename Block>
 std::uint8_t* VoxelOrderWriter::write_level(const LevelEntry& level, const Block& block, std::uint8_t* dst) {
   std::vector<std::uint32_t>& starts = scratch_->starts;
-  SortScratch& scratch = scratch_->sort;
+  detail::SortScratch& scratch = scratch_->sort;
   // The segments start at every vertex that does not end its voxline (branch-free: ends are
   // scattered, a branch would mispredict often).
   starts.resize(level.vertex_count);
@@ -367,10 +227,19 @@ std::uint8_t* VoxelOrderWriter::write_level(const LevelEntry& level, const Block
   if (n_starts != level.segment_count) throw std::logic_error("VoxelOrderWriter: level segment count mismatch");
   const std::uint32_t bits = order_entry_bits(level.vertex_count, OrderPacking::Bits);
   for (std::size_t k = 0; k < directions_.size(); ++k) {
+    const int axis = axis_of_[k];
+    if constexpr (std::is_same_v<Block, PackedBlock>) {
+      if (axis >= 0 && starts.size() >= 2) {
+        if (std::uint8_t* end =
+                block.sums[axis].sort(starts, block.words, axis, level.vertex_count, bits, scratch, dst)) {
+          dst = end;
+          continue;
+        }
+      }
+    }
     scratch.keys.resize(starts.size());
     const auto& d = directions_[k];
     std::uint64_t all_or = 0, all_and = ~0ull;
-    const int axis = axis_of_[k];
     for (std::size_t n = 0; n < starts.size(); ++n) {
       const std::uint32_t a = starts[n];  // the segment (a, a + 1)
       double key;
@@ -380,12 +249,12 @@ std::uint8_t* VoxelOrderWriter::write_level(const LevelEntry& level, const Block
         key = 0;
         for (int c = 0; c < 3; ++c) key += (double(block.axis(a, c)) + double(block.axis(a + 1, c))) * double(d[c]);
       }
-      const std::uint64_t bits = sortable_bits(key);
+      const std::uint64_t bits = detail::sortable_bits(key);
       scratch.keys[n] = bits;
       all_or |= bits;
       all_and &= bits;
     }
-    dst = sort_segments(starts, level.vertex_count, bits, all_or ^ all_and, scratch, dst);
+    dst = detail::sort_segments(starts, level.vertex_count, bits, all_or ^ all_and, scratch, dst);
   }
   return dst;
 }
@@ -435,11 +304,7 @@ void build_orders_into_packed(std::span<const VoxelEntry> voxels, std::span<cons
 }
 
 std::uint64_t order_scratch_bytes(std::uint32_t max_vertices) {
-  // starts (u32) and, per segment (fewer than vertices), keys and packed_tmp (u64) and, for a voxel whose
-  // keys do not pack, keyed and keyed_tmp (16 bytes): all reserved once for the largest voxel
-  // (SortScratch). Plus the histograms.
-  const std::uint64_t per_vertex = sizeof(std::uint32_t) + 2 * sizeof(std::uint64_t) + 2 * sizeof(KeyedSegment);
-  return per_vertex * max_vertices + std::uint64_t(kMaxPasses) * (1u << kMaxDigitBits) * sizeof(std::uint32_t);
+  return sizeof(std::uint32_t) * std::uint64_t(max_vertices) + detail::sort_scratch_bytes(max_vertices);  // + starts
 }
 
 BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsigned threads,
