@@ -103,6 +103,15 @@ std::uint8_t* put_entries(std::uint8_t* dst, std::uint32_t bits, std::size_t n, 
   return dst;
 }
 
+// The exponent of the lowest set bit of a finite, nonzero float: it is a multiple of 2 to that power.
+int lowest_bit_exponent(float f) {
+  const auto bits = std::bit_cast<std::uint32_t>(f);
+  const std::uint32_t biased = (bits >> 23) & 0xFFu, fraction = bits & 0x7FFFFFu;
+  constexpr int kBias = 127, kFractionBits = 23;
+  if (biased == 0) return 1 - kBias - kFractionBits + std::countr_zero(fraction);  // subnormal
+  return int(biased) - kBias - kFractionBits + std::countr_zero(fraction | 0x800000u);
+}
+
 }  // namespace
 
 // Writes the order of one voxel's segments (block-local `starts`, ascending) by ascending `s.keys`
@@ -139,18 +148,18 @@ std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint3
 
 void QuantumSumKeys::prepare(const std::array<float, kPackedSteps + 1>& decoded) {
   usable_ = false;
-  // Every float is a multiple of the least ulp among them, so each d is an integer number of it, and a key
-  // (an exact sum in double) the sum of two such integers.
-  float least = std::numeric_limits<float>::infinity();
+  // Each d is an integer number of the largest power of two that divides them all, and a key (an exact sum in
+  // double) the sum of two such integers. That unit is at least the least ulp among them, and for a voxel across
+  // 0 it is coarser than the ulps of its values near 0 (exact cancellations of lo and q * step): measuring in the
+  // least ulp instead would leave such a voxel's buckets too wide for the shortcut.
+  int unit_exponent = std::numeric_limits<int>::max();
   for (const float d : decoded) {
     if (!std::isfinite(d)) return;
-    if (d != 0) least = std::min(least, std::fabs(d));
+    if (d != 0) unit_exponent = std::min(unit_exponent, lowest_bit_exponent(d));
   }
-  if (std::isinf(least)) return;  // all zero: one key, nothing to rank
-  const int unit_exponent = std::max(std::ilogb(least), std::numeric_limits<float>::min_exponent - 1) -
-                            (std::numeric_limits<float>::digits - 1);
-  const double per_unit = std::ldexp(1.0, -unit_exponent);  // a power of two: the products are exact
-  constexpr double kMaxUnits = 0x1p50;                      // the sums stay exact in double and in int64
+  if (unit_exponent == std::numeric_limits<int>::max()) return;  // all zero: one key, nothing to rank
+  const double per_unit = std::ldexp(1.0, -unit_exponent);       // a power of two: the products are exact
+  constexpr double kMaxUnits = 0x1p50;                           // the sums stay exact in double and in int64
   for (std::uint32_t q = 0; q <= kPackedSteps; ++q) {
     const double units = double(decoded[q]) * per_unit;
     if (!(std::fabs(units) < kMaxUnits)) return;

@@ -67,7 +67,7 @@ class QuantumSumKeys {
   bool usable_ = false;
   int offset_bits_ = 0;
   std::uint64_t span_ = 0;                            // a bucket's keys lie in [floor_[s], floor_[s] + span_]
-  std::array<std::int64_t, kPackedSteps + 1> units_;  // d[q] in units of the least ulp among the d
+  std::array<std::int64_t, kPackedSteps + 1> units_;  // d[q] in units of the largest power of two dividing them all
   std::array<std::int64_t, kSums> floor_;             // by quantum sum: the least sum of units it may hold
 };
 

@@ -105,8 +105,10 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Case{"Positive", 10.3f, 20.1f, true}, Case{"Negative", -61.933f, -51.933f, true},
                       Case{"AcrossAPowerOfTwo", 60.5f, 70.5f, true}, Case{"AThousandAway", 1000.0f, 1010.0f, true},
                       Case{"Fine", 0.001f, 0.002f, true}, Case{"Denormal", 0.0f, 1.0e-40f, true},
-                      // Keys near 0 are finer than those far from it: the buckets' spread is too wide.
-                      Case{"AcrossZero", -1.933f, 8.067f, false},
+                      // Values near 0 are exact differences of lo and q * step: no finer than those.
+                      Case{"AcrossZero", -2.188f, 7.812f, true}, Case{"AroundZero", -5.0f, 5.0f, true},
+                      // But here lo's ulp is far finer than those of the larger values: the buckets spread too wide.
+                      Case{"AcrossZeroNearItsLowEnd", -0.3f, 9.7f, false},
                       // A quantum narrower than a few ulps: the buckets touch.
                       Case{"NarrowerThanItsUlps", 50.0f, 50.0001f, false},
                       Case{"AMillionAway", 1.0e6f, 1.0e6f + 10, false}, Case{"Flat", 5.0f, 5.0f, false}),
