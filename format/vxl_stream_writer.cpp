@@ -100,6 +100,26 @@ void VxlStreamWriter::append(Section section, std::span<const std::uint8_t> byte
   written_[i] += bytes.size();
 }
 
+std::uint64_t VxlStreamWriter::block_lead(Section section, std::uint64_t at) const {
+  const std::size_t i = entry_[section];
+  if (i >= table_.size()) throw std::logic_error("VxlStreamWriter::block_lead: no such section");
+  return (table_[i].offset + at) % DirectRegionWriter::kBlock;
+}
+
+void VxlStreamWriter::append_from_block(Section section, std::uint8_t* block, std::uint64_t size) {
+  const std::size_t i = entry_[section];
+  if (i >= table_.size() || size > table_[i].size - written_[i])
+    throw std::logic_error("VxlStreamWriter::append_from_block: more bytes than the section was planned for");
+  std::uint8_t* const bytes = block + block_lead(section, written_[i]);
+  if (size == 0) return;
+  checksums_[i]->update(bytes, size);  // first: the region may overwrite what precedes them, never them
+  if (regions_.empty())
+    out_.pwrite(bytes, size, table_[i].offset + written_[i]);
+  else
+    regions_[i]->append_from_block(block, size);
+  written_[i] += size;
+}
+
 FileWindow VxlStreamWriter::open_window(Section section, std::uint64_t size, unsigned threads) {
   const std::size_t i = entry_[section];
   if (i >= table_.size() || size > table_[i].size - written_[i])

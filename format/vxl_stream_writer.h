@@ -38,6 +38,12 @@ class VxlStreamWriter : public VxlSections {
   // Appends to a payload. Throws std::logic_error past the payload's planned size (or for kGrps when
   // there is no GRPS section), vxl::Error (Output) when the write fails.
   void append(Section section, std::span<const std::uint8_t> bytes);
+  // Where byte `at` of `section`'s payload falls in its 4 KiB block of the file (DirectRegionWriter::kBlock).
+  std::uint64_t block_lead(Section section, std::uint64_t at) const;
+  // Appends the `size` bytes at block + block_lead(section, bytes appended so far), as append does; with direct
+  // writes their whole blocks go to the file straight from `block` (block-aligned; the writer may overwrite the
+  // bytes before them in it) instead of being copied through the staging (DirectRegionWriter::append_from_block).
+  void append_from_block(Section section, std::uint8_t* block, std::uint64_t size);
   template <typename T>
   void append_items(Section section, std::span<const T> items) {
     append(section, {reinterpret_cast<const std::uint8_t*>(items.data()), items.size_bytes()});

@@ -37,20 +37,32 @@ std::vector<std::uint8_t> file_bytes(const std::string& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// Regions back to back (the first from offset 0), of sizes below, at and across block boundaries.
+// Regions back to back (the first from offset 0), of sizes below, at and across block boundaries. With
+// `from_blocks`, every other piece is appended from a block-aligned buffer laid out as append_from_block wants.
 void write_regions(const std::string& path, bool use_direct_io, const std::vector<std::uint8_t>& expected,
-                   const std::vector<std::uint64_t>& ends) {
+                   const std::vector<std::uint64_t>& ends, bool from_blocks = false) {
   AtomicOutputFile out(path);
   out.allocate(expected.size());
   const int direct_fd = use_direct_io ? out.direct_descriptor() : -1;
   std::mt19937 rng(5);
+  constexpr std::uint64_t block = DirectRegionWriter::kBlock;
+  std::unique_ptr<std::uint8_t, void (*)(void*)> buffer(
+      static_cast<std::uint8_t*>(std::aligned_alloc(block, 20000 + block)), std::free);
   std::uint64_t start = 0;
   for (std::uint64_t end : ends) {
-    DirectRegionWriter region(out, direct_fd, start, end - start, 3 * DirectRegionWriter::kBlock);
+    DirectRegionWriter region(out, direct_fd, start, end - start, 3 * block);
+    bool next_from_block = false;
     for (std::uint64_t at = start; at < end;) {
       const std::uint64_t n =
           std::min<std::uint64_t>(end - at, std::uniform_int_distribution<std::uint64_t>(1, 20000)(rng));
-      region.append({expected.data() + at, n});
+      if (next_from_block) {
+        std::fill_n(buffer.get(), block, std::uint8_t{0xEE});  // what precedes the bytes is the writer's
+        std::copy_n(expected.data() + at, n, buffer.get() + region.block_lead());
+        region.append_from_block(buffer.get(), n);
+      } else {
+        region.append({expected.data() + at, n});
+      }
+      next_from_block = from_blocks && !next_from_block;
       at += n;
     }
     start = end;
@@ -75,6 +87,20 @@ TEST(DirectWrites, RegionsOfAnySizeAppendedInPiecesGiveThePlainBytes) {
   AtomicOutputFile probe(dir.file("probe.bin"));
   if (probe.direct_descriptor() < 0)
     GTEST_LOG_(INFO) << "this file system refuses O_DIRECT: only the fallback was exercised";
+}
+
+TEST(DirectWrites, RegionsAppendedFromBlocksGiveThePlainBytes) {
+  ScratchDir dir;
+  std::mt19937 rng(4);
+  std::vector<std::uint8_t> expected(600000);
+  for (auto& b : expected) b = static_cast<std::uint8_t>(rng());
+  const std::uint64_t block = DirectRegionWriter::kBlock;
+  const std::vector<std::uint64_t> ends = {5, block + 3, 3 * block, 7 * block + 1, 130001, 599000, 600000};
+  for (bool direct : {true, false}) {
+    const std::string path = dir.file(direct ? "direct.bin" : "buffered.bin");
+    write_regions(path, direct, expected, ends, true);
+    EXPECT_TRUE(file_bytes(path) == expected) << (direct ? "with" : "without") << " O_DIRECT";
+  }
 }
 
 // A mapped output (what VxlWriter fills) is memory written to the file at commit(): whole 4 KiB blocks

@@ -78,8 +78,7 @@ std::uint64_t staged_batches_bytes(const ConversionCounts& c) {
 // How VERT's vertices are held: block by block (setting block_staging_bytes and the pool) when the blocks'
 // staging takes at most an eighth of what is left and the pool at most half.
 void plan_block_staging(const MemoryBudget& budget, const ConversionCounts& counts, ConversionPlan& plan) {
-  constexpr std::uint64_t block = DirectRegionWriter::kBlock;
-  plan.pool_chunk_bytes = (plan.order_chunk_bytes + block - 1) / block * block;
+  plan.pool_chunk_bytes = chunk_buffer_bytes(plan.order_chunk_bytes);
   plan.pool_read_back_bytes =
       VxlStreamWriter::read_back_bytes(largest_chunk_vertex_bytes(counts, plan.order_chunk_bytes));
   const std::uint64_t orders_part = 2 * (plan.pool_chunk_bytes + plan.pool_read_back_bytes);
@@ -186,6 +185,11 @@ std::uint64_t block_staging_total(const ConversionCounts& c, std::uint64_t stagi
   return total;
 }
 
+std::uint64_t chunk_buffer_bytes(std::uint64_t order_chunk_bytes) {
+  constexpr std::uint64_t block = DirectRegionWriter::kBlock;
+  return (order_chunk_bytes + block - 1) / block * block + block;
+}
+
 bool plan_voxel_runs(MemoryBudget& budget, const ConversionPlan& plan, std::uint64_t runs_bytes) {
   std::uint64_t largest = 0;
   for (const VoxelRange& r : plan.ranges) largest = std::max(largest, r.bytes);
@@ -243,7 +247,7 @@ ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& cou
   if (plan.block_staging_bytes > 0)
     budget.take(plan.pool_bytes, "the vertex blocks being written, then the orders being built and their vertices");
   else
-    budget.take(plan.order_chunk_bytes * (plan.direct_staging_bytes > 0 ? 2 : 1),
+    budget.take(chunk_buffer_bytes(plan.order_chunk_bytes) * (plan.direct_staging_bytes > 0 ? 2 : 1),
                 "the part of the orders being written", ", or a smaller --voxel-size");
   plan.ranges = cut_ranges(budget, counts, plan.block_staging_bytes > 0);
   plan.voxel_index_buffer_bytes = plan_voxel_index(budget, room_at_write, counts);

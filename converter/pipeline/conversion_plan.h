@@ -107,4 +107,8 @@ inline std::uint64_t orders_start(std::span<const VoxelEntry> voxels, std::uint6
 // queue's spares and each (voxel, level) block's own (DirectRegionWriter::staging_size).
 std::uint64_t block_staging_total(const ConversionCounts& counts, std::uint64_t staging);
 
+// The buffer one chunk of orders of up to `order_chunk_bytes` is built in: block-aligned and a block larger, for
+// the orders start where their first byte falls in its block of the file (VxlStreamWriter::append_from_block).
+std::uint64_t chunk_buffer_bytes(std::uint64_t order_chunk_bytes);
+
 }  // namespace vxl

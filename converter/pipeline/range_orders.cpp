@@ -32,8 +32,11 @@ void StreamingConversion::write_orders(const VoxelRange& r, std::span<const std:
   std::vector<std::uint64_t> chunk_bounds;
   for (std::size_t cut : cuts) chunk_bounds.push_back(vertex_start(cut));
   const std::uint64_t vertex_size = vertex_bytes(job_.settings.positions);
-  // The chunks' orders and the vertices read back: in pool_ after the blocks' staging is done with.
-  std::unique_ptr<std::uint8_t[]> own_chunks[2];
+  // The chunks' orders and the vertices read back: in pool_ after the blocks' staging is done with. A chunk's
+  // buffer is block-aligned and one block larger than its orders: they start where their first byte falls in its
+  // block of the file, so that the writer writes their whole blocks from the buffer without a copy
+  // (VxlStreamWriter::append_from_block).
+  std::unique_ptr<std::uint8_t, void (*)(void*)> own_chunks[2] = {{nullptr, std::free}, {nullptr, std::free}};
   std::uint8_t* chunks[2] = {};
   std::optional<ChunkVertices> chunk_vertices;
   if (plan_.block_staging_bytes > 0) {
@@ -61,10 +64,13 @@ void StreamingConversion::write_orders(const VoxelRange& r, std::span<const std:
     const std::uint64_t base = orders_start(first);
     const int b = plan_.direct_staging_bytes > 0 ? c % 2 : 0;
     if (chunks[b] == nullptr) {
-      own_chunks[b] = std::make_unique_for_overwrite<std::uint8_t[]>(plan_.order_chunk_bytes);
+      void* p = std::aligned_alloc(DirectRegionWriter::kBlock, chunk_buffer_bytes(plan_.order_chunk_bytes));
+      if (p == nullptr) throw std::bad_alloc();
+      own_chunks[b].reset(static_cast<std::uint8_t*>(p));
       chunks[b] = own_chunks[b].get();
     }
-    const std::span<std::uint8_t> chunk(chunks[b], orders_start(end) - base);
+    const std::span<std::uint8_t> chunk(chunks[b] + out_->block_lead(VxlStreamWriter::kOrdb, base),
+                                        orders_start(end) - base);
     // Largest voxels first, so that the threads finish the chunk at about the same time.
     by_size.resize(end - first);
     std::iota(by_size.begin(), by_size.end(), first);
@@ -78,10 +84,12 @@ void StreamingConversion::write_orders(const VoxelRange& r, std::span<const std:
                          chunk.data() + (table_.voxels[g].order_offset - base));
     });
     if (writing.valid()) writing.get();  // rethrows a failed write
+    std::uint8_t* const block = chunks[b];
     if (plan_.direct_staging_bytes > 0)
-      writing = BackgroundTask<>([this, chunk] { out_->append(VxlStreamWriter::kOrdb, chunk); });
+      writing = BackgroundTask<>(
+          [this, block, chunk] { out_->append_from_block(VxlStreamWriter::kOrdb, block, chunk.size()); });
     else
-      out_->append(VxlStreamWriter::kOrdb, chunk);
+      out_->append_from_block(VxlStreamWriter::kOrdb, block, chunk.size());
     summary_.orders_seconds += seconds_since(t0);
     report(stage, double(end - r.first) / double(std::max<std::size_t>(1, r.end - r.first)));
   }

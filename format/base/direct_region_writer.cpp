@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
@@ -62,6 +63,43 @@ void DirectRegionWriter::append(std::span<const std::uint8_t> bytes) {
     if (staged_ == staging_bytes_) write_staged();
   }
   if (position_ == end_ && staged_ > 0) write_staged();
+}
+
+void DirectRegionWriter::append_from_block(std::uint8_t* block, std::uint64_t size) {
+  if (queue_ != nullptr) throw std::logic_error("DirectRegionWriter::append_from_block: not with a queue");
+  if (reinterpret_cast<std::uintptr_t>(block) % kBlock != 0)
+    throw std::logic_error("DirectRegionWriter::append_from_block: a block that is not aligned");
+  if (size > end_ - position_) throw std::logic_error("DirectRegionWriter::append_from_block: past the region's end");
+  std::uint64_t lead = block_lead();
+  if (staged_ == 0 && lead != 0) {  // the region's first block, shared with its neighbour: through append
+    const std::uint64_t n = std::min(size, kBlock - lead);
+    append({block + lead, n});
+    block += kBlock;
+    size -= n;
+    lead = 0;
+  }
+  if (size == 0) return;
+  // What is staged: its whole blocks written, the rest (the lead of the block the bytes start in) put before them.
+  if (staged_ > lead) {
+    write_blocks(out_, direct_fd_, staging_.get(), staged_ - lead, staging_start_);
+    staging_start_ += staged_ - lead;
+  }
+  if (lead > 0) std::memcpy(block, staging_.get() + (staged_ - lead), lead);
+  staged_ = 0;
+  const std::uint64_t at = position_ - lead, total = lead + size;  // `at`: block-aligned
+  position_ += size;
+  const std::uint64_t whole = position_ == end_ ? total : total / kBlock * kBlock;  // the last bytes go at once
+  write_blocks(out_, direct_fd_, block, whole, at);
+  if (whole == total) return;
+  // The partial block at the end stays staged for the next append.
+  if (!staging_) {
+    void* p = std::aligned_alloc(kBlock, staging_bytes_);
+    if (p == nullptr) throw std::bad_alloc();
+    staging_ = {static_cast<std::uint8_t*>(p), std::free};
+  }
+  std::memcpy(staging_.get(), block + whole, total - whole);
+  staging_start_ = at + whole;
+  staged_ = total - whole;
 }
 
 void DirectRegionWriter::write_staged() {

@@ -42,6 +42,14 @@ class DirectRegionWriter {
   // direct I/O (EINVAL: tmpfs, some network file systems) it falls back to pwrite for good.
   void append(std::span<const std::uint8_t> bytes);
 
+  // Where the next byte appended falls in its block (the file offset modulo kBlock).
+  std::uint64_t block_lead() const { return position_ % kBlock; }
+  // Appends the `size` bytes at block + block_lead(), as append does, but writes their whole blocks straight from
+  // `block` (block-aligned, its first block_lead() bytes the writer's to overwrite with the bytes staged before
+  // them) instead of copying them through the staging: for large appends from a buffer laid out so. Not with a
+  // queue (std::logic_error).
+  void append_from_block(std::uint8_t* block, std::uint64_t size);
+
   // Writes `size` bytes from `data` at file offset `offset` (block-aligned, as `data` is): whole blocks
   // through `direct_fd` (set to -1 where the file system refuses direct I/O: then plain pwrite), a last
   // partial block through the page cache. Throws vxl::Error (Output).
