@@ -1,6 +1,7 @@
 // Sequential writes to one region of an output file that bypass the page cache (O_DIRECT) for the
 // region's whole 4 KiB blocks; the partial blocks at its two ends, which it may share with its
-// neighbours, go through ordinary pwrite.
+// neighbours, go through ordinary pwrite, each with the staging it belongs to (a buffered write waits for
+// the file's direct writes in flight, so the thread that appends does not make them).
 //
 // Why: on a virtual machine whose host takes back the guest's free memory, every page of page cache a
 // large output occupies is a fresh page the host must fault in again. Buffered writes of 2 GiB ran at
@@ -50,13 +51,15 @@ class DirectRegionWriter {
   // queue (std::logic_error).
   void append_from_block(std::uint8_t* block, std::uint64_t size);
 
-  // Writes `size` bytes from `data` at file offset `offset` (block-aligned, as `data` is): whole blocks
-  // through `direct_fd` (set to -1 where the file system refuses direct I/O: then plain pwrite), a last
-  // partial block through the page cache. Throws vxl::Error (Output).
+  // Writes `size` bytes from `data` at file offset `offset` (block-aligned, as `data` is) but the first `skip`
+  // (less than a block): whole blocks through `direct_fd` (set to -1 where the file system refuses direct I/O:
+  // then plain pwrite), a first block with bytes skipped and a last partial block through the page cache.
+  // Throws vxl::Error (Output).
   static void write_blocks(AtomicOutputFile& out, int& direct_fd, const std::uint8_t* data, std::uint64_t size,
-                           std::uint64_t offset);
+                           std::uint64_t offset, std::uint64_t skip = 0);
 
  private:
+  void start_staging();
   void write_staged();
 
   AtomicOutputFile& out_;
@@ -66,6 +69,8 @@ class DirectRegionWriter {
   std::unique_ptr<std::uint8_t, void (*)(void*)> staging_{nullptr, nullptr};
   std::uint64_t staged_ = 0;         // bytes in staging_
   std::uint64_t staging_start_ = 0;  // the file offset of staging_[0] (block-aligned)
+  std::uint64_t skip_ = 0;           // staging_'s first bytes that are the neighbour's (the region's first block)
+  bool staging_is_spare_ = false;    // staging_ came from the queue (a region may fill more stagings than its own)
   DirectWriteQueue* queue_;
 };
 

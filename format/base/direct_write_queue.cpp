@@ -21,11 +21,11 @@ DirectWriteQueue::~DirectWriteQueue() {
   // writer_'s destructor joins it: the writer drains the queue first.
 }
 
-std::uint8_t* DirectWriteQueue::submit(std::uint8_t* buffer, std::uint64_t size, std::uint64_t offset, bool recycle,
-                                       bool want_spare) {
+std::uint8_t* DirectWriteQueue::submit(std::uint8_t* buffer, std::uint64_t size, std::uint64_t offset,
+                                       std::uint64_t skip, bool recycle, bool want_spare) {
   std::unique_lock lock(mutex_);
   if (failure_) std::rethrow_exception(failure_);
-  jobs_.push_back({buffer, size, offset, recycle});
+  jobs_.push_back({buffer, size, offset, skip, recycle});
   changed_.notify_all();
   if (!want_spare) return nullptr;
   // A job queued with `recycle` comes back as a spare once written, so this wait ends.
@@ -54,7 +54,7 @@ void DirectWriteQueue::run() {
       lock.unlock();
       std::exception_ptr failed;
       try {
-        DirectRegionWriter::write_blocks(out_, direct_fd_, job.buffer, job.size, job.offset);
+        DirectRegionWriter::write_blocks(out_, direct_fd_, job.buffer, job.size, job.offset, job.skip);
       } catch (...) {
         failed = std::current_exception();
       }

@@ -30,11 +30,13 @@ class DirectWriteQueue {
 
   std::uint64_t buffer_bytes() const { return buffer_bytes_; }
 
-  // Queues `size` bytes at `buffer` for file offset `offset` (block-aligned): whole blocks are written
-  // directly, a partial last one through the page cache (DirectRegionWriter::write_blocks). A buffer of
+  // Queues `size` bytes at `buffer` for file offset `offset` (block-aligned), the first `skip` not written:
+  // whole blocks are written directly, a partial first or last one through the page cache
+  // (DirectRegionWriter::write_blocks). A buffer of
   // buffer_bytes() (`recycle`) becomes a spare once written. With `want_spare`, returns a spare, waiting
   // for one if none is free; otherwise nullptr. Rethrows an earlier failed write.
-  std::uint8_t* submit(std::uint8_t* buffer, std::uint64_t size, std::uint64_t offset, bool recycle, bool want_spare);
+  std::uint8_t* submit(std::uint8_t* buffer, std::uint64_t size, std::uint64_t offset, std::uint64_t skip, bool recycle,
+                       bool want_spare);
 
   // Waits until every queued write is done; rethrows the first failure.
   void finish();
@@ -42,7 +44,7 @@ class DirectWriteQueue {
  private:
   struct Job {
     std::uint8_t* buffer;
-    std::uint64_t size, offset;
+    std::uint64_t size, offset, skip;
     bool recycle;
   };
   void run();
