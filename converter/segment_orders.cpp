@@ -190,9 +190,19 @@ void VoxelOrderWriter::write_packed(const VoxelEntry& v, std::span<const LevelEn
   PackedBlock& block = scratch_->packed;
   block.words = words;
   const VertexPacker packer(v);
+  // The quantum sums' tables (some 7k operations an axis) pay only where the sorts are long, and only along
+  // the axes a shared set sorts by (a per-voxel set's random directions are no axes).
+  constexpr std::uint32_t kRankedVoxelVertices = 1u << 14;
+  const bool ranked = !set_->per_voxel() && v.vertex_count >= kRankedVoxelVertices;
   for (int c = 0; c < 3; ++c) {
     for (std::uint32_t q = 0; q <= kPackedSteps; ++q) block.decoded[c][q] = packer.decode_axis(c, q);
-    block.sums[c].prepare(block.decoded[c]);
+    const bool along_c = std::any_of(set_->directions.begin(), set_->directions.end(), [&](const auto& d) {
+      return d[c] == 1.0f && d[(c + 1) % 3] == 0.0f && d[(c + 2) % 3] == 0.0f;
+    });
+    if (ranked && along_c)
+      block.sums[c].prepare(block.decoded[c]);
+    else
+      block.sums[c].clear();
   }
   write_levels(v, row, block, dst);
 }

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <array>
+#include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -50,6 +52,8 @@ class QuantumSumKeys {
  public:
   // From the axis's decoded quanta (PackedBlock::decoded).
   void prepare(const std::array<float, kPackedSteps + 1>& decoded);
+  // Not prepared: sort returns nullptr.
+  void clear() { usable_ = false; }
   // Whether the buckets are apart (sort may still find a key outside its bucket and return nullptr).
   bool usable() const { return usable_; }
   // Writes the order of the block's segments (block-local `starts`, ascending) by ascending key, ties by

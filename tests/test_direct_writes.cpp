@@ -38,7 +38,7 @@ std::vector<std::uint8_t> file_bytes(const std::string& path) {
 }
 
 // Regions back to back (the first from offset 0), of sizes below, at and across block boundaries. With
-// `from_blocks`, every other piece is appended from a block-aligned buffer laid out as append_from_block wants.
+// `from_blocks`, most pieces are appended from a block-aligned buffer laid out as append_from_block wants.
 void write_regions(const std::string& path, bool use_direct_io, const std::vector<std::uint8_t>& expected,
                    const std::vector<std::uint64_t>& ends, bool from_blocks = false) {
   AtomicOutputFile out(path);
@@ -47,22 +47,25 @@ void write_regions(const std::string& path, bool use_direct_io, const std::vecto
   std::mt19937 rng(5);
   constexpr std::uint64_t block = DirectRegionWriter::kBlock;
   std::unique_ptr<std::uint8_t, void (*)(void*)> buffer(
-      static_cast<std::uint8_t*>(std::aligned_alloc(block, 20000 + block)), std::free);
+      static_cast<std::uint8_t*>(std::aligned_alloc(block, (20000 + 2 * block) / block * block)), std::free);
+  ASSERT_NE(buffer, nullptr);
   std::uint64_t start = 0;
-  for (std::uint64_t end : ends) {
+  for (std::size_t r = 0; r < ends.size(); ++r) {
+    const std::uint64_t end = ends[r];
     DirectRegionWriter region(out, direct_fd, start, end - start, 3 * block);
-    bool next_from_block = false;
-    for (std::uint64_t at = start; at < end;) {
+    // Pieces from blocks two times in three, the pattern shifted per region: a region's first piece, and
+    // pieces back to back, come from blocks too.
+    std::size_t piece = r;
+    for (std::uint64_t at = start; at < end; ++piece) {
       const std::uint64_t n =
           std::min<std::uint64_t>(end - at, std::uniform_int_distribution<std::uint64_t>(1, 20000)(rng));
-      if (next_from_block) {
+      if (from_blocks && piece % 3 != 0) {
         std::fill_n(buffer.get(), block, std::uint8_t{0xEE});  // what precedes the bytes is the writer's
         std::copy_n(expected.data() + at, n, buffer.get() + region.block_lead());
         region.append_from_block(buffer.get(), n);
       } else {
         region.append({expected.data() + at, n});
       }
-      next_from_block = from_blocks && !next_from_block;
       at += n;
     }
     start = end;

@@ -52,9 +52,9 @@ void StreamingConversion::write_orders(const VoxelRange& r, std::span<const std:
   }
   // With direct writes a chunk is written on its own thread while the next one is built (the write waits
   // on the disk, not the CPU); through the page cache it is written before the next one is built.
-  // The buffers are taken once at the largest chunk's size and not cleared: the writers write every
-  // byte of their voxels' orders, padding included. (Regrowing and zeroing them per chunk took 3 of the
-  // 11 s of a 10M conversion's orders: fresh pages cost much on a virtual machine.)
+  // The buffers are taken once (chunk_buffer_bytes, for the largest chunk) and not cleared: the writers write
+  // every byte of their voxels' orders, padding included. (Regrowing and zeroing them per chunk took 3 of
+  // the 11 s of a 10M conversion's orders: fresh pages cost much on a virtual machine.)
   std::vector<std::size_t> by_size;  // a chunk's voxels
   BackgroundTask<> writing;
   for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {

@@ -32,8 +32,9 @@ class DirectRegionWriter {
   DirectRegionWriter(AtomicOutputFile& out, int direct_fd, std::uint64_t offset, std::uint64_t size,
                      std::uint64_t staging_bytes, std::uint8_t* staging_memory = nullptr,
                      DirectWriteQueue* queue = nullptr);
-  // The staging buffer a region of `size` bytes takes (allocated at its first append): `staging_bytes`
-  // rounded up to blocks, but no more than the region can fill.
+  // The staging buffer a region of `size` bytes takes (allocated when first needed): `staging_bytes` rounded
+  // up to blocks, but no more than the region can fill (the blocks it spans, with one for where it may start
+  // inside a block).
   static std::uint64_t staging_size(std::uint64_t size, std::uint64_t staging_bytes);
   DirectRegionWriter(const DirectRegionWriter&) = delete;
   DirectRegionWriter& operator=(const DirectRegionWriter&) = delete;
