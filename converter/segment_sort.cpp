@@ -103,6 +103,16 @@ std::uint8_t* put_entries(std::uint8_t* dst, std::uint32_t bits, std::size_t n, 
   return dst;
 }
 
+// Sorts s.keys — each a `bits`-bit key above a block-local index of `index_bits` bits — by key (ties keep the
+// ascending index order they come in) and writes their indices as `entry_bits`-bit entries to dst.
+std::uint8_t* sort_indexed_keys(SortScratch& s, int index_bits, int bits, std::uint32_t entry_bits, std::uint8_t* dst) {
+  radix_sort_bits(
+      s.keys, s.packed_tmp, s.counts, [](std::uint64_t x) { return x; }, index_bits, bits);
+  const std::uint64_t index_mask = (1ull << index_bits) - 1;
+  return put_entries(dst, entry_bits, s.keys.size(),
+                     [&](std::size_t i) { return static_cast<std::uint32_t>(s.keys[i] & index_mask); });
+}
+
 // The exponent of the lowest set bit of a finite, nonzero float: it is a multiple of 2 to that power.
 int lowest_bit_exponent(float f) {
   const auto bits = std::bit_cast<std::uint32_t>(f);
@@ -131,11 +141,7 @@ std::uint8_t* sort_segments(const std::vector<std::uint32_t>& starts, std::uint3
     // In place: one array less to fill and to keep in cache (the largest voxels' do not fit).
     const std::uint64_t field = (1ull << bits) - 1;  // bits < 64 here
     for (std::size_t i = 0; i < n; ++i) s.keys[i] = ((s.keys[i] >> low) & field) << index_bits | starts[i];
-    radix_sort_bits(
-        s.keys, s.packed_tmp, s.counts, [](std::uint64_t x) { return x; }, index_bits, bits);
-    const std::uint64_t index_mask = (1ull << index_bits) - 1;
-    return put_entries(dst, entry_bits, n,
-                       [&](std::size_t i) { return static_cast<std::uint32_t>(s.keys[i] & index_mask); });
+    return sort_indexed_keys(s, index_bits, bits, entry_bits, dst);
   }
   s.keyed.reserve(s.max_vertices);
   s.keyed_tmp.reserve(s.max_vertices);
@@ -205,11 +211,7 @@ std::uint8_t* QuantumSumKeys::sort(const std::vector<std::uint32_t>& starts, con
     s.keys.resize(n);
     for (std::size_t i = 0; i < n; ++i) s.keys[i] = key_of(starts[i]) << index_bits | starts[i];
     if (outside != 0) return nullptr;
-    radix_sort_bits(
-        s.keys, s.packed_tmp, s.counts, [](std::uint64_t x) { return x; }, index_bits, key_bits);
-    const std::uint64_t index_mask = (1ull << index_bits) - 1;
-    return put_entries(dst, entry_bits, n,
-                       [&](std::size_t i) { return static_cast<std::uint32_t>(s.keys[i] & index_mask); });
+    return sort_indexed_keys(s, index_bits, key_bits, entry_bits, dst);
   }
   // One counting sort by the whole key: a pass over 4-byte indices instead of radix passes over 8-byte items.
   s.bucket_keys.reserve(s.max_vertices);

@@ -40,7 +40,7 @@ std::vector<std::uint8_t> file_bytes(const std::string& path) {
 // Regions back to back (the first from offset 0), of sizes below, at and across block boundaries. With
 // `from_blocks`, most pieces are appended from a block-aligned buffer laid out as append_from_block wants.
 void write_regions(const std::string& path, bool use_direct_io, const std::vector<std::uint8_t>& expected,
-                   const std::vector<std::uint64_t>& ends, bool from_blocks = false) {
+                   const std::vector<std::uint64_t>& ends, bool from_blocks) {
   AtomicOutputFile out(path);
   out.allocate(expected.size());
   const int direct_fd = use_direct_io ? out.direct_descriptor() : -1;
@@ -73,20 +73,26 @@ void write_regions(const std::string& path, bool use_direct_io, const std::vecto
   out.commit();
 }
 
-TEST(DirectWrites, RegionsOfAnySizeAppendedInPiecesGiveThePlainBytes) {
-  ScratchDir dir;
-  std::mt19937 rng(3);
+// 600000 random bytes written as regions ending at `ends`, with O_DIRECT and without: the plain bytes both ways.
+void expect_plain_bytes(const ScratchDir& dir, std::uint32_t seed, const std::vector<std::uint64_t>& ends,
+                        bool from_blocks) {
+  std::mt19937 rng(seed);
   std::vector<std::uint8_t> expected(600000);
   for (auto& b : expected) b = static_cast<std::uint8_t>(rng());
-  const std::uint64_t block = DirectRegionWriter::kBlock;
-  const std::vector<std::uint64_t> ends = {7,         block - 1,     block,  block + 1,       5 * block + 100,
-                                           9 * block, 9 * block + 4, 120000, 40 * block + 13, 599999,
-                                           600000};
   for (bool direct : {true, false}) {
     const std::string path = dir.file(direct ? "direct.bin" : "buffered.bin");
-    write_regions(path, direct, expected, ends);
+    write_regions(path, direct, expected, ends, from_blocks);
     EXPECT_TRUE(file_bytes(path) == expected) << (direct ? "with" : "without") << " O_DIRECT";
   }
+}
+
+TEST(DirectWrites, RegionsOfAnySizeAppendedInPiecesGiveThePlainBytes) {
+  ScratchDir dir;
+  const std::uint64_t block = DirectRegionWriter::kBlock;
+  expect_plain_bytes(dir, 3,
+                     {7, block - 1, block, block + 1, 5 * block + 100, 9 * block, 9 * block + 4, 120000,
+                      40 * block + 13, 599999, 600000},
+                     false);
   AtomicOutputFile probe(dir.file("probe.bin"));
   if (probe.direct_descriptor() < 0)
     GTEST_LOG_(INFO) << "this file system refuses O_DIRECT: only the fallback was exercised";
@@ -94,16 +100,8 @@ TEST(DirectWrites, RegionsOfAnySizeAppendedInPiecesGiveThePlainBytes) {
 
 TEST(DirectWrites, RegionsAppendedFromBlocksGiveThePlainBytes) {
   ScratchDir dir;
-  std::mt19937 rng(4);
-  std::vector<std::uint8_t> expected(600000);
-  for (auto& b : expected) b = static_cast<std::uint8_t>(rng());
   const std::uint64_t block = DirectRegionWriter::kBlock;
-  const std::vector<std::uint64_t> ends = {5, block + 3, 3 * block, 7 * block + 1, 130001, 599000, 600000};
-  for (bool direct : {true, false}) {
-    const std::string path = dir.file(direct ? "direct.bin" : "buffered.bin");
-    write_regions(path, direct, expected, ends, true);
-    EXPECT_TRUE(file_bytes(path) == expected) << (direct ? "with" : "without") << " O_DIRECT";
-  }
+  expect_plain_bytes(dir, 4, {5, block + 3, 3 * block, 7 * block + 1, 130001, 599000, 600000}, true);
 }
 
 // A mapped output (what VxlWriter fills) is memory written to the file at commit(): whole 4 KiB blocks

@@ -41,11 +41,7 @@ std::uint64_t DirectRegionWriter::staging_size(std::uint64_t size, std::uint64_t
 void DirectRegionWriter::append(std::span<const std::uint8_t> bytes) {
   if (bytes.size() > end_ - position_) throw std::logic_error("DirectRegionWriter::append: past the region's end");
   while (!bytes.empty()) {
-    if (!staging_) {
-      void* p = std::aligned_alloc(kBlock, staging_bytes_);
-      if (p == nullptr) throw std::bad_alloc();
-      staging_ = {static_cast<std::uint8_t*>(p), std::free};
-    }
+    ensure_staging();
     if (staged_ == 0) start_staging();
     const std::uint64_t n = std::min<std::uint64_t>(bytes.size(), staging_bytes_ - staged_);
     std::memcpy(staging_.get() + staged_, bytes.data(), n);
@@ -55,6 +51,13 @@ void DirectRegionWriter::append(std::span<const std::uint8_t> bytes) {
     if (staged_ == staging_bytes_) write_staged();
   }
   if (position_ == end_ && staged_ > 0) write_staged();
+}
+
+void DirectRegionWriter::ensure_staging() {
+  if (staging_) return;
+  void* p = std::aligned_alloc(kBlock, staging_bytes_);
+  if (p == nullptr) throw std::bad_alloc();
+  staging_ = {static_cast<std::uint8_t*>(p), std::free};
 }
 
 void DirectRegionWriter::start_staging() {
@@ -94,11 +97,7 @@ void DirectRegionWriter::append_from_block(std::uint8_t* block, std::uint64_t si
   const std::uint64_t whole = position_ == end_ ? total : total / kBlock * kBlock;
   if (whole > 0) write_blocks(out_, direct_fd_, block, whole, at, skip);
   if (whole == total) return;
-  if (!staging_) {
-    void* p = std::aligned_alloc(kBlock, staging_bytes_);
-    if (p == nullptr) throw std::bad_alloc();
-    staging_ = {static_cast<std::uint8_t*>(p), std::free};
-  }
+  ensure_staging();
   std::memcpy(staging_.get(), block + whole, total - whole);
   staging_start_ = at + whole;
   staged_ = total - whole;

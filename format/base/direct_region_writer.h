@@ -60,6 +60,7 @@ class DirectRegionWriter {
                            std::uint64_t offset, std::uint64_t skip = 0);
 
  private:
+  void ensure_staging();  // the writer's own staging, at first need (unless the caller gave one)
   void start_staging();
   void write_staged();
 
