@@ -38,6 +38,9 @@ struct ConvertSummary {
   // convert_streaming only: the placing passes cut the streamlines by the voxel runs the counting pass kept
   // (false: they voxelised again, the limit leaving no room for the runs).
   bool voxelised_once = false;
+  // convert_streaming only: the voxel index's lists were filled as the first range was placed (false: sorted at
+  // the write stage from the voxline and streamline tables read back, the limit leaving no room to hold them).
+  bool voxel_index_while_placing = false;
   // convert_streaming: the source's; convert_tractogram: the conversion's own (the reader's are in the
   // Tractogram, for its caller to show).
   std::vector<std::string> warnings;

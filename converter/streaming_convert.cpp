@@ -50,6 +50,19 @@ void StreamingConversion::write_rest() {
   if (!table_.levels.empty()) out_->append_items<LevelEntry>(VxlStreamWriter::kLods, table_.levels);
 }
 
+// The voxel index's lists are filled as the first range is placed where the plan leaves room for them: the write
+// stage then writes them instead of reading VXLN and STRM back (twice) to sort them.
+void StreamingConversion::plan_index_lists() {
+  const std::uint64_t bytes = VoxelIndexLists::bytes(table_.voxels.size(), table_.meta.voxline_count);
+  if (!plan_voxel_index_lists(budget_, plan_, bytes)) return;
+  table_.index_lists_held = bytes;
+  std::vector<std::uint64_t> voxlines(table_.voxels.size());
+  for (std::size_t g = 0; g < voxlines.size(); ++g)  // each voxline has one vertex more than it has segments
+    voxlines[g] = table_.voxels[g].vertex_count - table_.voxels[g].segment_count;
+  table_.index_lists.emplace(voxlines);
+  summary_.voxel_index_while_placing = true;
+}
+
 ConvertSummary StreamingConversion::run() {
   if (job_.settings.memory_limit == 0) throw std::logic_error("convert_streaming: memory_limit must be > 0");
   check_source_type();
@@ -79,6 +92,7 @@ ConvertSummary StreamingConversion::run() {
     table_.runs_held = table_.runs.bytes();
   else
     table_.runs.clear();
+  plan_index_lists();
   staged_held_ = plan_.staged_bytes;
   table_.spans.resize(table_.meta.streamline_count);
   if (plan_.block_staging_bytes > 0) {
@@ -106,14 +120,20 @@ ConvertSummary StreamingConversion::run() {
   report("writing", 0.0);
   t0 = Clock::now();
   write_rest();
-  // The voxel index's buffer takes the memory the ranges and the pool gave back: the pool itself where it is
-  // large enough (its pages are in memory already; fresh ones cost more than the sorting on some machines).
-  std::span<std::uint8_t> index_buffer;
-  if (pool_ && plan_.pool_bytes >= plan_.voxel_index_buffer_bytes)
-    index_buffer = {pool_.get(), plan_.voxel_index_buffer_bytes};
-  else
-    pool_.reset();
-  out_->append_voxel_index(plan_.voxel_index_buffer_bytes, index_buffer);
+  if (table_.index_lists) {
+    out_->append_voxel_index(*table_.index_lists);
+    table_.index_lists.reset();
+    budget_.shrink(0, table_.index_lists_held);
+  } else {
+    // The voxel index's buffer takes the memory the ranges and the pool gave back: the pool itself where it is
+    // large enough (its pages are in memory already; fresh ones cost more than the sorting on some machines).
+    std::span<std::uint8_t> index_buffer;
+    if (pool_ && plan_.pool_bytes >= plan_.voxel_index_buffer_bytes)
+      index_buffer = {pool_.get(), plan_.voxel_index_buffer_bytes};
+    else
+      pool_.reset();
+    out_->append_voxel_index(plan_.voxel_index_buffer_bytes, index_buffer);
+  }
   pool_.reset();
   if (!scan_.lengths.empty()) out_->append_items<float>(VxlStreamWriter::kSlen, scan_.lengths);
   out_->append(VxlStreamWriter::kProv, {reinterpret_cast<const std::uint8_t*>(provenance.data()), provenance.size()});

@@ -85,16 +85,33 @@ void fill_voxel_index(std::uint64_t voxel_count, std::uint64_t voxline_count, st
     each_voxline(io, voxline_count, part, [&](std::uint64_t j, const VoxlineEntry& e) {
       while (strm.at(s + 1) <= j) ++s;  // the streamline voxline j belongs to (STRM checked by the caller)
       if (e.voxel < begin || e.voxel >= end) return;
-      std::uint32_t word = static_cast<std::uint32_t>(s);
-      if (e.count_flags & kVoxlineSyntheticFirst) word |= IndexedVoxline::kSyntheticFirst;
-      if (j == strm.at(s)) word |= IndexedVoxline::kFirstOfStreamline;
-      if (j + 1 == strm.at(s + 1)) word |= IndexedVoxline::kLastOfStreamline;
-      lists[cursor[e.voxel - begin]++ - first[begin]] = {word};
+      lists[cursor[e.voxel - begin]++ - first[begin]] = indexed_voxline(s, e, j == strm.at(s), j + 1 == strm.at(s + 1));
     });
     if (io.in_place.empty())
       io.write({reinterpret_cast<const std::uint8_t*>(lists.data()), lists.size() * sizeof(IndexedVoxline)});
     begin = end;
   }
+}
+
+VoxelIndexLists::VoxelIndexLists(std::span<const std::uint64_t> voxlines) : first_(voxlines.size() + 1, 0) {
+  for (std::size_t v = 0; v < voxlines.size(); ++v) first_[v + 1] = first_[v] + voxlines[v];
+  next_.assign(first_.begin(), first_.end() - 1);
+  entries_.reset(new IndexedVoxline[first_.back()]);
+}
+
+bool VoxelIndexLists::add_streamline(std::uint64_t s, std::span<const VoxlineEntry> voxlines) {
+  for (std::size_t j = 0; j < voxlines.size(); ++j) {
+    const VoxlineEntry& e = voxlines[j];
+    if (e.voxel >= next_.size() || next_[e.voxel] == first_[e.voxel + 1]) return false;
+    entries_[next_[e.voxel]++] = indexed_voxline(s, e, j == 0, j + 1 == voxlines.size());
+  }
+  return true;
+}
+
+bool VoxelIndexLists::complete() const {
+  for (std::size_t v = 0; v < next_.size(); ++v)
+    if (next_[v] != first_[v + 1]) return false;
+  return true;
 }
 
 namespace {

@@ -54,6 +54,41 @@ inline constexpr std::uint64_t kVoxelIndexPartEntries = 1 << 20;
 // larger than that alone). Each pass reads both tables in order, in parts of about 8 MB.
 void fill_voxel_index(std::uint64_t voxel_count, std::uint64_t voxline_count, std::uint64_t streamline_count,
                       const VoxelIndexIo& io, std::uint64_t buffer_bytes);
+// The list entry of voxel table entry `e` of streamline `s`, which is its streamline's first and/or last voxline.
+inline IndexedVoxline indexed_voxline(std::uint64_t s, const VoxlineEntry& e, bool first, bool last) {
+  std::uint32_t word = static_cast<std::uint32_t>(s);
+  if (e.count_flags & kVoxlineSyntheticFirst) word |= IndexedVoxline::kSyntheticFirst;
+  if (first) word |= IndexedVoxline::kFirstOfStreamline;
+  if (last) word |= IndexedVoxline::kLastOfStreamline;
+  return {word};
+}
+
+// VXIX's payload filled as a writer produces VXLN, streamline by streamline in order, when every voxel's list
+// fits in memory at once (4 bytes a voxline): the same lists fill_voxel_index sorts, without reading the tables
+// back.
+class VoxelIndexLists {
+ public:
+  // For voxels of these voxline counts (`voxlines[v]`: voxel v's).
+  explicit VoxelIndexLists(std::span<const std::uint64_t> voxlines);
+  // Streamline s's voxlines, in order. False when one would overflow its voxel's list (other counts).
+  bool add_streamline(std::uint64_t s, std::span<const VoxlineEntry> voxlines);
+  // Whether every list is full.
+  bool complete() const;
+  // VXIX's payload: the list starts (voxel count + 1), then the lists.
+  std::span<const std::uint64_t> starts() const { return first_; }
+  std::span<const IndexedVoxline> lists() const { return {entries_.get(), first_.back()}; }
+  // The memory it holds for these counts.
+  static std::uint64_t bytes(std::uint64_t voxel_count, std::uint64_t voxline_count) {
+    return 16 * voxel_count + 8 + sizeof(IndexedVoxline) * voxline_count;
+  }
+
+ private:
+  std::vector<std::uint64_t> first_, next_;  // where each voxel's list starts; where its next entry goes
+  // Left uninitialised: every entry is written once before complete() holds (its pages are faulted in as the
+  // lists fill, not all at once up front).
+  std::unique_ptr<IndexedVoxline[]> entries_;
+};
+
 // The same from tables in memory into a whole payload of voxel_index_bytes(), in one range.
 void fill_voxel_index_payload(std::span<std::uint8_t> payload, std::span<const std::uint64_t> strm,
                               std::span<const VoxlineEntry> voxlines);

@@ -177,6 +177,16 @@ void VxlStreamWriter::append_voxel_index(std::uint64_t buffer_bytes, std::span<s
   fill_voxel_index(voxels, voxlines, streamlines, io, buffer_bytes);
 }
 
+void VxlStreamWriter::append_voxel_index(const VoxelIndexLists& lists) {
+  const std::size_t x = entry_[kVxix];
+  if (x >= table_.size()) return;
+  if (!lists.complete() || written_[x] != 0 ||
+      lists.starts().size_bytes() + lists.lists().size_bytes() != table_[x].size)
+    throw std::logic_error("VxlStreamWriter::append_voxel_index: lists incomplete or for other counts, or VXIX begun");
+  append_items<std::uint64_t>(kVxix, lists.starts());
+  append_items<IndexedVoxline>(kVxix, lists.lists());
+}
+
 void VxlStreamWriter::commit() {
   for (std::size_t i = 0; i < table_.size(); ++i) {
     if (written_[i] != table_[i].size)

@@ -23,6 +23,8 @@
 
 namespace vxl {
 
+class VoxelIndexLists;
+
 class VxlStreamWriter : public VxlSections {
  public:
   using Section = Index;  // VVAL and SVAL: never planned here, so appending to them throws
@@ -96,6 +98,8 @@ class VxlStreamWriter : public VxlSections {
   // alone), one pass over both tables per buffer full besides the one that counts the lists. `scratch`, where
   // given, is the caller's memory for that buffer (4-byte aligned).
   void append_voxel_index(std::uint64_t buffer_bytes, std::span<std::uint8_t> scratch = {});
+  // Appends VXIX from lists filled as VXLN was made (`lists` complete, for this file's counts).
+  void append_voxel_index(const VoxelIndexLists& lists);
 
   // Throws std::logic_error unless every payload has been appended in full; then writes the table and
   // the header and links the file into place. Without commit() the destructor discards the file.

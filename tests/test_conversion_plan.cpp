@@ -235,6 +235,23 @@ TEST(ConversionPlan, VoxelRunsAreKeptOnlyBesideThePlanAndItsLargestRange) {
   EXPECT_FALSE(plan_voxel_runs(tight, cut, 8 * kMiB));
 }
 
+TEST(ConversionPlan, VoxelIndexListsAreHeldOnlyInHalfOfWhatThePlanAndItsLargestRangeLeave) {
+  const Table t(std::vector<std::uint32_t>(500, 1000));
+  MemoryBudget budget(200 * kMiB, "source.tck");
+  const ConversionPlan plan = plan_conversion(budget, t.counts());
+  ASSERT_EQ(plan.ranges.size(), 1u);
+  ASSERT_GT(plan.voxel_index_buffer_bytes, 0u);
+  const std::uint64_t used = budget.used(), half = (budget.left() - plan.ranges[0].bytes) / 2;
+  EXPECT_FALSE(plan_voxel_index_lists(budget, plan, half + 1));
+  EXPECT_EQ(budget.used(), used) << "lists that do not fit take nothing";
+  EXPECT_TRUE(plan_voxel_index_lists(budget, plan, half));
+  EXPECT_EQ(budget.used(), used + half);
+  // A file without a voxel index (plan_voxel_index: no buffer) holds no lists.
+  ConversionPlan without = plan;
+  without.voxel_index_buffer_bytes = 0;
+  EXPECT_FALSE(plan_voxel_index_lists(budget, without, 0));
+}
+
 TEST(ConversionPlan, TheSameCountsGiveTheSamePlan) {
   const Table t(std::vector<std::uint32_t>(1500, 2500));
   MemoryBudget a(20 * kMiB, "source.tck"), b(20 * kMiB, "source.tck");

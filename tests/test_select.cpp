@@ -371,6 +371,40 @@ TEST(SelectionIndex, FilledInPartsItIsTheSameIndex) {
   }
 }
 
+// A streamed conversion that holds every list fills them as it writes VXLN, streamline by streamline
+// (VoxelIndexLists): the same payload, and lists that the streamlines overflow or leave short are told apart.
+TEST(SelectionIndex, FilledStreamlineByStreamlineItIsTheSameIndex) {
+  ScratchDir dir;
+  convert_tractogram(synth(3000, 5), dir.file("p.vxl"), settings(PositionEncoding::Packed, 4.0));
+  const VxlFile f = VxlFile::open(dir.file("p.vxl"));
+  const auto strm = f.streamline_first_voxline();
+  const auto voxlines = f.voxlines();
+  std::vector<std::uint64_t> counts(f.voxels().size());
+  for (std::size_t v = 0; v < counts.size(); ++v) counts[v] = f.voxels()[v].vertex_count - f.voxels()[v].segment_count;
+  VoxelIndexLists lists(counts);
+  for (std::uint64_t s = 0; s + 1 < strm.size(); ++s) {
+    EXPECT_FALSE(lists.complete()) << "before streamline " << s;
+    ASSERT_TRUE(lists.add_streamline(s, voxlines.subspan(strm[s], strm[s + 1] - strm[s])));
+  }
+  EXPECT_TRUE(lists.complete());
+  std::vector<std::uint8_t> filled;
+  for (const auto part : {std::as_bytes(lists.starts()), std::as_bytes(lists.lists())})
+    for (const std::byte b : part) filled.push_back(static_cast<std::uint8_t>(b));
+  ASSERT_EQ(filled.size(), voxel_index_bytes(f.meta()));
+  const auto* stored = reinterpret_cast<const std::uint8_t*>(f.voxel_index_first().data());
+  EXPECT_TRUE(std::equal(filled.begin(), filled.end(), stored)) << "the file's VXIX";
+  // One voxline more than a voxel's count overflows its list; a voxel out of range is refused.
+  std::vector<std::uint64_t> fewer = counts;
+  const std::size_t v = voxlines[0].voxel;
+  fewer[v] = 0;
+  VoxelIndexLists short_lists(fewer);
+  EXPECT_FALSE(short_lists.add_streamline(0, voxlines.first(1)));
+  VoxelIndexLists again(counts);
+  VoxlineEntry outside = voxlines[0];
+  outside.voxel = static_cast<std::uint32_t>(counts.size());
+  EXPECT_FALSE(again.add_streamline(0, {&outside, 1}));
+}
+
 // Voxline and streamline tables that do not hold together, checksums resealed so that only the structure
 // can tell: building the index, and selecting with or without it, is refused naming the file (Input) —
 // never a read past a table. An index holds no point counts (the block says where a voxline ends), so a count

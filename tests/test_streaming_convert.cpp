@@ -266,6 +266,7 @@ TEST(StreamingConvert, VoxelRunsAreKeptWhereTheyFitAndTheBytesAreTheSame) {
   const std::string whole = dir.file("whole.vxl"), ranged = dir.file("ranged.vxl");
   s = convert_streaming(tck, ranged, settings, small_ranges);
   EXPECT_TRUE(s.voxelised_once);
+  EXPECT_TRUE(s.voxel_index_while_placing) << "the voxel index's lists filled by the first of several ranges";
   EXPECT_GE(s.partitions, 3u);
   EXPECT_TRUE(file_bytes(whole) == file_bytes(ranged));
   EXPECT_GT(streamlines_across_ranges(ranged, s.partition_starts), 1000u);
@@ -282,6 +283,19 @@ TEST(StreamingConvert, VoxelRunsAreKeptWhereTheyFitAndTheBytesAreTheSame) {
   EXPECT_TRUE(s.voxelised_once);
   EXPECT_GE(s.partitions, 2u);
   EXPECT_TRUE(file_bytes(whole) == file_bytes(ranged));
+}
+
+// The voxel index's lists are filled as the first range is placed where the limit holds them, and sorted from the
+// tables read back at the write stage where it does not: the in-memory conversion's bytes either way.
+TEST(StreamingConvert, TheVoxelIndexIsFilledWhilePlacingWhereItFitsAndTheBytesAreTheSame) {
+  ScratchDir dir;
+  const std::string tck = dir.file("in.tck");
+  write_synth_tck(tck, 12000);
+  ConvertSummary s = expect_identical(dir, tck, settings_for(10.0), 256 * kMiB);
+  EXPECT_TRUE(s.voxel_index_while_placing);
+  s = expect_identical(dir, tck, settings_for(10.0), 24 * kMiB);  // no room for the lists
+  EXPECT_FALSE(s.voxel_index_while_placing);
+  EXPECT_GE(s.partitions, 2u);
 }
 
 // Float64 big-endian source, an empty streamline, no Inf terminator: the provenance (checksum, header,

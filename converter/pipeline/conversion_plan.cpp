@@ -190,11 +190,26 @@ std::uint64_t chunk_buffer_bytes(std::uint64_t order_chunk_bytes) {
   return (order_chunk_bytes + block - 1) / block * block + block;
 }
 
-bool plan_voxel_runs(MemoryBudget& budget, const ConversionPlan& plan, std::uint64_t runs_bytes) {
+namespace {
+
+// What the limit leaves beside `plan`'s largest range.
+std::uint64_t left_beside_ranges(const MemoryBudget& budget, const ConversionPlan& plan) {
   std::uint64_t largest = 0;
   for (const VoxelRange& r : plan.ranges) largest = std::max(largest, r.bytes);
-  if (budget.left() < largest || runs_bytes > budget.left() - largest) return false;
+  return budget.left() > largest ? budget.left() - largest : 0;
+}
+
+}  // namespace
+
+bool plan_voxel_runs(MemoryBudget& budget, const ConversionPlan& plan, std::uint64_t runs_bytes) {
+  if (runs_bytes > left_beside_ranges(budget, plan)) return false;
   budget.take(runs_bytes, "the voxel runs");
+  return true;
+}
+
+bool plan_voxel_index_lists(MemoryBudget& budget, const ConversionPlan& plan, std::uint64_t lists_bytes) {
+  if (plan.voxel_index_buffer_bytes == 0 || lists_bytes > left_beside_ranges(budget, plan) / 2) return false;
+  budget.take(lists_bytes, "the voxel index's lists");
   return true;
 }
 
@@ -225,8 +240,9 @@ std::uint64_t plan_voxel_index(const MemoryBudget& budget, std::uint64_t room, c
 
 ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& counts) {
   ConversionPlan plan;
-  budget.take(kTableBufferEntries * (sizeof(VoxlineEntry) + sizeof(std::uint64_t)),
-              "the buffer of the voxline and streamline tables");
+  plan.table_buffer_entries = std::clamp<std::uint64_t>(budget.limit() >> 14, 1 << 15, 1 << 18);
+  budget.take(2 * plan.table_buffer_entries * (sizeof(VoxlineEntry) + sizeof(std::uint64_t)),
+              "the buffers of the voxline and streamline tables");
   budget.take(counts.meta.streamline_count * sizeof(std::array<std::uint32_t, 2>),
               "the voxel span of every streamline");
   plan.staged_bytes = staged_batches_bytes(counts);

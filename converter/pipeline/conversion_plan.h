@@ -17,8 +17,6 @@
 
 namespace vxl {
 
-// Voxline and streamline table entries written at once.
-inline constexpr std::size_t kTableBufferEntries = 1 << 16;
 // Spare stagings for the blocks' write queue (DirectWriteQueue): how far the writes may fall behind.
 inline constexpr std::uint64_t kSpareBlockStagings = 32;
 // Memory per point of a batch being read, at worst: two batches (one read while the other is processed),
@@ -64,6 +62,9 @@ struct ConversionCounts {
 };
 
 struct ConversionPlan {
+  // Voxline and streamline table entries written at once (TableAppender: two buffers of each, one filling while
+  // the other is written): more under larger limits, so that a large source's tables take fewer writes.
+  std::uint64_t table_buffer_entries = 0;
   std::uint64_t staged_bytes = 0;          // two batches' staged voxlines, as first taken (they may grow)
   std::uint64_t direct_staging_bytes = 0;  // per section; 0: the output is written through the page cache
   std::uint64_t order_chunk_bytes = 0;     // orders built and written at once (at least the largest voxel's)
@@ -89,6 +90,12 @@ ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& cou
 // placing passes need not voxelise again) are kept: when they fit beside what `plan` took from `budget` and
 // its largest range. Then they are taken from `budget`.
 bool plan_voxel_runs(MemoryBudget& budget, const ConversionPlan& plan, std::uint64_t runs_bytes);
+
+// Whether the voxel index's lists are filled as the first range is placed (VoxelIndexLists, of `lists_bytes`)
+// rather than sorted at the write stage from the tables read back: when the file has a voxel index and the
+// lists take at most half of what the limit leaves beside `plan` and its largest range (the rest is margin for
+// batches that grow). Then they are taken from `budget`.
+bool plan_voxel_index_lists(MemoryBudget& budget, const ConversionPlan& plan, std::uint64_t lists_bytes);
 
 // The voxel index's buffer at the write stage, when `room` is what the limit leaves then (the ranges, the
 // pool and the orders' chunks given back): every voxel's list at once (4 bytes a voxline) when they fit,

@@ -45,10 +45,7 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
   } else {
     ends_ = VoxlineEnds(r.vertex_end - r.vertex_first);
   }
-  if (tables) {
-    placing.voxline_buffer.reserve(kTableBufferEntries);
-    placing.streamline_buffer.reserve(kTableBufferEntries);
-  }
+  if (tables) placing.table_appender.emplace(*out_, plan_.table_buffer_entries);
   // Batch k is staged in parts (cut_batch) while batch k - 1, staged before, is placed in streamline order.
   // With packed positions the placing is split too, at a voxel that halves the range's vertices: each half
   // places the voxlines of its own voxels (their blocks are apart), the first also writes the tables. The
@@ -65,23 +62,34 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
                                  voxels.begin());
   }
   const bool split = placing.split < r.end;
-  int staging = 0;           // the set of parts the current batch is staged in
-  bool other_placed = true;  // whether the other set's parts are placed
+  const bool index = tables && table_.index_lists;  // the first range fills the voxel index's lists
+  int staging = 0;                                  // the set of parts the current batch is staged in
+  bool other_placed = true;                         // whether the other set's parts are placed
   auto place_staged = [&](int set, int half) {
     for (const StagedPart& part : placing.parts[set]) place_part(placing, part, half);
+  };
+  auto index_staged = [&](int set) {
+    for (const StagedPart& part : placing.parts[set]) index_part(part);
   };
   BatchCut cut{};
   const auto prepare = [&](const Tractogram& b, std::uint64_t first) {
     if (first + b.streamline_count() > table_.spans.size()) fail_changed();  // more streamlines than pass 1 counted
     cut = cut_batch(b);
   };
-  // Parts 0 and 1 place the earlier batch (its halves), so that its errors come first; then the staging parts.
+  // Items 0 and 1 place the earlier batch (its halves), so that its errors come first, and item 2 adds it to the
+  // voxel index's lists; then the staging parts.
+  constexpr std::uint64_t kIndexItem = 2, kFirstStagingItem = 3;
   const auto item = [&](const Tractogram& b, std::uint64_t first, std::uint64_t i) {
-    if (i < 2) {
+    if (i < kIndexItem) {
       if (!other_placed && (i == 0 || split)) place_staged(1 - staging, static_cast<int>(i));
       return;
     }
-    stage_part(placing, b, first, cut[i - 2], cut[i - 1], placing.parts[staging][i - 2]);
+    if (i == kIndexItem) {
+      if (!other_placed && index) index_staged(1 - staging);
+      return;
+    }
+    const std::uint64_t p = i - kFirstStagingItem;
+    stage_part(placing, b, first, cut[p], cut[p + 1], placing.parts[staging][p]);
   };
   const auto finish = [&](const Tractogram&, std::uint64_t) {
     other_placed = false;
@@ -91,14 +99,16 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
       for (const StagedPart& part : set) staged += part.bytes();
     budget_.track(staged, staged_held_, [] { return std::string("the voxlines of two batches being placed"); });
   };
-  reader_->each_batch("placing" + of, 2 + kBatchParts, prepare, item, finish);
+  reader_->each_batch("placing" + of, kFirstStagingItem + kBatchParts, prepare, item, finish);
   if (!other_placed) {
     place_staged(1 - staging, 0);
     if (split) place_staged(1 - staging, 1);
+    if (index) index_staged(1 - staging);
   }
   placing.sink.finish();  // rethrows a failed write (each block's completeness is checked below)
   if (placing.streamlines != table_.meta.streamline_count ||
-      (tables && placing.voxline_index != table_.meta.voxline_count))
+      (tables && placing.voxline_index != table_.meta.voxline_count) ||
+      (tables && table_.index_lists && !table_.index_lists->complete()))
     fail_changed();
   const std::uint32_t levels = job_.settings.levels;
   for (std::size_t local = 0; local < table_.global_id.size(); ++local) {
@@ -108,9 +118,8 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
       if (table_.cursor[local * levels + d] != placing.block_end[local * levels + d]) fail_changed();
   }
   if (tables) {
-    placing.streamline_buffer.push_back(placing.voxline_index);
-    out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, placing.streamline_buffer);
-    out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, placing.voxline_buffer);
+    placing.table_appender->add_streamline(placing.voxline_index);
+    placing.table_appender->finish();
   }
   summary_.voxelize_seconds += seconds_since(t0);
 }
@@ -251,6 +260,17 @@ void StreamingConversion::cut_by_runs(std::uint64_t first_point, std::uint64_t p
   }
 }
 
+// In streamline order: adds the voxlines of a part staged in the first range to the voxel index's lists.
+void StreamingConversion::index_part(const StagedPart& part) {
+  std::size_t entry = 0;  // the streamline's first in part.table_entries
+  for (std::size_t k = 0; k < part.streamline_voxlines.size(); ++k) {
+    const std::uint32_t voxlines = part.streamline_voxlines[k];
+    if (!table_.index_lists->add_streamline(part.source_first + k, {part.table_entries.data() + entry, voxlines}))
+      fail_changed();  // more voxlines in a voxel than pass 2 counted
+    entry += voxlines;
+  }
+}
+
 // In streamline order: copies the vertices a part staged for half `half` of the range (split at
 // placing.split) to their blocks (each voxel's next place for the streamline's depth) and, for the first
 // range's first half, writes the part's voxline and streamline table entries and keeps its streamlines' spans.
@@ -260,20 +280,10 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
   if (placing.tables && half == 0) {
     for (std::size_t k = 0; k < part.streamline_voxlines.size(); ++k) {
       table_.spans[part.source_first + k] = part.spans[k];
-      placing.streamline_buffer.push_back(placing.voxline_index);
+      placing.table_appender->add_streamline(placing.voxline_index);
       placing.voxline_index += part.streamline_voxlines[k];
-      if (placing.streamline_buffer.size() == kTableBufferEntries) {
-        out_->append_items<std::uint64_t>(VxlStreamWriter::kStrm, placing.streamline_buffer);
-        placing.streamline_buffer.clear();
-      }
     }
-    for (const VoxlineEntry& e : part.table_entries) {
-      placing.voxline_buffer.push_back(e);
-      if (placing.voxline_buffer.size() == kTableBufferEntries) {
-        out_->append_items<VoxlineEntry>(VxlStreamWriter::kVxln, placing.voxline_buffer);
-        placing.voxline_buffer.clear();
-      }
-    }
+    for (const VoxlineEntry& e : part.table_entries) placing.table_appender->add_voxline(e);
   }
   const std::uint64_t bytes = vertex_bytes(job_.settings.positions);
   const auto* from = packed() ? reinterpret_cast<const std::uint8_t*>(part.words[half].data())

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "converter/pipeline/batch_reader.h"
 #include "converter/pipeline/conversion_plan.h"
 #include "converter/pipeline/memory_budget.h"
+#include "converter/pipeline/table_appender.h"
 #include "converter/pipeline/vertex_sink.h"
 #include "converter/pipeline/voxel_runs.h"
 #include "converter/position_packing.h"
@@ -29,6 +31,7 @@
 #include "converter/voxelize_streamline.h"
 #include "format/base/direct_region_writer.h"
 #include "format/base/direct_write_queue.h"
+#include "format/voxel_voxlines.h"
 #include "format/vxl_positions.h"
 #include "format/vxl_stream_writer.h"
 
@@ -121,6 +124,10 @@ struct StreamedVoxelTable {
   VoxelRuns runs;
   std::uint64_t runs_held = 0;
   bool runs_kept = false;  // for the placing passes
+  // The voxel index's lists, filled by the first range's placing when the plan holds them (else empty: the write
+  // stage sorts them from the tables read back), and what the budget counts of them.
+  std::optional<VoxelIndexLists> index_lists;
+  std::uint64_t index_lists_held = 0;
 };
 
 // One conversion within a memory limit: run() reads the source with a BatchReader, scans it (scan), counts
@@ -145,6 +152,7 @@ class StreamingConversion {
                    std::span<const std::vector<std::uint32_t>, kBatchParts> local_ids);
   void drop_runs();
   void build_table();
+  void plan_index_lists();
   void build_range(const VoxelRange& r, std::size_t index, std::size_t count);
   void count_part(const Tractogram& b, std::uint64_t first, std::uint64_t begin, std::uint64_t end,
                   std::uint64_t points, std::uint64_t synthetic, std::uint64_t most_voxels, std::uint64_t other_voxels,
@@ -157,6 +165,7 @@ class StreamingConversion {
   void stage_part(const RangePlacement& placing, const Tractogram& b, std::uint64_t first, std::uint64_t begin,
                   std::uint64_t end, StagedPart& part) const;
   void place_part(RangePlacement& placing, const StagedPart& part, int half);
+  void index_part(const StagedPart& part);
   void cut_by_runs(std::uint64_t first_point, std::uint64_t points, std::uint64_t& run,
                    std::vector<TempVoxline>& out) const;
   void write_orders(const VoxelRange& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
@@ -228,8 +237,7 @@ struct StreamingConversion::RangePlacement {
   bool tables;                        // the first range: also the voxline and streamline tables
   VertexSink sink;                    // where the range's vertices go (blocks by local voxel id * levels + level)
   std::vector<VertexPacker> packers;  // by voxel - range.first (packed positions)
-  std::vector<VoxlineEntry> voxline_buffer;
-  std::vector<std::uint64_t> streamline_buffer;
+  std::optional<TableAppender> table_appender;  // the first range's VXLN and STRM
   std::uint64_t voxline_index = 0, streamlines = 0;
   std::size_t split = 0;  // the first voxel of the second placing half (range.end: placed whole)
   // By (local id * levels + depth), for the range's voxels: where the block ends (its last vertex + 1).
