@@ -28,15 +28,16 @@ std::string format_mm(double v) {
               "a voxline of more than 2^31-1 points; use a smaller --voxel-size");
 }
 
-// The one way both find tight bounds: widen [lo, hi] to `count` points (xyz). Callers keep lo and hi in
-// locals: stored through pointers, the compiler would have to assume they alias the points and store them
-// back after every point.
+// The one way both find tight bounds: widen [lo, hi] to `count` points (xyz). Six named locals, not the arrays:
+// stored through pointers, the compiler would have to assume they alias the points, and indexed in a loop over
+// the axes it kept them on the stack, stored and reloaded at every point (twice the time).
 inline void widen(float lo[3], float hi[3], const float* xyz, std::uint64_t count) {
-  for (std::uint64_t k = 0; k < count; ++k)
-    for (int c = 0; c < 3; ++c) {
-      lo[c] = std::min(lo[c], xyz[3 * k + c]);
-      hi[c] = std::max(hi[c], xyz[3 * k + c]);
-    }
+  float lx = lo[0], ly = lo[1], lz = lo[2], hx = hi[0], hy = hi[1], hz = hi[2];
+  for (const float* p = xyz; p != xyz + 3 * count; p += 3) {
+    lx = std::min(lx, p[0]), ly = std::min(ly, p[1]), lz = std::min(lz, p[2]);
+    hx = std::max(hx, p[0]), hy = std::max(hy, p[1]), hz = std::max(hz, p[2]);
+  }
+  lo[0] = lx, lo[1] = ly, lo[2] = lz, hi[0] = hx, hi[1] = hy, hi[2] = hz;
 }
 
 // ... and store them: a zero bound as +0 whichever zero came first (-0 + 0 = +0).
@@ -51,32 +52,36 @@ inline void store_tight_bounds(const float lo[3], const float hi[3], VoxelEntry&
 
 void BoundsScan::add(const float* pts, const std::uint64_t* offsets, std::uint64_t first, std::uint64_t end,
                      std::uint64_t index_base, float* lengths) {
-  // Locals, not the fields: the compiler cannot tell that `this` does not alias the points.
+  // Locals, not the fields: the compiler cannot tell that `this` does not alias the points. Each streamline in
+  // three short loops (finite, bounds, steps) over points in cache: together in one, the compiler shuffled the
+  // bounds through vector registers at every point.
   float l[3] = {lo[0], lo[1], lo[2]}, h[3] = {hi[0], hi[1], hi[2]};
   double step2 = longest_step2;
   std::uint64_t step2_sum = step2_sum_fixed, step_count = steps;
   for (std::uint64_t k = first; k < end && bad_streamline == kNone; ++k) {
-    for (std::uint64_t i = offsets[k]; i < offsets[k + 1]; ++i) {
-      const float* p = pts + 3 * i;
+    const float* const points = pts + 3 * offsets[k];
+    const std::uint64_t n = offsets[k + 1] - offsets[k];
+    for (std::uint64_t i = 0; i < n; ++i) {
+      const float* p = points + 3 * i;
       if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) {
         bad_streamline = index_base + k;
-        bad_point = i - offsets[k];
+        bad_point = i;
         break;
       }
-      for (int c = 0; c < 3; ++c) {  // in float: converting to double afterwards gives the same bounds
-        l[c] = std::min(l[c], p[c]);
-        h[c] = std::max(h[c], p[c]);
-      }
-      if (i > offsets[k]) {
-        double d2 = 0;
-        for (int c = 0; c < 3; ++c) d2 += (double(p[c]) - p[c - 3]) * (double(p[c]) - p[c - 3]);
-        step2 = std::max(step2, d2);
-        step2_sum += static_cast<std::uint64_t>(std::min(d2, 0x1p20) * 1024.0);
-        ++step_count;
-      }
     }
-    // While its points are in cache (a streamline with a bad point fails the conversion: its length is moot).
-    if (lengths) lengths[k] = stored_length_of({pts + 3 * offsets[k], std::size_t(3 * (offsets[k + 1] - offsets[k]))});
+    if (bad_streamline != kNone) break;  // its bounds and length are moot: the conversion fails
+    widen(l, h, points, n);              // in float: converting to double afterwards gives the same bounds
+    for (std::uint64_t i = 1; i < n; ++i) {
+      const float* p = points + 3 * i;
+      const double dx = double(p[0]) - p[-3], dy = double(p[1]) - p[-2], dz = double(p[2]) - p[-1];
+      const double d2 = dx * dx + dy * dy + dz * dz;
+      step2 = std::max(step2, d2);
+      // Signed: the same value (at most 2^30), without the branch an unsigned conversion takes.
+      step2_sum += static_cast<std::uint64_t>(static_cast<std::int64_t>(std::min(d2, 0x1p20) * 1024.0));
+    }
+    step_count += n > 0 ? n - 1 : 0;
+    // While its points are in cache.
+    if (lengths) lengths[k] = stored_length_of({points, std::size_t(3 * n)});
   }
   std::copy(l, l + 3, lo);
   std::copy(h, h + 3, hi);
