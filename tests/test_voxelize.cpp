@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 
 #include "converter/segment_orders.h"
+#include "converter/voxel_table.h"
 #include "converter/voxelize.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
@@ -154,6 +155,63 @@ TEST(Voxelize, PackingWhilePlacingGivesTheWordsOfPackingThePlacedBlocks) {
       EXPECT_EQ(0, std::memcmp(&voxels[i], &floats.voxels[i], sizeof(VoxelEntry))) << "voxel " << i;
     EXPECT_EQ(voxlines.size(), floats.voxlines.size());
     EXPECT_EQ(first, floats.streamline_first_voxline);
+  }
+}
+
+// The bounds scan against a plain reading of its points: bounds, longest step, the step sum in 1/1024 mm^2
+// (each step capped at 1 m^2) and the count, whatever the split into calls; it stops at the first non-finite
+// point and names it (streamline numbered from the base, point within the streamline), and later calls keep it.
+TEST(Voxelize, BoundsScanFindsBoundsStepsAndTheFirstNonFinitePoint) {
+  const Tractogram t = make({{1, 2, 3, 4, -6, 3.5f},
+                             {},
+                             {0, 0, 0},
+                             {-7, 8, 9, 2000, 8, 9, -7.25f, 8, 10},
+                             {0.5f, 0.5f, -40, 0.5f, 0.5f, -39}});
+  std::vector<float> lengths(t.streamline_count());
+  detail::BoundsScan whole, first, second;
+  whole.add(t.positions.data(), t.offsets.data(), 0, t.streamline_count(), 0, lengths.data());
+  first.add(t.positions.data(), t.offsets.data(), 0, 3, 0);
+  second.add(t.positions.data(), t.offsets.data(), 3, t.streamline_count(), 0);
+  first.merge(second);
+  double longest = 0;
+  std::uint64_t sum = 0, steps = 0;
+  for (std::uint64_t k = 0; k < t.streamline_count(); ++k)
+    for (std::uint64_t i = t.offsets[k] + 1; i < t.offsets[k + 1]; ++i) {
+      double d2 = 0;
+      for (int c = 0; c < 3; ++c) d2 += std::pow(double(t.positions[3 * i + c]) - t.positions[3 * i + c - 3], 2);
+      longest = std::max(longest, d2);
+      sum += static_cast<std::uint64_t>(std::min(d2, 0x1p20) * 1024.0);
+      ++steps;
+    }
+  for (const detail::BoundsScan* scan : {&whole, &first}) {
+    EXPECT_EQ(scan->lo[0], -7.25f);
+    EXPECT_EQ(scan->lo[1], -6.0f);
+    EXPECT_EQ(scan->lo[2], -40.0f);
+    EXPECT_EQ(scan->hi[0], 2000.0f);
+    EXPECT_EQ(scan->hi[1], 8.0f);
+    EXPECT_EQ(scan->hi[2], 10.0f);
+    EXPECT_EQ(scan->longest_step2, longest);
+    EXPECT_EQ(scan->step2_sum_fixed, sum);
+    EXPECT_EQ(scan->steps, steps);
+    EXPECT_EQ(scan->steps, 4u);
+    EXPECT_EQ(scan->bad_streamline, detail::BoundsScan::kNone);
+  }
+  EXPECT_EQ(lengths[1], 0.0f);
+  EXPECT_FLOAT_EQ(lengths[4], 1.0f);
+  // A non-finite coordinate: the scan stops there and a later call does not replace it.
+  Tractogram bad = make({{1, 2, 3}, {1, 1, 1, 2, 2, 2, 3, INFINITY, 3, NAN, 4, 4}});
+  detail::BoundsScan scan;
+  scan.add(bad.positions.data(), bad.offsets.data(), 0, 2, 100);
+  EXPECT_EQ(scan.bad_streamline, 101u);
+  EXPECT_EQ(scan.bad_point, 2u);
+  scan.add(bad.positions.data(), bad.offsets.data(), 1, 2, 7);
+  EXPECT_EQ(scan.bad_streamline, 101u);
+  try {
+    scan.check("bad.tck");
+    FAIL() << "a non-finite point was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_NE(std::string(e.what()).find("streamline 101 (point 2)"), std::string::npos) << e.what();
   }
 }
 
