@@ -6,6 +6,7 @@
 #include <mutex>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -81,6 +82,35 @@ TEST(Parallel, InOrderTheLowestItemsErrorIsRethrownWhateverTheTiming) {
     }
     EXPECT_EQ(ran.load(), 3) << threads << " threads";
   }
+}
+
+// Handed out in a given order: one thread runs the items in that order; the lowest item's error is still the one
+// rethrown though it was handed out last; an order that is not of the items is refused.
+TEST(Parallel, InOrderItemsAreHandedOutInTheOrderGivenAndTheLowestErrorStillWins) {
+  const std::vector<std::uint64_t> order = {3, 4, 1, 2, 0};
+  std::vector<std::uint64_t> ran;
+  parallel_for_first_error_in_order(
+      5, 1, [&](std::uint64_t i, unsigned) { ran.push_back(i); }, order);
+  EXPECT_EQ(ran, order);
+  for (unsigned threads : {1u, 2u}) {
+    std::atomic<int> count{0};
+    try {
+      parallel_for_first_error_in_order(
+          5, threads,
+          [&](std::uint64_t i, unsigned) {
+            ++count;
+            if (i == 0 || i == 3) throw std::runtime_error("item " + std::to_string(i));
+          },
+          order);
+      ADD_FAILURE() << "nothing was rethrown";
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "item 0") << threads << " threads";
+    }
+    EXPECT_EQ(count.load(), 5) << threads << " threads";
+  }
+  EXPECT_THROW(parallel_for_first_error_in_order(
+                   3, 1, [](std::uint64_t, unsigned) {}, order),
+               std::logic_error);
 }
 
 TEST(Parallel, InvokeRunsBothAndRethrows) {

@@ -6,7 +6,10 @@
 #include <cstdint>
 #include <exception>
 #include <memory>
+#include <span>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "converter/pipeline/conversion_plan.h"
 #include "converter/pipeline/memory_budget.h"
@@ -39,9 +42,12 @@ class BatchReader {
   // cores around it, so that cutting a batch in a few parts keeps every core busy even when the read and
   // the parts take unequal times. An error of a part comes before one of the read (which is further on in
   // the file), the lowest part's first. Throws as the budget does when a streamline is too long to hold
-  // whole or the two batches outgrow what is left.
+  // whole or the two batches outgrow what is left. With `hand_out` (a permutation of [0, parts)), the parts
+  // are handed out in that order after the read — the longest first, so that the threads finish together —
+  // their errors still lowest part first.
   template <typename Prepare, typename Part, typename Finish>
-  void each_batch(const std::string& stage, std::uint64_t parts, Prepare&& prepare, Part&& part, Finish&& finish);
+  void each_batch(const std::string& stage, std::uint64_t parts, Prepare&& prepare, Part&& part, Finish&& finish,
+                  std::span<const std::uint64_t> hand_out = {});
   // The same with the whole batch as one part: body(batch, first).
   template <typename Body>
   void each_batch(const std::string& stage, Body&& body) {
@@ -75,7 +81,15 @@ class BatchReader {
 
 template <typename Prepare, typename Part, typename Finish>
 void BatchReader::each_batch(const std::string& stage, std::uint64_t parts, Prepare&& prepare, Part&& part,
-                             Finish&& finish) {
+                             Finish&& finish, std::span<const std::uint64_t> hand_out) {
+  // The items: the read (when it comes beside the parts), then the parts, in hand_out's order if given.
+  const std::uint64_t read_items = read_ahead_ ? 1 : 0;
+  std::vector<std::uint64_t> items;
+  if (!hand_out.empty()) {
+    if (hand_out.size() != parts) throw std::logic_error("BatchReader::each_batch: hand_out is not of the parts");
+    if (read_ahead_) items.push_back(0);
+    for (const std::uint64_t p : hand_out) items.push_back(p + read_items);
+  }
   source_->rewind();
   ++passes_;
   report(stage, 0.0);
@@ -96,10 +110,13 @@ void BatchReader::each_batch(const std::string& stage, std::uint64_t parts, Prep
       }
     };
     // Item 0, handed out first, reads the next batch; items 1.. are the parts.
-    parallel_for_first_error_in_order(parts + (read_ahead_ ? 1 : 0), threads_, [&](std::uint64_t item, unsigned) {
-      if (read_ahead_ && item == 0) return read_next();
-      part(batch, first, item - (read_ahead_ ? 1 : 0));
-    });
+    parallel_for_first_error_in_order(
+        parts + read_items, threads_,
+        [&](std::uint64_t item, unsigned) {
+          if (read_ahead_ && item == 0) return read_next();
+          part(batch, first, item - read_items);
+        },
+        items);
     finish(batch, first);
     if (!read_ahead_) read_next();
     if (read_error) std::rethrow_exception(read_error);

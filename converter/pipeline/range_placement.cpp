@@ -4,6 +4,7 @@
 #include "converter/pipeline/streaming_conversion.h"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <optional>
 
@@ -77,8 +78,12 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
     cut = cut_batch(b);
   };
   // Items 0 and 1 place the earlier batch (its halves), so that its errors come first, and item 2 adds it to the
-  // voxel index's lists; then the staging parts.
+  // voxel index's lists; then the staging parts. They are handed out longest first, the staging parts (on the
+  // 10M set 4-5 ms each, a half 3-3.5 ms, the index 1.2 ms): handed out in their order, the last staging part
+  // ran alone at the end of every batch.
   constexpr std::uint64_t kIndexItem = 2, kFirstStagingItem = 3;
+  static_assert(kBatchParts == 3);
+  constexpr std::array<std::uint64_t, kFirstStagingItem + kBatchParts> kLongestFirst = {3, 4, 5, 0, 1, 2};
   const auto item = [&](const Tractogram& b, std::uint64_t first, std::uint64_t i) {
     if (i < kIndexItem) {
       if (!other_placed && (i == 0 || split)) place_staged(1 - staging, static_cast<int>(i));
@@ -99,7 +104,7 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
       for (const StagedPart& part : set) staged += part.bytes();
     budget_.track(staged, staged_held_, [] { return std::string("the voxlines of two batches being placed"); });
   };
-  reader_->each_batch("placing" + of, kFirstStagingItem + kBatchParts, prepare, item, finish);
+  reader_->each_batch("placing" + of, kFirstStagingItem + kBatchParts, prepare, item, finish, kLongestFirst);
   if (!other_placed) {
     place_staged(1 - staging, 0);
     if (split) place_staged(1 - staging, 1);

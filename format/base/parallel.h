@@ -19,6 +19,8 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
+#include <stdexcept>
 #include <thread>
 #include <type_traits>
 #include <utility>
@@ -66,10 +68,16 @@ void parallel_for(std::uint64_t count, unsigned threads, Fn&& fn) {
 // Like parallel_for, but every item runs to its end and the exception rethrown is that of the lowest item
 // that threw: for work cut in order (the parts of a batch of streamlines), so that the error reported is
 // the first in that order, whatever the timing.
+// With `order` (a permutation of [0, count), or empty for 0, 1, ...), the items are handed out in that order —
+// the longest first, say, so that the threads finish together — and the exception is still the lowest item's.
 template <typename Fn>
-void parallel_for_first_error_in_order(std::uint64_t count, unsigned threads, Fn&& fn) {
+void parallel_for_first_error_in_order(std::uint64_t count, unsigned threads, Fn&& fn,
+                                       std::span<const std::uint64_t> order = {}) {
+  if (!order.empty() && order.size() != count)
+    throw std::logic_error("parallel_for_first_error_in_order: the order is not of the items");
   std::vector<std::exception_ptr> errors(count);
-  parallel_for(count, threads, [&](std::uint64_t i, unsigned t) {
+  parallel_for(count, threads, [&](std::uint64_t k, unsigned t) {
+    const std::uint64_t i = order.empty() ? k : order[k];
     try {
       fn(i, t);
     } catch (...) {
