@@ -148,8 +148,9 @@ class StreamingConversion {
   void count_voxels();
   struct PlanPart;
   std::vector<std::uint32_t> fold_into_first(PlanPart& main, const PlanPart& other) const;
-  void record_runs(std::uint64_t first, const BatchCut& cut, std::span<PlanPart, kBatchParts> parts,
-                   std::span<const std::vector<std::uint32_t>, kBatchParts> local_ids);
+  struct PendingRuns;
+  void append_runs(PendingRuns& pending);
+  void hold_runs(std::span<PlanPart, kBatchParts> parts, PendingRuns& pending);
   void drop_runs();
   void build_table();
   void plan_index_lists();
@@ -252,6 +253,16 @@ struct StreamingConversion::PlanPart {
   detail::VoxelBounds bounds;
   std::uint64_t voxlines = 0, synthetic = 0;  // in the batch being counted
   std::vector<VoxelRun> runs;                 // of the batch being counted (local ids of `sink`'s index)
+};
+
+// A batch's voxel runs as pass 2 counted them, waiting to be appended to table_.runs (append_runs) while the next
+// batch is counted: each part's list, its first streamline in the source and (parts past the first) its local ids in
+// the first part's index.
+struct StreamingConversion::PendingRuns {
+  std::array<std::vector<VoxelRun>, kBatchParts> runs;
+  std::array<std::uint64_t, kBatchParts> first{};
+  std::array<std::vector<std::uint32_t>, kBatchParts> local_ids;
+  bool waiting = false;
 };
 
 }  // namespace vxl::streaming
