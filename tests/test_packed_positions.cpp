@@ -137,6 +137,16 @@ TEST(PackedPositions, ThePackerRoundsExactlyLikeTheSpecsQuotient) {
         }
         std::uniform_real_distribution<double> inside(v.tight_min[c], v.tight_max[c]);
         for (int i = 0; i < 3000; ++i) xs.push_back(static_cast<float>(inside(rng)));
+        // Outside the box (clamped to 0 and kPackedSteps).
+        xs.insert(xs.end(), {std::nextafter(v.tight_min[c], -INFINITY), v.tight_min[c] - 1000 * step,
+                             std::nextafter(v.tight_max[c], INFINITY), v.tight_max[c] + 1000 * step});
+        // words() over many vertices at once gives each one's word.
+        std::vector<float> many;
+        for (float x : xs)
+          many.insert(many.end(), {v.tight_min[0], v.tight_min[1], v.tight_min[2]}), many[many.size() - 3 + c] = x;
+        std::vector<std::uint32_t> many_words(xs.size());
+        packer.words(many.data(), xs.size(), many_words.data());
+        for (std::size_t i = 0; i < xs.size(); ++i) ASSERT_EQ(many_words[i], packer.pack(many.data() + 3 * i)) << i;
         for (float x : xs) {
           float xyz[3] = {v.tight_min[0], v.tight_min[1], v.tight_min[2]};
           xyz[c] = x;
@@ -154,6 +164,17 @@ TEST(PackedPositions, ThePackerRoundsExactlyLikeTheSpecsQuotient) {
   }
   EXPECT_GT(half_steps, 90000u);
   EXPECT_GT(points, 500000u);
+  // A box flat along an axis (step 0): that axis's quantum is 0, the others as in a full box.
+  VoxelEntry flat = box(-4.0, 2.0);
+  flat.tight_max[1] = flat.tight_min[1];
+  const VertexPacker packer(flat);
+  float xyz[6] = {-3.0f, flat.tight_min[1], -2.5f, -2.1f, flat.tight_min[1], -4.0f};
+  std::uint32_t words[2];
+  packer.words(xyz, 2, words);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ((words[i] >> 10) & kPackedAxisMask, 0u);
+    EXPECT_EQ(words[i], packer.pack(xyz + 3 * i));
+  }
 }
 
 TEST_P(PackedConversion, EveryPointComesBackWithinTheBound) {
