@@ -120,11 +120,7 @@ ConvertSummary StreamingConversion::run() {
   report("writing", 0.0);
   t0 = Clock::now();
   write_rest();
-  if (table_.index_lists) {
-    out_->append_voxel_index(*table_.index_lists);
-    table_.index_lists.reset();
-    budget_.shrink(0, table_.index_lists_held);
-  } else {
+  if (!summary_.voxel_index_while_placing) {
     // The voxel index's buffer takes the memory the ranges and the pool gave back: the pool itself where it is
     // large enough (its pages are in memory already; fresh ones cost more than the sorting on some machines).
     std::span<std::uint8_t> index_buffer;

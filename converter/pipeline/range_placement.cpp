@@ -126,6 +126,11 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
     placing.table_appender->add_streamline(placing.voxline_index);
     placing.table_appender->finish();
   }
+  if (tables && table_.index_lists) {  // written now, so that the orders do not build beside their memory
+    out_->append_voxel_index(*table_.index_lists);
+    table_.index_lists.reset();
+    budget_.shrink(0, table_.index_lists_held);
+  }
   summary_.voxelize_seconds += seconds_since(t0);
 }
 

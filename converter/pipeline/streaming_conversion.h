@@ -124,8 +124,8 @@ struct StreamedVoxelTable {
   VoxelRuns runs;
   std::uint64_t runs_held = 0;
   bool runs_kept = false;  // for the placing passes
-  // The voxel index's lists, filled by the first range's placing when the plan holds them (else empty: the write
-  // stage sorts them from the tables read back), and what the budget counts of them.
+  // The voxel index's lists, filled by the first range's placing when the plan holds them and written at its end
+  // (else empty: the write stage sorts them from the tables read back), and what the budget counts of them.
   std::optional<VoxelIndexLists> index_lists;
   std::uint64_t index_lists_held = 0;
 };
