@@ -20,8 +20,8 @@
 // each streamline's length (4 bytes), its voxel runs where they fit (8 bytes a voxline: the placing passes then do not
 // voxelise again), one part of the source read into a buffer and two batches of whole streamlines, two batches' staged
 // voxlines, one range's blocks (or, written block by block, their stagings and then two chunks of them read
-// back), an orders chunk or two and the sort buffers; at the end, the voxel index's buffer. The source is read
-// a part at a time (pread); the output is
+// back), an orders chunk or two and the sort buffers; the voxel index's lists while the first range is placed, where
+// they fit (else, at the end, a buffer to sort them in). The source is read a part at a time (pread); the output is
 // written with pwrite, or past the page cache (O_DIRECT) under limits of 256 MiB or more, so neither
 // stays in resident memory. Only TCK sources stream.
 #pragma once

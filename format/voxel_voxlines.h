@@ -7,9 +7,9 @@
 // back into VXLN or STRM.
 //
 // Files since 1.4 / 2.3 carry it (VXIX, spec §5.14): the writers fill it from their tables at the end
-// (fill_voxel_index), and a reader maps it. For an older file the same lists are built once, in memory, when
-// the first query needs them. The viewer's renderers find each vertex's
-// streamline through it too.
+// (fill_voxel_index), or a streamed conversion as it makes them (VoxelIndexLists), and a reader maps it. For an older
+// file the same lists are built once, in memory, when the first query needs them. The viewer's renderers find each
+// vertex's streamline through it too.
 #pragma once
 
 #include <cstdint>
@@ -77,9 +77,9 @@ class VoxelIndexLists {
   // VXIX's payload: the list starts (voxel count + 1), then the lists.
   std::span<const std::uint64_t> starts() const { return first_; }
   std::span<const IndexedVoxline> lists() const { return {entries_.get(), first_.back()}; }
-  // The memory it holds for these counts.
+  // The memory it holds for these counts, with the counts it is made from.
   static std::uint64_t bytes(std::uint64_t voxel_count, std::uint64_t voxline_count) {
-    return 16 * voxel_count + 8 + sizeof(IndexedVoxline) * voxline_count;
+    return 24 * voxel_count + 8 + sizeof(IndexedVoxline) * voxline_count;
   }
 
  private:

@@ -296,6 +296,14 @@ TEST(StreamingConvert, TheVoxelIndexIsFilledWhilePlacingWhereItFitsAndTheBytesAr
   s = expect_identical(dir, tck, settings_for(10.0), 24 * kMiB);  // no room for the lists
   EXPECT_FALSE(s.voxel_index_while_placing);
   EXPECT_GE(s.partitions, 2u);
+  // One thread (the read after each batch's items, the placing before the staging), and float32 positions (the
+  // placing in one item).
+  ConvertSettings one = settings_for(10.0);
+  one.threads = 1;
+  EXPECT_TRUE(expect_identical(dir, tck, one, 256 * kMiB).voxel_index_while_placing);
+  ConvertSettings float32 = settings_for(10.0);
+  float32.positions = PositionEncoding::Float32;
+  EXPECT_TRUE(expect_identical(dir, tck, float32, 256 * kMiB).voxel_index_while_placing);
 }
 
 // Float64 big-endian source, an empty streamline, no Inf terminator: the provenance (checksum, header,

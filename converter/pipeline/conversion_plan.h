@@ -74,8 +74,9 @@ struct ConversionPlan {
   // chunks (pool_chunk_bytes each) and two chunks' vertices read back (pool_read_back_bytes each).
   std::uint64_t pool_bytes = 0, pool_chunk_bytes = 0, pool_read_back_bytes = 0;
   std::vector<VoxelRange> ranges;  // at least one (with no voxels: one empty range, which writes the tables)
-  // The write stage's voxel index (VxlStreamWriter::append_voxel_index): the lists sorted at once, one pass
-  // over VXLN and STRM per buffer full (plan_voxel_index).
+  // The write stage's voxel index (VxlStreamWriter::append_voxel_index), where its lists are not filled while
+  // placing (plan_voxel_index_lists): the lists sorted at once, one pass over VXLN and STRM per buffer full
+  // (plan_voxel_index). 0: the file has no voxel index.
   std::uint64_t voxel_index_buffer_bytes = 0;
 };
 

@@ -194,7 +194,8 @@ void StreamingConversion::append_runs(PendingRuns& pending) {
 }
 
 // Keeps recording the runs while they take at most half of what the limit leaves (the rest is the voxel table's
-// and the plan's), else drops them. The lists of the batch being counted and of the one waiting count with them.
+// and the plan's), else drops them. The lists of the batch just counted count with them, and the memory the
+// earlier batch's lists keep for the next one.
 void StreamingConversion::hold_runs(std::span<PlanPart, kBatchParts> parts, PendingRuns& pending) {
   std::uint64_t lists = 0;
   for (std::size_t p = 0; p < kBatchParts; ++p)
