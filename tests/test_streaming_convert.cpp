@@ -246,16 +246,20 @@ TEST(StreamingConvert, LongStepsAndDiagonalOrdersAreIdentical) {
 
 // The placing passes cut the streamlines by the voxel runs the counting pass kept where the limit leaves
 // room for them, and voxelise again where it does not: the same bytes either way, in one range or several,
-// with points added at voxel faces (whose streamlines are voxelised again) or without.
-TEST(StreamingConvert, VoxelRunsAreKeptWhereTheyFitAndTheBytesAreTheSame) {
+// with points added at voxel faces (whose streamlines are voxelised again) or without. Likewise the voxel
+// index's lists, filled as the first range is placed where the limit holds them, else sorted from the tables
+// read back at the write stage.
+TEST(StreamingConvert, VoxelRunsAndIndexListsAreKeptWhereTheyFitAndTheBytesAreTheSame) {
   ScratchDir dir;
   const std::string tck = dir.file("in.tck");
   write_synth_tck(tck, 12000);
   ConvertSummary s = expect_identical(dir, tck, settings_for(10.0), 256 * kMiB);
   EXPECT_TRUE(s.voxelised_once);
+  EXPECT_TRUE(s.voxel_index_while_placing);
   EXPECT_EQ(s.partitions, 1u);
   s = expect_identical(dir, tck, settings_for(10.0), 21 * kMiB);  // several ranges, no room for the runs
   EXPECT_FALSE(s.voxelised_once);
+  EXPECT_FALSE(s.voxel_index_while_placing) << "no room for the index's lists either";
   EXPECT_GE(s.partitions, 3u);
   // Several ranges beside the runs: streamlines with no voxel in a range are skipped past their runs (under
   // 256 MiB, so that a range holds its vertices and the request cuts it).
@@ -285,19 +289,12 @@ TEST(StreamingConvert, VoxelRunsAreKeptWhereTheyFitAndTheBytesAreTheSame) {
   EXPECT_TRUE(file_bytes(whole) == file_bytes(ranged));
 }
 
-// The voxel index's lists are filled as the first range is placed where the limit holds them, and sorted from the
-// tables read back at the write stage where it does not: the in-memory conversion's bytes either way.
-TEST(StreamingConvert, TheVoxelIndexIsFilledWhilePlacingWhereItFitsAndTheBytesAreTheSame) {
+// The voxel index's lists filled while placing with one thread (the read after each batch's items, the placing
+// before the staging) and with float32 positions (the placing in one item): the in-memory conversion's bytes.
+TEST(StreamingConvert, TheVoxelIndexListsFillWithOneThreadAndWithFloat32Positions) {
   ScratchDir dir;
   const std::string tck = dir.file("in.tck");
   write_synth_tck(tck, 12000);
-  ConvertSummary s = expect_identical(dir, tck, settings_for(10.0), 256 * kMiB);
-  EXPECT_TRUE(s.voxel_index_while_placing);
-  s = expect_identical(dir, tck, settings_for(10.0), 24 * kMiB);  // no room for the lists
-  EXPECT_FALSE(s.voxel_index_while_placing);
-  EXPECT_GE(s.partitions, 2u);
-  // One thread (the read after each batch's items, the placing before the staging), and float32 positions (the
-  // placing in one item).
   ConvertSettings one = settings_for(10.0);
   one.threads = 1;
   EXPECT_TRUE(expect_identical(dir, tck, one, 256 * kMiB).voxel_index_while_placing);

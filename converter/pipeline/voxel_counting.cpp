@@ -121,8 +121,8 @@ void StreamingConversion::count_voxels() {
     }
     std::array<std::vector<std::uint32_t>, kBatchParts> local_ids;  // part p's local ids in the first's index
     for (std::size_t p = 1; p < kBatchParts; ++p) local_ids[p] = fold_into_first(main, parts[p]);
-    if (counting_.recording_runs) hold_runs(parts, pending);
-    if (counting_.recording_runs) {  // this batch's runs wait for the next round (or the end)
+    if (counting_.recording_runs) hold_runs(parts, pending);  // which may drop them
+    if (counting_.recording_runs) {                           // this batch's runs wait for the next round (or the end)
       for (std::size_t p = 0; p < kBatchParts; ++p) {
         std::swap(parts[p].runs, pending.runs[p]);
         pending.first[p] = first + cut[p];
