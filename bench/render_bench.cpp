@@ -1,4 +1,5 @@
-// Viewer benchmark. For each scene (.vxl, with its source TCK):
+// Viewer benchmark. First the cost of a process start (`voxview --help`), then for each scene (.vxl, with its
+// source TCK):
 //   * time from process start to the first frame read back: `voxview FILE --render` as a child process,
 //     for the .vxl and for the source TCK (converted in memory);
 //   * per-frame CPU work (cull + voxel sort + order pick + command building), median over a 72-view
@@ -83,6 +84,12 @@ int run(int argc, char** argv) {
     modes.push_back(*mode);
   }
 
+  // What every start of the viewer costs before it does anything: loading the program and its libraries.
+  std::vector<double> help;
+  for (int r = 0; r < 5; ++r) help.push_back(run_child_seconds({VOXVIEW_CLI, "--help"}));
+  std::printf("process start: voxview --help median %.3f s (min %.3f) over 5 runs\n", median(help),
+              *std::min_element(help.begin(), help.end()));
+
   vxl::HeadlessGlContext context;
   std::printf("GL: %s %s; image %dx%d\n", context.version_string().c_str(), context.renderer().c_str(), size, size);
   for (const std::string& spec : scenes) {
@@ -101,10 +108,11 @@ int run(int argc, char** argv) {
     auto t_upload = Clock::now();
     vxl::Renderer renderer(file);
     double upload_s = std::chrono::duration<double>(Clock::now() - t_upload).count();
-    std::printf("\nscene %s: %llu streamlines, %llu segments, %u voxels of %g mm, GPU %.0f MiB, upload %.3f s\n",
-                vxl_path.c_str(), (unsigned long long)file.meta().streamline_count,
-                (unsigned long long)file.meta().segment_count, file.meta().voxel_count, file.meta().voxel_size,
-                renderer.gpu_bytes() / 1048576.0, upload_s);
+    std::printf(
+        "\nscene %s: %llu streamlines, %llu segments, %u voxels of %g mm, GPU %.0f MiB, upload %.3f s (%.2f GB/s)\n",
+        vxl_path.c_str(), (unsigned long long)file.meta().streamline_count,
+        (unsigned long long)file.meta().segment_count, file.meta().voxel_count, file.meta().voxel_size,
+        renderer.gpu_bytes() / 1048576.0, upload_s, renderer.gpu_bytes() / 1e9 / upload_s);
     std::printf("  first frame read back (process start -> PNG written): .vxl %.3f s", median(first_vxl));
     if (!source.empty())
       std::printf(", source %.3f s (ratio %.1fx)", median(first_src), median(first_src) / median(first_vxl));

@@ -1,5 +1,6 @@
 // voxview's command line: a mistyped option gets the nearest one, an unknown view the list of views, and
-// messages about options carry no file name; a picture is written in the format its extension names.
+// messages about options carry no file name; a picture is written in the format its extension names, through
+// the picture module loaded when it is written (a missing module is an error naming it, and writes nothing).
 #include <filesystem>
 
 #include "tests/test_support.h"
@@ -55,6 +56,25 @@ TEST(VoxviewCommandLine, APictureIsWrittenInTheFormatItsExtensionNames) {
   EXPECT_EQ(bmp.exit_code, 2) << bmp.output;
   EXPECT_NE(bmp.output.find("names no picture format"), std::string::npos) << bmp.output;
   EXPECT_FALSE(std::filesystem::exists(dir.file("a.bmp")));
+}
+
+TEST(VoxviewCommandLine, AMissingPictureModuleIsAnErrorThatNamesItAndWritesNothing) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  const std::string args = test::q(dir.file("a.tck")) + " --size 32x32 --render " + test::q(dir.file("a.png"));
+  const test::CommandResult missing =
+      test::run_program("VOXLINES_PICTURE_MODULE=" + test::q(dir.file("none.so")) + " " + VOXVIEW_CLI, args);
+  EXPECT_EQ(missing.exit_code, 4) << missing.output;
+  EXPECT_NE(missing.output.find("the picture module libvoxlines_pictures.so (OpenImageIO), which could not be loaded"),
+            std::string::npos)
+      << missing.output;
+  EXPECT_NE(missing.output.find(dir.file("none.so")), std::string::npos) << missing.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.png")));
+  for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+    EXPECT_EQ(e.path().filename(), "a.tck") << "left behind: " << e.path();
+  // Found where the build put it, the same command writes the picture.
+  EXPECT_EQ(test::run_program(VOXVIEW_CLI, args).exit_code, 0);
+  EXPECT_TRUE(std::filesystem::exists(dir.file("a.png")));
 }
 
 }  // namespace

@@ -199,6 +199,8 @@ TEST_F(Window, MovingFramesDrawACoarserLevelWithinTheFrameBudget) {
   EXPECT_GT(j.at("first_picture_s").get<double>(), 0.0);
   // On screen after it was drawn (the swap that shows it), and after the window and the viewer were made.
   const auto& startup = j.at("startup");
+  EXPECT_GE(startup.at("main_s").get<double>(), 0.0);
+  EXPECT_GE(startup.at("window_open_s").get<double>(), startup.at("main_s").get<double>());
   EXPECT_GT(startup.at("window_open_s").get<double>(), 0.0);
   EXPECT_GE(startup.at("viewer_ready_s").get<double>(), startup.at("window_open_s").get<double>());
   EXPECT_GE(j.at("first_picture_s").get<double>(), startup.at("viewer_ready_s").get<double>());

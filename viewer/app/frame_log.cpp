@@ -64,7 +64,8 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
   j["frame_budget_ms"] = frame_budget_ms;
   // The figure a user sees: the first picture as it reaches the screen, everything before it included.
   j["first_on_screen_s"] = startup.first_on_screen_s;
-  j["startup"] = {{"window_open_s", startup.window_open_s},
+  j["startup"] = {{"main_s", startup.main_s},
+                  {"window_open_s", startup.window_open_s},
                   {"viewer_ready_s", startup.viewer_ready_s},
                   {"first_on_screen_s", startup.first_on_screen_s}};
   j["first_picture_s"] = s.first_picture_s;

@@ -39,6 +39,7 @@ struct FrameSummary {
 // Where the time before the first picture on screen went, in seconds since the process started
 // (process_clock.h); -1 where not reached.
 struct StartupTimes {
+  double main_s = -1;             // the program and its shared libraries loaded: main() is about to run
   double window_open_s = -1;      // the window and its GL context exist (the scene files are open before it)
   double viewer_ready_s = -1;     // the first level uploaded, the shaders built, the panel made
   double first_on_screen_s = -1;  // the buffer swap that shows the first drawn picture has completed

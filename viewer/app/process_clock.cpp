@@ -33,12 +33,14 @@ double seconds_since_exec() {
 }
 
 // Taken during static initialisation, before main: what the dynamic loader spent is added from /proc.
+const double g_before_main = seconds_since_exec();
 const std::chrono::steady_clock::time_point g_start =
-    std::chrono::steady_clock::now() - std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                           std::chrono::duration<double>(seconds_since_exec()));
+    std::chrono::steady_clock::now() -
+    std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(g_before_main));
 
 }  // namespace
 
 std::chrono::steady_clock::time_point process_start() { return g_start; }
+double seconds_before_main() { return g_before_main; }
 
 }  // namespace vxl::app

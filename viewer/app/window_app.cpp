@@ -461,6 +461,7 @@ int run_window(const ViewerOptions& o) {
   RegionEditor regions(o);                            // parses the regions: a bad one fails there too
   WindowPtr window = open_window(o);
   StartupTimes startup;
+  startup.main_s = seconds_before_main();
   startup.window_open_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   session->choose_detail(o);  // the driver's limits: the window's context is current
   ViewerWindow viewer(o, std::move(session), std::move(regions), window.get(), start, startup);

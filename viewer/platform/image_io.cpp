@@ -1,9 +1,5 @@
 #include "viewer/platform/image_io.h"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
-
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -18,6 +14,7 @@
 
 #include "format/base/error.h"
 #include "format/base/output_path.h"
+#include "viewer/platform/picture_module_loader.h"
 
 namespace vxl {
 
@@ -63,15 +60,12 @@ void fsync_file(const fs::path& p, const std::string& target) {
   if (rc != 0) output_fail(target, "fsync failed", std::strerror(err));
 }
 
-OIIO::ImageBuf wrap(const Image& img, const char* which) {
+void check_well_formed(const Image& img, const char* which) {
   if (img.width <= 0 || img.height <= 0 ||
       img.rgba.size() != static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height) * 4)
     throw std::runtime_error(std::string("compare_images: image ") + which + " is malformed (" +
                              std::to_string(img.width) + "x" + std::to_string(img.height) + ", " +
                              std::to_string(img.rgba.size()) + " bytes)");
-  OIIO::ImageSpec spec(img.width, img.height, 4, OIIO::TypeDesc::UINT8);
-  // ImageBuf wraps the caller's memory; compare() only reads it.
-  return OIIO::ImageBuf(spec, const_cast<std::uint8_t*>(img.rgba.data()));
 }
 
 }  // namespace
@@ -89,27 +83,18 @@ void write_image_as(const std::string& format, const std::string& path, int w, i
                 std::to_string(h) + " RGBA8 needs " + std::to_string(static_cast<std::size_t>(w) * h * 4) + ", for",
             path);
 
+  const pictures::Api& module = pictures::picture_module(path);
   const fs::path target(output_target(path));
   std::error_code ec;
   const fs::path tmp = reserve_temp_file(target, path);
   try {
     // The format is named explicitly: the temporary name's extension is not the output's.
-    auto out = OIIO::ImageOutput::create(format);
-    if (!out) io_fail("OpenImageIO has no " + format + " writer for", path, OIIO::geterror());
-    // JPEG holds no alpha: write the colour channels only (a stride of 4 bytes a pixel skips it).
-    const int channels = format == "jpeg" ? 3 : 4;
-    OIIO::ImageSpec spec(w, h, channels, format == "openexr" ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
-    if (channels == 4) spec.attribute("oiio:UnassociatedAlpha", 1);  // straight alpha: write the bytes verbatim
-    if (format == "jpeg") spec.attribute("CompressionQuality", 95);
-    const std::string what = "the " + format + " picture";
-    if (!out->open(tmp.string(), spec)) output_fail(path, "cannot open " + what + " for writing", out->geterror());
-    if (!out->write_image(OIIO::TypeDesc::UINT8, rgba.data(), 4)) {
-      const std::string err = out->geterror();
-      out->close();
-      output_fail(path, "cannot write " + what, err);
+    std::string error;
+    switch (module.write(format.c_str(), tmp.c_str(), w, h, rgba.data(), error)) {
+      case pictures::WriteStatus::Ok: break;
+      case pictures::WriteStatus::NoWriter: io_fail("OpenImageIO has no " + format + " writer for", path, error);
+      case pictures::WriteStatus::OutputFailed: output_fail(path, error);
     }
-    if (!out->close()) output_fail(path, "cannot finish " + what, out->geterror());
-    out.reset();
     fsync_file(tmp, path);
     fs::rename(tmp, target, ec);
     if (ec) output_fail(path, "cannot rename the temporary file into place", ec.message());
@@ -176,39 +161,10 @@ void write_picture(const std::string& path, int w, int h, const std::vector<std:
 }
 
 Image read_image(const std::string& path) {
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);  // keep the file's straight alpha (no premultiply)
-  auto in = OIIO::ImageInput::open(path, &config);
-  if (!in) io_fail("read_image: cannot open", path, OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  const int nch = spec.nchannels;
-  if (spec.width <= 0 || spec.height <= 0 || nch <= 0 || spec.depth > 1)
-    io_fail("read_image: unsupported image layout in", path);
-
-  std::vector<std::uint8_t> raw(static_cast<std::size_t>(spec.width) * spec.height * nch);
-  if (!in->read_image(0, 0, 0, nch, OIIO::TypeDesc::UINT8, raw.data()))
-    io_fail("read_image: cannot read", path, in->geterror());
-  in->close();
-
   Image img;
-  img.width = spec.width;
-  img.height = spec.height;
-  img.rgba.resize(static_cast<std::size_t>(img.width) * img.height * 4);
-  int alpha = spec.alpha_channel;
-  if (alpha < 0 || alpha >= nch) alpha = nch == 2 ? 1 : nch >= 4 ? 3 : -1;
-  const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint8_t* s = raw.data() + i * nch;
-    std::uint8_t* d = img.rgba.data() + i * 4;
-    if (nch >= 3) {
-      d[0] = s[0];
-      d[1] = s[1];
-      d[2] = s[2];
-    } else {
-      d[0] = d[1] = d[2] = s[0];
-    }
-    d[3] = alpha >= 0 ? s[alpha] : 255;
-  }
+  std::string error;
+  if (!pictures::picture_module(path).read(path.c_str(), img.width, img.height, img.rgba, error))
+    io_fail("read_image: cannot read", path, error);
   return img;
 }
 
@@ -217,23 +173,22 @@ ImageDiff compare_images(const Image& a, const Image& b) {
     throw std::runtime_error("compare_images: sizes differ (" + std::to_string(a.width) + "x" +
                              std::to_string(a.height) + " vs " + std::to_string(b.width) + "x" +
                              std::to_string(b.height) + ")");
-  const OIIO::ImageBuf A = wrap(a, "a");
-  const OIIO::ImageBuf B = wrap(b, "b");
-  // failthresh 0: every pixel with any differing channel counts as a failure.
-  const OIIO::ImageBufAlgo::CompareResults r = OIIO::ImageBufAlgo::compare(A, B, 0.0f, 0.0f);
-  // CompareResults::error is also set when any pixel exceeds failthresh (always, with 0 here):
-  // only an error without failing pixels is a real failure.
-  if (r.error && r.nfail == 0 && r.nwarn == 0)
-    throw std::runtime_error("compare_images: OpenImageIO compare failed: " + OIIO::geterror());
+  check_well_formed(a, "a");
+  check_well_formed(b, "b");
+  // Thresholds 0: every pixel with any differing channel counts as a failure.
+  pictures::Comparison r;
+  std::string error;
+  if (!pictures::picture_module("").compare(a.width, a.height, a.rgba.data(), b.rgba.data(), 4, 0.0f, 0.0f, r, error))
+    throw std::runtime_error("compare_images: OpenImageIO compare failed: " + error);
   ImageDiff d;
-  d.mean_error = r.meanerror;
+  d.mean_error = r.mean_error;
   d.rms_error = r.rms_error;
-  d.psnr = r.PSNR;
-  d.max_error = r.maxerror;
-  d.max_x = r.maxx;
-  d.max_y = r.maxy;
-  d.max_channel = r.maxc;
-  d.differing_pixels = r.nfail;
+  d.psnr = r.psnr;
+  d.max_error = r.max_error;
+  d.max_x = r.max_x;
+  d.max_y = r.max_y;
+  d.max_channel = r.max_channel;
+  d.differing_pixels = r.failing_pixels;
   return d;
 }
 

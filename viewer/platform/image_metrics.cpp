@@ -1,13 +1,12 @@
 #include "viewer/platform/image_metrics.h"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "viewer/platform/picture_module_loader.h"
 
 namespace vxl {
 
@@ -22,18 +21,13 @@ void check_same_size(const Image& a, const Image& b, const char* who) {
                              std::to_string(b.width) + "x" + std::to_string(b.height) + ")");
 }
 
-OIIO::ImageBuf wrap(const Image& img) {
-  OIIO::ImageSpec spec(img.width, img.height, 4, OIIO::TypeDesc::UINT8);
-  return OIIO::ImageBuf(spec, const_cast<std::uint8_t*>(img.rgba.data()));  // compare() only reads it
-}
-
 // ImageBufAlgo::compare over the colour channels, values on OpenImageIO's 0..1 scale.
-OIIO::ImageBufAlgo::CompareResults compare_rgb(const Image& a, const Image& b) {
-  const OIIO::ROI rgb(0, a.width, 0, a.height, 0, 1, 0, 3);
-  const OIIO::ImageBuf A = wrap(a), B = wrap(b);
-  // Thresholds 1: nothing counts as a failure, so `error` is set only when the comparison itself failed.
-  OIIO::ImageBufAlgo::CompareResults r = OIIO::ImageBufAlgo::compare(A, B, 1.0f, 1.0f, rgb);
-  if (r.error) throw std::runtime_error("image comparison failed: " + OIIO::geterror());
+pictures::Comparison compare_rgb(const Image& a, const Image& b) {
+  pictures::Comparison r;
+  std::string error;
+  // Thresholds 1: nothing counts as a failure, so a false return means the comparison itself failed.
+  if (!pictures::picture_module("").compare(a.width, a.height, a.rgba.data(), b.rgba.data(), 3, 1.0f, 1.0f, r, error))
+    throw std::runtime_error("image comparison failed: " + error);
   return r;
 }
 
@@ -53,7 +47,7 @@ std::vector<double> luminance(const Image& img) {
 
 double mean_abs_difference(const Image& a, const Image& b) {
   check_same_size(a, b, "mean_abs_difference");
-  return compare_rgb(a, b).meanerror * 255.0;
+  return compare_rgb(a, b).mean_error * 255.0;
 }
 
 double error_change(const Image& a, const Image& a_ref, const Image& b, const Image& b_ref) {
@@ -116,12 +110,12 @@ double ssim_luminance(const Image& a, const Image& b) {
 
 ImageScore score_image(const Image& test, const Image& reference) {
   check_same_size(test, reference, "score_image");
-  const OIIO::ImageBufAlgo::CompareResults r = compare_rgb(test, reference);
+  const pictures::Comparison r = compare_rgb(test, reference);
   ImageScore s;
   s.rmse = r.rms_error * 255.0;
   s.psnr = r.rms_error > 0 ? 20.0 * std::log10(1.0 / r.rms_error) : std::numeric_limits<double>::infinity();
-  s.mean_abs = r.meanerror * 255.0;
-  s.max_abs = r.maxerror * 255.0;
+  s.mean_abs = r.mean_error * 255.0;
+  s.max_abs = r.max_error * 255.0;
   s.ssim = ssim_luminance(test, reference);
   return s;
 }
