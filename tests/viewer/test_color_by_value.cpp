@@ -160,7 +160,8 @@ TEST_F(ColorByValue, ManyTextureSpansColourLikeOne) {
   }
   t.point_values.push_back({"along", along});
   VxlFile f = make_scene(dir, std::move(t), 6.0);
-  Renderer one(f), many(f, 3000);
+  // Spans of a few voxels each.
+  Renderer one(f), many(f, 4 * SceneLayout::largest_voxel_texels(std::vector<const VxlFile*>{&f}));
   EXPECT_GT(many.layout().texture_spans().size(), 3u);
   Camera cam = top_view();
   cam.azimuth_deg = 30;

@@ -129,7 +129,7 @@ TEST_F(GpuMemoryBudget, TheBudgetIsNeverExceededAndTheNearestSpansComeFirst) {
     if (seen[c]) continue;
     seen[c] = true;
     const TextureSpan& t = r.layout().texture_spans()[c];
-    const std::uint64_t bytes = 4 * t.words() + 2 * t.order_entries();
+    const std::uint64_t bytes = 4 * t.words() + 4 * t.order_words;
     const bool fits = used + bytes <= pool->budget();
     if (fits) used += bytes;
     waiting += fits ? 0 : 1;
@@ -177,7 +177,7 @@ TEST_F(GpuMemoryBudget, EvictedSpansDrawTheSamePictureWhenUploadedAgain) {
       if (seen[c]) continue;
       seen[c] = true;
       const TextureSpan& t = probe.layout().texture_spans()[c];
-      bytes += 4 * t.words() + 2 * t.order_entries();
+      bytes += 4 * t.words() + 4 * t.order_words;
     }
     return bytes;
   };

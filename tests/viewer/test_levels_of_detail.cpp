@@ -150,10 +150,8 @@ TEST_F(LevelsOfDetail, TheBudgetIsNeverExceeded) {
 TEST_F(LevelsOfDetail, ATextureLimitTooSmallForFullDetailLeavesACoarserLevel) {
   const VxlFile f = file();
   const std::vector<const VxlFile*> files = {&f};
-  std::uint64_t largest_voxel = 0;
-  for (std::size_t i = 0; i < f.voxels().size(); ++i)
-    largest_voxel = std::max<std::uint64_t>(largest_voxel, 3ull * (f.level(i, 0).segment_count + 64));
-  const std::uint64_t texels = largest_voxel / 2;  // not even the largest voxel's full orders fit
+  // Not even the largest voxel fits at full detail.
+  const std::uint64_t texels = SceneLayout::largest_voxel_texels(files) / 2;
   EXPECT_THROW(SceneLayout(files, texels, 0), Error);
   const std::uint32_t level = SceneLayout::finest_level_within(files, texels, ~0ull);
   EXPECT_GT(level, 0u);

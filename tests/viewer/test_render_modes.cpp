@@ -229,10 +229,10 @@ TEST_F(RenderModes, TheGpuCopyTakesAtMostTwelveBytesAPoint) {
   EXPECT_GT(per_point, 9.0) << "positions and orders are all there";
 }
 
-// A voxel of more than 65 536 vertices has 3-byte order entries in the file and 16 + 16 bits on the GPU (a
-// low and a high half): its stored orders must draw the same segments as its block order. In one fixed
-// colour the picture does not depend on the order (every blend applies the same function), so the two
-// are equal pixel for pixel; a wrong high half joins unrelated vertices.
+// A voxel of more than 65 536 vertices has order entries of more than 16 bits, which the vertex shader reads
+// from the file's bytes across two 32-bit words where they straddle one: its stored orders must draw the same
+// segments as its block order. In one fixed colour the picture does not depend on the order (every blend
+// applies the same function), so the two are equal pixel for pixel; a wrong shift joins unrelated vertices.
 TEST_F(RenderModes, WideVoxelsDrawTheirStoredOrdersRight) {
   SynthSettings synth;
   synth.streamlines = 1500;
@@ -240,7 +240,7 @@ TEST_F(RenderModes, WideVoxelsDrawTheirStoredOrdersRight) {
   ASSERT_EQ(f.meta().voxel_count, 1u);
   ASSERT_GT(f.voxels()[0].vertex_count, 65536u);
   Renderer r(f);
-  ASSERT_GT(r.layout().texture_spans()[0].wide_segments, 0u);
+  ASSERT_GT(r.layout().voxels()[0].order_bits, 16u);
   Camera cam = perspective_view();
   RenderSettings axis_settings = settings(RenderMode::Axis, 0.1f), block_settings = settings(RenderMode::Basic, 0.1f);
   axis_settings.color = block_settings.color = ColorMode::Fixed;
@@ -278,8 +278,10 @@ TEST_F(RenderModes, ManyTextureSpansRenderLikeOne) {
     t.add_streamline(p.data(), 30);
   }
   VxlFile f = make_scene(dir, std::move(t), 6.0);
-  // More spans than one draw binds (Renderer::kMaxBoundSpans): the draws bind them a few at a time.
-  Renderer one(f), many(f, 3000), more_than_a_draw_binds(f, 700);
+  // More spans than one draw binds (Renderer::kMaxBoundSpans): the draws bind them a few at a time. At a few
+  // times the largest voxel's size a span holds a few voxels.
+  const std::uint64_t voxel_texels = SceneLayout::largest_voxel_texels(std::vector<const VxlFile*>{&f});
+  Renderer one(f), many(f, 16 * voxel_texels), more_than_a_draw_binds(f, 4 * voxel_texels);
   EXPECT_EQ(one.layout().texture_spans().size(), 1u);
   EXPECT_GT(many.layout().texture_spans().size(), 3u);
   EXPECT_GT(more_than_a_draw_binds.layout().texture_spans().size(), 2 * Renderer::kMaxBoundSpans);
@@ -407,7 +409,8 @@ TEST_F(RenderModes, SegsortDrawsTheSegmentsOfItsLevelInEverySpanAndFile) {
   segsort.color = basic.color = ColorMode::Fixed;
   for (std::uint32_t level : {0u, 1u}) {
     SCOPED_TRACE(level);
-    Renderer r(std::vector<const VxlFile*>{&a, &b}, 100000, level);
+    const std::vector<const VxlFile*> files = {&a, &b};
+    Renderer r(files, SceneLayout::largest_voxel_texels(files), level);  // spans of few voxels
     ASSERT_GE(r.layout().texture_spans().size(), level == 0 ? 3u : 2u);
     const Image sorted = render_image(r, perspective_view(), segsort, 96, 96);
     const std::uint64_t segments = r.stats().segments_drawn;

@@ -100,7 +100,7 @@ TEST_F(LinePassSpans, APlanOverMoreSpansThanSlotsDrawsAsOverOneSpan) {
   ASSERT_EQ(one_span, 1u);
   // Spans of about the largest voxel each: more than the program's slots, so draw_plan rebinds them as
   // the plan goes, each run in the plan's order.
-  const std::uint64_t texels = std::max<std::uint64_t>(4096, SceneLayout::largest_voxel_texels(files));
+  const std::uint64_t texels = SceneLayout::largest_voxel_texels(files);
   const Image split = draw_through_line_pass(f, texels, &many_spans, &slots);
   ASSERT_GT(many_spans, std::size_t(slots)) << "the scene must need more spans than one draw binds";
   EXPECT_GT(test::lit_pixels(whole), 500);

@@ -75,8 +75,8 @@ TEST(SegmentSort, TheSorterWritesEveryVisibleVoxelsSegmentsFarToNear) {
   for (std::uint32_t level : {0u, 1u}) {
     SCOPED_TRACE(level);
     // Small texture buffers: several spans.
-    const std::uint64_t entries = SceneLayout(file, 1u << 27, level).texture_spans()[0].order_entries();
-    const SceneLayout layout(file, entries / 4 + 1, level);
+    const std::uint64_t words = SceneLayout(file, 1u << 27, level).texture_spans()[0].order_words;
+    const SceneLayout layout(file, words / 4 + 1, level);
     ASSERT_GT(layout.texture_spans().size(), 2u);
     FramePlan plan;
     plan_frame(layout, view_of(camera), PlanOrder::Block, plan);

@@ -106,7 +106,8 @@ TEST_F(SeveralFiles, VoxelsOfAllFilesAreSortedTogether) {
 TEST_F(SeveralFiles, FilesWithDifferentOrderSetsAndGroupOpacity) {
   VxlFile a = convert(dir, lines_at({15, -5}, "A"), "a.vxl", "axis+diag");
   VxlFile b = convert(dir, lines_at({5, -15}, "B"), "b.vxl", "random:4");
-  Renderer r({&a, &b}, 1200);  // small texture buffers: several spans per file
+  // Texture buffers as small as the largest voxel: several spans per file.
+  Renderer r({&a, &b}, SceneLayout::largest_voxel_texels(std::vector<const VxlFile*>{&a, &b}));
   EXPECT_GT(r.layout().texture_spans().size(), 2u);
   Image axis = render_image(r, top_view(), settings(RenderMode::Axis), 64, 64);
   Image exact = render_image(r, top_view(), settings(RenderMode::Exact), 64, 64);

@@ -125,6 +125,7 @@ int run_headless(const ViewerOptions& o) {
       annotations->draw(frame_camera, o.settings, *renderer, o.width, o.height);
     }
     std::vector<std::uint8_t> rgba = target.read_rgba();
+    renderer->check_uploaded(true);  // a damaged file's picture is not written
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::string png = o.turntable ? turntable_frame_path(*o.render_png, i, frames) : *o.render_png;
     write_picture(png, o.width, o.height, rgba);

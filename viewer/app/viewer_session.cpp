@@ -37,6 +37,11 @@ Renderer& ViewerSession::renderer_at(std::uint32_t level, bool eager) {
   return *r;
 }
 
+void ViewerSession::check_uploaded(bool wait) {
+  for (auto* renderers : {&renderers_, &focus_renderers_})
+    for (auto& [level, renderer] : *renderers) renderer->check_uploaded(wait);
+}
+
 void ViewerSession::set_focus(const std::vector<std::vector<std::uint64_t>>& kept) {
   bool any = false;
   for (const auto& k : kept) any |= !k.empty();

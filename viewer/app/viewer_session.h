@@ -69,6 +69,9 @@ class ViewerSession {
   // The renderer of the context's files at `context_level` and the focus's copy at full detail, one scene
   // (its groups: SceneGroups::focus_first), made on first use like renderer_at. Needs set_focus.
   Renderer& focus_first_renderer(std::uint32_t context_level, bool eager);
+  // Every renderer's checks of what it uploaded (Renderer::check_uploaded): rethrows a failure; with `wait`,
+  // once all have run.
+  void check_uploaded(bool wait);
   // The files' per-voxel indexes, shared by the renderers and the selections (built once, on first use).
   const std::shared_ptr<VoxelVoxlinesCache>& indexes() const { return indexes_; }
 

@@ -13,6 +13,7 @@
 
 #include <epoxy/gl.h>
 
+#include "format/base/error.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/frame_budget.h"
 #include "viewer/app/frame_pacing.h"
@@ -27,6 +28,16 @@
 #include "viewer/render/scene_framing.h"
 
 namespace vxl::app {
+
+namespace {
+
+// A damaged file (the checks of what was uploaded failed: vxl::Error, Input) is not drawn on in another mode:
+// the error ends the window, as it ends headless rendering (exit 3). Called in a handler, it rethrows there.
+void rethrow_if_damaged(const std::exception& e) {
+  if (const auto* error = dynamic_cast<const Error*>(&e); error != nullptr && error->kind() == ErrorKind::Input) throw;
+}
+
+}  // namespace
 
 bool same_view(const Camera& a, const Camera& b) {
   return a.target == b.target && a.distance == b.distance && a.azimuth_deg == b.azimuth_deg &&
@@ -166,6 +177,7 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
   try {
     renderer.draw(camera, s, width, height, target);
   } catch (const std::exception& e) {
+    rethrow_if_damaged(e);
     // A mode that cannot run here (e.g. exact out of node memory): say so and keep showing something.
     set_error(std::string(render_mode_name(s.mode)) + ": " + e.what() + ": showing axis");
     s.mode = RenderMode::Axis;
@@ -248,6 +260,7 @@ double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& co
     }
     completes = renderer.draw_piece(piece_ms);
   } catch (const std::exception& e) {
+    rethrow_if_damaged(e);
     // Exact out of node memory, say: keep the picture on screen and stop refining it.
     set_error(std::string(exact_stage ? "exact when still" : render_mode_name(rest.stage_mode())) + ": " + e.what() +
               (exact_stage ? ": turned off" : ": showing axis"));
@@ -448,6 +461,8 @@ int ViewerWindow::run() {
     }
     if (closing) break;
   }
+  // What was drawn is checked before the window reports success: a damaged file exits 3, as headless.
+  session_->check_uploaded(true);
   if (options_.stats_json)
     write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms, startup_, selection_ms_,
                       drag_end_);

@@ -63,6 +63,36 @@ void TextureBuffer::create(GLenum internal_format, const void* data, std::size_t
   glBindBuffer(GL_TEXTURE_BUFFER, 0);
 }
 
+void* TextureBuffer::create_mapped(std::size_t bytes) {
+  glGenBuffers(1, &buffer);
+  glBindBuffer(GL_TEXTURE_BUFFER, buffer);
+  const auto size = static_cast<GLsizeiptr>(bytes > 16 ? bytes : 16);
+  glBufferData(GL_TEXTURE_BUFFER, size, nullptr, GL_STATIC_DRAW);
+  // Invalidated: the driver need not keep (or copy) what the buffer held.
+  void* memory = glMapBufferRange(GL_TEXTURE_BUFFER, 0, size, GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
+  glBindBuffer(GL_TEXTURE_BUFFER, 0);
+  if (memory == nullptr) {
+    destroy();
+    throw std::runtime_error("the driver could not map a buffer of " + std::to_string(size) + " bytes for writing");
+  }
+  return memory;
+}
+
+void TextureBuffer::finish_mapped(GLenum internal_format) {
+  glBindBuffer(GL_TEXTURE_BUFFER, buffer);
+  const GLboolean kept = glUnmapBuffer(GL_TEXTURE_BUFFER);
+  if (kept == GL_FALSE) {
+    glBindBuffer(GL_TEXTURE_BUFFER, 0);
+    destroy();
+    throw std::runtime_error("the driver lost a buffer's contents while it was being filled");
+  }
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_BUFFER, texture);
+  glTexBuffer(GL_TEXTURE_BUFFER, internal_format, buffer);
+  glBindTexture(GL_TEXTURE_BUFFER, 0);
+  glBindBuffer(GL_TEXTURE_BUFFER, 0);
+}
+
 void TextureBuffer::destroy() {
   if (texture) glDeleteTextures(1, &texture);
   if (buffer) glDeleteBuffers(1, &buffer);

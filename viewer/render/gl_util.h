@@ -16,6 +16,11 @@ GLuint make_compute_program(const std::string& source);
 struct TextureBuffer {
   GLuint buffer = 0, texture = 0;
   void create(GLenum internal_format, const void* data, std::size_t bytes);
+  // The same filled in place: create_mapped makes the buffer `bytes` long (at least 16) and returns its
+  // memory mapped for writing, which any thread may fill; finish_mapped unmaps it and makes the texture.
+  // Throws std::runtime_error when the driver cannot map or loses the contents.
+  void* create_mapped(std::size_t bytes);
+  void finish_mapped(GLenum internal_format);
   void destroy();
 };
 

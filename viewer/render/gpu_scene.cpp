@@ -6,6 +6,7 @@
 
 #include "format/base/error.h"
 #include "format/base/parallel.h"
+#include "format/vxl_draw_check.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -16,77 +17,70 @@ std::uint64_t GpuScene::driver_limit() {
   return texels > 0 ? static_cast<std::uint64_t>(texels) : 65536;  // 65536 is the GL 3.3 minimum
 }
 
-// Voxel i's part of its span: checks every order entry (open() does not: it would cost O(points) there),
-// finds the segment starts from order 0, checks the packed words' voxline-end bits against them (float32: sets
-// them where no segment starts), the decoding info, its table entries and its orders at 16 bits (plus high halves).
-void GpuScene::upload_voxel(const VxlFile& file, std::uint32_t i, std::uint32_t li, std::uint32_t index,
-                            const TextureSpan& c, std::vector<std::uint32_t>& words, std::vector<std::uint16_t>& orders,
-                            std::vector<std::uint8_t>& is_start, std::vector<float>& xyz) const {
+// Voxel i's orders at the span's level, as the file stores them.
+void GpuScene::copy_voxel_orders(const VxlFile& file, std::uint32_t i, std::uint32_t li, const TextureSpan& c,
+                                 std::uint8_t* orders) const {
+  const VoxelEntry& v = file.voxels()[li];
+  const std::uint32_t level = layout_.files()[c.file].level;
+  std::memcpy(orders + 4 * layout_.voxels()[i].order_word,
+              file.order_bytes().data() + level_orders_offset(v, file.levels_of(li), level,
+                                                              file.meta().stored_order_count, file.order_packing()),
+              level_orders_size(file.level(li, level), c.slots, file.order_packing()));
+}
+
+// Voxel i's part of its span's words: the block's packed words as stored (a float32 block packed here, its
+// voxline-end bits from order 0, whose entries this therefore checks), zeros after the block up to the next
+// voxel's, and the small decoding info and table entries.
+void GpuScene::fill_voxel_words(const VxlFile& file, std::uint32_t i, std::uint32_t li, std::uint32_t index,
+                                const TextureSpan& c, std::uint32_t* words, VoxelScratch& scratch) const {
   const VoxelEntry& v = file.voxels()[li];
   const VoxelDrawInfo& d = layout_.voxels()[i];
   // The scene's level of the voxel: a prefix of its block and that level's orders (.vxl spec §5.12).
   const std::uint32_t level = layout_.files()[c.file].level;
   const LevelEntry counts = file.level(li, level);
-  const std::uint64_t ordr_at =
-      file.orders_offset() +
-      level_orders_offset(v, file.levels_of(li), level, file.meta().stored_order_count, file.order_packing());
-  is_start.assign(counts.vertex_count, 0);
-  const bool wide = counts.vertex_count > kU16OrderMaxVertices;
-  for (std::uint32_t k = 0; k < c.slots; ++k) {
-    OrderView o = file.order(li, k, level);
-    std::uint16_t* low = orders.data() + k * c.segments + d.seg_first;
-    std::uint16_t* high = orders.data() + c.slots * c.segments + k * c.wide_segments + d.seg_first;
+  std::uint32_t* block = words + d.vertex_first;
+  if (file.position_encoding() == PositionEncoding::Packed) {
+    std::memcpy(block, file.packed_vertices().data() + v.vertex_first, 4 * std::uint64_t(counts.vertex_count));
+  } else {
+    // float32 blocks carry no end bits: they come from order 0 (a vertex where no segment starts).
+    std::vector<std::uint8_t>& is_start = scratch.is_start;
+    is_start.assign(counts.vertex_count, 0);
+    const OrderView o = file.order(li, 0, level);
     for (std::uint32_t n = 0; n < o.count; ++n) {
       const std::uint32_t e = o[n];
       if (e + 1ull >= counts.vertex_count)
-        throw Error(ErrorKind::Input, file.path(), ordr_at,
-                    "order entry out of range in voxel " + std::to_string(li) + " (run `voxlines verify`)");
-      low[n] = static_cast<std::uint16_t>(e);
-      if (wide) high[n] = static_cast<std::uint16_t>(e >> 16);
-      if (k == 0) is_start[e] = 1;
-    }
-  }
-  std::uint32_t starts = 0;
-  for (std::uint8_t b : is_start) starts += b;
-  if (starts != counts.segment_count)  // a repeated entry in order 0: it is no permutation
-    throw Error(
-        ErrorKind::Input, file.path(), ordr_at,
-        "order 0 of voxel " + std::to_string(li) + " is not a permutation of its segments (run `voxlines verify`)");
-
-  std::uint32_t* block = words.data() + d.vertex_first;
-  if (file.position_encoding() == PositionEncoding::Packed) {
-    // A packed file's voxline-end bits are the ones drawn (spec §5.4). This loop reads every word anyway, so
-    // it checks them against order 0: a file whose bits disagree is refused, not drawn with segments
-    // across voxlines.
-    std::copy_n(file.packed_vertices().data() + v.vertex_first, counts.vertex_count, block);
-    for (std::uint32_t n = 0; n < counts.vertex_count; ++n)
-      if (((block[n] & kPackedVoxlineEnd) != 0) == (is_start[n] != 0) || (block[n] & kPackedReservedBit) != 0)
         throw Error(ErrorKind::Input, file.path(),
-                    file.find_section(section_id("VERT"))->offset + 4 * (v.vertex_first + n),
-                    "packed vertex " + std::to_string(n) + " of voxel " + std::to_string(li) +
-                        ": voxline-end bit disagrees with order 0, or reserved bit set (run `voxlines verify`)");
-  } else {
-    // float32 blocks carry no end bits: they come from order 0 (a vertex where no segment starts).
-    xyz.resize(3 * std::uint64_t(counts.vertex_count));
-    file.read_vertices(li, v.vertex_first, counts.vertex_count, xyz.data());
-    pack_block(v, xyz.data(), counts.vertex_count, block);
+                    file.orders_offset() + level_orders_offset(v, file.levels_of(li), level,
+                                                               file.meta().stored_order_count, file.order_packing()),
+                    "order entry out of range in voxel " + std::to_string(li) + " (run `voxlines verify`)");
+      is_start[e] = 1;
+    }
+    scratch.xyz.resize(3 * std::uint64_t(counts.vertex_count));
+    file.read_vertices(li, v.vertex_first, counts.vertex_count, scratch.xyz.data());
+    pack_block(v, scratch.xyz.data(), counts.vertex_count, block);
     for (std::uint32_t n = 0; n < counts.vertex_count; ++n) block[n] |= is_start[n] ? 0u : kPackedVoxlineEnd;
   }
+  const std::uint64_t group = SceneLayout::kGroup;
+  const std::uint64_t padded_vertices = (counts.vertex_count + group - 1) / group * group;
+  std::fill(block + counts.vertex_count, block + padded_vertices, 0u);
 
-  // Decoding info: lo and step per axis as the spec computes them (binary32), and the block's first word.
-  std::uint32_t* info = words.data() + c.info_first() + 8ull * index;
+  // Decoding info (TextureSpan::kInfoWords): lo and step per axis as the spec computes them (binary32), where
+  // the block and the orders are, and the level's counts, which the shader clamps the file's entries to.
+  std::uint32_t* info = words + c.info_first() + TextureSpan::kInfoWords * index;
   for (int a = 0; a < 3; ++a) {
     const float lo = v.tight_min[a], step = (v.tight_max[a] - v.tight_min[a]) / static_cast<float>(kPackedSteps);
     std::memcpy(info + a, &lo, 4);
     std::memcpy(info + 3 + a, &step, 4);
   }
   info[6] = static_cast<std::uint32_t>(d.vertex_first);
-  info[7] = 0;
-  const std::uint64_t group = SceneLayout::kGroup;
-  for (std::uint64_t g = d.seg_first / group; g < (d.seg_first + counts.segment_count + group - 1) / group; ++g)
-    words[c.segment_table_first() + g] = index;
-  for (std::uint64_t g = d.vertex_first / group; g < (d.vertex_first + counts.vertex_count + group - 1) / group; ++g)
-    words[c.vertex_table_first() + g] = index;
+  info[7] = counts.vertex_count;
+  info[8] = static_cast<std::uint32_t>(d.seg_first);
+  info[9] = counts.segment_count;
+  info[10] = d.order_bits;
+  info[11] = static_cast<std::uint32_t>(d.order_word);
+  const std::uint64_t padded_segments = (counts.segment_count + group - 1) / group * group;
+  std::fill_n(words + c.segment_table_first() + d.seg_first / group, padded_segments / group, index);
+  std::fill_n(words + c.vertex_table_first() + d.vertex_first / group, padded_vertices / group, index);
 }
 
 namespace {
@@ -106,7 +100,8 @@ GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels, 
       pool_(pool ? std::move(pool) : std::make_shared<GpuMemoryPool>()),
       spans_(layout_.texture_spans().size()),
       resident_(layout_.texture_spans().size(), false),
-      uploaded_bytes_(layout_.texture_spans().size(), 0) {
+      uploaded_bytes_(layout_.texture_spans().size(), 0),
+      checked_(layout_.texture_spans().size(), false) {
   owner_ = pool_->add_owner([this](std::uint32_t c) { evict(c); });
   try {
     // A scene that fits the budget's free room is uploaded whole now; one that does not, span by span as
@@ -129,7 +124,7 @@ GpuScene::GpuScene(std::vector<const VxlFile*> files, std::uint64_t max_texels, 
 
 std::uint64_t GpuScene::span_bytes(std::uint32_t c) const {
   const TextureSpan& t = layout_.texture_spans()[c];
-  std::uint64_t bytes = 4 * t.words() + 2 * t.order_entries();
+  std::uint64_t bytes = 4 * t.words() + 4 * t.order_words;
   if (dataset_content_ == DatasetContent::StreamlineOrder) bytes += 4 * dataset_per_span_[c].size();
   if (dataset_content_ == DatasetContent::ViewOrder) bytes += 4 * t.segments;
   if (t.file < attributes_.size()) bytes += 8 * t.vertices;
@@ -140,22 +135,80 @@ void GpuScene::upload_span(std::uint32_t ci) {
   const TextureSpan& c = layout_.texture_spans()[ci];
   const VxlFile& file = *files_[c.file];
   const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
-  std::vector<std::uint32_t> words(c.words(), 0);
-  std::vector<std::uint16_t> orders(c.order_entries(), 0);
-  // Voxels fill disjoint ranges of every array, so they are uploaded in parallel.
-  std::vector<std::vector<std::uint8_t>> is_start(resolve_threads(0));  // scratch per thread
-  std::vector<std::vector<float>> xyz(resolve_threads(0));
-  parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
-    const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
-    upload_voxel(file, i, i - file_first, static_cast<std::uint32_t>(k), c, words, orders, is_start[t], xyz[t]);
-  });
   GpuTextureSpan& g = spans_[ci];
-  g.words.create(GL_RGBA32UI, words.data(), words.size() * 4);
-  g.orders.create(GL_R16UI, orders.data(), orders.size() * 2);
+  // Filled in place in the GPU's buffers by several threads: voxels fill disjoint ranges of both. The words
+  // fill while this thread has the driver make the order buffer (which a software driver clears first).
+  auto* words = static_cast<std::uint32_t*>(g.words.create_mapped(4 * c.words()));
+  try {
+    BackgroundTask<> filling([&] {
+      std::vector<VoxelScratch> scratch(resolve_threads(0));  // per thread
+      parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
+        const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
+        fill_voxel_words(file, i, i - file_first, static_cast<std::uint32_t>(k), c, words, scratch[t]);
+      });
+      // The last words of the tables' texel, which no voxel fills.
+      std::fill(words + c.vertex_table_first() + c.vertices / SceneLayout::kGroup, words + c.words(), 0u);
+    });
+    auto* orders = static_cast<std::uint8_t*>(g.orders.create_mapped(4 * c.order_words));
+    try {
+      parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned) {
+        const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
+        copy_voxel_orders(file, i, i - file_first, c, orders);
+      });
+      filling.get();
+    } catch (...) {
+      g.orders.finish_mapped(GL_R32UI);
+      throw;
+    }
+    g.orders.finish_mapped(GL_R32UI);
+  } catch (...) {
+    g.words.finish_mapped(GL_RGBA32UI);
+    g.words.destroy();
+    g.orders.destroy();
+    throw;
+  }
+  g.words.finish_mapped(GL_RGBA32UI);
   upload_extras(ci);
   resident_[ci] = true;
   uploaded_bytes_[ci] = span_bytes(ci);
   gpu_bytes_ += uploaded_bytes_[ci];
+  if (!checked_[ci]) {
+    checked_[ci] = true;
+    unchecked_.push_back(ci);
+  }
+}
+
+void GpuScene::check_uploaded(bool wait) {
+  if (check_failure_) std::rethrow_exception(check_failure_);
+  do {
+    if (checks_.valid() && (wait || checks_.ready())) {
+      try {
+        checks_.get();
+      } catch (...) {
+        check_failure_ = std::current_exception();
+        throw;
+      }
+    }
+    start_checks();
+  } while (wait && checks_.valid());
+}
+
+void GpuScene::start_checks() {
+  if (checks_.valid() || unchecked_.empty()) return;
+  // Each span's voxels at its file's level; one core is left to the drawing thread.
+  std::vector<std::uint32_t> spans = std::move(unchecked_);
+  unchecked_.clear();
+  checks_ = BackgroundTask<>([this, spans = std::move(spans)] {
+    for (std::uint32_t ci : spans) {
+      const TextureSpan& c = layout_.texture_spans()[ci];
+      const FileLayout& f = layout_.files()[c.file];
+      std::vector<std::vector<std::uint8_t>> scratch(resolve_threads(0));
+      parallel_for(c.voxel_count, std::max(1u, resolve_threads(0) - 1), [&](std::uint64_t k, unsigned t) {
+        check_voxel_drawing(*files_[c.file], c.voxel_first + static_cast<std::uint32_t>(k) - f.voxel_first, f.level,
+                            scratch[t]);
+      });
+    }
+  });
 }
 
 void GpuScene::upload_extras(std::uint32_t ci) {

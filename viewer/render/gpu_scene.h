@@ -1,8 +1,11 @@
 // The GPU copy of a scene of one or more .vxl files, laid out as scene_layout.h describes: per texture span the
-// packed positions with their voxels' decoding info and lookup tables (float32 files are packed on the way, as
-// the .vxl spec §5.4 says), the stored orders at 16 bits (32 for voxels of more than 65 536 vertices), each
-// entry checked, and — only when first needed — a dataset-order buffer and per-vertex values. About 4 bytes
-// a vertex and 2 an order entry, where float positions and widened orders took 12 and 4.
+// file's bytes — each voxel's packed positions and its stored orders at the span's level, copied from the
+// mapping into mapped GPU buffers by several threads, never re-encoded — with their voxels' decoding info and
+// lookup tables, and — only when first needed — a dataset-order buffer and per-vertex values. Float32 files
+// are packed on the way (the .vxl spec §5.4's encoding, their voxline ends from order 0). The vertex shader
+// decodes what it reads and clamps every index to its buffer, so a damaged file draws wrong lines but never
+// reads outside a buffer; the checks that tell a damaged file (format/vxl_draw_check.h) run beside the
+// drawing, on other threads, for every span uploaded (check_uploaded).
 //
 // Spans are uploaded on demand within a GPU memory budget shared with the context's other scenes
 // (gpu_memory_pool.h): as many as fit when the scene is made, then each frame the spans its voxels lie in
@@ -20,6 +23,7 @@
 #include <span>
 #include <vector>
 
+#include "format/base/parallel.h"
 #include "format/vxl_file.h"
 #include "viewer/render/gl_util.h"
 #include "viewer/render/gpu_memory_pool.h"
@@ -89,6 +93,14 @@ class GpuScene {
   void upload_view_order(const std::vector<const std::vector<std::uint32_t>*>& per_span,
                          const std::vector<std::pair<std::uint64_t, std::uint64_t>>& ranges);
 
+  // The draw checks (format/vxl_draw_check.h) of the spans uploaded so far, run on other threads than the
+  // caller's, one core left to it: starts them for the spans uploaded since the last call, and rethrows the
+  // failure (vxl::Error, Input) of checks that have finished. With `wait`, returns once every span uploaded
+  // is checked. A scene whose checks failed stays failed: every later call rethrows.
+  void check_uploaded(bool wait);
+  // Starts the checks of the spans uploaded since they last started, unless some are still running.
+  void start_checks();
+
  private:
   // The bytes span c takes on the GPU with its current attributes and dataset order.
   std::uint64_t span_bytes(std::uint32_t c) const;
@@ -100,11 +112,16 @@ class GpuScene {
   // budget.
   void upload_resident_again();
   void release();
-  // Voxel `voxel` of the scene (`local` in its file, `index` in its span): its words, info, table entries
-  // and orders into the span's arrays.
-  void upload_voxel(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, std::uint32_t index,
-                    const TextureSpan& span, std::vector<std::uint32_t>& words, std::vector<std::uint16_t>& orders,
-                    std::vector<std::uint8_t>& is_start, std::vector<float>& xyz) const;
+  // Voxel `voxel` of the scene (`local` in its file, `index` in its span): its block, info and table entries
+  // into the span's mapped words; its orders into the span's mapped orders.
+  struct VoxelScratch {
+    std::vector<std::uint8_t> is_start;
+    std::vector<float> xyz;
+  };
+  void fill_voxel_words(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, std::uint32_t index,
+                        const TextureSpan& span, std::uint32_t* words, VoxelScratch& scratch) const;
+  void copy_voxel_orders(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, const TextureSpan& span,
+                         std::uint8_t* orders) const;
   std::vector<const VxlFile*> files_;
   SceneLayout layout_;
   std::shared_ptr<GpuMemoryPool> pool_;
@@ -121,6 +138,10 @@ class GpuScene {
   std::vector<std::vector<std::uint32_t>> dataset_per_span_;  // StreamlineOrder: each span's array
   std::vector<std::int64_t> dataset_first_;
   std::vector<std::int32_t> dataset_count_;
+  std::vector<bool> checked_;             // per span: its draw checks have run or are running
+  std::vector<std::uint32_t> unchecked_;  // spans uploaded since the checks last started
+  std::exception_ptr check_failure_;      // the first failed check, rethrown by every check_uploaded
+  BackgroundTask<> checks_;               // last: joined first, while what it reads still exists
 };
 
 }  // namespace vxl

@@ -185,20 +185,22 @@ void LinePass::bind_spans(GLuint program, std::span<const std::uint32_t> bound,
   // Per slot: where its ids start in this draw and how its buffers are laid out (scene_layout.h); a slot
   // left empty starts past every id.
   std::vector<std::pair<const char*, std::vector<GLint>>> fields = {
-      {"u_span_base", {}},     {"u_span_segments", {}},      {"u_span_slots", {}},        {"u_span_wide", {}},
-      {"u_span_vertices", {}}, {"u_span_segment_table", {}}, {"u_span_vertex_table", {}},
+      {"u_span_base", {}},   {"u_span_segments", {}},      {"u_span_slots", {}},        {"u_span_vertices", {}},
+      {"u_span_voxels", {}}, {"u_span_segment_table", {}}, {"u_span_vertex_table", {}}, {"u_span_order_words", {}},
   };
   for (std::size_t slot = 0; slot < bound_spans_; ++slot) {
-    std::int64_t values[] = {std::numeric_limits<std::int32_t>::max(), 1, 1, 0, 0, 0, 0};
+    std::int64_t values[] = {std::numeric_limits<std::int32_t>::max(), 1, 1, 0, 1, 0, 0, 1};
     if (slot < bound.size()) {
       const TextureSpan& c = spans[bound[slot]];
+      // The order buffer holds at least one word (gl::TextureBuffer keeps 16 bytes for an empty one).
       const std::int64_t used[] = {base[slot],
                                    static_cast<std::int64_t>(std::max<std::uint64_t>(1, c.segments)),
                                    c.slots,
-                                   static_cast<std::int64_t>(c.wide_segments),
                                    static_cast<std::int64_t>(c.vertices),
+                                   std::max<std::int64_t>(1, c.voxel_count),
                                    static_cast<std::int64_t>(c.segment_table_first()),
-                                   static_cast<std::int64_t>(c.vertex_table_first())};
+                                   static_cast<std::int64_t>(c.vertex_table_first()),
+                                   static_cast<std::int64_t>(std::max<std::uint64_t>(1, c.order_words))};
       std::copy(std::begin(used), std::end(used), values);
     }
     for (std::size_t f = 0; f < fields.size(); ++f) fields[f].second.push_back(static_cast<GLint>(values[f]));

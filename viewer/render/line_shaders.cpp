@@ -26,10 +26,10 @@ std::string span_fetchers(unsigned span_count) {
   s += "uvec4 fetch_words(int c, int t) {\n";
   for (unsigned c = 0; c < span_count; ++c)
     s += "  if (c == " + std::to_string(c) + ") return texelFetch(u_words" + std::to_string(c) + ", t);\n";
-  s += "  return uvec4(0u);\n}\nint fetch_order(int c, int j) {\n";
+  s += "  return uvec4(0u);\n}\nuint fetch_order_word(int c, int j) {\n";
   for (unsigned c = 0; c < span_count; ++c)
-    s += "  if (c == " + std::to_string(c) + ") return int(texelFetch(u_ord" + std::to_string(c) + ", j).r);\n";
-  s += "  return 0;\n}\nint fetch_dataset(int c, int j) {\n";
+    s += "  if (c == " + std::to_string(c) + ") return texelFetch(u_ord" + std::to_string(c) + ", j).r;\n";
+  s += "  return 0u;\n}\nint fetch_dataset(int c, int j) {\n";
   for (unsigned c = 0; c < span_count; ++c)
     s += "  if (c == " + std::to_string(c) + ") return int(texelFetch(u_dat" + std::to_string(c) + ", j).r);\n";
   s += "  return 0;\n}\nuvec2 fetch_attributes(int c, int v) {\n";
@@ -41,18 +41,32 @@ std::string span_fetchers(unsigned span_count) {
 
 // The spans' layout uniforms and the packed position decoder.
 const char* const kSpanLayout = R"(
-// The spans' layout (scene_layout.h): S padded segments per slot, K slots, the first W entries of each
-// slot with high halves, V padded vertices, where the segment and vertex tables start (in words).
+// The spans' layout (scene_layout.h): S padded segments per slot, K slots, V padded vertices, the voxels,
+// where the segment and vertex tables start (in words), the order buffer's words. Every index into a span's
+// buffers is clamped to them: a damaged file draws wrong lines, never reads outside a buffer.
 uniform int u_span_base[SPANS];
 uniform int u_span_segments[SPANS];
 uniform int u_span_slots[SPANS];
-uniform int u_span_wide[SPANS];
 uniform int u_span_vertices[SPANS];
+uniform int u_span_voxels[SPANS];
 uniform int u_span_segment_table[SPANS];
 uniform int u_span_vertex_table[SPANS];
+uniform int u_span_order_words[SPANS];
 const uint kVoxlineEnd = 0x40000000u;
 uint fetch_word(int c, int i) { return fetch_words(c, i >> 2)[i & 3]; }
-// A packed position (.vxl spec §5.4) of the voxel whose two info texels are `lo_step`, `rest`.
+// The voxel a table entry names, and its three info texels (scene_layout.h, TextureSpan::kInfoWords).
+int table_voxel(int c, int i) { return clamp(int(fetch_word(c, i)), 0, u_span_voxels[c] - 1); }
+uvec4 fetch_info(int c, int voxel, int texel) { return fetch_words(c, (u_span_vertices[c] >> 2) + 3 * voxel + texel); }
+// `bits` bits (1 to 32) from bit `bit` of the span's orders, least significant first (.vxl spec §5.5).
+uint order_bits(int c, uint bit, uint bits) {
+  int last = u_span_order_words[c] - 1;
+  int w = min(int(bit >> 5u), last);
+  uint shift = bit & 31u;
+  uint value = fetch_order_word(c, w) >> shift;
+  if (shift + bits > 32u) value |= fetch_order_word(c, min(w + 1, last)) << (32u - shift);
+  return bits >= 32u ? value : value & ((1u << bits) - 1u);
+}
+// A packed position (.vxl spec §5.4) of the voxel whose first two info texels are `lo_step`, `rest`.
 vec3 decode(uint word, uvec4 lo_step, uvec4 rest) {
   vec3 q = vec3(float(word & 1023u), float((word >> 10) & 1023u), float((word >> 20) & 1023u));
   vec3 step = uintBitsToFloat(uvec3(lo_step.w, rest.x, rest.y));
@@ -102,6 +116,8 @@ const char* const kVertexSegmentEnds = R"(void main() {
   int voxel;            // span-local voxel index
   int v;                // the segment's first vertex, in the span's words
   bool dropped = false; // a block-order id whose vertex ends its voxline: no segment
+  bool ordered = false; // a slot entry: v is the block's first vertex plus the entry
+  uint entry = 0u;
   if (seg < 2 * A) {
     int j = seg;        // entry in the slots
     if (seg >= A) {
@@ -111,23 +127,29 @@ const char* const kVertexSegmentEnds = R"(void main() {
     }
     int slot = j / S;
     int at = j - slot * S;
-    voxel = int(fetch_word(c, u_span_segment_table[c] + (at >> 5)));
-    int e = fetch_order(c, j);
-    if (at < u_span_wide[c]) e += fetch_order(c, A + slot * u_span_wide[c] + at) << 16;
-    v = int(fetch_words(c, (u_span_vertices[c] >> 2) + 2 * voxel + 1).z) + e;
+    voxel = table_voxel(c, u_span_segment_table[c] + (at >> 5));
+    // Entry `at - seg_first` of the voxel's order `slot`, as the file stores it; the arrays follow one
+    // another, each starting on a byte.
+    uvec4 orders = fetch_info(c, voxel, 2);  // seg_first, segment count, bits, order word
+    uint n = uint(clamp(at - int(orders.x), 0, max(int(orders.y) - 1, 0)));
+    uint array_bits = ((orders.y * orders.z + 7u) >> 3) << 3;
+    entry = order_bits(c, (orders.w << 5) + uint(slot) * array_bits + n * orders.z, orders.z);
+    ordered = true;
   } else if (seg < 2 * A + u_span_vertices[c]) {
     v = seg - 2 * A;
-    voxel = int(fetch_word(c, u_span_vertex_table[c] + (v >> 5)));
+    voxel = table_voxel(c, u_span_vertex_table[c] + (v >> 5));
     dropped = (fetch_word(c, v) & kVoxlineEnd) != 0u;
   } else {
-    v = fetch_dataset(c, seg - 2 * A - u_span_vertices[c]);
-    voxel = int(fetch_word(c, u_span_vertex_table[c] + (v >> 5)));
+    v = clamp(fetch_dataset(c, seg - 2 * A - u_span_vertices[c]), 0, max(u_span_vertices[c] - 2, 0));
+    voxel = table_voxel(c, u_span_vertex_table[c] + (v >> 5));
   }
   // A dropped id becomes a line of length zero at its vertex, which rasterises to nothing: cheaper than a
   // line outside the clip volume, which llvmpipe sends through its clipper (basic mode took 1.6x longer).
   if (dropped) end = 0;
-  uvec4 lo_step = fetch_words(c, (u_span_vertices[c] >> 2) + 2 * voxel);
-  uvec4 rest = fetch_words(c, (u_span_vertices[c] >> 2) + 2 * voxel + 1);
+  uvec4 lo_step = fetch_info(c, voxel, 0);
+  uvec4 rest = fetch_info(c, voxel, 1);  // step.y, step.z, vertex_first, vertex count
+  // The entry's segment (entry, entry + 1) of the block: an entry past the block's last segment is clamped to it.
+  if (ordered) v = int(rest.z) + int(min(entry, max(rest.w, 2u) - 2u));
   vec3 p = decode(fetch_word(c, v + end), lo_step, rest);
   vec3 q = decode(fetch_word(c, v + 1 - end), lo_step, rest);
   if (dropped) q = p;

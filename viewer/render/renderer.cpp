@@ -225,6 +225,7 @@ void Renderer::start_frame(const Camera& camera, const RenderSettings& s, int wi
 }
 
 void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
+  scene_.check_uploaded(false);
   pieces_.reset();
   ModePass& mode = pass(s.mode);
   start_frame(camera, s, width, height);
@@ -233,6 +234,7 @@ void Renderer::draw(const Camera& camera, const RenderSettings& s, int width, in
   glDisable(GL_BLEND);
   enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  scene_.start_checks();  // of what this frame uploaded; their failure stops the next frame
 }
 
 struct Renderer::Pieces {
@@ -278,6 +280,7 @@ void Renderer::begin_pieces(const Camera& camera, const RenderSettings& s, int w
 
 bool Renderer::draw_piece(double max_ms) {
   if (!pieces_) throw std::logic_error("Renderer::draw_piece without begin_pieces");
+  scene_.check_uploaded(false);
   if (pieces_->done) return true;
   switch (pieces_->kind) {
     case PieceKind::Whole: {

@@ -99,6 +99,12 @@ class Renderer {
   // framebuffer rather than only in slice_color_texture(): exact then reads it from there.
   bool base_in_framebuffer() const { return base_in_framebuffer_; }
 
+  // The checks of what the renderer has uploaded, which run beside the drawing (GpuScene::check_uploaded):
+  // rethrows their failure (vxl::Error, Input: the file is damaged); with `wait`, once all have run. draw()
+  // and draw_piece() call it without waiting before they draw, so a damaged file stops being drawn at the
+  // first frame after its checks fail; a program that writes a picture waits for them first.
+  void check_uploaded(bool wait) { scene_.check_uploaded(wait); }
+
   const FrameStats& stats() const { return stats_; }
   // The scene's groups (scene_groups.h) and value sets (per-vertex sets first, then per-streamline ones).
   const SceneGroups& groups() const { return groups_; }

@@ -51,15 +51,15 @@ std::uint64_t SceneLayout::largest_voxel_texels(std::span<const VxlFile* const> 
       alone.voxel_count = 1;
       alone.vertices = padded(e.vertex_count);
       alone.segments = padded(e.segment_count);
-      alone.wide_segments = e.vertex_count > kU16OrderMaxVertices ? alone.segments : 0;
-      largest = std::max({largest, alone.words() / 4, alone.order_entries()});
+      alone.order_words = level_orders_size(e, alone.slots, f->order_packing()) / 4;
+      largest = std::max({largest, alone.words() / 4, alone.order_words});
     }
   return largest;
 }
 
 std::uint64_t SceneLayout::span_upload_bytes(std::uint32_t span) const {
   const TextureSpan& c = spans_[span];
-  return 4 * c.words() + 2 * c.order_entries() + 4 * c.segments + 8 * c.vertices;
+  return 4 * c.words() + 4 * c.order_words + 4 * c.segments + 8 * c.vertices;
 }
 
 std::uint64_t SceneLayout::upload_bytes() const {
@@ -135,32 +135,32 @@ void SceneLayout::lay_out(std::span<const VxlFile* const> files, std::uint64_t m
     const std::uint32_t slots = fl.stored_orders;
     auto padded = [](std::uint64_t n) { return (n + kGroup - 1) / kGroup * kGroup; };
     fl.level = file_levels[fi];
-    auto wide = [](const LevelEntry& e) { return e.vertex_count > kU16OrderMaxVertices; };
     auto counts = [&](std::uint32_t local) { return file.level(local, fl.level); };
-    // Both buffers of a span within the limit: its words (4 a texel) and its order entries; and its ids
+    // The level's K orders as the file stores them, padded to 4 bytes (spec §5.5): whole words.
+    auto order_words = [&](const LevelEntry& e) { return level_orders_size(e, slots, file.order_packing()) / 4; };
+    // Both buffers of a span within the limit: its words (4 a texel) and its order words; and its ids
     // within one draw's.
     auto fits = [&](const TextureSpan& c) {
-      return c.words() / 4 <= max_texels && c.order_entries() <= max_texels &&
+      return c.words() / 4 <= max_texels && c.order_words <= max_texels &&
              c.virtual_ids() <= std::uint64_t(std::numeric_limits<std::int32_t>::max() / 2);
     };
     auto voxels = file.voxels();
     TextureSpan current;
     current.file = fi;
     current.slots = slots;
-    // Sets the span's voxels' ranges: vertex blocks in file order, segment ranges wide voxels first (the
-    // high bits cover the first W entries of each slot).
+    // Sets the span's voxels' ranges, in file order: vertex blocks, segment ranges and orders.
     auto close_span = [&] {
-      std::uint64_t vertex = 0, seg = 0;
-      for (bool wide_pass : {true, false})
-        for (std::uint32_t i = current.voxel_first; i < current.voxel_first + current.voxel_count; ++i) {
-          const LevelEntry e = counts(i - fl.voxel_first);
-          if (wide(e) != wide_pass) continue;
-          voxels_[i].seg_first = seg;
-          seg += padded(e.segment_count);
-        }
+      std::uint64_t vertex = 0, seg = 0, word = 0;
       for (std::uint32_t i = current.voxel_first; i < current.voxel_first + current.voxel_count; ++i) {
-        voxels_[i].vertex_first = vertex;
-        vertex += padded(counts(i - fl.voxel_first).vertex_count);
+        const LevelEntry e = counts(i - fl.voxel_first);
+        VoxelDrawInfo& v = voxels_[i];
+        v.vertex_first = vertex;
+        v.seg_first = seg;
+        v.order_word = word;
+        v.order_bits = order_entry_bits(e.vertex_count, file.order_packing());
+        vertex += padded(e.vertex_count);
+        seg += padded(e.segment_count);
+        word += order_words(e);
       }
       spans_.push_back(current);
     };
@@ -170,12 +170,12 @@ void SceneLayout::lay_out(std::span<const VxlFile* const> files, std::uint64_t m
       const std::uint32_t i = fl.voxel_first + li;
       TextureSpan grown = current, alone = current;
       alone.voxel_count = 0;
-      alone.segments = alone.wide_segments = alone.vertices = 0;
+      alone.segments = alone.vertices = alone.order_words = 0;
       for (TextureSpan* c : {&grown, &alone}) {
         c->voxel_count++;
         c->vertices += padded(e.vertex_count);
         c->segments += padded(e.segment_count);
-        if (wide(e)) c->wide_segments += padded(e.segment_count);
+        c->order_words += order_words(e);
       }
       if (!fits(alone))
         throw Error(ErrorKind::Unsupported, file.path(), std::nullopt,

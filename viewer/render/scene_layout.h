@@ -6,16 +6,19 @@
 // ranges of one file) small enough for the driver's texture-buffer limit; there may be any number of spans:
 // a draw binds a few at a time (LinePass::draw_plan). Each span holds, in four texture
 // buffers (gpu_scene.h says how each is filled):
-//   words:   RGBA32UI, 4 words a texel: the packed positions (.vxl spec §5.4), each voxel's block starting at a
-//            multiple of kGroup words; then 8 words of decoding info per voxel; then one voxel index per kGroup
-//            order entries (the segment table) and per kGroup vertices (the vertex table), so that the vertex
-//            shader finds any entry's or vertex's voxel with one fetch;
-//   orders:  R16UI: K "slots" of S entries each (S = the span's segments, each voxel's range starting at a
-//            multiple of kGroup; K its file's stored orders), the stored orders at 16 bits, voxel-local; then
-//            the high 16 bits of the entries of the voxels with more than 65 536 vertices, which come first in
-//            every slot (their W entries) — so 2 bytes an entry, 4 only where the file stores 3 or 4;
+//   words:   RGBA32UI, 4 words a texel: the packed positions as the file stores them (.vxl spec §5.4), each
+//            voxel's block starting at a multiple of kGroup words; then kInfoWords words of decoding info per
+//            voxel (VoxelGpuInfo); then one voxel index per kGroup slot entries (the segment table) and per
+//            kGroup vertices (the vertex table), so that the vertex shader finds any entry's or vertex's voxel
+//            with one fetch;
+//   orders:  R32UI: each voxel's K stored orders of the span's level as the file stores them (ORDB, or whole
+//            bytes in an older file's ORDR: spec §5.5), from the word `order_word`; the vertex shader decodes an
+//            entry with one or two fetches and a shift;
 //   dataset: S entries in streamline order (built only when the `unsorted` mode is first used);
 //   values:  per vertex, for the colour modes that need them.
+// "Slots" number the entries the vertex shader can draw: K slots of S entries each (S = the span's segments,
+// each voxel's range starting at a multiple of kGroup, so that the segment table finds it; K its file's
+// stored orders); entry j of voxel v's range in slot k is entry j of v's order k.
 // The vertex shader maps gl_VertexID ("virtual vertex id") to a segment end: per span, ids
 //   [0, 2A)             forward slot entries (A = K S),
 //   [2A, 4A)            the same slots read backwards (entry j of a slot appears at S - 1 - j), so a voxel's
@@ -47,6 +50,8 @@ struct VoxelDrawInfo {
   std::uint32_t vertex_count;
   std::uint64_t seg_first;     // within its span's slots; a multiple of SceneLayout::kGroup
   std::uint64_t vertex_first;  // within its span's words; a multiple of SceneLayout::kGroup
+  std::uint64_t order_word;    // where its orders start in its span's order buffer, in 32-bit words
+  std::uint32_t order_bits;    // bits per order entry at its level (spec §5.5)
 };
 
 // One set of texture buffers: a contiguous voxel range of one file. Named "span", not "chunk", because the
@@ -56,18 +61,21 @@ struct TextureSpan {
   std::uint32_t slots = 1;                         // its file's K
   std::uint32_t voxel_first = 0, voxel_count = 0;  // scene voxel range
   std::uint64_t segments = 0;                      // S, with each voxel's range padded to a multiple of kGroup
-  std::uint64_t wide_segments = 0;                 // W: the first W entries of each slot have high bits
   std::uint64_t vertices = 0;                      // V, with each voxel's block padded to a multiple of kGroup
+  std::uint64_t order_words = 0;                   // its voxels' stored orders at its level, in 32-bit words
   std::uint64_t virtual_base = 0;                  // first virtual vertex id
   // How many virtual ids the span's four ranges take (below 2^31).
   std::uint64_t virtual_ids() const { return 2 * (2 * std::uint64_t(slots) * segments + vertices + segments); }
   // Where the parts of the words buffer start, in words (see above); its size in words.
   std::uint64_t info_first() const { return vertices; }
-  std::uint64_t segment_table_first() const { return vertices + 8ull * voxel_count; }
+  std::uint64_t segment_table_first() const { return vertices + kInfoWords * std::uint64_t(voxel_count); }
   std::uint64_t vertex_table_first() const { return segment_table_first() + segments / kGroupSize; }
   std::uint64_t words() const { return (vertex_table_first() + vertices / kGroupSize + 3) / 4 * 4; }
-  std::uint64_t order_entries() const { return std::uint64_t(slots) * (segments + wide_segments); }
   static constexpr std::uint64_t kGroupSize = 32;
+  // Decoding info per voxel, three texels (line_shaders.cpp reads them):
+  //   lo.x lo.y lo.z step.x | step.y step.z vertex_first vertex_count | seg_first segment_count bits order_word
+  // (lo and step as binary32 bits, spec §5.4; the rest the VoxelDrawInfo fields and the level's counts).
+  static constexpr std::uint64_t kInfoWords = 12;
 };
 
 // Where one file's voxels are in the scene, and its sorting directions.
