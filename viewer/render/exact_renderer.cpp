@@ -53,25 +53,12 @@ out vec4 frag;
 void main() { frag = vec4(texture(u_result, v_uv).rgb, 1.0); }
 )";
 
-// IEEE binary16 -> binary32 (the colours are stored with GLSL's packHalf2x16).
-float half_to_float(std::uint16_t h) {
-  const std::uint32_t sign = std::uint32_t(h & 0x8000u) << 16, exponent = (h >> 10) & 0x1Fu, mantissa = h & 0x3FFu;
-  if (exponent == 0) {  // zero or subnormal: mantissa * 2^-24
-    const float f = std::ldexp(static_cast<float>(mantissa), -24);
-    return sign ? -f : f;
-  }
-  const std::uint32_t bits = sign | (exponent == 0x1F ? 0x7F800000u : (exponent + 112) << 23) | mantissa << 13;
-  float f;
-  std::memcpy(&f, &bits, 4);
-  return f;
-}
-
 }  // namespace
 
-ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity)
-    : ExactRenderer(lines.pass_host(), node_capacity) {}
+ExactRenderer::ExactRenderer(Renderer& lines, std::uint64_t node_capacity, ExactResolve resolve)
+    : ExactRenderer(lines.pass_host(), node_capacity, resolve) {}
 
-ExactRenderer::ExactRenderer(PassHost& host, std::uint64_t node_capacity) : host_(host) {
+ExactRenderer::ExactRenderer(PassHost& host, std::uint64_t node_capacity, ExactResolve resolve) : host_(host) {
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
   glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -85,6 +72,10 @@ ExactRenderer::ExactRenderer(PassHost& host, std::uint64_t node_capacity) : host
   list_program_ = host_.lines().make_program(kListFragment, "#version 430 core");
   clear_program_ = gl::make_compute_program(kClearCompute);
   blit_program_ = gl::make_program(shaders::kFullscreenVertex, kBlitFragment);
+  if (resolve == ExactResolve::Gpu || (resolve == ExactResolve::Auto && !software_rasterizer())) {
+    gpu_ = std::make_unique<GpuListResolve>();
+    if (!gpu_->agrees_with_cpu()) gpu_.reset();  // this driver composites otherwise: the CPU does it
+  }
   glGenBuffers(1, &nodes_);
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, nodes_);
   glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(capacity_ * 16), nullptr, GL_DYNAMIC_COPY);
@@ -130,6 +121,11 @@ void ExactRenderer::begin(const Camera& camera, const RenderSettings& s, int wid
   for (std::size_t v = 0; v < plan_.count.size(); ++v)
     segments_before_[v + 1] = segments_before_[v] + plan_.count[v] / 2;
   start_image(s.background());
+  if (gpu_) {  // the picture so far lives on the GPU from here
+    glBindTexture(GL_TEXTURE_2D, result_);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, image_.data());
+  }
   next_ = 0;
   per_segment_ = 0;
   composited_ms_ = 0;
@@ -206,9 +202,11 @@ bool ExactRenderer::step(double max_ms) {
 }
 
 void ExactRenderer::show_image() {
-  glBindTexture(GL_TEXTURE_2D, result_);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, image_.data());
+  if (!gpu_) {
+    glBindTexture(GL_TEXTURE_2D, result_);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA, GL_FLOAT, image_.data());
+  }
   enable_clip_distances(0);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glViewport(0, 0, width_, height_);
@@ -293,6 +291,10 @@ void ExactRenderer::resolve_band(int y0, int y1, std::uint32_t stored) {
   ++passes_;
   fragments_ += stored;
   if (stored == 0) return;
+  if (gpu_) {
+    gpu_->resolve(heads_, nodes_, stored, result_, width_, y0, y1);
+    return;
+  }
   // The shaders' writes must be visible to the read-backs.
   glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   heads_copy_.resize(std::size_t(width_) * height_);
@@ -302,33 +304,7 @@ void ExactRenderer::resolve_band(int y0, int y1, std::uint32_t stored) {
   nodes_copy_.resize(stored);
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, nodes_);
   glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(stored) * 16, nodes_copy_.data());
-
-  std::vector<std::pair<float, std::uint32_t>> list;  // (depth, node)
-  for (int y = y0; y < y1; ++y)
-    for (int x = 0; x < width_; ++x) {
-      list.clear();
-      for (std::uint32_t i = heads_copy_[std::size_t(y) * width_ + x]; i != 0xFFFFFFFFu; i = nodes_copy_[i][3]) {
-        if (i >= stored || list.size() >= stored) throw std::runtime_error("exact mode: corrupt fragment list");
-        float depth;
-        std::memcpy(&depth, &nodes_copy_[i][2], 4);
-        list.push_back({depth, i});
-      }
-      if (list.empty()) continue;
-      // Farthest first; at equal depths the fragment stored first (drawn earlier: an earlier voxel in the
-      // visibility order) goes under, as it does when runs of voxels are composited one after another.
-      std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) {
-        return a.first > b.first || (a.first == b.first && a.second < b.second);
-      });
-      float* out = image_.data() + (std::size_t(y) * width_ + x) * 4;
-      glm::vec3 color = glm::make_vec3(out);
-      for (const auto& [depth, i] : list) {
-        const std::array<std::uint32_t, 4>& n = nodes_copy_[i];
-        const glm::vec3 c(half_to_float(n[0] & 0xFFFF), half_to_float(n[0] >> 16), half_to_float(n[1] & 0xFFFF));
-        const float a = half_to_float(n[1] >> 16);
-        color = c * a + color * (1.0f - a);
-      }
-      out[0] = color.r, out[1] = color.g, out[2] = color.b, out[3] = 1.0f;
-    }
+  composite_lists_on_cpu(heads_copy_, nodes_copy_, width_, y0, y1, image_);
 }
 
 }  // namespace vxl
