@@ -200,8 +200,9 @@ TEST_F(GpuMemoryBudget, EvictedSpansDrawTheSamePictureWhenUploadedAgain) {
   EXPECT_GT(lit_pixels(top), 100);
 }
 
-// A window spreads a large upload over frames: upload_for uploads about a time limit's worth of spans a call,
-// the nearest first, and says when the view has all it needs; the picture is then the eager scene's.
+// A window spreads a large upload over frames: upload_for fills a few spans at a time on other threads, the
+// nearest first, returns after about its time limit with those done resident, and says when the view has all
+// it needs; the picture is then the eager scene's.
 TEST_F(GpuMemoryBudget, UploadsSpreadOverCallsGiveTheSamePicture) {
   Renderer eager({&*file_}, kTexels, 0);
   Renderer lazy({&*file_}, kTexels, 0, std::make_shared<GpuMemoryPool>(), /*eager=*/false);
@@ -211,12 +212,12 @@ TEST_F(GpuMemoryBudget, UploadsSpreadOverCallsGiveTheSamePicture) {
   s.opacity = 0.3f;
   int calls = 1;
   std::uint64_t before = 0;
-  while (!lazy.upload_for(view(), 1.0, s.clipping, 1e-6)) {  // a millionth of a millisecond: one span a call
-    EXPECT_GT(lazy.gpu_bytes(), before) << "call " << calls;
+  while (!lazy.upload_for(view(), 1.0, s.clipping, 1e-6)) {  // a millionth of a millisecond: hardly any wait
+    EXPECT_GE(lazy.gpu_bytes(), before) << "call " << calls;
     before = lazy.gpu_bytes();
-    ++calls;
+    ASSERT_LT(++calls, 1000000) << "the uploads never end";
   }
-  EXPECT_GT(calls, 4);
+  EXPECT_GT(calls, 4) << "spread over calls, a few spans filling at a time";
   FramePlan plan;
   lazy.plan(view(), 1.0, PlanOrder::Nearest, plan);
   EXPECT_TRUE(lazy.span_resident(lazy.layout().span_of_id(plan.first.back())));

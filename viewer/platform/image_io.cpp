@@ -1,6 +1,7 @@
 #include "viewer/platform/image_io.h"
 
 #include <fcntl.h>
+#include <stb_image_write.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -83,17 +84,30 @@ void write_image_as(const std::string& format, const std::string& path, int w, i
                 std::to_string(h) + " RGBA8 needs " + std::to_string(static_cast<std::size_t>(w) * h * 4) + ", for",
             path);
 
-  const pictures::Api& module = pictures::picture_module(path);
+  // PNG and JPEG through stb_image_write (libstb, which the panel's Dear ImGui links anyway): writing the
+  // usual picture loads nothing, where OpenImageIO's libraries take half a second. TIFF and OpenEXR through
+  // the picture module (OpenImageIO), loaded here on first use.
+  const bool with_stb = format == "png" || format == "jpeg";
+  const pictures::Api* module = with_stb ? nullptr : &pictures::picture_module(path);
   const fs::path target(output_target(path));
   std::error_code ec;
   const fs::path tmp = reserve_temp_file(target, path);
   try {
     // The format is named explicitly: the temporary name's extension is not the output's.
-    std::string error;
-    switch (module.write(format.c_str(), tmp.c_str(), w, h, rgba.data(), error)) {
-      case pictures::WriteStatus::Ok: break;
-      case pictures::WriteStatus::NoWriter: io_fail("OpenImageIO has no " + format + " writer for", path, error);
-      case pictures::WriteStatus::OutputFailed: output_fail(path, error);
+    if (with_stb) {
+      errno = 0;
+      // Straight alpha, the bytes as given; JPEG keeps the colour channels (quality 95).
+      const int written = format == "png" ? stbi_write_png(tmp.c_str(), w, h, 4, rgba.data(), w * 4)
+                                          : stbi_write_jpg(tmp.c_str(), w, h, 4, rgba.data(), 95);
+      if (written == 0)
+        output_fail(path, "cannot write the " + format + " picture", errno != 0 ? std::strerror(errno) : "");
+    } else {
+      std::string error;
+      switch (module->write(format.c_str(), tmp.c_str(), w, h, rgba.data(), error)) {
+        case pictures::WriteStatus::Ok: break;
+        case pictures::WriteStatus::NoWriter: io_fail("OpenImageIO has no " + format + " writer for", path, error);
+        case pictures::WriteStatus::OutputFailed: output_fail(path, error);
+      }
     }
     fsync_file(tmp, path);
     fs::rename(tmp, target, ec);

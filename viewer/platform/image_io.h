@@ -1,6 +1,7 @@
 #pragma once
-// Image files through OpenImageIO: PNG, JPEG, TIFF or OpenEXR output (atomic), RGBA8 input and numeric
-// comparison.
+// Image files: PNG, JPEG, TIFF or OpenEXR output (atomic), RGBA8 input and numeric comparison. PNG and JPEG
+// are written with stb_image_write; TIFF and OpenEXR, reading and comparing with OpenImageIO, in a module
+// loaded on first use (picture_module.h).
 //
 // Alpha is straight (unassociated) on both sides: the bytes given to write_png are the bytes in the
 // file, and read_image returns the file's bytes. (OpenImageIO would otherwise un-premultiply on PNG

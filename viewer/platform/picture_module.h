@@ -1,10 +1,11 @@
 // The picture module's interface: what image_io.cpp asks of OpenImageIO, behind one table of functions that
 // libvoxlines_pictures.so (picture_module.cpp) exports and picture_module_loader.cpp loads with dlopen the
-// first time a picture is written, read or compared.
+// first time a TIFF or OpenEXR picture is written or any picture read or compared.
 //
-// Why a module: OpenImageIO pulls in some 270 shared libraries, and linking them costs every start of a
+// Why a module: OpenImageIO pulls in some 250 shared libraries, and linking them costs every start of a
 // program that links it about half a second (more on a cold disk), whether it writes a picture or not. The
-// viewer writes pictures only for --render and screenshots, so only those pay for it.
+// viewer writes PNG and JPEG without it (stb_image_write), so only the other formats, the tests' reading and
+// the benchmarks' comparisons pay for it.
 //
 // Both sides are built together by this project (same compiler, same standard library), so the table passes
 // C++ types; no exception crosses it: every function reports failure through its return value and `error`.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <thread>
 
 #include "format/base/error.h"
 #include "format/base/parallel.h"
@@ -131,51 +132,87 @@ std::uint64_t GpuScene::span_bytes(std::uint32_t c) const {
   return bytes;
 }
 
-void GpuScene::upload_span(std::uint32_t ci) {
+void GpuScene::upload_span(std::uint32_t c) {
+  begin_upload(c);
+  finish_upload(filling_.size() - 1);
+}
+
+void GpuScene::begin_upload(std::uint32_t ci) {
   const TextureSpan& c = layout_.texture_spans()[ci];
   const VxlFile& file = *files_[c.file];
   const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
   GpuTextureSpan& g = spans_[ci];
-  // Filled in place in the GPU's buffers by several threads: voxels fill disjoint ranges of both. The words
+  // Filled in place in the GPU's buffers by other threads: voxels fill disjoint ranges of both. The words
   // fill while this thread has the driver make the order buffer (which a software driver clears first).
+  Filling f;
+  f.span = ci;
   auto* words = static_cast<std::uint32_t*>(g.words.create_mapped(4 * c.words()));
-  try {
-    BackgroundTask<> filling([&] {
-      std::vector<VoxelScratch> scratch(resolve_threads(0));  // per thread
-      parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
-        const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
-        fill_voxel_words(file, i, i - file_first, static_cast<std::uint32_t>(k), c, words, scratch[t]);
-      });
-      // The last words of the tables' texel, which no voxel fills.
-      std::fill(words + c.vertex_table_first() + c.vertices / SceneLayout::kGroup, words + c.words(), 0u);
+  f.words = BackgroundTask<>([this, &c, &file, file_first, words] {
+    std::vector<VoxelScratch> scratch(resolve_threads(0));  // per thread
+    parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
+      const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
+      fill_voxel_words(file, i, i - file_first, static_cast<std::uint32_t>(k), c, words, scratch[t]);
     });
+    // The last words of the tables' texel, which no voxel fills.
+    std::fill(words + c.vertex_table_first() + c.vertices / SceneLayout::kGroup, words + c.words(), 0u);
+  });
+  try {
     auto* orders = static_cast<std::uint8_t*>(g.orders.create_mapped(4 * c.order_words));
-    try {
+    f.orders = BackgroundTask<>([this, &c, &file, file_first, orders] {
       parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned) {
         const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
         copy_voxel_orders(file, i, i - file_first, c, orders);
       });
-      filling.get();
-    } catch (...) {
-      g.orders.finish_mapped(GL_R32UI);
-      throw;
-    }
-    g.orders.finish_mapped(GL_R32UI);
+    });
   } catch (...) {
+    f.words = {};  // joined: nothing writes to the mapping after this
     g.words.finish_mapped(GL_RGBA32UI);
     g.words.destroy();
-    g.orders.destroy();
     throw;
   }
-  g.words.finish_mapped(GL_RGBA32UI);
-  upload_extras(ci);
-  resident_[ci] = true;
+  filling_.push_back(std::move(f));
   uploaded_bytes_[ci] = span_bytes(ci);
   gpu_bytes_ += uploaded_bytes_[ci];
+}
+
+void GpuScene::finish_upload(std::size_t k) {
+  Filling f = std::move(filling_[k]);
+  filling_.erase(filling_.begin() + static_cast<std::ptrdiff_t>(k));
+  const std::uint32_t ci = f.span;
+  GpuTextureSpan& g = spans_[ci];
+  std::exception_ptr error;
+  for (BackgroundTask<>* task : {&f.words, &f.orders}) try {
+      task->get();
+    } catch (...) {
+      if (!error) error = std::current_exception();
+    }
+  try {
+    g.words.finish_mapped(GL_RGBA32UI);
+    g.orders.finish_mapped(GL_R32UI);
+    if (error) std::rethrow_exception(error);
+    upload_extras(ci);
+  } catch (...) {
+    g.words.destroy();
+    g.orders.destroy();
+    gpu_bytes_ -= uploaded_bytes_[ci];
+    pool_->remove(owner_, ci);
+    throw;
+  }
+  resident_[ci] = true;
   if (!checked_[ci]) {
     checked_[ci] = true;
     unchecked_.push_back(ci);
   }
+}
+
+std::optional<std::size_t> GpuScene::filling_index(std::uint32_t c) const {
+  for (std::size_t k = 0; k < filling_.size(); ++k)
+    if (filling_[k].span == c) return k;
+  return std::nullopt;
+}
+
+void GpuScene::finish_uploads() {
+  while (!filling_.empty()) finish_upload(0);
 }
 
 void GpuScene::check_uploaded(bool wait) {
@@ -238,7 +275,18 @@ void GpuScene::upload_extras(std::uint32_t ci) {
 }
 
 void GpuScene::evict(std::uint32_t c) {
-  if (!resident_[c]) return;
+  if (const std::optional<std::size_t> k = filling_index(c)) {
+    // Its fill is joined (its failure dropped: nothing of it stays) before its buffers go.
+    Filling f = std::move(filling_[*k]);
+    filling_.erase(filling_.begin() + static_cast<std::ptrdiff_t>(*k));
+    f = {};
+    for (gl::TextureBuffer* buffer : {&spans_[c].words, &spans_[c].orders}) try {
+        buffer->finish_mapped(GL_R32UI);
+      } catch (const std::exception&) {  // contents lost: they are dropped anyway
+      }
+  } else if (!resident_[c]) {
+    return;
+  }
   gpu_bytes_ -= uploaded_bytes_[c];
   spans_[c].words.destroy();
   spans_[c].orders.destroy();
@@ -247,17 +295,24 @@ void GpuScene::evict(std::uint32_t c) {
   resident_[c] = false;
 }
 
-GpuScene::Residency GpuScene::make_resident(std::span<const std::uint32_t> needed, double max_ms) {
+GpuScene::Residency GpuScene::make_resident(std::span<const std::uint32_t> needed, double max_ms, bool wait) {
   const auto start = std::chrono::steady_clock::now();
+  auto elapsed_ms = [&] {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  };
   const std::uint64_t use = pool_->begin_use();
   for (std::uint32_t c : needed)
-    if (resident_[c]) pool_->touch(owner_, c, use);
+    if (resident_[c] || filling_index(c)) pool_->touch(owner_, c, use);
   Residency r;
   bool uploaded = false;
   for (std::uint32_t c : needed) {
     if (resident_[c]) continue;
-    if (uploaded &&
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() >= max_ms) {
+    if (const std::optional<std::size_t> k = filling_index(c)) {
+      if (wait) finish_upload(*k);
+      continue;
+    }
+    // Waiting: at least one span, then until the time is up. Not waiting: a few spans filling at a time.
+    if (wait ? uploaded && elapsed_ms() >= max_ms : filling_.size() >= kMaxFilling) {
       r.complete = false;
       r.out_of_time = true;
       break;
@@ -267,9 +322,26 @@ GpuScene::Residency GpuScene::make_resident(std::span<const std::uint32_t> neede
       r.complete = false;
       continue;
     }
-    upload_span(c);
+    begin_upload(c);
     pool_->add(owner_, c, bytes, use);
+    if (wait) finish_upload(filling_.size() - 1);
     uploaded = true;
+  }
+  if (!wait) {
+    // The fills that end within the time, finished here (a millisecond's sleep between looks).
+    for (;;) {
+      for (std::size_t k = 0; k < filling_.size();)
+        if (filling_[k].words.ready() && filling_[k].orders.ready())
+          finish_upload(k);
+        else
+          ++k;
+      if (filling_.empty() || elapsed_ms() >= max_ms) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    if (!filling_.empty()) {
+      r.complete = false;
+      r.out_of_time = true;
+    }
   }
   return r;
 }
@@ -277,6 +349,7 @@ GpuScene::Residency GpuScene::make_resident(std::span<const std::uint32_t> neede
 void GpuScene::upload_resident_again() {
   // Only the dataset and attribute buffers change: the positions and orders stay. A span whose new size
   // does not fit the budget is evicted whole.
+  finish_uploads();
   const std::uint64_t use = pool_->begin_use();
   for (std::uint32_t c = 0; c < spans_.size(); ++c)
     if (resident_[c]) pool_->touch(owner_, c, use);
@@ -302,7 +375,7 @@ GpuScene::~GpuScene() {
 
 void GpuScene::release() {
   for (std::uint32_t c = 0; c < spans_.size(); ++c) {
-    if (resident_[c]) pool_->remove(owner_, c);
+    if (resident_[c] || filling_index(c)) pool_->remove(owner_, c);
     evict(c);
   }
 }

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -68,13 +69,17 @@ class GpuScene {
 
   // Uploads the spans in `needed` that are not resident, in that order (the most important first), evicting
   // the least recently used spans of the pool's scenes that `needed` does not hold; a span that does not fit
-  // stays out. With a time limit, stops once `max_ms` have passed (at least one span is uploaded).
+  // stays out. Waiting (the default), with a time limit, stops once `max_ms` have passed (at least one span
+  // is uploaded). Not waiting (`wait` false: a window at rest, whose event loop must not block on an upload),
+  // starts the fills of up to kMaxFilling spans on other threads, and returns once those that end within
+  // `max_ms` are resident: calling again finishes and starts more. A span still filling is not drawn.
   struct Residency {
     bool complete = true;      // every span of `needed` is resident
-    bool out_of_time = false;  // stopped by the time limit: calling again uploads more
+    bool out_of_time = false;  // stopped by the time limit or by fills still running: calling again uploads more
   };
+  static constexpr std::size_t kMaxFilling = 2;
   Residency make_resident(std::span<const std::uint32_t> needed,
-                          double max_ms = std::numeric_limits<double>::infinity());
+                          double max_ms = std::numeric_limits<double>::infinity(), bool wait = true);
 
   // Gives every span an attribute buffer of 2 words per vertex made from its file's `per_file` entry
   // (vertex_attributes.h) as the span is uploaded; an empty vector empties them. Resident spans are
@@ -104,7 +109,13 @@ class GpuScene {
  private:
   // The bytes span c takes on the GPU with its current attributes and dataset order.
   std::uint64_t span_bytes(std::uint32_t c) const;
+  // A span's upload: its buffers made and mapped here, filled on other threads (begin_upload); joined,
+  // unmapped and made resident (finish_upload of its entry in filling_). upload_span does both at once.
   void upload_span(std::uint32_t c);
+  void begin_upload(std::uint32_t c);
+  void finish_upload(std::size_t filling);
+  void finish_uploads();  // every span filling
+  std::optional<std::size_t> filling_index(std::uint32_t c) const;
   // Span c's dataset and attribute buffers, for the current dataset content and attributes.
   void upload_extras(std::uint32_t c);
   void evict(std::uint32_t c);
@@ -138,6 +149,11 @@ class GpuScene {
   std::vector<std::vector<std::uint32_t>> dataset_per_span_;  // StreamlineOrder: each span's array
   std::vector<std::int64_t> dataset_first_;
   std::vector<std::int32_t> dataset_count_;
+  struct Filling {
+    std::uint32_t span = 0;
+    BackgroundTask<> words, orders;  // filling the span's mapped buffers
+  };
+  std::vector<Filling> filling_;          // spans being uploaded (begun, not finished)
   std::vector<bool> checked_;             // per span: its draw checks have run or are running
   std::vector<std::uint32_t> unchecked_;  // spans uploaded since the checks last started
   std::exception_ptr check_failure_;      // the first failed check, rethrown by every check_uploaded

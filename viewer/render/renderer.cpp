@@ -125,7 +125,7 @@ void Renderer::plan_and_count(const Camera& camera, double aspect, PlanOrder ord
 bool Renderer::upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms) {
   FramePlan nearest;
   plan(camera, aspect, PlanOrder::Nearest, nearest, clipping);
-  return !scene_.make_resident(spans_nearest_first(scene_.layout(), nearest), max_ms).out_of_time;
+  return !scene_.make_resident(spans_nearest_first(scene_.layout(), nearest), max_ms, false).out_of_time;
 }
 
 void Renderer::keep_resident(FramePlan& plan) {

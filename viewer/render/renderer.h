@@ -142,9 +142,11 @@ class Renderer {
   // The most GPU memory a frame of `camera` with `clipping` can need: the spans its visible voxels lie in,
   // with everything a mode may upload for them (SceneLayout::span_upload_bytes).
   std::uint64_t view_bytes(const Camera& camera, double aspect, const Clipping& clipping = {}) const;
-  // Uploads, for about `max_ms` (at least one span), the spans a frame of `camera` needs that are not
-  // resident, the nearest voxels' first, so that a window can spread a large upload over frames. True once
-  // nothing more can be uploaded for that view (all resident, or the budget holds no more).
+  // Uploads the spans a frame of `camera` needs that are not resident, the nearest voxels' first, filled on
+  // other threads a few at a time (GpuScene::make_resident without waiting), so that a window can spread a
+  // large upload over frames and its event loop never waits for one: returns after about `max_ms`, with the
+  // spans whose fill ended by then resident. True once nothing more can be uploaded for that view (all
+  // resident, or the budget holds no more).
   bool upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms);
 
   // The renderer as its transparency modes see it (modes/pass_host.h): its line pass, scene, plan and base.
