@@ -5,7 +5,8 @@
 //   * per-frame CPU work (cull + voxel sort + order pick + command building), median over a 72-view
 //     turntable, at the file's voxel size;
 //   * frame time per mode (glFinish-bounded) and the renderer's CPU time of the frame (FrameStats::plan_ms:
-//     for segsort it includes the segment sort), medians of a few frames over the turntable.
+//     for segsort it includes the segment sort), medians of a few frames over the turntable; for exact, also
+//     with the lists composited on the GPU and on the CPU (exact_resolve.h), whichever the mode chooses.
 // Prints numbers; asserts nothing.
 //
 // Usage: render_bench --scene FILE.vxl[:SOURCE.tck] ... [--size N] [--frames N] [--modes a,b,...]
@@ -22,6 +23,7 @@
 #include "bench/child_process.h"
 #include "viewer/platform/egl_context.h"
 #include "viewer/platform/offscreen_target.h"
+#include "viewer/render/exact_renderer.h"
 #include "viewer/render/frame_plan.h"
 #include "viewer/render/renderer.h"
 
@@ -159,6 +161,27 @@ int run(int argc, char** argv) {
       if (unsorted_ms > 0) std::printf("  (%.2fx unsorted)", m / unsorted_ms);
       std::printf("\n");
       std::fflush(stdout);
+      if (mode == vxl::RenderMode::Exact) {
+        // The exact frame with its lists composited each way (exact_resolve.h), whichever the mode chose here.
+        for (auto [resolve, name] :
+             {std::pair{vxl::ExactResolve::Gpu, "GPU"}, std::pair{vxl::ExactResolve::Cpu, "CPU"}}) {
+          vxl::ExactRenderer exact(renderer, 0, resolve);
+          std::vector<double> resolved;
+          for (int f = 0; f <= frames; ++f) {
+            vxl::Camera cam = turntable_camera(renderer, f, frames + 1);
+            target.bind();
+            glFinish();
+            auto t0 = Clock::now();
+            exact.draw(cam, s, size, size, target.framebuffer());
+            glFinish();
+            if (f > 0) resolved.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+          }
+          std::printf("  frame time exact, lists composited on the %s%s: median %9.1f ms\n", name,
+                      exact.resolve() == resolve ? "" : " (refused: the driver disagrees, on the CPU)",
+                      median(resolved));
+          std::fflush(stdout);
+        }
+      }
     }
   }
   return 0;
