@@ -137,25 +137,32 @@ int run(int argc, char** argv) {
 
     vxl::OffscreenTarget target(size, size);
     double unsorted_ms = 0;
-    for (vxl::RenderMode mode : modes) {
-      vxl::RenderSettings s;
-      s.mode = mode;
-      s.opacity = 0.05f;
-      std::vector<double> ms, cpu_ms;
-      renderer.prepare(mode);
+    // The median time of `frames` frames over the turntable (after a warm-up), each drawn by draw(camera) and
+    // bounded by glFinish; with `cpu`, the renderer's CPU time of each frame too.
+    auto timed_frames = [&](auto&& draw, std::vector<double>* cpu = nullptr) {
+      std::vector<double> ms;
       for (int f = 0; f <= frames; ++f) {
         vxl::Camera cam = turntable_camera(renderer, f, frames + 1);
         target.bind();
         glFinish();
         auto t0 = Clock::now();
-        renderer.draw(cam, s, size, size, target.framebuffer());
+        draw(cam);
         glFinish();
         if (f > 0) {  // the first is a warm-up
           ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-          cpu_ms.push_back(renderer.stats().plan_ms);
+          if (cpu) cpu->push_back(renderer.stats().plan_ms);
         }
       }
-      double m = median(ms);
+      return median(ms);
+    };
+    for (vxl::RenderMode mode : modes) {
+      vxl::RenderSettings s;
+      s.mode = mode;
+      s.opacity = 0.05f;
+      std::vector<double> cpu_ms;
+      renderer.prepare(mode);
+      const double m = timed_frames(
+          [&](const vxl::Camera& cam) { renderer.draw(cam, s, size, size, target.framebuffer()); }, &cpu_ms);
       if (mode == vxl::RenderMode::Unsorted) unsorted_ms = m;
       std::printf("  frame time %-9s median %9.1f ms, CPU %8.2f ms", vxl::render_mode_name(mode), m, median(cpu_ms));
       if (unsorted_ms > 0) std::printf("  (%.2fx unsorted)", m / unsorted_ms);
@@ -166,19 +173,10 @@ int run(int argc, char** argv) {
         for (auto [resolve, name] :
              {std::pair{vxl::ExactResolve::Gpu, "GPU"}, std::pair{vxl::ExactResolve::Cpu, "CPU"}}) {
           vxl::ExactRenderer exact(renderer, 0, resolve);
-          std::vector<double> resolved;
-          for (int f = 0; f <= frames; ++f) {
-            vxl::Camera cam = turntable_camera(renderer, f, frames + 1);
-            target.bind();
-            glFinish();
-            auto t0 = Clock::now();
-            exact.draw(cam, s, size, size, target.framebuffer());
-            glFinish();
-            if (f > 0) resolved.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-          }
+          const double resolved =
+              timed_frames([&](const vxl::Camera& cam) { exact.draw(cam, s, size, size, target.framebuffer()); });
           std::printf("  frame time exact, lists composited on the %s%s: median %9.1f ms\n", name,
-                      exact.resolve() == resolve ? "" : " (refused: the driver disagrees, on the CPU)",
-                      median(resolved));
+                      exact.resolve() == resolve ? "" : " (refused: the driver disagrees, on the CPU)", resolved);
           std::fflush(stdout);
         }
       }

@@ -64,6 +64,18 @@ Image draw(const VxlFile& f) {
   return test::render_image(r, camera, s, 320, 320);
 }
 
+// The checks of what `r` uploaded refuse it: an input error at byte `at` whose message holds `why`.
+void expect_refused(Renderer& r, std::uint64_t at, const std::string& why) {
+  try {
+    r.check_uploaded(true);
+    ADD_FAILURE() << "not refused: " << why;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_EQ(e.offset(), at) << e.what();
+    EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+  }
+}
+
 bool lit(const Image& img, int x, int y) { return (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0; }
 
 // Every entry of every stored order of one voxel past its block (by different amounts, within the entries'
@@ -103,16 +115,7 @@ TEST_F(DamagedDraw, OrderEntriesPastTheBlockDrawTheBlocksOwnSegmentsAndAreRefuse
   EXPECT_EQ(stray, 0) << "a damaged entry drew a line that is none of the file's segments";
 
   Renderer r(damaged);
-  try {
-    r.check_uploaded(true);
-    ADD_FAILURE() << "the damaged orders were not refused";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::Input);
-    EXPECT_EQ(e.offset(), orders_at) << e.what();
-    EXPECT_NE(std::string(e.what()).find("order entry out of range in voxel " + std::to_string(voxel)),
-              std::string::npos)
-        << e.what();
-  }
+  expect_refused(r, orders_at, "order entry out of range in voxel " + std::to_string(voxel));
   // A scene whose checks failed stays refused.
   EXPECT_THROW(r.check_uploaded(false), Error);
 }
@@ -126,14 +129,7 @@ TEST_F(DamagedDraw, AReservedBitIsNotDrawnAndIsRefused) {
   const VxlFile damaged = write_damaged();
   EXPECT_EQ(compare_images(draw(intact), draw(damaged)).differing_pixels, 0u);
   Renderer r(damaged);
-  try {
-    r.check_uploaded(true);
-    ADD_FAILURE() << "the reserved bit was not refused";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::Input);
-    EXPECT_EQ(e.offset(), word_at) << e.what();
-    EXPECT_NE(std::string(e.what()).find("reserved bit set"), std::string::npos) << e.what();
-  }
+  expect_refused(r, word_at, "reserved bit set");
 }
 
 }  // namespace
