@@ -48,7 +48,8 @@ std::string voxview_description(const std::string& version) {
          " is converted first, as 'voxlines convert' does (in memory, or streamed through a temporary\n"
          ".vxl when it would not fit in memory or under --memory-limit).\n"
          "Opening a .vxl checks its structure (header, section table, section sizes, voxel table, names) in\n"
-         "O(voxels) but not its checksums: damaged positions, orders or values are drawn as they are. --verify\n"
+         "O(voxels) but not its checksums: damaged positions or values are drawn as they are; order entries outside\n"
+         "their block and wrong voxline ends are found beside the drawing, which then stops (exit 3). --verify\n"
          "checks everything first, as 'voxlines verify' does.\n" +
          controls_as_paragraph(110);
 }
