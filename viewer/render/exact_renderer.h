@@ -44,8 +44,7 @@ class ExactRenderer {
   // nodes as fit in min(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, 256 MiB).
   explicit ExactRenderer(PassHost& host, std::uint64_t node_capacity = 0, ExactResolve resolve = ExactResolve::Auto);
   // The same over `lines`' passes (Renderer::pass_host).
-  explicit ExactRenderer(Renderer& lines, std::uint64_t node_capacity = 0,
-                         ExactResolve resolve = ExactResolve::Auto);
+  explicit ExactRenderer(Renderer& lines, std::uint64_t node_capacity = 0, ExactResolve resolve = ExactResolve::Auto);
   // Where this renderer composites: Gpu or Cpu (Gpu only where the driver passed GpuListResolve::agrees_with_cpu).
   ExactResolve resolve() const { return gpu_ ? ExactResolve::Gpu : ExactResolve::Cpu; }
   ~ExactRenderer();
