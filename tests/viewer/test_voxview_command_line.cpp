@@ -23,6 +23,26 @@ TEST(VoxviewCommandLine, TyposAndUnknownViewsSayWhatIsKnown) {
   EXPECT_EQ(view.output.find("<input>"), std::string::npos) << view.output;
 }
 
+// An opacity or a line width must be a number in its range: NaN (which every range check lets through by
+// comparing false) and infinities are usage errors, naming the option, before anything is drawn.
+TEST(VoxviewCommandLine, OpacitiesAndLineWidthsThatAreNoNumberInTheirRangeAreUsageErrors) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  const std::string render = test::q(dir.file("a.tck")) + " --size 16x16 --render " + test::q(dir.file("a.png"));
+  const char* const refused[][2] = {
+      {"--opacity", "nan"},       {"--opacity", "-nan"},        {"--opacity", "inf"},
+      {"--opacity", "2"},         {"--line-width", "nan"},      {"--line-width", "inf"},
+      {"--focus-opacity", "nan"}, {"--context-opacity", "nan"}, {"--context-opacity", "-0.5"}};
+  for (const auto& [option, value] : refused) {
+    const test::CommandResult r =
+        test::run_program(VOXVIEW_CLI, render + " --include 0,0,0,50 " + option + " " + value);
+    EXPECT_EQ(r.exit_code, 2) << option << " " << value << ": " << r.output;
+    EXPECT_NE(r.output.find(std::string(option) + ": expected a number from"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("a.png"))) << option << " " << value;
+  }
+  EXPECT_EQ(test::run_program(VOXVIEW_CLI, render + " --opacity 1e-3 --line-width 16").exit_code, 0);
+}
+
 TEST(VoxviewCommandLine, APictureIsWrittenInTheFormatItsExtensionNames) {
   test::ScratchDir dir;
   ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);

@@ -1,5 +1,7 @@
 #include "viewer/app/voxview_cli.h"
 
+#include <cmath>
+#include <cstdlib>
 #include <vector>
 
 #include "converter/readers/source_formats.h"
@@ -35,6 +37,21 @@ std::vector<std::string> cli11_arguments(int argc, const char* const* argv) {
     }
   }
   return args;
+}
+
+// A number from `lo` to `hi`. CLI::Range lets NaN through (every comparison with it is false), and an opacity or a
+// line width of NaN drew a black picture.
+CLI::Validator number_from_to(double lo, double hi) {
+  const std::string range = CLI::detail::to_string(lo) + " to " + CLI::detail::to_string(hi);
+  return CLI::Validator(
+      [lo, hi, range](const std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v < lo || v > hi)
+          return "expected a number from " + range + ", got '" + text + "'";
+        return {};
+      },
+      "NUMBER in [" + range + "]");
 }
 
 }  // namespace
@@ -88,7 +105,7 @@ void declare_picture(CLI::App& cli, ViewerArguments& a) {
       ->check(CLI::IsMember(render_mode_names()));
   cli.add_option("--opacity", a.opacity, "line opacity, 1 down to 0.001")
       ->default_val(0.3)
-      ->check(CLI::Range(0.001, 1.0));
+      ->check(number_from_to(0.001, 1.0));
   cli.add_option("--view", a.view, view_names_text() + ", or AZ,EL in degrees");
   cli.add_option("--size", a.size, "image or window size WxH")->default_val("1024x1024");
   cli.add_flag("--ortho", a.options.orthographic, "orthographic projection (default perspective)");
@@ -146,11 +163,11 @@ void declare_selection(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--focus-opacity", a.focus_opacity,
                  "with a selection: the selected streamlines' opacity "
                  "(default --opacity)")
-      ->check(CLI::Range(0.001, 1.0));
+      ->check(number_from_to(0.001, 1.0));
   cli.add_option("--context-opacity", a.context_opacity,
                  "with a selection: the other streamlines' opacity (0 hides them)")
       ->default_val(0.02)
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(number_from_to(0.0, 1.0));
 }
 
 // Per-point values, lighting, line width, background and annotations.
@@ -163,7 +180,9 @@ void declare_lines(CLI::App& cli, ViewerArguments& a) {
       "--lighting", a.lighting,
       "light the lines (illuminated lines: a line along the light, which comes from the viewer's upper left, is "
       "dark, one across it bright)");
-  cli.add_option("--line-width", a.line_width, "line width in pixels")->default_val(1.0)->check(CLI::Range(1.0, 16.0));
+  cli.add_option("--line-width", a.line_width, "line width in pixels")
+      ->default_val(1.0)
+      ->check(number_from_to(1.0, 16.0));
   cli.add_option("--background", a.background, "the background colour: " + background_color_forms())
       ->default_val("black");
   cli.add_flag("--orientation-labels", a.orientation_labels,
