@@ -463,6 +463,32 @@ TEST(SelectionRegions, ASphereHoldsItsSurfaceAsTckeditDoes) {
   EXPECT_FALSE(box.contains(out));
 }
 
+// Numbers are read as tckedit reads them: a decimal to a double, then to a float. 1 + 2^-24 + 2^-80 rounds to
+// the double 1 + 2^-24, a tie between the floats 1 and 1 + 2^-23 that goes to 1 (the even one); read straight
+// to a float it would be 1 + 2^-23. A radius below the floats' least (1e-46) is 0, as there; one beyond their
+// range is refused naming the radius; "+-5" is no number.
+TEST(SelectionRegions, NumbersAreReadAsTckeditReadsThem) {
+  const Region tie =
+      parse_region("0,0,0,1.00000005960464477539062582718061255302767487140869206996285356581211090087890625");
+  const float one[3] = {1, 0, 0}, above[3] = {std::nextafter(1.0f, 2.0f), 0, 0};
+  EXPECT_TRUE(tie.contains(one));
+  EXPECT_FALSE(tie.contains(above)) << "the radius was read straight to a float";
+  const Region tiny = parse_region("1,2,3,1e-46");
+  const float centre[3] = {1, 2, 3}, next[3] = {1, 2, std::nextafter(3.0f, 4.0f)};
+  EXPECT_TRUE(tiny.contains(centre));
+  EXPECT_FALSE(tiny.contains(next));
+  for (const char* refused : {"+-5,0,0,1", "0,++1,0,1", "0,0,0,1e308"}) {
+    try {
+      (void)parse_region(refused);
+      ADD_FAILURE() << refused << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Usage) << refused;
+      if (std::string(refused).ends_with("1e308"))
+        EXPECT_NE(std::string(e.what()).find("radius"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(SelectionRegions, AMaskHoldsThePointsWhoseNearestVoxelIsSet) {
   ScratchDir dir;
   // 4 x 4 x 4 voxels of 2 mm, voxel (i, j, k) centred at (10 + 2i, -2j, 2k) (y flipped); voxel (1, 2, 3) = 7.

@@ -14,7 +14,9 @@ namespace {
   throw Error(ErrorKind::Usage, text, std::nullopt, "not a usable region: " + why);
 }
 
-// "a,b,c,..." as floats; nothing when a piece is not exactly a number.
+// "a,b,c,..." as floats; nothing when a piece is not exactly a number (one sign, '+' or '-', at most). Each is
+// read as a double and then rounded to a float, as tckedit reads a region (MRtrix's parse_floats, then its
+// float geometry): a decimal that lies next to the midpoint of two floats rounds as it does there.
 std::optional<std::vector<float>> parse_floats(std::string_view s) {
   std::vector<float> out;
   while (true) {
@@ -22,11 +24,14 @@ std::optional<std::vector<float>> parse_floats(std::string_view s) {
     std::string_view piece = s.substr(0, comma);
     while (!piece.empty() && piece.front() == ' ') piece.remove_prefix(1);
     while (!piece.empty() && piece.back() == ' ') piece.remove_suffix(1);
-    if (!piece.empty() && piece.front() == '+') piece.remove_prefix(1);
-    float v = 0;
+    if (!piece.empty() && piece.front() == '+') {
+      piece.remove_prefix(1);
+      if (!piece.empty() && (piece.front() == '-' || piece.front() == '+')) return std::nullopt;  // "+-5"
+    }
+    double v = 0;
     const auto [end, ec] = std::from_chars(piece.data(), piece.data() + piece.size(), v);
     if (piece.empty() || ec != std::errc() || end != piece.data() + piece.size()) return std::nullopt;
-    out.push_back(v);
+    out.push_back(static_cast<float>(v));
     if (comma == std::string_view::npos) return out;
     s.remove_prefix(comma + 1);
   }
@@ -203,7 +208,9 @@ Region parse_region(const std::string& text) {
   if (!names_file) {
     if (const auto v = parse_floats(text)) {
       if (v->size() != 4) bad_region(text, "a sphere is X,Y,Z,R (centre and radius, RAS mm)");
-      if (!all_finite(*v)) bad_region(text, "the sphere's centre and radius must be finite");
+      if (!all_finite({(*v)[0], (*v)[1], (*v)[2]})) bad_region(text, "the sphere's centre must be finite");
+      if (!std::isfinite((*v)[3]))
+        bad_region(text, "the sphere's radius must be a finite number of mm that a float holds (below 3.4e38)");
       if ((*v)[3] < 0) bad_region(text, "the sphere's radius is negative");
       return Region::sphere({(*v)[0], (*v)[1], (*v)[2]}, (*v)[3], text);
     }
