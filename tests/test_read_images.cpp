@@ -135,6 +135,12 @@ TEST(MrtrixImage, DamagedOrUnsupportedHeadersAreRefusedNamingTheFile) {
   }
   hostile::write_file(dir.file("lost.mih"), test::mih_header(good, "missing.dat"));
   EXPECT_NE(std::string(error_of(dir.file("lost.mih")).what()).find("missing.dat"), std::string::npos);
+  // A negative offset after an existing data file is a bad offset, not a file named "good.dat -5".
+  hostile::write_file(dir.file("good.dat"), std::string(24, '\0'));
+  hostile::write_file(dir.file("negative.mih"), test::mih_header(good, "good.dat -5"));
+  const Error negative = error_of(dir.file("negative.mih"));
+  EXPECT_EQ(negative.kind(), ErrorKind::Input) << negative.what();
+  EXPECT_NE(std::string(negative.what()).find("bad offset: '-5'"), std::string::npos) << negative.what();
 }
 
 // A bomb in .mif.gz form: refused from the header as a .nii.gz is.

@@ -94,10 +94,14 @@ std::optional<MrtrixHeader> parse_mrtrix_header(const std::string& path, std::sp
     if (h.fields["file"].size() > 1)
       fail_unsupported(path, name + " data split across " + std::to_string(h.fields["file"].size()) +
                                  " files ('file:' entries); convert it to a single .mif first");
-    // "NAME [OFFSET]": the name may hold spaces, the offset is the last word when it is a number.
+    // "NAME [OFFSET]": the name may hold spaces, the offset is the last word when it is a number. A negative one
+    // is a bad offset, as MRtrix says, not part of the name.
     const std::size_t space = file.rfind(' ');
     const std::string tail = space == std::string::npos ? "" : file.substr(space + 1);
     const bool numbered = !tail.empty() && tail.find_first_not_of("0123456789") == std::string::npos;
+    if (tail.size() > 1 && tail[0] == '-' && tail.find_first_not_of("0123456789", 1) == std::string::npos)
+      fail_input(path, std::nullopt,
+                 name + " 'file:' has a bad offset: '" + tail + "' (a number of bytes into the data file, 0 or more)");
     h.data_file = numbered ? std::string(trim(std::string_view(file).substr(0, space))) : file;
     if (h.data_file.empty()) fail_input(path, std::nullopt, name + " 'file:' names no file: '" + file + "'");
     file = ". " + (numbered ? tail : "0");
