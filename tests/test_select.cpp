@@ -17,8 +17,11 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <Eigen/Geometry>
+
 #include "converter/convert.h"
 #include "converter/readers/read_tractogram.h"
+#include "converter/readers/volume_image.h"
 #include "converter/selection/region.h"
 #include "converter/selection/selection_output.h"
 #include "converter/selection/streamline_selection.h"
@@ -26,6 +29,7 @@
 #include "format/base/error.h"
 #include "format/vxl_verify.h"
 #include "tests/hostile_vxl.h"
+#include "tests/mif_test_files.h"
 #include "tests/nifti_test_files.h"
 #include "tests/test_support.h"
 
@@ -487,6 +491,73 @@ TEST(SelectionRegions, NumbersAreReadAsTckeditReadsThem) {
         EXPECT_NE(std::string(e.what()).find("radius"), std::string::npos) << e.what();
     }
   }
+}
+
+// A mask's lookup is tckedit's float32 affine product (Eigen's Transform<float, 3, AffineCompact> times the
+// point), whose rounding depends on the order of the sums: the lookup sums as Eigen does, to the bit, on
+// oblique matrices and points spread over a brain's range. Summed left to right, about a quarter would differ.
+TEST(SelectionRegions, MaskLookupRoundsAsEigensAffineProduct) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> coordinate(-120.0f, 120.0f), coefficient(-1.0f, 1.0f);
+  int differ = 0;
+  for (int n = 0; n < 100000; ++n) {
+    Eigen::Transform<float, 3, Eigen::AffineCompact> t;
+    float rows[12];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c)
+        rows[4 * r + c] = t.matrix()(r, c) = c == 3 ? coordinate(random) : coefficient(random);
+    const float p[3] = {coordinate(random), coordinate(random), coordinate(random)};
+    const Eigen::Vector3f v = t * Eigen::Vector3f(p[0], p[1], p[2]);
+    for (int r = 0; r < 3; ++r) differ += mask_row(rows + 4 * r, p) != v[r];
+  }
+  EXPECT_EQ(differ, 0);
+}
+
+// A mask's header read as MRtrix reads it (converter/readers/image_geometry.h), each case with a point that the
+// earlier reading put in another voxel. A 4^3 mask of 2 mm voxels whose centres lie at -3, -1, 1, 3 mm on
+// every axis (with its sform); only voxel (1, 1, 1), centred at (-1, -1, -1), is set.
+TEST(SelectionRegions, MaskHeadersAreReadAsMRtrixReadsThem) {
+  ScratchDir dir;
+  std::vector<std::int16_t> one(64, 0);
+  one[(1 * 4 + 1) * 4 + 1] = 1;
+  const std::array<double, 12> grid = {2, 0, 0, -3, 0, 2, 0, -3, 0, 0, 2, -3};
+  const float centre[3] = {-1, -1, -1};
+  // Rewrites the mask's header through nifti_clib.
+  auto rewrite = [&](const std::string& name, auto&& change) {
+    const std::string path = dir.file(name);
+    test::write_nifti_int16(path, {4, 4, 4}, one, grid);
+    nifti_image* nim = nifti_image_read(path.c_str(), 1);
+    change(*nim);
+    nifti_image_write(nim);
+    nifti_image_free(nim);
+    return path;
+  };
+  // Units of metres (or microns) are ignored, as MRtrix ignores them (they were scaled by 1000).
+  EXPECT_TRUE(
+      parse_region(rewrite("metres.nii", [](nifti_image& n) { n.xyz_units = NIFTI_UNITS_METER; })).contains(centre));
+  // Neither sform nor qform: the image centred on the origin, as MRtrix places it (voxel 0 was put at the origin).
+  EXPECT_TRUE(
+      parse_region(rewrite("none.nii", [](nifti_image& n) { n.sform_code = n.qform_code = 0; })).contains(centre));
+  // The same for an MRtrix image without 'transform:'.
+  test::MifSpec mif{{4, 4, 4}, {2, 2, 2}, {1, 2, 3}};
+  std::string bytes = test::mif_bytes(mif, std::vector<double>(one.begin(), one.end()));
+  for (std::size_t at; (at = bytes.find("transform:")) != std::string::npos;) bytes.replace(at, 10, "comments: ");
+  test::write_file(dir.file("none.mif"), std::vector<char>(bytes.begin(), bytes.end()));
+  EXPECT_TRUE(parse_region(dir.file("none.mif")).contains(centre));
+  // pixdim within a relative 1e-5 of the sform's axis lengths: MRtrix keeps pixdim as the voxel size.
+  const std::string near = rewrite("pixdim.nii", [](nifti_image& n) {
+    n.pixdim[1] = n.dx = 2.0f * (1 + 6e-6f);
+    n.pixdim[2] = n.dy = n.pixdim[3] = n.dz = 2.0f;
+  });
+  EXPECT_EQ(read_volume_image(near).voxel_to_ras[0], double(2.0f * (1 + 6e-6f)));
+  // Stored right to left (LAS): x flipped, voxel i centred at 3 - 2i. A point on the face between voxels 1 and
+  // 2 (x = 0) is in voxel 1 (x = 1) in MRtrix's realigned image, where it rounds from the other side; in the
+  // stored order it rounded to voxel 2.
+  std::vector<std::int16_t> left(64, 0);
+  left[(1 * 4 + 1) * 4 + 1] = 1;
+  test::write_nifti_int16(dir.file("las.nii"), {4, 4, 4}, left, {-2, 0, 0, 3, 0, 2, 0, -3, 0, 0, 2, -3});
+  const float face[3] = {0, -1, -1};
+  EXPECT_TRUE(parse_region(dir.file("las.nii")).contains(face));
 }
 
 TEST(SelectionRegions, AMaskHoldsThePointsWhoseNearestVoxelIsSet) {

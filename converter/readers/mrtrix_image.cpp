@@ -142,29 +142,37 @@ Layout layout(const std::string& path, const std::optional<std::string>& text, s
   return l;
 }
 
-// The voxel-to-scanner matrix: scanner = R * (vox * index) + t, R and t the header's 'transform:' rows
-// (identity without them).
-std::array<double, 16> voxel_to_ras(const std::string& path, const MrtrixHeader& h, const std::vector<double>& vox) {
-  const std::size_t axes = vox.size();
-  std::array<double, 16> m{};
-  for (int r = 0; r < 3; ++r) m[5 * r] = 1.0;
+// The geometry as MRtrix derives it from 'transform:' (centred without it) and 'vox:' (image_geometry.h), its
+// voxel-to-RAS mapping checked.
+ImageGeometry geometry(const std::string& path, const MrtrixHeader& h, const std::vector<double>& vox,
+                       const std::array<std::int64_t, 3>& dims) {
+  std::optional<std::array<double, 12>> transform;
   if (h.fields.contains("transform")) {
     const auto& rows = h.fields["transform"];
     if (rows.size() != 3)
       fail_input(path, std::nullopt,
                  "MRtrix image header has " + std::to_string(rows.size()) + " 'transform:' rows, expected 3");
+    transform.emplace();
     for (int r = 0; r < 3; ++r) {
       const std::string row = rows[std::size_t(r)].get<std::string>();
       const std::vector<double> v = numbers(path, "transform", row);
       if (v.size() != 4) bad_field(path, "transform", row, "4 numbers per row");
-      for (int c = 0; c < 4; ++c) m[4 * r + c] = v[std::size_t(c)];
+      for (int c = 0; c < 4; ++c) (*transform)[std::size_t(4 * r + c)] = v[std::size_t(c)];
     }
   }
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) m[4 * r + c] *= c < int(axes) ? vox[std::size_t(c)] : 1.0;
-  m[15] = 1.0;
-  check_voxel_to_ras(path, m, "the transform and vox");
-  return m;
+  std::array<double, 3> sizes{1.0, 1.0, 1.0};
+  for (std::size_t a = 0; a < std::min<std::size_t>(3, vox.size()); ++a) sizes[a] = vox[a];
+  if (transform) {  // refused as stored (MRtrix would replace a non-finite one), then as MRtrix makes it
+    std::array<double, 16> stored{};
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c)
+        stored[std::size_t(4 * r + c)] = (*transform)[std::size_t(4 * r + c)] * (c < 3 ? sizes[std::size_t(c)] : 1.0);
+    stored[15] = 1.0;
+    check_voxel_to_ras(path, stored, "the transform and vox");
+  }
+  const ImageGeometry g = mrtrix_geometry(transform, sizes, dims);
+  check_voxel_to_ras(path, g.voxel_to_ras(), "the transform and vox");
+  return g;
 }
 
 // The sizes of the axes ('dim:'), whole numbers 1 to 2^31, at most kMaxAxes of them.
@@ -224,7 +232,7 @@ VolumeImage read_mrtrix_image(const std::string& path, const ImageLimits& limits
   for (std::size_t a = 0; a < std::min<std::size_t>(3, axes); ++a) dims[a] = dim[a];
   check_image_size(path, dims, limits);
 
-  const std::array<double, 16> m = voxel_to_ras(path, h, vox);
+  const ImageGeometry image_geometry = geometry(path, h, vox, dims);
   const auto [inter, slope] = scaling(path, h);
 
   // The file offset (in samples) of each axis' step, and of the last sample of the first volume.
@@ -268,7 +276,8 @@ VolumeImage read_mrtrix_image(const std::string& path, const ImageLimits& limits
   VolumeImage v;
   v.path = path;
   v.dims = dims;
-  v.voxel_to_ras = m;
+  v.geometry = image_geometry;
+  v.voxel_to_ras = image_geometry.voxel_to_ras();
   const std::size_t n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
   v.values.assign(n, 0.0f);
   // Through the stored samples in file order (an odometer over the axes, fastest first), keeping those of

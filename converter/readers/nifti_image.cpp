@@ -140,16 +140,35 @@ ImagePtr read_header(const std::string& path, GzipBytes& stream, std::vector<uns
   return image;
 }
 
-// voxel index -> RAS mm from the header's sform (or qform), checked.
-std::array<double, 16> voxel_to_ras(const nifti_image& nim, const std::string& path) {
-  const nifti_dmat44& m = nim.sform_code > 0 ? nim.sto_xyz : nim.qto_xyz;
-  const double unit = nim.xyz_units == NIFTI_UNITS_METER ? 1000.0 : nim.xyz_units == NIFTI_UNITS_MICRON ? 0.001 : 1.0;
-  std::array<double, 16> a{};
+// The header's geometry as MRtrix derives it (image_geometry.h: the sform, else the qform, else centred; the
+// units ignored), its voxel-to-RAS mapping checked.
+ImageGeometry geometry(const nifti_image& nim, const std::array<std::int64_t, 3>& dims, const std::string& path) {
+  NiftiGeometryFields f;
+  f.sform_code = nim.sform_code;
+  f.qform_code = nim.qform_code;
   for (int row = 0; row < 3; ++row)
-    for (int col = 0; col < 4; ++col) a[4 * row + col] = m.m[row][col] * unit;
-  a[15] = 1.0;
-  check_voxel_to_ras(path, a, nim.sform_code > 0 ? "the sform" : nim.qform_code > 0 ? "the qform" : "pixdim");
-  return a;
+    for (int col = 0; col < 4; ++col) f.srow[std::size_t(row)][std::size_t(col)] = nim.sto_xyz.m[row][col];
+  f.quatern_b = nim.quatern_b;
+  f.quatern_c = nim.quatern_c;
+  f.quatern_d = nim.quatern_d;
+  f.qoffset = {nim.qoffset_x, nim.qoffset_y, nim.qoffset_z};
+  // pixdim[0]'s sign, which nifti_clib keeps as qfac (-1 when negative, as MRtrix reads it).
+  f.pixdim = {nim.qfac, nim.pixdim[1], nim.pixdim[2], nim.pixdim[3]};
+  // A damaged sform is refused as stored (MRtrix would replace a non-finite one, with a warning), then what
+  // MRtrix makes of the header.
+  if (nim.sform_code > 0) {
+    std::array<double, 16> stored{};
+    for (int row = 0; row < 3; ++row)
+      for (int col = 0; col < 4; ++col) stored[std::size_t(4 * row + col)] = nim.sto_xyz.m[row][col];
+    stored[15] = 1.0;
+    check_voxel_to_ras(path, stored, "the sform");
+  }
+  const ImageGeometry g = nifti_geometry(f, dims);
+  check_voxel_to_ras(path, g.voxel_to_ras(),
+                     nim.sform_code > 0   ? "the sform"
+                     : nim.qform_code > 0 ? "the qform"
+                                          : "pixdim");
+  return g;
 }
 
 }  // namespace
@@ -170,7 +189,7 @@ VolumeImage read_nifti_image(const std::string& path, const ImageLimits& limits)
   const SampleType type = sample_type(nim->datatype, path);
   // From the header alone, before anything is inflated or allocated.
   check_image_size(path, dims, limits);
-  const std::array<double, 16> affine = voxel_to_ras(*nim, path);
+  const ImageGeometry image_geometry = geometry(*nim, dims, path);
   const std::size_t n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);  // the first volume
   const std::size_t size = sample_bytes(type);
   const std::uint64_t start = static_cast<std::uint64_t>(nim->iname_offset);
@@ -190,7 +209,8 @@ VolumeImage read_nifti_image(const std::string& path, const ImageLimits& limits)
   VolumeImage v;
   v.path = path;
   v.dims = dims;
-  v.voxel_to_ras = affine;
+  v.geometry = image_geometry;
+  v.voxel_to_ras = image_geometry.voxel_to_ras();
   const bool swap = nim->byteorder != nifti_short_order();
   const double slope = nim->scl_slope, inter = nim->scl_inter;
   const bool scaled = slope != 0.0 && std::isfinite(slope) && std::isfinite(inter);

@@ -13,12 +13,15 @@
 #include <string>
 #include <vector>
 
+#include "converter/readers/image_geometry.h"
+
 namespace vxl {
 
 struct VolumeImage {
   std::string path;
   std::array<std::int64_t, 3> dims{0, 0, 0};
   std::vector<float> values;              // x fastest, then y, then z
+  ImageGeometry geometry;                 // as MRtrix derives it from the header (image_geometry.h)
   std::array<double, 16> voxel_to_ras{};  // row-major 4x4: voxel index (the centre of voxel (i, j, k)) -> RAS mm
 };
 

@@ -83,28 +83,14 @@ Region Region::mask(const VolumeImage& image, std::optional<float> label, std::s
   if (last[0] < 0)
     bad_region(r.text_, label ? "the image holds no voxel of label " + std::to_string(*label) : "the mask is empty");
 
-  // RAS -> voxel: the inverse of the image's affine, in double, then rounded to float32 as tckedit keeps it.
+  // Looked up as tckedit looks a mask up (image_geometry.h): in the image realigned to near-RAS axes, through
+  // its scanner-to-voxel affine in float32.
+  const MaskLookup lookup = mask_lookup(image.geometry, image.dims, first, last);
+  r.ras_to_voxel_ = lookup.scanner_to_voxel;
+  r.dims_ = lookup.dims;
+  r.offset_ = lookup.offset;
+  r.step_ = lookup.step;
   const auto& a = image.voxel_to_ras;
-  const double m[3][3] = {{a[0], a[1], a[2]}, {a[4], a[5], a[6]}, {a[8], a[9], a[10]}};
-  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-  double inv[3][3];
-  for (int row = 0; row < 3; ++row)
-    for (int col = 0; col < 3; ++col) {
-      // The cofactor of (col, row), over the determinant.
-      const int r0 = (col + 1) % 3, r1 = (col + 2) % 3, c0 = (row + 1) % 3, c1 = (row + 2) % 3;
-      inv[row][col] = (m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]) / det;
-    }
-  const double t[3] = {a[3], a[7], a[11]};
-  for (int row = 0; row < 3; ++row) {
-    double offset = 0;
-    for (int col = 0; col < 3; ++col) {
-      r.ras_to_voxel_[4 * row + col] = static_cast<float>(inv[row][col]);
-      offset -= inv[row][col] * t[col];
-    }
-    r.ras_to_voxel_[4 * row + 3] = static_cast<float>(offset);
-  }
 
   // The RAS box of the set voxels' cubes: the corners of [first - 1/2, last + 1/2] through the affine,
   // widened by a voxel's hundredth for the float32 lookup's rounding.
@@ -132,15 +118,16 @@ bool Region::contains(const float* p) const {
     case Shape::Box:
       return p[0] >= lo_[0] && p[0] <= hi_[0] && p[1] >= lo_[1] && p[1] <= hi_[1] && p[2] >= lo_[2] && p[2] <= hi_[2];
     case Shape::Mask: {
-      std::int64_t index[3];
+      // In float32, as Eigen evaluates tckedit's affine product (Transform<float, 3, AffineCompact> times a
+      // point): the four terms summed in pairs (test SelectionRegions.MaskLookupRoundsAsEigensAffineProduct).
+      std::int64_t at = offset_;
       for (int row = 0; row < 3; ++row) {
-        const float* m = &ras_to_voxel_[4 * row];
-        const float v = m[0] * p[0] + m[1] * p[1] + m[2] * p[2] + m[3];
+        const float v = mask_row(&ras_to_voxel_[4 * row], p);
         const float rounded = std::round(v);
         if (!(rounded >= 0.0f && rounded < float(dims_[row]))) return false;
-        index[row] = static_cast<std::int64_t>(rounded);
+        at += static_cast<std::int64_t>(rounded) * step_[row];
       }
-      return set_[static_cast<std::size_t>((index[2] * dims_[1] + index[1]) * dims_[0] + index[0])] != 0;
+      return set_[static_cast<std::size_t>(at)] != 0;
     }
   }
   return false;

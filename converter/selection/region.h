@@ -51,11 +51,19 @@ class Region {
   std::string text_;
   Point3f centre_{}, lo_{}, hi_{};  // sphere centre; box corners (a mask's: the RAS box of its set voxels)
   float radius_ = 0, radius2_ = 0;
-  // Mask: the selected voxels (1 byte each, x fastest) and RAS -> voxel, row-major 3 x 4, in float32.
+  // Mask: the selected voxels (1 byte each, in the stored order, x fastest), and how a point finds its voxel
+  // (converter/readers/image_geometry.h, MaskLookup): RAS -> realigned voxel, row-major 3 x 4, in float32, the
+  // realigned sizes, and the stored sample of realigned index n at offset_ + n . step_.
   std::array<std::int64_t, 3> dims_{};
   std::vector<std::uint8_t> set_;
   std::array<float, 12> ras_to_voxel_{};
+  std::int64_t offset_ = 0;
+  std::array<std::int64_t, 3> step_{};
 };
+
+// One row of a mask's RAS -> voxel affine (4 floats) applied to `p` in float32, in the order Eigen sums tckedit's
+// affine product: (m0 p0 + m1 p1) + (m2 p2 + m3).
+inline float mask_row(const float* m, const float* p) { return (m[0] * p[0] + m[1] * p[1]) + (m[2] * p[2] + m[3]); }
 
 // Parses one region argument:
 //   X,Y,Z,R                  a sphere (RAS mm), as tckedit writes it
