@@ -256,6 +256,32 @@ TEST_F(Selection, RegionsOutsideEverythingOrHoldingEverything) {
   EXPECT_EQ(select_streamlines(f, outside).streamlines.size(), source_->streamline_count());
 }
 
+// A streamline without points is never selected, as tckedit never writes one: not by an exclude, an inverted
+// query or a length limit of 0, which every streamline with points passes.
+TEST(SelectionEmptyStreamlines, AreNeverSelected) {
+  ScratchDir dir;
+  Tractogram t;
+  const float line[] = {0, 0, 0, 10, 0, 0, 20, 0, 0};
+  for (int s = 0; s < 6; ++s) {
+    if (s % 2 == 0) t.add_streamline(line, 0);
+    t.add_streamline(line, s == 5 ? 1 : 3);  // the last one a single point
+  }
+  convert_tractogram(std::move(t), dir.file("e.vxl"), settings(PositionEncoding::Float32));
+  const VxlFile f = VxlFile::open(dir.file("e.vxl"));
+  ASSERT_EQ(f.meta().streamline_count, 9u);
+  const std::vector<std::uint64_t> with_points = {1, 2, 4, 5, 7, 8};
+  SelectionCriteria exclude;
+  exclude.exclude.push_back(parse_region("500,500,500,1"));
+  EXPECT_EQ(select_streamlines(f, exclude).streamlines, with_points);
+  SelectionCriteria inverted;
+  inverted.include.push_back(parse_region("500,500,500,1"));
+  inverted.invert = true;
+  EXPECT_EQ(select_streamlines(f, inverted).streamlines, with_points);
+  SelectionCriteria length;
+  length.min_length = 0;
+  EXPECT_EQ(select_streamlines(f, length).streamlines, with_points);
+}
+
 TEST_F(Selection, ASmallSphereTestsOnlyTheVoxelsItTouches) {
   const VxlFile f = VxlFile::open(dir_->file("f32.vxl"));
   SelectionCriteria c;

@@ -303,8 +303,11 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
       walk_streamlines(file, lengths);
     }
   }
+  // A streamline without points is never kept, inverted or not: tckedit's reader skips it, so it never writes one.
+  const std::span<const std::uint64_t> first_voxline = file.streamline_first_voxline();
   for (std::uint64_t s = 0; s < n; ++s)
-    if ((passes[s] != 0) != criteria.invert) result.streamlines.push_back(s);
+    if ((passes[s] != 0) != criteria.invert && first_voxline[s + 1] != first_voxline[s])
+      result.streamlines.push_back(s);
   return result;
 }
 
