@@ -25,6 +25,7 @@
 #include "converter/selection/region.h"
 #include "converter/selection/selection_output.h"
 #include "converter/selection/streamline_selection.h"
+#include "converter/streamline_outputs.h"
 #include "converter/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_verify.h"
@@ -513,8 +514,9 @@ TEST(SelectionRegions, NumbersAreReadAsTckeditReadsThem) {
       ADD_FAILURE() << refused << " was accepted";
     } catch (const Error& e) {
       EXPECT_EQ(e.kind(), ErrorKind::Usage) << refused;
-      if (std::string(refused).ends_with("1e308"))
+      if (std::string(refused).ends_with("1e308")) {
         EXPECT_NE(std::string(e.what()).find("radius"), std::string::npos) << e.what();
+      }
     }
   }
 }
@@ -565,7 +567,10 @@ TEST(SelectionRegions, MaskHeadersAreReadAsMRtrixReadsThem) {
   EXPECT_TRUE(
       parse_region(rewrite("none.nii", [](nifti_image& n) { n.sform_code = n.qform_code = 0; })).contains(centre));
   // The same for an MRtrix image without 'transform:'.
-  test::MifSpec mif{{4, 4, 4}, {2, 2, 2}, {1, 2, 3}};
+  test::MifSpec mif;
+  mif.dims = {4, 4, 4};
+  mif.vox = {2, 2, 2};
+  mif.layout = {1, 2, 3};
   std::string bytes = test::mif_bytes(mif, std::vector<double>(one.begin(), one.end()));
   for (std::size_t at; (at = bytes.find("transform:")) != std::string::npos;) bytes.replace(at, 10, "comments: ");
   test::write_file(dir.file("none.mif"), std::vector<char>(bytes.begin(), bytes.end()));
@@ -756,6 +761,34 @@ TEST(SelectionCli, CountJsonAndTheCriteriaInTheTckHeader) {
   const Tractogram back = read_tractogram(dir.file("o.tck"));
   EXPECT_LE(back.streamline_count(), n);
   EXPECT_NE(back.source.header.dump().find("include 0,-18,10,20"), std::string::npos) << back.source.header.dump();
+}
+
+// One table of output formats (converter/streamline_outputs.h): select writes every suffix it lists and export
+// every one it marks exported, and both commands' help and refusals list exactly those (select's omitted .trk).
+TEST(SelectionCli, OutputSuffixesComeFromOneTable) {
+  ScratchDir dir;
+  convert_tractogram(synth(30), dir.file("in.vxl"), settings(PositionEncoding::Packed));
+  for (const StreamlineOutputFormat& f : streamline_outputs())
+    for (const std::string& suffix : f.suffixes) {
+      const std::string out = dir.file("out" + suffix);
+      EXPECT_EQ(run_cli("select " + test::q(dir.file("in.vxl")) + " " + test::q(out) + " --include 0,0,0,50").exit_code,
+                0)
+          << suffix;
+      EXPECT_TRUE(std::filesystem::exists(out)) << suffix;
+      std::filesystem::remove(out);
+      EXPECT_EQ(run_cli("export " + test::q(dir.file("in.vxl")) + " " + test::q(out)).exit_code, f.exported ? 0 : 2)
+          << suffix;
+      EXPECT_EQ(std::filesystem::exists(out), f.exported) << suffix;
+    }
+  const test::CommandResult select = run_cli("select " + test::q(dir.file("in.vxl")) + " o.txt --include 0,0,0,5");
+  EXPECT_EQ(select.exit_code, 2);
+  EXPECT_NE(select.output.find("written to .tck, .trx, .vtk, .trk, .trk.gz or .vxl"), std::string::npos)
+      << select.output;
+  EXPECT_NE(run_cli("select --help").output.find(streamline_output_suffixes(false)), std::string::npos);
+  const test::CommandResult exported = run_cli("export " + test::q(dir.file("in.vxl")) + " o.txt");
+  EXPECT_EQ(exported.exit_code, 2);
+  EXPECT_NE(exported.output.find("export writes .tck, .trx, .vtk, .trk or .trk.gz files"), std::string::npos)
+      << exported.output;
 }
 
 TEST(SelectionCli, HostileRegionsAreRefusedNamingTheArgumentAndWriteNothing) {

@@ -8,6 +8,7 @@
 #include "converter/export_trk.h"
 #include "converter/export_trx.h"
 #include "converter/export_vtk.h"
+#include "converter/streamline_outputs.h"
 #include "format/base/error.h"
 
 namespace vxl::cli {
@@ -61,12 +62,12 @@ void add_export_command(CLI::App& app) {
       return;
     }
     if (opt->output.empty()) throw Error(ErrorKind::Usage, opt->input, std::nullopt, "export needs an output file");
-    std::string lower = opt->output;
-    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-    const bool tck = lower.ends_with(".tck"), trx = lower.ends_with(".trx"), vtk = lower.ends_with(".vtk"),
-               trk = lower.ends_with(".trk") || lower.ends_with(".trk.gz");
-    if (!tck && !trx && !vtk && !trk)
-      throw Error(ErrorKind::Usage, opt->output, std::nullopt, "export writes .tck, .trx, .vtk, .trk or .trk.gz files");
+    const std::optional<StreamlineOutput> format = streamline_output_of(opt->output, true);
+    if (!format)
+      throw Error(ErrorKind::Usage, opt->output, std::nullopt,
+                  "export writes " + streamline_output_suffixes(true) + " files");
+    const bool tck = format == StreamlineOutput::Tck, trx = format == StreamlineOutput::Trx,
+               trk = format == StreamlineOutput::Trk;
     if (!tck && (opt->tck.tsf_path || opt->tck.value))
       throw Error(ErrorKind::Usage, opt->output, std::nullopt,
                   "--tsf and --value go with a .tck output (a .trx, .vtk or .trk holds the value sets)");

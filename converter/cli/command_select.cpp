@@ -5,6 +5,7 @@
 #include "converter/cli/commands.h"
 #include "converter/selection/selection_output.h"
 #include "converter/selection/streamline_selection.h"
+#include "converter/streamline_outputs.h"
 #include "format/base/error.h"
 
 namespace vxl::cli {
@@ -38,7 +39,8 @@ void add_select_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "select",
       "Select streamlines by regions and length (virtual dissection), with MRtrix tckedit's rules:\n"
-      "  voxlines select IN.vxl OUT.tck|.trx|.vtk|.vxl --include ROI [--include ROI]... [--exclude ROI]...\n"
+      "  voxlines select IN.vxl OUT.tck|.trx|.vtk|.trk|.trk.gz|.vxl --include ROI [--include ROI]... "
+      "[--exclude ROI]...\n"
       "  voxlines select IN.vxl --include ROI --count [--json]\n"
       "A streamline is kept when every --include region holds one of its points, every --ends-in region its first\n"
       "or last point, no --exclude region any of its points, and its length is within the limits. ROI: X,Y,Z,R (a\n"
@@ -49,10 +51,12 @@ void add_select_command(CLI::App& app) {
       "to a region's surface may be decided differently from tckedit on the source. Lengths are the source's in\n"
       "either case (measured when converting; files of format 2.3 and older have their points measured).");
   cmd->add_option("input", opt->input, ".vxl file")->required();
-  cmd->add_option("output", opt->output,
-                  "the selected streamlines, in source order: .tck (with --tsf: one per-point value set), .trx "
-                  "(groups, dpv, dps, dpg), .vtk or .vxl (the input's conversion settings); written atomically, valid "
-                  "when empty. Not needed with --count");
+  cmd->add_option(
+      "output", opt->output,
+      "the selected streamlines, in source order, as " + streamline_output_suffixes(false) +
+          ": .tck (with --tsf: one per-point value set), .trx (groups, dpv, dps, dpg), .vtk, .trk (TrackVis "
+          "v2) or .vxl (the input's conversion settings); written atomically, valid when empty. Not needed "
+          "with --count");
   cmd->add_option("--include", opt->include, "a region every kept streamline passes through (repeatable)")
       ->type_name("ROI");
   cmd->add_option("--exclude", opt->exclude, "a region no kept streamline touches (repeatable)")->type_name("ROI");
@@ -75,7 +79,8 @@ void add_select_command(CLI::App& app) {
       throw Error(ErrorKind::Usage, opt->input, std::nullopt,
                   opt->count ? "--count prints the count: give no output file" : "give an output file, or --count");
     if (!opt->output.empty() && !is_selection_output(opt->output))
-      throw Error(ErrorKind::Usage, opt->output, std::nullopt, "a selection is written to .tck, .trx, .vtk or .vxl");
+      throw Error(ErrorKind::Usage, opt->output, std::nullopt,
+                  "a selection is written to " + streamline_output_suffixes(false));
     for (const std::optional<double>& limit : {opt->min_length, opt->max_length})
       if (limit && !(std::isfinite(*limit) && *limit >= 0))
         throw Error(ErrorKind::Usage, "--min-length/--max-length", std::nullopt,

@@ -10,17 +10,13 @@
 #include "converter/export_trx.h"
 #include "converter/export_values.h"
 #include "converter/export_vtk.h"
+#include "converter/streamline_outputs.h"
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
 namespace {
-
-std::string lower_case(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
 
 // The source block of the .vxl's provenance (spec §5.8), as the readers filled it; fields of the wrong
 // type are left empty (PROV may hold any JSON).
@@ -85,31 +81,28 @@ Tractogram subset_tractogram(const VxlFile& file, const StreamlineSubset& subset
 
 }  // namespace
 
-bool is_selection_output(const std::string& path) {
-  const std::string lower = lower_case(path);
-  return lower.ends_with(".tck") || lower.ends_with(".trx") || lower.ends_with(".vtk") || lower.ends_with(".vxl") ||
-         lower.ends_with(".trk") || lower.ends_with(".trk.gz");
-}
+bool is_selection_output(const std::string& path) { return streamline_output_of(path, false).has_value(); }
 
 std::vector<std::string> write_selection(const VxlFile& file, const StreamlineSubset& subset,
                                          const std::string& out_path, const TckExportSettings& tck,
                                          const std::vector<std::string>& header) {
-  const std::string lower = lower_case(out_path);
-  if (lower.ends_with(".tck")) return export_tck(file, out_path, tck, &subset, header).warnings;
+  const std::optional<StreamlineOutput> format = streamline_output_of(out_path, false);
+  if (!format)
+    throw Error(ErrorKind::Usage, out_path, std::nullopt,
+                "a selection is written to " + streamline_output_suffixes(false));
+  if (*format == StreamlineOutput::Tck) return export_tck(file, out_path, tck, &subset, header).warnings;
   if (tck.tsf_path || tck.value)
     throw Error(ErrorKind::Usage, out_path, std::nullopt,
                 "--tsf and --value go with a .tck output (a .trx, .vtk, .trk or .vxl holds the value sets)");
-  if (lower.ends_with(".trx")) {
-    export_trx(file, out_path, &subset);
-  } else if (lower.ends_with(".trk") || lower.ends_with(".trk.gz")) {
-    return export_trk(file, out_path, &subset).warnings;
-  } else if (lower.ends_with(".vtk")) {
-    export_vtk(file, out_path, &subset);
-    if (std::optional<std::string> lost = group_values_not_written(file, "a VTK")) return {*lost};
-  } else if (lower.ends_with(".vxl")) {
-    convert_tractogram(subset_tractogram(file, subset), out_path, settings_of(file));
-  } else {
-    throw Error(ErrorKind::Usage, out_path, std::nullopt, "a selection is written to .tck, .trx, .vtk, .trk or .vxl");
+  switch (*format) {
+    case StreamlineOutput::Tck: break;
+    case StreamlineOutput::Trx: export_trx(file, out_path, &subset); break;
+    case StreamlineOutput::Trk: return export_trk(file, out_path, &subset).warnings;
+    case StreamlineOutput::Vtk:
+      export_vtk(file, out_path, &subset);
+      if (std::optional<std::string> lost = group_values_not_written(file, "a VTK")) return {*lost};
+      break;
+    case StreamlineOutput::Vxl: convert_tractogram(subset_tractogram(file, subset), out_path, settings_of(file)); break;
   }
   return {};
 }
