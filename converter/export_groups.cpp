@@ -68,6 +68,11 @@ std::vector<std::string> group_file_names(const std::vector<StreamlineGroup>& gr
     for (char& c : name)
       if (c == '/' || c == '\\' || static_cast<unsigned char>(c) < ' ' || c == 127) c = '_';
     if (name.empty() || name.front() == '.') name = "_" + name;
+    if (name.size() > kMaxGroupFileNameBytes) {
+      std::size_t cut = kMaxGroupFileNameBytes;
+      while (cut > 0 && (static_cast<unsigned char>(name[cut]) & 0xC0) == 0x80) --cut;  // not inside a character
+      name.resize(cut);
+    }
     std::string unique = name;
     for (int k = 2; taken.contains(lower_case(unique)); ++k) unique = name + "_" + std::to_string(k);
     taken.insert(lower_case(unique));

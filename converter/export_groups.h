@@ -28,7 +28,10 @@ std::optional<std::string> group_values_not_written(const VxlFile& file, const s
                                                     const std::optional<std::string>& only_group = std::nullopt);
 
 // One file name per group (same order), without the extension: the group name with '/', '\', control
-// characters and a leading '.' replaced by '_' (never empty), made unique, ignoring case, by "_2", "_3", …
+// characters and a leading '.' replaced by '_' (never empty), cut to kMaxGroupFileNameBytes at a UTF-8
+// character's start (a file system holds 255 bytes a name, with the extension and the suffix), made unique,
+// ignoring case, by "_2", "_3", …
+inline constexpr std::size_t kMaxGroupFileNameBytes = 200;
 std::vector<std::string> group_file_names(const std::vector<StreamlineGroup>& groups);
 
 struct SplitGroupFile {

@@ -150,6 +150,30 @@ TEST(ExportGroups, FileNamesAreSafeAndUnique) {
   const std::vector<StreamlineGroup> groups = {{"a/b", {}}, {"a_b", {}},  {"..", {}},
                                                {"A_B", {}}, {"x\ny", {}}, {"", {}}};
   EXPECT_EQ(group_file_names(groups), (std::vector<std::string>{"a_b", "a_b_2", "_..", "A_B_3", "x_y", "_"}));
+  // Names longer than a file system holds are cut at a character's start, and stay unique: two names of 300
+  // characters that differ only at their end, of two-byte characters from byte 199 on.
+  std::string first = std::string(199, 'a'), second;
+  for (int i = 0; i < 100; ++i) first += "\xC3\xA9";  // é
+  second = first + "x";
+  first += "y";
+  const std::vector<std::string> cut = group_file_names({{first, {}}, {second, {}}});
+  ASSERT_EQ(cut.size(), 2u);
+  EXPECT_EQ(cut[0], std::string(199, 'a'));  // byte 199 starts an é that does not fit in 200 bytes
+  EXPECT_EQ(cut[1], std::string(199, 'a') + "_2");
+}
+
+// A group named longer than a file name may be: every group's file is written (the last one failed, exit 5,
+// with the others written).
+TEST(ExportGroups, SplitGroupsWritesAGroupWithAVeryLongName) {
+  ScratchDir dir;
+  Tractogram t = grouped_tractogram();
+  t.groups.push_back({std::string(300, 'L'), {2, 3}});
+  ConvertSettings s;
+  convert_tractogram(std::move(t), dir.file("long.vxl"), s);
+  const auto r = test::run_cli("export " + q(dir.file("long.vxl")) + " --split-groups " + q(dir.file("groups")));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("groups/" + std::string(kMaxGroupFileNameBytes, 'L') + ".tck")));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.file("groups")), {}), 4);
 }
 
 }  // namespace
