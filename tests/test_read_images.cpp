@@ -107,6 +107,15 @@ TEST(MrtrixImage, DamagedOrUnsupportedHeadersAreRefusedNamingTheFile) {
   flat.transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0};
   MifSpec bad_layout = good;
   bad_layout.layout = {1, 1, 3};
+  MifSpec negative_vox = good;
+  negative_vox.vox[0] = -1;
+  std::string no_layout = bytes;  // "layout:" renamed, one letter changed: the data offset holds
+  const std::size_t layout_at = no_layout.find("layout:");
+  ASSERT_NE(layout_at, std::string::npos);
+  no_layout[layout_at + 5] = 'x';
+  MifSpec scientific_dim = good;  // a later 'dim:' line, the same sizes in another notation
+  scientific_dim.extra = "dim: " + std::to_string(good.dims[0]) + "e0," + std::to_string(good.dims[1]) + "," +
+                         std::to_string(good.dims[2]) + "\n";
   struct Case {
     std::string name, bytes;
     ErrorKind kind;
@@ -116,6 +125,13 @@ TEST(MrtrixImage, DamagedOrUnsupportedHeadersAreRefusedNamingTheFile) {
       {"bit.mif", test::mif_bytes(bit, indices(24)), ErrorKind::Unsupported, "datatype Bit"},
       {"flat.mif", test::mif_bytes(flat, indices(24)), ErrorKind::Input, "voxel axis 2 0 mm long"},
       {"layout.mif", test::mif_bytes(bad_layout, indices(24)), ErrorKind::Input, "layout"},
+      {"negative-vox.mif", test::mif_bytes(negative_vox, indices(24)), ErrorKind::Input,
+       "'vox: -1.000000,3.000000,4.000000': expected positive voxel sizes"},
+      {"no-layout.mif", no_layout, ErrorKind::Input, "lacks 'layout:'"},
+      {"scientific-dim.mif", test::mif_bytes(scientific_dim, indices(24)), ErrorKind::Input,
+       "expected whole numbers 1 to 2^31, in digits"},
+      {"gzip-named.nii", hostile::gzip(test::nifti1_bytes({2, 2, 2}, 2, 8, std::string(8, '\1'))), ErrorKind::Input,
+       "holds gzip-compressed data but is not named .gz"},
       {"cut.mif", bytes.substr(0, bytes.size() - 10), ErrorKind::Input, "truncated MRtrix image data"},
       {"noend.mif", bytes.substr(0, bytes.find("END")), ErrorKind::Input, "no 'END' line"},
       {"cut.mif.gz", hostile::gzip(bytes, /*finish=*/false), ErrorKind::Input, "end-of-stream marker"},

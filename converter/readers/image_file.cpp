@@ -1,5 +1,6 @@
 #include "converter/readers/image_file.h"
 
+#include <cctype>
 #include <filesystem>
 
 #include "converter/readers/regular_file.h"
@@ -21,8 +22,15 @@ MappedFile open_image(const std::string& path, const std::string& format) {
 ImageFile::ImageFile(const std::string& path, const std::string& format)
     : path_(path), file_(open_image(path, format)) {
   cap_ = inflate_cap(file_.size()) - kInflateSlack + kImageInflateSlack;
-  if (is_gzip(file_.bytes()))
+  if (is_gzip(file_.bytes())) {
+    // Read as its name says, as MRtrix reads it: gzip data in a file not named .gz is not that format's.
+    std::string lower = path;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (!lower.ends_with(".gz"))
+      fail_input(path, 0, "holds gzip-compressed data but is not named .gz (rename it " +
+                              std::filesystem::path(path).filename().string() + ".gz)");
     stream_.emplace(path, file_.bytes(), warnings_, cap_, "real images compress about 2-10x, masks far more");
+  }
   else
     stream_.emplace(file_.bytes());
 }

@@ -116,15 +116,11 @@ struct Layout {
   std::vector<bool> reversed;      // per axis
 };
 
-Layout layout(const std::string& path, const std::optional<std::string>& text, std::size_t axes) {
+Layout layout(const std::string& path, const std::string& text, std::size_t axes) {
   Layout l;
   l.reversed.assign(axes, false);
-  if (!text) {
-    for (std::size_t a = 0; a < axes; ++a) l.order.push_back(a);
-    return l;
-  }
-  const std::vector<std::string> pieces = split(*text);
-  if (pieces.size() != axes) bad_field(path, "layout", *text, std::to_string(axes) + " entries, one per axis");
+  const std::vector<std::string> pieces = split(text);
+  if (pieces.size() != axes) bad_field(path, "layout", text, std::to_string(axes) + " entries, one per axis");
   std::vector<int> rank(axes, -1);
   for (std::size_t a = 0; a < axes; ++a) {
     const std::string& p = pieces[a];
@@ -133,7 +129,7 @@ Layout layout(const std::string& path, const std::optional<std::string>& text, s
     const auto [end, ec] = std::from_chars(digits, p.data() + p.size(), r);
     if (p.size() < 2 || (p[0] != '+' && p[0] != '-') || ec != std::errc() || end != p.data() + p.size() || r < 0 ||
         r >= int(axes) || std::count(rank.begin(), rank.end(), r) > 0)
-      bad_field(path, "layout", *text, "a sign and a distinct rank 0 to " + std::to_string(axes - 1) + " per axis");
+      bad_field(path, "layout", text, "a sign and a distinct rank 0 to " + std::to_string(axes - 1) + " per axis");
     rank[a] = r;
     l.reversed[a] = p[0] == '-';
   }
@@ -175,13 +171,17 @@ ImageGeometry geometry(const std::string& path, const MrtrixHeader& h, const std
   return g;
 }
 
-// The sizes of the axes ('dim:'), whole numbers 1 to 2^31, at most kMaxAxes of them.
+// The sizes of the axes ('dim:'), whole numbers 1 to 2^31 written in digits (MRtrix reads them as integers:
+// "4e1" is none), at most kMaxAxes of them.
 std::vector<std::int64_t> dimensions(const std::string& path, const std::string& text) {
   std::vector<std::int64_t> dim;
-  for (double d : numbers(path, "dim", text)) {
-    if (d < 1 || d > double(std::int64_t(1) << 31) || d != std::floor(d))
-      bad_field(path, "dim", text, "whole numbers 1 to 2^31");
-    dim.push_back(static_cast<std::int64_t>(d));
+  for (const std::string& piece : split(text)) {
+    std::int64_t d = 0;
+    const auto [end, ec] = std::from_chars(piece.data(), piece.data() + piece.size(), d);
+    if (piece.empty() || ec != std::errc() || end != piece.data() + piece.size() || d < 1 ||
+        d > (std::int64_t(1) << 31))
+      bad_field(path, "dim", text, "whole numbers 1 to 2^31, in digits");
+    dim.push_back(d);
   }
   if (dim.size() > kMaxAxes) bad_field(path, "dim", text, "at most 16 axes");
   return dim;
@@ -225,7 +225,10 @@ VolumeImage read_mrtrix_image(const std::string& path, const ImageLimits& limits
   const std::vector<std::int64_t> dim = dimensions(path, field("dim"));
   const std::vector<double> vox = numbers(path, "vox", field("vox"));
   if (vox.size() != dim.size()) bad_field(path, "vox", field("vox"), std::to_string(dim.size()) + " sizes, as dim");
-  const Layout order = layout(path, h.last("layout"), dim.size());
+  for (std::size_t a = 0; a < std::min<std::size_t>(3, vox.size()); ++a)
+    if (!(vox[a] > 0)) bad_field(path, "vox", field("vox"), "positive voxel sizes (mm)");
+  // MRtrix writes 'layout:' in every image header and will not read one without it.
+  const Layout order = layout(path, field("layout"), dim.size());
   const Datatype type = datatype(path, h.datatype);
   const std::size_t axes = dim.size();
   std::array<std::int64_t, 3> dims{1, 1, 1};
