@@ -1,5 +1,6 @@
 // libFuzzer target: the image reader of voxview --image and select's masks (read_volume_image) on
-// arbitrary bytes, as a .nii (plain or gzipped: the reader goes by the gzip magic) and as a .mif. Whatever
+// arbitrary bytes, as a .nii and as a .mif (named .gz when they start with the gzip magic, as the reader
+// refuses gzip data under another name). Whatever
 // it accepts must be whole: as many values as voxels, all finite, and a sane voxel-to-RAS mapping.
 #include <cmath>
 #include <cstdio>
@@ -32,7 +33,8 @@ void read(const std::string& path) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  read(vxl::fuzz::write_input(data, size, ".nii"));
-  read(vxl::fuzz::write_input(data, size, ".mif"));
+  const bool gzipped = size >= 2 && data[0] == 0x1f && data[1] == 0x8b;
+  read(vxl::fuzz::write_input(data, size, gzipped ? ".nii.gz" : ".nii"));
+  read(vxl::fuzz::write_input(data, size, gzipped ? ".mif.gz" : ".mif"));
   return 0;
 }
