@@ -1,9 +1,14 @@
 // voxview's command line: a mistyped option gets the nearest one, an unknown view the list of views, and
 // messages about options carry no file name; a picture is written in the format its extension names, through
 // the picture module loaded when it is written (a missing module is an error naming it, and writes nothing).
+#include <sys/resource.h>
+
 #include <filesystem>
 
+#include <epoxy/gl.h>
+
 #include "tests/test_support.h"
+#include "viewer/platform/egl_context.h"
 #include "viewer/platform/image_io.h"
 
 namespace vxl {
@@ -41,6 +46,30 @@ TEST(VoxviewCommandLine, OpacitiesAndLineWidthsThatAreNoNumberInTheirRangeAreUsa
     EXPECT_FALSE(std::filesystem::exists(dir.file("a.png"))) << option << " " << value;
   }
   EXPECT_EQ(test::run_program(VOXVIEW_CLI, render + " --opacity 1e-3 --line-width 16").exit_code, 0);
+}
+
+// A picture larger than the driver holds (llvmpipe caps one buffer's bytes, below its limit on a side) is
+// refused from the driver's answer, before any framebuffer is made: exit 4 saying what does fit, at a small part
+// of the memory that allocating and shrinking took (1.9 GB on this machine).
+TEST(VoxviewCommandLine, APictureTheDriverCannotHoldIsRefusedBeforeAllocating) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  GLint side = 0;
+  {
+    HeadlessGlContext context;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &side);
+  }
+  const std::string size = std::to_string(side) + "x" + std::to_string(side * 3 / 4);
+  const test::CommandResult r = test::run_program(
+      VOXVIEW_CLI, test::q(dir.file("a.tck")) + " --render " + test::q(dir.file("a.png")) + " --size " + size);
+  if (r.exit_code == 0) GTEST_SKIP() << "this driver holds a " << size << " picture";
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("the driver holds no float colour buffer this large"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the largest of this shape it allocates is "), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.png")));
+  rusage children{};
+  getrusage(RUSAGE_CHILDREN, &children);
+  EXPECT_LT(children.ru_maxrss, 1 << 20) << "KiB: a framebuffer was allocated";
 }
 
 TEST(VoxviewCommandLine, APictureIsWrittenInTheFormatItsExtensionNames) {

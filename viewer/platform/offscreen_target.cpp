@@ -47,6 +47,15 @@ std::string incomplete(GLenum target, const char* which) {
   return std::string(which) + " framebuffer incomplete, status " + hex(status);
 }
 
+// Whether the driver says, without allocating it, that it can hold the colour buffer of a w x h picture (a
+// proxy texture: a software driver caps a buffer's bytes, llvmpipe at 1 GiB, which no limit query tells).
+bool driver_holds(int w, int h) {
+  glTexImage2D(GL_PROXY_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
+  GLint held = 0;
+  glGetTexLevelParameteriv(GL_PROXY_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &held);
+  return held != 0;
+}
+
 // Clears stale error flags so that a later glGetError() reports our own calls (bounded: a lost
 // context may keep reporting errors).
 void drain_gl_errors() {
@@ -110,18 +119,21 @@ void OffscreenTarget::allocate() {
     throw Error(ErrorKind::Unsupported, size, std::nullopt,
                 "beyond the GL driver's limit of " + std::to_string(limit) +
                     " pixels a side (GL_MAX_TEXTURE_SIZE, GL_MAX_RENDERBUFFER_SIZE, GL_MAX_VIEWPORT_DIMS)");
-  const std::string why = try_allocate();
+  // Drivers also cap a buffer's bytes (llvmpipe refuses the 2 GiB float colour buffer of 16384x8192): asked
+  // first without allocating, else found by allocating; either way the largest size of this shape that
+  // allocates is found, to say what can be drawn.
+  const bool held = driver_holds(width_, height_);
+  const std::string why = held ? try_allocate() : "the driver holds no float colour buffer this large";
   if (why.empty()) return;
-  // Drivers also cap a buffer's bytes (llvmpipe refuses the 2 GiB float colour buffer of 16384x8192),
-  // which no query tells: find the largest size of this shape that allocates, to say what can be drawn.
   const int width = width_, height = height_;
   std::string largest = "none";
   for (double scale = 0.9; scale * std::max(width, height) >= 1; scale *= 0.9) {
     width_ = std::max(1, static_cast<int>(width * scale));
     height_ = std::max(1, static_cast<int>(height * scale));
-    if (try_allocate().empty()) {
+    // Where the driver refused the size without allocating, the smaller ones are asked the same way.
+    if (driver_holds(width_, height_) && (!held || try_allocate().empty())) {
       largest = std::to_string(width_) + "x" + std::to_string(height_);
-      release();
+      if (held) release();
       break;
     }
   }
