@@ -27,11 +27,11 @@ ImageFile::ImageFile(const std::string& path, const std::string& format)
     std::string lower = path;
     for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (!lower.ends_with(".gz"))
-      fail_input(path, 0, "holds gzip-compressed data but is not named .gz (rename it " +
-                              std::filesystem::path(path).filename().string() + ".gz)");
+      fail_input(path, 0,
+                 "holds gzip-compressed data but is not named .gz (rename it " +
+                     std::filesystem::path(path).filename().string() + ".gz)");
     stream_.emplace(path, file_.bytes(), warnings_, cap_, "real images compress about 2-10x, masks far more");
-  }
-  else
+  } else
     stream_.emplace(file_.bytes());
 }
 
