@@ -67,7 +67,6 @@ Region Region::mask(const VolumeImage& image, std::optional<float> label, std::s
   Region r;
   r.shape_ = Shape::Mask;
   r.text_ = std::move(text);
-  r.dims_ = image.dims;
   r.set_.resize(image.values.size());
   std::array<std::int64_t, 3> first{INT64_MAX, INT64_MAX, INT64_MAX}, last{-1, -1, -1};
   std::size_t at = 0;
