@@ -18,6 +18,12 @@ double polyline_length(std::span<const float> xyz);
 // The length SLEN stores for those points: polyline_length rounded to float32.
 inline float stored_length_of(std::span<const float> xyz) { return static_cast<float>(polyline_length(xyz)); }
 
+// The length as MRtrix's tckedit measures it for -minlength and -maxlength, to the bit: each segment's end points
+// subtracted, squared and summed as x² + (y² + z²) (Eigen's unrolled sum), and square-rooted in float32, the segments
+// added in order to a float32 sum; NaN for no points. It differs from stored_length_of by up to (points + 5) float32
+// roundings of the length (spec §5.15), which is how a selection knows when SLEN decides a limit as tckedit would.
+float float32_polyline_length(std::span<const float> xyz);
+
 // Streamline s's length from the file's SLEN, which it must have: throws vxl::Error (Input, naming the file and
 // the byte) for a value that is not finite or has its sign bit set (-0 included).
 double stored_length(const VxlFile& file, std::uint64_t streamline);

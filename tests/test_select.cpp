@@ -7,6 +7,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -22,6 +23,7 @@
 #include "converter/convert.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/volume_image.h"
+#include "converter/selection/length_limits.h"
 #include "converter/selection/region.h"
 #include "converter/selection/selection_output.h"
 #include "converter/selection/streamline_selection.h"
@@ -71,13 +73,16 @@ std::vector<std::uint64_t> brute_force(const Tractogram& t, const SelectionCrite
     for (const Region& r : c.ends_in)
       pass = pass && last > first && (r.contains(point(first)) || r.contains(point(last - 1)));
     if (c.min_length || c.max_length) {
-      double length = 0;
+      // tckedit's float32 sum, Eigen's order for a segment: x² + (y² + z²).
+      float length = 0;
       for (std::uint64_t i = first + 1; i < last; ++i) {
-        double d2 = 0;
-        for (int k = 0; k < 3; ++k) d2 += std::pow(double(point(i)[k]) - point(i - 1)[k], 2);
-        length += std::sqrt(d2);
+        const float dx = point(i)[0] - point(i - 1)[0], dy = point(i)[1] - point(i - 1)[1],
+                    dz = point(i)[2] - point(i - 1)[2];
+        const float yz = dy * dy + dz * dz;
+        length += std::sqrt(dx * dx + yz);
       }
-      pass = pass && !(c.min_length && length < *c.min_length) && !(c.max_length && length > *c.max_length);
+      pass =
+          pass && !(c.min_length && length < float(*c.min_length)) && !(c.max_length && length > float(*c.max_length));
     }
     if (pass != c.invert) kept.push_back(s);
   }
@@ -214,9 +219,10 @@ TEST_F(Selection, ExcludeOnlyEndsOnlyAndLengthOnlyMatchTheReference) {
   }
 }
 
-// Length limits on a file with packed positions are the source's exactly (SLEN holds the source points'
-// lengths), as is every walk of the points with float32 positions; the walk over packed points is within the bound.
-TEST_F(Selection, LengthLimitsOnAPackedFileAreTheSourcesExactly) {
+// Length limits on a file with packed positions follow the source (SLEN holds the source points' lengths, within
+// a few float32 roundings of tckedit's, which random limits do not meet), as does every walk of the points with
+// float32 positions.
+TEST_F(Selection, LengthLimitsOnAPackedFileAreTheSources) {
   Tractogram copy = *source_;
   convert_tractogram(std::move(copy), dir_->file("packed.vxl"), settings(PositionEncoding::Packed));
   const VxlFile packed = VxlFile::open(dir_->file("packed.vxl")), f32 = VxlFile::open(dir_->file("f32.vxl"));
@@ -233,7 +239,8 @@ TEST_F(Selection, LengthLimitsOnAPackedFileAreTheSourcesExactly) {
     if (trial % 3 != 2) c.max_length = std::max(a, b);
     const SelectionResult r = select_streamlines(packed, c);
     ASSERT_EQ(r.streamlines, brute_force(*source_, c)) << "trial " << trial;
-    EXPECT_EQ(r.bytes_read, packed.voxels().size_bytes() + 4 * r.streamlines_measured) << "lengths only";
+    EXPECT_EQ(r.streamlines_measured, 0u) << "a packed file's lengths are SLEN's";
+    EXPECT_EQ(r.bytes_read, packed.voxels().size_bytes() + 4 * r.lengths_read) << "lengths only";
     ASSERT_EQ(select_streamlines(f32, c, nullptr, SelectionPath::ScanTable).streamlines, r.streamlines);
     cut += !r.streamlines.empty() && r.streamlines.size() < source_->streamline_count();
   }
@@ -281,6 +288,104 @@ TEST(SelectionEmptyStreamlines, AreNeverSelected) {
   SelectionCriteria length;
   length.min_length = 0;
   EXPECT_EQ(select_streamlines(f, length).streamlines, with_points);
+}
+
+// Two fixed-step streamlines (point k = p0 + k·v in float32) whose float32 lengths, as tckedit sums them, lie
+// just beyond a limit that their double-precision lengths (SLEN's) meet: tckedit 3.0.3 drops both, given that
+// SLEN length as -maxlength and -minlength. The first ends 54.020523 long against SLEN's 54.020515, the second
+// 66.506897 against 66.50692.
+TEST(SelectionLengths, FixedStepStreamlinesOnALimitAreDecidedAsTckeditDecides) {
+  ScratchDir dir;
+  Tractogram t;
+  auto add = [&t](std::array<float, 3> p0, std::array<float, 3> v, int n) {
+    std::vector<float> xyz;
+    for (int k = 0; k < n; ++k)
+      for (int c = 0; c < 3; ++c) xyz.push_back(p0[c] + float(k) * v[c]);
+    t.add_streamline(xyz.data(), n);
+  };
+  add({-33.150001525878906f, -21.059999465942383f, 24.100000381469727f},
+      {-0.375f, -0.29899999499320984f, -0.1420000046491623f}, 109);
+  add({-23.420000076293945f, 10.40999984741211f, -16.149999618530273f},
+      {-0.4480000138282776f, 0.16200000047683716f, -0.15199999511241913f}, 134);
+  convert_tractogram(std::move(t), dir.file("steps.vxl"), settings(PositionEncoding::Float32));
+  const VxlFile f = VxlFile::open(dir.file("steps.vxl"));
+  ASSERT_EQ(f.streamline_lengths()[0], 54.02051544189453f);
+  ASSERT_EQ(f.streamline_lengths()[1], 66.50691986083984f);
+  for (const SelectionPath path : {SelectionPath::Fastest, SelectionPath::ScanTable}) {
+    SelectionCriteria at_most, at_least, at_most_float, at_least_float;
+    at_most.max_length = 54.02051544189453;  // streamline 1 is 66.5 mm long
+    at_least.min_length = 66.50691986083984;
+    at_most_float.max_length = 54.02052307128906;
+    at_least_float.min_length = 66.50689697265625;
+    EXPECT_EQ(select_streamlines(f, at_most, nullptr, path).streamlines, std::vector<std::uint64_t>{});
+    EXPECT_EQ(select_streamlines(f, at_least, nullptr, path).streamlines, std::vector<std::uint64_t>{});
+    EXPECT_EQ(select_streamlines(f, at_most_float, nullptr, path).streamlines, std::vector<std::uint64_t>{0});
+    EXPECT_EQ(select_streamlines(f, at_least_float, nullptr, path).streamlines, std::vector<std::uint64_t>{1});
+  }
+  SelectionCriteria far;
+  far.min_length = 20, far.max_length = 100;
+  const SelectionResult r = select_streamlines(f, far);
+  EXPECT_EQ(r.lengths_read, 2u);
+  EXPECT_EQ(r.streamlines_measured, 0u) << "SLEN decides lengths far from the limits";
+}
+
+// The source header's step_size widens the limits as tckedit reads it (a tenth of a step, or half a step over
+// downsample_factor; a value that does not read as one number is no step_size; a negative one narrows; a
+// downsample_factor of 0 opens them; 0 over 0 closes them, even without a length option; an unreadable
+// downsample_factor is refused). Four straight streamlines 9.94, 9.96, 10.04 and 10.06 mm long, --min-length 10.
+TEST(SelectionLengths, TheSourceStepSizeWidensTheLimitsAsTckeditReadsIt) {
+  ScratchDir dir;
+  struct Case {
+    std::vector<std::pair<std::string, std::vector<std::string>>> header;
+    std::size_t kept, kept_without_limits;
+  };
+  const std::vector<Case> cases = {
+      {{}, 2, 4},
+      {{{"step_size", {"0.5"}}}, 3, 4},
+      {{{"step_size", {"0.5 # mm"}}}, 3, 4},
+      {{{"step_size", {"0.5 mm"}}}, 2, 4},
+      {{{"step_size", {"0.5", "0.5"}}}, 2, 4},
+      {{{"step_size", {"-0.5"}}}, 1, 4},
+      {{{"step_size", {"inf"}}}, 2, 4},
+      {{{"step_size", {"1e39"}}}, 2, 4},
+      {{{"step_size", {"0.5"}}, {"downsample_factor", {"2.5"}}}, 4, 4},
+      {{{"step_size", {"0.5"}}, {"downsample_factor", {"0"}}}, 4, 4},
+      {{{"step_size", {"0"}}, {"downsample_factor", {"0"}}}, 0, 0},
+      {{{"step_size", {"-200"}}}, 0, 0},
+  };
+  auto file_with = [&](const auto& header, const std::string& name) {
+    Tractogram t;
+    for (const float x : {9.94f, 9.96f, 10.04f, 10.06f}) {
+      const float line[] = {0, 0, 0, x, 0, 0};
+      t.add_streamline(line, 2);
+    }
+    for (const auto& [key, lines] : header) t.source.header[key] = lines;
+    convert_tractogram(std::move(t), dir.file(name), settings(PositionEncoding::Float32));
+    return VxlFile::open(dir.file(name));
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const VxlFile f = file_with(cases[i].header, std::to_string(i) + ".vxl");
+    SelectionCriteria limit, none;
+    limit.min_length = 10;
+    EXPECT_EQ(select_streamlines(f, limit).streamlines.size(), cases[i].kept) << "case " << i;
+    EXPECT_EQ(select_streamlines(f, none).streamlines.size(), cases[i].kept_without_limits) << "case " << i;
+  }
+  const VxlFile refused =
+      file_with(std::vector<std::pair<std::string, std::vector<std::string>>>{{"step_size", {"0.5"}},
+                                                                              {"downsample_factor", {"two"}}},
+                "refused.vxl");
+  try {
+    (void)select_streamlines(refused, SelectionCriteria{});
+    ADD_FAILURE() << "an unreadable downsample_factor was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_NE(std::string(e.what()).find("downsample_factor 'two'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("refused.vxl"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(mrtrix_float(" 0.25\t"), 0.25f);
+  EXPECT_EQ(mrtrix_float("-INF"), -std::numeric_limits<float>::infinity());
+  EXPECT_FALSE(mrtrix_float("0x10").has_value());
+  EXPECT_FALSE(mrtrix_float("").has_value());
 }
 
 TEST_F(Selection, ASmallSphereTestsOnlyTheVoxelsItTouches) {
@@ -488,6 +593,14 @@ TEST(SelectionRegions, ASphereHoldsItsSurfaceAsTckeditDoes) {
   const float at[3] = {1.5f, 2.5f, -3.25f}, next[3] = {1.5f, 2.5f, std::nextafter(-3.25f, 0.0f)};
   EXPECT_TRUE(zero.contains(at));
   EXPECT_FALSE(zero.contains(next));
+  // Where the order of the float32 sum decides: tckedit (Eigen) sums x² + (y² + z²). Each radius squared is one
+  // of the two orders' sums for its point, as tckedit 3.0.3 was seen to keep the first point and drop the second.
+  const Region kept_tie = parse_region("0,0,0,5.795355796813965");
+  const float kept_point[3] = {4.376504421234131f, -1.4132816791534424f, -3.5263283252716064f};
+  EXPECT_TRUE(kept_tie.contains(kept_point)) << "summed (x² + y²) + z²";
+  const Region dropped_tie = parse_region("0,0,0,6.2973432540893555");
+  const float dropped_point[3] = {3.0867607593536377f, 4.184473991394043f, -3.552269697189331f};
+  EXPECT_FALSE(dropped_tie.contains(dropped_point)) << "summed (x² + y²) + z²";
   const Region box = parse_region("box:0,0,0,1,2,3");
   const float corner[3] = {1, 2, 3}, out[3] = {1, 2, 3.0001f};
   EXPECT_TRUE(box.contains(corner));

@@ -48,8 +48,9 @@ void add_select_command(CLI::App& app) {
       "(its non-zero voxels: the voxel nearest to the point) or FILE.nii[.gz]:LABEL (one label of a parcellation).\n"
       "Points are those the .vxl stores: bit for bit the source's with --positions float32; with packed positions\n"
       "(the default) within the bound `voxlines info` prints, so a streamline whose deciding point lies that close\n"
-      "to a region's surface may be decided differently from tckedit on the source. Lengths are the source's in\n"
-      "either case (measured when converting; files of format 2.3 and older have their points measured).");
+      "to a region's surface may be decided differently from tckedit on the source. Length limits are tckedit's:\n"
+      "its float32 sum, the limits widened by the source header's step_size (a tenth of it, or half of it over\n"
+      "downsample_factor); to the bit with float32 positions, within a few float32 roundings with packed ones.");
   cmd->add_option("input", opt->input, ".vxl file")->required();
   cmd->add_option(
       "output", opt->output,
@@ -110,6 +111,7 @@ void add_select_command(CLI::App& app) {
                           {"voxels_touched", result.voxels_touched},
                           {"voxels", file.meta().voxel_count},
                           {"points_tested", result.points_tested},
+                          {"lengths_read", result.lengths_read},
                           {"streamlines_measured", result.streamlines_measured},
                           {"bytes_read", result.bytes_read},
                           {"file_bytes", file.bytes().size()}};
@@ -123,11 +125,11 @@ void add_select_command(CLI::App& app) {
     }
     if (opt->verbose && !opt->json)
       std::fprintf(stderr,
-                   "select: %u of %u voxels touched, %llu points tested, %llu streamlines measured, %llu of %llu "
-                   "bytes read\n",
+                   "select: %u of %u voxels touched, %llu points tested, %llu lengths read, %llu streamlines measured, "
+                   "%llu of %llu bytes read\n",
                    result.voxels_touched, file.meta().voxel_count, (unsigned long long)result.points_tested,
-                   (unsigned long long)result.streamlines_measured, (unsigned long long)result.bytes_read,
-                   (unsigned long long)file.bytes().size());
+                   (unsigned long long)result.lengths_read, (unsigned long long)result.streamlines_measured,
+                   (unsigned long long)result.bytes_read, (unsigned long long)file.bytes().size());
   });
 }
 

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "converter/selection/length_limits.h"
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
 #include "format/base/parallel.h"
@@ -64,20 +65,23 @@ VoxelRegions regions_per_voxel(const VxlFile& file, const RegionTable& table, st
   return out;
 }
 
-// A number from the source header kept in PROV (a TCK's "key: value" lines are arrays of strings there).
-std::optional<double> source_header_number(const VxlFile& file, const char* key) {
-  const nlohmann::json prov = parse_json(file.provenance_json(), file.path(), file.provenance_offset(), "PROV");
-  if (!prov.is_object() || !prov.contains("source") || !prov["source"].is_object()) return std::nullopt;
-  const nlohmann::json header = prov["source"].value("header", nlohmann::json());
-  if (!header.is_object() || !header.contains(key)) return std::nullopt;
-  nlohmann::json v = header[key];
-  if (v.is_array() && !v.empty()) v = v.back();
-  try {
-    const double x = v.is_number() ? v.get<double>() : v.is_string() ? std::stod(v.get<std::string>()) : NAN;
-    return std::isfinite(x) ? std::optional<double>(x) : std::nullopt;
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
+// Whether SLEN's length decides the limits as tckedit's float32 measure of the same points would: it lies farther
+// from each limit than the two can differ. tckedit's sum of n - 1 segment lengths, each within 5 roundings, is
+// within (n + 5) float32 roundings (2^-24 of the length each) of the exact length, and SLEN within one: twice
+// (n + 16) of them is a safe margin.
+bool slen_decides(double length, const LengthLimits& limits, std::uint64_t points) {
+  const double tolerance = double(points + 16) * 0x1p-23 * length;
+  return !(std::fabs(length - limits.min) <= tolerance) && !(std::fabs(length - limits.max) <= tolerance);
+}
+
+// Streamline s's source points: its voxlines' own point counts.
+std::uint64_t streamline_point_count(const VxlFile& file, std::uint64_t s) {
+  file.check_streamline_run(s);
+  const std::span<const std::uint64_t> first = file.streamline_first_voxline();
+  std::uint64_t points = 0;
+  for (const VoxlineEntry& v : file.voxlines().subspan(first[s], first[s + 1] - first[s]))
+    points += v.count_flags & kVoxlineCountMask;
+  return points;
 }
 
 // The regions one streamline's points fell in (a streamline with none is not listed).
@@ -239,13 +243,6 @@ std::vector<StreamlineHits> hits_by_index(HitSearch& q, const VoxelVoxlines& ind
 
 }  // namespace
 
-double length_limit_margin(const VxlFile& file) {
-  const std::optional<double> step = source_header_number(file, "step_size");
-  if (!step || *step <= 0) return 0;
-  const std::optional<double> downsample = source_header_number(file, "downsample_factor");
-  return (downsample && *downsample > 0 ? 0.5 / *downsample : 0.1) * *step;
-}
-
 SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria, const VoxelVoxlines* index,
                                    SelectionPath path) {
   if (criteria.min_length && criteria.max_length && *criteria.min_length > *criteria.max_length)
@@ -278,30 +275,37 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
   const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
   result.bytes_read += result.points_tested * vertex_bytes;
 
-  // Length limits, for the streamlines still in: their lengths from SLEN (4 bytes each), or measured from their
-  // points through the whole voxline table (files without SLEN; and the table-walking path, so that tests
-  // compare the two).
-  if (criteria.min_length || criteria.max_length) {
-    const double margin = length_limit_margin(file);
-    auto apply = [&](std::uint64_t s, double length) {
-      ++result.streamlines_measured;
-      if ((criteria.min_length && length < *criteria.min_length - margin) ||
-          (criteria.max_length && length > *criteria.max_length + margin))
-        passes[s] = 0;
-    };
-    if (!file.streamline_lengths().empty() && path == SelectionPath::Fastest) {
-      for (std::uint64_t s = 0; s < n; ++s)
-        if (passes[s] != 0) apply(s, stored_length(file, s));
-      result.bytes_read += 4 * result.streamlines_measured;
-    } else {
-      WalkCallbacks lengths;
-      lengths.read_points = [&](std::uint64_t s) { return passes[s] != 0; };
-      lengths.streamline = [&](std::uint64_t s, std::span<const float> points) {
-        result.bytes_read += points.size() / 3 * vertex_bytes;
-        apply(s, double(stored_length_of(points)));
-      };
-      walk_streamlines(file, lengths);
+  // Length limits, for the streamlines still in (tckedit applies its thresholds even without options: a header
+  // can make them cut). SLEN decides a packed file's lengths: its points are not the source's, and SLEN is
+  // within (points + 5) float32 roundings of tckedit's length. With float32 positions SLEN decides where it lies
+  // farther than that from both limits, and the points of the rest are measured as tckedit measures them, so
+  // the answer is tckedit's to the bit. Files without SLEN, and the table-walking path, measure every length.
+  const LengthLimits limits = tckedit_length_limits(file, criteria.min_length, criteria.max_length);
+  if (!limits.keep_every_length()) {
+    constexpr std::uint8_t kMeasure = 2;
+    const bool slen = !file.streamline_lengths().empty() && path == SelectionPath::Fastest;
+    const bool source_points = file.position_encoding() == PositionEncoding::Float32;
+    for (std::uint64_t s = 0; s < n; ++s) {
+      if (passes[s] == 0) continue;
+      if (!slen) {
+        passes[s] = kMeasure;
+        continue;
+      }
+      ++result.lengths_read;
+      const double length = stored_length(file, s);
+      passes[s] = !source_points || slen_decides(length, limits, streamline_point_count(file, s))
+                      ? std::uint8_t(limits.keeps(static_cast<float>(length)))
+                      : kMeasure;
     }
+    result.bytes_read += 4 * result.lengths_read;
+    WalkCallbacks lengths;
+    lengths.read_points = [&](std::uint64_t s) { return passes[s] == kMeasure; };
+    lengths.streamline = [&](std::uint64_t s, std::span<const float> points) {
+      ++result.streamlines_measured;
+      result.bytes_read += points.size() / 3 * vertex_bytes;
+      passes[s] = limits.keeps(float32_polyline_length(points));
+    };
+    if (std::find(passes.begin(), passes.end(), kMeasure) != passes.end()) walk_streamlines(file, lengths);
   }
   // A streamline without points is never kept, inverted or not: tckedit's reader skips it, so it never writes one.
   const std::span<const std::uint64_t> first_voxline = file.streamline_first_voxline();

@@ -4,14 +4,15 @@
 //   kept  when every include region contains at least one of the streamline's source points, every
 //         ends-in region contains its first or its last point (tckedit's -include with -ends_only), no
 //         exclude region contains any of its points, and its length (the sum of its segments' lengths)
-//         lies within [min_length, max_length] (widened as tckedit widens them: by a tenth of the source's
-//         step_size, or half a step over its downsample_factor, when the source header has one);
-//         `invert` keeps exactly the others.
+//         passes tckedit's length thresholds (length_limits.h: the limits in float32, widened by the source
+//         header's step_size, the length summed in float32); `invert` keeps exactly the others.
 //
 // Points are the source points as the .vxl stores them (synthetic face points are not tested): bit for bit
 // the source's with --positions float32, within the file's packed bound otherwise, so that a streamline
 // whose deciding point lies within that bound of a region's surface may be decided differently from
-// tckedit on the source file. Lengths are the source points' (SLEN), bit for bit what the converter measured.
+// tckedit on the source file. Lengths are decided as tckedit decides them on the source: to the bit with float32
+// positions (SLEN where it lies clearly on one side of a limit, the points measured otherwise); with packed
+// positions from SLEN, the source points' length within a few float32 roundings of tckedit's.
 //
 // The voxel grid is the index: a region is tested only against the voxlines of the voxels whose bounds it
 // may touch. With a VoxelVoxlines index (the file's VXIX, or one given) the streamlines crossing them are
@@ -19,7 +20,7 @@
 // (older files), by walking the voxline table (8 bytes a voxline, about a tenth of the source's bytes).
 // Length limits read the lengths of the streamlines that pass the regions from the file's SLEN (4 bytes a
 // streamline; their source points' lengths, format/streamline_length.h); files without SLEN have their
-// points read instead, through the whole voxline table.
+// points read instead, through the whole voxline table, as do the few float32 streamlines SLEN cannot decide.
 #pragma once
 
 #include <cstdint>
@@ -43,6 +44,7 @@ struct SelectionResult {
   // What the query touched, for --verbose and the benchmark.
   std::uint32_t voxels_touched = 0;        // voxels some region may touch
   std::uint64_t points_tested = 0;         // vertices read for the regions
+  std::uint64_t lengths_read = 0;          // SLEN lengths read for the length limits
   std::uint64_t streamlines_measured = 0;  // streamlines whose points were read for the length limits
   std::uint64_t bytes_read = 0;            // of the file: the tables walked and the vertices read
   // Per region (includes, then ends-in, then excludes, each in the order given): the streamlines it holds
@@ -58,12 +60,10 @@ inline constexpr std::size_t kMaxRegions = 64;
 // points (tests and the benchmark compare both).
 enum class SelectionPath { Fastest, ScanTable };
 
-// How far tckedit widens length limits for this file's source (0 when its header has no step_size).
-double length_limit_margin(const VxlFile& file);
-
 // Throws vxl::Error: Usage for more than kMaxRegions regions or min_length > max_length, Input for a .vxl
-// whose tables do not hold together. `index`, when given, must be VoxelVoxlines::of_file(file)'s: the
-// result is the same with or without it (without it, the file's VXIX is used when it has one), and by either path.
+// whose tables do not hold together or whose source header tckedit would refuse (length_limits.h). `index`, when given,
+// must be VoxelVoxlines::of_file(file)'s: the result is the same with or without it (without it, the file's VXIX is
+// used when it has one), and by either path.
 SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria,
                                    const VoxelVoxlines* index = nullptr, SelectionPath path = SelectionPath::Fastest);
 
