@@ -11,9 +11,13 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <random>
+#include <tuple>
+
+#include <sys/resource.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -31,6 +35,7 @@
 #include "converter/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_verify.h"
+#include "tests/address_sanitizer.h"
 #include "tests/hostile_vxl.h"
 #include "tests/mif_test_files.h"
 #include "tests/nifti_test_files.h"
@@ -902,6 +907,70 @@ TEST(SelectionCli, OutputSuffixesComeFromOneTable) {
   EXPECT_EQ(exported.exit_code, 2);
   EXPECT_NE(exported.output.find("export writes .tck, .trx, .vtk, .trk or .trk.gz files"), std::string::npos)
       << exported.output;
+}
+
+// A mask named 64 times is read once and its voxels kept once, cropped to what is set: a 256³ image's 16.7M
+// voxels, kept whole for each of 64 regions, took over 1 GiB. The limit on regions is checked before any file
+// is read: a 65th region naming no file is refused for the count.
+TEST(SelectionCli, AMaskNamedSixtyFourTimesIsReadOnceAndTheLimitComesFirst) {
+  ScratchDir dir;
+  convert_tractogram(synth(300), dir.file("in.vxl"), settings(PositionEncoding::Float32));
+  std::string voxels(std::size_t(256) * 256 * 256, '\0');
+  for (std::size_t k = 108; k < 148; ++k)
+    for (std::size_t j = 108; j < 148; ++j)
+      for (std::size_t i = 108; i < 148; ++i) voxels[i + 256 * (j + 256 * k)] = 1;
+  std::ofstream(dir.file("m.nii"), std::ios::binary)
+      << test::nifti1_bytes({256, 256, 256}, DT_UINT8, 8, voxels, {1, 0, 0, -128, 0, 1, 0, -128, 0, 0, 1, -128});
+  std::string many, one = " --include " + test::q(dir.file("m.nii"));
+  for (int i = 0; i < 64; ++i) many += one;
+  const std::string in = test::q(dir.file("in.vxl"));
+  const test::CommandResult once = run_cli("select " + in + " --count" + one);
+  ASSERT_EQ(once.exit_code, 0) << once.output;
+  EXPECT_GT(std::stoull(once.output), 0u);
+  const test::CommandResult sixty_four = run_cli("select " + in + " --count" + many);
+  ASSERT_EQ(sixty_four.exit_code, 0) << sixty_four.output;
+  EXPECT_EQ(sixty_four.output, once.output);
+  if (!test::kAddressSanitizer) {
+    rusage children{};
+    getrusage(RUSAGE_CHILDREN, &children);
+    EXPECT_LT(children.ru_maxrss, 400 << 10) << "KiB: the mask was kept once per region";
+  }
+  const test::CommandResult too_many =
+      run_cli("select " + in + " --count" + many + " --include " + test::q(dir.file("absent.nii")));
+  EXPECT_EQ(too_many.exit_code, 2) << too_many.output;
+  EXPECT_NE(too_many.output.find("at most 64 regions in one selection (65 given)"), std::string::npos)
+      << too_many.output;
+
+  const std::vector<Region> together = parse_regions({dir.file("m.nii"), "1,2,3,4", dir.file("m.nii")});
+  ASSERT_EQ(together.size(), 3u);
+  EXPECT_EQ(together[1].shape(), Region::Shape::Sphere);
+  const float inside[3] = {0, 0, 0}, outside[3] = {30, 0, 0};
+  for (const std::size_t r : {0u, 2u}) {
+    EXPECT_EQ(together[r].shape(), Region::Shape::Mask);
+    EXPECT_TRUE(together[r].contains(inside));
+    EXPECT_FALSE(together[r].contains(outside));
+  }
+}
+
+// An image this process cannot hold is refused naming the file and the limit (exit 4), not "out of memory" or
+// "cannot map": under a 1 GiB address-space limit, a 512 MiB uint8 mask (2 GiB as float32 samples) and a 2 GiB
+// float64 one (which cannot be mapped). Both files are sparse.
+TEST(SelectionCli, AnImageBeyondTheMemoryLimitIsRefusedNamingTheFileAndTheLimit) {
+  if (test::kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit";
+  ScratchDir dir;
+  convert_tractogram(synth(50), dir.file("in.vxl"), settings(PositionEncoding::Float32));
+  for (const auto& [name, datatype, bits] :
+       {std::tuple{"u8.nii", DT_UINT8, 8}, std::tuple{"f64.nii", DT_FLOAT64, 64}}) {
+    const std::string path = dir.file(name);
+    std::ofstream(path, std::ios::binary) << test::nifti1_bytes({1024, 1024, 512}, datatype, bits, "");
+    std::filesystem::resize_file(path, 352 + std::uintmax_t(1024) * 1024 * 512 * (bits / 8));
+    const test::CommandResult r = test::run_program(
+        "/bin/sh", "-c 'ulimit -v 1048576 && exec \"$0\" \"$@\"' " + test::q(VOXLINES_CLI) + " select " +
+                       test::q(dir.file("in.vxl")) + " --count --include " + test::q(path));
+    EXPECT_EQ(r.exit_code, 4) << name << ": " << r.output;
+    EXPECT_NE(r.output.find(name), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("address-space limit (ulimit -v) of 1.0 GiB"), std::string::npos) << r.output;
+  }
 }
 
 TEST(SelectionCli, HostileRegionsAreRefusedNamingTheArgumentAndWriteNothing) {

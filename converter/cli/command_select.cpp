@@ -86,10 +86,23 @@ void add_select_command(CLI::App& app) {
       if (limit && !(std::isfinite(*limit) && *limit >= 0))
         throw Error(ErrorKind::Usage, "--min-length/--max-length", std::nullopt,
                     "a length limit is a finite, non-negative number of mm");
+    // The limit before any image is read; each image read once however often it is named.
+    std::vector<std::string> texts = opt->include;
+    texts.insert(texts.end(), opt->exclude.begin(), opt->exclude.end());
+    texts.insert(texts.end(), opt->ends_in.begin(), opt->ends_in.end());
+    if (texts.size() > kMaxRegions)
+      throw Error(ErrorKind::Usage, "--include/--exclude/--ends-in", std::nullopt,
+                  "at most " + std::to_string(kMaxRegions) + " regions in one selection (" +
+                      std::to_string(texts.size()) + " given)");
+    std::vector<Region> regions = parse_regions(texts);
     SelectionCriteria criteria;
-    for (const std::string& r : opt->include) criteria.include.push_back(parse_region(r));
-    for (const std::string& r : opt->exclude) criteria.exclude.push_back(parse_region(r));
-    for (const std::string& r : opt->ends_in) criteria.ends_in.push_back(parse_region(r));
+    auto take = [&](std::vector<Region>& into, std::size_t first, std::size_t count) {
+      into.assign(std::make_move_iterator(regions.begin() + first),
+                  std::make_move_iterator(regions.begin() + first + count));
+    };
+    take(criteria.include, 0, opt->include.size());
+    take(criteria.exclude, opt->include.size(), opt->exclude.size());
+    take(criteria.ends_in, opt->include.size() + opt->exclude.size(), opt->ends_in.size());
     criteria.min_length = opt->min_length;
     criteria.max_length = opt->max_length;
     criteria.invert = opt->invert;

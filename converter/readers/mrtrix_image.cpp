@@ -282,6 +282,7 @@ VolumeImage read_mrtrix_image(const std::string& path, const ImageLimits& limits
   v.geometry = image_geometry;
   v.voxel_to_ras = image_geometry.voxel_to_ras();
   const std::size_t n = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
+  reserve_values(v, path, n);
   v.values.assign(n, 0.0f);
   // Through the stored samples in file order (an odometer over the axes, fastest first), keeping those of
   // the first volume.

@@ -216,7 +216,7 @@ VolumeImage read_nifti_image(const std::string& path, const ImageLimits& limits)
   const bool scaled = slope != 0.0 && std::isfinite(slope) && std::isfinite(inter);
   // A block at a time, in the file's type: the destination grows as data arrive, so that a damaged stream
   // is refused having allocated little more than what it held.
-  v.values.reserve(n);
+  reserve_values(v, path, n);
   const std::size_t block = std::max<std::size_t>(1, (std::size_t(1) << 20) / size);
   while (v.values.size() < n) {
     const std::size_t count = std::min(block, n - v.values.size());

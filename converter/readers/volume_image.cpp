@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <new>
+#include <stdexcept>
 
 #include "converter/readers/mrtrix_image.h"
 #include "converter/readers/nifti_image.h"
 #include "format/base/error.h"
+#include "format/base/memory_available.h"
 
 namespace vxl {
 namespace {
@@ -91,6 +94,17 @@ void check_image_size(const std::string& path, const std::array<std::int64_t, 3>
     fail_unsupported(path, "the image has " + std::to_string(static_cast<std::uint64_t>(voxels)) +
                                " voxels per volume; at most " + std::to_string(limits.max_voxels) + " are read (" +
                                limits.reason + ")");
+}
+
+void reserve_values(VolumeImage& image, const std::string& path, std::uint64_t voxels) {
+  try {
+    image.values.reserve(static_cast<std::size_t>(voxels));
+  } catch (const std::bad_alloc&) {
+    fail_unsupported(path, "its " + std::to_string(voxels) + " voxels take " + std::to_string(4 * voxels) +
+                               " bytes as float32 samples, more than can be allocated within " + memory_limit_text());
+  } catch (const std::length_error&) {
+    fail_unsupported(path, "its " + std::to_string(voxels) + " voxels cannot be held in memory");
+  }
 }
 
 void check_voxel_to_ras(const std::string& path, const std::array<double, 16>& a, const std::string& source) {

@@ -33,6 +33,10 @@ struct ImageLimits {
   std::string reason = "at most 2^30 voxels are read";  // completes the refusal: why this limit
 };
 
+// Makes room for an image's `voxels` float32 samples before any is read. Throws vxl::Error (Unsupported, naming
+// `path`, the bytes and what bounds this process's memory) when they cannot be allocated.
+void reserve_values(VolumeImage& image, const std::string& path, std::uint64_t voxels);
+
 // Reads `path` as the format its extension names (case-insensitive). Throws vxl::Error: Input (exit 3)
 // for a malformed file, Unsupported (exit 4) for another format, a feature or a size beyond `limits`.
 VolumeImage read_volume_image(const std::string& path, const ImageLimits& limits = {});

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <variant>
 
 #include "format/base/error.h"
 
@@ -67,28 +68,34 @@ Region Region::mask(const VolumeImage& image, std::optional<float> label, std::s
   Region r;
   r.shape_ = Shape::Mask;
   r.text_ = std::move(text);
-  r.set_.resize(image.values.size());
+  auto selected = [&](float v) { return label ? v == *label : v != 0.0f; };
   std::array<std::int64_t, 3> first{INT64_MAX, INT64_MAX, INT64_MAX}, last{-1, -1, -1};
   std::size_t at = 0;
   for (std::int64_t k = 0; k < image.dims[2]; ++k)
     for (std::int64_t j = 0; j < image.dims[1]; ++j)
       for (std::int64_t i = 0; i < image.dims[0]; ++i, ++at) {
-        const float v = image.values[at];
-        if (label ? v != *label : v == 0.0f) continue;
-        r.set_[at] = 1;
+        if (!selected(image.values[at])) continue;
         const std::int64_t index[3] = {i, j, k};
         for (int c = 0; c < 3; ++c) first[c] = std::min(first[c], index[c]), last[c] = std::max(last[c], index[c]);
       }
   if (last[0] < 0)
     bad_region(r.text_, label ? "the image holds no voxel of label " + std::to_string(*label) : "the mask is empty");
 
-  // Looked up as tckedit looks a mask up (image_geometry.h): in the image realigned to near-RAS axes, through
-  // its scanner-to-voxel affine in float32.
+  // Looked up as tckedit looks a mask up (image_geometry.h): in the image realigned to near-RAS axes and cropped to
+  // the set voxels, through its scanner-to-voxel affine in float32. Only the crop is kept, one byte a voxel in the
+  // cropped realigned order, so that a mask costs what its set voxels span, not the image.
   const MaskLookup lookup = mask_lookup(image.geometry, image.dims, first, last);
   r.ras_to_voxel_ = lookup.scanner_to_voxel;
   r.dims_ = lookup.dims;
-  r.offset_ = lookup.offset;
-  r.step_ = lookup.step;
+  std::vector<std::uint8_t> set(static_cast<std::size_t>(r.dims_[0] * r.dims_[1] * r.dims_[2]));
+  std::size_t n = 0;
+  for (std::int64_t n2 = 0; n2 < r.dims_[2]; ++n2)
+    for (std::int64_t n1 = 0; n1 < r.dims_[1]; ++n1)
+      for (std::int64_t n0 = 0; n0 < r.dims_[0]; ++n0, ++n) {
+        const std::int64_t sample = lookup.offset + n0 * lookup.step[0] + n1 * lookup.step[1] + n2 * lookup.step[2];
+        set[n] = selected(image.values[static_cast<std::size_t>(sample)]);
+      }
+  r.set_ = std::make_shared<const std::vector<std::uint8_t>>(std::move(set));
   const auto& a = image.voxel_to_ras;
 
   // The RAS box of the set voxels' cubes: the corners of [first - 1/2, last + 1/2] through the affine,
@@ -120,14 +127,14 @@ bool Region::contains(const float* p) const {
     case Shape::Mask: {
       // In float32, as Eigen evaluates tckedit's affine product (Transform<float, 3, AffineCompact> times a
       // point): the four terms summed in pairs (test SelectionRegions.MaskLookupRoundsAsEigensAffineProduct).
-      std::int64_t at = offset_;
+      std::int64_t index[3];
       for (int row = 0; row < 3; ++row) {
         const float v = mask_row(&ras_to_voxel_[4 * row], p);
         const float rounded = std::round(v);
         if (!(rounded >= 0.0f && rounded < float(dims_[row]))) return false;
-        at += static_cast<std::int64_t>(rounded) * step_[row];
+        index[row] = static_cast<std::int64_t>(rounded);
       }
-      return set_[static_cast<std::size_t>(at)] != 0;
+      return (*set_)[static_cast<std::size_t>(index[0] + dims_[0] * (index[1] + dims_[1] * index[2]))] != 0;
     }
   }
   return false;
@@ -178,7 +185,16 @@ bool Region::may_touch(const float* lo, const float* hi) const {
   return true;
 }
 
-Region parse_region(const std::string& text) {
+namespace {
+
+// An argument naming an image: the file, and the label when one is chosen.
+struct ImageArgument {
+  std::string path;
+  std::optional<float> label;
+};
+
+// A sphere or a box, made; or the image an argument names, checked to exist and to have an image's name.
+std::variant<Region, ImageArgument> parse_argument(const std::string& text) {
   std::error_code ec;
   const bool names_file = std::filesystem::exists(text, ec);
   if (!names_file && text.starts_with("box:")) {
@@ -225,7 +241,41 @@ Region parse_region(const std::string& text) {
     throw Error(ErrorKind::Unsupported, path, std::nullopt,
                 "a region image must be NIfTI (.nii, .nii.gz) or MRtrix (.mif, .mif.gz, .mih); convert other formats "
                 "first (e.g. mrconvert)");
-  return Region::mask(read_volume_image(path), label, text);
+  return ImageArgument{path, label};
 }
+
+}  // namespace
+
+std::vector<Region> parse_regions(const std::vector<std::string>& texts) {
+  std::vector<std::optional<Region>> regions(texts.size());
+  std::vector<std::pair<std::size_t, ImageArgument>> images;
+  for (std::size_t i = 0; i < texts.size(); ++i) {
+    std::variant<Region, ImageArgument> parsed = parse_argument(texts[i]);
+    if (Region* r = std::get_if<Region>(&parsed))
+      regions[i] = std::move(*r);
+    else
+      images.emplace_back(i, std::get<ImageArgument>(std::move(parsed)));
+  }
+  // Each file read once, in the order first named; its regions made before the next is read.
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    const std::string& path = images[i].second.path;
+    if (regions[images[i].first]) continue;
+    const VolumeImage image = read_volume_image(path);
+    for (std::size_t j = i; j < images.size(); ++j) {
+      const auto& [at, argument] = images[j];
+      if (argument.path != path || regions[at]) continue;
+      regions[at] = Region::mask(image, argument.label, texts[at]);
+      // The same argument again shares the voxels.
+      for (std::size_t k = j + 1; k < images.size(); ++k)
+        if (texts[images[k].first] == texts[at]) regions[images[k].first] = regions[at];
+    }
+  }
+  std::vector<Region> out;
+  out.reserve(regions.size());
+  for (std::optional<Region>& r : regions) out.push_back(std::move(*r));
+  return out;
+}
+
+Region parse_region(const std::string& text) { return std::move(parse_regions({text}).front()); }
 
 }  // namespace vxl

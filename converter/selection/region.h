@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -51,14 +52,12 @@ class Region {
   std::string text_;
   Point3f centre_{}, lo_{}, hi_{};  // sphere centre; box corners (a mask's: the RAS box of its set voxels)
   float radius_ = 0, radius2_ = 0;
-  // Mask: the selected voxels (1 byte each, in the stored order, x fastest), and how a point finds its voxel
-  // (converter/readers/image_geometry.h, MaskLookup): RAS -> realigned voxel, row-major 3 x 4, in float32, the
-  // realigned sizes, and the stored sample of realigned index n at offset_ + n . step_.
+  // Mask: how a point finds its voxel (converter/readers/image_geometry.h, MaskLookup: RAS -> the cropped
+  // realigned image's voxel, row-major 3 x 4, in float32), that image's sizes, and which of its voxels are selected
+  // (1 byte each, n0 fastest; shared by the copies of a region).
   std::array<std::int64_t, 3> dims_{};
-  std::vector<std::uint8_t> set_;
+  std::shared_ptr<const std::vector<std::uint8_t>> set_;
   std::array<float, 12> ras_to_voxel_{};
-  std::int64_t offset_ = 0;
-  std::array<std::int64_t, 3> step_{};
 };
 
 // One row of a mask's RAS -> voxel affine (4 floats) applied to `p` in float32, in the order Eigen sums tckedit's
@@ -74,5 +73,10 @@ inline float mask_row(const float* m, const float* p) { return (m[0] * p[0] + m[
 // non-finite radius, a box with a lower corner above the upper one, an empty mask, an absent label), and
 // the image reader's errors (3, 4) for a file that cannot be read as an image.
 Region parse_region(const std::string& text);
+
+// Parses several region arguments, as parse_region does each: the spheres and boxes first, in order (so that a
+// malformed one is reported before any file is read), then each image file once, however many arguments name
+// it (with or without labels), one image held at a time; an argument given twice shares its voxels.
+std::vector<Region> parse_regions(const std::vector<std::string>& texts);
 
 }  // namespace vxl

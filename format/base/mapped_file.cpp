@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "format/base/error.h"
+#include "format/base/memory_available.h"
 #include "format/base/regular_file.h"
 
 namespace vxl {
@@ -23,6 +24,9 @@ MappedFile::MappedFile(const std::string& path) : path_(path) {
     if (p == MAP_FAILED) {
       int e = errno;
       ::close(fd);
+      if (e == ENOMEM)  // the file is fine; this process cannot hold it
+        throw Error(ErrorKind::Unsupported, path, std::nullopt,
+                    "cannot map its " + std::to_string(size_) + " bytes within " + memory_limit_text());
       fail_input(path, std::nullopt, std::string("cannot map: ") + std::strerror(e));
     }
     data_ = static_cast<const std::uint8_t*>(p);
@@ -61,10 +65,14 @@ FileWindow::FileWindow(int fd, const std::string& path, std::uint64_t offset, st
                    write ? MAP_SHARED : MAP_PRIVATE | MAP_POPULATE, fd, static_cast<off_t>(start));
   if (p == MAP_FAILED) {
     map_size_ = 0;
+    const int e = errno;
     if (write)
       throw Error(ErrorKind::Output, path, std::nullopt,
-                  std::string("cannot map part of the output: ") + std::strerror(errno));
-    fail_input(path, offset, std::string("cannot map: ") + std::strerror(errno));
+                  std::string("cannot map part of the output: ") + std::strerror(e));
+    if (e == ENOMEM)
+      throw Error(ErrorKind::Unsupported, path, offset,
+                  "cannot map " + std::to_string(size) + " bytes of it within " + memory_limit_text());
+    fail_input(path, offset, std::string("cannot map: ") + std::strerror(e));
   }
   map_ = p;
   bytes_ = {static_cast<std::uint8_t*>(p) + (offset - start), static_cast<std::size_t>(size)};

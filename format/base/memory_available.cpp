@@ -5,6 +5,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <sys/resource.h>
+
 #include "format/base/memory_size.h"
 
 namespace vxl {
@@ -55,6 +57,20 @@ std::optional<std::uint64_t> available_memory() {
   std::optional<std::uint64_t> available = meminfo("MemAvailable");
   if (const auto headroom = cgroup_headroom()) available = available ? std::min(*available, *headroom) : *headroom;
   return available;
+}
+
+std::string memory_limit_text() {
+  auto gib = [](std::uint64_t bytes) {
+    std::ostringstream text;
+    text.precision(1);
+    text << std::fixed << double(bytes) / double(1ull << 30) << " GiB";
+    return text.str();
+  };
+  rlimit address_space{};
+  if (::getrlimit(RLIMIT_AS, &address_space) == 0 && address_space.rlim_cur != RLIM_INFINITY)
+    return "the address-space limit (ulimit -v) of " + gib(address_space.rlim_cur);
+  if (const auto available = available_memory()) return "the " + gib(*available) + " of memory available";
+  return "this machine's memory";
 }
 
 std::uint64_t in_memory_estimate(std::uint64_t source_bytes) {

@@ -18,6 +18,10 @@ namespace vxl {
 // takes it) overrides all of them. nullopt when none can be read.
 std::optional<std::uint64_t> available_memory();
 
+// What bounds this process's memory, for a refusal's message: "the address-space limit (ulimit -v) of 4.0 GiB"
+// when RLIMIT_AS is set, else "the 12.3 GiB of memory available" (available_memory), else "this machine's memory".
+std::string memory_limit_text();
+
 // The estimated peak of a conversion in memory of a TCK source of `source_bytes` bytes.
 std::uint64_t in_memory_estimate(std::uint64_t source_bytes);
 
