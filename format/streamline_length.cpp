@@ -30,9 +30,18 @@ float float32_polyline_length(std::span<const float> xyz) {
 
 double stored_length(const VxlFile& file, std::uint64_t streamline) {
   const float length = file.streamline_lengths()[streamline];
-  if (!std::isfinite(length) || std::signbit(length))  // no writer stores -0 either
+  auto refuse = [&](const std::string& why) {
     fail_input(file.path(), file.find_section(section_id("SLEN"))->offset + 4 * streamline,
-               "SLEN length of streamline " + std::to_string(streamline) + " is not a finite number ≥ 0");
+               "SLEN length of streamline " + std::to_string(streamline) + " " + why);
+  };
+  if (!std::isfinite(length) || std::signbit(length)) refuse("is not a finite number ≥ 0");  // nor -0
+  // No streamline is longer than all the file's points could make: each segment within the bounds' diagonal.
+  const MetaSection& m = file.meta();
+  const double diagonal = std::hypot(m.bounds_max[0] - m.bounds_min[0], m.bounds_max[1] - m.bounds_min[1],
+                                     m.bounds_max[2] - m.bounds_min[2]);
+  if (double(length) > double(m.point_count) * diagonal * (1 + 0x1p-20) + 1e-6)
+    refuse("(" + std::to_string(length) + " mm) is longer than the file's " + std::to_string(m.point_count) +
+           " points within its bounds can make");
   return length;
 }
 

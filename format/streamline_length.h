@@ -25,7 +25,8 @@ inline float stored_length_of(std::span<const float> xyz) { return static_cast<f
 float float32_polyline_length(std::span<const float> xyz);
 
 // Streamline s's length from the file's SLEN, which it must have: throws vxl::Error (Input, naming the file and
-// the byte) for a value that is not finite or has its sign bit set (-0 included).
+// the byte) for a value that is not finite, has its sign bit set (-0 included), or is longer than all the
+// file's points could make within its bounds. (A caller that trusts the values checks the section's checksum.)
 double stored_length(const VxlFile& file, std::uint64_t streamline);
 
 }  // namespace vxl

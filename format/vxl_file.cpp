@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "format/base/checked_count.h"
+#include "format/base/checksum.h"
 #include "format/base/error.h"
 #include "format/base/utf8_check.h"
 #include "format/vxlz_layout.h"
@@ -23,7 +24,20 @@ std::string section_name(std::uint32_t id) {
 VxlFile VxlFile::open(const std::string& path) {
   VxlFile f{MappedFile(path)};
   f.validate();
+  f.checksum_checked_ = std::make_unique<std::atomic<std::uint8_t>[]>(f.sections_.size());
   return f;
+}
+
+void VxlFile::check_section_checksum(std::uint32_t id) const {
+  const SectionEntry* e = find_section(id);
+  if (!e) return;
+  std::atomic<std::uint8_t>& checked = checksum_checked_[static_cast<std::size_t>(e - sections_.data())];
+  if (checked.load(std::memory_order_acquire) != 0) return;
+  if (xxh3_64(bytes().data() + e->offset, e->size) != e->checksum)
+    fail_input(
+        path(), e->offset,
+        "checksum mismatch in section " + section_name(id) + ": the file is damaged (voxlines verify checks all)");
+  checked.store(1, std::memory_order_release);
 }
 
 const SectionEntry* VxlFile::find_section(std::uint32_t id) const {

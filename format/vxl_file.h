@@ -8,9 +8,11 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -69,6 +71,10 @@ class VxlFile {
   const FileHeader& header() const { return header_; }
   std::span<const SectionEntry> sections() const { return sections_; }
   const SectionEntry* find_section(std::uint32_t id) const;
+  // The section's checksum against its bytes (XXH3_64; once per section and file: a later call costs nothing).
+  // For a reader that trusts a section's values beyond what open() checks, as a selection trusts VXIX and SLEN.
+  // Throws vxl::Error (Input) naming the section and its offset. Nothing when the file lacks the section.
+  void check_section_checksum(std::uint32_t id) const;
 
   const MetaSection& meta() const { return meta_; }
   std::span<const DirectionEntry> directions() const { return directions_; }
@@ -158,6 +164,8 @@ class VxlFile {
       const std::function<void(std::string_view name, std::uint64_t members_at, std::uint64_t count)>& visit) const;
 
   MappedFile file_;
+  // Per section table entry: 1 once check_section_checksum has found it whole.
+  std::unique_ptr<std::atomic<std::uint8_t>[]> checksum_checked_;
   FileHeader header_{};
   std::span<const SectionEntry> sections_;
   MetaSection meta_{};

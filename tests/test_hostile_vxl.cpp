@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "converter/export_trx.h"
@@ -314,8 +315,9 @@ TEST(HostileVxl, VoxelIndexEntriesAndOrderBitsThatLieAreRefusedWhereUsed) {
 }
 
 // The streamline lengths (SLEN, spec §5.15): a size for other counts is refused on open; a length that is not a
-// finite number ≥ 0 is refused by `select` where it is read (exit 3, naming the byte) and by `verify`; a finite
-// length that is not its points' is found by `verify`.
+// finite number ≥ 0, or longer than all the file's points could make within its bounds, is refused by `select`
+// where it is read (exit 3, naming the byte) and by `verify`; another length that is not its points' is found by
+// `verify`.
 TEST(HostileVxl, StreamlineLengthsThatDoNotFitOrLieAreRefused) {
   ScratchDir dir;
   const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
@@ -338,7 +340,9 @@ TEST(HostileVxl, StreamlineLengthsThatDoNotFitOrLieAreRefused) {
   const Case cases[] = {{"NaN", NAN, true, "is not a finite number"},
                         {"negative", -1.0f, true, "is not a finite number"},
                         {"minus zero", -0.0f, true, "is not a finite number"},
-                        {"a thousand times longer", 1000.0f * 150.0f, false, "differs from its points'"}};
+                        {"longer than all the points could make", 1e30f, true, "within its bounds can make"},
+                        {"twice as long", 2 * VxlFile::open(dir.file("h.vxl")).streamline_lengths()[streamlines - 1],
+                         false, "differs from its points'"}};
   const std::uint64_t last = streamlines - 1;
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
@@ -358,6 +362,31 @@ TEST(HostileVxl, StreamlineLengthsThatDoNotFitOrLieAreRefused) {
     const auto v = test::run_cli("verify " + q(dir.file("bad.vxl")));
     EXPECT_EQ(v.exit_code, 1) << v.output;
     EXPECT_NE(v.output.find(c.verify_message), std::string::npos) << v.output;
+  }
+}
+
+// The tables a selection trusts (VOXT, STRM, VXIX or VXLN, SLEN) are checksummed before use: one flipped bit in a
+// VXIX entry answered 22 streamlines instead of 21 with exit 0, a flipped SLEN bit kept a streamline it should
+// not have. Now exit 3 naming the section, nothing written.
+TEST(HostileVxl, ASelectionRefusesTheTablesItTrustsWhenTheirChecksumsFail) {
+  ScratchDir dir;
+  const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
+  const VxlFile f = VxlFile::open(dir.file("h.vxl"));
+  const std::uint64_t vxix_entries = valid.entry("VXIX").offset + 8 * (f.voxels().size() + 1);
+  for (const auto& [section, at, query] :
+       {std::tuple{"VXIX", vxix_entries, std::string(" --include box:-1000,-1000,-1000,1000,1000,1000")},
+        std::tuple{"SLEN", valid.entry("SLEN").offset + 1, std::string(" --min-length 1")},
+        std::tuple{"STRM", valid.entry("STRM").offset + 8, std::string(" --min-length 1")},
+        // A voxel's tight x minimum, its last mantissa bit: within the slack open() allows.
+        std::tuple{"VOXT", valid.entry("VOXT").offset + 16, std::string(" --include 0,0,0,5")}}) {
+    SCOPED_TRACE(section);
+    VxlBytes b = valid;
+    b.bytes[static_cast<std::size_t>(at)] ^= 1;  // checksums left stale
+    b.write(dir.file("bad.vxl"));
+    const auto r = test::run_cli("select " + q(dir.file("bad.vxl")) + " " + q(dir.file("out.tck")) + query);
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find(std::string("checksum mismatch in section ") + section), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("out.tck")));
   }
 }
 

@@ -250,6 +250,11 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
   const RegionTable table(criteria);
   SelectionResult result;
   const std::uint64_t n = file.meta().streamline_count;
+  // The tables whose values decide membership are checksummed before they are trusted (once per file: the
+  // window's selections pay once). The vertex blocks, read in part, are checked for structure as they are read.
+  auto trust = [&file](const char(&id)[5]) { file.check_section_checksum(section_id(id)); };
+  trust("VOXT");
+  trust("STRM");
   const VoxelRegions voxel_regions = regions_per_voxel(file, table, result.voxels_touched);
   result.bytes_read = file.voxels().size_bytes();
   HitSearch search{file, table, voxel_regions};
@@ -261,6 +266,7 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
     file_index = VoxelVoxlines::of_file(file);
     index = file_index ? &*file_index : nullptr;
   }
+  trust(index && !file.voxel_index_first().empty() ? "VXIX" : "VXLN");
   const std::vector<StreamlineHits> hits =
       index ? hits_by_index(search, *index, result.bytes_read) : hits_by_scan(search, result.bytes_read);
   result.points_tested = search.points_tested;
@@ -285,6 +291,8 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
     constexpr std::uint8_t kMeasure = 2;
     const bool slen = !file.streamline_lengths().empty() && path == SelectionPath::Fastest;
     const bool source_points = file.position_encoding() == PositionEncoding::Float32;
+    if (slen) trust("SLEN");
+    if (!slen || source_points) trust("VXLN");  // walked, or counted for the streamlines near a limit
     for (std::uint64_t s = 0; s < n; ++s) {
       if (passes[s] == 0) continue;
       if (!slen) {
