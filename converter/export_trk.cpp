@@ -175,6 +175,47 @@ std::array<std::uint8_t, trk::kHeaderSize> header_bytes(const Geometry& g, const
   return h;
 }
 
+// The stored (voxmm) point for a RAS point: the inverse affine's answer in double, rounded to float32. With a
+// TRK source's own header, every RAS point came from a stored point through trk::voxmm_point_to_ras, and that
+// point lies within two float32 steps of the answer on each axis: it is found, so that a reader gets the very
+// same float32 coordinates back (the export is lossless). With another header a RAS point generally has no such
+// stored point (voxmm coordinates, measured from the volume's corner, are coarser than RAS ones near the
+// origin), and the answer is within one float32 step at the voxmm coordinate's magnitude.
+struct VoxmmInverse {
+  trk::Mat4 to_voxmm, to_ras;
+  bool search;
+
+  std::array<float, 3> voxmm(const float* ras) const {
+    const double x = ras[0], y = ras[1], z = ras[2];
+    std::array<float, 3> v;
+    for (int r = 0; r < 3; ++r)
+      v[r] = static_cast<float>(to_voxmm[r][0] * x + to_voxmm[r][1] * y + to_voxmm[r][2] * z + to_voxmm[r][3]);
+    if (!search || maps_to(v, ras)) return v;
+    constexpr int kSteps[] = {-1, 1, -2, 2, 0};
+    for (const int a : kSteps)
+      for (const int b : kSteps)
+        for (const int c : kSteps) {
+          const std::array<float, 3> w{step(v[0], a), step(v[1], b), step(v[2], c)};
+          if (maps_to(w, ras)) return w;
+        }
+    return v;
+  }
+
+ private:
+  static float step(float f, int k) {
+    for (; k > 0; --k) f = std::nextafter(f, INFINITY);
+    for (; k < 0; ++k) f = std::nextafter(f, -INFINITY);
+    return f;
+  }
+  bool maps_to(const std::array<float, 3>& v, const float* ras) const {
+    for (int r = 0; r < 3; ++r)
+      if (std::bit_cast<std::uint32_t>(trk::voxmm_point_to_ras(to_ras, r, v[0], v[1], v[2])) !=
+          std::bit_cast<std::uint32_t>(ras[r]))
+        return false;
+    return true;
+  }
+};
+
 // The inverse of an affine whose last row is 0 0 0 1, or nullopt when it is singular.
 std::optional<trk::Mat4> inverse_affine(const trk::Mat4& a) {
   const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
@@ -255,6 +296,8 @@ TrkExportSummary export_trk(const VxlFile& file, const std::string& out_path, co
   if (prov.is_object() && prov.contains("source") && prov["source"].is_object() &&
       prov["source"].value("format", nlohmann::json()) == "trk")
     geometry = trk_source_geometry(prov["source"].value("header", nlohmann::json()));
+  // A TRK source's points were mapped to RAS by this header's affine: each has a stored point to go back to.
+  bool source_header = geometry.has_value();
   if (!geometry) geometry = reference_geometry(file, out_path);
 
   std::vector<std::string> scalar_names, property_names;
@@ -284,10 +327,12 @@ TrkExportSummary export_trk(const VxlFile& file, const std::string& out_path, co
     // A provenance header the reader would refuse (PROV may hold anything): the reference instead.
     header = header_bytes(reference_geometry(file, out_path), scalar_names, scalars.size(), property_names,
                           properties.size(), count);
+    source_header = false;
     to_voxmm = inverse_affine(trk::voxmm_to_rasmm(header, out_path, ignored));
   }
   if (!to_voxmm) fail_unsupported(out_path, "the header's voxmm to RAS mapping is singular");
-  const trk::Mat4& m = *to_voxmm;
+  const trk::Mat4 to_ras = trk::voxmm_to_rasmm(header, out_path, ignored);
+  const VoxmmInverse inverse{*to_voxmm, to_ras, source_header};
 
   std::vector<std::vector<float>> point_values;
   if (!scalars.empty()) {
@@ -317,10 +362,9 @@ TrkExportSummary export_trk(const VxlFile& file, const std::string& out_path, co
     record.clear();
     record.push_back(std::bit_cast<float>(static_cast<std::int32_t>(n)));
     for (std::uint64_t i = 0; i < n; ++i, ++point) {
-      const double x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
-      for (int r = 0; r < 3; ++r)
-        record.push_back(static_cast<float>(m[r][0] * x + m[r][1] * y + m[r][2] * z + m[r][3]));
-      for (const std::vector<float>& v : point_values) record.push_back(v[point]);
+      const std::array<float, 3> v = inverse.voxmm(&xyz[3 * i]);
+      record.insert(record.end(), v.begin(), v.end());
+      for (const std::vector<float>& values : point_values) record.push_back(values[point]);
     }
     for (const std::vector<float>& v : streamline_values) record.push_back(v[index]);
     out.write(record.data(), record.size() * sizeof(float));

@@ -436,7 +436,7 @@ void read_records(GzipBytes& stream, const TrkHeader& h, const Mat4& a, Tractogr
       const Bytes pt(q, point_bytes, h.big_endian);
       const double x = pt.f32(0), y = pt.f32(4), z = pt.f32(8);
       for (int r = 0; r < 3; ++r) {
-        const float v = static_cast<float>(a[r][0] * x + a[r][1] * y + a[r][2] * z + a[r][3]);
+        const float v = voxmm_point_to_ras(a, r, x, y, z);
         if (!std::isfinite(v))
           fail_at(p, "streamline #" + std::to_string(count) + " point " + std::to_string(i) +
                          " is not finite after mapping to RAS mm");

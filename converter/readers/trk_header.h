@@ -38,6 +38,12 @@ using Mat4 = std::array<std::array<double, 4>, 4>;
 // warnings it gives on the way. Throws vxl::Error naming `path` as read_trk does for a bad header.
 Mat4 voxmm_to_rasmm(std::span<const std::uint8_t> header, const std::string& path, std::vector<std::string>& warnings);
 
+// One RAS coordinate (row r) of a stored point, as read_trk computes it: the affine in double, left to right,
+// rounded once to float32. The exporter inverts this very arithmetic.
+inline float voxmm_point_to_ras(const Mat4& a, int r, double x, double y, double z) {
+  return static_cast<float>(a[r][0] * x + a[r][1] * y + a[r][2] * z + a[r][3]);
+}
+
 // The orientation of an affine's voxel axes as nibabel's aff2axcodes gives it ("RAS", "LPS", …);
 // nullopt for a singular one.
 std::optional<std::string> orientation_code(const Mat4& vox_to_ras);
