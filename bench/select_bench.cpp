@@ -1,9 +1,10 @@
 // Selection benchmark: `voxlines select` on a .vxl against MRtrix `tckedit` on its TCK, for spheres of 5, 10
 // and 20 mm at three places — the densest voxel (a bundle's core), the top of the brain (cortex) and outside
-// the bounds (empty space) — and one exclude. Each query: the selected count of both, the wall time of both
-// (medians, warm page cache), their ratio, and the bytes of the file `select` reads (its tables and the
-// vertices it tests) against the TCK's size (tckedit reads all of it). tckedit is run only when it is
-// installed; nothing else needs it.
+// the bounds (empty space) — one exclude, every streamline (a box around them all), and length limits alone.
+// Each query: the selected count of both, the wall time of both (medians, warm page cache), their ratio, the
+// peak resident memory of both (select's includes the pages of the .vxl it maps), and the bytes of the file
+// `select` reads (its tables and the vertices it tests) against the TCK's size (tckedit reads all of it).
+// tckedit is run only when it is installed; nothing else needs it.
 //
 // Usage: select_bench FILE.tck FILE.vxl [--rounds N] [--tckedit-rounds N] [--voxlines PATH]
 // (--voxlines: the program to time, by default the build's; a copy keeps a long run apart from rebuilds)
@@ -98,6 +99,12 @@ int main(int argc, char** argv) {
                      {"--include", sphere(centre(densest), 10), "--exclude", sphere(beside, 4)},
                      {"-include", sphere(centre(densest), 10), "-exclude", sphere(beside, 4)}});
 
+  queries.push_back({"everything (a box holding all)",
+                     {"--include", "box:-100000,-100000,-100000,100000,100000,100000"},
+                     {"-include", "0,0,0,200000"}});
+  queries.push_back({"length 60-120 mm only",
+                     {"--min-length", "60", "--max-length", "120"},
+                     {"-minlength", "60", "-maxlength", "120"}});
   const std::string tckedit = find_tckedit();
   const auto tck_bytes = std::filesystem::file_size(tck);
   const std::string out = (std::filesystem::temp_directory_path() / "select_bench_out.tck").string();
@@ -105,8 +112,8 @@ int main(int argc, char** argv) {
               (unsigned long long)m.streamline_count, (unsigned long long)file.bytes().size(),
               (unsigned long long)tck_bytes);
   std::printf("tckedit: %s\n", tckedit.empty() ? "not installed (its columns are empty)" : tckedit.c_str());
-  std::printf("%-28s %9s %9s %10s %10s %8s %14s\n", "query", "selected", "tckedit", "select s", "tckedit s", "ratio",
-              "select bytes");
+  std::printf("%-31s %9s %9s %10s %10s %7s %9s %9s %14s\n", "query", "selected", "tckedit", "select s", "tckedit s",
+              "ratio", "select MB", "tckedit MB", "select bytes");
   for (const Query& q : queries) {
     // The count and bytes from --json, then the timed runs writing the TCK.
     std::vector<std::string> count_args = {cli, "select", vxl_path, "--count", "--json"};
@@ -123,17 +130,21 @@ int main(int argc, char** argv) {
     std::vector<std::string> args = {cli, "select", vxl_path, out};
     args.insert(args.end(), q.ours.begin(), q.ours.end());
     // A run that fails must not pass for a fast one.
+    long peak_kib = 0;
     auto timed = [&](const std::vector<std::string>& command) {
       const vxl::bench::ChildRun run = run_child(command, true);
       if (run.exit_code != 0) {
         std::fprintf(stderr, "failed (exit %d): %s ...\n", run.exit_code, command[0].c_str());
         std::exit(1);
       }
+      peak_kib = std::max(peak_kib, run.peak_rss_kib);
       return run.seconds;
     };
     timed(args);  // warm
     std::vector<double> ours;
     for (int r = 0; r < rounds; ++r) ours.push_back(timed(args));
+    const long our_peak_kib = peak_kib;
+    peak_kib = 0;
     double theirs = -1;
     long long their_count = -1;
     if (!tckedit.empty()) {
@@ -145,9 +156,10 @@ int main(int argc, char** argv) {
       their_count = tck_count(out);
     }
     const double ours_s = median(ours);
-    std::printf("%-28s %9llu %9lld %10.3f %10.3f %8.1f %14llu\n", q.name.c_str(),
+    std::printf("%-31s %9llu %9lld %10.3f %10.3f %7.1f %9.0f %9.0f %14llu\n", q.name.c_str(),
                 (unsigned long long)j["selected"].get<std::uint64_t>(), their_count, ours_s, theirs,
-                theirs > 0 ? theirs / ours_s : 0.0, (unsigned long long)j["bytes_read"].get<std::uint64_t>());
+                theirs > 0 ? theirs / ours_s : 0.0, our_peak_kib / 1024.0, theirs > 0 ? peak_kib / 1024.0 : 0.0,
+                (unsigned long long)j["bytes_read"].get<std::uint64_t>());
   }
   std::filesystem::remove(out);
   std::filesystem::remove(out + ".json");

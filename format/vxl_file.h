@@ -68,6 +68,8 @@ class VxlFile {
 
   const std::string& path() const { return file_.path(); }
   std::span<const std::uint8_t> bytes() const { return file_.bytes(); }
+  // MappedFile::release_resident_pages: a pass through the whole file keeps its resident size bounded.
+  void release_resident_pages() const { file_.release_resident_pages(); }
   const FileHeader& header() const { return header_; }
   std::span<const SectionEntry> sections() const { return sections_; }
   const SectionEntry* find_section(std::uint32_t id) const;

@@ -1,8 +1,12 @@
 #include "converter/selection/streamline_selection.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <new>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -84,10 +88,27 @@ std::uint64_t streamline_point_count(const VxlFile& file, std::uint64_t s) {
   return points;
 }
 
-// The regions one streamline's points fell in (a streamline with none is not listed).
-struct StreamlineHits {
-  std::uint64_t streamline;
-  Bits regions;
+// The regions each streamline's points fell in, one word a streamline. Its zeroed pages come from the system as
+// they are first written (calloc), so a small query touches little of it; a large one costs 8 bytes a streamline,
+// where a list of (streamline, regions) per hit voxline, sorted and merged, took 16 a voxline twice over (a box
+// holding the 1M set: 400 MB).
+class RegionHits {
+ public:
+  explicit RegionHits(std::uint64_t streamlines)
+      : bits_(static_cast<Bits*>(std::calloc(std::max<std::uint64_t>(streamlines, 1), sizeof(Bits)))) {
+    if (!bits_) throw std::bad_alloc();
+  }
+  // From any thread.
+  void add(std::uint64_t streamline, Bits regions) {
+    std::atomic_ref<Bits>(bits_.get()[streamline]).fetch_or(regions, std::memory_order_relaxed);
+  }
+  Bits operator[](std::uint64_t streamline) const { return bits_.get()[streamline]; }
+
+ private:
+  struct Free {
+    void operator()(Bits* p) const { std::free(p); }
+  };
+  std::unique_ptr<Bits, Free> bits_;
 };
 
 // One voxline, as a region test needs it.
@@ -163,14 +184,13 @@ bool claim_vertices(VoxlinePlace& v, std::uint64_t& cursor, std::uint64_t end) {
 // voxel's cursor (spec §5.6), so cursors are kept for the touched voxels alone and a voxline elsewhere
 // costs one table entry and one look at its voxel's bits; written out rather than run through
 // walk_streamlines' callbacks for that reason (the empty query on the 1M set went from 0.3 s to 0.12 s).
-std::vector<StreamlineHits> hits_by_scan(HitSearch& q, std::uint64_t& bytes_read) {
+void hits_by_scan(HitSearch& q, RegionHits& hits, std::uint64_t& bytes_read) {
   const std::uint64_t n = q.file.meta().streamline_count;
   std::vector<std::uint64_t> cursor(q.voxels.size() * q.levels, 0), end(cursor.size(), 0);
   for (std::size_t i = 0; i < q.voxels.size(); ++i)
     if (q.voxel_regions.touching[i] != 0)
       for (std::uint32_t d = 0; d < q.levels; ++d)
         cursor[i * q.levels + d] = q.depth_start(i, d), end[i * q.levels + d] = q.depth_end(i, d);
-  std::vector<StreamlineHits> hits;
   for (std::uint64_t s = 0; s < n; ++s) {
     const std::uint64_t first = q.strm[s], last = q.strm[s + 1];
     q.file.check_streamline_run(s);
@@ -188,38 +208,40 @@ std::vector<StreamlineHits> hits_by_scan(HitSearch& q, std::uint64_t& bytes_read
                    "voxline runs past its voxel's vertex block (or its level's part of it)");
       hit |= q.test_voxline(v, ~hit);
     }
-    if (hit != 0) hits.push_back({s, hit});
+    if (hit != 0) hits.add(s, hit);
   }
   bytes_read += q.strm.size_bytes() + q.voxlines.size_bytes();
-  return hits;
 }
 
 // Only the voxels the regions may touch, through their lists (VoxelVoxlines): a voxel's list, placed in its
 // block (place_voxel_voxlines), is all a voxline costs. Voxels are independent here, so they are searched side
-// by side (the hits sorted afterwards; the first error in voxel order reported).
-std::vector<StreamlineHits> hits_by_index(HitSearch& q, const VoxelVoxlines& index, std::uint64_t& bytes_read) {
+// by side (the first error in voxel order reported).
+void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, std::uint64_t& bytes_read) {
   std::vector<std::uint32_t> touched;
   for (std::size_t voxel = 0; voxel < q.voxels.size(); ++voxel)
     if (q.voxel_regions.touching[voxel] != 0) touched.push_back(std::uint32_t(voxel));
-  std::vector<std::vector<StreamlineHits>> per_voxel(touched.size());
   struct Scratch {
     std::vector<std::uint8_t> ends;
     std::vector<PlacedVoxline> placed;
   };
   std::vector<HitSearch> per_thread(resolve_threads(0), q);
   std::vector<Scratch> scratch(per_thread.size());
+  // A query touching most voxels reads most blocks: their pages are let go as it goes (walk_streamlines does so too).
+  std::atomic<std::uint64_t> read_since_release = 0;
   parallel_for_first_error_in_order(touched.size(), 0, [&](std::uint64_t k, unsigned t) {
     HitSearch& search = per_thread[t];
     const std::uint32_t voxel = touched[k];
+    if (read_since_release.fetch_add(4ull * q.voxels[voxel].vertex_count) > (64ull << 20)) {
+      read_since_release = 0;
+      q.file.release_resident_pages();
+    }
     place_voxel_voxlines(q.file, index, voxel, scratch[t].ends, scratch[t].placed);
     for (const PlacedVoxline& p : scratch[t].placed) {
       VoxlinePlace v{voxel, p.own, p.synthetic_first, p.first_of_streamline, !p.last_of_streamline, p.first_vertex};
-      if (const Bits hit = search.test_voxline(v, ~Bits(0)); hit != 0) per_voxel[k].push_back({p.streamline, hit});
+      if (const Bits hit = search.test_voxline(v, ~Bits(0)); hit != 0) hits.add(p.streamline, hit);
     }
   });
-  std::vector<StreamlineHits> hits;
   for (std::size_t k = 0; k < touched.size(); ++k) {
-    hits.insert(hits.end(), per_voxel[k].begin(), per_voxel[k].end());
     // The list, and the block's voxline ends: its packed words (float32: order 0), read whole.
     const VoxelEntry& v = q.voxels[touched[k]];
     bytes_read += index.of_voxel(touched[k]).size_bytes() +
@@ -228,17 +250,6 @@ std::vector<StreamlineHits> hits_by_index(HitSearch& q, const VoxelVoxlines& ind
                        : order_array_bytes(v.segment_count, q.file.order(touched[k], 0).bits));
   }
   for (const HitSearch& search : per_thread) q.points_tested += search.points_tested;
-  // One entry per streamline, in streamline order, as the scan gives them.
-  std::sort(hits.begin(), hits.end(),
-            [](const StreamlineHits& a, const StreamlineHits& b) { return a.streamline < b.streamline; });
-  std::size_t kept = 0;
-  for (const StreamlineHits& h : hits)
-    if (kept > 0 && hits[kept - 1].streamline == h.streamline)
-      hits[kept - 1].regions |= h.regions;
-    else
-      hits[kept++] = h;
-  hits.resize(kept);
-  return hits;
 }
 
 }  // namespace
@@ -267,16 +278,21 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
     index = file_index ? &*file_index : nullptr;
   }
   trust(index && !file.voxel_index_first().empty() ? "VXIX" : "VXLN");
-  const std::vector<StreamlineHits> hits =
-      index ? hits_by_index(search, *index, result.bytes_read) : hits_by_scan(search, result.bytes_read);
+  RegionHits hits(n);
+  if (index)
+    hits_by_index(search, *index, hits, result.bytes_read);
+  else
+    hits_by_scan(search, hits, result.bytes_read);
   result.points_tested = search.points_tested;
 
   const Bits needed = table.include | table.ends;
   std::vector<std::uint8_t> passes(n, needed == 0 ? 1 : 0);
   result.streamlines_per_region.assign(table.regions.size(), 0);
-  for (const StreamlineHits& h : hits) {
-    passes[h.streamline] = (h.regions & needed) == needed && (h.regions & table.exclude) == 0;
-    for (Bits b = h.regions; b != 0; b &= b - 1) ++result.streamlines_per_region[std::countr_zero(b)];
+  for (std::uint64_t s = 0; s < n; ++s) {
+    const Bits regions = hits[s];
+    if (regions == 0) continue;
+    passes[s] = (regions & needed) == needed && (regions & table.exclude) == 0;
+    for (Bits b = regions; b != 0; b &= b - 1) ++result.streamlines_per_region[std::countr_zero(b)];
   }
   const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
   result.bytes_read += result.points_tested * vertex_bytes;
@@ -315,6 +331,7 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
     };
     if (std::find(passes.begin(), passes.end(), kMeasure) != passes.end()) walk_streamlines(file, lengths);
   }
+  file.release_resident_pages();  // what the query read; the writer reads again what it needs
   // A streamline without points is never kept, inverted or not: tckedit's reader skips it, so it never writes one.
   const std::span<const std::uint64_t> first_voxline = file.streamline_first_voxline();
   for (std::uint64_t s = 0; s < n; ++s)

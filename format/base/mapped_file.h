@@ -22,6 +22,10 @@ class MappedFile {
   std::size_t size() const { return size_; }
   std::span<const std::uint8_t> bytes() const { return {data_, size_}; }
   const std::string& path() const { return path_; }
+  // Drops the pages this process has read from its page tables: the file stays in the page cache, and a later
+  // read maps them again (a minor fault). A long pass through a large file calls it now and then, so that its
+  // resident size stays what it reads between calls, not the whole file.
+  void release_resident_pages() const;
 
  private:
   void release();
