@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -53,38 +54,69 @@ vxl::Camera turntable_camera(const vxl::Renderer& r, int step, int steps) {
 
 }  // namespace
 
-int run(int argc, char** argv) {
+struct BenchOptions {
   std::vector<std::string> scenes;
   int size = 1024, frames = 5;
+  std::vector<vxl::RenderMode> modes;
+};
+
+// The command line; nullopt (after a message) when it is not one.
+std::optional<BenchOptions> parse_options(int argc, char** argv) {
+  BenchOptions o;
   std::string every_mode;  // render_settings.h's table, the default of --modes
   for (const std::string& name : vxl::render_mode_names()) every_mode += (every_mode.empty() ? "" : ",") + name;
   std::string modes_arg = every_mode;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--scene" && i + 1 < argc)
-      scenes.push_back(argv[++i]);
+      o.scenes.push_back(argv[++i]);
     else if (a == "--size" && i + 1 < argc)
-      size = std::stoi(argv[++i]);
+      o.size = std::stoi(argv[++i]);
     else if (a == "--frames" && i + 1 < argc)
-      frames = std::stoi(argv[++i]);
+      o.frames = std::stoi(argv[++i]);
     else if (a == "--modes" && i + 1 < argc)
       modes_arg = argv[++i];
     else {
       std::fprintf(stderr,
                    "usage: render_bench --scene FILE.vxl[:SOURCE.tck]... [--size N] [--frames N] [--modes a,b]\n");
-      return 2;
+      return std::nullopt;
     }
   }
-  std::vector<vxl::RenderMode> modes;
   std::stringstream ss(modes_arg);
   for (std::string m; std::getline(ss, m, ',');) {
     const auto mode = vxl::parse_render_mode(m);
     if (!mode) {
       std::fprintf(stderr, "render_bench: unknown mode '%s' (modes: %s)\n", m.c_str(), every_mode.c_str());
-      return 2;
+      return std::nullopt;
     }
-    modes.push_back(*mode);
+    o.modes.push_back(*mode);
   }
+  return o;
+}
+
+// CPU work per frame over a turntable.
+void print_plan_times(vxl::Renderer& renderer) {
+  vxl::FramePlan plan;
+  for (auto [order, name] : {std::pair{vxl::PlanOrder::Nearest, "axis (sort + nearest order)"},
+                             std::pair{vxl::PlanOrder::Block, "basic (sort only)"}}) {
+    std::vector<double> ms;
+    for (int step = 0; step < 72; ++step) {
+      vxl::Camera cam = turntable_camera(renderer, step, 72);
+      auto t0 = Clock::now();
+      renderer.plan(cam, 1.0, order, plan);
+      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    }
+    std::printf("  CPU per frame, %-28s median %.3f ms, max %.3f ms (%llu voxels drawn at the last view)\n", name,
+                median(ms), *std::max_element(ms.begin(), ms.end()), (unsigned long long)plan.voxels_drawn);
+  }
+}
+
+int run(int argc, char** argv) {
+  const std::optional<BenchOptions> options = parse_options(argc, argv);
+  if (!options) return 2;
+  const std::vector<std::string>& scenes = options->scenes;
+  const std::vector<vxl::RenderMode>& modes = options->modes;
+  const int size = options->size, frames = options->frames;
 
   // What every start of the viewer costs before it does anything: loading the program and its libraries.
   std::vector<double> help;
@@ -120,20 +152,7 @@ int run(int argc, char** argv) {
       std::printf(", source %.3f s (ratio %.1fx)", median(first_src), median(first_src) / median(first_vxl));
     std::printf("\n");
 
-    // CPU work per frame over a turntable.
-    vxl::FramePlan plan;
-    for (auto [order, name] : {std::pair{vxl::PlanOrder::Nearest, "axis (sort + nearest order)"},
-                               std::pair{vxl::PlanOrder::Block, "basic (sort only)"}}) {
-      std::vector<double> ms;
-      for (int step = 0; step < 72; ++step) {
-        vxl::Camera cam = turntable_camera(renderer, step, 72);
-        auto t0 = Clock::now();
-        renderer.plan(cam, 1.0, order, plan);
-        ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-      }
-      std::printf("  CPU per frame, %-28s median %.3f ms, max %.3f ms (%llu voxels drawn at the last view)\n", name,
-                  median(ms), *std::max_element(ms.begin(), ms.end()), (unsigned long long)plan.voxels_drawn);
-    }
+    print_plan_times(renderer);
 
     vxl::OffscreenTarget target(size, size);
     double unsorted_ms = 0;

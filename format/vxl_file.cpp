@@ -183,6 +183,30 @@ void VxlFile::validate_section_table() {
   }
 }
 
+// §7 step 3, META's own fields (meta_ read from the file's META at `meta_at`).
+void VxlFile::validate_meta_fields(std::uint64_t meta_at) const {
+  const std::string& p = file_.path();
+  const MetaSection& m = meta_;
+  if (!std::isfinite(m.voxel_size) || !(m.voxel_size > 0))
+    fail_input(p, meta_at + 56, "voxel size must be finite and positive");
+  if (m.stored_order_count < 1 || m.stored_order_count > kVxlMaxStoredOrders)
+    fail_input(p, meta_at + 52, "stored order count must be 1..64");
+  if (m.voxel_count > std::uint32_t(std::numeric_limits<std::int32_t>::max()))
+    fail_input(p, meta_at + 48, "voxel count exceeds 2^31-1");
+  for (int c = 0; c < 3; ++c) {
+    if (m.grid_dims[c] < 0) fail_input(p, meta_at + 88 + 4 * c, "negative grid dimension");
+    if (!std::isfinite(m.grid_origin[c]) || !std::isfinite(m.bounds_min[c]) || !std::isfinite(m.bounds_max[c]))
+      fail_input(p, meta_at + 64, "non-finite grid origin or bounds");
+  }
+  check_grid_geometry(m, p, meta_at);
+  // Every source point and every synthetic one is a vertex (spec §6.2), so these bound what a reader
+  // reserves for the points: an unchecked point_count would ask for up to 2^64 floats.
+  if (m.point_count > m.vertex_count || m.synthetic_point_count > m.vertex_count - m.point_count)
+    fail_input(p, meta_at + 8,
+               "point_count " + std::to_string(m.point_count) + " + synthetic_point_count " +
+                   std::to_string(m.synthetic_point_count) + " exceed vertex_count " + std::to_string(m.vertex_count));
+}
+
 // §7 step 3: META, and every section's size against its counts; sets the section spans.
 void VxlFile::validate_meta_and_sizes() {
   const std::string& p = file_.path();
@@ -203,24 +227,7 @@ void VxlFile::validate_meta_and_sizes() {
   std::memcpy(&meta_, meta.data(), sizeof meta_);
   const std::uint64_t meta_at = offset_of("META");
   const MetaSection& m = meta_;
-  if (!std::isfinite(m.voxel_size) || !(m.voxel_size > 0))
-    fail_input(p, meta_at + 56, "voxel size must be finite and positive");
-  if (m.stored_order_count < 1 || m.stored_order_count > kVxlMaxStoredOrders)
-    fail_input(p, meta_at + 52, "stored order count must be 1..64");
-  if (m.voxel_count > std::uint32_t(std::numeric_limits<std::int32_t>::max()))
-    fail_input(p, meta_at + 48, "voxel count exceeds 2^31-1");
-  for (int c = 0; c < 3; ++c) {
-    if (m.grid_dims[c] < 0) fail_input(p, meta_at + 88 + 4 * c, "negative grid dimension");
-    if (!std::isfinite(m.grid_origin[c]) || !std::isfinite(m.bounds_min[c]) || !std::isfinite(m.bounds_max[c]))
-      fail_input(p, meta_at + 64, "non-finite grid origin or bounds");
-  }
-  check_grid_geometry(m, p, meta_at);
-  // Every source point and every synthetic one is a vertex (spec §6.2), so these bound what a reader
-  // reserves for the points: an unchecked point_count would ask for up to 2^64 floats.
-  if (m.point_count > m.vertex_count || m.synthetic_point_count > m.vertex_count - m.point_count)
-    fail_input(p, meta_at + 8,
-               "point_count " + std::to_string(m.point_count) + " + synthetic_point_count " +
-                   std::to_string(m.synthetic_point_count) + " exceed vertex_count " + std::to_string(m.vertex_count));
+  validate_meta_fields(meta_at);
   auto expect_size = [&](const char(&id)[5], std::optional<std::uint64_t> expected, const char* what) {
     auto s = section(id, true);
     if (!expected || s.size() != *expected)

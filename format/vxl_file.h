@@ -158,6 +158,7 @@ class VxlFile {
   void validate_header();
   void validate_section_table();
   void validate_meta_and_sizes();
+  void validate_meta_fields(std::uint64_t meta_at) const;
   void validate_voxel_table();
   void validate_voxel_index(std::span<const std::uint8_t> vxix);
   // Walks GRPS (spec §5.9) checking its structure and names (valid UTF-8, no NUL) but not the members:
