@@ -23,5 +23,7 @@ const std::vector<StreamlineOutputFormat>& streamline_outputs();
 std::optional<StreamlineOutput> streamline_output_of(const std::string& path, bool exported_only);
 // ".tck, .trx, .vtk, .trk, .trk.gz or .vxl" (without .vxl when `exported_only`), for help texts and messages.
 std::string streamline_output_suffixes(bool exported_only);
+// "OUT.tck|.trx|.vtk|.trk|.trk.gz|.vxl", for a usage line.
+std::string streamline_output_usage(bool exported_only);
 
 }  // namespace vxl

@@ -39,18 +39,22 @@ void add_select_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "select",
       "Select streamlines by regions and length (virtual dissection), with MRtrix tckedit's rules:\n"
-      "  voxlines select IN.vxl OUT.tck|.trx|.vtk|.trk|.trk.gz|.vxl --include ROI [--include ROI]... "
-      "[--exclude ROI]...\n"
-      "  voxlines select IN.vxl --include ROI --count [--json]\n"
-      "A streamline is kept when every --include region holds one of its points, every --ends-in region its first\n"
-      "or last point, no --exclude region any of its points, and its length is within the limits. ROI: X,Y,Z,R (a\n"
-      "sphere, RAS mm; a point at distance <= R is inside), box:X0,Y0,Z0,X1,Y1,Z1, FILE.nii[.gz] or FILE.mif[.gz]\n"
-      "(its non-zero voxels: the voxel nearest to the point) or FILE.nii[.gz]:LABEL (one label of a parcellation).\n"
-      "Points are those the .vxl stores: bit for bit the source's with --positions float32; with packed positions\n"
-      "(the default) within the bound `voxlines info` prints, so a streamline whose deciding point lies that close\n"
-      "to a region's surface may be decided differently from tckedit on the source. Length limits are tckedit's:\n"
-      "its float32 sum, the limits widened by the source header's step_size (a tenth of it, or half of it over\n"
-      "downsample_factor); to the bit with float32 positions, within a few float32 roundings with packed ones.");
+      "  voxlines select IN.vxl " +
+          streamline_output_usage(false) +
+          " --include ROI [--include ROI]... "
+          "[--exclude ROI]...\n"
+          "  voxlines select IN.vxl --include ROI --count [--json]\n"
+          "A streamline is kept when every --include region holds one of its points, every --ends-in region its first\n"
+          "or last point, no --exclude region any of its points, and its length is within the limits. ROI: X,Y,Z,R (a\n"
+          "sphere, RAS mm; a point at distance <= R is inside), box:X0,Y0,Z0,X1,Y1,Z1, FILE.nii[.gz] or FILE.mif[.gz]\n"
+          "(its non-zero voxels: the voxel nearest to the point) or FILE.nii[.gz]:LABEL (one label of a "
+          "parcellation).\n"
+          "Points are those the .vxl stores: bit for bit the source's with --positions float32; with packed positions\n"
+          "(the default) within the bound `voxlines info` prints, so a streamline whose deciding point lies that "
+          "close\n"
+          "to a region's surface may be decided differently from tckedit on the source. Length limits are tckedit's:\n"
+          "its float32 sum, the limits widened by the source header's step_size (a tenth of it, or half of it over\n"
+          "downsample_factor); to the bit with float32 positions, within a few float32 roundings with packed ones.");
   cmd->add_option("input", opt->input, ".vxl file")->required();
   cmd->add_option(
       "output", opt->output,
@@ -109,6 +113,7 @@ void add_select_command(CLI::App& app) {
 
     const VxlFile file = VxlFile::open(opt->input);
     const SelectionResult result = select_streamlines(file, criteria);
+    file.release_resident_pages();  // what the query read; the writer maps again what it needs
     const std::uint64_t total = file.meta().streamline_count;
     std::vector<std::string> warnings;
     if (!opt->count) {

@@ -331,7 +331,6 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
     };
     if (std::find(passes.begin(), passes.end(), kMeasure) != passes.end()) walk_streamlines(file, lengths);
   }
-  file.release_resident_pages();  // what the query read; the writer reads again what it needs
   // A streamline without points is never kept, inverted or not: tckedit's reader skips it, so it never writes one.
   const std::span<const std::uint64_t> first_voxline = file.streamline_first_voxline();
   for (std::uint64_t s = 0; s < n; ++s)
