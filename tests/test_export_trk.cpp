@@ -123,7 +123,7 @@ TEST(ExportTrk, KeepsTheHeaderOfATrkSource) {
 }
 
 // A TRK source's points come back bit for bit, even under an oblique affine: each RAS point was made from a stored
-// point, and the export finds that stored point (the inverse affine's answer alone missed some by an ulp).
+// point, and the export finds that stored point (the inverse affine's answer alone misses some by an ulp).
 TEST(ExportTrk, ATrkSourceComesBackBitForBitUnderAnObliqueAffine) {
   ScratchDir dir;
   SynthSettings settings;

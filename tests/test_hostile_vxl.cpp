@@ -366,8 +366,8 @@ TEST(HostileVxl, StreamlineLengthsThatDoNotFitOrLieAreRefused) {
 }
 
 // The tables a selection trusts (VOXT, STRM, VXIX or VXLN, SLEN) are checksummed before use: one flipped bit in a
-// VXIX entry answered 22 streamlines instead of 21 with exit 0, a flipped SLEN bit kept a streamline it should
-// not have. Now exit 3 naming the section, nothing written.
+// VXIX entry would add a streamline to the answer, one in SLEN keep a streamline it should not. Each is exit 3
+// naming the section, with nothing written.
 TEST(HostileVxl, ASelectionRefusesTheTablesItTrustsWhenTheirChecksumsFail) {
   ScratchDir dir;
   const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));

@@ -910,7 +910,7 @@ TEST(SelectionCli, OutputSuffixesComeFromOneTable) {
 }
 
 // A mask named 64 times is read once and its voxels kept once, cropped to what is set: a 256³ image's 16.7M
-// voxels, kept whole for each of 64 regions, took over 1 GiB. The limit on regions is checked before any file
+// voxels kept whole for each of 64 regions would take over 1 GiB. The limit on regions is checked before any file
 // is read: a 65th region naming no file is refused for the count.
 TEST(SelectionCli, AMaskNamedSixtyFourTimesIsReadOnceAndTheLimitComesFirst) {
   ScratchDir dir;

@@ -80,7 +80,7 @@ LengthLimits tckedit_length_limits(const VxlFile& file, std::optional<double> mi
     if (!downsample)
       fail_input(file.path(), file.provenance_offset(),
                  "the source header's downsample_factor '" + *downsample_text +
-                     "' is not a number: tckedit refuses such a file when it applies length limits");
+                     "' is not a number: tckedit refuses to edit such a file");
     error_margin = static_cast<float>(0.5 / *downsample);
   }
   limits.max += error_margin * *step;

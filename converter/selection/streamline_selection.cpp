@@ -89,9 +89,9 @@ std::uint64_t streamline_point_count(const VxlFile& file, std::uint64_t s) {
 }
 
 // The regions each streamline's points fell in, one word a streamline. Its zeroed pages come from the system as
-// they are first written (calloc), so a small query touches little of it; a large one costs 8 bytes a streamline,
-// where a list of (streamline, regions) per hit voxline, sorted and merged, took 16 a voxline twice over (a box
-// holding the 1M set: 400 MB).
+// they are first written (calloc), so a small query touches little of it, and a large one costs 8 bytes a
+// streamline: a list of (streamline, regions) per hit voxline, to be sorted and merged, would take 16 bytes a
+// voxline twice over (400 MB for a box holding the 1M set).
 class RegionHits {
  public:
   explicit RegionHits(std::uint64_t streamlines)
