@@ -25,17 +25,43 @@ std::vector<std::string> criteria_lines(const std::vector<std::string>& include,
   return out;
 }
 
+struct SelectOptions {
+  std::string input, output;
+  std::vector<std::string> include, exclude, ends_in;
+  std::optional<double> min_length, max_length;
+  bool invert = false, count = false, json = false, verbose = false;
+  TckExportSettings tck;
+};
+
+// The criteria the options give. The region limit is checked before any image is read, and each image is read once
+// however often it is named.
+SelectionCriteria criteria_of(const SelectOptions& opt) {
+  std::vector<std::string> texts = opt.include;
+  texts.insert(texts.end(), opt.exclude.begin(), opt.exclude.end());
+  texts.insert(texts.end(), opt.ends_in.begin(), opt.ends_in.end());
+  if (texts.size() > kMaxRegions)
+    throw Error(ErrorKind::Usage, "--include/--exclude/--ends-in", std::nullopt,
+                "at most " + std::to_string(kMaxRegions) + " regions in one selection (" +
+                    std::to_string(texts.size()) + " given)");
+  std::vector<Region> regions = parse_regions(texts);
+  SelectionCriteria criteria;
+  auto take = [&](std::vector<Region>& into, std::size_t first, std::size_t count) {
+    into.assign(std::make_move_iterator(regions.begin() + first),
+                std::make_move_iterator(regions.begin() + first + count));
+  };
+  take(criteria.include, 0, opt.include.size());
+  take(criteria.exclude, opt.include.size(), opt.exclude.size());
+  take(criteria.ends_in, opt.include.size() + opt.exclude.size(), opt.ends_in.size());
+  criteria.min_length = opt.min_length;
+  criteria.max_length = opt.max_length;
+  criteria.invert = opt.invert;
+  return criteria;
+}
+
 }  // namespace
 
 void add_select_command(CLI::App& app) {
-  struct Options {
-    std::string input, output;
-    std::vector<std::string> include, exclude, ends_in;
-    std::optional<double> min_length, max_length;
-    bool invert = false, count = false, json = false, verbose = false;
-    TckExportSettings tck;
-  };
-  auto opt = std::make_shared<Options>();
+  auto opt = std::make_shared<SelectOptions>();
   CLI::App* cmd = app.add_subcommand(
       "select",
       "Select streamlines by regions and length (virtual dissection), with MRtrix tckedit's rules:\n"
@@ -90,26 +116,7 @@ void add_select_command(CLI::App& app) {
       if (limit && !(std::isfinite(*limit) && *limit >= 0))
         throw Error(ErrorKind::Usage, "--min-length/--max-length", std::nullopt,
                     "a length limit is a finite, non-negative number of mm");
-    // The limit before any image is read; each image read once however often it is named.
-    std::vector<std::string> texts = opt->include;
-    texts.insert(texts.end(), opt->exclude.begin(), opt->exclude.end());
-    texts.insert(texts.end(), opt->ends_in.begin(), opt->ends_in.end());
-    if (texts.size() > kMaxRegions)
-      throw Error(ErrorKind::Usage, "--include/--exclude/--ends-in", std::nullopt,
-                  "at most " + std::to_string(kMaxRegions) + " regions in one selection (" +
-                      std::to_string(texts.size()) + " given)");
-    std::vector<Region> regions = parse_regions(texts);
-    SelectionCriteria criteria;
-    auto take = [&](std::vector<Region>& into, std::size_t first, std::size_t count) {
-      into.assign(std::make_move_iterator(regions.begin() + first),
-                  std::make_move_iterator(regions.begin() + first + count));
-    };
-    take(criteria.include, 0, opt->include.size());
-    take(criteria.exclude, opt->include.size(), opt->exclude.size());
-    take(criteria.ends_in, opt->include.size() + opt->exclude.size(), opt->ends_in.size());
-    criteria.min_length = opt->min_length;
-    criteria.max_length = opt->max_length;
-    criteria.invert = opt->invert;
+    const SelectionCriteria criteria = criteria_of(*opt);
 
     const VxlFile file = VxlFile::open(opt->input);
     const SelectionResult result = select_streamlines(file, criteria);
