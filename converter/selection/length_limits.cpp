@@ -25,10 +25,7 @@ std::string_view strip(std::string_view s) {
 // gives it: each line's value up to a '#' (a comment) and stripped, the lines joined by '\n'. The TCK reader
 // appends a following line without a colon to the value before it; MRtrix skips such a line, so only the
 // first line of each value counts. std::nullopt when the header lacks the key.
-std::optional<std::string> mrtrix_header_value(const VxlFile& file, const char* key) {
-  const nlohmann::json prov = parse_json(file.provenance_json(), file.path(), file.provenance_offset(), "PROV");
-  if (!prov.is_object() || !prov.contains("source") || !prov["source"].is_object()) return std::nullopt;
-  const nlohmann::json header = prov["source"].value("header", nlohmann::json());
+std::optional<std::string> mrtrix_header_value(const nlohmann::json& header, const char* key) {
   if (!header.is_object() || !header.contains(key)) return std::nullopt;
   const nlohmann::json& lines = header[key];
   std::string joined;
@@ -43,6 +40,13 @@ std::optional<std::string> mrtrix_header_value(const VxlFile& file, const char* 
   else
     add(lines);
   return joined;
+}
+
+// The source header kept in PROV (null when there is none), read once for all its keys.
+nlohmann::json source_header(const VxlFile& file) {
+  const nlohmann::json prov = parse_json(file.provenance_json(), file.path(), file.provenance_offset(), "PROV");
+  if (!prov.is_object() || !prov.contains("source") || !prov["source"].is_object()) return nullptr;
+  return prov["source"].value("header", nlohmann::json());
 }
 
 }  // namespace
@@ -71,11 +75,12 @@ LengthLimits tckedit_length_limits(const VxlFile& file, std::optional<double> mi
   // tckedit rounds each option (a double) to float32 for its header, then reads it back: the same float.
   if (min_length) limits.min = static_cast<float>(*min_length);
   if (max_length) limits.max = static_cast<float>(*max_length);
-  const std::optional<std::string> step_text = mrtrix_header_value(file, "step_size");
+  const nlohmann::json header = source_header(file);
+  const std::optional<std::string> step_text = mrtrix_header_value(header, "step_size");
   const std::optional<float> step = step_text ? mrtrix_float(*step_text) : std::nullopt;
   if (!step || !std::isfinite(*step)) return limits;
   float error_margin = 0.1f;
-  if (const std::optional<std::string> downsample_text = mrtrix_header_value(file, "downsample_factor")) {
+  if (const std::optional<std::string> downsample_text = mrtrix_header_value(header, "downsample_factor")) {
     const std::optional<float> downsample = mrtrix_float(*downsample_text);
     if (!downsample)
       fail_input(file.path(), file.provenance_offset(),
