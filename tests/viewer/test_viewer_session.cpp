@@ -78,10 +78,54 @@ TEST_F(ViewerSessionTest, AViewsLevelIsTheOneItsRenderersWouldMeasure) {
         measured = level;
         break;
       }
-    EXPECT_EQ(session.level_for_view(view(), 1.5, slab), measured) << "budget " << budget;
+    const Camera camera = view();
+    EXPECT_EQ(session.picture_levels(&camera, 1.5, slab).level, measured) << "budget " << budget;
+    EXPECT_EQ(session.picture_levels(nullptr, 1.5, slab).level, d.level) << "a turntable: the whole scene's level";
     finer_than_the_scene |= measured < d.level;
   }
   EXPECT_TRUE(finer_than_the_scene) << "the test needs a budget where the slab is drawn finer than the scene";
+}
+
+// Focus first, as the window and headless rendering both ask for it: the focus at full detail and the context
+// at the level that fits the rest where the picture is coarser than full detail; one level for all where the
+// copy does not fit (and the focus dropped), where the picture is at full detail anyway, or under --level.
+TEST_F(ViewerSessionTest, FocusFirstIsOnePolicyForEveryPicture) {
+  const std::vector<const VxlFile*> files{&*file};
+  const std::uint64_t whole = SceneLayout(files, *options.span_texels, 0).upload_bytes();
+  std::vector<std::vector<std::uint64_t>> kept(1);  // every third streamline: spread over the whole scene
+  for (std::uint64_t s = 0; s < file->meta().streamline_count; s += 3) kept[0].push_back(s);
+  const Camera camera = view();
+  bool focus_first_seen = false, dropped_seen = false;
+  for (int k = 1; k < 12; ++k) {
+    options.gpu_memory = whole * k / 12;
+    ViewerSession session(options);
+    session.choose_detail(options);
+    const PictureLevels alone = session.picture_levels(&camera, 1.5, {});
+    EXPECT_EQ(session.focus_copy_needed(alone.level), alone.level > 0);
+    session.set_focus(kept);
+    ASSERT_TRUE(session.has_focus());
+    const PictureLevels p = session.picture_levels(&camera, 1.5, {});
+    EXPECT_EQ(p.level, alone.level) << "one level for all is the same with a focus";
+    if (alone.level == 0) {
+      EXPECT_FALSE(p.focus_first) << "a picture at full detail has no focus first";
+      EXPECT_TRUE(session.has_focus()) << "kept for the coarser pictures of a moving camera";
+    } else if (p.focus_first) {
+      focus_first_seen = true;
+      EXPECT_GE(p.context_level(), alone.level) << "the focus takes the budget first";
+      EXPECT_LE(p.focus_first->focus_bytes, session.detail().budget);
+    } else {
+      dropped_seen = true;
+      EXPECT_FALSE(session.has_focus()) << "a copy that does not fit is dropped";
+      EXPECT_EQ(p.context_level(), alone.level);
+    }
+  }
+  EXPECT_TRUE(focus_first_seen) << "the test needs a budget where focus first fits";
+  EXPECT_TRUE(dropped_seen) << "the test needs a budget where the copy does not fit";
+  options.gpu_memory.reset();
+  options.level = 1;
+  ViewerSession forced(options);
+  forced.choose_detail(options);
+  EXPECT_FALSE(forced.focus_copy_needed(1)) << "--level fixes the level: no focus first";
 }
 
 }  // namespace

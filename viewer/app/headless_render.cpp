@@ -71,24 +71,22 @@ int run_headless(const ViewerOptions& o) {
   session.choose_detail(o);
   const SceneDetail& detail = session.detail();
   const double aspect = double(o.width) / o.height;
-  // The level whose whole copy fits the budget, or for one view (not a turntable, not --level) the finest
-  // level whose visible part fits: a slab or a close view of a large scene is drawn in more detail.
-  const bool per_view = !detail.forced && o.turntable <= 1 && detail.level > 0;
-  const Camera camera = initial_camera(framing_points(session.layout_at(per_view ? 0 : detail.level)), o, aspect);
-  const std::uint32_t level = per_view ? session.level_for_view(camera, aspect, o.settings.clipping) : detail.level;
-  // Focus first: when the budget forces the scene coarser, the selection's full-detail copy takes the budget
-  // first and the context the finest level that fits what is left (view_level.h).
-  std::optional<FocusFirstLevels> focus_first;
-  if (selection && level > 0 && !detail.forced) {
+  // One view (not a turntable) may be drawn finer than the whole scene: a slab or a close view of a large scene.
+  const bool one_view = o.turntable <= 1;
+  const Camera camera = initial_camera(framing_points(session.framing_layout(one_view)), o, aspect);
+  const Camera* const view = one_view ? &camera : nullptr;
+  PictureLevels levels = session.picture_levels(view, aspect, o.settings.clipping);
+  // Focus first: the selection's full-detail copy is made only where the picture is drawn coarser.
+  if (selection && session.focus_copy_needed(levels.level)) {
     try {
       session.set_focus(selection->kept);
-      focus_first = session.focus_first_levels(
-          per_view ? visible_bytes(camera, aspect, session.bounds(), o.settings.clipping)
-                   : LayoutBytes([](const SceneLayout& layout) { return layout.upload_bytes(); }));
-    } catch (const std::exception& e) {  // the copy could not be written: drawn at one level, as before
+      levels = session.picture_levels(view, aspect, o.settings.clipping);
+    } catch (const std::exception& e) {  // the copy could not be written: drawn at one level
       std::fprintf(stderr, "voxview: the focus is drawn with the context: %s\n", e.what());
     }
   }
+  const std::uint32_t level = levels.level;
+  const std::optional<FocusFirstLevels>& focus_first = levels.focus_first;
   if (focus_first)
     std::fprintf(stderr,
                  "voxview: focus first: the %llu selected streamlines at full detail (level 0, %s of GPU memory), "

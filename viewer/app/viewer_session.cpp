@@ -22,8 +22,21 @@ void ViewerSession::choose_detail(const ViewerOptions& o) {
 
 std::uint32_t ViewerSession::levels_in_files() const { return SceneLayout::coarsest_level(files_) + 1; }
 
-std::uint32_t ViewerSession::level_for_view(const Camera& camera, double aspect, const Clipping& clipping) {
-  return app::level_for_view(*layouts_, *detail_, camera, aspect, bounds_, clipping);
+const SceneLayout& ViewerSession::framing_layout(bool one_view) {
+  return layouts_->at(one_view && !detail_->forced ? 0 : detail_->level);
+}
+
+PictureLevels ViewerSession::picture_levels(const Camera* camera, double aspect, const Clipping& clipping) {
+  const bool one_view = camera != nullptr && !detail_->forced && detail_->level > 0;
+  PictureLevels p;
+  p.level = one_view ? level_for_view(*layouts_, *detail_, *camera, aspect, bounds_, clipping) : detail_->level;
+  if (!has_focus() || !focus_copy_needed(p.level)) return p;
+  p.focus_first =
+      focus_first_levels(*layouts_, *focus_layout_, *detail_,
+                         one_view ? visible_bytes(*camera, aspect, bounds_, clipping)
+                                  : LayoutBytes([](const SceneLayout& layout) { return layout.upload_bytes(); }));
+  if (!p.focus_first) set_focus({}, nullptr);
+  return p;
 }
 
 Renderer& ViewerSession::renderer_at(std::uint32_t level, bool eager) {
@@ -55,11 +68,6 @@ void ViewerSession::set_focus(const std::vector<std::vector<std::uint64_t>>& kep
   focus_ = std::move(copy);
   focus_kept_ = kept;
   if (focus_ && !focus_->files().empty()) focus_layout_.emplace(focus_->files(), detail_->span_texels, 0);
-}
-
-std::optional<FocusFirstLevels> ViewerSession::focus_first_levels(const LayoutBytes& bytes) {
-  if (!focus_layout_) return std::nullopt;
-  return app::focus_first_levels(*layouts_, *focus_layout_, *detail_, bytes);
 }
 
 Renderer& ViewerSession::focus_first_renderer(std::uint32_t context_level, bool eager) {

@@ -21,6 +21,13 @@
 
 namespace vxl::app {
 
+struct PictureLevels {
+  std::uint32_t level = 0;                      // the level of the whole picture drawn at one level
+  std::optional<FocusFirstLevels> focus_first;  // set: the focus at full detail, the context at its level
+  // The level the picture's context is drawn at.
+  std::uint32_t context_level() const { return focus_first ? focus_first->context : level; }
+};
+
 class ViewerSession {
  public:
   // Opens the inputs (converting a source tractogram) and reads --image: a bad file or image fails here,
@@ -47,8 +54,18 @@ class ViewerSession {
   const SceneLayout& layout_at(std::uint32_t level) { return layouts_->at(level); }
   // What the renderers' projection covers: the lines' bounds joined with the image's box.
   const SceneBounds& bounds() const { return bounds_; }
-  // The level `camera` with `clipping` is drawn at (view_level.h), measured with the renderer's bounds.
-  std::uint32_t level_for_view(const Camera& camera, double aspect, const Clipping& clipping);
+  // The layout the default framing is measured on: full detail where one view (`one_view`: not a turntable) may be
+  // drawn finer than the scene's level, else the scene's level.
+  const SceneLayout& framing_layout(bool one_view);
+  // The levels one picture is drawn at, the one policy of the window and headless rendering (view_level.h). For
+  // one view (`camera`): the finest level whose visible part with `clipping` fits the budget; for the whole scene
+  // (null: a turntable's frames) the scene's level. With a focus set and that level coarser than full detail,
+  // focus first where the copy fits beside the context; where it does not, the focus is dropped (set_focus with
+  // none) and the scene drawn at one level, as without it.
+  PictureLevels picture_levels(const Camera* camera, double aspect, const Clipping& clipping);
+  // Whether a selection's full-detail copy (set_focus) is worth making for pictures drawn at `coarsest_drawn` at
+  // most: focus first only draws pictures coarser than full detail, and never where --level fixed the level.
+  bool focus_copy_needed(std::uint32_t coarsest_drawn) const { return !detail_->forced && coarsest_drawn > 0; }
 
   // The renderer of `level`, made on first use with the image and the current groups; `eager`: it uploads
   // its whole level at once when made (else span by span as frames need them).
@@ -63,9 +80,6 @@ class ViewerSession {
   // The same with a copy of `kept` made elsewhere (the window's, off its thread); null: no focus copy.
   void set_focus(const std::vector<std::vector<std::uint64_t>>& kept, std::shared_ptr<const FocusCopy> copy);
   bool has_focus() const { return focus_layout_.has_value(); }
-  // The focus's and the context's levels for `bytes` (view_level.h); nullopt without a focus, or when it
-  // does not fit beside the context: then the scene is drawn at one level.
-  std::optional<FocusFirstLevels> focus_first_levels(const LayoutBytes& bytes);
   // The renderer of the context's files at `context_level` and the focus's copy at full detail, one scene
   // (its groups: SceneGroups::focus_first), made on first use like renderer_at. Needs set_focus.
   Renderer& focus_first_renderer(std::uint32_t context_level, bool eager);

@@ -58,7 +58,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
       files_(session_->files()),
       regions_(std::move(regions)),
       selection_worker_(files_, session_->indexes()),
-      focus_first_wanted_(!session_->detail().forced && SceneLayout::coarsest_level(session_->files()) > 0),
+      focus_first_wanted_(session_->focus_copy_needed(SceneLayout::coarsest_level(session_->files()))),
       focus_copies_(files_),
       detail_(session_->detail()),
       start_(start),
@@ -429,15 +429,7 @@ int ViewerWindow::run() {
         scheduler_->next(changed, scripted_last, closing,
                          [&] {
                            const double aspect = double(fb_w) / fb_h;
-                           if (session_->has_focus()) {
-                             // Focus first: the copy's visible bytes first, the context at the level that fits the
-                             // rest; a copy that does not fit beside it is dropped (one level for all, as without it).
-                             if (const std::optional<FocusFirstLevels> f = session_->focus_first_levels(
-                                     visible_bytes(camera, aspect, session_->bounds(), state_.settings.clipping)))
-                               return f->context;
-                             session_->set_focus({}, nullptr);
-                           }
-                           return session_->level_for_view(camera, aspect, state_.settings.clipping);
+                           return session_->picture_levels(&camera, aspect, state_.settings.clipping).context_level();
                          }),
         key, moving);
     pacing.frame_ended(scheduler_->rest().stage() != RestStage::Done, drawn_now);
