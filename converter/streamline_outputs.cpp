@@ -7,9 +7,23 @@ namespace vxl {
 
 const std::vector<StreamlineOutputFormat>& streamline_outputs() {
   static const std::vector<StreamlineOutputFormat> formats = {
-      {StreamlineOutput::Tck, {".tck"}, true},  {StreamlineOutput::Trx, {".trx"}, true},
-      {StreamlineOutput::Vtk, {".vtk"}, true},  {StreamlineOutput::Trk, {".trk", ".trk.gz"}, true},
-      {StreamlineOutput::Vxl, {".vxl"}, false},
+      {StreamlineOutput::Tck,
+       {".tck"},
+       true,
+       "Float32LE, the source TCK header's properties kept; --tsf writes one per-point value set beside it"},
+      {StreamlineOutput::Trx,
+       {".trx"},
+       true,
+       "zip, stored: float32 positions, uint64 offsets; groups, dpv, dps and dpg kept"},
+      {StreamlineOutput::Vtk,
+       {".vtk"},
+       true,
+       "legacy BINARY POLYDATA: values as POINT_DATA / CELL_DATA scalars, groups as 0/1 CELL_DATA arrays"},
+      {StreamlineOutput::Trk,
+       {".trk", ".trk.gz"},
+       true,
+       "TrackVis v2: a TRK source's header, values as scalars and properties"},
+      {StreamlineOutput::Vxl, {".vxl"}, false, "converted again with the input's conversion settings"},
   };
   return formats;
 }
@@ -34,6 +48,20 @@ std::vector<std::string> suffixes_of(bool exported_only) {
 }
 
 }  // namespace
+
+std::string streamline_output_help(bool exported_only) {
+  std::vector<const StreamlineOutputFormat*> formats;
+  for (const StreamlineOutputFormat& f : streamline_outputs())
+    if (f.exported || !exported_only) formats.push_back(&f);
+  std::string text;
+  for (std::size_t i = 0; i < formats.size(); ++i) {
+    text += i == 0 ? "" : i + 1 == formats.size() ? " or " : ", ";
+    for (std::size_t k = 0; k < formats[i]->suffixes.size(); ++k)
+      text += (k == 0 ? "" : " / ") + formats[i]->suffixes[k];
+    text += " (" + formats[i]->keeps + ")";
+  }
+  return text;
+}
 
 std::string streamline_output_usage(bool exported_only) {
   std::string text = "OUT";

@@ -16,6 +16,7 @@ struct StreamlineOutputFormat {
   StreamlineOutput format;
   std::vector<std::string> suffixes;  // lower case, the longest first where one ends another
   bool exported;                      // `export` writes it (select writes every format)
+  std::string keeps;                  // what the written file holds, for help texts
 };
 const std::vector<StreamlineOutputFormat>& streamline_outputs();
 
@@ -23,6 +24,8 @@ const std::vector<StreamlineOutputFormat>& streamline_outputs();
 std::optional<StreamlineOutput> streamline_output_of(const std::string& path, bool exported_only);
 // ".tck, .trx, .vtk, .trk, .trk.gz or .vxl" (without .vxl when `exported_only`), for help texts and messages.
 std::string streamline_output_suffixes(bool exported_only);
+// Each format with what it keeps: ".tck (...), .trx (...), ... or .vxl (...)", for an output's help text.
+std::string streamline_output_help(bool exported_only);
 // "OUT.tck|.trx|.vtk|.trk|.trk.gz|.vxl", for a usage line.
 std::string streamline_output_usage(bool exported_only);
 

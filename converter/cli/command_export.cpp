@@ -32,12 +32,8 @@ void add_export_command(CLI::App& app) {
       "Write the original streamlines of a .vxl back to TCK, TRX, legacy VTK or TrackVis TRK (chosen by the output's "
       "extension)");
   cmd->add_option("input", opt->input, ".vxl file")->required();
-  cmd->add_option(
-      "output", opt->output,
-      "output .tck (Float32LE, the source TCK header's properties kept), .trx (zip, stored: float32 positions, "
-      "uint64 offsets, groups, dpv, dps and dpg kept) or .vtk (legacy BINARY POLYDATA, values kept as POINT_DATA / "
-      "CELL_DATA scalars, groups as 0/1 CELL_DATA arrays) or .trk / .trk.gz (TrackVis v2: a TRK source's header, "
-      "values as scalars and properties); written atomically. Not with --split-groups");
+  cmd->add_option("output", opt->output,
+                  "output " + streamline_output_help(true) + "; written atomically. Not with --split-groups");
   cmd->add_option("--tsf", opt->tck.tsf_path,
                   "with a .tck output: also write one per-point value set as an MRtrix TSF");
   cmd->add_option("--value", opt->tck.value,

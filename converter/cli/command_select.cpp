@@ -82,12 +82,9 @@ void add_select_command(CLI::App& app) {
           "its float32 sum, the limits widened by the source header's step_size (a tenth of it, or half of it over\n"
           "downsample_factor); to the bit with float32 positions, within a few float32 roundings with packed ones.");
   cmd->add_option("input", opt->input, ".vxl file")->required();
-  cmd->add_option(
-      "output", opt->output,
-      "the selected streamlines, in source order, as " + streamline_output_suffixes(false) +
-          ": .tck (with --tsf: one per-point value set), .trx (groups, dpv, dps, dpg), .vtk, .trk (TrackVis "
-          "v2) or .vxl (the input's conversion settings); written atomically, valid when empty. Not needed "
-          "with --count");
+  cmd->add_option("output", opt->output,
+                  "the selected streamlines, in source order, as " + streamline_output_help(false) +
+                      "; written atomically, valid when empty. Not needed with --count");
   cmd->add_option("--include", opt->include, "a region every kept streamline passes through (repeatable)")
       ->type_name("ROI");
   cmd->add_option("--exclude", opt->exclude, "a region no kept streamline touches (repeatable)")->type_name("ROI");
