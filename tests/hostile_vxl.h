@@ -14,7 +14,7 @@
 
 #include <gtest/gtest.h>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 #include "format/vxl_layout.h"
 #include "format/vxl_value_sets.h"
 #include "tests/reseal_checksums.h"

@@ -5,9 +5,9 @@
 #include <gtest/gtest.h>
 
 #include "converter/command_line_typos.h"
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 #include "converter/readers/source_formats.h"
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "tests/test_support.h"
 
 namespace vxl {

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "converter/convert/segment_orders.h"
 #include "converter/pipeline/conversion_plan.h"
-#include "converter/segment_orders.h"
 #include "format/base/error.h"
 
 namespace vxl {

@@ -17,11 +17,11 @@
 
 #include <gtest/gtest.h>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
+#include "converter/convert/streaming_convert.h"
+#include "converter/export/tck_writer.h"
 #include "converter/readers/read_tractogram.h"
-#include "converter/streaming_convert.h"
-#include "converter/synth.h"
-#include "converter/tck_writer.h"
+#include "converter/synth/synth.h"
 #include "format/base/atomic_output.h"
 #include "format/base/direct_region_writer.h"
 #include "format/base/direct_write_queue.h"

@@ -5,13 +5,13 @@
 #include <filesystem>
 #include <numeric>
 
-#include "converter/convert.h"
-#include "converter/export_groups.h"
-#include "converter/export_tck.h"
-#include "converter/export_vtk.h"
+#include "converter/convert/convert.h"
+#include "converter/export/export_groups.h"
+#include "converter/export/export_tck.h"
+#include "converter/export/export_vtk.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
@@ -162,7 +162,7 @@ TEST(ExportGroups, FileNamesAreSafeAndUnique) {
   EXPECT_EQ(cut[1], std::string(199, 'a') + "_2");
 }
 
-// A group named longer than a file name may be: every group's file is written (the last one failed, exit 5,
+// A group named longer than a file name may be: every group's file is written, that one's too (not exit 5
 // with the others written).
 TEST(ExportGroups, SplitGroupsWritesAGroupWithAVeryLongName) {
   ScratchDir dir;

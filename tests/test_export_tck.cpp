@@ -4,11 +4,11 @@
 #include <cmath>
 #include <limits>
 
-#include "converter/convert.h"
-#include "converter/export_tck.h"
+#include "converter/convert/convert.h"
+#include "converter/export/export_tck.h"
 #include "converter/readers/mrtrix_header.h"
 #include "converter/readers/read_tractogram.h"
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "format/vxl_file.h"
 #include "tests/mrtrix_test_files.h"
 #include "tests/test_support.h"

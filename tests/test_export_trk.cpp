@@ -7,10 +7,10 @@
 #include <cmath>
 #include <filesystem>
 
-#include "converter/convert.h"
-#include "converter/export_trk.h"
+#include "converter/convert/convert.h"
+#include "converter/export/export_trk.h"
 #include "converter/readers/read_tractogram.h"
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "format/vxl_file.h"
 #include "tests/export_test_support.h"
 #include "tests/test_support.h"

@@ -9,11 +9,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "converter/convert.h"
-#include "converter/export_tck.h"
-#include "converter/export_trx.h"
+#include "converter/convert/convert.h"
+#include "converter/export/export_tck.h"
+#include "converter/export/export_trx.h"
 #include "converter/readers/read_tractogram.h"
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"

@@ -13,10 +13,10 @@
 #include <limits>
 #include <thread>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
+#include "converter/export/tck_writer.h"
 #include "converter/readers/read_tractogram.h"
-#include "converter/synth.h"
-#include "converter/tck_writer.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
@@ -283,8 +283,8 @@ TEST(Extremes, RunningOutOfMemoryFailsCleanly) {
 #endif
 }
 
-// The two skips above must follow the build: with Clang, which does not define __SANITIZE_ADDRESS__, they
-// were not taken and the tests failed under ASan. VOXLINES_TESTS_SANITIZED comes from the CMake option.
+// The two skips above must follow the build: Clang does not define __SANITIZE_ADDRESS__, so skips keyed on
+// it are not taken under Clang's ASan. VOXLINES_TESTS_SANITIZED comes from the CMake option.
 TEST(Extremes, TheAddressSanitizerSkipFollowsTheBuild) {
   EXPECT_EQ(test::kAddressSanitizer, VOXLINES_TESTS_SANITIZED != 0);
 }

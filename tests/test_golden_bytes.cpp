@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "converter/convert/streaming_convert.h"
 #include "converter/readers/read_tractogram.h"
-#include "converter/streaming_convert.h"
 #include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"

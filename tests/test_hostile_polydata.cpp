@@ -82,8 +82,8 @@ TEST(HostileVtp, CellCountsThatWrapAreMalformed) {
   }
 }
 
-// Counts far beyond what an array holds were refused as "a likely decompression bomb" (exit 4) before
-// the array's own headers were read, also where nothing is compressed; a count its bytes, text or block
+// Counts far beyond what an array holds are not refused as "a likely decompression bomb" (exit 4) before
+// the array's own headers are read, also where nothing is compressed: a count its bytes, text or block
 // headers contradict is malformed (exit 3). Only data that agrees with its count is held to the budget.
 TEST(HostileVtp, CountsBeyondWhatTheArraysHoldAreMalformed) {
   ScratchDir dir;
@@ -105,9 +105,9 @@ TEST(HostileVtp, CountsBeyondWhatTheArraysHoldAreMalformed) {
     }
 }
 
-// A VTK array named %00 became a value set named "" (the empty-name rule came before the NUL), a%00b was
-// cut to a; `verify` passed the file and `export .trx` refused it (exit 4). Names are mapped at conversion
-// to ones every command accepts, each change warned about.
+// VTK array names that decode to a NUL (%00, a%00b), a path separator, ".." or a backslash neither become
+// an empty name nor are cut at the NUL: names are mapped at conversion to ones every command accepts
+// (`verify` and `export .trx` both take the file), each change warned about.
 TEST(HostileVtk, ArrayNamesAreMappedToNamesEveryCommandAccepts) {
   ScratchDir dir;
   const std::string in = dir.file("names.vtk"), vxl = dir.file("names.vxl");
@@ -128,8 +128,8 @@ TEST(HostileVtk, ArrayNamesAreMappedToNamesEveryCommandAccepts) {
   }
 }
 
-// Malformed files that were read as something else: fractional offsets (1.5 read as 1), integer arrays
-// with fractions, an ASCII array longer than declared. Each is malformed now.
+// Malformed files that must not be read as something else: fractional offsets (1.5 is not read as 1),
+// integer arrays with fractions, an ASCII array longer than declared. Each is malformed.
 TEST(HostileVtk, FractionsAndSurplusValuesAreMalformed) {
   ScratchDir dir;
   const std::string head =
@@ -189,7 +189,7 @@ TEST(HostileVtp, FractionalOffsetsAndSurplusAsciiValuesAreMalformed) {
                        "offsets must be non-decreasing integers; offset 0 is 1.5"));
 }
 
-// Bytes after a block's zlib stream, inside its declared compressed size, were ignored.
+// Bytes after a block's zlib stream, inside its declared compressed size, are not ignored: malformed.
 TEST(HostileVtp, JunkAfterAZlibStreamIsMalformed) {
   ScratchDir dir;
   const std::string p = dir.file("z.vtp");
@@ -202,7 +202,7 @@ TEST(HostileVtp, JunkAfterAZlibStreamIsMalformed) {
 }
 
 // VTK numbers cells vertices first, then lines, whatever order the file lists them in: with VERTICES after
-// LINES the line took the vertex's cell value (10 where the file says 42).
+// LINES the line keeps its own cell value (42), not the vertex's (10).
 TEST(HostileVtk, VerticesAfterLinesStillComeFirstInCellData) {
   ScratchDir dir;
   const std::string p = dir.file("v.vtk");
@@ -215,8 +215,8 @@ TEST(HostileVtk, VerticesAfterLinesStillComeFirstInCellData) {
   EXPECT_EQ(t.streamline_values[0].values, std::vector<float>{42});
 }
 
-// A valid VTP was refused when a comment before the data named <AppendedData> (the block was found by a
-// text search); a '>' inside a quoted attribute of the real tag cut it short.
+// A valid VTP is read when a comment before the data names <AppendedData>: the block is found as an
+// element, not by a text search, and a '>' inside a quoted attribute of the real tag does not cut it short.
 TEST(HostileVtp, AppendedDataIsFoundAsAnElementNotAsText) {
   ScratchDir dir;
   for (const bool base64 : {false, true}) {

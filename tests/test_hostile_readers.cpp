@@ -1,6 +1,5 @@
 // Hostile source files (tests/hostile_inputs.h writes them): each must be refused with a vxl::Error of
-// the right kind, or read with a warning where data would otherwise be lost silently. Every test here
-// failed before the reader was fixed.
+// the right kind, or read with a warning where data would otherwise be lost silently.
 #include <algorithm>
 #include <cstring>
 #include <filesystem>

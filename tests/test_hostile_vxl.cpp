@@ -9,7 +9,7 @@
 #include <tuple>
 #include <vector>
 
-#include "converter/export_trx.h"
+#include "converter/export/export_trx.h"
 #include "format/base/error.h"
 #include "format/base/utf8_check.h"
 #include "format/vxl_file.h"
@@ -169,8 +169,8 @@ TEST(HostileVxl, PointCountBeyondTheVerticesIsRefusedBeforeAnyReservation) {
 }
 
 // Geometry a resealed file moves (a voxel's tight bounds 1e6 mm away or at 1e38, bounds or origin at
-// 1e308, a voxel size or grid that no longer covers the bounds) was drawn as a blank picture (exit 0) and
-// passed verify: open() now refuses it (exit 3), so verify and the viewer do too.
+// 1e308, a voxel size or grid that does not cover the bounds) is refused by open() (exit 3), so verify and
+// the viewer refuse it too, rather than pass it or draw a blank picture (exit 0).
 TEST(HostileVxl, GeometryMovedAwayFromTheLinesIsRefusedOnOpen) {
   ScratchDir dir;
   const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
@@ -390,8 +390,8 @@ TEST(HostileVxl, ASelectionRefusesTheTablesItTrustsWhenTheirChecksumsFail) {
   }
 }
 
-// PROV is any JSON to open(): fields of the wrong type made `info` exit 70 (type_error 302/306) and
-// `export x.trx` too. They are ignored now, as missing fields are.
+// PROV is any JSON to open(): fields of the wrong type are ignored, as missing fields are, so neither
+// `info` nor `export x.trx` exits 70 on them (type_error 302/306).
 TEST(HostileVxl, ProvenanceOfTheWrongTypesIsIgnored) {
   ScratchDir dir;
   const VxlBytes valid = VxlBytes::make(dir.file("h.vxl"));
@@ -445,8 +445,9 @@ TEST(HostileVxl, ValueSetNamesAreWrittenAsUtf8) {
   EXPECT_EQ(VxlFile::open(dir.file("v.vxl")).vertex_values().name(0), "caf\xc3\xa9");
 }
 
-// Two groups of one name cannot both be groups/NAME.uint32: export refused them only when libzip failed to
-// add the second member (exit 5, as if the output were at fault). The input's groups are what TRX cannot hold.
+// Two groups of one name cannot both be groups/NAME.uint32: export refuses them as unsupported, not only when
+// libzip fails to add the second member (exit 5, as if the output were at fault). The input's groups are what
+// TRX cannot hold.
 TEST(HostileVxl, ExportOfGroupsTrxCannotHoldIsUnsupportedNotAnOutputError) {
   ScratchDir dir;
   for (const std::string& second : {std::string("CST_left"), std::string(70000, 'g')}) {

@@ -1,5 +1,5 @@
 // Every JSON the converter reads (a TRX header.json, the PROV of a .vxl or .vxlz) is refused when it nests
-// deeper than kMaxJsonDepth, before it is parsed: deeper documents exhausted the stack when used. The view
+// deeper than kMaxJsonDepth, before it is parsed: deeper documents would exhaust the stack. The view
 // file's parse has its own test beside the other view-file tests.
 #include <filesystem>
 #include <string>
@@ -77,8 +77,8 @@ TEST(JsonLimits, DeepTrxHeaderIsMalformed) {
   }
 }
 
-// A PROV nested 100000 deep (about 200 KB) crashed info, export and unpack by stack overflow; verify
-// said the file was valid.
+// A PROV nested 100000 deep (about 200 KB), deep enough to overflow the stack, is refused by info, export,
+// unpack and verify alike.
 TEST(JsonLimits, DeepProvenanceIsRefusedByEveryCommand) {
   ScratchDir dir;
   const std::string p = dir.file("deep.vxl");

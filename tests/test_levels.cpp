@@ -11,12 +11,12 @@
 
 #include <gtest/gtest.h>
 
-#include "converter/convert.h"
-#include "converter/pack.h"
-#include "converter/streaming_convert.h"
-#include "converter/synth.h"
-#include "converter/tck_writer.h"
-#include "converter/unpack.h"
+#include "converter/convert/convert.h"
+#include "converter/convert/streaming_convert.h"
+#include "converter/export/tck_writer.h"
+#include "converter/package/pack.h"
+#include "converter/package/unpack.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_levels.h"

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "converter/convert/memory_choice.h"
 #include "format/base/memory_available.h"
 #include "tests/test_support.h"
 

@@ -143,8 +143,8 @@ TEST(OutputPath, MissingFolderOrAFolderAsOutputIsAnOutputError) {
   }
 }
 
-// `export X.vxl OUT.tck --tsf OUT.tck` exited 0 with the TSF renamed over the TCK: the streamlines were lost.
-// Refused (exit 2) under any name for the same file, and nothing is written.
+// `export X.vxl OUT.tck --tsf OUT.tck` would rename the TSF over the TCK and lose the streamlines: it is
+// refused (exit 2) under any name for the same file, and nothing is written.
 TEST(OutputPath, TsfOnTheTckItselfIsAUsageError) {
   ScratchDir dir;
   const std::string vxl = dir.file("values.vxl"), tck = dir.file("out.tck"), sub = dir.file("sub");

@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 #include "format/vxl_file.h"
 #include "format/vxl_positions.h"
 #include "format/vxl_streamlines.h"

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <sstream>
 
-#include "converter/convert.h"
-#include "converter/export_vtk.h"
+#include "converter/convert/convert.h"
+#include "converter/export/export_vtk.h"
 #include "converter/readers/read_tractogram.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <map>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 #include "converter/readers/read_tractogram.h"
 #include "format/vxl_file.h"
 #include "tests/real_fixture_outcomes.h"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "converter/segment_sort.h"
+#include "converter/convert/segment_sort.h"
 #include "format/vxl_layout.h"
 #include "format/vxl_positions.h"
 

@@ -24,15 +24,15 @@
 
 #include <Eigen/Geometry>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
+#include "converter/export/streamline_outputs.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/volume_image.h"
 #include "converter/selection/length_limits.h"
 #include "converter/selection/region.h"
 #include "converter/selection/selection_output.h"
 #include "converter/selection/streamline_selection.h"
-#include "converter/streamline_outputs.h"
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_verify.h"
 #include "tests/address_sanitizer.h"
@@ -659,8 +659,8 @@ TEST(SelectionRegions, MaskLookupRoundsAsEigensAffineProduct) {
   EXPECT_EQ(differ, 0);
 }
 
-// A mask's header read as MRtrix reads it (converter/readers/image_geometry.h), each case with a point that the
-// earlier reading put in another voxel. A 4^3 mask of 2 mm voxels whose centres lie at -3, -1, 1, 3 mm on
+// A mask's header read as MRtrix reads it (converter/readers/image_geometry.h), each case with a point that a
+// reading otherwise would put in another voxel. A 4^3 mask of 2 mm voxels whose centres lie at -3, -1, 1, 3 mm on
 // every axis (with its sform); only voxel (1, 1, 1), centred at (-1, -1, -1), is set.
 TEST(SelectionRegions, MaskHeadersAreReadAsMRtrixReadsThem) {
   ScratchDir dir;
@@ -678,10 +678,10 @@ TEST(SelectionRegions, MaskHeadersAreReadAsMRtrixReadsThem) {
     nifti_image_free(nim);
     return path;
   };
-  // Units of metres (or microns) are ignored, as MRtrix ignores them (they were scaled by 1000).
+  // Units of metres (or microns) are ignored, as MRtrix ignores them (not scaled by 1000).
   EXPECT_TRUE(
       parse_region(rewrite("metres.nii", [](nifti_image& n) { n.xyz_units = NIFTI_UNITS_METER; })).contains(centre));
-  // Neither sform nor qform: the image centred on the origin, as MRtrix places it (voxel 0 was put at the origin).
+  // Neither sform nor qform: the image centred on the origin, as MRtrix places it (not voxel 0 at the origin).
   EXPECT_TRUE(
       parse_region(rewrite("none.nii", [](nifti_image& n) { n.sform_code = n.qform_code = 0; })).contains(centre));
   // The same for an MRtrix image without 'transform:'.
@@ -881,7 +881,7 @@ TEST(SelectionCli, CountJsonAndTheCriteriaInTheTckHeader) {
   EXPECT_NE(back.source.header.dump().find("include 0,-18,10,20"), std::string::npos) << back.source.header.dump();
 }
 
-// One table of output formats (converter/streamline_outputs.h): select writes every suffix it lists and export
+// One table of output formats (converter/export/streamline_outputs.h): select writes every suffix it lists and export
 // every one it marks exported, and both commands' help and refusals list exactly those (select's omitted .trk).
 TEST(SelectionCli, OutputSuffixesComeFromOneTable) {
   ScratchDir dir;

@@ -1,10 +1,10 @@
-// The one policy that turns a source into a .vxl for both programs (converter/source_to_vxl.h): when it
+// The one policy that turns a source into a .vxl for both programs (converter/convert/source_to_vxl.h): when it
 // streams, that both routes write the same bytes, and that open_as_vxl leaves no temporary file behind.
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 
-#include "converter/source_to_vxl.h"
+#include "converter/convert/source_to_vxl.h"
 #include "format/base/error.h"
 #include "tests/test_support.h"
 

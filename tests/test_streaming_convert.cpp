@@ -14,12 +14,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
+#include "converter/convert/streaming_convert.h"
+#include "converter/export/tck_writer.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/tck_stream.h"
-#include "converter/streaming_convert.h"
-#include "converter/synth.h"
-#include "converter/tck_writer.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "format/base/memory_size.h"
 #include "format/vxl_file.h"
@@ -616,8 +616,8 @@ TEST(StreamingConvert, PeakResidentMemoryStaysUnderTheLimit) {
 namespace vxl {
 namespace {
 
-// Found by fuzz_tck: a header line longer than the stream's first read was judged while cut (no colon
-// yet) and refused with another error than the whole-file reader gives. Both must fail alike.
+// Found by fuzz_tck: a header line longer than the stream's first read must not be judged while cut (no
+// colon yet) and refused with another error than the whole-file reader gives. Both must fail alike.
 TEST(StreamingConvert, AHeaderLineCutByTheFirstReadFailsAsInMemory) {
   ScratchDir dir;
   const std::string tck = dir.file("long_key.tck");

@@ -5,11 +5,11 @@
 #include <memory>
 #include <vector>
 
+#include "converter/export/tck_writer.h"
 #include "converter/pipeline/batch_reader.h"
 #include "converter/pipeline/streamline_source.h"
 #include "converter/readers/read_tractogram.h"
-#include "converter/synth.h"
-#include "converter/tck_writer.h"
+#include "converter/synth/synth.h"
 #include "test_support.h"
 
 namespace vxl {

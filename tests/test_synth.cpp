@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "format/base/checksum.h"
 
 namespace {

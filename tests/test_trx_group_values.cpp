@@ -14,14 +14,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "converter/export_groups.h"
-#include "converter/export_tck.h"
-#include "converter/export_trk.h"
-#include "converter/export_trx.h"
-#include "converter/pack.h"
+#include "converter/export/export_groups.h"
+#include "converter/export/export_tck.h"
+#include "converter/export/export_trk.h"
+#include "converter/export/export_trx.h"
+#include "converter/package/pack.h"
+#include "converter/package/unpack.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/selection/selection_output.h"
-#include "converter/unpack.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_group_values.h"
@@ -318,7 +318,7 @@ TEST(GdatSection, FilesWithoutGroupValuesHaveNoSection) {
   EXPECT_EQ(f.groups().size(), 2u);
 }
 
-// The version a file with GDAT carries (spec §10): every file written now has streamline lengths (2.4 with packed
+// The version a file with GDAT carries (spec §10): every file written has streamline lengths (2.4 with packed
 // positions or levels, 1.5 otherwise), which holds GDAT too; a package with it is 2.2, one without 2.0.
 TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
   ScratchDir dir;

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <functional>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "format/base/error.h"
@@ -196,7 +196,7 @@ TEST(ValueSets, PointValuesFollowTheirPointsIntoTheVertexBlocks) {
   EXPECT_EQ(plain.find_section(section_id("VVAL")), nullptr);
 }
 
-// Beyond 64 value sets the rest are dropped: that was said only inside PROV, never on stderr.
+// Beyond 64 value sets the rest are dropped, and a warning on stderr says so.
 TEST(ValueSets, SetsBeyondTheCapAreDroppedWithAWarningOnStderr) {
   ScratchDir dir;
   std::string vtk =

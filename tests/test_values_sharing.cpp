@@ -9,14 +9,14 @@
 #include <functional>
 #include <limits>
 
-#include "converter/convert.h"
-#include "converter/export_tck.h"
-#include "converter/export_trx.h"
-#include "converter/pack.h"
+#include "converter/convert/convert.h"
+#include "converter/export/export_tck.h"
+#include "converter/export/export_trx.h"
+#include "converter/package/pack.h"
+#include "converter/package/unpack.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
-#include "converter/synth.h"
-#include "converter/unpack.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_verify.h"

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "converter/voxel_size_auto.h"
+#include "converter/convert/voxel_size_auto.h"
 #include "format/base/error.h"
 #include "tests/mrtrix_test_files.h"
 #include "tests/test_support.h"

@@ -5,9 +5,9 @@
 
 #include <sys/resource.h>
 
-#include "converter/segment_orders.h"
-#include "converter/voxel_table.h"
-#include "converter/voxelize.h"
+#include "converter/convert/segment_orders.h"
+#include "converter/convert/voxel_table.h"
+#include "converter/convert/voxelize.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_positions.h"
@@ -227,8 +227,8 @@ TEST(Voxelize, TooSmallAVoxelIsRefusedWithASuggestion) {
   }
 }
 
-// Regression (found by fuzz_tck): one step of 8e8 mm at 10 mm voxels would cross ~1e8 faces; the budget
-// must be checked before the crossings are generated, not after (it took 8 GB).
+// Found by fuzz_tck: one step of 8e8 mm at 10 mm voxels would cross ~1e8 faces (8 GB of crossings); the
+// budget must be checked before the crossings are generated, not after.
 TEST(Voxelize, OneHugeStepIsRefusedBeforeAllocating) {
   struct rusage before {};
   getrusage(RUSAGE_SELF, &before);

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"

@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "tests/reseal_checksums.h"

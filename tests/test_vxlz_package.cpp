@@ -13,11 +13,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "converter/convert.h"
-#include "converter/pack.h"
+#include "converter/convert/convert.h"
+#include "converter/package/pack.h"
+#include "converter/package/unpack.h"
 #include "converter/readers/read_tractogram.h"
-#include "converter/synth.h"
-#include "converter/unpack.h"
+#include "converter/synth/synth.h"
 #include "format/base/checksum.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
@@ -64,7 +64,7 @@ std::string convert_to(Tractogram t, const std::string& path, double voxel_size 
 }
 
 // Written as a new file: truncating and rewriting one makes ext4 flush it on close (auto_da_alloc),
-// which made the thousands of rewrites below take seconds.
+// which would make the thousands of rewrites below take seconds.
 void dump(const std::string& p, const std::vector<char>& bytes, std::size_t n) {
   std::filesystem::remove(p);
   std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(n));
@@ -462,8 +462,8 @@ TEST_F(DamagedVxlz, DamageBehindValidChecksumsNeverCrashes) {
   EXPECT_GT(accepted, 0u);
 }
 
-// Found by fuzz_vxlz: a Draco stream whose point count is damaged behind valid checksums made Draco
-// allocate 6 GB before our count check ran. Now refused before Draco decodes anything.
+// Found by fuzz_vxlz: a Draco stream whose point count is damaged behind valid checksums, which would make
+// Draco allocate 6 GB, is refused before Draco decodes anything.
 TEST_F(DamagedVxlz, ADracoPointCountBeyondTheChunkIsRefusedBeforeDecoding) {
   std::vector<char> bytes = slurp(good());
   const std::string magic = "DRACO";

@@ -11,9 +11,9 @@
 #include "converter/cli/convert_cohort.h"
 #include "converter/cli/convert_file.h"
 #include "converter/cli/progress_bar.h"
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
+#include "converter/convert/segment_orders.h"
 #include "converter/readers/source_formats.h"
-#include "converter/segment_orders.h"
 #include "format/base/error.h"
 #include "format/base/memory_size.h"
 

@@ -3,12 +3,13 @@
 #include <optional>
 
 #include "converter/cli/commands.h"
-#include "converter/export_groups.h"
-#include "converter/export_tck.h"
-#include "converter/export_trk.h"
-#include "converter/export_trx.h"
-#include "converter/export_vtk.h"
-#include "converter/streamline_outputs.h"
+#include "converter/export/export_groups.h"
+#include "converter/export/export_tck.h"
+#include "converter/export/export_trk.h"
+#include "converter/export/export_trx.h"
+#include "converter/export/export_vtk.h"
+#include "converter/export/groups_not_written.h"
+#include "converter/export/streamline_outputs.h"
 #include "format/base/error.h"
 
 namespace vxl::cli {

@@ -1,7 +1,7 @@
 #include <cstdio>
 
 #include "converter/cli/commands.h"
-#include "converter/pack.h"
+#include "converter/package/pack.h"
 #include "format/vxl_file.h"
 
 namespace vxl::cli {

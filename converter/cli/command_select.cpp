@@ -3,9 +3,9 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/cli/commands.h"
+#include "converter/export/streamline_outputs.h"
 #include "converter/selection/selection_output.h"
 #include "converter/selection/streamline_selection.h"
-#include "converter/streamline_outputs.h"
 #include "format/base/error.h"
 
 namespace vxl::cli {

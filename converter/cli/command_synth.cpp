@@ -1,8 +1,8 @@
 #include <cstdio>
 
 #include "converter/cli/commands.h"
-#include "converter/synth.h"
-#include "converter/tck_writer.h"
+#include "converter/export/tck_writer.h"
+#include "converter/synth/synth.h"
 
 namespace vxl::cli {
 

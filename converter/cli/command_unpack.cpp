@@ -2,7 +2,7 @@
 
 #include "converter/cli/commands.h"
 #include "converter/cli/progress_bar.h"
-#include "converter/unpack.h"
+#include "converter/package/unpack.h"
 
 namespace vxl::cli {
 

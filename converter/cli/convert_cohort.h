@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 
 namespace vxl::cli {
 

@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "converter/source_to_vxl.h"
+#include "converter/convert/source_to_vxl.h"
 #include "format/base/memory_size.h"
 
 namespace vxl::cli {

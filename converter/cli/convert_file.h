@@ -1,5 +1,5 @@
 // One conversion IN -> OUT.vxl, shared by `voxlines convert IN OUT.vxl` and the cohort form
-// (convert_cohort.h): converts through convert_source (converter/source_to_vxl.h, which decides whether the
+// (convert_cohort.h): converts through convert_source (converter/convert/source_to_vxl.h, which decides whether the
 // source streams, as voxview's opening of a source does) and describes the result.
 #pragma once
 
@@ -7,14 +7,14 @@
 #include <string>
 #include <vector>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 
 namespace vxl::cli {
 
 // Converts `input` into `output` (written atomically) and returns the lines to print on stdout: the counts,
 // the passes under a memory limit and, with `verbose`, the stage times. Each warning of the source is
 // handed to `warn` (without the file's name) as soon as it is known. Without a memory limit, a TCK whose
-// conversion in memory would not fit in the available memory (memory_available.h; shared by
+// conversion in memory would not fit in the available memory (convert/memory_choice.h; shared by
 // `concurrent_files` conversions) is streamed under a limit that fits, and a line on stderr says so
 // ("voxlines: IN: converting in memory would take ...").
 // Throws vxl::Error.

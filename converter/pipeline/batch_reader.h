@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "converter/convert/voxelize.h"
 #include "converter/pipeline/conversion_plan.h"
 #include "converter/pipeline/memory_budget.h"
 #include "converter/pipeline/streamline_source.h"
 #include "converter/tractogram.h"
-#include "converter/voxelize.h"
 #include "format/base/parallel.h"
 
 namespace vxl {

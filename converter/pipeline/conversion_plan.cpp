@@ -4,7 +4,7 @@
 #include <array>
 #include <string>
 
-#include "converter/segment_orders.h"
+#include "converter/convert/segment_orders.h"
 #include "format/base/direct_region_writer.h"
 #include "format/voxel_voxlines.h"
 #include "format/vxl_levels.h"

@@ -28,6 +28,13 @@ inline constexpr std::uint64_t kDirectWritesFromLimit = 256ull << 20;
 // The voxel table's bytes per voxel while it is built, with `levels` levels of detail.
 std::uint64_t voxel_table_bytes_per_voxel(std::uint32_t levels);
 
+// Sizes the conversion otherwise derives from the limit, set by tests (to reach on small data what
+// only large data would) and benchmarks; 0 keeps the derived value. The output does not depend on them.
+struct StreamingTuning {
+  std::uint64_t order_chunk_bytes = 0;  // orders built and written this much at a time (or one voxel)
+  std::uint64_t range_bytes = 0;        // ranges of voxels cut to hold at most this much (or one voxel; 0: the limit)
+};
+
 // How the source is read, from the limit alone (before anything is read).
 struct ReadPlan {
   std::uint64_t read_buffer_bytes = 0;

@@ -6,7 +6,7 @@
 #include <array>
 #include <utility>
 
-#include "converter/voxel_size_auto.h"
+#include "converter/convert/voxel_size_auto.h"
 #include "format/base/parallel.h"
 
 namespace vxl::streaming {

@@ -4,13 +4,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "converter/convert.h"
-#include "converter/export_groups.h"
-#include "converter/export_trk.h"
-#include "converter/export_trx.h"
-#include "converter/export_values.h"
-#include "converter/export_vtk.h"
-#include "converter/streamline_outputs.h"
+#include "converter/convert/convert.h"
+#include "converter/export/export_trk.h"
+#include "converter/export/export_trx.h"
+#include "converter/export/export_values.h"
+#include "converter/export/export_vtk.h"
+#include "converter/export/groups_not_written.h"
+#include "converter/export/streamline_outputs.h"
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
 #include "format/vxl_streamlines.h"

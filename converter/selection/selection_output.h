@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "converter/export_tck.h"
-#include "converter/streamline_subset.h"
+#include "converter/export/export_tck.h"
+#include "converter/export/streamline_subset.h"
 #include "format/vxl_file.h"
 
 namespace vxl {

@@ -10,7 +10,7 @@
 
 #include <unistd.h>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 #include "format/base/error.h"
 
 namespace vxl::fuzz {

@@ -8,10 +8,10 @@
 #include <iterator>
 #include <optional>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
+#include "converter/convert/streaming_convert.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/tck_stream.h"
-#include "converter/streaming_convert.h"
 #include "format/base/error.h"
 #include "tests/fuzz/fuzz_input.h"
 

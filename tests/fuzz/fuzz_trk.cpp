@@ -10,7 +10,7 @@
 
 #include <zlib.h>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 #include "converter/readers/read_tractogram.h"
 #include "format/base/error.h"
 #include "tests/fuzz/fuzz_input.h"

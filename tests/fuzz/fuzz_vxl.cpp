@@ -4,7 +4,7 @@
 // damage too.
 #include <vector>
 
-#include "converter/export_tck.h"
+#include "converter/export/export_tck.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"

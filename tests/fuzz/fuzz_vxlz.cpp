@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "converter/unpack.h"
+#include "converter/package/unpack.h"
 #include "format/base/error.h"
 #include "format/vxl_verify.h"
 #include "tests/fuzz/fuzz_input.h"

@@ -1,3 +1,3 @@
 // Must not compile: the format library may not use the converter (the include_direction test builds this
 // and expects the include to be missing, which is what keeps the layers' direction).
-#include "converter/convert.h"
+#include "converter/convert/convert.h"

@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "converter/convert.h"
+#include "converter/convert/convert.h"
 #include "format/vxl_file.h"
 #include "tests/test_support.h"
 #include "viewer/platform/egl_context.h"

@@ -166,7 +166,7 @@ TEST(CameraFile, MissingKeysKeepDefaultsAndBadOnesNameFileAndKey) {
                 .settings.background_color,
             glm::vec3(1.0f));
 
-  // Nested 100000 deep, the file crashed the viewer by stack overflow: refused before it is parsed.
+  // Nested 100000 deep, deep enough to overflow the stack of a recursive parse: refused before it is parsed.
   const std::string deep =
       error_of(R"({"voxview_view": 1, "x": )" + std::string(100000, '[') + std::string(100000, ']') + "}");
   EXPECT_NE(deep.find("bad.json: at byte " + std::to_string(25 + kMaxJsonDepth - 1) +
@@ -183,7 +183,7 @@ TEST(CameraFile, MissingKeysKeepDefaultsAndBadOnesNameFileAndKey) {
   }
 }
 
-// A view file's camera or slab beyond what draws a picture (ViewLimits) was accepted and drew nothing.
+// A view file's camera or slab beyond what draws a picture (ViewLimits) is refused, not drawn as nothing.
 TEST(CameraFile, CamerasAndSlabsThatDrawNothingAreRefused) {
   auto error_of = [](const std::string& inner) -> std::string {
     try {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "tests/viewer/render_support.h"
 

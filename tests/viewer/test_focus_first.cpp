@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "converter/convert.h"
-#include "converter/synth.h"
+#include "converter/convert/convert.h"
+#include "converter/synth/synth.h"
 #include "format/vxl_file.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/app/focus_copy.h"
@@ -108,7 +108,7 @@ TEST_F(FocusFirst, TheFocusTakesFullDetailFirstAndTheContextTheLevelThatFitsTheR
 TEST_F(FocusFirst, WithoutASelectionThereIsNoCopyAndTheLevelIsUnchanged) {
   const FocusCopy none(files(), {{}});
   EXPECT_TRUE(none.files().empty());
-  // One level for every file is the layout it always was.
+  // One level for every file is the same layout as that level alone.
   LevelLayouts context(files(), span_texels());
   const std::vector<std::uint32_t> one = {1};
   const SceneLayout same(files(), span_texels(), one);

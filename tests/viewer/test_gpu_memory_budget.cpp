@@ -3,7 +3,7 @@
 // again.
 #include <memory>
 
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_metrics.h"

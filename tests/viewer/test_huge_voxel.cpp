@@ -18,9 +18,9 @@ using test::q;
 
 test::CommandResult voxview(const std::string& args) { return test::run_program(VOXVIEW_CLI, args); }
 
-// `convert --voxel-size 1e8` (up to 1e300) gives one voxel holding the whole tractogram, valid, but the
-// viewer drew nothing ("0 voxels drawn"): the near plane sat at 10^-4 of a far plane one voxel beyond the
-// scene, i.e. 10 m away. One voxel is drawn now, as at 1e6.
+// `convert --voxel-size 1e8` (up to 1e300) gives one voxel holding the whole tractogram, valid; the viewer
+// draws that voxel, as at 1e6, rather than nothing ("0 voxels drawn"), which a near plane at 10^-4 of a far
+// plane one voxel beyond the scene (i.e. 10 m away) would give.
 TEST(VoxviewHugeVoxel, OneVoxelLargerThanTheSceneIsDrawn) {
   ScratchDir dir;
   auto r = test::run_cli("synth " + q(dir.file("in.tck")) + " --streamlines 30 --seed 1");

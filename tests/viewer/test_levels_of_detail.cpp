@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <numeric>
 
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_metrics.h"
@@ -161,7 +161,7 @@ TEST_F(LevelsOfDetail, ATextureLimitTooSmallForFullDetailLeavesACoarserLevel) {
   EXPECT_GT(test::lit_pixels(render_image(r, whole_view(), s, 96, 96)), 500);
 }
 
-// A budget below 1 MiB was reported as "0 MiB" on both sides ("needs 0 MiB ... budget of 0 MiB"): small
+// A budget below 1 MiB is not reported as "0 MiB" on both sides ("needs 0 MiB ... budget of 0 MiB"): small
 // sizes are given in bytes.
 TEST_F(LevelsOfDetail, ABudgetNoLevelFitsSaysBothSizesInBytes) {
   const VxlFile f = file();

@@ -10,9 +10,9 @@
 
 #include <glm/glm.hpp>
 
-#include "converter/convert.h"
-#include "converter/segment_orders.h"
-#include "converter/synth.h"
+#include "converter/convert/convert.h"
+#include "converter/convert/segment_orders.h"
+#include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_verify.h"

@@ -593,9 +593,9 @@ TEST(PlatformImageIo, ReadErrorsAndRgbFiles) {
   EXPECT_EQ(img.rgba, (std::vector<std::uint8_t>{10, 20, 30, 255, 40, 50, 60, 255}));
 }
 
-// --size 16384x8192 (or a view file's "size") exited 70 with "framebuffer incomplete": the driver caps
-// a buffer's bytes below its per-side limit. Both limits are now an Unsupported error (exit 4) that says
-// what fits.
+// --size 16384x8192 (or a view file's "size") is beyond what the driver holds, though within its per-side
+// limit: the driver caps a buffer's bytes below it. Both limits are an Unsupported error (exit 4) that says
+// what fits, not exit 70 with "framebuffer incomplete".
 TEST_F(PlatformTarget, SizesTheDriverCannotHoldAreUnsupportedAndSayWhatFits) {
   GLint max_tex = 0;
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);

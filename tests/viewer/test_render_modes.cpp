@@ -2,7 +2,7 @@
 // hand-made scenes whose correct picture is known.
 #include <cmath>
 
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_metrics.h"
 
@@ -246,7 +246,7 @@ TEST_F(RenderModes, ExactInDepthPassesEqualsExactInOnePass) {
 
 // The GPU copy (scene_layout.h): packed positions (4 bytes a vertex) and the three stored orders as the file
 // packs them (16 bits an entry or fewer here: at most 6 bytes a segment) serve all six directions and the block
-// order in at most 12 bytes a source point; float positions and 32-bit orders took about 29.
+// order in at most 12 bytes a source point; float positions and 32-bit orders would take about 29.
 TEST_F(RenderModes, TheGpuCopyTakesAtMostTwelveBytesAPoint) {
   SynthSettings synth;
   synth.streamlines = 20000;

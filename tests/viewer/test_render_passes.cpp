@@ -3,7 +3,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_metrics.h"
 #include "viewer/render/clip_uniforms.h"

@@ -1,4 +1,4 @@
-// voxview opens a source tractogram as `voxlines convert` converts it (converter/source_to_vxl.h): under a
+// voxview opens a source tractogram as `voxlines convert` converts it (converter/convert/source_to_vxl.h): under a
 // small --memory-limit it streams through a temporary .vxl, the scene's bytes are those of the conversion in
 // memory, and no temporary file is left, also when the source is damaged.
 #include <cstdlib>

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
-#include "converter/convert.h"
-#include "converter/synth.h"
+#include "converter/convert/convert.h"
+#include "converter/synth/synth.h"
 #include "tests/test_support.h"
 #include "viewer/render/camera.h"
 #include "viewer/render/frame_plan.h"

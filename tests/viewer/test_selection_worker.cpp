@@ -3,8 +3,8 @@
 // comes back as an error, not an exception on the window's thread.
 #include <gtest/gtest.h>
 
-#include "converter/convert.h"
-#include "converter/synth.h"
+#include "converter/convert/convert.h"
+#include "converter/synth/synth.h"
 #include "tests/test_support.h"
 #include "viewer/app/selection_worker.h"
 

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "converter/convert.h"
-#include "converter/synth.h"
+#include "converter/convert/convert.h"
+#include "converter/synth/synth.h"
 #include "format/vxl_streamlines.h"
 #include "tests/hostile_vxl.h"
 #include "tests/test_support.h"

@@ -5,8 +5,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "converter/convert.h"
-#include "converter/synth.h"
+#include "converter/convert/convert.h"
+#include "converter/synth/synth.h"
 #include "format/vxl_file.h"
 #include "tests/test_support.h"
 #include "viewer/app/view_level.h"

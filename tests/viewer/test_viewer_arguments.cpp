@@ -221,7 +221,7 @@ TEST(ViewerArguments, BadOrConflictingOptionsAreUsageErrors) {
 }
 
 // Options that draw nothing (an azimuth of 1e308, a slab of 1e-300 mm, a focus at 1e308 mm) or make no
-// sense (a frame budget of NaN, an infinite orbit) were accepted; they are usage errors now.
+// sense (a frame budget of NaN, an infinite orbit) are usage errors.
 TEST(ViewerArguments, OptionsThatDrawNothingAreUsageErrors) {
   auto error_contains = [](const ViewerArguments& a, const std::string& part) {
     const std::string error = usage_error_of(a);
@@ -243,8 +243,8 @@ TEST(ViewerArguments, OptionsThatDrawNothingAreUsageErrors) {
   EXPECT_EQ(usage_error_of(given("--view", &ViewerArguments::view, "-720,95")), "no error");  // elevation clamped
 }
 
-// A view file without "camera" gave the default camera (target at the origin, 300 mm away): a picture of
-// whatever lies there. It is framed now, as without a view file; its settings still apply.
+// A view file without "camera" is framed as without a view file, not shown from the default camera (target
+// at the origin, 300 mm away: a picture of whatever lies there); its settings still apply.
 TEST(ViewerArguments, AViewFileWithoutACameraIsFramedAsWithoutOne) {
   ScratchDir dir;
   const std::string path = dir.file("look.json");
@@ -258,7 +258,8 @@ TEST(ViewerArguments, AViewFileWithoutACameraIsFramedAsWithoutOne) {
 }
 
 // Every output is checked before anything is read or drawn: --render into a missing folder or onto a
-// folder exited 70 after the rendering; a FIFO or a device was replaced by a regular file.
+// folder fails before the rendering, not with exit 70 after it; a FIFO or a device is never replaced by a
+// regular file.
 TEST(ViewerArguments, OutputPathsAreCheckedFirstAndNeverReplaceAFifoOrDevice) {
   ScratchDir dir;
   const std::string fifo = dir.file("fifo.png"), null_link = dir.file("null.png");
@@ -312,8 +313,8 @@ TEST(ViewerArguments, OutputPathsAreCheckedFirstAndNeverReplaceAFifoOrDevice) {
   }
 }
 
-// A size the GL driver cannot allocate, from --size or from a view file, is exit 4 naming what fits (it
-// was exit 70, "framebuffer incomplete"); a driver that allocates it draws it.
+// A size the GL driver cannot allocate, from --size or from a view file, is exit 4 naming what fits (not
+// exit 70, "framebuffer incomplete"); a driver that allocates it draws it.
 TEST(Voxview, SizeBeyondWhatTheDriverAllocatesIsUnsupported) {
   ScratchDir dir;
   const std::string tck = dir.file("s.tck"), vxl = dir.file("s.vxl"), view = dir.file("big.json");
@@ -332,7 +333,7 @@ TEST(Voxview, SizeBeyondWhatTheDriverAllocatesIsUnsupported) {
 }
 
 // A view file whose scalar, groups or colouring the scene cannot honour is a bad file (exit 3, naming it);
-// the same from the command line stays a usage error (exit 2). Both exited 2.
+// the same from the command line is a usage error (exit 2).
 TEST(Voxview, ColourSettingsFromAViewFileAreTheFilesErrors) {
   ScratchDir dir;
   const std::string tck = dir.file("s.tck"), vxl = dir.file("s.vxl"), png = dir.file("o.png");

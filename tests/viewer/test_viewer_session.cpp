@@ -1,7 +1,7 @@
 // The scene voxview shows (viewer_session.h): one renderer per level, made once with the image and the
 // current groups, and a view's level measured on the layouts exactly as the renderers would measure it
 // (the lines' bounds joined with the image's box).
-#include "converter/synth.h"
+#include "converter/synth/synth.h"
 #include "tests/nifti_test_files.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/app/viewer_session.h"

@@ -50,7 +50,7 @@ TEST(VoxviewCommandLine, OpacitiesAndLineWidthsThatAreNoNumberInTheirRangeAreUsa
 
 // A picture larger than the driver holds (llvmpipe caps one buffer's bytes, below its limit on a side) is
 // refused from the driver's answer, before any framebuffer is made: exit 4 saying what does fit, at a small part
-// of the memory that allocating and shrinking took (1.9 GB on this machine).
+// of the memory that allocating and shrinking would take (1.9 GB on the development machine).
 TEST(VoxviewCommandLine, APictureTheDriverCannotHoldIsRefusedBeforeAllocating) {
   test::ScratchDir dir;
   ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);

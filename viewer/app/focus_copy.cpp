@@ -7,8 +7,8 @@
 
 #include <unistd.h>
 
+#include "converter/export/streamline_subset.h"
 #include "converter/selection/selection_output.h"
-#include "converter/streamline_subset.h"
 
 namespace vxl::app {
 

@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "converter/temporary_vxl.h"
-#include "converter/unpack.h"
+#include "converter/convert/temporary_vxl.h"
+#include "converter/package/unpack.h"
 #include "format/base/error.h"
 #include "format/base/memory_size.h"
 #include "format/vxl_verify.h"

@@ -1,6 +1,6 @@
 // Opens what the user gave voxview: a .vxl is memory-mapped as is; a .vxlz is unpacked into a temporary
 // .vxl; a source tractogram (readers/source_formats.h) is converted as `voxlines convert` converts it
-// (converter/source_to_vxl.h: in memory, or streamed through the temporary file when it is larger than the
+// (converter/convert/source_to_vxl.h: in memory, or streamed through the temporary file when it is larger than the
 // memory or --memory-limit) into a temporary .vxl that only the mapping keeps alive, with a hint on how to
 // convert once for fast reopening.
 #pragma once
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "converter/source_to_vxl.h"
+#include "converter/convert/source_to_vxl.h"
 #include "format/vxl_file.h"
 #include "viewer/app/viewer_options.h"
 

@@ -37,7 +37,7 @@ struct ViewerOptions {
   int width = 1024, height = 1024;
   bool size_given = false;   // by --size or a saved view: the window keeps it (else it fits the screen)
   double voxel_size = 10.0;  // for converting a source tractogram
-  // --memory-limit: a source tractogram is streamed within this many bytes (converter/source_to_vxl.h);
+  // --memory-limit: a source tractogram is streamed within this many bytes (converter/convert/source_to_vxl.h);
   // 0: only a TCK too big for the available memory is.
   std::uint64_t memory_limit = 0;
   // Level of detail (.vxl spec §5.12): the one --level names, else the finest within the GPU memory budget

@@ -1,0 +1,83 @@
+#include "converter/convert/source_to_vxl.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+
+#include "converter/convert/memory_choice.h"
+#include "converter/convert/streaming_convert.h"
+#include "converter/convert/temporary_vxl.h"
+#include "converter/readers/read_tractogram.h"
+#include "converter/readers/read_tsf.h"
+#include "converter/readers/source_formats.h"
+#include "format/base/error.h"
+#include "format/base/memory_available.h"
+#include "format/base/memory_size.h"
+
+namespace vxl {
+namespace {
+
+bool is_streamable(const std::string& path) {
+  const SourceMatch match = source_format_of(path);
+  return match.format && match.format->streamable;
+}
+
+// The limit to stream `input` within when none was given: only for a streamable source without TSF values
+// whose conversion in memory would not fit in its share of the available memory. 0: convert in memory.
+std::uint64_t chosen_memory_limit(const std::string& input, const SourceConversion& c) {
+  if (c.settings.memory_limit > 0 || !c.tsf.empty() || !is_streamable(input)) return c.settings.memory_limit;
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(input, ec);
+  const std::optional<std::uint64_t> available = available_memory();
+  if (ec || !available) return 0;
+  const std::uint64_t share = *available / std::max(1u, c.concurrent_files);
+  const std::optional<std::uint64_t> limit = automatic_memory_limit(bytes, share);
+  if (!limit) return 0;
+  if (c.notice)
+    c.notice(input + ": converting in memory would take about " + format_memory_size(in_memory_estimate(bytes)) +
+             " of the " + format_memory_size(share) + " available" +
+             (c.concurrent_files > 1 ? " to each file converted at once" : "") +
+             ": streaming it within --memory-limit " + memory_limit_argument(*limit) + " (the output is the same)");
+  return *limit;
+}
+
+void warn_each(const SourceConversion& c, const std::vector<std::string>& warnings) {
+  if (c.warn)
+    for (const std::string& w : warnings) c.warn(w);
+}
+
+}  // namespace
+
+SourceConversionReport convert_source(const std::string& input, const std::string& output, const SourceConversion& c) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SourceConversionReport report;
+  ConvertSettings settings = c.settings;
+  settings.memory_limit = chosen_memory_limit(input, c);
+  if (settings.memory_limit > 0) {
+    if (!c.tsf.empty())
+      throw Error(ErrorKind::Unsupported, input, std::nullopt,
+                  "--memory-limit does not carry --tsf values yet; convert without the limit");
+    report.summary = convert_streaming(input, output, settings);
+    report.read_seconds = report.summary.read_seconds;
+    report.streamed = true;
+    report.memory_limit = settings.memory_limit;
+    warn_each(c, report.summary.warnings);
+    return report;
+  }
+  Tractogram t = read_tractogram(input);
+  for (const std::string& f : c.tsf) attach_tsf(t, f);
+  report.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  warn_each(c, t.source.warnings);
+  report.summary = convert_tractogram(std::move(t), output, settings);
+  warn_each(c, report.summary.warnings);
+  return report;
+}
+
+OpenedSource open_as_vxl(const std::string& input, const SourceConversion& c, const std::string& temporary_dir) {
+  SourceConversionReport report;
+  TemporaryVxl t = open_through_temporary_vxl(
+      input, [&](const std::string& path) { report = convert_source(input, path, c); }, temporary_dir);
+  return {std::move(t.file), std::move(report), std::move(t.path), t.in_ram};
+}
+
+}  // namespace vxl

@@ -1,0 +1,162 @@
+#include "converter/convert/streaming_convert.h"
+
+#include <memory>
+#include <utility>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+#include "converter/pipeline/streaming_conversion.h"
+#include "converter/readers/source_formats.h"
+#include "format/base/error.h"
+#include "format/base/parallel.h"
+
+namespace vxl {
+namespace streaming {
+
+void StreamingConversion::fail_changed() const {
+  fail_input(job_.path, std::nullopt,
+             "the file changed while it was being converted (--memory-limit reads it several times)");
+}
+
+void StreamingConversion::check_source_type() const {
+  const SourceMatch match = source_format_of(job_.path);
+  if (!match.format || !match.format->streamable)
+    fail_unsupported(job_.path, "--memory-limit streams TCK sources only (.tck); convert " +
+                                    std::string(match.format ? match.format->name : "other") + " sources without it");
+}
+
+void StreamingConversion::open_stream() {
+  reader_ = std::make_unique<BatchReader>(job_.path, budget_, job_.threads, job_.settings.progress);
+}
+
+void StreamingConversion::write_rest() {
+  out_->append_meta(table_.meta);
+  std::vector<DirectionEntry> directions = order_directions(job_.order_set);
+  out_->append_items<DirectionEntry>(VxlStreamWriter::kDirs, directions);
+  if (job_.order_set.per_voxel()) {  // VDIR, a function of (seed, voxel coordinate): made in bounded slices
+    const std::size_t slice = 4096;
+    std::vector<DirectionEntry> voxel_directions;
+    for (std::size_t first = 0; first < table_.voxels.size(); first += slice) {
+      const std::span<const VoxelEntry> part =
+          std::span<const VoxelEntry>(table_.voxels).subspan(first, std::min(slice, table_.voxels.size() - first));
+      voxel_directions.resize(part.size() * directions.size());
+      fill_voxel_directions(job_.order_set, part, voxel_directions);
+      out_->append_items<DirectionEntry>(VxlStreamWriter::kVdir, voxel_directions);
+    }
+  }
+  out_->append_items<VoxelEntry>(VxlStreamWriter::kVoxt, table_.voxels);
+  if (!table_.levels.empty()) out_->append_items<LevelEntry>(VxlStreamWriter::kLods, table_.levels);
+}
+
+// The voxel index's lists are filled as the first range is placed where the plan leaves room for them: the write
+// stage then writes them instead of reading VXLN and STRM back (twice) to sort them.
+void StreamingConversion::plan_index_lists() {
+  const std::uint64_t bytes = VoxelIndexLists::bytes(table_.voxels.size(), table_.meta.voxline_count);
+  if (!plan_voxel_index_lists(budget_, plan_, bytes)) return;
+  table_.index_lists_held = bytes;
+  std::vector<std::uint64_t> voxlines(table_.voxels.size());
+  for (std::size_t g = 0; g < voxlines.size(); ++g)  // each voxline has one vertex more than it has segments
+    voxlines[g] = table_.voxels[g].vertex_count - table_.voxels[g].segment_count;
+  table_.index_lists.emplace(voxlines);
+  summary_.voxel_index_while_placing = true;
+}
+
+ConvertSummary StreamingConversion::run() {
+  if (job_.settings.memory_limit == 0) throw std::logic_error("convert_streaming: memory_limit must be > 0");
+  check_source_type();
+  job_.order_set = parse_order_set(job_.settings.orders);
+  job_.threads = resolve_threads(job_.settings.threads);
+  if (!job_.settings.voxel_size_auto) detail::check_voxel_size(job_.settings.voxel_size, job_.path);
+  detail::check_level_count(job_.settings.levels, job_.path);
+  summary_.passes = 0;
+
+  auto t0 = Clock::now();
+  open_stream();
+  scan();
+  summary_.read_seconds = seconds_since(t0);
+
+  t0 = Clock::now();
+  count_voxels();
+  build_table();
+  summary_.voxelize_seconds = seconds_since(t0);
+  // Planned without the voxel runs, which are kept for the placing passes only where the plan leaves room.
+  budget_.shrink(0, table_.runs_held);
+  plan_ = plan_conversion(
+      budget_,
+      {table_.meta, table_.voxels, table_.levels, job_.settings.levels, job_.settings.positions, table_.order_bytes,
+       job_.threads, reader_->plan().batch_streamlines, job_.tuning.order_chunk_bytes, job_.tuning.range_bytes});
+  table_.runs_kept = counting_.recording_runs && plan_voxel_runs(budget_, plan_, table_.runs.bytes());
+  if (table_.runs_kept)
+    table_.runs_held = table_.runs.bytes();
+  else
+    table_.runs.clear();
+  plan_index_lists();
+  staged_held_ = plan_.staged_bytes;
+  table_.spans.resize(table_.meta.streamline_count);
+  if (plan_.block_staging_bytes > 0) {
+    void* p = std::aligned_alloc(DirectRegionWriter::kBlock, plan_.pool_bytes);
+    if (p == nullptr) throw std::bad_alloc();
+    pool_.reset(static_cast<std::uint8_t*>(p));
+  }
+  const std::vector<VoxelRange>& ranges = plan_.ranges;
+
+  const std::string provenance =
+      provenance_json(reader_->source(), job_.settings, job_.threads, job_.voxel_size_choice);
+  out_ = std::make_unique<VxlStreamWriter>(
+      job_.out_path, section_sizes(table_.meta, table_.order_bytes, provenance.size(), 0), plan_.direct_staging_bytes);
+  for (std::size_t k = 0; k < ranges.size(); ++k) {
+    build_range(ranges[k], k, ranges.size());
+#if defined(__GLIBC__)
+    malloc_trim(0);  // give back what the range freed, lest the allocator keep it resident for the next one
+#endif
+  }
+
+  summary_.voxelised_once = table_.runs_kept;
+  table_.runs.clear();
+  budget_.shrink(0, table_.runs_held);
+
+  report("writing", 0.0);
+  t0 = Clock::now();
+  write_rest();
+  if (!summary_.voxel_index_while_placing) {
+    // The voxel index's buffer takes the memory the ranges and the pool gave back: the pool itself where it is
+    // large enough (its pages are in memory already; fresh ones cost more than the sorting on some machines).
+    std::span<std::uint8_t> index_buffer;
+    if (pool_ && plan_.pool_bytes >= plan_.voxel_index_buffer_bytes)
+      index_buffer = {pool_.get(), plan_.voxel_index_buffer_bytes};
+    else
+      pool_.reset();
+    out_->append_voxel_index(plan_.voxel_index_buffer_bytes, index_buffer);
+  }
+  pool_.reset();
+  if (!scan_.lengths.empty()) out_->append_items<float>(VxlStreamWriter::kSlen, scan_.lengths);
+  out_->append(VxlStreamWriter::kProv, {reinterpret_cast<const std::uint8_t*>(provenance.data()), provenance.size()});
+  out_->commit();
+  summary_.write_seconds += seconds_since(t0);
+  report("writing", 1.0);
+
+  summary_.take_counts(table_.meta);
+  summary_.passes = reader_->passes();
+  summary_.partitions = ranges.size();
+  summary_.vertices_read_back = plan_.block_staging_bytes > 0;
+  for (const VoxelRange& r : ranges) summary_.partition_starts.push_back(r.first);
+  summary_.warnings = reader_->source().warnings;
+  return summary_;
+}
+
+}  // namespace streaming
+
+ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
+                                 const ConvertSettings& settings) {
+  return convert_streaming(source_path, out_path, settings, StreamingTuning{});
+}
+
+ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
+                                 const ConvertSettings& settings, const StreamingTuning& tuning) {
+  streaming::StreamingConversion conversion(source_path, out_path, settings, tuning);
+  return conversion.run();
+}
+
+}  // namespace vxl

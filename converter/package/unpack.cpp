@@ -1,0 +1,485 @@
+#include "converter/package/unpack.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "converter/convert/position_packing.h"
+#include "converter/convert/segment_orders.h"
+#include "converter/convert/voxel_table.h"
+#include "format/base/error.h"
+#include "format/base/json_limits.h"
+#include "format/base/parallel.h"
+#include "format/streamline_length.h"
+#include "format/vxl_file.h"
+#include "format/vxl_group_values.h"
+#include "format/vxl_value_sets.h"
+#include "format/vxl_writer.h"
+#include "format/vxlz_draco.h"
+#include "format/vxlz_package.h"
+#include "format/vxlz_quantize.h"
+#include "format/vxlz_tables.h"
+#include "format/vxlz_values.h"
+
+namespace vxl {
+namespace {
+
+// The exact tables of the .vxl, rebuilt from the package's streams (spec §7 steps 2-4), and where each
+// voxline's points go.
+struct Structure {
+  std::vector<std::uint64_t> strm;              // N + 1
+  std::vector<VoxlineEntry> voxlines;           // L
+  std::vector<std::uint8_t> starts_streamline;  // L + 1 (the last entry 1): voxline j is a streamline's first
+  std::vector<VoxelEntry> voxels;               // coord, vertex and segment counts, vertex_first, order layout
+  std::vector<LevelEntry> levels;               // LODS: voxel_count x (level_count - 1)
+  std::uint32_t level_count = 1;
+  std::uint64_t order_bytes = 0;
+  // Voxline j's first vertex is voxels[voxel].vertex_first + offset_in_voxel[j] (< 2^32: a voxel's
+  // vertex count is).
+  std::vector<std::uint32_t> offset_in_voxel;
+  // Chunk c starts at own point chunk_start_point[c] of voxline chunk_start_voxline[c].
+  std::vector<std::uint64_t> chunk_start_voxline, chunk_start_point;
+
+  bool connected(std::uint64_t j) const { return !starts_streamline[j + 1]; }
+  std::uint64_t first_vertex(std::uint64_t j) const {
+    return voxels[voxlines[j].voxel].vertex_first + offset_in_voxel[j];
+  }
+};
+
+// Inflates and decodes the voxline table, the voxel and the count streams side by side.
+std::vector<VoxlineEntry> read_voxlines(const VxlzFile& f, std::span<const std::array<std::int32_t, 3>> coords) {
+  const std::uint64_t l = f.meta().voxline_count;
+  const std::uint32_t vxlv = section_id("VXLV"), vxlc = section_id("VXLC");
+  std::vector<std::uint8_t> voxel_stream, count_stream;
+  std::vector<VoxlineEntry> voxlines;
+  auto both = [](auto&& voxel_part, auto&& count_part) { parallel_invoke(true, voxel_part, count_part); };
+  both([&] { voxel_stream = f.inflate(vxlv); }, [&] { count_stream = f.inflate(vxlc); });
+  // Every entry takes at least a byte of each stream: refuse a count they cannot hold before allocating.
+  if (l > voxel_stream.size() || l > count_stream.size())
+    fail_input(f.path(), f.context(l > voxel_stream.size() ? vxlv : vxlc).section_offset,
+               "stream too short for META's " + std::to_string(l) + " voxlines");
+  voxlines.resize(l);
+  both([&] { decode_voxline_voxels(voxel_stream, coords, voxlines, f.context(vxlv)); },
+       [&] { decode_voxline_counts(count_stream, voxlines, f.context(vxlc)); });
+  return voxlines;
+}
+
+Structure rebuild_structure(const VxlzFile& f, std::uint32_t level_count) {
+  const MetaSection& m = f.meta();
+  const PackSection& k = f.pack();
+  const std::string& p = f.path();
+  Structure s;
+  s.level_count = level_count;
+  const auto coords =
+      decode_voxel_coords(f.inflate(section_id("VOXC")), m.voxel_count, m.grid_dims, f.context(section_id("VOXC")));
+  s.strm = decode_streamline_voxlines(f.inflate(section_id("STRL")), m.streamline_count, m.voxline_count,
+                                      f.context(section_id("STRL")));
+  s.voxlines = read_voxlines(f, coords);
+
+  const std::uint64_t vxlc_at = f.context(section_id("VXLC")).section_offset;
+  const std::uint64_t l = m.voxline_count;
+  s.starts_streamline.assign(l + 1, 0);
+  s.starts_streamline[l] = 1;
+  for (std::uint64_t j = 0; j < m.streamline_count; ++j) {
+    if (s.strm[j] == s.strm[j + 1]) continue;
+    s.starts_streamline[s.strm[j]] = 1;
+    if (s.voxlines[s.strm[j]].count_flags & kVoxlineSyntheticFirst)
+      fail_input(p, vxlc_at, "streamline " + std::to_string(j) + " starts with a synthetic point");
+  }
+
+  // One walk: every voxline's place among its voxel's voxlines of its streamline's depth (spec §5.12), the
+  // counts per voxel and depth, the chunk starts, the totals. Streamline by streamline: the depth is the
+  // streamline's.
+  const std::uint32_t levels = level_count;
+  std::vector<std::uint64_t> vertex_count(std::uint64_t(m.voxel_count) * levels, 0),
+      voxline_count(std::uint64_t(m.voxel_count) * levels, 0);
+  s.offset_in_voxel.resize(l);
+  s.chunk_start_voxline.reserve(k.chunk_count);
+  s.chunk_start_point.reserve(k.chunk_count);
+  std::uint64_t points = 0, synthetic = 0;
+  auto for_each_voxline = [&](auto&& body) {
+    for (std::uint64_t st = 0; st < m.streamline_count; ++st) {
+      const std::uint32_t depth = streamline_depth(st, levels);
+      for (std::uint64_t j = s.strm[st]; j < s.strm[st + 1]; ++j) body(j, depth);
+    }
+  };
+  for_each_voxline([&](std::uint64_t j, std::uint32_t depth) {
+    const VoxlineEntry& e = s.voxlines[j];
+    const std::uint64_t own = e.count_flags & kVoxlineCountMask;
+    std::uint64_t& count = vertex_count[std::uint64_t(e.voxel) * levels + depth];
+    if (count + own + s.connected(j) > 0xFFFFFFFFu)
+      fail_input(p, vxlc_at, "voxel " + std::to_string(e.voxel) + " gets 2^32 or more vertices");
+    if (own > k.point_count - points)
+      fail_input(p, vxlc_at, "voxlines hold more points than PACK's point count " + std::to_string(k.point_count));
+    s.offset_in_voxel[j] = static_cast<std::uint32_t>(count);  // within its depth, for now
+    count += own + s.connected(j);
+    voxline_count[std::uint64_t(e.voxel) * levels + depth] += 1;
+    // Chunks start every chunk_points shipped points; record which voxline holds each start.
+    while (s.chunk_start_voxline.size() < k.chunk_count &&
+           s.chunk_start_voxline.size() * k.chunk_points < points + own) {
+      s.chunk_start_voxline.push_back(j);
+      s.chunk_start_point.push_back(s.chunk_start_voxline.size() * k.chunk_points - k.chunk_points - points);
+    }
+    points += own;
+    synthetic += e.count_flags >> 31;
+  });
+  std::uint64_t vertices = 0;
+  s.voxels.resize(m.voxel_count);
+  s.levels.resize(std::uint64_t(m.voxel_count) * (levels - 1));
+  // depth_start[i * levels + d]: where depth d's voxlines begin in voxel i's block (after the deeper ones).
+  std::vector<std::uint32_t> depth_start(std::uint64_t(m.voxel_count) * levels, 0);
+  for (std::uint32_t i = 0; i < m.voxel_count; ++i) {
+    std::uint64_t prefix_vertices = 0, prefix_segments = 0;
+    for (std::uint32_t d = levels; d-- > 0;) {
+      depth_start[std::uint64_t(i) * levels + d] = static_cast<std::uint32_t>(prefix_vertices);
+      prefix_vertices += vertex_count[std::uint64_t(i) * levels + d];
+      prefix_segments += vertex_count[std::uint64_t(i) * levels + d] - voxline_count[std::uint64_t(i) * levels + d];
+      if (prefix_vertices > 0xFFFFFFFFu)
+        fail_input(p, vxlc_at, "voxel " + std::to_string(i) + " gets 2^32 or more vertices");
+      if (d > 0)
+        s.levels[std::uint64_t(i) * (levels - 1) + d - 1] = {static_cast<std::uint32_t>(prefix_vertices),
+                                                             static_cast<std::uint32_t>(prefix_segments)};
+    }
+    if (prefix_vertices < 1) fail_input(p, vxlc_at, "voxel " + std::to_string(i) + " gets no vertices");
+    VoxelEntry& v = s.voxels[i];
+    v = {};
+    std::copy(coords[i].begin(), coords[i].end(), v.coord);
+    v.vertex_first = vertices;
+    v.vertex_count = static_cast<std::uint32_t>(prefix_vertices);
+    v.segment_count = static_cast<std::uint32_t>(prefix_segments);
+    vertices += prefix_vertices;
+  }
+  for_each_voxline([&](std::uint64_t j, std::uint32_t depth) {
+    s.offset_in_voxel[j] += depth_start[std::uint64_t(s.voxlines[j].voxel) * levels + depth];
+  });
+  auto expect = [&](const char* what, std::uint64_t got, std::uint64_t meta_value) {
+    if (got != meta_value)
+      fail_input(p, vxlc_at,
+                 std::string("voxlines give ") + std::to_string(got) + " " + what + " but META says " +
+                     std::to_string(meta_value));
+  };
+  expect("vertices", vertices, m.vertex_count);
+  expect("segments", vertices - l, m.segment_count);
+  expect("synthetic points", synthetic, m.synthetic_point_count);
+  expect("source points", points - synthetic, m.point_count);
+  expect("shipped points", points, k.point_count);
+  s.order_bytes = layout_orders(s.voxels, s.levels, levels, m.stored_order_count);
+  return s;
+}
+
+// The shipped PROV with the package's parameters added (spec §7 step 6).
+std::string provenance_with_package(const VxlzFile& f) {
+  nlohmann::json j = nlohmann::json::object();
+  if (f.has_section(section_id("PROV"))) {
+    const std::vector<std::uint8_t> raw = f.inflate(section_id("PROV"));
+    j = parse_json({reinterpret_cast<const char*>(raw.data()), raw.size()}, f.path(), std::nullopt, "PROV");
+    if (j.is_discarded() || !j.is_object())
+      fail_input(f.path(), f.context(section_id("PROV")).section_offset, "PROV is not a JSON object");
+  }
+  const PackSection& k = f.pack();
+  j["vxlz"] = {{"package", std::filesystem::path(f.path()).filename().string()},
+               {"bits", k.quantization_bits},
+               {"quantum_mm", k.quantum},
+               {"range_mm", k.range},
+               {"error_bound_mm", k.error_bound},
+               {"max_error_mm", k.max_error},
+               {"rms_error_mm", k.rms_error}};
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// Decodes chunk c into VERT (spec §5, §6, §7 step 4): own points at their voxline's place, and each
+// voxline's first point also as the connecting vertex of the voxline before it in the same streamline.
+// Marks the last vertex of every voxline that ends in this chunk (for the orders).
+void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, std::span<float> vert,
+                  VoxlineEnds& ends) {
+  const Quantizer quantizer(f.pack());
+  const std::uint64_t count = f.chunk_point_count(chunk);
+  const ChunkBytes bytes = f.chunk(chunk);
+  ResidualChunk residuals(bytes, f.pack().joint_bits, count, f.path());
+
+  std::uint64_t j = s.chunk_start_voxline[chunk];
+  std::uint64_t in_voxline = s.chunk_start_point[chunk];
+  LinearPredictor predictor;
+  predictor.reset();
+  const std::uint64_t max_value = quantizer.max_value();
+  for (std::uint64_t i = 0; i < count;) {
+    const std::uint64_t own = s.voxlines[j].count_flags & kVoxlineCountMask;
+    const std::uint64_t run = std::min(own - in_voxline, count - i);
+    const std::uint64_t first = s.first_vertex(j);
+    if (in_voxline == 0 && s.starts_streamline[j]) predictor.start_streamline();
+    float* dst = vert.data() + 3 * (first + in_voxline);
+    for (std::uint64_t r = 0; r < run; ++r, dst += 3) {
+      std::int32_t residual[3];
+      residuals.next(residual);
+      std::array<std::int64_t, 3> q;
+      for (int a = 0; a < 3; ++a) q[a] = predictor.predict(a) + residual[a];
+      // One unsigned comparison per value also catches negatives; checked per point so that a damaged
+      // chunk cannot drive the prediction into overflow.
+      if (static_cast<std::uint64_t>(q[0]) > max_value || static_cast<std::uint64_t>(q[1]) > max_value ||
+          static_cast<std::uint64_t>(q[2]) > max_value)
+        fail_input(f.path(), bytes.symbols_offset,
+                   "position chunk: point " + std::to_string(chunk * f.pack().chunk_points + i + r) +
+                       " decodes outside the quantisation grid");
+      for (int a = 0; a < 3; ++a) dst[a] = quantizer.dequantize(q[a], a);
+      predictor.push(q);
+    }
+    if (in_voxline == 0 && !s.starts_streamline[j]) {
+      // The previous voxline's connecting vertex is a copy of this first point, bit for bit.
+      const std::uint64_t previous_own = s.voxlines[j - 1].count_flags & kVoxlineCountMask;
+      std::memcpy(vert.data() + 3 * (s.first_vertex(j - 1) + previous_own), vert.data() + 3 * first, 12);
+    }
+    i += run;
+    in_voxline += run;
+    if (in_voxline == own) {
+      ends.set(first + own + s.connected(j) - 1);
+      ++j;
+      in_voxline = 0;
+    }
+  }
+}
+
+// The value sets as the .vxl lays them out (spec §7 step 8): per vertex, each voxline's own values at
+// its own vertices and, at its connecting vertex, a copy of the next voxline's first value (as the
+// positions); per streamline, as shipped.
+void write_point_values(const Structure& s, const std::vector<NamedValues>& sets, std::span<std::uint8_t> payload,
+                        std::uint64_t vertex_count, unsigned threads) {
+  std::vector<std::string> names;
+  for (const NamedValues& v : sets) names.push_back(v.name);
+  const std::vector<std::span<float>> arrays = layout_value_sets(payload, names, vertex_count);
+  parallel_for(sets.size(), threads, [&](std::uint64_t k, unsigned) {
+    const float* shipped = sets[k].values.data();
+    std::uint64_t point = 0;
+    for (std::uint64_t j = 0; j < s.voxlines.size(); ++j) {
+      const std::uint64_t own = s.voxlines[j].count_flags & kVoxlineCountMask;
+      float* dst = arrays[k].data() + s.first_vertex(j);
+      std::copy(shipped + point, shipped + point + own, dst);
+      point += own;
+      if (s.connected(j)) dst[own] = shipped[point];
+    }
+  });
+  finish_value_sets(payload);
+}
+
+void write_streamline_values(const std::vector<NamedValues>& sets, std::span<std::uint8_t> payload,
+                             std::uint64_t count) {
+  std::vector<std::string> names;
+  for (const NamedValues& v : sets) names.push_back(v.name);
+  const std::vector<std::span<float>> arrays = layout_value_sets(payload, names, count);
+  for (std::size_t k = 0; k < sets.size(); ++k)
+    std::copy(sets[k].values.begin(), sets[k].values.end(), arrays[k].begin());
+  finish_value_sets(payload);
+}
+
+template <typename T>
+std::span<std::uint8_t> bytes_of(std::span<T> s) {
+  return {reinterpret_cast<std::uint8_t*>(s.data()), s.size_bytes()};
+}
+
+// GDAT (package spec §4.8): the .vxl payload, deflated. Checked as a .vxl reader checks it, against the
+// package's groups, so that the .vxl written opens.
+std::vector<std::uint8_t> unpacked_group_values(const VxlzFile& f, std::uint64_t group_count) {
+  const StreamContext context = f.context(section_id("GDAT"));
+  std::vector<std::uint8_t> raw = f.inflate(section_id("GDAT"));
+  (void)decode_group_values(raw, group_count, [&](std::uint64_t pos, const std::string& what) {
+    fail_input(context.file, context.section_offset,
+               "section GDAT, inflated byte " + std::to_string(pos) + ": " + what);
+  });
+  return raw;
+}
+
+// What a package carries besides the positions and the tables: groups, their values and the value sets.
+struct PackageExtras {
+  std::vector<std::uint8_t> groups_bytes;        // GRPS's .vxl payload
+  std::vector<std::uint8_t> group_values_bytes;  // GDAT's
+  std::vector<NamedValues> point_values, streamline_values;
+};
+
+PackageExtras read_extras(const VxlzFile& f, unsigned threads) {
+  PackageExtras extras;
+  std::uint64_t group_count = 0;
+  if (f.has_section(section_id("GRPS"))) {
+    const std::vector<StreamlineGroup> groups =
+        decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count, f.context(section_id("GRPS")));
+    group_count = groups.size();
+    extras.groups_bytes = encode_groups(groups);
+  }
+  // GDAT travels as the .vxl payload (package spec §4.8): checked against the groups, written back as it came.
+  if (f.has_section(section_id("GDAT"))) extras.group_values_bytes = unpacked_group_values(f, group_count);
+
+  // Value sets (spec §4.7), checked against PACK's and META's counts before anything is inflated.
+  if (f.has_section(section_id("PVAL")))
+    extras.point_values = decode_value_section(f.section_payload(section_id("PVAL")), f.pack().point_count,
+                                               f.context(section_id("PVAL")), threads);
+  if (f.has_section(section_id("SVAL")))
+    extras.streamline_values = decode_value_section(f.section_payload(section_id("SVAL")), f.meta().streamline_count,
+                                                    f.context(section_id("SVAL")), threads);
+  return extras;
+}
+
+// Sets META's bounds from the voxels' tight bounds (package spec §7 step 1), and refuses what a damaged
+// package would make: a grid, or positions decoded outside their voxels, that open() refuses.
+void set_bounds_checked(MetaSection& meta, std::span<const VoxelEntry> voxels, const std::string& path) {
+  // The global bounds (step 1).
+  for (int c = 0; c < 3; ++c) {
+    meta.bounds_min[c] = meta.bounds_max[c] = 0;
+    for (std::size_t i = 0; i < voxels.size(); ++i) {
+      meta.bounds_min[c] =
+          i == 0 ? voxels[i].tight_min[c] : std::min<double>(meta.bounds_min[c], voxels[i].tight_min[c]);
+      meta.bounds_max[c] =
+          i == 0 ? voxels[i].tight_max[c] : std::max<double>(meta.bounds_max[c], voxels[i].tight_max[c]);
+    }
+  }
+  // A damaged package's grid, or positions it decodes outside their voxels, would make a file open() refuses.
+  check_grid_geometry(meta, path, std::nullopt);
+  for (std::size_t i = 0; i < voxels.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      if (!tight_bounds_in_place(meta, voxels[i], c))
+        fail_input(path, std::nullopt,
+                   "the positions decode outside their voxels: " + misplaced_voxel(meta, voxels[i], i, c));
+}
+
+// Each streamline's length (SLEN, spec §5.15) from the decoded points, synthetic face points left out: the
+// package's positions are the source of the file written.
+void measure_streamlines(const Structure& s, std::span<const float> vertices, std::span<float> lengths,
+                         unsigned threads) {
+  const std::uint64_t n = lengths.size(), parts = std::min<std::uint64_t>(n, 64ull * threads);
+  parallel_for(parts, threads, [&](std::uint64_t part, unsigned) {
+    std::vector<float> xyz;
+    for (std::uint64_t k = n * part / parts; k < n * (part + 1) / parts; ++k) {
+      xyz.clear();
+      for (std::uint64_t j = s.strm[k]; j < s.strm[k + 1]; ++j) {
+        const std::uint32_t own = s.voxlines[j].count_flags & kVoxlineCountMask;
+        const std::uint32_t from = (s.voxlines[j].count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
+        const float* first = vertices.data() + 3 * s.first_vertex(j);
+        xyz.insert(xyz.end(), first + 3 * from, first + 3 * std::max(own, from));
+      }
+      lengths[k] = stored_length_of(xyz);
+    }
+  });
+}
+
+}  // namespace
+
+UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
+  using Clock = std::chrono::steady_clock;
+  auto seconds_since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  const unsigned threads = resolve_threads(settings.threads);
+  auto progress = [&](const char* stage, double fraction) {
+    if (settings.progress) settings.progress(stage, fraction);
+  };
+  UnpackSummary summary;
+  auto t0 = Clock::now();
+  progress("decoding", 0.0);
+
+  detail::check_level_count(settings.levels, in_path);
+  const VxlzFile f = VxlzFile::open(in_path);
+  if (f.meta().order_set == static_cast<std::uint32_t>(OrderSet::Random))
+    fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");
+  Structure s = rebuild_structure(f, settings.levels);
+  const std::string provenance = provenance_with_package(f);
+  PackageExtras extras = read_extras(f, threads);
+
+  MetaSection meta = f.meta();
+  meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
+  meta.level_count = s.level_count > 1 && meta.voxel_count > 0 ? s.level_count : 0;
+  const bool packed = settings.positions == PositionEncoding::Packed;
+  VxlSectionSizes sizes = section_sizes(meta, s.order_bytes, provenance.size(), extras.groups_bytes.size(),
+                                        static_cast<std::uint32_t>(extras.point_values.size()),
+                                        static_cast<std::uint32_t>(extras.streamline_values.size()));
+  sizes.group_values = extras.group_values_bytes.size();
+  VxlWriter out(out_path, sizes);
+  // Packed positions are decoded as floats first (tight bounds and orders come from them), then packed.
+  std::vector<float> float_blocks(packed ? 3 * meta.vertex_count : 0);
+  const std::span<float> vertices = packed ? std::span<float>(float_blocks) : out.float_vertices();
+  prefault_for_write(bytes_of(out.float_vertices()), threads);
+  std::copy(s.voxels.begin(), s.voxels.end(), out.voxels().begin());
+  std::copy(s.levels.begin(), s.levels.end(), out.levels().begin());
+
+  // Positions: chunks in parallel, each into its own voxlines' places.
+  std::atomic<std::uint64_t> done{0};
+  VoxlineEnds ends(meta.vertex_count);
+  parallel_for(f.chunk_count(), threads, [&](std::uint64_t chunk, unsigned t) {
+    decode_chunk(f, s, chunk, vertices, ends);
+    if (t == 0)
+      progress("decoding", double(++done) / double(f.chunk_count()));
+    else
+      ++done;
+  });
+
+  measure_streamlines(s, vertices, out.streamline_lengths(), threads);
+  summary.decode_seconds = seconds_since(t0);
+
+  // Per voxel, while its block is in cache: its tight bounds from the decoded vertices (spec §7 step 3),
+  // then its orders for the shipped directions (step 5).
+  t0 = Clock::now();
+  OrderSetSpec set;
+  set.kind = static_cast<OrderSet>(meta.order_set);
+  for (const DirectionEntry& d : f.directions()) set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
+  // ORDB and the sections after it (VXLN, STRM, PROV, GRPS), which are filled after the orders: one
+  // populate for all, instead of a fault per page for the voxline table's 8 bytes per voxline.
+  prefault_for_write(out.file().subspan(static_cast<std::size_t>(out.orders().data() - out.file().data())), threads);
+  std::span<VoxelEntry> voxels = out.voxels();
+  std::vector<VoxelOrderWriter> writers;
+  for (unsigned t = 0; t < threads; ++t) writers.emplace_back(set);
+  std::atomic<std::uint64_t> ordered{0};
+  std::vector<double> repack_bound(threads, 0.0);  // per thread: the largest of its voxels' packing bounds
+  // One more item before the voxels: float32 vertices are final, so their checksum is taken here, beside
+  // the orders, rather than alone at the end.
+  parallel_for(voxels.size() + 1, threads, [&](std::uint64_t item, unsigned t) {
+    if (item == 0) {
+      if (!packed) out.checksum_vertices_now();
+      return;
+    }
+    VoxelEntry& v = voxels[item - 1];
+    detail::set_tight_bounds({&v, 1}, vertices.data(), 0);
+    const std::span<const LevelEntry> row = level_row(s.levels, item - 1, s.level_count);
+    std::uint8_t* orders = out.orders().data() + v.order_offset;
+    // Orders from what the file holds, as every conversion builds them: the packed words, or the floats.
+    if (packed) {
+      pack_vertex_blocks({&v, 1}, vertices, ends, out.packed_vertices(), 1);
+      repack_bound[t] = std::max(repack_bound[t], packed_error_bound(v));
+      writers[t].write_packed(v, row, out.packed_vertices().data() + v.vertex_first, orders);
+    } else {
+      writers[t].write(v, row, vertices, ends, orders);
+    }
+    const std::uint64_t d = ++ordered;
+    if (t == 0 && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
+  });
+  progress("ordering", 1.0);
+  float_blocks = {};
+  set_bounds_checked(meta, voxels, f.path());
+  summary.orders_seconds = seconds_since(t0);
+
+  t0 = Clock::now();
+  progress("writing", 0.0);
+  out.set_meta(meta);
+  std::copy(f.directions().begin(), f.directions().end(), out.directions().begin());
+  std::copy(s.voxlines.begin(), s.voxlines.end(), out.voxlines().begin());
+  std::copy(s.strm.begin(), s.strm.end(), out.streamline_first_voxline().begin());
+  std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
+  std::copy(extras.groups_bytes.begin(), extras.groups_bytes.end(), out.groups().begin());
+  std::copy(extras.group_values_bytes.begin(), extras.group_values_bytes.end(), out.group_values().begin());
+  if (!extras.point_values.empty())
+    write_point_values(s, extras.point_values, out.vertex_values(), meta.vertex_count, threads);
+  if (!extras.streamline_values.empty())
+    write_streamline_values(extras.streamline_values, out.streamline_values(), meta.streamline_count);
+  out.commit(threads);
+  summary.write_seconds = seconds_since(t0);
+  progress("writing", 1.0);
+
+  summary.streamlines = meta.streamline_count;
+  summary.points = meta.point_count;
+  summary.voxels = meta.voxel_count;
+  summary.pack = f.pack();
+  summary.repack_error_bound = *std::max_element(repack_bound.begin(), repack_bound.end());
+  summary.point_value_sets = static_cast<std::uint32_t>(extras.point_values.size());
+  summary.streamline_value_sets = static_cast<std::uint32_t>(extras.streamline_values.size());
+  return summary;
+}
+
+}  // namespace vxl

@@ -1,0 +1,42 @@
+// `voxlines unpack`: a .vxlz package back to a .vxl (spec/vxlz-package-v2.md §7). The tables are taken
+// as shipped (never re-voxelised: quantisation could move a point across a voxel face), the position
+// chunks are decoded in parallel straight into the output's vertex blocks, the connecting vertices are
+// written as copies of the decoded next points, and the tight bounds and the orders are recomputed from
+// the decoded vertices. The value sets come back bit-exact, per vertex as the converter laid them out.
+// The result passes `voxlines verify`.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "converter/convert/voxelize.h"
+#include "format/vxl_levels.h"
+#include "format/vxl_positions.h"
+#include "format/vxlz_layout.h"
+
+namespace vxl {
+
+struct UnpackSettings {
+  unsigned threads = 0;                                   // 0: all cores
+  PositionEncoding positions = PositionEncoding::Packed;  // of the .vxl written (spec §5.4)
+  std::uint32_t levels = kDefaultLevels;                  // of the .vxl written (spec §5.12), 1 .. kMaxLevels
+  ProgressFn progress;                                    // stages "decoding", "ordering", "writing"; may be empty
+};
+
+struct UnpackSummary {
+  std::uint64_t streamlines = 0, points = 0, voxels = 0;
+  PackSection pack{};             // quantisation and the stated bound
+  double repack_error_bound = 0;  // of the packed positions written (0 for float32), per axis, in mm
+  // How far, per axis, a written position may lie from the packed .vxl's: the package's quantisation
+  // and then the output's own packing.
+  double error_bound() const { return pack.error_bound + repack_error_bound; }
+  std::uint32_t point_value_sets = 0, streamline_value_sets = 0;  // VVAL / SVAL written, bit-exact
+  double decode_seconds = 0, orders_seconds = 0, write_seconds = 0;
+};
+
+// Validates the whole package (spec §8) and writes `out_path` atomically: a refused package leaves
+// nothing at the output path. Throws vxl::Error (Input for a damaged package, naming the file, the byte
+// offset and what was expected; Unsupported for a newer version; Output).
+UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings);
+
+}  // namespace vxl
