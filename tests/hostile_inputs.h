@@ -1,6 +1,6 @@
 // Hostile source files, written by code so that the test tree holds no binary data: each function writes
 // one damaged or malicious file (or FIFO) to `path`. They stay small on disk; the bombs among them would
-// inflate to tens of MiB, which the fixed readers refuse long before.
+// inflate to tens of MiB, which the readers refuse long before.
 #pragma once
 
 #include <algorithm>

@@ -77,7 +77,7 @@ TEST(ReadTrx, EveryFixtureHasTheDocumentedCounts) {
   }
 }
 
-// Reference values: an independent reader (zipfile + numpy), run in ../shared/data/real as
+// Reference values: an independent reader (zipfile + numpy), run in the real-data folder as
 //   /usr/bin/python3 -c "import zipfile, json, numpy as np; z =
 //   zipfile.ZipFile('niivue__sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx'); h =
 //   json.loads(z.read('header.json')); p = np.frombuffer(z.read('positions.3.float32'), '<f4').reshape(-1, 3); o =

@@ -1,8 +1,8 @@
 // How much memory a conversion may take without a --memory-limit, and when to stream instead.
 //
-// A conversion in memory holds the source's points, the voxel blocks and the orders at once: measured
-// peaks are 2.5 to 2.6 times the TCK's size (1M synthetic streamlines: 1.4 GB for 539 MB; 10M: 17.3 GB for
-// 6.9 GB). When that estimate does not fit in what is available (format/base/memory_available.h),
+// A conversion in memory holds the source's points, the voxel blocks and the orders at once: its peak is
+// about twice the TCK's size (1M synthetic streamlines: 1.36 GB for a 690 MB TCK), estimated at three times
+// for a margin. When that estimate does not fit in what is available (format/base/memory_available.h),
 // `voxlines convert` and voxview stream the TCK (streaming_convert.h) within a limit that does, and say so
 // (source_to_vxl.h).
 #pragma once
