@@ -80,8 +80,18 @@ void VertexPacker::words(const float* xyz, std::uint64_t count, std::uint32_t* p
 }
 
 void VertexPacker::decode(const std::uint32_t* packed, std::uint64_t count, float* xyz) const {
-  for (std::uint64_t i = 0; i < count; ++i)
-    for (int c = 0; c < 3; ++c) xyz[3 * i + c] = decode_axis(c, (packed[i] >> (10 * c)) & kPackedAxisMask);
+  // The bounds in locals: `xyz` may alias the members as far as the compiler knows, which would reload them
+  // for every coordinate. The same arithmetic as decode_axis.
+  const float lo_x = lo_[0], lo_y = lo_[1], lo_z = lo_[2], step_x = step_[0], step_y = step_[1], step_z = step_[2];
+  for (std::uint64_t i = 0; i < count; ++i, xyz += 3) {
+    const std::uint32_t w = packed[i];
+    const float dx = static_cast<float>(w & kPackedAxisMask) * step_x;
+    const float dy = static_cast<float>((w >> 10) & kPackedAxisMask) * step_y;
+    const float dz = static_cast<float>((w >> 20) & kPackedAxisMask) * step_z;
+    xyz[0] = lo_x + dx;
+    xyz[1] = lo_y + dy;
+    xyz[2] = lo_z + dz;
+  }
 }
 
 void pack_block(const VoxelEntry& voxel, float* xyz, std::uint32_t count, std::uint32_t* packed) {

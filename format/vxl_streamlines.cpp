@@ -7,6 +7,49 @@
 #include "format/base/error.h"
 
 namespace vxl {
+namespace {
+
+// The vertices of the voxline kLookahead entries ahead of the walk, prefetched: the voxlines of one streamline lie in
+// different voxels' blocks, far apart, and a walk that reads points otherwise waits on memory for each one. Where they
+// land is their voxel's cursor now (exact unless a voxline between moves it): a hint only.
+class VertexPrefetch {
+ public:
+  VertexPrefetch(const VxlFile& f, const WalkCallbacks& cb, const std::vector<std::uint64_t>& cursor)
+      : f_(f), cb_(cb), cursor_(cursor), levels_(f.level_count()), count_(f.meta().streamline_count) {
+    const bool packed = f.position_encoding() == PositionEncoding::Packed;
+    base_ = packed ? reinterpret_cast<const std::uint8_t*>(f.packed_vertices().data())
+                   : reinterpret_cast<const std::uint8_t*>(f.float_vertices().data());
+    vertex_bytes_ = packed ? 4 : 12;
+    read_ = count_ > 0 && reads(0);
+  }
+  // Called for voxline j, in order.
+  void operator()(std::uint64_t j) {
+    const auto strm = f_.streamline_first_voxline();
+    const std::uint64_t target = j + kLookahead;
+    if (target >= strm[count_]) return;
+    while (streamline_ + 1 < count_ && strm[streamline_ + 1] <= target) read_ = reads(++streamline_);
+    if (!read_) return;
+    const std::uint32_t voxel = f_.voxlines()[target].voxel;
+    if (voxel >= f_.voxels().size()) return;  // a damaged entry: the walk refuses it when it reaches it
+    const std::uint64_t at = cursor_[voxel * levels_ + streamline_depth(streamline_, levels_)];
+    if (at < f_.meta().vertex_count) __builtin_prefetch(base_ + at * vertex_bytes_);
+  }
+
+ private:
+  static constexpr std::uint64_t kLookahead = 16;
+  bool reads(std::uint64_t s) const { return !cb_.read_points || cb_.read_points(s); }
+  const VxlFile& f_;
+  const WalkCallbacks& cb_;
+  const std::vector<std::uint64_t>& cursor_;
+  std::uint32_t levels_;
+  std::uint64_t count_;
+  const std::uint8_t* base_ = nullptr;
+  std::uint64_t vertex_bytes_ = 4;
+  std::uint64_t streamline_ = 0;  // the streamline of voxline j + kLookahead
+  bool read_ = false;             // whether its points are read
+};
+
+}  // namespace
 
 void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   const std::string& p = f.path();
@@ -29,7 +72,7 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
       cursor[i * levels + d] = voxels[i].vertex_first + depth_first_vertex(f.levels_of(i), d);
       cursor_end[i * levels + d] = voxels[i].vertex_first + depth_end_vertex(voxels[i], f.levels_of(i), d);
     }
-  std::vector<float> points, block;
+  std::vector<float> points;
   std::uint64_t total_points = 0, synthetic = 0;
   // The mapped pages read are let go every so often: a walk through a whole file (export, a large selection)
   // otherwise keeps every page it touched resident (the 1M set's blocks and tables: 365 MB).
@@ -38,14 +81,18 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   std::uint64_t read_since_release = 0;
   // A connecting vertex and the next voxline's first point are one source point, stored in two voxels'
   // blocks: equal bit for bit as float32, within both voxels' error bounds when packed (spec §5.4).
+  std::vector<double> error_bound;  // per voxel, packed
+  if (packed)
+    for (const VoxelEntry& v : voxels) error_bound.push_back(packed_error_bound(v));
   auto same_point = [&](const float* a, std::uint32_t voxel_a, const float* b, std::uint32_t voxel_b) {
     if (!packed) return std::memcmp(a, b, 12) == 0;
-    const double tolerance = packed_error_bound(voxels[voxel_a]) + packed_error_bound(voxels[voxel_b]);
+    const double tolerance = error_bound[voxel_a] + error_bound[voxel_b];
     for (int c = 0; c < 3; ++c)
       if (!(std::abs(double(a[c]) - double(b[c])) <= tolerance)) return false;
     return true;
   };
 
+  VertexPrefetch prefetch(f, cb, cursor);
   for (std::uint64_t s = 0; s < m.streamline_count; ++s) {
     const std::uint64_t first = strm[s], last = strm[s + 1];
     const std::uint32_t depth = streamline_depth(s, levels);
@@ -54,6 +101,7 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
     float pending_connector[3];  // previous voxline's connecting vertex, when `connector_voxel` is set
     std::int64_t connector_voxel = -1;
     for (std::uint64_t j = first; j < last; ++j) {
+      prefetch(j);
       const VoxlineEntry& e = voxlines[j];
       const std::uint64_t at = vxln_at + 8 * j;
       f.check_voxline(j);
@@ -72,14 +120,18 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
       read_since_release += sizeof(VoxlineEntry);
       if (read) {
         read_since_release += need * vertex_bytes;
-        block.resize(3 * need);
-        f.read_vertices(e.voxel, here, need, block.data());
+        // Decoded straight into `points`; the synthetic first point and the connecting vertex are taken off after.
+        const std::size_t start = points.size();
+        points.resize(start + 3 * need);
+        float* const block = points.data() + start;
+        f.read_vertices(e.voxel, here, need, block);
         if (connector_voxel >= 0 &&
-            !same_point(pending_connector, static_cast<std::uint32_t>(connector_voxel), block.data(), e.voxel))
+            !same_point(pending_connector, static_cast<std::uint32_t>(connector_voxel), block, e.voxel))
           fail_input(p, at, "connecting vertex differs from the next voxline's first point");
-        points.insert(points.end(), block.begin() + 3 * skip, block.begin() + 3 * own);
         connector_voxel = connected ? std::int64_t(e.voxel) : -1;
-        if (connected) std::copy_n(block.begin() + 3 * own, 3, pending_connector);
+        if (connected) std::copy_n(block + 3 * own, 3, pending_connector);
+        if (skip > 0) std::copy(block + 3 * skip, block + 3 * own, block);
+        points.resize(start + 3 * (own - skip));
       }
       if (cb.voxline) cb.voxline({s, e.voxel, here, own, synthetic_first, j == first, connected});
       here += need;

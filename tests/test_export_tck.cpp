@@ -6,6 +6,7 @@
 
 #include "converter/convert/convert.h"
 #include "converter/export/export_tck.h"
+#include "converter/export/tck_writer.h"
 #include "converter/readers/mrtrix_header.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/synth/synth.h"
@@ -49,6 +50,29 @@ nlohmann::json values(std::initializer_list<const char*> v) {
   nlohmann::json a = nlohmann::json::array();
   for (const char* s : v) a.push_back(s);
   return a;
+}
+
+// Told the points up front, a TCK (or TSF) is written past the page cache by a queue of its own: the same bytes as
+// written through the page cache, also when the streamlines outgrow several of its stagings; told more points
+// than it is given, it refuses to commit, and nothing appears at the path.
+TEST(TckWriter, KnowingItsSizeItWritesTheSameBytesPastThePageCache) {
+  ScratchDir dir;
+  SynthSettings synth;
+  synth.streamlines = 30000;  // about 20 MB: several 4 MiB stagings
+  const Tractogram t = synthesize_tractogram(synth);
+  auto write = [&](const std::string& path, std::optional<std::uint64_t> points) {
+    TckWriter w(path, t.streamline_count(), {"note: one"}, points);
+    for (std::uint64_t i = 0; i < t.streamline_count(); ++i)
+      w.add(std::span<const float>(t.positions.data() + 3 * t.offsets[i], 3 * (t.offsets[i + 1] - t.offsets[i])));
+    w.finish();
+  };
+  write(dir.file("buffered.tck"), std::nullopt);
+  write(dir.file("direct.tck"), t.point_count());
+  const std::vector<char> buffered = test::slurp(dir.file("buffered.tck"));
+  ASSERT_GT(buffered.size(), 16u << 20);
+  EXPECT_TRUE(buffered == test::slurp(dir.file("direct.tck")));
+  EXPECT_THROW(write(dir.file("short.tck"), t.point_count() + 1), std::logic_error);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("short.tck")));
 }
 
 TEST(ExportTck, KeepsTheSourceHeaderProperties) {

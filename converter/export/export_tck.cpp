@@ -141,9 +141,9 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
   if (std::optional<std::string> lost = group_values_not_written(file, "a TCK", settings.group))
     summary.warnings.push_back(*lost);
 
-  TckWriter writer(out_path, counts.streamlines, header);
+  TckWriter writer(out_path, counts.streamlines, header, counts.points);
   std::optional<TsfWriter> tsf;
-  if (settings.tsf_path) tsf.emplace(*settings.tsf_path, counts.streamlines, header);
+  if (settings.tsf_path) tsf.emplace(*settings.tsf_path, counts.streamlines, header, counts.points);
   std::uint64_t point = 0;
   WalkCallbacks cb;
   cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };

@@ -1,6 +1,8 @@
 #include "converter/export/tck_writer.h"
 
+#include <cstdlib>
 #include <limits>
+#include <stdexcept>
 
 #include "converter/readers/mrtrix_header.h"
 
@@ -23,12 +25,38 @@ std::string mrtrix_header(const std::string& magic, std::uint64_t count, const s
 
 }  // namespace
 
+namespace {
+
+// Bytes staged per direct write: large enough that the writes are few, small beside the output; the queue's
+// spares let the writes fall this many stagings behind.
+constexpr std::uint64_t kDirectStagingBytes = 4ull << 20;
+constexpr std::uint64_t kSpareStagings = 2;
+
+}  // namespace
+
 MrtrixTrackWriter::MrtrixTrackWriter(const std::string& path, const char* magic, std::size_t record_values,
-                                     std::uint64_t count, const std::vector<std::string>& extra_header)
+                                     std::uint64_t count, const std::vector<std::string>& extra_header,
+                                     std::optional<std::uint64_t> records)
     : out_(path), record_values_(record_values) {
   const std::string head = mrtrix_header(magic, count, extra_header);
-  out_.write(head.data(), head.size());
   buffer_.reserve(1 << 20);
+  if (!records) {
+    out_.write(head.data(), head.size());
+    return;
+  }
+  // Every record, a separator after each streamline and the terminator, 4 bytes a value.
+  const std::uint64_t size = head.size() + (*records + count + 1) * record_values * sizeof(float);
+  out_.allocate(size);
+  void* memory = std::aligned_alloc(DirectRegionWriter::kBlock, (1 + kSpareStagings) * kDirectStagingBytes);
+  if (memory == nullptr) throw std::bad_alloc();
+  stagings_ = {static_cast<std::uint8_t*>(memory), std::free};
+  std::vector<std::uint8_t*> spares;
+  for (std::uint64_t k = 1; k <= kSpareStagings; ++k) spares.push_back(stagings_.get() + k * kDirectStagingBytes);
+  const int direct_fd = out_.direct_descriptor();
+  queue_ = std::make_unique<DirectWriteQueue>(out_, direct_fd, spares, kDirectStagingBytes);
+  direct_ = std::make_unique<DirectRegionWriter>(out_, direct_fd, 0, size, kDirectStagingBytes, stagings_.get(),
+                                                 queue_.get());
+  direct_->append({reinterpret_cast<const std::uint8_t*>(head.data()), head.size()});
 }
 
 void MrtrixTrackWriter::add(std::span<const float> values) {
@@ -38,20 +66,28 @@ void MrtrixTrackWriter::add(std::span<const float> values) {
 }
 
 void MrtrixTrackWriter::flush() {
-  out_.write(buffer_.data(), buffer_.size() * sizeof(float));
+  if (direct_)
+    direct_->append({reinterpret_cast<const std::uint8_t*>(buffer_.data()), buffer_.size() * sizeof(float)});
+  else
+    out_.write(buffer_.data(), buffer_.size() * sizeof(float));
   buffer_.clear();
 }
 
 void MrtrixTrackWriter::finish() {
   buffer_.insert(buffer_.end(), record_values_, std::numeric_limits<float>::infinity());
   flush();
+  if (direct_ && !direct_->complete())
+    throw std::logic_error("MrtrixTrackWriter: fewer records than the writer was told of");
+  if (queue_) queue_->finish();
   out_.commit();
 }
 
-TckWriter::TckWriter(const std::string& path, std::uint64_t count, const std::vector<std::string>& extra_header)
-    : MrtrixTrackWriter(path, kTckFile.magic, 3, count, extra_header) {}
+TckWriter::TckWriter(const std::string& path, std::uint64_t count, const std::vector<std::string>& extra_header,
+                     std::optional<std::uint64_t> points)
+    : MrtrixTrackWriter(path, kTckFile.magic, 3, count, extra_header, points) {}
 
-TsfWriter::TsfWriter(const std::string& path, std::uint64_t count, const std::vector<std::string>& extra_header)
-    : MrtrixTrackWriter(path, kTsfFile.magic, 1, count, extra_header) {}
+TsfWriter::TsfWriter(const std::string& path, std::uint64_t count, const std::vector<std::string>& extra_header,
+                     std::optional<std::uint64_t> points)
+    : MrtrixTrackWriter(path, kTsfFile.magic, 1, count, extra_header, points) {}
 
 }  // namespace vxl

@@ -44,6 +44,9 @@ class DirectRegionWriter {
   // direct I/O (EINVAL: tmpfs, some network file systems) it falls back to pwrite for good.
   void append(std::span<const std::uint8_t> bytes);
 
+  // Whether the whole region has been appended (and so written).
+  bool complete() const { return position_ == end_; }
+
   // Where the next byte appended falls in its block (the file offset modulo kBlock).
   std::uint64_t block_lead() const { return position_ % kBlock; }
   // Appends the `size` bytes at block + block_lead(), as append does, but writes their whole blocks straight from
