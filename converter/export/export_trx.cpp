@@ -46,13 +46,6 @@ std::optional<Matrix> matrix_from(const nlohmann::json& j) {
   return m;
 }
 
-// A member name made from a group name must stay one file inside groups/, and fit the zip's 16-bit name length.
-bool usable_member_name(const std::string& name) {
-  return !name.empty() && name != "." && name != ".." &&
-         name.find_first_of(std::string("/\\\0", 3)) == std::string::npos &&
-         name.size() <= 0xFFFF - std::string("groups/.uint32").size();
-}
-
 class ZipWriter {
  public:
   explicit ZipWriter(const std::string& path) : path_(path) {
@@ -164,7 +157,7 @@ void export_trx(const VxlFile& file, const std::string& out_path, const Streamli
   // input's limit (exit 4), not a failure to write (exit 5).
   std::unordered_set<std::string> names;
   for (std::size_t g = 0; g < groups.size(); ++g) {
-    if (!usable_member_name(groups[g].name))
+    if (!usable_trx_member_name(groups[g].name, "groups/", ".uint32"))
       fail_unsupported(file.path(), "group name '" + groups[g].name.substr(0, 200) +
                                         "' cannot be a TRX member name (groups/NAME.uint32)");
     if (!names.insert(groups[g].name).second)

@@ -8,12 +8,6 @@
 namespace vxl {
 namespace {
 
-// A member name made from a set name must stay one file inside dpv/ or dps/.
-bool usable_member_name(const std::string& name) {
-  return !name.empty() && name != "." && name != ".." &&
-         name.find_first_of(std::string("/\\\0", 3)) == std::string::npos;
-}
-
 // "base[i]" -> base and i; nothing for other names.
 bool split_component(const std::string& name, std::string& base, std::uint32_t& index) {
   const std::size_t open = name.rfind('[');
@@ -39,7 +33,7 @@ void add_members(const VxlFile& file, const ValueSets& sets, const std::string& 
   for (const ValueSetRun& run : value_set_runs(sets)) {
     const std::string& base = run.name;
     const std::uint32_t k = run.first, m = run.components;
-    if (!usable_member_name(base))
+    if (!usable_trx_member_name(base, dir + "/", (m > 1 ? "." + std::to_string(m) : std::string()) + ".float32"))
       fail_unsupported(file.path(),
                        "value set name '" + base + "' cannot be a TRX member name (" + dir + "/NAME.float32)");
     TrxValueMember member;
@@ -54,6 +48,12 @@ void add_members(const VxlFile& file, const ValueSets& sets, const std::string& 
 }
 
 }  // namespace
+
+bool usable_trx_member_name(const std::string& name, const std::string& folder, const std::string& suffix) {
+  return !name.empty() && name != "." && name != ".." &&
+         name.find_first_of(std::string("/\\\0", 3)) == std::string::npos &&
+         name.size() <= 0xFFFF - folder.size() - suffix.size();
+}
 
 std::vector<ValueSetRun> value_set_runs(const ValueSets& sets) {
   std::vector<ValueSetRun> runs;

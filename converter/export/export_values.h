@@ -33,6 +33,10 @@ struct TrxValueMember {
   std::vector<float> data;  // row-major: one row of `components` values per point or streamline
 };
 
+// Whether `name` (a group's or a value set's) can name a TRX member FOLDER/NAME.SUFFIX: one file inside the folder
+// (not empty, not "." or "..", no '/', '\\' or NUL) whose path fits the zip's 16-bit name length.
+bool usable_trx_member_name(const std::string& name, const std::string& folder, const std::string& suffix);
+
 // The dpv (from VVAL) and dps (from SVAL) members of a TRX. Sets named NAME[0], NAME[1], … NAME[m-1] in a
 // row (how the readers split a multi-component TRX array, .vxl spec §5.11) become one NAME.m.float32
 // member again. Throws vxl::Error (Unsupported) for a name that cannot be a member name.

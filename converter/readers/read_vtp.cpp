@@ -33,13 +33,13 @@ namespace {
 // zlib cannot expand data by more than this (deflate's best case), plus a little for the block framing.
 constexpr std::uint64_t kZlibMaxRatio = 1032;
 
-struct Type {
+struct XmlDataType {
   char kind = 0;  // 'i', 'u', 'f'; 0 for arrays we skip (String, Bit)
   unsigned size = 0;
 };
 
-Type parse_type(const std::string& name) {
-  static const std::pair<const char*, Type> types[] = {
+XmlDataType parse_data_type(const std::string& name) {
+  static const std::pair<const char*, XmlDataType> types[] = {
       {"Int8", {'i', 1}},    {"UInt8", {'u', 1}},   {"Int16", {'i', 2}}, {"UInt16", {'u', 2}},
       {"Int32", {'i', 4}},   {"UInt32", {'u', 4}},  {"Int64", {'i', 8}}, {"UInt64", {'u', 8}},
       {"Float32", {'f', 4}}, {"Float64", {'f', 8}}, {"Char", {'i', 1}},  {"UChar", {'u', 1}}};
@@ -262,7 +262,7 @@ class VtpParser {
       if (!points) fail(offset(piece), "expected <Points><DataArray>");
       if (count_attribute(points, "NumberOfComponents") != 3)
         fail(offset(points), "Points must have NumberOfComponents=\"3\"");
-      const Type pt = parse_type(points.attribute("type").as_string());
+      const XmlDataType pt = parse_data_type(points.attribute("type").as_string());
       if (pt.kind != 'f') fail(offset(points), "Points must be Float32 or Float64");
       points_type_ = points.attribute("type").as_string();
       p.points = decode(points, 3, p.point_count, "Points");
@@ -296,7 +296,7 @@ class VtpParser {
       d.name = a.attribute("Name").as_string();
       d.components = a.attribute("NumberOfComponents") ? count_attribute(a, "NumberOfComponents") : 1;
       if (d.components == 0) fail(offset(a), "DataArray '" + d.name + "' with NumberOfComponents=\"0\"");
-      if (parse_type(a.attribute("type").as_string()).kind == 0) {
+      if (parse_data_type(a.attribute("type").as_string()).kind == 0) {
         warnings_.push_back("array '" + d.name + "' of type " + a.attribute("type").as_string() + " skipped");
         continue;
       }
@@ -313,7 +313,7 @@ class VtpParser {
   // The values of one DataArray: `tuples` x `components`, as double.
   std::vector<double> decode(const pugi::xml_node& a, std::uint64_t components, std::uint64_t tuples,
                              const std::string& what) {
-    const Type type = parse_type(a.attribute("type").as_string());
+    const XmlDataType type = parse_data_type(a.attribute("type").as_string());
     if (type.kind == 0)
       fail(offset(a), what + ": type '" + std::string(a.attribute("type").as_string()) + "' is not numeric");
     if (a.attribute("NumberOfComponents") && count_attribute(a, "NumberOfComponents") != components)

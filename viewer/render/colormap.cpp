@@ -43,30 +43,31 @@ const std::array<glm::vec3, kColormapSamples> kViridis = {{
     {0.845561f, 0.887322f, 0.099702f}, {0.926106f, 0.897330f, 0.104071f}, {0.993248f, 0.906157f, 0.143936f},
 }};
 
-struct Named {
+struct NamedColormap {
   Colormap map;
   const char* name;
 };
-constexpr Named kNames[] = {{Colormap::Grey, "grey"}, {Colormap::Hot, "hot"}, {Colormap::Viridis, "viridis"}};
+constexpr NamedColormap kColormapNames[] = {
+    {Colormap::Grey, "grey"}, {Colormap::Hot, "hot"}, {Colormap::Viridis, "viridis"}};
 
 }  // namespace
 
 std::optional<Colormap> parse_colormap(const std::string& name) {
-  for (const Named& n : kNames)
+  for (const NamedColormap& n : kColormapNames)
     if (name == n.name) return n.map;
   if (name == "gray") return Colormap::Grey;
   return std::nullopt;
 }
 
 const char* colormap_name(Colormap map) {
-  for (const Named& n : kNames)
+  for (const NamedColormap& n : kColormapNames)
     if (n.map == map) return n.name;
   return "?";
 }
 
 std::vector<std::string> colormap_names() {
   std::vector<std::string> names;
-  for (const Named& n : kNames) names.emplace_back(n.name);
+  for (const NamedColormap& n : kColormapNames) names.emplace_back(n.name);
   return names;
 }
 
