@@ -538,6 +538,15 @@ TEST_F(Window, AScriptedDragReportsTheSelectionsTimes) {
   EXPECT_GE(j.at("selections").get<int>(), 2);  // the first (at start) and at least one while dragging
   EXPECT_GT(j.at("selection_median_ms").get<double>(), 0.0);
   EXPECT_GE(j.at("selection_p95_ms").get<double>(), j.at("selection_median_ms").get<double>());
+  // The first picture does not wait for the command line's selection (its --context-opacity is accepted before the
+  // selection's groups exist): each frame says whether its picture shows one; once in, it stays, to the last frame.
+  bool shown = false;
+  for (const nlohmann::json& f : j.at("frames")) {
+    const bool selection = f.value("selection", false);
+    EXPECT_TRUE(selection || !shown) << f.dump();
+    shown = selection;
+  }
+  EXPECT_TRUE(shown);
   const test::CommandResult bad = run_voxview_in_xvfb(shell_quoted(vxl) + " --drag-region 1,0 --frames 2");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   const test::CommandResult none = run_voxview_in_xvfb(shell_quoted(vxl) + " --drag-region 1,0,0 --frames 2");

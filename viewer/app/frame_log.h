@@ -27,6 +27,7 @@ struct FrameRecord {
   FrameWork work = FrameWork::Whole;
   bool completes = true;     // the picture it drew is complete and on screen (a piece: only the last one's)
   bool focus_first = false;  // the focus drawn at level 0 from its copy, the context at `level`
+  bool selection = false;    // the picture shows a selection of the regions (focus and context)
 };
 
 struct FrameSummary {

@@ -110,7 +110,7 @@ std::vector<const VxlFile*> pointers(const std::vector<VxlFile>& files) {
 }
 
 void check_color_options(const std::string& path, const Renderer& r, const RenderSettings& s,
-                         const ViewFileSettings& from_view_file) {
+                         const ViewFileSettings& from_view_file, const std::vector<std::string>& groups_to_come) {
   // The option's error, or the view file's when it set the value: "--scalar: ..." or "FILE: settings.scalar: ...
   // in INPUT".
   auto refuse = [&](bool from_file, const std::string& option, const std::string& key, const std::string& what) {
@@ -128,10 +128,13 @@ void check_color_options(const std::string& path, const Renderer& r, const Rende
   if (!s.scalar.empty() && std::find(names.begin(), names.end(), s.scalar) == names.end())
     refuse(from_view_file.scalar, "--scalar", "scalar",
            "no value set '" + s.scalar + "'" + (names.empty() ? " (it has none)" : " (it has: " + available + ")"));
+  std::vector<std::string> group_names = groups_to_come;
+  if (group_names.empty())
+    for (const SceneGroup& sg : r.groups().groups()) group_names.push_back(sg.name);
   for (const GroupStyle& g : s.group_styles)
-    if (r.groups().find(g.name) < 0) {
+    if (std::find(group_names.begin(), group_names.end(), g.name) == group_names.end()) {
       std::string groups;
-      for (const SceneGroup& sg : r.groups().groups()) groups += (groups.empty() ? "" : ", ") + sg.name;
+      for (const std::string& name : group_names) groups += (groups.empty() ? "" : ", ") + name;
       const auto& file_groups = from_view_file.groups;
       refuse(std::find(file_groups.begin(), file_groups.end(), g.name) != file_groups.end(), "--group", "groups",
              "no group '" + g.name + "' (groups: " + groups + ")");

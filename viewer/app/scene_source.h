@@ -51,8 +51,9 @@ std::vector<const VxlFile*> pointers(const std::vector<VxlFile>& files);
 
 // Refuses colour options the scene cannot honour, naming the file and what it has: --color scalar without
 // values, an unknown --scalar, a --group that is no group of the scene (Usage); the same settings from a
-// view file (`from_view_file`) are that file's error (Input).
+// view file (`from_view_file`) are that file's error (Input). `groups`: the names a --group may take when they are
+// not yet the renderer's (a selection on its way: "selected" and "context"); empty: the renderer's.
 void check_color_options(const std::string& path, const Renderer& renderer, const RenderSettings& settings,
-                         const ViewFileSettings& from_view_file = {});
+                         const ViewFileSettings& from_view_file = {}, const std::vector<std::string>& groups = {});
 
 }  // namespace vxl::app

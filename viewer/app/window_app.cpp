@@ -72,14 +72,18 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
     for (std::size_t i = 0; i < f->voxels().size(); ++i)
       for (std::uint32_t d = 0; d < segments.size(); ++d) segments[d] += f->level(i, d).segment_count;
   first_level_ = first_picture_level(segments, detail_.level);
-  // The command line's selection first: its groups are those the options name.
-  update_selection(true);
+  // The command line's selection runs on the worker: the first picture does not wait for it (the panel says it is
+  // coming), the focus appears when it is ready. Scripted frames without a drag still wait for it, frame by frame.
+  update_selection(false);
   // Scene-wide facts (bounds, groups, value sets, voxel cubes) are the same at every level.
   Renderer& first = renderer_at(first_level_);
   grid_.emplace(std::span<const VxlFile* const>(files_));  // the files opened: not a focus copy drawn beside them
   controller_ = CameraController(Camera{}, std::max(1.0, glm::length(first.scene_max() - first.scene_min()) * 0.5));
   stats_.has_image = session_->image() != nullptr;
-  check_color_options(o.inputs_name(), first, o.settings, o.from_view_file);
+  // With regions, the options' groups are the selection's, on their way.
+  check_color_options(o.inputs_name(), first, o.settings, o.from_view_file,
+                      o.selecting() ? std::vector<std::string>{SceneGroups::kSelected, SceneGroups::kContext}
+                                    : std::vector<std::string>{});
   GLint major = 0, minor = 0;
   glGetIntegerv(GL_MAJOR_VERSION, &major);
   glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -355,6 +359,7 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
     drawn_ = key;
     frames_.push_back({task.level, moving, ms, seconds_since_start()});
     frames_.back().focus_first = focus_first_at(task.level);
+    frames_.back().selection = selection_.has_value();
     return true;
   }
   if (task.work == PictureWork::Piece) {
@@ -362,6 +367,7 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
     const double ms = refine(key.width, key.height, task.level, completes);
     frames_.push_back({task.level, false, ms, seconds_since_start(), task.frame_work, completes});
     frames_.back().focus_first = focus_first_at(task.level);
+    frames_.back().selection = selection_.has_value();
     return true;
   }
   return false;

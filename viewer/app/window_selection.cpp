@@ -28,6 +28,7 @@ void ViewerWindow::update_selection(bool wait) {
     } else {
       try {
         selection_worker_.request(regions_.revision(), regions_.criteria());
+        if (!selection_) stats_.selection = "selecting the regions' streamlines ...";
       } catch (const std::exception& e) {  // a region that does not parse: said, and no selection
         set_error(e.what());
         if (selection_) apply_selection(std::nullopt);
