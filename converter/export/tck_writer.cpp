@@ -23,10 +23,6 @@ std::string mrtrix_header(const std::string& magic, std::uint64_t count, const s
   return head;
 }
 
-}  // namespace
-
-namespace {
-
 // Bytes staged per direct write: large enough that the writes are few, small beside the output; the queue's
 // spares let the writes fall this many stagings behind.
 constexpr std::uint64_t kDirectStagingBytes = 4ull << 20;
