@@ -35,7 +35,7 @@ void synth(const std::string& path, int streamlines, int seed) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
 }
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+using vxl::test::contains;
 
 // Three sources of two formats and a file name with dots; returns their paths.
 std::vector<std::string> make_sources(const ScratchDir& dir) {

@@ -25,7 +25,7 @@ namespace {
 
 using test::ScratchDir;
 
-Tractogram grouped_tractogram() {
+Tractogram trx_grouped_tractogram() {
   SynthSettings settings;
   settings.streamlines = 400;
   Tractogram t = synthesize_tractogram(settings);
@@ -122,15 +122,15 @@ bool have_python_numpy() { return test::run_program("/usr/bin/python3", "-c 'imp
 
 TEST(ExportTrx, ReadsBackIdenticallyWithGroups) {
   ScratchDir dir;
-  const VxlFile f = VxlFile::open(test::convert_float32(grouped_tractogram(), dir.file("g.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(trx_grouped_tractogram(), dir.file("g.vxl")));
   ASSERT_GT(f.meta().synthetic_point_count, 0u);
   export_trx(f, dir.file("g.trx"));
   const Tractogram back = read_trx(dir.file("g.trx"));
   expect_same_streamlines(streamlines_of(f), back);
-  expect_same_streamlines(grouped_tractogram(), back);
+  expect_same_streamlines(trx_grouped_tractogram(), back);
   ASSERT_EQ(back.groups.size(), 2u);
   // Member names are listed in archive order; compare as a set.
-  for (const StreamlineGroup& expected : grouped_tractogram().groups) {
+  for (const StreamlineGroup& expected : trx_grouped_tractogram().groups) {
     auto it =
         std::find_if(back.groups.begin(), back.groups.end(), [&](const auto& g) { return g.name == expected.name; });
     ASSERT_NE(it, back.groups.end()) << expected.name;
@@ -143,7 +143,7 @@ TEST(ExportTrx, ReadsBackIdenticallyWithGroups) {
 TEST(ExportTrx, StructureFollowsTheSpecificationInAnIndependentReader) {
   if (!have_python_numpy()) GTEST_SKIP() << "/usr/bin/python3 with numpy is needed for the independent check";
   ScratchDir dir;
-  const VxlFile f = VxlFile::open(test::convert_float32(grouped_tractogram(), dir.file("g.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(trx_grouped_tractogram(), dir.file("g.vxl")));
   export_trx(f, dir.file("g.trx"));
   const std::string out = check_trx_in_python(dir, dir.file("g.trx"));
   EXPECT_NE(out.find("TRX-OK 402 " + std::to_string(f.meta().point_count) + " AF right|CST_left"), std::string::npos)
@@ -165,7 +165,7 @@ TEST(ExportTrx, EmptyTractogram) {
 
 TEST(ExportTrx, DefaultReferenceCoversTheBounds) {
   ScratchDir dir;
-  const VxlFile f = VxlFile::open(test::convert_float32(grouped_tractogram(), dir.file("g.vxl")));
+  const VxlFile f = VxlFile::open(test::convert_float32(trx_grouped_tractogram(), dir.file("g.vxl")));
   const TrxReference r = trx_reference(f);
   for (int c = 0; c < 3; ++c) {
     EXPECT_EQ(r.voxel_to_rasmm[c][c], 1.0);
@@ -177,7 +177,7 @@ TEST(ExportTrx, DefaultReferenceCoversTheBounds) {
 
 TEST(ExportTrx, GroupNameThatCannotBeAMemberIsUnsupported) {
   ScratchDir dir;
-  Tractogram t = grouped_tractogram();
+  Tractogram t = trx_grouped_tractogram();
   t.groups.push_back({"a/b", {2}});
   const VxlFile f = VxlFile::open(test::convert_float32(std::move(t), dir.file("g.vxl")));
   try {
@@ -191,7 +191,7 @@ TEST(ExportTrx, GroupNameThatCannotBeAMemberIsUnsupported) {
 
 TEST(ExportTrx, CliChoosesTheFormatByExtension) {
   ScratchDir dir;
-  const std::string vxl = test::convert_float32(grouped_tractogram(), dir.file("g.vxl"));
+  const std::string vxl = test::convert_float32(trx_grouped_tractogram(), dir.file("g.vxl"));
   auto r = test::run_cli("export '" + vxl + "' '" + dir.file("g.TRX") + "'");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(read_trx(dir.file("g.TRX")).streamline_count(), 402u);

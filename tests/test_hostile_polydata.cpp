@@ -21,7 +21,7 @@ namespace hostile = vxl::test::hostile;
 using hostile::error_of;
 using vxl::test::ScratchDir;
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+using vxl::test::contains;
 
 // `convert IN OUT.vxl` exits with `code`, names IN and leaves nothing at OUT.
 void expect_convert_refused(const ScratchDir& dir, const std::string& in, int code) {

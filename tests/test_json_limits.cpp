@@ -19,7 +19,7 @@ namespace hostile = vxl::test::hostile;
 using vxl::test::q;
 using vxl::test::ScratchDir;
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+using vxl::test::contains;
 
 const std::string kTooDeep = "JSON nested deeper than " + std::to_string(vxl::kMaxJsonDepth) + " arrays and objects";
 

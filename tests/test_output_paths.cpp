@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 using vxl::test::q;
 using vxl::test::ScratchDir;
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+using vxl::test::contains;
 
 mode_t lmode(const std::string& path) {
   struct stat st {};

@@ -26,7 +26,7 @@ namespace {
 using vxl::test::has_warning;
 using vxl::test::real;
 
-struct Counts {
+struct TrxCounts {
   const char* file;
   std::uint64_t streamlines;
   std::uint64_t points;
@@ -37,7 +37,7 @@ struct Counts {
 // NB_STREAMLINES (459), but its offsets hold 460 streamline starts and no sentinel (the last entry,
 // 95708, is below NB_VERTICES = 95865); the data is the same 460 streamlines as the older
 // niivue__tests__dpsv.trx and niivue__C_PHP.trk.gz, whose last streamline has 157 points.
-const Counts kTrxFixtures[] = {
+const TrxCounts kTrxFixtures[] = {
     {"niivue__sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx", 508, 141447, "float32"},
     {"niivue__dpsv.trx", 460, 95865, "float16"},
     {"niivue__tests__dpsv.trx", 460, 95865, "float16"},

@@ -34,7 +34,7 @@ namespace {
 using test::raw;
 using test::ScratchDir;
 
-constexpr std::uint64_t kMiB = 1ull << 20;
+using vxl::test::kMiB;
 
 void write_synth_tck(const std::string& path, std::uint64_t streamlines, std::uint64_t seed = 1) {
   Tractogram t = synthesize_tractogram({streamlines, seed});

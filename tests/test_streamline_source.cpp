@@ -15,7 +15,7 @@
 namespace vxl {
 namespace {
 
-constexpr std::uint64_t kMiB = 1ull << 20;
+constexpr std::uint64_t kMebibyte = 1ull << 20;
 
 // Every streamline of every batch of one pass, as one tractogram, and the batches' sizes.
 struct Pass {
@@ -72,10 +72,10 @@ TEST(StreamlineSource, ATckAndTheSameStreamlinesInMemoryReadAlikePassAfterPass) 
       w.add({t.positions.data() + 3 * t.offsets[i], 3 * (t.offsets[i + 1] - t.offsets[i])});
     w.finish();
   }
-  MemoryBudget budget(64 * kMiB, tck);
+  MemoryBudget budget(64 * kMebibyte, tck);
   BatchReader from_file(tck, budget, 2, {});
   const Tractogram in_memory = read_tck(tck);
-  MemoryBudget other(64 * kMiB, tck);
+  MemoryBudget other(64 * kMebibyte, tck);
   BatchReader from_memory(std::make_unique<TractogramBatchSource>(in_memory, 700), plan_reading(other), other, 2, {});
   for (int pass = 0; pass < 2; ++pass) {
     const Pass a = one_pass(from_file), b = one_pass(from_memory);
@@ -87,7 +87,7 @@ TEST(StreamlineSource, ATckAndTheSameStreamlinesInMemoryReadAlikePassAfterPass) 
   }
   EXPECT_EQ(from_file.passes(), 2u);
   EXPECT_EQ(from_file.source().xxh3_128, in_memory.source.xxh3_128);
-  EXPECT_GT(budget.used(), 16 * kMiB) << "the batches are counted against the budget";
+  EXPECT_GT(budget.used(), 16 * kMebibyte) << "the batches are counted against the budget";
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -20,6 +21,11 @@
 #include <gtest/gtest.h>
 
 namespace vxl::test {
+
+// Whether `part` occurs in `s` (a message, an output).
+inline bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+inline constexpr std::uint64_t kMiB = 1ull << 20;
 
 // The bytes of a file. Throws when it cannot be opened, so that two missing files never compare equal.
 inline std::vector<char> slurp(const std::string& path) {

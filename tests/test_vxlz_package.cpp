@@ -55,7 +55,8 @@ Tractogram test_tractogram(std::uint64_t streamlines = 1500) {
   return t;
 }
 
-std::string convert_to(Tractogram t, const std::string& path, double voxel_size = 10.0, const char* orders = "axis") {
+std::string convert_for_package(Tractogram t, const std::string& path, double voxel_size = 10.0,
+                                const char* orders = "axis") {
   ConvertSettings s;
   s.voxel_size = voxel_size;
   s.orders = orders;
@@ -65,7 +66,7 @@ std::string convert_to(Tractogram t, const std::string& path, double voxel_size 
 
 // Written as a new file: truncating and rewriting one makes ext4 flush it on close (auto_da_alloc),
 // which would make the thousands of rewrites below take seconds.
-void dump(const std::string& p, const std::vector<char>& bytes, std::size_t n) {
+void dump_bytes(const std::string& p, const std::vector<char>& bytes, std::size_t n) {
   std::filesystem::remove(p);
   std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(n));
 }
@@ -200,7 +201,7 @@ class VxlzPackage : public ::testing::TestWithParam<std::uint32_t> {
 };
 
 TEST_P(VxlzPackage, RoundTripKeepsStructureAndStaysWithinTheBound) {
-  const std::string vxl = convert_to(test_tractogram(), dir.file("synthetic.vxl"));
+  const std::string vxl = convert_for_package(test_tractogram(), dir.file("synthetic.vxl"));
   ASSERT_GT(VxlFile::open(vxl).meta().synthetic_point_count, 0u) << "the test data must have synthetic points";
   round_trip(dir, vxl, GetParam());
 }
@@ -250,7 +251,7 @@ TEST(VxlzPackageOptions, ChunkSizeAndThreadsDoNotChangeTheResult) {
   // Decoded values depend only on the quantised points, never on how they are chunked or scheduled;
   // tiny chunks also split streamlines and voxlines across chunk boundaries.
   ScratchDir dir;
-  const std::string vxl = convert_to(test_tractogram(300), dir.file("s.vxl"));
+  const std::string vxl = convert_for_package(test_tractogram(300), dir.file("s.vxl"));
   PackSettings tiny;
   tiny.chunk_points = 7;
   tiny.threads = 2;
@@ -267,7 +268,7 @@ TEST(VxlzPackageOptions, ChunkSizeAndThreadsDoNotChangeTheResult) {
 TEST(VxlzPackageOptions, PackageBytesDoNotDependOnThreads) {
   // The measured errors in PACK are summed in chunk order, whichever thread encoded which chunk.
   ScratchDir dir;
-  const VxlFile f = VxlFile::open(convert_to(test_tractogram(300), dir.file("s.vxl")));
+  const VxlFile f = VxlFile::open(convert_for_package(test_tractogram(300), dir.file("s.vxl")));
   PackSettings s;
   s.chunk_points = 64;
   s.threads = 1;
@@ -281,7 +282,7 @@ TEST(VxlzPackageOptions, EmptyTractogram) {
   ScratchDir dir;
   Tractogram t;
   t.source.path = "empty.tck";
-  const std::string vxl = convert_to(std::move(t), dir.file("empty.vxl"));
+  const std::string vxl = convert_for_package(std::move(t), dir.file("empty.vxl"));
   round_trip(dir, vxl, 14);
 }
 
@@ -289,7 +290,7 @@ TEST(VxlzPackageOptions, EmptyTractogram) {
 // component as the axes do (verify checks every order's sortedness against the decoded vertices).
 TEST(VxlzPackageOptions, AxisDiagOrdersAreRebuiltForTheDecodedPositions) {
   ScratchDir dir;
-  const std::string vxl = convert_to(test_tractogram(300), dir.file("diag.vxl"), 5.0, "axis+diag");
+  const std::string vxl = convert_for_package(test_tractogram(300), dir.file("diag.vxl"), 5.0, "axis+diag");
   ASSERT_EQ(VxlFile::open(vxl).meta().stored_order_count, 7u);
   const VxlFile copy = VxlFile::open(round_trip(dir, vxl, 14));
   EXPECT_EQ(copy.meta().order_set, static_cast<std::uint32_t>(OrderSet::AxisDiag));
@@ -298,7 +299,7 @@ TEST(VxlzPackageOptions, AxisDiagOrdersAreRebuiltForTheDecodedPositions) {
 // Per-voxel random directions (VDIR) are not part of the package format: refused before any output.
 TEST(VxlzPackageOptions, RandomOrderSetsAreRefusedWithoutOutput) {
   ScratchDir dir;
-  const std::string vxl = convert_to(test_tractogram(50), dir.file("random.vxl"), 10.0, "random:4");
+  const std::string vxl = convert_for_package(test_tractogram(50), dir.file("random.vxl"), 10.0, "random:4");
   try {
     pack_vxl(VxlFile::open(vxl), dir.file("r.vxlz"), {});
     ADD_FAILURE() << "packing a random:4 file must fail";
@@ -311,7 +312,7 @@ TEST(VxlzPackageOptions, RandomOrderSetsAreRefusedWithoutOutput) {
 
 TEST(VxlzPackageOptions, BitsOutOfRangeAreAUsageError) {
   ScratchDir dir;
-  const std::string vxl = convert_to(test_tractogram(20), dir.file("s.vxl"));
+  const std::string vxl = convert_for_package(test_tractogram(20), dir.file("s.vxl"));
   for (std::uint32_t bits : {10u, 17u}) {
     PackSettings s;
     s.bits = bits;
@@ -347,7 +348,7 @@ class DamagedVxlz : public ::testing::Test {
     for (std::uint64_t s = 0; s < t.streamline_count(); ++s) length.values.push_back(float(s) * 3.5f);
     t.point_values.push_back(fa);
     t.streamline_values.push_back(length);
-    convert_to(std::move(t), dir.file("small.vxl"), 8);
+    convert_for_package(std::move(t), dir.file("small.vxl"), 8);
     PackSettings s;
     s.chunk_points = 16;  // several chunks
     pack_vxl(VxlFile::open(dir.file("small.vxl")), good(), s);
@@ -411,7 +412,7 @@ TEST_F(DamagedVxlz, EverySingleByteChangeIsRefused) {
   for (std::size_t pos = 0; pos < bytes.size(); ++pos) {
     std::vector<char> b = bytes;
     b[pos] = static_cast<char>(b[pos] ^ (1 + pos % 255));
-    dump(bad, b, b.size());
+    dump_bytes(bad, b, b.size());
     SCOPED_TRACE(pos);
     expect_refused(bad, "byte " + std::to_string(pos));
     if (HasFailure()) break;
@@ -422,13 +423,13 @@ TEST_F(DamagedVxlz, EveryTruncationIsRefused) {
   const std::vector<char> bytes = slurp(good());
   const std::string bad = dir.file("bad.vxlz");
   for (std::size_t n = 0; n < bytes.size(); ++n) {
-    dump(bad, bytes, n);
+    dump_bytes(bad, bytes, n);
     expect_refused(bad, "truncated to " + std::to_string(n));
     if (HasFailure()) break;
   }
   std::vector<char> longer = bytes;
   longer.push_back(0);
-  dump(bad, longer, longer.size());
+  dump_bytes(bad, longer, longer.size());
   expect_refused(bad, "one byte appended");
 }
 
@@ -446,7 +447,7 @@ TEST_F(DamagedVxlz, DamageBehindValidChecksumsNeverCrashes) {
     std::vector<char> b = bytes;
     b[pos] = static_cast<char>(b[pos] ^ (pos % 2 ? 0x80 : 0x01));  // the lowest or the highest bit
     test::reseal_checksums(b.data(), b.size());
-    dump(bad, b, b.size());
+    dump_bytes(bad, b, b.size());
     try {
       unpack_vxlz(bad, out(), {});
       const VerifyResult r = verify_vxl(out());
@@ -476,7 +477,7 @@ TEST_F(DamagedVxlz, ADracoPointCountBeyondTheChunkIsRefusedBeforeDecoding) {
     const std::int32_t huge = 1 << 29;
     std::memcpy(b.data() + (at - bytes.begin()) + 11, &huge, sizeof huge);
     test::reseal_checksums(b.data(), b.size());
-    dump(dir.file("count.vxlz"), b, b.size());
+    dump_bytes(dir.file("count.vxlz"), b, b.size());
     expect_refused(dir.file("count.vxlz"), "Draco point count at byte " + std::to_string(at - bytes.begin()));
     try {
       unpack_vxlz(dir.file("count.vxlz"), out(), {});
@@ -493,7 +494,7 @@ TEST_F(DamagedVxlz, OtherMajorVersionsAreUnsupported) {
   for (const std::uint8_t version : {1, 3}) {
     std::vector<char> b = slurp(good());
     b[8] = static_cast<char>(version);
-    dump(dir.file("other.vxlz"), b, b.size());
+    dump_bytes(dir.file("other.vxlz"), b, b.size());
     try {
       unpack_vxlz(dir.file("other.vxlz"), out(), {});
       ADD_FAILURE() << int(version);
@@ -654,7 +655,7 @@ TEST_F(DamagedVxlz, MetaFieldsThatContradictTheGridAreRefusedOnOpen) {
 TEST_F(DamagedVxlz, CliReportsDamageWithExitCode3) {
   std::vector<char> b = slurp(good());
   b[b.size() / 2] ^= 0x10;
-  dump(dir.file("bad.vxlz"), b, b.size());
+  dump_bytes(dir.file("bad.vxlz"), b, b.size());
   const auto r = test::run_cli("unpack '" + dir.file("bad.vxlz") + "' '" + out() + "'");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("bad.vxlz"), std::string::npos) << r.output;
@@ -666,7 +667,7 @@ TEST_F(DamagedVxlz, CliReportsDamageWithExitCode3) {
 
 TEST(VxlzPackCli, PackUnpackVerify) {
   ScratchDir dir;
-  const std::string vxl = convert_to(test_tractogram(100), dir.file("s.vxl"));
+  const std::string vxl = convert_for_package(test_tractogram(100), dir.file("s.vxl"));
   auto r = test::run_cli("pack '" + vxl + "' '" + dir.file("s.vxlz") + "' --bits 11");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("error bound"), std::string::npos) << r.output;
@@ -688,7 +689,7 @@ TEST(VxlzPackageReal, StrokeAndAfqRoundTrip) {
                            "niivue__sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx",
                            "niivue__C_PHP.trk.gz", "mrtrix3__tmp.tck", "nibabel__empty.tck"}) {
     SCOPED_TRACE(name);
-    const std::string vxl = convert_to(read_tractogram(test::real(name)), dir.file("real.vxl"));
+    const std::string vxl = convert_for_package(read_tractogram(test::real(name)), dir.file("real.vxl"));
     for (std::uint32_t bits : {11u, 14u, 16u}) round_trip(dir, vxl, bits);
   }
 }
@@ -703,7 +704,7 @@ namespace {
 // measured between the .vxl that was packed and the unpacked one.
 TEST(VxlzPackageOptions, UnpackPrintsABoundThatHoldsForWhatItWrote) {
   ScratchDir dir;
-  const std::string vxl = convert_to(test_tractogram(), dir.file("s.vxl"));
+  const std::string vxl = convert_for_package(test_tractogram(), dir.file("s.vxl"));
   ASSERT_EQ(test::run_cli("pack " + test::q(vxl) + " " + test::q(dir.file("s.vxlz"))).exit_code, 0);
   const VxlFile original = VxlFile::open(vxl);
   auto printed_bound = [](const std::string& output) {

@@ -34,7 +34,7 @@ void expect_colour(const Image& img, int c, int r, const glm::vec3& rgb, int tol
     EXPECT_NEAR(p[k], rgb[k] * 255.0f, tolerance) << what << " channel " << k << " at " << c << "," << r;
 }
 
-bool background(const Image& img, int c, int r) {
+bool is_background(const Image& img, int c, int r) {
   return (img.pixel(c, r)[0] | img.pixel(c, r)[1] | img.pixel(c, r)[2]) == 0;
 }
 
@@ -134,7 +134,7 @@ TEST_F(ColorByValue, GroupsHaveTheirColourAndOpacity) {
   Image styled = render_image(r, top_view(), s, 64, 64);
   expect_colour(styled, column_of(0.5), row_of(line_y(0)), glm::vec3(1, 0, 0), 0, "A");
   expect_colour(styled, column_of(0.5), row_of(line_y(2)), glm::vec3(1, 0, 0), 0, "A");
-  for (double x : {-12.5, 0.5, 13.5}) EXPECT_TRUE(background(styled, column_of(x), row_of(line_y(1)))) << x;
+  for (double x : {-12.5, 0.5, 13.5}) EXPECT_TRUE(is_background(styled, column_of(x), row_of(line_y(1)))) << x;
   expect_colour(styled, column_of(0.5), row_of(line_y(3)), group_palette(2), 1, "ungrouped");
 
   // Group opacity is a factor on the opacity, in every colour mode: B at half of 1, blended over black.

@@ -76,7 +76,9 @@ void expect_refused(Renderer& r, std::uint64_t at, const std::string& why) {
   }
 }
 
-bool lit(const Image& img, int x, int y) { return (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0; }
+bool any_channel_lit(const Image& img, int x, int y) {
+  return (img.pixel(x, y)[0] | img.pixel(x, y)[1] | img.pixel(x, y)[2]) != 0;
+}
 
 // Every entry of every stored order of one voxel past its block (by different amounts, within the entries'
 // bits): clamped, each draws the block's last segment, which the intact file draws too, so the damaged picture
@@ -108,8 +110,8 @@ TEST_F(DamagedDraw, OrderEntriesPastTheBlockDrawTheBlocksOwnSegmentsAndAreRefuse
   int lost = 0, stray = 0;
   for (int y = 0; y < good.height; ++y)
     for (int x = 0; x < good.width; ++x) {
-      lost += lit(good, x, y) && !lit(bad, x, y);
-      stray += lit(bad, x, y) && !lit(good, x, y);
+      lost += any_channel_lit(good, x, y) && !any_channel_lit(bad, x, y);
+      stray += any_channel_lit(bad, x, y) && !any_channel_lit(good, x, y);
     }
   EXPECT_GT(lost, 20) << "the damaged voxel's segments are no longer drawn";
   EXPECT_EQ(stray, 0) << "a damaged entry drew a line that is none of the file's segments";
