@@ -7,49 +7,6 @@
 #include "format/base/error.h"
 
 namespace vxl {
-namespace {
-
-// The vertices of the voxline kLookahead entries ahead of the walk, prefetched: the voxlines of one streamline lie in
-// different voxels' blocks, far apart, and a walk that reads points otherwise waits on memory for each one. Where they
-// land is their voxel's cursor now (exact unless a voxline between moves it): a hint only.
-class VertexPrefetch {
- public:
-  VertexPrefetch(const VxlFile& f, const WalkCallbacks& cb, const std::vector<std::uint64_t>& cursor)
-      : f_(f), cb_(cb), cursor_(cursor), levels_(f.level_count()), count_(f.meta().streamline_count) {
-    const bool packed = f.position_encoding() == PositionEncoding::Packed;
-    base_ = packed ? reinterpret_cast<const std::uint8_t*>(f.packed_vertices().data())
-                   : reinterpret_cast<const std::uint8_t*>(f.float_vertices().data());
-    vertex_bytes_ = packed ? 4 : 12;
-    read_ = count_ > 0 && reads(0);
-  }
-  // Called for voxline j, in order.
-  void operator()(std::uint64_t j) {
-    const auto strm = f_.streamline_first_voxline();
-    const std::uint64_t target = j + kLookahead;
-    if (target >= strm[count_]) return;
-    while (streamline_ + 1 < count_ && strm[streamline_ + 1] <= target) read_ = reads(++streamline_);
-    if (!read_) return;
-    const std::uint32_t voxel = f_.voxlines()[target].voxel;
-    if (voxel >= f_.voxels().size()) return;  // a damaged entry: the walk refuses it when it reaches it
-    const std::uint64_t at = cursor_[voxel * levels_ + streamline_depth(streamline_, levels_)];
-    if (at < f_.meta().vertex_count) __builtin_prefetch(base_ + at * vertex_bytes_);
-  }
-
- private:
-  static constexpr std::uint64_t kLookahead = 16;
-  bool reads(std::uint64_t s) const { return !cb_.read_points || cb_.read_points(s); }
-  const VxlFile& f_;
-  const WalkCallbacks& cb_;
-  const std::vector<std::uint64_t>& cursor_;
-  std::uint32_t levels_;
-  std::uint64_t count_;
-  const std::uint8_t* base_ = nullptr;
-  std::uint64_t vertex_bytes_ = 4;
-  std::uint64_t streamline_ = 0;  // the streamline of voxline j + kLookahead
-  bool read_ = false;             // whether its points are read
-};
-
-}  // namespace
 
 void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
   const std::string& p = f.path();
@@ -92,7 +49,6 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
     return true;
   };
 
-  VertexPrefetch prefetch(f, cb, cursor);
   for (std::uint64_t s = 0; s < m.streamline_count; ++s) {
     const std::uint64_t first = strm[s], last = strm[s + 1];
     const std::uint32_t depth = streamline_depth(s, levels);
@@ -101,7 +57,6 @@ void walk_streamlines(const VxlFile& f, const WalkCallbacks& cb) {
     float pending_connector[3];  // previous voxline's connecting vertex, when `connector_voxel` is set
     std::int64_t connector_voxel = -1;
     for (std::uint64_t j = first; j < last; ++j) {
-      prefetch(j);
       const VoxlineEntry& e = voxlines[j];
       const std::uint64_t at = vxln_at + 8 * j;
       f.check_voxline(j);
