@@ -2,18 +2,28 @@
 // dragged in a straight line through the middle of a .vxl's bounds (left to right, then back to front),
 // as voxview recomputes it: the selection (`voxlines select`'s rules) through the whole voxline table and
 // through the per-voxel index (VoxelVoxlines: the file's VXIX, or for an older file built once when the first
-// region appears, its build time and bytes printed), then the focus/context groups and the table of one byte per
-// streamline that the window uploads after each change (the per-vertex attributes, vertex_attributes.h, are made once,
-// as spans are uploaded: their time for every voxel is printed too). Medians and p95 per step.
+// region appears, its build time and bytes printed), and through the index with the voxline boxes of the voxels
+// the last positions touched (voxline_boxes.h, as the window keeps them; a packed file's), then the focus/context
+// groups and the table of one byte per streamline that the window uploads after each change (the per-vertex attributes,
+// vertex_attributes.h, are made once, as spans are uploaded: their time for every voxel is printed too). Medians and
+// p95 per step.
 //
-// Usage: drag_bench FILE.vxl [--steps N] [--radius MM]
+// With --from X,Y,Z the sphere follows the window's scripted drag instead (voxview --include X,Y,Z,R
+// --drag-region DX,DY,DZ): --steps positions from X,Y,Z, DX,DY,DZ mm apart (--by; default 2,0,0), each selected
+// through the index after the last, as the window's selection worker does; the table walk is left out.
+//
+// Usage: drag_bench FILE.vxl [--steps N] [--radius MM] [--from X,Y,Z [--by DX,DY,DZ]]
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "converter/selection/streamline_selection.h"
+#include "converter/selection/voxline_boxes.h"
 #include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
 #include "viewer/render/scene_groups.h"
@@ -42,10 +52,19 @@ int main(int argc, char** argv) {
   }
   int steps = 40;
   double radius = 10;
+  std::optional<std::array<double, 3>> from;
+  std::array<double, 3> by = {2, 0, 0};
+  auto triple = [](const char* text) {
+    std::array<double, 3> v{};
+    if (std::sscanf(text, "%lf,%lf,%lf", &v[0], &v[1], &v[2]) != 3) throw std::invalid_argument(text);
+    return v;
+  };
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--steps" && i + 1 < argc) steps = std::max(2, std::stoi(argv[++i]));
     if (a == "--radius" && i + 1 < argc) radius = std::stod(argv[++i]);
+    if (a == "--from" && i + 1 < argc) from = triple(argv[++i]);
+    if (a == "--by" && i + 1 < argc) by = triple(argv[++i]);
   }
   try {
     const vxl::VxlFile file = vxl::VxlFile::open(argv[1]);
@@ -75,47 +94,70 @@ int main(int argc, char** argv) {
     }
     std::printf("per-vertex attributes of every voxel, once (one thread): %.0f ms\n", ms_since(t0));
 
-    std::vector<double> scan_ms, indexed_ms, groups_ms;
+    // The sphere's centres: the window's drag, or the two sweeps through the middle of the bounds.
+    std::vector<std::array<double, 3>> centres;
+    if (from) {
+      for (int step = 0; step < steps; ++step)
+        centres.push_back({(*from)[0] + step * by[0], (*from)[1] + step * by[1], (*from)[2] + step * by[2]});
+    } else {
+      for (int axis : {0, 1})
+        for (int step = 0; step < steps; ++step) {
+          std::array<double, 3> centre{};
+          for (int c = 0; c < 3; ++c) centre[c] = 0.5 * (m.bounds_min[c] + m.bounds_max[c]);
+          const double t = double(step) / (steps - 1);
+          centre[axis] = m.bounds_min[axis] + t * (m.bounds_max[axis] - m.bounds_min[axis]);
+          centres.push_back(centre);
+        }
+    }
+    std::vector<double> scan_ms, indexed_ms, boxed_ms, groups_ms;
+    vxl::VoxlineBoxes boxes(file);  // the window's selection worker keeps one per file
     std::uint64_t selected_total = 0;
     const std::vector<const vxl::VxlFile*> files = {&file};
-    for (int axis : {0, 1}) {
-      for (int step = 0; step < steps; ++step) {
-        float centre[3];
-        for (int c = 0; c < 3; ++c) centre[c] = 0.5f * (m.bounds_min[c] + m.bounds_max[c]);
-        const double t = double(step) / (steps - 1);
-        centre[axis] = float(m.bounds_min[axis] + t * (m.bounds_max[axis] - m.bounds_min[axis]));
-        vxl::SelectionCriteria c;
-        c.include.push_back(vxl::parse_region(std::to_string(centre[0]) + "," + std::to_string(centre[1]) + "," +
-                                              std::to_string(centre[2]) + "," + std::to_string(radius)));
+    for (const std::array<double, 3>& centre : centres) {
+      vxl::SelectionCriteria c;
+      c.include.push_back(vxl::parse_region(std::to_string(centre[0]) + "," + std::to_string(centre[1]) + "," +
+                                            std::to_string(centre[2]) + "," + std::to_string(radius)));
+      std::optional<vxl::SelectionResult> scan;
+      if (!from) {
         t0 = Clock::now();
-        const vxl::SelectionResult scan = vxl::select_streamlines(file, c, nullptr, vxl::SelectionPath::ScanTable);
+        scan = vxl::select_streamlines(file, c, nullptr, vxl::SelectionPath::ScanTable);
         scan_ms.push_back(ms_since(t0));
-        t0 = Clock::now();
-        vxl::SelectionResult indexed = vxl::select_streamlines(file, c, &*index);
-        indexed_ms.push_back(ms_since(t0));
-        if (indexed.streamlines != scan.streamlines) {
-          std::fprintf(stderr, "drag_bench: the index and the scan disagree at step %d\n", step);
-          return 1;
-        }
-        selected_total += indexed.streamlines.size();
-        // What the window does with a new selection: the groups, then one byte per streamline.
-        t0 = Clock::now();
-        const vxl::SceneGroups groups = vxl::SceneGroups::selection(files, {std::move(indexed.streamlines)});
-        std::vector<std::uint8_t> table(m.streamline_count);
-        for (std::uint64_t s = 0; s < m.streamline_count; ++s) table[s] = std::uint8_t(groups.group_of(0, s));
-        groups_ms.push_back(ms_since(t0));
       }
+      t0 = Clock::now();
+      vxl::SelectionResult indexed = vxl::select_streamlines(file, c, &*index);
+      indexed_ms.push_back(ms_since(t0));
+      t0 = Clock::now();
+      const vxl::SelectionResult boxed = vxl::select_streamlines(file, c, &*index, vxl::SelectionPath::Fastest, &boxes);
+      boxed_ms.push_back(ms_since(t0));
+      if (boxed.streamlines != indexed.streamlines) {
+        std::fprintf(stderr, "drag_bench: the boxes and the index disagree at (%g, %g, %g)\n", centre[0], centre[1],
+                     centre[2]);
+        return 1;
+      }
+      if (scan && indexed.streamlines != scan->streamlines) {
+        std::fprintf(stderr, "drag_bench: the index and the scan disagree at (%g, %g, %g)\n", centre[0], centre[1],
+                     centre[2]);
+        return 1;
+      }
+      selected_total += indexed.streamlines.size();
+      // What the window does with a new selection: the groups, then one byte per streamline.
+      t0 = Clock::now();
+      const vxl::SceneGroups groups = vxl::SceneGroups::selection(files, {std::move(indexed.streamlines)});
+      std::vector<std::uint8_t> table(m.streamline_count);
+      for (std::uint64_t s = 0; s < m.streamline_count; ++s) table[s] = std::uint8_t(groups.group_of(0, s));
+      groups_ms.push_back(ms_since(t0));
     }
     auto row = [](const char* what, const std::vector<double>& v) {
       if (v.empty()) return;
       const Spread s = spread(v);
       std::printf("| %s | %.1f | %.1f |\n", what, s.median, s.p95);
     };
-    std::printf("%d positions of a %g mm sphere, %.0f streamlines selected on average\n\n", 2 * steps, radius,
-                double(selected_total) / (2 * steps));
+    std::printf("%zu positions of a %g mm sphere, %.0f streamlines selected on average\n\n", centres.size(), radius,
+                double(selected_total) / double(centres.size()));
     std::printf("| per position | median ms | p95 ms |\n|---|---:|---:|\n");
     row("select, scanning the voxline table", scan_ms);
     row("select, through the per-voxel index", indexed_ms);
+    row("select, through the index and the voxline boxes kept from the last position", boxed_ms);
     row("focus/context groups and the byte per streamline (before upload)", groups_ms);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "drag_bench: %s\n", e.what());

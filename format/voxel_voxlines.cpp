@@ -169,26 +169,28 @@ std::optional<VoxelVoxlines> VoxelVoxlines::of_file(const VxlFile& file) {
 }
 
 void place_voxel_voxlines(const VxlFile& file, const VoxelVoxlines& index, std::size_t voxel,
-                          std::vector<std::uint8_t>& ends, std::vector<PlacedVoxline>& out) {
+                          std::vector<std::uint8_t>& ends, std::vector<PlacedVoxline>& out, std::uint32_t level) {
   out.clear();
   const VoxelEntry& v = file.voxels()[voxel];
   const std::uint64_t voxt_at = file.find_section(section_id("VOXT"))->offset + sizeof(VoxelEntry) * voxel;
-  // Where each voxline ends in the block (spec §5.4): the packed words say it; float32 blocks by order 0, which
-  // starts a segment at every other vertex (an entry out of range marks nothing: the walk below stays in the block).
-  ends.assign(v.vertex_count, 1);
-  if (file.position_encoding() == PositionEncoding::Packed) {
-    const std::uint32_t* words = file.packed_vertices().data() + v.vertex_first;
-    for (std::uint32_t i = 0; i < v.vertex_count; ++i) ends[i] = (words[i] & kPackedVoxlineEnd) != 0;
-  } else {
-    const OrderView starts = file.order(voxel, 0, 0);
-    for (std::uint32_t k = 0; k < starts.count; ++k)
-      if (const std::uint32_t e = starts[k]; e < v.vertex_count) ends[e] = 0;
-  }
   const std::uint32_t levels = file.level_count();
   const auto row = file.levels_of(voxel);
+  level = std::min(level, levels > 0 ? levels - 1 : 0u);
   std::array<std::uint64_t, kMaxLevels> cursor{}, end{};
   for (std::uint32_t d = 0; d < levels; ++d)
     cursor[d] = depth_first_vertex(row, d), end[d] = depth_end_vertex(v, row, d);
+  // Where each voxline ends in the level's prefix (spec §5.4): a packed word's end bit, read where the walk below
+  // goes; in a float32 block, where the level's order 0 starts no segment (an entry out of range marks nothing:
+  // the walk stays in the block).
+  const bool packed = file.position_encoding() == PositionEncoding::Packed;
+  const std::uint32_t* words = packed ? file.packed_vertices().data() + v.vertex_first : nullptr;
+  if (!packed) {
+    const std::uint32_t prefix = voxel_level(v, row, level).vertex_count;
+    ends.assign(prefix, 1);
+    const OrderView starts = file.order(voxel, 0, level);
+    for (std::uint32_t k = 0; k < starts.count; ++k)
+      if (const std::uint32_t e = starts[k]; e < prefix) ends[e] = 0;
+  }
   const std::uint64_t n = file.meta().streamline_count;
   for (const IndexedVoxline& e : index.of_voxel(voxel)) {
     PlacedVoxline p;
@@ -197,13 +199,18 @@ void place_voxel_voxlines(const VxlFile& file, const VoxelVoxlines& index, std::
       fail_input(file.path(), voxt_at,
                  "voxel " + std::to_string(voxel) + "'s list names a streamline past the streamline count");
     p.depth = streamline_depth(p.streamline, levels);
+    if (p.depth < level) continue;  // outside the level's prefix
     p.synthetic_first = (e.word & IndexedVoxline::kSyntheticFirst) != 0;
     p.first_of_streamline = (e.word & IndexedVoxline::kFirstOfStreamline) != 0;
     p.last_of_streamline = (e.word & IndexedVoxline::kLastOfStreamline) != 0;
+    const std::uint64_t stop_limit = end[p.depth];
     std::uint64_t stop = cursor[p.depth];
-    while (stop < end[p.depth] && !ends[stop]) ++stop;
+    if (packed)
+      while (stop < stop_limit && (words[stop] & kPackedVoxlineEnd) == 0) ++stop;
+    else
+      while (stop < stop_limit && !ends[stop]) ++stop;
     const std::uint64_t vertices = stop - cursor[p.depth] + 1;
-    if (stop >= end[p.depth] || vertices <= (p.last_of_streamline ? 0u : 1u))
+    if (stop >= stop_limit || vertices <= (p.last_of_streamline ? 0u : 1u))
       fail_input(file.path(), voxt_at, "the voxel's voxlines run past its vertex block (or a level's part of it)");
     p.own = static_cast<std::uint32_t>(vertices - (p.last_of_streamline ? 0 : 1));
     p.first_vertex = v.vertex_first + cursor[p.depth];

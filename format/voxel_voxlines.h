@@ -137,11 +137,13 @@ struct PlacedVoxline {
 
 // Places voxel `voxel`'s list in its block, in list order, as spec §5.14 says: a voxline of depth d starts at
 // that depth's cursor (spec §5.6, §5.12) and ends at the first voxline end from there (the packed words' end
-// bit; with float32 positions, a vertex where no segment of order 0 starts). `ends` is scratch. Throws
+// bit; with float32 positions, a vertex where no segment of order 0 starts). Only the voxlines of level `level`
+// (its streamlines of depth >= level: the block's prefix a renderer draws at that level) are placed, and only
+// that prefix is read, so a coarse level costs its own vertices, not the block's. `ends` is scratch. Throws
 // vxl::Error (Input) naming the file when the list and the block disagree: a streamline past the count, a
 // voxline past its depth's part of the block.
 void place_voxel_voxlines(const VxlFile& file, const VoxelVoxlines& index, std::size_t voxel,
-                          std::vector<std::uint8_t>& ends, std::vector<PlacedVoxline>& out);
+                          std::vector<std::uint8_t>& ends, std::vector<PlacedVoxline>& out, std::uint32_t level = 0);
 
 // The indexes of several files, each built on first use, once, by whichever thread asks first (the
 // window's selection thread or its renderer); the others wait for it.

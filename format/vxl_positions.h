@@ -40,6 +40,12 @@ class VertexPacker {
   void decode(const std::uint32_t* packed, std::uint64_t count, float* xyz) const;
   // Axis c's coordinate for quantum q (0..kPackedSteps), as decode() gives it.
   float decode_axis(int c, std::uint32_t q) const;
+  // One word's 3 floats, as decode() gives them; inline for loops that decode only some of a block's words.
+  void decode_word(std::uint32_t w, float* xyz) const {
+    xyz[0] = lo_[0] + static_cast<float>(w & kPackedAxisMask) * step_[0];  // each product rounded: no fused add
+    xyz[1] = lo_[1] + static_cast<float>((w >> 10) & kPackedAxisMask) * step_[1];
+    xyz[2] = lo_[2] + static_cast<float>((w >> 20) & kPackedAxisMask) * step_[2];
+  }
 
  private:
   std::uint32_t word(const float* xyz) const;

@@ -32,6 +32,7 @@
 #include "converter/selection/region.h"
 #include "converter/selection/selection_output.h"
 #include "converter/selection/streamline_selection.h"
+#include "converter/selection/voxline_boxes.h"
 #include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_verify.h"
@@ -142,6 +143,8 @@ class Selection : public ::testing::Test {
     convert_tractogram(std::move(copy), dir_->file("f32.vxl"), settings(PositionEncoding::Float32));
     copy = *source_;
     convert_tractogram(std::move(copy), dir_->file("f32_4mm.vxl"), settings(PositionEncoding::Float32, 4.0));
+    copy = *source_;
+    convert_tractogram(std::move(copy), dir_->file("packed_4mm.vxl"), settings(PositionEncoding::Packed, 4.0));
   }
   static void TearDownTestSuite() {
     delete source_;
@@ -208,6 +211,95 @@ TEST_F(Selection, RandomSpheresBoxesAndMasksMatchTheBruteForceReference) {
   }
   // The random regions must mostly cut the set, or the comparison says little.
   EXPECT_GT(nonempty, cases / 3);
+}
+
+// A packed file's points are tested where they lie in its words, each region's window of quanta first; the scan of
+// the voxline table decodes every point it tests. Both must find the same points in every kind of region, the
+// spheres' surfaces included: spheres centred on points, radii ending on points.
+TEST_F(Selection, OnAPackedFileTheIndexAndTheScanFindTheSamePoints) {
+  const VxlFile f = VxlFile::open(dir_->file("packed_4mm.vxl"));
+  std::mt19937 rng(5);
+  const std::string labels = write_oblique_labels(*dir_, rng);
+  const std::vector<float> decoded = f.all_vertices();
+  std::uniform_int_distribution<std::uint64_t> vertex(0, f.meta().vertex_count - 1);
+  std::uniform_real_distribution<float> radius(0.5f, 15), side(1, 30);
+  auto a_point = [&] {
+    const float* p = &decoded[3 * vertex(rng)];
+    return std::array<float, 3>{p[0], p[1], p[2]};
+  };
+  auto region = [&](int kind) {
+    const auto c = a_point();
+    if (kind == 0) return sphere(c[0], c[1], c[2], radius(rng));
+    if (kind == 1) {  // its surface through another point
+      const auto q = a_point();
+      const float r =
+          std::sqrt((c[0] - q[0]) * (c[0] - q[0]) + (c[1] - q[1]) * (c[1] - q[1]) + (c[2] - q[2]) * (c[2] - q[2]));
+      return sphere(c[0], c[1], c[2], std::min(r, 20.0f));
+    }
+    if (kind == 2) {  // a corner on a point
+      char text[200];
+      std::snprintf(text, sizeof text, "box:%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", c[0], c[1], c[2], c[0] + side(rng),
+                    c[1] + side(rng), c[2] + side(rng));
+      return parse_region(text);
+    }
+    return parse_region(labels + ":1");
+  };
+  int nonempty = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    SelectionCriteria c;
+    c.include.push_back(region(trial % 4));
+    if (trial % 3 == 1) c.include.push_back(region((trial + 1) % 3));
+    if (trial % 4 == 2) c.exclude.push_back(region(trial % 3));
+    if (trial % 5 == 3) c.ends_in.push_back(region(trial % 2));
+    if (trial % 7 == 4) c.include.clear(), c.ends_in.push_back(region(0)), c.ends_in.push_back(region(1));
+    const SelectionResult indexed = select_streamlines(f, c),
+                          scan = select_streamlines(f, c, nullptr, SelectionPath::ScanTable);
+    ASSERT_EQ(indexed.streamlines, scan.streamlines) << "trial " << trial;
+    ASSERT_EQ(indexed.streamlines_per_region, scan.streamlines_per_region) << "trial " << trial;
+    nonempty += !indexed.streamlines.empty();
+  }
+  EXPECT_GT(nonempty, 30);
+}
+
+// The window keeps each voxel's voxlines boxed between selections (VoxlineBoxes): a sphere dragged in steps, with a
+// second region of every kind, ends and exclusions, selects what a selection without the boxes selects, whether the
+// boxes are all kept or let go after every selection (a budget of nothing).
+TEST_F(Selection, VoxlineBoxesKeptBetweenSelectionsChangeNothing) {
+  const VxlFile f = VxlFile::open(dir_->file("packed_4mm.vxl"));
+  std::mt19937 rng(9);
+  const std::string labels = write_oblique_labels(*dir_, rng);
+  const std::optional<VoxelVoxlines> index = VoxelVoxlines::of_file(f);
+  ASSERT_TRUE(index.has_value());
+  std::uniform_real_distribution<float> step(-3, 3), radius(2, 14);
+  std::uint64_t all_kept_bytes = 0;
+  for (const std::uint64_t budget : {VoxlineBoxes::kDefaultBudgetBytes, std::uint64_t(0)}) {
+    VoxlineBoxes boxes(f, budget);
+    std::array<float, 3> centre = {float(kSynthCentre[0]), float(kSynthCentre[1]), float(kSynthCentre[2])};
+    std::uint64_t kept = 0, cases = 0;
+    for (int trial = 0; trial < 48; ++trial) {
+      for (float& c : centre) c += step(rng);
+      SelectionCriteria c;
+      const Region dragged = sphere(centre[0], centre[1], centre[2], radius(rng));
+      (trial % 6 == 5 ? c.exclude : c.include).push_back(dragged);
+      if (trial % 4 == 1) c.include.push_back(sphere(centre[0] + 15, centre[1], centre[2], 8));
+      if (trial % 4 == 2) c.ends_in.push_back(parse_region("box:-80,-110,-60,0,80,80"));
+      if (trial % 4 == 3) c.include.push_back(parse_region(labels + ":2"));
+      if (trial % 6 == 5) c.include.push_back(sphere(centre[0], centre[1], centre[2], 30));
+      const SelectionResult plain = select_streamlines(f, c, &*index),
+                            boxed = select_streamlines(f, c, &*index, SelectionPath::Fastest, &boxes);
+      ASSERT_EQ(boxed.streamlines, plain.streamlines) << "trial " << trial << " budget " << budget;
+      ASSERT_EQ(boxed.streamlines_per_region, plain.streamlines_per_region) << "trial " << trial;
+      EXPECT_LE(boxed.points_tested, plain.points_tested) << "trial " << trial;
+      kept += boxed.streamlines.size();
+      ++cases;
+    }
+    EXPECT_GT(kept, 20 * cases) << "the regions select something to compare";
+    if (budget != 0) {
+      all_kept_bytes = boxes.bytes();
+    } else {
+      EXPECT_LT(boxes.bytes(), all_kept_bytes) << "the voxels the last selection did not use let go";
+    }
+  }
 }
 
 TEST_F(Selection, ExcludeOnlyEndsOnlyAndLengthOnlyMatchTheReference) {

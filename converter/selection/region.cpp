@@ -148,6 +148,18 @@ float slack(float a, float b) { return 1e-3f + 1e-6f * std::max(std::abs(a), std
 
 }  // namespace
 
+void Region::reach(float* lo, float* hi) const {
+  for (int c = 0; c < 3; ++c) {
+    if (shape_ == Shape::Sphere) {
+      const float s = radius_ + slack(centre_[0] + centre_[1] + centre_[2], radius_);
+      lo[c] = centre_[c] - s, hi[c] = centre_[c] + s;
+    } else {
+      const float s = slack(lo_[c], hi_[c]);
+      lo[c] = lo_[c] - s, hi[c] = hi_[c] + s;
+    }
+  }
+}
+
 bool Region::holds_box(const float* lo, const float* hi) const {
   if (shape_ == Shape::Mask) return false;
   if (shape_ == Shape::Sphere) {

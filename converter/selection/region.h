@@ -41,6 +41,9 @@ class Region {
   bool contains(const float* p) const;
   // False only when no point of the box [lo, hi] can be inside (up to float rounding).
   bool may_touch(const float* lo, const float* hi) const;
+  // A box [lo, hi] holding every point that can be inside (up to float rounding, widened by the same slack as
+  // may_touch): a query can skip a point outside it without the exact test.
+  void reach(float* lo, float* hi) const;
   // True only when every point of the box [lo, hi] is inside (up to float rounding, with the same slack
   // inwards); always false for a mask. A query need not test the points of a voxel such a region holds.
   bool holds_box(const float* lo, const float* hi) const;

@@ -1,10 +1,12 @@
 #include "converter/selection/streamline_selection.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <new>
 #include <string>
@@ -12,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/selection/length_limits.h"
+#include "converter/selection/voxline_boxes.h"
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
 #include "format/base/parallel.h"
@@ -27,6 +30,7 @@ using Bits = std::uint64_t;
 // The regions, numbered: includes first, then ends-in, then excludes (bit r is region r).
 struct RegionTable {
   std::vector<const Region*> regions;
+  std::vector<std::array<float, 6>> reach;  // per region: Region::reach's lo, then hi
   Bits include = 0, ends = 0, exclude = 0;
 
   explicit RegionTable(const SelectionCriteria& c) {
@@ -34,6 +38,8 @@ struct RegionTable {
       for (const Region& r : list) {
         kind |= Bits(1) << regions.size();
         regions.push_back(&r);
+        std::array<float, 6>& box = reach.emplace_back();
+        r.reach(box.data(), box.data() + 3);
       }
     };
     if (c.include.size() + c.ends_in.size() + c.exclude.size() > kMaxRegions)
@@ -88,28 +94,106 @@ std::uint64_t streamline_point_count(const VxlFile& file, std::uint64_t s) {
   return points;
 }
 
-// The regions each streamline's points fell in, one word a streamline. Its zeroed pages come from the system as
-// they are first written (calloc), so a small query touches little of it, and a large one costs 8 bytes a
-// streamline: a list of (streamline, regions) per hit voxline, to be sorted and merged, would take 16 bytes a
-// voxline twice over (400 MB for a box holding the 1M set).
+// fn(i) for each i, a multiple of 8, where bytes [i, i + 8) of `bytes` are not all zero (the last part padded).
+template <typename Fn>
+void for_each_nonzero_chunk(const std::uint8_t* bytes, std::uint64_t count, Fn&& fn) {
+  for (std::uint64_t i = 0; i < count; i += 8) {
+    std::uint64_t chunk = 0;
+    std::memcpy(&chunk, bytes + i, std::min<std::uint64_t>(8, count - i));
+    if (chunk != 0) fn(i);
+  }
+}
+
+// The regions each streamline's points fell in: a byte a streamline for each 8 regions (one byte for most
+// selections). Its zeroed pages come from the system as they are first written (calloc), so a small query touches
+// little of it, and a large one costs a byte a streamline: a list of (streamline, regions) per hit voxline, to be
+// sorted and merged, would take 16 bytes a voxline twice over (400 MB for a box holding the 1M set). Bytes, not a
+// word for all 64 regions: the hits land all over the table, and each lands in a cache line of its own.
 class RegionHits {
  public:
-  explicit RegionHits(std::uint64_t streamlines)
-      : bits_(static_cast<Bits*>(std::calloc(std::max<std::uint64_t>(streamlines, 1), sizeof(Bits)))) {
-    if (!bits_) throw std::bad_alloc();
+  RegionHits(std::uint64_t streamlines, std::size_t regions)
+      : stride_(std::max<std::size_t>(1, (regions + 7) / 8)),
+        bytes_(static_cast<std::uint8_t*>(std::calloc(std::max<std::uint64_t>(streamlines, 1), stride_))) {
+    if (!bytes_) throw std::bad_alloc();
   }
   // From any thread.
   void add(std::uint64_t streamline, Bits regions) {
-    std::atomic_ref<Bits>(bits_.get()[streamline]).fetch_or(regions, std::memory_order_relaxed);
+    std::uint8_t* at = bytes_.get() + streamline * stride_;
+    for (std::size_t b = 0; b < stride_; ++b)
+      if (const auto part = static_cast<std::uint8_t>(regions >> (8 * b)); part != 0)
+        std::atomic_ref<std::uint8_t>(at[b]).fetch_or(part, std::memory_order_relaxed);
   }
-  Bits operator[](std::uint64_t streamline) const { return bits_.get()[streamline]; }
+  Bits operator[](std::uint64_t streamline) const {
+    const std::uint8_t* at = bytes_.get() + streamline * stride_;
+    Bits regions = 0;
+    for (std::size_t b = 0; b < stride_; ++b) regions |= Bits(at[b]) << (8 * b);
+    return regions;
+  }
+  // fn(streamline, regions) for each streamline with a hit, in order; eight bytes at a time past those without
+  // (most of them, in a small selection).
+  template <typename Fn>
+  void for_each(std::uint64_t streamlines, Fn&& fn) const {
+    std::uint64_t next = 0;  // the first streamline not yet looked at
+    for_each_nonzero_chunk(bytes_.get(), streamlines * stride_, [&](std::uint64_t byte) {
+      for (std::uint64_t s = std::max(next, byte / stride_); s <= (byte + 7) / stride_ && s < streamlines; ++s)
+        if (const Bits regions = (*this)[s]; regions != 0) fn(s, regions);
+      next = std::max(next, (byte + 7) / stride_ + 1);
+    });
+  }
+  // A streamline's bytes on their way to the cache before add() needs them: the locked OR of add() waits for its
+  // line, and one add after another would wait for one line after another.
+  void prefetch(std::uint64_t streamline) const { __builtin_prefetch(bytes_.get() + streamline * stride_, 1, 1); }
 
  private:
   struct Free {
-    void operator()(Bits* p) const { std::free(p); }
+    void operator()(std::uint8_t* p) const { std::free(p); }
   };
-  std::unique_ptr<Bits, Free> bits_;
+  std::size_t stride_;
+  std::unique_ptr<std::uint8_t, Free> bytes_;
 };
+
+// The quanta of a packed voxel's axes (spec §5.4) that decode inside one region's reach: a point with a quantum
+// outside them is outside the region, which three integer compares tell before any decoding or exact test.
+struct QuantumWindow {
+  std::array<std::uint32_t, 3> first{}, span{};  // q is in when q - first <= span (unsigned)
+
+  bool holds(std::uint32_t w) const {
+    return (w & kPackedAxisMask) - first[0] <= span[0] && ((w >> 10) & kPackedAxisMask) - first[1] <= span[1] &&
+           ((w >> 20) & kPackedAxisMask) - first[2] <= span[2];
+  }
+};
+
+// decode_axis grows with q (lo + q * step, step >= 0, each step rounded as decode rounds it), so the window is
+// found by bisection; a voxel whose bounds make it shrink (a damaged table) gets every quantum.
+QuantumWindow quantum_window(const VertexPacker& packer, const std::array<float, 6>& reach) {
+  QuantumWindow window;
+  for (int c = 0; c < 3; ++c) {
+    const float low = packer.decode_axis(c, 0), high = packer.decode_axis(c, kPackedSteps);
+    if (!(low <= high) || !std::isfinite(low) || !std::isfinite(high)) {
+      window.first[c] = 0, window.span[c] = kPackedSteps;
+      continue;
+    }
+    // The first quantum whose coordinate passes `below` (kPackedSteps + 1 when none does).
+    auto first_where = [&](auto below) {
+      std::uint32_t lo = 0, hi = kPackedSteps + 1;
+      while (lo < hi) {
+        const std::uint32_t mid = (lo + hi) / 2;
+        if (below(packer.decode_axis(c, mid)))
+          lo = mid + 1;
+        else
+          hi = mid;
+      }
+      return lo;
+    };
+    const std::uint32_t first = first_where([&](float x) { return x < reach[c]; });
+    const std::uint32_t end = first_where([&](float x) { return x <= reach[3 + c]; });
+    if (end <= first)  // none: an empty window
+      window.first[c] = kPackedSteps + 1, window.span[c] = 0;
+    else
+      window.first[c] = first, window.span[c] = end - 1 - first;
+  }
+  return window;
+}
 
 // One voxline, as a region test needs it.
 struct VoxlinePlace {
@@ -155,6 +239,47 @@ struct HitSearch {
       if ((i == 0 && v.first_of_streamline) || (i + 1 == v.own && !v.connected)) test |= at_ends & left & ~hit;
       for (Bits b = test; b != 0; b &= b - 1) {
         const int r = std::countr_zero(b);
+        if (table.regions[r]->contains(p)) hit |= Bits(1) << r;
+      }
+    }
+    return hit;
+  }
+
+  // test_voxline for a voxline of a packed file, read from its words where they lie: a point is decoded and
+  // tested only for the regions whose quantum window (windows[r], for v's voxel) holds it, and the voxline's
+  // test stops once every region it can still hit has been hit.
+  // `box_holds`: regions holding every point the test would read (VoxlineBoxes), hit without reading them.
+  Bits test_packed_voxline(const VoxlinePlace& v, Bits open, const VertexPacker& packer,
+                           const std::array<QuantumWindow, kMaxRegions>& windows, Bits box_holds = 0) {
+    const Bits touching = voxel_regions.touching[v.voxel] & open;
+    const Bits anywhere = touching & (table.include | table.exclude);
+    const Bits at_ends = (v.first_of_streamline || !v.connected) ? touching & table.ends : 0;
+    if ((anywhere | at_ends) == 0) return 0;
+    const std::uint32_t from = v.synthetic_first ? 1 : 0;
+    if (from >= v.own) return 0;
+    const Bits held = voxel_regions.holding[v.voxel] | box_holds;
+    Bits hit = (anywhere | at_ends) & held;
+    const Bits left = (anywhere | at_ends) & ~held;
+    if (left == 0) return hit;
+    points_tested += v.own - from;
+    const std::uint32_t* words = file.packed_vertices().data() + v.first_vertex;
+    const Bits ends_left = at_ends & left;
+    for (std::uint32_t i = from; i < v.own; ++i) {
+      const bool end_point = (i == 0 && v.first_of_streamline) || (i + 1 == v.own && !v.connected);
+      Bits test = anywhere & left & ~hit;
+      if (end_point) test |= ends_left & ~hit;
+      // Nothing left to find but at the last point, for a region that wants ends: straight there.
+      if (test == 0) {
+        if ((ends_left & ~hit) == 0 || v.connected || i + 1 >= v.own) break;
+        i = v.own - 2;
+        continue;
+      }
+      float p[3];
+      bool decoded = false;
+      for (Bits b = test; b != 0; b &= b - 1) {
+        const int r = std::countr_zero(b);
+        if (!windows[std::size_t(r)].holds(words[i])) continue;
+        if (!decoded) packer.decode_word(words[i], p), decoded = true;
         if (table.regions[r]->contains(p)) hit |= Bits(1) << r;
       }
     }
@@ -213,41 +338,116 @@ void hits_by_scan(HitSearch& q, RegionHits& hits, std::uint64_t& bytes_read) {
   bytes_read += q.strm.size_bytes() + q.voxlines.size_bytes();
 }
 
+// A boxed voxline's regions: those its box misses (`outside`) and those holding the whole box (`inside`), of the
+// regions `candidates` (bit r: windows[r] is region r's window in the voxline's voxel).
+struct BoxVerdict {
+  Bits outside = 0, inside = 0;
+};
+BoxVerdict box_verdict(const BoxedVoxline& b, Bits candidates, const RegionTable& table, const VertexPacker& packer,
+                       const std::array<QuantumWindow, kMaxRegions>& windows) {
+  BoxVerdict verdict;
+  if (b.lo[0] > b.hi[0]) return {candidates, 0};  // no point to test
+  const std::uint32_t lo_word = b.lo[0] | std::uint32_t(b.lo[1]) << 10 | std::uint32_t(b.lo[2]) << 20;
+  const std::uint32_t hi_word = b.hi[0] | std::uint32_t(b.hi[1]) << 10 | std::uint32_t(b.hi[2]) << 20;
+  float lo[3], hi[3];
+  bool decoded = false;
+  for (Bits bits = candidates; bits != 0; bits &= bits - 1) {
+    const int r = std::countr_zero(bits);
+    const QuantumWindow& w = windows[std::size_t(r)];
+    bool misses = false;
+    for (int c = 0; c < 3; ++c)  // the box's quanta and the window's do not overlap on axis c
+      misses |= b.hi[c] < w.first[c] || b.lo[c] > w.first[c] + w.span[c];
+    if (misses) {
+      verdict.outside |= Bits(1) << r;
+      continue;
+    }
+    if (!decoded) packer.decode_word(lo_word, lo), packer.decode_word(hi_word, hi), decoded = true;
+    if (table.regions[r]->holds_box(lo, hi)) verdict.inside |= Bits(1) << r;
+  }
+  return verdict;
+}
+
+// One thread's scratch for the voxels it searches.
+struct VoxelScratch {
+  std::vector<std::uint8_t> ends;
+  std::vector<PlacedVoxline> placed;
+  std::array<QuantumWindow, kMaxRegions> windows;
+};
+
+// How many voxlines ahead a streamline's hit bytes are fetched (RegionHits::prefetch).
+constexpr std::size_t kHitsAhead = 16;
+
+// A packed voxel's voxlines through their boxes: only those across a region's surface are read point by point.
+void boxed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacker& packer, VoxlineBoxes& boxes,
+                      const VoxelVoxlines& index, VoxelScratch& scratch, RegionHits& hits) {
+  const Bits candidates = search.voxel_regions.touching[voxel] & ~search.voxel_regions.holding[voxel];
+  const std::uint64_t first = search.voxels[voxel].vertex_first;
+  const std::span<const BoxedVoxline> list = boxes.voxel(voxel, index);
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    if (k + kHitsAhead < list.size()) hits.prefetch(list[k + kHitsAhead].streamline);
+    const BoxedVoxline& b = list[k];
+    const BoxVerdict verdict = box_verdict(b, candidates, search.table, packer, scratch.windows);
+    const VoxlinePlace v{voxel,
+                         b.own,
+                         (b.flags & BoxedVoxline::kSyntheticFirst) != 0,
+                         (b.flags & BoxedVoxline::kFirstOfStreamline) != 0,
+                         (b.flags & BoxedVoxline::kLastOfStreamline) == 0,
+                         first + b.first};
+    if (const Bits hit = search.test_packed_voxline(v, ~verdict.outside, packer, scratch.windows, verdict.inside))
+      hits.add(b.streamline, hit);
+  }
+}
+
+// A voxel's voxlines placed in its block and tested: a packed block's points where they lie, a float32 block's
+// read out.
+void placed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacker* packer, const VoxelVoxlines& index,
+                       VoxelScratch& scratch, RegionHits& hits) {
+  place_voxel_voxlines(search.file, index, voxel, scratch.ends, scratch.placed);
+  const std::vector<PlacedVoxline>& placed = scratch.placed;
+  for (std::size_t k = 0; k < placed.size(); ++k) {
+    if (k + kHitsAhead < placed.size()) hits.prefetch(placed[k + kHitsAhead].streamline);
+    const PlacedVoxline& p = placed[k];
+    const VoxlinePlace v{voxel, p.own, p.synthetic_first, p.first_of_streamline, !p.last_of_streamline, p.first_vertex};
+    const Bits hit =
+        packer ? search.test_packed_voxline(v, ~Bits(0), *packer, scratch.windows) : search.test_voxline(v, ~Bits(0));
+    if (hit != 0) hits.add(p.streamline, hit);
+  }
+}
+
 // Only the voxels the regions may touch, through their lists (VoxelVoxlines): a voxel's list, placed in its
-// block (place_voxel_voxlines), is all a voxline costs. Voxels are independent here, so they are searched side
-// by side (the first error in voxel order reported).
-void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, std::uint64_t& bytes_read) {
+// block (place_voxel_voxlines, or kept boxed by `boxes` between selections), is all a voxline costs. Voxels are
+// independent here, so they are searched side by side (the first error in voxel order reported).
+void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, std::uint64_t& bytes_read,
+                   VoxlineBoxes* boxes) {
   std::vector<std::uint32_t> touched;
   for (std::size_t voxel = 0; voxel < q.voxels.size(); ++voxel)
     if (q.voxel_regions.touching[voxel] != 0) touched.push_back(std::uint32_t(voxel));
-  struct Scratch {
-    std::vector<std::uint8_t> ends;
-    std::vector<PlacedVoxline> placed;
-  };
+  const bool packed = q.file.position_encoding() == PositionEncoding::Packed;
   std::vector<HitSearch> per_thread(resolve_threads(0), q);
-  std::vector<Scratch> scratch(per_thread.size());
+  std::vector<VoxelScratch> scratch(per_thread.size());
   // A query touching most voxels reads most blocks: their pages are let go as it goes (walk_streamlines does so too).
   std::atomic<std::uint64_t> read_since_release = 0;
-  parallel_for_first_error_in_order(touched.size(), 0, [&](std::uint64_t k, unsigned t) {
-    HitSearch& search = per_thread[t];
+  parallel_for_first_error_in_order(touched.size(), unsigned(per_thread.size()), [&](std::uint64_t k, unsigned t) {
     const std::uint32_t voxel = touched[k];
     if (read_since_release.fetch_add(4ull * q.voxels[voxel].vertex_count) > (64ull << 20)) {
       read_since_release = 0;
       q.file.release_resident_pages();
     }
-    place_voxel_voxlines(q.file, index, voxel, scratch[t].ends, scratch[t].placed);
-    for (const PlacedVoxline& p : scratch[t].placed) {
-      VoxlinePlace v{voxel, p.own, p.synthetic_first, p.first_of_streamline, !p.last_of_streamline, p.first_vertex};
-      if (const Bits hit = search.test_voxline(v, ~Bits(0)); hit != 0) hits.add(p.streamline, hit);
+    if (!packed) return placed_voxel_hits(per_thread[t], voxel, nullptr, index, scratch[t], hits);
+    const VertexPacker packer(q.voxels[voxel]);
+    for (Bits b = q.voxel_regions.touching[voxel]; b != 0; b &= b - 1) {
+      const int r = std::countr_zero(b);
+      scratch[t].windows[std::size_t(r)] = quantum_window(packer, q.table.reach[std::size_t(r)]);
     }
+    if (boxes) return boxed_voxel_hits(per_thread[t], voxel, packer, *boxes, index, scratch[t], hits);
+    placed_voxel_hits(per_thread[t], voxel, &packer, index, scratch[t], hits);
   });
   for (std::size_t k = 0; k < touched.size(); ++k) {
     // The list, and the block's voxline ends: its packed words (float32: order 0), read whole.
     const VoxelEntry& v = q.voxels[touched[k]];
-    bytes_read += index.of_voxel(touched[k]).size_bytes() +
-                  (q.file.position_encoding() == PositionEncoding::Packed
-                       ? 4ull * v.vertex_count
-                       : order_array_bytes(v.segment_count, q.file.order(touched[k], 0).bits));
+    bytes_read +=
+        index.of_voxel(touched[k]).size_bytes() +
+        (packed ? 4ull * v.vertex_count : order_array_bytes(v.segment_count, q.file.order(touched[k], 0).bits));
   }
   for (const HitSearch& search : per_thread) q.points_tested += search.points_tested;
 }
@@ -255,7 +455,7 @@ void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, s
 }  // namespace
 
 SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria, const VoxelVoxlines* index,
-                                   SelectionPath path) {
+                                   SelectionPath path, VoxlineBoxes* boxes) {
   if (criteria.min_length && criteria.max_length && *criteria.min_length > *criteria.max_length)
     throw Error(ErrorKind::Usage, "--min-length", std::nullopt, "the minimum length is above the maximum length");
   const RegionTable table(criteria);
@@ -278,22 +478,22 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
     index = file_index ? &*file_index : nullptr;
   }
   trust(index && !file.voxel_index_first().empty() ? "VXIX" : "VXLN");
-  RegionHits hits(n);
-  if (index)
-    hits_by_index(search, *index, hits, result.bytes_read);
-  else
+  RegionHits hits(n, table.regions.size());
+  if (index) {
+    if (file.position_encoding() != PositionEncoding::Packed) boxes = nullptr;
+    hits_by_index(search, *index, hits, result.bytes_read, boxes);
+    if (boxes) boxes->selection_done();
+  } else
     hits_by_scan(search, hits, result.bytes_read);
   result.points_tested = search.points_tested;
 
   const Bits needed = table.include | table.ends;
   std::vector<std::uint8_t> passes(n, needed == 0 ? 1 : 0);
   result.streamlines_per_region.assign(table.regions.size(), 0);
-  for (std::uint64_t s = 0; s < n; ++s) {
-    const Bits regions = hits[s];
-    if (regions == 0) continue;
+  hits.for_each(n, [&](std::uint64_t s, Bits regions) {
     passes[s] = (regions & needed) == needed && (regions & table.exclude) == 0;
     for (Bits b = regions; b != 0; b &= b - 1) ++result.streamlines_per_region[std::countr_zero(b)];
-  }
+  });
   const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
   result.bytes_read += result.points_tested * vertex_bytes;
 
@@ -332,10 +532,18 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
     if (std::find(passes.begin(), passes.end(), kMeasure) != passes.end()) walk_streamlines(file, lengths);
   }
   // A streamline without points is never kept, inverted or not: tckedit's reader skips it, so it never writes one.
+  // A streamline that passes by a point in a region has points: only the others are looked up in STRM.
   const std::span<const std::uint64_t> first_voxline = file.streamline_first_voxline();
-  for (std::uint64_t s = 0; s < n; ++s)
-    if ((passes[s] != 0) != criteria.invert && first_voxline[s + 1] != first_voxline[s])
-      result.streamlines.push_back(s);
+  const bool passing_have_points = !criteria.invert && needed != 0;
+  auto keep_from = [&](std::uint64_t first, std::uint64_t end) {
+    for (std::uint64_t s = first; s < end; ++s)
+      if ((passes[s] != 0) != criteria.invert && (passing_have_points || first_voxline[s + 1] != first_voxline[s]))
+        result.streamlines.push_back(s);
+  };
+  if (criteria.invert)
+    keep_from(0, n);
+  else  // only the streamlines that pass: eight at a time past the others
+    for_each_nonzero_chunk(passes.data(), n, [&](std::uint64_t s) { keep_from(s, std::min(n, s + 8)); });
   return result;
 }
 

@@ -33,6 +33,8 @@
 
 namespace vxl {
 
+class VoxlineBoxes;
+
 struct SelectionCriteria {
   std::vector<Region> include, exclude, ends_in;
   std::optional<double> min_length, max_length;  // mm
@@ -63,8 +65,11 @@ enum class SelectionPath { Fastest, ScanTable };
 // Throws vxl::Error: Usage for more than kMaxRegions regions or min_length > max_length, Input for a .vxl
 // whose tables do not hold together or whose source header tckedit would refuse (length_limits.h). `index`, when given,
 // must be VoxelVoxlines::of_file(file)'s: the result is the same with or without it (without it, the file's VXIX is
-// used when it has one), and by either path.
+// used when it has one), and by either path. `boxes` (the file's, kept by a caller that selects again and again, as
+// the window does while a region moves) lets a packed file's later selections pass over the voxlines they can
+// decide from their boxes; the result is the same without it.
 SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria,
-                                   const VoxelVoxlines* index = nullptr, SelectionPath path = SelectionPath::Fastest);
+                                   const VoxelVoxlines* index = nullptr, SelectionPath path = SelectionPath::Fastest,
+                                   VoxlineBoxes* boxes = nullptr);
 
 }  // namespace vxl

@@ -28,16 +28,23 @@ std::vector<std::uint64_t> streamline_of_vertex(const VxlFile& f) {
   return of;
 }
 
+// A synthetic set of `streamlines`, converted in `dir`.
+VxlFile synthetic_vxl(const test::ScratchDir& dir, std::uint64_t streamlines, double voxel_size, std::uint32_t levels,
+                      PositionEncoding positions) {
+  SynthSettings synth;
+  synth.streamlines = streamlines;
+  ConvertSettings c;
+  c.voxel_size = voxel_size;
+  c.levels = levels;
+  c.threads = 2;
+  c.positions = positions;
+  convert_tractogram(synthesize_tractogram(synth), dir.file("s.vxl"), c);
+  return VxlFile::open(dir.file("s.vxl"));
+}
+
 TEST(VertexAttributes, EveryLevelsPrefixHoldsTheStreamlinesTheWalkGives) {
   test::ScratchDir dir;
-  SynthSettings synth;
-  synth.streamlines = 1500;
-  ConvertSettings c;
-  c.voxel_size = 6;
-  c.levels = 4;
-  c.threads = 2;
-  convert_tractogram(synthesize_tractogram(synth), dir.file("s.vxl"), c);
-  const VxlFile f = VxlFile::open(dir.file("s.vxl"));
+  const VxlFile f = synthetic_vxl(dir, 1500, 6, 4, PositionEncoding::Packed);
   ASSERT_GT(f.level_count(), 1u);
   const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f);
   ASSERT_TRUE(index.has_value());
@@ -58,6 +65,39 @@ TEST(VertexAttributes, EveryLevelsPrefixHoldsTheStreamlinesTheWalkGives) {
       checked += n;
     }
   EXPECT_GT(checked, f.meta().vertex_count);  // the coarse levels too
+}
+
+// A level's placement reads that level's prefix only, and gives the voxlines that the whole block's placement
+// gives for the streamlines of depth >= the level, at the same places: with packed and with float32 positions.
+TEST(VertexAttributes, ALevelsPlacementIsTheWholePlacementOfItsStreamlines) {
+  for (const PositionEncoding positions : {PositionEncoding::Packed, PositionEncoding::Float32}) {
+    test::ScratchDir dir;
+    const VxlFile f = synthetic_vxl(dir, 1200, 8, 3, positions);
+    const std::optional<VoxelVoxlines> index = VoxelVoxlines::build(f);
+    ASSERT_TRUE(index.has_value());
+    std::vector<std::uint8_t> ends;
+    std::vector<PlacedVoxline> whole, part;
+    std::uint64_t compared = 0;
+    for (std::size_t v = 0; v < f.voxels().size(); ++v) {
+      place_voxel_voxlines(f, *index, v, ends, whole, 0);
+      for (std::uint32_t level = 1; level < f.level_count(); ++level) {
+        place_voxel_voxlines(f, *index, v, ends, part, level);
+        std::vector<PlacedVoxline> expected;
+        for (const PlacedVoxline& p : whole)
+          if (p.depth >= level) expected.push_back(p);
+        ASSERT_EQ(part.size(), expected.size()) << "voxel " << v << " level " << level;
+        const std::uint64_t prefix_end = f.voxels()[v].vertex_first + f.level(v, level).vertex_count;
+        for (std::size_t k = 0; k < part.size(); ++k) {
+          EXPECT_EQ(part[k].streamline, expected[k].streamline);
+          EXPECT_EQ(part[k].first_vertex, expected[k].first_vertex);
+          EXPECT_EQ(part[k].own, expected[k].own);
+          EXPECT_LE(part[k].first_vertex + part[k].vertices(), prefix_end);
+        }
+        compared += part.size();
+      }
+    }
+    EXPECT_GT(compared, 100u) << "the coarse levels hold voxlines to compare";
+  }
 }
 
 TEST(VertexAttributes, ValuesComeFromVvalAsTheyAreAndFromSvalThroughTheStreamline) {

@@ -3,12 +3,13 @@
 namespace vxl::app {
 
 SceneSelection select_in_scene(std::span<const VxlFile* const> files, const SelectionCriteria& criteria,
-                               VoxelVoxlinesCache* indexes) {
+                               VoxelVoxlinesCache* indexes, std::span<const std::unique_ptr<VoxlineBoxes>> boxes) {
   SceneSelection out;
   for (std::size_t i = 0; i < files.size(); ++i) {
     const VxlFile* f = files[i];
     const VoxelVoxlines* index = indexes ? indexes->of(i) : nullptr;
-    SelectionResult r = select_streamlines(*f, criteria, index);
+    SelectionResult r =
+        select_streamlines(*f, criteria, index, SelectionPath::Fastest, boxes.empty() ? nullptr : boxes[i].get());
     out.streamlines_per_region.resize(r.streamlines_per_region.size(), 0);
     for (std::size_t i = 0; i < r.streamlines_per_region.size(); ++i)
       out.streamlines_per_region[i] += r.streamlines_per_region[i];

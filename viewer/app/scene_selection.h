@@ -5,10 +5,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "converter/selection/streamline_selection.h"
+#include "converter/selection/voxline_boxes.h"
 #include "viewer/render/scene_groups.h"
 
 namespace vxl::app {
@@ -21,8 +23,10 @@ struct SceneSelection {
 };
 
 // `indexes` (one per file, or null), for selections repeated as regions move: each then reads the voxels
-// its regions touch, not every file's whole voxline table.
+// its regions touch, not every file's whole voxline table; `boxes` (empty, or one per file) keeps what each
+// selection learned of the voxels it touched for the next (voxline_boxes.h).
 SceneSelection select_in_scene(std::span<const VxlFile* const> files, const SelectionCriteria& criteria,
-                               VoxelVoxlinesCache* indexes = nullptr);
+                               VoxelVoxlinesCache* indexes = nullptr,
+                               std::span<const std::unique_ptr<VoxlineBoxes>> boxes = {});
 
 }  // namespace vxl::app

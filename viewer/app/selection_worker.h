@@ -2,13 +2,15 @@
 // file asks for a new selection every frame, and one can take longer than a frame (hundreds of milliseconds on
 // 10^7 streamlines where a region meets dense voxels), so the frames keep their budget and the picture takes each
 // selection when it is ready. The files' per-voxel indexes (VoxelVoxlines) come from the shared cache: the files'
-// own, or built by the first run that needs them (or by a renderer sharing the cache) and reused.
+// own, or built by the first run that needs them (or by a renderer sharing the cache) and reused; each file's
+// VoxlineBoxes, the worker's own, carry what one selection learned of its voxels to the next.
 #pragma once
 
 #include <memory>
 #include <vector>
 
 #include "converter/selection/streamline_selection.h"
+#include "converter/selection/voxline_boxes.h"
 #include "viewer/app/newest_request_worker.h"
 #include "viewer/app/scene_selection.h"
 
@@ -19,9 +21,17 @@ namespace vxl::app {
 class SelectionWorker : public NewestRequestWorker<SelectionCriteria, SceneSelection> {
  public:
   SelectionWorker(std::vector<const VxlFile*> files, std::shared_ptr<VoxelVoxlinesCache> indexes)
-      : NewestRequestWorker([files = std::move(files), indexes = std::move(indexes)](const SelectionCriteria& c) {
-          return select_in_scene(files, c, indexes.get());
+      : NewestRequestWorker([files, indexes = std::move(indexes), boxes = boxes_of(files)](const SelectionCriteria& c) {
+          return select_in_scene(files, c, indexes.get(), *boxes);
         }) {}
+
+ private:
+  using Boxes = std::vector<std::unique_ptr<VoxlineBoxes>>;
+  static std::shared_ptr<Boxes> boxes_of(const std::vector<const VxlFile*>& files) {
+    auto boxes = std::make_shared<Boxes>();
+    for (const VxlFile* f : files) boxes->push_back(std::make_unique<VoxlineBoxes>(*f));
+    return boxes;
+  }
 };
 
 }  // namespace vxl::app

@@ -32,11 +32,15 @@ void voxel_attributes(const VxlFile& file, std::size_t voxel, const AttributeSou
     for (std::uint32_t i = 0; i < vertices; ++i)
       out[2 * i] = std::bit_cast<std::uint32_t>(per_vertex[v.vertex_first + i]);
 
-  // The voxel's voxlines, placed in its block through its list (spec §5.14); the scratch is kept for the
-  // thread's next voxel.
+  // The voxel's voxlines, placed in its block through its list (spec §5.14): those of the coarsest level whose
+  // prefix holds the vertices drawn, so that a coarse level's words cost its own vertices. The scratch is kept for
+  // the thread's next voxel.
+  const auto row = file.levels_of(voxel);
+  std::uint32_t level = 0;
+  while (level + 1 < file.level_count() && voxel_level(v, row, level + 1).vertex_count >= vertices) ++level;
   thread_local std::vector<std::uint8_t> ends;
   thread_local std::vector<PlacedVoxline> placed;
-  place_voxel_voxlines(file, *source.index, voxel, ends, placed);
+  place_voxel_voxlines(file, *source.index, voxel, ends, placed, level);
   for (const PlacedVoxline& p : placed) {
     const std::uint64_t first = p.first_vertex - v.vertex_first;
     if (first >= vertices) continue;  // beyond the prefix drawn

@@ -1,0 +1,57 @@
+// What one selection learns about the voxels it touches, kept for the next: each voxel's voxlines placed in its
+// block (place_voxel_voxlines) with the box of the points a region test reads, in the block's packed quanta
+// (spec §5.4). A region dragged through the window asks for a selection every frame, and consecutive positions
+// touch mostly the same voxels: with their voxlines boxed, a voxline whose box misses a region is passed over and
+// one whose box the region holds is kept, both without reading its points; only voxlines across a region's
+// surface are tested point by point. The boxes hold for any region and any position, so nothing is invalidated as
+// regions move. Packed files only (a float32 file's selections take the plain path).
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "format/voxel_voxlines.h"
+#include "format/vxl_file.h"
+
+namespace vxl {
+
+// One voxline of a voxel, placed and boxed.
+struct BoxedVoxline {
+  static constexpr std::uint8_t kSyntheticFirst = 1, kFirstOfStreamline = 2, kLastOfStreamline = 4;
+  std::uint32_t streamline = 0;
+  std::uint32_t first = 0;  // its first vertex, counted from the voxel's first
+  std::uint32_t own = 0;    // its own points (spec §5.6)
+  std::uint8_t flags = 0;
+  // The quanta of the points a region test reads (own points but a synthetic first): lo > hi on an axis when none.
+  std::array<std::uint16_t, 3> lo{}, hi{};
+};
+
+class VoxlineBoxes {
+ public:
+  // What the boxes of the voxels not used by the last selection may take before they are let go.
+  static constexpr std::uint64_t kDefaultBudgetBytes = 256ull << 20;
+
+  explicit VoxlineBoxes(const VxlFile& file, std::uint64_t budget_bytes = kDefaultBudgetBytes);
+  VoxlineBoxes(const VoxlineBoxes&) = delete;
+  VoxlineBoxes& operator=(const VoxlineBoxes&) = delete;
+
+  // Voxel `voxel`'s voxlines, boxed on first use (placed through `index`, the file's, and its words read once).
+  // Threads may ask for different voxels at once. Throws what place_voxel_voxlines throws for a damaged file.
+  std::span<const BoxedVoxline> voxel(std::size_t voxel, const VoxelVoxlines& index);
+  // After each selection: over the budget, the voxels it did not use are let go.
+  void selection_done();
+  std::uint64_t bytes() const { return bytes_; }
+
+ private:
+  const VxlFile& file_;
+  std::uint64_t budget_;
+  std::vector<std::vector<BoxedVoxline>> lists_;  // per voxel; empty until boxed
+  std::unique_ptr<std::atomic<bool>[]> boxed_, used_;
+  std::atomic<std::uint64_t> bytes_ = 0;
+};
+
+}  // namespace vxl
