@@ -55,6 +55,8 @@ class SceneGroups {
   }
   // Whether every streamline of `file` is in one group (no per-streamline lookup needed).
   bool uniform(std::size_t file) const { return files_[file].of_streamline.empty(); }
+  // Each streamline's group, for a file that is not uniform.
+  std::span<const std::uint32_t> streamline_groups(std::size_t file) const { return files_[file].of_streamline; }
   int find(const std::string& name) const;
 
  private:
