@@ -116,12 +116,8 @@ Region Region::mask(const VolumeImage& image, std::optional<float> label, std::s
 
 bool Region::contains(const float* p) const {
   switch (shape_) {
-    case Shape::Sphere: {
-      // tckedit: (pos - p).squaredNorm() <= radius^2, in float32, summed as Eigen unrolls a sum of three
-      // (halves: x, then y + z).
-      const float dx = centre_[0] - p[0], dy = centre_[1] - p[1], dz = centre_[2] - p[2];
-      return dx * dx + (dy * dy + dz * dz) <= radius2_;
-    }
+    case Shape::Sphere:  // tckedit: (pos - p).squaredNorm() <= radius^2, in float32
+      return squared_distance(p) <= radius2_;
     case Shape::Box:
       return p[0] >= lo_[0] && p[0] <= hi_[0] && p[1] >= lo_[1] && p[1] <= hi_[1] && p[2] >= lo_[2] && p[2] <= hi_[2];
     case Shape::Mask: {

@@ -39,6 +39,15 @@ class Region {
   // The argument it was made from, for messages and provenance.
   const std::string& text() const { return text_; }
   bool contains(const float* p) const;
+  // A sphere's: its centre and radius, and the float32 squared distance contains() compares with radius_squared()
+  // (tckedit's arithmetic), so that a caller keeping distances decides as contains() does.
+  const Point3f& centre() const { return centre_; }
+  float radius() const { return radius_; }
+  float radius_squared() const { return radius2_; }
+  float squared_distance(const float* p) const {
+    const float dx = centre_[0] - p[0], dy = centre_[1] - p[1], dz = centre_[2] - p[2];
+    return dx * dx + (dy * dy + dz * dz);  // summed as Eigen unrolls a sum of three (halves: x, then y + z)
+  }
   // False only when no point of the box [lo, hi] can be inside (up to float rounding).
   bool may_touch(const float* lo, const float* hi) const;
   // A box [lo, hi] holding every point that can be inside (up to float rounding, widened by the same slack as

@@ -377,16 +377,86 @@ struct VoxelScratch {
 // How many voxlines ahead a streamline's hit bytes are fetched (RegionHits::prefetch).
 constexpr std::size_t kHitsAhead = 16;
 
-// A packed voxel's voxlines through their boxes: only those across a region's surface are read point by point.
+// A float a little below (or above) `x`, so that a distance bound kept in float32 stays a bound.
+float float_below(double x) {
+  const auto f = static_cast<float>(x);
+  return double(f) > x ? std::nextafter(f, -INFINITY) : f;
+}
+float float_above(double x) {
+  const auto f = static_cast<float>(x);
+  return double(f) < x ? std::nextafter(f, INFINITY) : f;
+}
+
+// The sphere a drag moves, followed through the distances VoxlineBoxes keeps (near_lo, near_hi): how far it moved
+// since a voxel's were measured decides most voxlines; the others are measured again, point by point.
+struct DraggedSphere {
+  const Region* sphere = nullptr;
+  Bits bit = 0;
+  double radius = 0, margin = 0;
+
+  DraggedSphere(const RegionTable& table, int region) {
+    if (region < 0) return;
+    sphere = table.regions[std::size_t(region)];
+    bit = Bits(1) << region;
+    radius = sphere->radius();
+    const Point3f& c = sphere->centre();
+    // Far more than the float32 rounding of a distance and of its test (Region's slack, and then some).
+    margin = 1e-3 + 1e-6 * (std::abs(c[0]) + std::abs(c[1]) + std::abs(c[2]) + radius);
+  }
+  // Decides b for the sphere where its distances, `moved` since they were measured (infinite when they never
+  // were), allow; else its box (box_verdict over the `candidates` left), else its points, measured again. Its
+  // distances are then from the sphere's centre.
+  BoxVerdict decide(BoxedVoxline& b, double moved, Bits candidates, const std::uint32_t* words,
+                    const VertexPacker& packer, const RegionTable& table,
+                    const std::array<QuantumWindow, kMaxRegions>& windows) const {
+    double lo = b.near_lo - moved, hi = b.near_hi + moved;
+    BoxVerdict verdict;
+    if (lo > radius + margin)
+      verdict.outside = bit;
+    else if (hi < radius - margin)
+      verdict.inside = bit;
+    const BoxVerdict boxed = box_verdict(b, candidates & ~(verdict.outside | verdict.inside), table, packer, windows);
+    verdict.outside |= boxed.outside, verdict.inside |= boxed.inside;
+    if (((verdict.outside | verdict.inside) & bit) == 0) {  // measured again, with contains()'s arithmetic
+      float nearest = INFINITY;
+      for (std::uint32_t i = (b.flags & BoxedVoxline::kSyntheticFirst) ? 1 : 0; i < b.own; ++i) {
+        float p[3];
+        packer.decode_word(words[b.first + i], p);
+        nearest = std::min(nearest, sphere->squared_distance(p));
+      }
+      (nearest <= sphere->radius_squared() ? verdict.inside : verdict.outside) |= bit;
+      lo = hi = std::sqrt(double(nearest));
+    }
+    b.near_lo = float_below(std::max(0.0, lo));
+    b.near_hi = float_above(hi);
+    return verdict;
+  }
+};
+
+// A packed voxel's voxlines through their boxes: only those across a region's surface are read point by point, and
+// for the dragged sphere only those its move may have carried across.
 void boxed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacker& packer, VoxlineBoxes& boxes,
-                      const VoxelVoxlines& index, VoxelScratch& scratch, RegionHits& hits) {
+                      const VoxelVoxlines& index, const DraggedSphere& dragged, VoxelScratch& scratch,
+                      RegionHits& hits) {
   const Bits candidates = search.voxel_regions.touching[voxel] & ~search.voxel_regions.holding[voxel];
   const std::uint64_t first = search.voxels[voxel].vertex_first;
-  const std::span<const BoxedVoxline> list = boxes.voxel(voxel, index);
+  const std::span<BoxedVoxline> list = boxes.voxel(voxel, index);
+  const std::uint32_t* words = search.file.packed_vertices().data() + first;
+  const bool follow = (candidates & dragged.bit) != 0;
+  VoxelReference& reference = boxes.reference(voxel);
+  double moved = INFINITY;
+  if (follow && reference.known) {
+    const Point3f& c = dragged.sphere->centre();
+    moved = std::hypot(double(c[0]) - reference.centre[0], double(c[1]) - reference.centre[1],
+                       double(c[2]) - reference.centre[2]);
+  }
+  reference.known = reference.known && !follow;  // until every voxline's distances are the new centre's
   for (std::size_t k = 0; k < list.size(); ++k) {
     if (k + kHitsAhead < list.size()) hits.prefetch(list[k + kHitsAhead].streamline);
-    const BoxedVoxline& b = list[k];
-    const BoxVerdict verdict = box_verdict(b, candidates, search.table, packer, scratch.windows);
+    BoxedVoxline& b = list[k];
+    const BoxVerdict verdict = follow
+                                   ? dragged.decide(b, moved, candidates, words, packer, search.table, scratch.windows)
+                                   : box_verdict(b, candidates, search.table, packer, scratch.windows);
     const VoxlinePlace v{voxel,
                          b.own,
                          (b.flags & BoxedVoxline::kSyntheticFirst) != 0,
@@ -396,6 +466,7 @@ void boxed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacker
     if (const Bits hit = search.test_packed_voxline(v, ~verdict.outside, packer, scratch.windows, verdict.inside))
       hits.add(b.streamline, hit);
   }
+  if (follow) reference = {dragged.sphere->centre(), true};
 }
 
 // A voxel's voxlines placed in its block and tested: a packed block's points where they lie, a float32 block's
@@ -423,6 +494,13 @@ void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, s
   for (std::size_t voxel = 0; voxel < q.voxels.size(); ++voxel)
     if (q.voxel_regions.touching[voxel] != 0) touched.push_back(std::uint32_t(voxel));
   const bool packed = q.file.position_encoding() == PositionEncoding::Packed;
+  // The first sphere among the includes and excludes is the one a drag moves, as far as the boxes know.
+  int sphere = -1;
+  for (std::size_t r = 0; r < q.table.regions.size() && sphere < 0; ++r)
+    if (q.table.regions[r]->shape() == Region::Shape::Sphere && ((q.table.include | q.table.exclude) >> r & 1))
+      sphere = int(r);
+  if (boxes) boxes->track_region(sphere);
+  const DraggedSphere dragged(q.table, sphere);
   std::vector<HitSearch> per_thread(resolve_threads(0), q);
   std::vector<VoxelScratch> scratch(per_thread.size());
   // A query touching most voxels reads most blocks: their pages are let go as it goes (walk_streamlines does so too).
@@ -439,7 +517,7 @@ void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, s
       const int r = std::countr_zero(b);
       scratch[t].windows[std::size_t(r)] = quantum_window(packer, q.table.reach[std::size_t(r)]);
     }
-    if (boxes) return boxed_voxel_hits(per_thread[t], voxel, packer, *boxes, index, scratch[t], hits);
+    if (boxes) return boxed_voxel_hits(per_thread[t], voxel, packer, *boxes, index, dragged, scratch[t], hits);
     placed_voxel_hits(per_thread[t], voxel, &packer, index, scratch[t], hits);
   });
   for (std::size_t k = 0; k < touched.size(); ++k) {

@@ -11,11 +11,12 @@ VoxlineBoxes::VoxlineBoxes(const VxlFile& file, std::uint64_t budget_bytes)
       budget_(budget_bytes),
       lists_(file.voxels().size()),
       boxed_(new std::atomic<bool>[file.voxels().size()]),
-      used_(new std::atomic<bool>[file.voxels().size()]) {
+      used_(new std::atomic<bool>[file.voxels().size()]),
+      references_(file.voxels().size()) {
   for (std::size_t v = 0; v < lists_.size(); ++v) boxed_[v] = false, used_[v] = false;
 }
 
-std::span<const BoxedVoxline> VoxlineBoxes::voxel(std::size_t voxel, const VoxelVoxlines& index) {
+std::span<BoxedVoxline> VoxlineBoxes::voxel(std::size_t voxel, const VoxelVoxlines& index) {
   used_[voxel] = true;
   if (boxed_[voxel]) return lists_[voxel];
   thread_local std::vector<std::uint8_t> ends;
@@ -43,9 +44,16 @@ std::span<const BoxedVoxline> VoxlineBoxes::voxel(std::size_t voxel, const Voxel
     for (int c = 0; c < 3; ++c)
       b.lo[c] = static_cast<std::uint16_t>(lo[c]), b.hi[c] = static_cast<std::uint16_t>(hi[c]);
   }
+  references_[voxel].known = false;
   bytes_ += list.capacity() * sizeof(BoxedVoxline);
   boxed_[voxel] = true;
   return list;
+}
+
+void VoxlineBoxes::track_region(int region) {
+  if (region == tracked_region_) return;
+  tracked_region_ = region;
+  for (VoxelReference& r : references_) r.known = false;
 }
 
 void VoxlineBoxes::selection_done() {

@@ -4,7 +4,10 @@
 // touch mostly the same voxels: with their voxlines boxed, a voxline whose box misses a region is passed over and
 // one whose box the region holds is kept, both without reading its points; only voxlines across a region's
 // surface are tested point by point. The boxes hold for any region and any position, so nothing is invalidated as
-// regions move. Packed files only (a float32 file's selections take the plain path).
+// regions move. For one sphere (the first among the includes and excludes: the one a drag moves) each voxline also
+// keeps how far its nearest point lies from the centre it was last measured from: moved by d since, the sphere can
+// only have crossed the voxlines whose distance was within d of its radius, and only those are measured again.
+// Packed files only (a float32 file's selections take the plain path).
 #pragma once
 
 #include <array>
@@ -28,6 +31,16 @@ struct BoxedVoxline {
   std::uint8_t flags = 0;
   // The quanta of the points a region test reads (own points but a synthetic first): lo > hi on an axis when none.
   std::array<std::uint16_t, 3> lo{}, hi{};
+  // Where the nearest of those points lies from the voxel's reference centre (VoxelReference), in mm: a dragged
+  // sphere moved by d from there has it within [near_lo - d, near_hi + d], which decides most voxlines without
+  // their points. Unknown: [0, infinity].
+  float near_lo = 0, near_hi = 0;
+};
+
+// The centre a voxel's near_lo / near_hi are measured from, when `known`.
+struct VoxelReference {
+  std::array<float, 3> centre{};
+  bool known = false;
 };
 
 class VoxlineBoxes {
@@ -41,7 +54,12 @@ class VoxlineBoxes {
 
   // Voxel `voxel`'s voxlines, boxed on first use (placed through `index`, the file's, and its words read once).
   // Threads may ask for different voxels at once. Throws what place_voxel_voxlines throws for a damaged file.
-  std::span<const BoxedVoxline> voxel(std::size_t voxel, const VoxelVoxlines& index);
+  std::span<BoxedVoxline> voxel(std::size_t voxel, const VoxelVoxlines& index);
+  // The centre a boxed voxel's distances (near_lo, near_hi) were measured from.
+  VoxelReference& reference(std::size_t voxel) { return references_[voxel]; }
+  // The sphere the distances follow: region `region` of the selection (-1: none). Another region than the last
+  // selection's forgets every voxel's distances.
+  void track_region(int region);
   // After each selection: over the budget, the voxels it did not use are let go.
   void selection_done();
   std::uint64_t bytes() const { return bytes_; }
@@ -51,6 +69,8 @@ class VoxlineBoxes {
   std::uint64_t budget_;
   std::vector<std::vector<BoxedVoxline>> lists_;  // per voxel; empty until boxed
   std::unique_ptr<std::atomic<bool>[]> boxed_, used_;
+  std::vector<VoxelReference> references_;
+  int tracked_region_ = -1;
   std::atomic<std::uint64_t> bytes_ = 0;
 };
 

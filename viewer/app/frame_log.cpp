@@ -81,6 +81,7 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
   j["selections"] = selection_ms.size();
   j["selection_median_ms"] = selection_median;
   j["selection_p95_ms"] = selection_p95;
+  j["selection_ms"] = selection_ms;  // each selection taken into the picture, in order
   if (drag_end)
     j["drag_end_wait"] = {{"waited", drag_end->waited}, {"ms", drag_end->ms}, {"timed_out", drag_end->timed_out}};
   nlohmann::json list = nlohmann::json::array();
