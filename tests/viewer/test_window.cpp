@@ -538,6 +538,8 @@ TEST_F(Window, AScriptedDragReportsTheSelectionsTimes) {
   EXPECT_GE(j.at("selections").get<int>(), 2);  // the first (at start) and at least one while dragging
   EXPECT_GT(j.at("selection_median_ms").get<double>(), 0.0);
   EXPECT_GE(j.at("selection_p95_ms").get<double>(), j.at("selection_median_ms").get<double>());
+  ASSERT_EQ(j.at("selection_ms").size(), j.at("selections").get<std::size_t>());  // each one's time, listed
+  for (const auto& ms : j.at("selection_ms")) EXPECT_GT(ms.get<double>(), 0.0);
   // The first picture does not wait for the command line's selection (its --context-opacity is accepted before the
   // selection's groups exist): each frame says whether its picture shows one; once in, it stays, to the last frame.
   bool shown = false;
