@@ -542,13 +542,19 @@ TEST_F(Window, AScriptedDragReportsTheSelectionsTimes) {
   for (const auto& ms : j.at("selection_ms")) EXPECT_GT(ms.get<double>(), 0.0);
   // The first picture does not wait for the command line's selection (its --context-opacity is accepted before the
   // selection's groups exist): each frame says whether its picture shows one; once in, it stays, to the last frame.
+  // The frames that took a new selection in are marked: the first to show one is, and none without one is.
   bool shown = false;
+  int taken = 0;
   for (const nlohmann::json& f : j.at("frames")) {
-    const bool selection = f.value("selection", false);
+    const bool selection = f.value("selection", false), new_selection = f.value("new_selection", false);
     EXPECT_TRUE(selection || !shown) << f.dump();
+    EXPECT_TRUE(!new_selection || selection) << f.dump();
+    if (selection && !shown) EXPECT_TRUE(new_selection) << f.dump();
+    taken += new_selection;
     shown = selection;
   }
   EXPECT_TRUE(shown);
+  EXPECT_GE(taken, 1);
   const test::CommandResult bad = run_voxview_in_xvfb(shell_quoted(vxl) + " --drag-region 1,0 --frames 2");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   const test::CommandResult none = run_voxview_in_xvfb(shell_quoted(vxl) + " --drag-region 1,0,0 --frames 2");

@@ -94,6 +94,7 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
                     {"since_start_s", f.since_start_s}});
     if (f.focus_first) list.back()["focus_level"] = 0;  // focus first: `level` is the context's
     if (f.selection) list.back()["selection"] = true;
+    if (f.new_selection) list.back()["new_selection"] = true;
   }
   j["frames"] = list;
   const std::string text = j.dump(2) + "\n";

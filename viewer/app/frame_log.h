@@ -25,9 +25,10 @@ struct FrameRecord {
   double ms = 0;             // drawing the frame, GPU work included
   double since_start_s = 0;  // when it was on screen
   FrameWork work = FrameWork::Whole;
-  bool completes = true;     // the picture it drew is complete and on screen (a piece: only the last one's)
-  bool focus_first = false;  // the focus drawn at level 0 from its copy, the context at `level`
-  bool selection = false;    // the picture shows a selection of the regions (focus and context)
+  bool completes = true;       // the picture it drew is complete and on screen (a piece: only the last one's)
+  bool focus_first = false;    // the focus drawn at level 0 from its copy, the context at `level`
+  bool selection = false;      // the picture shows a selection of the regions (focus and context)
+  bool new_selection = false;  // its selection (or the focus copy) was taken into the picture for this frame
 };
 
 struct FrameSummary {

@@ -130,6 +130,7 @@ class ViewerWindow {
   std::optional<std::uint64_t> selection_revision_;  // the regions' revision last asked for
   std::optional<std::uint64_t> cleared_revision_;    // all regions removed at this revision: older selections are stale
   std::uint64_t selection_generation_ = 0;           // counts the selections taken into the picture
+  std::uint64_t framed_generation_ = 0;              // the selection generation of the last frame drawn whole
   SelectionWorker selection_worker_;
   // Focus first: copies of the selection for pictures coarser than full detail (none with --level, or
   // when the files hold no coarser level).

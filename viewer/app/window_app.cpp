@@ -360,6 +360,8 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
     frames_.push_back({task.level, moving, ms, seconds_since_start()});
     frames_.back().focus_first = focus_first_at(task.level);
     frames_.back().selection = selection_.has_value();
+    frames_.back().new_selection = selection_.has_value() && key.selection != framed_generation_;
+    framed_generation_ = key.selection;
     return true;
   }
   if (task.work == PictureWork::Piece) {
