@@ -436,11 +436,10 @@ struct DraggedSphere {
 // A packed voxel's voxlines through their boxes: only those across a region's surface are read point by point, and
 // for the dragged sphere only those its move may have carried across.
 void boxed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacker& packer, VoxlineBoxes& boxes,
-                      const VoxelVoxlines& index, const DraggedSphere& dragged, VoxelScratch& scratch,
+                      std::span<BoxedVoxline> list, const DraggedSphere& dragged, VoxelScratch& scratch,
                       RegionHits& hits) {
   const Bits candidates = search.voxel_regions.touching[voxel] & ~search.voxel_regions.holding[voxel];
   const std::uint64_t first = search.voxels[voxel].vertex_first;
-  const std::span<BoxedVoxline> list = boxes.voxel(voxel, index);
   const std::uint32_t* words = search.file.packed_vertices().data() + first;
   const bool follow = (candidates & dragged.bit) != 0;
   VoxelReference& reference = boxes.reference(voxel);
@@ -517,7 +516,9 @@ void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, s
       const int r = std::countr_zero(b);
       scratch[t].windows[std::size_t(r)] = quantum_window(packer, q.table.reach[std::size_t(r)]);
     }
-    if (boxes) return boxed_voxel_hits(per_thread[t], voxel, packer, *boxes, index, dragged, scratch[t], hits);
+    if (boxes)
+      if (const std::optional<std::span<BoxedVoxline>> list = boxes->voxel(voxel, index))
+        return boxed_voxel_hits(per_thread[t], voxel, packer, *boxes, *list, dragged, scratch[t], hits);
     placed_voxel_hits(per_thread[t], voxel, &packer, index, scratch[t], hits);
   });
   for (std::size_t k = 0; k < touched.size(); ++k) {

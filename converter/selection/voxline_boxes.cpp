@@ -16,12 +16,22 @@ VoxlineBoxes::VoxlineBoxes(const VxlFile& file, std::uint64_t budget_bytes)
   for (std::size_t v = 0; v < lists_.size(); ++v) boxed_[v] = false, used_[v] = false;
 }
 
-std::span<BoxedVoxline> VoxlineBoxes::voxel(std::size_t voxel, const VoxelVoxlines& index) {
+std::optional<std::span<BoxedVoxline>> VoxlineBoxes::voxel(std::size_t voxel, const VoxelVoxlines& index) {
   used_[voxel] = true;
-  if (boxed_[voxel]) return lists_[voxel];
+  if (boxed_[voxel]) return std::span<BoxedVoxline>(lists_[voxel]);
+  const std::uint64_t need = index.of_voxel(voxel).size() * sizeof(BoxedVoxline);
+  if (bytes_.fetch_add(need) + need > budget_) {
+    bytes_ -= need;
+    return std::nullopt;
+  }
   thread_local std::vector<std::uint8_t> ends;
   thread_local std::vector<PlacedVoxline> placed;
-  place_voxel_voxlines(file_, index, voxel, ends, placed);
+  try {
+    place_voxel_voxlines(file_, index, voxel, ends, placed);
+  } catch (...) {
+    bytes_ -= need;
+    throw;
+  }
   const VoxelEntry& v = file_.voxels()[voxel];
   const std::uint32_t* words = file_.packed_vertices().data();
   std::vector<BoxedVoxline>& list = lists_[voxel];
@@ -45,9 +55,8 @@ std::span<BoxedVoxline> VoxlineBoxes::voxel(std::size_t voxel, const VoxelVoxlin
       b.lo[c] = static_cast<std::uint16_t>(lo[c]), b.hi[c] = static_cast<std::uint16_t>(hi[c]);
   }
   references_[voxel].known = false;
-  bytes_ += list.capacity() * sizeof(BoxedVoxline);
   boxed_[voxel] = true;
-  return list;
+  return std::span<BoxedVoxline>(list);
 }
 
 void VoxlineBoxes::track_region(int region) {
@@ -58,8 +67,8 @@ void VoxlineBoxes::track_region(int region) {
 
 void VoxlineBoxes::selection_done() {
   for (std::size_t v = 0; v < lists_.size(); ++v) {
-    if (bytes_ > budget_ && boxed_[v] && !used_[v]) {
-      bytes_ -= lists_[v].capacity() * sizeof(BoxedVoxline);
+    if (bytes_ > budget_ / 2 && boxed_[v] && !used_[v]) {
+      bytes_ -= lists_[v].size() * sizeof(BoxedVoxline);
       std::vector<BoxedVoxline>().swap(lists_[v]);
       boxed_[v] = false;
     }

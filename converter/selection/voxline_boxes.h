@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -45,22 +46,24 @@ struct VoxelReference {
 
 class VoxlineBoxes {
  public:
-  // What the boxes of the voxels not used by the last selection may take before they are let go.
+  // What the boxes may take in all (36 bytes a voxline: 7M voxlines). A selection reads the voxels it finds no room
+  // for without boxes; past half of it, those the last selection did not use are let go.
   static constexpr std::uint64_t kDefaultBudgetBytes = 256ull << 20;
 
   explicit VoxlineBoxes(const VxlFile& file, std::uint64_t budget_bytes = kDefaultBudgetBytes);
   VoxlineBoxes(const VoxlineBoxes&) = delete;
   VoxlineBoxes& operator=(const VoxlineBoxes&) = delete;
 
-  // Voxel `voxel`'s voxlines, boxed on first use (placed through `index`, the file's, and its words read once).
-  // Threads may ask for different voxels at once. Throws what place_voxel_voxlines throws for a damaged file.
-  std::span<BoxedVoxline> voxel(std::size_t voxel, const VoxelVoxlines& index);
+  // Voxel `voxel`'s voxlines, boxed on first use (placed through `index`, the file's, and its words read once);
+  // nullopt when boxing them would take the boxes past the budget. Threads may ask for different voxels at once.
+  // Throws what place_voxel_voxlines throws for a damaged file.
+  std::optional<std::span<BoxedVoxline>> voxel(std::size_t voxel, const VoxelVoxlines& index);
   // The centre a boxed voxel's distances (near_lo, near_hi) were measured from.
   VoxelReference& reference(std::size_t voxel) { return references_[voxel]; }
   // The sphere the distances follow: region `region` of the selection (-1: none). Another region than the last
   // selection's forgets every voxel's distances.
   void track_region(int region);
-  // After each selection: over the budget, the voxels it did not use are let go.
+  // After each selection: past half the budget, the voxels it did not use are let go.
   void selection_done();
   std::uint64_t bytes() const { return bytes_; }
 
