@@ -215,34 +215,51 @@ struct HitSearch {
   std::uint64_t vxln_at = file.find_section(section_id("VXLN"))->offset;
   std::vector<float> xyz = {};
 
-  // Tests one voxline in a voxel the regions may touch against those regions still `open` for its
-  // streamline; returns the regions holding one of its points.
-  Bits test_voxline(const VoxlinePlace& v, Bits open) {
+  // Where a voxline's test starts, for both tests below: the regions still `open` for its streamline that its
+  // points can hit, less those decided without them (a region holding the whole voxel, or the voxline's box:
+  // `box_holds`), and the first point to read.
+  struct VoxlineTest {
+    Bits anywhere = 0, ends = 0;  // left to find at any of its points / at its streamline's end points
+    Bits hit = 0;
+    std::uint32_t from = 0;
+    bool points_needed() const { return (anywhere | ends) != 0; }
+    // The regions point i is tested against.
+    Bits wanted(const VoxlinePlace& v, std::uint32_t i) const {
+      Bits test = anywhere & ~hit;
+      if ((i == 0 && v.first_of_streamline) || (i + 1 == v.own && !v.connected)) test |= ends & ~hit;
+      return test;
+    }
+  };
+  VoxlineTest begin_test(const VoxlinePlace& v, Bits open, Bits box_holds) {
+    VoxlineTest t;
     const Bits touching = voxel_regions.touching[v.voxel] & open;
     const Bits anywhere = touching & (table.include | table.exclude);
     const Bits at_ends = (v.first_of_streamline || !v.connected) ? touching & table.ends : 0;
-    if ((anywhere | at_ends) == 0) return 0;
-    const std::uint32_t from = v.synthetic_first ? 1 : 0;
-    if (from >= v.own) return 0;  // only a synthetic point: nothing to test
+    t.from = v.synthetic_first ? 1 : 0;
+    if ((anywhere | at_ends) == 0 || t.from >= v.own) return t;  // nothing to test, or only a synthetic point
     // A region holding the whole voxel holds every point tested here (a voxline's end point is a source
     // point: synthetic points are never first or last of a streamline).
-    const Bits held = voxel_regions.holding[v.voxel];
-    Bits hit = (anywhere | at_ends) & held;
-    const Bits left = (anywhere | at_ends) & ~held;
-    if (left == 0) return hit;
+    const Bits held = voxel_regions.holding[v.voxel] | box_holds;
+    t.hit = (anywhere | at_ends) & held;
+    t.anywhere = anywhere & ~held;
+    t.ends = at_ends & ~held;
+    if (t.points_needed()) points_tested += v.own - t.from;
+    return t;
+  }
+
+  // Tests one voxline in a voxel the regions may touch against those regions still `open` for its
+  // streamline; returns the regions holding one of its points.
+  Bits test_voxline(const VoxlinePlace& v, Bits open) {
+    VoxlineTest t = begin_test(v, open, 0);
+    if (!t.points_needed()) return t.hit;
     xyz.resize(3 * std::size_t(v.own));
     file.read_vertices(v.voxel, v.first_vertex, v.own, xyz.data());
-    points_tested += v.own - from;
-    for (std::uint32_t i = from; i < v.own; ++i) {
-      const float* p = &xyz[3 * std::size_t(i)];
-      Bits test = anywhere & left & ~hit;
-      if ((i == 0 && v.first_of_streamline) || (i + 1 == v.own && !v.connected)) test |= at_ends & left & ~hit;
-      for (Bits b = test; b != 0; b &= b - 1) {
+    for (std::uint32_t i = t.from; i < v.own; ++i)
+      for (Bits b = t.wanted(v, i); b != 0; b &= b - 1) {
         const int r = std::countr_zero(b);
-        if (table.regions[r]->contains(p)) hit |= Bits(1) << r;
+        if (table.regions[r]->contains(&xyz[3 * std::size_t(i)])) t.hit |= Bits(1) << r;
       }
-    }
-    return hit;
+    return t.hit;
   }
 
   // test_voxline for a voxline of a packed file, read from its words where they lie: a point is decoded and
@@ -251,26 +268,14 @@ struct HitSearch {
   // `box_holds`: regions holding every point the test would read (VoxlineBoxes), hit without reading them.
   Bits test_packed_voxline(const VoxlinePlace& v, Bits open, const VertexPacker& packer,
                            const std::array<QuantumWindow, kMaxRegions>& windows, Bits box_holds = 0) {
-    const Bits touching = voxel_regions.touching[v.voxel] & open;
-    const Bits anywhere = touching & (table.include | table.exclude);
-    const Bits at_ends = (v.first_of_streamline || !v.connected) ? touching & table.ends : 0;
-    if ((anywhere | at_ends) == 0) return 0;
-    const std::uint32_t from = v.synthetic_first ? 1 : 0;
-    if (from >= v.own) return 0;
-    const Bits held = voxel_regions.holding[v.voxel] | box_holds;
-    Bits hit = (anywhere | at_ends) & held;
-    const Bits left = (anywhere | at_ends) & ~held;
-    if (left == 0) return hit;
-    points_tested += v.own - from;
+    VoxlineTest t = begin_test(v, open, box_holds);
+    if (!t.points_needed()) return t.hit;
     const std::uint32_t* words = file.packed_vertices().data() + v.first_vertex;
-    const Bits ends_left = at_ends & left;
-    for (std::uint32_t i = from; i < v.own; ++i) {
-      const bool end_point = (i == 0 && v.first_of_streamline) || (i + 1 == v.own && !v.connected);
-      Bits test = anywhere & left & ~hit;
-      if (end_point) test |= ends_left & ~hit;
+    for (std::uint32_t i = t.from; i < v.own; ++i) {
+      const Bits test = t.wanted(v, i);
       // Nothing left to find but at the last point, for a region that wants ends: straight there.
       if (test == 0) {
-        if ((ends_left & ~hit) == 0 || v.connected || i + 1 >= v.own) break;
+        if ((t.ends & ~t.hit) == 0 || v.connected || i + 1 >= v.own) break;
         i = v.own - 2;
         continue;
       }
@@ -280,10 +285,10 @@ struct HitSearch {
         const int r = std::countr_zero(b);
         if (!windows[std::size_t(r)].holds(words[i])) continue;
         if (!decoded) packer.decode_word(words[i], p), decoded = true;
-        if (table.regions[r]->contains(p)) hit |= Bits(1) << r;
+        if (table.regions[r]->contains(p)) t.hit |= Bits(1) << r;
       }
     }
-    return hit;
+    return t.hit;
   }
 
   // Where the voxlines of depth `depth` start and end in a voxel's block (spec §5.4, §5.12).
