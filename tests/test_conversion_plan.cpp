@@ -70,13 +70,13 @@ TEST(ConversionPlan, ReadingTakesTheProgramAndTheReadBufferAndSizesTheBatches) {
     EXPECT_GE(plan.read_buffer_bytes, 64u << 10);
     EXPECT_LE(plan.read_buffer_bytes, 4 * kMiB);
     EXPECT_EQ(budget.used(), 16 * kMiB + plan.read_buffer_bytes);
-    EXPECT_GE(plan.batch_streamlines, 1024u);
-    EXPECT_LE(plan.batch_streamlines, 1u << 20);
+    EXPECT_GE(plan.batch_points, 1024u);
+    EXPECT_LE(plan.batch_points, 1u << 20);
     EXPECT_EQ(plan.max_header_bytes, budget.left() / 4);
     EXPECT_EQ(plan.max_points_held, budget.left() / kHeldBytesPerPoint);
   }
   MemoryBudget larger(512 * kMiB, "source.tck"), smaller(64 * kMiB, "source.tck");
-  EXPECT_GT(plan_reading(larger).batch_streamlines, plan_reading(smaller).batch_streamlines);
+  EXPECT_GT(plan_reading(larger).batch_points, plan_reading(smaller).batch_points);
 }
 
 TEST(ConversionPlan, ALimitBelowTheProgramItselfIsRefusedWithASuggestion) {
@@ -138,7 +138,7 @@ TEST(ConversionPlan, AVoxelTooLargeForWhatIsLeftIsNamed) {
 }
 
 TEST(ConversionPlan, LargeLimitsWriteDirectlyAndVertexBlocksAreReadBack) {
-  const Table t(std::vector<std::uint32_t>(300, 5000));
+  const Table t(std::vector<std::uint32_t>(300, 500'000));  // VERT: 600 MB, more than the limit
   MemoryBudget budget(512 * kMiB, "source.tck");
   const ConversionPlan plan = plan_conversion(budget, t.counts());
   EXPECT_GT(plan.direct_staging_bytes, 0u);
@@ -148,6 +148,21 @@ TEST(ConversionPlan, LargeLimitsWriteDirectlyAndVertexBlocksAreReadBack) {
   EXPECT_GE(plan.pool_chunk_bytes, plan.order_chunk_bytes);
   EXPECT_EQ(plan.ranges.size(), 1u);
   EXPECT_LE(budget.used(), budget.limit());
+}
+
+// Holding VERT whole costs less than writing its blocks and reading them back: where it fits in one range, it is
+// held, unless the blocks are asked for.
+TEST(ConversionPlan, VerticesThatFitAreHeldWholeUnlessTheBlocksAreAskedFor) {
+  const Table t(std::vector<std::uint32_t>(300, 5000));  // VERT: 6 MB
+  MemoryBudget budget(512 * kMiB, "source.tck");
+  const ConversionPlan plan = plan_conversion(budget, t.counts());
+  EXPECT_GT(plan.direct_staging_bytes, 0u);
+  EXPECT_EQ(plan.block_staging_bytes, 0u);
+  EXPECT_EQ(plan.ranges.size(), 1u);
+  ConversionCounts asked = t.counts();
+  asked.vertex_blocks_request = true;
+  MemoryBudget again(512 * kMiB, "source.tck");
+  EXPECT_GT(plan_conversion(again, asked).block_staging_bytes, 0u);
 }
 
 TEST(ConversionPlan, TheOrderChunkFollowsTheRequestButHoldsTheLargestVoxel) {

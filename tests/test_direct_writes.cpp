@@ -207,9 +207,9 @@ TEST(DirectWrites, RegionsInterleavedThroughAWriteQueueGiveThePlainBytes) {
 }
 
 // Under a limit that turns direct writes on, VERT is written block by block as it is placed and read back
-// for the orders where its (voxel, level) blocks are few (10 mm voxels), and held in memory where their
-// staging would not fit (1 mm voxels: hundreds of thousands of blocks); packed or float32, each way must
-// write the in-memory conversion's bytes.
+// for the orders where its (voxel, level) blocks are few (10 mm voxels; asked for, as VERT would fit whole), and
+// held in memory where their staging would not fit (1 mm voxels: hundreds of thousands of blocks); packed or
+// float32, each way must write the bytes of a conversion from memory.
 TEST(DirectWrites, AStreamingConversionWithDirectWritesWritesTheInMemoryBytes) {
   ScratchDir dir;
   const std::string tck = dir.file("in.tck"), whole = dir.file("whole.vxl"), direct = dir.file("direct.vxl");
@@ -241,6 +241,7 @@ TEST(DirectWrites, AStreamingConversionWithDirectWritesWritesTheInMemoryBytes) {
       SCOPED_TRACE("orders chunk " + std::to_string(chunk));
       StreamingTuning tuning;
       tuning.order_chunk_bytes = chunk;
+      tuning.vertex_blocks = true;
       const ConvertSummary s = convert_streaming(tck, direct, settings, tuning);
       EXPECT_EQ(s.vertices_read_back, c.read_back);
       const std::vector<std::uint8_t> a = file_bytes(whole), b = file_bytes(direct);

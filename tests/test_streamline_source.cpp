@@ -43,6 +43,10 @@ TEST(StreamlineSource, ATractogramIsHandedOutInBatchesOfWholeStreamlinesThenEnds
   std::uint64_t first = 0;
   while (source.next(batch)) {
     sizes.push_back(batch.streamline_count());
+    // As a TCK's batches: up to the first streamline that brings the points and streamlines to 300.
+    const std::uint64_t n = batch.streamline_count();
+    if (first + n < t.streamline_count()) EXPECT_GE(batch.point_count() + n, 300u);
+    EXPECT_LT(batch.offsets[n - 1] + (n - 1), 300u) << "a batch goes no further than the streamline that fills it";
     ASSERT_EQ(batch.offsets.front(), 0u);
     for (std::uint64_t k = 0; k < batch.streamline_count(); ++k) {
       const std::uint64_t n = batch.offsets[k + 1] - batch.offsets[k];
@@ -53,13 +57,14 @@ TEST(StreamlineSource, ATractogramIsHandedOutInBatchesOfWholeStreamlinesThenEnds
     }
     first += batch.streamline_count();
   }
-  EXPECT_EQ(sizes, (std::vector<std::uint64_t>{300, 300, 300, 100}));
+  EXPECT_EQ(first, t.streamline_count());
+  EXPECT_GT(sizes.size(), 3u);
   EXPECT_EQ(batch.streamline_count(), 0u) << "the batch after the last is empty";
   EXPECT_DOUBLE_EQ(source.progress(), 1.0);
   source.rewind();
   EXPECT_DOUBLE_EQ(source.progress(), 0.0);
   ASSERT_TRUE(source.next(batch));
-  EXPECT_EQ(batch.streamline_count(), 300u) << "a rewound source starts again at the first streamline";
+  EXPECT_EQ(batch.streamline_count(), sizes.front()) << "a rewound source starts again at the first streamline";
 }
 
 TEST(StreamlineSource, ATckAndTheSameStreamlinesInMemoryReadAlikePassAfterPass) {
@@ -83,7 +88,7 @@ TEST(StreamlineSource, ATckAndTheSameStreamlinesInMemoryReadAlikePassAfterPass) 
     EXPECT_EQ(a.all.positions, in_memory.positions) << "pass " << pass;
     EXPECT_EQ(b.all.offsets, in_memory.offsets) << "pass " << pass;
     EXPECT_EQ(b.all.positions, in_memory.positions) << "pass " << pass;
-    EXPECT_GT(b.batch_sizes.size(), 5u) << "700 streamlines a batch";
+    EXPECT_GT(b.batch_sizes.size(), 5u) << "700 points and streamlines a batch";
   }
   EXPECT_EQ(from_file.passes(), 2u);
   EXPECT_EQ(from_file.source().xxh3_128, in_memory.source.xxh3_128);

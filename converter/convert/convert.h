@@ -22,26 +22,26 @@ struct ConvertSettings {
   // Levels of detail (spec §5.12): 1 .. kMaxLevels; 1 writes none.
   std::uint32_t levels = kDefaultLevels;
   ProgressFn progress;
-  // Bytes of memory convert_streaming may use (streaming_convert.h); 0: no limit. Not recorded in the
-  // output: a limited conversion writes the same bytes as an unlimited one.
+  // Bytes of memory the conversion's passes may use (streaming_convert.h); 0: chosen from the source's size and the
+  // memory available (memory_choice.h). Not recorded in the output: every limit writes the same bytes.
   std::uint64_t memory_limit = 0;
 };
 
 struct ConvertSummary {
   std::uint64_t streamlines = 0, points = 0, voxels = 0, vertices = 0, segments = 0, synthetic_points = 0;
   double voxelize_seconds = 0, orders_seconds = 0, write_seconds = 0;
-  double read_seconds = 0;                      // convert_streaming only: the first pass over the source
+  double read_seconds = 0;                      // the first pass over the source
   std::uint64_t passes = 1;                     // times the source was read
   std::uint64_t partitions = 1;                 // voxel ranges whose blocks and orders were built one after another
-  std::vector<std::uint64_t> partition_starts;  // convert_streaming only: the first voxel of each range
-  bool vertices_read_back = false;              // convert_streaming only: VERT written block by block, not held
-  // convert_streaming only: the placing passes cut the streamlines by the voxel runs the counting pass kept
+  std::vector<std::uint64_t> partition_starts;  // the first voxel of each range
+  bool vertices_read_back = false;              // VERT written block by block, not held
+  // the placing passes cut the streamlines by the voxel runs the counting pass kept
   // (false: they voxelised again, the limit leaving no room for the runs).
   bool voxelised_once = false;
-  // convert_streaming only: the voxel index's lists were filled as the first range was placed (false: sorted at
+  // the voxel index's lists were filled as the first range was placed (false: sorted at
   // the write stage from the voxline and streamline tables read back, the limit leaving no room to hold them).
   bool voxel_index_while_placing = false;
-  // convert_streaming: the source's; convert_tractogram: the conversion's own (the reader's are in the
+  // convert_streaming from a file: the source's; convert_tractogram: the conversion's own (the reader's are in the
   // Tractogram, for its caller to show).
   std::vector<std::string> warnings;
 
@@ -56,8 +56,10 @@ struct ConvertSummary {
   }
 };
 
-// Consumes the tractogram (its positions are released as soon as they are copied) and writes `out_path`
-// atomically. Throws vxl::Error. settings.memory_limit is not used here.
+// Converts a tractogram read whole (its value sets checked and named as every reader of the file accepts, its
+// groups kept) by the passes of streaming_convert.h, reading it from memory a batch at a time, and writes
+// `out_path` atomically. settings.memory_limit bounds what the passes take besides the tractogram (0: chosen
+// for its size). Throws vxl::Error.
 ConvertSummary convert_tractogram(Tractogram&& tractogram, const std::string& out_path,
                                   const ConvertSettings& settings);
 

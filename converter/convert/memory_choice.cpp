@@ -5,23 +5,33 @@
 namespace vxl {
 namespace {
 
-constexpr double kPeakPerSourceByte = 3.0;  // measured 2.5-2.6, rounded up
-constexpr std::uint64_t kMinimumLimit = 64ull << 20;
-// More gains little: streaming's extra passes are cheap next to the work, and a machine's other jobs keep
-// the rest.
-constexpr std::uint64_t kMaximumLimit = 6ull << 30;
+constexpr std::uint64_t kMiB = 1ull << 20;
+constexpr std::uint64_t kSmallestDefault = 256 * kMiB;
+// More gains little: a larger source's extra passes are cheap next to the work, and a machine's other jobs
+// keep the rest.
+constexpr std::uint64_t kLargestDefault = 6ull << 30;
+constexpr std::uint64_t kMinimumLimit = 64 * kMiB;
+constexpr std::uint64_t kAssumedAvailable = 1ull << 30;
+
+std::uint64_t wanted(std::uint64_t source_bytes) {
+  return std::clamp(source_bytes / 8 * 9, kSmallestDefault, kLargestDefault);
+}
+
+std::uint64_t ceiling(std::optional<std::uint64_t> available) {
+  // Half, not all: a conversion that fills the machine pushes out everything else.
+  return std::max(kMinimumLimit, available.value_or(kAssumedAvailable) / 2);
+}
 
 }  // namespace
 
-std::uint64_t in_memory_estimate(std::uint64_t source_bytes) {
-  return static_cast<std::uint64_t>(kPeakPerSourceByte * double(source_bytes));
+std::uint64_t default_memory_limit(std::uint64_t source_bytes, std::optional<std::uint64_t> available) {
+  return std::min(wanted(source_bytes), ceiling(available));
 }
 
-std::optional<std::uint64_t> automatic_memory_limit(std::uint64_t source_bytes, std::uint64_t available) {
-  // Half, not all: a conversion that fills the machine pushes out everything else (and, at 90 %, the 10M
-  // set converted in memory peaked at 19.6 GB of 24 GB).
-  if (double(in_memory_estimate(source_bytes)) <= 0.5 * double(available)) return std::nullopt;
-  return std::clamp(available / 2, kMinimumLimit, kMaximumLimit);
+std::uint64_t held_source_memory_limit(std::optional<std::uint64_t> available) { return ceiling(available); }
+
+bool limited_by_available_memory(std::uint64_t source_bytes, std::optional<std::uint64_t> available) {
+  return ceiling(available) < wanted(source_bytes);
 }
 
 }  // namespace vxl

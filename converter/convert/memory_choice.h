@@ -1,10 +1,12 @@
-// How much memory a conversion may take without a --memory-limit, and when to stream instead.
+// How much memory a conversion takes when no --memory-limit is given.
 //
-// A conversion in memory holds the source's points, the voxel blocks and the orders at once: its peak is
-// about twice the TCK's size (1M synthetic streamlines: 1.36 GB for a 690 MB TCK), estimated at three times
-// for a margin. When that estimate does not fit in what is available (format/base/memory_available.h),
-// `voxlines convert` and voxview stream the TCK (streaming_convert.h) within a limit that does, and say so
-// (source_to_vxl.h).
+// Every conversion runs the same passes within a memory limit (streaming_convert.h): the limit sizes their
+// batches, voxel ranges, order chunks and buffers, and a larger one buys fewer passes over the source and more
+// ordering threads, never different bytes. Without a limit the conversion takes about the source's size: on
+// 1M-streamline TCKs (2 cores) that is where one range of voxels, held in memory, is ordered on every thread
+// (a 690 MB TCK: 3.4 s within 768 MiB, 4.8-5.0 s within 512 MiB, where its largest voxel's sort buffers
+// leave room for one ordering thread). Never more than half of what is available (format/base/memory_available.h),
+// so that a source larger than the memory streams within what there is.
 #pragma once
 
 #include <cstdint>
@@ -12,11 +14,18 @@
 
 namespace vxl {
 
-// The estimated peak of a conversion in memory of a TCK source of `source_bytes` bytes.
-std::uint64_t in_memory_estimate(std::uint64_t source_bytes);
+// The limit for a TCK source of `source_bytes` (the file's size):
+// 9/8 of it, at least 256 MiB and at most 6 GiB, but at most half of `available` (unknown: 1 GiB is assumed)
+// and never under 64 MiB.
+std::uint64_t default_memory_limit(std::uint64_t source_bytes, std::optional<std::uint64_t> available);
 
-// The --memory-limit to stream with when the estimate exceeds half of `available`: half of what is
-// available, at least 64 MiB and at most 6 GiB; nullopt when converting in memory fits.
-std::optional<std::uint64_t> automatic_memory_limit(std::uint64_t source_bytes, std::uint64_t available);
+// The limit for a source already read whole (a format that does not stream, or TCK with TSF values): half of
+// `available`, at least 64 MiB. Its passes take what they need of it (batches, buffers) and hold no copy of the
+// source; a smaller default would refuse sources that it takes no more memory to convert.
+std::uint64_t held_source_memory_limit(std::optional<std::uint64_t> available);
+
+// Whether `available` memory made the default limit smaller than the source wants (then the conversion
+// reads it more times, and the programs say so).
+bool limited_by_available_memory(std::uint64_t source_bytes, std::optional<std::uint64_t> available);
 
 }  // namespace vxl

@@ -22,23 +22,21 @@ bool is_streamable(const std::string& path) {
   return match.format && match.format->streamable;
 }
 
-// The limit to stream `input` within when none was given: only for a streamable source without TSF values
-// whose conversion in memory would not fit in its share of the available memory. 0: convert in memory.
-std::uint64_t chosen_memory_limit(const std::string& input, const SourceConversion& c) {
-  if (c.settings.memory_limit > 0 || !c.tsf.empty() || !is_streamable(input)) return c.settings.memory_limit;
+// The limit to stream `input` within: the one given, or else memory_choice's for its size and its share of the
+// available memory (said by `notice` when that share limits it).
+std::uint64_t streaming_limit(const std::string& input, const SourceConversion& c) {
+  if (c.settings.memory_limit > 0) return c.settings.memory_limit;
   std::error_code ec;
-  const std::uintmax_t bytes = std::filesystem::file_size(input, ec);
-  const std::optional<std::uint64_t> available = available_memory();
-  if (ec || !available) return 0;
-  const std::uint64_t share = *available / std::max(1u, c.concurrent_files);
-  const std::optional<std::uint64_t> limit = automatic_memory_limit(bytes, share);
-  if (!limit) return 0;
-  if (c.notice)
-    c.notice(input + ": converting in memory would take about " + format_memory_size(in_memory_estimate(bytes)) +
-             " of the " + format_memory_size(share) + " available" +
-             (c.concurrent_files > 1 ? " to each file converted at once" : "") +
-             ": streaming it within --memory-limit " + memory_limit_argument(*limit) + " (the output is the same)");
-  return *limit;
+  const std::uintmax_t size = std::filesystem::file_size(input, ec);
+  const std::uint64_t bytes = ec ? 0 : size;
+  std::optional<std::uint64_t> share = available_memory();
+  if (share) *share /= std::max(1u, c.concurrent_files);
+  const std::uint64_t limit = default_memory_limit(bytes, share);
+  if (c.notice && limited_by_available_memory(bytes, share))
+    c.notice(input + ": " + format_memory_size(*share) + " of memory available" +
+             (c.concurrent_files > 1 ? " to each file converted at once" : "") + ": converting within --memory-limit " +
+             memory_limit_argument(limit) + " (more passes over the source; the output is the same)");
+  return limit;
 }
 
 void warn_each(const SourceConversion& c, const std::vector<std::string>& warnings) {
@@ -52,11 +50,12 @@ SourceConversionReport convert_source(const std::string& input, const std::strin
   const auto t0 = std::chrono::steady_clock::now();
   SourceConversionReport report;
   ConvertSettings settings = c.settings;
-  settings.memory_limit = chosen_memory_limit(input, c);
-  if (settings.memory_limit > 0) {
-    if (!c.tsf.empty())
-      throw Error(ErrorKind::Unsupported, input, std::nullopt,
-                  "--memory-limit does not carry --tsf values yet; convert without the limit");
+  if (!c.tsf.empty() && settings.memory_limit > 0)
+    throw Error(ErrorKind::Unsupported, input, std::nullopt,
+                "--memory-limit does not carry --tsf values yet; convert without the limit");
+  // A memory limit with a source that cannot stream is refused there, naming the formats that can.
+  if (c.tsf.empty() && (is_streamable(input) || settings.memory_limit > 0)) {
+    settings.memory_limit = streaming_limit(input, c);
     report.summary = convert_streaming(input, output, settings);
     report.read_seconds = report.summary.read_seconds;
     report.streamed = true;

@@ -1,12 +1,13 @@
 // One way to turn a source tractogram (readers/source_formats.h) into a .vxl, for both programs: `voxlines
 // convert` writes it to the output it is given (convert_source), `voxview` opens it through a temporary file
-// (open_as_vxl). Both follow one policy, so that a source too big for memory streams in either program:
+// (open_as_vxl). Every conversion runs the same passes within a memory limit (streaming_convert.h):
 //
-//   * with a memory limit (settings.memory_limit > 0) the source is streamed within it (streaming_convert.h;
-//     TCK only, refused for other formats and with TSF values);
-//   * without one, a TCK whose conversion in memory would not fit in the available memory
-//     (memory_choice.h, shared by `concurrent_files` conversions at once) is streamed within a limit that
-//     fits, and `notice` says so; everything else is converted in memory (convert.h).
+//   * a TCK without TSF values is read from its file pass after pass (streamed) within the limit given
+//     (settings.memory_limit > 0), or else the one memory_choice.h chooses from its size and its share of the
+//     available memory (`concurrent_files` conversions at once); `notice` says when that share is too small
+//     for what the source wants;
+//   * other formats, and a TCK with TSF values, are read whole first and converted from memory (convert.h);
+//     a memory limit is refused for them.
 //
 // Either way the output's bytes are the same.
 #pragma once
@@ -28,15 +29,16 @@ struct SourceConversion {
   unsigned concurrent_files = 1;  // conversions sharing the available memory at once
   // Each warning of the source or of the conversion, without the file's name, as soon as it is known.
   std::function<void(const std::string&)> warn;
-  // The choice to stream a source without a limit, as a line naming the source (without a program name).
+  // That the memory available limits a conversion without --memory-limit, as a line naming the source (without a
+  // program name).
   std::function<void(const std::string&)> notice;
 };
 
 struct SourceConversionReport {
   ConvertSummary summary;
   double read_seconds = 0;         // reading the source (in memory), or the first pass over it (streamed)
-  bool streamed = false;           // through convert_streaming, the source read several times
-  std::uint64_t memory_limit = 0;  // the limit it streamed within, given or chosen; 0 in memory
+  bool streamed = false;           // read from its file several times (a TCK), not held in memory
+  std::uint64_t memory_limit = 0;  // the limit it streamed within, given or chosen; 0 when held in memory
 };
 
 // Converts `input` into `output` (written atomically: nothing is left at `output` on failure). Throws vxl::Error.

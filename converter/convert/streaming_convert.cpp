@@ -1,5 +1,6 @@
 #include "converter/convert/streaming_convert.h"
 
+#include <algorithm>
 #include <memory>
 #include <utility>
 
@@ -11,6 +12,8 @@
 #include "converter/readers/source_formats.h"
 #include "format/base/error.h"
 #include "format/base/parallel.h"
+#include "format/vxl_value_sets.h"
+#include "format/vxl_writer.h"
 
 namespace vxl {
 namespace streaming {
@@ -21,6 +24,7 @@ void StreamingConversion::fail_changed() const {
 }
 
 void StreamingConversion::check_source_type() const {
+  if (job_.held) return;
   const SourceMatch match = source_format_of(job_.path);
   if (!match.format || !match.format->streamable)
     fail_unsupported(job_.path, "--memory-limit streams TCK sources only (.tck); convert " +
@@ -28,7 +32,62 @@ void StreamingConversion::check_source_type() const {
 }
 
 void StreamingConversion::open_stream() {
-  reader_ = std::make_unique<BatchReader>(job_.path, budget_, job_.threads, job_.settings.progress);
+  if (!job_.held) {
+    reader_ = std::make_unique<BatchReader>(job_.path, budget_, job_.threads, job_.settings.progress);
+    return;
+  }
+  const ReadPlan plan = plan_reading(budget_);
+  reader_ = std::make_unique<BatchReader>(std::make_unique<TractogramBatchSource>(*job_.held, plan.batch_points), plan,
+                                          budget_, job_.threads, job_.settings.progress);
+}
+
+// The held source's per-point values, spread over the vertices as they are placed: VVAL's payload, held whole
+// (the arrays of all sets follow one another in it, so no range's part of them could be written alone).
+void StreamingConversion::plan_vertex_values() {
+  if (!job_.held || job_.held->point_values.empty()) return;
+  const std::vector<ValueSet>& sets = job_.held->point_values;
+  const std::uint64_t bytes = value_sets_bytes(sets.size(), table_.meta.vertex_count);
+  budget_.track(bytes, vertex_values_held_, [] { return "the per-point values spread over the vertices"; });
+  vertex_values_.assign(bytes, 0);
+  std::vector<std::string> names;
+  for (const ValueSet& v : sets) names.push_back(v.name);
+  vertex_value_arrays_ = layout_value_sets(vertex_values_, names, table_.meta.vertex_count);
+}
+
+// The held source's sections besides the blocks and tables: VVAL (placed), SVAL, GRPS and GDAT.
+void StreamingConversion::write_held_extras() {
+  if (!job_.held) return;
+  const Tractogram& t = *job_.held;
+  if (!vertex_values_.empty()) {
+    finish_value_sets(vertex_values_);
+    out_->append(VxlStreamWriter::kVval, vertex_values_);
+    vertex_value_arrays_.clear();
+    std::vector<std::uint8_t>().swap(vertex_values_);
+    budget_.shrink(0, vertex_values_held_);
+  }
+  if (!t.streamline_values.empty()) {
+    std::vector<std::uint8_t> payload(value_sets_bytes(t.streamline_values.size(), t.streamline_count()), 0);
+    std::vector<std::string> names;
+    for (const ValueSet& v : t.streamline_values) names.push_back(v.name);
+    const std::vector<std::span<float>> arrays = layout_value_sets(payload, names, t.streamline_count());
+    for (std::size_t k = 0; k < arrays.size(); ++k)
+      std::copy(t.streamline_values[k].values.begin(), t.streamline_values[k].values.end(), arrays[k].begin());
+    finish_value_sets(payload);
+    out_->append(VxlStreamWriter::kSval, payload);
+  }
+  if (!t.groups.empty()) out_->append(VxlStreamWriter::kGrps, encode_groups(t.groups));
+  if (!t.group_values.empty()) out_->append(VxlStreamWriter::kGdat, encode_group_values(t.group_values));
+}
+
+// The output's section sizes: the voxel table's counts, and a held source's value sets and groups.
+VxlSectionSizes StreamingConversion::output_sizes(std::uint64_t provenance_bytes) const {
+  if (!job_.held) return section_sizes(table_.meta, table_.order_bytes, provenance_bytes, 0);
+  const Tractogram& t = *job_.held;
+  VxlSectionSizes sizes = section_sizes(
+      table_.meta, table_.order_bytes, provenance_bytes, t.groups.empty() ? 0 : encode_groups(t.groups).size(),
+      static_cast<std::uint32_t>(t.point_values.size()), static_cast<std::uint32_t>(t.streamline_values.size()));
+  if (!t.group_values.empty()) sizes.group_values = encode_group_values(t.group_values).size();
+  return sizes;
 }
 
 void StreamingConversion::write_rest() {
@@ -81,12 +140,13 @@ ConvertSummary StreamingConversion::run() {
   count_voxels();
   build_table();
   summary_.voxelize_seconds = seconds_since(t0);
+  plan_vertex_values();
   // Planned without the voxel runs, which are kept for the placing passes only where the plan leaves room.
   budget_.shrink(0, table_.runs_held);
-  plan_ = plan_conversion(
-      budget_,
-      {table_.meta, table_.voxels, table_.levels, job_.settings.levels, job_.settings.positions, table_.order_bytes,
-       job_.threads, reader_->plan().batch_streamlines, job_.tuning.order_chunk_bytes, job_.tuning.range_bytes});
+  plan_ =
+      plan_conversion(budget_, {table_.meta, table_.voxels, table_.levels, job_.settings.levels,
+                                job_.settings.positions, table_.order_bytes, job_.threads, reader_->plan().batch_points,
+                                job_.tuning.order_chunk_bytes, job_.tuning.range_bytes, job_.tuning.vertex_blocks});
   table_.runs_kept = counting_.recording_runs && plan_voxel_runs(budget_, plan_, table_.runs.bytes());
   if (table_.runs_kept)
     table_.runs_held = table_.runs.bytes();
@@ -104,8 +164,7 @@ ConvertSummary StreamingConversion::run() {
 
   const std::string provenance =
       provenance_json(reader_->source(), job_.settings, job_.threads, job_.voxel_size_choice);
-  out_ = std::make_unique<VxlStreamWriter>(
-      job_.out_path, section_sizes(table_.meta, table_.order_bytes, provenance.size(), 0), plan_.direct_staging_bytes);
+  out_ = std::make_unique<VxlStreamWriter>(job_.out_path, output_sizes(provenance.size()), plan_.direct_staging_bytes);
   for (std::size_t k = 0; k < ranges.size(); ++k) {
     build_range(ranges[k], k, ranges.size());
 #if defined(__GLIBC__)
@@ -132,6 +191,7 @@ ConvertSummary StreamingConversion::run() {
   }
   pool_.reset();
   if (!scan_.lengths.empty()) out_->append_items<float>(VxlStreamWriter::kSlen, scan_.lengths);
+  write_held_extras();
   out_->append(VxlStreamWriter::kProv, {reinterpret_cast<const std::uint8_t*>(provenance.data()), provenance.size()});
   out_->commit();
   summary_.write_seconds += seconds_since(t0);
@@ -142,7 +202,7 @@ ConvertSummary StreamingConversion::run() {
   summary_.partitions = ranges.size();
   summary_.vertices_read_back = plan_.block_staging_bytes > 0;
   for (const VoxelRange& r : ranges) summary_.partition_starts.push_back(r.first);
-  summary_.warnings = reader_->source().warnings;
+  if (!job_.held) summary_.warnings = reader_->source().warnings;  // a held source's are its reader's to show
   return summary_;
 }
 
@@ -151,6 +211,12 @@ ConvertSummary StreamingConversion::run() {
 ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
                                  const ConvertSettings& settings) {
   return convert_streaming(source_path, out_path, settings, StreamingTuning{});
+}
+
+ConvertSummary convert_streaming(const Tractogram& held, const std::string& out_path, const ConvertSettings& settings,
+                                 const StreamingTuning& tuning) {
+  streaming::StreamingConversion conversion(held, out_path, settings, tuning);
+  return conversion.run();
 }
 
 ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,

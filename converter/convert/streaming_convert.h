@@ -45,4 +45,10 @@ ConvertSummary convert_streaming(const std::string& source_path, const std::stri
 ConvertSummary convert_streaming(const std::string& source_path, const std::string& out_path,
                                  const ConvertSettings& settings, const StreamingTuning& tuning);
 
+// Converts a source already in memory by the same passes, reading it a batch at a time (TractogramBatchSource)
+// within settings.memory_limit (> 0; the tractogram itself not counted), with its value sets and groups, which
+// must be prepared as convert_tractogram prepares them. The summary has no warnings (the reader's are in `held`).
+ConvertSummary convert_streaming(const Tractogram& held, const std::string& out_path, const ConvertSettings& settings,
+                                 const StreamingTuning& tuning = {});
+
 }  // namespace vxl

@@ -72,11 +72,12 @@ std::uint64_t staged_batches_bytes(const ConversionCounts& c) {
   const double per_point = (24.0 * double(meta.voxline_count) + 8.0 * double(meta.streamline_count) +
                             double(vertex_bytes(c.positions)) * vertices) /
                            points;
-  return static_cast<std::uint64_t>(2 * 2 * per_point * double(c.batch_streamlines));
+  return static_cast<std::uint64_t>(2 * 2 * per_point * double(c.batch_points));
 }
 
 // How VERT's vertices are held: block by block (setting block_staging_bytes and the pool) when the blocks'
-// staging takes at most an eighth of what is left and the pool at most half.
+// staging takes at most an eighth of what is left and the pool at most half, and VERT is not held whole in
+// memory (vertices_held_whole).
 void plan_block_staging(const MemoryBudget& budget, const ConversionCounts& counts, ConversionPlan& plan) {
   plan.pool_chunk_bytes = chunk_buffer_bytes(plan.order_chunk_bytes);
   plan.pool_read_back_bytes =
@@ -99,20 +100,48 @@ void plan_block_staging(const MemoryBudget& budget, const ConversionCounts& coun
 // buffer is taken before this). An ordering thread's buffers grow with the largest voxel, so a range
 // orders with fewer threads when they would take more than a quarter of the room (the orders do not
 // depend on the thread count).
-std::vector<VoxelRange> cut_ranges(MemoryBudget& budget, const ConversionCounts& c, bool block_staging) {
-  const std::uint64_t room = c.range_request > 0 ? std::min(c.range_request, budget.left()) : budget.left();
-  auto per_thread = [&](const VoxelRange& r) {
+// Range r's ordering threads and what building it holds, in `room`.
+struct RangeCost {
+  const ConversionCounts& c;
+  std::uint64_t room;
+  bool block_staging;
+  std::uint64_t per_thread(const VoxelRange& r) const {
     return order_scratch_bytes(r.max_vertices) + end_bits_bytes(c, r.max_vertices);
-  };
-  auto order_threads = [&](const VoxelRange& r) {
+  }
+  unsigned order_threads(const VoxelRange& r) const {
     return static_cast<unsigned>(std::clamp<std::uint64_t>(room / 4 / per_thread(r), 1, c.threads));
-  };
-  auto cost = [&](const VoxelRange& r) {
+  }
+  std::uint64_t operator()(const VoxelRange& r) const {
     const std::uint64_t v = r.vertex_end - r.vertex_first;
     const std::uint64_t end_bits = is_packed(c) ? 0 : (v / 64 + 1) * 8;
     const std::uint64_t held = block_staging ? end_bits : vertex_bytes(c.positions) * v + end_bits;
     return held + order_threads(r) * per_thread(r);
-  };
+  }
+};
+
+// Every voxel as one range.
+VoxelRange whole_range(const ConversionCounts& c) {
+  VoxelRange r{0, c.voxels.size(), 0, 0, 0};
+  if (c.voxels.empty()) return r;
+  r.vertex_first = c.voxels.front().vertex_first;
+  r.vertex_end = c.voxels.back().vertex_first + c.voxels.back().vertex_count;
+  for (const VoxelEntry& v : c.voxels) r.max_vertices = std::max(r.max_vertices, v.vertex_count);
+  return r;
+}
+
+// Whether VERT is held whole, in one range, beside the orders' two chunks: then it is, rather than written block by
+// block and read back, which costs more than holding it (1M streamlines, 57M vertices, limit 512 MiB: 1.0-1.3 s of
+// the placing pass).
+bool vertices_held_whole(const MemoryBudget& budget, const ConversionCounts& c, std::uint64_t order_chunk_bytes) {
+  const std::uint64_t chunks = 2 * chunk_buffer_bytes(order_chunk_bytes);
+  if (c.range_request > 0 || c.vertex_blocks_request || chunks > budget.left()) return false;
+  return RangeCost{c, budget.left() - chunks, false}(whole_range(c)) <= budget.left() - chunks;
+}
+
+std::vector<VoxelRange> cut_ranges(MemoryBudget& budget, const ConversionCounts& c, bool block_staging) {
+  const std::uint64_t room = c.range_request > 0 ? std::min(c.range_request, budget.left()) : budget.left();
+  const RangeCost cost{c, room, block_staging};
+  auto order_threads = [&](const VoxelRange& r) { return cost.order_threads(r); };
   auto alone = [&](std::size_t i) {
     const VoxelEntry& v = c.voxels[i];
     VoxelRange r{i, i + 1, v.vertex_first, v.vertex_first + v.vertex_count, v.vertex_count};
@@ -165,7 +194,7 @@ ReadPlan plan_reading(MemoryBudget& budget) {
   budget.take(kBaselineBytes, "the program itself");
   plan.read_buffer_bytes = std::clamp<std::uint64_t>(limit / 64, 64 << 10, 4 * kMiB);
   budget.take(plan.read_buffer_bytes, "the read buffer");
-  plan.batch_streamlines = std::clamp<std::uint64_t>(limit / 64 / 16, 1024, 1 << 20);
+  plan.batch_points = std::clamp<std::uint64_t>(limit / 64 / 16, 1024, 1 << 20);
   plan.max_header_bytes = std::max<std::uint64_t>(1, budget.left() / 4);
   plan.max_points_held = budget.left() / kHeldBytesPerPoint;
   return plan;
@@ -259,7 +288,8 @@ ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& cou
                                                                   orders_start(counts.voxels, counts.order_bytes, i));
   // What the pool, the orders' chunks and the ranges take is given back before the write stage.
   const std::uint64_t room_at_write = budget.left();
-  if (plan.direct_staging_bytes > 0) plan_block_staging(budget, counts, plan);
+  if (plan.direct_staging_bytes > 0 && !vertices_held_whole(budget, counts, plan.order_chunk_bytes))
+    plan_block_staging(budget, counts, plan);
   if (plan.block_staging_bytes > 0)
     budget.take(plan.pool_bytes, "the vertex blocks being written, then the orders being built and their vertices");
   else

@@ -33,14 +33,17 @@ std::uint64_t voxel_table_bytes_per_voxel(std::uint32_t levels);
 struct StreamingTuning {
   std::uint64_t order_chunk_bytes = 0;  // orders built and written this much at a time (or one voxel)
   std::uint64_t range_bytes = 0;        // ranges of voxels cut to hold at most this much (or one voxel; 0: the limit)
+  // VERT written block by block wherever the limit allows it (direct writes), also where it could be held whole.
+  bool vertex_blocks = false;
 };
 
 // How the source is read, from the limit alone (before anything is read).
 struct ReadPlan {
   std::uint64_t read_buffer_bytes = 0;
-  std::uint64_t batch_streamlines = 0;  // streamlines per batch (a batch holds whole streamlines)
-  std::uint64_t max_header_bytes = 0;   // the longest TCK header read
-  std::uint64_t max_points_held = 0;    // points a batch may hold (a longer streamline is refused)
+  // A batch holds whole streamlines, up to the first that brings its points and streamlines to this many.
+  std::uint64_t batch_points = 0;
+  std::uint64_t max_header_bytes = 0;  // the longest TCK header read
+  std::uint64_t max_points_held = 0;   // points a batch may hold (a longer streamline is refused)
 };
 // Takes the program's own memory and the read buffer from `budget`.
 ReadPlan plan_reading(MemoryBudget& budget);
@@ -63,9 +66,10 @@ struct ConversionCounts {
   PositionEncoding positions = PositionEncoding::Packed;
   std::uint64_t order_bytes = 0;          // ORDB's payload
   unsigned threads = 1;                   // resolved
-  std::uint64_t batch_streamlines = 0;    // ReadPlan::batch_streamlines
+  std::uint64_t batch_points = 0;         // ReadPlan::batch_points
   std::uint64_t order_chunk_request = 0;  // StreamingTuning::order_chunk_bytes (0: derived)
   std::uint64_t range_request = 0;        // StreamingTuning::range_bytes (0: what the limit leaves)
+  bool vertex_blocks_request = false;     // StreamingTuning::vertex_blocks
 };
 
 struct ConversionPlan {

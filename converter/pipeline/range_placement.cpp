@@ -7,6 +7,7 @@
 #include <array>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 
 #include "format/base/parallel.h"
 
@@ -178,6 +179,7 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
     part.voxlines[h].clear();
     part.words[h].clear();
     part.xyz[h].clear();
+    part.values[h].clear();
   }
   part.table_entries.clear();
   part.streamline_voxlines.clear();
@@ -193,8 +195,7 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
     run = *at;
   }
   for (std::uint64_t k = begin; k < end; ++k) {
-    part.sink.voxlines.clear();
-    part.sink.synthetic_xyz.clear();
+    part.sink.clear();
     const std::uint64_t points = b.offsets[k + 1] - b.offsets[k];
     const bool by_runs = table_.runs_kept && points > 0 &&
                          (run >= table_.runs.size() || table_.runs[run].voxel != VoxelRuns::kVoxelisedAgain);
@@ -236,6 +237,8 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
       staged.resize(staged_at + 3 * used);
       float* const xyz = staged.data() + staged_at;
       detail::place_voxline(streamline, j, pts, part.sink.synthetic_xyz.data(), xyz);
+      if (!vertex_value_arrays_.empty())
+        stage_values(part, streamline, j, used, job_.held->offsets[first], part.values[half]);
       // A vertex outside the bounds pass 2 found (packed: it would be clamped) means the source changed, also
       // where its size and time did not.
       const VoxelEntry& voxel = table_.voxels[g];
@@ -253,6 +256,27 @@ void StreamingConversion::stage_part(const RangePlacement& placing, const Tracto
       part.streamline_voxlines.push_back(static_cast<std::uint32_t>(streamline.size()));
       part.spans.push_back(span);
     }
+  }
+}
+
+// Appends to `out` the values of every set of the held source for the `used` vertices of voxline j of `streamline`
+// (of a batch whose first point is the source's point `point_base`), as place_voxline lays the vertices out: an
+// added point's value interpolated where it lies on its step, a connecting vertex's the next voxline's first.
+void StreamingConversion::stage_values(const StagedPart& part, std::span<const TempVoxline> streamline, std::size_t j,
+                                       std::uint64_t used, std::uint64_t point_base, std::vector<float>& out) const {
+  const TempVoxline& v = streamline[j];
+  for (const ValueSet& set : job_.held->point_values) {
+    const float* src = set.values.data() + point_base;
+    const auto first_value = [&](const TempVoxline& x) {
+      if (x.synthetic == kNoSynthetic) return src[x.src_first];
+      const double a = src[x.src_first - 1], b = src[x.src_first], at = part.sink.synthetic_t[x.synthetic];
+      return static_cast<float>(a + at * (b - a));
+    };
+    const std::size_t at = out.size();
+    if (v.synthetic != kNoSynthetic) out.push_back(first_value(v));
+    out.insert(out.end(), src + v.src_first, src + v.src_first + v.src_count);
+    if (j + 1 < streamline.size()) out.push_back(first_value(streamline[j + 1]));
+    if (out.size() - at != used) throw std::logic_error("stage_values: a voxline's values and vertices differ");
   }
 }
 
@@ -298,6 +322,7 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
   const std::uint64_t bytes = vertex_bytes(job_.settings.positions);
   const auto* from = packed() ? reinterpret_cast<const std::uint8_t*>(part.words[half].data())
                               : reinterpret_cast<const std::uint8_t*>(part.xyz[half].data());
+  const float* values = part.values[half].data();
   for (const StagedVoxline& v : part.voxlines[half]) {
     const std::size_t block = std::size_t(v.voxel) * levels + v.depth;
     std::uint64_t& cursor = table_.cursor[block];
@@ -306,6 +331,10 @@ void StreamingConversion::place_part(RangePlacement& placing, const StagedPart& 
     if (!packed()) ends_.set(at + v.count - 1);
     placing.sink.put(block, at, from, v.count);
     from += v.count * bytes;
+    for (std::span<float> array : vertex_value_arrays_) {
+      std::copy_n(values, v.count, array.data() + cursor);
+      values += v.count;
+    }
     cursor += v.count;
   }
   if (half == 0) placing.streamlines += part.end - part.begin;

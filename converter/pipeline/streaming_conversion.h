@@ -68,9 +68,16 @@ struct SinkOf {
   Index index;
   std::vector<TempVoxline> voxlines;
   std::vector<float> synthetic_xyz;
+  std::vector<double> synthetic_t;  // where each added point lies on its step: per-point values are interpolated there
   bool too_many_synthetic = false;
+  void clear() {
+    voxlines.clear();
+    synthetic_xyz.clear();
+    synthetic_t.clear();
+  }
   std::uint64_t bytes() const {
-    return voxlines.capacity() * sizeof(TempVoxline) + synthetic_xyz.capacity() * sizeof(float);
+    return voxlines.capacity() * sizeof(TempVoxline) + synthetic_xyz.capacity() * sizeof(float) +
+           synthetic_t.capacity() * sizeof(double);
   }
 };
 
@@ -79,6 +86,9 @@ using Sink = SinkOf<VoxelIndex>;
 // What the conversion was asked to do.
 struct StreamingJob {
   std::string path, out_path;
+  // A source already in memory (convert_tractogram), read batch by batch from there; its value sets and
+  // groups are written too. Null: the TCK file at `path`, read a part at a time.
+  const Tractogram* held = nullptr;
   ConvertSettings settings;  // its voxel_size chosen by the scan under --voxel-size auto
   StreamingTuning tuning;
   OrderSetSpec order_set;
@@ -136,7 +146,11 @@ class StreamingConversion {
  public:
   StreamingConversion(const std::string& source, const std::string& out, const ConvertSettings& settings,
                       const StreamingTuning& tuning)
-      : job_{source, out, settings, tuning, {}, 1, {}}, budget_(settings.memory_limit, source) {}
+      : job_{source, out, nullptr, settings, tuning, {}, 1, {}}, budget_(settings.memory_limit, source) {}
+  StreamingConversion(const Tractogram& held, const std::string& out, const ConvertSettings& settings,
+                      const StreamingTuning& tuning)
+      : job_{held.source.path, out, &held, settings, tuning, {}, 1, {}},
+        budget_(settings.memory_limit, held.source.path) {}
 
   ConvertSummary run();
 
@@ -176,6 +190,12 @@ class StreamingConversion {
   // Where voxel i's orders start in ORDB (i = voxel count: the payload's end).
   std::uint64_t orders_start(std::size_t i) const { return vxl::orders_start(table_.voxels, table_.order_bytes, i); }
   void write_rest();
+  // The held source's per-point values (VVAL), placed with the vertices: the payload, held whole.
+  void plan_vertex_values();
+  void stage_values(const StagedPart& part, std::span<const TempVoxline> streamline, std::size_t j, std::uint64_t used,
+                    std::uint64_t point_base, std::vector<float>& out) const;
+  void write_held_extras();
+  VxlSectionSizes output_sizes(std::uint64_t provenance_bytes) const;
   [[noreturn]] void fail_changed() const;
   void report(const std::string& stage, double fraction) const {
     if (job_.settings.progress) job_.settings.progress(stage.c_str(), fraction);
@@ -195,6 +215,10 @@ class StreamingConversion {
   // again).
   std::unique_ptr<std::uint8_t, void (*)(void*)> pool_{nullptr, std::free};
   VoxlineEnds ends_;  // float32 positions: the voxline ends of the range being built
+  // The held source's per-point values spread over the vertices (VVAL's payload) and its arrays, one per set.
+  std::vector<std::uint8_t> vertex_values_;
+  std::vector<std::span<float>> vertex_value_arrays_;
+  std::uint64_t vertex_values_held_ = 0;  // as taken from the budget
   std::unique_ptr<VxlStreamWriter> out_;
 };
 
@@ -214,6 +238,8 @@ struct StreamingConversion::StagedPart {
   std::array<std::vector<StagedVoxline>, 2> voxlines;  // per half: the voxlines in range, in order
   std::array<std::vector<std::uint32_t>, 2> words;     // packed: per half, those voxlines' vertices in order
   std::array<std::vector<float>, 2> xyz;               // float32: the same
+  // A held source's per-point values: per half, each staged voxline's values of every set, set after set.
+  std::array<std::vector<float>, 2> values;
   // First range: every voxline's VXLN entry and each streamline's voxline count and lowest and highest voxel.
   std::vector<VoxlineEntry> table_entries;
   std::vector<std::uint32_t> streamline_voxlines;
@@ -224,7 +250,7 @@ struct StreamingConversion::StagedPart {
                       spans.capacity() * sizeof(std::array<std::uint32_t, 2>);
     for (int h = 0; h < 2; ++h)
       b += voxlines[h].capacity() * sizeof(StagedVoxline) + words[h].capacity() * sizeof(std::uint32_t) +
-           xyz[h].capacity() * sizeof(float);
+           (xyz[h].capacity() + values[h].capacity()) * sizeof(float);
     return b;
   }
 };

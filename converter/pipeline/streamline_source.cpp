@@ -5,8 +5,10 @@
 namespace vxl {
 
 bool TractogramBatchSource::next(Tractogram& batch) {
-  const std::uint64_t first = next_, end = std::min(tractogram_.streamline_count(), next_ + batch_streamlines_);
   const std::vector<std::uint64_t>& offsets = tractogram_.offsets;
+  const std::uint64_t first = next_, n = tractogram_.streamline_count();
+  std::uint64_t end = first;
+  while (end < n && (offsets[end] - offsets[first]) + (end - first) < batch_points_) ++end;
   batch.offsets.clear();
   batch.positions.clear();
   if (first >= end) {

@@ -33,27 +33,28 @@ class TckBatchSource final : public StreamlineSource {
  public:
   TckBatchSource(const std::string& path, const ReadPlan& plan)
       : stream_(path, plan.max_header_bytes, plan.read_buffer_bytes),
-        batch_streamlines_(plan.batch_streamlines),
+        batch_points_(plan.batch_points),
         max_points_held_(plan.max_points_held) {}
   const SourceInfo& source() const override { return stream_.source(); }
   double progress() const override {
     return double(stream_.position()) / double(std::max<std::uint64_t>(1, stream_.file_size()));
   }
   void rewind() override { stream_.rewind(); }
-  bool next(Tractogram& batch) override { return stream_.next(batch, batch_streamlines_, max_points_held_); }
+  bool next(Tractogram& batch) override { return stream_.next(batch, batch_points_, max_points_held_); }
   bool overflowed() const override { return stream_.overflowed(); }
 
  private:
   TckStream stream_;
-  std::uint64_t batch_streamlines_, max_points_held_;
+  std::uint64_t batch_points_, max_points_held_;
 };
 
-// Streamlines in memory (`tractogram`, which must outlive the source), `batch_streamlines` at a time; each
-// batch is a copy of its streamlines' points.
+// Streamlines in memory (`tractogram`, which must outlive the source), in batches cut as a TCK's are (up to the
+// first streamline that brings the batch's points and streamlines to `batch_points`); each batch is a copy of its
+// streamlines' points.
 class TractogramBatchSource final : public StreamlineSource {
  public:
-  TractogramBatchSource(const Tractogram& tractogram, std::uint64_t batch_streamlines)
-      : tractogram_(tractogram), batch_streamlines_(std::max<std::uint64_t>(1, batch_streamlines)) {}
+  TractogramBatchSource(const Tractogram& tractogram, std::uint64_t batch_points)
+      : tractogram_(tractogram), batch_points_(std::max<std::uint64_t>(1, batch_points)) {}
   const SourceInfo& source() const override { return tractogram_.source; }
   double progress() const override {
     return double(next_) / double(std::max<std::uint64_t>(1, tractogram_.streamline_count()));
@@ -63,7 +64,7 @@ class TractogramBatchSource final : public StreamlineSource {
 
  private:
   const Tractogram& tractogram_;
-  std::uint64_t batch_streamlines_;
+  std::uint64_t batch_points_;
   std::uint64_t next_ = 0;  // the next streamline to hand out
 };
 

@@ -227,8 +227,7 @@ void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, s
   const float* pts = b.positions.data();
   const std::uint64_t bytes_per_voxel = voxel_table_bytes_per_voxel(job_.settings.levels);
   for (std::uint64_t k = begin; k < end; ++k) {
-    part.sink.voxlines.clear();
-    part.sink.synthetic_xyz.clear();
+    part.sink.clear();
     detail::voxelize_streamline(table_.grid, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], part.sink,
                                 table_.synthetic_limit - std::min(table_.synthetic_limit, synthetic + part.synthetic));
     if (part.sink.too_many_synthetic)
