@@ -1,10 +1,12 @@
-// The one policy that turns a source into a .vxl for both programs (converter/convert/source_to_vxl.h): when it
-// streams, that both routes write the same bytes, and that open_as_vxl leaves no temporary file behind.
+// The one policy that turns a source into a .vxl for both programs (converter/convert/source_to_vxl.h): the limit a
+// TCK streams within, that every limit writes the same bytes, and that open_as_vxl leaves no temporary file behind.
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 
 #include "converter/convert/source_to_vxl.h"
+#include "converter/export/tck_writer.h"
+#include "converter/pipeline/memory_budget.h"
 #include "format/base/error.h"
 #include "tests/test_support.h"
 
@@ -45,6 +47,28 @@ TEST(SourceToVxl, ATckStreamsWithinALimitChosenFromItsSizeAndSaysWhenMemoryIsSho
   EXPECT_NE(notice.find(tck + ": 4.0 MiB of memory available: converting within --memory-limit 64M"), std::string::npos)
       << notice;
   EXPECT_EQ(test::slurp(dir.file("whole.vxl")), test::slurp(dir.file("chosen.vxl")));
+}
+
+// A chosen limit is raised where the source needs more (here: two batches each holding one streamline of 6M
+// points whole, 288 MB, over the least default of 256 MiB); a limit given is not.
+TEST(SourceToVxl, AChosenLimitIsRaisedWhereTheSourceNeedsMore) {
+  ScratchDir dir;
+  const std::string tck = dir.file("long.tck");
+  {
+    std::vector<float> xyz(3 * 6'000'000);
+    for (std::size_t i = 0; i < xyz.size() / 3; ++i) xyz[3 * i + 2] = static_cast<float>(i) * 1e-5f;
+    TckWriter w(tck, 1);
+    w.add(xyz);
+    w.finish();
+  }
+  SourceConversion conversion;
+  conversion.settings.threads = 2;
+  const SourceConversionReport raised = convert_source(tck, dir.file("raised.vxl"), conversion);
+  EXPECT_GT(raised.memory_limit, 288'000'000u);
+  EXPECT_EQ(raised.summary.points, 6'000'000u);
+  conversion.settings.memory_limit = 256ull << 20;
+  EXPECT_THROW(convert_source(tck, dir.file("given.vxl"), conversion), MemoryLimitTooSmall);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("given.vxl")));
 }
 
 TEST(SourceToVxl, OpenAsVxlStreamsThroughATemporaryFileItRemoves) {

@@ -1,16 +1,18 @@
-// Voxelisation (Algorithm 1 + face splitting, spec §6) and order building (spec §6.4) on hand-made data.
+// Voxelisation (Algorithm 1 + face splitting, spec §6) and order building (spec §6.4) on hand-made data, read back
+// from the file the conversion writes.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
 #include <sys/resource.h>
 
+#include "converter/convert/convert.h"
 #include "converter/convert/segment_orders.h"
 #include "converter/convert/voxel_table.h"
-#include "converter/convert/voxelize.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_positions.h"
+#include "format/vxl_verify.h"
 #include "tests/test_support.h"
 
 namespace vxl {
@@ -23,11 +25,46 @@ Tractogram make(std::initializer_list<std::vector<float>> streamlines) {
   return t;
 }
 
-VoxelizedTractogram run(Tractogram t, double voxel = 10.0, unsigned threads = 1) {
-  VoxelizeSettings s;
+// What a conversion wrote, copied out of its file.
+struct Voxelized {
+  MetaSection meta{};
+  std::vector<VoxelEntry> voxels;
+  std::vector<float> vertices;       // float32 positions
+  std::vector<std::uint32_t> words;  // packed positions
+  std::vector<std::uint8_t> orders;  // ORDB's payload
+  std::vector<VoxlineEntry> voxlines;
+  std::vector<std::uint64_t> streamline_first_voxline;
+  bool valid = false;  // verify_vxl's verdict
+};
+
+ConvertSettings settings_for(double voxel, unsigned threads) {
+  ConvertSettings s;
   s.voxel_size = voxel;
   s.threads = threads;
-  return voxelize(std::move(t), s);
+  s.positions = PositionEncoding::Float32;
+  s.levels = 1;
+  return s;
+}
+
+Voxelized convert(Tractogram t, const ConvertSettings& settings) {
+  test::ScratchDir dir;
+  const std::string path = dir.file("out.vxl");
+  convert_tractogram(std::move(t), path, settings);
+  const VxlFile f = VxlFile::open(path);
+  Voxelized v;
+  v.meta = f.meta();
+  v.voxels.assign(f.voxels().begin(), f.voxels().end());
+  v.vertices.assign(f.float_vertices().begin(), f.float_vertices().end());
+  v.words.assign(f.packed_vertices().begin(), f.packed_vertices().end());
+  v.orders.assign(f.order_bytes().begin(), f.order_bytes().end());
+  v.voxlines.assign(f.voxlines().begin(), f.voxlines().end());
+  v.streamline_first_voxline.assign(f.streamline_first_voxline().begin(), f.streamline_first_voxline().end());
+  v.valid = verify_vxl(path).valid;
+  return v;
+}
+
+Voxelized run(Tractogram t, double voxel = 10.0, unsigned threads = 1) {
+  return convert(std::move(t), settings_for(voxel, threads));
 }
 
 TEST(Voxelize, AlgorithmOneAddsOneConnectingVertexPerVoxelChange) {
@@ -110,9 +147,9 @@ TEST(Voxelize, ResultDoesNotDependOnTheThreadCount) {
   EXPECT_EQ(one.streamline_first_voxline, four.streamline_first_voxline);
 }
 
-// Packing while placing (pass 1 finds the tight bounds) must give what placing floats, then taking the tight
-// bounds from the blocks and packing them gives: the same voxel entries and the same words (end bits set
-// on each voxline's last vertex), with 1 and 3 threads and synthetic points at the faces.
+// Packing while placing (the counting pass finds the tight bounds) must give what packing the float32 blocks
+// gives: the same voxel entries and the same words (end bits aside: verify checks them on each voxline's last
+// vertex), with 1 and 3 threads, levels of detail and synthetic points at the faces.
 TEST(Voxelize, PackingWhilePlacingGivesTheWordsOfPackingThePlacedBlocks) {
   Tractogram t;
   for (int s = 0; s < 300; ++s) {
@@ -124,37 +161,30 @@ TEST(Voxelize, PackingWhilePlacingGivesTheWordsOfPackingThePlacedBlocks) {
     t.add_streamline(pts.data(), 30);
   }
   for (unsigned threads : {1u, 3u}) {
-    VoxelizeSettings vs;
-    vs.voxel_size = 3.0;
-    vs.threads = threads;
-    vs.levels = 3;
-    Tractogram source = t;
-    VoxelizedTractogram floats = voxelize(std::move(source), vs);
-    std::vector<std::uint32_t> expected(floats.meta.vertex_count);
-    for (const VoxelEntry& v : floats.voxels) {
-      pack_block(v, floats.vertices.data() + 3 * v.vertex_first, v.vertex_count, expected.data() + v.vertex_first);
-      for (std::uint32_t k = 0; k < v.vertex_count; ++k)
-        if (floats.voxline_ends.test(v.vertex_first + k)) expected[v.vertex_first + k] |= kPackedVoxlineEnd;
-    }
+    ConvertSettings settings = settings_for(3.0, threads);
+    settings.levels = 3;
+    const Voxelized floats = convert(t, settings);
     ASSERT_GT(floats.meta.synthetic_point_count, 0u) << "the faces must be crossed by long steps";
+    std::vector<std::uint32_t> expected(floats.meta.vertex_count);
+    std::vector<float> xyz = floats.vertices;
+    for (const VoxelEntry& v : floats.voxels)
+      pack_block(v, xyz.data() + 3 * v.vertex_first, v.vertex_count, expected.data() + v.vertex_first);
 
-    vs.pack_positions = true;
-    Tractogram again = t;
-    VoxelPlan plan = plan_voxels(again, vs);
-    std::vector<VoxelEntry> voxels(plan.meta().voxel_count);
-    std::vector<LevelEntry> levels(plan.levels().size());
-    std::vector<VoxlineEntry> voxlines(plan.meta().voxline_count);
-    std::vector<std::uint64_t> first(plan.meta().streamline_count + 1);
-    std::vector<std::uint32_t> words(plan.meta().vertex_count);
-    VoxelBlocks blocks{voxels, levels, {}, voxlines, first, {}, {}};
-    blocks.packed_vertices = words;
-    place_vertices(std::move(plan), std::move(again), blocks);
+    settings.positions = PositionEncoding::Packed;
+    const Voxelized packed = convert(t, settings);
+    EXPECT_TRUE(packed.valid);
+    std::vector<std::uint32_t> words = packed.words;
+    for (std::uint32_t& w : words) w &= ~kPackedVoxlineEnd;
     EXPECT_TRUE(words == expected) << threads << " threads";
-    ASSERT_EQ(voxels.size(), floats.voxels.size());
-    for (std::size_t i = 0; i < voxels.size(); ++i)
-      EXPECT_EQ(0, std::memcmp(&voxels[i], &floats.voxels[i], sizeof(VoxelEntry))) << "voxel " << i;
-    EXPECT_EQ(voxlines.size(), floats.voxlines.size());
-    EXPECT_EQ(first, floats.streamline_first_voxline);
+    ASSERT_EQ(packed.voxels.size(), floats.voxels.size());
+    for (std::size_t i = 0; i < packed.voxels.size(); ++i) {
+      VoxelEntry a = packed.voxels[i], b = floats.voxels[i];
+      a.order_offset = b.order_offset = 0;  // the orders' widths may differ with the positions' encoding
+      a.flags = b.flags = 0;
+      EXPECT_EQ(0, std::memcmp(&a, &b, sizeof(VoxelEntry))) << "voxel " << i;
+    }
+    EXPECT_EQ(packed.voxlines.size(), floats.voxlines.size());
+    EXPECT_EQ(packed.streamline_first_voxline, floats.streamline_first_voxline);
   }
 }
 
@@ -216,10 +246,8 @@ TEST(Voxelize, BoundsScanFindsBoundsStepsAndTheFirstNonFinitePoint) {
 }
 
 TEST(Voxelize, TooSmallAVoxelIsRefusedWithASuggestion) {
-  VoxelizeSettings s;
-  s.voxel_size = 0.001;
   try {
-    voxelize(make({{0, 0, 0, 50, 0, 0}}), s);
+    run(make({{0, 0, 0, 50, 0, 0}}), 0.001);
     FAIL();
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
@@ -233,7 +261,7 @@ TEST(Voxelize, OneHugeStepIsRefusedBeforeAllocating) {
   struct rusage before {};
   getrusage(RUSAGE_SELF, &before);
   try {
-    voxelize(make({{0, 0, 0, 1, 1, 1, 8.2e8f, 2, 2}}), {});
+    run(make({{0, 0, 0, 1, 1, 1, 8.2e8f, 2, 2}}));
     FAIL() << "accepted";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
@@ -248,11 +276,10 @@ TEST(SegmentOrders, AxisOrdersSortByMidpointWithStableTies) {
   // Segments inside one voxel with x-midpoints 5, 1, 3 and a tie on y.
   auto vt = run(make({{4, 1, 1, 6, 1, 1}, {0, 1, 1, 2, 1, 1}, {2, 1, 1, 4, 1, 1}}));
   ASSERT_EQ(vt.voxels.size(), 1u);
-  BuiltOrders o = build_orders(vt, parse_order_set("axis"), 1, {});
-  ASSERT_EQ(o.directions.size(), 3u);
+  EXPECT_EQ(vt.meta.stored_order_count, 3u);
   // Six vertices: entries of 3 bits (the bit width of 5), each array of 3 entries in 2 bytes (spec §5.5).
-  ASSERT_EQ(o.bytes.size(), 8u);
-  const OrderView x{o.bytes.data() + vt.voxels[0].order_offset, 3, 3}, y{x.data + 2, 3, 3};
+  ASSERT_EQ(vt.orders.size(), 8u);
+  const OrderView x{vt.orders.data() + vt.voxels[0].order_offset, 3, 3}, y{x.data + 2, 3, 3};
   // blocks: [4,6] at 0-1, [0,2] at 2-3, [2,4] at 4-5; +X order: midpoints 1, 3, 5 -> starts 2, 4, 0
   EXPECT_EQ(x[0], 2u);
   EXPECT_EQ(x[1], 4u);
@@ -271,13 +298,12 @@ TEST(SegmentOrders, SeventeenBitEntriesAboveU16Range) {
     pts.insert(pts.end(), {float(i % 5) * 0.1f, float((i * 7) % 9) * 0.1f, float(i % 3) * 0.1f});
   Tractogram t;
   t.add_streamline(pts.data(), 70000);
-  auto vt = run(std::move(t));
-  BuiltOrders o = build_orders(vt, parse_order_set("axis"), 2, {});
+  auto vt = run(std::move(t), 10.0, 2);
   EXPECT_EQ(vt.voxels[0].flags, 1u);                   // beyond 16 bits: the renderer uploads high halves
   const std::uint64_t array = (69999u * 17u + 7) / 8;  // 17 bits: the bit width of 69 999
-  EXPECT_EQ(o.bytes.size(), align_up(3 * array, 4));
+  EXPECT_EQ(vt.orders.size(), align_up(3 * array, 4));
   for (std::uint32_t k = 0; k < 3; ++k) {
-    const OrderView order{o.bytes.data() + k * array, 69999, 17};
+    const OrderView order{vt.orders.data() + k * array, 69999, 17};
     std::vector<std::uint8_t> seen(69999, 0);
     for (std::uint32_t n = 0; n < order.count; ++n) {
       ASSERT_LT(order[n], 69999u) << "order " << k << " entry " << n;

@@ -269,66 +269,8 @@ std::uint8_t* VoxelOrderWriter::write_level(const LevelEntry& level, const Block
   return dst;
 }
 
-namespace {
-
-// Calls write(writer, i, dst) for every voxel i, in parallel, with the thread's VoxelOrderWriter and the
-// voxel's place in `orders`.
-template <typename Write>
-void write_all_orders(std::span<const VoxelEntry> voxels, const OrderSetSpec& set, std::span<std::uint8_t> orders,
-                      unsigned threads, const ProgressFn& progress, Write&& write) {
-  std::uint32_t max_vertices = 0;
-  for (const VoxelEntry& v : voxels) max_vertices = std::max(max_vertices, v.vertex_count);
-  std::atomic<std::size_t> done{0};
-  // One writer (sort scratch for the largest voxel) per thread, made by the thread that uses it.
-  std::vector<std::optional<VoxelOrderWriter>> writers(resolve_threads(threads));
-  parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned t) {
-    if (!writers[t]) writers[t].emplace(set, max_vertices);
-    write(*writers[t], i, orders.data() + voxels[i].order_offset);
-    const std::size_t d = ++done;
-    if (t == 0 && progress && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
-  });
-  if (progress) progress("ordering", 1.0);
-}
-
-}  // namespace
-
-void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const LevelEntry> levels,
-                       std::uint32_t level_count, std::span<const float> vertices, const VoxlineEnds& ends,
-                       const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,
-                       const ProgressFn& progress) {
-  write_all_orders(voxels, set, orders, threads, progress,
-                   [&](VoxelOrderWriter& w, std::uint64_t i, std::uint8_t* dst) {
-                     w.write(voxels[i], level_row(levels, i, level_count), vertices, ends, dst);
-                   });
-}
-
-void build_orders_into_packed(std::span<const VoxelEntry> voxels, std::span<const LevelEntry> levels,
-                              std::uint32_t level_count, std::span<const std::uint32_t> packed_vertices,
-                              const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,
-                              const ProgressFn& progress) {
-  write_all_orders(voxels, set, orders, threads, progress,
-                   [&](VoxelOrderWriter& w, std::uint64_t i, std::uint8_t* dst) {
-                     w.write_packed(voxels[i], level_row(levels, i, level_count),
-                                    packed_vertices.data() + voxels[i].vertex_first, dst);
-                   });
-}
-
 std::uint64_t order_scratch_bytes(std::uint32_t max_vertices) {
   return sizeof(std::uint32_t) * std::uint64_t(max_vertices) + detail::sort_scratch_bytes(max_vertices);  // + starts
-}
-
-BuiltOrders build_orders(VoxelizedTractogram& vt, const OrderSetSpec& set, unsigned threads,
-                         const ProgressFn& progress) {
-  BuiltOrders out;
-  out.directions = order_directions(set);
-  vt.meta.stored_order_count = static_cast<std::uint32_t>(set.directions.size());
-  vt.meta.order_set = static_cast<std::uint32_t>(set.kind);
-  const std::uint32_t level_count = std::max<std::uint32_t>(1, vt.meta.level_count);
-  out.bytes.assign(layout_orders(vt.voxels, vt.levels, level_count, vt.meta.stored_order_count), 0);
-  if (set.per_voxel()) out.voxel_directions.resize(vt.voxels.size() * set.directions.size());
-  fill_voxel_directions(set, vt.voxels, out.voxel_directions);
-  build_orders_into(vt.voxels, vt.levels, level_count, vt.vertices, vt.voxline_ends, set, out.bytes, threads, progress);
-  return out;
 }
 
 }  // namespace vxl

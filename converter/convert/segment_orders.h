@@ -103,31 +103,8 @@ class VoxelOrderWriter {
   std::unique_ptr<Scratch> scratch_;
 };
 
-// Sorts every voxel's segments for every direction of `set` into `orders`, the ORDB payload laid out
-// by layout_orders (its padding bytes zeroed).
-void build_orders_into(std::span<const VoxelEntry> voxels, std::span<const LevelEntry> levels,
-                       std::uint32_t level_count, std::span<const float> vertices, const VoxlineEnds& ends,
-                       const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,
-                       const ProgressFn& progress);
-// The same from the packed blocks (VERT's words, their voxline-end bits set): the orders of the positions
-// the words decode to, which are what pack_block leaves in the float blocks, so the bytes are the same.
-void build_orders_into_packed(std::span<const VoxelEntry> voxels, std::span<const LevelEntry> levels,
-                              std::uint32_t level_count, std::span<const std::uint32_t> packed_vertices,
-                              const OrderSetSpec& set, std::span<std::uint8_t> orders, unsigned threads,
-                              const ProgressFn& progress);
-
-// An upper bound of what build_orders_into allocates per worker thread (its sort buffers, growth
+// An upper bound of what a VoxelOrderWriter allocates (its sort buffers, growth
 // included) when no voxel has more than `max_vertices` vertices, for callers that budget memory.
 std::uint64_t order_scratch_bytes(std::uint32_t max_vertices);
-
-struct BuiltOrders {
-  std::vector<DirectionEntry> directions;
-  std::vector<DirectionEntry> voxel_directions;  // the VDIR payload; empty unless the set is random
-  std::vector<std::uint8_t> bytes;               // the ORDB payload
-};
-
-// All of the above in memory: sets the voxels' flags and order_offset and the meta's order fields.
-BuiltOrders build_orders(VoxelizedTractogram& voxelized, const OrderSetSpec& set, unsigned threads,
-                         const ProgressFn& progress);
 
 }  // namespace vxl

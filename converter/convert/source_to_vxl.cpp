@@ -7,6 +7,7 @@
 #include "converter/convert/memory_choice.h"
 #include "converter/convert/streaming_convert.h"
 #include "converter/convert/temporary_vxl.h"
+#include "converter/pipeline/memory_budget.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "converter/readers/source_formats.h"
@@ -22,21 +23,38 @@ bool is_streamable(const std::string& path) {
   return match.format && match.format->streamable;
 }
 
-// The limit to stream `input` within: the one given, or else memory_choice's for its size and its share of the
-// available memory (said by `notice` when that share limits it).
-std::uint64_t streaming_limit(const std::string& input, const SourceConversion& c) {
-  if (c.settings.memory_limit > 0) return c.settings.memory_limit;
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(input, ec);
-  const std::uint64_t bytes = ec ? 0 : size;
+// Streams `input` within the limit given, or else within memory_choice's for its size and its share of the available
+// memory (said by `notice` when that share limits it), raised up to the largest chosen limit where some part of the
+// work needs more: a chosen limit does not refuse a source the memory holds.
+void stream_source(const std::string& input, const std::string& output, ConvertSettings settings,
+                   const SourceConversion& c, SourceConversionReport& report) {
   std::optional<std::uint64_t> share = available_memory();
   if (share) *share /= std::max(1u, c.concurrent_files);
-  const std::uint64_t limit = default_memory_limit(bytes, share);
-  if (c.notice && limited_by_available_memory(bytes, share))
-    c.notice(input + ": " + format_memory_size(*share) + " of memory available" +
-             (c.concurrent_files > 1 ? " to each file converted at once" : "") + ": converting within --memory-limit " +
-             memory_limit_argument(limit) + " (more passes over the source; the output is the same)");
-  return limit;
+  const bool chosen = settings.memory_limit == 0;
+  if (chosen) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(input, ec);
+    const std::uint64_t bytes = ec ? 0 : size;
+    settings.memory_limit = default_memory_limit(bytes, share);
+    if (c.notice && limited_by_available_memory(bytes, share))
+      c.notice(input + ": " + format_memory_size(*share) + " of memory available" +
+               (c.concurrent_files > 1 ? " to each file converted at once" : "") +
+               ": converting within --memory-limit " + memory_limit_argument(settings.memory_limit) +
+               " (more passes over the source; the output is the same)");
+  }
+  for (;;) {
+    try {
+      report.summary = convert_streaming(input, output, settings);
+      break;
+    } catch (const MemoryLimitTooSmall& e) {
+      const std::uint64_t largest = largest_chosen_memory_limit(share);
+      if (!chosen || settings.memory_limit >= largest || e.suggested() <= settings.memory_limit) throw;
+      settings.memory_limit = std::min(largest, e.suggested());
+    }
+  }
+  report.read_seconds = report.summary.read_seconds;
+  report.streamed = true;
+  report.memory_limit = settings.memory_limit;
 }
 
 void warn_each(const SourceConversion& c, const std::vector<std::string>& warnings) {
@@ -55,11 +73,7 @@ SourceConversionReport convert_source(const std::string& input, const std::strin
                 "--memory-limit does not carry --tsf values yet; convert without the limit");
   // A memory limit with a source that cannot stream is refused there, naming the formats that can.
   if (c.tsf.empty() && (is_streamable(input) || settings.memory_limit > 0)) {
-    settings.memory_limit = streaming_limit(input, c);
-    report.summary = convert_streaming(input, output, settings);
-    report.read_seconds = report.summary.read_seconds;
-    report.streamed = true;
-    report.memory_limit = settings.memory_limit;
+    stream_source(input, output, settings, c, report);
     warn_each(c, report.summary.warnings);
     return report;
   }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "converter/convert/voxelize.h"
 #include "format/base/error.h"
 
 namespace vxl {
@@ -19,7 +20,6 @@ constexpr std::array<double, 13> kSizes = {1, 1.25, 1.5, 2, 2.5, 3, 3.5, 4, 5, 6
 // What the converter refuses (voxel_table.h, voxelize.h), and the measured connecting vertices a point
 // gets per step / size: auto refuses what no listed size can convert.
 constexpr double kMaxGridCells = 2147483647.0;
-constexpr double kMaxSyntheticPerPoint = 1.0;
 constexpr double kSyntheticPerStep = 1.25;
 
 std::string format_mm(double v) {

@@ -72,7 +72,9 @@ std::uint64_t staged_batches_bytes(const ConversionCounts& c) {
   const double per_point = (24.0 * double(meta.voxline_count) + 8.0 * double(meta.streamline_count) +
                             double(vertex_bytes(c.positions)) * vertices) /
                            points;
-  return static_cast<std::uint64_t>(2 * 2 * per_point * double(c.batch_points));
+  // A batch holds no more than the whole source.
+  const std::uint64_t batch = std::min(c.batch_points, meta.point_count + meta.streamline_count);
+  return static_cast<std::uint64_t>(2 * 2 * per_point * double(batch));
 }
 
 // How VERT's vertices are held: block by block (setting block_staging_bytes and the pool) when the blocks'

@@ -6,7 +6,20 @@
 #include <cstdint>
 #include <string>
 
+#include "format/base/error.h"
+
 namespace vxl {
+
+// A limit too small for some part of the work (Unsupported), with the limit the message suggests.
+class MemoryLimitTooSmall : public Error {
+ public:
+  MemoryLimitTooSmall(const std::string& path, const std::string& what, std::uint64_t suggested)
+      : Error(ErrorKind::Unsupported, path, std::nullopt, what), suggested_(suggested) {}
+  std::uint64_t suggested() const { return suggested_; }
+
+ private:
+  std::uint64_t suggested_;
+};
 
 class MemoryBudget {
  public:
@@ -36,7 +49,7 @@ class MemoryBudget {
     used_ -= held - bytes;
     held = bytes;
   }
-  // Throws Unsupported: `what` needs `needs` on top of `others`; suggests a quarter more than their sum.
+  // Throws MemoryLimitTooSmall: `what` needs `needs` on top of `others`; suggests a quarter more than their sum.
   [[noreturn]] void fail(std::uint64_t needs, std::uint64_t others, const std::string& what,
                          const std::string& hint = "") const;
 

@@ -69,8 +69,7 @@ void StreamingConversion::count_voxels() {
   table_.grid = detail::set_grid(table_.meta, scan_.lo, scan_.hi, job_.path);
   // plan_voxels' limit on added points, applied to the whole source (plan_voxels applies it per
   // thread's range: the two can differ only in whether a borderline source is refused).
-  table_.synthetic_limit =
-      static_cast<std::uint64_t>(VoxelizeSettings{}.max_synthetic_per_point * double(table_.meta.point_count)) + 4096;
+  table_.synthetic_limit = static_cast<std::uint64_t>(kMaxSyntheticPerPoint * double(table_.meta.point_count)) + 4096;
   const std::uint32_t levels = job_.settings.levels;
   // Part 0 counts into the source's voxel index; the others into indexes of their own, folded into it
   // after each batch.
