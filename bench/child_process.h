@@ -18,7 +18,8 @@ namespace vxl::bench {
 struct ChildRun {
   double seconds;
   long peak_rss_kib;
-  int exit_code;  // -1 when the child did not exit normally
+  int exit_code;       // -1 when the child did not exit normally
+  double cpu_seconds;  // user + system
 };
 
 inline ChildRun run_child(const std::vector<std::string>& args, bool quiet = false) {
@@ -40,7 +41,9 @@ inline ChildRun run_child(const std::vector<std::string>& args, bool quiet = fal
   struct rusage ru {};
   wait4(pid, &status, 0, &ru);
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return {s, ru.ru_maxrss, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+  const double cpu =
+      double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  return {s, ru.ru_maxrss, WIFEXITED(status) ? WEXITSTATUS(status) : -1, cpu};
 }
 
 }  // namespace vxl::bench

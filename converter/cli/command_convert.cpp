@@ -74,11 +74,12 @@ void add_orders_option(CLI::App* cmd, std::string& orders) {
 void add_memory_limit_option(CLI::App* cmd, std::string& memory_limit) {
   cmd->add_option(
          "--memory-limit", memory_limit,
-         "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): reads the source several times and writes the "
-         "output in parts, byte-identical to a conversion without the limit. " +
+         "use at most SIZE of memory (bytes, or K/M/G: 512M, 2G): the source is read as many times and the output "
+         "written in as many parts as SIZE needs, the bytes the same for any limit. " +
              source_format_names_text("/", true) + " sources only (" + source_format_names_text("/", false) +
-             " are refused); a limit too small for the data is refused, naming what needs how much. With "
-             "--output-dir the limit is per file: --jobs N may use N times SIZE")
+             " are refused); a limit too small for the data is refused, naming what needs how much. Without it: 9/8 "
+             "of the file's size (256 MiB to 6 GiB, at most half of the available memory; raised there where the "
+             "data needs more). With --output-dir the limit is per file: --jobs N may use N times SIZE")
       ->type_name("SIZE")
       ->check(CLI::Validator(
           [](std::string& s) {

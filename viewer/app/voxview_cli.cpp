@@ -62,8 +62,8 @@ std::string voxview_description(const std::string& version) {
          "voxview FILE... [--render OUT.png]: a window, or headless to PNG with --render.\n"
          "Opens a .vxl instantly (memory-mapped); a " +
          source_suffixes_text("/") +
-         " is converted first, as 'voxlines convert' does (in memory, or streamed through a temporary\n"
-         ".vxl when it would not fit in memory or under --memory-limit).\n"
+         " is converted first, as 'voxlines convert' does, through a temporary .vxl in $TMPDIR\n"
+         "(else /tmp) that is removed once mapped.\n"
          "Opening a .vxl checks its structure (header, section table, section sizes, voxel table, names) in\n"
          "O(voxels) but not its checksums: damaged positions or values are drawn as they are; order entries outside\n"
          "their block and wrong voxline ends are found beside the drawing, which then stops (exit 3). --verify\n"
@@ -231,12 +231,11 @@ void declare_loading(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--voxel-size", a.options.voxel_size, "voxel size in mm when converting a source tractogram")
       ->default_val(10.0)
       ->check(CLI::PositiveNumber);
-  cli.add_option(
-         "--memory-limit", a.memory_limit,
-         "convert a source tractogram within SIZE of memory (bytes, or K/M/G: 512M, 2G), as 'voxlines convert "
-         "--memory-limit' does: streamed through a temporary .vxl in $TMPDIR (else /tmp), removed once mapped. " +
-             source_format_names_text("/", true) + " sources only (" + source_format_names_text("/", false) +
-             " are refused). Without it, a TCK too big for the available memory is streamed all the same")
+  cli.add_option("--memory-limit", a.memory_limit,
+                 "convert a source tractogram within SIZE of memory (bytes, or K/M/G: 512M, 2G), as 'voxlines convert "
+                 "--memory-limit' does. " +
+                     source_format_names_text("/", true) + " sources only (" + source_format_names_text("/", false) +
+                     " are refused). Without it, a limit is chosen from the file's size and the available memory")
       ->type_name("SIZE");
   cli.add_option("--gpu-memory", a.gpu_memory,
                  "GPU memory the lines may take (bytes, or K/M/G: 512M, 2G): the finest level of detail that fits is "
