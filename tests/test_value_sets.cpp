@@ -9,10 +9,12 @@
 #include <functional>
 
 #include "converter/convert/convert.h"
+#include "converter/convert/streaming_convert.h"
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
+#include "format/vxl_positions.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"
 #include "tests/mrtrix_test_files.h"
@@ -194,6 +196,73 @@ TEST(ValueSets, PointValuesFollowTheirPointsIntoTheVertexBlocks) {
   EXPECT_EQ(plain.header().version_minor, 5);
   EXPECT_TRUE(plain.vertex_values().empty());
   EXPECT_EQ(plain.find_section(section_id("VVAL")), nullptr);
+}
+
+// A source read whole goes through the passes of any conversion: its per-point values placed range by range (and,
+// written block by block, beside blocks that are read back), its per-streamline values and groups written at the end,
+// the same bytes under every limit. "x" is each point's x, so every vertex (added on a face or connecting) carries
+// its own x wherever it was placed.
+TEST(ValueSets, ASourceReadWholeWritesItsValuesAlikeUnderEveryLimit) {
+  ScratchDir dir;
+  Tractogram t;
+  std::vector<float> x, index;
+  for (int s = 0; s < 3000; ++s) {
+    std::vector<float> pts;
+    for (int i = 0; i < 12; ++i) {  // 5 mm along z over 4 mm voxels: points added on faces
+      const float a = 0.25f * i + 0.37f * s;
+      pts.insert(pts.end(), {12 * std::cos(a) + float(s % 11), 12 * std::sin(a), 5.0f * i - 0.01f * s});
+      x.push_back(pts[pts.size() - 3]);
+      index.push_back(float(x.size()));
+    }
+    t.add_streamline(pts.data(), 12);
+  }
+  t.point_values.push_back({"x", x});
+  t.point_values.push_back({"index", index});
+  std::vector<float> per_streamline(t.streamline_count());
+  for (std::size_t k = 0; k < per_streamline.size(); ++k) per_streamline[k] = float(k % 7);
+  t.streamline_values.push_back({"k", per_streamline});
+  t.groups.push_back({"odd", {1, 3, 5, 2999}});
+  // Packed positions are placed in two halves of the voxels side by side; float32 ones in one.
+  for (const PositionEncoding encoding : {PositionEncoding::Float32, PositionEncoding::Packed}) {
+    SCOPED_TRACE(position_encoding_name(encoding));
+    ConvertSettings settings;
+    settings.voxel_size = 4;
+    settings.positions = encoding;
+    settings.threads = 2;
+    convert_tractogram(Tractogram(t), dir.file("default.vxl"), settings);
+    const std::vector<char> expected = test::slurp(dir.file("default.vxl"));
+
+    StreamingTuning ranges;  // several ranges of voxels, one pass each
+    ranges.range_bytes = 256 << 10;
+    settings.memory_limit = 64ull << 20;
+    const ConvertSummary cut = convert_streaming(t, dir.file("ranges.vxl"), settings, ranges);
+    EXPECT_GT(cut.partitions, 2u);
+    EXPECT_TRUE(test::slurp(dir.file("ranges.vxl")) == expected);
+
+    StreamingTuning blocks;  // written block by block and read back
+    blocks.vertex_blocks = true;
+    settings.memory_limit = 512ull << 20;
+    const ConvertSummary read_back = convert_streaming(t, dir.file("blocks.vxl"), settings, blocks);
+    EXPECT_TRUE(read_back.vertices_read_back);
+    EXPECT_TRUE(test::slurp(dir.file("blocks.vxl")) == expected);
+
+    const VxlFile f = VxlFile::open(dir.file("default.vxl"));
+    EXPECT_GT(f.meta().synthetic_point_count, 1000u);
+    const auto along = f.vertex_values().values(0);
+    std::vector<float> xyz;
+    for (const VoxelEntry& v : f.voxels()) {  // every vertex carries its own x (packed: within the bound)
+      xyz.resize(3 * std::size_t(v.vertex_count));
+      if (encoding == PositionEncoding::Packed)
+        unpack_block(v, f.packed_vertices().data() + v.vertex_first, v.vertex_count, xyz.data());
+      else
+        std::copy_n(f.float_vertices().data() + 3 * v.vertex_first, xyz.size(), xyz.data());
+      for (std::uint32_t e = 0; e < v.vertex_count; ++e)
+        ASSERT_NEAR(along[v.vertex_first + e], xyz[3 * e], 0.01) << "vertex " << v.vertex_first + e;
+    }
+    EXPECT_EQ(f.streamline_values().size(), 1u);
+    ASSERT_EQ(f.groups().size(), 1u);
+    EXPECT_EQ(f.groups()[0].members, (std::vector<std::uint64_t>{1, 3, 5, 2999}));
+  }
 }
 
 // Beyond 64 value sets the rest are dropped, and a warning on stderr says so.

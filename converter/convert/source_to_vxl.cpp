@@ -23,13 +23,19 @@ bool is_streamable(const std::string& path) {
   return match.format && match.format->streamable;
 }
 
+// The memory available to one of the conversions running at once.
+std::optional<std::uint64_t> memory_share(const SourceConversion& c) {
+  std::optional<std::uint64_t> share = available_memory();
+  if (share) *share /= std::max(1u, c.concurrent_files);
+  return share;
+}
+
 // Streams `input` within the limit given, or else within memory_choice's for its size and its share of the available
 // memory (said by `notice` when that share limits it), raised up to the largest chosen limit where some part of the
 // work needs more: a chosen limit does not refuse a source the memory holds.
 void stream_source(const std::string& input, const std::string& output, ConvertSettings settings,
                    const SourceConversion& c, SourceConversionReport& report) {
-  std::optional<std::uint64_t> share = available_memory();
-  if (share) *share /= std::max(1u, c.concurrent_files);
+  const std::optional<std::uint64_t> share = memory_share(c);
   const bool chosen = settings.memory_limit == 0;
   if (chosen) {
     std::error_code ec;
@@ -81,6 +87,7 @@ SourceConversionReport convert_source(const std::string& input, const std::strin
   for (const std::string& f : c.tsf) attach_tsf(t, f);
   report.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   warn_each(c, t.source.warnings);
+  if (settings.memory_limit == 0) settings.memory_limit = held_source_memory_limit(memory_share(c));
   report.summary = convert_tractogram(std::move(t), output, settings);
   warn_each(c, report.summary.warnings);
   return report;

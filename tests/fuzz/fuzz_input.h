@@ -31,6 +31,7 @@ void read_and_convert(const std::string& path, Read read) {
   try {
     ConvertSettings s;
     s.threads = 1;
+    s.memory_limit = 64u << 20;  // small buffers for small inputs; a limit does not change the bytes
     convert_tractogram(read(path), path + ".vxl", s);
   } catch (const Error&) {
   }
