@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <stdexcept>
 #include <utility>
 
 #if defined(__GLIBC__)
@@ -42,10 +43,19 @@ void StreamingConversion::open_stream() {
 }
 
 // The held source's per-point values, spread over the vertices as they are placed: VVAL's payload, held whole
-// (the arrays of all sets follow one another in it, so no range's part of them could be written alone).
+// (the arrays of all sets follow one another in it, so no range's part of them could be written alone). Checks
+// that every value set has a value per point or streamline.
 void StreamingConversion::plan_vertex_values() {
-  if (!job_.held || job_.held->point_values.empty()) return;
-  const std::vector<ValueSet>& sets = job_.held->point_values;
+  if (!job_.held) return;
+  const Tractogram& t = *job_.held;
+  // convert_tractogram refuses such sources (prepare_value_sets): a caller that did not check has a bug.
+  for (const ValueSet& v : t.point_values)
+    if (v.values.size() != t.point_count()) throw std::logic_error("convert_streaming: not a value per point");
+  for (const ValueSet& v : t.streamline_values)
+    if (v.values.size() != t.streamline_count())
+      throw std::logic_error("convert_streaming: not a value per streamline");
+  const std::vector<ValueSet>& sets = t.point_values;
+  if (sets.empty()) return;
   const std::uint64_t bytes = value_sets_bytes(sets.size(), table_.meta.vertex_count);
   budget_.track(bytes, vertex_values_held_, [] { return "the per-point values spread over the vertices"; });
   vertex_values_.assign(bytes, 0);

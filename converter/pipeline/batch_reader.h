@@ -8,6 +8,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "converter/convert/voxelize.h"
@@ -15,9 +16,17 @@
 #include "converter/pipeline/memory_budget.h"
 #include "converter/pipeline/streamline_source.h"
 #include "converter/tractogram.h"
-#include "format/base/parallel.h"
+#include "format/base/batch_queue.h"
 
 namespace vxl {
+
+// What a pass does with each batch (BatchReader::each_batch): its parts, the pieces of the sink's work on the
+// batch before, and the order they are handed out in (BatchQueueShape::hand_out).
+struct BatchPass {
+  std::uint64_t parts = 1;
+  std::uint64_t sink_items = 0;
+  std::span<const std::uint64_t> hand_out = {};
+};
 
 class BatchReader {
  public:
@@ -33,26 +42,25 @@ class BatchReader {
   const SourceInfo& source() const { return source_->source(); }
   unsigned passes() const { return passes_; }  // each_batch calls so far
 
-  // Reads the source once, batch by batch; `stage` names the pass in the progress reports. Per batch (its
-  // first streamline's index in the source is `first`): prepare(batch, first) on the calling thread, then
-  // part(batch, first, p) for every p in [0, parts) on the reader's threads while the next batch is read
-  // beside them, then finish(batch, first) on the calling thread (with one thread, the read comes after
-  // finish). The read is one more item for the same threads, not a thread of its own: the parts fill the
-  // cores around it, so that cutting a batch in a few parts keeps every core busy even when the read and
-  // the parts take unequal times. An error of a part comes before one of the read (which is further on in
-  // the file), the lowest part's first. Throws as the budget does when a streamline is too long to hold
-  // whole or the two batches outgrow what is left. With `hand_out` (a permutation of [0, parts)), the parts
-  // are handed out in that order after the read — the longest first, so that the threads finish together —
-  // their errors still lowest part first.
-  template <typename Prepare, typename Part, typename Finish>
-  void each_batch(const std::string& stage, std::uint64_t parts, Prepare&& prepare, Part&& part, Finish&& finish,
-                  std::span<const std::uint64_t> hand_out = {});
-  // The same with the whole batch as one part: body(batch, first).
+  // Reads the source once, batch by batch, as a queue (format/base/batch_queue.h: run_batch_queue); `stage` names
+  // the pass in the progress reports. Per batch (its first streamline's index in the source is `first`, its slot
+  // `slot`): prepare(batch, first, slot) on the calling thread, then part(batch, first, p, slot) for every p in
+  // [0, pass.parts) on the reader's threads, beside the next batch's read and sink(item, slot of the batch before)
+  // for every item in [0, pass.sink_items), then finish(batch, first, slot) on the calling thread; after the last
+  // batch, its sink alone. The sink must read only what the parts of its batch made (in the slot's place), never
+  // the batch, whose slot the next batch is being read into. Errors: the sink's, then the parts', then the read's,
+  // the lowest item's first. Throws as the budget does when a streamline is too long to hold whole or the two
+  // batches outgrow what is left.
+  template <typename Prepare, typename Part, typename Sink, typename Finish>
+  void each_batch(const std::string& stage, const BatchPass& pass, Prepare&& prepare, Part&& part, Sink&& sink,
+                  Finish&& finish);
+  // The same with the whole batch as one part and no sink: body(batch, first).
   template <typename Body>
   void each_batch(const std::string& stage, Body&& body) {
-    const auto none = [](const Tractogram&, std::uint64_t) {};
     each_batch(
-        stage, 1, none, [&](const Tractogram& b, std::uint64_t first, std::uint64_t) { body(b, first); }, none);
+        stage, BatchPass{}, [](const Tractogram&, std::uint64_t, int) {},
+        [&](const Tractogram& b, std::uint64_t first, std::uint64_t, int) { body(b, first); },
+        [](std::uint64_t, int) {}, [](const Tractogram&, std::uint64_t, int) {});
   }
 
   // Notes the longest streamline of batch b (numbered from `first`), for the message of a budget exceeded
@@ -78,52 +86,34 @@ class BatchReader {
   ProgressFn progress_;
 };
 
-template <typename Prepare, typename Part, typename Finish>
-void BatchReader::each_batch(const std::string& stage, std::uint64_t parts, Prepare&& prepare, Part&& part,
-                             Finish&& finish, std::span<const std::uint64_t> hand_out) {
-  // The items: the read (when it comes beside the parts), then the parts, in hand_out's order if given.
-  const std::uint64_t read_items = read_ahead_ ? 1 : 0;
-  std::vector<std::uint64_t> items;
-  if (!hand_out.empty()) {
-    if (read_ahead_) items.push_back(0);
-    for (const std::uint64_t p : hand_out) items.push_back(p + read_items);
-  }
+template <typename Prepare, typename Part, typename Sink, typename Finish>
+void BatchReader::each_batch(const std::string& stage, const BatchPass& pass, Prepare&& prepare, Part&& part,
+                             Sink&& sink, Finish&& finish) {
   source_->rewind();
   ++passes_;
   report(stage, 0.0);
-  std::uint64_t first = 0;
-  int current = 0;
-  bool more = source_->next(batches_[current]);
-  check_overflow(batches_[current], first);
-  while (more) {
-    const int other = 1 - current;
-    const Tractogram& batch = batches_[current];
-    prepare(batch, first);
-    std::exception_ptr read_error;
-    const auto read_next = [&] {
-      try {
-        more = source_->next(batches_[other]);
-      } catch (...) {
-        read_error = std::current_exception();
-      }
-    };
-    // Item 0, handed out first, reads the next batch; items 1.. are the parts.
-    parallel_for_first_error_in_order(
-        parts + read_items, threads_,
-        [&](std::uint64_t item, unsigned) {
-          if (read_ahead_ && item == 0) return read_next();
-          part(batch, first, item - read_items);
-        },
-        items);
-    finish(batch, first);
-    if (!read_ahead_) read_next();
-    if (read_error) std::rethrow_exception(read_error);
-    first += batch.streamline_count();
-    current = other;
-    check_overflow(batches_[current], first);
-    track_batches();
-    report(stage, source_->progress());
-  }
+  std::uint64_t first[2] = {0, 0}, read_streamlines = 0;
+  const auto read = [&](int slot) {
+    const bool more = source_->next(batches_[slot]);
+    first[slot] = read_streamlines;
+    check_overflow(batches_[slot], read_streamlines);
+    read_streamlines += batches_[slot].streamline_count();
+    return more;
+  };
+  bool started = false;
+  run_batch_queue(
+      threads_, {pass.parts, pass.sink_items, read_ahead_, pass.hand_out}, read,
+      [&](int slot) {
+        if (started) {  // both batches are in memory now: one being read while the other was processed
+          track_batches();
+          report(stage, source_->progress());
+        }
+        started = true;
+        prepare(std::as_const(batches_[slot]), first[slot], slot);
+      },
+      [&](int slot, std::uint64_t p, unsigned) { part(std::as_const(batches_[slot]), first[slot], p, slot); },
+      [&](int slot, std::uint64_t item, unsigned) { sink(item, slot); },
+      [&](int slot) { finish(std::as_const(batches_[slot]), first[slot], slot); });
   report(stage, 1.0);
 }
 

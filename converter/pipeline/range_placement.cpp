@@ -65,52 +65,35 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
   }
   const bool split = placing.split < r.end;
   const bool index = tables && table_.index_lists;  // the first range fills the voxel index's lists
-  int staging = 0;                                  // the set of parts the current batch is staged in
-  bool other_placed = true;                         // whether the other set's parts are placed
-  auto place_staged = [&](int set, int half) {
-    for (const StagedPart& part : placing.parts[set]) place_part(placing, part, half);
-  };
-  auto index_staged = [&](int set) {
-    for (const StagedPart& part : placing.parts[set]) index_part(part);
-  };
   BatchCut cut{};
-  const auto prepare = [&](const Tractogram& b, std::uint64_t first) {
+  const auto prepare = [&](const Tractogram& b, std::uint64_t first, int) {
     if (first + b.streamline_count() > table_.spans.size()) fail_changed();  // more streamlines than pass 1 counted
     cut = cut_batch(b);
   };
-  // Items 0 and 1 place the earlier batch (its halves), so that its errors come first, and item 2 adds it to the
-  // voxel index's lists; then the staging parts. They are handed out longest first, the staging parts (on the
-  // 10M set 4-5 ms each, a half 3-3.5 ms, the index 1.2 ms): handed out in their order, the last staging part
-  // ran alone at the end of every batch.
-  constexpr std::uint64_t kIndexItem = 2, kFirstStagingItem = 3;
-  static_assert(kBatchParts == 3);
-  constexpr std::array<std::uint64_t, kFirstStagingItem + kBatchParts> kLongestFirst = {3, 4, 5, 0, 1, 2};
-  const auto item = [&](const Tractogram& b, std::uint64_t first, std::uint64_t i) {
-    if (i < kIndexItem) {
-      if (!other_placed && (i == 0 || split)) place_staged(1 - staging, static_cast<int>(i));
-      return;
-    }
-    if (i == kIndexItem) {
-      if (!other_placed && index) index_staged(1 - staging);
-      return;
-    }
-    const std::uint64_t p = i - kFirstStagingItem;
-    stage_part(placing, b, first, cut[p], cut[p + 1], placing.parts[staging][p]);
+  const auto stage = [&](const Tractogram& b, std::uint64_t first, std::uint64_t p, int slot) {
+    stage_part(placing, b, first, cut[p], cut[p + 1], placing.parts[slot][p]);
   };
-  const auto finish = [&](const Tractogram&, std::uint64_t) {
-    other_placed = false;
-    staging = 1 - staging;
+  // The sink, in streamline order: the earlier batch placed in its halves (items 0 and 1), then added to the voxel
+  // index's lists (item 2), so that its errors come first. Handed out after the staging parts (on the 10M set 4-5 ms
+  // each, a half 3-3.5 ms, the index 1.2 ms): handed out first, the last staging part ran alone at the end of every
+  // batch.
+  const auto place = [&](std::uint64_t item, int slot) {
+    if (item == 2) {
+      if (index)
+        for (const StagedPart& part : placing.parts[slot]) index_part(part);
+    } else if (item == 0 || split) {
+      for (const StagedPart& part : placing.parts[slot]) place_part(placing, part, static_cast<int>(item));
+    }
+  };
+  const auto finish = [&](const Tractogram&, std::uint64_t, int) {
     std::uint64_t staged = 0;
     for (const auto& set : placing.parts)
       for (const StagedPart& part : set) staged += part.bytes();
     budget_.track(staged, staged_held_, [] { return std::string("the voxlines of two batches being placed"); });
   };
-  reader_->each_batch("placing" + of, kFirstStagingItem + kBatchParts, prepare, item, finish, kLongestFirst);
-  if (!other_placed) {
-    place_staged(1 - staging, 0);
-    if (split) place_staged(1 - staging, 1);
-    if (index) index_staged(1 - staging);
-  }
+  static_assert(kBatchParts == 3);
+  constexpr std::array<std::uint64_t, 3 + kBatchParts> kStagingFirst = {3, 4, 5, 0, 1, 2};
+  reader_->each_batch("placing" + of, {kBatchParts, 3, kStagingFirst}, prepare, stage, place, finish);
   placing.sink.finish();  // rethrows a failed write (each block's completeness is checked below)
   if (placing.streamlines != table_.meta.streamline_count ||
       (tables && placing.voxline_index != table_.meta.voxline_count) ||

@@ -17,7 +17,7 @@ void StreamingConversion::scan() {
   std::uint64_t streamlines = 0, points = 0;
   BatchCut cut{};
   std::array<detail::BoundsScan, kBatchParts> parts;
-  const auto prepare = [&](const Tractogram& b, std::uint64_t first) {
+  const auto prepare = [&](const Tractogram& b, std::uint64_t first, int) {
     reader_->note_longest(b, first);
     std::vector<float>& lengths = scan_.lengths;
     const std::uint64_t need = first + b.streamline_count();
@@ -31,15 +31,16 @@ void StreamingConversion::scan() {
     parts.fill(detail::BoundsScan());
   };
   // The parts are merged in order (a scan stops at a bad point; reading goes on for the reader's errors).
-  const auto scan_part = [&](const Tractogram& b, std::uint64_t first, std::uint64_t p) {
+  const auto scan_part = [&](const Tractogram& b, std::uint64_t first, std::uint64_t p, int) {
     parts[p].add(b.positions.data(), b.offsets.data(), cut[p], cut[p + 1], first, scan_.lengths.data() + first);
   };
-  const auto finish = [&](const Tractogram& b, std::uint64_t) {
+  const auto finish = [&](const Tractogram& b, std::uint64_t, int) {
     for (const detail::BoundsScan& part : parts) bounds.merge(part);
     streamlines += b.streamline_count();
     points += b.point_count();
   };
-  reader_->each_batch("reading", kBatchParts, prepare, scan_part, finish);
+  reader_->each_batch(
+      "reading", {kBatchParts}, prepare, scan_part, [](std::uint64_t, int) {}, finish);
   bounds.check(job_.path);
   for (int c = 0; c < 3; ++c) {
     scan_.lo[c] = bounds.lo[c];
@@ -82,7 +83,7 @@ void StreamingConversion::count_voxels() {
   BatchCut cut{};
   std::array<std::uint64_t, kBatchParts> most{};
   std::uint64_t start = 0;
-  const auto prepare = [&](const Tractogram& b, std::uint64_t) {
+  const auto prepare = [&](const Tractogram& b, std::uint64_t, int) {
     cut = cut_batch(b);
     // The voxels the limit leaves room for in this batch, shared among the parts: a part that would need
     // more fails (no matter how many the others add, so that the outcome does not depend on timing).
@@ -94,17 +95,14 @@ void StreamingConversion::count_voxels() {
     for (std::size_t p = 0; p < kBatchParts; ++p) most[p] = headroom / kBatchParts;
     most[0] += start + headroom % kBatchParts;
   };
-  // The parts, then one item more: the earlier batch's voxel runs appended to table_.runs (beside this batch's
-  // parts rather than on one thread between the rounds: 0.5 s of the 10M set's counting pass).
+  // The sink: the earlier batch's voxel runs appended to table_.runs (beside this batch's parts rather than on one
+  // thread between the rounds: 0.5 s of the 10M set's counting pass). Handed out after the parts.
   PendingRuns pending;
-  const auto count = [&](const Tractogram& b, std::uint64_t first, std::uint64_t p) {
-    if (p == kBatchParts) {
-      append_runs(pending);
-      return;
-    }
+  const auto count = [&](const Tractogram& b, std::uint64_t first, std::uint64_t p, int) {
     count_part(b, first, cut[p], cut[p + 1], points, synthetic, most[p], p == 0 ? 0 : start, parts[p]);
   };
-  const auto finish = [&](const Tractogram& b, std::uint64_t first) {
+  const auto append = [&](std::uint64_t, int) { append_runs(pending); };
+  const auto finish = [&](const Tractogram& b, std::uint64_t first, int) {
     for (PlanPart& part : parts) {
       voxlines += std::exchange(part.voxlines, 0);
       synthetic += std::exchange(part.synthetic, 0);
@@ -145,11 +143,10 @@ void StreamingConversion::count_voxels() {
     budget_.track(sinks, counting_.sink_held, [] { return std::string("the voxline lists of the batch's parts"); });
     points += b.point_count();
   };
-  reader_->each_batch("voxelising", kBatchParts + 1, prepare, count, finish);
-  if (counting_.recording_runs) {
-    append_runs(pending);
-    hold_runs(parts, pending);
-  }
+  static_assert(kBatchParts == 3);
+  constexpr std::array<std::uint64_t, kBatchParts + 1> kPartsFirst = {1, 2, 3, 0};
+  reader_->each_batch("voxelising", {kBatchParts, 1, kPartsFirst}, prepare, count, append, finish);
+  if (counting_.recording_runs) hold_runs(parts, pending);  // the last batch's runs, appended by the last sink
   table_.sink = std::move(main.sink);
   counting_.use = std::move(main.use);
   counting_.bounds = std::move(main.bounds);
