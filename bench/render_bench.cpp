@@ -1,7 +1,7 @@
 // Viewer benchmark. First the cost of a process start (`voxview --help`), then for each scene (.vxl, with its
 // source TCK):
 //   * time from process start to the first frame read back: `voxview FILE --render` as a child process,
-//     for the .vxl and for the source TCK (converted in memory);
+//     for the .vxl and for the source TCK (converted first);
 //   * per-frame CPU work (cull + voxel sort + order pick + command building), median over a 72-view
 //     turntable, at the file's voxel size;
 //   * frame time per mode (glFinish-bounded) and the renderer's CPU time of the frame (FrameStats::plan_ms:

@@ -11,7 +11,8 @@
 
 namespace vxl::streaming {
 
-// Pass 1: what plan_voxels' bounds scan finds, and the source's checksum and warnings.
+// Pass 1: the bounds, the longest step and each streamline's length (BoundsScan), and the source's checksum and
+// warnings.
 void StreamingConversion::scan() {
   detail::BoundsScan bounds;
   std::uint64_t streamlines = 0, points = 0;
@@ -57,19 +58,18 @@ void StreamingConversion::scan() {
   table_.meta.voxel_size = job_.settings.voxel_size;
 }
 
-// Pass 2: the vertex and segment counts and the tight bounds per voxel (plan_voxels' pass 1), kept per
-// voxel only. Each batch is cut in parts (cut_batch) counted side by side: the first into the source's voxel
-// index (table_.sink, counting_.use, counting_.bounds), the others into indexes of their own (PlanPart),
-// folded into it after the batch — the counts and bounds do not depend on the order streamlines are counted in.
+// Pass 2: the vertex and segment counts and the tight bounds per voxel, kept per voxel only. Each batch is cut in parts
+// (cut_batch) counted side by side: the first into the source's voxel index (table_.sink, counting_.use,
+// counting_.bounds), the others into indexes of their own (PlanPart), folded into it after the batch — the counts and
+// bounds do not depend on the order streamlines are counted in.
 void StreamingConversion::count_voxels() {
   counting_.use = detail::VoxelUse(job_.settings.levels);
-  if (table_.meta.point_count == 0) {  // no voxels (plan_voxels returns early too)
+  if (table_.meta.point_count == 0) {  // no voxels
     counting_.recording_runs = false;
     return;
   }
   table_.grid = detail::set_grid(table_.meta, scan_.lo, scan_.hi, job_.path);
-  // plan_voxels' limit on added points, applied to the whole source (plan_voxels applies it per
-  // thread's range: the two can differ only in whether a borderline source is refused).
+  // The limit on added points, applied to the whole source (so that the outcome does not depend on the threads).
   table_.synthetic_limit = static_cast<std::uint64_t>(kMaxSyntheticPerPoint * double(table_.meta.point_count)) + 4096;
   const std::uint32_t levels = job_.settings.levels;
   // Part 0 counts into the source's voxel index; the others into indexes of their own, folded into it
@@ -257,7 +257,7 @@ void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, s
   }
 }
 
-// The voxel table sorted by (z, y, x), as plan_voxels and layout_orders make it.
+// The voxel table sorted by (z, y, x), laid out for the orders (layout_orders).
 void StreamingConversion::build_table() {
   detail::LocalVoxels table{&table_.sink.index.coords(), &counting_.use, {}, {}};
   counting_.use.grow_to(table_.sink.index.coords().size());

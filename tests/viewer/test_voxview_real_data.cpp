@@ -1,5 +1,5 @@
 // `voxview --render` opens every readable real fixture headless, as a converted .vxl and directly from
-// the source file (converted in memory).
+// the source file (converted first).
 #include <filesystem>
 
 #include "tests/real_fixture_outcomes.h"

@@ -65,10 +65,9 @@ OpenedScene open_scene(const std::string& path, const SceneSourceOptions& option
   std::string lower = path;
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (!options.tsf.empty() && (lower.ends_with(".vxl") || lower.ends_with(".vxlz")))
-    throw Error(
-        ErrorKind::Usage, path, std::nullopt,
-        "--tsf adds values to a source tractogram converted in memory; a .vxl keeps the values it was converted "
-        "with (voxlines convert IN.tck OUT.vxl --tsf FILE.tsf)");
+    throw Error(ErrorKind::Usage, path, std::nullopt,
+                "--tsf adds values to a source tractogram as it is converted; a .vxl keeps the values it was converted "
+                "with (voxlines convert IN.tck OUT.vxl --tsf FILE.tsf)");
   if (lower.ends_with(".vxl")) {
     if (options.verify) verify_or_refuse(path, path);
     return {VxlFile::open(path), std::nullopt};

@@ -48,7 +48,7 @@ struct ViewerOptions {
   // uploads and evicts (gpu_scene.h). None: chosen (scene_detail.h).
   std::optional<std::uint64_t> span_texels;
   bool verify = false;           // --verify: check every .vxl in full (as `voxlines verify`) before drawing
-  std::vector<std::string> tsf;  // per-point values for a source tractogram (converted in memory)
+  std::vector<std::string> tsf;  // per-point values for a source tractogram (read whole with it)
   // Window: while the camera moves, draw the finest level whose measured frame time fits this budget
   // (frame_budget.h); at rest, the scene's level. 0: no budget.
   double frame_budget_ms = 100;

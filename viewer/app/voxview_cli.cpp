@@ -173,7 +173,7 @@ void declare_selection(CLI::App& cli, ViewerArguments& a) {
 // Per-point values, lighting, line width, background and annotations.
 void declare_lines(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--tsf", a.options.tsf,
-                 "a TSF file of per-point values for a .tck given as input (converted in memory), repeatable")
+                 "a TSF file of per-point values for a .tck given as input (read whole with it), repeatable")
       ->expected(1)
       ->take_all();
   cli.add_flag(
