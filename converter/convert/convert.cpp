@@ -79,7 +79,7 @@ ConvertSummary convert_tractogram(Tractogram&& t, const std::string& out_path, c
   // Warnings of the conversion itself: in PROV with the reader's, and in the summary for the caller to show.
   std::vector<std::string> warnings = prepare_value_sets(t);
   ConvertSettings settings = given;
-  if (settings.memory_limit == 0) settings.memory_limit = held_source_memory_limit(available_memory());
+  if (settings.memory_limit == 0) settings.memory_limit = largest_chosen_memory_limit(available_memory());
   ConvertSummary summary = convert_streaming(t, out_path, settings);
   summary.warnings = std::move(warnings);
   return summary;

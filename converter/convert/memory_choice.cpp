@@ -30,8 +30,6 @@ std::uint64_t default_memory_limit(std::uint64_t source_bytes, std::optional<std
 
 std::uint64_t largest_chosen_memory_limit(std::optional<std::uint64_t> available) { return ceiling(available); }
 
-std::uint64_t held_source_memory_limit(std::optional<std::uint64_t> available) { return ceiling(available); }
-
 bool limited_by_available_memory(std::uint64_t source_bytes, std::optional<std::uint64_t> available) {
   return ceiling(available) < wanted(source_bytes);
 }

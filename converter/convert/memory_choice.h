@@ -19,13 +19,10 @@ namespace vxl {
 // and never under 64 MiB.
 std::uint64_t default_memory_limit(std::uint64_t source_bytes, std::optional<std::uint64_t> available);
 
-// The limit for a source already read whole (a format that does not stream, or TCK with TSF values): the largest
-// chosen limit. Its passes take what they need of it (batches, buffers) and hold no copy of the
+// The most a chosen limit takes of `available`: half, at least 64 MiB. A chosen limit too small for some part of
+// the work is raised up to this. It is also the limit for a source already read whole (a format that does not
+// stream, or TCK with TSF values): its passes take what they need of it (batches, buffers) and hold no copy of the
 // source; a smaller default would refuse sources that it takes no more memory to convert.
-std::uint64_t held_source_memory_limit(std::optional<std::uint64_t> available);
-
-// The most a chosen limit takes of `available` (and what held_source_memory_limit gives): half, at least 64 MiB.
-// A chosen limit too small for some part of the work is raised up to this.
 std::uint64_t largest_chosen_memory_limit(std::optional<std::uint64_t> available);
 
 // Whether `available` memory made the default limit smaller than the source wants (then the conversion

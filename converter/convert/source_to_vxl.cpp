@@ -87,7 +87,7 @@ SourceConversionReport convert_source(const std::string& input, const std::strin
   for (const std::string& f : c.tsf) attach_tsf(t, f);
   report.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   warn_each(c, t.source.warnings);
-  if (settings.memory_limit == 0) settings.memory_limit = held_source_memory_limit(memory_share(c));
+  if (settings.memory_limit == 0) settings.memory_limit = largest_chosen_memory_limit(memory_share(c));
   report.summary = convert_tractogram(std::move(t), output, settings);
   warn_each(c, report.summary.warnings);
   return report;
