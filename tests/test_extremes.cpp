@@ -263,9 +263,10 @@ TEST(Extremes, AConversionKilledAtAnyMomentLeavesNoOutput) {
 }
 
 // Running out of memory fails cleanly: a message about memory, a non-zero exit code (4 when an
-// allocation fails, 5 when the output cannot be mapped), no output. The conversion is told it may use more
-// memory than the address space allows. (AddressSanitizer reserves terabytes of address space, so an
-// address-space limit cannot be used under it.)
+// allocation or a thread's start fails, 5 when the output cannot be mapped), no output. The conversion is
+// told it may use more memory than the address space allows; the address space is cut at several sizes, so
+// that the failure comes at different steps (a buffer, a thread's stack, the output's mapping).
+// (AddressSanitizer reserves terabytes of address space, so an address-space limit cannot be used under it.)
 TEST(Extremes, RunningOutOfMemoryFailsCleanly) {
 #if defined(VOXLINES_ADDRESS_SANITIZER)
   GTEST_SKIP() << "an address-space limit cannot be used under AddressSanitizer";
@@ -274,13 +275,16 @@ TEST(Extremes, RunningOutOfMemoryFailsCleanly) {
   const std::string tck = dir.file("in.tck"), out = dir.file("out.vxl");
   auto synth = test::run_cli("synth '" + tck + "' --streamlines 200000");
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
-  auto r = test::run_program("bash", "-c \"ulimit -v 200000; exec " + std::string(VOXLINES_CLI) + " convert '" + tck +
-                                         "' '" + out + "' --memory-limit 4G\"");
-  EXPECT_TRUE(r.exit_code == 4 || r.exit_code == 5) << r.output;
-  EXPECT_TRUE(r.output.find("out of memory") != std::string::npos ||
-              r.output.find("Cannot allocate memory") != std::string::npos)
-      << r.output;
-  EXPECT_FALSE(std::filesystem::exists(out));
+  for (int kib = 40000; kib <= 260000; kib += 20000) {
+    SCOPED_TRACE("ulimit -v " + std::to_string(kib));
+    auto r = test::run_program("bash", "-c \"ulimit -v " + std::to_string(kib) + "; exec " + std::string(VOXLINES_CLI) +
+                                           " convert '" + tck + "' '" + out + "' --memory-limit 4G\"");
+    EXPECT_TRUE(r.exit_code == 4 || r.exit_code == 5) << r.output;
+    EXPECT_TRUE(r.output.find("out of memory") != std::string::npos ||
+                r.output.find("Cannot allocate memory") != std::string::npos)
+        << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
 #endif
 }
 

@@ -21,10 +21,14 @@
 #include <optional>
 #include <span>
 #include <stdexcept>
+#include <string>
+#include <system_error>
 #include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
+
+#include "format/base/error.h"
 
 namespace vxl {
 
@@ -33,6 +37,19 @@ inline unsigned resolve_threads(unsigned requested) {
   if (requested > 0) return requested;
   const unsigned n = std::thread::hardware_concurrency();
   return n == 0 ? 1 : n;
+}
+
+// Starts a thread running fn. The system refuses a thread when the address space or the memory is spent
+// (each thread reserves its stack) or a process limit is reached: that is reported as running out of
+// memory (exit 4), as a failed allocation is, not as an internal error.
+template <typename Fn>
+std::thread start_thread(Fn&& fn) {
+  try {
+    return std::thread(std::forward<Fn>(fn));
+  } catch (const std::system_error& e) {
+    throw Error(ErrorKind::Unsupported, "", std::nullopt,
+                std::string("out of memory: cannot start a thread (") + e.what() + ")");
+  }
 }
 
 // Calls fn(item, thread) for every item in [0, count), handing items out one at a time to
@@ -59,7 +76,15 @@ void parallel_for(std::uint64_t count, unsigned threads, Fn&& fn) {
   };
   std::vector<std::thread> pool;
   pool.reserve(workers - 1);
-  for (unsigned t = 1; t < workers; ++t) pool.emplace_back(worker, t);
+  try {
+    for (unsigned t = 1; t < workers; ++t) pool.push_back(start_thread([&worker, t] { worker(t); }));
+  } catch (...) {
+    // The threads already started must be joined before the pool is destroyed (a joinable thread's
+    // destructor ends the process); they stop at their next item.
+    next = count;
+    for (std::thread& th : pool) th.join();
+    throw;
+  }
   worker(0);
   for (std::thread& th : pool) th.join();
   if (error) std::rethrow_exception(error);
@@ -110,7 +135,7 @@ class BackgroundTask {
   BackgroundTask() = default;
   template <typename Fn>
   explicit BackgroundTask(Fn&& fn) : state_(std::make_unique<State>()) {
-    thread_ = std::thread([state = state_.get(), fn = std::forward<Fn>(fn)]() mutable {
+    thread_ = start_thread([state = state_.get(), fn = std::forward<Fn>(fn)]() mutable {
       try {
         if constexpr (std::is_void_v<T>)
           fn();
