@@ -64,7 +64,8 @@ void fill_voxel_index(std::uint64_t voxel_count, std::uint64_t voxline_count, st
   io.write({reinterpret_cast<const std::uint8_t*>(first.data()), first.size() * 8});
 
   // Then the lists, a range of voxels per pass, each written in place in a buffer by a counting sort.
-  const std::uint64_t usable = io.buffer.empty() ? buffer_bytes : std::min(buffer_bytes, io.buffer.size_bytes());
+  const std::uint64_t usable =
+      io.buffer.empty() ? buffer_bytes : std::min<std::uint64_t>(buffer_bytes, io.buffer.size_bytes());
   const std::uint64_t buffer_entries =
       io.in_place.empty() ? std::max<std::uint64_t>(1, usable / sizeof(IndexedVoxline)) : voxline_count;
   std::vector<IndexedVoxline> buffer;

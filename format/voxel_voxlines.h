@@ -76,7 +76,7 @@ class VoxelIndexLists {
   bool complete() const;
   // VXIX's payload: the list starts (voxel count + 1), then the lists.
   std::span<const std::uint64_t> starts() const { return first_; }
-  std::span<const IndexedVoxline> lists() const { return {entries_.get(), first_.back()}; }
+  std::span<const IndexedVoxline> lists() const { return {entries_.get(), static_cast<std::size_t>(first_.back())}; }
   // The memory it holds for these counts, with the counts it is made from.
   static std::uint64_t bytes(std::uint64_t voxel_count, std::uint64_t voxline_count) {
     return 24 * voxel_count + 8 + sizeof(IndexedVoxline) * voxline_count;

@@ -21,8 +21,10 @@ std::string section_name(std::uint32_t id) {
   return s;
 }
 
-VxlFile VxlFile::open(const std::string& path) {
-  VxlFile f{MappedFile(path)};
+VxlFile VxlFile::open(const std::string& path) { return open(MappedFile(path)); }
+
+VxlFile VxlFile::open(MappedFile bytes) {
+  VxlFile f{std::move(bytes)};
   f.validate();
   f.checksum_checked_ = std::make_unique<std::atomic<std::uint8_t>[]>(f.sections_.size());
   return f;
@@ -217,7 +219,7 @@ void VxlFile::validate_meta_and_sizes() {
       if (required) fail_input(p, 64, std::string("required section ") + id + " is missing");
       return {};
     }
-    return {base + e->offset, e->size};
+    return {base + e->offset, static_cast<std::size_t>(e->size)};
   };
   auto offset_of = [&](const char(&id)[5]) -> std::uint64_t { return find_section(section_id(id))->offset; };
 
@@ -294,11 +296,11 @@ void VxlFile::validate_meta_and_sizes() {
   directions_ = {reinterpret_cast<const DirectionEntry*>(dirs.data()), m.stored_order_count};
   voxels_ = {reinterpret_cast<const VoxelEntry*>(voxt.data()), m.voxel_count};
   if (packed)
-    packed_vertices_ = {reinterpret_cast<const std::uint32_t*>(vert.data()), m.vertex_count};
+    packed_vertices_ = {reinterpret_cast<const std::uint32_t*>(vert.data()), static_cast<std::size_t>(m.vertex_count)};
   else
-    float_vertices_ = {reinterpret_cast<const float*>(vert.data()), m.vertex_count * 3};
-  voxlines_ = {reinterpret_cast<const VoxlineEntry*>(vxln.data()), m.voxline_count};
-  strm_ = {reinterpret_cast<const std::uint64_t*>(strm.data()), m.streamline_count + 1};
+    float_vertices_ = {reinterpret_cast<const float*>(vert.data()), static_cast<std::size_t>(m.vertex_count * 3)};
+  voxlines_ = {reinterpret_cast<const VoxlineEntry*>(vxln.data()), static_cast<std::size_t>(m.voxline_count)};
+  strm_ = {reinterpret_cast<const std::uint64_t*>(strm.data()), static_cast<std::size_t>(m.streamline_count + 1)};
   auto prov = section("PROV", false);
   provenance_ = {reinterpret_cast<const char*>(prov.data()), prov.size()};
   groups_ = section("GRPS", false);
@@ -385,8 +387,9 @@ void VxlFile::validate_voxel_index(std::span<const std::uint8_t> vxix) {
     if ((i == 0 && first[0] != 0) || (i > 0 && first[i] < first[i - 1]) ||
         (i == meta_.voxel_count && first[i] != meta_.voxline_count))
       fail_input(p, at + 8 * i, "VXIX voxel list starts must rise from 0 to the voxline count");
-  voxel_index_first_ = {first, meta_.voxel_count + 1ull};
-  voxel_index_entries_ = {reinterpret_cast<const IndexedVoxline*>(first + meta_.voxel_count + 1), meta_.voxline_count};
+  voxel_index_first_ = {first, static_cast<std::size_t>(meta_.voxel_count + 1)};
+  voxel_index_entries_ = {reinterpret_cast<const IndexedVoxline*>(first + meta_.voxel_count + 1),
+                          static_cast<std::size_t>(meta_.voxline_count)};
 }
 
 void VxlFile::validate_voxel_table() {

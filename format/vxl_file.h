@@ -65,6 +65,8 @@ class VxlFile {
   // Maps and validates; throws vxl::Error (Input, or Unsupported for a newer major version / unknown
   // required section) naming the file and the byte offset of the problem.
   static VxlFile open(const std::string& path);
+  // The same for a file's bytes already in memory (MappedFile::adopt: held, then freed with std::free).
+  static VxlFile open(MappedFile bytes);
 
   const std::string& path() const { return file_.path(); }
   std::span<const std::uint8_t> bytes() const { return file_.bytes(); }

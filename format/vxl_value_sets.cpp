@@ -122,7 +122,7 @@ std::string ValueSets::name(std::uint32_t k) const { return entries_[k].name; }
 
 std::span<const float> ValueSets::values(std::uint32_t k) const {
   const std::uint8_t* data = payload_.data() + value_sets_data_offset(entries_.size()) + k * value_array_stride(count_);
-  return {reinterpret_cast<const float*>(data), count_};
+  return {reinterpret_cast<const float*>(data), static_cast<std::size_t>(count_)};
 }
 
 int ValueSets::find(const std::string& name) const {

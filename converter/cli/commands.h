@@ -22,6 +22,7 @@ void add_select_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 void add_pack_command(CLI::App& app);
 void add_unpack_command(CLI::App& app);
+void add_share_command(CLI::App& app);
 
 // --positions packed|float32, shared by convert and unpack (spec §5.4).
 inline CLI::Option* add_positions_option(CLI::App* cmd, PositionEncoding& positions) {

@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   vxl::cli::add_synth_command(app);
   vxl::cli::add_pack_command(app);
   vxl::cli::add_unpack_command(app);
+  vxl::cli::add_share_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,6 +1,7 @@
 #include "format/base/mapped_file.h"
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <utility>
 
@@ -34,15 +35,27 @@ MappedFile::MappedFile(const std::string& path) : path_(path) {
   ::close(fd);  // the mapping keeps the file alive
 }
 
+MappedFile MappedFile::adopt(std::string name, std::uint8_t* malloced, std::size_t size) {
+  MappedFile f;
+  f.path_ = std::move(name);
+  f.data_ = malloced;
+  f.size_ = size;
+  f.adopted_ = true;
+  return f;
+}
+
 MappedFile::~MappedFile() { release(); }
 
 void MappedFile::release_resident_pages() const {
   // Read-only and private: nothing of ours is lost, the pages come back from the file.
-  if (data_ != nullptr) ::madvise(const_cast<std::uint8_t*>(data_), size_, MADV_DONTNEED);
+  if (data_ != nullptr && !adopted_) ::madvise(const_cast<std::uint8_t*>(data_), size_, MADV_DONTNEED);
 }
 
 MappedFile::MappedFile(MappedFile&& other) noexcept
-    : path_(std::move(other.path_)), data_(std::exchange(other.data_, nullptr)), size_(std::exchange(other.size_, 0)) {}
+    : path_(std::move(other.path_)),
+      data_(std::exchange(other.data_, nullptr)),
+      size_(std::exchange(other.size_, 0)),
+      adopted_(std::exchange(other.adopted_, false)) {}
 
 MappedFile& MappedFile::operator=(MappedFile&& other) noexcept {
   if (this != &other) {
@@ -50,14 +63,19 @@ MappedFile& MappedFile::operator=(MappedFile&& other) noexcept {
     path_ = std::move(other.path_);
     data_ = std::exchange(other.data_, nullptr);
     size_ = std::exchange(other.size_, 0);
+    adopted_ = std::exchange(other.adopted_, false);
   }
   return *this;
 }
 
 void MappedFile::release() {
-  if (data_ != nullptr) ::munmap(const_cast<std::uint8_t*>(data_), size_);
+  if (adopted_)
+    std::free(const_cast<std::uint8_t*>(data_));
+  else if (data_ != nullptr)
+    ::munmap(const_cast<std::uint8_t*>(data_), size_);
   data_ = nullptr;
   size_ = 0;
+  adopted_ = false;
 }
 
 FileWindow::FileWindow(int fd, const std::string& path, std::uint64_t offset, std::uint64_t size, Access access) {

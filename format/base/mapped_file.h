@@ -12,6 +12,9 @@ class MappedFile {
  public:
   // Maps `path` read-only; throws vxl::Error (kind Input) naming the file when it cannot.
   explicit MappedFile(const std::string& path);
+  // Bytes already in memory (from std::malloc), held and freed with std::free instead of mapped: for a reader
+  // that receives the file some other way (the web viewer fetches it). `name` stands for the path in errors.
+  static MappedFile adopt(std::string name, std::uint8_t* malloced, std::size_t size);
   ~MappedFile();
   MappedFile(MappedFile&& other) noexcept;
   MappedFile& operator=(MappedFile&& other) noexcept;
@@ -28,10 +31,12 @@ class MappedFile {
   void release_resident_pages() const;
 
  private:
+  MappedFile() = default;
   void release();
   std::string path_;
   const std::uint8_t* data_ = nullptr;
   std::size_t size_ = 0;
+  bool adopted_ = false;  // data_ is std::malloc's, not a mapping
 };
 
 // A mapping of bytes [offset, offset + size) of an open file, unmapped when the window is destroyed.

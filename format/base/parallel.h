@@ -32,8 +32,18 @@
 
 namespace vxl {
 
-// The number of worker threads for a requested count: `requested` itself, or all hardware threads for 0.
+// Whether this build can start threads: a WebAssembly build without them (the web viewer's) runs every
+// loop and every task on the calling thread.
+#if defined(__EMSCRIPTEN__) && !defined(__EMSCRIPTEN_PTHREADS__)
+inline constexpr bool kThreadsAvailable = false;
+#else
+inline constexpr bool kThreadsAvailable = true;
+#endif
+
+// The number of worker threads for a requested count: `requested` itself, or all hardware threads for 0
+// (1 where no thread can be started).
 inline unsigned resolve_threads(unsigned requested) {
+  if (!kThreadsAvailable) return 1;
   if (requested > 0) return requested;
   const unsigned n = std::thread::hardware_concurrency();
   return n == 0 ? 1 : n;
@@ -135,17 +145,11 @@ class BackgroundTask {
   BackgroundTask() = default;
   template <typename Fn>
   explicit BackgroundTask(Fn&& fn) : state_(std::make_unique<State>()) {
-    thread_ = start_thread([state = state_.get(), fn = std::forward<Fn>(fn)]() mutable {
-      try {
-        if constexpr (std::is_void_v<T>)
-          fn();
-        else
-          state->value.emplace(fn());
-      } catch (...) {
-        state->error = std::current_exception();
-      }
-      state->finished.store(true, std::memory_order_release);
-    });
+    if constexpr (!kThreadsAvailable) {
+      run(*state_, fn);  // done before the caller goes on: get() returns at once
+    } else {
+      thread_ = start_thread([state = state_.get(), fn = std::forward<Fn>(fn)]() mutable { run(*state, fn); });
+    }
   }
   BackgroundTask(BackgroundTask&&) noexcept = default;
   BackgroundTask& operator=(BackgroundTask&& other) noexcept {
@@ -172,6 +176,18 @@ class BackgroundTask {
     std::exception_ptr error;
     std::atomic<bool> finished{false};
   };
+  template <typename Fn>
+  static void run(State& state, Fn& fn) {
+    try {
+      if constexpr (std::is_void_v<T>)
+        fn();
+      else
+        state.value.emplace(fn());
+    } catch (...) {
+      state.error = std::current_exception();
+    }
+    state.finished.store(true, std::memory_order_release);
+  }
   void join() {
     if (thread_.joinable()) thread_.join();
   }

@@ -37,7 +37,7 @@ Camera initial_camera(std::span<const glm::dvec3> points, const ViewerOptions& o
   }
   Camera c;
   c.orthographic = options.orthographic;
-  auto view = options.view.value_or(std::array<double, 2>{-35.0, 25.0});
+  auto view = options.view.value_or(kDefaultView);
   c.azimuth_deg = view[0];
   c.elevation_deg = view[1];
   if (options.turntable > 1) {

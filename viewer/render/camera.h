@@ -54,6 +54,10 @@ struct ViewLimits {
   static constexpr double kMinFovDeg = 1, kMaxFovDeg = 179;
 };
 
+// The view a picture or a window opens with when none is given: {azimuth, elevation} in degrees, from the
+// front left and above, so that the three axes' directions all show.
+inline constexpr std::array<double, 2> kDefaultView{-35.0, 25.0};
+
 // Standard views (anterior up in axial views, patient right on screen right seen from above) like mrview's:
 // "axial"/"superior", "inferior", "sagittal"/"left", "right", "coronal"/"anterior", "posterior", or "AZ,EL" in degrees
 // (elevation clamped to [-90, 90]; an azimuth beyond ViewLimits is no view). Returns {azimuth, elevation}.

@@ -20,12 +20,16 @@ int bind_clip_half_spaces(GLuint program, std::span<const glm::dvec4> half_space
 }
 
 void enable_clip_distances(int n) {
+#if VOXLINES_WEBGL
+  (void)n;  // WebGL2 has no clip distances: the web viewer offers no slab or clip planes
+#else
   for (int i = 0; i < kMaxClipDistances; ++i) {
     if (i < n)
       glEnable(GL_CLIP_DISTANCE0 + i);
     else
       glDisable(GL_CLIP_DISTANCE0 + i);
   }
+#endif
 }
 
 }  // namespace vxl

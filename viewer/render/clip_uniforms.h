@@ -4,8 +4,8 @@
 
 #include <span>
 
-#include <epoxy/gl.h>
 #include <glm/glm.hpp>
+#include "viewer/render/gl_api.h"
 
 namespace vxl {
 

@@ -1,14 +1,36 @@
 #include "viewer/render/gl_util.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
 namespace vxl::gl {
 namespace {
 
+#if VOXLINES_WEBGL
+const char* const kDialect = R"(#version 300 es
+precision highp float;
+precision highp int;
+precision highp sampler2D;
+precision highp usampler2D;
+precision highp sampler3D;
+#define BUFFER_SAMPLER usampler2D
+#define FETCH_BUFFER(s, i) texelFetch(s, ivec2((i) & 4095, (i) >> 12), 0)
+#define CLIP_DISTANCES 0
+)";
+static_assert(kBufferTextureWidthLog2 == 12, "FETCH_BUFFER's row width");
+#else
+const char* const kDialect = R"(
+#define BUFFER_SAMPLER usamplerBuffer
+#define FETCH_BUFFER(s, i) texelFetch(s, i)
+#define CLIP_DISTANCES 1
+)";
+#endif
+
 GLuint compile(GLenum type, const std::string& source) {
   GLuint s = glCreateShader(type);
-  const char* src = source.c_str();
+  const std::string text = shader_source(source);
+  const char* src = text.c_str();
   glShaderSource(s, 1, &src, nullptr);
   glCompileShader(s);
   GLint ok = 0;
@@ -42,13 +64,130 @@ GLuint link(std::initializer_list<GLuint> shaders) {
   return p;
 }
 
+#if VOXLINES_WEBGL
+// The (format, type) that glTexSubImage2D takes for a TextureBuffer's internal format, and its texel size.
+struct PixelLayout {
+  GLenum format, type;
+  std::size_t texel_bytes;
+};
+PixelLayout pixel_layout(GLenum internal_format) {
+  switch (internal_format) {
+    case GL_RGBA32UI: return {GL_RGBA_INTEGER, GL_UNSIGNED_INT, 16};
+    case GL_RG32UI: return {GL_RG_INTEGER, GL_UNSIGNED_INT, 8};
+    case GL_R32UI: return {GL_RED_INTEGER, GL_UNSIGNED_INT, 4};
+    case GL_R16UI: return {GL_RED_INTEGER, GL_UNSIGNED_SHORT, 2};
+    case GL_R8UI: return {GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1};
+    case GL_R32F: return {GL_RED, GL_FLOAT, 4};
+    default:
+      throw std::logic_error("TextureBuffer: no pixel layout for internal format " + std::to_string(internal_format));
+  }
+}
+
+// WebGL2's stand-in for a buffer texture: a 2D texture of kBufferTextureWidth-texel rows holding `bytes`
+// (at least one texel), filled from `data` when given. A last row only partly filled leaves the rest zero.
+GLuint make_rows_texture(GLenum internal_format, const void* data, std::size_t bytes) {
+  const PixelLayout px = pixel_layout(internal_format);
+  const std::size_t texels = std::max<std::size_t>(1, bytes / px.texel_bytes);
+  const std::size_t rows = (texels + kBufferTextureWidth - 1) / kBufferTextureWidth;
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glTexStorage2D(GL_TEXTURE_2D, 1, internal_format, kBufferTextureWidth, static_cast<GLsizei>(rows));
+  // Integer textures are complete only when sampled without filtering.
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  if (data != nullptr && bytes >= px.texel_bytes) {
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    const std::size_t texels_given = bytes / px.texel_bytes;
+    const std::size_t full_rows = texels_given / kBufferTextureWidth;
+    const auto* bytes_in = static_cast<const std::uint8_t*>(data);
+    if (full_rows > 0)
+      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, kBufferTextureWidth, static_cast<GLsizei>(full_rows), px.format, px.type,
+                      bytes_in);
+    if (const std::size_t tail = texels_given - full_rows * kBufferTextureWidth; tail > 0)
+      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, static_cast<GLint>(full_rows), static_cast<GLsizei>(tail), 1, px.format,
+                      px.type, bytes_in + full_rows * kBufferTextureWidth * px.texel_bytes);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  }
+  glBindTexture(GL_TEXTURE_2D, 0);
+  return texture;
+}
+#endif
+
 }  // namespace
+
+std::string shader_source(const std::string& source) {
+  const std::size_t line_end = source.find('\n');
+  const std::string first = source.substr(0, line_end);
+  if (first.rfind("#version ", 0) != 0 || first.size() < 5 || first.compare(first.size() - 5, 5, " core") != 0)
+    return source;
+  const std::string rest = line_end == std::string::npos ? std::string() : source.substr(line_end + 1);
+  if constexpr (kWebGL)
+    return kDialect + rest;
+  else
+    return first + kDialect + rest;
+}
+
+std::uint64_t max_buffer_texels() {
+  GLint limit = 0;
+#if VOXLINES_WEBGL
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &limit);
+  return std::uint64_t(std::max(limit, 1)) * kBufferTextureWidth;
+#else
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &limit);
+  return std::uint64_t(std::max(limit, 1));
+#endif
+}
+
+void multi_draw(GLenum mode, const GLint* first, const GLsizei* count, GLsizei ranges) {
+#if VOXLINES_WEBGL
+  for (GLsizei i = 0; i < ranges; ++i) glDrawArrays(mode, first[i], count[i]);
+#else
+  glMultiDrawArrays(mode, first, count, ranges);
+#endif
+}
 
 GLuint make_program(const std::string& vs, const std::string& fs) {
   return link({compile(GL_VERTEX_SHADER, vs), compile(GL_FRAGMENT_SHADER, fs)});
 }
 
-GLuint make_compute_program(const std::string& cs) { return link({compile(GL_COMPUTE_SHADER, cs)}); }
+GLuint make_compute_program(const std::string& cs) {
+#if VOXLINES_WEBGL
+  (void)cs;
+  throw std::runtime_error("compute shaders need OpenGL 4.3, which WebGL2 is not");
+#else
+  return link({compile(GL_COMPUTE_SHADER, cs)});
+#endif
+}
+
+#if VOXLINES_WEBGL
+
+void TextureBuffer::create(GLenum internal_format, const void* data, std::size_t bytes) {
+  texture = make_rows_texture(internal_format, data, bytes);
+}
+
+void* TextureBuffer::create_mapped(std::size_t bytes) {
+  mapped_bytes_ = std::max<std::size_t>(bytes, 16);
+  staging_ = std::make_unique<std::uint8_t[]>(mapped_bytes_);
+  return staging_.get();
+}
+
+void TextureBuffer::finish_mapped(GLenum internal_format) {
+  texture = make_rows_texture(internal_format, staging_.get(), mapped_bytes_);
+  staging_.reset();
+}
+
+void TextureBuffer::update(std::size_t, const void*, std::size_t) {
+  throw std::runtime_error("updating a buffer texture in place needs desktop OpenGL");
+}
+
+void TextureBuffer::destroy() {
+  if (texture) glDeleteTextures(1, &texture);
+  texture = buffer = 0;
+  staging_.reset();
+}
+
+#else
 
 void TextureBuffer::create(GLenum internal_format, const void* data, std::size_t bytes) {
   glGenBuffers(1, &buffer);
@@ -93,11 +232,19 @@ void TextureBuffer::finish_mapped(GLenum internal_format) {
   glBindBuffer(GL_TEXTURE_BUFFER, 0);
 }
 
+void TextureBuffer::update(std::size_t offset, const void* data, std::size_t bytes) {
+  glBindBuffer(GL_TEXTURE_BUFFER, buffer);
+  glBufferSubData(GL_TEXTURE_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+  glBindBuffer(GL_TEXTURE_BUFFER, 0);
+}
+
 void TextureBuffer::destroy() {
   if (texture) glDeleteTextures(1, &texture);
   if (buffer) glDeleteBuffers(1, &buffer);
   texture = buffer = 0;
 }
+
+#endif
 
 void RenderTarget::ensure(int w, int h, GLenum f0, GLenum f1, bool with_depth) {
   if (fbo && w == width && h == height) return;

@@ -2,26 +2,50 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
-#include <epoxy/gl.h>
+#include "viewer/render/gl_api.h"
 
 namespace vxl::gl {
 
 // Compiles and links; throws std::runtime_error with the driver's log on failure.
+// Sources start with a desktop version line ("#version 330 core"); shader_source() puts the dialect's
+// prelude after it, which every shader may use: BUFFER_SAMPLER, the sampler type of a TextureBuffer (an
+// unsigned one), FETCH_BUFFER(sampler, i), its texel i, and CLIP_DISTANCES, 1 where gl_ClipDistance exists.
+// In the web build the version line becomes GLSL ES 3.00's, with the precisions it needs.
 GLuint make_program(const std::string& vertex_source, const std::string& fragment_source);
 GLuint make_compute_program(const std::string& source);
+std::string shader_source(const std::string& source);
 
-// A buffer object with a buffer texture viewing it (internal format e.g. GL_R32F, GL_R32UI).
+// The most texels a TextureBuffer may hold: GL_MAX_TEXTURE_BUFFER_SIZE, or in WebGL2 the rows of the
+// largest 2D texture.
+std::uint64_t max_buffer_texels();
+
+// glMultiDrawArrays; in WebGL2, which has it only as an extension, one draw per range, in order.
+void multi_draw(GLenum mode, const GLint* first, const GLsizei* count, GLsizei ranges);
+
+// A buffer object with a buffer texture viewing it (internal format e.g. GL_R32F, GL_R32UI); in WebGL2, which
+// has no buffer textures, a 2D texture of kBufferTextureWidth-texel rows (`buffer` stays 0) that shaders read
+// through FETCH_BUFFER.
 struct TextureBuffer {
   GLuint buffer = 0, texture = 0;
   void create(GLenum internal_format, const void* data, std::size_t bytes);
   // The same filled in place: create_mapped makes the buffer `bytes` long (at least 16) and returns its
   // memory mapped for writing, which any thread may fill; finish_mapped unmaps it and makes the texture.
-  // Throws std::runtime_error when the driver cannot map or loses the contents.
+  // Throws std::runtime_error when the driver cannot map or loses the contents. (WebGL2 maps nothing: the
+  // memory is the host's, copied to the texture by finish_mapped.)
   void* create_mapped(std::size_t bytes);
   void finish_mapped(GLenum internal_format);
+  // Replaces bytes [offset, offset + bytes) of a buffer made by create (desktop OpenGL only).
+  void update(std::size_t offset, const void* data, std::size_t bytes);
   void destroy();
+
+#if VOXLINES_WEBGL
+ private:
+  std::size_t mapped_bytes_ = 0;
+  std::unique_ptr<std::uint8_t[]> staging_;  // what create_mapped handed out
+#endif
 };
 
 // RAII-free owner of a framebuffer with colour textures, for multipass modes.

@@ -13,9 +13,8 @@
 namespace vxl {
 
 std::uint64_t GpuScene::driver_limit() {
-  GLint texels = 0;
-  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &texels);
-  return texels > 0 ? static_cast<std::uint64_t>(texels) : 65536;  // 65536 is the GL 3.3 minimum
+  const std::uint64_t texels = gl::max_buffer_texels();
+  return texels > 1 ? texels : 65536;  // 65536 is the GL 3.3 minimum
 }
 
 // Voxel i's orders at the span's level, as the file stores them.
@@ -405,11 +404,8 @@ void GpuScene::upload_view_order(const std::vector<const std::vector<std::uint32
   for (std::size_t c = 0; c < spans_.size(); ++c) {
     const auto [first, end] = ranges[c];
     if (first >= end || !resident_[c]) continue;
-    glBindBuffer(GL_TEXTURE_BUFFER, spans_[c].dataset.buffer);
-    glBufferSubData(GL_TEXTURE_BUFFER, static_cast<GLintptr>(4 * first), static_cast<GLsizeiptr>(4 * (end - first)),
-                    per_span[c]->data() + first);
+    spans_[c].dataset.update(4 * first, per_span[c]->data() + first, 4 * (end - first));
   }
-  glBindBuffer(GL_TEXTURE_BUFFER, 0);
 }
 
 const std::vector<std::int64_t>& GpuScene::dataset_first() {

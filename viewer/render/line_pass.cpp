@@ -100,9 +100,8 @@ void LinePass::prepare_attributes(const RenderSettings& s, const std::string& sc
 void LinePass::upload_streamline_groups(const SceneGroups& groups) {
   std::uint64_t total = 0;
   for (const VxlFile* f : files_) total += f->meta().streamline_count;
-  GLint max_texels = 0;
-  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
-  if (total > static_cast<std::uint64_t>(std::max(0, max_texels)) || total > 0xFFFFFFFFu)
+  const std::uint64_t max_texels = gl::max_buffer_texels();
+  if (total > max_texels || total > 0xFFFFFFFFu)
     throw Error(ErrorKind::Unsupported, files_.front()->path(), std::nullopt,
                 "colour or opacity by group needs a table of " + std::to_string(total) +
                     " streamlines; this GPU's buffer textures hold " + std::to_string(max_texels));
@@ -171,7 +170,7 @@ void LinePass::bind(GLuint program, const LineUniforms& u) const {
   // of their own: two sampler types must not share one), bound even when unused.
   const GLint groups_unit = static_cast<GLint>(kSamplersPerSpan * bound_spans_);
   glActiveTexture(GL_TEXTURE0 + groups_unit);
-  glBindTexture(GL_TEXTURE_BUFFER, streamline_groups_.texture);
+  glBindTexture(gl::kBufferTextureTarget, streamline_groups_.texture);
   glUniform1i(glGetUniformLocation(program, "u_streamline_group"), groups_unit);
   const GLint unit = groups_unit + 1;
   glActiveTexture(GL_TEXTURE0 + unit);
@@ -217,7 +216,7 @@ void LinePass::bind_spans(GLuint program, std::span<const std::uint32_t> bound,
     for (int t = 0; t < kSamplersPerSpan; ++t) {
       const GLint unit = static_cast<GLint>(kSamplersPerSpan * slot + t);
       glActiveTexture(GL_TEXTURE0 + unit);
-      glBindTexture(GL_TEXTURE_BUFFER, textures[t]);
+      glBindTexture(gl::kBufferTextureTarget, textures[t]);
       glUniform1i(glGetUniformLocation(program, (names[t] + std::to_string(slot)).c_str()), unit);
     }
   }
@@ -240,7 +239,7 @@ void LinePass::draw_plan(GLuint program, std::span<const std::int64_t> first,
   auto flush = [&] {
     if (run_first.empty()) return;
     bind_spans(program, bound, base);
-    glMultiDrawArrays(GL_LINES, run_first.data(), run_count.data(), static_cast<GLsizei>(run_first.size()));
+    gl::multi_draw(GL_LINES, run_first.data(), run_count.data(), static_cast<GLsizei>(run_first.size()));
     bound.clear();
     base.clear();
     run_first.clear();

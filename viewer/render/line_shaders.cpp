@@ -20,21 +20,21 @@ std::string span_fetchers(unsigned span_count) {
   std::string s;
   for (unsigned c = 0; c < span_count; ++c) {
     std::string i = std::to_string(c);
-    s += "uniform usamplerBuffer u_words" + i + ";\nuniform usamplerBuffer u_ord" + i +
-         ";\nuniform usamplerBuffer u_dat" + i + ";\nuniform usamplerBuffer u_att" + i + ";\n";
+    s += "uniform BUFFER_SAMPLER u_words" + i + ";\nuniform BUFFER_SAMPLER u_ord" + i +
+         ";\nuniform BUFFER_SAMPLER u_dat" + i + ";\nuniform BUFFER_SAMPLER u_att" + i + ";\n";
   }
   s += "uvec4 fetch_words(int c, int t) {\n";
   for (unsigned c = 0; c < span_count; ++c)
-    s += "  if (c == " + std::to_string(c) + ") return texelFetch(u_words" + std::to_string(c) + ", t);\n";
+    s += "  if (c == " + std::to_string(c) + ") return FETCH_BUFFER(u_words" + std::to_string(c) + ", t);\n";
   s += "  return uvec4(0u);\n}\nuint fetch_order_word(int c, int j) {\n";
   for (unsigned c = 0; c < span_count; ++c)
-    s += "  if (c == " + std::to_string(c) + ") return texelFetch(u_ord" + std::to_string(c) + ", j).r;\n";
+    s += "  if (c == " + std::to_string(c) + ") return FETCH_BUFFER(u_ord" + std::to_string(c) + ", j).r;\n";
   s += "  return 0u;\n}\nint fetch_dataset(int c, int j) {\n";
   for (unsigned c = 0; c < span_count; ++c)
-    s += "  if (c == " + std::to_string(c) + ") return int(texelFetch(u_dat" + std::to_string(c) + ", j).r);\n";
+    s += "  if (c == " + std::to_string(c) + ") return int(FETCH_BUFFER(u_dat" + std::to_string(c) + ", j).r);\n";
   s += "  return 0;\n}\nuvec2 fetch_attributes(int c, int v) {\n";
   for (unsigned c = 0; c < span_count; ++c)
-    s += "  if (c == " + std::to_string(c) + ") return texelFetch(u_att" + std::to_string(c) + ", v).rg;\n";
+    s += "  if (c == " + std::to_string(c) + ") return FETCH_BUFFER(u_att" + std::to_string(c) + ", v).rg;\n";
   s += "  return uvec2(0u);\n}\n";
   return s;
 }
@@ -83,7 +83,7 @@ uniform mat4 u_projection;
 uniform int u_color_mode;   // 0 direction, 1 fixed, 2 scalar, 3 group
 uniform vec3 u_fixed_color;
 uniform int u_attributes;   // 1: read (value bits, streamline) per vertex (vertex_attributes.h)
-uniform usamplerBuffer u_streamline_group;  // per streamline of the scene: its group mod GROUPS
+uniform BUFFER_SAMPLER u_streamline_group;  // per streamline of the scene: its group mod GROUPS
 uniform vec2 u_range;       // value -> t = (value - x) / (y - x)
 uniform vec4 u_group[GROUPS];  // per group (index mod GROUPS): colour, opacity factor
 uniform float u_opacity;
@@ -93,7 +93,9 @@ uniform int u_lighting;     // 0 off, 1 illuminated lines
 uniform vec3 u_light;       // towards the light, eye space
 uniform vec4 u_light_terms; // ambient, diffuse, specular, shininess
 uniform int u_orthographic;
+#if CLIP_DISTANCES
 out float gl_ClipDistance[CLIPS];
+#endif
 out vec4 v_color;           // colour (unless mapped) and alpha
 out vec2 v_light;           // lighting: colour * x + y (1, 0 when off)
 out float v_value;          // colour-map position, unclamped: mapped per fragment, so long segments are exact
@@ -158,7 +160,9 @@ const char* const kVertexSegmentEnds = R"(void main() {
 // main(), second half: clip distances, colour, opacity, value, lighting and position of the segment end.
 const char* const kVertexShading = R"(  vec3 rel = (p - u_eye_hi) - u_eye_lo;
   vec3 e = u_rotation * rel;
+#if CLIP_DISTANCES
   for (int i = 0; i < CLIPS; ++i) gl_ClipDistance[i] = i < u_clip_count ? dot(u_clip[i].xyz, rel) + u_clip[i].w : 1.0;
+#endif
   v_depth = -e.z;
   vec3 d = q - p;
   float len = length(d);
@@ -170,7 +174,7 @@ const char* const kVertexShading = R"(  vec3 rel = (p - u_eye_hi) - u_eye_lo;
   if (u_attributes != 0) {
     uvec2 a = fetch_attributes(c, v + end);
     float value = uintBitsToFloat(a.x);
-    vec4 group = u_group[int(texelFetch(u_streamline_group, int(a.y)).r) % GROUPS];
+    vec4 group = u_group[int(FETCH_BUFFER(u_streamline_group, int(a.y)).r) % GROUPS];
     alpha *= group.a;
     // A missing or non-finite value keeps the fixed colour.
     if (u_color_mode == 2 && !isnan(value) && !isinf(value)) {

@@ -25,12 +25,16 @@ uniform vec4 u_clip[CLIPS];  // camera-relative half-spaces: dot(n, p - eye) + d
 uniform int u_clip_count;
 out vec3 v_normal;
 out vec3 v_view;  // from the eye towards the surface
+#if CLIP_DISTANCES
 out float gl_ClipDistance[CLIPS];
+#endif
 void main() {
   vec3 rel = u_centre + a_position * u_scale;
   v_normal = a_normal;
   v_view = u_orthographic != 0 ? u_forward : rel;
+#if CLIP_DISTANCES
   for (int i = 0; i < CLIPS; ++i) gl_ClipDistance[i] = i < u_clip_count ? dot(u_clip[i].xyz, rel) + u_clip[i].w : 1.0;
+#endif
   gl_Position = u_projection * vec4(u_rotation * rel, 1.0);
 }
 )";
@@ -144,8 +148,11 @@ void RegionShells::draw(const Camera& camera, const glm::dmat4& projection, cons
   glUniform1i(glGetUniformLocation(program_, "u_slice_test"), slice_depth != 0 ? 1 : 0);
   glBindVertexArray(vao_);
 
-  // Shapes reaching beyond the near and far planes fitted to the scene are kept whole (depth clamped).
+  // Shapes reaching beyond the near and far planes fitted to the scene are kept whole (depth clamped; WebGL2
+  // cannot, and the web viewer draws no regions).
+#if !VOXLINES_WEBGL
   glEnable(GL_DEPTH_CLAMP);
+#endif
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);
   glDepthMask(GL_FALSE);
@@ -162,7 +169,9 @@ void RegionShells::draw(const Camera& camera, const glm::dmat4& projection, cons
     glUniform1f(glGetUniformLocation(program_, "u_base"), region_shell_alpha(1.0f, s->active));
     glDrawArrays(GL_TRIANGLES, sphere ? sphere_first_ : box_first_, sphere ? sphere_count_ : box_count_);
   }
+#if !VOXLINES_WEBGL
   glDisable(GL_DEPTH_CLAMP);
+#endif
   glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
   glDisable(GL_BLEND);

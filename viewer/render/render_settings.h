@@ -80,6 +80,9 @@ struct SliceSettings {
   bool operator==(const SliceSettings&) const = default;
 };
 
+// The line opacity voxview and the web viewer open with.
+inline constexpr float kDefaultLineOpacity = 0.3f;
+
 struct RenderSettings {
   RenderMode mode = RenderMode::Axis;
   ColorMode color = ColorMode::Direction;

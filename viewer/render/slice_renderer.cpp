@@ -21,11 +21,15 @@ uniform mat3 u_rotation;
 uniform mat4 u_projection;
 uniform vec4 u_clip[CLIPS];
 uniform int u_clip_count;
+#if CLIP_DISTANCES
 out float gl_ClipDistance[CLIPS];
+#endif
 out vec3 v_voxel;
 void main() {
   vec3 rel = u_corner[gl_VertexID];
+#if CLIP_DISTANCES
   for (int i = 0; i < CLIPS; ++i) gl_ClipDistance[i] = i < u_clip_count ? dot(u_clip[i].xyz, rel) + u_clip[i].w : 1.0;
+#endif
   v_voxel = u_voxel[gl_VertexID];  // affine in position, so the interpolation is exact
   gl_Position = u_projection * vec4(u_rotation * rel, 1.0);
 }

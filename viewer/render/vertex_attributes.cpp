@@ -1,6 +1,6 @@
 #include "viewer/render/vertex_attributes.h"
 
-#include <bit>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -8,6 +8,16 @@
 #include "format/vxl_levels.h"
 
 namespace vxl {
+namespace {
+
+// A float's bits (std::bit_cast, which the web build's C++ library lacks).
+std::uint32_t float_bits(float f) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &f, 4);
+  return bits;
+}
+
+}  // namespace
 
 ValueSource find_value_set(const VxlFile& file, const std::string& name) {
   if (int k = file.vertex_values().find(name); k >= 0)
@@ -20,7 +30,7 @@ ValueSource find_value_set(const VxlFile& file, const std::string& name) {
 void voxel_attributes(const VxlFile& file, std::size_t voxel, const AttributeSource& source, std::uint32_t vertices,
                       std::uint32_t* out) {
   const VoxelEntry& v = file.voxels()[voxel];
-  const std::uint32_t none = std::bit_cast<std::uint32_t>(std::numeric_limits<float>::quiet_NaN());
+  const std::uint32_t none = float_bits(std::numeric_limits<float>::quiet_NaN());
   for (std::uint32_t i = 0; i < vertices; ++i) out[2 * i] = none, out[2 * i + 1] = source.first_streamline;
   const std::span<const float> per_vertex = source.values.kind == ValueSource::Kind::Vertex
                                                 ? file.vertex_values().values(source.values.set)
@@ -29,8 +39,7 @@ void voxel_attributes(const VxlFile& file, std::size_t voxel, const AttributeSou
                                                     ? file.streamline_values().values(source.values.set)
                                                     : std::span<const float>{};
   if (!per_vertex.empty())
-    for (std::uint32_t i = 0; i < vertices; ++i)
-      out[2 * i] = std::bit_cast<std::uint32_t>(per_vertex[v.vertex_first + i]);
+    for (std::uint32_t i = 0; i < vertices; ++i) out[2 * i] = float_bits(per_vertex[v.vertex_first + i]);
 
   // The voxel's voxlines, placed in its block through its list (spec §5.14): those of the coarsest level whose
   // prefix holds the vertices drawn, so that a coarse level's words cost its own vertices. The scratch is kept for
@@ -45,8 +54,7 @@ void voxel_attributes(const VxlFile& file, std::size_t voxel, const AttributeSou
     const std::uint64_t first = p.first_vertex - v.vertex_first;
     if (first >= vertices) continue;  // beyond the prefix drawn
     const std::uint32_t number = source.first_streamline + p.streamline;
-    const std::uint32_t value =
-        per_streamline.empty() ? none : std::bit_cast<std::uint32_t>(per_streamline[p.streamline]);
+    const std::uint32_t value = per_streamline.empty() ? none : float_bits(per_streamline[p.streamline]);
     for (std::uint64_t i = first; i < std::min<std::uint64_t>(first + p.vertices(), vertices); ++i) {
       if (!per_streamline.empty()) out[2 * i] = value;
       out[2 * i + 1] = number;

@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "viewer/render/gl_api.h"
+
 namespace vxl {
 namespace {
 
@@ -16,7 +18,9 @@ constexpr ModeMaker kModeMakers[] = {
     {RenderMode::Opaque, make_opaque_pass},     {RenderMode::Unsorted, make_unsorted_pass},
     {RenderMode::Additive, make_additive_pass}, {RenderMode::Wboit, make_wboit_pass},
     {RenderMode::Basic, make_basic_pass},       {RenderMode::Axis, make_axis_pass},
+#if !VOXLINES_WEBGL  // WebGL2 has neither storage buffers and compute shaders nor buffers rewritten in place
     {RenderMode::Segsort, make_segsort_pass},   {RenderMode::Exact, make_exact_pass},
+#endif
 };
 
 }  // namespace

@@ -1,0 +1,33 @@
+// `voxlines share`: a folder that any static web server serves as it is, for people without voxview: the web
+// viewer (viewer/web: the project's reader and renderer in WebAssembly, drawing with WebGL2), the tractogram
+// as a .vxl (a .vxlz is unpacked into one), share.json naming it, and a README for the recipient.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace vxl {
+
+struct ShareSettings {
+  std::string title;           // shown by the page; empty: the file's name
+  std::string web_viewer_dir;  // the built web viewer (index.html, viewer.js, voxweb.js, voxweb.wasm)
+  unsigned threads = 0;        // for unpacking a .vxlz (0: all cores)
+};
+
+struct ShareSummary {
+  std::string data_file;  // the .vxl's name in the folder
+  std::uint64_t data_bytes = 0;
+  std::uint64_t streamlines = 0;
+  bool unpacked = false;  // the input was a .vxlz
+};
+
+// The files of the built web viewer that a shared folder holds.
+inline constexpr const char* kWebViewerFiles[] = {"index.html", "viewer.js", "voxweb.js", "voxweb.wasm"};
+
+// Writes the folder `out_dir`, which must not exist: made under a temporary name beside it and renamed
+// when complete, so that a failure or an interruption leaves no partial folder at `out_dir`. Throws
+// vxl::Error: Input for a damaged input, Unsupported when there is no web viewer, Output when the folder
+// cannot be written.
+ShareSummary share_folder(const std::string& in_path, const std::string& out_dir, const ShareSettings& settings);
+
+}  // namespace vxl

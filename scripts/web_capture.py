@@ -1,0 +1,167 @@
+#!/usr/bin/env python3
+"""Opens a page of the web viewer in headless Chromium and writes its first complete picture as a PNG.
+
+    scripts/web_capture.py URL OUT.png [--timeout S] [--chromium PATH]
+
+The page (viewer/web/page) resolves window.voxweb.ready after its first frame, or rejects it with the
+viewer's error; this waits for that and saves the canvas. Prints one JSON line: the milliseconds from
+navigation to the first picture ("first_picture_ms"), the page's JavaScript heap and what the console said.
+Exit 0 with the picture, 1 when the page reported an error, 2 on a browser or usage failure.
+
+Chromium is driven over the DevTools protocol on a pipe (--remote-debugging-pipe: JSON messages ended by a
+NUL byte, on file descriptors 3 and 4), which needs nothing beyond Python's standard library. WebGL2 runs on
+SwiftShader, Chromium's software renderer, so no GPU and no display are needed.
+"""
+import argparse
+import base64
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+
+class DevTools:
+    """The browser end of --remote-debugging-pipe."""
+
+    def __init__(self, chromium, profile):
+        to_browser_r, self._to_browser = os.pipe()
+        self._from_browser, from_browser_w = os.pipe()
+
+        def wire_pipes():  # in the child: the protocol's descriptors 3 (commands) and 4 (answers)
+            # Through fresh copies: a pipe may itself be 3 or 4, and dup2 onto itself would leave it
+            # closed on exec.
+            commands, answers = os.dup(to_browser_r), os.dup(from_browser_w)
+            os.dup2(commands, 3)
+            os.dup2(answers, 4)
+
+        self.process = subprocess.Popen(
+            [chromium, '--headless', '--remote-debugging-pipe', '--no-sandbox', '--no-first-run',
+             '--no-default-browser-check', '--disable-extensions', '--use-angle=swiftshader',
+             '--enable-unsafe-swiftshader', '--hide-scrollbars', '--mute-audio',
+             '--user-data-dir=' + profile, 'about:blank'],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            close_fds=False, preexec_fn=wire_pipes)
+        os.close(to_browser_r)
+        os.close(from_browser_w)
+        self._next_id = 0
+        self._buffer = b''
+        self.events = []
+
+    def _read_message(self, deadline):
+        while b'\0' not in self._buffer:
+            if time.monotonic() > deadline:
+                raise TimeoutError('the browser did not answer in time')
+            chunk = os.read(self._from_browser, 1 << 16)
+            if not chunk:
+                raise RuntimeError('the browser closed the DevTools pipe')
+            self._buffer += chunk
+        message, self._buffer = self._buffer.split(b'\0', 1)
+        return json.loads(message)
+
+    def call(self, method, params=None, session=None, timeout=30):
+        self._next_id += 1
+        message = {'id': self._next_id, 'method': method, 'params': params or {}}
+        if session:
+            message['sessionId'] = session
+        os.write(self._to_browser, json.dumps(message).encode() + b'\0')
+        deadline = time.monotonic() + timeout
+        while True:
+            answer = self._read_message(deadline)
+            if answer.get('id') == self._next_id:
+                if 'error' in answer:
+                    raise RuntimeError(f"{method}: {answer['error'].get('message')}")
+                return answer.get('result', {})
+            self.events.append(answer)
+
+    def wait_event(self, method, timeout):
+        deadline = time.monotonic() + timeout
+        for i, e in enumerate(self.events):
+            if e.get('method') == method:
+                return self.events.pop(i)
+        while True:
+            e = self._read_message(deadline)
+            if e.get('method') == method:
+                return e
+            self.events.append(e)
+
+    def close(self):
+        try:
+            self.call('Browser.close', timeout=5)
+        except (RuntimeError, TimeoutError, OSError):
+            pass
+        try:
+            self.process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+
+
+# Waits for the page's viewer, then for its first frame; gives the picture and the time it took.
+FIRST_PICTURE = """new Promise((resolve) => {
+  (function poll() {
+    if (!window.voxweb) return setTimeout(poll, 10);
+    window.voxweb.ready.then(
+      () => resolve({ png: document.getElementById('canvas').toDataURL('image/png'),
+                      first_picture_ms: performance.now(),
+                      heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null }),
+      (e) => resolve({ error: String(e && e.message || e) }));
+  })();
+})"""
+
+
+def capture(url, out, timeout, chromium):
+    profile = tempfile.mkdtemp(prefix='voxweb-chromium-')
+    browser = None
+    try:
+        browser = DevTools(chromium, profile)
+        target = browser.call('Target.createTarget', {'url': 'about:blank'})['targetId']
+        session = browser.call('Target.attachToTarget', {'targetId': target, 'flatten': True})['sessionId']
+        browser.call('Page.enable', session=session)
+        browser.call('Runtime.enable', session=session)
+        browser.call('Page.navigate', {'url': url}, session=session)
+        browser.wait_event('Page.loadEventFired', timeout)
+        result = browser.call('Runtime.evaluate', {'expression': FIRST_PICTURE, 'awaitPromise': True,
+                                                   'returnByValue': True, 'timeout': timeout * 1000},
+                              session=session, timeout=timeout)
+        console = [' '.join(str(a.get('value', a.get('description', ''))) for a in e['params'].get('args', []))
+                   for e in browser.events if e.get('method') == 'Runtime.consoleAPICalled']
+        value = result.get('result', {}).get('value') or {}
+        if 'exceptionDetails' in result:
+            value = {'error': result['exceptionDetails'].get('text', 'the page threw')}
+        report = {'url': url, 'console': console}
+        if 'error' in value:
+            report['error'] = value['error']
+            print(json.dumps(report))
+            return 1
+        png = base64.b64decode(value['png'].split(',', 1)[1])
+        with open(out + '.part', 'wb') as f:
+            f.write(png)
+        os.replace(out + '.part', out)
+        report.update({'first_picture_ms': round(value['first_picture_ms'], 1), 'heap_bytes': value['heap_bytes']})
+        print(json.dumps(report))
+        return 0
+    finally:
+        if browser:
+            browser.close()
+        shutil.rmtree(profile, ignore_errors=True)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('url')
+    parser.add_argument('out')
+    parser.add_argument('--timeout', type=float, default=120, help='seconds to wait for the first picture')
+    parser.add_argument('--chromium', default=shutil.which('chromium') or 'chromium')
+    args = parser.parse_args()
+    try:
+        return capture(args.url, args.out, args.timeout, args.chromium)
+    except (RuntimeError, TimeoutError, OSError) as e:
+        print(json.dumps({'url': args.url, 'error': f'browser: {e}'}))
+        return 2
+
+
+if __name__ == '__main__':
+    sys.exit(main())

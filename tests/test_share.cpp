@@ -1,0 +1,98 @@
+// `voxlines share`: the folder appears only when complete, with the web viewer's files, the tractogram as a
+// .vxl and share.json naming it; every refusal leaves no folder and no temporary one beside it. The web
+// viewer here is a stand-in folder (its files' contents do not matter to share); tests/web checks the real
+// one in a browser.
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "converter/share/share_folder.h"
+#include "test_support.h"
+
+namespace vxl {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A folder holding a file of each name share copies.
+std::string stand_in_web_viewer(const test::ScratchDir& dir) {
+  const std::string viewer = dir.file("web");
+  fs::create_directories(viewer);
+  for (const char* name : kWebViewerFiles) std::ofstream(viewer + "/" + name) << name;
+  return viewer;
+}
+
+// Nothing in the scratch folder but what the test made: no temporary folder left by share.
+int entries_named_part(const test::ScratchDir& dir) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir.path()))
+    n += e.path().filename().string().find(".part-") != std::string::npos;
+  return n;
+}
+
+struct SharedTractogram {
+  test::ScratchDir dir;
+  std::string tck = dir.file("in.tck"), vxl = dir.file("in.vxl"), viewer = stand_in_web_viewer(dir);
+  SharedTractogram() {
+    EXPECT_EQ(test::run_cli("synth " + test::q(tck) + " --streamlines 300").exit_code, 0);
+    EXPECT_EQ(test::run_cli("convert " + test::q(tck) + " " + test::q(vxl)).exit_code, 0);
+  }
+  test::CommandResult share(const std::string& in, const std::string& out, const std::string& more = "") const {
+    return test::run_cli("share " + test::q(in) + " " + test::q(out) + " --web-viewer " + test::q(viewer) + more);
+  }
+};
+
+TEST(Share, WritesTheViewerTheVxlAndShareJson) {
+  SharedTractogram t;
+  const std::string out = t.dir.file("shared");
+  const auto r = t.share(t.vxl, out, " --title 'Subject 7'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* name : kWebViewerFiles) EXPECT_EQ(test::slurp(out + "/" + name).size(), std::string(name).size());
+  EXPECT_EQ(test::slurp(out + "/in.vxl"), test::slurp(t.vxl));
+  const auto share = nlohmann::json::parse(test::slurp(out + "/share.json"));
+  EXPECT_EQ(share["file"], "in.vxl");
+  EXPECT_EQ(share["title"], "Subject 7");
+  EXPECT_TRUE(fs::is_regular_file(out + "/README.txt"));
+  EXPECT_EQ(entries_named_part(t.dir), 0);
+}
+
+TEST(Share, APackageIsUnpackedIntoAVxlThatVerifies) {
+  SharedTractogram t;
+  const std::string vxlz = t.dir.file("in.vxlz"), out = t.dir.file("shared");
+  ASSERT_EQ(test::run_cli("pack " + test::q(t.vxl) + " " + test::q(vxlz)).exit_code, 0);
+  const auto r = t.share(vxlz, out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("unpacked"), std::string::npos) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(test::slurp(out + "/share.json"))["file"], "in.vxl");
+  const auto verify = test::run_cli("verify " + test::q(out + "/in.vxl"));
+  EXPECT_EQ(verify.exit_code, 0) << verify.output;
+}
+
+TEST(Share, RefusalsLeaveNoFolder) {
+  SharedTractogram t;
+  const std::string out = t.dir.file("shared");
+  // Not a .vxl: refused as bad input, naming the file.
+  auto r = t.share(t.tck, out);
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("in.tck"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  // No web viewer: unsupported, saying how it is built.
+  r = test::run_cli("share " + test::q(t.vxl) + " " + test::q(out) + " --web-viewer " + test::q(t.dir.file("none")));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("VOXLINES_WEB"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  // An existing folder is not touched.
+  fs::create_directories(out);
+  std::ofstream(out + "/mine.txt") << "keep";
+  r = t.share(t.vxl, out);
+  EXPECT_EQ(r.exit_code, 5) << r.output;
+  EXPECT_EQ(test::slurp(out + "/mine.txt").size(), 4u);
+  EXPECT_FALSE(fs::exists(out + "/index.html"));
+  EXPECT_EQ(entries_named_part(t.dir), 0);
+}
+
+}  // namespace
+}  // namespace vxl

@@ -1,0 +1,156 @@
+#!/usr/bin/python3
+"""The web viewer draws what voxview draws: a folder made by `voxlines share`, served over HTTP and opened in
+headless Chromium (WebGL2 on SwiftShader), against `voxview --render` of the same file with the same camera
+(llvmpipe). Two rasterisers draw a line's pixels a little differently, so the pictures are compared by PSNR
+over R, G, B (at least MIN_PSNR dB), not byte for byte. Cases: a synthetic set of 20,000 streamlines, packed
+and float32, in the axis and unsorted modes; a .vxlz shared (unpacked by share); a damaged file, which the
+page must refuse with a message naming it.
+
+Usage: tests/web/test_web_viewer.py --voxlines PATH --voxview PATH --web-viewer DIR
+Exit 0 when every case holds, 1 otherwise, 77 when there is no Chromium to run it in.
+"""
+import argparse
+import functools
+import http.server
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+
+import numpy
+from PIL import Image
+
+MIN_PSNR = 35.0
+SIZE = '512x512'
+CAPTURE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'scripts', 'web_capture.py')
+
+
+def run(*command):
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise RuntimeError(f"{' '.join(command)}: exit {result.returncode}: {result.stdout}{result.stderr}")
+    return result.stdout
+
+
+def psnr_rgb(a_path, b_path):
+    a = numpy.asarray(Image.open(a_path).convert('RGB'), dtype=numpy.float64)
+    b = numpy.asarray(Image.open(b_path).convert('RGB'), dtype=numpy.float64)
+    if a.shape != b.shape:
+        raise RuntimeError(f'{a_path} is {a.shape}, {b_path} is {b.shape}')
+    mse = ((a - b) ** 2).mean()
+    return math.inf if mse == 0 else 10 * math.log10(255 ** 2 / mse)
+
+
+class QuietHandler(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args):
+        pass
+
+
+class Server:
+    """A static web server for one folder on a free port, in a thread."""
+
+    def __init__(self, folder):
+        handler = functools.partial(QuietHandler, directory=folder)
+        self.httpd = http.server.ThreadingHTTPServer(('127.0.0.1', 0), handler)
+        self.url = f'http://127.0.0.1:{self.httpd.server_address[1]}/'
+        threading.Thread(target=self.httpd.serve_forever, daemon=True).start()
+
+    def close(self):
+        self.httpd.shutdown()
+
+
+def capture(url, out):
+    """The page's first picture in `out`; returns capture's report (with 'error' when the page refused)."""
+    result = subprocess.run([sys.executable, CAPTURE, url, out, '--timeout', '120'], capture_output=True, text=True)
+    if result.returncode == 2:
+        raise RuntimeError(f'the browser failed: {result.stdout}{result.stderr}')
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--voxlines', required=True)
+    parser.add_argument('--voxview', required=True)
+    parser.add_argument('--web-viewer', required=True)
+    options = parser.parse_args()
+    if shutil.which('chromium') is None:
+        print('test_web_viewer: SKIPPED: no chromium on this machine (Debian: chromium)')
+        return 77
+
+    failures = []
+    with tempfile.TemporaryDirectory(prefix='voxweb-test-') as work:
+        def path(name):
+            return os.path.join(work, name)
+
+        run(options.voxlines, 'synth', path('s20k.tck'), '--streamlines', '20000')
+        run(options.voxlines, 'convert', path('s20k.tck'), path('packed.vxl'))
+        run(options.voxlines, 'convert', path('s20k.tck'), path('float32.vxl'), '--positions', 'float32')
+        run(options.voxlines, 'pack', path('packed.vxl'), path('packed.vxlz'))
+        with open(path('packed.vxl'), 'rb') as f:
+            whole = f.read()
+        with open(path('damaged.vxl'), 'wb') as f:
+            f.write(whole[:len(whole) // 2])
+
+        # Each case: the file shared, the mode, and the file voxview renders for reference.
+        cases = [('packed.vxl', 'axis'), ('packed.vxl', 'unsorted'), ('float32.vxl', 'axis'),
+                 ('float32.vxl', 'unsorted'), ('packed.vxlz', 'axis')]
+        for source in sorted({c[0] for c in cases} | {'damaged.vxl'}):
+            folder = path('share-' + source.replace('.', '-'))
+            result = subprocess.run([options.voxlines, 'share', path(source), folder, '--web-viewer',
+                                     options.web_viewer], capture_output=True, text=True)
+            if source == 'damaged.vxl':
+                # share opens what it shares: a damaged file is refused before it reaches a browser.
+                if result.returncode != 3 or 'damaged.vxl' not in result.stderr or os.path.exists(folder):
+                    failures.append(f'share of a damaged file: exit {result.returncode}, {result.stderr.strip()}')
+                continue
+            if result.returncode != 0:
+                failures.append(f'share {source}: exit {result.returncode}: {result.stderr.strip()}')
+
+        for source, mode in cases:
+            folder = path('share-' + source.replace('.', '-'))
+            shared = json.load(open(os.path.join(folder, 'share.json')))['file']
+            server = Server(folder)
+            try:
+                web = path(f'web-{source}-{mode}.png')
+                report = capture(f'{server.url}index.html?size={SIZE}#mode={mode}', web)
+            finally:
+                server.close()
+            if 'error' in report:
+                failures.append(f'{source} {mode}: the page failed: {report["error"]}')
+                continue
+            native = path(f'voxview-{source}-{mode}.png')
+            run(options.voxview, os.path.join(folder, shared), '--render', native, '--size', SIZE, '--mode', mode)
+            value = psnr_rgb(web, native)
+            print(f'{source} {mode}: PSNR {value:.2f} dB against voxview, first picture after '
+                  f'{report["first_picture_ms"]:.0f} ms')
+            if value < MIN_PSNR:
+                keep = os.path.join(tempfile.gettempdir(), 'voxweb-test-failed')
+                os.makedirs(keep, exist_ok=True)
+                shutil.copy(web, keep)
+                shutil.copy(native, keep)
+                failures.append(f'{source} {mode}: PSNR {value:.2f} dB < {MIN_PSNR} (pictures in {keep})')
+
+        # A damaged file reaching the page (served as it is, without share) is refused with its name.
+        folder = path('share-packed-vxl')
+        shutil.copy(path('damaged.vxl'), folder)
+        server = Server(folder)
+        try:
+            report = capture(f'{server.url}index.html?size={SIZE}&file=damaged.vxl', path('damaged.png'))
+        finally:
+            server.close()
+        if 'damaged.vxl' not in report.get('error', ''):
+            failures.append(f'a damaged file in the page: {report}')
+        else:
+            print(f'damaged.vxl in the page: {report["error"]}')
+
+    for f in failures:
+        print('FAILED: ' + f)
+    return 1 if failures else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

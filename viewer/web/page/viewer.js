@@ -1,0 +1,226 @@
+// The web viewer's page: fetches a .vxl file (?file=URL, else the one share.json names, or a file dropped
+// on the page), hands its bytes to the WebAssembly viewer (voxweb.js: the project's reader and renderer),
+// and turns the panel, the mouse and the address's #view part into its settings. Nothing of the method is
+// here: the voxel sort and the choice of stored orders run in the WebAssembly renderer, as in voxview.
+'use strict';
+
+(function () {
+  const $ = (id) => document.getElementById(id);
+  const canvas = $('canvas');
+  const params = new URLSearchParams(location.search);
+  // For tests and for embedding: ?size=WxH fixes the picture's size in pixels.
+  const fixedSize = /^(\d+)x(\d+)$/.exec(params.get('size') || '');
+
+  let settle;  // window.voxweb.ready: resolved after the first frame of a file, rejected on its error
+  window.voxweb = { ready: new Promise((resolve, reject) => { settle = { resolve, reject }; }) };
+
+  function say(text, isError) {
+    $('status').textContent = text;
+    $('status').className = isError ? 'error' : '';
+  }
+
+  function canvasSize() {
+    if (fixedSize) return [Number(fixedSize[1]), Number(fixedSize[2])];
+    const ratio = window.devicePixelRatio || 1;
+    return [Math.max(1, Math.round(canvas.clientWidth * ratio)), Math.max(1, Math.round(canvas.clientHeight * ratio))];
+  }
+
+  function fail(message) {
+    say(message, true);
+    settle.reject(new Error(message));
+  }
+
+  createVoxweb({ canvas }).then((Module) => {
+    const api = {
+      open: Module.cwrap('vw_open', 'number', ['number', 'number', 'string', 'number', 'number']),
+      error: Module.cwrap('vw_error', 'string', []),
+      info: Module.cwrap('vw_info', 'string', []),
+      set: Module.cwrap('vw_set', 'number', ['string', 'string']),
+      drag: Module.cwrap('vw_drag', null, ['number', 'number', 'number']),
+      zoom: Module.cwrap('vw_zoom', null, ['number']),
+      camera: Module.cwrap('vw_camera', 'string', []),
+      setCamera: Module.cwrap('vw_set_camera', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
+      draw: Module.cwrap('vw_draw', 'number', ['number', 'number']),
+    };
+    let opened = false, dirty = false, firstFrame = true;
+
+    function set(key, value) {
+      if (api.set(key, String(value)) !== 0) say(api.error(), true);
+      redraw();
+    }
+    function redraw() {
+      if (opened && !dirty) {
+        dirty = true;
+        requestAnimationFrame(frame);
+      }
+    }
+    function frame() {
+      dirty = false;
+      const [w, h] = canvasSize();
+      if (canvas.width !== w || canvas.height !== h) {
+        canvas.width = w;
+        canvas.height = h;
+      }
+      if (fixedSize) {
+        canvas.style.width = w + 'px';
+        canvas.style.height = h + 'px';
+      }
+      if (api.draw(w, h) !== 0) return fail(api.error());
+      if (firstFrame) {
+        firstFrame = false;
+        settle.resolve();
+      }
+    }
+
+    // The view in the address: #az=..&el=..&distance=..&target=x,y,z&mode=..&opacity=..&color=..
+    function viewHash() {
+      const c = JSON.parse(api.camera());
+      const h = new URLSearchParams();
+      h.set('az', c.az.toFixed(2));
+      h.set('el', c.el.toFixed(2));
+      h.set('distance', c.distance.toPrecision(6));
+      h.set('target', c.target.map((x) => x.toPrecision(7)).join(','));
+      h.set('mode', $('mode').value);
+      h.set('opacity', $('opacity').value);
+      h.set('color', $('color').value);
+      return '#' + h.toString();
+    }
+    function applyHash() {
+      const h = new URLSearchParams(location.hash.slice(1));
+      for (const key of ['mode', 'opacity', 'color']) {
+        if (!h.has(key)) continue;
+        $(key).value = h.get(key);
+        set(key, h.get(key));
+      }
+      if (h.has('az') && h.has('el') && h.has('distance') && h.has('target')) {
+        const t = h.get('target').split(',').map(Number);
+        if (api.setCamera(Number(h.get('az')), Number(h.get('el')), Number(h.get('distance')), t[0], t[1], t[2]) !== 0)
+          say(api.error(), true);
+      }
+      $('opacity-value').textContent = $('opacity').value;
+      redraw();
+    }
+
+    function openBytes(pointer, size, name) {
+      const [w, h] = canvasSize();
+      const t0 = performance.now();
+      if (api.open(pointer, size, name, w, h) !== 0) return fail(api.error());
+      opened = true;
+      const info = JSON.parse(api.info());
+      $('info').textContent = `${info.streamlines.toLocaleString()} streamlines, ` +
+        `${info.vertices.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`;
+      $('mode').replaceChildren(...info.modes.map((m) => {
+        const o = document.createElement('option');
+        o.value = m.name;
+        o.textContent = m.name;
+        o.title = m.description;
+        return o;
+      }));
+      $('mode').value = 'axis';
+      say(`${name}: opened in ${((performance.now() - t0) / 1000).toFixed(2)} s`);
+      applyHash();
+    }
+
+    // Streams the response into the WebAssembly memory as it arrives (one copy of the file in the tab).
+    async function fetchFile(url) {
+      say('fetching ' + url);
+      const response = await fetch(url);
+      if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
+      const declared = Number(response.headers.get('Content-Length'));
+      const chunks = [];
+      let received = 0, pointer = 0;
+      if (declared > 0) pointer = Module._malloc(declared);
+      const reader = response.body.getReader();
+      for (;;) {
+        const { done, value } = await reader.read();
+        if (done) break;
+        if (pointer && received + value.length <= declared)
+          Module.HEAPU8.set(value, pointer + received);
+        else
+          chunks.push(value);
+        received += value.length;
+        if (declared > 0) $('progress').value = received / declared;
+      }
+      if (!pointer || received !== declared) {  // no length given, or not the length given: copy what came
+        if (pointer) chunks.unshift(Module.HEAPU8.slice(pointer, pointer + Math.min(received, declared)));
+        if (pointer) Module._free(pointer);
+        pointer = Module._malloc(Math.max(1, received));
+        let at = 0;
+        for (const c of chunks) { Module.HEAPU8.set(c, pointer + at); at += c.length; }
+      }
+      $('progress').value = 1;
+      openBytes(pointer, received, url.split('/').pop());
+    }
+
+    async function dropFile(file) {
+      const bytes = new Uint8Array(await file.arrayBuffer());
+      const pointer = Module._malloc(Math.max(1, bytes.length));
+      Module.HEAPU8.set(bytes, pointer);
+      openBytes(pointer, bytes.length, file.name);
+    }
+
+    async function start() {
+      let url = params.get('file');
+      if (!url) {
+        const share = await fetch('share.json').then((r) => (r.ok ? r.json() : null)).catch(() => null);
+        if (share && share.file) url = share.file;
+        if (share && share.title) {
+          $('title').textContent = share.title;
+          document.title = share.title + ' — Voxlines';
+        }
+      }
+      if (url) await fetchFile(url);
+      else say('Drop a .vxl file on the page, or open it as index.html?file=URL');
+    }
+
+    // The panel.
+    $('mode').onchange = () => set('mode', $('mode').value);
+    $('opacity').oninput = () => { $('opacity-value').textContent = $('opacity').value; set('opacity', $('opacity').value); };
+    $('color').onchange = () => set('color', $('color').value);
+    for (const v of ['axial', 'inferior', 'coronal', 'posterior', 'sagittal', 'right']) {
+      const b = document.createElement('button');
+      b.textContent = v;
+      b.onclick = () => set('view', v);
+      $('views').appendChild(b);
+    }
+    $('screenshot').onclick = () => {
+      const a = document.createElement('a');
+      a.download = 'voxlines.png';
+      a.href = canvas.toDataURL('image/png');
+      a.click();
+    };
+    $('link').onclick = () => {
+      history.replaceState(null, '', viewHash());
+      if (navigator.clipboard) navigator.clipboard.writeText(location.href).catch(() => {});
+      say('the address now shows this view');
+    };
+
+    // The mouse: left drag orbits, right (or shift) drag pans, the wheel zooms.
+    const scale = () => canvas.height / Math.max(1, canvas.clientHeight);
+    canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+    canvas.addEventListener('pointerdown', (e) => {
+      canvas.setPointerCapture(e.pointerId);
+      api.drag(e.button === 2 || e.shiftKey ? 2 : 1, e.offsetX * scale(), e.offsetY * scale());
+    });
+    canvas.addEventListener('pointermove', (e) => {
+      if (!e.buttons) return;
+      api.drag(1, e.offsetX * scale(), e.offsetY * scale());  // continues the drag begun
+      redraw();
+    });
+    canvas.addEventListener('pointerup', () => api.drag(0, 0, 0));
+    canvas.addEventListener('wheel', (e) => { e.preventDefault(); api.zoom(-Math.sign(e.deltaY)); redraw(); }, { passive: false });
+    window.addEventListener('resize', redraw);
+    window.addEventListener('hashchange', applyHash);
+
+    // A file dropped on the page.
+    window.addEventListener('dragover', (e) => { e.preventDefault(); $('drop').style.display = 'flex'; });
+    window.addEventListener('dragleave', () => { $('drop').style.display = 'none'; });
+    window.addEventListener('drop', (e) => {
+      e.preventDefault();
+      $('drop').style.display = 'none';
+      if (e.dataTransfer.files.length) dropFile(e.dataTransfer.files[0]).catch((err) => fail(err.message));
+    });
+
+    start().catch((err) => fail(err.message));
+  }, (err) => fail('cannot start the viewer: ' + err));
+})();

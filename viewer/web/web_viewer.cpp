@@ -1,0 +1,247 @@
+// The web viewer's side in WebAssembly: a .vxl file's bytes (fetched by the page) opened by the same reader
+// as voxview's, drawn by the same renderer into the page's canvas with WebGL2, with the same camera
+// controller. The page (page/voxweb.js) calls these functions through Emscripten's cwrap; each returns 0
+// or an error whose message vw_error() gives.
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <emscripten/emscripten.h>
+#include <emscripten/html5.h>
+#include <nlohmann/json.hpp>
+
+#include "format/base/error.h"
+#include "format/vxl_file.h"
+#include "viewer/app/camera_controller.h"
+#include "viewer/render/camera.h"
+#include "viewer/render/render_settings.h"
+#include "viewer/render/renderer.h"
+#include "viewer/render/scene_framing.h"
+
+namespace vxl::web {
+namespace {
+
+// The modes WebGL2 can draw: exact needs storage buffers and compute shaders, segsort rewrites buffer
+// textures in place; WebGL2 has neither.
+bool drawable_on_the_web(RenderMode mode) { return mode != RenderMode::Exact && mode != RenderMode::Segsort; }
+
+struct Viewer {
+  std::optional<VxlFile> file;
+  std::unique_ptr<Renderer> renderer;
+  std::unique_ptr<app::CameraController> controller;
+  RenderSettings settings = [] {
+    RenderSettings s;
+    s.opacity = kDefaultLineOpacity;
+    return s;
+  }();
+  int width = 1, height = 1;
+};
+
+Viewer& viewer() {
+  static Viewer v;
+  return v;
+}
+
+std::string& last_error() {
+  static std::string e;
+  return e;
+}
+
+// Runs `fn`, turning an exception into an error code and vw_error()'s message.
+template <typename Fn>
+int guarded(Fn&& fn) {
+  try {
+    fn();
+    last_error().clear();
+    return 0;
+  } catch (const Error& e) {
+    last_error() = e.what();
+    return static_cast<int>(e.kind());
+  } catch (const std::exception& e) {
+    last_error() = e.what();
+    return 70;
+  }
+}
+
+void make_context() {
+  static EMSCRIPTEN_WEBGL_CONTEXT_HANDLE context = 0;
+  if (context > 0) return;
+  EmscriptenWebGLContextAttributes a;
+  emscripten_webgl_init_context_attributes(&a);
+  a.majorVersion = 2;
+  a.minorVersion = 0;
+  a.alpha = false;      // the picture is opaque over its background, as voxview's PNG
+  a.antialias = false;  // as voxview's offscreen picture
+  a.depth = true;
+  a.preserveDrawingBuffer = true;  // the screenshot reads the canvas after the frame
+  context = emscripten_webgl_create_context("#canvas", &a);
+  if (context <= 0) throw std::runtime_error("this browser offers no WebGL2 context");
+  emscripten_webgl_make_context_current(context);
+  // The wboit and additive modes render to float targets.
+  emscripten_webgl_enable_extension(context, "EXT_color_buffer_float");
+}
+
+// The camera a file opens with: the default view, framing the streamlines (as voxview's).
+Camera home_camera(const Renderer& renderer, double aspect) {
+  Camera c;
+  c.azimuth_deg = kDefaultView[0];
+  c.elevation_deg = kDefaultView[1];
+  c.frame_points(framing_points(renderer.layout()), aspect);
+  return c;
+}
+
+}  // namespace
+}  // namespace vxl::web
+
+using vxl::web::guarded;
+using vxl::web::viewer;
+
+extern "C" {
+
+// Takes the file's bytes (from malloc; freed by the viewer, also on failure) and opens them; the canvas is
+// then width x height pixels.
+EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* name, int width, int height) {
+  auto held = vxl::MappedFile::adopt(name, bytes, static_cast<std::size_t>(size));
+  return guarded([&] {
+    auto& v = viewer();
+    v.renderer.reset();
+    v.controller.reset();
+    v.file.reset();
+    v.file.emplace(vxl::VxlFile::open(std::move(held)));
+    vxl::web::make_context();
+    v.width = std::max(width, 1);
+    v.height = std::max(height, 1);
+    v.renderer = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file});
+    const vxl::Camera home = vxl::web::home_camera(*v.renderer, double(v.width) / v.height);
+    const glm::dvec3 extent = v.renderer->bounds_max() - v.renderer->bounds_min();
+    v.controller = std::make_unique<vxl::app::CameraController>(home, 0.5 * glm::length(extent));
+    v.controller->set_window_height(v.height);
+  });
+}
+
+EMSCRIPTEN_KEEPALIVE const char* vw_error() { return vxl::web::last_error().c_str(); }
+
+// What the page shows about the file: counts and the modes it can draw, as JSON.
+EMSCRIPTEN_KEEPALIVE const char* vw_info() {
+  static std::string text;
+  nlohmann::json j;
+  auto& v = viewer();
+  if (v.file) {
+    const auto& m = v.file->meta();
+    j["streamlines"] = m.streamline_count;
+    j["vertices"] = m.vertex_count;
+    j["voxels"] = v.file->voxels().size();
+    j["bytes"] = v.file->bytes().size();
+    j["gpu_bytes"] = v.renderer ? v.renderer->gpu_bytes() : 0;
+  }
+  nlohmann::json modes = nlohmann::json::array();
+  for (const vxl::RenderModeInfo& m : vxl::render_modes())
+    if (vxl::web::drawable_on_the_web(m.mode)) modes.push_back({{"name", m.name}, {"description", m.description}});
+  j["modes"] = modes;
+  text = j.dump();
+  return text.c_str();
+}
+
+// One setting by name, as voxview's options spell them: mode, color, opacity, fixed-color (hex), background
+// (hex), view ("AZ,EL" or a standard view's name), zoom (a factor over the framed view), lighting (0/1).
+EMSCRIPTEN_KEEPALIVE int vw_set(const char* key_text, const char* value_text) {
+  return guarded([&] {
+    const std::string key = key_text, value = value_text;
+    auto& v = viewer();
+    auto bad = [&] { return vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "bad " + key + ": '" + value + "'"); };
+    if (key == "mode") {
+      const auto mode = vxl::parse_render_mode(value);
+      if (!mode) throw bad();
+      if (!vxl::web::drawable_on_the_web(*mode))
+        throw vxl::Error(vxl::ErrorKind::Unsupported, "", std::nullopt,
+                         "the " + value + " mode needs storage buffers or compute shaders, which WebGL2 lacks");
+      v.settings.mode = *mode;
+    } else if (key == "color") {
+      const auto color = vxl::parse_color_mode(value);
+      if (!color) throw bad();
+      v.settings.color = *color;
+    } else if (key == "opacity") {
+      const float o = std::strtof(value.c_str(), nullptr);
+      if (!(o >= 0.001f && o <= 1.0f)) throw bad();
+      v.settings.opacity = o;
+    } else if (key == "fixed-color" || key == "background") {
+      const auto c = vxl::parse_hex_color(value);
+      if (!c) throw bad();
+      (key == "background" ? v.settings.background_color : v.settings.fixed_color) = *c;
+    } else if (key == "lighting") {
+      v.settings.lighting = value == "1";
+    } else if (key == "view") {
+      const auto view = vxl::parse_view(value);
+      if (!view || !v.controller) throw bad();
+      v.controller->set_view((*view)[0], (*view)[1]);
+    } else {
+      throw vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "no setting '" + key + "'");
+    }
+  });
+}
+
+// Mouse input in canvas pixels (y down): mode 1 orbits, 2 pans, 0 ends the drag.
+EMSCRIPTEN_KEEPALIVE void vw_drag(int mode, double x, double y) {
+  auto& c = viewer().controller;
+  if (!c) return;
+  if (mode == 0) return c->end_drag();
+  if (c->dragging() == vxl::app::DragMode::None)
+    c->begin_drag(mode == 1 ? vxl::app::DragMode::Orbit : vxl::app::DragMode::Pan, x, y);
+  else
+    c->drag_to(x, y);
+}
+
+EMSCRIPTEN_KEEPALIVE void vw_zoom(double steps) {
+  if (viewer().controller) viewer().controller->zoom(steps);
+}
+
+// The camera as JSON (target, distance, azimuth, elevation), for the link to this view; vw_set_camera takes it back.
+EMSCRIPTEN_KEEPALIVE const char* vw_camera() {
+  static std::string text;
+  auto& v = viewer();
+  if (!v.controller) return "{}";
+  const vxl::Camera& c = v.controller->camera();
+  text = nlohmann::json{{"az", c.azimuth_deg},
+                        {"el", c.elevation_deg},
+                        {"distance", c.distance},
+                        {"target", {c.target.x, c.target.y, c.target.z}}}
+             .dump();
+  return text.c_str();
+}
+
+EMSCRIPTEN_KEEPALIVE int vw_set_camera(double az, double el, double distance, double tx, double ty, double tz) {
+  return guarded([&] {
+    auto& v = viewer();
+    if (!v.controller) throw std::runtime_error("no file is open");
+    vxl::Camera c = v.controller->camera();
+    if (!(distance >= vxl::ViewLimits::kMinMm && distance <= vxl::ViewLimits::kMaxMm) || !std::isfinite(az) ||
+        !std::isfinite(el) || !std::isfinite(tx) || !std::isfinite(ty) || !std::isfinite(tz))
+      throw vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "a view outside the limits of a picture");
+    c.azimuth_deg = az;
+    c.elevation_deg = std::clamp(el, -90.0, 90.0);
+    c.distance = distance;
+    c.target = {tx, ty, tz};
+    v.controller->set_camera(c);
+  });
+}
+
+// Draws a frame into the canvas, now width x height pixels.
+EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height) {
+  return guarded([&] {
+    auto& v = viewer();
+    if (!v.renderer) throw std::runtime_error("no file is open");
+    v.width = std::max(width, 1);
+    v.height = std::max(height, 1);
+    v.controller->set_window_height(v.height);
+    v.renderer->draw(v.controller->camera(), v.settings, v.width, v.height, 0);
+    v.renderer->check_uploaded(false);
+  });
+}
+
+}  // extern "C"
+
+int main() { return 0; }
