@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
-"""Opens a page of the web viewer in headless Chromium and writes its first complete picture as a PNG.
+"""Opens a page of the web viewer in headless Chromium and writes its picture at full detail as a PNG.
 
     scripts/web_capture.py URL OUT.png [--timeout S] [--chromium PATH]
 
-The page (viewer/web/page) resolves window.voxweb.ready after its first frame, or rejects it with the
-viewer's error; this waits for that and saves the canvas. Prints one JSON line: the milliseconds from
-navigation to the first picture ("first_picture_ms"), the page's JavaScript heap and what the console said.
+The page (viewer/web/page) resolves window.voxweb.ready after its first frame (which may be drawn at a
+coarser level of detail) and window.voxweb.complete after its first frame at full detail, or rejects them
+with the viewer's error; this waits for both and saves the canvas. Prints one JSON line: the milliseconds
+from navigation to the first picture ("first_picture_ms") and to full detail ("full_detail_ms"), the page's
+JavaScript heap and what the console said.
 Exit 0 with the picture, 1 when the page reported an error, 2 on a browser or usage failure.
 
 Chromium is driven over the DevTools protocol on a pipe (--remote-debugging-pipe: JSON messages ended by a
@@ -99,24 +101,34 @@ class DevTools:
             self.process.wait()
 
 
-# Waits for the page's viewer, then for its first frame; gives the picture and the time it took.
+# Waits for the page's viewer, then for its first frame and its first at full detail; gives the picture
+# and the times. A read of the canvas waits for the frame before it, so each time includes its drawing.
 FIRST_PICTURE = """new Promise((resolve) => {
+  const canvas = () => document.getElementById('canvas');
+  const failed = (e) => resolve({ error: String(e && e.message || e) });
   (function poll() {
     if (!window.voxweb) return setTimeout(poll, 10);
-    window.voxweb.ready.then(
-      () => resolve({ png: document.getElementById('canvas').toDataURL('image/png'),
-                      first_picture_ms: performance.now(),
-                      heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null }),
-      (e) => resolve({ error: String(e && e.message || e) }));
+    window.voxweb.ready.then(() => {
+      const gl = canvas().getContext('webgl2');
+      gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+      const first = performance.now();
+      window.voxweb.complete.then(() => resolve({
+        png: canvas().toDataURL('image/png'), first_picture_ms: first, full_detail_ms: performance.now(),
+        heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null }), failed);
+    }, failed);
   })();
 })"""
 
 
-def capture(url, out, timeout, chromium):
+def capture(url, out, timeout, chromium, on_start=None):
+    """The page's report (a dict; with 'error' when the page failed), its picture written to `out`.
+    on_start(process) is called once the browser runs (a benchmark samples its memory)."""
     profile = tempfile.mkdtemp(prefix='voxweb-chromium-')
     browser = None
     try:
         browser = DevTools(chromium, profile)
+        if on_start:
+            on_start(browser.process)
         target = browser.call('Target.createTarget', {'url': 'about:blank'})['targetId']
         session = browser.call('Target.attachToTarget', {'targetId': target, 'flatten': True})['sessionId']
         browser.call('Page.enable', session=session)
@@ -134,15 +146,14 @@ def capture(url, out, timeout, chromium):
         report = {'url': url, 'console': console}
         if 'error' in value:
             report['error'] = value['error']
-            print(json.dumps(report))
-            return 1
+            return report
         png = base64.b64decode(value['png'].split(',', 1)[1])
         with open(out + '.part', 'wb') as f:
             f.write(png)
         os.replace(out + '.part', out)
-        report.update({'first_picture_ms': round(value['first_picture_ms'], 1), 'heap_bytes': value['heap_bytes']})
-        print(json.dumps(report))
-        return 0
+        report.update({'first_picture_ms': round(value['first_picture_ms'], 1),
+                       'full_detail_ms': round(value['full_detail_ms'], 1), 'heap_bytes': value['heap_bytes']})
+        return report
     finally:
         if browser:
             browser.close()
@@ -157,7 +168,9 @@ def main():
     parser.add_argument('--chromium', default=shutil.which('chromium') or 'chromium')
     args = parser.parse_args()
     try:
-        return capture(args.url, args.out, args.timeout, args.chromium)
+        report = capture(args.url, args.out, args.timeout, args.chromium)
+        print(json.dumps(report))
+        return 1 if 'error' in report else 0
     except (RuntimeError, TimeoutError, OSError) as e:
         print(json.dumps({'url': args.url, 'error': f'browser: {e}'}))
         return 2

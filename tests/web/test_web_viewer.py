@@ -126,7 +126,7 @@ def main():
             run(options.voxview, os.path.join(folder, shared), '--render', native, '--size', SIZE, '--mode', mode)
             value = psnr_rgb(web, native)
             print(f'{source} {mode}: PSNR {value:.2f} dB against voxview, first picture after '
-                  f'{report["first_picture_ms"]:.0f} ms')
+                  f'{report["first_picture_ms"]:.0f} ms, full detail after {report["full_detail_ms"]:.0f} ms')
             if value < MIN_PSNR:
                 keep = os.path.join(tempfile.gettempdir(), 'voxweb-test-failed')
                 os.makedirs(keep, exist_ok=True)

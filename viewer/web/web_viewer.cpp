@@ -1,7 +1,11 @@
 // The web viewer's side in WebAssembly: a .vxl file's bytes (fetched by the page) opened by the same reader
 // as voxview's, drawn by the same renderer into the page's canvas with WebGL2, with the same camera
-// controller. The page (page/voxweb.js) calls these functions through Emscripten's cwrap; each returns 0
+// controller. The page (page/viewer.js) calls these functions through Emscripten's cwrap; each returns 0
 // or an error whose message vw_error() gives.
+//
+// The first picture is drawn at the finest level of detail whose GPU copy is at most kFirstPictureBytes (a
+// software WebGL draws a 144k-streamline file's 8M segments in about 9 s on 2 cores); vw_refine() then adds
+// the full-detail renderer, which draws the view at rest while the first one keeps drawing it in motion.
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -21,6 +25,7 @@
 #include "viewer/render/render_settings.h"
 #include "viewer/render/renderer.h"
 #include "viewer/render/scene_framing.h"
+#include "viewer/render/scene_layout.h"
 
 namespace vxl::web {
 namespace {
@@ -29,9 +34,12 @@ namespace {
 // textures in place; WebGL2 has neither.
 bool drawable_on_the_web(RenderMode mode) { return mode != RenderMode::Exact && mode != RenderMode::Segsort; }
 
+constexpr std::uint64_t kFirstPictureBytes = 8ull << 20;
+
 struct Viewer {
   std::optional<VxlFile> file;
-  std::unique_ptr<Renderer> renderer;
+  std::unique_ptr<Renderer> quick;  // at the first picture's level; null when that is full detail
+  std::unique_ptr<Renderer> full;   // full detail: made by vw_open when it is the first picture's, else by vw_refine
   std::unique_ptr<app::CameraController> controller;
   RenderSettings settings = [] {
     RenderSettings s;
@@ -85,13 +93,28 @@ void make_context() {
   emscripten_webgl_enable_extension(context, "EXT_color_buffer_float");
 }
 
-// The camera a file opens with: the default view, framing the streamlines (as voxview's).
-Camera home_camera(const Renderer& renderer, double aspect) {
+// The camera a file opens with: the default view, framing the streamlines at full detail (as voxview's).
+Camera home_camera(const VxlFile& file, double aspect) {
   Camera c;
   c.azimuth_deg = kDefaultView[0];
   c.elevation_deg = kDefaultView[1];
-  c.frame_points(framing_points(renderer.layout()), aspect);
+  c.frame_points(framing_points(SceneLayout(file, gl::max_buffer_texels(), 0)), aspect);
   return c;
+}
+
+// The finest level whose GPU copy fits kFirstPictureBytes, else the coarsest the file has.
+std::uint32_t first_picture_level(const std::vector<const VxlFile*>& files) {
+  try {
+    return SceneLayout::finest_level_within(files, gl::max_buffer_texels(), kFirstPictureBytes);
+  } catch (const Error&) {
+    return SceneLayout::coarsest_level(files);
+  }
+}
+
+// The renderer a frame is drawn with: the first picture's while moving or before full detail is made.
+Renderer* renderer_for(Viewer& v, bool moving) {
+  if (v.quick && (moving || !v.full)) return v.quick.get();
+  return v.full.get();
 }
 
 }  // namespace
@@ -108,16 +131,20 @@ EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* n
   auto held = vxl::MappedFile::adopt(name, bytes, static_cast<std::size_t>(size));
   return guarded([&] {
     auto& v = viewer();
-    v.renderer.reset();
+    v.quick.reset();
+    v.full.reset();
     v.controller.reset();
     v.file.reset();
     v.file.emplace(vxl::VxlFile::open(std::move(held)));
     vxl::web::make_context();
     v.width = std::max(width, 1);
     v.height = std::max(height, 1);
-    v.renderer = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file});
-    const vxl::Camera home = vxl::web::home_camera(*v.renderer, double(v.width) / v.height);
-    const glm::dvec3 extent = v.renderer->bounds_max() - v.renderer->bounds_min();
+    const std::vector<const vxl::VxlFile*> files{&*v.file};
+    const std::uint32_t level = vxl::web::first_picture_level(files);
+    (level > 0 ? v.quick : v.full) = std::make_unique<vxl::Renderer>(files, 0, level);
+    const vxl::Camera home = vxl::web::home_camera(*v.file, double(v.width) / v.height);
+    const vxl::Renderer& any = *vxl::web::renderer_for(v, false);
+    const glm::dvec3 extent = any.bounds_max() - any.bounds_min();
     v.controller = std::make_unique<vxl::app::CameraController>(home, 0.5 * glm::length(extent));
     v.controller->set_window_height(v.height);
   });
@@ -136,7 +163,9 @@ EMSCRIPTEN_KEEPALIVE const char* vw_info() {
     j["vertices"] = m.vertex_count;
     j["voxels"] = v.file->voxels().size();
     j["bytes"] = v.file->bytes().size();
-    j["gpu_bytes"] = v.renderer ? v.renderer->gpu_bytes() : 0;
+    j["gpu_bytes"] = (v.quick ? v.quick->gpu_bytes() : 0) + (v.full ? v.full->gpu_bytes() : 0);
+    j["first_level"] = v.quick ? v.quick->layout().level() : 0;
+    j["full_detail"] = v.full != nullptr;
   }
   nlohmann::json modes = nlohmann::json::array();
   for (const vxl::RenderModeInfo& m : vxl::render_modes())
@@ -229,16 +258,26 @@ EMSCRIPTEN_KEEPALIVE int vw_set_camera(double az, double el, double distance, do
   });
 }
 
-// Draws a frame into the canvas, now width x height pixels.
-EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height) {
+// Makes the full-detail renderer when the first picture was coarser (nothing otherwise).
+EMSCRIPTEN_KEEPALIVE int vw_refine() {
   return guarded([&] {
     auto& v = viewer();
-    if (!v.renderer) throw std::runtime_error("no file is open");
+    if (!v.file) throw std::runtime_error("no file is open");
+    if (!v.full) v.full = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file});
+  });
+}
+
+// Draws a frame into the canvas, now width x height pixels; `moving` (a drag) draws the first picture's level.
+EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
+  return guarded([&] {
+    auto& v = viewer();
+    vxl::Renderer* renderer = v.file ? vxl::web::renderer_for(v, moving != 0) : nullptr;
+    if (renderer == nullptr) throw std::runtime_error("no file is open");
     v.width = std::max(width, 1);
     v.height = std::max(height, 1);
     v.controller->set_window_height(v.height);
-    v.renderer->draw(v.controller->camera(), v.settings, v.width, v.height, 0);
-    v.renderer->check_uploaded(false);
+    renderer->draw(v.controller->camera(), v.settings, v.width, v.height, 0);
+    renderer->check_uploaded(false);
   });
 }
 

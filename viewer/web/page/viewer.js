@@ -11,8 +11,13 @@
   // For tests and for embedding: ?size=WxH fixes the picture's size in pixels.
   const fixedSize = /^(\d+)x(\d+)$/.exec(params.get('size') || '');
 
-  let settle;  // window.voxweb.ready: resolved after the first frame of a file, rejected on its error
-  window.voxweb = { ready: new Promise((resolve, reject) => { settle = { resolve, reject }; }) };
+  // window.voxweb.ready: resolved after the first frame of a file, rejected on its error; .complete: after the
+  // first frame at full detail (the first may be drawn at a coarser level).
+  let settle, settleComplete;
+  window.voxweb = {
+    ready: new Promise((resolve, reject) => { settle = { resolve, reject }; }),
+    complete: new Promise((resolve, reject) => { settleComplete = { resolve, reject }; }),
+  };
 
   function say(text, isError) {
     $('status').textContent = text;
@@ -28,6 +33,7 @@
   function fail(message) {
     say(message, true);
     settle.reject(new Error(message));
+    settleComplete.reject(new Error(message));
   }
 
   createVoxweb({ canvas }).then((Module) => {
@@ -40,9 +46,11 @@
       zoom: Module.cwrap('vw_zoom', null, ['number']),
       camera: Module.cwrap('vw_camera', 'string', []),
       setCamera: Module.cwrap('vw_set_camera', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
-      draw: Module.cwrap('vw_draw', 'number', ['number', 'number']),
+      draw: Module.cwrap('vw_draw', 'number', ['number', 'number', 'number']),
+      refine: Module.cwrap('vw_refine', 'number', []),
     };
-    let opened = false, dirty = false, firstFrame = true;
+    // moving: a drag is under way (frames then come from the first picture's level of detail).
+    let opened = false, dirty = false, firstFrame = true, fullDetail = false, moving = false;
 
     function set(key, value) {
       if (api.set(key, String(value)) !== 0) say(api.error(), true);
@@ -65,11 +73,22 @@
         canvas.style.width = w + 'px';
         canvas.style.height = h + 'px';
       }
-      if (api.draw(w, h) !== 0) return fail(api.error());
+      if (api.draw(w, h, moving ? 1 : 0) !== 0) return fail(api.error());
       if (firstFrame) {
         firstFrame = false;
         settle.resolve();
+        if (!fullDetail) setTimeout(refine, 0);  // once the first picture is on the screen
       }
+      if (fullDetail && !moving) settleComplete.resolve();
+    }
+    function refine() {
+      const t0 = performance.now();
+      if (api.refine() !== 0) return fail(api.error());
+      fullDetail = true;
+      const info = JSON.parse(api.info());
+      say($('status').textContent + `\nfull detail in ${((performance.now() - t0) / 1000).toFixed(2)} s (first picture ` +
+          `at level ${info.first_level}: 1/${8 ** info.first_level} of the streamlines)`);
+      redraw();
     }
 
     // The view in the address: #az=..&el=..&distance=..&target=x,y,z&mode=..&opacity=..&color=..
@@ -107,6 +126,7 @@
       if (api.open(pointer, size, name, w, h) !== 0) return fail(api.error());
       opened = true;
       const info = JSON.parse(api.info());
+      fullDetail = info.full_detail;
       $('info').textContent = `${info.streamlines.toLocaleString()} streamlines, ` +
         `${info.vertices.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`;
       $('mode').replaceChildren(...info.modes.map((m) => {
@@ -200,6 +220,7 @@
     canvas.addEventListener('contextmenu', (e) => e.preventDefault());
     canvas.addEventListener('pointerdown', (e) => {
       canvas.setPointerCapture(e.pointerId);
+      moving = true;
       api.drag(e.button === 2 || e.shiftKey ? 2 : 1, e.offsetX * scale(), e.offsetY * scale());
     });
     canvas.addEventListener('pointermove', (e) => {
@@ -207,7 +228,7 @@
       api.drag(1, e.offsetX * scale(), e.offsetY * scale());  // continues the drag begun
       redraw();
     });
-    canvas.addEventListener('pointerup', () => api.drag(0, 0, 0));
+    canvas.addEventListener('pointerup', () => { api.drag(0, 0, 0); moving = false; redraw(); });
     canvas.addEventListener('wheel', (e) => { e.preventDefault(); api.zoom(-Math.sign(e.deltaY)); redraw(); }, { passive: false });
     window.addEventListener('resize', redraw);
     window.addEventListener('hashchange', applyHash);

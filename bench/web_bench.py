@@ -1,0 +1,113 @@
+#!/usr/bin/python3
+"""The web viewer's times and memory: for each .vxl given, `voxlines share` it, serve the folder over HTTP on
+this machine, open it in headless Chromium (software WebGL2: SwiftShader) and report, per round, the
+milliseconds from navigation to the first picture (drawn at a coarser level of detail for a large file) and to
+full detail, and the browser's peak memory: the resident set of all its processes together, sampled every
+50 ms, against the file's size.
+
+Usage: bench/web_bench.py FILE.vxl... [--rounds N] [--size WxH] [--voxlines PATH]
+"""
+import argparse
+import http.server
+import functools
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'scripts'))
+import web_capture  # noqa: E402
+
+
+class QuietHandler(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args):
+        pass
+
+
+def tree_rss_bytes(root):
+    """The resident memory of `root` and every process below it."""
+    children = {}
+    for pid in os.listdir('/proc'):
+        if not pid.isdigit():
+            continue
+        try:
+            with open(f'/proc/{pid}/stat') as f:
+                fields = f.read().rsplit(')', 1)[1].split()
+            children.setdefault(int(fields[1]), []).append(int(pid))
+        except OSError:
+            continue
+    total, todo = 0, [root]
+    while todo:
+        pid = todo.pop()
+        todo += children.get(pid, [])
+        try:
+            with open(f'/proc/{pid}/statm') as f:
+                total += int(f.read().split()[1]) * os.sysconf('SC_PAGE_SIZE')
+        except OSError:
+            pass
+    return total
+
+
+class PeakSampler:
+    def __init__(self):
+        self.peak, self._root, self._stop = 0, None, threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def start(self, process):
+        self._root = process.pid
+        self._thread.start()
+
+    def _run(self):
+        while not self._stop.wait(0.05):
+            self.peak = max(self.peak, tree_rss_bytes(self._root))
+
+    def stop(self):
+        self._stop.set()
+        if self._thread.is_alive():
+            self._thread.join()
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('files', nargs='+')
+    parser.add_argument('--rounds', type=int, default=2)
+    parser.add_argument('--size', default='1024x1024')
+    parser.add_argument('--voxlines', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), '..',
+                                                           'build', 'release', 'converter', 'voxlines'))
+    parser.add_argument('--chromium', default=shutil.which('chromium') or 'chromium')
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix='voxweb-bench-') as work:
+        for path in args.files:
+            folder = os.path.join(work, os.path.basename(path) + '.share')
+            subprocess.run([args.voxlines, 'share', path, folder], check=True, capture_output=True)
+            handler = functools.partial(QuietHandler, directory=folder)
+            httpd = http.server.ThreadingHTTPServer(('127.0.0.1', 0), handler)
+            threading.Thread(target=httpd.serve_forever, daemon=True).start()
+            url = f'http://127.0.0.1:{httpd.server_address[1]}/index.html?size={args.size}'
+            size = os.path.getsize(path)
+            try:
+                for r in range(args.rounds):
+                    sampler = PeakSampler()
+                    t0 = time.monotonic()
+                    try:
+                        report = web_capture.capture(url, os.path.join(work, 'picture.png'), 900, args.chromium,
+                                                     on_start=sampler.start)
+                    finally:
+                        sampler.stop()
+                    if 'error' in report:
+                        print(f'{os.path.basename(path)}: {report["error"]}')
+                        return 1
+                    print(f'{os.path.basename(path)} ({size / 2**20:.0f} MiB) round {r + 1}: first picture '
+                          f'{report["first_picture_ms"] / 1000:.2f} s, full detail {report["full_detail_ms"] / 1000:.2f} s, '
+                          f'browser peak RSS {sampler.peak / 2**20:.0f} MiB = {sampler.peak / size:.2f}x the file '
+                          f'(whole run {time.monotonic() - t0:.1f} s)', flush=True)
+            finally:
+                httpd.shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
