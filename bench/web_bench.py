@@ -101,7 +101,7 @@ def main():
                         print(f'{os.path.basename(path)}: {report["error"]}')
                         return 1
                     print(f'{os.path.basename(path)} ({size / 2**20:.0f} MiB) round {r + 1}: first picture '
-                          f'{report["first_picture_ms"] / 1000:.2f} s, full detail {report["full_detail_ms"] / 1000:.2f} s, '
+                          f'{report["first_picture_ms"] / 1000:.2f} s (level {report["first_level"]}), full detail {report["full_detail_ms"] / 1000:.2f} s, '
                           f'browser peak RSS {sampler.peak / 2**20:.0f} MiB = {sampler.peak / size:.2f}x the file '
                           f'(whole run {time.monotonic() - t0:.1f} s)', flush=True)
             finally:

@@ -114,6 +114,7 @@ FIRST_PICTURE = """new Promise((resolve) => {
       const first = performance.now();
       window.voxweb.complete.then(() => resolve({
         png: canvas().toDataURL('image/png'), first_picture_ms: first, full_detail_ms: performance.now(),
+        first_level: window.voxweb.info ? window.voxweb.info.first_level : null,
         heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null }), failed);
     }, failed);
   })();
@@ -152,7 +153,8 @@ def capture(url, out, timeout, chromium, on_start=None):
             f.write(png)
         os.replace(out + '.part', out)
         report.update({'first_picture_ms': round(value['first_picture_ms'], 1),
-                       'full_detail_ms': round(value['full_detail_ms'], 1), 'heap_bytes': value['heap_bytes']})
+                       'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'],
+                       'heap_bytes': value['heap_bytes']})
         return report
     finally:
         if browser:

@@ -3,10 +3,12 @@
 headless Chromium (WebGL2 on SwiftShader), against `voxview --render` of the same file with the same camera
 (llvmpipe). Two rasterisers draw a line's pixels a little differently, so the pictures are compared by PSNR
 over R, G, B (at least MIN_PSNR dB), not byte for byte. Cases: a synthetic set of 20,000 streamlines, packed
-and float32, in the axis and unsorted modes; a .vxlz shared (unpacked by share); a damaged file, which the
-page must refuse with a message naming it.
+and float32, in the axis and unsorted modes; a .vxlz shared (unpacked by share); with the real fixtures (when
+--real-data holds them), MRtrix's test tracks coloured by their AFD values; damaged files, which the page
+must refuse with a message naming them: one cut short (the reader's structure checks), and two whose structure
+holds but whose orders or vertices were overwritten (the draw checks that voxview runs, which the page runs too).
 
-Usage: tests/web/test_web_viewer.py --voxlines PATH --voxview PATH --web-viewer DIR
+Usage: tests/web/test_web_viewer.py --voxlines PATH --voxview PATH --web-viewer DIR [--real-data DIR]
 Exit 0 when every case holds, 1 otherwise, 77 when there is no Chromium to run it in.
 """
 import argparse
@@ -76,6 +78,7 @@ def main():
     parser.add_argument('--voxlines', required=True)
     parser.add_argument('--voxview', required=True)
     parser.add_argument('--web-viewer', required=True)
+    parser.add_argument('--real-data', default='')
     options = parser.parse_args()
     if shutil.which('chromium') is None:
         print('test_web_viewer: SKIPPED: no chromium on this machine (Debian: chromium)')
@@ -94,10 +97,24 @@ def main():
             whole = f.read()
         with open(path('damaged.vxl'), 'wb') as f:
             f.write(whole[:len(whole) // 2])
+        # 4 KiB of 0xFF inside ORDB and inside VERT: orders out of range, vertices with reserved bits set.
+        sections = {s['id']: s for s in json.loads(run(options.voxlines, 'info', path('packed.vxl'), '--json'))['sections']}
+        for name, section in (('ordb-damaged.vxl', 'ORDB'), ('vert-damaged.vxl', 'VERT')):
+            damaged = bytearray(whole)
+            at = sections[section]['offset'] + 1000
+            damaged[at:at + 4096] = b'\xff' * 4096
+            with open(path(name), 'wb') as f:
+                f.write(damaged)
 
-        # Each case: the file shared, the mode, and the file voxview renders for reference.
-        cases = [('packed.vxl', 'axis'), ('packed.vxl', 'unsorted'), ('float32.vxl', 'axis'),
-                 ('float32.vxl', 'unsorted'), ('packed.vxlz', 'axis')]
+        # Each case: the file shared, the page's settings (voxview's options of the same names).
+        cases = [('packed.vxl', 'mode=axis'), ('packed.vxl', 'mode=unsorted'), ('float32.vxl', 'mode=axis'),
+                 ('float32.vxl', 'mode=unsorted'), ('packed.vxlz', 'mode=axis')]
+        tracks, afd = (os.path.join(options.real_data, f) for f in ('test_data__tracks.tck', 'test_data__afd.tsf'))
+        if os.path.isfile(tracks) and os.path.isfile(afd):
+            run(options.voxlines, 'convert', tracks, path('afd.vxl'), '--tsf', afd)
+            cases.append(('afd.vxl', 'color=scalar&colormap=hot'))
+        else:
+            print(f'the AFD case is skipped: {tracks} is absent (the real fixtures live beside the project)')
         for source in sorted({c[0] for c in cases} | {'damaged.vxl'}):
             folder = path('share-' + source.replace('.', '-'))
             result = subprocess.run([options.voxlines, 'share', path(source), folder, '--web-viewer',
@@ -110,42 +127,44 @@ def main():
             if result.returncode != 0:
                 failures.append(f'share {source}: exit {result.returncode}: {result.stderr.strip()}')
 
-        for source, mode in cases:
+        for source, settings in cases:
             folder = path('share-' + source.replace('.', '-'))
             shared = json.load(open(os.path.join(folder, 'share.json')))['file']
             server = Server(folder)
             try:
-                web = path(f'web-{source}-{mode}.png')
-                report = capture(f'{server.url}index.html?size={SIZE}#mode={mode}', web)
+                web = path(f'web-{source}-{settings}.png')
+                report = capture(f'{server.url}index.html?size={SIZE}#{settings}', web)
             finally:
                 server.close()
             if 'error' in report:
-                failures.append(f'{source} {mode}: the page failed: {report["error"]}')
+                failures.append(f'{source} {settings}: the page failed: {report["error"]}')
                 continue
-            native = path(f'voxview-{source}-{mode}.png')
-            run(options.voxview, os.path.join(folder, shared), '--render', native, '--size', SIZE, '--mode', mode)
+            native = path(f'voxview-{source}-{settings}.png')
+            flags = [x for kv in settings.split('&') for x in ('--' + kv.split('=')[0], kv.split('=')[1])]
+            run(options.voxview, os.path.join(folder, shared), '--render', native, '--size', SIZE, *flags)
             value = psnr_rgb(web, native)
-            print(f'{source} {mode}: PSNR {value:.2f} dB against voxview, first picture after '
+            print(f'{source} {settings}: PSNR {value:.2f} dB against voxview, first picture after '
                   f'{report["first_picture_ms"]:.0f} ms, full detail after {report["full_detail_ms"]:.0f} ms')
             if value < MIN_PSNR:
                 keep = os.path.join(tempfile.gettempdir(), 'voxweb-test-failed')
                 os.makedirs(keep, exist_ok=True)
                 shutil.copy(web, keep)
                 shutil.copy(native, keep)
-                failures.append(f'{source} {mode}: PSNR {value:.2f} dB < {MIN_PSNR} (pictures in {keep})')
+                failures.append(f'{source} {settings}: PSNR {value:.2f} dB < {MIN_PSNR} (pictures in {keep})')
 
-        # A damaged file reaching the page (served as it is, without share) is refused with its name.
+        # Damaged files reaching the page (served as they are, without share) are refused with their names.
         folder = path('share-packed-vxl')
-        shutil.copy(path('damaged.vxl'), folder)
-        server = Server(folder)
-        try:
-            report = capture(f'{server.url}index.html?size={SIZE}&file=damaged.vxl', path('damaged.png'))
-        finally:
-            server.close()
-        if 'damaged.vxl' not in report.get('error', ''):
-            failures.append(f'a damaged file in the page: {report}')
-        else:
-            print(f'damaged.vxl in the page: {report["error"]}')
+        for name in ('damaged.vxl', 'ordb-damaged.vxl', 'vert-damaged.vxl'):
+            shutil.copy(path(name), folder)
+            server = Server(folder)
+            try:
+                report = capture(f'{server.url}index.html?size={SIZE}&file={name}', path(name + '.png'))
+            finally:
+                server.close()
+            if name not in report.get('error', ''):
+                failures.append(f'{name} in the page: {report}')
+            else:
+                print(f'{name} in the page: {report["error"]}')
 
     for f in failures:
         print('FAILED: ' + f)

@@ -22,6 +22,7 @@
 #include "format/vxl_file.h"
 #include "viewer/app/camera_controller.h"
 #include "viewer/render/camera.h"
+#include "viewer/render/colormap.h"
 #include "viewer/render/render_settings.h"
 #include "viewer/render/renderer.h"
 #include "viewer/render/scene_framing.h"
@@ -52,6 +53,14 @@ struct Viewer {
 Viewer& viewer() {
   static Viewer v;
   return v;
+}
+
+// Drops the file and its renderers (the GL objects first, the bytes they were made from last).
+void close(Viewer& v) {
+  v.controller.reset();
+  v.quick.reset();
+  v.full.reset();
+  v.file.reset();
 }
 
 std::string& last_error() {
@@ -117,6 +126,22 @@ Renderer* renderer_for(Viewer& v, bool moving) {
   return v.full.get();
 }
 
+// Opens `held` into `v` (closed): the file, the first picture's renderer, the camera.
+void open_file(Viewer& v, MappedFile held, int width, int height) {
+  v.file.emplace(VxlFile::open(std::move(held)));
+  make_context();
+  v.width = std::max(width, 1);
+  v.height = std::max(height, 1);
+  const std::vector<const VxlFile*> files{&*v.file};
+  const std::uint32_t level = first_picture_level(files);
+  (level > 0 ? v.quick : v.full) = std::make_unique<Renderer>(files, 0, level);
+  const Camera home = home_camera(*v.file, double(v.width) / v.height);
+  const Renderer& any = *renderer_for(v, false);
+  const glm::dvec3 extent = any.bounds_max() - any.bounds_min();
+  v.controller = std::make_unique<app::CameraController>(home, 0.5 * glm::length(extent));
+  v.controller->set_window_height(v.height);
+}
+
 }  // namespace
 }  // namespace vxl::web
 
@@ -131,22 +156,13 @@ EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* n
   auto held = vxl::MappedFile::adopt(name, bytes, static_cast<std::size_t>(size));
   return guarded([&] {
     auto& v = viewer();
-    v.quick.reset();
-    v.full.reset();
-    v.controller.reset();
-    v.file.reset();
-    v.file.emplace(vxl::VxlFile::open(std::move(held)));
-    vxl::web::make_context();
-    v.width = std::max(width, 1);
-    v.height = std::max(height, 1);
-    const std::vector<const vxl::VxlFile*> files{&*v.file};
-    const std::uint32_t level = vxl::web::first_picture_level(files);
-    (level > 0 ? v.quick : v.full) = std::make_unique<vxl::Renderer>(files, 0, level);
-    const vxl::Camera home = vxl::web::home_camera(*v.file, double(v.width) / v.height);
-    const vxl::Renderer& any = *vxl::web::renderer_for(v, false);
-    const glm::dvec3 extent = any.bounds_max() - any.bounds_min();
-    v.controller = std::make_unique<vxl::app::CameraController>(home, 0.5 * glm::length(extent));
-    v.controller->set_window_height(v.height);
+    vxl::web::close(v);
+    try {
+      vxl::web::open_file(v, std::move(held), width, height);
+    } catch (...) {
+      vxl::web::close(v);  // nothing half open
+      throw;
+    }
   });
 }
 
@@ -157,7 +173,7 @@ EMSCRIPTEN_KEEPALIVE const char* vw_info() {
   static std::string text;
   nlohmann::json j;
   auto& v = viewer();
-  if (v.file) {
+  if (v.controller) {  // open
     const auto& m = v.file->meta();
     j["streamlines"] = m.streamline_count;
     j["vertices"] = m.vertex_count;
@@ -166,6 +182,20 @@ EMSCRIPTEN_KEEPALIVE const char* vw_info() {
     j["gpu_bytes"] = (v.quick ? v.quick->gpu_bytes() : 0) + (v.full ? v.full->gpu_bytes() : 0);
     j["first_level"] = v.quick ? v.quick->layout().level() : 0;
     j["full_detail"] = v.full != nullptr;
+    const vxl::Renderer& r = *vxl::web::renderer_for(v, false);
+    j["values"] = r.value_set_names();
+    nlohmann::json groups = nlohmann::json::array();
+    for (std::size_t g = 0; g < r.groups().groups().size(); ++g) {
+      const vxl::SceneGroup& group = r.groups().groups()[g];
+      const glm::vec4 c = v.settings.group_color(group.name, g);
+      groups.push_back({{"name", group.name}, {"streamlines", group.streamlines}, {"color", {c.r, c.g, c.b}}});
+    }
+    j["groups"] = groups;
+    // What colouring by value shows: the set, its range and the colour map's samples (for the colour bar).
+    const auto range = r.scalar_range(v.settings);
+    nlohmann::json samples = nlohmann::json::array();
+    for (const glm::vec3& c : vxl::colormap_samples(v.settings.colormap)) samples.push_back({c.r, c.g, c.b});
+    j["scalar"] = {{"name", r.scalar_name(v.settings)}, {"range", {range[0], range[1]}}, {"samples", samples}};
   }
   nlohmann::json modes = nlohmann::json::array();
   for (const vxl::RenderModeInfo& m : vxl::render_modes())
@@ -176,7 +206,7 @@ EMSCRIPTEN_KEEPALIVE const char* vw_info() {
 }
 
 // One setting by name, as voxview's options spell them: mode, color, opacity, fixed-color (hex), background
-// (hex), view ("AZ,EL" or a standard view's name), zoom (a factor over the framed view), lighting (0/1).
+// (hex), scalar (a value set's name), colormap, view ("AZ,EL" or a standard view's name), lighting (0/1).
 EMSCRIPTEN_KEEPALIVE int vw_set(const char* key_text, const char* value_text) {
   return guarded([&] {
     const std::string key = key_text, value = value_text;
@@ -201,6 +231,12 @@ EMSCRIPTEN_KEEPALIVE int vw_set(const char* key_text, const char* value_text) {
       const auto c = vxl::parse_hex_color(value);
       if (!c) throw bad();
       (key == "background" ? v.settings.background_color : v.settings.fixed_color) = *c;
+    } else if (key == "scalar") {
+      v.settings.scalar = value;
+    } else if (key == "colormap") {
+      const auto map = vxl::parse_colormap(value);
+      if (!map) throw bad();
+      v.settings.colormap = *map;
     } else if (key == "lighting") {
       v.settings.lighting = value == "1";
     } else if (key == "view") {

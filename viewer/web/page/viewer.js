@@ -54,7 +54,35 @@
 
     function set(key, value) {
       if (api.set(key, String(value)) !== 0) say(api.error(), true);
+      if (key === 'color' || key === 'scalar' || key === 'colormap') showColouring();
       redraw();
+    }
+
+    // The colour bar of colouring by value, or the groups' colours.
+    function showColouring() {
+      const info = JSON.parse(api.info());
+      const color = $('color').value;
+      $('scalar-settings').hidden = color !== 'scalar';
+      if (color === 'scalar') {
+        const bar = $('colorbar').getContext('2d');
+        const samples = info.scalar.samples;
+        for (let x = 0; x < 256; ++x) {
+          const t = (x / 255) * (samples.length - 1), i = Math.min(Math.floor(t), samples.length - 2), f = t - i;
+          const c = samples[i].map((a, k) => Math.round(255 * (a + (samples[i + 1][k] - a) * f)));
+          bar.fillStyle = `rgb(${c[0]},${c[1]},${c[2]})`;
+          bar.fillRect(x, 0, 1, 12);
+        }
+        $('range-lo').textContent = info.scalar.range[0].toPrecision(4);
+        $('range-hi').textContent = info.scalar.range[1].toPrecision(4);
+      }
+      $('legend').replaceChildren(...(color === 'group' ? info.groups : []).map((g) => {
+        const row = document.createElement('div');
+        const swatch = document.createElement('span');
+        swatch.className = 'swatch';
+        swatch.style.background = `rgb(${g.color.map((a) => Math.round(255 * a)).join(',')})`;
+        row.append(swatch, `${g.name} (${g.streamlines.toLocaleString()})`);
+        return row;
+      }));
     }
     function redraw() {
       if (opened && !dirty) {
@@ -102,11 +130,15 @@
       h.set('mode', $('mode').value);
       h.set('opacity', $('opacity').value);
       h.set('color', $('color').value);
+      if ($('color').value === 'scalar') {
+        h.set('scalar', $('scalar').value);
+        h.set('colormap', $('colormap').value);
+      }
       return '#' + h.toString();
     }
     function applyHash() {
       const h = new URLSearchParams(location.hash.slice(1));
-      for (const key of ['mode', 'opacity', 'color']) {
+      for (const key of ['mode', 'opacity', 'color', 'scalar', 'colormap']) {
         if (!h.has(key)) continue;
         $(key).value = h.get(key);
         set(key, h.get(key));
@@ -126,6 +158,7 @@
       if (api.open(pointer, size, name, w, h) !== 0) return fail(api.error());
       opened = true;
       const info = JSON.parse(api.info());
+      window.voxweb.info = info;
       fullDetail = info.full_detail;
       $('info').textContent = `${info.streamlines.toLocaleString()} streamlines, ` +
         `${info.vertices.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`;
@@ -137,6 +170,11 @@
         return o;
       }));
       $('mode').value = 'axis';
+      // Colouring by value or by group where the file has them.
+      for (const o of [...$('color').options]) if (o.value === 'scalar' || o.value === 'group') o.remove();
+      if (info.values.length) $('color').add(new Option('value', 'scalar'));
+      if (info.groups.length > 1) $('color').add(new Option('group', 'group'));
+      $('scalar').replaceChildren(...info.values.map((name) => new Option(name, name)));
       say(`${name}: opened in ${((performance.now() - t0) / 1000).toFixed(2)} s`);
       applyHash();
     }
@@ -197,6 +235,8 @@
     $('mode').onchange = () => set('mode', $('mode').value);
     $('opacity').oninput = () => { $('opacity-value').textContent = $('opacity').value; set('opacity', $('opacity').value); };
     $('color').onchange = () => set('color', $('color').value);
+    $('scalar').onchange = () => set('scalar', $('scalar').value);
+    $('colormap').onchange = () => set('colormap', $('colormap').value);
     for (const v of ['axial', 'inferior', 'coronal', 'posterior', 'sagittal', 'right']) {
       const b = document.createElement('button');
       b.textContent = v;
