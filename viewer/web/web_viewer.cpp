@@ -6,6 +6,9 @@
 // The first picture is drawn at the finest level of detail whose GPU copy is at most kFirstPictureBytes (a
 // software WebGL draws a 144k-streamline file's 8M segments in about 9 s on 2 cores); vw_refine() then adds
 // the full-detail renderer, which draws the view at rest while the first one keeps drawing it in motion.
+// Its spans (kWebSpanTexels each) are uploaded a few per call of vw_upload, nearest the view first, so that the
+// page's thread — WebAssembly here has no other — never stops for the whole file: until the view's spans are
+// all on the GPU, frames at rest come from the first picture's level.
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -36,6 +39,7 @@ namespace {
 bool drawable_on_the_web(RenderMode mode) { return mode != RenderMode::Exact && mode != RenderMode::Segsort; }
 
 constexpr std::uint64_t kFirstPictureBytes = 8ull << 20;
+constexpr std::uint64_t kWebSpanTexels = 1ull << 20;  // 16 MiB of packed positions and voxel tables
 
 struct Viewer {
   std::optional<VxlFile> file;
@@ -48,6 +52,7 @@ struct Viewer {
     return s;
   }();
   int width = 1, height = 1;
+  bool full_pending = false;  // the full-detail spans of the last view at rest are not all uploaded yet
 };
 
 Viewer& viewer() {
@@ -120,9 +125,17 @@ std::uint32_t first_picture_level(const std::vector<const VxlFile*>& files) {
   }
 }
 
-// The renderer a frame is drawn with: the first picture's while moving or before full detail is made.
+// Uploads a few more of the full-detail spans the view needs (the nearest first); true once they all are.
+bool upload_full(Viewer& v) {
+  v.full_pending = !v.full->upload_for(v.controller->camera(), double(v.width) / v.height, Clipping{}, 0.0);
+  return !v.full_pending;
+}
+
+// The renderer a frame is drawn with: the first picture's while moving or while full detail is not ready for
+// the view.
 Renderer* renderer_for(Viewer& v, bool moving) {
-  if (v.quick && (moving || !v.full)) return v.quick.get();
+  if (!v.quick) return v.full.get();
+  if (moving || !v.full || !upload_full(v)) return v.quick.get();
   return v.full.get();
 }
 
@@ -182,7 +195,10 @@ EMSCRIPTEN_KEEPALIVE const char* vw_info() {
     j["gpu_bytes"] = (v.quick ? v.quick->gpu_bytes() : 0) + (v.full ? v.full->gpu_bytes() : 0);
     j["first_level"] = v.quick ? v.quick->layout().level() : 0;
     j["full_detail"] = v.full != nullptr;
-    const vxl::Renderer& r = *vxl::web::renderer_for(v, false);
+    const vxl::Renderer& r = v.full ? *v.full : *v.quick;
+    // How much of full detail is on the GPU, of the most it can take.
+    j["full_uploaded"] = v.full ? v.full->gpu_bytes() : 0;
+    j["full_bytes"] = v.full ? v.full->layout().upload_bytes() : 0;
     j["values"] = r.value_set_names();
     nlohmann::json groups = nlohmann::json::array();
     for (std::size_t g = 0; g < r.groups().groups().size(); ++g) {
@@ -299,18 +315,39 @@ EMSCRIPTEN_KEEPALIVE int vw_refine() {
   return guarded([&] {
     auto& v = viewer();
     if (!v.file) throw std::runtime_error("no file is open");
-    if (!v.full) v.full = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file});
+    if (v.full) return;
+    // Made without its spans (eager false): renderer_for uploads them a few at a time.
+    const std::vector<const vxl::VxlFile*> files{&*v.file};
+    const std::uint64_t span_texels = std::max(vxl::web::kWebSpanTexels, vxl::SceneLayout::largest_voxel_texels(files));
+    v.full =
+        std::make_unique<vxl::Renderer>(files, std::min(span_texels, vxl::gl::max_buffer_texels()), 0, nullptr, false);
+    v.full_pending = true;
   });
+}
+
+// Whether the last frame at rest was drawn before the full-detail spans of its view were all uploaded.
+EMSCRIPTEN_KEEPALIVE int vw_pending() { return viewer().quick && viewer().full && viewer().full_pending ? 1 : 0; }
+
+// Uploads a few more full-detail spans for the view: 1 once all it needs are on the GPU (the next frame at
+// rest is drawn at full detail), 0 while more remain, else an error code (vw_error).
+EMSCRIPTEN_KEEPALIVE int vw_upload() {
+  bool complete = false;
+  const int error = guarded([&] {
+    auto& v = viewer();
+    if (!v.controller || !v.full) throw std::runtime_error("no full-detail renderer to upload for");
+    complete = !v.quick || vxl::web::upload_full(v);
+  });
+  return error != 0 ? error : complete ? 1 : 0;
 }
 
 // Draws a frame into the canvas, now width x height pixels; `moving` (a drag) draws the first picture's level.
 EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
   return guarded([&] {
     auto& v = viewer();
-    vxl::Renderer* renderer = v.file ? vxl::web::renderer_for(v, moving != 0) : nullptr;
-    if (renderer == nullptr) throw std::runtime_error("no file is open");
+    if (!v.controller) throw std::runtime_error("no file is open");
     v.width = std::max(width, 1);
     v.height = std::max(height, 1);
+    vxl::Renderer* renderer = vxl::web::renderer_for(v, moving != 0);
     v.controller->set_window_height(v.height);
     renderer->draw(v.controller->camera(), v.settings, v.width, v.height, 0);
     renderer->check_uploaded(false);

@@ -48,6 +48,8 @@
       setCamera: Module.cwrap('vw_set_camera', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
       draw: Module.cwrap('vw_draw', 'number', ['number', 'number', 'number']),
       refine: Module.cwrap('vw_refine', 'number', []),
+      pending: Module.cwrap('vw_pending', 'number', []),
+      upload: Module.cwrap('vw_upload', 'number', []),
     };
     // moving: a drag is under way (frames then come from the first picture's level of detail).
     let opened = false, dirty = false, firstFrame = true, fullDetail = false, moving = false;
@@ -107,15 +109,36 @@
         settle.resolve();
         if (!fullDetail) setTimeout(refine, 0);  // once the first picture is on the screen
       }
-      if (fullDetail && !moving) settleComplete.resolve();
+      if (fullDetail && !moving) {
+        if (api.pending()) uploadSoon();
+        else {
+          $('progress').value = 1;
+          settleComplete.resolve();
+        }
+      }
+    }
+    // Full detail's upload, a few spans per task so that the page keeps taking input; one frame when done.
+    let uploading = false;
+    function uploadSoon() {
+      if (uploading) return;
+      uploading = true;
+      setTimeout(function step() {
+        if (moving) { uploading = false; return; }  // the drag's end draws and comes back here
+        const r = api.upload();
+        if (r > 1) { uploading = false; return fail(api.error()); }
+        const info = JSON.parse(api.info());
+        $('progress').value = info.full_uploaded / Math.max(1, info.full_bytes);
+        if (r === 0) return setTimeout(step, 0);
+        uploading = false;
+        redraw();
+      }, 0);
     }
     function refine() {
-      const t0 = performance.now();
       if (api.refine() !== 0) return fail(api.error());
       fullDetail = true;
       const info = JSON.parse(api.info());
-      say($('status').textContent + `\nfull detail in ${((performance.now() - t0) / 1000).toFixed(2)} s (first picture ` +
-          `at level ${info.first_level}: 1/${8 ** info.first_level} of the streamlines)`);
+      say($('status').textContent + `\nfirst picture at level ${info.first_level} (1/${8 ** info.first_level} of the ` +
+          'streamlines); full detail follows');
       redraw();
     }
 
