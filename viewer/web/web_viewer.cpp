@@ -6,9 +6,9 @@
 // The first picture is drawn at the finest level of detail whose GPU copy is at most kFirstPictureBytes (a
 // software WebGL draws a 144k-streamline file's 8M segments in about 9 s on 2 cores); vw_refine() then adds
 // the full-detail renderer, which draws the view at rest while the first one keeps drawing it in motion.
-// Its spans (kWebSpanTexels each) are uploaded a few per call of vw_upload, nearest the view first, so that the
-// page's thread — WebAssembly here has no other — never stops for the whole file: until the view's spans are
-// all on the GPU, frames at rest come from the first picture's level.
+// Its spans are uploaded a few per call of vw_upload, nearest the view first, so that the page's thread —
+// WebAssembly here has no other — takes input between them: until the view's spans are all on the GPU, frames
+// at rest come from the first picture's level.
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -39,7 +39,6 @@ namespace {
 bool drawable_on_the_web(RenderMode mode) { return mode != RenderMode::Exact && mode != RenderMode::Segsort; }
 
 constexpr std::uint64_t kFirstPictureBytes = 8ull << 20;
-constexpr std::uint64_t kWebSpanTexels = 1ull << 20;  // 16 MiB of packed positions and voxel tables
 
 struct Viewer {
   std::optional<VxlFile> file;
@@ -316,11 +315,11 @@ EMSCRIPTEN_KEEPALIVE int vw_refine() {
     auto& v = viewer();
     if (!v.file) throw std::runtime_error("no file is open");
     if (v.full) return;
-    // Made without its spans (eager false): renderer_for uploads them a few at a time.
-    const std::vector<const vxl::VxlFile*> files{&*v.file};
-    const std::uint64_t span_texels = std::max(vxl::web::kWebSpanTexels, vxl::SceneLayout::largest_voxel_texels(files));
-    v.full =
-        std::make_unique<vxl::Renderer>(files, std::min(span_texels, vxl::gl::max_buffer_texels()), 0, nullptr, false);
+    // Made without its spans (eager false): vw_upload and renderer_for upload them a few at a time. The spans
+    // are as large as the driver allows: each span more in a draw costs every vertex a branch of texture
+    // fetches (SwiftShader: spans of 2^23 texels, two for the 144k set, took its full-detail frame from 11 s
+    // to 14-16 s).
+    v.full = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file}, 0, 0, nullptr, false);
     v.full_pending = true;
   });
 }
@@ -356,4 +355,3 @@ EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
 
 }  // extern "C"
 
-int main() { return 0; }
