@@ -354,4 +354,3 @@ EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
 }
 
 }  // extern "C"
-
