@@ -9,6 +9,8 @@
 // Its spans are uploaded a few per call of vw_upload, nearest the view first, so that the page's thread —
 // WebAssembly here has no other — takes input between them: until the view's spans are all on the GPU, frames
 // at rest come from the first picture's level.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -154,6 +156,41 @@ void open_file(Viewer& v, MappedFile held, int width, int height) {
   v.controller->set_window_height(v.height);
 }
 
+// vw_info's JSON: the file, the renderers, and the modes the page may offer.
+void describe(Viewer& v, nlohmann::json& j) {
+  if (v.controller) {  // open
+    const auto& m = v.file->meta();
+    j["streamlines"] = m.streamline_count;
+    j["vertices"] = m.vertex_count;
+    j["voxels"] = v.file->voxels().size();
+    j["bytes"] = v.file->bytes().size();
+    j["gpu_bytes"] = (v.quick ? v.quick->gpu_bytes() : 0) + (v.full ? v.full->gpu_bytes() : 0);
+    j["first_level"] = v.quick ? v.quick->layout().level() : 0;
+    j["full_detail"] = v.full != nullptr;
+    const Renderer& r = v.full ? *v.full : *v.quick;
+    // How much of full detail is on the GPU, of the most it can take.
+    j["full_uploaded"] = v.full ? v.full->gpu_bytes() : 0;
+    j["full_bytes"] = v.full ? v.full->layout().upload_bytes() : 0;
+    j["values"] = r.value_set_names();
+    nlohmann::json groups = nlohmann::json::array();
+    for (std::size_t g = 0; g < r.groups().groups().size(); ++g) {
+      const SceneGroup& group = r.groups().groups()[g];
+      const glm::vec4 c = v.settings.group_color(group.name, g);
+      groups.push_back({{"name", group.name}, {"streamlines", group.streamlines}, {"color", {c.r, c.g, c.b}}});
+    }
+    j["groups"] = groups;
+    // What colouring by value shows: the set, its range and the colour map's samples (for the colour bar).
+    const auto range = r.scalar_range(v.settings);
+    nlohmann::json samples = nlohmann::json::array();
+    for (const glm::vec3& c : colormap_samples(v.settings.colormap)) samples.push_back({c.r, c.g, c.b});
+    j["scalar"] = {{"name", r.scalar_name(v.settings)}, {"range", {range[0], range[1]}}, {"samples", samples}};
+  }
+  nlohmann::json modes = nlohmann::json::array();
+  for (const RenderModeInfo& m : render_modes())
+    if (drawable_on_the_web(m.mode)) modes.push_back({{"name", m.name}, {"description", m.description}});
+  j["modes"] = modes;
+}
+
 }  // namespace
 }  // namespace vxl::web
 
@@ -180,42 +217,12 @@ EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* n
 
 EMSCRIPTEN_KEEPALIVE const char* vw_error() { return vxl::web::last_error().c_str(); }
 
-// What the page shows about the file: counts and the modes it can draw, as JSON.
+// What the page shows about the file: counts and the modes it can draw, as JSON ({"error": …} if that fails).
 EMSCRIPTEN_KEEPALIVE const char* vw_info() {
   static std::string text;
   nlohmann::json j;
   auto& v = viewer();
-  if (v.controller) {  // open
-    const auto& m = v.file->meta();
-    j["streamlines"] = m.streamline_count;
-    j["vertices"] = m.vertex_count;
-    j["voxels"] = v.file->voxels().size();
-    j["bytes"] = v.file->bytes().size();
-    j["gpu_bytes"] = (v.quick ? v.quick->gpu_bytes() : 0) + (v.full ? v.full->gpu_bytes() : 0);
-    j["first_level"] = v.quick ? v.quick->layout().level() : 0;
-    j["full_detail"] = v.full != nullptr;
-    const vxl::Renderer& r = v.full ? *v.full : *v.quick;
-    // How much of full detail is on the GPU, of the most it can take.
-    j["full_uploaded"] = v.full ? v.full->gpu_bytes() : 0;
-    j["full_bytes"] = v.full ? v.full->layout().upload_bytes() : 0;
-    j["values"] = r.value_set_names();
-    nlohmann::json groups = nlohmann::json::array();
-    for (std::size_t g = 0; g < r.groups().groups().size(); ++g) {
-      const vxl::SceneGroup& group = r.groups().groups()[g];
-      const glm::vec4 c = v.settings.group_color(group.name, g);
-      groups.push_back({{"name", group.name}, {"streamlines", group.streamlines}, {"color", {c.r, c.g, c.b}}});
-    }
-    j["groups"] = groups;
-    // What colouring by value shows: the set, its range and the colour map's samples (for the colour bar).
-    const auto range = r.scalar_range(v.settings);
-    nlohmann::json samples = nlohmann::json::array();
-    for (const glm::vec3& c : vxl::colormap_samples(v.settings.colormap)) samples.push_back({c.r, c.g, c.b});
-    j["scalar"] = {{"name", r.scalar_name(v.settings)}, {"range", {range[0], range[1]}}, {"samples", samples}};
-  }
-  nlohmann::json modes = nlohmann::json::array();
-  for (const vxl::RenderModeInfo& m : vxl::render_modes())
-    if (vxl::web::drawable_on_the_web(m.mode)) modes.push_back({{"name", m.name}, {"description", m.description}});
-  j["modes"] = modes;
+  if (guarded([&] { vxl::web::describe(v, j); }) != 0) j = {{"error", vxl::web::last_error()}};
   text = j.dump();
   return text.c_str();
 }
@@ -247,6 +254,10 @@ EMSCRIPTEN_KEEPALIVE int vw_set(const char* key_text, const char* value_text) {
       if (!c) throw bad();
       (key == "background" ? v.settings.background_color : v.settings.fixed_color) = *c;
     } else if (key == "scalar") {
+      const vxl::Renderer* r = v.full ? v.full.get() : v.quick.get();
+      const auto& names = r ? r->value_set_names() : std::vector<std::string>{};
+      if (std::find(names.begin(), names.end(), value) == names.end())
+        throw vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "no value set '" + value + "' in this file");
       v.settings.scalar = value;
     } else if (key == "colormap") {
       const auto map = vxl::parse_colormap(value);
