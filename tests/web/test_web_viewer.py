@@ -4,7 +4,8 @@ headless Chromium (WebGL2 on SwiftShader), against `voxview --render` of the sam
 (llvmpipe). Two rasterisers draw a line's pixels a little differently, so the pictures are compared by PSNR
 over R, G, B (at least MIN_PSNR dB), not byte for byte. Cases: a synthetic set of 20,000 streamlines, packed
 and float32, in the axis and unsorted modes; a .vxlz shared (unpacked by share); with the real fixtures (when
---real-data holds them), MRtrix's test tracks coloured by their AFD values; damaged files, which the page
+--real-data holds them), MRtrix's test tracks coloured by their AFD values; the packed file sent gzip-compressed
+(the length the server declares is then not the body's); damaged files, which the page
 must refuse with a message naming them: one cut short (the reader's structure checks), and two whose structure
 holds but whose orders or vertices were overwritten (the draw checks that voxview runs, which the page runs too).
 
@@ -13,6 +14,7 @@ Exit 0 when every case holds, 1 otherwise, 77 when there is no Chromium to run i
 """
 import argparse
 import functools
+import gzip
 import http.server
 import json
 import math
@@ -52,11 +54,28 @@ class QuietHandler(http.server.SimpleHTTPRequestHandler):
         pass
 
 
+class GzipHandler(QuietHandler):
+    """Sends .vxl files gzip-compressed (Content-Encoding: gzip): the Content-Length the page sees is then the
+    compressed size, smaller than the bytes it receives."""
+
+    def do_GET(self):
+        if not self.path.split('?')[0].endswith('.vxl'):
+            return super().do_GET()
+        with open(self.translate_path(self.path.split('?')[0]), 'rb') as f:
+            body = gzip.compress(f.read(), compresslevel=1)
+        self.send_response(200)
+        self.send_header('Content-Type', 'application/octet-stream')
+        self.send_header('Content-Encoding', 'gzip')
+        self.send_header('Content-Length', str(len(body)))
+        self.end_headers()
+        self.wfile.write(body)
+
+
 class Server:
     """A static web server for one folder on a free port, in a thread."""
 
-    def __init__(self, folder):
-        handler = functools.partial(QuietHandler, directory=folder)
+    def __init__(self, folder, handler_class=QuietHandler):
+        handler = functools.partial(handler_class, directory=folder)
         self.httpd = http.server.ThreadingHTTPServer(('127.0.0.1', 0), handler)
         self.url = f'http://127.0.0.1:{self.httpd.server_address[1]}/'
         threading.Thread(target=self.httpd.serve_forever, daemon=True).start()
@@ -127,10 +146,12 @@ def main():
             if result.returncode != 0:
                 failures.append(f'share {source}: exit {result.returncode}: {result.stderr.strip()}')
 
-        for source, settings in cases:
+        # Served compressed: the declared length is not the body's.
+        cases.append(('packed.vxl', 'mode=axis', GzipHandler))
+        for source, settings, *handler in cases:
             folder = path('share-' + source.replace('.', '-'))
             shared = json.load(open(os.path.join(folder, 'share.json')))['file']
-            server = Server(folder)
+            server = Server(folder, *handler)
             try:
                 web = path(f'web-{source}-{settings}.png')
                 report = capture(f'{server.url}index.html?size={SIZE}#{settings}', web)
@@ -143,7 +164,8 @@ def main():
             flags = [x for kv in settings.split('&') for x in ('--' + kv.split('=')[0], kv.split('=')[1])]
             run(options.voxview, os.path.join(folder, shared), '--render', native, '--size', SIZE, *flags)
             value = psnr_rgb(web, native)
-            print(f'{source} {settings}: PSNR {value:.2f} dB against voxview, first picture after '
+            served = ' (gzip)' if handler else ''
+            print(f'{source}{served} {settings}: PSNR {value:.2f} dB against voxview, first picture after '
                   f'{report["first_picture_ms"]:.0f} ms, full detail after {report["full_detail_ms"]:.0f} ms')
             if value < MIN_PSNR:
                 keep = os.path.join(tempfile.gettempdir(), 'voxweb-test-failed')

@@ -209,25 +209,30 @@
       if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
       const declared = Number(response.headers.get('Content-Length'));
       const chunks = [];
-      let received = 0, pointer = 0;
+      // Into the memory allocated for the declared length while the bytes fit it; past that (a length that
+      // was not the body's, as with a compressed transfer), into chunks copied together at the end.
+      let received = 0, inMemory = 0, pointer = 0;
       if (declared > 0) pointer = Module._malloc(declared);
       const reader = response.body.getReader();
       for (;;) {
         const { done, value } = await reader.read();
         if (done) break;
-        if (pointer && received + value.length <= declared)
-          Module.HEAPU8.set(value, pointer + received);
-        else
+        if (pointer && chunks.length === 0 && inMemory + value.length <= declared) {
+          Module.HEAPU8.set(value, pointer + inMemory);
+          inMemory += value.length;
+        } else {
           chunks.push(value);
+        }
         received += value.length;
-        if (declared > 0) $('progress').value = received / declared;
+        if (declared > 0) $('progress').value = Math.min(1, received / declared);
       }
-      if (!pointer || received !== declared) {  // no length given, or not the length given: copy what came
-        if (pointer) chunks.unshift(Module.HEAPU8.slice(pointer, pointer + Math.min(received, declared)));
+      if (chunks.length > 0 || !pointer) {
+        const whole = Module._malloc(Math.max(1, received));
+        if (pointer) Module.HEAPU8.copyWithin(whole, pointer, pointer + inMemory);
         if (pointer) Module._free(pointer);
-        pointer = Module._malloc(Math.max(1, received));
-        let at = 0;
-        for (const c of chunks) { Module.HEAPU8.set(c, pointer + at); at += c.length; }
+        let at = inMemory;
+        for (const c of chunks) { Module.HEAPU8.set(c, whole + at); at += c.length; }
+        pointer = whole;
       }
       $('progress').value = 1;
       openBytes(pointer, received, url.split('/').pop());
