@@ -1,0 +1,41 @@
+# The renderer's sources, relative to viewer/render/: the native library (viewer/CMakeLists.txt) and the web
+# viewer (viewer/web/CMakeLists.txt, which leaves out what WebGL2 cannot run) are built from this one list.
+set(VOXLINES_RENDER_SOURCES
+  background_color.cpp
+  camera.cpp
+  clip_planes.cpp
+  colormap.cpp
+  exact_renderer.cpp
+  exact_resolve.cpp
+  frame_plan.cpp
+  clip_uniforms.cpp
+  gl_util.cpp
+  gpu_memory_pool.cpp
+  gpu_scene.cpp
+  grid_overlay.cpp
+  line_lighting.cpp
+  line_pass.cpp
+  line_shaders.cpp
+  modes/additive_pass.cpp
+  modes/blend_states.cpp
+  modes/exact_pass.cpp
+  modes/fullscreen_composite.cpp
+  modes/mode_pass.cpp
+  modes/mode_table.cpp
+  modes/opaque_pass.cpp
+  modes/over_pass.cpp
+  modes/segsort_pass.cpp
+  modes/unsorted_pass.cpp
+  modes/wboit_pass.cpp
+  region_shapes.cpp
+  region_shells.cpp
+  render_settings.cpp
+  renderer.cpp
+  scene_framing.cpp
+  scene_groups.cpp
+  scene_layout.cpp
+  segment_sort.cpp
+  slice_renderer.cpp
+  vertex_attributes.cpp
+  view_queries.cpp
+  volume.cpp)
