@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "viewer/render/scene_layout.h"
+
 namespace vxl::app {
 
 FrameBudget::FrameBudget(double budget_ms, std::uint32_t scene_level, std::uint32_t coarsest_level)
@@ -42,6 +44,14 @@ std::uint32_t first_picture_level(std::span<const std::uint64_t> segments, std::
   for (std::uint32_t level = std::min(scene_level, coarsest); level <= coarsest; ++level)
     if (segments[level] <= kFirstPictureSegments) return level;
   return coarsest;
+}
+
+std::vector<std::uint64_t> level_segments(std::span<const VxlFile* const> files) {
+  std::vector<std::uint64_t> segments(SceneLayout::coarsest_level(files) + 1, 0);
+  for (const VxlFile* f : files)
+    for (std::size_t i = 0; i < f->voxels().size(); ++i)
+      for (std::uint32_t d = 0; d < segments.size(); ++d) segments[d] += f->level(i, d).segment_count;
+  return segments;
 }
 
 }  // namespace vxl::app

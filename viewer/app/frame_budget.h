@@ -8,7 +8,9 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <vector>
 
+#include "format/vxl_file.h"
 #include "format/vxl_levels.h"
 
 namespace vxl::app {
@@ -40,5 +42,7 @@ inline constexpr std::uint64_t kFirstPictureSegments = 250'000;
 
 // `segments[d]`: the scene's segments at level d (up to the coarsest level).
 std::uint32_t first_picture_level(std::span<const std::uint64_t> segments, std::uint32_t scene_level);
+// The files' segments at each level, up to the coarsest all of them have (first_picture_level's `segments`).
+std::vector<std::uint64_t> level_segments(std::span<const VxlFile* const> files);
 
 }  // namespace vxl::app

@@ -67,11 +67,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
   if (o.saved_show_regions) state_.show_regions = *o.saved_show_regions;  // as the saved view had them
   stats_.detail = describe_scene_detail(detail_, session_->levels_in_files());
   if (!stats_.detail.empty()) std::fprintf(stderr, "voxview: %s\n", stats_.detail.c_str());
-  std::vector<std::uint64_t> segments(SceneLayout::coarsest_level(files_) + 1, 0);
-  for (const VxlFile* f : files_)
-    for (std::size_t i = 0; i < f->voxels().size(); ++i)
-      for (std::uint32_t d = 0; d < segments.size(); ++d) segments[d] += f->level(i, d).segment_count;
-  first_level_ = first_picture_level(segments, detail_.level);
+  first_level_ = first_picture_level(level_segments(files_), detail_.level);
   // The command line's selection runs on the worker: the first picture does not wait for it (the panel says it is
   // coming), the focus appears when it is ready. Scripted frames without a drag still wait for it, frame by frame.
   update_selection(false);

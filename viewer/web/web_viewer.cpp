@@ -3,8 +3,9 @@
 // controller. The page (page/viewer.js) calls these functions through Emscripten's cwrap; each returns 0
 // or an error whose message vw_error() gives.
 //
-// The first picture is drawn at the finest level of detail whose GPU copy is at most kFirstPictureBytes (a
-// software WebGL draws a 144k-streamline file's 8M segments in about 9 s on 2 cores); vw_refine() then adds
+// The first picture is drawn at the level of detail voxview's window draws its first at (first_picture_level:
+// at most kFirstPictureSegments; a software WebGL draws a 144k-streamline file's 8M segments in about 9 s on
+// 2 cores); vw_refine() then adds
 // the full-detail renderer, which draws the view at rest while the first one keeps drawing it in motion.
 // Its spans are uploaded a few per call of vw_upload, nearest the view first, so that the page's thread —
 // WebAssembly here has no other — takes input between them: until the view's spans are all on the GPU, frames
@@ -26,6 +27,7 @@
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "viewer/app/camera_controller.h"
+#include "viewer/app/frame_budget.h"
 #include "viewer/render/camera.h"
 #include "viewer/render/colormap.h"
 #include "viewer/render/render_settings.h"
@@ -39,8 +41,6 @@ namespace {
 // The modes WebGL2 can draw: exact needs storage buffers and compute shaders, segsort rewrites buffer
 // textures in place; WebGL2 has neither.
 bool drawable_on_the_web(RenderMode mode) { return mode != RenderMode::Exact && mode != RenderMode::Segsort; }
-
-constexpr std::uint64_t kFirstPictureBytes = 8ull << 20;
 
 struct Viewer {
   std::optional<VxlFile> file;
@@ -117,15 +117,6 @@ Camera home_camera(const VxlFile& file, double aspect) {
   return c;
 }
 
-// The finest level whose GPU copy fits kFirstPictureBytes, else the coarsest the file has.
-std::uint32_t first_picture_level(const std::vector<const VxlFile*>& files) {
-  try {
-    return SceneLayout::finest_level_within(files, gl::max_buffer_texels(), kFirstPictureBytes);
-  } catch (const Error&) {
-    return SceneLayout::coarsest_level(files);
-  }
-}
-
 // Uploads a few more of the full-detail spans the view needs (the nearest first); true once they all are.
 bool upload_full(Viewer& v) {
   v.full_pending = !v.full->upload_for(v.controller->camera(), double(v.width) / v.height, Clipping{}, 0.0);
@@ -147,7 +138,7 @@ void open_file(Viewer& v, MappedFile held, int width, int height) {
   v.width = std::max(width, 1);
   v.height = std::max(height, 1);
   const std::vector<const VxlFile*> files{&*v.file};
-  const std::uint32_t level = first_picture_level(files);
+  const std::uint32_t level = app::first_picture_level(app::level_segments(files), 0);
   (level > 0 ? v.quick : v.full) = std::make_unique<Renderer>(files, 0, level);
   const Camera home = home_camera(*v.file, double(v.width) / v.height);
   const Renderer& any = *renderer_for(v, false);
