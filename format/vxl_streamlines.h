@@ -30,6 +30,9 @@ struct WalkCallbacks {
   // are walked through the table only (their vertices are not read), so a walk over a few streamlines
   // costs the table plus their points.
   std::function<bool(std::uint64_t streamline)> read_points;
+  // Threads that decode the points (0: all cores). The callbacks are called one at a time and in order
+  // whatever this is, though not always on the calling thread.
+  unsigned threads = 1;
 };
 
 // Checks the walk as it goes (table ranges, blocks consumed exactly, connecting vertices equal to the

@@ -146,6 +146,7 @@ ExportSummary export_tck(const VxlFile& file, const std::string& out_path, const
   if (settings.tsf_path) tsf.emplace(*settings.tsf_path, counts.streamlines, header, counts.points);
   std::uint64_t point = 0;
   WalkCallbacks cb;
+  cb.threads = 0;  // the points decoded on every core
   cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };
   cb.streamline = [&](std::uint64_t, std::span<const float> xyz) {
     writer.add(xyz);

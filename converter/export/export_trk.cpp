@@ -352,6 +352,7 @@ TrkExportSummary export_trk(const VxlFile& file, const std::string& out_path, co
   std::vector<float> record;
   std::uint64_t point = 0, walked = 0;  // source points and streamlines of the subset so far
   WalkCallbacks cb;
+  cb.threads = 0;  // the points decoded on every core
   cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };
   cb.streamline = [&](std::uint64_t, std::span<const float> xyz) {
     const std::uint64_t n = xyz.size() / 3;

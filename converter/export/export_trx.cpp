@@ -136,6 +136,7 @@ void export_trx(const VxlFile& file, const std::string& out_path, const Streamli
   offsets.reserve(counts.streamlines + 1);
   offsets.push_back(0);
   WalkCallbacks cb;
+  cb.threads = 0;  // the points decoded on every core
   cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };
   cb.streamline = [&](std::uint64_t, std::span<const float> xyz) {
     positions.insert(positions.end(), xyz.begin(), xyz.end());

@@ -79,6 +79,7 @@ std::vector<std::uint64_t> source_vertex_indices(const VxlFile& file, const Stre
   std::vector<std::uint64_t> out;
   out.reserve(subset_counts(file, subset).points);
   WalkCallbacks cb;
+  cb.threads = 0;  // the points decoded on every core
   cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };
   cb.voxline = [&](const VoxlineVisit& v) {
     if (!in_subset(subset, v.streamline)) return;

@@ -82,6 +82,7 @@ void export_vtk(const VxlFile& file, const std::string& out_path, const Streamli
   w.text("# vtk DataFile Version 3.0\nvoxlines export of " + source + " SPACE=RAS\nBINARY\nDATASET POLYDATA\nPOINTS " +
          std::to_string(m.points) + " float\n");
   WalkCallbacks cb;
+  cb.threads = 0;  // the points decoded on every core
   cb.read_points = [&](std::uint64_t s) { return in_subset(subset, s); };
   cb.voxline = [&](const VoxlineVisit& v) {
     if (!in_subset(subset, v.streamline)) return;

@@ -59,6 +59,7 @@ Tractogram subset_tractogram(const VxlFile& file, const StreamlineSubset& subset
   Tractogram t;
   t.source = source_of(file);
   WalkCallbacks cb;
+  cb.threads = 0;  // the points decoded on every core
   cb.read_points = [&](std::uint64_t s) { return subset.contains(s); };
   cb.streamline = [&](std::uint64_t, std::span<const float> xyz) { t.add_streamline(xyz.data(), xyz.size() / 3); };
   walk_streamlines(file, cb);
