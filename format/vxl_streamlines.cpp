@@ -67,14 +67,14 @@ class StreamlineWalk {
         voxlines_(f.voxlines()) {
     f.check_streamline_table();
     // One cursor per voxel and depth: a voxel's block holds the voxlines of deeper streamlines first (spec
-    // §5.4, §5.12), each depth's in streamline order. Each cursor's end is kept beside it.
+    // §5.4, §5.12), each depth's in streamline order. Each cursor's end is kept beside it: one cache line
+    // read per voxline walked.
     const auto voxels = f.voxels();
-    cursor_.resize(voxels.size() * levels_);
-    cursor_end_.resize(voxels.size() * levels_);
+    cursors_.resize(voxels.size() * levels_);
     for (std::size_t i = 0; i < voxels.size(); ++i)
       for (std::uint32_t d = 0; d < levels_; ++d) {
-        cursor_[i * levels_ + d] = voxels[i].vertex_first + depth_first_vertex(f.levels_of(i), d);
-        cursor_end_[i * levels_ + d] = voxels[i].vertex_first + depth_end_vertex(voxels[i], f.levels_of(i), d);
+        cursors_[i * levels_ + d] = {voxels[i].vertex_first + depth_first_vertex(f.levels_of(i), d),
+                                     voxels[i].vertex_first + depth_end_vertex(voxels[i], f.levels_of(i), d)};
       }
     if (packed_)
       for (const VoxelEntry& v : voxels) {
@@ -149,8 +149,9 @@ class StreamlineWalk {
       const bool connected = j + 1 < last;
       if (synthetic_first && j == first)
         fail_input(path_, vxln_at_ + 8 * j, "a streamline cannot start with a synthetic point");
-      std::uint64_t& here = cursor_[e.voxel * levels_ + depth];
-      const std::uint64_t end = cursor_end_[e.voxel * levels_ + depth];
+      Cursor& cursor = cursors_[e.voxel * levels_ + depth];
+      std::uint64_t& here = cursor.here;
+      const std::uint64_t end = cursor.end;
       const std::uint64_t need = std::uint64_t(own) + (connected ? 1 : 0);
       if (here > end || need > end - here)
         fail_input(path_, vxln_at_ + 8 * j, "voxline runs past its voxel's vertex block (or its level's part of it)");
@@ -253,7 +254,7 @@ class StreamlineWalk {
     const std::uint64_t voxels = f_.voxels().size();
     for (std::size_t i = 0; i < voxels; ++i)
       for (std::uint32_t d = 0; d < levels_; ++d)
-        if (cursor_[i * levels_ + d] != cursor_end_[i * levels_ + d])
+        if (cursors_[i * levels_ + d].here != cursors_[i * levels_ + d].end)
           fail_input(path_, f_.find_section(section_id("VOXT"))->offset + 64 * i,
                      "voxel block has vertices no voxline uses" +
                          (levels_ > 1 ? " (at depth " + std::to_string(d) + ")" : std::string()));
@@ -274,7 +275,10 @@ class StreamlineWalk {
   const std::uint64_t vxln_at_;
   const std::span<const std::uint64_t> strm_;
   const std::span<const VoxlineEntry> voxlines_;
-  std::vector<std::uint64_t> cursor_, cursor_end_;
+  struct Cursor {
+    std::uint64_t here, end;  // the next vertex of the voxel's depth, and one past its last
+  };
+  std::vector<Cursor> cursors_;
   std::vector<double> error_bound_;    // per voxel, packed
   std::vector<VertexPacker> packers_;  // per voxel, packed: made once, not once per voxline read
   std::uint64_t parts_ = 1;

@@ -4,6 +4,7 @@
 #include <cassert>
 
 #include "format/base/error.h"
+#include "format/base/parallel.h"
 
 namespace vxl {
 
@@ -47,16 +48,26 @@ SubsetCounts subset_counts(const VxlFile& file, const StreamlineSubset* subset) 
   if (!subset) return {file.meta().streamline_count, file.meta().point_count};
   const auto strm = file.streamline_first_voxline();
   const auto voxlines = file.voxlines();
-  SubsetCounts c{subset->size(), 0};
-  for (std::uint64_t s : subset->indices()) {
-    file.check_streamline_run(s);
-    for (std::uint64_t j = strm[s]; j < strm[s + 1]; ++j) {
-      const std::uint32_t own = voxlines[j].count_flags & kVoxlineCountMask;
-      const std::uint32_t skip = (voxlines[j].count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
-      file.check_voxline(j);
-      c.points += own - skip;
+  // In chunks on every core (a gather through the voxline table, waiting on memory); the first fault in
+  // streamline order is the one reported.
+  const std::span<const std::uint64_t> indices = subset->indices();
+  constexpr std::uint64_t kChunk = 1 << 14;
+  std::vector<std::uint64_t> points((indices.size() + kChunk - 1) / kChunk);
+  parallel_for_first_error_in_order(points.size(), 0, [&](std::uint64_t chunk, unsigned) {
+    std::uint64_t sum = 0;
+    for (const std::uint64_t s : indices.subspan(chunk * kChunk, std::min(kChunk, indices.size() - chunk * kChunk))) {
+      file.check_streamline_run(s);
+      for (std::uint64_t j = strm[s]; j < strm[s + 1]; ++j) {
+        const std::uint32_t own = voxlines[j].count_flags & kVoxlineCountMask;
+        const std::uint32_t skip = (voxlines[j].count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
+        file.check_voxline(j);
+        sum += own - skip;
+      }
     }
-  }
+    points[chunk] = sum;
+  });
+  SubsetCounts c{subset->size(), 0};
+  for (const std::uint64_t p : points) c.points += p;
   return c;
 }
 
