@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "format/base/error.h"
+#include "format/level_voxlines.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
 
@@ -220,8 +221,25 @@ void place_voxel_voxlines(const VxlFile& file, const VoxelVoxlines& index, std::
   }
 }
 
+struct VoxelVoxlinesCache::Levels {
+  std::array<std::once_flag, kMaxLevels> once;
+  std::array<std::optional<LevelVoxlines>, kMaxLevels> placed;
+};
+
 VoxelVoxlinesCache::VoxelVoxlinesCache(std::vector<const VxlFile*> files)
-    : files_(std::move(files)), once_(new std::once_flag[files_.size()]), indexes_(files_.size()) {}
+    : files_(std::move(files)),
+      once_(new std::once_flag[files_.size()]),
+      indexes_(files_.size()),
+      levels_(new Levels[files_.size()]) {}
+
+VoxelVoxlinesCache::~VoxelVoxlinesCache() = default;
+
+const LevelVoxlines& VoxelVoxlinesCache::level(std::size_t file, std::uint32_t level) {
+  if (level >= kMaxLevels) throw std::logic_error("VoxelVoxlinesCache::level: no such level");
+  Levels& l = levels_[file];
+  std::call_once(l.once[level], [&] { l.placed[level].emplace(*files_[file], level); });
+  return *l.placed[level];
+}
 
 const VoxelVoxlines* VoxelVoxlinesCache::of(std::size_t file) {
   std::call_once(once_[file], [&] { indexes_[file] = VoxelVoxlines::of_file(*files_[file]); });

@@ -145,19 +145,26 @@ struct PlacedVoxline {
 void place_voxel_voxlines(const VxlFile& file, const VoxelVoxlines& index, std::size_t voxel,
                           std::vector<std::uint8_t>& ends, std::vector<PlacedVoxline>& out, std::uint32_t level = 0);
 
+class LevelVoxlines;
+
 // The indexes of several files, each built on first use, once, by whichever thread asks first (the
 // window's selection thread or its renderer); the others wait for it.
 class VoxelVoxlinesCache {
  public:
   explicit VoxelVoxlinesCache(std::vector<const VxlFile*> files);
+  ~VoxelVoxlinesCache();
   // File `file`'s index; null when the file is too large for one. Rethrows the build's error (and builds
   // again at the next call).
   const VoxelVoxlines* of(std::size_t file);
+  // File `file`'s voxlines of level `level` placed (format/level_voxlines.h), made on first use, once; as `of`.
+  const LevelVoxlines& level(std::size_t file, std::uint32_t level);
 
  private:
+  struct Levels;  // per file: each level's, made once
   std::vector<const VxlFile*> files_;
   std::unique_ptr<std::once_flag[]> once_;
   std::vector<std::optional<VoxelVoxlines>> indexes_;
+  std::unique_ptr<Levels[]> levels_;
 };
 
 }  // namespace vxl

@@ -10,6 +10,13 @@
 
 namespace vxl {
 
+// Whether n bytes are all zero, as reserved fields and padding must be.
+inline bool all_zero(const std::uint8_t* p, std::uint64_t n) {
+  for (std::uint64_t i = 0; i < n; ++i)
+    if (p[i] != 0) return false;
+  return true;
+}
+
 static_assert(std::endian::native == std::endian::little, "the .vxl format is read in place: little-endian hosts only");
 
 inline constexpr std::array<std::uint8_t, 8> kVxlMagic = {0x89, 'V', 'X', 'L', '\r', '\n', 0x1A, '\n'};

@@ -18,12 +18,6 @@
 namespace vxl {
 namespace {
 
-bool all_zero(const std::uint8_t* p, std::uint64_t n) {
-  for (std::uint64_t i = 0; i < n; ++i)
-    if (p[i] != 0) return false;
-  return true;
-}
-
 void check_checksums_and_padding(const VxlFile& f) {
   const std::string& p = f.path();
   auto bytes = f.bytes();

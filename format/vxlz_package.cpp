@@ -14,10 +14,6 @@
 namespace vxl {
 namespace {
 
-bool all_zero(const std::uint8_t* p, std::size_t n) {
-  return std::all_of(p, p + n, [](std::uint8_t b) { return b == 0; });
-}
-
 template <typename T>
 std::vector<std::uint8_t> bytes_of(const T& value) {
   const auto* b = reinterpret_cast<const std::uint8_t*>(&value);

@@ -88,7 +88,7 @@ void LinePass::prepare_attributes(const RenderSettings& s, const std::string& sc
                       "colour or opacity by value or group needs the voxel index of voxlines, which holds fewer than "
                       "2^32 streamlines and voxlines of fewer than 2^26 points");
         per_file.push_back({name.empty() ? ValueSource{} : find_value_set(*files_[i], name),
-                            static_cast<std::uint32_t>(first_streamline), index});
+                            static_cast<std::uint32_t>(first_streamline), index, &indexes, i});
         first_streamline += files_[i]->meta().streamline_count;
       }
     scene_.upload_attributes(std::move(per_file));

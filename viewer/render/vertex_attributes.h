@@ -28,6 +28,9 @@ struct AttributeSource {
   ValueSource values;
   std::uint32_t first_streamline = 0;    // the number of the file's streamline 0 in the scene
   const VoxelVoxlines* index = nullptr;  // the file's
+  // Where the coarse levels' placements are kept (the file's number in it), or null: every level through `index`.
+  VoxelVoxlinesCache* cache = nullptr;
+  std::size_t file = 0;
 };
 
 // The first `vertices` vertices of voxel `voxel`'s block (a level's prefix, or all of it), 2 words each,
