@@ -42,9 +42,12 @@ std::vector<std::uint8_t> encode_cloud(const std::int32_t* values, std::size_t n
           reinterpret_cast<const std::uint8_t*>(buffer.data()) + buffer.size()};
 }
 
+}  // namespace
+
 // A decoded cloud of exactly n points with one int32 attribute of `components` components, its values
 // dense in point order: read in place from Draco's buffer when it is laid out so (sequential decoding
-// always is), else copied point by point through the attribute's mapping.
+// always is), else copied point by point through the attribute's mapping. Outside the anonymous namespace:
+// ResidualChunk, declared in the header, holds two.
 class DecodedCloud {
  public:
   DecodedCloud(std::span<const std::uint8_t> bytes, std::size_t n, int components, const char* what,
@@ -108,8 +111,6 @@ class DecodedCloud {
   std::vector<std::int32_t> copy_;
   const std::int32_t* values_ = nullptr;
 };
-
-}  // namespace
 
 std::uint32_t joint_symbol(const std::int32_t r[3], std::uint32_t joint_bits) {
   const std::uint32_t z0 = zigzag(r[0]), z1 = zigzag(r[1]), z2 = zigzag(r[2]);

@@ -45,7 +45,9 @@ TEST(StreamlineSource, ATractogramIsHandedOutInBatchesOfWholeStreamlinesThenEnds
     sizes.push_back(batch.streamline_count());
     // As a TCK's batches: up to the first streamline that brings the points and streamlines to 300.
     const std::uint64_t n = batch.streamline_count();
-    if (first + n < t.streamline_count()) EXPECT_GE(batch.point_count() + n, 300u);
+    if (first + n < t.streamline_count()) {
+      EXPECT_GE(batch.point_count() + n, 300u);
+    }
     EXPECT_LT(batch.offsets[n - 1] + (n - 1), 300u) << "a batch goes no further than the streamline that fills it";
     ASSERT_EQ(batch.offsets.front(), 0u);
     for (std::uint64_t k = 0; k < batch.streamline_count(); ++k) {
