@@ -27,16 +27,18 @@ LevelVoxlines::LevelVoxlines(const VxlFile& file, std::uint32_t level) {
   for (std::size_t v = 0; v < voxels.size(); ++v) first_[v + 1] += first_[v];
   placed_.resize(first_.back());
   std::vector<std::uint64_t> next(first_.begin(), first_.end() - 1);
-  for (const std::uint64_t s : streamlines)
+  for (const std::uint64_t s : streamlines) {
+    const std::uint32_t depth = streamline_depth(s, levels);
     for (std::uint64_t j = strm[s]; j < strm[s + 1]; ++j) {
       PlacedVoxline& p = placed_[next[voxlines[j].voxel]++];
       p.streamline = static_cast<std::uint32_t>(s);
       p.own = voxlines[j].count_flags & kVoxlineCountMask;
-      p.depth = streamline_depth(s, levels);
+      p.depth = depth;
       p.synthetic_first = (voxlines[j].count_flags & kVoxlineSyntheticFirst) != 0;
       p.first_of_streamline = j == strm[s];
       p.last_of_streamline = j + 1 == strm[s + 1];
     }
+  }
 
   // Placed in each block: a voxline of depth d at that depth's cursor (spec §5.6, §5.12).
   const std::uint64_t voxt_at = file.find_section(section_id("VOXT"))->offset;
