@@ -3,6 +3,7 @@
 // limit too small for a part must be refused naming that part.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -173,6 +174,23 @@ TEST(ConversionPlan, TheOrderChunkFollowsTheRequestButHoldsTheLargestVoxel) {
   MemoryBudget b(200 * kMiB, "source.tck");
   EXPECT_EQ(plan_conversion(b, t.counts(PositionEncoding::Packed, 4, 4 * kMiB)).order_chunk_bytes, t.order_bytes)
       << "never more than the whole ORDB payload";
+}
+
+// Unasked, a chunk holds two of the largest voxels' orders per ordering thread (so that no thread waits long at a
+// chunk's end), within 16 MiB and 256 MiB: larger chunks cost memory twice over and gain nothing.
+TEST(ConversionPlan, TheOrderChunkHoldsTwoLargestVoxelsPerThreadWithinItsBounds) {
+  const Table t(std::vector<std::uint32_t>(200, 200'000));  // each voxel's orders: a few MB; ORDB: hundreds
+  const std::uint64_t largest = t.voxels[1].order_offset - t.voxels[0].order_offset;
+  ASSERT_GT(t.order_bytes, 256 * kMiB);
+  ASSERT_LT(2 * largest, 16 * kMiB);
+  ASSERT_GT(2 * 8 * largest, 16 * kMiB);
+  ASSERT_LT(2 * 8 * largest, 256 * kMiB);
+  for (unsigned threads : {1u, 8u, 256u}) {
+    MemoryBudget budget(64ull << 30, "source.tck");
+    const std::uint64_t expected = std::clamp<std::uint64_t>(2 * threads * largest, 16 * kMiB, 256 * kMiB);
+    EXPECT_EQ(plan_conversion(budget, t.counts(PositionEncoding::Packed, threads)).order_chunk_bytes, expected)
+        << threads << " threads";
+  }
 }
 
 TEST(ConversionPlan, NoVoxelsMakeOneEmptyRangeThatWritesTheTables) {

@@ -115,6 +115,13 @@ void StreamingConversion::place_range(const VoxelRange& r, bool tables, const st
     table_.index_lists.reset();
     budget_.shrink(0, table_.index_lists_held);
   }
+  if (r.end == table_.voxels.size()) {
+    // The last range is placed: the voxel runs and spans serve no other pass, so their memory goes before the
+    // orders are built beside the range's vertices (1M streamlines: 72 MiB of runs).
+    table_.runs.clear();
+    budget_.shrink(0, table_.runs_held);
+    std::vector<std::array<std::uint32_t, 2>>().swap(table_.spans);
+  }
   summary_.voxelize_seconds += seconds_since(t0);
 }
 
