@@ -5,7 +5,7 @@
 // as it is appended; commit() checks that every payload is complete, writes the section table and the
 // header, and links the file into place (AtomicOutputFile), so a partial file never appears.
 //
-// The layout is VxlWriter's (plan_vxl_layout): the same content gives the same bytes either way.
+// The layout is plan_vxl_layout's (vxl_sections.h).
 #pragma once
 
 #include <cstdint>
@@ -19,7 +19,7 @@
 #include "format/base/direct_region_writer.h"
 #include "format/base/parallel.h"
 #include "format/vxl_layout.h"
-#include "format/vxl_writer.h"
+#include "format/vxl_sections.h"
 
 namespace vxl {
 

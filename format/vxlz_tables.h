@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "format/vxl_layout.h"
-#include "format/vxl_writer.h"
+#include "format/vxl_sections.h"
 #include "format/vxlz_streams.h"
 
 namespace vxl {

@@ -54,7 +54,7 @@ inline std::string gzip(const std::string& data, bool finish = true) {
   z.next_out = reinterpret_cast<Bytef*>(out.data());
   z.avail_out = static_cast<uInt>(out.size());
   deflate(&z, finish ? Z_FINISH : Z_FULL_FLUSH);
-  out.resize(out.size() - z.avail_out);
+  out.erase(out.size() - z.avail_out);  // erase, not resize: it never grows the string
   deflateEnd(&z);
   return out;
 }

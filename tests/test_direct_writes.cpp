@@ -104,52 +104,6 @@ TEST(DirectWrites, RegionsAppendedFromBlocksGiveThePlainBytes) {
   expect_plain_bytes(dir, 4, {5, block + 3, 3 * block, 7 * block + 1, 130001, 599000, 600000}, true);
 }
 
-// A mapped output (what VxlWriter fills) is memory written to the file at commit(): whole 4 KiB blocks
-// directly where allowed, the rest through the page cache. Every size around a block boundary must come
-// out whole, and nothing may appear at the path before commit().
-TEST(DirectWrites, AMappedOutputOfAnySizeIsWrittenWholeAtCommit) {
-  ScratchDir dir;
-  std::mt19937 rng(7);
-  for (std::uint64_t size : {std::uint64_t{1}, std::uint64_t{4095}, std::uint64_t{4096}, std::uint64_t{4097},
-                             std::uint64_t{3 * 4096 + 17}, std::uint64_t{(65u << 20) + 1234}}) {
-    std::vector<std::uint8_t> expected(size);
-    for (auto& b : expected) b = static_cast<std::uint8_t>(rng());
-    const std::string path = dir.file("mapped-" + std::to_string(size) + ".bin");
-    {
-      AtomicOutputFile out(path);
-      const std::span<std::uint8_t> bytes = out.map(size);
-      ASSERT_EQ(bytes.size(), size);
-      EXPECT_TRUE(std::all_of(bytes.begin(), bytes.end(), [](std::uint8_t b) { return b == 0; }));
-      std::copy(expected.begin(), expected.end(), bytes.begin());
-      EXPECT_FALSE(std::filesystem::exists(path)) << "nothing at the path before commit()";
-      out.commit();
-    }
-    EXPECT_TRUE(file_bytes(path) == expected) << size << " bytes";
-  }
-}
-
-// Parts of a mapped output written early (write_mapped_now, as convert does with the sections that are final while
-// the orders are built: their whole blocks only), the rest at commit(): the file must still be the bytes, whatever
-// the parts' order, overlap and alignment.
-TEST(DirectWrites, AMappedOutputWrittenPartlyEarlyIsWrittenWholeAtCommit) {
-  ScratchDir dir;
-  std::mt19937 rng(11);
-  const std::uint64_t size = 40 * 4096 + 123;
-  std::vector<std::uint8_t> expected(size);
-  for (auto& b : expected) b = static_cast<std::uint8_t>(rng());
-  const std::vector<std::array<std::uint64_t, 2>> parts = {
-      {5 * 4096 + 7, 9000}, {0, 4095}, {30 * 4096, 10 * 4096 + 123}, {2 * 4096, 3 * 4096}, {6 * 4096, 100}};
-  const std::string path = dir.file("early.bin");
-  {
-    AtomicOutputFile out(path);
-    const std::span<std::uint8_t> bytes = out.map(size);
-    std::copy(expected.begin(), expected.end(), bytes.begin());
-    for (const auto& [offset, n] : parts) out.write_mapped_now(offset, n);
-    out.commit();
-  }
-  EXPECT_TRUE(file_bytes(path) == expected);
-}
-
 // All regions open at once and appended in a random interleaving (as the placing pass appends to the
 // vertex blocks), their full stagings handed to a write queue and swapped for its spares: with no spare
 // (each submit waits for its own buffer to come back) and with a few, with and without O_DIRECT.

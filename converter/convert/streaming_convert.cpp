@@ -13,8 +13,8 @@
 #include "converter/readers/source_formats.h"
 #include "format/base/error.h"
 #include "format/base/parallel.h"
+#include "format/vxl_sections.h"
 #include "format/vxl_value_sets.h"
-#include "format/vxl_writer.h"
 
 namespace vxl {
 namespace streaming {

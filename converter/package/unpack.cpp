@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -12,14 +13,16 @@
 #include "converter/convert/position_packing.h"
 #include "converter/convert/segment_orders.h"
 #include "converter/convert/voxel_table.h"
+#include "converter/pipeline/range_orders.h"
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
 #include "format/base/parallel.h"
 #include "format/streamline_length.h"
+#include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
 #include "format/vxl_group_values.h"
+#include "format/vxl_stream_writer.h"
 #include "format/vxl_value_sets.h"
-#include "format/vxl_writer.h"
 #include "format/vxlz_draco.h"
 #include "format/vxlz_package.h"
 #include "format/vxlz_quantize.h"
@@ -363,6 +366,66 @@ void measure_streamlines(const Structure& s, std::span<const float> vertices, st
   });
 }
 
+// Decodes every position chunk into `vertices` (3 floats a vertex, VERT's order), in parallel, and marks the
+// voxline ends in `ends`.
+void decode_vertices(const VxlzFile& f, const Structure& s, std::span<float> vertices, VoxlineEnds& ends,
+                     unsigned threads, const std::function<void(double)>& progress) {
+  std::atomic<std::uint64_t> done{0};
+  parallel_for(f.chunk_count(), threads, [&](std::uint64_t chunk, unsigned t) {
+    decode_chunk(f, s, chunk, vertices, ends);
+    const std::uint64_t d = ++done;
+    if (t == 0) progress(double(d) / double(f.chunk_count()));
+  });
+}
+
+// Each voxel's tight bounds from its decoded vertices (spec §7 step 3) and, packed, its block packed into `packed`
+// (VERT's words). Returns the largest packing bound (0 for float32).
+double bound_and_pack(std::span<VoxelEntry> voxels, std::span<float> vertices, const VoxlineEnds& ends,
+                      std::span<std::uint32_t> packed, unsigned threads) {
+  std::vector<double> repack_bound(threads, 0.0);  // per thread: the largest of its voxels' packing bounds
+  parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned t) {
+    VoxelEntry& v = voxels[i];
+    detail::set_tight_bounds({&v, 1}, vertices.data(), 0);
+    if (packed.empty()) return;
+    pack_vertex_blocks({&v, 1}, vertices, ends, packed, 1);
+    repack_bound[t] = std::max(repack_bound[t], packed_error_bound(v));
+  });
+  return *std::max_element(repack_bound.begin(), repack_bound.end());
+}
+
+// The sections after VERT and ORDB (spec §7 steps 6-8): META with its bounds, the directions, the voxel and level
+// tables, the voxline and streamline tables with their voxel index, the lengths, PROV, and what the package carries
+// besides (groups, their values, the value sets).
+void append_tables(VxlStreamWriter& out, const VxlzFile& f, const Structure& s, const MetaSection& meta,
+                   std::span<const VoxelEntry> voxels, std::span<const float> lengths, const std::string& provenance,
+                   const PackageExtras& extras, unsigned threads) {
+  out.append_meta(meta);
+  out.append_items<DirectionEntry>(VxlStreamWriter::kDirs, f.directions());
+  out.append_items<VoxelEntry>(VxlStreamWriter::kVoxt, voxels);
+  if (!s.levels.empty()) out.append_items<LevelEntry>(VxlStreamWriter::kLods, s.levels);
+  out.append_items<VoxlineEntry>(VxlStreamWriter::kVxln, s.voxlines);
+  out.append_items<std::uint64_t>(VxlStreamWriter::kStrm, s.strm);
+  if (const std::uint64_t bytes = voxel_index_bytes(meta); bytes > 0) {
+    std::vector<std::uint8_t> payload(bytes);
+    fill_voxel_index_payload(payload, s.strm, s.voxlines);
+    out.append(VxlStreamWriter::kVxix, payload);
+  }
+  if (!lengths.empty()) out.append_items<float>(VxlStreamWriter::kSlen, lengths);
+  out.append(VxlStreamWriter::kProv, {reinterpret_cast<const std::uint8_t*>(provenance.data()), provenance.size()});
+  if (!extras.groups_bytes.empty()) out.append(VxlStreamWriter::kGrps, extras.groups_bytes);
+  if (!extras.point_values.empty()) {
+    std::vector<std::uint8_t> payload(value_sets_bytes(extras.point_values.size(), meta.vertex_count), 0);
+    write_point_values(s, extras.point_values, payload, meta.vertex_count, threads);
+    out.append(VxlStreamWriter::kVval, payload);
+  }
+  if (!extras.streamline_values.empty()) {
+    std::vector<std::uint8_t> payload(value_sets_bytes(extras.streamline_values.size(), meta.streamline_count), 0);
+    write_streamline_values(extras.streamline_values, payload, meta.streamline_count);
+    out.append(VxlStreamWriter::kSval, payload);
+  }
+  if (!extras.group_values_bytes.empty()) out.append(VxlStreamWriter::kGdat, extras.group_values_bytes);
+}
+
 }  // namespace
 
 UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
@@ -382,7 +445,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
     fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");
   Structure s = rebuild_structure(f, settings.levels);
   const std::string provenance = provenance_with_package(f);
-  PackageExtras extras = read_extras(f, threads);
+  const PackageExtras extras = read_extras(f, threads);
 
   MetaSection meta = f.meta();
   meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
@@ -392,83 +455,50 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
                                         static_cast<std::uint32_t>(extras.point_values.size()),
                                         static_cast<std::uint32_t>(extras.streamline_values.size()));
   sizes.group_values = extras.group_values_bytes.size();
-  VxlWriter out(out_path, sizes);
-  // Packed positions are decoded as floats first (tight bounds and orders come from them), then packed.
-  std::vector<float> float_blocks(packed ? 3 * meta.vertex_count : 0);
-  const std::span<float> vertices = packed ? std::span<float>(float_blocks) : out.float_vertices();
-  prefault_for_write(bytes_of(out.float_vertices()), threads);
-  std::copy(s.voxels.begin(), s.voxels.end(), out.voxels().begin());
-  std::copy(s.levels.begin(), s.levels.end(), out.levels().begin());
-
-  // Positions: chunks in parallel, each into its own voxlines' places.
-  std::atomic<std::uint64_t> done{0};
+  // The same stages as a conversion's last: VERT filled in place, then its orders a chunk of voxels at a time
+  // (write_range_orders, one range of every voxel), then the tables. A refused package leaves no file.
+  VxlStreamWriter out(out_path, sizes, kSectionDirectStagingBytes);
+  std::vector<VoxelEntry>& voxels = s.voxels;  // their tight bounds set from the decoded vertices
+  std::vector<float> lengths(meta.streamline_count);
   VoxlineEnds ends(meta.vertex_count);
-  parallel_for(f.chunk_count(), threads, [&](std::uint64_t chunk, unsigned t) {
-    decode_chunk(f, s, chunk, vertices, ends);
-    if (t == 0)
-      progress("decoding", double(++done) / double(f.chunk_count()));
-    else
-      ++done;
-  });
-
-  measure_streamlines(s, vertices, out.streamline_lengths(), threads);
-  summary.decode_seconds = seconds_since(t0);
-
-  // Per voxel, while its block is in cache: its tight bounds from the decoded vertices (spec §7 step 3),
-  // then its orders for the shipped directions (step 5).
-  t0 = Clock::now();
-  OrderSetSpec set;
-  set.kind = static_cast<OrderSet>(meta.order_set);
-  for (const DirectionEntry& d : f.directions()) set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
-  // ORDB and the sections after it (VXLN, STRM, PROV, GRPS), which are filled after the orders: one
-  // populate for all, instead of a fault per page for the voxline table's 8 bytes per voxline.
-  prefault_for_write(out.file().subspan(static_cast<std::size_t>(out.orders().data() - out.file().data())), threads);
-  std::span<VoxelEntry> voxels = out.voxels();
-  std::vector<VoxelOrderWriter> writers;
-  for (unsigned t = 0; t < threads; ++t) writers.emplace_back(set);
-  std::atomic<std::uint64_t> ordered{0};
-  std::vector<double> repack_bound(threads, 0.0);  // per thread: the largest of its voxels' packing bounds
-  // One more item before the voxels: float32 vertices are final, so their checksum is taken here, beside
-  // the orders, rather than alone at the end.
-  parallel_for(voxels.size() + 1, threads, [&](std::uint64_t item, unsigned t) {
-    if (item == 0) {
-      if (!packed) out.checksum_vertices_now();
-      return;
-    }
-    VoxelEntry& v = voxels[item - 1];
-    detail::set_tight_bounds({&v, 1}, vertices.data(), 0);
-    const std::span<const LevelEntry> row = level_row(s.levels, item - 1, s.level_count);
-    std::uint8_t* orders = out.orders().data() + v.order_offset;
-    // Orders from what the file holds, as every conversion builds them: the packed words, or the floats.
-    if (packed) {
-      pack_vertex_blocks({&v, 1}, vertices, ends, out.packed_vertices(), 1);
-      repack_bound[t] = std::max(repack_bound[t], packed_error_bound(v));
-      writers[t].write_packed(v, row, out.packed_vertices().data() + v.vertex_first, orders);
-    } else {
-      writers[t].write(v, row, vertices, ends, orders);
-    }
-    const std::uint64_t d = ++ordered;
-    if (t == 0 && (d & 63) == 0) progress("ordering", double(d) / double(voxels.size()));
-  });
-  progress("ordering", 1.0);
-  float_blocks = {};
-  set_bounds_checked(meta, voxels, f.path());
-  summary.orders_seconds = seconds_since(t0);
+  VoxelRange whole{0, voxels.size(), 0, meta.vertex_count, 0, threads, 0};
+  for (const VoxelEntry& v : voxels) whole.max_vertices = std::max(whole.max_vertices, v.vertex_count);
+  const auto place = [&](std::span<std::uint8_t> window) {
+    // Packed positions are decoded as floats first (tight bounds come from them), then packed into VERT.
+    std::vector<float> float_blocks(packed ? 3 * meta.vertex_count : 0);
+    const std::span<float> vertices =
+        packed ? std::span<float>(float_blocks)
+               : std::span<float>(reinterpret_cast<float*>(window.data()), window.size() / sizeof(float));
+    decode_vertices(f, s, vertices, ends, threads, [&](double d) { progress("decoding", d); });
+    measure_streamlines(s, vertices, lengths, threads);
+    const std::span<std::uint32_t> words =
+        packed ? std::span<std::uint32_t>(reinterpret_cast<std::uint32_t*>(window.data()), meta.vertex_count)
+               : std::span<std::uint32_t>();
+    summary.repack_error_bound = bound_and_pack(voxels, vertices, ends, words, threads);
+    set_bounds_checked(meta, voxels, f.path());
+    summary.decode_seconds = seconds_since(t0);
+  };
+  OrderSetSpec order_set;
+  order_set.kind = static_cast<OrderSet>(meta.order_set);
+  for (const DirectionEntry& d : f.directions()) order_set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
+  const auto order = [&](std::span<const std::uint8_t> window) {
+    RangeOrderSettings orders;
+    orders.order_set = &order_set;
+    orders.positions = settings.positions;
+    orders.order_chunk_bytes = order_chunk_bytes(voxels, s.order_bytes, threads, 0, s.order_bytes);
+    orders.direct = true;
+    orders.float_ends = &ends;
+    orders.progress = [&](double d) { progress("ordering", d); };
+    summary.orders_seconds =
+        write_range_orders(out, {voxels, s.levels, s.level_count, s.order_bytes}, whole, window, orders);
+  };
+  out.append_in_place(VxlStreamWriter::kVert, meta.vertex_count * vertex_bytes(settings.positions), threads, place,
+                      order);
 
   t0 = Clock::now();
   progress("writing", 0.0);
-  out.set_meta(meta);
-  std::copy(f.directions().begin(), f.directions().end(), out.directions().begin());
-  std::copy(s.voxlines.begin(), s.voxlines.end(), out.voxlines().begin());
-  std::copy(s.strm.begin(), s.strm.end(), out.streamline_first_voxline().begin());
-  std::copy(provenance.begin(), provenance.end(), out.provenance().begin());
-  std::copy(extras.groups_bytes.begin(), extras.groups_bytes.end(), out.groups().begin());
-  std::copy(extras.group_values_bytes.begin(), extras.group_values_bytes.end(), out.group_values().begin());
-  if (!extras.point_values.empty())
-    write_point_values(s, extras.point_values, out.vertex_values(), meta.vertex_count, threads);
-  if (!extras.streamline_values.empty())
-    write_streamline_values(extras.streamline_values, out.streamline_values(), meta.streamline_count);
-  out.commit(threads);
+  append_tables(out, f, s, meta, voxels, lengths, provenance, extras, threads);
+  out.commit();
   summary.write_seconds = seconds_since(t0);
   progress("writing", 1.0);
 
@@ -476,7 +506,6 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   summary.points = meta.point_count;
   summary.voxels = meta.voxel_count;
   summary.pack = f.pack();
-  summary.repack_error_bound = *std::max_element(repack_bound.begin(), repack_bound.end());
   summary.point_value_sets = static_cast<std::uint32_t>(extras.point_values.size());
   summary.streamline_value_sets = static_cast<std::uint32_t>(extras.streamline_values.size());
   return summary;

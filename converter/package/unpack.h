@@ -1,9 +1,10 @@
-// `voxlines unpack`: a .vxlz package back to a .vxl (spec/vxlz-package-v2.md §7). The tables are taken
-// as shipped (never re-voxelised: quantisation could move a point across a voxel face), the position
-// chunks are decoded in parallel straight into the output's vertex blocks, the connecting vertices are
-// written as copies of the decoded next points, and the tight bounds and the orders are recomputed from
-// the decoded vertices. The value sets come back bit-exact, per vertex as the converter laid them out.
-// The result passes `voxlines verify`.
+// `voxlines unpack`: a .vxlz package back to a .vxl (spec/vxlz-package-v2.md §7). The package is the source of
+// a conversion whose voxelisation is given: the tables are taken as shipped (never re-voxelised: quantisation
+// could move a point across a voxel face), the position chunks are decoded in parallel into the vertex blocks,
+// the connecting vertices written as copies of the decoded next points, the tight bounds set from the decoded
+// vertices, and the blocks packed, ordered (the conversion's orders stage, pipeline/range_orders.h) and written
+// (VxlStreamWriter) as a conversion's are. The value sets come back bit-exact, per vertex as the converter laid
+// them out. The result passes `voxlines verify`.
 #pragma once
 
 #include <cstdint>

@@ -21,8 +21,6 @@ constexpr std::uint64_t kBaselineBytes = 16 * kMiB;
 // slots, with their growth: up to 40 bytes), counts per voxel (with growth: 32), tight bounds (with
 // growth: 48), sort order, global id, the table itself (64) and cursor (8) — 200 bytes, and a margin.
 constexpr std::uint64_t kPlanBytesPerVoxel = 240;
-// The output's direct writes are staged this much per section.
-constexpr std::uint64_t kDirectStagingBytes = 2 * kMiB;
 // With direct writes VERT is not held in memory when its blocks are few enough: each (voxel, level)
 // block is written through a staging of its own of this size (less where an eighth of the memory left
 // does not allow, but never under the minimum), then read back a chunk of voxels at a time for their
@@ -222,6 +220,16 @@ std::uint64_t block_staging_total(const ConversionCounts& c, std::uint64_t stagi
   return total;
 }
 
+std::uint64_t order_chunk_bytes(std::span<const VoxelEntry> voxels, std::uint64_t order_bytes, unsigned threads,
+                                std::uint64_t request, std::uint64_t most) {
+  std::uint64_t largest = 0;
+  for (std::size_t i = 0; i < voxels.size(); ++i)
+    largest = std::max(largest, orders_start(voxels, order_bytes, i + 1) - orders_start(voxels, order_bytes, i));
+  const std::uint64_t wanted =
+      std::clamp(kChunkVoxelsPerThread * threads * largest, kMinOrderChunkBytes, kMaxOrderChunkBytes);
+  return std::max(largest, std::min({request > 0 ? request : wanted, order_bytes, most}));
+}
+
 std::uint64_t chunk_buffer_bytes(std::uint64_t order_chunk_bytes) {
   constexpr std::uint64_t block = DirectRegionWriter::kBlock;
   return (order_chunk_bytes + block - 1) / block * block + block;
@@ -286,18 +294,11 @@ ConversionPlan plan_conversion(MemoryBudget& budget, const ConversionCounts& cou
   budget.take(plan.staged_bytes, "the voxlines of two batches being placed");
   // Direct writes (the output bypasses the page cache) where the limit leaves room for their staging.
   if (budget.limit() >= kDirectWritesFromLimit) {
-    plan.direct_staging_bytes = kDirectStagingBytes;
-    budget.take(VxlStreamWriter::kCount * kDirectStagingBytes, "the staging of the output's direct writes");
+    plan.direct_staging_bytes = kSectionDirectStagingBytes;
+    budget.take(VxlStreamWriter::kCount * kSectionDirectStagingBytes, "the staging of the output's direct writes");
   }
-  std::uint64_t largest_voxel_orders = 0;
-  for (std::size_t i = 0; i < counts.voxels.size(); ++i)
-    largest_voxel_orders = std::max(largest_voxel_orders, orders_start(counts.voxels, counts.order_bytes, i + 1) -
-                                                              orders_start(counts.voxels, counts.order_bytes, i));
-  const std::uint64_t wanted_chunk = std::clamp(kChunkVoxelsPerThread * counts.threads * largest_voxel_orders,
-                                                kMinOrderChunkBytes, kMaxOrderChunkBytes);
-  plan.order_chunk_bytes = std::max(
-      largest_voxel_orders, std::min({counts.order_chunk_request > 0 ? counts.order_chunk_request : wanted_chunk,
-                                      counts.order_bytes, budget.left() / 8}));
+  plan.order_chunk_bytes = order_chunk_bytes(counts.voxels, counts.order_bytes, counts.threads,
+                                             counts.order_chunk_request, budget.left() / 8);
   // What the pool, the orders' chunks and the ranges take is given back before the write stage.
   const std::uint64_t room_at_write = budget.left();
   if (plan.direct_staging_bytes > 0 && !vertices_held_whole(budget, counts, plan.order_chunk_bytes))

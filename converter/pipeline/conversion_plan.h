@@ -24,6 +24,8 @@ inline constexpr std::uint64_t kSpareBlockStagings = 32;
 inline constexpr std::uint64_t kHeldBytesPerPoint = 2 * 2 * 3 * sizeof(float);
 // The output is written past the page cache (DirectRegionWriter) under limits of at least this much.
 inline constexpr std::uint64_t kDirectWritesFromLimit = 256ull << 20;
+// The output's direct writes are staged this much per section.
+inline constexpr std::uint64_t kSectionDirectStagingBytes = 2ull << 20;
 
 // The voxel table's bytes per voxel while it is built, with `levels` levels of detail.
 std::uint64_t voxel_table_bytes_per_voxel(std::uint32_t levels);
@@ -125,6 +127,12 @@ inline std::uint64_t orders_start(std::span<const VoxelEntry> voxels, std::uint6
 // The memory VERT's stagings take when written block by block with stagings of `staging` bytes: the write
 // queue's spares and each (voxel, level) block's own (DirectRegionWriter::staging_size).
 std::uint64_t block_staging_total(const ConversionCounts& counts, std::uint64_t staging);
+
+// The orders' chunk (ConversionPlan::order_chunk_bytes): `request` where it is > 0, else two of the largest voxels'
+// orders per ordering thread within 16 MiB and 256 MiB; at most `most` and the whole payload, and never less than
+// the largest voxel's orders.
+std::uint64_t order_chunk_bytes(std::span<const VoxelEntry> voxels, std::uint64_t order_bytes, unsigned threads,
+                                std::uint64_t request, std::uint64_t most);
 
 // The buffer one chunk of orders of up to `order_chunk_bytes` is built in: block-aligned and a block larger, for
 // the orders start where their first byte falls in its block of the file (VxlStreamWriter::append_from_block).

@@ -31,6 +31,25 @@ void StreamingConversion::build_range(const VoxelRange& r, std::size_t index, st
       [&](std::span<const std::uint8_t> window) { write_orders(r, window, "ordering" + of); });
 }
 
+// Range r's orders (range_orders.h) from its vertices in memory, or read back into the pool.
+void StreamingConversion::write_orders(const VoxelRange& r, std::span<const std::uint8_t> range_vertices,
+                                       const std::string& stage) {
+  RangeOrderSettings settings;
+  settings.order_set = &job_.order_set;
+  settings.positions = job_.settings.positions;
+  settings.order_chunk_bytes = plan_.order_chunk_bytes;
+  settings.direct = plan_.direct_staging_bytes > 0;
+  settings.float_ends = &ends_;
+  if (plan_.block_staging_bytes > 0) {
+    settings.pool = pool_.get();
+    settings.pool_chunk_bytes = plan_.pool_chunk_bytes;
+    settings.pool_read_back_bytes = plan_.pool_read_back_bytes;
+  }
+  settings.progress = [&](double fraction) { report(stage, fraction); };
+  const OrderedTable table{table_.voxels, table_.levels, job_.settings.levels, table_.order_bytes};
+  summary_.orders_seconds += write_range_orders(*out_, table, r, range_vertices, settings);
+}
+
 // Pass 2 + k, reading: places range r's vertices in `window` (its part of VERT); the first range also
 // writes the voxline and streamline tables. Each batch is cut in parts that are voxelised and packed
 // side by side (stage_part: packing needs only the voxel, whose tight bounds came from pass 2),

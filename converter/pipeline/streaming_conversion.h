@@ -1,6 +1,6 @@
 // The conversion within a memory limit (streaming_convert.h), in stages that share this class: the scan and
 // the voxel counts (voxel_counting.cpp), the plan (conversion_plan.h), each range's placing pass
-// (range_placement.cpp) and its orders (range_orders.cpp); streaming_convert.cpp runs them. Internal to
+// (range_placement.cpp) and its orders (range_orders.h); streaming_convert.cpp runs them. Internal to
 // those files.
 #pragma once
 
@@ -25,6 +25,7 @@
 #include "converter/pipeline/batch_reader.h"
 #include "converter/pipeline/conversion_plan.h"
 #include "converter/pipeline/memory_budget.h"
+#include "converter/pipeline/range_orders.h"
 #include "converter/pipeline/table_appender.h"
 #include "converter/pipeline/vertex_sink.h"
 #include "converter/pipeline/voxel_runs.h"
@@ -183,9 +184,6 @@ class StreamingConversion {
   void cut_by_runs(std::uint64_t first_point, std::uint64_t points, std::uint64_t& run,
                    std::vector<TempVoxline>& out) const;
   void write_orders(const VoxelRange& r, std::span<const std::uint8_t> range_vertices, const std::string& stage);
-  void write_voxel_orders(const VoxelRange& r, std::size_t g, std::span<const std::uint8_t> vertices,
-                          std::uint64_t vertices_first, VoxelOrderWriter& writer, VoxlineEnds& block_ends,
-                          std::uint8_t* dst);
   bool packed() const { return job_.settings.positions == PositionEncoding::Packed; }
   // Where voxel i's orders start in ORDB (i = voxel count: the payload's end).
   std::uint64_t orders_start(std::size_t i) const { return vxl::orders_start(table_.voxels, table_.order_bytes, i); }

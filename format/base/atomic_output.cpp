@@ -35,7 +35,6 @@ AtomicOutputFile::AtomicOutputFile(std::string path) : path_(std::move(path)), t
 }
 
 AtomicOutputFile::~AtomicOutputFile() {
-  unmap();
   if (direct_fd_ >= 0) ::close(direct_fd_);
   if (fd_ >= 0) ::close(fd_);
   if (!committed_ && !temp_path_.empty()) ::unlink(temp_path_.c_str());
@@ -46,7 +45,6 @@ void AtomicOutputFile::fail(const std::string& what) const {
 }
 
 void AtomicOutputFile::write(const void* data, std::size_t size) {
-  if (map_ != nullptr) fail("internal error: write() on a mapped file");
   const auto* p = static_cast<const std::uint8_t*>(data);
   while (size > 0) {
     ssize_t n = ::write(fd_, p, size);
@@ -70,7 +68,6 @@ void AtomicOutputFile::write_zeros(std::size_t size) {
 }
 
 void AtomicOutputFile::pwrite(const void* data, std::size_t size, std::uint64_t offset) {
-  if (map_ != nullptr) fail("internal error: pwrite() on a mapped file");
   const auto* p = static_cast<const std::uint8_t*>(data);
   while (size > 0) {
     ssize_t n = ::pwrite(fd_, p, size, static_cast<off_t>(offset));
@@ -98,7 +95,7 @@ void AtomicOutputFile::pread(void* data, std::size_t size, std::uint64_t offset)
 }
 
 void AtomicOutputFile::allocate(std::uint64_t size) {
-  if (map_ != nullptr || position_ != 0) fail("internal error: allocate() on a file already written to");
+  if (position_ != 0) fail("internal error: allocate() on a file already written to");
   if (size == 0) return;
   // fallocate reserves the blocks (ENOSPC surfaces here); file systems without it get a sparse file.
   if (::fallocate(fd_, 0, 0, static_cast<off_t>(size)) != 0) {
@@ -110,30 +107,9 @@ void AtomicOutputFile::allocate(std::uint64_t size) {
   position_ = size;
 }
 
-std::span<std::uint8_t> AtomicOutputFile::map(std::uint64_t size) {
-  if (map_ != nullptr || position_ != 0) fail("internal error: map() on a file already written to");
-  if (size == 0) return {};
-  allocate(size);
-  // Anonymous memory, written to the file by commit(): a shared mapping of the file would fault every page
-  // through the page cache (zeroed, then marked dirty, then written back), which costs about three times
-  // the CPU of fresh anonymous pages plus one direct write (docs/performance.md).
-  void* p = ::mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-  if (p == MAP_FAILED) fail(std::string("cannot allocate memory for the output: ") + std::strerror(errno));
-  map_ = static_cast<std::uint8_t*>(p);
-  map_size_ = size;
-  return {map_, size};
-}
-
 FileWindow AtomicOutputFile::map_window(std::uint64_t offset, std::uint64_t size) {
-  if (map_ != nullptr) fail("internal error: map_window() on a mapped file");
   if (offset > position_ || size > position_ - offset) fail("internal error: map_window() past the allocated size");
   return FileWindow(fd_, path_, offset, size, FileWindow::Access::Write);
-}
-
-void AtomicOutputFile::unmap() noexcept {
-  if (map_ != nullptr) ::munmap(map_, map_size_);
-  map_ = nullptr;
-  map_size_ = 0;
 }
 
 int AtomicOutputFile::direct_descriptor() {
@@ -145,61 +121,7 @@ int AtomicOutputFile::direct_descriptor() {
   return direct_fd_;
 }
 
-namespace {
-constexpr std::uint64_t kBlock = 4096;  // what O_DIRECT asks of offsets and sizes (the mapping is page-aligned)
-}  // namespace
-
-void AtomicOutputFile::write_at(int fd, const std::uint8_t* data, std::uint64_t size, std::uint64_t offset) {
-  while (size > 0) {
-    const ssize_t n = ::pwrite(fd, data, size, static_cast<off_t>(offset));
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) fail(std::string("write failed: ") + std::strerror(errno));
-    data += n;
-    size -= static_cast<std::uint64_t>(n);
-    offset += static_cast<std::uint64_t>(n);
-  }
-}
-
-void AtomicOutputFile::write_mapped_range(std::uint64_t begin, std::uint64_t end) {
-  // Whole blocks past the page cache where the file system allows it, the rest (and everything, where
-  // O_DIRECT is refused) through it.
-  constexpr std::uint64_t kChunk = 64u << 20;
-  std::uint64_t done = begin;
-  if (const int direct = direct_descriptor(); direct >= 0) {
-    const std::uint64_t whole = end / kBlock * kBlock;
-    while (done < whole) {
-      const ssize_t n = ::pwrite(direct, map_ + done, std::min(kChunk, whole - done), static_cast<off_t>(done));
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0 && errno == EINVAL) break;  // alignment refused after all: the page cache takes the rest
-      if (n < 0) fail(std::string("write failed: ") + std::strerror(errno));
-      done += static_cast<std::uint64_t>(n);
-    }
-  }
-  write_at(fd_, map_ + done, end - done, done);
-}
-
-void AtomicOutputFile::write_mapped_now(std::uint64_t offset, std::uint64_t size) {
-  if (map_ == nullptr || offset > map_size_ || size > map_size_ - offset)
-    fail("internal error: write_mapped_now() outside the mapped file");
-  const std::uint64_t begin = (offset + kBlock - 1) / kBlock * kBlock, end = (offset + size) / kBlock * kBlock;
-  if (begin >= end) return;
-  write_mapped_range(begin, end);
-  written_.emplace_back(begin, end);
-}
-
-void AtomicOutputFile::write_mapped() {
-  std::sort(written_.begin(), written_.end());
-  std::uint64_t at = 0;  // block-aligned: 0 or the end of a range written
-  for (const auto& [begin, end] : written_) {
-    if (begin > at) write_mapped_range(at, begin);
-    at = std::max(at, end);
-  }
-  if (at < map_size_) write_mapped_range(at, map_size_);
-}
-
 void AtomicOutputFile::commit() {
-  if (map_ != nullptr) write_mapped();
-  unmap();  // the file must not change once it has a name
   if (direct_fd_ >= 0) ::close(direct_fd_);
   direct_fd_ = -1;
   if (temp_path_.empty()) {

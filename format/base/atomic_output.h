@@ -5,8 +5,8 @@
 // back to a hidden temporary name that is removed on failure (a SIGKILL can then leave that temporary
 // file, never a partial file at the output path).
 //
-// The data is either appended with write() or, when its size is known up front, filled in place through
-// map(): the caller writes into memory of the file's size, which commit() writes past the page cache.
+// The data is appended with write(), or, when its size is known up front (allocate()), written at its offsets with
+// pwrite(), through map_window(), or past the page cache through direct_descriptor().
 #pragma once
 
 #include <cstddef>
@@ -24,7 +24,7 @@ class AtomicOutputFile {
  public:
   // Throws vxl::Error (Output) naming the path, also when format/base/output_path.h's rule refuses it.
   explicit AtomicOutputFile(std::string path);
-  ~AtomicOutputFile();  // discards the data (and any mapping) unless committed
+  ~AtomicOutputFile();  // discards the data unless committed
   AtomicOutputFile(const AtomicOutputFile&) = delete;
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 
@@ -36,19 +36,9 @@ class AtomicOutputFile {
   void pread(void* data, std::size_t size, std::uint64_t offset);
   std::uint64_t position() const { return position_; }
 
-  // Sizes the still empty file to `size` bytes and returns `size` bytes of memory, all zero, that commit()
-  // writes to it (with O_DIRECT for its whole 4 KiB blocks where the file system allows it). The disk space
-  // is reserved here where the file system allows it, so a full disk is an Error now rather than at
-  // commit(). Call at most once, before any write(); the span stays valid until commit() or destruction.
-  std::span<std::uint8_t> map(std::uint64_t size);
-
-  // Writes the whole 4 KiB blocks inside bytes [offset, offset + size) of map()'s memory to the file now, so that
-  // commit() has only the rest left to write. Those bytes must not change afterwards. May run on another thread
-  // while the caller fills other bytes, but not beside another call of it or commit().
-  void write_mapped_now(std::uint64_t offset, std::uint64_t size);
-
-  // Sizes the still empty file to `size` bytes like map(), without mapping it: the caller then fills it
-  // with pwrite(), or a part at a time through map_window().
+  // Sizes the still empty file to `size` bytes, reserving its disk space where the file system allows it (a full
+  // disk is an Error now rather than later): the caller then fills it with pwrite(), or a part at a time through
+  // map_window().
   void allocate(std::uint64_t size);
 
   // A writable mapping of bytes [offset, offset + size) of an allocate()d file (FileWindow::Access::Write):
@@ -61,26 +51,18 @@ class AtomicOutputFile {
   // first call, closed by commit().
   int direct_descriptor();
 
-  void commit();  // unmaps, then replaces any existing file at the path (where its symbolic links lead)
+  void commit();  // replaces any existing file at the path (where its symbolic links lead)
 
   const std::string& path() const { return path_; }
 
  private:
   [[noreturn]] void fail(const std::string& what) const;
-  void write_mapped();  // writes what write_mapped_now() has not of map()'s memory to the file
-  // Writes map()'s bytes [begin, end) (begin on a block): whole blocks with O_DIRECT where allowed.
-  void write_mapped_range(std::uint64_t begin, std::uint64_t end);
-  void write_at(int fd, const std::uint8_t* data, std::uint64_t size, std::uint64_t offset);
-  void unmap() noexcept;
   std::string path_;
   std::string target_;     // path_, or where its symbolic links lead
   std::string temp_path_;  // empty when using O_TMPFILE
   int fd_ = -1;
   int direct_fd_ = -2;  // -2: not opened yet
   std::uint64_t position_ = 0;
-  std::uint8_t* map_ = nullptr;
-  std::uint64_t map_size_ = 0;
-  std::vector<std::pair<std::uint64_t, std::uint64_t>> written_;  // the block ranges write_mapped_now() wrote
   bool committed_ = false;
 };
 

@@ -1,4 +1,4 @@
-#include "format/vxl_writer.h"
+#include "format/vxl_sections.h"
 
 #include <algorithm>
 #include <cstring>
@@ -149,61 +149,6 @@ std::vector<std::uint8_t> vxl_header_bytes(std::span<const SectionEntry> table, 
   h.header_checksum = xxh3_64(bytes.data(), bytes.size());
   std::memcpy(bytes.data(), &h, sizeof h);
   return bytes;
-}
-
-VxlWriter::VxlWriter(const std::string& path, const VxlSectionSizes& sizes) : out_(path), positions_(sizes.positions) {
-  VxlLayout layout = plan_vxl_layout(sizes);
-  table_ = std::move(layout.table);
-  file_ = out_.map(layout.file_size);
-}
-
-SectionEntry* VxlWriter::entry(Index i) {
-  for (SectionEntry& e : table_)
-    if (std::memcmp(e.id, kIds[i], 4) == 0) return &e;
-  return nullptr;  // an optional section that is not there
-}
-
-std::span<std::uint8_t> VxlWriter::payload(Index i) {
-  const SectionEntry* e = entry(i);
-  return e ? file_.subspan(e->offset, e->size) : std::span<std::uint8_t>{};
-}
-
-void VxlWriter::set_meta(const MetaSection& meta) {
-  MetaSection m = meta;
-  std::memset(m.reserved, 0, sizeof m.reserved);
-  std::memcpy(payload(kMeta).data(), &m, sizeof m);
-}
-
-void VxlWriter::write_now(std::span<const std::uint8_t> bytes) {
-  if (bytes.empty()) return;
-  out_.write_mapped_now(static_cast<std::uint64_t>(bytes.data() - file_.data()), bytes.size());
-}
-
-void VxlWriter::checksum_vertices_now() {
-  SectionEntry& vert = *entry(kVert);  // required: always in the table
-  vert.checksum = xxh3_64(file_.data() + vert.offset, vert.size);
-  vertices_checksummed_ = true;
-}
-
-void VxlWriter::commit(unsigned threads) {
-  if (const std::span<std::uint8_t> vxix = payload(kVxix); !vxix.empty())
-    fill_voxel_index_payload(vxix, streamline_first_voxline(), voxlines());
-  // Largest payloads first, so that the big ones (VERT, ORDR) run side by side.
-  std::vector<std::size_t> by_size;
-  const SectionEntry* vert = entry(kVert);
-  for (std::size_t i = 0; i < table_.size(); ++i)
-    if (!(&table_[i] == vert && vertices_checksummed_)) by_size.push_back(i);
-  std::stable_sort(by_size.begin(), by_size.end(),
-                   [&](std::size_t a, std::size_t b) { return table_[a].size > table_[b].size; });
-  parallel_for(by_size.size(), threads, [&](std::uint64_t k, unsigned) {
-    SectionEntry& e = table_[by_size[k]];
-    e.checksum = xxh3_64(file_.data() + e.offset, e.size);
-  });
-
-  std::vector<std::uint8_t> header = vxl_header_bytes(table_, file_.size(), positions_);
-  std::memcpy(file_.data(), header.data(), header.size());
-  file_ = {};
-  out_.commit();
 }
 
 }  // namespace vxl
