@@ -278,6 +278,28 @@ TEST(VxlzPackageOptions, PackageBytesDoNotDependOnThreads) {
   EXPECT_EQ(slurp(dir.file("one.vxlz")), slurp(dir.file("three.vxlz")));
 }
 
+// Unpack orders the voxels on every thread it is given, a chunk at a time (write_range_orders), and writes past the
+// page cache: the file it writes, byte for byte, must not depend on the thread count, packed or float32.
+TEST(VxlzPackageOptions, UnpackedBytesDoNotDependOnThreads) {
+  ScratchDir dir;
+  const VxlFile f = VxlFile::open(convert_for_package(test_tractogram(300), dir.file("s.vxl")));
+  PackSettings pack;
+  pack.chunk_points = 64;
+  pack_vxl(f, dir.file("s.vxlz"), pack);
+  for (PositionEncoding positions : {PositionEncoding::Packed, PositionEncoding::Float32}) {
+    UnpackSettings s;
+    s.positions = positions;
+    s.threads = 1;
+    unpack_vxlz(dir.file("s.vxlz"), dir.file("one.vxl"), s);
+    s.threads = 3;
+    unpack_vxlz(dir.file("s.vxlz"), dir.file("three.vxl"), s);
+    EXPECT_EQ(slurp(dir.file("one.vxl")), slurp(dir.file("three.vxl"))) << static_cast<int>(positions);
+    EXPECT_TRUE(verify_vxl(dir.file("three.vxl")).valid);
+    std::filesystem::remove(dir.file("one.vxl"));
+    std::filesystem::remove(dir.file("three.vxl"));
+  }
+}
+
 TEST(VxlzPackageOptions, EmptyTractogram) {
   ScratchDir dir;
   Tractogram t;
