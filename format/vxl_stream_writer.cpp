@@ -148,6 +148,15 @@ std::span<std::uint8_t> VxlStreamWriter::fill_buffer(Section section, std::uint6
   return {fill_buffers_[section].get(), size};
 }
 
+// A complete section takes no more parts: its buffer's memory goes back before the sections after it are made.
+void VxlStreamWriter::release_fill_buffer_if_complete(Section section) {
+  const std::size_t i = entry_[section];
+  if (i < table_.size() && written_[i] == table_[i].size) {
+    fill_buffers_[section].reset();
+    fill_capacity_[section] = 0;
+  }
+}
+
 void VxlStreamWriter::append_meta(const MetaSection& meta) {
   MetaSection m = meta;
   std::memset(m.reserved, 0, sizeof m.reserved);

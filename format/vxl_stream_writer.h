@@ -1,7 +1,7 @@
 // Writes a .vxl file (spec §2–§5) whose payloads are produced piece by piece, in bounded memory: each
 // section's bytes are appended in order (sections may be interleaved), written with pwrite at their
-// final offsets or filled in place through a mapping that is dropped when the part is done, so nothing of
-// the output stays in this process's memory. Each section is checksummed
+// final offsets or filled in place through a mapping that is dropped when the part is done (with direct writes:
+// in a buffer, kept for the section's next part until the section is complete). Each section is checksummed
 // as it is appended; commit() checks that every payload is complete, writes the section table and the
 // header, and links the file into place (AtomicOutputFile), so a partial file never appears.
 //
@@ -27,7 +27,7 @@ class VoxelIndexLists;
 
 class VxlStreamWriter : public VxlSections {
  public:
-  using Section = Index;  // VVAL and SVAL: never planned here, so appending to them throws
+  using Section = Index;
 
   // Creates the output at `path`, sized for these payloads (which read as zero until written).
   // Throws vxl::Error (Output).
@@ -55,8 +55,8 @@ class VxlStreamWriter : public VxlSections {
   // needs no buffer of its own and no copy; then calls then(std::span<const std::uint8_t>), which may
   // still read the part. Appends to other sections may happen inside both. The part is checksummed and
   // unmapped when then() returns. With direct writes the part is filled in a buffer (kept for the
-  // section's next part), mapping it would put it in the page cache, and written out on another thread
-  // while then() runs.
+  // section's next part, and let go once the section is complete), mapping it would put it in the page cache,
+  // and written out on another thread while then() runs.
   template <typename Fill, typename Then>
   void append_in_place(Section section, std::uint64_t size, unsigned threads, Fill&& fill, Then&& then) {
     if (!regions_.empty()) {
@@ -65,6 +65,7 @@ class VxlStreamWriter : public VxlSections {
       BackgroundTask<> writing([&] { append(section, buffer); });
       then(std::span<const std::uint8_t>(buffer));  // on a throw, `writing` waits for the write first
       writing.get();
+      release_fill_buffer_if_complete(section);
       return;
     }
     FileWindow window = open_window(section, size, threads);
@@ -109,6 +110,7 @@ class VxlStreamWriter : public VxlSections {
   FileWindow open_window(Section section, std::uint64_t size, unsigned threads);
   void close_window(Section section, FileWindow& window);
   std::span<std::uint8_t> fill_buffer(Section section, std::uint64_t size, unsigned threads);
+  void release_fill_buffer_if_complete(Section section);
 
   AtomicOutputFile out_;
   PositionEncoding positions_;

@@ -278,11 +278,6 @@ void write_streamline_values(const std::vector<NamedValues>& sets, std::span<std
   finish_value_sets(payload);
 }
 
-template <typename T>
-std::span<std::uint8_t> bytes_of(std::span<T> s) {
-  return {reinterpret_cast<std::uint8_t*>(s.data()), s.size_bytes()};
-}
-
 // GDAT (package spec §4.8): the .vxl payload, deflated. Checked as a .vxl reader checks it, against the
 // package's groups, so that the .vxl written opens.
 std::vector<std::uint8_t> unpacked_group_values(const VxlzFile& f, std::uint64_t group_count) {

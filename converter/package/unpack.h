@@ -32,6 +32,8 @@ struct UnpackSummary {
   // and then the output's own packing.
   double error_bound() const { return pack.error_bound + repack_error_bound; }
   std::uint32_t point_value_sets = 0, streamline_value_sets = 0;  // VVAL / SVAL written, bit-exact
+  // decode: the package read, the positions decoded, each voxel's bounds set and its block packed; orders: the
+  // orders built and written; write: the tables after them.
   double decode_seconds = 0, orders_seconds = 0, write_seconds = 0;
 };
 

@@ -31,11 +31,12 @@ constexpr std::uint64_t kPlanBytesPerVoxel = 240;
 constexpr std::uint64_t kBlockStagingBytes = 128 * 1024;
 constexpr std::uint64_t kMinBlockStagingBytes = 16 * 1024;
 // The orders are built a run of voxels at a time (a chunk, handed out largest voxel first), in a buffer
-// that holds kChunkVoxelsPerThread of the largest voxels per ordering thread: enough that no thread waits
+// that holds kChunkVoxelsPerThread of the largest voxels per thread of the conversion (a range under a tight
+// limit may order on fewer: its chunk is then larger than it needs): enough that no thread waits
 // long for the one still ordering a large voxel at the chunk's end, and no more (each chunk's buffer is
 // held twice). Measured on 2 cores: 1M streamlines (largest voxel's orders 5.6 MiB) took as long with
 // 16 MiB chunks as with 78 MiB, and 120 MiB less memory; 10M (63 MiB) took 12.2 s in chunks of one
-// voxel against 10.4 s in chunks of four. At least kMinOrderChunkBytes (a direct write's size), at most
+// voxel against 10.4 s in chunks of four. At least kMinOrderChunkBytes (each chunk one large direct write), at most
 // kMaxOrderChunkBytes and an eighth of the memory left (never less than the largest voxel's orders).
 constexpr std::uint64_t kChunkVoxelsPerThread = 2;
 constexpr std::uint64_t kMinOrderChunkBytes = 16 * kMiB;

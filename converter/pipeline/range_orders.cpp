@@ -151,6 +151,7 @@ double write_range_orders(VxlStreamWriter& out, const OrderedTable& table, const
   run_batch_queue(
       threads, {r.order_threads, direct ? 1u : 0u, true, {}}, read, prepare, order,
       [&](int slot, std::uint64_t, unsigned) { write(slot); }, finish);
+  if (cuts.size() == 1 && settings.progress) settings.progress(1.0);  // no voxels: nothing to order
   return seconds;
 }
 

@@ -66,7 +66,7 @@ class AtomicOutputFile {
   bool committed_ = false;
 };
 
-// Faults in the pages of `bytes` (inside a map() mapping, a window, or fresh anonymous memory) ready for writing, in
+// Faults in the pages of `bytes` (inside a window, or fresh anonymous memory) ready for writing, in
 // bulk and in address order (MADV_POPULATE_WRITE), split over up to `threads` threads, as single-page folios
 // (MADV_RANDOM; see the .cpp for why). A caller that then writes scattered over the range is spared a page fault per
 // first touch of a page, which is far slower. Only a hint: without kernel support (before Linux 5.14)

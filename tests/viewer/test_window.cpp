@@ -549,7 +549,9 @@ TEST_F(Window, AScriptedDragReportsTheSelectionsTimes) {
     const bool selection = f.value("selection", false), new_selection = f.value("new_selection", false);
     EXPECT_TRUE(selection || !shown) << f.dump();
     EXPECT_TRUE(!new_selection || selection) << f.dump();
-    if (selection && !shown) EXPECT_TRUE(new_selection) << f.dump();
+    if (selection && !shown) {
+      EXPECT_TRUE(new_selection) << f.dump();
+    }
     taken += new_selection;
     shown = selection;
   }
