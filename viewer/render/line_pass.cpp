@@ -109,13 +109,7 @@ void LinePass::upload_streamline_groups(const SceneGroups& groups) {
   std::uint64_t at = 0;
   for (std::size_t i = 0; i < files_.size(); ++i) {
     const std::uint64_t n = files_[i]->meta().streamline_count;
-    if (groups.uniform(i)) {
-      std::fill_n(table.begin() + at, n, std::uint8_t(groups.group_of(i, 0) % shaders::kShaderGroups));
-    } else {  // one plain loop over the file's groups (10^7 streamlines on the window's thread at each selection)
-      const std::uint32_t* from = groups.streamline_groups(i).data();
-      std::uint8_t* to = table.data() + at;
-      for (std::uint64_t s = 0; s < n; ++s) to[s] = static_cast<std::uint8_t>(from[s] % shaders::kShaderGroups);
-    }
+    groups.write_table(i, {table.data() + at, static_cast<std::size_t>(n)}, shaders::kShaderGroups);
     at += n;
   }
   streamline_groups_.destroy();

@@ -1,5 +1,6 @@
 #include "viewer/render/scene_groups.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <limits>
 
@@ -49,8 +50,9 @@ SceneGroups SceneGroups::selection(std::span<const VxlFile* const> files,
   out.files_.resize(files.size());
   for (std::size_t i = 0; i < files.size(); ++i) {
     const std::uint64_t n = files[i]->meta().streamline_count;
-    out.files_[i].of_streamline.assign(n, 1);
-    for (std::uint64_t s : kept[i]) out.files_[i].of_streamline[s] = 0;
+    out.files_[i].constant = 1;
+    out.files_[i].members = kept[i];
+    out.files_[i].members_group = 0;
     out.groups_[0].streamlines += kept[i].size();
     out.groups_[1].streamlines += n - kept[i].size();
   }
@@ -61,13 +63,29 @@ SceneGroups SceneGroups::focus_first(std::span<const VxlFile* const> files, std:
                                      const std::vector<std::vector<std::uint64_t>>& kept) {
   SceneGroups out = selection(files.first(context_files), kept);
   out.groups_.push_back({kSelectedInContext, out.groups_[0].streamlines, true});
-  for (std::size_t i = 0; i < context_files; ++i)
-    for (std::uint64_t s : kept[i]) out.files_[i].of_streamline[s] = 2;
+  for (std::size_t i = 0; i < context_files; ++i) out.files_[i].members_group = 2;
   out.files_.resize(files.size());  // the copies: every streamline selected (constant group 0)
   out.groups_[0].streamlines = 0;
   for (std::size_t i = context_files; i < files.size(); ++i)
     out.groups_[0].streamlines += files[i]->meta().streamline_count;
   return out;
+}
+
+std::uint32_t SceneGroups::group_of(std::size_t file, std::uint64_t streamline) const {
+  const PerFile& f = files_[file];
+  if (!f.of_streamline.empty()) return f.of_streamline[streamline];
+  return std::binary_search(f.members.begin(), f.members.end(), streamline) ? f.members_group : f.constant;
+}
+
+void SceneGroups::write_table(std::size_t file, std::span<std::uint8_t> out, std::uint32_t modulo) const {
+  const PerFile& f = files_[file];
+  if (!f.of_streamline.empty()) {
+    for (std::size_t s = 0; s < out.size(); ++s) out[s] = static_cast<std::uint8_t>(f.of_streamline[s] % modulo);
+    return;
+  }
+  std::fill(out.begin(), out.end(), static_cast<std::uint8_t>(f.constant % modulo));
+  const auto member = static_cast<std::uint8_t>(f.members_group % modulo);
+  for (std::uint64_t s : f.members) out[s] = member;
 }
 
 int SceneGroups::find(const std::string& name) const {

@@ -49,20 +49,24 @@ class SceneGroups {
   static constexpr const char* kSelectedInContext = "selected (drawn from its full-detail copy)";
 
   const std::vector<SceneGroup>& groups() const { return groups_; }
-  std::uint32_t group_of(std::size_t file, std::uint64_t streamline) const {
-    const PerFile& f = files_[file];
-    return f.of_streamline.empty() ? f.constant : f.of_streamline[streamline];
-  }
+  std::uint32_t group_of(std::size_t file, std::uint64_t streamline) const;
   // Whether every streamline of `file` is in one group (no per-streamline lookup needed).
-  bool uniform(std::size_t file) const { return files_[file].of_streamline.empty(); }
-  // Each streamline's group, for a file that is not uniform.
-  std::span<const std::uint32_t> streamline_groups(std::size_t file) const { return files_[file].of_streamline; }
+  bool uniform(std::size_t file) const { return files_[file].of_streamline.empty() && files_[file].members.empty(); }
+  // Writes each of `file`'s streamlines' group modulo `modulo` to out[0 .. streamline count): the table the
+  // renderer uploads (one plain pass, 10^7 streamlines at each selection).
+  void write_table(std::size_t file, std::span<std::uint8_t> out, std::uint32_t modulo) const;
   int find(const std::string& name) const;
 
  private:
+  // A file's streamlines are in `constant`, but for those listed in `of_streamline` (a group per streamline: a
+  // file's own groups) or in `members` (increasing: a selection's, in `members_group`). A selection lists its kept
+  // streamlines rather than a group per streamline: a few hundred thousand against 4 bytes for each of 10^7,
+  // made anew at every position of a dragged region.
   struct PerFile {
     std::uint32_t constant = 0;
-    std::vector<std::uint32_t> of_streamline;  // empty: all in `constant`
+    std::vector<std::uint32_t> of_streamline;
+    std::vector<std::uint64_t> members;
+    std::uint32_t members_group = 0;
   };
   std::vector<SceneGroup> groups_;
   std::vector<PerFile> files_;
