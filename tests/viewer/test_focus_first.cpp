@@ -2,6 +2,7 @@
 // coarser than full detail, a selection's focus is drawn from a full-detail copy of its own, whose bytes
 // count first, and the context at the finest level that fits what is left — in one scene, one pass.
 // The level choice is checked on layouts alone (no GL); the pictures through voxview.
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -134,6 +135,18 @@ TEST_F(FocusFirst, TheSelectedStreamlinesInTheContextsFilesAreHidden) {
   EXPECT_EQ(groups.group_of(0, 61), 1u);
   EXPECT_TRUE(groups.uniform(1));
   EXPECT_EQ(groups.group_of(1, 0), 0u);
+  // The table the renderer uploads says the same of every streamline, taken modulo the shader's groups.
+  const std::uint64_t n = file->meta().streamline_count;
+  std::vector<std::uint8_t> table(n, 255), two(n, 255);
+  groups.write_table(0, table, 256);
+  groups.write_table(0, two, 2);
+  for (std::uint64_t s = 0; s < n; ++s) {
+    ASSERT_EQ(table[s], groups.group_of(0, s)) << s;
+    ASSERT_EQ(two[s], groups.group_of(0, s) % 2) << s;
+  }
+  std::vector<std::uint8_t> copy_table(copy.files()[0]->meta().streamline_count, 255);
+  groups.write_table(1, copy_table, 256);
+  EXPECT_TRUE(std::all_of(copy_table.begin(), copy_table.end(), [](std::uint8_t g) { return g == 0; }));
 }
 
 // Pixels of the focus colour (pure red) in a picture.
