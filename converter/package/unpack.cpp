@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -460,9 +461,12 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   for (const VoxelEntry& v : voxels) whole.max_vertices = std::max(whole.max_vertices, v.vertex_count);
   const auto place = [&](std::span<std::uint8_t> window) {
     // Packed positions are decoded as floats first (tight bounds come from them), then packed into VERT.
-    std::vector<float> float_blocks(packed ? 3 * meta.vertex_count : 0);
+    // Left uninitialised: the chunks write every vertex (rebuild_structure checked that the voxlines' points are the
+    // package's), and zeroing them first cost a serial pass over fresh pages (0.3 s for 1M streamlines).
+    std::unique_ptr<float[]> float_blocks =
+        packed ? std::make_unique_for_overwrite<float[]>(3 * meta.vertex_count) : nullptr;
     const std::span<float> vertices =
-        packed ? std::span<float>(float_blocks)
+        packed ? std::span<float>(float_blocks.get(), 3 * meta.vertex_count)
                : std::span<float>(reinterpret_cast<float*>(window.data()), window.size() / sizeof(float));
     decode_vertices(f, s, vertices, ends, threads, [&](double d) { progress("decoding", d); });
     measure_streamlines(s, vertices, lengths, threads);
