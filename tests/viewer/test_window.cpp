@@ -373,6 +373,16 @@ TEST_F(Window, AScriptedDragUnderABudgetEndsWithTheFocusCopyOfItsLastPosition) {
   EXPECT_TRUE(wait.at("waited").get<bool>()) << "the copy takes longer than a frame";
   EXPECT_GT(wait.at("ms").get<double>(), 0.0);
   EXPECT_FALSE(wait.at("timed_out").get<bool>());
+  // Nothing is refined while the copy is on its way (its picture would be drawn again): no refinement piece comes
+  // before the first picture with the copy.
+  bool refined = false;
+  for (const nlohmann::json& f : j.at("frames")) {
+    if (f.contains("focus_level")) {
+      EXPECT_FALSE(refined) << "a refinement piece was drawn while the focus copy was on its way: " << j.dump();
+      break;
+    }
+    refined |= f.value("work", std::string("whole")) != "whole";
+  }
   CommandResult r = run_voxview_in_xvfb(shell_quoted(vxl) + args + " --include=" + scene.sphere_at(10) +
                                         " --frames 3 --screenshot " + shell_quoted(still));
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -543,7 +553,9 @@ TEST_F(Window, AScriptedDragReportsTheSelectionsTimes) {
   // The first picture does not wait for the command line's selection (its --context-opacity is accepted before the
   // selection's groups exist): each frame says whether its picture shows one; once in, it stays, to the last frame.
   // The frames that took a new selection in are marked: the first to show one is, and none without one is.
-  bool shown = false;
+  // Nothing is refined while a selection is on its way (the picture it changes would be drawn again): no refinement
+  // piece comes before a frame that takes a new selection in.
+  bool shown = false, refined = false;
   int taken = 0;
   for (const nlohmann::json& f : j.at("frames")) {
     const bool selection = f.value("selection", false), new_selection = f.value("new_selection", false);
@@ -552,6 +564,8 @@ TEST_F(Window, AScriptedDragReportsTheSelectionsTimes) {
     if (selection && !shown) {
       EXPECT_TRUE(new_selection) << f.dump();
     }
+    EXPECT_FALSE(new_selection && refined) << "a refinement piece was drawn while this selection was on its way";
+    refined |= f.value("work", std::string("whole")) != "whole";
     taken += new_selection;
     shown = selection;
   }
