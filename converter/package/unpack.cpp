@@ -457,8 +457,8 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   std::vector<VoxelEntry>& voxels = s.voxels;  // their tight bounds set from the decoded vertices
   std::vector<float> lengths(meta.streamline_count);
   VoxlineEnds ends(meta.vertex_count);
-  VoxelRange whole{0, voxels.size(), 0, meta.vertex_count, 0, threads, 0};
-  for (const VoxelEntry& v : voxels) whole.max_vertices = std::max(whole.max_vertices, v.vertex_count);
+  VoxelRange whole = whole_range(voxels);
+  whole.order_threads = threads;
   const auto place = [&](std::span<std::uint8_t> window) {
     // Packed positions are decoded as floats first (tight bounds come from them), then packed into VERT.
     // Left uninitialised: the chunks write every vertex (rebuild_structure checked that the voxlines' points are the

@@ -126,23 +126,13 @@ struct RangeCost {
   }
 };
 
-// Every voxel as one range.
-VoxelRange whole_range(const ConversionCounts& c) {
-  VoxelRange r{0, c.voxels.size(), 0, 0, 0};
-  if (c.voxels.empty()) return r;
-  r.vertex_first = c.voxels.front().vertex_first;
-  r.vertex_end = c.voxels.back().vertex_first + c.voxels.back().vertex_count;
-  for (const VoxelEntry& v : c.voxels) r.max_vertices = std::max(r.max_vertices, v.vertex_count);
-  return r;
-}
-
 // Whether VERT is held whole, in one range, beside the orders' two chunks: then it is, rather than written block by
 // block and read back, which costs more than holding it (1M streamlines, 57M vertices, limit 512 MiB: 1.0-1.3 s of
 // the placing pass).
 bool vertices_held_whole(const MemoryBudget& budget, const ConversionCounts& c, std::uint64_t order_chunk_bytes) {
   const std::uint64_t chunks = 2 * chunk_buffer_bytes(order_chunk_bytes);
   if (c.range_request > 0 || c.vertex_blocks_request || chunks > budget.left()) return false;
-  return RangeCost{c, budget.left() - chunks, false}(whole_range(c)) <= budget.left() - chunks;
+  return RangeCost{c, budget.left() - chunks, false}(whole_range(c.voxels)) <= budget.left() - chunks;
 }
 
 std::vector<VoxelRange> cut_ranges(MemoryBudget& budget, const ConversionCounts& c, bool block_staging) {
@@ -219,6 +209,15 @@ std::uint64_t block_staging_total(const ConversionCounts& c, std::uint64_t stagi
     }
   }
   return total;
+}
+
+VoxelRange whole_range(std::span<const VoxelEntry> voxels) {
+  VoxelRange r{0, voxels.size(), 0, 0, 0};
+  if (voxels.empty()) return r;
+  r.vertex_first = voxels.front().vertex_first;
+  r.vertex_end = voxels.back().vertex_first + voxels.back().vertex_count;
+  for (const VoxelEntry& v : voxels) r.max_vertices = std::max(r.max_vertices, v.vertex_count);
+  return r;
 }
 
 std::uint64_t order_chunk_bytes(std::span<const VoxelEntry> voxels, std::uint64_t order_bytes, unsigned threads,

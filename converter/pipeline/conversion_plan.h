@@ -59,6 +59,9 @@ struct VoxelRange {
   std::uint64_t bytes = 0;         // what building it holds besides what plan_conversion took: vertices, sorts
 };
 
+// Every voxel (laid out: vertex_first and vertex_count set) as one range, ordered on one thread.
+VoxelRange whole_range(std::span<const VoxelEntry> voxels);
+
 // What the voxel table fixed, for plan_conversion.
 struct ConversionCounts {
   const MetaSection& meta;             // streamline, point, synthetic point and voxline counts
