@@ -40,6 +40,41 @@ TEST(FrameBudget, NeverFinerThanTheSceneNorCoarserThanTheFile) {
   EXPECT_EQ(single.level_for(true), 0u);
 }
 
+// A selection being made on the other cores slows the drawing down: frames under it are measured apart, so
+// that the level chosen while it runs fits the budget, and the one chosen once it is done is not held back.
+TEST(FrameBudget, EachLoadIsMeasuredApart) {
+  FrameBudget budget(100, 0, 4);
+  const FrameLoad idle, selecting{false, true};
+  budget.record(1, 60, idle);
+  budget.record(1, 150, selecting);
+  EXPECT_EQ(budget.level_for(true, idle), 1u);
+  EXPECT_EQ(budget.level_for(true, selecting), 2u);
+  budget.record(1, 70, idle);  // a later idle frame does not replace what the selection costs
+  EXPECT_EQ(budget.level_for(true, selecting), 2u);
+  EXPECT_DOUBLE_EQ(budget.estimate_ms(1, selecting), 150.0);
+}
+
+// A load not measured at a level: another load's cost there, scaled by what the two cost where both were
+// measured (the focus drawn beside the context costs its own segments at every level).
+TEST(FrameBudget, AnUnmeasuredLoadIsScaledByTheLoadsRatio) {
+  FrameBudget budget(100, 0, 4);
+  const FrameLoad idle, with_focus{true, false};
+  budget.record(2, 10, idle);
+  budget.record(2, 20, with_focus);
+  budget.record(1, 60, idle);
+  EXPECT_DOUBLE_EQ(budget.estimate_ms(1, with_focus), 120.0)
+      << "level 1 measured without the focus, twice dearer with it";
+  EXPECT_EQ(budget.level_for(true, with_focus), 2u);
+  EXPECT_EQ(budget.level_for(true, idle), 1u);
+
+  FrameBudget first_frames(100, 0, 4);
+  first_frames.record(1, 60, idle);
+  EXPECT_DOUBLE_EQ(first_frames.estimate_ms(1, {true, true}), 60.0) << "no ratio known yet: unscaled";
+  first_frames.record(1, 90, {false, true});
+  first_frames.record(1, 200, {true, false});
+  EXPECT_DOUBLE_EQ(first_frames.estimate_ms(0, {true, true}), 200.0 * 8) << "one load away before two";
+}
+
 TEST(FrameBudget, TheFirstPictureIsTheFinestLevelOfAtMostAQuarterMillionSegments) {
   // The 1M set's levels: level 2's 870k segments take 1-3 s on llvmpipe, too long for the first picture.
   const std::uint64_t segments[] = {55'000'000, 7'000'000, 870'000, 110'000, 14'000};

@@ -45,6 +45,20 @@ TEST(PictureScheduler, AChangedPictureIsDrawnWholeAtTheFirstThenTheBudgetsLevel)
   EXPECT_EQ(view.asked, 0) << "the view's level is asked only at rest";
 }
 
+// While a selection is made on the other cores, whole pictures are measured and chosen under that load.
+TEST(PictureScheduler, WholePicturesAreMeasuredAndChosenUnderTheirLoad) {
+  PictureScheduler s = scheduler(true);
+  ViewLevel view{0};
+  s.drawn_whole(RenderMode::Axis, s.next(true, false, false, view.fn()).level, 40);  // level 2, idle
+  s.drawn_whole(RenderMode::Axis, 2, 5);
+  EXPECT_EQ(s.next(true, false, false, view.fn()).level, kSceneLevel);
+  s.set_load({false, true});
+  s.drawn_whole(RenderMode::Axis, 2, 20);  // a selection on its way: four times the cost
+  EXPECT_EQ(s.next(true, false, false, view.fn()).level, 2u) << "level 1 would take 8 x 20 ms while it runs";
+  s.set_load({});
+  EXPECT_EQ(s.next(true, false, false, view.fn()).level, kSceneLevel) << "idle again: 8 x 5 ms fits";
+}
+
 TEST(PictureScheduler, AtRestACoarsePictureIsRefinedAtTheViewsLevelThenToExact) {
   PictureScheduler s = scheduler(true);
   ViewLevel view{0};  // a slab: full detail fits

@@ -1,6 +1,7 @@
 #include "viewer/app/frame_budget.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "viewer/render/scene_layout.h"
@@ -12,27 +13,62 @@ FrameBudget::FrameBudget(double budget_ms, std::uint32_t scene_level, std::uint3
       scene_level_(std::min(scene_level, kMaxLevels - 1)),
       coarsest_level_(std::clamp(coarsest_level, scene_level_, kMaxLevels - 1)) {}
 
-void FrameBudget::record(std::uint32_t level, double ms) {
-  if (level < kMaxLevels && ms >= 0) measured_ms_[level] = ms;
+void FrameBudget::record(std::uint32_t level, double ms, FrameLoad load) {
+  if (level < kMaxLevels && ms >= 0) measured_ms_[load.index()][level] = ms;
 }
 
-double FrameBudget::estimate_ms(std::uint32_t level) const {
-  if (level >= kMaxLevels) return 0;
-  if (measured_ms_[level] > 0) return measured_ms_[level];
+double FrameBudget::estimate_from_levels(const Costs& costs, std::uint32_t level) {
+  if (costs[level] > 0) return costs[level];
   // The nearest measured level, scaled by the segments: 1/8 of them per level.
   for (std::uint32_t distance = 1; distance < kMaxLevels; ++distance)
     for (const int sign : {-1, 1}) {
       const int other = int(level) + sign * int(distance);
-      if (other < 0 || other >= int(kMaxLevels) || measured_ms_[other] <= 0) continue;
-      return measured_ms_[other] * std::pow(double(kLevelRatio), double(other - int(level)));
+      if (other < 0 || other >= int(kMaxLevels) || costs[other] <= 0) continue;
+      return costs[other] * std::pow(double(kLevelRatio), double(other - int(level)));
     }
   return 0;
 }
 
-std::uint32_t FrameBudget::level_for(bool moving) const {
+double FrameBudget::load_ratio(std::size_t load, std::size_t other, std::uint32_t level) const {
+  for (std::uint32_t distance = 0; distance < kMaxLevels; ++distance)
+    for (const int sign : {-1, 1}) {
+      const int l = int(level) + sign * int(distance);
+      if (l < 0 || l >= int(kMaxLevels)) continue;
+      if (measured_ms_[load][l] > 0 && measured_ms_[other][l] > 0)
+        return measured_ms_[load][l] / measured_ms_[other][l];
+    }
+  return 0;
+}
+
+double FrameBudget::estimate_ms(std::uint32_t level, FrameLoad load) const {
+  if (level >= kMaxLevels) return 0;
+  const std::size_t own = load.index();
+  if (measured_ms_[own][level] > 0) return measured_ms_[own][level];
+  // The other loads, the nearest first (one difference before two).
+  std::array<std::size_t, FrameLoad::kCount - 1> others{};
+  std::size_t n = 0;
+  for (const int differences : {1, 2})
+    for (std::size_t other = 0; other < FrameLoad::kCount; ++other)
+      if (std::popcount(other ^ own) == differences) others[n++] = other;
+  // This level measured under another load, scaled by what the two loads cost where both were measured.
+  for (const std::size_t other : others)
+    if (const double ratio = load_ratio(own, other, level); ratio > 0 && measured_ms_[other][level] > 0)
+      return measured_ms_[other][level] * ratio;
+  if (const double ms = estimate_from_levels(measured_ms_[own], level); ms > 0) return ms;
+  // Nothing under this load yet (the first frames of a selection): another load's estimate, unscaled when no
+  // ratio is known; the next frame measures it.
+  for (const std::size_t other : others)
+    if (const double ms = estimate_from_levels(measured_ms_[other], level); ms > 0) {
+      const double ratio = load_ratio(own, other, level);
+      return ratio > 0 ? ms * ratio : ms;
+    }
+  return 0;
+}
+
+std::uint32_t FrameBudget::level_for(bool moving, FrameLoad load) const {
   if (!moving || budget_ms_ <= 0) return scene_level_;
   for (std::uint32_t level = scene_level_; level <= coarsest_level_; ++level) {
-    const double ms = estimate_ms(level);
+    const double ms = estimate_ms(level, load);
     if (ms <= budget_ms_) return level;  // unmeasured (0): try it
   }
   return coarsest_level_;

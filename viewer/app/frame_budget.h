@@ -2,7 +2,10 @@
 // detail (.vxl spec §5.12) whose measured cost fits the budget; at rest, the scene's own level (the finest
 // the GPU memory budget allows, scene_detail.h). Costs are measured per level as frames are drawn; a level
 // not measured yet is estimated from its nearest measured neighbour at 8x per level (the segments it
-// draws). Pure logic: testable without GL.
+// draws). A frame's cost also depends on what else it draws and shares the machine with (FrameLoad): each load
+// is measured apart, and a load not measured at a level is estimated first from another load's cost at that
+// level, scaled by what the two loads cost at a level where both were measured, then from its own nearest
+// measured level. Pure logic: testable without GL.
 #pragma once
 
 #include <array>
@@ -15,22 +18,40 @@
 
 namespace vxl::app {
 
+// What a frame draws besides the context at its level, and what it shares the cores with.
+struct FrameLoad {
+  // The focus drawn at full detail from its copy beside the context (focus first): its own segments.
+  bool focus = false;
+  // A selection or a focus copy being made on other threads: on a machine with few cores (and a software
+  // rasteriser) it takes time from the drawing.
+  bool work_in_flight = false;
+
+  std::size_t index() const { return (focus ? 1 : 0) + (work_in_flight ? 2 : 0); }
+  static constexpr std::size_t kCount = 4;
+};
+
 class FrameBudget {
  public:
   // budget_ms <= 0: no budget (always the scene's level).
   FrameBudget(double budget_ms, std::uint32_t scene_level, std::uint32_t coarsest_level);
 
-  // The level to draw a frame at; `moving`: the camera changed since the last frame.
-  std::uint32_t level_for(bool moving) const;
-  // A frame drawn at `level` took `ms`.
-  void record(std::uint32_t level, double ms);
-  // The estimated frame time at `level`; 0 when nothing has been measured.
-  double estimate_ms(std::uint32_t level) const;
+  // The level to draw a frame at under `load`; `moving`: the camera changed since the last frame.
+  std::uint32_t level_for(bool moving, FrameLoad load = {}) const;
+  // A frame drawn at `level` under `load` took `ms`.
+  void record(std::uint32_t level, double ms, FrameLoad load = {});
+  // The estimated frame time at `level` under `load`; 0 when nothing has been measured.
+  double estimate_ms(std::uint32_t level, FrameLoad load = {}) const;
 
  private:
+  using Costs = std::array<double, kMaxLevels>;  // per level; 0: not measured
+  // From the nearest level measured under the same load; 0 when none was.
+  static double estimate_from_levels(const Costs& costs, std::uint32_t level);
+  // How much dearer `load` is than `other`, at the level nearest `level` where both were measured; 0: none.
+  double load_ratio(std::size_t load, std::size_t other, std::uint32_t level) const;
+
   double budget_ms_;
   std::uint32_t scene_level_, coarsest_level_;
-  std::array<double, kMaxLevels> measured_ms_{};  // 0: not measured
+  std::array<Costs, FrameLoad::kCount> measured_ms_{};
 };
 
 // The window's first picture comes before the scene's level is uploaded: the finest level, from the scene's

@@ -9,7 +9,7 @@ PictureScheduler::PictureScheduler(FrameBudget budget, RestRefinement rest, std:
 std::uint32_t PictureScheduler::whole_level(bool scripted_last) const {
   if (scripted_last) return scene_level_;
   if (!drawn_any_) return first_level_;
-  return budget_.level_for(true);
+  return budget_.level_for(true, load_);
 }
 
 PictureTask PictureScheduler::next(bool changed, bool scripted_last, bool closing,
@@ -36,7 +36,7 @@ PictureTask PictureScheduler::next(bool changed, bool scripted_last, bool closin
 }
 
 void PictureScheduler::drawn_whole(RenderMode mode, std::uint32_t level, double ms) {
-  budget_.record(level, ms);
+  budget_.record(level, ms, load_);
   // Full detail for any view only at level 0 (or the level --level forces); otherwise the refinement
   // decides, once at rest, which level this view can have.
   rest_.drawn_whole(mode, level == 0 || (level_forced_ && level == scene_level_));

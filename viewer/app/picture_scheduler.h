@@ -55,6 +55,9 @@ class PictureScheduler {
   bool pieces_begun() const { return pieces_begun_; }
   void begin_pieces() { pieces_begun_ = true; }
   void abandon_pieces() { pieces_begun_ = false; }
+  // What the next frames draw besides the context and share the cores with: whole pictures are measured and
+  // their level chosen under it (frame_budget.h).
+  void set_load(FrameLoad load) { load_ = load; }
   // The user turned "exact when still" on or off (the panel, key E).
   void set_exact_when_still(bool on);
 
@@ -67,6 +70,7 @@ class PictureScheduler {
   std::uint32_t whole_level(bool scripted_last) const;
 
   FrameBudget budget_;
+  FrameLoad load_;
   RestRefinement rest_;
   std::uint32_t scene_level_;
   bool level_forced_;

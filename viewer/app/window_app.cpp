@@ -432,6 +432,7 @@ int ViewerWindow::run() {
     const bool changed = !drawn_ || !same_picture(*drawn_, key);
     const bool scripted_last = closing && frames_done && !options_.until_refined;
     // The picture (and so what the panel should say) changed after the panel was built.
+    scheduler_->set_load({session_->has_focus(), work_in_flight()});
     const bool drawn_now = draw_picture(
         scheduler_->next(changed, scripted_last, closing,
                          [&] {
