@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <new>
 
 #include "format/base/checked_count.h"
 #include "format/base/checksum.h"
@@ -28,6 +30,19 @@ VxlFile VxlFile::open(MappedFile bytes) {
   f.validate();
   f.checksum_checked_ = std::make_unique<std::atomic<std::uint8_t>[]>(f.sections_.size());
   return f;
+}
+
+std::vector<SectionEntry> VxlFile::read_section_table(const std::string& path, std::span<const std::uint8_t> first,
+                                                      std::uint64_t file_size) {
+  const std::size_t held = static_cast<std::size_t>(std::min<std::uint64_t>(first.size(), file_size));
+  auto* copy = static_cast<std::uint8_t*>(std::malloc(std::max<std::size_t>(held, 1)));
+  if (copy == nullptr) throw std::bad_alloc();
+  std::memcpy(copy, first.data(), held);
+  VxlFile f{MappedFile::adopt(path, copy, held)};
+  f.file_size_ = file_size;
+  f.validate_header();
+  f.validate_section_table();
+  return {f.sections_.begin(), f.sections_.end()};
 }
 
 void VxlFile::check_section_checksum(std::uint32_t id) const {
@@ -119,10 +134,11 @@ std::string other_format_hint(const std::uint8_t* bytes, std::uint64_t size) {
 // §7 step 1.
 void VxlFile::validate_header() {
   const std::string& p = file_.path();
-  const std::uint64_t size = file_.size();
+  const std::uint64_t size = file_size_;
   const std::uint8_t* base = file_.data();
-  if (const std::string hint = other_format_hint(base, size); !hint.empty()) fail_input(p, 0, hint);
+  if (const std::string hint = other_format_hint(base, file_.size()); !hint.empty()) fail_input(p, 0, hint);
   if (size < sizeof(FileHeader)) fail_input(p, size, "file too short for a .vxl header (64 bytes)");
+  if (file_.size() < sizeof(FileHeader)) fail_input(p, file_.size(), "the first bytes read end before the header");
   std::memcpy(&header_, base, sizeof header_);
   if (std::memcmp(header_.magic, kVxlMagic.data(), 8) != 0) fail_input(p, 0, "not a .vxl file (bad magic)");
   if (header_.version_major != kVxlVersionMajor && header_.version_major != kVxlVersionMajorPackedPositions)
@@ -139,13 +155,16 @@ void VxlFile::validate_header() {
   if (header_.flags != 0) fail_input(p, 36, "unknown header flags");
   const std::uint64_t table_end = sizeof(FileHeader) + std::uint64_t(header_.section_count) * sizeof(SectionEntry);
   if (table_end > size) fail_input(p, 64, "section table runs past the end of the file");
+  if (table_end > file_.size())
+    fail_input(p, file_.size(),
+               "the first bytes read end before the section table (" + std::to_string(table_end) + " bytes)");
   sections_ = {reinterpret_cast<const SectionEntry*>(base + sizeof(FileHeader)), header_.section_count};
 }
 
 // §7 step 2: every entry in bounds, aligned, in order, unique; unknown required sections refused.
 void VxlFile::validate_section_table() {
   const std::string& p = file_.path();
-  const std::uint64_t size = file_.size();
+  const std::uint64_t size = file_size_;
   const std::uint64_t table_end = sizeof(FileHeader) + sections_.size_bytes();
   std::uint64_t previous_end = table_end;
   std::vector<std::uint32_t> seen;

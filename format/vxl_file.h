@@ -67,6 +67,11 @@ class VxlFile {
   static VxlFile open(const std::string& path);
   // The same for a file's bytes already in memory (MappedFile::adopt: held, then freed with std::free).
   static VxlFile open(MappedFile bytes);
+  // Spec §7 steps 1 and 2 alone, for a reader that fetches a file by byte ranges (vxl_fetch_plan.h): the header
+  // and the section table, checked as open() checks them, from the first bytes of a file of `file_size` bytes.
+  // Throws vxl::Error as open() does, and when `first` ends before the section table does.
+  static std::vector<SectionEntry> read_section_table(const std::string& path, std::span<const std::uint8_t> first,
+                                                      std::uint64_t file_size);
 
   const std::string& path() const { return file_.path(); }
   std::span<const std::uint8_t> bytes() const { return file_.bytes(); }
@@ -153,7 +158,7 @@ class VxlFile {
   const ValueSets& streamline_values() const { return streamline_values_; }
 
  private:
-  explicit VxlFile(MappedFile file) : file_(std::move(file)) {}
+  explicit VxlFile(MappedFile file) : file_(std::move(file)), file_size_(file_.size()) {}
   void validate();
   [[noreturn]] void fail_streamline_table(std::uint64_t entry) const;
   [[noreturn]] void fail_voxline(std::uint64_t j) const;
@@ -169,6 +174,7 @@ class VxlFile {
       const std::function<void(std::string_view name, std::uint64_t members_at, std::uint64_t count)>& visit) const;
 
   MappedFile file_;
+  std::uint64_t file_size_ = 0;  // file_.size(), or more where file_ holds only its first bytes (read_section_table)
   // Per section table entry: 1 once check_section_checksum has found it whole.
   std::unique_ptr<std::atomic<std::uint8_t>[]> checksum_checked_;
   FileHeader header_{};

@@ -1,0 +1,80 @@
+#include "format/vxl_fetch_plan.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "format/vxl_levels.h"
+#include "format/vxl_value_sets.h"
+
+namespace vxl {
+
+std::vector<ByteRange> merge_ranges(std::vector<ByteRange> ranges, std::uint64_t gap) {
+  std::erase_if(ranges, [](const ByteRange& r) { return r.end <= r.begin; });
+  std::sort(ranges.begin(), ranges.end(), [](const ByteRange& a, const ByteRange& b) { return a.begin < b.begin; });
+  std::vector<ByteRange> merged;
+  for (const ByteRange& r : ranges) {
+    if (!merged.empty() && r.begin <= merged.back().end + gap)
+      merged.back().end = std::max(merged.back().end, r.end);
+    else
+      merged.push_back(r);
+  }
+  return merged;
+}
+
+std::vector<ByteRange> ranges_to_open(const std::string& path, std::span<const std::uint8_t> first,
+                                      std::uint64_t file_size) {
+  const std::vector<SectionEntry> sections = VxlFile::read_section_table(path, first, file_size);
+  auto id_of = [](const SectionEntry& e) {
+    std::uint32_t id;
+    std::memcpy(&id, e.id, 4);
+    return id;
+  };
+  std::uint64_t voxel_count = 0;
+  for (const SectionEntry& e : sections)
+    if (id_of(e) == section_id("VOXT")) voxel_count = e.size / sizeof(VoxelEntry);
+  std::vector<ByteRange> ranges{{0, sizeof(FileHeader) + sections.size() * sizeof(SectionEntry)}};
+  for (const SectionEntry& e : sections) {
+    const std::uint32_t id = id_of(e);
+    std::uint64_t bytes = e.size;  // what open() reads of it
+    if (id == section_id("VERT") || id == section_id("ORDB") || id == section_id("ORDR") || id == section_id("VXLN") ||
+        id == section_id("STRM") || id == section_id("SLEN"))
+      bytes = 0;
+    else if (id == section_id("VXIX"))
+      bytes = std::min(e.size, 8 * (voxel_count + 1));
+    else if (id == section_id("VVAL") || id == section_id("SVAL"))
+      bytes = std::min(e.size, value_sets_data_offset(kMaxValueSets));
+    ranges.push_back({e.offset, e.offset + bytes});
+  }
+  return merge_ranges(std::move(ranges), 0);
+}
+
+std::vector<ByteRange> ranges_of_level(const VxlFile& file, std::uint32_t level, std::uint64_t gap) {
+  const std::uint64_t vert = file.find_section(section_id("VERT"))->offset;
+  const std::uint64_t orders = file.orders_offset();
+  const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
+  const std::uint32_t k = file.meta().stored_order_count;
+  std::vector<ByteRange> ranges;
+  ranges.reserve(2 * file.voxels().size());
+  for (std::size_t i = 0; i < file.voxels().size(); ++i) {
+    const VoxelEntry& v = file.voxels()[i];
+    const LevelEntry at_level = file.level(i, level);
+    const std::uint64_t first = vert + v.vertex_first * vertex_bytes;
+    ranges.push_back({first, first + at_level.vertex_count * vertex_bytes});
+    const std::uint64_t offset = orders + level_orders_offset(v, file.levels_of(i), level, k, file.order_packing());
+    ranges.push_back({offset, offset + level_orders_size(at_level, k, file.order_packing())});
+  }
+  return merge_ranges(std::move(ranges), gap);
+}
+
+std::vector<ByteRange> ranges_missing(std::span<const ByteRange> held, std::uint64_t size) {
+  std::vector<ByteRange> missing;
+  std::uint64_t at = 0;
+  for (const ByteRange& r : held) {
+    if (r.begin > at) missing.push_back({at, std::min(r.begin, size)});
+    at = std::max(at, r.end);
+  }
+  if (at < size) missing.push_back({at, size});
+  return missing;
+}
+
+}  // namespace vxl

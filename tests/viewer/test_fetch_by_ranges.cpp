@@ -1,0 +1,126 @@
+// Reading a .vxl by byte ranges (format/vxl_fetch_plan.h), as the web viewer does over HTTP Range requests: a
+// buffer holding only what ranges_to_open and ranges_of_level name (the rest filled with garbage) opens, passes
+// the draw checks and draws that level exactly as the whole file does.
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "converter/synth/synth.h"
+#include "format/base/error.h"
+#include "format/vxl_fetch_plan.h"
+#include "tests/viewer/render_support.h"
+
+namespace vxl {
+namespace {
+
+using test::gl_context;
+using test::render_image;
+using test::ScratchDir;
+
+std::vector<std::uint8_t> read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The file's bytes where `held` says, 0xA5 elsewhere, as a reader's buffer of the file's size.
+MappedFile partial_copy(const std::vector<std::uint8_t>& whole, std::span<const ByteRange> held) {
+  auto* buffer = static_cast<std::uint8_t*>(std::malloc(whole.size()));
+  std::memset(buffer, 0xA5, whole.size());
+  for (const ByteRange& r : held) std::memcpy(buffer + r.begin, whole.data() + r.begin, r.end - r.begin);
+  return MappedFile::adopt("partial.vxl", buffer, whole.size());
+}
+
+Camera whole_view() {
+  Camera c;
+  c.target = glm::dvec3(0, -15, 10);
+  c.distance = 320;
+  c.azimuth_deg = 30;
+  c.elevation_deg = 20;
+  return c;
+}
+
+class FetchByRanges : public ::testing::TestWithParam<bool> {};  // packed positions or float32
+
+TEST_P(FetchByRanges, ALevelDrawsFromItsRangesAloneAsFromTheWholeFile) {
+  gl_context();
+  ScratchDir dir;
+  SynthSettings synth;
+  synth.streamlines = 12000;
+  ConvertSettings s;
+  s.voxel_size = 10;
+  s.levels = 4;
+  s.positions = GetParam() ? PositionEncoding::Packed : PositionEncoding::Float32;
+  convert_tractogram(synthesize_tractogram(synth), dir.file("scene.vxl"), s);
+  const std::vector<std::uint8_t> whole = read_bytes(dir.file("scene.vxl"));
+  const std::span<const std::uint8_t> first(whole.data(), std::min<std::size_t>(whole.size(), kSectionTableBytesMax));
+  const std::vector<ByteRange> to_open = ranges_to_open("scene.vxl", first, whole.size());
+  const VxlFile reference = VxlFile::open(dir.file("scene.vxl"));
+  RenderSettings settings;
+  settings.opacity = 0.3f;
+  for (const std::uint32_t level : {1u, 2u, 3u}) {
+    std::vector<ByteRange> held = to_open;
+    const std::vector<ByteRange> of_level = ranges_of_level(reference, level, 0);
+    held.insert(held.end(), of_level.begin(), of_level.end());
+    held = merge_ranges(held, 0);
+    std::uint64_t bytes = 0;
+    for (const ByteRange& r : held) bytes += r.end - r.begin;
+    EXPECT_LT(bytes, whole.size() / 4) << "level " << level << ": a small part of the file";
+
+    const VxlFile partial = VxlFile::open(partial_copy(whole, held));
+    Renderer from_ranges(partial, 0, level), from_whole(reference, 0, level);
+    const Image a = render_image(from_ranges, whole_view(), settings, 96, 96);
+    from_ranges.check_uploaded(true);  // throws on a damaged block or order
+    const Image b = render_image(from_whole, whole_view(), settings, 96, 96);
+    EXPECT_GT(test::lit_pixels(b), 200);
+    EXPECT_EQ(a.rgba, b.rgba) << "level " << level;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Positions, FetchByRanges, ::testing::Values(true, false),
+                         [](const auto& info) { return info.param ? "Packed" : "Float32"; });
+
+TEST(FetchPlan, RangesMergeAndTheMissingOnesCoverTheRest) {
+  EXPECT_EQ(merge_ranges({{10, 20}, {0, 5}, {18, 30}, {34, 40}, {7, 7}}, 0),
+            (std::vector<ByteRange>{{0, 5}, {10, 30}, {34, 40}}));
+  EXPECT_EQ(merge_ranges({{10, 20}, {0, 5}, {34, 40}}, 5), (std::vector<ByteRange>{{0, 20}, {34, 40}}));
+  const std::vector<ByteRange> held{{0, 5}, {10, 30}, {34, 40}};
+  EXPECT_EQ(ranges_missing(held, 50), (std::vector<ByteRange>{{5, 10}, {30, 34}, {40, 50}}));
+  EXPECT_EQ(ranges_missing(held, 40), (std::vector<ByteRange>{{5, 10}, {30, 34}}));
+  EXPECT_EQ(ranges_missing({}, 3), (std::vector<ByteRange>{{0, 3}}));
+}
+
+TEST(FetchPlan, TheFirstBytesAreCheckedAsOpenChecksThem) {
+  ScratchDir dir;
+  SynthSettings synth;
+  synth.streamlines = 500;
+  convert_tractogram(synthesize_tractogram(synth), dir.file("small.vxl"), ConvertSettings{});
+  const std::vector<std::uint8_t> whole = read_bytes(dir.file("small.vxl"));
+  const auto expect_refused = [](std::span<const std::uint8_t> first, std::uint64_t size, const std::string& what) {
+    try {
+      ranges_to_open("small.vxl", first, size);
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  expect_refused(std::span(whole).first(80), whole.size(), "end before the section table");
+  expect_refused(std::span(whole).first(4096), whole.size() - 1, "truncated or extended");
+  const std::string tck = "mrtrix tracks\nfile: . 40\nEND\n";
+  expect_refused(std::span(reinterpret_cast<const std::uint8_t*>(tck.data()), tck.size()), 4096, "MRtrix TCK");
+  // Every section open() needs lies in the ranges; the point and order data do not.
+  const std::vector<ByteRange> ranges = ranges_to_open("small.vxl", std::span(whole).first(4096), whole.size());
+  const VxlFile f = VxlFile::open(dir.file("small.vxl"));
+  const auto held = [&](std::uint64_t at) {
+    for (const ByteRange& r : ranges)
+      if (at >= r.begin && at < r.end) return true;
+    return false;
+  };
+  for (const std::uint32_t id : {section_id("META"), section_id("DIRS"), section_id("VOXT"), section_id("LODS")})
+    EXPECT_TRUE(held(f.find_section(id)->offset)) << section_name(id);
+  EXPECT_FALSE(held(f.find_section(section_id("VERT"))->offset));
+  EXPECT_FALSE(held(f.orders_offset()));
+}
+
+}  // namespace
+}  // namespace vxl
