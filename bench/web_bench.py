@@ -3,13 +3,13 @@
 this machine, open it in headless Chromium (software WebGL2: SwiftShader) and report, per round, the
 milliseconds from navigation to the first picture (drawn at a coarser level of detail for a large file) and to
 full detail, and the browser's peak memory: the resident set of all its processes together, sampled every
-50 ms, against the file's size.
+50 ms, against the file's size. The server answers Range requests (as nginx or Apache do; the page then fetches
+the first picture's level first), or with --server whole ignores them (as `python3 -m http.server`: the page
+fetches the file whole), or with --server first-range answers one range a request.
 
-Usage: bench/web_bench.py FILE.vxl... [--rounds N] [--size WxH] [--voxlines PATH]
+Usage: bench/web_bench.py FILE.vxl... [--rounds N] [--size WxH] [--server ranges|first-range|whole] [--voxlines PATH]
 """
 import argparse
-import http.server
-import functools
 import os
 import shutil
 import subprocess
@@ -20,11 +20,10 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'scripts'))
 import web_capture  # noqa: E402
+import web_server  # noqa: E402
 
-
-class QuietHandler(http.server.SimpleHTTPRequestHandler):
-    def log_message(self, *args):
-        pass
+SERVERS = {'ranges': web_server.RangeHandler, 'first-range': web_server.FirstRangeHandler,
+           'whole': web_server.QuietHandler}
 
 
 def tree_rss_bytes(root):
@@ -75,6 +74,7 @@ def main():
     parser.add_argument('files', nargs='+')
     parser.add_argument('--rounds', type=int, default=2)
     parser.add_argument('--size', default='1024x1024')
+    parser.add_argument('--server', choices=sorted(SERVERS), default='ranges')
     parser.add_argument('--voxlines', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), '..',
                                                            'build', 'release', 'converter', 'voxlines'))
     parser.add_argument('--chromium', default=shutil.which('chromium') or 'chromium')
@@ -83,10 +83,8 @@ def main():
         for path in args.files:
             folder = os.path.join(work, os.path.basename(path) + '.share')
             subprocess.run([args.voxlines, 'share', path, folder], check=True, capture_output=True)
-            handler = functools.partial(QuietHandler, directory=folder)
-            httpd = http.server.ThreadingHTTPServer(('127.0.0.1', 0), handler)
-            threading.Thread(target=httpd.serve_forever, daemon=True).start()
-            url = f'http://127.0.0.1:{httpd.server_address[1]}/index.html?size={args.size}'
+            server = web_server.Server(folder, SERVERS[args.server])
+            url = f'{server.url}index.html?size={args.size}'
             size = os.path.getsize(path)
             try:
                 for r in range(args.rounds):
@@ -100,12 +98,12 @@ def main():
                     if 'error' in report:
                         print(f'{os.path.basename(path)}: {report["error"]}')
                         return 1
-                    print(f'{os.path.basename(path)} ({size / 2**20:.0f} MiB) round {r + 1}: first picture '
+                    print(f'{os.path.basename(path)} ({size / 2**20:.0f} MiB, server: {args.server}) round {r + 1}: first picture '
                           f'{report["first_picture_ms"] / 1000:.2f} s (level {report["first_level"]}), full detail {report["full_detail_ms"] / 1000:.2f} s, '
                           f'browser peak RSS {sampler.peak / 2**20:.0f} MiB = {sampler.peak / size:.2f}x the file '
                           f'(whole run {time.monotonic() - t0:.1f} s)', flush=True)
             finally:
-                httpd.shutdown()
+                server.close()
     return 0
 
 

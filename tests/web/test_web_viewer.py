@@ -5,7 +5,9 @@ headless Chromium (WebGL2 on SwiftShader), against `voxview --render` of the sam
 over R, G, B (at least MIN_PSNR dB), not byte for byte. Cases: a synthetic set of 20,000 streamlines, packed
 and float32, in the axis and unsorted modes; a .vxlz shared (unpacked by share); with the real fixtures (when
 --real-data holds them), MRtrix's test tracks coloured by their AFD values; the packed file sent gzip-compressed
-(the length the server declares is then not the body's); damaged files, which the page
+(the length the server declares is then not the body's). The files are served by a server that answers Range
+requests (the page then fetches the first picture's level first, many ranges a request), one that answers the
+first range only, and one that ignores Range (the page then fetches the file whole). Damaged files, which the page
 must refuse with a message naming them: one cut short (the reader's structure checks), and two whose structure
 holds but whose orders or vertices were overwritten (the draw checks that voxview runs, which the page runs too).
 
@@ -13,9 +15,7 @@ Usage: tests/web/test_web_viewer.py --voxlines PATH --voxview PATH --web-viewer 
 Exit 0 when every case holds, 1 otherwise, 77 when there is no Chromium to run it in.
 """
 import argparse
-import functools
 import gzip
-import http.server
 import json
 import math
 import os
@@ -23,10 +23,12 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import threading
 
 import numpy
 from PIL import Image
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'scripts'))
+from web_server import FirstRangeHandler, QuietHandler, RangeHandler, Server  # noqa: E402
 
 MIN_PSNR = 35.0
 SIZE = '512x512'
@@ -49,11 +51,6 @@ def psnr_rgb(a_path, b_path):
     return math.inf if mse == 0 else 10 * math.log10(255 ** 2 / mse)
 
 
-class QuietHandler(http.server.SimpleHTTPRequestHandler):
-    def log_message(self, *args):
-        pass
-
-
 class GzipHandler(QuietHandler):
     """Sends .vxl files gzip-compressed (Content-Encoding: gzip): the Content-Length the page sees is then the
     compressed size, smaller than the bytes it receives."""
@@ -69,19 +66,6 @@ class GzipHandler(QuietHandler):
         self.send_header('Content-Length', str(len(body)))
         self.end_headers()
         self.wfile.write(body)
-
-
-class Server:
-    """A static web server for one folder on a free port, in a thread."""
-
-    def __init__(self, folder, handler_class=QuietHandler):
-        handler = functools.partial(handler_class, directory=folder)
-        self.httpd = http.server.ThreadingHTTPServer(('127.0.0.1', 0), handler)
-        self.url = f'http://127.0.0.1:{self.httpd.server_address[1]}/'
-        threading.Thread(target=self.httpd.serve_forever, daemon=True).start()
-
-    def close(self):
-        self.httpd.shutdown()
 
 
 def capture(url, out):
@@ -125,13 +109,14 @@ def main():
             with open(path(name), 'wb') as f:
                 f.write(damaged)
 
-        # Each case: the file shared, the page's settings (voxview's options of the same names).
-        cases = [('packed.vxl', 'mode=axis'), ('packed.vxl', 'mode=unsorted'), ('float32.vxl', 'mode=axis'),
-                 ('float32.vxl', 'mode=unsorted'), ('packed.vxlz', 'mode=axis')]
+        # Each case: the file shared, the page's settings (voxview's options of the same names), the server.
+        cases = [('packed.vxl', 'mode=axis', RangeHandler), ('packed.vxl', 'mode=unsorted', QuietHandler),
+                 ('float32.vxl', 'mode=axis', RangeHandler), ('float32.vxl', 'mode=unsorted', FirstRangeHandler),
+                 ('packed.vxlz', 'mode=axis', RangeHandler)]
         tracks, afd = (os.path.join(options.real_data, f) for f in ('test_data__tracks.tck', 'test_data__afd.tsf'))
         if os.path.isfile(tracks) and os.path.isfile(afd):
             run(options.voxlines, 'convert', tracks, path('afd.vxl'), '--tsf', afd)
-            cases.append(('afd.vxl', 'color=scalar&colormap=hot'))
+            cases.append(('afd.vxl', 'color=scalar&colormap=hot', RangeHandler))
         else:
             print(f'the AFD case is skipped: {tracks} is absent (the real fixtures live beside the project)')
         for source in sorted({c[0] for c in cases} | {'damaged.vxl'}):
@@ -148,10 +133,12 @@ def main():
 
         # Served compressed: the declared length is not the body's.
         cases.append(('packed.vxl', 'mode=axis', GzipHandler))
-        for source, settings, *handler in cases:
+        served_by = {RangeHandler: 'ranges', FirstRangeHandler: 'first range only', QuietHandler: 'no ranges',
+                     GzipHandler: 'gzip, no ranges'}
+        for source, settings, handler in cases:
             folder = path('share-' + source.replace('.', '-'))
             shared = json.load(open(os.path.join(folder, 'share.json')))['file']
-            server = Server(folder, *handler)
+            server = Server(folder, handler)
             try:
                 web = path(f'web-{source}-{settings}.png')
                 report = capture(f'{server.url}index.html?size={SIZE}#{settings}', web)
@@ -164,7 +151,7 @@ def main():
             flags = [x for kv in settings.split('&') for x in ('--' + kv.split('=')[0], kv.split('=')[1])]
             run(options.voxview, os.path.join(folder, shared), '--render', native, '--size', SIZE, *flags)
             value = psnr_rgb(web, native)
-            served = ' (gzip)' if handler else ''
+            served = f' ({served_by[handler]})'
             print(f'{source}{served} {settings}: PSNR {value:.2f} dB against voxview, first picture after '
                   f'{report["first_picture_ms"]:.0f} ms, full detail after {report["full_detail_ms"]:.0f} ms')
             if value < MIN_PSNR:
@@ -174,11 +161,13 @@ def main():
                 shutil.copy(native, keep)
                 failures.append(f'{source} {settings}: PSNR {value:.2f} dB < {MIN_PSNR} (pictures in {keep})')
 
-        # Damaged files reaching the page (served as they are, without share) are refused with their names.
+        # Damaged files reaching the page (served as they are, without share, by ranges) are refused with their
+        # names: cut short by the first bytes' checks, overwritten by the draw checks of the first level or of
+        # full detail.
         folder = path('share-packed-vxl')
         for name in ('damaged.vxl', 'ordb-damaged.vxl', 'vert-damaged.vxl'):
             shutil.copy(path(name), folder)
-            server = Server(folder)
+            server = Server(folder, RangeHandler)
             try:
                 report = capture(f'{server.url}index.html?size={SIZE}&file={name}', path(name + '.png'))
             finally:

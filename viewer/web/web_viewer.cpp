@@ -19,12 +19,14 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <emscripten/emscripten.h>
 #include <emscripten/html5.h>
 #include <nlohmann/json.hpp>
 
 #include "format/base/error.h"
+#include "format/vxl_fetch_plan.h"
 #include "format/vxl_file.h"
 #include "viewer/app/camera_controller.h"
 #include "viewer/app/frame_budget.h"
@@ -53,7 +55,10 @@ struct Viewer {
     return s;
   }();
   int width = 1, height = 1;
-  bool full_pending = false;  // the full-detail spans of the last view at rest are not all uploaded yet
+  bool full_pending = false;      // the full-detail spans of the last view at rest are not all uploaded yet
+  std::uint32_t first_level = 0;  // the first picture's level of detail
+  // A file fetched by ranges (vw_plan_open): the bytes its buffer holds so far, sorted and disjoint.
+  std::vector<ByteRange> held;
 };
 
 Viewer& viewer() {
@@ -67,6 +72,18 @@ void close(Viewer& v) {
   v.quick.reset();
   v.full.reset();
   v.file.reset();
+  v.held.clear();
+}
+
+// Whether the buffer holds the whole file (fetched whole, or every range fetched).
+bool complete(const Viewer& v) {
+  return v.file && v.held.size() == 1 && v.held[0].begin == 0 && v.held[0].end >= v.file->bytes().size();
+}
+
+// What vw_plan_open named (with the first bytes): what a buffer given to vw_open without `whole` holds.
+std::vector<ByteRange>& planned_ranges() {
+  static std::vector<ByteRange> ranges;
+  return ranges;
 }
 
 std::string& last_error() {
@@ -131,15 +148,20 @@ Renderer* renderer_for(Viewer& v, bool moving) {
   return v.full.get();
 }
 
-// Opens `held` into `v` (closed): the file, the first picture's renderer, the camera.
-void open_file(Viewer& v, MappedFile held, int width, int height) {
-  v.file.emplace(VxlFile::open(std::move(held)));
-  make_context();
+// Opens `bytes` into `v` (closed): the file, and the first picture's level (nothing drawn yet).
+void open_file(Viewer& v, MappedFile bytes, int width, int height) {
+  v.file.emplace(VxlFile::open(std::move(bytes)));
   v.width = std::max(width, 1);
   v.height = std::max(height, 1);
+  v.first_level = app::first_picture_level(app::level_segments(std::vector<const VxlFile*>{&*v.file}), 0);
+}
+
+// The first picture's renderer and the camera: the file's bytes of that level are in (all of them, or those of
+// ranges_of_level).
+void show_file(Viewer& v) {
+  make_context();
   const std::vector<const VxlFile*> files{&*v.file};
-  const std::uint32_t level = app::first_picture_level(app::level_segments(files), 0);
-  (level > 0 ? v.quick : v.full) = std::make_unique<Renderer>(files, 0, level);
+  (v.first_level > 0 ? v.quick : v.full) = std::make_unique<Renderer>(files, 0, v.first_level);
   const Camera home = home_camera(*v.file, double(v.width) / v.height);
   const Renderer& any = *renderer_for(v, false);
   const glm::dvec3 extent = any.bounds_max() - any.bounds_min();
@@ -191,16 +213,100 @@ using vxl::web::viewer;
 extern "C" {
 
 // Takes the file's bytes (from malloc; freed by the viewer, also on failure) and opens them; the canvas is
-// then width x height pixels.
-EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* name, int width, int height) {
-  auto held = vxl::MappedFile::adopt(name, bytes, static_cast<std::size_t>(size));
+// then width x height pixels. `whole`: the buffer holds the whole file, and the first picture's renderer is
+// made; else it holds what vw_plan_open named, and vw_level_ranges says what the first picture needs before
+// vw_show makes it.
+EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* name, int width, int height, int whole) {
+  auto file = vxl::MappedFile::adopt(name, bytes, static_cast<std::size_t>(size));
   return guarded([&] {
     auto& v = viewer();
     vxl::web::close(v);
     try {
-      vxl::web::open_file(v, std::move(held), width, height);
+      vxl::web::open_file(v, std::move(file), width, height);
+      if (whole) {
+        v.held = {{0, static_cast<std::uint64_t>(size)}};
+        vxl::web::show_file(v);
+      } else {
+        v.held = vxl::web::planned_ranges();
+      }
     } catch (...) {
       vxl::web::close(v);  // nothing half open
+      throw;
+    }
+  });
+}
+
+// Fetching by ranges. `first`: the file's first `first_size` bytes (at least vxl::kSectionTableBytesMax, or the
+// whole file if shorter) of `file_size`. What the reader needs to open the file, as JSON [[begin, end], ...]
+// (end exclusive), or {"error": ...}; the page fetches them into a buffer of the file's size, then vw_open.
+EMSCRIPTEN_KEEPALIVE const char* vw_plan_open(const std::uint8_t* first, double first_size, double file_size,
+                                              const char* name) {
+  static std::string text;
+  nlohmann::json j = nlohmann::json::array();
+  std::vector<vxl::ByteRange> ranges;
+  const int error = guarded([&] {
+    ranges =
+        vxl::ranges_to_open(name, {first, static_cast<std::size_t>(first_size)}, static_cast<std::uint64_t>(file_size));
+  });
+  if (error != 0) {
+    j = {{"error", vxl::web::last_error()}};
+  } else {
+    const auto held = static_cast<std::uint64_t>(first_size);
+    for (const vxl::ByteRange& r : ranges)
+      if (r.end > held) j.push_back({std::max(r.begin, held), r.end});
+    ranges.push_back({0, held});
+    vxl::web::planned_ranges() = vxl::merge_ranges(std::move(ranges), 0);
+  }
+  text = j.dump();
+  return text.c_str();
+}
+
+// The ranges the first picture needs that the buffer does not hold yet (JSON, as vw_plan_open's), counted as
+// held from now on. `gap`: ranges closer than this are fetched as one.
+EMSCRIPTEN_KEEPALIVE const char* vw_level_ranges(double gap) {
+  static std::string text;
+  auto& v = viewer();
+  nlohmann::json j = nlohmann::json::array();
+  if (v.file) {
+    std::vector<vxl::ByteRange> wanted = vxl::ranges_of_level(*v.file, v.first_level, static_cast<std::uint64_t>(gap));
+    std::vector<vxl::ByteRange> fetch;
+    for (const vxl::ByteRange& missing : vxl::ranges_missing(v.held, v.file->bytes().size()))
+      for (const vxl::ByteRange& w : wanted)
+        if (w.begin < missing.end && missing.begin < w.end)
+          fetch.push_back({std::max(w.begin, missing.begin), std::min(w.end, missing.end)});
+    for (const vxl::ByteRange& r : fetch) j.push_back({r.begin, r.end});
+    fetch.insert(fetch.end(), v.held.begin(), v.held.end());
+    v.held = vxl::merge_ranges(std::move(fetch), 0);
+  }
+  text = j.dump();
+  return text.c_str();
+}
+
+// The rest of the file (JSON ranges of at most `piece` bytes each), counted as held from now on: full detail and
+// colouring by value or group read it (vw_refine after it is in).
+EMSCRIPTEN_KEEPALIVE const char* vw_missing_ranges(double piece) {
+  static std::string text;
+  auto& v = viewer();
+  nlohmann::json j = nlohmann::json::array();
+  if (v.file) {
+    const auto step = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(piece));
+    for (const vxl::ByteRange& r : vxl::ranges_missing(v.held, v.file->bytes().size()))
+      for (std::uint64_t at = r.begin; at < r.end; at += step) j.push_back({at, std::min(r.end, at + step)});
+    v.held = {{0, v.file->bytes().size()}};
+  }
+  text = j.dump();
+  return text.c_str();
+}
+
+// Makes the first picture's renderer once its ranges are in (vw_open without `whole`).
+EMSCRIPTEN_KEEPALIVE int vw_show() {
+  return guarded([&] {
+    auto& v = viewer();
+    if (!v.file) throw std::runtime_error("no file is open");
+    try {
+      vxl::web::show_file(v);
+    } catch (...) {
+      vxl::web::close(v);
       throw;
     }
   });
@@ -231,10 +337,17 @@ EMSCRIPTEN_KEEPALIVE int vw_set(const char* key_text, const char* value_text) {
       if (!vxl::web::drawable_on_the_web(*mode))
         throw vxl::Error(vxl::ErrorKind::Unsupported, "", std::nullopt,
                          "the " + value + " mode needs storage buffers or compute shaders, which WebGL2 lacks");
+      // It draws in the streamlines' order, from the voxline and streamline tables.
+      if (*mode == vxl::RenderMode::Unsorted && !vxl::web::complete(v))
+        throw vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "the unsorted mode waits for the whole file");
       v.settings.mode = *mode;
     } else if (key == "color") {
       const auto color = vxl::parse_color_mode(value);
       if (!color) throw bad();
+      // Values and groups are read per vertex from the voxline and streamline tables.
+      if ((*color == vxl::ColorMode::Scalar || *color == vxl::ColorMode::Group) && !vxl::web::complete(v))
+        throw vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt,
+                         "colouring by " + value + " waits for the whole file");
       v.settings.color = *color;
     } else if (key == "opacity") {
       const float o = std::strtof(value.c_str(), nullptr);
@@ -317,6 +430,7 @@ EMSCRIPTEN_KEEPALIVE int vw_refine() {
     auto& v = viewer();
     if (!v.file) throw std::runtime_error("no file is open");
     if (v.full) return;
+    if (!vxl::web::complete(v)) throw std::runtime_error("full detail needs the whole file: fetch it first");
     // Made without its spans (eager false): vw_upload and renderer_for upload them a few at a time. The spans
     // are as large as the driver allows: each span more in a draw costs every vertex a branch of texture
     // fetches (SwiftShader: spans of 2^23 texels, two for the 144k set, took its full-detail frame from 11 s

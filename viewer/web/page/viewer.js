@@ -38,7 +38,11 @@
 
   createVoxweb({ canvas }).then((Module) => {
     const api = {
-      open: Module.cwrap('vw_open', 'number', ['number', 'number', 'string', 'number', 'number']),
+      open: Module.cwrap('vw_open', 'number', ['number', 'number', 'string', 'number', 'number', 'number']),
+      planOpen: Module.cwrap('vw_plan_open', 'string', ['number', 'number', 'number', 'string']),
+      levelRanges: Module.cwrap('vw_level_ranges', 'string', ['number']),
+      missingRanges: Module.cwrap('vw_missing_ranges', 'string', ['number']),
+      show: Module.cwrap('vw_show', 'number', []),
       error: Module.cwrap('vw_error', 'string', []),
       info: Module.cwrap('vw_info', 'string', []),
       set: Module.cwrap('vw_set', 'number', ['string', 'string']),
@@ -53,6 +57,10 @@
     };
     // moving: a drag is under way (frames then come from the first picture's level of detail).
     let opened = false, dirty = false, firstFrame = true, fullDetail = false, moving = false;
+    // The whole file is in the WebAssembly memory (false while a file fetched by ranges still has some to come).
+    let bytesComplete = true;
+    // Fetching by ranges finishes the file after the first picture: fetchRest, set by fetchByRanges.
+    let fetchRest = null;
 
     function set(key, value) {
       if (api.set(key, String(value)) !== 0) say(api.error(), true);
@@ -107,9 +115,9 @@
       if (firstFrame) {
         firstFrame = false;
         settle.resolve();
-        if (!fullDetail) setTimeout(refine, 0);  // once the first picture is on the screen
+        setTimeout(afterFirstPicture, 0);  // once the first picture is on the screen
       }
-      if (fullDetail && !moving) {
+      if (fullDetail && bytesComplete && !moving) {
         if (api.pending()) uploadSoon();
         else {
           $('progress').value = 1;
@@ -132,6 +140,24 @@
         uploading = false;
         redraw();
       }, 0);
+    }
+    // The rest of a file fetched by ranges, then full detail.
+    async function afterFirstPicture() {
+      if (fetchRest) {
+        const rest = fetchRest;
+        fetchRest = null;
+        try {
+          if (!(await rest())) return;  // another file was opened meanwhile
+        } catch (err) {
+          return fail(err.message);
+        }
+        bytesComplete = true;
+        offerColourings(JSON.parse(api.info()));
+        for (const o of $('mode').options) o.disabled = false;
+        applyHash(true);
+      }
+      if (!fullDetail) refine();
+      else redraw();
     }
     function refine() {
       if (api.refine() !== 0) return fail(api.error());
@@ -159,14 +185,22 @@
       }
       return '#' + h.toString();
     }
-    function applyHash() {
+    // Settings that read the voxline and streamline tables, which a file fetched by ranges brings last: colouring
+    // by value or group, and the unsorted mode (it draws in the streamlines' order).
+    function needsWholeFile(key, value) {
+      return key === 'color' || key === 'scalar' || key === 'colormap' || (key === 'mode' && value === 'unsorted');
+    }
+    // afterWholeFile: only the settings that waited for the whole file (the view may have moved since).
+    function applyHash(afterWholeFile) {
       const h = new URLSearchParams(location.hash.slice(1));
       for (const key of ['mode', 'opacity', 'color', 'scalar', 'colormap']) {
         if (!h.has(key)) continue;
+        const waits = needsWholeFile(key, h.get(key));
+        if (afterWholeFile === true ? !waits : waits && !bytesComplete) continue;
         $(key).value = h.get(key);
         set(key, h.get(key));
       }
-      if (h.has('az') && h.has('el') && h.has('distance') && h.has('target')) {
+      if (afterWholeFile !== true && h.has('az') && h.has('el') && h.has('distance') && h.has('target')) {
         const t = h.get('target').split(',').map(Number);
         if (api.setCamera(Number(h.get('az')), Number(h.get('el')), Number(h.get('distance')), t[0], t[1], t[2]) !== 0)
           say(api.error(), true);
@@ -175,10 +209,15 @@
       redraw();
     }
 
+    // The whole file's bytes (from Module._malloc; the viewer frees them).
     function openBytes(pointer, size, name) {
       const [w, h] = canvasSize();
       const t0 = performance.now();
-      if (api.open(pointer, size, name, w, h) !== 0) return fail(api.error());
+      if (api.open(pointer, size, name, w, h, 1) !== 0) return fail(api.error());
+      shown(name, t0);
+    }
+    // The file is open and its first picture's renderer made: the panel, then the first frame.
+    function shown(name, t0) {
       opened = true;
       const info = JSON.parse(api.info());
       window.voxweb.info = info;
@@ -190,22 +229,173 @@
         o.value = m.name;
         o.textContent = m.name;
         o.title = m.description;
+        o.disabled = !bytesComplete && needsWholeFile('mode', m.name);
+        if (o.disabled) o.title += ' (once the whole file is in)';
         return o;
       }));
       $('mode').value = 'axis';
-      // Colouring by value or by group where the file has them.
       for (const o of [...$('color').options]) if (o.value === 'scalar' || o.value === 'group') o.remove();
-      if (info.values.length) $('color').add(new Option('value', 'scalar'));
-      if (info.groups.length > 1) $('color').add(new Option('group', 'group'));
-      $('scalar').replaceChildren(...info.values.map((name) => new Option(name, name)));
+      if (bytesComplete) offerColourings(info);
       say(`${name}: opened in ${((performance.now() - t0) / 1000).toFixed(2)} s`);
       applyHash();
     }
 
-    // Streams the response into the WebAssembly memory as it arrives (one copy of the file in the tab).
+    // Colouring by value or by group where the file has them (they read the whole file).
+    function offerColourings(info) {
+      if (info.values.length) $('color').add(new Option('value', 'scalar'));
+      if (info.groups.length > 1) $('color').add(new Option('group', 'group'));
+      $('scalar').replaceChildren(...info.values.map((name) => new Option(name, name)));
+    }
+
+    // Fetching by HTTP Range requests: the header and section table, what the reader needs to open the file,
+    // the first picture's level of detail, then the rest (.vxl spec §5.12: a level is a prefix of every voxel's
+    // block and its own orders, so it is many small ranges, asked for many at a time).
+    const FIRST_BYTES = 4096, RANGES_PER_REQUEST = 200, LEVEL_GAP = 4096, REST_PIECE = 8 << 20;
+    const SINGLE_RANGE_GAP = 1 << 20;  // for a server that answers one range a request
+    let generation = 0;  // each file opened counts one: what is fetched for an older one is dropped
+
+    // "bytes A-B/T" -> [A, B + 1, T] (T: null when unknown); null when malformed.
+    function contentRange(header) {
+      const m = /^bytes (\d+)-(\d+)\/(\d+|\*)$/.exec((header || '').trim());
+      return m ? [Number(m[1]), Number(m[2]) + 1, m[3] === '*' ? null : Number(m[3])] : null;
+    }
+    // Sorted [begin, end) pairs with those less than `gap` apart merged.
+    function coalesce(ranges, gap) {
+      const merged = [];
+      for (const r of [...ranges].sort((a, b) => a[0] - b[0])) {
+        const last = merged[merged.length - 1];
+        if (last && r[0] <= last[1] + gap) last[1] = Math.max(last[1], r[1]);
+        else merged.push([r[0], r[1]]);
+      }
+      return merged;
+    }
+    function indexOf(bytes, needle, from) {
+      search: for (let i = from; i + needle.length <= bytes.length; ++i) {
+        for (let k = 0; k < needle.length; ++k) if (bytes[i + k] !== needle[k]) continue search;
+        return i;
+      }
+      return -1;
+    }
+    // A multipart/byteranges body -> [[begin, end, bytes], ...].
+    function parts(body, boundary) {
+      const marker = new TextEncoder().encode('--' + boundary), blank = new TextEncoder().encode('\r\n\r\n');
+      const found = [];
+      for (let at = indexOf(body, marker, 0); at >= 0;) {
+        at += marker.length;
+        if (body[at] === 45 && body[at + 1] === 45) break;  // "--": the closing delimiter
+        const headersEnd = indexOf(body, blank, at);
+        if (headersEnd < 0) break;
+        const headers = new TextDecoder('latin1').decode(body.subarray(at, headersEnd));
+        const r = contentRange((/content-range:([^\r\n]*)/i.exec(headers) || [])[1]);
+        const start = headersEnd + blank.length;
+        if (!r || start + r[1] - r[0] > body.length) throw new Error('a malformed multipart/byteranges answer');
+        found.push([r[0], r[1], body.subarray(start, start + r[1] - r[0])]);
+        at = indexOf(body, marker, start + r[1] - r[0]);
+      }
+      return found;
+    }
+    // Fetches `ranges` ([begin, end) pairs) of the file into its buffer: `target` = {url, gen, pointer, size,
+    // received}. Several ranges a request; the ones a server left out (some answer the first range only) one at a
+    // time. False when another file was opened meanwhile.
+    async function fetchRanges(target, ranges) {
+      const covered = (r, got) => got.some((g) => g[0] <= r[0] && r[1] <= g[1]);
+      let left = target.multipart === false ? ranges : [];
+      for (let i = 0; i < ranges.length && target.multipart !== false; i += RANGES_PER_REQUEST) {
+        const batch = ranges.slice(i, i + RANGES_PER_REQUEST);
+        const got = await fetchBatch(target, batch);
+        if (got === null) return false;
+        if (batch.length > 1) target.multipart = got.length > 1;
+        left = left.concat(batch.filter((r) => !covered(r, got)));
+        if (target.multipart === false) left = left.concat(ranges.slice(i + RANGES_PER_REQUEST));
+      }
+      // One range a request: the small ones merged, a little more fetched for far fewer requests.
+      if (target.multipart === false) left = coalesce(left, SINGLE_RANGE_GAP);
+      for (const r of left) {
+        const got = await fetchBatch(target, [r]);
+        if (got === null) return false;
+        if (!covered(r, got)) throw new Error(`${target.url}: the server did not send bytes ${r[0]}-${r[1] - 1}`);
+      }
+      return true;
+    }
+    // One request: the ranges received (null when another file was opened meanwhile).
+    async function fetchBatch(target, batch) {
+      const spec = batch.map((r) => `${r[0]}-${r[1] - 1}`).join(',');
+      const response = await fetch(target.url, { headers: { Range: 'bytes=' + spec } });
+      if (response.status !== 206) throw new Error(`${target.url}: HTTP ${response.status} to a range request`);
+      const body = new Uint8Array(await response.arrayBuffer());
+      if (target.gen !== generation) return null;
+      const boundary = /multipart\/byteranges;\s*boundary="?([^";]+)"?/i.exec(response.headers.get('Content-Type') || '');
+      let got;
+      if (boundary) {
+        got = parts(body, boundary[1]);
+      } else {
+        const r = contentRange(response.headers.get('Content-Range'));
+        if (!r || r[1] - r[0] !== body.length) throw new Error(`${target.url}: a range answer of the wrong length`);
+        got = [[r[0], r[1], body]];
+      }
+      for (const [begin, end, bytes] of got) {
+        if (end > target.size) throw new Error(`${target.url}: bytes ${begin}-${end - 1} lie past the file's end`);
+        Module.HEAPU8.set(bytes, target.pointer + begin);
+        target.received += end - begin;
+      }
+      $('progress').value = Math.min(1, target.received / target.size);
+      return got;
+    }
+    // Opens `url` by ranges, given the answer to its first request (206, the first bytes); draws the first
+    // picture, and leaves fetchRest to bring the rest.
+    async function fetchByRanges(url, response, total, t0) {
+      const gen = generation, name = url.split('/').pop();
+      const first = new Uint8Array(await response.arrayBuffer());
+      if (gen !== generation) return;
+      const scratch = Module._malloc(Math.max(1, first.length));
+      Module.HEAPU8.set(first, scratch);
+      const plan = JSON.parse(api.planOpen(scratch, first.length, total, name));
+      Module._free(scratch);
+      if (plan.error) return fail(plan.error);
+      const pointer = Module._malloc(total);
+      if (!pointer) return fail(`${name}: no memory for its ${total.toLocaleString()} bytes`);
+      Module.HEAPU8.set(first, pointer);
+      const target = { url, gen, pointer, size: total, received: first.length };
+      let ok;
+      try {
+        ok = await fetchRanges(target, plan);
+      } catch (err) {
+        Module._free(pointer);
+        throw err;
+      }
+      if (!ok) return Module._free(pointer);
+      const [w, h] = canvasSize();
+      // From here the viewer holds the buffer (and frees it).
+      if (api.open(pointer, total, name, w, h, 0) !== 0) return fail(api.error());
+      if (!(await fetchRanges(target, JSON.parse(api.levelRanges(LEVEL_GAP)))) || gen !== generation) return;
+      if (api.show() !== 0) return fail(api.error());
+      bytesComplete = false;
+      fetchRest = () => fetchRanges(target, JSON.parse(api.missingRanges(REST_PIECE)));
+      shown(name, t0);
+    }
+
+    // Fetches `url`: by ranges where the server answers them, else whole.
     async function fetchFile(url) {
       say('fetching ' + url);
-      const response = await fetch(url);
+      ++generation;
+      bytesComplete = true;
+      fetchRest = null;
+      const t0 = performance.now();
+      let probe;
+      try {
+        probe = await fetch(url, { headers: { Range: `bytes=0-${FIRST_BYTES - 1}` } });
+      } catch (err) {  // a server that answers a range request wrongly (e.g. compressed after "identity" was asked)
+        return fetchWhole(url, await fetch(url));
+      }
+      if (!probe.ok) throw new Error(`${url}: HTTP ${probe.status}`);
+      const total = probe.status === 206 ? contentRange(probe.headers.get('Content-Range')) : null;
+      if (total && total[2] !== null && total[0] === 0) return fetchByRanges(url, probe, total[2], t0);
+      if (probe.status === 206) probe.body.cancel();
+      return fetchWhole(url, probe.status === 206 ? await fetch(url) : probe);
+    }
+
+    // Streams the response into the WebAssembly memory as it arrives (one copy of the file in the tab).
+    async function fetchWhole(url, response) {
       if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
       const declared = Number(response.headers.get('Content-Length'));
       const chunks = [];
@@ -239,6 +429,9 @@
     }
 
     async function dropFile(file) {
+      ++generation;
+      bytesComplete = true;
+      fetchRest = null;
       const bytes = new Uint8Array(await file.arrayBuffer());
       const pointer = Module._malloc(Math.max(1, bytes.length));
       Module.HEAPU8.set(bytes, pointer);
