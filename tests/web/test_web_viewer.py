@@ -8,7 +8,7 @@ and float32, in the axis and unsorted modes; a .vxlz shared (unpacked by share);
 (the length the server declares is then not the body's). The files are served by a server that answers Range
 requests (the page then fetches the first picture's level first, many ranges a request), one that answers the
 first range only, and one that ignores Range (the page then fetches the file whole). Damaged files, which the page
-must refuse with a message naming them: one cut short (the reader's structure checks), and two whose structure
+must refuse with a message naming them (and a file replaced on the server while the page fetches it): one cut short (the reader's structure checks), and two whose structure
 holds but whose orders or vertices were overwritten (the draw checks that voxview runs, which the page runs too).
 
 Usage: tests/web/test_web_viewer.py --voxlines PATH --voxview PATH --web-viewer DIR [--real-data DIR]
@@ -66,6 +66,18 @@ class GzipHandler(QuietHandler):
         self.send_header('Content-Length', str(len(body)))
         self.end_headers()
         self.wfile.write(body)
+
+
+class ChangingHandler(RangeHandler):
+    """Serves changed.vxl as packed.vxl to the first request and as float32.vxl (another size) to the next: a file
+    replaced on the server while the page fetches it by ranges."""
+    requests = 0
+
+    def translate_path(self, path):
+        if not path.split('?')[0].endswith('changed.vxl'):
+            return super().translate_path(path)
+        ChangingHandler.requests += 1
+        return super().translate_path('/packed.vxl' if ChangingHandler.requests == 1 else '/float32.vxl')
 
 
 def capture(url, out):
@@ -165,6 +177,16 @@ def main():
         # names: cut short by the first bytes' checks, overwritten by the draw checks of the first level or of
         # full detail.
         folder = path('share-packed-vxl')
+        shutil.copy(path('float32.vxl'), folder)
+        server = Server(folder, ChangingHandler)
+        try:
+            report = capture(f'{server.url}index.html?size={SIZE}&file=changed.vxl', path('changed.png'))
+        finally:
+            server.close()
+        if 'changed on the server' not in report.get('error', ''):
+            failures.append(f'a file changed on the server while fetched: {report}')
+        else:
+            print(f'changed.vxl in the page: {report["error"]}')
         for name in ('damaged.vxl', 'ordb-damaged.vxl', 'vert-damaged.vxl'):
             shutil.copy(path(name), folder)
             server = Server(folder, RangeHandler)

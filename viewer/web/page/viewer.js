@@ -276,7 +276,7 @@
       }
       return -1;
     }
-    // A multipart/byteranges body -> [[begin, end, bytes], ...].
+    // A multipart/byteranges body -> [[begin, end, bytes, the file's size or null], ...].
     function parts(body, boundary) {
       const marker = new TextEncoder().encode('--' + boundary), blank = new TextEncoder().encode('\r\n\r\n');
       const found = [];
@@ -289,7 +289,7 @@
         const r = contentRange((/content-range:([^\r\n]*)/i.exec(headers) || [])[1]);
         const start = headersEnd + blank.length;
         if (!r || start + r[1] - r[0] > body.length) throw new Error('a malformed multipart/byteranges answer');
-        found.push([r[0], r[1], body.subarray(start, start + r[1] - r[0])]);
+        found.push([r[0], r[1], body.subarray(start, start + r[1] - r[0]), r[2]]);
         at = indexOf(body, marker, start + r[1] - r[0]);
       }
       return found;
@@ -331,10 +331,12 @@
       } else {
         const r = contentRange(response.headers.get('Content-Range'));
         if (!r || r[1] - r[0] !== body.length) throw new Error(`${target.url}: a range answer of the wrong length`);
-        got = [[r[0], r[1], body]];
+        got = [[r[0], r[1], body, r[2]]];
       }
-      for (const [begin, end, bytes] of got) {
+      for (const [begin, end, bytes, total] of got) {
         if (end > target.size) throw new Error(`${target.url}: bytes ${begin}-${end - 1} lie past the file's end`);
+        if (total !== null && total !== target.size)
+          throw new Error(`${target.url} changed on the server while it was fetched (now ${total} bytes)`);
         Module.HEAPU8.set(bytes, target.pointer + begin);
         target.received += end - begin;
       }
