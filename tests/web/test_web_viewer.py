@@ -108,6 +108,10 @@ def main():
         run(options.voxlines, 'convert', path('s20k.tck'), path('packed.vxl'))
         run(options.voxlines, 'convert', path('s20k.tck'), path('float32.vxl'), '--positions', 'float32')
         run(options.voxlines, 'pack', path('packed.vxl'), path('packed.vxlz'))
+        # 50,000 streamlines: a first picture at level 2, so that level 1 is fetched and drawn between it and full
+        # detail.
+        run(options.voxlines, 'synth', path('s50k.tck'), '--streamlines', '50000')
+        run(options.voxlines, 'convert', path('s50k.tck'), path('s50k.vxl'))
         with open(path('packed.vxl'), 'rb') as f:
             whole = f.read()
         with open(path('damaged.vxl'), 'wb') as f:
@@ -124,7 +128,7 @@ def main():
         # Each case: the file shared, the page's settings (voxview's options of the same names), the server.
         cases = [('packed.vxl', 'mode=axis', RangeHandler), ('packed.vxl', 'mode=unsorted', QuietHandler),
                  ('float32.vxl', 'mode=axis', RangeHandler), ('float32.vxl', 'mode=unsorted', FirstRangeHandler),
-                 ('packed.vxlz', 'mode=axis', RangeHandler)]
+                 ('packed.vxlz', 'mode=axis', RangeHandler), ('s50k.vxl', 'mode=axis', RangeHandler)]
         tracks, afd = (os.path.join(options.real_data, f) for f in ('test_data__tracks.tck', 'test_data__afd.tsf'))
         if os.path.isfile(tracks) and os.path.isfile(afd):
             run(options.voxlines, 'convert', tracks, path('afd.vxl'), '--tsf', afd)
@@ -159,6 +163,8 @@ def main():
             if 'error' in report:
                 failures.append(f'{source} {settings}: the page failed: {report["error"]}')
                 continue
+            if source == 's50k.vxl' and report['first_level'] != 2:
+                failures.append(f's50k.vxl: first picture at level {report["first_level"]}, not 2 (no level between)')
             native = path(f'voxview-{source}-{settings}.png')
             flags = [x for kv in settings.split('&') for x in ('--' + kv.split('=')[0], kv.split('=')[1])]
             run(options.voxview, os.path.join(folder, shared), '--render', native, '--size', SIZE, *flags)

@@ -47,7 +47,9 @@ bool drawable_on_the_web(RenderMode mode) { return mode != RenderMode::Exact && 
 struct Viewer {
   std::optional<VxlFile> file;
   std::unique_ptr<Renderer> quick;  // at the first picture's level; null when that is full detail
-  std::unique_ptr<Renderer> full;   // full detail: made by vw_open when it is the first picture's, else by vw_refine
+  // A file fetched by ranges, at rest until full detail is ready: the finest level fetched since (vw_show_level).
+  std::unique_ptr<Renderer> interim;
+  std::unique_ptr<Renderer> full;  // full detail: made by vw_open when it is the first picture's, else by vw_refine
   std::unique_ptr<app::CameraController> controller;
   RenderSettings settings = [] {
     RenderSettings s;
@@ -70,6 +72,7 @@ Viewer& viewer() {
 void close(Viewer& v) {
   v.controller.reset();
   v.quick.reset();
+  v.interim.reset();
   v.full.reset();
   v.file.reset();
   v.held.clear();
@@ -144,7 +147,9 @@ bool upload_full(Viewer& v) {
 // the view.
 Renderer* renderer_for(Viewer& v, bool moving) {
   if (!v.quick) return v.full.get();
-  if (moving || !v.full || !upload_full(v)) return v.quick.get();
+  if (moving) return v.quick.get();
+  if (!v.full || !upload_full(v)) return v.interim ? v.interim.get() : v.quick.get();
+  v.interim.reset();  // full detail is on the GPU for this view
   return v.full.get();
 }
 
@@ -177,8 +182,10 @@ void describe(Viewer& v, nlohmann::json& j) {
     j["vertices"] = m.vertex_count;
     j["voxels"] = v.file->voxels().size();
     j["bytes"] = v.file->bytes().size();
-    j["gpu_bytes"] = (v.quick ? v.quick->gpu_bytes() : 0) + (v.full ? v.full->gpu_bytes() : 0);
+    j["gpu_bytes"] = (v.quick ? v.quick->gpu_bytes() : 0) + (v.interim ? v.interim->gpu_bytes() : 0) +
+                     (v.full ? v.full->gpu_bytes() : 0);
     j["first_level"] = v.quick ? v.quick->layout().level() : 0;
+    j["level_segments"] = app::level_segments(std::vector<const VxlFile*>{&*v.file});
     j["full_detail"] = v.full != nullptr;
     const Renderer& r = v.full ? *v.full : *v.quick;
     // How much of full detail is on the GPU, of the most it can take.
@@ -261,14 +268,16 @@ EMSCRIPTEN_KEEPALIVE const char* vw_plan_open(const std::uint8_t* first, double 
   return text.c_str();
 }
 
-// The ranges the first picture needs that the buffer does not hold yet (JSON, as vw_plan_open's), counted as
-// held from now on. `gap`: ranges closer than this are fetched as one.
-EMSCRIPTEN_KEEPALIVE const char* vw_level_ranges(double gap) {
+// The ranges level `level` needs (the first picture's: -1) that the buffer does not hold yet (JSON, as
+// vw_plan_open's), counted as held from now on. `gap`: ranges closer than this are fetched as one.
+EMSCRIPTEN_KEEPALIVE const char* vw_level_ranges(int level, double gap) {
   static std::string text;
   auto& v = viewer();
   nlohmann::json j = nlohmann::json::array();
   if (v.file) {
-    std::vector<vxl::ByteRange> wanted = vxl::ranges_of_level(*v.file, v.first_level, static_cast<std::uint64_t>(gap));
+    const std::uint32_t wanted_level =
+        level < 0 ? v.first_level : std::min(static_cast<std::uint32_t>(level), v.file->level_count() - 1);
+    std::vector<vxl::ByteRange> wanted = vxl::ranges_of_level(*v.file, wanted_level, static_cast<std::uint64_t>(gap));
     std::vector<vxl::ByteRange> fetch;
     for (const vxl::ByteRange& missing : vxl::ranges_missing(v.held, v.file->bytes().size()))
       for (const vxl::ByteRange& w : wanted)
@@ -296,6 +305,19 @@ EMSCRIPTEN_KEEPALIVE const char* vw_missing_ranges(double piece) {
   }
   text = j.dump();
   return text.c_str();
+}
+
+// Draws frames at rest at `level` (finer than the first picture's, coarser than full detail) once its ranges are
+// in (vw_level_ranges), until full detail is ready; frames in motion stay at the first picture's level.
+EMSCRIPTEN_KEEPALIVE int vw_show_level(int level) {
+  return guarded([&] {
+    auto& v = viewer();
+    if (!v.controller || !v.quick) throw std::runtime_error("no first picture to refine");
+    if (level <= 0 || static_cast<std::uint32_t>(level) >= v.first_level)
+      throw std::runtime_error("not a level between");
+    v.interim.reset();  // its GPU memory before the next one's
+    v.interim = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file}, 0, level);
+  });
 }
 
 // Makes the first picture's renderer once its ranges are in (vw_open without `whole`).

@@ -40,7 +40,8 @@
     const api = {
       open: Module.cwrap('vw_open', 'number', ['number', 'number', 'string', 'number', 'number', 'number']),
       planOpen: Module.cwrap('vw_plan_open', 'string', ['number', 'number', 'number', 'string']),
-      levelRanges: Module.cwrap('vw_level_ranges', 'string', ['number']),
+      levelRanges: Module.cwrap('vw_level_ranges', 'string', ['number', 'number']),
+      showLevel: Module.cwrap('vw_show_level', 'number', ['number']),
       missingRanges: Module.cwrap('vw_missing_ranges', 'string', ['number']),
       show: Module.cwrap('vw_show', 'number', []),
       error: Module.cwrap('vw_error', 'string', []),
@@ -252,6 +253,9 @@
     // block and its own orders, so it is many small ranges, asked for many at a time).
     const FIRST_BYTES = 4096, RANGES_PER_REQUEST = 200, LEVEL_GAP = 4096, REST_PIECE = 8 << 20;
     const SINGLE_RANGE_GAP = 1 << 20;  // for a server that answers one range a request
+    // The finest level drawn at rest before full detail: a software WebGL draws about a million segments a second,
+    // and each such picture delays full detail by its upload and its frames.
+    const INTERIM_SEGMENTS = 2e6;
     let generation = 0;  // each file opened counts one: what is fetched for an older one is dropped
 
     // "bytes A-B/T" -> [A, B + 1, T] (T: null when unknown); null when malformed.
@@ -369,10 +373,22 @@
       const [w, h] = canvasSize();
       // From here the viewer holds the buffer (and frees it).
       if (api.open(pointer, total, name, w, h, 0) !== 0) return fail(api.error());
-      if (!(await fetchRanges(target, JSON.parse(api.levelRanges(LEVEL_GAP)))) || gen !== generation) return;
+      if (!(await fetchRanges(target, JSON.parse(api.levelRanges(-1, LEVEL_GAP)))) || gen !== generation) return;
       if (api.show() !== 0) return fail(api.error());
       bytesComplete = false;
-      fetchRest = () => fetchRanges(target, JSON.parse(api.missingRanges(REST_PIECE)));
+      // The finer levels one after the other (each an eighth of the next: 1/64, 1/8 of the file...), each drawn
+      // at rest as it comes, then the rest of the file. False when another file was opened meanwhile.
+      fetchRest = async () => {
+        const info = JSON.parse(api.info());
+        for (let level = info.first_level - 1; level >= 1 && info.level_segments[level] <= INTERIM_SEGMENTS; --level) {
+          if (!(await fetchRanges(target, JSON.parse(api.levelRanges(level, LEVEL_GAP))))) return false;
+          if (api.showLevel(level) !== 0) throw new Error(api.error());
+          say(`${name}: level ${level} (1/${8 ** level} of the streamlines) in; fetching the rest`);
+          redraw();
+          await new Promise((resolve) => setTimeout(resolve, 0));  // its frame before the next fetch
+        }
+        return fetchRanges(target, JSON.parse(api.missingRanges(REST_PIECE)));
+      };
       shown(name, t0);
     }
 
