@@ -70,11 +70,25 @@ std::vector<ByteRange> ranges_missing(std::span<const ByteRange> held, std::uint
   std::vector<ByteRange> missing;
   std::uint64_t at = 0;
   for (const ByteRange& r : held) {
-    if (r.begin > at) missing.push_back({at, std::min(r.begin, size)});
+    if (r.begin >= size) break;
+    if (r.begin > at) missing.push_back({at, r.begin});
     at = std::max(at, r.end);
   }
   if (at < size) missing.push_back({at, size});
   return missing;
+}
+
+std::vector<ByteRange> ranges_intersection(std::span<const ByteRange> a, std::span<const ByteRange> b) {
+  std::vector<ByteRange> both;
+  for (std::size_t i = 0, j = 0; i < a.size() && j < b.size();) {
+    const std::uint64_t begin = std::max(a[i].begin, b[j].begin), end = std::min(a[i].end, b[j].end);
+    if (begin < end) both.push_back({begin, end});
+    if (a[i].end < b[j].end)
+      ++i;
+    else
+      ++j;
+  }
+  return both;
 }
 
 }  // namespace vxl

@@ -38,4 +38,7 @@ std::vector<ByteRange> merge_ranges(std::vector<ByteRange> ranges, std::uint64_t
 // [0, size) less `held` (sorted and disjoint, as the functions above give them).
 std::vector<ByteRange> ranges_missing(std::span<const ByteRange> held, std::uint64_t size);
 
+// The bytes in both `a` and `b` (each sorted and disjoint), in one pass over both.
+std::vector<ByteRange> ranges_intersection(std::span<const ByteRange> a, std::span<const ByteRange> b);
+
 }  // namespace vxl

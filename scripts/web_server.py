@@ -5,7 +5,8 @@
   `python3 -m http.server` serves a shared folder;
 * `RangeHandler`: answers `Range: bytes=...` with 206, one range as it is and several as multipart/byteranges,
   as nginx or Apache do;
-* `FirstRangeHandler`: answers only the first of several ranges (a server or proxy that does not do multipart).
+* `FirstRangeHandler`: answers only the first of several ranges (a server or proxy that does not do multipart);
+* `WholeForSeveralHandler`: answers several ranges with the whole file (status 200), as servers do past a limit.
 
 Usage as a program: scripts/web_server.py FOLDER [--port N] [--no-range] serves FOLDER until interrupted.
 """
@@ -25,6 +26,12 @@ class QuietHandler(http.server.SimpleHTTPRequestHandler):
 
 class RangeHandler(QuietHandler):
     multipart = True
+    # What it answered since the last reset: 206 with one range, and 206 with several (multipart/byteranges).
+    answers = {'one range': 0, 'multipart': 0}
+
+    @classmethod
+    def reset_counts(cls):
+        RangeHandler.answers = {'one range': 0, 'multipart': 0}
 
     def do_GET(self):
         spec = self.headers.get('Range')
@@ -53,7 +60,9 @@ class RangeHandler(QuietHandler):
                 self.send_response(206)
                 self.send_header('Content-Type', 'application/octet-stream')
                 self.send_header('Content-Range', f'bytes {begin}-{end}/{size}')
+                RangeHandler.answers['one range'] += 1
             else:
+                RangeHandler.answers['multipart'] += 1
                 boundary = uuid.uuid4().hex
                 pieces = []
                 for begin, end in ranges:
@@ -91,6 +100,16 @@ class RangeHandler(QuietHandler):
 
 class FirstRangeHandler(RangeHandler):
     multipart = False
+
+
+class WholeForSeveralHandler(RangeHandler):
+    """Answers one range with 206 and several with the whole file (200), as servers do past a limit on ranges."""
+
+    def do_GET(self):
+        spec = self.headers.get('Range') or ''
+        if ',' in spec:
+            return QuietHandler.do_GET(self)
+        return super().do_GET()
 
 
 class Server:

@@ -88,6 +88,11 @@ TEST(FetchPlan, RangesMergeAndTheMissingOnesCoverTheRest) {
   EXPECT_EQ(ranges_missing(held, 50), (std::vector<ByteRange>{{5, 10}, {30, 34}, {40, 50}}));
   EXPECT_EQ(ranges_missing(held, 40), (std::vector<ByteRange>{{5, 10}, {30, 34}}));
   EXPECT_EQ(ranges_missing({}, 3), (std::vector<ByteRange>{{0, 3}}));
+  EXPECT_EQ(ranges_missing(std::vector<ByteRange>{{0, 5}, {8, 12}}, 6), (std::vector<ByteRange>{{5, 6}}))
+      << "held past the end";
+  EXPECT_EQ(ranges_intersection(held, std::vector<ByteRange>{{3, 12}, {20, 36}, {39, 60}}),
+            (std::vector<ByteRange>{{3, 5}, {10, 12}, {20, 30}, {34, 36}, {39, 40}}));
+  EXPECT_TRUE(ranges_intersection(held, {}).empty());
 }
 
 TEST(FetchPlan, TheFirstBytesAreCheckedAsOpenChecksThem) {

@@ -7,7 +7,8 @@ and float32, in the axis and unsorted modes; a .vxlz shared (unpacked by share);
 --real-data holds them), MRtrix's test tracks coloured by their AFD values; the packed file sent gzip-compressed
 (the length the server declares is then not the body's). The files are served by a server that answers Range
 requests (the page then fetches the first picture's level first, many ranges a request), one that answers the
-first range only, and one that ignores Range (the page then fetches the file whole). Damaged files, which the page
+first range only, one that answers several with the whole file, and one that ignores Range (the page then fetches
+the file whole). Damaged files, which the page
 must refuse with a message naming them (and a file replaced on the server while the page fetches it): one cut short (the reader's structure checks), and two whose structure
 holds but whose orders or vertices were overwritten (the draw checks that voxview runs, which the page runs too).
 
@@ -28,7 +29,7 @@ import numpy
 from PIL import Image
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'scripts'))
-from web_server import FirstRangeHandler, QuietHandler, RangeHandler, Server  # noqa: E402
+from web_server import FirstRangeHandler, QuietHandler, RangeHandler, Server, WholeForSeveralHandler  # noqa: E402
 
 MIN_PSNR = 35.0
 SIZE = '512x512'
@@ -128,7 +129,7 @@ def main():
         # Each case: the file shared, the page's settings (voxview's options of the same names), the server.
         cases = [('packed.vxl', 'mode=axis', RangeHandler), ('packed.vxl', 'mode=unsorted', QuietHandler),
                  ('float32.vxl', 'mode=axis', RangeHandler), ('float32.vxl', 'mode=unsorted', FirstRangeHandler),
-                 ('packed.vxlz', 'mode=axis', RangeHandler), ('s50k.vxl', 'mode=axis', RangeHandler)]
+                 ('packed.vxlz', 'mode=axis', WholeForSeveralHandler), ('s50k.vxl', 'mode=axis', RangeHandler)]
         tracks, afd = (os.path.join(options.real_data, f) for f in ('test_data__tracks.tck', 'test_data__afd.tsf'))
         if os.path.isfile(tracks) and os.path.isfile(afd):
             run(options.voxlines, 'convert', tracks, path('afd.vxl'), '--tsf', afd)
@@ -150,11 +151,12 @@ def main():
         # Served compressed: the declared length is not the body's.
         cases.append(('packed.vxl', 'mode=axis', GzipHandler))
         served_by = {RangeHandler: 'ranges', FirstRangeHandler: 'first range only', QuietHandler: 'no ranges',
-                     GzipHandler: 'gzip, no ranges'}
+                     GzipHandler: 'gzip, no ranges', WholeForSeveralHandler: 'one range, or the whole file for several'}
         for source, settings, handler in cases:
             folder = path('share-' + source.replace('.', '-'))
             shared = json.load(open(os.path.join(folder, 'share.json')))['file']
             server = Server(folder, handler)
+            RangeHandler.reset_counts()
             try:
                 web = path(f'web-{source}-{settings}.png')
                 report = capture(f'{server.url}index.html?size={SIZE}#{settings}', web)
@@ -163,15 +165,24 @@ def main():
             if 'error' in report:
                 failures.append(f'{source} {settings}: the page failed: {report["error"]}')
                 continue
-            if source == 's50k.vxl' and report['first_level'] != 2:
-                failures.append(f's50k.vxl: first picture at level {report["first_level"]}, not 2 (no level between)')
+            if source == 's50k.vxl' and (report['first_level'] != 2 or report['levels_shown'] != [1]):
+                failures.append(f's50k.vxl: first picture at level {report["first_level"]}, then levels '
+                                f'{report["levels_shown"]} drawn before full detail, not 2 then [1]')
+            # How the page fetched: many ranges a request where the server answers so, one a request where it
+            # answers only the first.
+            answers = dict(RangeHandler.answers)
+            if handler is RangeHandler and answers['multipart'] == 0:
+                failures.append(f'{source} {settings}: no multipart/byteranges request by ranges: {answers}')
+            if handler is FirstRangeHandler and (answers['multipart'] != 0 or answers['one range'] < 3):
+                failures.append(f'{source} {settings}: not fetched one range a request: {answers}')
             native = path(f'voxview-{source}-{settings}.png')
             flags = [x for kv in settings.split('&') for x in ('--' + kv.split('=')[0], kv.split('=')[1])]
             run(options.voxview, os.path.join(folder, shared), '--render', native, '--size', SIZE, *flags)
             value = psnr_rgb(web, native)
             served = f' ({served_by[handler]})'
             print(f'{source}{served} {settings}: PSNR {value:.2f} dB against voxview, first picture after '
-                  f'{report["first_picture_ms"]:.0f} ms, full detail after {report["full_detail_ms"]:.0f} ms')
+                  f'{report["first_picture_ms"]:.0f} ms, full detail after {report["full_detail_ms"]:.0f} ms; '
+                  f'range answers {answers}')
             if value < MIN_PSNR:
                 keep = os.path.join(tempfile.gettempdir(), 'voxweb-test-failed')
                 os.makedirs(keep, exist_ok=True)

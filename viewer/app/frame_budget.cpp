@@ -55,13 +55,10 @@ double FrameBudget::estimate_ms(std::uint32_t level, FrameLoad load) const {
     if (const double ratio = load_ratio(own, other, level); ratio > 0 && measured_ms_[other][level] > 0)
       return measured_ms_[other][level] * ratio;
   if (const double ms = estimate_from_levels(measured_ms_[own], level); ms > 0) return ms;
-  // Nothing under this load yet (the first frames of a selection): another load's estimate, unscaled when no
-  // ratio is known; the next frame measures it.
+  // Nothing under this load yet (the first frames of a selection), so no ratio is known either: another load's
+  // estimate as it is; the next frame measures this one.
   for (const std::size_t other : others)
-    if (const double ms = estimate_from_levels(measured_ms_[other], level); ms > 0) {
-      const double ratio = load_ratio(own, other, level);
-      return ratio > 0 ? ms * ratio : ms;
-    }
+    if (const double ms = estimate_from_levels(measured_ms_[other], level); ms > 0) return ms;
   return 0;
 }
 

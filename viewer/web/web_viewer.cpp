@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -57,10 +58,12 @@ struct Viewer {
     return s;
   }();
   int width = 1, height = 1;
-  bool full_pending = false;      // the full-detail spans of the last view at rest are not all uploaded yet
-  std::uint32_t first_level = 0;  // the first picture's level of detail
-  // A file fetched by ranges (vw_plan_open): the bytes its buffer holds so far, sorted and disjoint.
-  std::vector<ByteRange> held;
+  bool full_pending = false;                  // the full-detail spans of the last view at rest are not all uploaded yet
+  std::uint32_t first_level = 0;              // the first picture's level of detail
+  std::vector<std::uint64_t> level_segments;  // the file's segments at each level
+  // A file fetched by ranges (vw_plan_open): the bytes its buffer holds so far, sorted and disjoint, and those the
+  // page was last asked to fetch (held once vw_arrived says they are in).
+  std::vector<ByteRange> held, asked;
 };
 
 Viewer& viewer() {
@@ -76,6 +79,8 @@ void close(Viewer& v) {
   v.full.reset();
   v.file.reset();
   v.held.clear();
+  v.asked.clear();
+  v.level_segments.clear();
 }
 
 // Whether the buffer holds the whole file (fetched whole, or every range fetched).
@@ -158,7 +163,8 @@ void open_file(Viewer& v, MappedFile bytes, int width, int height) {
   v.file.emplace(VxlFile::open(std::move(bytes)));
   v.width = std::max(width, 1);
   v.height = std::max(height, 1);
-  v.first_level = app::first_picture_level(app::level_segments(std::vector<const VxlFile*>{&*v.file}), 0);
+  v.level_segments = app::level_segments(std::vector<const VxlFile*>{&*v.file});
+  v.first_level = app::first_picture_level(v.level_segments, 0);
 }
 
 // The first picture's renderer and the camera: the file's bytes of that level are in (all of them, or those of
@@ -185,7 +191,7 @@ void describe(Viewer& v, nlohmann::json& j) {
     j["gpu_bytes"] = (v.quick ? v.quick->gpu_bytes() : 0) + (v.interim ? v.interim->gpu_bytes() : 0) +
                      (v.full ? v.full->gpu_bytes() : 0);
     j["first_level"] = v.quick ? v.quick->layout().level() : 0;
-    j["level_segments"] = app::level_segments(std::vector<const VxlFile*>{&*v.file});
+    j["level_segments"] = v.level_segments;
     j["full_detail"] = v.full != nullptr;
     const Renderer& r = v.full ? *v.full : *v.quick;
     // How much of full detail is on the GPU, of the most it can take.
@@ -224,6 +230,11 @@ extern "C" {
 // made; else it holds what vw_plan_open named, and vw_level_ranges says what the first picture needs before
 // vw_show makes it.
 EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* name, int width, int height, int whole) {
+  if (!(size >= 0 && size <= double(std::numeric_limits<std::size_t>::max()))) {
+    std::free(bytes);
+    vxl::web::last_error() = std::string(name) + ": too large for the web viewer";
+    return static_cast<int>(vxl::ErrorKind::Input);
+  }
   auto file = vxl::MappedFile::adopt(name, bytes, static_cast<std::size_t>(size));
   return guarded([&] {
     auto& v = viewer();
@@ -269,7 +280,7 @@ EMSCRIPTEN_KEEPALIVE const char* vw_plan_open(const std::uint8_t* first, double 
 }
 
 // The ranges level `level` needs (the first picture's: -1) that the buffer does not hold yet (JSON, as
-// vw_plan_open's), counted as held from now on. `gap`: ranges closer than this are fetched as one.
+// vw_plan_open's); vw_arrived once they are in. `gap`: ranges closer than this are fetched as one.
 EMSCRIPTEN_KEEPALIVE const char* vw_level_ranges(int level, double gap) {
   static std::string text;
   auto& v = viewer();
@@ -277,31 +288,26 @@ EMSCRIPTEN_KEEPALIVE const char* vw_level_ranges(int level, double gap) {
   if (v.file) {
     const std::uint32_t wanted_level =
         level < 0 ? v.first_level : std::min(static_cast<std::uint32_t>(level), v.file->level_count() - 1);
-    std::vector<vxl::ByteRange> wanted = vxl::ranges_of_level(*v.file, wanted_level, static_cast<std::uint64_t>(gap));
-    std::vector<vxl::ByteRange> fetch;
-    for (const vxl::ByteRange& missing : vxl::ranges_missing(v.held, v.file->bytes().size()))
-      for (const vxl::ByteRange& w : wanted)
-        if (w.begin < missing.end && missing.begin < w.end)
-          fetch.push_back({std::max(w.begin, missing.begin), std::min(w.end, missing.end)});
-    for (const vxl::ByteRange& r : fetch) j.push_back({r.begin, r.end});
-    fetch.insert(fetch.end(), v.held.begin(), v.held.end());
-    v.held = vxl::merge_ranges(std::move(fetch), 0);
+    const std::vector<vxl::ByteRange> wanted =
+        vxl::ranges_of_level(*v.file, wanted_level, static_cast<std::uint64_t>(gap));
+    v.asked = vxl::ranges_intersection(wanted, vxl::ranges_missing(v.held, v.file->bytes().size()));
+    for (const vxl::ByteRange& r : v.asked) j.push_back({r.begin, r.end});
   }
   text = j.dump();
   return text.c_str();
 }
 
-// The rest of the file (JSON ranges of at most `piece` bytes each), counted as held from now on: full detail and
-// colouring by value or group read it (vw_refine after it is in).
+// The rest of the file (JSON ranges of at most `piece` bytes each; vw_arrived once they are in): full detail,
+// the unsorted mode and colouring by value or group read it.
 EMSCRIPTEN_KEEPALIVE const char* vw_missing_ranges(double piece) {
   static std::string text;
   auto& v = viewer();
   nlohmann::json j = nlohmann::json::array();
   if (v.file) {
     const auto step = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(piece));
-    for (const vxl::ByteRange& r : vxl::ranges_missing(v.held, v.file->bytes().size()))
+    v.asked = vxl::ranges_missing(v.held, v.file->bytes().size());
+    for (const vxl::ByteRange& r : v.asked)
       for (std::uint64_t at = r.begin; at < r.end; at += step) j.push_back({at, std::min(r.end, at + step)});
-    v.held = {{0, v.file->bytes().size()}};
   }
   text = j.dump();
   return text.c_str();
@@ -318,6 +324,14 @@ EMSCRIPTEN_KEEPALIVE int vw_show_level(int level) {
     v.interim.reset();  // its GPU memory before the next one's
     v.interim = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file}, 0, level);
   });
+}
+
+// The ranges vw_level_ranges or vw_missing_ranges gave last are in the buffer.
+EMSCRIPTEN_KEEPALIVE void vw_arrived() {
+  auto& v = viewer();
+  v.asked.insert(v.asked.end(), v.held.begin(), v.held.end());
+  v.held = vxl::merge_ranges(std::move(v.asked), 0);
+  v.asked.clear();
 }
 
 // Makes the first picture's renderer once its ranges are in (vw_open without `whole`).

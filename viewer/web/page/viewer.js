@@ -17,6 +17,7 @@
   window.voxweb = {
     ready: new Promise((resolve, reject) => { settle = { resolve, reject }; }),
     complete: new Promise((resolve, reject) => { settleComplete = { resolve, reject }; }),
+    levelsShown: [],  // the levels drawn at rest between the first picture and full detail (a file fetched by ranges)
   };
 
   function say(text, isError) {
@@ -44,6 +45,7 @@
       showLevel: Module.cwrap('vw_show_level', 'number', ['number']),
       missingRanges: Module.cwrap('vw_missing_ranges', 'string', ['number']),
       show: Module.cwrap('vw_show', 'number', []),
+      arrived: Module.cwrap('vw_arrived', null, []),
       error: Module.cwrap('vw_error', 'string', []),
       info: Module.cwrap('vw_info', 'string', []),
       set: Module.cwrap('vw_set', 'number', ['string', 'string']),
@@ -145,12 +147,13 @@
     // The rest of a file fetched by ranges, then full detail.
     async function afterFirstPicture() {
       if (fetchRest) {
-        const rest = fetchRest;
+        const rest = fetchRest, gen = generation;
         fetchRest = null;
         try {
           if (!(await rest())) return;  // another file was opened meanwhile
         } catch (err) {
-          return fail(err.message);
+          if (gen === generation) fail(err.message);
+          return;
         }
         bytesComplete = true;
         offerColourings(JSON.parse(api.info()));
@@ -251,7 +254,7 @@
     // Fetching by HTTP Range requests: the header and section table, what the reader needs to open the file,
     // the first picture's level of detail, then the rest (.vxl spec §5.12: a level is a prefix of every voxel's
     // block and its own orders, so it is many small ranges, asked for many at a time).
-    const FIRST_BYTES = 4096, RANGES_PER_REQUEST = 200, LEVEL_GAP = 4096, REST_PIECE = 8 << 20;
+    const FIRST_BYTES = 4096, RANGES_PER_REQUEST = 200, REQUEST_BYTES = 32 << 20, LEVEL_GAP = 4096, REST_PIECE = 8 << 20;
     const SINGLE_RANGE_GAP = 1 << 20;  // for a server that answers one range a request
     // The finest level drawn at rest before full detail: a software WebGL draws about a million segments a second,
     // and each such picture delays full detail by its upload and its frames.
@@ -281,7 +284,7 @@
       return -1;
     }
     // A multipart/byteranges body -> [[begin, end, bytes, the file's size or null], ...].
-    function parts(body, boundary) {
+    function parts(body, boundary, url) {
       const marker = new TextEncoder().encode('--' + boundary), blank = new TextEncoder().encode('\r\n\r\n');
       const found = [];
       for (let at = indexOf(body, marker, 0); at >= 0;) {
@@ -292,46 +295,70 @@
         const headers = new TextDecoder('latin1').decode(body.subarray(at, headersEnd));
         const r = contentRange((/content-range:([^\r\n]*)/i.exec(headers) || [])[1]);
         const start = headersEnd + blank.length;
-        if (!r || start + r[1] - r[0] > body.length) throw new Error('a malformed multipart/byteranges answer');
+        if (!r || start + r[1] - r[0] > body.length) throw new Error(`${url}: a malformed multipart/byteranges answer`);
         found.push([r[0], r[1], body.subarray(start, start + r[1] - r[0]), r[2]]);
         at = indexOf(body, marker, start + r[1] - r[0]);
       }
       return found;
     }
-    // Fetches `ranges` ([begin, end) pairs) of the file into its buffer: `target` = {url, gen, pointer, size,
-    // received}. Several ranges a request; the ones a server left out (some answer the first range only) one at a
-    // time. False when another file was opened meanwhile.
+    // The largest file the WebAssembly memory (32-bit, 4 GiB at most) can hold, with room for the viewer.
+    const MAX_FILE_BYTES = 2 ** 32 - 2 ** 28;
+    function allocate(size, name) {
+      if (size > MAX_FILE_BYTES) throw new Error(`${name}: ${size.toLocaleString()} bytes, more than the web viewer can hold (4 GiB less 256 MiB)`);
+      const pointer = Module._malloc(Math.max(1, size));
+      if (!pointer) throw new Error(`${name}: no memory for its ${size.toLocaleString()} bytes`);
+      return pointer;
+    }
+    // Whether `target` (a file being fetched) is still the one being opened: a file opened since drops it.
+    const current = (target) => target.gen === generation;
+
+    // Fetches `ranges` ([begin, end) pairs) of the file into its buffer: `target` = {url, name, gen, pointer, size,
+    // received}. Several ranges a request (up to RANGES_PER_REQUEST and REQUEST_BYTES); the ones a server left out
+    // (some answer the first range only) one at a time. False when another file was opened meanwhile.
     async function fetchRanges(target, ranges) {
       const covered = (r, got) => got.some((g) => g[0] <= r[0] && r[1] <= g[1]);
       let left = target.multipart === false ? ranges : [];
-      for (let i = 0; i < ranges.length && target.multipart !== false; i += RANGES_PER_REQUEST) {
-        const batch = ranges.slice(i, i + RANGES_PER_REQUEST);
+      for (let i = 0; i < ranges.length && target.multipart !== false && !target.whole;) {
+        let j = i + 1, bytes = ranges[i][1] - ranges[i][0];
+        while (j < ranges.length && j - i < RANGES_PER_REQUEST && bytes + ranges[j][1] - ranges[j][0] <= REQUEST_BYTES)
+          bytes += ranges[j][1] - ranges[j++][0];
+        const batch = ranges.slice(i, j);
         const got = await fetchBatch(target, batch);
         if (got === null) return false;
-        if (batch.length > 1) target.multipart = got.length > 1;
+        if (batch.length > 1 && !target.whole) target.multipart = got.length > 1;
         left = left.concat(batch.filter((r) => !covered(r, got)));
-        if (target.multipart === false) left = left.concat(ranges.slice(i + RANGES_PER_REQUEST));
+        if (target.multipart === false) left = left.concat(ranges.slice(j));
+        i = j;
       }
+      if (target.whole) return current(target);
       // One range a request: the small ones merged, a little more fetched for far fewer requests.
       if (target.multipart === false) left = coalesce(left, SINGLE_RANGE_GAP);
       for (const r of left) {
         const got = await fetchBatch(target, [r]);
         if (got === null) return false;
-        if (!covered(r, got)) throw new Error(`${target.url}: the server did not send bytes ${r[0]}-${r[1] - 1}`);
+        if (!target.whole && !covered(r, got)) throw new Error(`${target.url}: the server did not send bytes ${r[0]}-${r[1] - 1}`);
       }
-      return true;
+      return current(target);
     }
-    // One request: the ranges received (null when another file was opened meanwhile).
+    // One request: the ranges received (null when another file was opened meanwhile). A server that answers a
+    // range request with the whole file (status 200, as some do past a number of ranges) gives it all at once.
     async function fetchBatch(target, batch) {
       const spec = batch.map((r) => `${r[0]}-${r[1] - 1}`).join(',');
       const response = await fetch(target.url, { headers: { Range: 'bytes=' + spec } });
-      if (response.status !== 206) throw new Error(`${target.url}: HTTP ${response.status} to a range request`);
+      if (!current(target)) return null;
+      if (response.status !== 206 && response.status !== 200)
+        throw new Error(`${target.url}: HTTP ${response.status} to a range request`);
       const body = new Uint8Array(await response.arrayBuffer());
-      if (target.gen !== generation) return null;
-      const boundary = /multipart\/byteranges;\s*boundary="?([^";]+)"?/i.exec(response.headers.get('Content-Type') || '');
+      if (!current(target)) return null;
       let got;
-      if (boundary) {
-        got = parts(body, boundary[1]);
+      const boundary = /multipart\/byteranges;\s*boundary="?([^";]+)"?/i.exec(response.headers.get('Content-Type') || '');
+      if (response.status === 200) {
+        if (body.length !== target.size)
+          throw new Error(`${target.url} changed on the server while it was fetched (now ${body.length} bytes)`);
+        target.whole = true;
+        got = [[0, body.length, body, body.length]];
+      } else if (boundary) {
+        got = parts(body, boundary[1], target.url);
       } else {
         const r = contentRange(response.headers.get('Content-Range'));
         if (!r || r[1] - r[0] !== body.length) throw new Error(`${target.url}: a range answer of the wrong length`);
@@ -347,33 +374,40 @@
       $('progress').value = Math.min(1, target.received / target.size);
       return got;
     }
-    // Opens `url` by ranges, given the answer to its first request (206, the first bytes); draws the first
+    // Fetches `ranges` and tells the viewer they are in (vw_arrived); false when another file was opened meanwhile.
+    async function bring(target, ranges) {
+      if (!(await fetchRanges(target, ranges))) return false;
+      api.arrived();
+      return true;
+    }
+    // Opens a file by ranges, given the answer to its first request (206, the first bytes); draws the first
     // picture, and leaves fetchRest to bring the rest.
-    async function fetchByRanges(url, response, total, t0) {
-      const gen = generation, name = url.split('/').pop();
+    async function fetchByRanges(target, response, t0) {
+      const { name, size } = target;
       const first = new Uint8Array(await response.arrayBuffer());
-      if (gen !== generation) return;
-      const scratch = Module._malloc(Math.max(1, first.length));
+      if (!current(target)) return;
+      if (first.length === 0 || first.length > size)
+        throw new Error(`${target.url}: a first range answer of ${first.length} bytes for a file of ${size}`);
+      const scratch = allocate(first.length, name);
       Module.HEAPU8.set(first, scratch);
-      const plan = JSON.parse(api.planOpen(scratch, first.length, total, name));
+      const plan = JSON.parse(api.planOpen(scratch, first.length, size, name));
       Module._free(scratch);
       if (plan.error) return fail(plan.error);
-      const pointer = Module._malloc(total);
-      if (!pointer) return fail(`${name}: no memory for its ${total.toLocaleString()} bytes`);
-      Module.HEAPU8.set(first, pointer);
-      const target = { url, gen, pointer, size: total, received: first.length };
+      target.pointer = allocate(size, name);
+      Module.HEAPU8.set(first, target.pointer);
+      target.received = first.length;
       let ok;
       try {
         ok = await fetchRanges(target, plan);
       } catch (err) {
-        Module._free(pointer);
+        Module._free(target.pointer);
         throw err;
       }
-      if (!ok) return Module._free(pointer);
+      if (!ok) return Module._free(target.pointer);
       const [w, h] = canvasSize();
       // From here the viewer holds the buffer (and frees it).
-      if (api.open(pointer, total, name, w, h, 0) !== 0) return fail(api.error());
-      if (!(await fetchRanges(target, JSON.parse(api.levelRanges(-1, LEVEL_GAP)))) || gen !== generation) return;
+      if (api.open(target.pointer, size, name, w, h, 0) !== 0) return fail(api.error());
+      if (!(await bring(target, JSON.parse(api.levelRanges(-1, LEVEL_GAP))))) return;
       if (api.show() !== 0) return fail(api.error());
       bytesComplete = false;
       // The finer levels one after the other (each an eighth of the next: 1/64, 1/8 of the file...), each drawn
@@ -381,21 +415,32 @@
       fetchRest = async () => {
         const info = JSON.parse(api.info());
         for (let level = info.first_level - 1; level >= 1 && info.level_segments[level] <= INTERIM_SEGMENTS; --level) {
-          if (!(await fetchRanges(target, JSON.parse(api.levelRanges(level, LEVEL_GAP))))) return false;
-          if (api.showLevel(level) !== 0) throw new Error(api.error());
+          if (!(await bring(target, JSON.parse(api.levelRanges(level, LEVEL_GAP))))) return false;
+          if (api.showLevel(level) !== 0) throw new Error(`${name}: ${api.error()}`);
+          window.voxweb.levelsShown.push(level);
           say(`${name}: level ${level} (1/${8 ** level} of the streamlines) in; fetching the rest`);
           redraw();
           await new Promise((resolve) => setTimeout(resolve, 0));  // its frame before the next fetch
+          if (!current(target)) return false;
         }
-        return fetchRanges(target, JSON.parse(api.missingRanges(REST_PIECE)));
+        return bring(target, JSON.parse(api.missingRanges(REST_PIECE)));
       };
       shown(name, t0);
     }
 
-    // Fetches `url`: by ranges where the server answers them, else whole.
+    // Fetches `url`: by ranges where the server answers them, else whole. What fails after another file was
+    // opened is not said.
     async function fetchFile(url) {
+      const target = { url, name: url.split('/').pop(), gen: ++generation };
+      try {
+        await fetchFileInto(target);
+      } catch (err) {
+        if (current(target)) throw err;
+      }
+    }
+    async function fetchFileInto(target) {
+      const { url } = target;
       say('fetching ' + url);
-      ++generation;
       bytesComplete = true;
       fetchRest = null;
       const t0 = performance.now();
@@ -403,55 +448,69 @@
       try {
         probe = await fetch(url, { headers: { Range: `bytes=0-${FIRST_BYTES - 1}` } });
       } catch (err) {  // a server that answers a range request wrongly (e.g. compressed after "identity" was asked)
-        return fetchWhole(url, await fetch(url));
+        probe = await fetch(url);
       }
+      if (!current(target)) return;
       if (!probe.ok) throw new Error(`${url}: HTTP ${probe.status}`);
-      const total = probe.status === 206 ? contentRange(probe.headers.get('Content-Range')) : null;
-      if (total && total[2] !== null && total[0] === 0) return fetchByRanges(url, probe, total[2], t0);
+      const range = probe.status === 206 ? contentRange(probe.headers.get('Content-Range')) : null;
+      if (range && range[2] !== null && range[0] === 0) {
+        target.size = range[2];
+        return fetchByRanges(target, probe, t0);
+      }
       if (probe.status === 206) probe.body.cancel();
-      return fetchWhole(url, probe.status === 206 ? await fetch(url) : probe);
+      return fetchWhole(target, probe.status === 206 ? await fetch(url) : probe);
     }
 
     // Streams the response into the WebAssembly memory as it arrives (one copy of the file in the tab).
-    async function fetchWhole(url, response) {
+    async function fetchWhole(target, response) {
+      const { url, name } = target;
       if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
       const declared = Number(response.headers.get('Content-Length'));
       const chunks = [];
       // Into the memory allocated for the declared length while the bytes fit it; past that (a length that
       // was not the body's, as with a compressed transfer), into chunks copied together at the end.
       let received = 0, inMemory = 0, pointer = 0;
-      if (declared > 0) pointer = Module._malloc(declared);
+      if (declared > 0) pointer = allocate(declared, name);
       const reader = response.body.getReader();
-      for (;;) {
-        const { done, value } = await reader.read();
-        if (done) break;
-        if (pointer && chunks.length === 0 && inMemory + value.length <= declared) {
-          Module.HEAPU8.set(value, pointer + inMemory);
-          inMemory += value.length;
-        } else {
-          chunks.push(value);
+      try {
+        for (;;) {
+          const { done, value } = await reader.read();
+          if (!current(target)) throw null;  // another file was opened meanwhile: this one is dropped
+          if (done) break;
+          if (pointer && chunks.length === 0 && inMemory + value.length <= declared) {
+            Module.HEAPU8.set(value, pointer + inMemory);
+            inMemory += value.length;
+          } else {
+            chunks.push(value);
+          }
+          received += value.length;
+          if (received > MAX_FILE_BYTES) allocate(received, name);  // says why it is refused
+          if (declared > 0) $('progress').value = Math.min(1, received / declared);
         }
-        received += value.length;
-        if (declared > 0) $('progress').value = Math.min(1, received / declared);
-      }
-      if (chunks.length > 0 || !pointer) {
-        const whole = Module._malloc(Math.max(1, received));
-        if (pointer) Module.HEAPU8.copyWithin(whole, pointer, pointer + inMemory);
+        if (chunks.length > 0 || !pointer) {
+          const whole = allocate(received, name);
+          if (pointer) Module.HEAPU8.copyWithin(whole, pointer, pointer + inMemory);
+          if (pointer) Module._free(pointer);
+          pointer = whole;
+          let at = inMemory;
+          for (const c of chunks) { Module.HEAPU8.set(c, whole + at); at += c.length; }
+        }
+      } catch (err) {
         if (pointer) Module._free(pointer);
-        let at = inMemory;
-        for (const c of chunks) { Module.HEAPU8.set(c, whole + at); at += c.length; }
-        pointer = whole;
+        if (err === null) return;
+        throw err;
       }
       $('progress').value = 1;
-      openBytes(pointer, received, url.split('/').pop());
+      openBytes(pointer, received, name);
     }
 
     async function dropFile(file) {
-      ++generation;
+      const target = { name: file.name, gen: ++generation };
       bytesComplete = true;
       fetchRest = null;
       const bytes = new Uint8Array(await file.arrayBuffer());
-      const pointer = Module._malloc(Math.max(1, bytes.length));
+      if (!current(target)) return;
+      const pointer = allocate(bytes.length, file.name);
       Module.HEAPU8.set(bytes, pointer);
       openBytes(pointer, bytes.length, file.name);
     }
