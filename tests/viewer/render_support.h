@@ -55,6 +55,16 @@ inline Camera top_view(double height_mm = 64) {
   return c;
 }
 
+// The synthetic brain (`voxlines synth`, centred near (0, -15, 10)) seen whole from the front left and above.
+inline Camera synth_brain_view(double distance = 320) {
+  Camera c;
+  c.target = glm::dvec3(0, -15, 10);
+  c.distance = distance;
+  c.azimuth_deg = 30;
+  c.elevation_deg = 20;
+  return c;
+}
+
 // The pixel column and row whose centre world x and y fall in, under top_view() on a 64 x 64 image.
 inline int column_of(double x) { return static_cast<int>(x + 31.5); }
 inline int row_of(double y) { return static_cast<int>(31.5 - y); }

@@ -31,15 +31,6 @@ MappedFile partial_copy(const std::vector<std::uint8_t>& whole, std::span<const 
   return MappedFile::adopt("partial.vxl", buffer, whole.size());
 }
 
-Camera whole_view() {
-  Camera c;
-  c.target = glm::dvec3(0, -15, 10);
-  c.distance = 320;
-  c.azimuth_deg = 30;
-  c.elevation_deg = 20;
-  return c;
-}
-
 class FetchByRanges : public ::testing::TestWithParam<bool> {};  // packed positions or float32
 
 TEST_P(FetchByRanges, ALevelDrawsFromItsRangesAloneAsFromTheWholeFile) {
@@ -69,9 +60,9 @@ TEST_P(FetchByRanges, ALevelDrawsFromItsRangesAloneAsFromTheWholeFile) {
 
     const VxlFile partial = VxlFile::open(partial_copy(whole, held));
     Renderer from_ranges(partial, 0, level), from_whole(reference, 0, level);
-    const Image a = render_image(from_ranges, whole_view(), settings, 96, 96);
+    const Image a = render_image(from_ranges, test::synth_brain_view(), settings, 96, 96);
     from_ranges.check_uploaded(true);  // throws on a damaged block or order
-    const Image b = render_image(from_whole, whole_view(), settings, 96, 96);
+    const Image b = render_image(from_whole, test::synth_brain_view(), settings, 96, 96);
     EXPECT_GT(test::lit_pixels(b), 200);
     EXPECT_EQ(a.rgba, b.rgba) << "level " << level;
   }

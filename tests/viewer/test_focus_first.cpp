@@ -41,14 +41,7 @@ class FocusFirst : public ::testing::Test {
     for (std::uint64_t s = 0; s < file->meta().streamline_count; s += 60) kept[0].push_back(s);
     return kept;
   }
-  static Camera view() {
-    Camera c;
-    c.target = glm::dvec3(0, -15, 10);
-    c.distance = 320;
-    c.azimuth_deg = 30;
-    c.elevation_deg = 20;
-    return c;
-  }
+  static Camera view() { return test::synth_brain_view(); }
   ScratchDir dir;
   Tractogram tractogram;
   std::optional<VxlFile> file;

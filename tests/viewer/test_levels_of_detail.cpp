@@ -45,15 +45,6 @@ double mean_luminance(const Image& img) {
   return sum / double(img.rgba.size() / 4);
 }
 
-Camera whole_view() {
-  Camera c;
-  c.target = glm::dvec3(0, -15, 10);
-  c.distance = 320;
-  c.azimuth_deg = 30;
-  c.elevation_deg = 20;
-  return c;
-}
-
 TEST(LevelOpacity, ACoarseSegmentStandsForTheSegmentsItSamples) {
   EXPECT_FLOAT_EQ(SceneLayout::level_opacity(0.3f, 0), 0.3f);
   EXPECT_NEAR(1.0 - SceneLayout::level_opacity(0.05f, 1), std::pow(0.95, 8), 1e-6);
@@ -71,15 +62,15 @@ TEST_F(LevelsOfDetail, ACoarseLevelDrawsOnlyItsSegments) {
   for (std::uint32_t level = 0; level < 3; ++level) {
     Renderer r(f, 0, level);
     EXPECT_EQ(r.layout().level(), level);
-    render_image(r, whole_view(), s, 128, 128);
+    render_image(r, test::synth_brain_view(), s, 128, 128);
     EXPECT_EQ(r.stats().segments_drawn, level_segments(f, level)) << "level " << level;
     RenderSettings unsorted = s;  // the streamline-order draw: the level's voxlines only
     unsorted.mode = RenderMode::Unsorted;
-    render_image(r, whole_view(), unsorted, 128, 128);
+    render_image(r, test::synth_brain_view(), unsorted, 128, 128);
     EXPECT_EQ(r.stats().segments_drawn, level_segments(f, level)) << "unsorted, level " << level;
     RenderSettings segsort = s;  // each voxel's level segments, sorted for the view
     segsort.mode = RenderMode::Segsort;
-    render_image(r, whole_view(), segsort, 128, 128);
+    render_image(r, test::synth_brain_view(), segsort, 128, 128);
     EXPECT_EQ(r.stats().segments_drawn, level_segments(f, level)) << "segsort, level " << level;
     if (level > 0) {
       EXPECT_LT(r.gpu_bytes() * 4, previous_bytes) << "level " << level;
@@ -98,14 +89,14 @@ TEST_F(LevelsOfDetail, CompensatedOpacityKeepsTheBrightness) {
   RenderSettings s;
   s.opacity = 0.02f;
   Renderer full(f, 0, 0), coarse(f, 0, 1);
-  const Image a = render_image(full, whole_view(), s, 160, 160);
-  const Image b = render_image(coarse, whole_view(), s, 160, 160);
+  const Image a = render_image(full, test::synth_brain_view(), s, 160, 160);
+  const Image b = render_image(coarse, test::synth_brain_view(), s, 160, 160);
   const double la = mean_luminance(a), lb = mean_luminance(b);
   ASSERT_GT(la, 1.0) << "the scene is in view";
   EXPECT_NEAR(lb / la, 1.0, 0.2);
   RenderSettings uncompensated = s;
   uncompensated.opacity = s.opacity / 8;  // what the coarse level's opacity would have to undo
-  const Image c = render_image(coarse, whole_view(), uncompensated, 160, 160);
+  const Image c = render_image(coarse, test::synth_brain_view(), uncompensated, 160, 160);
   EXPECT_LT(mean_luminance(c) / la, 0.5) << "the check can tell a missing compensation";
   EXPECT_GT(ssim_luminance(a, b), 0.5) << "a coarse level looks like the whole";
 }
@@ -136,11 +127,11 @@ TEST_F(LevelsOfDetail, TheBudgetIsNeverExceeded) {
     s.mode = RenderMode::Unsorted;  // uploads the dataset order
     r.prepare(RenderMode::Unsorted);
     s.color = ColorMode::Group;  // uploads the per-vertex attributes
-    render_image(r, whole_view(), s, 64, 64);
+    render_image(r, test::synth_brain_view(), s, 64, 64);
     EXPECT_LE(r.gpu_bytes(), budget) << "budget " << budget << ", level " << level;
     EXPECT_LE(r.gpu_bytes(), r.layout().upload_bytes());
     s.mode = RenderMode::Segsort;  // its view order replaces the dataset order in the same buffers
-    render_image(r, whole_view(), s, 64, 64);
+    render_image(r, test::synth_brain_view(), s, 64, 64);
     EXPECT_LE(r.gpu_bytes(), budget) << "segsort, budget " << budget << ", level " << level;
   }
 }
@@ -158,7 +149,7 @@ TEST_F(LevelsOfDetail, ATextureLimitTooSmallForFullDetailLeavesACoarserLevel) {
   Renderer r(f, texels, level);
   RenderSettings s;
   s.opacity = 0.05f;
-  EXPECT_GT(test::lit_pixels(render_image(r, whole_view(), s, 96, 96)), 500);
+  EXPECT_GT(test::lit_pixels(render_image(r, test::synth_brain_view(), s, 96, 96)), 500);
 }
 
 // A budget below 1 MiB is not reported as "0 MiB" on both sides ("needs 0 MiB ... budget of 0 MiB"): small

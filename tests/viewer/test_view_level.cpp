@@ -9,6 +9,7 @@
 #include "converter/synth/synth.h"
 #include "format/vxl_file.h"
 #include "tests/test_support.h"
+#include "tests/viewer/render_support.h"
 #include "viewer/app/view_level.h"
 
 namespace vxl::app {
@@ -30,14 +31,7 @@ class ViewLevel : public ::testing::Test {
   std::vector<const VxlFile*> files() const { return {&*file}; }
   // Small spans, so that a slab touches only some of them at every level.
   std::uint64_t span_texels() const { return SceneLayout::largest_voxel_texels(files()); }
-  static Camera view() {
-    Camera c;
-    c.target = glm::dvec3(0, -15, 10);
-    c.distance = 320;
-    c.azimuth_deg = 30;
-    c.elevation_deg = 20;
-    return c;
-  }
+  static Camera view() { return test::synth_brain_view(); }
   static Clipping slab() {
     Clipping c;
     c.slab_mm = 6;

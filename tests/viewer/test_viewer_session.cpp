@@ -32,14 +32,7 @@ class ViewerSessionTest : public ::testing::Test {
     // Small spans, so that a slab touches only some of them.
     options.span_texels = SceneLayout::largest_voxel_texels(std::vector<const VxlFile*>{&*file});
   }
-  static Camera view() {
-    Camera c;
-    c.target = glm::dvec3(0, -15, 10);
-    c.distance = 200;
-    c.azimuth_deg = 30;
-    c.elevation_deg = 20;
-    return c;
-  }
+  static Camera view() { return test::synth_brain_view(200); }
   ScratchDir dir;
   ViewerOptions options;
   std::optional<VxlFile> file;
