@@ -48,7 +48,9 @@ std::string readme(const std::string& title, const std::string& data_file) {
          "Opening index.html straight from the disk does not work: browsers do not let a page read files\n"
          "beside it. The folder can be put as it is on institutional web space or GitHub Pages.\n\n"
          "In the page: drag to turn, right-drag (or shift-drag) to pan, the wheel to zoom. \"Copy link to\n"
-         "this view\" puts the view in the address, so that whoever opens the link sees what you saw.\n\n"
+         "this view\" puts the view in the address, so that whoever opens the link sees what you saw.\n"
+         "A large tractogram is drawn in less detail where it would not fit the GPU: index.html?gpu=2G (or\n"
+         "512M...) says how much GPU memory the page may take.\n\n"
          "The data is " +
          data_file +
          " (the .vxl format); the Voxlines tools (voxlines, voxview) read it and export it back to\n"

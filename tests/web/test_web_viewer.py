@@ -126,14 +126,20 @@ def main():
             with open(path(name), 'wb') as f:
                 f.write(damaged)
 
-        # Each case: the file shared, the page's settings (voxview's options of the same names), the server.
-        cases = [('packed.vxl', 'mode=axis', RangeHandler), ('packed.vxl', 'mode=unsorted', QuietHandler),
-                 ('float32.vxl', 'mode=axis', RangeHandler), ('float32.vxl', 'mode=unsorted', FirstRangeHandler),
-                 ('packed.vxlz', 'mode=axis', WholeForSeveralHandler), ('s50k.vxl', 'mode=axis', RangeHandler)]
+        # Each case: the file shared, the page's settings (voxview's options of the same names), the server, and
+        # a GPU memory budget (?gpu=, voxview's --gpu-memory) or None. 16M holds level 1 of the 50k set, not full
+        # detail: the page then draws level 1 at rest, as voxview does (at a low opacity: a coarse level's few lines,
+        # their opacity compensated, make the two rasterisers' differences count more than a dense picture's).
+        cases = [('packed.vxl', 'mode=axis', RangeHandler, None), ('packed.vxl', 'mode=unsorted', QuietHandler, None),
+                 ('float32.vxl', 'mode=axis', RangeHandler, None),
+                 ('float32.vxl', 'mode=unsorted', FirstRangeHandler, None),
+                 ('packed.vxlz', 'mode=axis', WholeForSeveralHandler, None),
+                 ('s50k.vxl', 'mode=axis', RangeHandler, None),
+                 ('s50k.vxl', 'mode=axis&opacity=0.02', RangeHandler, '16M')]
         tracks, afd = (os.path.join(options.real_data, f) for f in ('test_data__tracks.tck', 'test_data__afd.tsf'))
         if os.path.isfile(tracks) and os.path.isfile(afd):
             run(options.voxlines, 'convert', tracks, path('afd.vxl'), '--tsf', afd)
-            cases.append(('afd.vxl', 'color=scalar&colormap=hot', RangeHandler))
+            cases.append(('afd.vxl', 'color=scalar&colormap=hot', RangeHandler, None))
         else:
             print(f'the AFD case is skipped: {tracks} is absent (the real fixtures live beside the project)')
         for source in sorted({c[0] for c in cases} | {'damaged.vxl'}):
@@ -149,25 +155,27 @@ def main():
                 failures.append(f'share {source}: exit {result.returncode}: {result.stderr.strip()}')
 
         # Served compressed: the declared length is not the body's.
-        cases.append(('packed.vxl', 'mode=axis', GzipHandler))
+        cases.append(('packed.vxl', 'mode=axis', GzipHandler, None))
         served_by = {RangeHandler: 'ranges', FirstRangeHandler: 'first range only', QuietHandler: 'no ranges',
                      GzipHandler: 'gzip, no ranges', WholeForSeveralHandler: 'one range, or the whole file for several'}
-        for source, settings, handler in cases:
+        for source, settings, handler, budget in cases:
             folder = path('share-' + source.replace('.', '-'))
             shared = json.load(open(os.path.join(folder, 'share.json')))['file']
             server = Server(folder, handler)
             RangeHandler.reset_counts()
             try:
                 web = path(f'web-{source}-{settings}.png')
-                report = capture(f'{server.url}index.html?size={SIZE}#{settings}', web)
+                query = f'size={SIZE}' + (f'&gpu={budget}' if budget else '')
+                report = capture(f'{server.url}index.html?{query}#{settings}', web)
             finally:
                 server.close()
             if 'error' in report:
                 failures.append(f'{source} {settings}: the page failed: {report["error"]}')
                 continue
-            if source == 's50k.vxl' and (report['first_level'] != 2 or report['levels_shown'] != [1]):
-                failures.append(f's50k.vxl: first picture at level {report["first_level"]}, then levels '
-                                f'{report["levels_shown"]} drawn before full detail, not 2 then [1]')
+            levels = (report['first_level'], report['levels_shown'], report['full_level'])
+            if source == 's50k.vxl' and levels != ((2, [], 1) if budget else (2, [1], 0)):
+                failures.append(f's50k.vxl, GPU budget {budget}: first picture at level {levels[0]}, then levels '
+                                f'{levels[1]} drawn before level {levels[2]} at rest')
             # How the page fetched: many ranges a request where the server answers so, one a request where it
             # answers only the first.
             answers = dict(RangeHandler.answers)
@@ -177,9 +185,10 @@ def main():
                 failures.append(f'{source} {settings}: not fetched one range a request: {answers}')
             native = path(f'voxview-{source}-{settings}.png')
             flags = [x for kv in settings.split('&') for x in ('--' + kv.split('=')[0], kv.split('=')[1])]
+            flags += ['--gpu-memory', budget] if budget else []
             run(options.voxview, os.path.join(folder, shared), '--render', native, '--size', SIZE, *flags)
             value = psnr_rgb(web, native)
-            served = f' ({served_by[handler]})'
+            served = f' ({served_by[handler]}' + (f', GPU budget {budget})' if budget else ')')
             print(f'{source}{served} {settings}: PSNR {value:.2f} dB against voxview, first picture after '
                   f'{report["first_picture_ms"]:.0f} ms, full detail after {report["full_detail_ms"]:.0f} ms; '
                   f'range answers {answers}')
@@ -215,6 +224,18 @@ def main():
                 failures.append(f'{name} in the page: {report}')
             else:
                 print(f'{name} in the page: {report["error"]}')
+
+        # A GPU memory budget that is not a size, and one that not even the coarsest level fits: refused, saying so.
+        for budget, expected in (('lots', "'lots' is not a size of memory"), ('1K', 'does not fit the GPU memory budget')):
+            server = Server(folder, RangeHandler)
+            try:
+                report = capture(f'{server.url}index.html?size={SIZE}&file=packed.vxl&gpu={budget}', path('budget.png'))
+            finally:
+                server.close()
+            if expected not in report.get('error', ''):
+                failures.append(f'GPU budget {budget}: {report}')
+            else:
+                print(f'GPU budget {budget} in the page: {report["error"]}')
 
     for f in failures:
         print('FAILED: ' + f)

@@ -6,7 +6,9 @@
 // The first picture is drawn at the level of detail voxview's window draws its first at (first_picture_level:
 // at most kFirstPictureSegments; a software WebGL draws a 144k-streamline file's 8M segments in about 9 s on
 // 2 cores); vw_refine() then adds
-// the full-detail renderer, which draws the view at rest while the first one keeps drawing it in motion.
+// the full-detail renderer, which draws the view at rest while the first one keeps drawing it in motion. "Full
+// detail" is the finest level whose GPU copy fits the page's GPU memory budget (vw_set_gpu_budget), as voxview's
+// --gpu-memory chooses: level 0 when it fits.
 // Its spans are uploaded a few per call of vw_upload, nearest the view first, so that the page's thread —
 // WebAssembly here has no other — takes input between them: until the view's spans are all on the GPU, frames
 // at rest come from the first picture's level.
@@ -20,6 +22,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <emscripten/emscripten.h>
@@ -27,12 +30,14 @@
 #include <nlohmann/json.hpp>
 
 #include "format/base/error.h"
+#include "format/base/memory_size.h"
 #include "format/vxl_fetch_plan.h"
 #include "format/vxl_file.h"
 #include "viewer/app/camera_controller.h"
 #include "viewer/app/frame_budget.h"
 #include "viewer/render/camera.h"
 #include "viewer/render/colormap.h"
+#include "viewer/render/gl_util.h"
 #include "viewer/render/render_settings.h"
 #include "viewer/render/renderer.h"
 #include "viewer/render/scene_framing.h"
@@ -58,6 +63,8 @@ struct Viewer {
     return s;
   }();
   int width = 1, height = 1;
+  std::uint64_t gpu_budget = 0;               // bytes; 0: none (vw_set_gpu_budget)
+  std::uint32_t full_level = 0;               // the level drawn at rest: the finest within gpu_budget
   bool full_pending = false;                  // the full-detail spans of the last view at rest are not all uploaded yet
   std::uint32_t first_level = 0;              // the first picture's level of detail
   std::vector<std::uint64_t> level_segments;  // the file's segments at each level
@@ -158,13 +165,24 @@ Renderer* renderer_for(Viewer& v, bool moving) {
   return v.full.get();
 }
 
-// Opens `bytes` into `v` (closed): the file, and the first picture's level (nothing drawn yet).
+// Whether the buffer holds every byte `level` draws from (ranges_of_level).
+bool holds_level(const Viewer& v, std::uint32_t level) {
+  const std::vector<ByteRange> missing = ranges_missing(v.held, v.file->bytes().size());
+  return ranges_intersection(ranges_of_level(*v.file, level, 0), missing).empty();
+}
+
+// Opens `bytes` into `v` (closed): the file, the level drawn at rest (the finest within the GPU budget, with spans
+// as large as the driver allows) and the first picture's (nothing drawn yet). The budget's level needs the
+// context's texture limit, so the context is made here.
 void open_file(Viewer& v, MappedFile bytes, int width, int height) {
   v.file.emplace(VxlFile::open(std::move(bytes)));
   v.width = std::max(width, 1);
   v.height = std::max(height, 1);
-  v.level_segments = app::level_segments(std::vector<const VxlFile*>{&*v.file});
-  v.first_level = app::first_picture_level(v.level_segments, 0);
+  const std::vector<const VxlFile*> files{&*v.file};
+  v.level_segments = app::level_segments(files);
+  make_context();
+  v.full_level = v.gpu_budget > 0 ? SceneLayout::finest_level_within(files, gl::max_buffer_texels(), v.gpu_budget) : 0;
+  v.first_level = app::first_picture_level(v.level_segments, v.full_level);
 }
 
 // The first picture's renderer and the camera: the file's bytes of that level are in (all of them, or those of
@@ -172,7 +190,7 @@ void open_file(Viewer& v, MappedFile bytes, int width, int height) {
 void show_file(Viewer& v) {
   make_context();
   const std::vector<const VxlFile*> files{&*v.file};
-  (v.first_level > 0 ? v.quick : v.full) = std::make_unique<Renderer>(files, 0, v.first_level);
+  (v.first_level > v.full_level ? v.quick : v.full) = std::make_unique<Renderer>(files, 0, v.first_level);
   const Camera home = home_camera(*v.file, double(v.width) / v.height);
   const Renderer& any = *renderer_for(v, false);
   const glm::dvec3 extent = any.bounds_max() - any.bounds_min();
@@ -190,7 +208,9 @@ void describe(Viewer& v, nlohmann::json& j) {
     j["bytes"] = v.file->bytes().size();
     j["gpu_bytes"] = (v.quick ? v.quick->gpu_bytes() : 0) + (v.interim ? v.interim->gpu_bytes() : 0) +
                      (v.full ? v.full->gpu_bytes() : 0);
-    j["first_level"] = v.quick ? v.quick->layout().level() : 0;
+    j["first_level"] = v.quick ? v.quick->layout().level() : v.full_level;
+    j["full_level"] = v.full_level;
+    j["gpu_budget"] = v.gpu_budget;
     j["level_segments"] = v.level_segments;
     j["full_detail"] = v.full != nullptr;
     const Renderer& r = v.full ? *v.full : *v.quick;
@@ -319,7 +339,8 @@ EMSCRIPTEN_KEEPALIVE int vw_show_level(int level) {
   return guarded([&] {
     auto& v = viewer();
     if (!v.controller || !v.quick) throw std::runtime_error("no first picture to refine");
-    if (level <= 0 || static_cast<std::uint32_t>(level) >= v.first_level)
+    if (level <= 0 || static_cast<std::uint32_t>(level) <= v.full_level ||
+        static_cast<std::uint32_t>(level) >= v.first_level)
       throw std::runtime_error("not a level between");
     v.interim.reset();  // its GPU memory before the next one's
     v.interim = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file}, 0, level);
@@ -460,18 +481,34 @@ EMSCRIPTEN_KEEPALIVE int vw_set_camera(double az, double el, double distance, do
   });
 }
 
-// Makes the full-detail renderer when the first picture was coarser (nothing otherwise).
+// The GPU memory budget of the files opened from now on, written as voxview's --gpu-memory ("512M", "2G"; empty:
+// none): what is drawn at rest is the finest level whose GPU copy fits it.
+EMSCRIPTEN_KEEPALIVE int vw_set_gpu_budget(const char* text) {
+  return guarded([&] {
+    const std::string_view t = text;
+    const std::optional<std::uint64_t> bytes = vxl::parse_memory_size(t);
+    if (!t.empty() && !bytes)
+      throw vxl::Error(vxl::ErrorKind::Usage, "gpu", std::nullopt,
+                       "'" + std::string(t) + "' is not a size of memory (e.g. 512M, 2G)");
+    viewer().gpu_budget = bytes.value_or(0);
+  });
+}
+
+// Makes the full-detail renderer (at the budget's level) when the first picture was coarser (nothing otherwise).
+// The bytes that level draws from must be in (vw_level_ranges for it); the rest of the file may still be coming.
 EMSCRIPTEN_KEEPALIVE int vw_refine() {
   return guarded([&] {
     auto& v = viewer();
     if (!v.file) throw std::runtime_error("no file is open");
     if (v.full) return;
-    if (!vxl::web::complete(v)) throw std::runtime_error("full detail needs the whole file: fetch it first");
+    if (!vxl::web::holds_level(v, v.full_level))
+      throw std::runtime_error("level " + std::to_string(v.full_level) + " is not all fetched yet");
     // Made without its spans (eager false): vw_upload and renderer_for upload them a few at a time. The spans
     // are as large as the driver allows: each span more in a draw costs every vertex a branch of texture
     // fetches (SwiftShader: spans of 2^23 texels, two for the 144k set, took its full-detail frame from 11 s
     // to 14-16 s).
-    v.full = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file}, 0, 0, nullptr, false);
+    v.full =
+        std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file}, 0, v.full_level, nullptr, false);
     v.full_pending = true;
   });
 }

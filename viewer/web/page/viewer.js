@@ -10,6 +10,11 @@
   const params = new URLSearchParams(location.search);
   // For tests and for embedding: ?size=WxH fixes the picture's size in pixels.
   const fixedSize = /^(\d+)x(\d+)$/.exec(params.get('size') || '');
+  // The GPU memory budget (voxview's --gpu-memory): what is drawn at rest is the finest level of detail whose GPU
+  // copy fits it. ?gpu=SIZE (512M, 2G) sets it; else a quarter of the memory the browser reports
+  // (navigator.deviceMemory, at most 8 GiB), as voxview takes a quarter where the driver reports none: WebGL
+  // reports no GPU memory. 1 GiB where the browser reports nothing either.
+  const gpuBudget = params.get('gpu') || `${Math.round((navigator.deviceMemory || 4) * 256)}M`;
 
   // window.voxweb.ready: resolved after the first frame of a file, rejected on its error; .complete: after the
   // first frame at full detail (the first may be drawn at a coarser level).
@@ -57,6 +62,7 @@
       refine: Module.cwrap('vw_refine', 'number', []),
       pending: Module.cwrap('vw_pending', 'number', []),
       upload: Module.cwrap('vw_upload', 'number', []),
+      setGpuBudget: Module.cwrap('vw_set_gpu_budget', 'number', ['string']),
     };
     // moving: a drag is under way (frames then come from the first picture's level of detail).
     let opened = false, dirty = false, firstFrame = true, fullDetail = false, moving = false;
@@ -120,9 +126,9 @@
         settle.resolve();
         setTimeout(afterFirstPicture, 0);  // once the first picture is on the screen
       }
-      if (fullDetail && bytesComplete && !moving) {
+      if (fullDetail && !moving) {
         if (api.pending()) uploadSoon();
-        else {
+        else if (bytesComplete) {
           $('progress').value = 1;
           settleComplete.resolve();
         }
@@ -138,7 +144,7 @@
         const r = api.upload();
         if (r > 1) { uploading = false; return fail(api.error()); }
         const info = JSON.parse(api.info());
-        $('progress').value = info.full_uploaded / Math.max(1, info.full_bytes);
+        if (bytesComplete) $('progress').value = info.full_uploaded / Math.max(1, info.full_bytes);  // else the fetch's
         if (r === 0) return setTimeout(step, 0);
         uploading = false;
         redraw();
@@ -163,13 +169,20 @@
       if (!fullDetail) refine();
       else redraw();
     }
+    // False when it failed (and said why).
     function refine() {
-      if (api.refine() !== 0) return fail(api.error());
+      if (api.refine() !== 0) {
+        fail(api.error());
+        return false;
+      }
       fullDetail = true;
       const info = JSON.parse(api.info());
+      const atRest = info.full_level === 0 ? 'full detail follows'
+        : `level ${info.full_level} follows, the finest whose copy fits the GPU memory budget of ${gpuBudget} (?gpu= sets it)`;
       say($('status').textContent + `\nfirst picture at level ${info.first_level} (1/${8 ** info.first_level} of the ` +
-          'streamlines); full detail follows');
+          `streamlines); ${atRest}`);
       redraw();
+      return true;
     }
 
     // The view in the address: #az=..&el=..&distance=..&target=x,y,z&mode=..&opacity=..&color=..
@@ -411,10 +424,13 @@
       if (api.show() !== 0) return fail(api.error());
       bytesComplete = false;
       // The finer levels one after the other (each an eighth of the next: 1/64, 1/8 of the file...), each drawn
-      // at rest as it comes, then the rest of the file. False when another file was opened meanwhile.
+      // at rest as it comes; then what the level drawn at rest reads (full detail, or the finest the GPU budget
+      // holds), drawn as soon as it is in; then the rest of the file (the voxline and streamline tables, the values,
+      // the levels finer than the budget's). False when another file was opened meanwhile.
       fetchRest = async () => {
         const info = JSON.parse(api.info());
-        for (let level = info.first_level - 1; level >= 1 && info.level_segments[level] <= INTERIM_SEGMENTS; --level) {
+        for (let level = info.first_level - 1; level > info.full_level && info.level_segments[level] <= INTERIM_SEGMENTS;
+          --level) {
           if (!(await bring(target, JSON.parse(api.levelRanges(level, LEVEL_GAP))))) return false;
           if (api.showLevel(level) !== 0) throw new Error(`${name}: ${api.error()}`);
           window.voxweb.levelsShown.push(level);
@@ -423,6 +439,8 @@
           await new Promise((resolve) => setTimeout(resolve, 0));  // its frame before the next fetch
           if (!current(target)) return false;
         }
+        if (!(await bring(target, JSON.parse(api.levelRanges(info.full_level, LEVEL_GAP))))) return false;
+        if (!fullDetail && !refine()) return false;
         return bring(target, JSON.parse(api.missingRanges(REST_PIECE)));
       };
       shown(name, t0);
@@ -580,6 +598,7 @@
       if (e.dataTransfer.files.length) dropFile(e.dataTransfer.files[0]).catch((err) => fail(err.message));
     });
 
+    if (api.setGpuBudget(gpuBudget) !== 0) return fail(api.error());
     start().catch((err) => fail(err.message));
   }, (err) => fail('cannot start the viewer: ' + err));
 })();
