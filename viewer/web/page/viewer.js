@@ -66,6 +66,8 @@
     };
     // moving: a drag is under way (frames then come from the first picture's level of detail).
     let opened = false, dirty = false, firstFrame = true, fullDetail = false, moving = false;
+    // The last frame shows the view at rest at full detail (a file fetched by ranges: possibly before its tables are in).
+    let fullShown = false;
     // The whole file is in the WebAssembly memory (false while a file fetched by ranges still has some to come).
     let bytesComplete = true;
     // Fetching by ranges finishes the file after the first picture: fetchRest, set by fetchByRanges.
@@ -121,6 +123,7 @@
         canvas.style.height = h + 'px';
       }
       if (api.draw(w, h, moving ? 1 : 0) !== 0) return fail(api.error());
+      fullShown = fullDetail && !moving && !api.pending();
       if (firstFrame) {
         firstFrame = false;
         settle.resolve();
@@ -128,11 +131,13 @@
       }
       if (fullDetail && !moving) {
         if (api.pending()) uploadSoon();
-        else if (bytesComplete) {
-          $('progress').value = 1;
-          settleComplete.resolve();
-        }
+        else if (bytesComplete) done();
       }
+    }
+    // Full detail is on the screen and the whole file in.
+    function done() {
+      $('progress').value = 1;
+      settleComplete.resolve();
     }
     // Full detail's upload, a few spans per task so that the page keeps taking input; one frame when done.
     let uploading = false;
@@ -167,6 +172,7 @@
         applyHash(true);
       }
       if (!fullDetail) refine();
+      else if (!dirty && fullShown) done();  // drawn at full detail already: no frame more (SwiftShader: seconds)
       else redraw();
     }
     // False when it failed (and said why).
@@ -223,7 +229,7 @@
           say(api.error(), true);
       }
       $('opacity-value').textContent = $('opacity').value;
-      redraw();
+      if (afterWholeFile !== true) redraw();  // after it, only a setting applied (set) asks for a frame
     }
 
     // The whole file's bytes (from Module._malloc; the viewer frees them).
