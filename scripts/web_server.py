@@ -26,12 +26,15 @@ class QuietHandler(http.server.SimpleHTTPRequestHandler):
 
 class RangeHandler(QuietHandler):
     multipart = True
-    # What it answered since the last reset: 206 with one range, and 206 with several (multipart/byteranges).
+    # What it answered since the last reset: 206 with one range, and 206 with several (multipart/byteranges); and
+    # the bytes of the file those answers held.
     answers = {'one range': 0, 'multipart': 0}
+    bytes_sent = 0
 
     @classmethod
     def reset_counts(cls):
         RangeHandler.answers = {'one range': 0, 'multipart': 0}
+        RangeHandler.bytes_sent = 0
 
     def do_GET(self):
         spec = self.headers.get('Range')
@@ -50,6 +53,7 @@ class RangeHandler(QuietHandler):
             return
         if not self.multipart:
             ranges = ranges[:1]
+        RangeHandler.bytes_sent += sum(end + 1 - begin for begin, end in ranges)
         with open(path, 'rb') as f:
             def read(begin, end):
                 f.seek(begin)

@@ -129,13 +129,15 @@ def main():
         # Each case: the file shared, the page's settings (voxview's options of the same names), the server, and
         # a GPU memory budget (?gpu=, voxview's --gpu-memory) or None. 16M holds level 1 of the 50k set, not full
         # detail: the page then draws level 1 at rest, as voxview does (at a low opacity: a coarse level's few lines,
-        # their opacity compensated, make the two rasterisers' differences count more than a dense picture's).
+        # their opacity compensated, make the two rasterisers' differences count more than a dense picture's), and
+        # fetches only what level 1 reads, unless a setting reads the whole file (unsorted: then it fetches the rest).
         cases = [('packed.vxl', 'mode=axis', RangeHandler, None), ('packed.vxl', 'mode=unsorted', QuietHandler, None),
                  ('float32.vxl', 'mode=axis', RangeHandler, None),
                  ('float32.vxl', 'mode=unsorted', FirstRangeHandler, None),
                  ('packed.vxlz', 'mode=axis', WholeForSeveralHandler, None),
                  ('s50k.vxl', 'mode=axis', RangeHandler, None),
-                 ('s50k.vxl', 'mode=axis&opacity=0.02', RangeHandler, '16M')]
+                 ('s50k.vxl', 'mode=axis&opacity=0.02', RangeHandler, '16M'),
+                 ('s50k.vxl', 'mode=unsorted&opacity=0.02', RangeHandler, '16M')]
         tracks, afd = (os.path.join(options.real_data, f) for f in ('test_data__tracks.tck', 'test_data__afd.tsf'))
         if os.path.isfile(tracks) and os.path.isfile(afd):
             run(options.voxlines, 'convert', tracks, path('afd.vxl'), '--tsf', afd)
@@ -172,6 +174,10 @@ def main():
             if 'error' in report:
                 failures.append(f'{source} {settings}: the page failed: {report["error"]}')
                 continue
+            size = os.path.getsize(os.path.join(folder, shared))
+            if budget and handler is RangeHandler and (RangeHandler.bytes_sent < size) != ('unsorted' not in settings):
+                failures.append(f'{source} {settings}, GPU budget {budget}: {RangeHandler.bytes_sent} of its {size} '
+                                'bytes fetched (the whole file only for a setting that reads it)')
             levels = (report['first_level'], report['levels_shown'], report['full_level'])
             if source == 's50k.vxl' and levels != ((2, [], 1) if budget else (2, [1], 0)):
                 failures.append(f's50k.vxl, GPU budget {budget}: first picture at level {levels[0]}, then levels '
@@ -191,7 +197,7 @@ def main():
             served = f' ({served_by[handler]}' + (f', GPU budget {budget})' if budget else ')')
             print(f'{source}{served} {settings}: PSNR {value:.2f} dB against voxview, first picture after '
                   f'{report["first_picture_ms"]:.0f} ms, full detail after {report["full_detail_ms"]:.0f} ms; '
-                  f'range answers {answers}')
+                  f'range answers {answers}, {RangeHandler.bytes_sent} of {size} bytes')
             if value < MIN_PSNR:
                 keep = os.path.join(tempfile.gettempdir(), 'voxweb-test-failed')
                 os.makedirs(keep, exist_ok=True)

@@ -72,8 +72,13 @@
     let bytesComplete = true;
     // Fetching by ranges finishes the file after the first picture: fetchRest, set by fetchByRanges.
     let fetchRest = null;
+    // Where the GPU budget draws a coarser level than full detail, fetching stops once that level is in: restLater
+    // brings the rest when a setting needs it (fetchRestNow).
+    let restLater = null, restPromise = null;
 
     function set(key, value) {
+      if (!bytesComplete && restLater && needsWholeFileNow(key, String(value)))
+        return fetchRestNow().then(() => set(key, value));
       if (api.set(key, String(value)) !== 0) say(api.error(), true);
       if (key === 'color' || key === 'scalar' || key === 'colormap') showColouring();
       redraw();
@@ -131,7 +136,7 @@
       }
       if (fullDetail && !moving) {
         if (api.pending()) uploadSoon();
-        else if (bytesComplete) done();
+        else if (bytesComplete || restLater) done();
       }
     }
     // Full detail is on the screen and the whole file in.
@@ -166,14 +171,41 @@
           if (gen === generation) fail(err.message);
           return;
         }
-        bytesComplete = true;
-        offerColourings(JSON.parse(api.info()));
-        for (const o of $('mode').options) o.disabled = false;
-        applyHash(true);
+        if (restLater) {  // stopped at the budget's level: what needs the rest is offered, and fetches it
+          offerColourings(JSON.parse(api.info()));
+          for (const o of $('mode').options) if (o.disabled) [o.disabled, o.title] = [false, o.title.replace(WAITS, FETCHES)];
+          if (hashWaits()) return fetchRestNow();  // its settings' frame is the one at rest
+        } else {
+          wholeFileIn();
+        }
       }
       if (!fullDetail) refine();
       else if (!dirty && fullShown) done();  // drawn at full detail already: no frame more (SwiftShader: seconds)
       else redraw();
+    }
+    // The whole file is in: what waited for it is offered, and what the address asked of it applied.
+    function wholeFileIn() {
+      bytesComplete = true;
+      offerColourings(JSON.parse(api.info()));
+      for (const o of $('mode').options) [o.disabled, o.title] = [false, o.title.replace(WAITS, '').replace(FETCHES, '')];
+      applyHash(true);
+    }
+    // Fetches the rest of a file that stopped at the budget's level (once, however many settings ask), then
+    // wholeFileIn.
+    function fetchRestNow() {
+      if (!restPromise) {
+        const bring = restLater, gen = generation;
+        restLater = null;
+        say($('status').textContent + '\nfetching the rest of the file');
+        restPromise = (async () => {
+          try {
+            if (await bring()) wholeFileIn();
+          } catch (err) {
+            if (gen === generation) fail(err.message);
+          }
+        })();
+      }
+      return restPromise;
     }
     // False when it failed (and said why).
     function refine() {
@@ -212,6 +244,16 @@
     // by value or group, and the unsorted mode (it draws in the streamlines' order).
     function needsWholeFile(key, value) {
       return key === 'color' || key === 'scalar' || key === 'colormap' || (key === 'mode' && value === 'unsorted');
+    }
+    // What a setting asks of the file now: the voxline and streamline tables, for the unsorted mode and colouring by
+    // value or group.
+    function needsWholeFileNow(key, value) {
+      return (key === 'mode' && value === 'unsorted') || (key === 'color' && (value === 'scalar' || value === 'group'));
+    }
+    // Whether the address asks for a setting that needs the whole file.
+    function hashWaits() {
+      const h = new URLSearchParams(location.hash.slice(1));
+      return ['mode', 'color'].some((key) => h.has(key) && needsWholeFileNow(key, h.get(key)));
     }
     // afterWholeFile: only the settings that waited for the whole file (the view may have moved since).
     function applyHash(afterWholeFile) {
@@ -253,7 +295,7 @@
         o.textContent = m.name;
         o.title = m.description;
         o.disabled = !bytesComplete && needsWholeFile('mode', m.name);
-        if (o.disabled) o.title += ' (once the whole file is in)';
+        if (o.disabled) o.title += WAITS;
         return o;
       }));
       $('mode').value = 'axis';
@@ -278,6 +320,8 @@
     // The finest level drawn at rest before full detail: a software WebGL draws about a million segments a second,
     // and each such picture delays full detail by its upload and its frames.
     const INTERIM_SEGMENTS = 2e6;
+    // What the panel says of a mode that reads the whole file, while it is not in.
+    const WAITS = ' (once the whole file is in)', FETCHES = ' (fetches the whole file)';
     let generation = 0;  // each file opened counts one: what is fetched for an older one is dropped
 
     // "bytes A-B/T" -> [A, B + 1, T] (T: null when unknown); null when malformed.
@@ -447,7 +491,10 @@
         }
         if (!(await bring(target, JSON.parse(api.levelRanges(info.full_level, LEVEL_GAP))))) return false;
         if (!fullDetail && !refine()) return false;
-        return bring(target, JSON.parse(api.missingRanges(REST_PIECE)));
+        const rest = () => bring(target, JSON.parse(api.missingRanges(REST_PIECE)));
+        if (info.full_level === 0) return rest();
+        restLater = rest;  // the budget draws a coarser level: the rest when a setting needs it
+        return true;
       };
       shown(name, t0);
     }
@@ -466,7 +513,7 @@
       const { url } = target;
       say('fetching ' + url);
       bytesComplete = true;
-      fetchRest = null;
+      fetchRest = restLater = restPromise = null;
       const t0 = performance.now();
       let probe;
       try {
@@ -531,7 +578,7 @@
     async function dropFile(file) {
       const target = { name: file.name, gen: ++generation };
       bytesComplete = true;
-      fetchRest = null;
+      fetchRest = restLater = restPromise = null;
       const bytes = new Uint8Array(await file.arrayBuffer());
       if (!current(target)) return;
       const pointer = allocate(bytes.length, file.name);
