@@ -7,7 +7,12 @@ full detail, and the browser's peak memory: the resident set of all its processe
 the first picture's level first), or with --server whole ignores them (as `python3 -m http.server`: the page
 fetches the file whole), or with --server first-range answers one range a request.
 
-Usage: bench/web_bench.py FILE.vxl... [--rounds N] [--size WxH] [--server ranges|first-range|whole] [--voxlines PATH]
+Also the resident memory of each kind of Chromium process at the peak (browser, renderer: the page and its
+WebAssembly memory, gpu-process: SwiftShader's copies of the textures), the level drawn at rest and, by ranges, the
+bytes fetched. --gpu sets the page's GPU memory budget (?gpu=).
+
+Usage: bench/web_bench.py FILE.vxl... [--rounds N] [--size WxH] [--server ranges|first-range|whole] [--gpu SIZE]
+       [--voxlines PATH]
 """
 import argparse
 import os
@@ -26,8 +31,20 @@ SERVERS = {'ranges': web_server.RangeHandler, 'first-range': web_server.FirstRan
            'whole': web_server.QuietHandler}
 
 
+def process_kind(pid):
+    """Chromium's name for what a process does (--type=renderer, gpu-process, ...); 'browser' for the main one."""
+    try:
+        with open(f'/proc/{pid}/cmdline', 'rb') as f:
+            for arg in f.read().replace(b'\0', b' ').split():  # children rewrite their title: spaces
+                if arg.startswith(b'--type='):
+                    return arg[7:].decode()
+    except OSError:
+        pass
+    return 'browser'
+
+
 def tree_rss_bytes(root):
-    """The resident memory of `root` and every process below it."""
+    """The resident memory of `root` and every process below it: {kind: bytes} (process_kind)."""
     children = {}
     for pid in os.listdir('/proc'):
         if not pid.isdigit():
@@ -38,21 +55,24 @@ def tree_rss_bytes(root):
             children.setdefault(int(fields[1]), []).append(int(pid))
         except OSError:
             continue
-    total, todo = 0, [root]
+    by_kind, todo = {}, [root]
     while todo:
         pid = todo.pop()
         todo += children.get(pid, [])
         try:
             with open(f'/proc/{pid}/statm') as f:
-                total += int(f.read().split()[1]) * os.sysconf('SC_PAGE_SIZE')
+                rss = int(f.read().split()[1]) * os.sysconf('SC_PAGE_SIZE')
         except OSError:
-            pass
-    return total
+            continue
+        kind = process_kind(pid)
+        by_kind[kind] = by_kind.get(kind, 0) + rss
+    return by_kind
 
 
 class PeakSampler:
     def __init__(self):
         self.peak, self._root, self._stop = 0, None, threading.Event()
+        self.at_peak = {}  # {kind: bytes} when the total peaked
         self._thread = threading.Thread(target=self._run, daemon=True)
 
     def start(self, process):
@@ -61,7 +81,9 @@ class PeakSampler:
 
     def _run(self):
         while not self._stop.wait(0.05):
-            self.peak = max(self.peak, tree_rss_bytes(self._root))
+            by_kind = tree_rss_bytes(self._root)
+            if sum(by_kind.values()) > self.peak:
+                self.peak, self.at_peak = sum(by_kind.values()), by_kind
 
     def stop(self):
         self._stop.set()
@@ -75,6 +97,7 @@ def main():
     parser.add_argument('--rounds', type=int, default=2)
     parser.add_argument('--size', default='1024x1024')
     parser.add_argument('--server', choices=sorted(SERVERS), default='ranges')
+    parser.add_argument('--gpu', help="the page's GPU memory budget (?gpu=, e.g. 256M)")
     parser.add_argument('--voxlines', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), '..',
                                                            'build', 'release', 'converter', 'voxlines'))
     parser.add_argument('--chromium', default=shutil.which('chromium') or 'chromium')
@@ -84,11 +107,12 @@ def main():
             folder = os.path.join(work, os.path.basename(path) + '.share')
             subprocess.run([args.voxlines, 'share', path, folder], check=True, capture_output=True)
             server = web_server.Server(folder, SERVERS[args.server])
-            url = f'{server.url}index.html?size={args.size}'
+            url = f'{server.url}index.html?size={args.size}' + (f'&gpu={args.gpu}' if args.gpu else '')
             size = os.path.getsize(path)
             try:
                 for r in range(args.rounds):
                     sampler = PeakSampler()
+                    web_server.RangeHandler.reset_counts()
                     t0 = time.monotonic()
                     try:
                         report = web_capture.capture(url, os.path.join(work, 'picture.png'), 900, args.chromium,
@@ -102,6 +126,12 @@ def main():
                           f'{report["first_picture_ms"] / 1000:.2f} s (level {report["first_level"]}), full detail {report["full_detail_ms"] / 1000:.2f} s, '
                           f'browser peak RSS {sampler.peak / 2**20:.0f} MiB = {sampler.peak / size:.2f}x the file '
                           f'(whole run {time.monotonic() - t0:.1f} s)', flush=True)
+                    kinds = ', '.join(f'{k} {v / 2**20:.0f}' for k, v in sorted(sampler.at_peak.items()))
+                    fetched = (f'; fetched by ranges {web_server.RangeHandler.bytes_sent / 2**20:.0f} MiB'
+                               if args.server != 'whole' else '')
+                    budget = f', GPU budget {args.gpu}' if args.gpu else ''
+                    print(f'    at the peak, MiB: {kinds}; drawn at rest: level {report.get("full_level")}{budget}'
+                          f'{fetched}', flush=True)
             finally:
                 server.close()
     return 0
