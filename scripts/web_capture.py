@@ -116,6 +116,7 @@ FIRST_PICTURE = """new Promise((resolve) => {
         png: canvas().toDataURL('image/png'), first_picture_ms: first, full_detail_ms: performance.now(),
         first_level: window.voxweb.info ? window.voxweb.info.first_level : null,
         full_level: window.voxweb.info ? window.voxweb.info.full_level : null,
+        mode: window.voxweb.mode ? window.voxweb.mode() : null,
         levels_shown: window.voxweb.levelsShown || [],
         heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null }), failed);
     }, failed);
@@ -155,7 +156,7 @@ def capture(url, out, timeout, chromium, on_start=None):
             f.write(png)
         os.replace(out + '.part', out)
         report.update({'first_picture_ms': round(value['first_picture_ms'], 1),
-                       'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'], 'full_level': value.get('full_level'),
+                       'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'], 'full_level': value.get('full_level'), 'mode': value.get('mode'),
                        'levels_shown': value['levels_shown'],
                        'heap_bytes': value['heap_bytes']})
         return report

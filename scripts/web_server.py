@@ -40,6 +40,8 @@ class RangeHandler(QuietHandler):
         spec = self.headers.get('Range')
         path = self.translate_path(self.path.split('?')[0])
         if not spec or not os.path.isfile(path):
+            if os.path.isfile(path) and path.endswith(('.vxl', '.vxlz')):
+                RangeHandler.bytes_sent += os.path.getsize(path)  # the whole file
             return super().do_GET()
         size = os.path.getsize(path)
         ranges = self.parse_ranges(spec, size)

@@ -210,6 +210,8 @@ void describe(Viewer& v, nlohmann::json& j) {
                      (v.full ? v.full->gpu_bytes() : 0);
     j["first_level"] = v.quick ? v.quick->layout().level() : v.full_level;
     j["full_level"] = v.full_level;
+    for (const RenderModeInfo& m : render_modes())
+      if (m.mode == v.settings.mode) j["mode"] = m.name;  // what frames are drawn in now
     j["gpu_budget"] = v.gpu_budget;
     j["level_segments"] = v.level_segments;
     j["full_detail"] = v.full != nullptr;
@@ -501,7 +503,7 @@ EMSCRIPTEN_KEEPALIVE int vw_refine() {
     auto& v = viewer();
     if (!v.file) throw std::runtime_error("no file is open");
     if (v.full) return;
-    if (!vxl::web::holds_level(v, v.full_level))
+    if (!vxl::web::complete(v) && !vxl::web::holds_level(v, v.full_level))
       throw std::runtime_error("level " + std::to_string(v.full_level) + " is not all fetched yet");
     // Made without its spans (eager false): vw_upload and renderer_for upload them a few at a time. The spans
     // are as large as the driver allows: each span more in a draw costs every vertex a branch of texture

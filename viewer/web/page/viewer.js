@@ -64,6 +64,7 @@
       upload: Module.cwrap('vw_upload', 'number', []),
       setGpuBudget: Module.cwrap('vw_set_gpu_budget', 'number', ['string']),
     };
+    window.voxweb.mode = () => JSON.parse(api.info()).mode;  // the mode frames are drawn in (for tests)
     // moving: a drag is under way (frames then come from the first picture's level of detail).
     let opened = false, dirty = false, firstFrame = true, fullDetail = false, moving = false;
     // The last frame shows the view at rest at full detail (a file fetched by ranges: possibly before its tables are in).
@@ -77,8 +78,13 @@
     let restLater = null, restPromise = null;
 
     function set(key, value) {
-      if (!bytesComplete && restLater && needsWholeFileNow(key, String(value)))
-        return fetchRestNow().then(() => set(key, value));
+      if (!bytesComplete && (restLater || restPromise) && needsWholeFileNow(key, String(value))) {
+        // Applied once the rest is in, if this file is still open and the panel still asks for it.
+        const gen = generation;
+        return fetchRestNow(false).then(() => {
+          if (gen === generation && bytesComplete && $(key).value === String(value)) set(key, value);
+        });
+      }
       if (api.set(key, String(value)) !== 0) say(api.error(), true);
       if (key === 'color' || key === 'scalar' || key === 'colormap') showColouring();
       redraw();
@@ -174,34 +180,38 @@
         if (restLater) {  // stopped at the budget's level: what needs the rest is offered, and fetches it
           offerColourings(JSON.parse(api.info()));
           for (const o of $('mode').options) if (o.disabled) [o.disabled, o.title] = [false, o.title.replace(WAITS, FETCHES)];
-          if (hashWaits()) return fetchRestNow();  // its settings' frame is the one at rest
+          if (hashWaits()) return fetchRestNow(true);  // its settings' frame is the one at rest
+          applyHash(true);  // the link's colouring, which needs no more (e.g. fixed)
         } else {
-          wholeFileIn();
+          wholeFileIn(true);
         }
       }
       if (!fullDetail) refine();
       else if (!dirty && fullShown) done();  // drawn at full detail already: no frame more (SwiftShader: seconds)
       else redraw();
     }
-    // The whole file is in: what waited for it is offered, and what the address asked of it applied.
-    function wholeFileIn() {
+    // The whole file is in: what waited for it is offered, and (withLink) what the address asked of it applied.
+    function wholeFileIn(withLink) {
       bytesComplete = true;
       offerColourings(JSON.parse(api.info()));
       for (const o of $('mode').options) [o.disabled, o.title] = [false, o.title.replace(WAITS, '').replace(FETCHES, '')];
-      applyHash(true);
+      if (withLink) applyHash(true);
     }
     // Fetches the rest of a file that stopped at the budget's level (once, however many settings ask), then
-    // wholeFileIn.
-    function fetchRestNow() {
+    // wholeFileIn; forLink: the address asked for a setting that reads it. A failed fetch can be asked for again.
+    function fetchRestNow(forLink) {
       if (!restPromise) {
         const bring = restLater, gen = generation;
         restLater = null;
         say($('status').textContent + '\nfetching the rest of the file');
         restPromise = (async () => {
           try {
-            if (await bring()) wholeFileIn();
+            if (await bring()) wholeFileIn(forLink);
           } catch (err) {
-            if (gen === generation) fail(err.message);
+            if (gen !== generation) return;
+            [restLater, restPromise] = [bring, null];
+            if (forLink) fail(err.message);  // the link's picture cannot be drawn
+            else say(err.message, true);
           }
         })();
       }
@@ -258,6 +268,7 @@
     // afterWholeFile: only the settings that waited for the whole file (the view may have moved since).
     function applyHash(afterWholeFile) {
       const h = new URLSearchParams(location.hash.slice(1));
+      if (afterWholeFile !== true && !bytesComplete && restLater && hashWaits()) fetchRestNow(true);
       for (const key of ['mode', 'opacity', 'color', 'scalar', 'colormap']) {
         if (!h.has(key)) continue;
         const waits = needsWholeFile(key, h.get(key));
@@ -284,6 +295,8 @@
     // The file is open and its first picture's renderer made: the panel, then the first frame.
     function shown(name, t0) {
       opened = true;
+      firstFrame = true;  // its first frame starts the rest (afterFirstPicture)
+      fullShown = false;
       const info = JSON.parse(api.info());
       window.voxweb.info = info;
       fullDetail = info.full_detail;
@@ -307,6 +320,7 @@
 
     // Colouring by value or by group where the file has them (they read the whole file).
     function offerColourings(info) {
+      for (const o of [...$('color').options]) if (o.value === 'scalar' || o.value === 'group') o.remove();
       if (info.values.length) $('color').add(new Option('value', 'scalar'));
       if (info.groups.length > 1) $('color').add(new Option('group', 'group'));
       $('scalar').replaceChildren(...info.values.map((name) => new Option(name, name)));
