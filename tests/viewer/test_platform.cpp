@@ -201,7 +201,7 @@ void write_rgb_png_by_hand(const std::string& path, std::uint32_t w, std::uint32
   std::vector<std::uint8_t> header;
   be32(header, w);
   be32(header, h);
-  header.insert(header.end(), {8, 2, 0, 0, 0});  // 8 bits, RGB, deflate, no filter method, not interlaced
+  header.insert(header.end(), {8, 2, 0, 0, 0});  // 8 bits, RGB, deflate, filter method 0, not interlaced
   chunk("IHDR", header);
   std::vector<std::uint8_t> rows;
   for (std::uint32_t y = 0; y < h; ++y) {
@@ -616,7 +616,7 @@ TEST(PlatformImageIo, ReadErrorsAndRgbFiles) {
 
   // A 3-channel file gets alpha 255.
   const std::string rgb = (dir.path() / "rgb.png").string();
-  write_rgb_png_by_hand(rgb, 2, 1, {10, 20, 30, 40, 50, 60});
+  ASSERT_NO_FATAL_FAILURE(write_rgb_png_by_hand(rgb, 2, 1, {10, 20, 30, 40, 50, 60}));
   const Image img = vxl::read_image(rgb);
   ASSERT_EQ(img.width, 2);
   ASSERT_EQ(img.height, 1);
