@@ -156,7 +156,8 @@ def capture(url, out, timeout, chromium, on_start=None):
             f.write(png)
         os.replace(out + '.part', out)
         report.update({'first_picture_ms': round(value['first_picture_ms'], 1),
-                       'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'], 'full_level': value.get('full_level'), 'mode': value.get('mode'),
+                       'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'],
+                       'full_level': value.get('full_level'), 'mode': value.get('mode'),
                        'levels_shown': value['levels_shown'],
                        'heap_bytes': value['heap_bytes']})
         return report

@@ -216,39 +216,29 @@ def main():
         # names: cut short by the first bytes' checks, overwritten by the draw checks of the first level or of
         # full detail.
         folder = path('share-packed-vxl')
-        shutil.copy(path('float32.vxl'), folder)
-        server = Server(folder, ChangingHandler)
-        try:
-            report = capture(f'{server.url}index.html?size={SIZE}&file=changed.vxl', path('changed.png'))
-        finally:
-            server.close()
-        if 'changed on the server' not in report.get('error', ''):
-            failures.append(f'a file changed on the server while fetched: {report}')
-        else:
-            print(f'changed.vxl in the page: {report["error"]}')
-        for name in ('damaged.vxl', 'ordb-damaged.vxl', 'vert-damaged.vxl'):
-            shutil.copy(path(name), folder)
-            server = Server(folder, RangeHandler)
-            try:
-                report = capture(f'{server.url}index.html?size={SIZE}&file={name}', path(name + '.png'))
-            finally:
-                server.close()
-            if name not in report.get('error', ''):
-                failures.append(f'{name} in the page: {report}')
-            else:
-                print(f'{name} in the page: {report["error"]}')
 
-        # A GPU memory budget that is not a size, and one that not even the coarsest level fits: refused, saying so.
-        for budget, expected in (('lots', "'lots' is not a size of memory"), ('1K', 'does not fit the GPU memory budget')):
-            server = Server(folder, RangeHandler)
+        def expect_refused(what, query, expected, handler=RangeHandler):
+            """The page opened with `query` (served from `folder`) fails with a message holding `expected`."""
+            server = Server(folder, handler)
             try:
-                report = capture(f'{server.url}index.html?size={SIZE}&file=packed.vxl&gpu={budget}', path('budget.png'))
+                report = capture(f'{server.url}index.html?size={SIZE}&{query}', path('refused.png'))
             finally:
                 server.close()
             if expected not in report.get('error', ''):
-                failures.append(f'GPU budget {budget}: {report}')
+                failures.append(f'{what} in the page: {report}')
             else:
-                print(f'GPU budget {budget} in the page: {report["error"]}')
+                print(f'{what} in the page: {report["error"]}')
+
+        shutil.copy(path('float32.vxl'), folder)
+        expect_refused('a file changed on the server while fetched', 'file=changed.vxl', 'changed on the server',
+                       ChangingHandler)
+        for name in ('damaged.vxl', 'ordb-damaged.vxl', 'vert-damaged.vxl'):
+            shutil.copy(path(name), folder)
+            expect_refused(name, f'file={name}', name)
+
+        # A GPU memory budget that is not a size, and one that not even the coarsest level fits: refused, saying so.
+        for budget, expected in (('lots', "'lots' is not a size of memory"), ('1K', 'does not fit the GPU memory budget')):
+            expect_refused(f'GPU budget {budget}', f'file=packed.vxl&gpu={budget}', expected)
 
     for f in failures:
         print('FAILED: ' + f)

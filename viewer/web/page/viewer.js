@@ -134,14 +134,15 @@
         canvas.style.height = h + 'px';
       }
       if (api.draw(w, h, moving ? 1 : 0) !== 0) return fail(api.error());
-      fullShown = fullDetail && !moving && !api.pending();
+      const pending = api.pending();
+      fullShown = fullDetail && !moving && !pending;
       if (firstFrame) {
         firstFrame = false;
         settle.resolve();
         setTimeout(afterFirstPicture, 0);  // once the first picture is on the screen
       }
       if (fullDetail && !moving) {
-        if (api.pending()) uploadSoon();
+        if (pending) uploadSoon();
         else if (bytesComplete || restLater) done();
       }
     }
