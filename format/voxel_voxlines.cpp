@@ -85,8 +85,8 @@ void fill_voxel_index(std::uint64_t voxel_count, std::uint64_t voxline_count, st
     StreamlineTableReader strm(io, streamline_count + 1);
     std::uint64_t s = 0;
     each_voxline(io, voxline_count, part, [&](std::uint64_t j, const VoxlineEntry& e) {
-      while (strm.at(s + 1) <= j) ++s;  // the streamline voxline j belongs to (STRM checked by the caller)
       if (e.voxel < begin || e.voxel >= end) return;
+      while (strm.at(s + 1) <= j) ++s;  // the streamline voxline j belongs to (STRM checked by the caller)
       lists[cursor[e.voxel - begin]++ - first[begin]] = indexed_voxline(s, e, j == strm.at(s), j + 1 == strm.at(s + 1));
     });
     if (io.in_place.empty())

@@ -26,6 +26,11 @@ float VertexPacker::decode_axis(int c, std::uint32_t q) const {
   return lo_[c] + offset;
 }
 
+void VertexPacker::decode_axis_table(int c, std::span<float, kPackedSteps + 1> table) const {
+  const float lo = lo_[c], step = step_[c];
+  for (std::uint32_t q = 0; q <= kPackedSteps; ++q) table[q] = lo + static_cast<float>(q) * step;  // as decode_axis
+}
+
 namespace {
 
 // One coordinate's quantum. Here, not a member, so that the loops of words() and pack() inline it (as a

@@ -40,6 +40,8 @@ class VertexPacker {
   void decode(const std::uint32_t* packed, std::uint64_t count, float* xyz) const;
   // Axis c's coordinate for quantum q (0..kPackedSteps), as decode() gives it.
   float decode_axis(int c, std::uint32_t q) const;
+  // decode_axis(c, q) for every q, in one call: a voxel's table is filled by one loop, not 1024 calls.
+  void decode_axis_table(int c, std::span<float, kPackedSteps + 1> table) const;
   // One word's 3 floats, as decode() gives them; inline for loops that decode only some of a block's words.
   void decode_word(std::uint32_t w, float* xyz) const {
     xyz[0] = lo_[0] + static_cast<float>(w & kPackedAxisMask) * step_[0];  // each product rounded: no fused add

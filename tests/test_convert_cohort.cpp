@@ -18,11 +18,6 @@ namespace {
 using test::run_cli;
 using test::ScratchDir;
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-}
-
 std::set<std::string> names_in(const std::filesystem::path& dir) {
   std::set<std::string> names;
   for (const auto& e : std::filesystem::directory_iterator(dir)) names.insert(e.path().filename().string());
@@ -75,9 +70,10 @@ TEST(ConvertCohort, OutputsAreTheSingleFileConversionsByteForByte) {
       const std::string single = dir.file("single.vxl");
       auto s = run_cli("convert '" + inputs[i] + "' '" + single + "' --threads " + single_threads);
       ASSERT_EQ(s.exit_code, 0) << s.output;
-      const std::string cohort_bytes = slurp(out + "/" + names[i]);
+      const std::string cohort_bytes = test::slurp<std::string>(out + "/" + names[i]);
       EXPECT_FALSE(cohort_bytes.empty()) << names[i];
-      EXPECT_TRUE(cohort_bytes == slurp(single)) << names[i] << " differs from the single-file conversion";
+      EXPECT_TRUE(cohort_bytes == test::slurp<std::string>(single))
+          << names[i] << " differs from the single-file conversion";
     }
   }
 }

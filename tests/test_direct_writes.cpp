@@ -32,11 +32,6 @@ namespace {
 
 using test::ScratchDir;
 
-std::vector<std::uint8_t> file_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 // Regions back to back (the first from offset 0), of sizes below, at and across block boundaries. With
 // `from_blocks`, most pieces are appended from a block-aligned buffer laid out as append_from_block wants.
 void write_regions(const std::string& path, bool use_direct_io, const std::vector<std::uint8_t>& expected,
@@ -82,7 +77,8 @@ void expect_plain_bytes(const ScratchDir& dir, std::uint32_t seed, const std::ve
   for (bool direct : {true, false}) {
     const std::string path = dir.file(direct ? "direct.bin" : "buffered.bin");
     write_regions(path, direct, expected, ends, from_blocks);
-    EXPECT_TRUE(file_bytes(path) == expected) << (direct ? "with" : "without") << " O_DIRECT";
+    EXPECT_TRUE(test::slurp<std::vector<std::uint8_t>>(path) == expected)
+        << (direct ? "with" : "without") << " O_DIRECT";
   }
 }
 
@@ -155,7 +151,7 @@ TEST(DirectWrites, RegionsInterleavedThroughAWriteQueueGiveThePlainBytes) {
       }
       queue.finish();
       out.commit();
-      EXPECT_TRUE(file_bytes(path) == expected);
+      EXPECT_TRUE(test::slurp<std::vector<std::uint8_t>>(path) == expected);
     }
   }
 }
@@ -198,7 +194,8 @@ TEST(DirectWrites, AStreamingConversionWithDirectWritesWritesTheInMemoryBytes) {
       tuning.vertex_blocks = true;
       const ConvertSummary s = convert_streaming(tck, direct, settings, tuning);
       EXPECT_EQ(s.vertices_read_back, c.read_back);
-      const std::vector<std::uint8_t> a = file_bytes(whole), b = file_bytes(direct);
+      const std::vector<std::uint8_t> a = test::slurp<std::vector<std::uint8_t>>(whole),
+                                      b = test::slurp<std::vector<std::uint8_t>>(direct);
       EXPECT_GT(a.size(), 1000000u);
       EXPECT_TRUE(a == b) << "the conversion with direct writes differs (" << a.size() << " vs " << b.size()
                           << " bytes)";

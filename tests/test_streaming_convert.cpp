@@ -50,11 +50,6 @@ void write_raw_tck(const std::string& path, const std::string& datatype, const s
   test::write_mrtrix_file(path, "mrtrix tracks", datatype, data, extra);
 }
 
-std::vector<char> file_bytes(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-}
-
 ConvertSettings settings_for(double voxel_size, const std::string& orders = "axis") {
   ConvertSettings s;
   s.voxel_size = voxel_size;
@@ -70,7 +65,7 @@ ConvertSummary expect_identical(const ScratchDir& dir, const std::string& tck, C
   convert_tractogram(read_tractogram(tck), whole, settings);
   settings.memory_limit = limit;
   ConvertSummary s = convert_streaming(tck, limited, settings);
-  std::vector<char> a = file_bytes(whole), b = file_bytes(limited);
+  std::vector<char> a = test::slurp(whole), b = test::slurp(limited);
   EXPECT_GT(a.size(), 0u);
   EXPECT_TRUE(a == b) << "the limited conversion differs from the in-memory one (" << a.size() << " vs " << b.size()
                       << " bytes)";
@@ -272,7 +267,7 @@ TEST(StreamingConvert, VoxelRunsAndIndexListsAreKeptWhereTheyFitAndTheBytesAreTh
   EXPECT_TRUE(s.voxelised_once);
   EXPECT_TRUE(s.voxel_index_while_placing) << "the voxel index's lists filled by the first of several ranges";
   EXPECT_GE(s.partitions, 3u);
-  EXPECT_TRUE(file_bytes(whole) == file_bytes(ranged));
+  EXPECT_TRUE(test::slurp(whole) == test::slurp(ranged));
   EXPECT_GT(streamlines_across_ranges(ranged, s.partition_starts), 1000u);
   // 1 mm voxels: points added at voxel faces, their streamlines voxelised again in the placing pass.
   write_synth_tck(tck, 2000, 7);
@@ -286,7 +281,7 @@ TEST(StreamingConvert, VoxelRunsAndIndexListsAreKeptWhereTheyFitAndTheBytesAreTh
   s = convert_streaming(tck, ranged, settings, small_ranges);
   EXPECT_TRUE(s.voxelised_once);
   EXPECT_GE(s.partitions, 2u);
-  EXPECT_TRUE(file_bytes(whole) == file_bytes(ranged));
+  EXPECT_TRUE(test::slurp(whole) == test::slurp(ranged));
 }
 
 // The voxel index's lists filled while placing with one thread (the read after each batch's items, the placing
@@ -356,7 +351,7 @@ TEST(StreamingConvert, RealTckFixturesAreIdentical) {
     try {
       convert_streaming(tck, limited, settings);
       EXPECT_FALSE(expected) << "the in-memory conversion failed, the limited one did not";
-      EXPECT_TRUE(file_bytes(whole) == file_bytes(limited));
+      EXPECT_TRUE(test::slurp(whole) == test::slurp(limited));
       ++compared;
     } catch (const Error& e) {
       EXPECT_EQ(expected, e.kind()) << e.what();
@@ -540,7 +535,7 @@ TEST(StreamingConvert, CliConvertsWithALimitAndSaysHowItSplitTheWork) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("memory limit 20.0 MiB:"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find(" 1 parts"), std::string::npos) << r.output;
-  EXPECT_TRUE(file_bytes(whole) == file_bytes(limited));
+  EXPECT_TRUE(test::slurp(whole) == test::slurp(limited));
   EXPECT_NE(test::run_cli("convert --help").output.find("--memory-limit"), std::string::npos);
 }
 

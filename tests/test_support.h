@@ -27,11 +27,17 @@ inline bool contains(const std::string& s, const std::string& part) { return s.f
 
 inline constexpr std::uint64_t kMiB = 1ull << 20;
 
-// The bytes of a file. Throws when it cannot be opened, so that two missing files never compare equal.
-inline std::vector<char> slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+// The bytes of a file, in one read (a character at a time took a third of some tests' time under the
+// sanitizers). Throws when it cannot be opened or read, so that two missing files never compare equal.
+template <typename Bytes = std::vector<char>>
+Bytes slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw std::runtime_error("cannot open " + path);
-  return {std::istreambuf_iterator<char>(in), {}};
+  Bytes bytes(static_cast<std::size_t>(in.tellg()), 0);
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size())))
+    throw std::runtime_error("cannot read " + path);
+  return bytes;
 }
 
 // Writes `bytes` to `path`, replacing it.

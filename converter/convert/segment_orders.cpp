@@ -138,10 +138,20 @@ struct PackedBlock {
   bool ends_voxline(std::uint32_t e) const { return (words[e] & kPackedVoxlineEnd) != 0; }
 };
 
+// A small voxel's packed words decoded whole: fewer operations than the three tables, and no larger.
+struct DecodedPackedBlock {
+  const std::uint32_t* words;
+  const float* xyz;
+  float axis(std::uint32_t e, int c) const { return xyz[3 * std::size_t(e) + c]; }
+  bool ends_voxline(std::uint32_t e) const { return (words[e] & kPackedVoxlineEnd) != 0; }
+};
+constexpr std::uint32_t kDecodedWholeVertices = kPackedSteps + 1;  // 3 floats each: the tables' size
+
 struct VoxelOrderWriter::Scratch {
   std::vector<std::uint32_t> starts;
   detail::SortScratch sort;
-  PackedBlock packed;  // write_packed's tables, 85 KiB: here rather than on the stack or per voxel
+  PackedBlock packed;          // write_packed's tables, 85 KiB: here rather than on the stack or per voxel
+  std::vector<float> decoded;  // a small voxel's positions
 };
 
 VoxelOrderWriter::VoxelOrderWriter(const OrderSetSpec& set, std::uint32_t max_vertices)
@@ -187,15 +197,22 @@ void VoxelOrderWriter::write(const VoxelEntry& v, std::span<const LevelEntry> ro
 
 void VoxelOrderWriter::write_packed(const VoxelEntry& v, std::span<const LevelEntry> row, const std::uint32_t* words,
                                     std::uint8_t* dst) {
+  const VertexPacker packer(v);
+  if (v.vertex_count <= kDecodedWholeVertices) {
+    std::vector<float>& xyz = scratch_->decoded;
+    xyz.resize(3 * std::size_t(v.vertex_count));
+    packer.decode(words, v.vertex_count, xyz.data());
+    write_levels(v, row, DecodedPackedBlock{words, xyz.data()}, dst);
+    return;
+  }
   PackedBlock& block = scratch_->packed;
   block.words = words;
-  const VertexPacker packer(v);
   // The quantum sums' tables (some 7k operations an axis) pay only where the sorts are long, and only along
   // the axes a shared set sorts by (a per-voxel set's random directions are no axes).
   constexpr std::uint32_t kRankedVoxelVertices = 1u << 14;
   const bool ranked = !set_->per_voxel() && v.vertex_count >= kRankedVoxelVertices;
   for (int c = 0; c < 3; ++c) {
-    for (std::uint32_t q = 0; q <= kPackedSteps; ++q) block.decoded[c][q] = packer.decode_axis(c, q);
+    packer.decode_axis_table(c, block.decoded[c]);
     const bool along_c = std::any_of(set_->directions.begin(), set_->directions.end(), [&](const auto& d) {
       return d[c] == 1.0f && d[(c + 1) % 3] == 0.0f && d[(c + 2) % 3] == 0.0f;
     });

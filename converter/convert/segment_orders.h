@@ -88,7 +88,8 @@ class VoxelOrderWriter {
 
  private:
   void use_directions_of(const VoxelEntry& v);
-  // Every level's orders of v's block, read through `block` (FloatBlock or PackedBlock in the .cpp).
+  // Every level's orders of v's block, read through `block` (FloatBlock, PackedBlock or DecodedPackedBlock in the
+  // .cpp).
   template <typename Block>
   void write_levels(const VoxelEntry& v, std::span<const LevelEntry> row, const Block& block, std::uint8_t* dst);
   // The K orders of the first `level.vertex_count` vertices of the block; returns the end of what it wrote.
