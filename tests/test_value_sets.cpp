@@ -232,8 +232,10 @@ TEST(ValueSets, ASourceReadWholeWritesItsValuesAlikeUnderEveryLimit) {
     convert_tractogram(Tractogram(t), dir.file("default.vxl"), settings);
     const std::vector<char> expected = test::slurp(dir.file("default.vxl"));
 
-    StreamingTuning ranges;  // several ranges of voxels, one pass each
-    ranges.range_bytes = 256 << 10;
+    // Several ranges of voxels, one pass each: about half a MiB of a range is taken before its voxels, so 640 KiB
+    // gives 13 (float32) and 5 (packed) ranges, and anything under that one a voxel (a thousand passes).
+    StreamingTuning ranges;
+    ranges.range_bytes = 640 << 10;
     settings.memory_limit = 64ull << 20;
     const ConvertSummary cut = convert_streaming(t, dir.file("ranges.vxl"), settings, ranges);
     EXPECT_GT(cut.partitions, 2u);
