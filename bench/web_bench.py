@@ -9,7 +9,8 @@ fetches the file whole), or with --server first-range answers one range a reques
 
 Also the resident memory of each kind of Chromium process at the peak (browser, renderer: the page and its
 WebAssembly memory, gpu-process: SwiftShader's copies of the textures), the level drawn at rest, by ranges the
-bytes fetched, and the page's WebAssembly memory and JavaScript heap once it is done. --gpu sets the page's GPU memory budget (?gpu=).
+bytes fetched, and once the page is done its WebAssembly memory (and malloc's use of it: now and at most) and
+its JavaScript heap. --gpu sets the page's GPU memory budget (?gpu=).
 
 Usage: bench/web_bench.py FILE.vxl... [--rounds N] [--size WxH] [--server ranges|first-range|whole] [--gpu SIZE]
        [--voxlines PATH]
@@ -130,9 +131,10 @@ def main():
                     fetched = (f'; fetched by ranges {web_server.RangeHandler.bytes_sent / 2**20:.0f} MiB'
                                if args.server != 'whole' else '')
                     budget = f', GPU budget {args.gpu}' if args.gpu else ''
-                    page = ''
-                    if report.get('wasm_bytes') is not None and report.get('heap_bytes') is not None:
-                        page = (f'; at full detail the page\'s WebAssembly memory {report["wasm_bytes"] / 2**20:.0f} MiB, '
+                    page, memory = '', report.get('memory')
+                    if memory and memory.get('peak') is not None and report.get('heap_bytes') is not None:
+                        page = (f'; once done, the page\'s WebAssembly memory {memory["wasm"] / 2**20:.0f} MiB (malloc: '
+                                f'{memory["in_use"] / 2**20:.0f} MiB in use, {memory["peak"] / 2**20:.0f} MiB at most), '
                                 f'JavaScript heap {report["heap_bytes"] / 2**20:.0f} MiB')
                     print(f'    at the peak, MiB: {kinds}; drawn at rest: level {report.get("full_level")}{budget}'
                           f'{fetched}{page}', flush=True)

@@ -119,7 +119,7 @@ FIRST_PICTURE = """new Promise((resolve) => {
         mode: window.voxweb.mode ? window.voxweb.mode() : null,
         levels_shown: window.voxweb.levelsShown || [],
         heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null,
-        wasm_bytes: window.voxweb.wasmBytes ? window.voxweb.wasmBytes() : null }), failed);
+        memory: window.voxweb.memory ? window.voxweb.memory() : null }), failed);
     }, failed);
   })();
 })"""
@@ -160,7 +160,7 @@ def capture(url, out, timeout, chromium, on_start=None):
                        'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'],
                        'full_level': value.get('full_level'), 'mode': value.get('mode'),
                        'levels_shown': value['levels_shown'],
-                       'heap_bytes': value['heap_bytes'], 'wasm_bytes': value.get('wasm_bytes')})
+                       'heap_bytes': value['heap_bytes'], 'memory': value.get('memory')})
         return report
     finally:
         if browser:

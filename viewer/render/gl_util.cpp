@@ -173,6 +173,7 @@ void* TextureBuffer::create_mapped(std::size_t bytes) {
 }
 
 void TextureBuffer::finish_mapped(GLenum internal_format) {
+  if (!staging_) return;  // finished already
   texture = make_rows_texture(internal_format, staging_.get(), mapped_bytes_);
   staging_.reset();
 }

@@ -34,7 +34,7 @@ struct TextureBuffer {
   // The same filled in place: create_mapped makes the buffer `bytes` long (at least 16) and returns its
   // memory mapped for writing, which any thread may fill; finish_mapped unmaps it and makes the texture.
   // Throws std::runtime_error when the driver cannot map or loses the contents. (WebGL2 maps nothing: the
-  // memory is the host's, copied to the texture by finish_mapped.)
+  // memory is the host's, copied to the texture by finish_mapped, which does nothing a second time.)
   void* create_mapped(std::size_t bytes);
   void finish_mapped(GLenum internal_format);
   // Replaces bytes [offset, offset + bytes) of a buffer made by create (desktop OpenGL only).

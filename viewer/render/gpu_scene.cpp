@@ -156,6 +156,12 @@ void GpuScene::begin_upload(std::uint32_t ci) {
     std::fill(words + c.vertex_table_first() + c.vertices / SceneLayout::kGroup, words + c.words(), 0u);
   });
   try {
+    // Without threads the words are filled by now: their texture is made before the orders' host copy is
+    // allocated, so a WebAssembly page's memory (which keeps its high-water mark) holds one of the two, not both.
+    if constexpr (!kThreadsAvailable) {
+      f.words.get();
+      g.words.finish_mapped(GL_RGBA32UI);
+    }
     auto* orders = static_cast<std::uint8_t*>(g.orders.create_mapped(4 * c.order_words));
     f.orders = BackgroundTask<>([this, &c, &file, file_first, orders] {
       parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned) {
@@ -181,7 +187,7 @@ void GpuScene::finish_upload(std::size_t k) {
   GpuTextureSpan& g = spans_[ci];
   std::exception_ptr error;
   for (BackgroundTask<>* task : {&f.words, &f.orders}) try {
-      task->get();
+      if (task->valid()) task->get();
     } catch (...) {
       if (!error) error = std::current_exception();
     }
@@ -327,10 +333,12 @@ GpuScene::Residency GpuScene::make_resident(std::span<const std::uint32_t> neede
     uploaded = true;
   }
   if (!wait) {
-    // The fills that end within the time, finished here (a millisecond's sleep between looks).
+    // The fills that end within the time, finished here (a millisecond's sleep between looks). A task already
+    // waited for (the words, without threads) is done.
+    const auto done = [](const BackgroundTask<>& task) { return !task.valid() || task.ready(); };
     for (;;) {
       for (std::size_t k = 0; k < filling_.size();)
-        if (filling_[k].words.ready() && filling_[k].orders.ready())
+        if (done(filling_[k].words) && done(filling_[k].orders))
           finish_upload(k);
         else
           ++k;

@@ -25,6 +25,8 @@
 #include <string_view>
 #include <vector>
 
+#include <malloc.h>
+
 #include <emscripten/emscripten.h>
 #include <emscripten/html5.h>
 #include <nlohmann/json.hpp>
@@ -213,6 +215,11 @@ void describe(Viewer& v, nlohmann::json& j) {
     for (const RenderModeInfo& m : render_modes())
       if (m.mode == v.settings.mode) j["mode"] = m.name;  // what frames are drawn in now
     j["gpu_budget"] = v.gpu_budget;
+    // The WebAssembly memory's use: malloc's bytes in use now, and the most its heap has held (which the memory,
+    // never shrinking, keeps).
+    const struct mallinfo heap = mallinfo();
+    j["heap_in_use"] = static_cast<std::uint64_t>(heap.uordblks);
+    j["heap_peak"] = static_cast<std::uint64_t>(heap.usmblks);
     j["level_segments"] = v.level_segments;
     j["full_detail"] = v.full != nullptr;
     const Renderer& r = v.full ? *v.full : *v.quick;

@@ -65,7 +65,10 @@
       setGpuBudget: Module.cwrap('vw_set_gpu_budget', 'number', ['string']),
     };
     window.voxweb.mode = () => JSON.parse(api.info()).mode;  // the mode frames are drawn in (for tests)
-    window.voxweb.wasmBytes = () => Module.HEAPU8.length;  // the WebAssembly memory's size (for benchmarks)
+    window.voxweb.memory = () => {  // the WebAssembly memory's size and malloc's use of it (for benchmarks)
+      const info = JSON.parse(api.info());
+      return { wasm: Module.HEAPU8.length, in_use: info.heap_in_use, peak: info.heap_peak };
+    };
     // moving: a drag is under way (frames then come from the first picture's level of detail).
     let opened = false, dirty = false, firstFrame = true, fullDetail = false, moving = false;
     // The last frame shows the view at rest at full detail (a file fetched by ranges: possibly before its tables are in).
