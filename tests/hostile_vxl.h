@@ -18,6 +18,7 @@
 #include "format/vxl_layout.h"
 #include "format/vxl_value_sets.h"
 #include "tests/reseal_checksums.h"
+#include "tests/test_support.h"
 
 namespace vxl::test {
 
@@ -50,9 +51,8 @@ class VxlBytes {
     ConvertSettings s;
     s.voxel_size = voxel_size;
     convert_tractogram(hostile_source(), path, s);
-    std::ifstream in(path, std::ios::binary);
     VxlBytes b;
-    b.bytes.assign(std::istreambuf_iterator<char>(in), {});
+    b.bytes = test::slurp(path);
     return b;
   }
 
@@ -124,9 +124,8 @@ inline VxlBytes vxl_with_deep_provenance(const std::string& path, std::size_t de
   const std::string pad(2 * depth, 'x');
   t.source.header = {{"deep", pad}};
   convert_tractogram(std::move(t), path, {});
-  std::ifstream in(path, std::ios::binary);
   VxlBytes b;
-  b.bytes.assign(std::istreambuf_iterator<char>(in), {});
+  b.bytes = test::slurp(path);
   const std::string quoted = '"' + pad + '"';
   const auto at = std::search(b.bytes.begin(), b.bytes.end(), quoted.begin(), quoted.end());
   EXPECT_NE(at, b.bytes.end());

@@ -443,8 +443,7 @@ TEST(ReadTrkBroken, UnsupportedVersionAndMissingFile) {
 TEST(ReadTrkBroken, TruncatedGzip) {
   VXL_REQUIRE_REAL_DATA();
   vxl::test::ScratchDir dir;
-  std::ifstream in(real("niivue__stroke.trk.gz"), std::ios::binary);
-  std::vector<char> buf((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<char> buf = vxl::test::slurp(real("niivue__stroke.trk.gz"));
   buf.resize(buf.size() / 2);
   const std::string p = dir.file("half.trk.gz");
   std::ofstream(p, std::ios::binary).write(buf.data(), static_cast<std::streamsize>(buf.size()));

@@ -360,8 +360,7 @@ TEST(ExportVtk, RoundTripsPointsBitExactlyAndKeepsValues) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("warning"), std::string::npos) << "values are exported to .vtk: " << r.output;
   // Big-endian float32 after the POINTS line.
-  std::ifstream in(dir.file("a.vtk"), std::ios::binary);
-  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string bytes = test::slurp<std::string>(dir.file("a.vtk"));
   const std::size_t at = bytes.find("POINTS 5 float\n") + 15;
   ASSERT_EQ(bytes.compare(0, 26, "# vtk DataFile Version 3.0"), 0);
   EXPECT_NE(bytes.find("\nBINARY\n"), std::string::npos);

@@ -289,11 +289,7 @@ TEST(ValueSets, OpenRefusesAMalformedSection) {
   Tractogram t = five_points();
   t.point_values.push_back({"v", {1, 2, 3, 4, 5}});
   convert_tractogram(std::move(t), dir.file("v.vxl"), {});
-  std::string bytes;
-  {
-    std::ifstream in(dir.file("v.vxl"), std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  std::string bytes = test::slurp<std::string>(dir.file("v.vxl"));
   VxlFile f = VxlFile::open(dir.file("v.vxl"));
   const std::uint64_t at = f.find_section(section_id("VVAL"))->offset;
   auto patched = [&](std::uint64_t offset, std::uint32_t value) {

@@ -239,11 +239,7 @@ TEST(ValuesPackage, ConnectingValuesThatDifferFromTheNextPointAreRefused) {
     }
   ASSERT_NE(connecting, ~0ull);
   const std::uint64_t at = f.find_section(section_id("VVAL"))->offset + value_sets_data_offset(2) + 4 * connecting;
-  std::vector<char> bytes;
-  {
-    std::ifstream in(vxl, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  std::vector<char> bytes = test::slurp(vxl);
   bytes[at] ^= 1;
   std::ofstream(dir.file("bad.vxl"), std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   // No checksum to reseal: VxlFile::open checks the structure only, and pack reads the values.

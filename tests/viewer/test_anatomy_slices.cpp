@@ -322,8 +322,7 @@ TEST(AnatomyVolume, TextureLimitIsTheViewersOwn) {
 
 TEST_F(AnatomyCli, BadImagesAreRefusedNamingTheFile) {
   const std::string good = write_nifti(dir, "good");
-  std::ifstream in(good, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bytes = test::slurp<std::string>(good);
   ASSERT_GT(bytes.size(), 352u + kN * kN * kN * 4 - 1);
   auto write = [&](const std::string& name, const std::string& content) {
     std::ofstream(dir.file(name), std::ios::binary) << content;
@@ -339,8 +338,7 @@ TEST_F(AnatomyCli, BadImagesAreRefusedNamingTheFile) {
   negative[44] = static_cast<char>(-5), negative[45] = static_cast<char>(0xFF);
   // A gzipped file cut short: its data stops in the middle.
   const std::string gz = write_nifti(dir, "zipped", NiftiSpec{false, true, false, ".nii.gz"});
-  std::ifstream gin(gz, std::ios::binary);
-  const std::string gz_bytes((std::istreambuf_iterator<char>(gin)), std::istreambuf_iterator<char>());
+  const std::string gz_bytes = test::slurp<std::string>(gz);
   const std::pair<std::string, std::string> cases[] = {
       {write("truncated.nii", bytes.substr(0, bytes.size() - 1000)), "truncated"},
       {write("header_only.nii", bytes.substr(0, 200)), "truncated NIfTI header"},

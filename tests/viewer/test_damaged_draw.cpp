@@ -30,8 +30,7 @@ class DamagedDraw : public ::testing::Test {
     s.voxel_size = 25;
     const std::string path = dir.file("intact.vxl");
     convert_tractogram(synthesize_tractogram(synth), path, s);
-    std::ifstream in(path, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
+    bytes = test::slurp(path);
     return path;
   }
   VxlFile write_damaged() {

@@ -18,11 +18,6 @@ using test::gl_context;
 using test::render_image;
 using test::ScratchDir;
 
-std::vector<std::uint8_t> read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 // The file's bytes where `held` says, 0xA5 elsewhere, as a reader's buffer of the file's size.
 MappedFile partial_copy(const std::vector<std::uint8_t>& whole, std::span<const ByteRange> held) {
   auto* buffer = static_cast<std::uint8_t*>(std::malloc(whole.size()));
@@ -43,7 +38,7 @@ TEST_P(FetchByRanges, ALevelDrawsFromItsRangesAloneAsFromTheWholeFile) {
   s.levels = 4;
   s.positions = GetParam() ? PositionEncoding::Packed : PositionEncoding::Float32;
   convert_tractogram(synthesize_tractogram(synth), dir.file("scene.vxl"), s);
-  const std::vector<std::uint8_t> whole = read_bytes(dir.file("scene.vxl"));
+  const std::vector<std::uint8_t> whole = test::slurp<std::vector<std::uint8_t>>(dir.file("scene.vxl"));
   const std::span<const std::uint8_t> first(whole.data(), std::min<std::size_t>(whole.size(), kSectionTableBytesMax));
   const std::vector<ByteRange> to_open = ranges_to_open("scene.vxl", first, whole.size());
   const VxlFile reference = VxlFile::open(dir.file("scene.vxl"));
@@ -91,7 +86,7 @@ TEST(FetchPlan, TheFirstBytesAreCheckedAsOpenChecksThem) {
   SynthSettings synth;
   synth.streamlines = 500;
   convert_tractogram(synthesize_tractogram(synth), dir.file("small.vxl"), ConvertSettings{});
-  const std::vector<std::uint8_t> whole = read_bytes(dir.file("small.vxl"));
+  const std::vector<std::uint8_t> whole = test::slurp<std::vector<std::uint8_t>>(dir.file("small.vxl"));
   const auto expect_refused = [](std::span<const std::uint8_t> first, std::uint64_t size, const std::string& what) {
     try {
       ranges_to_open("small.vxl", first, size);

@@ -286,8 +286,7 @@ TEST_F(AnnotatedFigures, SavedViewsKeepTheLabelsTheColourBarAndTheBackground) {
   const std::string look = " --view axial --color scalar --orientation-labels --colorbar --background '#203040'";
   auto first = voxview(look + " --render " + at("a.png") + " --save-camera " + at("v.json"));
   ASSERT_EQ(first.exit_code, 0) << first.output;
-  std::ifstream in(dir.file("v.json"));
-  const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string json = test::slurp<std::string>(dir.file("v.json"));
   EXPECT_NE(json.find("\"orientation_labels\": true"), std::string::npos) << json;
   EXPECT_NE(json.find("\"colorbar\": true"), std::string::npos) << json;
   EXPECT_NE(json.find("\"background\": \"#203040\""), std::string::npos) << json;

@@ -215,11 +215,6 @@ void describe(Viewer& v, nlohmann::json& j) {
     for (const RenderModeInfo& m : render_modes())
       if (m.mode == v.settings.mode) j["mode"] = m.name;  // what frames are drawn in now
     j["gpu_budget"] = v.gpu_budget;
-    // The WebAssembly memory's use: malloc's bytes in use now, and the most its heap has held (which the memory,
-    // never shrinking, keeps).
-    const struct mallinfo heap = mallinfo();
-    j["heap_in_use"] = static_cast<std::uint64_t>(heap.uordblks);
-    j["heap_peak"] = static_cast<std::uint64_t>(heap.usmblks);
     j["level_segments"] = v.level_segments;
     j["full_detail"] = v.full != nullptr;
     const Renderer& r = v.full ? *v.full : *v.quick;
@@ -387,6 +382,17 @@ EMSCRIPTEN_KEEPALIVE const char* vw_info() {
   auto& v = viewer();
   if (guarded([&] { vxl::web::describe(v, j); }) != 0) j = {{"error", vxl::web::last_error()}};
   text = j.dump();
+  return text.c_str();
+}
+
+// The WebAssembly memory's use, for benchmarks (a walk of malloc's heap: not for every step): JSON {"in_use": malloc's
+// bytes in use now, "peak": the most its heap has held, which the memory, never shrinking, keeps}.
+EMSCRIPTEN_KEEPALIVE const char* vw_memory() {
+  static std::string text;
+  const struct mallinfo heap = mallinfo();
+  text = nlohmann::json{{"in_use", static_cast<std::uint64_t>(heap.uordblks)},
+                        {"peak", static_cast<std::uint64_t>(heap.usmblks)}}
+             .dump();
   return text.c_str();
 }
 

@@ -53,6 +53,7 @@
       arrived: Module.cwrap('vw_arrived', null, []),
       error: Module.cwrap('vw_error', 'string', []),
       info: Module.cwrap('vw_info', 'string', []),
+      memory: Module.cwrap('vw_memory', 'string', []),
       set: Module.cwrap('vw_set', 'number', ['string', 'string']),
       drag: Module.cwrap('vw_drag', null, ['number', 'number', 'number']),
       zoom: Module.cwrap('vw_zoom', null, ['number']),
@@ -65,10 +66,8 @@
       setGpuBudget: Module.cwrap('vw_set_gpu_budget', 'number', ['string']),
     };
     window.voxweb.mode = () => JSON.parse(api.info()).mode;  // the mode frames are drawn in (for tests)
-    window.voxweb.memory = () => {  // the WebAssembly memory's size and malloc's use of it (for benchmarks)
-      const info = JSON.parse(api.info());
-      return { wasm: Module.HEAPU8.length, in_use: info.heap_in_use, peak: info.heap_peak };
-    };
+    // The WebAssembly memory's size and malloc's use of it (for benchmarks).
+    window.voxweb.memory = () => ({ wasm: Module.HEAPU8.length, ...JSON.parse(api.memory()) });
     // moving: a drag is under way (frames then come from the first picture's level of detail).
     let opened = false, dirty = false, firstFrame = true, fullDetail = false, moving = false;
     // The last frame shows the view at rest at full detail (a file fetched by ranges: possibly before its tables are in).
