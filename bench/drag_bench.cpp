@@ -12,7 +12,9 @@
 // --drag-region DX,DY,DZ): --steps positions from X,Y,Z, DX,DY,DZ mm apart (--by; default 2,0,0), each selected
 // through the index after the last, as the window's selection worker does; the table walk is left out.
 //
-// Usage: drag_bench FILE.vxl [--steps N] [--radius MM] [--from X,Y,Z [--by DX,DY,DZ]]
+// With --boxes-only, only the window's path (through the index and the boxes) is run: for a profiler.
+//
+// Usage: drag_bench FILE.vxl [--steps N] [--radius MM] [--from X,Y,Z [--by DX,DY,DZ]] [--boxes-only]
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -64,29 +66,61 @@ std::vector<std::array<double, 3>> sphere_centres(const vxl::MetaSection& m,
   return centres;
 }
 
-}  // namespace
+constexpr const char* kUsage =
+    "usage: drag_bench FILE.vxl [--steps N] [--radius MM] [--from X,Y,Z [--by DX,DY,DZ]] [--boxes-only]\n";
 
-int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: drag_bench FILE.vxl [--steps N] [--radius MM]\n");
-    return 2;
-  }
+struct Arguments {
   int steps = 40;
   double radius = 10;
   std::optional<std::array<double, 3>> from;
   std::array<double, 3> by = {2, 0, 0};
+  bool boxes_only = false;
+};
+
+// The options after the file; nullopt (said on stderr) for one it does not know.
+std::optional<Arguments> parse_arguments(int argc, char** argv) {
+  Arguments a;
   auto triple = [](const char* text) {
     std::array<double, 3> v{};
     if (std::sscanf(text, "%lf,%lf,%lf", &v[0], &v[1], &v[2]) != 3) throw std::invalid_argument(text);
     return v;
   };
   for (int i = 2; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--steps" && i + 1 < argc) steps = std::max(2, std::stoi(argv[++i]));
-    if (a == "--radius" && i + 1 < argc) radius = std::stod(argv[++i]);
-    if (a == "--from" && i + 1 < argc) from = triple(argv[++i]);
-    if (a == "--by" && i + 1 < argc) by = triple(argv[++i]);
+    const std::string option = argv[i];
+    if (option == "--steps" && i + 1 < argc)
+      a.steps = std::max(2, std::stoi(argv[++i]));
+    else if (option == "--radius" && i + 1 < argc)
+      a.radius = std::stod(argv[++i]);
+    else if (option == "--from" && i + 1 < argc)
+      a.from = triple(argv[++i]);
+    else if (option == "--by" && i + 1 < argc)
+      a.by = triple(argv[++i]);
+    else if (option == "--boxes-only")
+      a.boxes_only = true;
+    else {
+      std::fprintf(stderr, "drag_bench: unknown argument %s\n%s", option.c_str(), kUsage);
+      return std::nullopt;
+    }
   }
+  return a;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
+    std::fprintf(argc < 2 ? stderr : stdout, "%s", kUsage);
+    return argc < 2 ? 2 : 0;
+  }
+  std::optional<Arguments> parsed;
+  try {
+    parsed = parse_arguments(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "drag_bench: bad number %s\n%s", e.what(), kUsage);
+    return 2;
+  }
+  if (!parsed) return 2;
+  const auto [steps, radius, from, by, boxes_only] = *parsed;
   try {
     const vxl::VxlFile file = vxl::VxlFile::open(argv[1]);
     const vxl::MetaSection& m = file.meta();
@@ -109,11 +143,11 @@ int main(int argc, char** argv) {
     // The per-vertex words of every voxel at full detail: what uploading the whole scene makes once.
     t0 = Clock::now();
     std::vector<std::uint32_t> words;
-    for (std::size_t v = 0; v < file.voxels().size(); ++v) {
+    for (std::size_t v = 0; v < (boxes_only ? 0 : file.voxels().size()); ++v) {
       words.resize(2 * std::size_t(file.voxels()[v].vertex_count));
       vxl::voxel_attributes(file, v, {{}, 0, &*index}, file.voxels()[v].vertex_count, words.data());
     }
-    std::printf("per-vertex attributes of every voxel, once (one thread): %.0f ms\n", ms_since(t0));
+    if (!boxes_only) std::printf("per-vertex attributes of every voxel, once (one thread): %.0f ms\n", ms_since(t0));
 
     const std::vector<std::array<double, 3>> centres = sphere_centres(m, from, by, steps);
     std::vector<double> scan_ms, indexed_ms, boxed_ms, groups_ms;
@@ -125,31 +159,34 @@ int main(int argc, char** argv) {
       c.include.push_back(vxl::parse_region(std::to_string(centre[0]) + "," + std::to_string(centre[1]) + "," +
                                             std::to_string(centre[2]) + "," + std::to_string(radius)));
       std::optional<vxl::SelectionResult> scan;
-      if (!from) {
+      if (!from && !boxes_only) {
         t0 = Clock::now();
         scan = vxl::select_streamlines(file, c, nullptr, vxl::SelectionPath::ScanTable);
         scan_ms.push_back(ms_since(t0));
       }
+      std::optional<vxl::SelectionResult> indexed;
+      if (!boxes_only) {
+        t0 = Clock::now();
+        indexed = vxl::select_streamlines(file, c, &*index);
+        indexed_ms.push_back(ms_since(t0));
+      }
       t0 = Clock::now();
-      vxl::SelectionResult indexed = vxl::select_streamlines(file, c, &*index);
-      indexed_ms.push_back(ms_since(t0));
-      t0 = Clock::now();
-      const vxl::SelectionResult boxed = vxl::select_streamlines(file, c, &*index, vxl::SelectionPath::Fastest, &boxes);
+      vxl::SelectionResult boxed = vxl::select_streamlines(file, c, &*index, vxl::SelectionPath::Fastest, &boxes);
       boxed_ms.push_back(ms_since(t0));
-      if (boxed.streamlines != indexed.streamlines) {
+      if (indexed && boxed.streamlines != indexed->streamlines) {
         std::fprintf(stderr, "drag_bench: the boxes and the index disagree at (%g, %g, %g)\n", centre[0], centre[1],
                      centre[2]);
         return 1;
       }
-      if (scan && indexed.streamlines != scan->streamlines) {
+      if (scan && indexed->streamlines != scan->streamlines) {
         std::fprintf(stderr, "drag_bench: the index and the scan disagree at (%g, %g, %g)\n", centre[0], centre[1],
                      centre[2]);
         return 1;
       }
-      selected_total += indexed.streamlines.size();
+      selected_total += boxed.streamlines.size();
       // What the window does with a new selection: the groups, then one byte per streamline.
       t0 = Clock::now();
-      const vxl::SceneGroups groups = vxl::SceneGroups::selection(files, {std::move(indexed.streamlines)});
+      const vxl::SceneGroups groups = vxl::SceneGroups::selection(files, {std::move(boxed.streamlines)});
       std::vector<std::uint8_t> table(m.streamline_count);
       groups.write_table(0, table, 256);
       groups_ms.push_back(ms_since(t0));
@@ -167,8 +204,11 @@ int main(int argc, char** argv) {
     row("select, through the index and the voxline boxes kept from the last position", boxed_ms);
     row("focus/context groups and the byte per streamline (before upload)", groups_ms);
     // The first position alone: the window's first selection, whose boxes are all made then.
-    std::printf("\nfirst position: through the index %.1f ms, through the index while its boxes are made %.1f ms\n",
-                indexed_ms.front(), boxed_ms.front());
+    if (!indexed_ms.empty())
+      std::printf("\nfirst position: through the index %.1f ms, through the index while its boxes are made %.1f ms\n",
+                  indexed_ms.front(), boxed_ms.front());
+    else
+      std::printf("\nfirst position, while its boxes are made: %.1f ms\n", boxed_ms.front());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "drag_bench: %s\n", e.what());
     return 1;

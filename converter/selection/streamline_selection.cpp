@@ -97,11 +97,16 @@ std::uint64_t streamline_point_count(const VxlFile& file, std::uint64_t s) {
 // fn(i) for each i, a multiple of 8, where bytes [i, i + 8) of `bytes` are not all zero (the last part padded).
 template <typename Fn>
 void for_each_nonzero_chunk(const std::uint8_t* bytes, std::uint64_t count, Fn&& fn) {
-  for (std::uint64_t i = 0; i < count; i += 8) {
-    std::uint64_t chunk = 0;
-    std::memcpy(&chunk, bytes + i, std::min<std::uint64_t>(8, count - i));
+  const std::uint64_t whole = count / 8 * 8;
+  for (std::uint64_t i = 0; i < whole; i += 8) {  // a fixed-size copy: one load, where a variable one is a loop
+    std::uint64_t chunk;
+    std::memcpy(&chunk, bytes + i, 8);
     if (chunk != 0) fn(i);
   }
+  if (whole == count) return;
+  std::uint64_t chunk = 0;
+  std::memcpy(&chunk, bytes + whole, count - whole);
+  if (chunk != 0) fn(whole);
 }
 
 // The regions each streamline's points fell in: a byte a streamline for each 8 regions (one byte for most
@@ -120,8 +125,11 @@ class RegionHits {
   void add(std::uint64_t streamline, Bits regions) {
     std::uint8_t* at = bytes_.get() + streamline * stride_;
     for (std::size_t b = 0; b < stride_; ++b)
-      if (const auto part = static_cast<std::uint8_t>(regions >> (8 * b)); part != 0)
-        std::atomic_ref<std::uint8_t>(at[b]).fetch_or(part, std::memory_order_relaxed);
+      if (const auto part = static_cast<std::uint8_t>(regions >> (8 * b)); part != 0) {
+        std::atomic_ref<std::uint8_t> byte(at[b]);
+        // A streamline crosses a region in several voxlines: the locked OR only where a bit is new.
+        if ((byte.load(std::memory_order_relaxed) & part) != part) byte.fetch_or(part, std::memory_order_relaxed);
+      }
   }
   Bits operator[](std::uint64_t streamline) const {
     const std::uint8_t* at = bytes_.get() + streamline * stride_;
@@ -133,6 +141,13 @@ class RegionHits {
   // (most of them, in a small selection).
   template <typename Fn>
   void for_each(std::uint64_t streamlines, Fn&& fn) const {
+    if (stride_ == 1) {  // most selections: a byte a streamline, no division
+      for_each_nonzero_chunk(bytes_.get(), streamlines, [&](std::uint64_t first) {
+        for (std::uint64_t s = first; s < std::min(streamlines, first + 8); ++s)
+          if (bytes_.get()[s] != 0) fn(s, Bits(bytes_.get()[s]));
+      });
+      return;
+    }
     std::uint64_t next = 0;  // the first streamline not yet looked at
     for_each_nonzero_chunk(bytes_.get(), streamlines * stride_, [&](std::uint64_t byte) {
       for (std::uint64_t s = std::max(next, byte / stride_); s <= (byte + 7) / stride_ && s < streamlines; ++s)
@@ -416,19 +431,30 @@ struct DraggedSphere {
                     const std::array<QuantumWindow, kMaxRegions>& windows) const {
     double lo = b.near_lo - moved, hi = b.near_hi + moved;
     BoxVerdict verdict;
-    if (lo > radius + margin)
+    if (lo > radius + margin) {
       verdict.outside = bit;
-    else if (hi < radius - margin)
+    } else if (hi < radius - margin) {
       verdict.inside = bit;
-    const BoxVerdict boxed = box_verdict(b, candidates & ~(verdict.outside | verdict.inside), table, packer, windows);
-    verdict.outside |= boxed.outside, verdict.inside |= boxed.inside;
+    } else if (b.nearest != BoxedVoxline::kNoNearest) {  // the point that was nearest, tested as contains() tests it
+      float p[3];
+      packer.decode_word(words[b.first + b.nearest], p);
+      const float d2 = sphere->squared_distance(p);
+      if (d2 <= sphere->radius_squared()) verdict.inside = bit;
+      hi = std::min(hi, std::sqrt(double(d2)));
+    }
+    if (const Bits rest = candidates & ~(verdict.outside | verdict.inside); rest != 0) {
+      const BoxVerdict boxed = box_verdict(b, rest, table, packer, windows);
+      verdict.outside |= boxed.outside, verdict.inside |= boxed.inside;
+    }
     if (((verdict.outside | verdict.inside) & bit) == 0) {  // measured again, with contains()'s arithmetic
       float nearest = INFINITY;
+      std::uint32_t nearest_at = BoxedVoxline::kNoNearest;
       for (std::uint32_t i = (b.flags & BoxedVoxline::kSyntheticFirst) ? 1 : 0; i < b.own; ++i) {
         float p[3];
         packer.decode_word(words[b.first + i], p);
-        nearest = std::min(nearest, sphere->squared_distance(p));
+        if (const float d2 = sphere->squared_distance(p); d2 < nearest) nearest = d2, nearest_at = i;
       }
+      b.nearest = std::uint16_t(std::min<std::uint32_t>(nearest_at, BoxedVoxline::kNoNearest));
       (nearest <= sphere->radius_squared() ? verdict.inside : verdict.outside) |= bit;
       lo = hi = std::sqrt(double(nearest));
     }
@@ -443,7 +469,8 @@ struct DraggedSphere {
 void boxed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacker& packer, VoxlineBoxes& boxes,
                       std::span<BoxedVoxline> list, const DraggedSphere& dragged, VoxelScratch& scratch,
                       RegionHits& hits) {
-  const Bits candidates = search.voxel_regions.touching[voxel] & ~search.voxel_regions.holding[voxel];
+  const Bits touching = search.voxel_regions.touching[voxel];
+  const Bits candidates = touching & ~search.voxel_regions.holding[voxel];
   const std::uint64_t first = search.voxels[voxel].vertex_first;
   const std::uint32_t* words = search.file.packed_vertices().data() + first;
   const bool follow = (candidates & dragged.bit) != 0;
@@ -461,6 +488,7 @@ void boxed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacker
     const BoxVerdict verdict = follow
                                    ? dragged.decide(b, moved, candidates, words, packer, search.table, scratch.windows)
                                    : box_verdict(b, candidates, search.table, packer, scratch.windows);
+    if ((touching & ~verdict.outside) == 0) continue;  // outside every region near the voxel
     const VoxlinePlace v{voxel,
                          b.own,
                          (b.flags & BoxedVoxline::kSyntheticFirst) != 0,
@@ -572,21 +600,32 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
   result.points_tested = search.points_tested;
 
   const Bits needed = table.include | table.ends;
-  std::vector<std::uint8_t> passes(n, needed == 0 ? 1 : 0);
-  result.streamlines_per_region.assign(table.regions.size(), 0);
-  hits.for_each(n, [&](std::uint64_t s, Bits regions) {
-    passes[s] = (regions & needed) == needed && (regions & table.exclude) == 0;
-    for (Bits b = regions; b != 0; b &= b - 1) ++result.streamlines_per_region[std::countr_zero(b)];
-  });
   const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
   result.bytes_read += result.points_tested * vertex_bytes;
-
+  result.streamlines_per_region.assign(table.regions.size(), 0);
+  auto count_regions = [&](Bits regions) {
+    for (Bits b = regions; b != 0; b &= b - 1) ++result.streamlines_per_region[std::countr_zero(b)];
+  };
   // Length limits, for the streamlines still in (tckedit applies its thresholds even without options: a header
-  // can make them cut). SLEN decides a packed file's lengths: its points are not the source's, and SLEN is
-  // within (points + 5) float32 roundings of tckedit's length. With float32 positions SLEN decides where it lies
-  // farther than that from both limits, and the points of the rest are measured as tckedit measures them, so
-  // the answer is tckedit's to the bit. Files without SLEN, and the table-walking path, measure every length.
+  // can make them cut).
   const LengthLimits limits = tckedit_length_limits(file, criteria.min_length, criteria.max_length);
+  if (limits.keep_every_length() && !criteria.invert && needed != 0) {
+    // The streamlines kept are those whose hits pass, in order, and they have points: no table of the rest.
+    hits.for_each(n, [&](std::uint64_t s, Bits regions) {
+      count_regions(regions);
+      if ((regions & needed) == needed && (regions & table.exclude) == 0) result.streamlines.push_back(s);
+    });
+    return result;
+  }
+  std::vector<std::uint8_t> passes(n, needed == 0 ? 1 : 0);
+  hits.for_each(n, [&](std::uint64_t s, Bits regions) {
+    passes[s] = (regions & needed) == needed && (regions & table.exclude) == 0;
+    count_regions(regions);
+  });
+  // SLEN decides a packed file's lengths: its points are not the source's, and SLEN is within (points + 5) float32
+  // roundings of tckedit's length. With float32 positions SLEN decides where it lies farther than that from both
+  // limits, and the points of the rest are measured as tckedit measures them, so the answer is tckedit's to the
+  // bit. Files without SLEN, and the table-walking path, measure every length.
   if (!limits.keep_every_length()) {
     constexpr std::uint8_t kMeasure = 2;
     const bool slen = !file.streamline_lengths().empty() && path == SelectionPath::Fastest;

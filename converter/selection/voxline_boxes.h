@@ -32,6 +32,10 @@ struct BoxedVoxline {
   std::uint8_t flags = 0;
   // The quanta of the points a region test reads (own points but a synthetic first): lo > hi on an axis when none.
   std::array<std::uint16_t, 3> lo{}, hi{};
+  // Which of its points was the nearest when its distances were last measured (kNoNearest: unknown): still inside
+  // the moved sphere, it decides the voxline without the others.
+  static constexpr std::uint16_t kNoNearest = 0xFFFF;
+  std::uint16_t nearest = kNoNearest;
   // Where the nearest of those points lies from the voxel's reference centre (VoxelReference), in mm: a dragged
   // sphere moved by d from there has it within [near_lo - d, near_hi + d], which decides most voxlines without
   // their points. Unknown: [0, infinity].
@@ -43,6 +47,8 @@ struct VoxelReference {
   std::array<float, 3> centre{};
   bool known = false;
 };
+
+static_assert(sizeof(BoxedVoxline) == 36, "the budget counts 36 bytes a voxline");
 
 class VoxlineBoxes {
  public:
