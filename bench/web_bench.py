@@ -12,8 +12,12 @@ WebAssembly memory, gpu-process: SwiftShader's copies of the textures), the leve
 bytes fetched, and once the page is done its WebAssembly memory (and malloc's use of it: now and at most) and
 its JavaScript heap. --gpu sets the page's GPU memory budget (?gpu=).
 
-Usage: bench/web_bench.py FILE.vxl... [--rounds N] [--size WxH] [--server ranges|first-range|whole] [--gpu SIZE]
-       [--voxlines PATH]
+Each round starts a browser of its own (a cold browser: its GPU process, SwiftShader, starts with the page), or
+with --warm all rounds run in one browser, a tab after another: the first round's browser is cold, the later
+rounds' warm (as for a recipient who has a browser open, or opens a second link).
+
+Usage: bench/web_bench.py FILE.vxl... [--rounds N] [--warm] [--size WxH] [--server ranges|first-range|whole]
+       [--gpu SIZE] [--voxlines PATH]
 """
 import argparse
 import os
@@ -96,6 +100,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('files', nargs='+')
     parser.add_argument('--rounds', type=int, default=2)
+    parser.add_argument('--warm', action='store_true', help='all rounds in one browser (the first cold, then warm)')
     parser.add_argument('--size', default='1024x1024')
     parser.add_argument('--server', choices=sorted(SERVERS), default='ranges')
     parser.add_argument('--gpu', help="the page's GPU memory budget (?gpu=, e.g. 256M)")
@@ -110,20 +115,26 @@ def main():
             server = web_server.Server(folder, SERVERS[args.server])
             url = f'{server.url}index.html?size={args.size}' + (f'&gpu={args.gpu}' if args.gpu else '')
             size = os.path.getsize(path)
+            shared = web_capture.Browser(args.chromium) if args.warm else None
             try:
                 for r in range(args.rounds):
                     sampler = PeakSampler()
                     web_server.RangeHandler.reset_counts()
                     t0 = time.monotonic()
+                    picture = os.path.join(work, 'picture.png')
                     try:
-                        report = web_capture.capture(url, os.path.join(work, 'picture.png'), 900, args.chromium,
-                                                     on_start=sampler.start)
+                        if shared:
+                            sampler.start(shared.process)
+                            report = shared.capture(url, picture, 900)
+                        else:
+                            report = web_capture.capture(url, picture, 900, args.chromium, on_start=sampler.start)
                     finally:
                         sampler.stop()
                     if 'error' in report:
                         print(f'{os.path.basename(path)}: {report["error"]}')
                         return 1
-                    print(f'{os.path.basename(path)} ({size / 2**20:.0f} MiB, server: {args.server}) round {r + 1}: first picture '
+                    browser = 'warm' if shared and r > 0 else 'cold'
+                    print(f'{os.path.basename(path)} ({size / 2**20:.0f} MiB, server: {args.server}) round {r + 1}, {browser} browser: first picture '
                           f'{report["first_picture_ms"] / 1000:.2f} s (level {report["first_level"]}), full detail {report["full_detail_ms"] / 1000:.2f} s, '
                           f'browser peak RSS {sampler.peak / 2**20:.0f} MiB = {sampler.peak / size:.2f}x the file '
                           f'(whole run {time.monotonic() - t0:.1f} s)', flush=True)
@@ -138,7 +149,11 @@ def main():
                                 f'JavaScript heap {report["heap_bytes"] / 2**20:.0f} MiB')
                     print(f'    at the peak, MiB: {kinds}; drawn at rest: level {report.get("full_level")}{budget}'
                           f'{fetched}{page}', flush=True)
+                    steps = ', '.join(f'{name} {ms / 1000:.2f}' for name, ms in report.get('marks', []))
+                    print(f'    on the way to the first picture, s from navigation: {steps}', flush=True)
             finally:
+                if shared:
+                    shared.__exit__(None, None, None)
                 server.close()
     return 0
 

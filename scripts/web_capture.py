@@ -118,6 +118,8 @@ FIRST_PICTURE = """new Promise((resolve) => {
         full_level: window.voxweb.info ? window.voxweb.info.full_level : null,
         mode: window.voxweb.mode ? window.voxweb.mode() : null,
         levels_shown: window.voxweb.levelsShown || [],
+        marks: performance.getEntriesByType('mark').filter((m) => m.startTime <= first)
+          .map((m) => [m.name.replace('voxweb:', ''), m.startTime]),
         heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null,
         memory: window.voxweb.memory ? window.voxweb.memory() : null }), failed);
     }, failed);
@@ -125,19 +127,15 @@ FIRST_PICTURE = """new Promise((resolve) => {
 })"""
 
 
-def capture(url, out, timeout, chromium, on_start=None):
-    """The page's report (a dict; with 'error' when the page failed), its picture written to `out`.
-    on_start(process) is called once the browser runs (a benchmark samples its memory)."""
-    profile = tempfile.mkdtemp(prefix='voxweb-chromium-')
-    browser = None
+def capture_in(browser, url, out, timeout):
+    """The page's report (a dict; with 'error' when the page failed) in a new tab of `browser` (a DevTools), its
+    picture written to `out`; the tab is closed after."""
+    target = browser.call('Target.createTarget', {'url': 'about:blank'})['targetId']
     try:
-        browser = DevTools(chromium, profile)
-        if on_start:
-            on_start(browser.process)
-        target = browser.call('Target.createTarget', {'url': 'about:blank'})['targetId']
         session = browser.call('Target.attachToTarget', {'targetId': target, 'flatten': True})['sessionId']
         browser.call('Page.enable', session=session)
         browser.call('Runtime.enable', session=session)
+        browser.events.clear()
         browser.call('Page.navigate', {'url': url}, session=session)
         browser.wait_event('Page.loadEventFired', timeout)
         result = browser.call('Runtime.evaluate', {'expression': FIRST_PICTURE, 'awaitPromise': True,
@@ -145,27 +143,58 @@ def capture(url, out, timeout, chromium, on_start=None):
                               session=session, timeout=timeout)
         console = [' '.join(str(a.get('value', a.get('description', ''))) for a in e['params'].get('args', []))
                    for e in browser.events if e.get('method') == 'Runtime.consoleAPICalled']
-        value = result.get('result', {}).get('value') or {}
-        if 'exceptionDetails' in result:
-            value = {'error': result['exceptionDetails'].get('text', 'the page threw')}
-        report = {'url': url, 'console': console}
-        if 'error' in value:
-            report['error'] = value['error']
-            return report
-        png = base64.b64decode(value['png'].split(',', 1)[1])
-        with open(out + '.part', 'wb') as f:
-            f.write(png)
-        os.replace(out + '.part', out)
-        report.update({'first_picture_ms': round(value['first_picture_ms'], 1),
-                       'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'],
-                       'full_level': value.get('full_level'), 'mode': value.get('mode'),
-                       'levels_shown': value['levels_shown'],
-                       'heap_bytes': value['heap_bytes'], 'memory': value.get('memory')})
-        return report
     finally:
-        if browser:
-            browser.close()
-        shutil.rmtree(profile, ignore_errors=True)
+        browser.call('Target.closeTarget', {'targetId': target})
+    value = result.get('result', {}).get('value') or {}
+    if 'exceptionDetails' in result:
+        value = {'error': result['exceptionDetails'].get('text', 'the page threw')}
+    report = {'url': url, 'console': console}
+    if 'error' in value:
+        report['error'] = value['error']
+        return report
+    png = base64.b64decode(value['png'].split(',', 1)[1])
+    with open(out + '.part', 'wb') as f:
+        f.write(png)
+    os.replace(out + '.part', out)
+    report.update({'first_picture_ms': round(value['first_picture_ms'], 1),
+                   'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'],
+                   'full_level': value.get('full_level'), 'mode': value.get('mode'),
+                   'levels_shown': value['levels_shown'], 'marks': value.get('marks', []),
+                   'heap_bytes': value['heap_bytes'], 'memory': value.get('memory')})
+    return report
+
+
+class Browser:
+    """A headless Chromium with a fresh profile, for pages opened one after another (a warm browser after the
+    first); `with Browser(chromium) as b: b.capture(url, out, timeout)`."""
+
+    def __init__(self, chromium):
+        self._profile = tempfile.mkdtemp(prefix='voxweb-chromium-')
+        try:
+            self.devtools = DevTools(chromium, self._profile)
+        except BaseException:
+            shutil.rmtree(self._profile, ignore_errors=True)
+            raise
+        self.process = self.devtools.process
+
+    def capture(self, url, out, timeout):
+        return capture_in(self.devtools, url, out, timeout)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.devtools.close()
+        shutil.rmtree(self._profile, ignore_errors=True)
+
+
+def capture(url, out, timeout, chromium, on_start=None):
+    """The page's report in a browser of its own (capture_in). on_start(process) is called once the browser runs
+    (a benchmark samples its memory)."""
+    with Browser(chromium) as browser:
+        if on_start:
+            on_start(browser.process)
+        return browser.capture(url, out, timeout)
 
 
 def main():

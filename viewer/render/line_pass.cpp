@@ -58,11 +58,16 @@ void LinePass::make_programs(bool slice_test) {
   for (GLuint* p : {&over_program_, &accum_program_, &reveal_program_, &additive_program_})
     if (*p) glDeleteProgram(std::exchange(*p, 0));
   slice_test_ = slice_test;
-  const char* const version = "#version 330 core";
-  over_program_ = make_program(shaders::kLineOverFragment, version);
-  accum_program_ = make_program(shaders::kLineWboitAccumFragment, version);
-  reveal_program_ = make_program(shaders::kLineWboitRevealFragment, version);
-  additive_program_ = make_program(shaders::kLineAdditiveFragment, version);
+}
+
+GLuint LinePass::program(GLuint& slot, Fragment fragment) const {
+  if (slot) return slot;
+  const char* body = fragment == Fragment::Over         ? shaders::kLineOverFragment
+                     : fragment == Fragment::WboitAccum ? shaders::kLineWboitAccumFragment
+                     : fragment == Fragment::WboitReveal ? shaders::kLineWboitRevealFragment
+                                                         : shaders::kLineAdditiveFragment;
+  slot = make_program(body, "#version 330 core");
+  return slot;
 }
 
 GLuint LinePass::make_program(const char* fragment_body, const char* version) const {

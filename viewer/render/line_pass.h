@@ -46,16 +46,18 @@ class LinePass {
   LinePass(const LinePass&) = delete;
   LinePass& operator=(const LinePass&) = delete;
 
-  // Makes the line programs again, testing fragments against the slices' depth or not (a scene without an
-  // image does not pay for the test).
+  // Forgets the line programs, to be made again on first use testing fragments against the slices' depth or not
+  // (a scene without an image does not pay for the test).
   void make_programs(bool slice_test);
   // A program of the line vertex shader and line_fragment(body, version) for this scene's span slots and
   // slice test (the exact mode's list pass). The caller deletes it.
   GLuint make_program(const char* fragment_body, const char* version) const;
-  GLuint over() const { return over_program_; }
-  GLuint wboit_accum() const { return accum_program_; }
-  GLuint wboit_reveal() const { return reveal_program_; }
-  GLuint additive() const { return additive_program_; }
+  // The modes' line programs, each made on first use: a software rasteriser (SwiftShader in a browser) takes a
+  // good part of a second for one, and a picture needs one or two of the four.
+  GLuint over() const { return program(over_program_, Fragment::Over); }
+  GLuint wboit_accum() const { return program(accum_program_, Fragment::WboitAccum); }
+  GLuint wboit_reveal() const { return program(reveal_program_, Fragment::WboitReveal); }
+  GLuint additive() const { return program(additive_program_, Fragment::Additive); }
   unsigned bound_spans() const { return bound_spans_; }  // span slots of the line programs
   GLuint vao() const { return vao_; }                    // core profile draws need a bound VAO, even without attributes
 
@@ -79,13 +81,15 @@ class LinePass {
 
  private:
   void upload_streamline_groups(const SceneGroups& groups);
+  enum class Fragment { Over, WboitAccum, WboitReveal, Additive };
+  GLuint program(GLuint& slot, Fragment fragment) const;
 
   GpuScene& scene_;
   const std::vector<const VxlFile*>& files_;
   GLuint vao_ = 0;
   unsigned bound_spans_ = 1;
   bool slice_test_ = false;
-  GLuint over_program_ = 0, accum_program_ = 0, reveal_program_ = 0, additive_program_ = 0;
+  mutable GLuint over_program_ = 0, accum_program_ = 0, reveal_program_ = 0, additive_program_ = 0;
   std::string attributes_key_;  // what the attribute buffers hold ("" : nothing)
   // One byte per streamline of the scene (the files' streamlines one after another): its group mod the
   // shader's group table. A new selection or grouping uploads this alone, not the per-vertex attributes.

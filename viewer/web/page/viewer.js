@@ -5,6 +5,9 @@
 'use strict';
 
 (function () {
+  // Steps on the way to the first picture, for benchmarks (performance.getEntriesByType('mark')).
+  const mark = (step) => performance.mark('voxweb:' + step);
+  mark('script');
   const $ = (id) => document.getElementById(id);
   const canvas = $('canvas');
   const params = new URLSearchParams(location.search);
@@ -43,6 +46,7 @@
   }
 
   createVoxweb({ canvas }).then((Module) => {
+    mark('wasm ready');
     const api = {
       open: Module.cwrap('vw_open', 'number', ['number', 'number', 'string', 'number', 'number', 'number']),
       planOpen: Module.cwrap('vw_plan_open', 'string', ['number', 'number', 'number', 'string']),
@@ -140,6 +144,7 @@
       const pending = api.pending();
       fullShown = fullDetail && !moving && !pending;
       if (firstFrame) {
+        mark('first frame drawn');
         firstFrame = false;
         settle.resolve();
         setTimeout(afterFirstPicture, 0);  // once the first picture is on the screen
@@ -466,6 +471,7 @@
     async function fetchByRanges(target, response, t0) {
       const { name, size } = target;
       const first = new Uint8Array(await response.arrayBuffer());
+      mark('first bytes');
       if (!current(target)) return;
       if (first.length === 0 || first.length > size)
         throw new Error(`${target.url}: a first range answer of ${first.length} bytes for a file of ${size}`);
@@ -485,11 +491,15 @@
         throw err;
       }
       if (!ok) return Module._free(target.pointer);
+      mark('tables fetched');
       const [w, h] = canvasSize();
       // From here the viewer holds the buffer (and frees it).
       if (api.open(target.pointer, size, name, w, h, 0) !== 0) return fail(api.error());
+      mark('opened');
       if (!(await bring(target, JSON.parse(api.levelRanges(-1, LEVEL_GAP))))) return;
+      mark('first level fetched');
       if (api.show() !== 0) return fail(api.error());
+      mark('first level uploaded');
       bytesComplete = false;
       // The finer levels one after the other (each an eighth of the next: 1/64, 1/8 of the file...), each drawn
       // at rest as it comes; then what the level drawn at rest reads (full detail, or the finest the GPU budget
