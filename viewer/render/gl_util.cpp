@@ -83,6 +83,8 @@ PixelLayout pixel_layout(GLenum internal_format) {
   }
 }
 
+constexpr std::size_t kUploadBandBytes = 8u << 20;
+
 // WebGL2's stand-in for a buffer texture: a 2D texture of kBufferTextureWidth-texel rows holding `bytes`
 // (at least one texel), filled from `data` when given. A last row only partly filled leaves the rest zero.
 GLuint make_rows_texture(GLenum internal_format, const void* data, std::size_t bytes) {
@@ -101,9 +103,14 @@ GLuint make_rows_texture(GLenum internal_format, const void* data, std::size_t b
     const std::size_t texels_given = bytes / px.texel_bytes;
     const std::size_t full_rows = texels_given / kBufferTextureWidth;
     const auto* bytes_in = static_cast<const std::uint8_t*>(data);
-    if (full_rows > 0)
-      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, kBufferTextureWidth, static_cast<GLsizei>(full_rows), px.format, px.type,
-                      bytes_in);
+    // In bands of rows: a browser copies what one call passes into memory shared with its GPU process, and a
+    // span's texture is up to 512 MiB.
+    const std::size_t row_bytes = kBufferTextureWidth * px.texel_bytes;
+    const std::size_t band_rows = std::max<std::size_t>(1, kUploadBandBytes / row_bytes);
+    for (std::size_t row = 0; row < full_rows; row += band_rows)
+      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, static_cast<GLint>(row), kBufferTextureWidth,
+                      static_cast<GLsizei>(std::min(band_rows, full_rows - row)), px.format, px.type,
+                      bytes_in + row * row_bytes);
     if (const std::size_t tail = texels_given - full_rows * kBufferTextureWidth; tail > 0)
       glTexSubImage2D(GL_TEXTURE_2D, 0, 0, static_cast<GLint>(full_rows), static_cast<GLsizei>(tail), 1, px.format,
                       px.type, bytes_in + full_rows * kBufferTextureWidth * px.texel_bytes);

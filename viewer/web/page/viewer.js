@@ -369,23 +369,91 @@
       }
       return -1;
     }
-    // A multipart/byteranges body -> [[begin, end, bytes, the file's size or null], ...].
-    function parts(body, boundary, url) {
+    // Where a response's body goes, a chunk at a time as it arrives, straight into the file's buffer (a body is
+    // never held whole: a page fetching a large file in 32 MiB requests would otherwise hold them until collected).
+    // Each sink checks a part's place in the file before writing a byte of it; end() gives the parts written,
+    // [[begin, end, the file's size or null], ...].
+    function copyInto(target, at, bytes) {
+      Module.HEAPU8.set(bytes, target.pointer + at);
+    }
+    // The whole file (a 200 answer), or one range ([begin, end) of `total`).
+    function rangeSink(target, begin, end, total, url, wrong) {
+      let at = begin;
+      return {
+        add(bytes) {
+          if (at + bytes.length > end) throw new Error(wrong);
+          copyInto(target, at, bytes);
+          at += bytes.length;
+        },
+        end() {
+          if (at !== end) throw new Error(wrong);
+          return [[begin, end, total]];
+        },
+      };
+    }
+    // A multipart/byteranges body: each part's headers, then its bytes, found as they arrive.
+    function multipartSink(target, boundary, url) {
       const marker = new TextEncoder().encode('--' + boundary), blank = new TextEncoder().encode('\r\n\r\n');
       const found = [];
-      for (let at = indexOf(body, marker, 0); at >= 0;) {
-        at += marker.length;
-        if (body[at] === 45 && body[at + 1] === 45) break;  // "--": the closing delimiter
-        const headersEnd = indexOf(body, blank, at);
-        if (headersEnd < 0) break;
-        const headers = new TextDecoder('latin1').decode(body.subarray(at, headersEnd));
-        const r = contentRange((/content-range:([^\r\n]*)/i.exec(headers) || [])[1]);
-        const start = headersEnd + blank.length;
-        if (!r || start + r[1] - r[0] > body.length) throw new Error(`${url}: a malformed multipart/byteranges answer`);
-        found.push([r[0], r[1], body.subarray(start, start + r[1] - r[0]), r[2]]);
-        at = indexOf(body, marker, start + r[1] - r[0]);
+      let pending = new Uint8Array(0);  // bytes not yet placed: a delimiter's or headers' start
+      let part = null;  // the part whose bytes come next: {begin, end, total, at}
+      let closed = false;
+      const malformed = () => new Error(`${url}: a malformed multipart/byteranges answer`);
+      // Takes what it can of `bytes` (the pending ones first); keeps the rest pending.
+      function take(bytes) {
+        let at = 0;
+        while (at < bytes.length && !closed) {
+          if (part) {  // the part's bytes, straight into the file
+            const n = Math.min(part.end - part.at, bytes.length - at);
+            copyInto(target, part.at, bytes.subarray(at, at + n));
+            part.at += n;
+            at += n;
+            if (part.at === part.end) found.push([part.begin, part.end, part.total]), part = null;
+            continue;
+          }
+          const delimiter = indexOf(bytes, marker, at);
+          if (delimiter < 0) {  // keep what may be a delimiter's start
+            at = Math.max(at, bytes.length - marker.length);
+            break;
+          }
+          const after = delimiter + marker.length;
+          if (after + 2 > bytes.length) { at = delimiter; break; }
+          if (bytes[after] === 45 && bytes[after + 1] === 45) { closed = true; break; }  // "--": the closing one
+          const headersEnd = indexOf(bytes, blank, after);
+          if (headersEnd < 0) {
+            if (bytes.length - delimiter > 1 << 16) throw malformed();
+            at = delimiter;
+            break;
+          }
+          const headers = new TextDecoder('latin1').decode(bytes.subarray(after, headersEnd));
+          const r = contentRange((/content-range:([^\r\n]*)/i.exec(headers) || [])[1]);
+          if (!r) throw malformed();
+          checkPart(target, r[0], r[1], r[2]);
+          part = { begin: r[0], end: r[1], total: r[2], at: r[0] };
+          if (part.at === part.end) found.push([part.begin, part.end, part.total]), part = null;
+          at = headersEnd + blank.length;
+        }
+        pending = bytes.slice(at);
       }
-      return found;
+      return {
+        add(bytes) {
+          if (pending.length === 0) return take(bytes);
+          const joined = new Uint8Array(pending.length + bytes.length);
+          joined.set(pending);
+          joined.set(bytes, pending.length);
+          take(joined);
+        },
+        end() {
+          if (part) throw malformed();  // cut in a part's bytes
+          return found;
+        },
+      };
+    }
+    // A part's place in the file, checked before its bytes are written.
+    function checkPart(target, begin, end, total) {
+      if (end > target.size) throw new Error(`${target.url}: bytes ${begin}-${end - 1} lie past the file's end`);
+      if (total !== null && total !== target.size)
+        throw new Error(`${target.url} changed on the server while it was fetched (now ${total} bytes)`);
     }
     // The largest file the WebAssembly memory (32-bit, 4 GiB at most) can hold, with room for the viewer.
     const MAX_FILE_BYTES = 2 ** 32 - 2 ** 28;
@@ -434,29 +502,32 @@
       if (!current(target)) return null;
       if (response.status !== 206 && response.status !== 200)
         throw new Error(`${target.url}: HTTP ${response.status} to a range request`);
-      const body = new Uint8Array(await response.arrayBuffer());
-      if (!current(target)) return null;
-      let got;
       const boundary = /multipart\/byteranges;\s*boundary="?([^";]+)"?/i.exec(response.headers.get('Content-Type') || '');
+      let sink;
       if (response.status === 200) {
-        if (body.length !== target.size)
-          throw new Error(`${target.url} changed on the server while it was fetched (now ${body.length} bytes)`);
+        sink = rangeSink(target, 0, target.size, target.size, target.url,
+          `${target.url} changed on the server while it was fetched (its length is not ${target.size} bytes)`);
         target.whole = true;
-        got = [[0, body.length, body, body.length]];
       } else if (boundary) {
-        got = parts(body, boundary[1], target.url);
+        sink = multipartSink(target, boundary[1], target.url);
       } else {
         const r = contentRange(response.headers.get('Content-Range'));
-        if (!r || r[1] - r[0] !== body.length) throw new Error(`${target.url}: a range answer of the wrong length`);
-        got = [[r[0], r[1], body, r[2]]];
+        if (!r) throw new Error(`${target.url}: a range answer without a valid Content-Range`);
+        checkPart(target, r[0], r[1], r[2]);
+        sink = rangeSink(target, r[0], r[1], r[2], target.url, `${target.url}: a range answer of the wrong length`);
       }
-      for (const [begin, end, bytes, total] of got) {
-        if (end > target.size) throw new Error(`${target.url}: bytes ${begin}-${end - 1} lie past the file's end`);
-        if (total !== null && total !== target.size)
-          throw new Error(`${target.url} changed on the server while it was fetched (now ${total} bytes)`);
-        Module.HEAPU8.set(bytes, target.pointer + begin);
-        target.received += end - begin;
+      const reader = response.body.getReader();
+      for (;;) {
+        const { done, value } = await reader.read();
+        if (!current(target)) {
+          reader.cancel().catch(() => {});
+          return null;
+        }
+        if (done) break;
+        sink.add(value);
       }
+      const got = sink.end();
+      for (const [begin, end] of got) target.received += end - begin;
       $('progress').value = Math.min(1, target.received / target.size);
       return got;
     }
