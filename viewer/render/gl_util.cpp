@@ -1,6 +1,7 @@
 #include "viewer/render/gl_util.h"
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -185,6 +186,35 @@ void TextureBuffer::finish_mapped(GLenum internal_format) {
   staging_.reset();
 }
 
+void TextureBuffer::create_in_parts(GLenum internal_format, std::size_t bytes, const PartFill& fill) {
+  const PixelLayout px = pixel_layout(internal_format);
+  texture = make_rows_texture(internal_format, nullptr, bytes);
+  const std::size_t row_bytes = kBufferTextureWidth * px.texel_bytes;
+  const std::size_t part_bytes = std::max<std::size_t>(1, kUploadBandBytes / row_bytes) * row_bytes;
+  std::vector<std::uint8_t> part;
+  try {
+    for (std::size_t first = 0; first < bytes; first += part_bytes) {
+      part.assign(std::min(part_bytes, bytes - first), 0);
+      fill(first, part);
+      const std::size_t rows = part.size() / row_bytes, tail = (part.size() - rows * row_bytes) / px.texel_bytes;
+      const auto row = static_cast<GLint>(first / row_bytes);
+      glBindTexture(GL_TEXTURE_2D, texture);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      if (rows > 0)
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, row, kBufferTextureWidth, static_cast<GLsizei>(rows), px.format, px.type,
+                        part.data());
+      if (tail > 0)
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, row + static_cast<GLint>(rows), static_cast<GLsizei>(tail), 1, px.format,
+                        px.type, part.data() + rows * row_bytes);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+      glBindTexture(GL_TEXTURE_2D, 0);
+    }
+  } catch (...) {
+    destroy();
+    throw;
+  }
+}
+
 void TextureBuffer::update(std::size_t, const void*, std::size_t) {
   throw std::runtime_error("updating a buffer texture in place needs desktop OpenGL");
 }
@@ -238,6 +268,22 @@ void TextureBuffer::finish_mapped(GLenum internal_format) {
   glTexBuffer(GL_TEXTURE_BUFFER, internal_format, buffer);
   glBindTexture(GL_TEXTURE_BUFFER, 0);
   glBindBuffer(GL_TEXTURE_BUFFER, 0);
+}
+
+void TextureBuffer::create_in_parts(GLenum internal_format, std::size_t bytes, const PartFill& fill) {
+  auto* memory = static_cast<std::uint8_t*>(create_mapped(bytes));
+  try {
+    std::memset(memory, 0, bytes);
+    fill(0, {memory, bytes});
+  } catch (...) {
+    try {
+      finish_mapped(internal_format);
+    } catch (const std::exception&) {  // the contents are dropped anyway
+    }
+    destroy();
+    throw;
+  }
+  finish_mapped(internal_format);
 }
 
 void TextureBuffer::update(std::size_t offset, const void* data, std::size_t bytes) {

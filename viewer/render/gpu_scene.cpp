@@ -18,29 +18,50 @@ std::uint64_t GpuScene::driver_limit() {
 }
 
 // Voxel i's orders at the span's level, as the file stores them.
+template <typename T>
+void GpuScene::FillWindow<T>::put(std::uint64_t at, const T* from, std::uint64_t n) const {
+  const std::uint64_t begin = std::max(at, first), stop = std::min(at + n, end);
+  if (begin < stop) std::memcpy(data + (begin - first), from + (begin - at), (stop - begin) * sizeof(T));
+}
+
+template <typename T>
+void GpuScene::FillWindow<T>::fill(std::uint64_t at, std::uint64_t n, T value) const {
+  const std::uint64_t begin = std::max(at, first), stop = std::min(at + n, end);
+  if (begin < stop) std::fill(data + (begin - first), data + (stop - first), value);
+}
+
 void GpuScene::copy_voxel_orders(const VxlFile& file, std::uint32_t i, std::uint32_t li, const TextureSpan& c,
-                                 std::uint8_t* orders) const {
+                                 const FillWindow<std::uint8_t>& orders) const {
   const VoxelEntry& v = file.voxels()[li];
   const std::uint32_t level = layout_.files()[c.file].level;
-  std::memcpy(orders + 4 * layout_.voxels()[i].order_word,
-              file.order_bytes().data() + level_orders_offset(v, file.levels_of(li), level,
-                                                              file.meta().stored_order_count, file.order_packing()),
-              level_orders_size(file.level(li, level), c.slots, file.order_packing()));
+  orders.put(4 * layout_.voxels()[i].order_word,
+             file.order_bytes().data() + level_orders_offset(v, file.levels_of(li), level,
+                                                             file.meta().stored_order_count, file.order_packing()),
+             level_orders_size(file.level(li, level), c.slots, file.order_packing()));
 }
 
 // Voxel i's part of its span's words: the block's packed words as stored (a float32 block packed here, its
 // voxline-end bits from order 0, whose entries this therefore checks), zeros after the block up to the next
 // voxel's, and the small decoding info and table entries.
 void GpuScene::fill_voxel_words(const VxlFile& file, std::uint32_t i, std::uint32_t li, std::uint32_t index,
-                                const TextureSpan& c, std::uint32_t* words, VoxelScratch& scratch) const {
+                                const TextureSpan& c, const FillWindow<std::uint32_t>& words,
+                                VoxelScratch& scratch) const {
   const VoxelEntry& v = file.voxels()[li];
   const VoxelDrawInfo& d = layout_.voxels()[i];
   // The scene's level of the voxel: a prefix of its block and that level's orders (.vxl spec §5.12).
   const std::uint32_t level = layout_.files()[c.file].level;
   const LevelEntry counts = file.level(li, level);
-  std::uint32_t* block = words + d.vertex_first;
+  const std::uint64_t group = SceneLayout::kGroup;
+  const std::uint64_t padded_vertices = (counts.vertex_count + group - 1) / group * group;
+  const std::uint64_t padded_segments = (counts.segment_count + group - 1) / group * group;
+  const std::uint64_t info_at = c.info_first() + TextureSpan::kInfoWords * std::uint64_t(index);
+  const std::uint64_t segment_table_at = c.segment_table_first() + d.seg_first / group;
+  const std::uint64_t vertex_table_at = c.vertex_table_first() + d.vertex_first / group;
+  if (!words.meets(d.vertex_first, padded_vertices) && !words.meets(info_at, TextureSpan::kInfoWords) &&
+      !words.meets(segment_table_at, padded_segments / group) && !words.meets(vertex_table_at, padded_vertices / group))
+    return;
   if (file.position_encoding() == PositionEncoding::Packed) {
-    std::memcpy(block, file.packed_vertices().data() + v.vertex_first, 4 * std::uint64_t(counts.vertex_count));
+    words.put(d.vertex_first, file.packed_vertices().data() + v.vertex_first, counts.vertex_count);
   } else {
     // float32 blocks carry no end bits: they come from order 0 (a vertex where no segment starts).
     std::vector<std::uint8_t>& is_start = scratch.is_start;
@@ -57,16 +78,16 @@ void GpuScene::fill_voxel_words(const VxlFile& file, std::uint32_t i, std::uint3
     }
     scratch.xyz.resize(3 * std::uint64_t(counts.vertex_count));
     file.read_vertices(li, v.vertex_first, counts.vertex_count, scratch.xyz.data());
-    pack_block(v, scratch.xyz.data(), counts.vertex_count, block);
-    for (std::uint32_t n = 0; n < counts.vertex_count; ++n) block[n] |= is_start[n] ? 0u : kPackedVoxlineEnd;
+    scratch.block.resize(counts.vertex_count);
+    pack_block(v, scratch.xyz.data(), counts.vertex_count, scratch.block.data());
+    for (std::uint32_t n = 0; n < counts.vertex_count; ++n) scratch.block[n] |= is_start[n] ? 0u : kPackedVoxlineEnd;
+    words.put(d.vertex_first, scratch.block.data(), counts.vertex_count);
   }
-  const std::uint64_t group = SceneLayout::kGroup;
-  const std::uint64_t padded_vertices = (counts.vertex_count + group - 1) / group * group;
-  std::fill(block + counts.vertex_count, block + padded_vertices, 0u);
+  words.fill(d.vertex_first + counts.vertex_count, padded_vertices - counts.vertex_count, 0u);
 
   // Decoding info (TextureSpan::kInfoWords): lo and step per axis as the spec computes them (binary32), where
   // the block and the orders are, and the level's counts, which the shader clamps the file's entries to.
-  std::uint32_t* info = words + c.info_first() + TextureSpan::kInfoWords * index;
+  std::uint32_t info[TextureSpan::kInfoWords] = {};
   for (int a = 0; a < 3; ++a) {
     const float lo = v.tight_min[a], step = (v.tight_max[a] - v.tight_min[a]) / static_cast<float>(kPackedSteps);
     std::memcpy(info + a, &lo, 4);
@@ -78,9 +99,9 @@ void GpuScene::fill_voxel_words(const VxlFile& file, std::uint32_t i, std::uint3
   info[9] = counts.segment_count;
   info[10] = d.order_bits;
   info[11] = static_cast<std::uint32_t>(d.order_word);
-  const std::uint64_t padded_segments = (counts.segment_count + group - 1) / group * group;
-  std::fill_n(words + c.segment_table_first() + d.seg_first / group, padded_segments / group, index);
-  std::fill_n(words + c.vertex_table_first() + d.vertex_first / group, padded_vertices / group, index);
+  words.put(info_at, info, TextureSpan::kInfoWords);
+  words.fill(segment_table_at, padded_segments / group, index);
+  words.fill(vertex_table_at, padded_vertices / group, index);
 }
 
 namespace {
@@ -136,7 +157,40 @@ void GpuScene::upload_span(std::uint32_t c) {
   finish_upload(filling_.size() - 1);
 }
 
+void GpuScene::upload_span_in_parts(std::uint32_t ci) {
+  const TextureSpan& c = layout_.texture_spans()[ci];
+  const VxlFile& file = *files_[c.file];
+  const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
+  GpuTextureSpan& g = spans_[ci];
+  VoxelScratch scratch;
+  g.words.create_in_parts(GL_RGBA32UI, 4 * c.words(), [&](std::uint64_t first_byte, std::span<std::uint8_t> part) {
+    const FillWindow<std::uint32_t> words{reinterpret_cast<std::uint32_t*>(part.data()), first_byte / 4,
+                                          (first_byte + part.size()) / 4};
+    for (std::uint32_t k = 0; k < c.voxel_count; ++k)
+      fill_voxel_words(file, c.voxel_first + k, c.voxel_first + k - file_first, k, c, words, scratch);
+  });
+  try {
+    g.orders.create_in_parts(GL_R32UI, 4 * c.order_words, [&](std::uint64_t first_byte, std::span<std::uint8_t> part) {
+      const FillWindow<std::uint8_t> orders{part.data(), first_byte, first_byte + part.size()};
+      for (std::uint32_t k = 0; k < c.voxel_count; ++k)
+        copy_voxel_orders(file, c.voxel_first + k, c.voxel_first + k - file_first, c, orders);
+    });
+  } catch (...) {
+    g.words.destroy();
+    throw;
+  }
+}
+
 void GpuScene::begin_upload(std::uint32_t ci) {
+  if constexpr (!kThreadsAvailable) {  // made here: nothing fills on other threads
+    upload_span_in_parts(ci);
+    Filling f;
+    f.span = ci;
+    filling_.push_back(std::move(f));
+    uploaded_bytes_[ci] = span_bytes(ci);
+    gpu_bytes_ += uploaded_bytes_[ci];
+    return;
+  }
   const TextureSpan& c = layout_.texture_spans()[ci];
   const VxlFile& file = *files_[c.file];
   const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
@@ -148,25 +202,21 @@ void GpuScene::begin_upload(std::uint32_t ci) {
   auto* words = static_cast<std::uint32_t*>(g.words.create_mapped(4 * c.words()));
   f.words = BackgroundTask<>([this, &c, &file, file_first, words] {
     std::vector<VoxelScratch> scratch(resolve_threads(0));  // per thread
+    const FillWindow<std::uint32_t> window{words, 0, c.words()};
     parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
       const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
-      fill_voxel_words(file, i, i - file_first, static_cast<std::uint32_t>(k), c, words, scratch[t]);
+      fill_voxel_words(file, i, i - file_first, static_cast<std::uint32_t>(k), c, window, scratch[t]);
     });
     // The last words of the tables' texel, which no voxel fills.
     std::fill(words + c.vertex_table_first() + c.vertices / SceneLayout::kGroup, words + c.words(), 0u);
   });
   try {
-    // Without threads the words are filled by now: their texture is made before the orders' host copy is
-    // allocated, so a WebAssembly page's memory (which keeps its high-water mark) holds one of the two, not both.
-    if constexpr (!kThreadsAvailable) {
-      f.words.get();
-      g.words.finish_mapped(GL_RGBA32UI);
-    }
     auto* orders = static_cast<std::uint8_t*>(g.orders.create_mapped(4 * c.order_words));
     f.orders = BackgroundTask<>([this, &c, &file, file_first, orders] {
+      const FillWindow<std::uint8_t> window{orders, 0, 4 * std::uint64_t(c.order_words)};
       parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned) {
         const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
-        copy_voxel_orders(file, i, i - file_first, c, orders);
+        copy_voxel_orders(file, i, i - file_first, c, window);
       });
     });
   } catch (...) {

@@ -123,16 +123,29 @@ class GpuScene {
   // budget.
   void upload_resident_again();
   void release();
+  // Elements [first, end) of a span's words or order bytes being filled, at `data`: the whole buffer, or one part
+  // of it (TextureBuffer::create_in_parts); what falls outside is not written.
+  template <typename T>
+  struct FillWindow {
+    T* data;
+    std::uint64_t first, end;
+    bool meets(std::uint64_t at, std::uint64_t n) const { return n > 0 && at < end && at + n > first; }
+    void put(std::uint64_t at, const T* from, std::uint64_t n) const;
+    void fill(std::uint64_t at, std::uint64_t n, T value) const;
+  };
   // Voxel `voxel` of the scene (`local` in its file, `index` in its span): its block, info and table entries
-  // into the span's mapped words; its orders into the span's mapped orders.
+  // into the span's words; its orders into the span's order bytes (as far as the windows reach).
   struct VoxelScratch {
     std::vector<std::uint8_t> is_start;
     std::vector<float> xyz;
+    std::vector<std::uint32_t> block;
   };
   void fill_voxel_words(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, std::uint32_t index,
-                        const TextureSpan& span, std::uint32_t* words, VoxelScratch& scratch) const;
+                        const TextureSpan& span, const FillWindow<std::uint32_t>& words, VoxelScratch& scratch) const;
   void copy_voxel_orders(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, const TextureSpan& span,
-                         std::uint8_t* orders) const;
+                         const FillWindow<std::uint8_t>& orders) const;
+  // Without threads (a web page): span c's words and orders made a part at a time (create_in_parts).
+  void upload_span_in_parts(std::uint32_t c);
   std::vector<const VxlFile*> files_;
   SceneLayout layout_;
   std::shared_ptr<GpuMemoryPool> pool_;

@@ -62,8 +62,8 @@ void LinePass::make_programs(bool slice_test) {
 
 GLuint LinePass::program(GLuint& slot, Fragment fragment) const {
   if (slot) return slot;
-  const char* body = fragment == Fragment::Over         ? shaders::kLineOverFragment
-                     : fragment == Fragment::WboitAccum ? shaders::kLineWboitAccumFragment
+  const char* body = fragment == Fragment::Over          ? shaders::kLineOverFragment
+                     : fragment == Fragment::WboitAccum  ? shaders::kLineWboitAccumFragment
                      : fragment == Fragment::WboitReveal ? shaders::kLineWboitRevealFragment
                                                          : shaders::kLineAdditiveFragment;
   slot = make_program(body, "#version 330 core");

@@ -496,6 +496,28 @@
     }
     // One request: the ranges received (null when another file was opened meanwhile). A server that answers a
     // range request with the whole file (status 200, as some do past a number of ranges) gives it all at once.
+    // Hands `response`'s body to `sink` a chunk at a time; false when another file was opened meanwhile. Read into
+    // one buffer of its own where the browser lets it (a byte stream's reader), so that the chunks, copied out at
+    // once, leave nothing for the collector; else chunk by chunk as the browser makes them.
+    async function readBody(response, sink, target) {
+      let reader, buffer = null;
+      try {
+        reader = response.body.getReader({ mode: 'byob' });
+        buffer = new ArrayBuffer(1 << 20);
+      } catch (err) {
+        reader = response.body.getReader();
+      }
+      for (;;) {
+        const { done, value } = await (buffer ? reader.read(new Uint8Array(buffer)) : reader.read());
+        if (!current(target)) {
+          reader.cancel().catch(() => {});
+          return false;
+        }
+        if (done) return true;
+        sink.add(value);
+        if (buffer) buffer = value.buffer;  // handed back by the read, to be read into again
+      }
+    }
     async function fetchBatch(target, batch) {
       const spec = batch.map((r) => `${r[0]}-${r[1] - 1}`).join(',');
       const response = await fetch(target.url, { headers: { Range: 'bytes=' + spec } });
@@ -516,16 +538,7 @@
         checkPart(target, r[0], r[1], r[2]);
         sink = rangeSink(target, r[0], r[1], r[2], target.url, `${target.url}: a range answer of the wrong length`);
       }
-      const reader = response.body.getReader();
-      for (;;) {
-        const { done, value } = await reader.read();
-        if (!current(target)) {
-          reader.cancel().catch(() => {});
-          return null;
-        }
-        if (done) break;
-        sink.add(value);
-      }
+      if (!(await readBody(response, sink, target))) return null;
       const got = sink.end();
       for (const [begin, end] of got) target.received += end - begin;
       $('progress').value = Math.min(1, target.received / target.size);
