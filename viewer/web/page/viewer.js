@@ -451,6 +451,7 @@
     }
     // A part's place in the file, checked before its bytes are written.
     function checkPart(target, begin, end, total) {
+      if (end <= begin) throw new Error(`${target.url}: a range answer for bytes ${begin}-${end - 1}, which holds none`);
       if (end > target.size) throw new Error(`${target.url}: bytes ${begin}-${end - 1} lie past the file's end`);
       if (total !== null && total !== target.size)
         throw new Error(`${target.url} changed on the server while it was fetched (now ${total} bytes)`);
