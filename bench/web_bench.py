@@ -151,6 +151,12 @@ def main():
                           f'{fetched}{page}', flush=True)
                     steps = ', '.join(f'{name} {ms / 1000:.2f}' for name, ms in report.get('marks', []))
                     print(f'    on the way to the first picture, s from navigation: {steps}', flush=True)
+                    tasks = report.get('long_tasks')
+                    if tasks is not None:
+                        after = [d for start, d in tasks if start >= report['first_picture_ms']]
+                        print(f'    the page\'s tasks of 50 ms and more: {len(tasks)}, the longest {max([0] + [d for _, d in tasks]):.0f} ms; '
+                              f'after the first picture {len(after)}, the longest {max([0] + after):.0f} ms, '
+                              f'{sum(after) / 1000:.1f} s in all', flush=True)
             finally:
                 if shared:
                     shared.__exit__(None, None, None)

@@ -121,7 +121,8 @@ FIRST_PICTURE = """new Promise((resolve) => {
         marks: performance.getEntriesByType('mark').filter((m) => m.startTime <= first)
           .map((m) => [m.name.replace('voxweb:', ''), m.startTime]),
         heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null,
-        memory: window.voxweb.memory ? window.voxweb.memory() : null }), failed);
+        memory: window.voxweb.memory ? window.voxweb.memory() : null,
+        long_tasks: window.voxweb.longTasks ? window.voxweb.longTasks() : null }), failed);
     }, failed);
   })();
 })"""
@@ -160,7 +161,8 @@ def capture_in(browser, url, out, timeout):
                    'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'],
                    'full_level': value.get('full_level'), 'mode': value.get('mode'),
                    'levels_shown': value['levels_shown'], 'marks': value.get('marks', []),
-                   'heap_bytes': value['heap_bytes'], 'memory': value.get('memory')})
+                   'heap_bytes': value['heap_bytes'], 'memory': value.get('memory'),
+                   'long_tasks': value.get('long_tasks')})
     return report
 
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace vxl::gl {
@@ -186,32 +187,47 @@ void TextureBuffer::finish_mapped(GLenum internal_format) {
   staging_.reset();
 }
 
-void TextureBuffer::create_in_parts(GLenum internal_format, std::size_t bytes, const PartFill& fill) {
-  const PixelLayout px = pixel_layout(internal_format);
+void TextureBuffer::begin_parts(GLenum internal_format, std::size_t bytes) {
   texture = make_rows_texture(internal_format, nullptr, bytes);
+  parts_format_ = internal_format;
+  parts_bytes_ = bytes;
+  next_part_ = 0;
+}
+
+bool TextureBuffer::fill_part(const PartFill& fill) {
+  if (!texture || next_part_ >= parts_bytes_) return false;
+  const PixelLayout px = pixel_layout(parts_format_);
   const std::size_t row_bytes = kBufferTextureWidth * px.texel_bytes;
   const std::size_t part_bytes = std::max<std::size_t>(1, kUploadBandBytes / row_bytes) * row_bytes;
-  std::vector<std::uint8_t> part;
+  const std::size_t first = next_part_;
   try {
-    for (std::size_t first = 0; first < bytes; first += part_bytes) {
-      part.assign(std::min(part_bytes, bytes - first), 0);
-      fill(first, part);
-      const std::size_t rows = part.size() / row_bytes, tail = (part.size() - rows * row_bytes) / px.texel_bytes;
-      const auto row = static_cast<GLint>(first / row_bytes);
-      glBindTexture(GL_TEXTURE_2D, texture);
-      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-      if (rows > 0)
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, row, kBufferTextureWidth, static_cast<GLsizei>(rows), px.format, px.type,
-                        part.data());
-      if (tail > 0)
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, row + static_cast<GLint>(rows), static_cast<GLsizei>(tail), 1, px.format,
-                        px.type, part.data() + rows * row_bytes);
-      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-      glBindTexture(GL_TEXTURE_2D, 0);
-    }
+    part_.assign(std::min(part_bytes, parts_bytes_ - first), 0);
+    fill(first, part_);
   } catch (...) {
     destroy();
     throw;
+  }
+  const std::size_t rows = part_.size() / row_bytes, tail = (part_.size() - rows * row_bytes) / px.texel_bytes;
+  const auto row = static_cast<GLint>(first / row_bytes);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  if (rows > 0)
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, row, kBufferTextureWidth, static_cast<GLsizei>(rows), px.format, px.type,
+                    part_.data());
+  if (tail > 0)
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, row + static_cast<GLint>(rows), static_cast<GLsizei>(tail), 1, px.format,
+                    px.type, part_.data() + rows * row_bytes);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  next_part_ = first + part_.size();
+  if (next_part_ < parts_bytes_) return true;
+  std::vector<std::uint8_t>().swap(part_);
+  return false;
+}
+
+void TextureBuffer::create_in_parts(GLenum internal_format, std::size_t bytes, const PartFill& fill) {
+  begin_parts(internal_format, bytes);
+  while (fill_part(fill)) {
   }
 }
 
@@ -223,6 +239,8 @@ void TextureBuffer::destroy() {
   if (texture) glDeleteTextures(1, &texture);
   texture = buffer = 0;
   staging_.reset();
+  std::vector<std::uint8_t>().swap(part_);
+  parts_bytes_ = next_part_ = 0;
 }
 
 #else
@@ -270,20 +288,34 @@ void TextureBuffer::finish_mapped(GLenum internal_format) {
   glBindBuffer(GL_TEXTURE_BUFFER, 0);
 }
 
-void TextureBuffer::create_in_parts(GLenum internal_format, std::size_t bytes, const PartFill& fill) {
-  auto* memory = static_cast<std::uint8_t*>(create_mapped(bytes));
+void TextureBuffer::begin_parts(GLenum internal_format, std::size_t bytes) {
+  parts_memory_ = static_cast<std::uint8_t*>(create_mapped(bytes));
+  parts_format_ = internal_format;
+  parts_bytes_ = bytes;
+  next_part_ = 0;
+}
+
+bool TextureBuffer::fill_part(const PartFill& fill) {
+  if (!parts_memory_) return false;
+  std::uint8_t* memory = std::exchange(parts_memory_, nullptr);
   try {
-    std::memset(memory, 0, bytes);
-    fill(0, {memory, bytes});
+    std::memset(memory, 0, parts_bytes_);
+    fill(0, {memory, parts_bytes_});
   } catch (...) {
     try {
-      finish_mapped(internal_format);
+      finish_mapped(parts_format_);
     } catch (const std::exception&) {  // the contents are dropped anyway
     }
     destroy();
     throw;
   }
-  finish_mapped(internal_format);
+  finish_mapped(parts_format_);
+  return false;
+}
+
+void TextureBuffer::create_in_parts(GLenum internal_format, std::size_t bytes, const PartFill& fill) {
+  begin_parts(internal_format, bytes);
+  fill_part(fill);
 }
 
 void TextureBuffer::update(std::size_t offset, const void* data, std::size_t bytes) {
@@ -293,6 +325,7 @@ void TextureBuffer::update(std::size_t offset, const void* data, std::size_t byt
 }
 
 void TextureBuffer::destroy() {
+  parts_memory_ = nullptr;  // unmapped with the buffer
   if (texture) glDeleteTextures(1, &texture);
   if (buffer) glDeleteBuffers(1, &buffer);
   texture = buffer = 0;

@@ -6,6 +6,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "viewer/render/gl_api.h"
 
@@ -46,14 +47,23 @@ struct TextureBuffer {
   // rethrown, the buffer destroyed.
   using PartFill = std::function<void(std::uint64_t first_byte, std::span<std::uint8_t> part)>;
   void create_in_parts(GLenum internal_format, std::size_t bytes, const PartFill& fill);
+  // create_in_parts a part a call: begin_parts makes the buffer, each fill_part fills and copies the next part and
+  // says whether more remain (so that a page can take input between parts).
+  void begin_parts(GLenum internal_format, std::size_t bytes);
+  bool fill_part(const PartFill& fill);
   // Replaces bytes [offset, offset + bytes) of a buffer made by create (desktop OpenGL only).
   void update(std::size_t offset, const void* data, std::size_t bytes);
   void destroy();
 
-#if VOXLINES_WEBGL
  private:
+  GLenum parts_format_ = 0;
+  std::size_t parts_bytes_ = 0, next_part_ = 0;  // begin_parts' size, and where the next part starts
+#if VOXLINES_WEBGL
   std::size_t mapped_bytes_ = 0;
   std::unique_ptr<std::uint8_t[]> staging_;  // what create_mapped handed out
+  std::vector<std::uint8_t> part_;           // the part being filled
+#else
+  std::uint8_t* parts_memory_ = nullptr;  // the buffer, mapped by begin_parts
 #endif
 };
 

@@ -157,35 +157,50 @@ void GpuScene::upload_span(std::uint32_t c) {
   finish_upload(filling_.size() - 1);
 }
 
-void GpuScene::upload_span_in_parts(std::uint32_t ci) {
-  const TextureSpan& c = layout_.texture_spans()[ci];
+void GpuScene::begin_parts(Filling& f) {
+  const TextureSpan& c = layout_.texture_spans()[f.span];
+  GpuTextureSpan& g = spans_[f.span];
+  f.in_parts = true;
+  g.words.begin_parts(GL_RGBA32UI, 4 * c.words());
+  g.orders.begin_parts(GL_R32UI, 4 * c.order_words);
+}
+
+bool GpuScene::fill_next_part(Filling& f) {
+  const TextureSpan& c = layout_.texture_spans()[f.span];
   const VxlFile& file = *files_[c.file];
   const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
-  GpuTextureSpan& g = spans_[ci];
-  VoxelScratch scratch;
-  g.words.create_in_parts(GL_RGBA32UI, 4 * c.words(), [&](std::uint64_t first_byte, std::span<std::uint8_t> part) {
-    const FillWindow<std::uint32_t> words{reinterpret_cast<std::uint32_t*>(part.data()), first_byte / 4,
-                                          (first_byte + part.size()) / 4};
-    for (std::uint32_t k = 0; k < c.voxel_count; ++k)
-      fill_voxel_words(file, c.voxel_first + k, c.voxel_first + k - file_first, k, c, words, scratch);
-  });
-  try {
-    g.orders.create_in_parts(GL_R32UI, 4 * c.order_words, [&](std::uint64_t first_byte, std::span<std::uint8_t> part) {
-      const FillWindow<std::uint8_t> orders{part.data(), first_byte, first_byte + part.size()};
+  GpuTextureSpan& g = spans_[f.span];
+  if (!f.words_made) {
+    VoxelScratch scratch;
+    f.words_made = !g.words.fill_part([&](std::uint64_t first_byte, std::span<std::uint8_t> part) {
+      const FillWindow<std::uint32_t> words{reinterpret_cast<std::uint32_t*>(part.data()), first_byte / 4,
+                                            (first_byte + part.size()) / 4};
       for (std::uint32_t k = 0; k < c.voxel_count; ++k)
-        copy_voxel_orders(file, c.voxel_first + k, c.voxel_first + k - file_first, c, orders);
+        fill_voxel_words(file, c.voxel_first + k, c.voxel_first + k - file_first, k, c, words, scratch);
     });
-  } catch (...) {
-    g.words.destroy();
-    throw;
+    return true;
   }
+  return g.orders.fill_part([&](std::uint64_t first_byte, std::span<std::uint8_t> part) {
+    const FillWindow<std::uint8_t> orders{part.data(), first_byte, first_byte + part.size()};
+    for (std::uint32_t k = 0; k < c.voxel_count; ++k)
+      copy_voxel_orders(file, c.voxel_first + k, c.voxel_first + k - file_first, c, orders);
+  });
+}
+
+void GpuScene::drop_filling(std::size_t k) {
+  const std::uint32_t ci = filling_[k].span;
+  filling_.erase(filling_.begin() + static_cast<std::ptrdiff_t>(k));
+  spans_[ci].words.destroy();
+  spans_[ci].orders.destroy();
+  gpu_bytes_ -= uploaded_bytes_[ci];
+  pool_->remove(owner_, ci);
 }
 
 void GpuScene::begin_upload(std::uint32_t ci) {
-  if constexpr (!kThreadsAvailable) {  // made here: nothing fills on other threads
-    upload_span_in_parts(ci);
+  if constexpr (!kThreadsAvailable) {  // made here, part by part: nothing fills on other threads
     Filling f;
     f.span = ci;
+    begin_parts(f);
     filling_.push_back(std::move(f));
     uploaded_bytes_[ci] = span_bytes(ci);
     gpu_bytes_ += uploaded_bytes_[ci];
@@ -242,6 +257,9 @@ void GpuScene::finish_upload(std::size_t k) {
       if (!error) error = std::current_exception();
     }
   try {
+    if (f.in_parts)
+      while (fill_next_part(f)) {
+      }
     g.words.finish_mapped(GL_RGBA32UI);
     g.orders.finish_mapped(GL_R32UI);
     if (error) std::rethrow_exception(error);
@@ -383,12 +401,22 @@ GpuScene::Residency GpuScene::make_resident(std::span<const std::uint32_t> neede
     uploaded = true;
   }
   if (!wait) {
-    // The fills that end within the time, finished here (a millisecond's sleep between looks). A task already
-    // waited for (the words, without threads) is done.
+    // The fills that end within the time, finished here (a millisecond's sleep between looks). A span made in
+    // parts gets at least one part, then as many as the time allows; one that fails is dropped.
     const auto done = [](const BackgroundTask<>& task) { return !task.valid() || task.ready(); };
+    const auto parts_left = [&](std::size_t k) {
+      try {
+        bool more = fill_next_part(filling_[k]);
+        while (more && elapsed_ms() < max_ms) more = fill_next_part(filling_[k]);
+        return more;
+      } catch (...) {
+        drop_filling(k);
+        throw;
+      }
+    };
     for (;;) {
       for (std::size_t k = 0; k < filling_.size();)
-        if (done(filling_[k].words) && done(filling_[k].orders))
+        if (filling_[k].in_parts ? !parts_left(k) : done(filling_[k].words) && done(filling_[k].orders))
           finish_upload(k);
         else
           ++k;

@@ -144,8 +144,14 @@ class GpuScene {
                         const TextureSpan& span, const FillWindow<std::uint32_t>& words, VoxelScratch& scratch) const;
   void copy_voxel_orders(const VxlFile& file, std::uint32_t voxel, std::uint32_t local, const TextureSpan& span,
                          const FillWindow<std::uint8_t>& orders) const;
-  // Without threads (a web page): span c's words and orders made a part at a time (create_in_parts).
-  void upload_span_in_parts(std::uint32_t c);
+  struct Filling;
+  // Without threads (a web page) a span's words, then its orders, are made a part at a time
+  // (TextureBuffer::begin_parts), a part a call of fill_next_part (false once the last is made), so that a page
+  // takes input between parts; make_resident without waiting makes parts for its time, at least one.
+  void begin_parts(Filling& f);
+  bool fill_next_part(Filling& f);
+  // Forgets filling_[k] and what it made (a fill that failed).
+  void drop_filling(std::size_t k);
   std::vector<const VxlFile*> files_;
   SceneLayout layout_;
   std::shared_ptr<GpuMemoryPool> pool_;
@@ -165,6 +171,8 @@ class GpuScene {
   struct Filling {
     std::uint32_t span = 0;
     BackgroundTask<> words, orders;  // filling the span's mapped buffers
+    bool in_parts = false;           // made part by part on this thread instead (fill_next_part)
+    bool words_made = false;         // in parts: the words are, the orders come next
   };
   std::vector<Filling> filling_;          // spans being uploaded (begun, not finished)
   std::vector<bool> checked_;             // per span: its draw checks have run or are running

@@ -8,6 +8,14 @@
   // Steps on the way to the first picture, for benchmarks (performance.getEntriesByType('mark')).
   const mark = (step) => performance.mark('voxweb:' + step);
   mark('script');
+  // The page's long tasks (50 ms and more, during which it takes no input), [start, duration] in ms, for benchmarks.
+  const longTasks = [];
+  try {
+    new PerformanceObserver((list) => {
+      for (const e of list.getEntries()) longTasks.push([e.startTime, e.duration]);
+    }).observe({ type: 'longtask' });
+  } catch (err) {  // a browser without them: none listed
+  }
   const $ = (id) => document.getElementById(id);
   const canvas = $('canvas');
   const params = new URLSearchParams(location.search);
@@ -26,6 +34,7 @@
     ready: new Promise((resolve, reject) => { settle = { resolve, reject }; }),
     complete: new Promise((resolve, reject) => { settleComplete = { resolve, reject }; }),
     levelsShown: [],  // the levels drawn at rest between the first picture and full detail (a file fetched by ranges)
+    longTasks: () => longTasks.slice(),
   };
 
   function say(text, isError) {
