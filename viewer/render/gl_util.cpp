@@ -225,12 +225,6 @@ bool TextureBuffer::fill_part(const PartFill& fill) {
   return false;
 }
 
-void TextureBuffer::create_in_parts(GLenum internal_format, std::size_t bytes, const PartFill& fill) {
-  begin_parts(internal_format, bytes);
-  while (fill_part(fill)) {
-  }
-}
-
 void TextureBuffer::update(std::size_t, const void*, std::size_t) {
   throw std::runtime_error("updating a buffer texture in place needs desktop OpenGL");
 }
@@ -311,11 +305,6 @@ bool TextureBuffer::fill_part(const PartFill& fill) {
   }
   finish_mapped(parts_format_);
   return false;
-}
-
-void TextureBuffer::create_in_parts(GLenum internal_format, std::size_t bytes, const PartFill& fill) {
-  begin_parts(internal_format, bytes);
-  fill_part(fill);
 }
 
 void TextureBuffer::update(std::size_t offset, const void* data, std::size_t bytes) {

@@ -40,15 +40,13 @@ struct TextureBuffer {
   // memory is the host's, copied to the texture by finish_mapped, which does nothing a second time.)
   void* create_mapped(std::size_t bytes);
   void finish_mapped(GLenum internal_format);
-  // The same filled a part at a time: fill(first_byte, part) writes bytes [first_byte, first_byte + part.size())
-  // of the contents into `part` (zeroed before). WebGL2 copies each part (8 MiB of rows at most) into the
+  // The same filled a part a call: begin_parts makes the buffer `bytes` long; each fill_part calls
+  // fill(first_byte, part) to write bytes [first_byte, first_byte + part.size()) of the contents into `part`
+  // (zeroed before), and says whether more parts remain. WebGL2 copies each part (8 MiB of rows at most) into the
   // texture as it is filled, so that a page's memory, which keeps its high-water mark, holds one part and not a
-  // texture's whole contents; desktop OpenGL maps the buffer and fills it as one part. What fill throws is
-  // rethrown, the buffer destroyed.
+  // texture's whole contents, and the page takes input between parts; desktop OpenGL maps the buffer and fills it
+  // as one part. What fill throws is rethrown, the buffer destroyed.
   using PartFill = std::function<void(std::uint64_t first_byte, std::span<std::uint8_t> part)>;
-  void create_in_parts(GLenum internal_format, std::size_t bytes, const PartFill& fill);
-  // create_in_parts a part a call: begin_parts makes the buffer, each fill_part fills and copies the next part and
-  // says whether more remain (so that a page can take input between parts).
   void begin_parts(GLenum internal_format, std::size_t bytes);
   bool fill_part(const PartFill& fill);
   // Replaces bytes [offset, offset + bytes) of a buffer made by create (desktop OpenGL only).

@@ -71,7 +71,8 @@ class GpuScene {
   // the least recently used spans of the pool's scenes that `needed` does not hold; a span that does not fit
   // stays out. Waiting (the default), with a time limit, stops once `max_ms` have passed (at least one span
   // is uploaded). Not waiting (`wait` false: a window at rest, whose event loop must not block on an upload),
-  // starts the fills of up to kMaxFilling spans on other threads, and returns once those that end within
+  // starts the fills of up to kMaxFilling spans on other threads (without threads, a web page: makes their parts
+  // on this thread, at least one, fill_next_part), and returns once those that end within
   // `max_ms` are resident: calling again finishes and starts more. A span still filling is not drawn.
   struct Residency {
     bool complete = true;      // every span of `needed` is resident
@@ -124,7 +125,7 @@ class GpuScene {
   void upload_resident_again();
   void release();
   // Elements [first, end) of a span's words or order bytes being filled, at `data`: the whole buffer, or one part
-  // of it (TextureBuffer::create_in_parts); what falls outside is not written.
+  // of it (TextureBuffer::fill_part); what falls outside is not written.
   template <typename T>
   struct FillWindow {
     T* data;

@@ -386,7 +386,7 @@
       Module.HEAPU8.set(bytes, target.pointer + at);
     }
     // The whole file (a 200 answer), or one range ([begin, end) of `total`).
-    function rangeSink(target, begin, end, total, url, wrong) {
+    function rangeSink(target, begin, end, total, wrong) {
       let at = begin;
       return {
         add(bytes) {
@@ -438,8 +438,7 @@
           const r = contentRange((/content-range:([^\r\n]*)/i.exec(headers) || [])[1]);
           if (!r) throw malformed();
           checkPart(target, r[0], r[1], r[2]);
-          part = { begin: r[0], end: r[1], total: r[2], at: r[0] };
-          if (part.at === part.end) found.push([part.begin, part.end, part.total]), part = null;
+          part = { begin: r[0], end: r[1], total: r[2], at: r[0] };  // not empty: checkPart
           at = headersEnd + blank.length;
         }
         pending = bytes.slice(at);
@@ -537,7 +536,7 @@
       const boundary = /multipart\/byteranges;\s*boundary="?([^";]+)"?/i.exec(response.headers.get('Content-Type') || '');
       let sink;
       if (response.status === 200) {
-        sink = rangeSink(target, 0, target.size, target.size, target.url,
+        sink = rangeSink(target, 0, target.size, target.size,
           `${target.url} changed on the server while it was fetched (its length is not ${target.size} bytes)`);
         target.whole = true;
       } else if (boundary) {
@@ -546,7 +545,7 @@
         const r = contentRange(response.headers.get('Content-Range'));
         if (!r) throw new Error(`${target.url}: a range answer without a valid Content-Range`);
         checkPart(target, r[0], r[1], r[2]);
-        sink = rangeSink(target, r[0], r[1], r[2], target.url, `${target.url}: a range answer of the wrong length`);
+        sink = rangeSink(target, r[0], r[1], r[2], `${target.url}: a range answer of the wrong length`);
       }
       if (!(await readBody(response, sink, target))) return null;
       const got = sink.end();
