@@ -159,7 +159,7 @@ def main():
                               f'{sum(after) / 1000:.1f} s in all', flush=True)
             finally:
                 if shared:
-                    shared.__exit__(None, None, None)
+                    shared.close()
                 server.close()
     return 0
 

@@ -182,12 +182,16 @@ class Browser:
     def capture(self, url, out, timeout):
         return capture_in(self.devtools, url, out, timeout)
 
+    def close(self):
+        """Closes the browser and removes its profile."""
+        self.devtools.close()
+        shutil.rmtree(self._profile, ignore_errors=True)
+
     def __enter__(self):
         return self
 
     def __exit__(self, *exc):
-        self.devtools.close()
-        shutil.rmtree(self._profile, ignore_errors=True)
+        self.close()
 
 
 def capture(url, out, timeout, chromium, on_start=None):
