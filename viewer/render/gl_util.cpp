@@ -87,6 +87,23 @@ PixelLayout pixel_layout(GLenum internal_format) {
 
 constexpr std::size_t kUploadBandBytes = 8u << 20;
 
+// Copies `bytes` (whole texels) into the bound rows texture from row `first_row` on: whole rows in bands of at most
+// kUploadBandBytes (a browser copies what one call passes into memory shared with its GPU process, and a span's
+// texture is up to 512 MiB), then a last row's first texels.
+void upload_rows(const PixelLayout& px, std::size_t first_row, const std::uint8_t* data, std::size_t bytes) {
+  const std::size_t row_bytes = kBufferTextureWidth * px.texel_bytes;
+  const std::size_t rows = bytes / row_bytes, tail = (bytes - rows * row_bytes) / px.texel_bytes;
+  const std::size_t band_rows = std::max<std::size_t>(1, kUploadBandBytes / row_bytes);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  for (std::size_t row = 0; row < rows; row += band_rows)
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, static_cast<GLint>(first_row + row), kBufferTextureWidth,
+                    static_cast<GLsizei>(std::min(band_rows, rows - row)), px.format, px.type, data + row * row_bytes);
+  if (tail > 0)
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, static_cast<GLint>(first_row + rows), static_cast<GLsizei>(tail), 1, px.format,
+                    px.type, data + rows * row_bytes);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+}
+
 // WebGL2's stand-in for a buffer texture: a 2D texture of kBufferTextureWidth-texel rows holding `bytes`
 // (at least one texel), filled from `data` when given. A last row only partly filled leaves the rest zero.
 GLuint make_rows_texture(GLenum internal_format, const void* data, std::size_t bytes) {
@@ -100,24 +117,8 @@ GLuint make_rows_texture(GLenum internal_format, const void* data, std::size_t b
   // Integer textures are complete only when sampled without filtering.
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  if (data != nullptr && bytes >= px.texel_bytes) {
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    const std::size_t texels_given = bytes / px.texel_bytes;
-    const std::size_t full_rows = texels_given / kBufferTextureWidth;
-    const auto* bytes_in = static_cast<const std::uint8_t*>(data);
-    // In bands of rows: a browser copies what one call passes into memory shared with its GPU process, and a
-    // span's texture is up to 512 MiB.
-    const std::size_t row_bytes = kBufferTextureWidth * px.texel_bytes;
-    const std::size_t band_rows = std::max<std::size_t>(1, kUploadBandBytes / row_bytes);
-    for (std::size_t row = 0; row < full_rows; row += band_rows)
-      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, static_cast<GLint>(row), kBufferTextureWidth,
-                      static_cast<GLsizei>(std::min(band_rows, full_rows - row)), px.format, px.type,
-                      bytes_in + row * row_bytes);
-    if (const std::size_t tail = texels_given - full_rows * kBufferTextureWidth; tail > 0)
-      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, static_cast<GLint>(full_rows), static_cast<GLsizei>(tail), 1, px.format,
-                      px.type, bytes_in + full_rows * kBufferTextureWidth * px.texel_bytes);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  }
+  if (data != nullptr && bytes >= px.texel_bytes)
+    upload_rows(px, 0, static_cast<const std::uint8_t*>(data), bytes / px.texel_bytes * px.texel_bytes);
   glBindTexture(GL_TEXTURE_2D, 0);
   return texture;
 }
@@ -207,17 +208,8 @@ bool TextureBuffer::fill_part(const PartFill& fill) {
     destroy();
     throw;
   }
-  const std::size_t rows = part_.size() / row_bytes, tail = (part_.size() - rows * row_bytes) / px.texel_bytes;
-  const auto row = static_cast<GLint>(first / row_bytes);
   glBindTexture(GL_TEXTURE_2D, texture);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  if (rows > 0)
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, row, kBufferTextureWidth, static_cast<GLsizei>(rows), px.format, px.type,
-                    part_.data());
-  if (tail > 0)
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, row + static_cast<GLint>(rows), static_cast<GLsizei>(tail), 1, px.format,
-                    px.type, part_.data() + rows * row_bytes);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  upload_rows(px, first / row_bytes, part_.data(), part_.size());
   glBindTexture(GL_TEXTURE_2D, 0);
   next_part_ = first + part_.size();
   if (next_part_ < parts_bytes_) return true;

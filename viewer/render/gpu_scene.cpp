@@ -17,7 +17,6 @@ std::uint64_t GpuScene::driver_limit() {
   return texels > 1 ? texels : 65536;  // 65536 is the GL 3.3 minimum
 }
 
-// Voxel i's orders at the span's level, as the file stores them.
 template <typename T>
 void GpuScene::FillWindow<T>::put(std::uint64_t at, const T* from, std::uint64_t n) const {
   const std::uint64_t begin = std::max(at, first), stop = std::min(at + n, end);
@@ -30,6 +29,7 @@ void GpuScene::FillWindow<T>::fill(std::uint64_t at, std::uint64_t n, T value) c
   if (begin < stop) std::fill(data + (begin - first), data + (stop - first), value);
 }
 
+// Voxel i's orders at the span's level, as the file stores them.
 void GpuScene::copy_voxel_orders(const VxlFile& file, std::uint32_t i, std::uint32_t li, const TextureSpan& c,
                                  const FillWindow<std::uint8_t>& orders) const {
   const VoxelEntry& v = file.voxels()[li];
