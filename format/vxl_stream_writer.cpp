@@ -140,12 +140,12 @@ void VxlStreamWriter::close_window(Section section, FileWindow& window) {
 std::span<std::uint8_t> VxlStreamWriter::fill_buffer(Section section, std::uint64_t size, unsigned threads) {
   if (size > fill_capacity_[section]) {
     fill_buffers_[section].reset();
-    fill_buffers_[section] = std::make_unique_for_overwrite<std::uint8_t[]>(size);
+    fill_buffers_[section] = std::unique_ptr<std::uint8_t[]>(new std::uint8_t[size]);  // uninitialised
     fill_capacity_[section] = size;
     // Fresh pages, faulted in by several threads at once rather than one by one as they are filled.
-    prefault_for_write({fill_buffers_[section].get(), size}, threads);
+    prefault_for_write({fill_buffers_[section].get(), static_cast<std::size_t>(size)}, threads);
   }
-  return {fill_buffers_[section].get(), size};
+  return {fill_buffers_[section].get(), static_cast<std::size_t>(size)};
 }
 
 // A complete section takes no more parts: its buffer's memory goes back before the sections after it are made.

@@ -1,10 +1,11 @@
-// `voxlines share`: the folder appears only when complete, with the web viewer's files, the tractogram as a
-// .vxl and share.json naming it; every refusal leaves no folder and no temporary one beside it. The web
-// viewer here is a stand-in folder (its files' contents do not matter to share); tests/web checks the real
+// `voxlines share`: the folder appears only when complete, with the web viewer's files, the tractogram (a .vxl,
+// or a .vxlz as it is or unpacked) and share.json naming it; every refusal leaves no folder and no temporary one beside
+// it. The web viewer here is a stand-in folder (its files' contents do not matter to share); tests/web checks the real
 // one in a browser.
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -59,16 +60,44 @@ TEST(Share, WritesTheViewerTheVxlAndShareJson) {
   EXPECT_EQ(entries_named_part(t.dir), 0);
 }
 
-TEST(Share, APackageIsUnpackedIntoAVxlThatVerifies) {
+TEST(Share, APackageIsSharedAsItIs) {
   SharedTractogram t;
   const std::string vxlz = t.dir.file("in.vxlz"), out = t.dir.file("shared");
   ASSERT_EQ(test::run_cli("pack " + test::q(t.vxl) + " " + test::q(vxlz)).exit_code, 0);
   const auto r = t.share(vxlz, out);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("unpacked"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("unpacked by the page"), std::string::npos) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(test::slurp(out + "/share.json"))["file"], "in.vxlz");
+  EXPECT_EQ(test::slurp(out + "/in.vxlz"), test::slurp(vxlz));
+  EXPECT_FALSE(fs::exists(out + "/in.vxl"));
+}
+
+TEST(Share, APackageIsUnpackedIntoAVxlThatVerifiesWhenAsked) {
+  SharedTractogram t;
+  const std::string vxlz = t.dir.file("in.vxlz"), out = t.dir.file("shared");
+  ASSERT_EQ(test::run_cli("pack " + test::q(t.vxl) + " " + test::q(vxlz)).exit_code, 0);
+  const auto r = t.share(vxlz, out, " --unpack");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("unpacked from the .vxlz"), std::string::npos) << r.output;
   EXPECT_EQ(nlohmann::json::parse(test::slurp(out + "/share.json"))["file"], "in.vxl");
+  EXPECT_FALSE(fs::exists(out + "/in.vxlz"));
   const auto verify = test::run_cli("verify " + test::q(out + "/in.vxl"));
   EXPECT_EQ(verify.exit_code, 0) << verify.output;
+}
+
+TEST(Share, ADamagedPackageIsRefusedBeforeItIsShared) {
+  SharedTractogram t;
+  const std::string vxlz = t.dir.file("in.vxlz"), out = t.dir.file("shared");
+  ASSERT_EQ(test::run_cli("pack " + test::q(t.vxl) + " " + test::q(vxlz)).exit_code, 0);
+  std::vector<char> bytes = test::slurp(vxlz);
+  bytes[bytes.size() / 2] ^= 0x40;  // inside the positions: only its section's checksum sees it
+  std::ofstream(vxlz, std::ios::binary | std::ios::trunc).write(bytes.data(), std::ssize(bytes));
+  const auto r = t.share(vxlz, out);
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("in.vxlz"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("checksum"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(entries_named_part(t.dir), 0);
 }
 
 TEST(Share, RefusalsLeaveNoFolder) {

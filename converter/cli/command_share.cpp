@@ -31,22 +31,26 @@ void add_share_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "share",
       "Make a folder that shows a tractogram in any web browser, with the same sorted transparency as voxview:\n"
-      "the web viewer, the tractogram as a .vxl (a .vxlz is unpacked) and a README for the recipient. Serve it\n"
-      "with any static web server (python3 -m http.server in the folder) and open index.html");
+      "the web viewer, the tractogram (a .vxl, or a .vxlz, which the page unpacks) and a README for the recipient.\n"
+      "Serve it with any static web server (python3 -m http.server in the folder) and open index.html");
   cmd->add_option("input", opt->input, ".vxl file or .vxlz package")->required();
   cmd->add_option("output", opt->output, "the folder to make (must not exist; appears only when complete)")->required();
   cmd->add_option("--title", opt->settings.title, "title the page shows (default: the input's name)");
   cmd->add_option("--web-viewer", opt->settings.web_viewer_dir,
                   "the built web viewer's folder (default: $VOXLINES_WEB_VIEWER, this build's, or "
                   "PREFIX/share/voxlines/web)");
-  cmd->add_option("--threads", opt->settings.threads, "worker threads for unpacking a .vxlz (0: all cores)")
-      ->default_val(0);
+  cmd->add_flag("--unpack", opt->settings.unpack,
+                "a .vxlz: write it unpacked, as a .vxl (about 8 times larger to host; the page then fetches a large\n"
+                "one by ranges and shows its first picture before the rest is in, where it fetches a .vxlz whole)");
+  cmd->add_option("--threads", opt->settings.threads, "worker threads for --unpack (0: all cores)")->default_val(0);
   cmd->callback([opt] {
     if (opt->settings.web_viewer_dir.empty()) opt->settings.web_viewer_dir = default_web_viewer_dir();
     const ShareSummary s = share_folder(opt->input, opt->output, opt->settings);
     std::printf("%s: %llu streamlines in %s (%.1f MiB%s); serve the folder and open index.html\n", opt->output.c_str(),
                 (unsigned long long)s.streamlines, s.data_file.c_str(), double(s.data_bytes) / (1 << 20),
-                s.unpacked ? ", unpacked from the .vxlz" : "");
+                s.unpacked  ? ", unpacked from the .vxlz"
+                : s.package ? ", unpacked by the page"
+                            : "");
   });
 }
 

@@ -7,6 +7,8 @@
 #include <limits>
 #include <utility>
 
+#include "format/base/float_bits.h"
+
 namespace vxl::detail {
 
 std::uint64_t sortable_bits(double d) {
@@ -115,7 +117,7 @@ std::uint8_t* sort_indexed_keys(SortScratch& s, int index_bits, int bits, std::u
 
 // The exponent of the lowest set bit of a finite, nonzero float: it is a multiple of 2 to that power.
 int lowest_bit_exponent(float f) {
-  const auto bits = std::bit_cast<std::uint32_t>(f);
+  const auto bits = float_bits(f);
   const std::uint32_t biased = (bits >> 23) & 0xFFu, fraction = bits & 0x7FFFFFu;
   constexpr int kBias = 127, kFractionBits = 23;
   if (biased == 0) return 1 - kBias - kFractionBits + std::countr_zero(fraction);  // subnormal

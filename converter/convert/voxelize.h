@@ -10,6 +10,8 @@
 #include <functional>
 #include <vector>
 
+#include "format/base/parallel.h"
+
 namespace vxl {
 
 // Called with a stage name and a fraction in [0, 1] of that stage; may be empty.
@@ -31,7 +33,13 @@ class VoxlineEnds {
   bool test(std::uint64_t vertex) const { return (words_[vertex >> 6] >> (vertex & 63)) & 1u; }
   // Atomic: the blocks of two threads can meet inside one word.
   void set(std::uint64_t vertex) {
-    std::atomic_ref<std::uint64_t>(words_[vertex >> 6]).fetch_or(1ull << (vertex & 63), std::memory_order_relaxed);
+    const std::uint64_t bit = 1ull << (vertex & 63);
+#if defined(__cpp_lib_atomic_ref)
+    std::atomic_ref<std::uint64_t>(words_[vertex >> 6]).fetch_or(bit, std::memory_order_relaxed);
+#else  // a C++ library without atomic_ref: the web viewer's, whose build runs one thread
+    static_assert(!kThreadsAvailable);
+    words_[vertex >> 6] |= bit;
+#endif
   }
 
  private:

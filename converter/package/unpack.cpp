@@ -464,7 +464,7 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
     // Left uninitialised: the chunks write every vertex (rebuild_structure checked that the voxlines' points are the
     // package's), and zeroing them first cost a serial pass over fresh pages (0.3 s for 1M streamlines).
     std::unique_ptr<float[]> float_blocks =
-        packed ? std::make_unique_for_overwrite<float[]>(3 * meta.vertex_count) : nullptr;
+        packed ? std::unique_ptr<float[]>(new float[3 * meta.vertex_count]) : nullptr;
     const std::span<float> vertices =
         packed ? std::span<float>(float_blocks.get(), 3 * meta.vertex_count)
                : std::span<float>(reinterpret_cast<float*>(window.data()), window.size() / sizeof(float));

@@ -87,7 +87,7 @@ double write_range_orders(VxlStreamWriter& out, const OrderedTable& table, const
     for (int b = 0; b < 2; ++b) {
       blocks[b] = settings.pool + b * settings.pool_chunk_bytes;
       read_buffers[b] = {settings.pool + 2 * settings.pool_chunk_bytes + b * settings.pool_read_back_bytes,
-                         settings.pool_read_back_bytes};
+                         static_cast<std::size_t>(settings.pool_read_back_bytes)};
     }
   // Per ordering thread, sized for the range's largest voxel once (fresh pages are dear; see above), by the queue's
   // thread (reads and writes take a thread each beside the ordering threads: they wait on the disk).
@@ -121,7 +121,8 @@ double write_range_orders(VxlStreamWriter& out, const OrderedTable& table, const
     }
     const std::uint64_t base = orders_start(k.first);
     k.block = blocks[b];
-    k.orders = {k.block + out.block_lead(VxlStreamWriter::kOrdb, base), orders_start(k.end) - base};
+    k.orders = {k.block + out.block_lead(VxlStreamWriter::kOrdb, base),
+                static_cast<std::size_t>(orders_start(k.end) - base)};
     k.by_size.resize(k.end - k.first);
     std::iota(k.by_size.begin(), k.by_size.end(), k.first);
     std::stable_sort(k.by_size.begin(), k.by_size.end(), [&](std::size_t a, std::size_t b) {

@@ -14,6 +14,7 @@
 #include "format/vxl_file.h"
 #include "format/vxl_layout.h"
 #include "format/vxlz_layout.h"
+#include "format/vxlz_package.h"
 
 namespace vxl {
 namespace {
@@ -53,8 +54,8 @@ std::string readme(const std::string& title, const std::string& data_file) {
          "512M...) says how much GPU memory the page may take.\n\n"
          "The data is " +
          data_file +
-         " (the .vxl format); the Voxlines tools (voxlines, voxview) read it and export it back to\n"
-         "TCK or TRX.\n";
+         " (the .vxl format, or a .vxlz package of it); the Voxlines tools (voxlines, voxview) read it\n"
+         "and export it back to TCK or TRX.\n";
 }
 
 // The folder's content, written into `staging`.
@@ -68,17 +69,21 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
   }
   const auto magic = magic_of(in_path);
   fs::path data = fs::path(in_path).filename();
-  if (std::equal(kVxlzMagic.begin(), kVxlzMagic.end(), magic.begin())) {
+  const bool package = std::equal(kVxlzMagic.begin(), kVxlzMagic.end(), magic.begin());
+  if (package && settings.unpack) {
     data.replace_extension(".vxl");
     UnpackSettings unpack;
     unpack.threads = settings.threads;
     summary.streamlines = unpack_vxlz(in_path, (staging / data).string(), unpack).streamlines;
     summary.unpacked = true;
   } else {
-    // Opened first, so that a damaged file is refused here rather than in the recipient's browser.
-    const VxlFile file = VxlFile::open(in_path);
-    summary.streamlines = file.meta().streamline_count;
-    if (data.extension() != ".vxl") data.replace_extension(".vxl");
+    // Opened first, so that a damaged file is refused here rather than in the recipient's browser (a package's
+    // checksums cover every byte of it).
+    summary.streamlines =
+        package ? VxlzFile::open(in_path).meta().streamline_count : VxlFile::open(in_path).meta().streamline_count;
+    summary.package = package;
+    const char* suffix = package ? ".vxlz" : ".vxl";
+    if (data.extension() != suffix) data.replace_extension(suffix);
     std::error_code ec;
     fs::copy_file(in_path, staging / data, ec);
     if (ec) fail_output((staging / data).string(), "cannot copy the tractogram: " + ec.message());

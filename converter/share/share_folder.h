@@ -1,6 +1,7 @@
 // `voxlines share`: a folder that any static web server serves as it is, for people without voxview: the web
 // viewer (viewer/web: the project's reader and renderer in WebAssembly, drawing with WebGL2), the tractogram
-// as a .vxl (a .vxlz is unpacked into one), share.json naming it, and a README for the recipient.
+// as given (a .vxl, which the page fetches by ranges, or a .vxlz, which it fetches whole and unpacks; or the .vxlz
+// unpacked here into a .vxl), share.json naming it, and a README for the recipient.
 #pragma once
 
 #include <cstdint>
@@ -11,14 +12,18 @@ namespace vxl {
 struct ShareSettings {
   std::string title;           // shown by the page; empty: the file's name
   std::string web_viewer_dir;  // the built web viewer (index.html, viewer.js, voxweb.js, voxweb.wasm)
-  unsigned threads = 0;        // for unpacking a .vxlz (0: all cores)
+  // A .vxlz: unpacked into a .vxl in the folder (8 times larger to host, but a large one then shows its first
+  // picture before the whole file is in), else copied as it is.
+  bool unpack = false;
+  unsigned threads = 0;  // for unpacking a .vxlz (0: all cores)
 };
 
 struct ShareSummary {
-  std::string data_file;  // the .vxl's name in the folder
+  std::string data_file;  // the tractogram's name in the folder
   std::uint64_t data_bytes = 0;
   std::uint64_t streamlines = 0;
-  bool unpacked = false;  // the input was a .vxlz
+  bool package = false;   // the folder holds a .vxlz
+  bool unpacked = false;  // the input was a .vxlz, unpacked (ShareSettings::unpack)
 };
 
 // The files of the built web viewer that a shared folder holds.

@@ -97,10 +97,16 @@ void AtomicOutputFile::pread(void* data, std::size_t size, std::uint64_t offset)
 void AtomicOutputFile::allocate(std::uint64_t size) {
   if (position_ != 0) fail("internal error: allocate() on a file already written to");
   if (size == 0) return;
-  // fallocate reserves the blocks (ENOSPC surfaces here); file systems without it get a sparse file.
-  if (::fallocate(fd_, 0, 0, static_cast<off_t>(size)) != 0) {
-    if (errno != EOPNOTSUPP && errno != ENOSYS)
-      fail(std::string("cannot reserve the output size: ") + std::strerror(errno));
+    // fallocate reserves the blocks (ENOSPC surfaces here); file systems without it get a sparse file. The web
+    // viewer's in-memory file system has none: sizing a file there reserves its memory.
+#if defined(__EMSCRIPTEN__)
+  const int reserved = ENOSYS;
+#else
+  const int reserved = ::fallocate(fd_, 0, 0, static_cast<off_t>(size)) == 0 ? 0 : errno;
+#endif
+  if (reserved != 0) {
+    if (reserved != EOPNOTSUPP && reserved != ENOSYS)
+      fail(std::string("cannot reserve the output size: ") + std::strerror(reserved));
     if (::ftruncate(fd_, static_cast<off_t>(size)) != 0)
       fail(std::string("cannot size the output: ") + std::strerror(errno));
   }

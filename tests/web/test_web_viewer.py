@@ -3,14 +3,16 @@
 headless Chromium (WebGL2 on SwiftShader), against `voxview --render` of the same file with the same camera
 (llvmpipe). Two rasterisers draw a line's pixels a little differently, so the pictures are compared by PSNR
 over R, G, B (at least MIN_PSNR dB), not byte for byte. Cases: a synthetic set of 20,000 streamlines, packed
-and float32, in the axis and unsorted modes; a .vxlz shared (unpacked by share); with the real fixtures (when
+and float32, in the axis and unsorted modes; a .vxlz shared as it is (fetched whole and unpacked by the page, with
+the converter's own code built for WebAssembly); with the real fixtures (when
 --real-data holds them), MRtrix's test tracks coloured by their AFD values; the packed file sent gzip-compressed
 (the length the server declares is then not the body's). The files are served by a server that answers Range
 requests (the page then fetches the first picture's level first, many ranges a request), one that answers the
 first range only, one that answers several with the whole file, and one that ignores Range (the page then fetches
 the file whole). Damaged files, which the page
-must refuse with a message naming them (and a file replaced on the server while the page fetches it): one cut short (the reader's structure checks), and two whose structure
-holds but whose orders or vertices were overwritten (the draw checks that voxview runs, which the page runs too).
+must refuse with a message naming them (and a file replaced on the server while the page fetches it): one cut short
+(the reader's structure checks), two whose structure holds but whose orders or vertices were overwritten (the draw
+checks that voxview runs, which the page runs too), and a package with a byte changed (its checksums).
 
 Usage: tests/web/test_web_viewer.py --voxlines PATH --voxview PATH --web-viewer DIR [--real-data DIR]
 Exit 0 when every case holds, 1 otherwise, 77 when there is no Chromium to run it in.
@@ -125,6 +127,11 @@ def main():
             damaged[at:at + 4096] = b'\xff' * 4096
             with open(path(name), 'wb') as f:
                 f.write(damaged)
+        with open(path('packed.vxlz'), 'rb') as f:
+            package = bytearray(f.read())
+        package[len(package) // 2] ^= 0x40  # inside the positions
+        with open(path('damaged.vxlz'), 'wb') as f:
+            f.write(package)
 
         # Each case: the file shared, the page's settings (voxview's options of the same names), the server, and
         # a GPU memory budget (?gpu=, voxview's --gpu-memory) or None. 16M holds level 1 of the 50k set, not full
@@ -175,6 +182,8 @@ def main():
                 failures.append(f'{source} {settings}: the page failed: {report["error"]}')
                 continue
             size = os.path.getsize(os.path.join(folder, shared))
+            if source.endswith('.vxlz') and shared != source:
+                failures.append(f'{source}: shared as {shared}, not as the package itself')
             # Under the budget, level 1 and what opens the file: under a quarter of it (an eighth of the points and
             # orders, the voxel tables); the whole file only for a setting that reads it.
             whole = 'unsorted' in settings
@@ -235,6 +244,8 @@ def main():
         for name in ('damaged.vxl', 'ordb-damaged.vxl', 'vert-damaged.vxl'):
             shutil.copy(path(name), folder)
             expect_refused(name, f'file={name}', name)
+        shutil.copy(path('damaged.vxlz'), folder)
+        expect_refused('damaged.vxlz', 'file=damaged.vxlz', 'damaged.vxlz: at byte')
 
         # A GPU memory budget that is not a size, and one that not even the coarsest level fits: refused, saying so.
         for budget, expected in (('lots', "'lots' is not a size of memory"), ('1K', 'does not fit the GPU memory budget')):

@@ -43,6 +43,7 @@
 #include "viewer/render/renderer.h"
 #include "viewer/render/scene_framing.h"
 #include "viewer/render/scene_layout.h"
+#include "viewer/web/web_package.h"
 
 namespace vxl::web {
 namespace {
@@ -250,9 +251,9 @@ using vxl::web::viewer;
 extern "C" {
 
 // Takes the file's bytes (from malloc; freed by the viewer, also on failure) and opens them; the canvas is
-// then width x height pixels. `whole`: the buffer holds the whole file, and the first picture's renderer is
-// made; else it holds what vw_plan_open named, and vw_level_ranges says what the first picture needs before
-// vw_show makes it.
+// then width x height pixels. A .vxlz package (whole) is unpacked first, and its bytes freed once it is. `whole`: the
+// buffer holds the whole file, and the first picture's renderer is made; else it holds what vw_plan_open named, and
+// vw_level_ranges says what the first picture needs before vw_show makes it.
 EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* name, int width, int height, int whole) {
   if (!(size >= 0 && size <= double(std::numeric_limits<std::size_t>::max()))) {
     std::free(bytes);
@@ -264,9 +265,10 @@ EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* n
     auto& v = viewer();
     vxl::web::close(v);
     try {
+      if (whole && vxl::web::is_package(file.bytes())) file = vxl::web::unpack_package(file.bytes(), name);
       vxl::web::open_file(v, std::move(file), width, height);
       if (whole) {
-        v.held = {{0, static_cast<std::uint64_t>(size)}};
+        v.held = {{0, v.file->bytes().size()}};  // an unpacked package's, not the package's
         vxl::web::show_file(v);
       } else {
         v.held = vxl::web::planned_ranges();

@@ -1,5 +1,5 @@
-// The web viewer's page: fetches a .vxl file (?file=URL, else the one share.json names, or a file dropped
-// on the page), hands its bytes to the WebAssembly viewer (voxweb.js: the project's reader and renderer),
+// The web viewer's page: fetches a .vxl file or a .vxlz package (?file=URL, else the one share.json names, or a file
+// dropped on the page), hands its bytes to the WebAssembly viewer (voxweb.js: the project's reader, unpacker and renderer),
 // and turns the panel, the mouse and the address's #view part into its settings. Nothing of the method is
 // here: the voxel sort and the choice of stored orders run in the WebAssembly renderer, as in voxview.
 'use strict';
@@ -303,11 +303,22 @@
       if (afterWholeFile !== true) redraw();  // after it, only a setting applied (set) asks for a frame
     }
 
-    // The whole file's bytes (from Module._malloc; the viewer frees them).
-    function openBytes(pointer, size, name) {
+    // Whether a file's first bytes are a .vxlz package's magic (\x89VXZ\r\n\x1a\n).
+    const PACKAGE_MAGIC = [0x89, 0x56, 0x58, 0x5a, 0x0d, 0x0a, 0x1a, 0x0a];
+    const isPackage = (bytes) => bytes.length >= 8 && PACKAGE_MAGIC.every((b, i) => bytes[i] === b);
+
+    // The whole file's bytes (from Module._malloc; the viewer frees them). A package is unpacked first, on this
+    // thread (WebAssembly here has no other): the page says so and shows it before that begins.
+    async function openBytes(pointer, size, name, target) {
       const [w, h] = canvasSize();
       const t0 = performance.now();
+      if (isPackage(Module.HEAPU8.subarray(pointer, pointer + 8))) {
+        say(`${name}: unpacking the package`);
+        await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
+        if (!current(target)) return Module._free(pointer);
+      }
       if (api.open(pointer, size, name, w, h, 1) !== 0) return fail(api.error());
+      mark('opened');
       shown(name, t0);
     }
     // The file is open and its first picture's renderer made: the panel, then the first frame.
@@ -568,6 +579,7 @@
       if (!current(target)) return;
       if (first.length === 0 || first.length > size)
         throw new Error(`${target.url}: a first range answer of ${first.length} bytes for a file of ${size}`);
+      if (isPackage(first)) return fetchWhole(target, await fetch(target.url));  // unpacked whole, so fetched whole
       const scratch = allocate(first.length, name);
       Module.HEAPU8.set(first, scratch);
       const plan = JSON.parse(api.planOpen(scratch, first.length, size, name));
@@ -693,7 +705,7 @@
         throw err;
       }
       $('progress').value = 1;
-      openBytes(pointer, received, name);
+      return openBytes(pointer, received, name, target);
     }
 
     async function dropFile(file) {
@@ -704,7 +716,7 @@
       if (!current(target)) return;
       const pointer = allocate(bytes.length, file.name);
       Module.HEAPU8.set(bytes, pointer);
-      openBytes(pointer, bytes.length, file.name);
+      return openBytes(pointer, bytes.length, file.name, target);
     }
 
     async function start() {
@@ -718,7 +730,7 @@
         }
       }
       if (url) await fetchFile(url);
-      else say('Drop a .vxl file on the page, or open it as index.html?file=URL');
+      else say('Drop a .vxl or .vxlz file on the page, or open it as index.html?file=URL');
     }
 
     // The panel.

@@ -1,0 +1,22 @@
+// A .vxlz package opened in the web page: unpacked as `voxlines unpack` unpacks it (converter/package/unpack.h),
+// through Emscripten's in-memory file system, into the .vxl bytes the viewer opens.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "format/base/mapped_file.h"
+
+namespace vxl::web {
+
+// Whether `bytes` begin as a .vxlz package does (its magic, spec/vxlz-package-v2.md §2.1).
+bool is_package(std::span<const std::uint8_t> bytes);
+
+// Unpacks the package `bytes` (named `name` in errors) into a .vxl held in memory. The package's bytes are
+// copied first, so the caller may free them once this returns; nothing is left in the file system, also when
+// the package is refused (vxl::Error, as unpack_vxlz throws it).
+MappedFile unpack_package(std::span<const std::uint8_t> bytes, const std::string& name);
+
+}  // namespace vxl::web
