@@ -157,6 +157,11 @@ def main():
                         print(f'    the page\'s tasks of 50 ms and more: {len(tasks)}, the longest {max([0] + [d for _, d in tasks]):.0f} ms; '
                               f'after the first picture {len(after)}, the longest {max([0] + after):.0f} ms, '
                               f'{sum(after) / 1000:.1f} s in all', flush=True)
+                    calls = sorted(report.get('slow_calls') or [], key=lambda c: -c[2])
+                    if calls:
+                        print('    the longest calls into the viewer, ms (at s from navigation): ' +
+                              ', '.join(f'{name} {ms:.0f} ({start / 1000:.1f})' for name, start, ms in calls[:8]),
+                              flush=True)
             finally:
                 if shared:
                     shared.close()

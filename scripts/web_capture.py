@@ -122,7 +122,8 @@ FIRST_PICTURE = """new Promise((resolve) => {
           .map((m) => [m.name.replace('voxweb:', ''), m.startTime]),
         heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null,
         memory: window.voxweb.memory ? window.voxweb.memory() : null,
-        long_tasks: window.voxweb.longTasks ? window.voxweb.longTasks() : null }), failed);
+        long_tasks: window.voxweb.longTasks ? window.voxweb.longTasks() : null,
+        slow_calls: window.voxweb.slowCalls ? window.voxweb.slowCalls() : null }), failed);
     }, failed);
   })();
 })"""
@@ -162,7 +163,7 @@ def capture_in(browser, url, out, timeout):
                    'full_level': value.get('full_level'), 'mode': value.get('mode'),
                    'levels_shown': value['levels_shown'], 'marks': value.get('marks', []),
                    'heap_bytes': value['heap_bytes'], 'memory': value.get('memory'),
-                   'long_tasks': value.get('long_tasks')})
+                   'long_tasks': value.get('long_tasks'), 'slow_calls': value.get('slow_calls')})
     return report
 
 

@@ -62,16 +62,15 @@ class RenderInPieces : public ::testing::Test {
   std::optional<VxlFile> file_;
 };
 
-TEST_F(RenderInPieces, SortedModesDrawTheSamePictureAVoxelAtATime) {
+TEST_F(RenderInPieces, SortedModesDrawTheSamePictureASegmentAtATime) {
   Renderer r(*file_);
   for (RenderMode mode : {RenderMode::Axis, RenderMode::Basic, RenderMode::Opaque}) {
     const Image whole = render_image(r, view(), settings(mode), kSize, kSize);
     ASSERT_GT(lit_pixels(whole), 500) << render_mode_name(mode);
     int pieces = 0;
-    // A millionth of a millisecond: every piece is one voxel.
+    // A millionth of a millisecond: every piece is one segment, a voxel drawn in many parts.
     const Image pieced = in_pieces(r, settings(mode), 1e-6, &pieces);
-    EXPECT_EQ(static_cast<std::uint64_t>(pieces), r.stats().voxels_drawn) << render_mode_name(mode);
-    EXPECT_GT(pieces, 10) << render_mode_name(mode);
+    EXPECT_GT(static_cast<std::uint64_t>(pieces), 10 * r.stats().voxels_drawn) << render_mode_name(mode);
     // The same draws in the same order into the same kind of buffer: the same bytes.
     EXPECT_EQ(compare_images(whole, pieced).differing_pixels, 0u) << render_mode_name(mode);
     // Unbounded: one piece.

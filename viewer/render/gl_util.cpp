@@ -314,6 +314,15 @@ void TextureBuffer::destroy() {
 
 #endif
 
+void finish_gpu_work() {
+  if constexpr (kWebGL) {
+    std::uint8_t pixel[4];
+    glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, pixel);
+  } else {
+    glFinish();
+  }
+}
+
 void RenderTarget::ensure(int w, int h, GLenum f0, GLenum f1, bool with_depth) {
   if (fbo && w == width && h == height) return;
   destroy();
@@ -327,7 +336,9 @@ void RenderTarget::ensure(int w, int h, GLenum f0, GLenum f1, bool with_depth) {
   for (int i = 0; i < n; ++i) {
     glGenTextures(1, &color[i]);
     glBindTexture(GL_TEXTURE_2D, color[i]);
-    glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(formats[i]), w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
+    // OpenGL ES (WebGL2) takes only the type that matches the format.
+    const GLenum type = formats[i] == GL_RGBA8 ? GL_UNSIGNED_BYTE : GL_FLOAT;
+    glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(formats[i]), w, h, 0, GL_RGBA, type, nullptr);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glFramebufferTexture2D(GL_FRAMEBUFFER, buffers[i], GL_TEXTURE_2D, color[i], 0);
@@ -340,7 +351,7 @@ void RenderTarget::ensure(int w, int h, GLenum f0, GLenum f1, bool with_depth) {
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
   }
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-    throw std::runtime_error("incomplete framebuffer for a multipass transparency mode");
+    throw std::runtime_error("incomplete framebuffer for a multipass transparency mode or a picture in pieces");
 }
 
 void RenderTarget::destroy() {

@@ -25,6 +25,10 @@ std::string shader_source(const std::string& source);
 // largest 2D texture.
 std::uint64_t max_buffer_texels();
 
+// Returns once the GPU has done every command given so far (a frame in pieces times its pieces with it):
+// glFinish; in WebGL2 a one-pixel read of the bound framebuffer, as a browser's finish() need not wait.
+void finish_gpu_work();
+
 // glMultiDrawArrays; in WebGL2, which has it only as an extension, one draw per range, in order.
 void multi_draw(GLenum mode, const GLint* first, const GLsizei* count, GLsizei ranges);
 
@@ -65,7 +69,8 @@ struct TextureBuffer {
 #endif
 };
 
-// RAII-free owner of a framebuffer with colour textures, for multipass modes.
+// RAII-free owner of a framebuffer with colour textures, for multipass modes (and the web viewer's pictures in
+// pieces).
 struct RenderTarget {
   GLuint fbo = 0, color[2] = {0, 0}, depth = 0;
   int width = 0, height = 0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <limits>
 #include <thread>
 
 #include "format/base/error.h"
@@ -290,6 +291,10 @@ void GpuScene::finish_uploads() {
 
 void GpuScene::check_uploaded(bool wait) {
   if (check_failure_) std::rethrow_exception(check_failure_);
+  if constexpr (!kThreadsAvailable) {
+    if (wait) check_some(std::numeric_limits<double>::infinity());
+    return;
+  }
   do {
     if (checks_.valid() && (wait || checks_.ready())) {
       try {
@@ -303,7 +308,33 @@ void GpuScene::check_uploaded(bool wait) {
   } while (wait && checks_.valid());
 }
 
+bool GpuScene::check_some(double max_ms) {
+  if (check_failure_) std::rethrow_exception(check_failure_);
+  checking_.insert(checking_.end(), unchecked_.begin(), unchecked_.end());
+  unchecked_.clear();
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::uint8_t> scratch;
+  try {
+    for (; checking_span_ < checking_.size(); ++checking_span_, checking_voxel_ = 0) {
+      const TextureSpan& c = layout_.texture_spans()[checking_[checking_span_]];
+      const FileLayout& f = layout_.files()[c.file];
+      while (checking_voxel_ < c.voxel_count) {
+        check_voxel_drawing(*files_[c.file],
+                            c.voxel_first + static_cast<std::uint32_t>(checking_voxel_++) - f.voxel_first, f.level,
+                            scratch);
+        if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() >= max_ms)
+          return false;
+      }
+    }
+  } catch (...) {
+    check_failure_ = std::current_exception();
+    throw;
+  }
+  return true;
+}
+
 void GpuScene::start_checks() {
+  if constexpr (!kThreadsAvailable) return;  // check_some runs them
   if (checks_.valid() || unchecked_.empty()) return;
   // Each span's voxels at its file's level; one core is left to the drawing thread.
   std::vector<std::uint32_t> spans = std::move(unchecked_);

@@ -103,9 +103,14 @@ class GpuScene {
   // caller's, one core left to it: starts them for the spans uploaded since the last call, and rethrows the
   // failure (vxl::Error, Input) of checks that have finished. With `wait`, returns once every span uploaded
   // is checked. A scene whose checks failed stays failed: every later call rethrows.
+  // Without threads (the web viewer) nothing runs beside the drawing: without `wait` this only rethrows, and the
+  // caller runs the checks a slice at a time between its frames (check_some).
   void check_uploaded(bool wait);
   // Starts the checks of the spans uploaded since they last started, unless some are still running.
   void start_checks();
+  // Without threads: runs the checks of the spans uploaded so far for about `max_ms` (at least one voxel's), and
+  // rethrows a failure as check_uploaded does. True once every span uploaded is checked.
+  bool check_some(double max_ms);
 
  private:
   // The bytes span c takes on the GPU with its current attributes and dataset order.
@@ -179,7 +184,11 @@ class GpuScene {
   std::vector<bool> checked_;             // per span: its draw checks have run or are running
   std::vector<std::uint32_t> unchecked_;  // spans uploaded since the checks last started
   std::exception_ptr check_failure_;      // the first failed check, rethrown by every check_uploaded
-  BackgroundTask<> checks_;               // last: joined first, while what it reads still exists
+  // Without threads: the span check_some is in (an index into checking_) and its next voxel.
+  std::vector<std::uint32_t> checking_;
+  std::size_t checking_span_ = 0;
+  std::uint64_t checking_voxel_ = 0;
+  BackgroundTask<> checks_;  // last: joined first, while what it reads still exists
 };
 
 }  // namespace vxl

@@ -247,6 +247,7 @@ struct Renderer::Pieces {
   std::vector<std::int64_t> first;  // PieceKind::Voxels: the frame plan
   std::vector<std::int32_t> count;
   std::size_t next = 0;                   // the first plan voxel not drawn yet
+  std::int32_t next_drawn = 0;            // of its ids, those drawn already (a voxel larger than a piece)
   std::uint64_t segments = 0, drawn = 0;  // the plan's, and those drawn so far
   double drawn_ms = 0;                    // the pieces' time so far: drawn / drawn_ms is the measured rate
   bool done = false;
@@ -312,24 +313,41 @@ void Renderer::draw_voxel_piece(double max_ms) {
   p.pass->piece_state();  // as the mode's draw()
   const GLuint program = lines_->over();
   bind_line_program(program, p.camera, p.settings, double(p.width) / std::max(1, p.height));
-  // Voxels up to what the measured rate draws in max_ms (before a measurement, llvmpipe's rate).
+  // Segments up to what the measured rate draws in max_ms (before a measurement, llvmpipe's rate), at least one.
   // The rate over all pieces so far, not the last one's: a piece's time varies with its voxels' fragments
   // and a software renderer's flushes, and the last rate alone made sizes swing from 5 to 400 ms.
   const double rate = p.drawn > 0 && p.drawn_ms > 0 ? double(p.drawn) / p.drawn_ms : kAssumedSegmentsPerMs;
   const double max_segments = std::isfinite(max_ms) ? rate * max_ms : std::numeric_limits<double>::infinity();
-  std::size_t end = p.next;
+  // Whole voxels while they fit, then a part of the next: a voxel's segments are consecutive ids drawn in order,
+  // so its parts in order blend as it does whole, and no piece outgrows max_ms however many segments a voxel
+  // holds (one of the 1M set took a software WebGL 1.3 s).
+  std::vector<std::int64_t> first;
+  std::vector<std::int32_t> count;
   std::uint64_t segments = 0;
-  do segments += static_cast<std::uint64_t>(p.count[end++] / 2);
-  while (end < p.count.size() && double(segments + p.count[end] / 2) <= max_segments);
-  const std::span<const std::int64_t> first(p.first);
-  const std::span<const std::int32_t> count(p.count);
-  lines_->draw_plan(program, first.subspan(p.next, end - p.next), count.subspan(p.next, end - p.next));
-  glFinish();  // the piece's time includes the GPU's work, for the next piece's size
+  while (p.next < p.count.size()) {
+    const std::int32_t left = p.count[p.next] - p.next_drawn;
+    if (left <= 0) {  // an empty run
+      ++p.next;
+      p.next_drawn = 0;
+      continue;
+    }
+    const double room = std::max(segments == 0 ? 1.0 : 0.0, std::floor(max_segments - double(segments)));
+    const std::int32_t ids = double(left / 2) <= room ? left : 2 * static_cast<std::int32_t>(room);
+    if (ids == 0) break;
+    first.push_back(p.first[p.next] + p.next_drawn);
+    count.push_back(ids);
+    segments += static_cast<std::uint64_t>(ids / 2);
+    p.next_drawn += ids;
+    if (p.next_drawn < p.count[p.next]) break;
+    ++p.next;
+    p.next_drawn = 0;
+  }
+  lines_->draw_plan(program, first, count);
+  gl::finish_gpu_work();  // the piece's time includes the GPU's work, for the next piece's size
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   p.drawn_ms += ms;
   p.drawn += segments;
-  p.next = end;
-  p.done = end == p.count.size();
+  p.done = p.next == p.count.size();
   if (p.done) draw_front_shells(p);
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);

@@ -104,6 +104,8 @@ class Renderer {
   // and draw_piece() call it without waiting before they draw, so a damaged file stops being drawn at the
   // first frame after its checks fail; a program that writes a picture waits for them first.
   void check_uploaded(bool wait) { scene_.check_uploaded(wait); }
+  // Without threads (the web viewer): runs those checks for about `max_ms` (GpuScene::check_some); true once done.
+  bool check_some(double max_ms) { return scene_.check_some(max_ms); }
 
   const FrameStats& stats() const { return stats_; }
   // The scene's groups (scene_groups.h) and value sets (per-vertex sets first, then per-streamline ones).

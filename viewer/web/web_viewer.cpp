@@ -73,6 +73,10 @@ struct Viewer {
   // A file fetched by ranges (vw_plan_open): the bytes its buffer holds so far, sorted and disjoint, and those the
   // page was last asked to fetch (held once vw_arrived says they are in).
   std::vector<ByteRange> held, asked;
+  // A picture at rest drawn in pieces (vw_draw_piece), copied to the canvas once complete: `piecing` is the
+  // renderer drawing it (null when none is under way).
+  gl::RenderTarget piece_target;
+  Renderer* piecing = nullptr;
 };
 
 Viewer& viewer() {
@@ -82,6 +86,8 @@ Viewer& viewer() {
 
 // Drops the file and its renderers (the GL objects first, the bytes they were made from last).
 void close(Viewer& v) {
+  v.piecing = nullptr;
+  v.piece_target.destroy();
   v.controller.reset();
   v.quick.reset();
   v.interim.reset();
@@ -149,6 +155,23 @@ Camera home_camera(const VxlFile& file, double aspect) {
   c.elevation_deg = kDefaultView[1];
   c.frame_points(framing_points(SceneLayout(file, gl::max_buffer_texels(), 0)), aspect);
   return c;
+}
+
+// How long a piece of a picture at rest draws, GPU work included (Renderer::draw_piece): the page takes input
+// between pieces, and the browser calls a task of 50 ms or more a long one.
+constexpr double kPieceMs = 40;
+
+// Draws the next piece of the picture under way; once it is complete, copies it to the canvas. True then.
+bool draw_next_piece(Viewer& v) {
+  const bool complete = v.piecing->draw_piece(kPieceMs);
+  v.piecing->check_uploaded(false);
+  if (!complete) return false;
+  v.piecing = nullptr;
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, v.piece_target.fbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glBlitFramebuffer(0, 0, v.width, v.height, 0, 0, v.width, v.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return true;
 }
 
 // Uploads a few more of the full-detail spans the view needs (the nearest first); true once they all are.
@@ -545,18 +568,60 @@ EMSCRIPTEN_KEEPALIVE int vw_upload() {
   return error != 0 ? error : complete ? 1 : 0;
 }
 
-// Draws a frame into the canvas, now width x height pixels; `moving` (a drag) draws the first picture's level.
+// Draws a frame into the canvas, now width x height pixels; `moving` (a drag) draws the first picture's level. At rest,
+// a level finer than the first picture's is drawn in pieces (a software WebGL draws the 144k set's full detail in
+// about 9 s): the first here, the rest by vw_draw_piece, the canvas keeping the last picture until it is complete.
+// A frame drawn meanwhile abandons the pieces.
 EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
   return guarded([&] {
     auto& v = viewer();
     if (!v.controller) throw std::runtime_error("no file is open");
+    v.piecing = nullptr;
     v.width = std::max(width, 1);
     v.height = std::max(height, 1);
     vxl::Renderer* renderer = vxl::web::renderer_for(v, moving != 0);
     v.controller->set_window_height(v.height);
-    renderer->draw(v.controller->camera(), v.settings, v.width, v.height, 0);
-    renderer->check_uploaded(false);
+    if (renderer == v.quick.get() || !v.quick) {
+      renderer->draw(v.controller->camera(), v.settings, v.width, v.height, 0);
+      renderer->check_uploaded(false);
+      return;
+    }
+    v.piece_target.ensure(v.width, v.height, GL_RGBA8, 0, true);
+    renderer->begin_pieces(v.controller->camera(), v.settings, v.width, v.height, v.piece_target.fbo);
+    v.piecing = renderer;
+    vxl::web::draw_next_piece(v);
   });
 }
+
+// Draws the next piece of the picture vw_draw began: 1 once it is complete and on the canvas (or when none is under
+// way), 0 while more remain, else an error code (vw_error).
+EMSCRIPTEN_KEEPALIVE int vw_draw_piece() {
+  bool complete = true;
+  const int error = guarded([&] {
+    auto& v = viewer();
+    if (v.piecing) complete = vxl::web::draw_next_piece(v);
+  });
+  return error != 0 ? error : complete ? 1 : 0;
+}
+
+// Runs the draw checks (format/vxl_draw_check.h) of what the renderers have uploaded for about 30 ms: 1 once none
+// are left, 0 while some are, else an error code (the file is damaged: vw_error). voxview runs them beside the
+// drawing; here the page calls this between its other tasks, and a failure stops every later frame.
+EMSCRIPTEN_KEEPALIVE int vw_check() {
+  constexpr double kCheckSliceMs = 30;
+  bool done = true;
+  const int error = guarded([&] {
+    auto& v = viewer();
+    for (vxl::Renderer* r : {v.quick.get(), v.interim.get(), v.full.get()})
+      if (r && !r->check_some(kCheckSliceMs)) {
+        done = false;
+        return;
+      }
+  });
+  return error != 0 ? error : done ? 1 : 0;
+}
+
+// Whether a picture vw_draw began in pieces is not complete yet.
+EMSCRIPTEN_KEEPALIVE int vw_pieces_under_way() { return viewer().piecing ? 1 : 0; }
 
 }  // extern "C"

@@ -73,11 +73,26 @@
       camera: Module.cwrap('vw_camera', 'string', []),
       setCamera: Module.cwrap('vw_set_camera', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
       draw: Module.cwrap('vw_draw', 'number', ['number', 'number', 'number']),
+      drawPiece: Module.cwrap('vw_draw_piece', 'number', []),
+      piecesUnderWay: Module.cwrap('vw_pieces_under_way', 'number', []),
+      check: Module.cwrap('vw_check', 'number', []),
       refine: Module.cwrap('vw_refine', 'number', []),
       pending: Module.cwrap('vw_pending', 'number', []),
       upload: Module.cwrap('vw_upload', 'number', []),
       setGpuBudget: Module.cwrap('vw_set_gpu_budget', 'number', ['string']),
     };
+    // The calls into the viewer of 50 ms and more, [name, start, ms] (for benchmarks: what the long tasks are).
+    const slowCalls = [];
+    for (const [name, call] of Object.entries(api)) {
+      api[name] = (...args) => {
+        const start = performance.now();
+        const result = call(...args);
+        const ms = performance.now() - start;
+        if (ms >= 50) slowCalls.push([name, start, ms]);
+        return result;
+      };
+    }
+    window.voxweb.slowCalls = () => slowCalls.slice();
     window.voxweb.mode = () => JSON.parse(api.info()).mode;  // the mode frames are drawn in (for tests)
     // The WebAssembly memory's size and malloc's use of it (for benchmarks).
     window.voxweb.memory = () => ({ wasm: Module.HEAPU8.length, ...JSON.parse(api.memory()) });
@@ -150,6 +165,41 @@
         canvas.style.height = h + 'px';
       }
       if (api.draw(w, h, moving ? 1 : 0) !== 0) return fail(api.error());
+      if (api.piecesUnderWay()) return drawPieces();  // a picture at rest in pieces: on the canvas once complete
+      shownFrame();
+    }
+    // A picture at rest drawn in pieces, one a task, so that the page takes input between them; a frame asked for
+    // meanwhile (redraw) abandons it.
+    function drawPieces() {
+      setTimeout(function step() {
+        if (dirty || moving) return;
+        const r = api.drawPiece();
+        if (r > 1) return fail(api.error());
+        if (r === 0) return setTimeout(step, 0);
+        shownFrame();
+      }, 0);
+    }
+    // The draw checks of what is on the GPU (voxview runs them beside the drawing; WebAssembly here has no other
+    // thread): a slice a task, between the page's other tasks, until none are left. Resolves true then, false when
+    // they refused the file (the page then fails).
+    let checking = null;
+    function checked() {
+      if (!checking) {
+        checking = new Promise((resolve) => {
+          setTimeout(function step() {
+            const r = api.check();
+            if (r === 0) return setTimeout(step, 0);
+            checking = null;
+            if (r > 1) fail(api.error());
+            resolve(r === 1);
+          }, 0);
+        });
+      }
+      return checking;
+    }
+    // The frame asked for is on the canvas.
+    function shownFrame() {
+      checked();
       const pending = api.pending();
       fullShown = fullDetail && !moving && !pending;
       if (firstFrame) {
@@ -163,10 +213,13 @@
         else if (bytesComplete || restLater) done();
       }
     }
-    // Full detail is on the screen and the whole file in.
+    // Full detail is on the screen and the whole file in: complete once what is drawn is checked.
     function done() {
-      $('progress').value = 1;
-      settleComplete.resolve();
+      checked().then((ok) => {
+        if (!ok) return;
+        $('progress').value = 1;
+        settleComplete.resolve();
+      });
     }
     // Full detail's upload, a few spans per task so that the page keeps taking input; one frame when done.
     let uploading = false;
