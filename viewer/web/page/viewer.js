@@ -153,8 +153,10 @@
         requestAnimationFrame(frame);
       }
     }
+    let piecesRun = 0;  // the frames drawn: pieces of an earlier one stop
     function frame() {
       dirty = false;
+      const run = ++piecesRun;
       const [w, h] = canvasSize();
       if (canvas.width !== w || canvas.height !== h) {
         canvas.width = w;
@@ -165,14 +167,14 @@
         canvas.style.height = h + 'px';
       }
       if (api.draw(w, h, moving ? 1 : 0) !== 0) return fail(api.error());
-      if (api.piecesUnderWay()) return drawPieces();  // a picture at rest in pieces: on the canvas once complete
+      if (api.piecesUnderWay()) return drawPieces(run);  // a picture at rest in pieces: on the canvas once complete
       shownFrame();
     }
     // A picture at rest drawn in pieces, one a task, so that the page takes input between them; a frame asked for
-    // meanwhile (redraw) abandons it.
-    function drawPieces() {
+    // meanwhile (redraw) abandons it, and its own pieces, if any, replace these.
+    function drawPieces(run) {
       setTimeout(function step() {
-        if (dirty || moving) return;
+        if (run !== piecesRun || dirty || moving) return;
         const r = api.drawPiece();
         if (r > 1) return fail(api.error());
         if (r === 0) return setTimeout(step, 0);
