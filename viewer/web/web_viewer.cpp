@@ -11,7 +11,9 @@
 // --gpu-memory chooses: level 0 when it fits.
 // Its spans are uploaded a few per call of vw_upload, nearest the view first, so that the page's thread —
 // WebAssembly here has no other — takes input between them: until the view's spans are all on the GPU, frames
-// at rest come from the first picture's level.
+// at rest come from the first picture's level. For the same reason a frame at rest finer than the first picture is
+// drawn in pieces (vw_draw_piece), and the draw checks run a slice a call (vw_check). A .vxlz is unpacked into a
+// .vxl in memory first (web_package.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
