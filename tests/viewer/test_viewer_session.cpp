@@ -53,6 +53,25 @@ TEST_F(ViewerSessionTest, RenderersAreMadeOncePerLevelWithTheImage) {
   EXPECT_EQ(session.levels_in_files(), 3u);
 }
 
+TEST_F(ViewerSessionTest, OneRendererDrawsALevelThatFitsInTheLargestSpans) {
+  options.span_texels.reset();  // the defaults: paging spans where full detail does not fit the budget
+  const std::vector<const VxlFile*> files{&*file};
+  options.gpu_memory = SceneLayout(files, GpuScene::driver_limit(), 0).upload_bytes() / 3;
+  for (const bool one_renderer : {false, true}) {
+    ViewerSession session(options);
+    session.choose_detail(options, one_renderer);
+    const SceneDetail& d = session.detail();
+    ASSERT_GT(d.level, 0u) << "the test needs a budget that full detail does not fit";
+    EXPECT_LT(d.span_texels, d.whole_span_texels) << "paging spans, smaller than the driver's";
+    // The scene's level and coarser ones fit whole: one renderer takes them in the largest spans; a finer level
+    // (a close view's) pages, as every level of the window's renderers, which share the budget.
+    EXPECT_EQ(session.span_texels_at(d.level), one_renderer ? d.whole_span_texels : d.span_texels);
+    EXPECT_EQ(session.span_texels_at(d.level + 1), one_renderer ? d.whole_span_texels : d.span_texels);
+    EXPECT_EQ(session.span_texels_at(d.level - 1), d.span_texels);
+    EXPECT_EQ(session.renderer_at(d.level, false).layout().level(), d.level);
+  }
+}
+
 TEST_F(ViewerSessionTest, AViewsLevelIsTheOneItsRenderersWouldMeasure) {
   const std::vector<const VxlFile*> files{&*file};
   const std::uint64_t whole = SceneLayout(files, *options.span_texels, 0).upload_bytes();

@@ -68,7 +68,7 @@ int run_headless(const ViewerOptions& o) {
                  (unsigned long long)selection->selected, (unsigned long long)selection->total);
   }
   context.emplace();
-  session.choose_detail(o);
+  session.choose_detail(o, /*one_renderer=*/true);
   const SceneDetail& detail = session.detail();
   const double aspect = double(o.width) / o.height;
   // One view (not a turntable) may be drawn finer than the whole scene: a slab or a close view of a large scene.

@@ -68,7 +68,7 @@ SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::o
   auto within_driver = [&](std::uint64_t wanted) {
     return std::min(driver, std::max(wanted, SceneLayout::largest_voxel_texels(files)));
   };
-  d.span_texels = within_driver(span_texels.value_or(driver));
+  d.span_texels = d.whole_span_texels = within_driver(span_texels.value_or(driver));
   d.level = level_within(files, d, level, gpu_memory.has_value());
   if (!span_texels && d.level > 0 && !d.forced) {  // full detail does not fit: page in small spans
     d.span_texels = within_driver(kPagingSpanTexels);

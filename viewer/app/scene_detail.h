@@ -15,15 +15,19 @@ namespace vxl::app {
 struct SceneDetail {
   std::uint32_t level = 0;
   std::uint64_t span_texels = 0;  // the most texels a GPU texture span holds
-  std::uint64_t budget = 0;       // bytes
-  std::string budget_source;      // where the budget comes from, for messages
-  bool forced = false;            // --level chose the level
+  // The same for a level drawn whole, alone within the budget (headless: one renderer): the driver's limit, as when
+  // full detail fits. Equal to span_texels unless paging chose smaller spans.
+  std::uint64_t whole_span_texels = 0;
+  std::uint64_t budget = 0;   // bytes
+  std::string budget_source;  // where the budget comes from, for messages
+  bool forced = false;        // --level chose the level
 };
 
 // The span size too: `span_texels` (--span-texels) when given, else the driver's texture-buffer limit when
 // full detail fits the budget (the fewest spans: a draw of one span is the cheapest, its shader needs no
 // span lookup), else kPagingSpanTexels, so that the budget can hold just the visible spans; raised to what
-// the largest voxel needs, within the driver's limit. Needs a current GL context. Throws vxl::Error
+// the largest voxel needs, within the driver's limit. whole_span_texels: the first of these, for a level that one
+// renderer draws whole within the budget. Needs a current GL context. Throws vxl::Error
 // (Unsupported) when even the coarsest level does not fit.
 SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::optional<std::uint32_t> level,
                                 std::optional<std::uint64_t> gpu_memory,

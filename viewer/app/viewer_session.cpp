@@ -14,8 +14,9 @@ ViewerSession::ViewerSession(const ViewerOptions& o)
   bounds_ = scene_bounds(files_, image());
 }
 
-void ViewerSession::choose_detail(const ViewerOptions& o) {
+void ViewerSession::choose_detail(const ViewerOptions& o, bool one_renderer) {
   detail_ = choose_scene_detail(files_, o.level, o.gpu_memory, o.span_texels);
+  one_renderer_ = one_renderer;
   gpu_memory_ = std::make_shared<GpuMemoryPool>(detail_->budget);
   layouts_.emplace(files_, detail_->span_texels);
 }
@@ -39,10 +40,14 @@ PictureLevels ViewerSession::picture_levels(const Camera* camera, double aspect,
   return p;
 }
 
+std::uint64_t ViewerSession::span_texels_at(std::uint32_t level) const {
+  return one_renderer_ && level >= detail_->level ? detail_->whole_span_texels : detail_->span_texels;
+}
+
 Renderer& ViewerSession::renderer_at(std::uint32_t level, bool eager) {
   std::unique_ptr<Renderer>& r = renderers_[level];
   if (!r) {
-    r = std::make_unique<Renderer>(files_, detail_->span_texels, level, gpu_memory_, eager);
+    r = std::make_unique<Renderer>(files_, span_texels_at(level), level, gpu_memory_, eager);
     r->share_indexes(indexes_);
     if (image_) r->set_volume(*image_);
     if (groups_) r->set_groups(*groups_);
@@ -78,7 +83,7 @@ Renderer& ViewerSession::focus_first_renderer(std::uint32_t context_level, bool 
     std::vector<std::uint32_t> levels(files_.size(), context_level);
     levels.resize(all.size(), 0);  // the focus's copies at full detail
     // Its own per-voxel indexes: the session's cover the context's files only.
-    r = std::make_unique<Renderer>(all, detail_->span_texels, context_level, gpu_memory_, eager, levels);
+    r = std::make_unique<Renderer>(all, span_texels_at(context_level), context_level, gpu_memory_, eager, levels);
     if (image_) r->set_volume(*image_);
     r->set_groups(SceneGroups::focus_first(all, files_.size(), focus_kept_));
   }

@@ -249,7 +249,8 @@ void declare_loading(CLI::App& cli, ViewerArguments& a) {
                  "the most texels one GPU texture span holds (at most the driver's texture-buffer limit): the "
                  "granule that a GPU memory budget too small for the whole scene uploads and evicts, nearest "
                  "visible spans first. Default: the driver's limit when full detail fits the budget (fewest "
-                 "spans, cheapest to draw), else 4M")
+                 "spans, cheapest to draw), else 4M; --render draws a level that fits the budget whole in the "
+                 "driver's limit too")
       ->check(CLI::Range(std::uint64_t(1024), std::uint64_t(1) << 31));
   cli.add_option("--level", a.options.level,
                  "draw this level of detail (0: every streamline; level d keeps about 1/8^d of them), whatever the "
