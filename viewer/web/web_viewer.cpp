@@ -188,6 +188,7 @@ Renderer* renderer_for(Viewer& v, bool moving) {
   if (!v.quick) return v.full.get();
   if (moving) return v.quick.get();
   if (!v.full || !upload_full(v)) return v.interim ? v.interim.get() : v.quick.get();
+  if (v.piecing == v.interim.get()) v.piecing = nullptr;
   v.interim.reset();  // full detail is on the GPU for this view
   return v.full.get();
 }
@@ -373,7 +374,8 @@ EMSCRIPTEN_KEEPALIVE int vw_show_level(int level) {
     if (level <= 0 || static_cast<std::uint32_t>(level) <= v.full_level ||
         static_cast<std::uint32_t>(level) >= v.first_level)
       throw std::runtime_error("not a level between");
-    v.interim.reset();  // its GPU memory before the next one's
+    if (v.piecing == v.interim.get()) v.piecing = nullptr;  // its pieces end with it
+    v.interim.reset();                                      // its GPU memory before the next one's
     v.interim = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file}, 0, level);
   });
 }
