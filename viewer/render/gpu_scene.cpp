@@ -316,12 +316,9 @@ bool GpuScene::check_some(double max_ms) {
   std::vector<std::uint8_t> scratch;
   try {
     for (; checking_span_ < checking_.size(); ++checking_span_, checking_voxel_ = 0) {
-      const TextureSpan& c = layout_.texture_spans()[checking_[checking_span_]];
-      const FileLayout& f = layout_.files()[c.file];
-      while (checking_voxel_ < c.voxel_count) {
-        check_voxel_drawing(*files_[c.file],
-                            c.voxel_first + static_cast<std::uint32_t>(checking_voxel_++) - f.voxel_first, f.level,
-                            scratch);
+      const std::uint32_t ci = checking_[checking_span_];
+      while (checking_voxel_ < layout_.texture_spans()[ci].voxel_count) {
+        check_span_voxel(ci, checking_voxel_++, scratch);
         if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() >= max_ms)
           return false;
       }
@@ -341,15 +338,17 @@ void GpuScene::start_checks() {
   unchecked_.clear();
   checks_ = BackgroundTask<>([this, spans = std::move(spans)] {
     for (std::uint32_t ci : spans) {
-      const TextureSpan& c = layout_.texture_spans()[ci];
-      const FileLayout& f = layout_.files()[c.file];
       std::vector<std::vector<std::uint8_t>> scratch(resolve_threads(0));
-      parallel_for(c.voxel_count, std::max(1u, resolve_threads(0) - 1), [&](std::uint64_t k, unsigned t) {
-        check_voxel_drawing(*files_[c.file], c.voxel_first + static_cast<std::uint32_t>(k) - f.voxel_first, f.level,
-                            scratch[t]);
-      });
+      parallel_for(layout_.texture_spans()[ci].voxel_count, std::max(1u, resolve_threads(0) - 1),
+                   [&](std::uint64_t k, unsigned t) { check_span_voxel(ci, k, scratch[t]); });
     }
   });
+}
+
+void GpuScene::check_span_voxel(std::uint32_t ci, std::uint64_t k, std::vector<std::uint8_t>& scratch) const {
+  const TextureSpan& c = layout_.texture_spans()[ci];
+  const FileLayout& f = layout_.files()[c.file];
+  check_voxel_drawing(*files_[c.file], c.voxel_first + static_cast<std::uint32_t>(k) - f.voxel_first, f.level, scratch);
 }
 
 void GpuScene::upload_extras(std::uint32_t ci) {

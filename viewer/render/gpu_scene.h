@@ -158,6 +158,8 @@ class GpuScene {
   bool fill_next_part(Filling& f);
   // Forgets filling_[k] and what it made (a fill that failed).
   void drop_filling(std::size_t k);
+  // The draw checks (format/vxl_draw_check.h) of voxel k of span ci, at its file's level.
+  void check_span_voxel(std::uint32_t ci, std::uint64_t k, std::vector<std::uint8_t>& scratch) const;
   std::vector<const VxlFile*> files_;
   SceneLayout layout_;
   std::shared_ptr<GpuMemoryPool> pool_;
