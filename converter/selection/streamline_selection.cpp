@@ -382,7 +382,11 @@ BoxVerdict box_verdict(const BoxedVoxline& b, Bits candidates, const RegionTable
       continue;
     }
     if (!decoded) packer.decode_word(lo_word, lo), packer.decode_word(hi_word, hi), decoded = true;
-    if (table.regions[r]->holds_box(lo, hi)) verdict.inside |= Bits(1) << r;
+    // The window is the region's bounding box: a sphere may still miss a box its corners reach into.
+    if (!table.regions[r]->may_touch(lo, hi))
+      verdict.outside |= Bits(1) << r;
+    else if (table.regions[r]->holds_box(lo, hi))
+      verdict.inside |= Bits(1) << r;
   }
   return verdict;
 }
@@ -423,9 +427,27 @@ struct DraggedSphere {
     // Far more than the float32 rounding of a distance and of its test (Region's slack, and then some).
     margin = 1e-3 + 1e-6 * (std::abs(c[0]) + std::abs(c[1]) + std::abs(c[2]) + radius);
   }
+  struct BoxDistances {
+    double nearest = 0, farthest = 0;
+  };
+  // From the centre to the nearest and the farthest point of b's box (its points' quanta decoded), in mm.
+  BoxDistances box_distances(const BoxedVoxline& b, const VertexPacker& packer) const {
+    float lo[3], hi[3];
+    packer.decode_word(b.lo[0] | std::uint32_t(b.lo[1]) << 10 | std::uint32_t(b.lo[2]) << 20, lo);
+    packer.decode_word(b.hi[0] | std::uint32_t(b.hi[1]) << 10 | std::uint32_t(b.hi[2]) << 20, hi);
+    const Point3f& c = sphere->centre();
+    double near2 = 0, far2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double below = double(lo[a]) - c[a], above = double(c[a]) - hi[a];
+      const double gap = std::max({below, above, 0.0});
+      const double reach = std::max(std::abs(below), std::abs(above));
+      near2 += gap * gap, far2 += reach * reach;
+    }
+    return {std::sqrt(near2), std::sqrt(far2)};
+  }
   // Decides b for the sphere where its distances, `moved` since they were measured (infinite when they never
-  // were), allow; else its box (box_verdict over the `candidates` left), else its points, measured again. Its
-  // distances are then from the sphere's centre.
+  // were), allow; else its box's nearest and farthest points (which also tighten its distances); else its points,
+  // measured again. The other `candidates` go through box_verdict. Its distances are then from the sphere's centre.
   BoxVerdict decide(BoxedVoxline& b, double moved, Bits candidates, const std::uint32_t* words,
                     const VertexPacker& packer, const RegionTable& table,
                     const std::array<QuantumWindow, kMaxRegions>& windows) const {
@@ -441,6 +463,17 @@ struct DraggedSphere {
       const float d2 = sphere->squared_distance(p);
       if (d2 <= sphere->radius_squared()) verdict.inside = bit;
       hi = std::min(hi, std::sqrt(double(d2)));
+    }
+    if (((verdict.outside | verdict.inside) & bit) == 0 && b.lo[0] <= b.hi[0]) {
+      // The box's nearest and farthest points bound the nearest point's distance: kept, they decide this voxline
+      // without its points after the next moves too.
+      const BoxDistances box = box_distances(b, packer);
+      lo = std::max(lo, box.nearest);
+      hi = std::min(hi, box.farthest);
+      if (lo > radius + margin)
+        verdict.outside = bit;
+      else if (hi < radius - margin)
+        verdict.inside = bit;
     }
     if (const Bits rest = candidates & ~(verdict.outside | verdict.inside); rest != 0) {
       const BoxVerdict boxed = box_verdict(b, rest, table, packer, windows);
