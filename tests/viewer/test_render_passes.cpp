@@ -1,5 +1,7 @@
 // The renderer's parts below Renderer: the table of the modes' passes (modes/mode_table.cpp) and the line
 // pass (line_pass.h), whose draws bind a frame plan's spans a few at a time.
+#include <limits>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -57,7 +59,10 @@ class LinePassSpans : public ::testing::Test {
 };
 
 // The scene's lines drawn back to front with the over program, straight through a LinePass (no Renderer).
-Image draw_through_line_pass(const VxlFile& f, std::uint64_t max_texels, std::size_t* spans, unsigned* slots) {
+// With `own_draw`, the draws are planned (LinePass::plan_draws) with that many segments per run from which a draw
+// binds one span, and `slots` is what a draw then binds.
+Image draw_through_line_pass(const VxlFile& f, std::uint64_t max_texels, std::size_t* spans, unsigned* slots,
+                             std::optional<std::uint64_t> own_draw = std::nullopt) {
   const std::vector<const VxlFile*> files = {&f};
   GpuScene scene(files, max_texels);
   LinePass lines(scene, files);
@@ -73,6 +78,10 @@ Image draw_through_line_pass(const VxlFile& f, std::uint64_t max_texels, std::si
   FramePlan plan;
   plan_view(scene.layout(), camera, projection, PlanOrder::Nearest, plan, {});
   EXPECT_TRUE(scene.make_resident(spans_nearest_first(scene.layout(), plan)).complete);
+  if (own_draw) {
+    lines.plan_draws(plan.first, plan.count, *own_draw);
+    *slots = lines.draw_spans();
+  }
   RenderSettings settings;
   settings.opacity = 0.3f;
   const SceneGroups groups(files);
@@ -105,6 +114,30 @@ TEST_F(LinePassSpans, APlanOverMoreSpansThanSlotsDrawsAsOverOneSpan) {
   ASSERT_GT(many_spans, std::size_t(slots)) << "the scene must need more spans than one draw binds";
   EXPECT_GT(test::lit_pixels(whole), 500);
   EXPECT_EQ(compare_images(whole, split).differing_pixels, 0u);
+}
+
+// Where a plan's runs of voxels in one span are long, a draw binds one span with the programs made for one slot:
+// the same picture as the draws over several spans, and as the scene in one span.
+TEST_F(LinePassSpans, LongRunsAreDrawnOneSpanADrawWithTheSamePicture) {
+  SynthSettings synth;
+  synth.streamlines = 400;
+  const VxlFile f = test::make_scene(dir, synthesize_tractogram(synth), 12.0);
+  const std::vector<const VxlFile*> files = {&f};
+  const std::uint64_t texels = SceneLayout::largest_voxel_texels(files);
+  std::size_t spans = 0, one_span = 0;
+  unsigned slots = 0, whole_slots = 0;
+  const Image whole = draw_through_line_pass(f, 0, &one_span, &whole_slots);
+  const Image several = draw_through_line_pass(f, texels, &spans, &slots, std::numeric_limits<std::uint64_t>::max());
+  ASSERT_GT(spans, 1u);
+  ASSERT_GT(slots, 1u) << "runs never long enough: draws bind several spans";
+  const Image one_a_draw = draw_through_line_pass(f, texels, &spans, &slots, 0);
+  EXPECT_EQ(slots, 1u) << "every run long enough: a draw binds one span";
+  EXPECT_GT(test::lit_pixels(whole), 500);
+  EXPECT_EQ(compare_images(several, one_a_draw).differing_pixels, 0u);
+  EXPECT_EQ(compare_images(whole, one_a_draw).differing_pixels, 0u);
+  // The default threshold: this scene's runs are far shorter than kSegmentsPerOwnDraw.
+  draw_through_line_pass(f, texels, &spans, &slots, LinePass::kSegmentsPerOwnDraw);
+  EXPECT_GT(slots, 1u);
 }
 
 TEST_F(LinePassSpans, AnEmptyPlanDrawsNothing) {

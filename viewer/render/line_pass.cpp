@@ -43,36 +43,68 @@ LinePass::LinePass(GpuScene& scene, const std::vector<const VxlFile*>& files) : 
     throw Error(ErrorKind::Unsupported, files_.front()->path(), std::nullopt,
                 "this GPU offers " + std::to_string(units) + " vertex-shader textures; the lines need " +
                     std::to_string(kSamplersPerSpan + 1));
+  draw_spans_ = bound_spans_;
   glGenVertexArrays(1, &vao_);
   make_programs(false);
 }
 
 LinePass::~LinePass() {
-  for (GLuint p : {over_program_, accum_program_, reveal_program_, additive_program_})
-    if (p) glDeleteProgram(p);
+  make_programs(false);
   streamline_groups_.destroy();
   if (vao_) glDeleteVertexArrays(1, &vao_);
 }
 
 void LinePass::make_programs(bool slice_test) {
-  for (GLuint* p : {&over_program_, &accum_program_, &reveal_program_, &additive_program_})
-    if (*p) glDeleteProgram(std::exchange(*p, 0));
+  for (auto* programs : {&programs_, &one_span_programs_})
+    for (GLuint& p : *programs)
+      if (p) glDeleteProgram(std::exchange(p, 0));
   slice_test_ = slice_test;
 }
 
-GLuint LinePass::program(GLuint& slot, Fragment fragment) const {
+GLuint LinePass::program(Fragment fragment, unsigned spans) const {
+  GLuint& slot = (spans == bound_spans_ ? programs_ : one_span_programs_)[static_cast<std::size_t>(fragment)];
   if (slot) return slot;
   const char* body = fragment == Fragment::Over          ? shaders::kLineOverFragment
                      : fragment == Fragment::WboitAccum  ? shaders::kLineWboitAccumFragment
                      : fragment == Fragment::WboitReveal ? shaders::kLineWboitRevealFragment
                                                          : shaders::kLineAdditiveFragment;
-  slot = make_program(body, "#version 330 core");
+  slot = make_program(body, "#version 330 core", spans);
   return slot;
 }
 
 GLuint LinePass::make_program(const char* fragment_body, const char* version) const {
-  return gl::make_program(shaders::line_vertex(bound_spans_, version),
+  return make_program(fragment_body, version, bound_spans_);
+}
+
+GLuint LinePass::make_program(const char* fragment_body, const char* version, unsigned spans) const {
+  return gl::make_program(shaders::line_vertex(spans, version),
                           shaders::line_fragment(fragment_body, version, slice_test_));
+}
+
+void LinePass::plan_draws(std::span<const std::int64_t> first, std::span<const std::int32_t> count,
+                          std::uint64_t segments_per_own_draw) {
+  draw_spans_ = bound_spans_;
+  if (bound_spans_ == 1 || first.empty()) return;
+  const SceneLayout& layout = scene_.layout();
+  std::uint64_t runs = 1, segments = 0;
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    if (i > 0 && layout.span_of_id(first[i]) != layout.span_of_id(first[i - 1])) ++runs;
+    segments += static_cast<std::uint64_t>(count[i] / 2);
+  }
+  if (segments / runs >= segments_per_own_draw) draw_spans_ = 1;
+}
+
+GLuint LinePass::drawn(GLuint program) const {
+  if (draw_spans_ == bound_spans_) return program;
+  for (std::size_t f = 0; f < kFragments; ++f)
+    if (program == programs_[f]) return this->program(static_cast<Fragment>(f), draw_spans_);
+  return program;
+}
+
+unsigned LinePass::span_slots(GLuint program) const {
+  for (const GLuint p : one_span_programs_)
+    if (p == program && p != 0) return 1;
+  return bound_spans_;
 }
 
 void LinePass::prepare_attributes(const RenderSettings& s, const std::string& scalar, const SceneGroups& groups,
@@ -122,7 +154,8 @@ void LinePass::upload_streamline_groups(const SceneGroups& groups) {
   streamline_groups_stale_ = false;
 }
 
-void LinePass::bind(GLuint program, const LineUniforms& u) const {
+void LinePass::bind(GLuint mode_program, const LineUniforms& u) const {
+  const GLuint program = drawn(mode_program);
   const Camera& camera = u.camera;
   const RenderSettings& s = u.settings;
   glUseProgram(program);
@@ -167,7 +200,7 @@ void LinePass::bind(GLuint program, const LineUniforms& u) const {
   bind_clip_half_spaces(program, clip_half_spaces(s.clipping, camera), eye);
   // The streamline groups' table on the first unit after the spans', the slices' depth on the next (units
   // of their own: two sampler types must not share one), bound even when unused.
-  const GLint groups_unit = static_cast<GLint>(kSamplersPerSpan * bound_spans_);
+  const GLint groups_unit = static_cast<GLint>(kSamplersPerSpan * span_slots(program));
   glActiveTexture(GL_TEXTURE0 + groups_unit);
   glBindTexture(gl::kBufferTextureTarget, streamline_groups_.texture);
   glUniform1i(glGetUniformLocation(program, "u_streamline_group"), groups_unit);
@@ -179,7 +212,7 @@ void LinePass::bind(GLuint program, const LineUniforms& u) const {
   glActiveTexture(GL_TEXTURE0);
 }
 
-void LinePass::bind_spans(GLuint program, std::span<const std::uint32_t> bound,
+void LinePass::bind_spans(GLuint program, unsigned slots, std::span<const std::uint32_t> bound,
                           std::span<const std::int64_t> base) const {
   const auto& spans = scene_.layout().texture_spans();
   // Per slot: where its ids start in this draw and how its buffers are laid out (scene_layout.h); a slot
@@ -188,7 +221,7 @@ void LinePass::bind_spans(GLuint program, std::span<const std::uint32_t> bound,
       {"u_span_base", {}},   {"u_span_segments", {}},      {"u_span_slots", {}},        {"u_span_vertices", {}},
       {"u_span_voxels", {}}, {"u_span_segment_table", {}}, {"u_span_vertex_table", {}}, {"u_span_order_words", {}},
   };
-  for (std::size_t slot = 0; slot < bound_spans_; ++slot) {
+  for (std::size_t slot = 0; slot < slots; ++slot) {
     std::int64_t values[] = {std::numeric_limits<std::int32_t>::max(), 1, 1, 0, 1, 0, 0, 1};
     if (slot < bound.size()) {
       const TextureSpan& c = spans[bound[slot]];
@@ -208,7 +241,7 @@ void LinePass::bind_spans(GLuint program, std::span<const std::uint32_t> bound,
   for (const auto& [name, values] : fields)
     glUniform1iv(glGetUniformLocation(program, name), static_cast<GLsizei>(values.size()), values.data());
   const char* names[kSamplersPerSpan] = {"u_words", "u_ord", "u_dat", "u_att"};
-  for (std::size_t slot = 0; slot < bound_spans_; ++slot) {
+  for (std::size_t slot = 0; slot < slots; ++slot) {
     const GpuTextureSpan* g = slot < bound.size() ? &scene_.texture_spans()[bound[slot]] : nullptr;
     const GLuint textures[kSamplersPerSpan] = {g ? g->words.texture : 0, g ? g->orders.texture : 0,
                                                g ? g->dataset.texture : 0, g ? g->attributes.texture : 0};
@@ -222,9 +255,11 @@ void LinePass::bind_spans(GLuint program, std::span<const std::uint32_t> bound,
   glActiveTexture(GL_TEXTURE0);
 }
 
-void LinePass::draw_plan(GLuint program, std::span<const std::int64_t> first,
+void LinePass::draw_plan(GLuint mode_program, std::span<const std::int64_t> first,
                          std::span<const std::int32_t> count) const {
   if (first.empty()) return;
+  const GLuint program = drawn(mode_program);
+  const unsigned slots = span_slots(program);
   glBindVertexArray(vao_);
   const SceneLayout& layout = scene_.layout();
   const auto& spans = layout.texture_spans();
@@ -237,7 +272,7 @@ void LinePass::draw_plan(GLuint program, std::span<const std::int64_t> first,
   std::int64_t next_base = 0;
   auto flush = [&] {
     if (run_first.empty()) return;
-    bind_spans(program, bound, base);
+    bind_spans(program, slots, bound, base);
     gl::multi_draw(GL_LINES, run_first.data(), run_count.data(), static_cast<GLsizei>(run_first.size()));
     bound.clear();
     base.clear();
@@ -250,7 +285,7 @@ void LinePass::draw_plan(GLuint program, std::span<const std::int64_t> first,
     std::size_t slot = std::find(bound.begin(), bound.end(), span) - bound.begin();
     if (slot == bound.size()) {
       const std::int64_t ids = static_cast<std::int64_t>(spans[span].virtual_ids());
-      if (bound.size() == bound_spans_ || next_base + ids > std::numeric_limits<std::int32_t>::max()) flush();
+      if (bound.size() == slots || next_base + ids > std::numeric_limits<std::int32_t>::max()) flush();
       slot = bound.size();
       bound.push_back(span);
       base.push_back(next_base);

@@ -117,6 +117,7 @@ void Renderer::plan_and_count(const Camera& camera, double aspect, PlanOrder ord
   auto t0 = std::chrono::steady_clock::now();
   plan(camera, aspect, order, out, clipping);
   keep_resident(out);
+  lines_->plan_draws(out.first, out.count);
   stats_.plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.voxels_drawn = out.voxels_drawn;
   stats_.segments_drawn = out.segments_drawn;
