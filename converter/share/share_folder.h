@@ -27,7 +27,8 @@ struct ShareSummary {
 };
 
 // The files of the built web viewer that a shared folder holds.
-inline constexpr const char* kWebViewerFiles[] = {"index.html", "viewer.js", "voxweb.js", "voxweb.wasm"};
+inline constexpr const char* kWebViewerFiles[] = {"index.html",       "viewer.js",    "voxweb.js",     "voxweb.wasm",
+                                                  "unpack_worker.js", "voxunpack.js", "voxunpack.wasm"};
 
 // Writes the folder `out_dir`, which must not exist: made under a temporary name beside it and renamed
 // when complete, so that a failure or an interruption leaves no partial folder at `out_dir`. Throws

@@ -3,8 +3,8 @@
 headless Chromium (WebGL2 on SwiftShader), against `voxview --render` of the same file with the same camera
 (llvmpipe). Two rasterisers draw a line's pixels a little differently, so the pictures are compared by PSNR
 over R, G, B (at least MIN_PSNR dB), not byte for byte. Cases: a synthetic set of 20,000 streamlines, packed
-and float32, in the axis and unsorted modes; a .vxlz shared as it is (fetched whole and unpacked by the page, with
-the converter's own code built for WebAssembly); with the real fixtures (when
+and float32, in the axis and unsorted modes; a .vxlz shared as it is (fetched whole and unpacked by the page in a worker,
+with the converter's own code built for WebAssembly); with the real fixtures (when
 --real-data holds them), MRtrix's test tracks coloured by their AFD values; the packed file sent gzip-compressed
 (the length the server declares is then not the body's). The files are served by a server that answers Range
 requests (the page then fetches the first picture's level first, many ranges a request), one that answers the
@@ -184,6 +184,9 @@ def main():
             size = os.path.getsize(os.path.join(folder, shared))
             if source.endswith('.vxlz') and shared != source:
                 failures.append(f'{source}: shared as {shared}, not as the package itself')
+            # A package is unpacked in a worker (unpack_worker.js), off the page's thread, which marks its answer.
+            if source.endswith('.vxlz') and 'unpacked' not in [name for name, _ in report['marks']]:
+                failures.append(f'{source}: not unpacked in a worker (marks: {report["marks"]})')
             # Under the budget, level 1 and what opens the file: under a quarter of it (an eighth of the points and
             # orders, the voxel tables); the whole file only for a setting that reads it.
             whole = 'unsorted' in settings

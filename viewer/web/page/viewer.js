@@ -358,19 +358,51 @@
       if (afterWholeFile !== true) redraw();  // after it, only a setting applied (set) asks for a frame
     }
 
+    // A package's bytes (an ArrayBuffer, handed over) unpacked in a worker of its own: {vxl: ArrayBuffer} or
+    // {error: text}. The worker ends with its answer.
+    function unpackInWorker(bytes, name) {
+      return new Promise((resolve) => {
+        const worker = new Worker('unpack_worker.js');
+        const answer = (message) => {
+          worker.terminate();
+          resolve(message);
+        };
+        worker.onmessage = (event) => answer(event.data);
+        worker.onerror = (event) => {
+          event.preventDefault();
+          answer({ error: `${name}: the unpacker could not run (${event.message || 'unpack_worker.js did not load'})` });
+        };
+        worker.postMessage({ bytes, name }, [bytes]);
+      });
+    }
+
     // Whether a file's first bytes are a .vxlz package's magic (\x89VXZ\r\n\x1a\n).
     const PACKAGE_MAGIC = [0x89, 0x56, 0x58, 0x5a, 0x0d, 0x0a, 0x1a, 0x0a];
     const isPackage = (bytes) => bytes.length >= 8 && PACKAGE_MAGIC.every((b, i) => bytes[i] === b);
 
-    // The whole file's bytes (from Module._malloc; the viewer frees them). A package is unpacked first, on this
-    // thread (WebAssembly here has no other): the page says so and shows it before that begins.
+    // The whole file's bytes (from Module._malloc; the viewer frees them). A package is unpacked first, in a
+    // worker (unpack_worker.js), so that the page keeps drawing and taking input; where the browser has no
+    // workers, by the viewer itself on this thread, the page saying so before it begins.
     async function openBytes(pointer, size, name, target) {
       const [w, h] = canvasSize();
       const t0 = performance.now();
       if (isPackage(Module.HEAPU8.subarray(pointer, pointer + 8))) {
         say(`${name}: unpacking the package`);
-        await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
-        if (!current(target)) return Module._free(pointer);
+        if (typeof Worker === 'function') {
+          const bytes = Module.HEAPU8.slice(pointer, pointer + size).buffer;
+          Module._free(pointer);
+          const answer = await unpackInWorker(bytes, name);
+          if (!current(target)) return;
+          if (answer.error !== undefined) return fail(answer.error);
+          mark('unpacked');
+          size = answer.vxl.byteLength;
+          pointer = Module._malloc(Math.max(size, 1));
+          if (!pointer) return fail(`${name}: not enough memory for the unpacked file (${size} bytes)`);
+          Module.HEAPU8.set(new Uint8Array(answer.vxl), pointer);
+        } else {
+          await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
+          if (!current(target)) return Module._free(pointer);
+        }
       }
       if (api.open(pointer, size, name, w, h, 1) !== 0) return fail(api.error());
       mark('opened');
