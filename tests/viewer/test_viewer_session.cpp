@@ -173,5 +173,42 @@ TEST_F(ViewerSessionTest, FocusFirstIsOnePolicyForEveryPicture) {
   EXPECT_FALSE(forced.focus_copy_needed(1)) << "--level fixes the level: no focus first";
 }
 
+// The focus-first renderer (the context's files at their level and the copy at full detail, one scene) takes the
+// largest spans only where both fit the budget whole in them; else it pages as the budget's choice of levels assumed.
+TEST_F(ViewerSessionTest, FocusFirstTakesTheLargestSpansOnlyWhereContextAndCopyFitWhole) {
+  options.span_texels.reset();
+  const std::vector<const VxlFile*> files{&*file};
+  const std::uint64_t full = SceneLayout(files, GpuScene::driver_limit(), 0).upload_bytes();
+  std::vector<std::vector<std::uint64_t>> kept(1);
+  for (std::uint64_t s = 0; s < file->meta().streamline_count; s += 3) kept[0].push_back(s);
+  const FocusCopy copy(files, kept);  // as set_focus makes it
+  std::vector<const VxlFile*> all = files;
+  all.insert(all.end(), copy.files().begin(), copy.files().end());
+  bool whole_seen = false, paging_seen = false;
+  for (int k = 1; k < 48; ++k) {
+    options.gpu_memory = full * k / 48;
+    ViewerSession session(options);
+    try {
+      session.choose_detail(options, /*one_renderer=*/true);
+    } catch (const Error&) {
+      continue;  // a budget below the coarsest level
+    }
+    const SceneDetail& d = session.detail();
+    if (d.level == 0) break;
+    ASSERT_LT(d.span_texels, d.whole_span_texels);
+    session.set_focus(kept);
+    std::vector<std::uint32_t> levels(files.size(), d.level);
+    levels.resize(all.size(), 0);
+    const bool fits = SceneLayout(all, d.whole_span_texels, levels).upload_bytes() <= d.budget;
+    EXPECT_EQ(session.focus_first_renderer(d.level, false).layout().max_texels(),
+              fits ? d.whole_span_texels : d.span_texels)
+        << "budget " << d.budget;
+    whole_seen |= fits;
+    paging_seen |= !fits;
+  }
+  EXPECT_TRUE(whole_seen) << "the test needs a budget that the context and the copy fit whole";
+  EXPECT_TRUE(paging_seen) << "the test needs a budget they do not fit whole";
+}
+
 }  // namespace
 }  // namespace vxl::app

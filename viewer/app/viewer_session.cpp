@@ -82,8 +82,13 @@ Renderer& ViewerSession::focus_first_renderer(std::uint32_t context_level, bool 
     all.insert(all.end(), focus_->files().begin(), focus_->files().end());
     std::vector<std::uint32_t> levels(files_.size(), context_level);
     levels.resize(all.size(), 0);  // the focus's copies at full detail
+    // The largest spans only where the context and the copy fit the budget whole in them: the choice of the context's
+    // level counted their visible part, which in spans that large is nearly all of them.
+    std::uint64_t span_texels = span_texels_at(context_level);
+    if (span_texels != detail_->span_texels && SceneLayout(all, span_texels, levels).upload_bytes() > detail_->budget)
+      span_texels = detail_->span_texels;
     // Its own per-voxel indexes: the session's cover the context's files only.
-    r = std::make_unique<Renderer>(all, span_texels_at(context_level), context_level, gpu_memory_, eager, levels);
+    r = std::make_unique<Renderer>(all, span_texels, context_level, gpu_memory_, eager, levels);
     if (image_) r->set_volume(*image_);
     r->set_groups(SceneGroups::focus_first(all, files_.size(), focus_kept_));
   }

@@ -110,6 +110,7 @@ bool SceneLayout::one_level() const {
 
 void SceneLayout::lay_out(std::span<const VxlFile* const> files, std::uint64_t max_texels,
                           std::span<const std::uint32_t> file_levels) {
+  max_texels_ = max_texels;
   level_ = 0;
   for (std::uint32_t l : file_levels) level_ = std::max(level_, l);
   std::uint64_t total_voxels = 0;

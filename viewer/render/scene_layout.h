@@ -117,6 +117,8 @@ class SceneLayout {
   // The level the scene is drawn at (the coarsest file's), and the opacity that makes a segment of it stand for the
   // 8^level segments of full detail it samples (.vxl spec §6.5): 1 - (1 - opacity)^(8^level).
   std::uint32_t level() const { return level_; }
+  // The most texels one of its spans may hold, as it was laid out with.
+  std::uint64_t max_texels() const { return max_texels_; }
   static float level_opacity(float opacity, std::uint32_t level);
 
   static constexpr std::uint64_t kGroup = TextureSpan::kGroupSize;
@@ -178,6 +180,7 @@ class SceneLayout {
   std::vector<VoxelDrawInfo> voxels_;
   std::vector<TextureSpan> spans_;
   std::uint64_t virtual_ids_ = 0;
+  std::uint64_t max_texels_ = 0;
   std::uint32_t level_ = 0;
   double voxel_size_ = 0;
   bool one_grid_ = true;

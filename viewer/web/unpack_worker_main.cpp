@@ -5,7 +5,6 @@
 #include <emscripten/emscripten.h>
 
 #include <cstdint>
-#include <cstdlib>
 #include <exception>
 #include <optional>
 #include <string>
@@ -34,12 +33,10 @@ EMSCRIPTEN_KEEPALIVE int vu_unpack(std::uint8_t* bytes, double size, const char*
   unpacked().reset();
   last_error().clear();
   try {
-    vxl::MappedFile file = vxl::web::unpack_package({bytes, static_cast<std::size_t>(size)}, name);
-    std::free(bytes);
-    unpacked().emplace(std::move(file));
+    unpacked().emplace(
+        vxl::web::unpack_package(vxl::MappedFile::adopt(name, bytes, static_cast<std::size_t>(size)), name));
     return 1;
   } catch (const std::exception& e) {
-    std::free(bytes);
     last_error() = e.what();
     return 0;
   }

@@ -29,12 +29,14 @@ bool is_package(std::span<const std::uint8_t> bytes) {
   return bytes.size() >= kVxlzMagic.size() && std::equal(kVxlzMagic.begin(), kVxlzMagic.end(), bytes.begin());
 }
 
-MappedFile unpack_package(std::span<const std::uint8_t> bytes, const std::string& name) {
+MappedFile unpack_package(MappedFile package_bytes, const std::string& name) {
   const RemovedAtExit package{package_path(name)}, unpacked{package.path + ".vxl"};
   std::FILE* f = std::fopen(package.path.c_str(), "wb");
+  const std::span<const std::uint8_t> bytes = package_bytes.bytes();
   const bool written = f != nullptr && std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
   if (f == nullptr || std::fclose(f) != 0 || !written)
     throw Error(ErrorKind::Unsupported, name, std::nullopt, "no memory to unpack this package in");
+  { const MappedFile released = std::move(package_bytes); }  // the file system's copy is the one unpacked
   UnpackSettings settings;
   settings.threads = 1;  // this WebAssembly build has no threads
   unpack_vxlz(package.path, unpacked.path, settings);

@@ -14,9 +14,9 @@ namespace vxl::web {
 // Whether `bytes` begin as a .vxlz package does (its magic, spec/vxlz-package-v2.md §2.1).
 bool is_package(std::span<const std::uint8_t> bytes);
 
-// Unpacks the package `bytes` (named `name` in errors) into a .vxl held in memory. The package's bytes are
-// copied first, so the caller may free them once this returns; nothing is left in the file system, also when
-// the package is refused (vxl::Error, as unpack_vxlz throws it).
-MappedFile unpack_package(std::span<const std::uint8_t> bytes, const std::string& name);
+// Unpacks the package `package` (named `name` in errors) into a .vxl held in memory. The package is copied into
+// the in-memory file system first and let go then, so that the memory holds it once while it is unpacked; nothing
+// is left in the file system, also when the package is refused (vxl::Error, as unpack_vxlz throws it).
+MappedFile unpack_package(MappedFile package, const std::string& name);
 
 }  // namespace vxl::web

@@ -291,7 +291,7 @@ EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* n
     auto& v = viewer();
     vxl::web::close(v);
     try {
-      if (whole && vxl::web::is_package(file.bytes())) file = vxl::web::unpack_package(file.bytes(), name);
+      if (whole && vxl::web::is_package(file.bytes())) file = vxl::web::unpack_package(std::move(file), name);
       vxl::web::open_file(v, std::move(file), width, height);
       if (whole) {
         v.held = {{0, v.file->bytes().size()}};  // an unpacked package's, not the package's

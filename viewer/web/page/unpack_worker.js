@@ -7,14 +7,14 @@ onmessage = async (event) => {
   const { bytes, name } = event.data;
   try {
     const unpacker = await createVoxunpack();
-    const pointer = unpacker._malloc(bytes.byteLength);
+    const pointer = unpacker._malloc(bytes.byteLength) >>> 0;  // addresses past 2 GiB come back negative
     if (!pointer) throw new Error(`${name}: no memory to unpack this package in`);
     unpacker.HEAPU8.set(new Uint8Array(bytes), pointer);
     if (!unpacker.ccall('vu_unpack', 'number', ['number', 'number', 'string'], [pointer, bytes.byteLength, name])) {
-      postMessage({ error: unpacker.UTF8ToString(unpacker._vu_error()) });
+      postMessage({ error: unpacker.UTF8ToString(unpacker._vu_error() >>> 0) });
       return;
     }
-    const data = unpacker._vu_data();
+    const data = unpacker._vu_data() >>> 0;
     const vxl = unpacker.HEAPU8.slice(data, data + unpacker._vu_size()).buffer;
     postMessage({ vxl }, [vxl]);
   } catch (error) {

@@ -358,15 +358,18 @@
       if (afterWholeFile !== true) redraw();  // after it, only a setting applied (set) asks for a frame
     }
 
-    // A package's bytes (an ArrayBuffer, handed over) unpacked in a worker of its own: {vxl: ArrayBuffer} or
-    // {error: text}. The worker ends with its answer.
-    function unpackInWorker(bytes, name) {
+    // A package's bytes (an ArrayBuffer, handed over) unpacked in `worker` (unpack_worker.js), which ends with its
+    // answer: {vxl: ArrayBuffer} or {error: text}. A package opened since ends the one before ({stale: true}).
+    let unpacking = null;  // {worker, answer} of the package being unpacked
+    function unpackInWorker(worker, bytes, name) {
+      if (unpacking) unpacking.answer({ stale: true });
       return new Promise((resolve) => {
-        const worker = new Worker('unpack_worker.js');
         const answer = (message) => {
           worker.terminate();
+          if (unpacking && unpacking.worker === worker) unpacking = null;
           resolve(message);
         };
+        unpacking = { worker, answer };
         worker.onmessage = (event) => answer(event.data);
         worker.onerror = (event) => {
           event.preventDefault();
@@ -374,6 +377,14 @@
         };
         worker.postMessage({ bytes, name }, [bytes]);
       });
+    }
+    // A worker for the unpacker; null where the browser has none or refuses it (a page opened from the disk).
+    function unpackWorker() {
+      try {
+        return typeof Worker === 'function' ? new Worker('unpack_worker.js') : null;
+      } catch (error) {
+        return null;
+      }
     }
 
     // Whether a file's first bytes are a .vxlz package's magic (\x89VXZ\r\n\x1a\n).
@@ -388,16 +399,20 @@
       const t0 = performance.now();
       if (isPackage(Module.HEAPU8.subarray(pointer, pointer + 8))) {
         say(`${name}: unpacking the package`);
-        if (typeof Worker === 'function') {
+        const worker = unpackWorker();
+        if (worker) {
           const bytes = Module.HEAPU8.slice(pointer, pointer + size).buffer;
           Module._free(pointer);
-          const answer = await unpackInWorker(bytes, name);
-          if (!current(target)) return;
+          const answer = await unpackInWorker(worker, bytes, name);
+          if (!current(target) || answer.stale) return;
           if (answer.error !== undefined) return fail(answer.error);
           mark('unpacked');
           size = answer.vxl.byteLength;
-          pointer = Module._malloc(Math.max(size, 1));
-          if (!pointer) return fail(`${name}: not enough memory for the unpacked file (${size} bytes)`);
+          try {
+            pointer = allocate(size, name);
+          } catch (error) {
+            return fail(error.message);
+          }
           Module.HEAPU8.set(new Uint8Array(answer.vxl), pointer);
         } else {
           await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
@@ -566,7 +581,7 @@
     const MAX_FILE_BYTES = 2 ** 32 - 2 ** 28;
     function allocate(size, name) {
       if (size > MAX_FILE_BYTES) throw new Error(`${name}: ${size.toLocaleString()} bytes, more than the web viewer can hold (4 GiB less 256 MiB)`);
-      const pointer = Module._malloc(Math.max(1, size));
+      const pointer = Module._malloc(Math.max(1, size)) >>> 0;  // an address past 2 GiB comes back negative
       if (!pointer) throw new Error(`${name}: no memory for its ${size.toLocaleString()} bytes`);
       return pointer;
     }
