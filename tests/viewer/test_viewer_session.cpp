@@ -1,6 +1,8 @@
 // The scene voxview shows (viewer_session.h): one renderer per level, made once with the image and the
 // current groups, and a view's level measured on the layouts exactly as the renderers would measure it
 // (the lines' bounds joined with the image's box).
+#include <functional>
+
 #include "converter/synth/synth.h"
 #include "tests/nifti_test_files.h"
 #include "tests/viewer/render_support.h"
@@ -33,6 +35,25 @@ class ViewerSessionTest : public ::testing::Test {
     options.span_texels = SceneLayout::largest_voxel_texels(std::vector<const VxlFile*>{&*file});
   }
   static Camera view() { return test::synth_brain_view(200); }
+  // check(session) for the budgets of k/48 of full detail's bytes in the driver's largest spans (k = 1, 2, ...) whose
+  // scene level is coarser than full detail, each session's detail chosen by default (paging spans) with
+  // `one_renderer`; the budgets below the coarsest level are passed over.
+  void for_each_paging_budget(bool one_renderer, const std::function<void(ViewerSession&)>& check) {
+    options.span_texels.reset();
+    const std::vector<const VxlFile*> files{&*file};
+    const std::uint64_t full = SceneLayout(files, GpuScene::driver_limit(), 0).upload_bytes();
+    for (int k = 1; k < 48; ++k) {
+      options.gpu_memory = full * k / 48;
+      ViewerSession session(options);
+      try {
+        session.choose_detail(options, one_renderer);
+      } catch (const Error&) {
+        continue;
+      }
+      if (session.detail().level == 0) return;
+      check(session);
+    }
+  }
   ScratchDir dir;
   ViewerOptions options;
   std::optional<VxlFile> file;
@@ -73,20 +94,10 @@ TEST_F(ViewerSessionTest, OneRendererDrawsALevelThatFitsInTheLargestSpans) {
 // The window keeps a renderer per level it draws, sharing the budget: the largest spans only where the scene's level
 // and every coarser one fit it together, else every level pages.
 TEST_F(ViewerSessionTest, TheWindowsLevelsTakeTheLargestSpansWhereTheyFitTogether) {
-  options.span_texels.reset();
   const std::vector<const VxlFile*> files{&*file};
-  const std::uint64_t full = SceneLayout(files, GpuScene::driver_limit(), 0).upload_bytes();
   bool whole_seen = false, paging_seen = false;
-  for (int k = 1; k < 48; ++k) {
-    options.gpu_memory = full * k / 48;
-    ViewerSession session(options);
-    try {
-      session.choose_detail(options, /*one_renderer=*/false);
-    } catch (const Error&) {
-      continue;  // a budget below the coarsest level
-    }
+  for_each_paging_budget(/*one_renderer=*/false, [&](ViewerSession& session) {
     const SceneDetail& d = session.detail();
-    if (d.level == 0) break;
     std::uint64_t together = 0;
     for (std::uint32_t level = d.level; level < session.levels_in_files(); ++level)
       together += SceneLayout(files, d.whole_span_texels, level).upload_bytes();
@@ -100,7 +111,7 @@ TEST_F(ViewerSessionTest, TheWindowsLevelsTakeTheLargestSpansWhereTheyFitTogethe
               SceneLayout(files, expected, d.level).texture_spans().size());
     whole_seen |= whole;
     paging_seen |= !whole;
-  }
+  });
   EXPECT_TRUE(whole_seen) << "the test needs a budget that the scene's and coarser levels fit whole";
   EXPECT_TRUE(paging_seen) << "the test needs a budget they do not fit together";
 }
@@ -176,25 +187,15 @@ TEST_F(ViewerSessionTest, FocusFirstIsOnePolicyForEveryPicture) {
 // The focus-first renderer (the context's files at their level and the copy at full detail, one scene) takes the
 // largest spans only where both fit the budget whole in them; else it pages as the budget's choice of levels assumed.
 TEST_F(ViewerSessionTest, FocusFirstTakesTheLargestSpansOnlyWhereContextAndCopyFitWhole) {
-  options.span_texels.reset();
   const std::vector<const VxlFile*> files{&*file};
-  const std::uint64_t full = SceneLayout(files, GpuScene::driver_limit(), 0).upload_bytes();
   std::vector<std::vector<std::uint64_t>> kept(1);
   for (std::uint64_t s = 0; s < file->meta().streamline_count; s += 3) kept[0].push_back(s);
   const FocusCopy copy(files, kept);  // as set_focus makes it
   std::vector<const VxlFile*> all = files;
   all.insert(all.end(), copy.files().begin(), copy.files().end());
   bool whole_seen = false, paging_seen = false;
-  for (int k = 1; k < 48; ++k) {
-    options.gpu_memory = full * k / 48;
-    ViewerSession session(options);
-    try {
-      session.choose_detail(options, /*one_renderer=*/true);
-    } catch (const Error&) {
-      continue;  // a budget below the coarsest level
-    }
+  for_each_paging_budget(/*one_renderer=*/true, [&](ViewerSession& session) {
     const SceneDetail& d = session.detail();
-    if (d.level == 0) break;
     ASSERT_LT(d.span_texels, d.whole_span_texels);
     session.set_focus(kept);
     std::vector<std::uint32_t> levels(files.size(), d.level);
@@ -205,7 +206,7 @@ TEST_F(ViewerSessionTest, FocusFirstTakesTheLargestSpansOnlyWhereContextAndCopyF
         << "budget " << d.budget;
     whole_seen |= fits;
     paging_seen |= !fits;
-  }
+  });
   EXPECT_TRUE(whole_seen) << "the test needs a budget that the context and the copy fit whole";
   EXPECT_TRUE(paging_seen) << "the test needs a budget they do not fit whole";
 }
