@@ -464,9 +464,11 @@ struct DraggedSphere {
       if (d2 <= sphere->radius_squared()) verdict.inside = bit;
       hi = std::min(hi, std::sqrt(double(d2)));
     }
+    Bits boxed_already = 0;  // the sphere, where its box was measured here: box_verdict would test it again
     if (((verdict.outside | verdict.inside) & bit) == 0 && b.lo[0] <= b.hi[0]) {
       // The box's nearest and farthest points bound the nearest point's distance: kept, they decide this voxline
       // without its points after the next moves too.
+      boxed_already = bit;
       const BoxDistances box = box_distances(b, packer);
       lo = std::max(lo, box.nearest);
       hi = std::min(hi, box.farthest);
@@ -475,7 +477,7 @@ struct DraggedSphere {
       else if (hi < radius - margin)
         verdict.inside = bit;
     }
-    if (const Bits rest = candidates & ~(verdict.outside | verdict.inside); rest != 0) {
+    if (const Bits rest = candidates & ~(verdict.outside | verdict.inside | boxed_already); rest != 0) {
       const BoxVerdict boxed = box_verdict(b, rest, table, packer, windows);
       verdict.outside |= boxed.outside, verdict.inside |= boxed.inside;
     }

@@ -36,9 +36,9 @@ class ViewerSessionTest : public ::testing::Test {
   }
   static Camera view() { return test::synth_brain_view(200); }
   // check(session) for the budgets of k/48 of full detail's bytes in the driver's largest spans (k = 1, 2, ...) whose
-  // scene level is coarser than full detail, each session's detail chosen by default (paging spans) with
-  // `one_renderer`; the budgets below the coarsest level are passed over.
-  void for_each_paging_budget(bool one_renderer, const std::function<void(ViewerSession&)>& check) {
+  // scene level is coarser than full detail, each session's detail chosen by default (paging spans) for one renderer;
+  // the budgets below the coarsest level are passed over.
+  void for_each_paging_budget(const std::function<void(ViewerSession&)>& check) {
     options.span_texels.reset();
     const std::vector<const VxlFile*> files{&*file};
     const std::uint64_t full = SceneLayout(files, GpuScene::driver_limit(), 0).upload_bytes();
@@ -46,7 +46,7 @@ class ViewerSessionTest : public ::testing::Test {
       options.gpu_memory = full * k / 48;
       ViewerSession session(options);
       try {
-        session.choose_detail(options, one_renderer);
+        session.choose_detail(options, /*one_renderer=*/true);
       } catch (const Error&) {
         continue;
       }
@@ -78,42 +78,19 @@ TEST_F(ViewerSessionTest, OneRendererDrawsALevelThatFitsInTheLargestSpans) {
   options.span_texels.reset();  // the defaults: paging spans where full detail does not fit the budget
   const std::vector<const VxlFile*> files{&*file};
   options.gpu_memory = SceneLayout(files, GpuScene::driver_limit(), 0).upload_bytes() / 3;
-  ViewerSession session(options);
-  session.choose_detail(options, /*one_renderer=*/true);
-  const SceneDetail& d = session.detail();
-  ASSERT_GT(d.level, 0u) << "the test needs a budget that full detail does not fit";
-  EXPECT_LT(d.span_texels, d.whole_span_texels) << "paging spans, smaller than the driver's";
-  // The scene's level and coarser ones fit whole: one renderer takes them in the largest spans; a finer level
-  // (a close view's) pages.
-  EXPECT_EQ(session.span_texels_at(d.level), d.whole_span_texels);
-  EXPECT_EQ(session.span_texels_at(d.level + 1), d.whole_span_texels);
-  EXPECT_EQ(session.span_texels_at(d.level - 1), d.span_texels);
-  EXPECT_EQ(session.renderer_at(d.level, false).layout().level(), d.level);
-}
-
-// The window keeps a renderer per level it draws, sharing the budget: the largest spans only where the scene's level
-// and every coarser one fit it together, else every level pages.
-TEST_F(ViewerSessionTest, TheWindowsLevelsTakeTheLargestSpansWhereTheyFitTogether) {
-  const std::vector<const VxlFile*> files{&*file};
-  bool whole_seen = false, paging_seen = false;
-  for_each_paging_budget(/*one_renderer=*/false, [&](ViewerSession& session) {
+  for (const bool one_renderer : {false, true}) {
+    ViewerSession session(options);
+    session.choose_detail(options, one_renderer);
     const SceneDetail& d = session.detail();
-    std::uint64_t together = 0;
-    for (std::uint32_t level = d.level; level < session.levels_in_files(); ++level)
-      together += SceneLayout(files, d.whole_span_texels, level).upload_bytes();
-    const bool whole = together <= d.budget;
-    EXPECT_EQ(scene_and_coarser_levels_fit_whole(files, d), whole) << "budget " << d.budget;
-    const std::uint64_t expected = whole ? d.whole_span_texels : d.span_texels;
-    EXPECT_EQ(session.span_texels_at(d.level), expected) << "budget " << d.budget;
-    EXPECT_EQ(session.span_texels_at(d.level + 1), expected) << "budget " << d.budget;
-    EXPECT_EQ(session.span_texels_at(d.level - 1), d.span_texels) << "a finer level pages";
-    EXPECT_EQ(session.renderer_at(d.level, false).layout().texture_spans().size(),
-              SceneLayout(files, expected, d.level).texture_spans().size());
-    whole_seen |= whole;
-    paging_seen |= !whole;
-  });
-  EXPECT_TRUE(whole_seen) << "the test needs a budget that the scene's and coarser levels fit whole";
-  EXPECT_TRUE(paging_seen) << "the test needs a budget they do not fit together";
+    ASSERT_GT(d.level, 0u) << "the test needs a budget that full detail does not fit";
+    EXPECT_LT(d.span_texels, d.whole_span_texels) << "paging spans, smaller than the driver's";
+    // The scene's level and coarser ones fit whole: one renderer takes them in the largest spans; a finer level
+    // (a close view's) pages, as every level of the window's renderers, which share the budget.
+    EXPECT_EQ(session.span_texels_at(d.level), one_renderer ? d.whole_span_texels : d.span_texels);
+    EXPECT_EQ(session.span_texels_at(d.level + 1), one_renderer ? d.whole_span_texels : d.span_texels);
+    EXPECT_EQ(session.span_texels_at(d.level - 1), d.span_texels);
+    EXPECT_EQ(session.renderer_at(d.level, false).layout().level(), d.level);
+  }
 }
 
 TEST_F(ViewerSessionTest, AViewsLevelIsTheOneItsRenderersWouldMeasure) {
@@ -194,7 +171,7 @@ TEST_F(ViewerSessionTest, FocusFirstTakesTheLargestSpansOnlyWhereContextAndCopyF
   std::vector<const VxlFile*> all = files;
   all.insert(all.end(), copy.files().begin(), copy.files().end());
   bool whole_seen = false, paging_seen = false;
-  for_each_paging_budget(/*one_renderer=*/true, [&](ViewerSession& session) {
+  for_each_paging_budget([&](ViewerSession& session) {
     const SceneDetail& d = session.detail();
     ASSERT_LT(d.span_texels, d.whole_span_texels);
     session.set_focus(kept);

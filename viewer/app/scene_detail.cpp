@@ -77,13 +77,6 @@ SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::o
   return d;
 }
 
-bool scene_and_coarser_levels_fit_whole(const std::vector<const VxlFile*>& files, const SceneDetail& d) {
-  std::uint64_t together = 0;
-  for (std::uint32_t level = d.level; level <= SceneLayout::coarsest_level(files); ++level)
-    together += SceneLayout(files, d.whole_span_texels, level).upload_bytes();
-  return together <= d.budget;
-}
-
 std::string describe_scene_detail(const SceneDetail& d, std::uint32_t levels_in_files) {
   if (d.level == 0) return "";
   const std::string what = "drawing level " + std::to_string(d.level) + " of " + std::to_string(levels_in_files - 1) +

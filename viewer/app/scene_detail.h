@@ -33,11 +33,6 @@ SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::o
                                 std::optional<std::uint64_t> gpu_memory,
                                 std::optional<std::uint64_t> span_texels = std::nullopt);
 
-// Whether the scene's level and every coarser one fit the budget together in spans of whole_span_texels: the
-// window's renderers (one per level it draws: the scene's at rest, coarser ones while moving) may then all take
-// the largest spans without evicting one another.
-bool scene_and_coarser_levels_fit_whole(const std::vector<const VxlFile*>& files, const SceneDetail& detail);
-
 // The span size when paging: 4M texels, at most 64 MiB of positions and tables and 8 MiB of orders.
 inline constexpr std::uint64_t kPagingSpanTexels = std::uint64_t(1) << 22;
 

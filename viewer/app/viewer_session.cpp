@@ -16,7 +16,7 @@ ViewerSession::ViewerSession(const ViewerOptions& o)
 
 void ViewerSession::choose_detail(const ViewerOptions& o, bool one_renderer) {
   detail_ = choose_scene_detail(files_, o.level, o.gpu_memory, o.span_texels);
-  whole_from_scene_level_ = one_renderer || scene_and_coarser_levels_fit_whole(files_, *detail_);
+  one_renderer_ = one_renderer;
   gpu_memory_ = std::make_shared<GpuMemoryPool>(detail_->budget);
   layouts_.emplace(files_, detail_->span_texels);
 }
@@ -41,7 +41,7 @@ PictureLevels ViewerSession::picture_levels(const Camera* camera, double aspect,
 }
 
 std::uint64_t ViewerSession::span_texels_at(std::uint32_t level) const {
-  return whole_from_scene_level_ && level >= detail_->level ? detail_->whole_span_texels : detail_->span_texels;
+  return one_renderer_ && level >= detail_->level ? detail_->whole_span_texels : detail_->span_texels;
 }
 
 Renderer& ViewerSession::renderer_at(std::uint32_t level, bool eager) {

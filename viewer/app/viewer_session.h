@@ -39,11 +39,9 @@ class ViewerSession {
   // Chooses the level of detail, the span size and the GPU memory budget (scene_detail.h) for the options'
   // --level, --gpu-memory and --span-texels. Needs a current GL context (the driver's limits); before any
   // layout, view or renderer.
-  // The scene's level and the coarser ones take spans as large as the driver allows (every span a draw binds costs
-  // every vertex a branch of fetches: the 10M set's level 1 drew in 21 s in spans of 64M texels, 36 s in the paging
-  // spans of 4M) where they fit the budget so: with `one_renderer` (headless: one renderer draws, alone within the
-  // budget) always, in the window (a renderer per level drawn, sharing the budget) where those levels fit it together
-  // (scene_detail.h). Finer levels (a close view's) page in small spans.
+  // `one_renderer`: only one renderer will draw (headless), so a level that fits the budget whole takes spans as
+  // large as the driver allows (fewer draws), where the window's renderers share the budget and page in small spans
+  // (drawn one span a draw where runs are long, line_pass.h, they draw as fast).
   void choose_detail(const ViewerOptions& options, bool one_renderer = false);
   const SceneDetail& detail() const { return *detail_; }
   // The levels the files hold (their coarsest level + 1), for messages.
@@ -72,8 +70,8 @@ class ViewerSession {
   // most: focus first only draws pictures coarser than full detail, and never where --level fixed the level.
   bool focus_copy_needed(std::uint32_t coarsest_drawn) const { return !detail_->forced && coarsest_drawn > 0; }
 
-  // The span size of a renderer at `level`: whole_span_texels at the scene's level or coarser where choose_detail
-  // found they fit so, else span_texels.
+  // The span size of a renderer at `level`: whole_span_texels for one renderer at the scene's level or coarser
+  // (it fits the budget whole), else span_texels.
   std::uint64_t span_texels_at(std::uint32_t level) const;
   // The renderer of `level`, made on first use with the image and the current groups; `eager`: it uploads
   // its whole level at once when made (else span by span as frames need them).
@@ -104,7 +102,7 @@ class ViewerSession {
   SceneBounds bounds_;  // the lines joined with the image's box: what the renderer's projection covers
   std::shared_ptr<VoxelVoxlinesCache> indexes_;
   std::optional<SceneDetail> detail_;
-  bool whole_from_scene_level_ = false;        // choose_detail's: span_texels_at's choice
+  bool one_renderer_ = false;                  // choose_detail's
   std::shared_ptr<GpuMemoryPool> gpu_memory_;  // every level's renderer shares it: together they never take more
   std::optional<LevelLayouts> layouts_;
   std::map<std::uint32_t, std::unique_ptr<Renderer>> renderers_;

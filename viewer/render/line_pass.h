@@ -88,9 +88,6 @@ class LinePass {
   // or a few at a time (plan_draws).
   void draw_plan(GLuint program, std::span<const std::int64_t> first, std::span<const std::int32_t> count) const;
 
-  // Enables the first n of the line shader's clip distances and disables the others (passes without
-  // gl_ClipDistance must run with none enabled).
-
  private:
   void upload_streamline_groups(const SceneGroups& groups);
   enum class Fragment { Over, WboitAccum, WboitReveal, Additive };
