@@ -10,14 +10,16 @@ fetches the file whole), or with --server first-range answers one range a reques
 Also the resident memory of each kind of Chromium process at the peak (browser, renderer: the page and its
 WebAssembly memory, gpu-process: SwiftShader's copies of the textures), the level drawn at rest, by ranges the
 bytes fetched, and once the page is done its WebAssembly memory (and malloc's use of it: now and at most) and
-its JavaScript heap. --gpu sets the page's GPU memory budget (?gpu=).
+its JavaScript heap. --gpu sets the page's GPU memory budget (?gpu=); --rate sends range answers at that many MB
+a second, as a network would (by ranges, full detail then arrives span by span: the pictures at rest drawn with
+some of its spans in, and when the first was shown).
 
 Each round starts a browser of its own (a cold browser: its GPU process, SwiftShader, starts with the page), or
 with --warm all rounds run in one browser, a tab after another: the first round's browser is cold, the later
 rounds' warm (as for a recipient who has a browser open, or opens a second link).
 
 Usage: bench/web_bench.py FILE.vxl... [--rounds N] [--warm] [--size WxH] [--server ranges|first-range|whole]
-       [--gpu SIZE] [--voxlines PATH]
+       [--gpu SIZE] [--rate MB_PER_S] [--voxlines PATH]
 """
 import argparse
 import os
@@ -104,10 +106,13 @@ def main():
     parser.add_argument('--size', default='1024x1024')
     parser.add_argument('--server', choices=sorted(SERVERS), default='ranges')
     parser.add_argument('--gpu', help="the page's GPU memory budget (?gpu=, e.g. 256M)")
+    parser.add_argument('--rate', type=float, default=0,
+                        help='MB a second the server sends range answers at (a network; default: at once)')
     parser.add_argument('--voxlines', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), '..',
                                                            'build', 'release', 'converter', 'voxlines'))
     parser.add_argument('--chromium', default=shutil.which('chromium') or 'chromium')
     args = parser.parse_args()
+    web_server.RangeHandler.rate = args.rate * 1e6
     with tempfile.TemporaryDirectory(prefix='voxweb-bench-') as work:
         for path in args.files:
             folder = os.path.join(work, os.path.basename(path) + '.share')
@@ -149,6 +154,12 @@ def main():
                                 f'JavaScript heap {report["heap_bytes"] / 2**20:.0f} MiB')
                     print(f'    at the peak, MiB: {kinds}; drawn at rest: level {report.get("full_level")}{budget}'
                           f'{fetched}{page}', flush=True)
+                    spans = report.get('spans_fetched') or []
+                    if spans:
+                        mixed = report.get('mixed_shown') or []
+                        print(f'    full detail fetched in {len(spans)} spans ({sum(s["in_view"] for s in spans)} in view, '
+                              f'the nearest first); pictures at rest shown with some of them in: {len(mixed)}' +
+                              (f', the first at {mixed[0] / 1000:.2f} s' if mixed else ''), flush=True)
                     steps = ', '.join(f'{name} {ms / 1000:.2f}' for name, ms in report.get('marks', []))
                     print(f'    on the way to the first picture, s from navigation: {steps}', flush=True)
                     tasks = report.get('long_tasks')

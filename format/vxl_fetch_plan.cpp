@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <iterator>
 
 #include "format/vxl_levels.h"
 #include "format/vxl_value_sets.h"
@@ -49,13 +50,19 @@ std::vector<ByteRange> ranges_to_open(const std::string& path, std::span<const s
 }
 
 std::vector<ByteRange> ranges_of_level(const VxlFile& file, std::uint32_t level, std::uint64_t gap) {
+  return ranges_of_voxels(file, level, 0, static_cast<std::uint32_t>(file.voxels().size()), gap);
+}
+
+std::vector<ByteRange> ranges_of_voxels(const VxlFile& file, std::uint32_t level, std::uint32_t voxel_first,
+                                        std::uint32_t voxel_count, std::uint64_t gap) {
   const std::uint64_t vert = file.find_section(section_id("VERT"))->offset;
   const std::uint64_t orders = file.orders_offset();
   const std::uint64_t vertex_bytes = file.position_encoding() == PositionEncoding::Packed ? 4 : 12;
   const std::uint32_t k = file.meta().stored_order_count;
   std::vector<ByteRange> ranges;
-  ranges.reserve(2 * file.voxels().size());
-  for (std::size_t i = 0; i < file.voxels().size(); ++i) {
+  const std::size_t end = std::min<std::size_t>(file.voxels().size(), std::size_t(voxel_first) + voxel_count);
+  ranges.reserve(2 * (end - std::min<std::size_t>(voxel_first, end)));
+  for (std::size_t i = voxel_first; i < end; ++i) {
     const VoxelEntry& v = file.voxels()[i];
     const LevelEntry at_level = file.level(i, level);
     const std::uint64_t first = vert + v.vertex_first * vertex_bytes;
@@ -76,6 +83,17 @@ std::vector<ByteRange> ranges_missing(std::span<const ByteRange> held, std::uint
   }
   if (at < size) missing.push_back({at, size});
   return missing;
+}
+
+bool ranges_held(std::span<const ByteRange> wanted, std::span<const ByteRange> held) {
+  for (const ByteRange& r : wanted) {
+    if (r.end <= r.begin) continue;
+    // The last held range that begins at or before r: r lies in it, or some of r is not held.
+    const auto after = std::upper_bound(held.begin(), held.end(), r.begin,
+                                        [](std::uint64_t at, const ByteRange& h) { return at < h.begin; });
+    if (after == held.begin() || std::prev(after)->end < r.end) return false;
+  }
+  return true;
 }
 
 std::vector<ByteRange> ranges_intersection(std::span<const ByteRange> a, std::span<const ByteRange> b) {

@@ -31,12 +31,19 @@ std::vector<ByteRange> ranges_to_open(const std::string& path, std::span<const s
 // What drawing `level` of every voxel reads: the prefix of its block in VERT and that level's orders (spec
 // §5.4, §5.5). Sorted, and merged where less than `gap` bytes lie between two.
 std::vector<ByteRange> ranges_of_level(const VxlFile& file, std::uint32_t level, std::uint64_t gap);
+// The same for voxels [voxel_first, voxel_first + voxel_count) of the voxel table only (a viewer's texture span).
+std::vector<ByteRange> ranges_of_voxels(const VxlFile& file, std::uint32_t level, std::uint32_t voxel_first,
+                                        std::uint32_t voxel_count, std::uint64_t gap);
 
 // Sorts `ranges` and merges those that overlap or lie less than `gap` bytes apart.
 std::vector<ByteRange> merge_ranges(std::vector<ByteRange> ranges, std::uint64_t gap);
 
 // [0, size) less `held` (sorted and disjoint, as the functions above give them).
 std::vector<ByteRange> ranges_missing(std::span<const ByteRange> held, std::uint64_t size);
+
+// Whether every byte of `wanted` lies in `held` (as merge_ranges(..., 0) gives it: sorted, disjoint, none touching);
+// a binary search of `held` per range of `wanted`.
+bool ranges_held(std::span<const ByteRange> wanted, std::span<const ByteRange> held);
 
 // The bytes in both `a` and `b` (each sorted and disjoint), in one pass over both.
 std::vector<ByteRange> ranges_intersection(std::span<const ByteRange> a, std::span<const ByteRange> b);

@@ -118,6 +118,8 @@ FIRST_PICTURE = """new Promise((resolve) => {
         full_level: window.voxweb.info ? window.voxweb.info.full_level : null,
         mode: window.voxweb.mode ? window.voxweb.mode() : null,
         levels_shown: window.voxweb.levelsShown || [],
+        spans_fetched: window.voxweb.spansFetched || [],
+        mixed_shown: window.voxweb.mixedShown || [],
         marks: performance.getEntriesByType('mark').filter((m) => m.startTime <= first)
           .map((m) => [m.name.replace('voxweb:', ''), m.startTime]),
         heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null,
@@ -161,7 +163,8 @@ def capture_in(browser, url, out, timeout):
     report.update({'first_picture_ms': round(value['first_picture_ms'], 1),
                    'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'],
                    'full_level': value.get('full_level'), 'mode': value.get('mode'),
-                   'levels_shown': value['levels_shown'], 'marks': value.get('marks', []),
+                   'levels_shown': value['levels_shown'], 'spans_fetched': value.get('spans_fetched', []),
+                   'mixed_shown': value.get('mixed_shown', []), 'marks': value.get('marks', []),
                    'heap_bytes': value['heap_bytes'], 'memory': value.get('memory'),
                    'long_tasks': value.get('long_tasks'), 'slow_calls': value.get('slow_calls')})
     return report

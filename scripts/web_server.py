@@ -16,6 +16,7 @@ import http.server
 import os
 import re
 import threading
+import time
 import uuid
 
 
@@ -30,6 +31,8 @@ class RangeHandler(QuietHandler):
     # the bytes of the file those answers held.
     answers = {'one range': 0, 'multipart': 0}
     bytes_sent = 0
+    # Bytes a second the range answers are sent at, as over a network slower than this machine (0: at once).
+    rate = 0
 
     @classmethod
     def reset_counts(cls):
@@ -82,7 +85,17 @@ class RangeHandler(QuietHandler):
         self.send_header('Content-Length', str(len(body)))
         self.send_header('Accept-Ranges', 'bytes')
         self.end_headers()
-        self.wfile.write(body)
+        self.send_body(body)
+
+    def send_body(self, body):
+        if not RangeHandler.rate:
+            return self.wfile.write(body)
+        start, piece = time.monotonic(), 1 << 16
+        for at in range(0, len(body), piece):
+            self.wfile.write(body[at:at + piece])
+            ahead = start + (at + piece) / RangeHandler.rate - time.monotonic()
+            if ahead > 0:
+                time.sleep(ahead)
 
     @staticmethod
     def parse_ranges(spec, size):

@@ -1,15 +1,19 @@
 // Reading a .vxl by byte ranges (format/vxl_fetch_plan.h), as the web viewer does over HTTP Range requests: a
 // buffer holding only what ranges_to_open and ranges_of_level name (the rest filled with garbage) opens, passes
-// the draw checks and draws that level exactly as the whole file does.
+// the draw checks and draws that level exactly as the whole file does; a level whose spans come one at a time, the
+// nearest the view first, draws those in with a coarser level in place of the others.
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
+#include <set>
 
 #include "converter/synth/synth.h"
 #include "format/base/error.h"
 #include "format/vxl_fetch_plan.h"
 #include "tests/viewer/render_support.h"
+#include "viewer/platform/image_metrics.h"
 
 namespace vxl {
 namespace {
@@ -26,20 +30,28 @@ MappedFile partial_copy(const std::vector<std::uint8_t>& whole, std::span<const 
   return MappedFile::adopt("partial.vxl", buffer, whole.size());
 }
 
-class FetchByRanges : public ::testing::TestWithParam<bool> {};  // packed positions or float32
+// A synthetic scene with levels of detail, packed positions or float32 (the parameter): dir/scene.vxl, whole() its
+// bytes and first() the first of them a reader fetches.
+class FetchByRanges : public ::testing::TestWithParam<bool> {
+ protected:
+  void SetUp() override {
+    gl_context();
+    SynthSettings synth;
+    synth.streamlines = 12000;
+    ConvertSettings s;
+    s.voxel_size = 10;
+    s.levels = 4;
+    s.positions = GetParam() ? PositionEncoding::Packed : PositionEncoding::Float32;
+    convert_tractogram(synthesize_tractogram(synth), dir.file("scene.vxl"), s);
+    whole = test::slurp<std::vector<std::uint8_t>>(dir.file("scene.vxl"));
+    first = std::span<const std::uint8_t>(whole.data(), std::min<std::size_t>(whole.size(), kSectionTableBytesMax));
+  }
+  ScratchDir dir;
+  std::vector<std::uint8_t> whole;
+  std::span<const std::uint8_t> first;
+};
 
 TEST_P(FetchByRanges, ALevelDrawsFromItsRangesAloneAsFromTheWholeFile) {
-  gl_context();
-  ScratchDir dir;
-  SynthSettings synth;
-  synth.streamlines = 12000;
-  ConvertSettings s;
-  s.voxel_size = 10;
-  s.levels = 4;
-  s.positions = GetParam() ? PositionEncoding::Packed : PositionEncoding::Float32;
-  convert_tractogram(synthesize_tractogram(synth), dir.file("scene.vxl"), s);
-  const std::vector<std::uint8_t> whole = test::slurp<std::vector<std::uint8_t>>(dir.file("scene.vxl"));
-  const std::span<const std::uint8_t> first(whole.data(), std::min<std::size_t>(whole.size(), kSectionTableBytesMax));
   const std::vector<ByteRange> to_open = ranges_to_open("scene.vxl", first, whole.size());
   const VxlFile reference = VxlFile::open(dir.file("scene.vxl"));
   RenderSettings settings;
@@ -63,6 +75,68 @@ TEST_P(FetchByRanges, ALevelDrawsFromItsRangesAloneAsFromTheWholeFile) {
   }
 }
 
+// The picture `r` draws in pieces with `stand_in` for its voxels whose span is not resident.
+Image mixed_picture(Renderer& r, Renderer* stand_in, const Camera& camera, const RenderSettings& settings, int size) {
+  OffscreenTarget target(size, size);
+  r.begin_pieces(camera, settings, size, size, target.framebuffer(), stand_in);
+  int pieces = 0;
+  while (!r.draw_piece(5) && ++pieces < 100000) {
+  }
+  glFinish();
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+  return Image{size, size, target.read_rgba()};
+}
+
+TEST_P(FetchByRanges, TheSpansInAreDrawnWithACoarserLevelInPlaceOfTheRest) {
+  const VxlFile reference = VxlFile::open(dir.file("scene.vxl"));
+  const std::vector<const VxlFile*> whole_file{&reference};
+  const std::uint64_t small_spans = 2 * SceneLayout::largest_voxel_texels(whole_file);
+  const Camera camera = test::synth_brain_view();
+  RenderSettings settings;
+  settings.opacity = 0.3f;
+  constexpr int kSize = 96;
+  constexpr std::uint32_t kCoarse = 2;
+
+  // The view's spans, nearest first; the nearer half of them fetched, with the coarse level and what opens the file.
+  Renderer probe(whole_file, small_spans, 0, nullptr, false);
+  const std::vector<std::uint32_t> nearest_first = probe.spans_for(camera, 1.0);
+  ASSERT_GE(nearest_first.size(), 4u);
+  const std::set<std::uint32_t> in(nearest_first.begin(), nearest_first.begin() + nearest_first.size() / 2);
+  std::vector<ByteRange> held = ranges_to_open("scene.vxl", first, whole.size());
+  for (const ByteRange& r : ranges_of_level(reference, kCoarse, 0)) held.push_back(r);
+  for (const std::uint32_t span : in) {
+    const TextureSpan& c = probe.layout().texture_spans()[span];
+    for (const ByteRange& r : ranges_of_voxels(reference, 0, c.voxel_first, c.voxel_count, 0)) held.push_back(r);
+  }
+  const VxlFile partial = VxlFile::open(partial_copy(whole, merge_ranges(held, 0)));
+  const std::vector<const VxlFile*> partial_file{&partial};
+  Renderer fine(partial_file, small_spans, 0, nullptr, false), coarse(partial_file, 0, kCoarse);
+  const auto fetched = [&](std::uint32_t span) { return in.count(span) > 0; };
+  while (!fine.upload_for(camera, 1.0, {}, std::numeric_limits<double>::infinity(), fetched)) {
+  }
+  for (std::uint32_t span = 0; span < fine.layout().texture_spans().size(); ++span)
+    EXPECT_EQ(fine.span_resident(span), fetched(span)) << "span " << span;
+  fine.check_uploaded(true);  // the spans fetched pass the draw checks: their ranges are all they read
+  const Image mixed = mixed_picture(fine, &coarse, camera, settings, kSize);
+  EXPECT_GT(fine.stats().voxels_drawn, 0u);
+  EXPECT_GT(fine.stats().voxels_waiting, 0u) << "drawn from the coarse level";
+
+  // With none of its spans the picture is the coarse level's, with all of them full detail's: the same bytes.
+  Renderer coarse_whole(reference, 0, kCoarse), none_in(whole_file, small_spans, 0, nullptr, false),
+      all_in(whole_file, small_spans, 0);
+  const Image coarse_picture = render_image(coarse_whole, camera, settings, kSize, kSize);
+  const Image full_picture = render_image(all_in, camera, settings, kSize, kSize);
+  EXPECT_EQ(
+      compare_images(mixed_picture(none_in, &coarse_whole, camera, settings, kSize), coarse_picture).differing_pixels,
+      0u);
+  EXPECT_EQ(none_in.gpu_bytes(), 0u) << "a stand-in's frame uploads nothing";
+  EXPECT_EQ(
+      compare_images(mixed_picture(all_in, &coarse_whole, camera, settings, kSize), full_picture).differing_pixels, 0u);
+  // The half: some pixels as neither.
+  EXPECT_GT(compare_images(mixed, coarse_picture).differing_pixels, 0u);
+  EXPECT_GT(compare_images(mixed, full_picture).differing_pixels, 0u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Positions, FetchByRanges, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "Packed" : "Float32"; });
 
@@ -79,6 +153,12 @@ TEST(FetchPlan, RangesMergeAndTheMissingOnesCoverTheRest) {
   EXPECT_EQ(ranges_intersection(held, std::vector<ByteRange>{{3, 12}, {20, 36}, {39, 60}}),
             (std::vector<ByteRange>{{3, 5}, {10, 12}, {20, 30}, {34, 36}, {39, 40}}));
   EXPECT_TRUE(ranges_intersection(held, {}).empty());
+  EXPECT_TRUE(ranges_held(std::vector<ByteRange>{{0, 5}, {12, 30}, {34, 34}, {36, 40}}, held));
+  EXPECT_FALSE(ranges_held(std::vector<ByteRange>{{0, 6}}, held));
+  EXPECT_FALSE(ranges_held(std::vector<ByteRange>{{28, 35}}, held)) << "across a gap";
+  EXPECT_FALSE(ranges_held(std::vector<ByteRange>{{40, 41}}, held)) << "past the last";
+  EXPECT_FALSE(ranges_held(std::vector<ByteRange>{{5, 9}}, held)) << "in a gap";
+  EXPECT_TRUE(ranges_held({}, held));
 }
 
 TEST(FetchPlan, TheFirstBytesAreCheckedAsOpenChecksThem) {

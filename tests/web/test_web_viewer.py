@@ -201,6 +201,15 @@ def main():
             if source == 's50k.vxl' and levels != ((2, [], 1) if budget else (2, [1], 0)):
                 failures.append(f's50k.vxl, GPU budget {budget}: first picture at level {levels[0]}, then levels '
                                 f'{levels[1]} drawn before level {levels[2]} at rest')
+            # Full detail fetched span by span, those the view needs first, each group the nearest first.
+            spans = report['spans_fetched']
+            if handler is RangeHandler and not budget and report['first_level'] > report['full_level'] == 0:
+                view = [s['distance'] for s in spans if s['in_view']]
+                rest = [s['distance'] for s in spans if not s['in_view']]
+                if (len(spans) < 2 or [s['in_view'] for s in spans] != [True] * len(view) + [False] * len(rest) or
+                        view != sorted(view) or rest != sorted(rest)):
+                    failures.append(f'{source} {settings}: full detail not fetched span by span, the view\'s nearest '
+                                    f'first: {spans}')
             # How the page fetched: many ranges a request where the server answers so, one a request where it
             # answers only the first.
             answers = dict(RangeHandler.answers)
@@ -216,7 +225,10 @@ def main():
             served = f' ({served_by[handler]}' + (f', GPU budget {budget})' if budget else ')')
             print(f'{source}{served} {settings}: PSNR {value:.2f} dB against voxview, first picture after '
                   f'{report["first_picture_ms"]:.0f} ms, full detail after {report["full_detail_ms"]:.0f} ms; '
-                  f'range answers {answers}, {RangeHandler.bytes_sent} of {size} bytes')
+                  f'range answers {answers}, {RangeHandler.bytes_sent} of {size} bytes; full detail in '
+                  f'{len(report["spans_fetched"])} spans {[round(s["distance"]) for s in report["spans_fetched"]]} '
+                  f'(in view {sum(s["in_view"] for s in report["spans_fetched"])}), {len(report["mixed_shown"])} '
+                  'pictures with some of them')
             if value < MIN_PSNR:
                 keep = os.path.join(tempfile.gettempdir(), 'voxweb-test-failed')
                 os.makedirs(keep, exist_ok=True)

@@ -123,10 +123,17 @@ void Renderer::plan_and_count(const Camera& camera, double aspect, PlanOrder ord
   stats_.segments_drawn = out.segments_drawn;
 }
 
-bool Renderer::upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms) {
+std::vector<std::uint32_t> Renderer::spans_for(const Camera& camera, double aspect, const Clipping& clipping) const {
   FramePlan nearest;
   plan(camera, aspect, PlanOrder::Nearest, nearest, clipping);
-  return !scene_.make_resident(spans_nearest_first(scene_.layout(), nearest), max_ms, false).out_of_time;
+  return spans_nearest_first(scene_.layout(), nearest);
+}
+
+bool Renderer::upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms,
+                          const std::function<bool(std::uint32_t span)>& may_upload) {
+  std::vector<std::uint32_t> spans = spans_for(camera, aspect, clipping);
+  if (may_upload) std::erase_if(spans, [&](std::uint32_t span) { return !may_upload(span); });
+  return !scene_.make_resident(spans, max_ms, false).out_of_time;
 }
 
 void Renderer::keep_resident(FramePlan& plan) {
@@ -252,9 +259,49 @@ struct Renderer::Pieces {
   std::uint64_t segments = 0, drawn = 0;  // the plan's, and those drawn so far
   double drawn_ms = 0;                    // the pieces' time so far: drawn / drawn_ms is the measured rate
   bool done = false;
+  Renderer* stand_in = nullptr;             // begin_pieces' stand-in, for the voxels not resident here
+  std::vector<std::uint8_t> from_stand_in;  // with one: per plan entry, whether it is the stand-in's
 };
 
-void Renderer::begin_pieces(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo) {
+bool Renderer::draws_in_voxel_pieces(RenderMode mode) { return pass(mode).piece_kind() == PieceKind::Voxels; }
+
+void Renderer::plan_with_stand_in(const Camera& camera, double aspect, PlanOrder order, const Clipping& clipping,
+                                  Renderer& stand_in, Pieces& p) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const SceneLayout& layout = scene_.layout();
+  if (stand_in.layout().voxels().size() != layout.voxels().size())
+    throw std::logic_error("Renderer: a stand-in of other voxels");
+  plan(camera, aspect, order, plan_, clipping);
+  FramePlan theirs;
+  stand_in.plan(camera, aspect, order, theirs, clipping);
+  std::vector<std::int32_t> entry_of(layout.voxels().size(), -1);  // a voxel's entry in the stand-in's plan
+  for (std::size_t i = 0; i < theirs.voxels.size(); ++i) entry_of[theirs.voxels[i]] = static_cast<std::int32_t>(i);
+  std::vector<std::int64_t> own_first, their_first;
+  std::vector<std::int32_t> own_count, their_count;
+  for (std::size_t i = 0; i < plan_.first.size(); ++i) {
+    const std::uint32_t voxel = plan_.voxels[i];
+    const bool own = scene_.resident(layout.voxels()[voxel].span);
+    if (!own && entry_of[voxel] < 0) continue;  // nothing of it at the stand-in's level
+    const std::int64_t first = own ? plan_.first[i] : theirs.first[entry_of[voxel]];
+    const std::int32_t count = own ? plan_.count[i] : theirs.count[entry_of[voxel]];
+    (own ? own_first : their_first).push_back(first);
+    (own ? own_count : their_count).push_back(count);
+    p.first.push_back(first);
+    p.count.push_back(count);
+    p.from_stand_in.push_back(own ? 0 : 1);
+    p.segments += static_cast<std::uint64_t>(count / 2);
+  }
+  lines_->plan_draws(own_first, own_count);
+  stand_in.lines_->plan_draws(their_first, their_count);
+  stats_.plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats_.voxels_drawn = own_first.size();
+  stats_.voxels_waiting = plan_.first.size() - own_first.size();
+  stats_.segments_drawn = 0;
+  for (const std::int32_t c : own_count) stats_.segments_drawn += static_cast<std::uint64_t>(c / 2);
+}
+
+void Renderer::begin_pieces(const Camera& camera, const RenderSettings& s, int width, int height, GLuint fbo,
+                            Renderer* stand_in) {
   pieces_ = std::make_unique<Pieces>();
   Pieces& p = *pieces_;
   p.camera = camera;
@@ -265,13 +312,20 @@ void Renderer::begin_pieces(const Camera& camera, const RenderSettings& s, int w
   p.pass = &pass(s.mode);
   p.kind = p.pass->piece_kind();
   if (p.kind == PieceKind::Voxels) {
+    if (stand_in) stand_in->start_frame(camera, s, width, height);  // its attributes for these settings
     start_frame(camera, s, width, height);
     clear_to_base(fbo, camera, s, width, height);
     const PlanOrder order = p.pass->plan_order(s, plan_);
-    plan_and_count(camera, double(width) / std::max(1, height), order, plan_, s.clipping);
-    p.first = plan_.first;
-    p.count = plan_.count;
-    for (std::int32_t ids : p.count) p.segments += static_cast<std::uint64_t>(ids / 2);
+    const double aspect = double(width) / std::max(1, height);
+    if (stand_in) {
+      p.stand_in = stand_in;
+      plan_with_stand_in(camera, aspect, order, s.clipping, *stand_in, p);
+    } else {
+      plan_and_count(camera, aspect, order, plan_, s.clipping);
+      p.first = plan_.first;
+      p.count = plan_.count;
+      for (std::int32_t ids : p.count) p.segments += static_cast<std::uint64_t>(ids / 2);
+    }
     p.done = p.first.empty();
     if (p.done) draw_front_shells(p);
   } else if (p.kind == PieceKind::Own) {
@@ -312,8 +366,6 @@ void Renderer::draw_voxel_piece(double max_ms) {
   glLineWidth(std::max(1.0f, p.settings.line_width));
   glDepthMask(GL_TRUE);
   p.pass->piece_state();  // as the mode's draw()
-  const GLuint program = lines_->over();
-  bind_line_program(program, p.camera, p.settings, double(p.width) / std::max(1, p.height));
   // Segments up to what the measured rate draws in max_ms (before a measurement, llvmpipe's rate), at least one.
   // The rate over all pieces so far, not the last one's: a piece's time varies with its voxels' fragments
   // and a software renderer's flushes, and the last rate alone made sizes swing from 5 to 400 ms.
@@ -324,6 +376,7 @@ void Renderer::draw_voxel_piece(double max_ms) {
   // holds (one of the 1M set took a software WebGL 1.3 s).
   std::vector<std::int64_t> first;
   std::vector<std::int32_t> count;
+  std::vector<std::uint8_t> from_stand_in;
   std::uint64_t segments = 0;
   while (p.next < p.count.size()) {
     const std::int32_t left = p.count[p.next] - p.next_drawn;
@@ -337,13 +390,22 @@ void Renderer::draw_voxel_piece(double max_ms) {
     if (ids == 0) break;
     first.push_back(p.first[p.next] + p.next_drawn);
     count.push_back(ids);
+    if (p.stand_in) from_stand_in.push_back(p.from_stand_in[p.next]);
     segments += static_cast<std::uint64_t>(ids / 2);
     p.next_drawn += ids;
     if (p.next_drawn < p.count[p.next]) break;
     ++p.next;
     p.next_drawn = 0;
   }
-  lines_->draw_plan(program, first, count);
+  if (!p.stand_in) {
+    draw_over_ranges(*this, p, first, count);
+  } else {  // runs of one renderer's entries, each with its own program, uniforms and spans
+    for (std::size_t run = 0, end = 0; run < first.size(); run = end) {
+      for (end = run + 1; end < first.size() && from_stand_in[end] == from_stand_in[run];) ++end;
+      draw_over_ranges(from_stand_in[run] ? *p.stand_in : *this, p, std::span(first).subspan(run, end - run),
+                       std::span(count).subspan(run, end - run));
+    }
+  }
   gl::finish_gpu_work();  // the piece's time includes the GPU's work, for the next piece's size
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   p.drawn_ms += ms;
@@ -353,6 +415,13 @@ void Renderer::draw_voxel_piece(double max_ms) {
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);
   enable_clip_distances(0);
+}
+
+void Renderer::draw_over_ranges(Renderer& renderer, const Pieces& p, std::span<const std::int64_t> first,
+                                std::span<const std::int32_t> count) {
+  const GLuint program = renderer.lines_->over();
+  renderer.bind_line_program(program, p.camera, p.settings, double(p.width) / std::max(1, p.height));
+  renderer.lines_->draw_plan(program, first, count);
 }
 
 void Renderer::draw_front_shells(const Pieces& p) {

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <initializer_list>
 #include <memory>
 #include <span>
@@ -82,8 +83,16 @@ class Renderer {
   // draws in the same order for opaque, basic and axis; exact composites runs of voxels as its draw()
   // does, only shorter ones. Modes that blend in no order (unsorted, additive, wboit) are drawn whole by
   // the first piece. A draw() in between abandons the pieces.
-  void begin_pieces(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo);
+  // stand_in: a renderer of the same files at a coarser level (with no image), for a picture while this one's
+  // spans are still coming (the web viewer fetching a level nearest the view first): the plan's voxels whose span
+  // is not resident are drawn from it, at its level, in their place back to front, and no span is uploaded. Only
+  // for the modes drawn in pieces of voxels (draws_in_voxel_pieces); ignored for the others. It must outlive the
+  // pieces (until draw(), the next begin_pieces() or the end of this renderer).
+  void begin_pieces(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo,
+                    Renderer* stand_in = nullptr);
   bool draw_piece(double max_ms);
+  // Whether `mode` is drawn in pieces of voxels, back to front (opaque, basic, axis): then a stand-in can fill in.
+  bool draws_in_voxel_pieces(RenderMode mode);
   // The share of the frame's segments drawn so far (1 when complete).
   double pieces_progress() const;
 
@@ -149,7 +158,11 @@ class Renderer {
   // large upload over frames and its event loop never waits for one: returns after about `max_ms`, with the
   // spans whose fill ended by then resident. True once nothing more can be uploaded for that view (all
   // resident, or the budget holds no more).
-  bool upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms);
+  // may_upload: when given, only the spans it accepts are uploaded (a file whose bytes are still arriving).
+  bool upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms,
+                  const std::function<bool(std::uint32_t span)>& may_upload = {});
+  // The spans a frame of `camera` needs, those of the nearest voxels first (upload_for's order).
+  std::vector<std::uint32_t> spans_for(const Camera& camera, double aspect, const Clipping& clipping = {}) const;
 
   // The renderer as its transparency modes see it (modes/pass_host.h): its line pass, scene, plan and base.
   // For drawing a mode's pass over this renderer's scene (e.g. an ExactRenderer with a small node buffer).
@@ -181,6 +194,13 @@ class Renderer {
   void bind_line_program(GLuint program, const Camera& camera, const RenderSettings& settings, double aspect) const;
   // draw_piece() of a frame drawn in runs of the plan's voxels (PieceKind::Voxels).
   void draw_voxel_piece(double max_ms);
+  // begin_pieces' plan with a stand-in: this renderer's resident voxels and the stand-in's entries for the others,
+  // in one back-to-front order (pieces.first/count/from_stand_in).
+  void plan_with_stand_in(const Camera& camera, double aspect, PlanOrder order, const Clipping& clipping,
+                          Renderer& stand_in, Pieces& pieces);
+  // Draws the ranges (first, count) with the over program of `renderer` (this one or a stand-in).
+  void draw_over_ranges(Renderer& renderer, const Pieces& pieces, std::span<const std::int64_t> first,
+                        std::span<const std::int32_t> count);
 
   std::vector<const VxlFile*> files_;
   SceneBounds line_bounds_;   // the files' (view_queries.h)

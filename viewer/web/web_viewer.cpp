@@ -11,9 +11,11 @@
 // --gpu-memory chooses: level 0 when it fits.
 // Its spans are uploaded a few per call of vw_upload, nearest the view first, so that the page's thread —
 // WebAssembly here has no other — takes input between them: until the view's spans are all on the GPU, frames
-// at rest come from the first picture's level. For the same reason a frame at rest finer than the first picture is
-// drawn in pieces (vw_draw_piece), and the draw checks run a slice a call (vw_check). A .vxlz is unpacked into a
-// .vxl in memory first (web_package.h).
+// at rest come from the first picture's level, or from the finest coarser level fetched since. A file fetched
+// by ranges fetches full detail span by span, the view's nearest first (vw_next_ranges), and frames at rest draw
+// the spans in with that coarser level in place of the others, back to front in one order. For the same reason a frame
+// at rest finer than the first picture is drawn in pieces (vw_draw_piece), and the draw checks run a slice a call
+// (vw_check). A .vxlz is unpacked into a .vxl in memory first (web_package.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -25,6 +27,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <malloc.h>
@@ -67,10 +70,17 @@ struct Viewer {
     return s;
   }();
   int width = 1, height = 1;
-  std::uint64_t gpu_budget = 0;               // bytes; 0: none (vw_set_gpu_budget)
-  std::uint32_t full_level = 0;               // the level drawn at rest: the finest within gpu_budget
-  bool full_pending = false;                  // the full-detail spans of the last view at rest are not all uploaded yet
-  std::uint32_t first_level = 0;              // the first picture's level of detail
+  std::uint64_t gpu_budget = 0;   // bytes; 0: none (vw_set_gpu_budget)
+  std::uint32_t full_level = 0;   // the level drawn at rest: the finest within gpu_budget
+  bool full_pending = false;      // the full-detail spans of the last view at rest are not all uploaded yet
+  std::uint32_t first_level = 0;  // the first picture's level of detail
+  // A file fetched by ranges whose full-detail renderer was made before that level's bytes were all in: its spans
+  // are uploaded as their bytes arrive (span_in), the view's nearest first (vw_next_ranges), and a frame at rest
+  // draws those resident with the coarser renderer standing in for the others (Renderer::begin_pieces).
+  bool spans_arriving = false;
+  std::vector<bool> span_in;                  // per full-detail span: every byte it reads is in the buffer
+  std::uint64_t drawn_uploaded = 0;           // the full-detail renderer's GPU bytes when the last frame was drawn
+  bool drawn_mixed = false;                   // the last frame at rest was drawn with a stand-in
   std::vector<std::uint64_t> level_segments;  // the file's segments at each level
   // A file fetched by ranges (vw_plan_open): the bytes its buffer holds so far, sorted and disjoint, and those the
   // page was last asked to fetch (held once vw_arrived says they are in).
@@ -98,6 +108,10 @@ void close(Viewer& v) {
   v.held.clear();
   v.asked.clear();
   v.level_segments.clear();
+  v.spans_arriving = false;
+  v.span_in.clear();
+  v.drawn_uploaded = 0;
+  v.drawn_mixed = false;
 }
 
 // Whether the buffer holds the whole file (fetched whole, or every range fetched).
@@ -176,21 +190,71 @@ bool draw_next_piece(Viewer& v) {
   return true;
 }
 
-// Uploads a few more of the full-detail spans the view needs (the nearest first); true once they all are.
-bool upload_full(Viewer& v) {
-  v.full_pending = !v.full->upload_for(v.controller->camera(), double(v.width) / v.height, Clipping{}, 0.0);
-  return !v.full_pending;
+// What upload_full found.
+enum class FullDetail { Ready, Uploading, WaitingForBytes };
+
+// Uploads a few more of the full-detail spans the view needs (the nearest first) whose bytes are in.
+FullDetail upload_full(Viewer& v) {
+  const Camera& camera = v.controller->camera();
+  const double aspect = double(v.width) / v.height;
+  if (!v.spans_arriving) {
+    v.full_pending = !v.full->upload_for(camera, aspect, Clipping{}, 0.0);
+    return v.full_pending ? FullDetail::Uploading : FullDetail::Ready;
+  }
+  const bool done = v.full->upload_for(camera, aspect, Clipping{}, 0.0, [&](std::uint32_t c) { return v.span_in[c]; });
+  const std::vector<std::uint32_t> needed = v.full->spans_for(camera, aspect);
+  v.full_pending =
+      !std::all_of(needed.begin(), needed.end(), [&](std::uint32_t c) { return v.full->span_resident(c); });
+  return !v.full_pending ? FullDetail::Ready : done ? FullDetail::WaitingForBytes : FullDetail::Uploading;
 }
 
 // The renderer a frame is drawn with: the first picture's while moving or while full detail is not ready for
-// the view.
+// the view (the finest coarser level fetched meanwhile, at rest).
 Renderer* renderer_for(Viewer& v, bool moving) {
   if (!v.quick) return v.full.get();
   if (moving) return v.quick.get();
-  if (!v.full || !upload_full(v)) return v.interim ? v.interim.get() : v.quick.get();
+  if (!v.full || upload_full(v) != FullDetail::Ready) return v.interim ? v.interim.get() : v.quick.get();
   if (v.piecing == v.interim.get()) v.piecing = nullptr;
   v.interim.reset();  // full detail is on the GPU for this view
   return v.full.get();
+}
+
+// Marks the full-detail spans whose bytes are all in the buffer now.
+void note_spans_in(Viewer& v) {
+  if (!v.full || !v.spans_arriving) return;
+  const std::vector<TextureSpan>& spans = v.full->layout().texture_spans();
+  v.span_in.resize(spans.size(), false);
+  for (std::uint32_t c = 0; c < spans.size(); ++c)
+    if (!v.span_in[c])
+      v.span_in[c] =
+          ranges_held(ranges_of_voxels(*v.file, v.full_level, spans[c].voxel_first, spans[c].voxel_count, 0), v.held);
+}
+
+// The full-detail spans in the order their bytes are fetched: those the view needs, the nearest first, then the
+// others by the distance of their nearest voxel to the eye; with that distance (mm) and whether the view needs it.
+struct SpanToFetch {
+  std::uint32_t span;
+  double distance;
+  bool in_view;
+};
+std::vector<SpanToFetch> spans_to_fetch(const Viewer& v) {
+  const Camera& camera = v.controller->camera();
+  const SceneLayout& layout = v.full->layout();
+  std::vector<double> nearest(layout.texture_spans().size(), std::numeric_limits<double>::infinity());
+  for (const VoxelDrawInfo& voxel : layout.voxels())
+    nearest[voxel.span] = std::min(nearest[voxel.span], glm::length(voxel.center - camera.eye()));
+  std::vector<SpanToFetch> order;
+  std::vector<bool> listed(nearest.size(), false);
+  for (const std::uint32_t c : v.full->spans_for(camera, double(v.width) / v.height)) {
+    order.push_back({c, nearest[c], true});
+    listed[c] = true;
+  }
+  const std::size_t in_view = order.size();
+  for (std::uint32_t c = 0; c < nearest.size(); ++c)
+    if (!listed[c]) order.push_back({c, nearest[c], false});
+  std::stable_sort(order.begin() + static_cast<std::ptrdiff_t>(in_view), order.end(),
+                   [](const SpanToFetch& a, const SpanToFetch& b) { return a.distance < b.distance; });
+  return order;
 }
 
 // Whether the buffer holds every byte `level` draws from (ranges_of_level).
@@ -248,6 +312,13 @@ void describe(Viewer& v, nlohmann::json& j) {
     // How much of full detail is on the GPU, of the most it can take.
     j["full_uploaded"] = v.full ? v.full->gpu_bytes() : 0;
     j["full_bytes"] = v.full ? v.full->layout().upload_bytes() : 0;
+    // Full detail's spans, those whose bytes are in (all, unless they arrive after it was made), and whether the
+    // last frame at rest drew some of them with a coarser level in place of the others.
+    const std::size_t spans = v.full ? v.full->layout().texture_spans().size() : 0;
+    j["full_spans"] = spans;
+    j["full_spans_in"] =
+        v.spans_arriving ? static_cast<std::size_t>(std::count(v.span_in.begin(), v.span_in.end(), true)) : spans;
+    j["mixed"] = v.drawn_mixed;
     j["values"] = r.value_set_names();
     nlohmann::json groups = nlohmann::json::array();
     for (std::size_t g = 0; g < r.groups().groups().size(); ++g) {
@@ -386,6 +457,37 @@ EMSCRIPTEN_KEEPALIVE void vw_arrived() {
   v.asked.insert(v.asked.end(), v.held.begin(), v.held.end());
   v.held = vxl::merge_ranges(std::move(v.asked), 0);
   v.asked.clear();
+  vxl::web::note_spans_in(v);
+}
+
+// The next full-detail spans to fetch (vw_refine made the renderer before their bytes were in): the view's, the
+// nearest first, then the others, nearest first; at least one span, and more while their bytes stay under `batch`.
+// JSON {"ranges": [[begin, end], ...] (vw_arrived once they are in; ranges closer than `gap` merged), "spans":
+// [{"span", "distance" (mm, its nearest voxel's from the eye), "in_view"}, ...]}; no ranges once every span is in.
+EMSCRIPTEN_KEEPALIVE const char* vw_next_ranges(double gap, double batch) {
+  static std::string text;
+  auto& v = viewer();
+  nlohmann::json spans = nlohmann::json::array(), ranges = nlohmann::json::array();
+  if (v.full && v.controller && v.spans_arriving) {
+    const std::vector<vxl::ByteRange> missing = vxl::ranges_missing(v.held, v.file->bytes().size());
+    std::vector<vxl::ByteRange> wanted;
+    std::uint64_t bytes = 0;
+    for (const vxl::web::SpanToFetch& next : vxl::web::spans_to_fetch(v)) {
+      if (v.span_in[next.span]) continue;
+      const vxl::TextureSpan& c = v.full->layout().texture_spans()[next.span];
+      for (const vxl::ByteRange& r : vxl::ranges_intersection(
+               vxl::ranges_of_voxels(*v.file, v.full_level, c.voxel_first, c.voxel_count, 0), missing)) {
+        wanted.push_back(r);
+        bytes += r.end - r.begin;
+      }
+      spans.push_back({{"span", next.span}, {"distance", next.distance}, {"in_view", next.in_view}});
+      if (double(bytes) >= batch) break;
+    }
+    v.asked = vxl::ranges_intersection(vxl::merge_ranges(std::move(wanted), static_cast<std::uint64_t>(gap)), missing);
+    for (const vxl::ByteRange& r : v.asked) ranges.push_back({r.begin, r.end});
+  }
+  text = nlohmann::json{{"ranges", ranges}, {"spans", spans}}.dump();
+  return text.c_str();
 }
 
 // Makes the first picture's renderer once its ranges are in (vw_open without `whole`).
@@ -539,21 +641,29 @@ EMSCRIPTEN_KEEPALIVE int vw_set_gpu_budget(const char* text) {
 }
 
 // Makes the full-detail renderer (at the budget's level) when the first picture was coarser (nothing otherwise).
-// The bytes that level draws from must be in (vw_level_ranges for it); the rest of the file may still be coming.
+// Where the bytes that level draws from are not all in yet (a file fetched by ranges), its spans are smaller, and
+// each is uploaded once its bytes are (vw_next_ranges names them, the view's nearest first); frames at rest draw
+// the spans in, with the coarser level in place of the others. The rest of the file may still be coming.
 EMSCRIPTEN_KEEPALIVE int vw_refine() {
   return guarded([&] {
     auto& v = viewer();
     if (!v.file) throw std::runtime_error("no file is open");
     if (v.full) return;
-    if (!vxl::web::complete(v) && !vxl::web::holds_level(v, v.full_level))
-      throw std::runtime_error("level " + std::to_string(v.full_level) + " is not all fetched yet");
-    // Made without its spans (eager false): vw_upload and renderer_for upload them a few at a time. The spans
-    // are as large as the driver allows: each span more in a draw costs every vertex a branch of texture
-    // fetches (SwiftShader: spans of 2^23 texels, two for the 144k set, took its full-detail frame from 11 s
-    // to 14-16 s).
-    v.full =
-        std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file}, 0, v.full_level, nullptr, false);
+    const std::vector<const vxl::VxlFile*> files{&*v.file};
+    // Spans of about 4 MiB of orders (2^20 words) while the bytes arrive: a span is uploaded and drawn once all of
+    // its voxels are in. Else as large as the driver allows: where runs of voxels are short, each span more in a
+    // draw costs every vertex a branch of texture fetches (SwiftShader: spans of 2^23 texels, two for the 144k
+    // set, took its full-detail frame from 11 s to 14-16 s).
+    constexpr std::uint64_t kArrivingSpanTexels = std::uint64_t(1) << 20;
+    v.spans_arriving = !vxl::web::complete(v) && !vxl::web::holds_level(v, v.full_level);
+    const std::uint64_t max_texels =
+        v.spans_arriving ? std::min(vxl::GpuScene::driver_limit(),
+                                    std::max(kArrivingSpanTexels, vxl::SceneLayout::largest_voxel_texels(files)))
+                         : 0;
+    // Made without its spans (eager false): vw_upload and renderer_for upload them a few at a time.
+    v.full = std::make_unique<vxl::Renderer>(files, max_texels, v.full_level, nullptr, false);
     v.full_pending = true;
+    vxl::web::note_spans_in(v);
   });
 }
 
@@ -561,15 +671,21 @@ EMSCRIPTEN_KEEPALIVE int vw_refine() {
 EMSCRIPTEN_KEEPALIVE int vw_pending() { return viewer().quick && viewer().full && viewer().full_pending ? 1 : 0; }
 
 // Uploads a few more full-detail spans for the view: 1 once all it needs are on the GPU (the next frame at
-// rest is drawn at full detail), 0 while more remain, else an error code (vw_error).
+// rest is drawn at full detail), 0 while more remain, else an error code (vw_error). Where the rest wait for
+// their bytes: -1 when spans were uploaded since the last frame (a frame at rest now shows more), -2 otherwise.
 EMSCRIPTEN_KEEPALIVE int vw_upload() {
-  bool complete = false;
+  int state = 1;
   const int error = guarded([&] {
     auto& v = viewer();
     if (!v.controller || !v.full) throw std::runtime_error("no full-detail renderer to upload for");
-    complete = !v.quick || vxl::web::upload_full(v);
+    if (!v.quick) return;
+    switch (vxl::web::upload_full(v)) {
+      case vxl::web::FullDetail::Ready: state = 1; break;
+      case vxl::web::FullDetail::Uploading: state = 0; break;
+      case vxl::web::FullDetail::WaitingForBytes: state = v.full->gpu_bytes() != v.drawn_uploaded ? -1 : -2; break;
+    }
   });
-  return error != 0 ? error : complete ? 1 : 0;
+  return error != 0 ? error : state;
 }
 
 // Draws a frame into the canvas, now width x height pixels; `moving` (a drag) draws the first picture's level. At rest,
@@ -585,13 +701,20 @@ EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
     v.height = std::max(height, 1);
     vxl::Renderer* renderer = vxl::web::renderer_for(v, moving != 0);
     v.controller->set_window_height(v.height);
+    // At rest with some of full detail's spans in and others still coming: those, with this one standing in.
+    vxl::Renderer* stand_in = nullptr;
+    if (!moving && v.full && renderer != v.full.get() && v.full->gpu_bytes() > 0 &&
+        v.full->draws_in_voxel_pieces(v.settings.mode))
+      stand_in = std::exchange(renderer, v.full.get());
+    v.drawn_mixed = stand_in != nullptr;
+    if (v.full) v.drawn_uploaded = v.full->gpu_bytes();
     if (renderer == v.quick.get() || !v.quick) {
       renderer->draw(v.controller->camera(), v.settings, v.width, v.height, 0);
       renderer->check_uploaded(false);
       return;
     }
     v.piece_target.ensure(v.width, v.height, GL_RGBA8, 0, true);
-    renderer->begin_pieces(v.controller->camera(), v.settings, v.width, v.height, v.piece_target.fbo);
+    renderer->begin_pieces(v.controller->camera(), v.settings, v.width, v.height, v.piece_target.fbo, stand_in);
     v.piecing = renderer;
     vxl::web::draw_next_piece(v);
   });

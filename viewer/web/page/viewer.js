@@ -34,6 +34,10 @@
     ready: new Promise((resolve, reject) => { settle = { resolve, reject }; }),
     complete: new Promise((resolve, reject) => { settleComplete = { resolve, reject }; }),
     levelsShown: [],  // the levels drawn at rest between the first picture and full detail (a file fetched by ranges)
+    // Full detail's spans in the order they were fetched ({span, distance, in_view}: vw_next_ranges), and the
+    // pictures at rest shown with some of them in and a coarser level in place of the others.
+    spansFetched: [],
+    mixedShown: [],  // when each was shown, ms from navigation
     longTasks: () => longTasks.slice(),
   };
 
@@ -62,6 +66,7 @@
       levelRanges: Module.cwrap('vw_level_ranges', 'string', ['number', 'number']),
       showLevel: Module.cwrap('vw_show_level', 'number', ['number']),
       missingRanges: Module.cwrap('vw_missing_ranges', 'string', ['number']),
+      nextRanges: Module.cwrap('vw_next_ranges', 'string', ['number', 'number']),
       show: Module.cwrap('vw_show', 'number', []),
       arrived: Module.cwrap('vw_arrived', null, []),
       error: Module.cwrap('vw_error', 'string', []),
@@ -154,8 +159,15 @@
       }
     }
     let piecesRun = 0;  // the frames drawn: pieces of an earlier one stop
+    // More of full detail arrived while a picture was being drawn in pieces: another once that one is shown.
+    let redrawAfterPieces = false;
+    function redrawWhenShown() {
+      if (api.piecesUnderWay()) redrawAfterPieces = true;
+      else redraw();
+    }
     function frame() {
       dirty = false;
+      redrawAfterPieces = false;  // this frame draws what is in
       const run = ++piecesRun;
       const [w, h] = canvasSize();
       if (canvas.width !== w || canvas.height !== h) {
@@ -202,6 +214,8 @@
     // The frame asked for is on the canvas.
     function shownFrame() {
       checked();
+      if (JSON.parse(api.info()).mixed && !moving) window.voxweb.mixedShown.push(performance.now());
+      if (redrawAfterPieces) redraw();
       const pending = api.pending();
       fullShown = fullDetail && !moving && !pending;
       if (firstFrame) {
@@ -236,7 +250,8 @@
         if (bytesComplete) $('progress').value = info.full_uploaded / Math.max(1, info.full_bytes);  // else the fetch's
         if (r === 0) return setTimeout(step, 0);
         uploading = false;
-        redraw();
+        if (r === 1) redraw();  // full detail for the view: now, whatever picture is under way
+        else if (r === -1) redrawWhenShown();  // more of it, the rest still coming: after the picture under way
       }, 0);
     }
     // The rest of a file fetched by ranges, then full detail.
@@ -461,6 +476,7 @@
     // the first picture's level of detail, then the rest (.vxl spec §5.12: a level is a prefix of every voxel's
     // block and its own orders, so it is many small ranges, asked for many at a time).
     const FIRST_BYTES = 4096, RANGES_PER_REQUEST = 200, REQUEST_BYTES = 32 << 20, LEVEL_GAP = 4096, REST_PIECE = 8 << 20;
+    const SPAN_BATCH = 4 << 20;  // full detail's spans fetched at a time: at least one, more while under this
     const SINGLE_RANGE_GAP = 1 << 20;  // for a server that answers one range a request
     // The finest level drawn at rest before full detail: a software WebGL draws about a million segments a second,
     // and each such picture delays full detail by its upload and its frames.
@@ -724,8 +740,21 @@
           await new Promise((resolve) => setTimeout(resolve, 0));  // its frame before the next fetch
           if (!current(target)) return false;
         }
-        if (!(await bring(target, JSON.parse(api.levelRanges(info.full_level, LEVEL_GAP))))) return false;
         if (!fullDetail && !refine()) return false;
+        // Full detail's spans, those the view needs the nearest first, each drawn as it comes (the coarser level in
+        // place of those still coming).
+        for (;;) {
+          const next = JSON.parse(api.nextRanges(LEVEL_GAP, SPAN_BATCH));
+          if (!next.ranges.length) break;
+          if (!(await bring(target, next.ranges))) return false;
+          window.voxweb.spansFetched.push(...next.spans);
+          const now = JSON.parse(api.info());
+          say(`${name}: ${now.full_spans_in} of the ${now.full_spans} parts of ` +
+              `${info.full_level === 0 ? 'full detail' : 'level ' + info.full_level} in, the nearest the view first`);
+          uploadSoon();
+        }
+        // Any the renderer did not split into spans (a file fetched whole meanwhile has them all).
+        if (!(await bring(target, JSON.parse(api.levelRanges(info.full_level, LEVEL_GAP))))) return false;
         const rest = () => bring(target, JSON.parse(api.missingRanges(REST_PIECE)));
         if (info.full_level === 0) return rest();
         restLater = rest;  // the budget draws a coarser level: the rest when a setting needs it
