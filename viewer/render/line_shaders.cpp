@@ -196,8 +196,10 @@ const char* const kVertexShading = R"(  vec3 rel = (p - u_eye_hi) - u_eye_lo;
     v_light = vec2(u_light_terms.x + u_light_terms.y * diffuse, u_light_terms.z * specular);
   }
   v_color = vec4(color, alpha);
-  // A hidden group (opacity 0): both ends outside the clip volume, so no line, in every mode.
-  gl_Position = hidden ? vec4(2.0, 2.0, 2.0, 1.0) : u_projection * vec4(e, 1.0);
+  // A hidden group (opacity 0): both ends at the segment's first end, a line of length zero, which rasterises to
+  // nothing in every mode. Not outside the clip volume: llvmpipe then sends the draw's lines through its clipper.
+  if (hidden && end == 1) e = u_rotation * ((q - u_eye_hi) - u_eye_lo);
+  gl_Position = u_projection * vec4(e, 1.0);
 }
 )";
 
