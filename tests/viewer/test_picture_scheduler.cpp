@@ -59,6 +59,38 @@ TEST(PictureScheduler, WholePicturesAreMeasuredAndChosenUnderTheirLoad) {
   EXPECT_EQ(s.next(true, false, false, view.fn()).level, kSceneLevel) << "idle again: 8 x 5 ms fits";
 }
 
+// A whole picture that left the focus's full-detail copy out (it does not fit the frame budget) is drawn again with
+// it first, in pieces at its own level; then the refinement goes on to the view's level.
+TEST(PictureScheduler, AFocusCopyLeftOutOfAWholePictureComesFirstAtRest) {
+  PictureScheduler s = scheduler(true);
+  ViewLevel view{kSceneLevel};
+  s.drawn_whole(RenderMode::Axis, kCoarsest, 40, true);
+  EXPECT_TRUE(s.focus_stage());
+  PictureTask t = s.next(false, false, false, view.fn());
+  EXPECT_EQ(t.work, PictureWork::Piece);
+  EXPECT_EQ(t.level, kCoarsest) << "the whole picture's level, with the copy";
+  EXPECT_EQ(t.frame_work, FrameWork::FocusPiece);
+  EXPECT_EQ(view.asked, 0);
+  s.begin_pieces();
+  s.piece_drawn(false);
+  EXPECT_TRUE(s.focus_stage());
+  s.piece_drawn(true);
+  EXPECT_FALSE(s.focus_stage());
+  EXPECT_FALSE(s.pieces_begun()) << "the full-detail stage begins its own pieces";
+  EXPECT_EQ(s.drawn_level(), kCoarsest);
+  t = s.next(false, false, false, view.fn());
+  EXPECT_EQ(t.work, PictureWork::Piece);
+  EXPECT_EQ(t.level, kSceneLevel);
+  EXPECT_EQ(t.frame_work, FrameWork::FullDetailPiece);
+  // A picture drawn whole with the copy (or without a focus) has no such stage; a change drops it.
+  s.drawn_whole(RenderMode::Axis, kCoarsest, 40, true);
+  s.drawn_whole(RenderMode::Axis, kCoarsest, 40);
+  EXPECT_FALSE(s.focus_stage());
+  EXPECT_EQ(s.next(false, false, false, view.fn()).frame_work, FrameWork::FullDetailPiece);
+  s.drawn_whole(RenderMode::Axis, kCoarsest, 40, true);
+  EXPECT_EQ(s.next(false, false, true, view.fn()).work, PictureWork::None) << "closing: nothing refined";
+}
+
 TEST(PictureScheduler, AtRestACoarsePictureIsRefinedAtTheViewsLevelThenToExact) {
   PictureScheduler s = scheduler(true);
   ViewLevel view{0};  // a slab: full detail fits

@@ -26,6 +26,7 @@ const char* work_name(FrameWork w) {
     case FrameWork::Whole: return "whole";
     case FrameWork::FullDetailPiece: return "full-detail piece";
     case FrameWork::ExactPiece: return "exact piece";
+    case FrameWork::FocusPiece: return "focus piece";
   }
   return "?";
 }

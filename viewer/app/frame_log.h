@@ -17,6 +17,7 @@ enum class FrameWork {
   Whole,            // a picture drawn whole, shown at once
   FullDetailPiece,  // a piece of the full-detail picture at rest
   ExactPiece,       // a piece of the exact picture at rest
+  FocusPiece,       // a piece of the picture drawn whole again with the focus's full-detail copy
 };
 
 struct FrameRecord {

@@ -21,6 +21,12 @@ PictureTask PictureScheduler::next(bool changed, bool scripted_last, bool closin
     return task;
   }
   if (closing || rest_.stage() == RestStage::Done) return task;
+  if (focus_left_out_) {
+    task.work = PictureWork::Piece;
+    task.level = drawn_level_;
+    task.frame_work = FrameWork::FocusPiece;
+    return task;
+  }
   if (!rest_level_) {  // once per picture drawn whole
     rest_level_ = level_for_view();
     if (rest_.stage() == RestStage::FullDetail && *rest_level_ == drawn_level_) {
@@ -35,7 +41,8 @@ PictureTask PictureScheduler::next(bool changed, bool scripted_last, bool closin
   return task;
 }
 
-void PictureScheduler::drawn_whole(RenderMode mode, std::uint32_t level, double ms) {
+void PictureScheduler::drawn_whole(RenderMode mode, std::uint32_t level, double ms, bool focus_left_out) {
+  focus_left_out_ = focus_left_out;
   budget_.record(level, ms, load_);
   // Full detail for any view only at level 0 (or the level --level forces); otherwise the refinement
   // decides, once at rest, which level this view can have.
@@ -48,6 +55,11 @@ void PictureScheduler::drawn_whole(RenderMode mode, std::uint32_t level, double 
 
 void PictureScheduler::piece_drawn(bool completes) {
   if (!completes) return;
+  if (focus_left_out_) {  // the whole picture's level with the copy: the refinement goes on from there
+    focus_left_out_ = false;
+    pieces_begun_ = false;
+    return;
+  }
   drawn_level_ = *rest_level_;
   rest_.stage_complete();
   pieces_begun_ = false;

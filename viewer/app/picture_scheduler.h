@@ -2,7 +2,8 @@
 // first at a coarse level (so that it comes at once), while the camera moves or a setting changes at the
 // finest level the frame budget allows (frame_budget.h), a script's last frame at the scene's level — and an
 // unchanged one is refined at rest a piece a frame (rest_refinement.h): to the finest level whose visible
-// part fits the GPU memory budget (view_level.h), then to the exact picture. Pure logic, testable without
+// part fits the GPU memory budget (view_level.h), then to the exact picture; first, where the whole picture left
+// a selection's full-detail focus copy out, to that picture with the copy. Pure logic, testable without
 // GL: the window draws what it says and reports back.
 #pragma once
 
@@ -45,8 +46,10 @@ class PictureScheduler {
   PictureTask next(bool changed, bool scripted_last, bool closing,
                    const std::function<std::uint32_t()>& level_for_view);
 
-  // A picture was drawn whole in `mode` at `level`, in `ms`: the refinement starts over.
-  void drawn_whole(RenderMode mode, std::uint32_t level, double ms);
+  // A picture was drawn whole in `mode` at `level`, in `ms`: the refinement starts over. focus_left_out: it drew the
+  // focus from the context's level, its full-detail copy not fitting the frame budget: the refinement first draws
+  // that picture again with the copy, in pieces at the same level (focus_stage()), then goes on.
+  void drawn_whole(RenderMode mode, std::uint32_t level, double ms, bool focus_left_out = false);
   // A piece of the refinement was drawn; `completes`: its stage's picture is complete and on screen.
   void piece_drawn(bool completes);
 
@@ -61,6 +64,8 @@ class PictureScheduler {
   // The user turned "exact when still" on or off (the panel, key E).
   void set_exact_when_still(bool on);
 
+  // The refinement's pieces draw the whole picture's level again with the focus copy (drawn_whole's focus_left_out).
+  bool focus_stage() const { return focus_left_out_; }
   const RestRefinement& rest() const { return rest_; }
   RestRefinement& rest() { return rest_; }
   // The level of the picture on screen.
@@ -80,6 +85,7 @@ class PictureScheduler {
   // The level the refinement draws this view at; none until the refinement has chosen it.
   std::optional<std::uint32_t> rest_level_;
   bool pieces_begun_ = false;
+  bool focus_left_out_ = false;
 };
 
 }  // namespace vxl::app

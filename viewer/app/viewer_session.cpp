@@ -75,6 +75,13 @@ void ViewerSession::set_focus(const std::vector<std::vector<std::uint64_t>>& kep
   if (focus_ && !focus_->files().empty()) focus_layout_.emplace(focus_->files(), detail_->span_texels, 0);
 }
 
+std::uint64_t ViewerSession::focus_segments() const {
+  std::uint64_t segments = 0;
+  if (focus_)
+    for (const VxlFile* f : focus_->files()) segments += f->meta().segment_count;
+  return segments;
+}
+
 Renderer& ViewerSession::focus_first_renderer(std::uint32_t context_level, bool eager) {
   std::unique_ptr<Renderer>& r = focus_renderers_[context_level];
   if (!r) {

@@ -86,6 +86,8 @@ class ViewerSession {
   // The same with a copy of `kept` made elsewhere (the window's, off its thread); null: no focus copy.
   void set_focus(const std::vector<std::vector<std::uint64_t>>& kept, std::shared_ptr<const FocusCopy> copy);
   bool has_focus() const { return focus_layout_.has_value(); }
+  // The segments of the focus's full-detail copy (0 without one).
+  std::uint64_t focus_segments() const;
   // The renderer of the context's files at `context_level` and the focus's copy at full detail, one scene
   // (its groups: SceneGroups::focus_first), made on first use like renderer_at. Needs set_focus.
   Renderer& focus_first_renderer(std::uint32_t context_level, bool eager);

@@ -88,6 +88,15 @@ class ViewerWindow {
   static constexpr double kWorkPollSeconds = 0.02;
   // Whether a picture at `level` draws the focus from its full-detail copy (focus first).
   bool focus_first_at(std::uint32_t level) const { return level > 0 && session_->has_focus(); }
+  // The same for a picture drawn whole, which must keep to the frame budget: below the scene's level, only where
+  // the copy's lines fit the budget at the rate the last whole picture was drawn at. Else the focus is drawn from
+  // the context's level, as while dragging, and the refinement at rest (in pieces) brings the copy in: on a
+  // software rasteriser a large focus copy drawn whole froze the window for seconds (9M segments: 4 s).
+  bool focus_first_whole_at(std::uint32_t level) const;
+  // Whether the focus copy's lines fit the frame budget at the last whole picture's rate.
+  bool focus_copy_fits_budget() const;
+  double segments_per_ms_ = 0;      // the last whole picture's drawing rate (0: none measured yet)
+  bool drawn_focus_first_ = false;  // the last picture drawn (whole or its last piece) drew the focus first
   // Writes the selected streamlines of every file to a stamped .tck (a key or the panel).
   void save_selection();
 
@@ -109,8 +118,9 @@ class ViewerWindow {
   double seconds_since_start() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
-  // The renderer of the scene's level, or of a coarser one (made on first use, for the frame budget).
-  Renderer& renderer_at(std::uint32_t level);
+  // The renderer of the scene's level, or of a coarser one (made on first use, for the frame budget); `whole`: for a
+  // picture drawn whole (focus_first_whole_at), else for the refinement's pieces.
+  Renderer& renderer_at(std::uint32_t level, bool whole);
   void save_screenshot(const std::string& path, int width, int height);
   // save_screenshot to a stamped name in the current directory; a failure is shown, not thrown.
   void save_stamped_screenshot(int width, int height);

@@ -72,7 +72,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
   // coming), the focus appears when it is ready. Scripted frames without a drag still wait for it, frame by frame.
   update_selection(false);
   // Scene-wide facts (bounds, groups, value sets, voxel cubes) are the same at every level.
-  Renderer& first = renderer_at(first_level_);
+  Renderer& first = renderer_at(first_level_, true);
   grid_.emplace(std::span<const VxlFile* const>(files_));  // the files opened: not a focus copy drawn beside them
   controller_ = CameraController(Camera{}, std::max(1.0, glm::length(first.scene_max() - first.scene_min()) * 0.5));
   stats_.has_image = session_->image() != nullptr;
@@ -151,16 +151,28 @@ void ViewerWindow::set_error(const std::string& message) {
   stats_.error = message;
 }
 
-Renderer& ViewerWindow::renderer_at(std::uint32_t level) {
+bool ViewerWindow::focus_copy_fits_budget() const {
+  if (options_.frame_budget_ms <= 0) return true;
+  const double rate = segments_per_ms_ > 0 ? segments_per_ms_ : Renderer::kAssumedSegmentsPerMs;
+  return double(session_->focus_segments()) / rate <= options_.frame_budget_ms;
+}
+
+bool ViewerWindow::focus_first_whole_at(std::uint32_t level) const {
+  // The picture at rest (a script's last frame, at the scene's level) always draws it.
+  return focus_first_at(level) && (level <= detail_.level || focus_copy_fits_budget());
+}
+
+Renderer& ViewerWindow::renderer_at(std::uint32_t level, bool whole) {
   // Focus first: below full detail, the context at `level` and the focus from its full-detail copy.
-  if (focus_first_at(level)) return session_->focus_first_renderer(level, false);
+  drawn_focus_first_ = whole ? focus_first_whole_at(level) : focus_first_at(level);
+  if (drawn_focus_first_) return session_->focus_first_renderer(level, false);
   // The first picture's level is uploaded whole at once; the others span by span as frames need them
   // (the refinement at rest spreads its level's upload over frames).
   return session_->renderer_at(level, level == first_level_);
 }
 
 double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
-  Renderer& renderer = renderer_at(level);
+  Renderer& renderer = renderer_at(level, true);
   RenderSettings& s = state_.settings;
   if (s.mode != drawn_mode_) stats_.error.clear();  // a new choice of mode gets a fresh start
   if (render_mode_info(s.mode).needs_gl43 && !stats_.exact_available) {
@@ -188,6 +200,7 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
   glFinish();  // the frame time should include the GPU's work, not only its submission
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
+  if (ms > 0 && renderer.stats().segments_drawn > 0) segments_per_ms_ = double(renderer.stats().segments_drawn) / ms;
   show_frame_figures(renderer, level);
   return ms;
 }
@@ -222,7 +235,7 @@ void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t le
                        : level < detail_.level
                            ? "level " + std::to_string(level) + ": the visible part fits the GPU memory budget"
                            : "";
-  if (focus_first_at(level))
+  if (drawn_focus_first_)
     stats_.frame_level = "focus at full detail, context at level " + std::to_string(level) +
                          (level > detail_.level ? " while the camera moves" : "");
 }
@@ -236,7 +249,7 @@ void ViewerWindow::present(int width, int height) const {
 
 double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& completes) {
   const auto t0 = std::chrono::steady_clock::now();
-  Renderer& renderer = renderer_at(level);
+  Renderer& renderer = renderer_at(level, false);
   if (!refine_target_) refine_target_.emplace(width, height);
   if (refine_target_->width() != width || refine_target_->height() != height) refine_target_->resize(width, height);
   RestRefinement& rest = scheduler_->rest();
@@ -279,8 +292,11 @@ double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& co
     draw_overlays(renderer, width, height);
     show_frame_figures(renderer, level);
   }
+  const bool focus_stage = scheduler_->focus_stage();
   scheduler_->piece_drawn(completes);
   stats_.refinement = rest.describe(completes ? 0 : renderer.pieces_progress());
+  if (focus_stage && !completes)
+    stats_.refinement = "the focus at full detail: " + std::to_string(int(100 * renderer.pieces_progress())) + " %";
   glFinish();
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -350,11 +366,11 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
   if (task.stage_skipped) stats_.refinement = scheduler_->rest().describe(0);
   if (task.work == PictureWork::Whole) {
     const double ms = draw_scene(key.width, key.height, task.level);
-    scheduler_->drawn_whole(state_.settings.mode, task.level, ms);
+    scheduler_->drawn_whole(state_.settings.mode, task.level, ms, focus_first_at(task.level) && !drawn_focus_first_);
     stats_.refinement = scheduler_->rest().describe(0);
     drawn_ = key;
     frames_.push_back({task.level, moving, ms, seconds_since_start()});
-    frames_.back().focus_first = focus_first_at(task.level);
+    frames_.back().focus_first = drawn_focus_first_;
     frames_.back().selection = selection_.has_value();
     frames_.back().new_selection = selection_.has_value() && key.selection != framed_generation_;
     framed_generation_ = key.selection;
@@ -367,7 +383,7 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
     bool completes = false;
     const double ms = refine(key.width, key.height, task.level, completes);
     frames_.push_back({task.level, false, ms, seconds_since_start(), task.frame_work, completes});
-    frames_.back().focus_first = focus_first_at(task.level);
+    frames_.back().focus_first = drawn_focus_first_;
     frames_.back().selection = selection_.has_value();
     return true;
   }
@@ -432,7 +448,7 @@ int ViewerWindow::run() {
     const bool changed = !drawn_ || !same_picture(*drawn_, key);
     const bool scripted_last = closing && frames_done && !options_.until_refined;
     // The picture (and so what the panel should say) changed after the panel was built.
-    scheduler_->set_load({session_->has_focus(), work_in_flight()});
+    scheduler_->set_load({session_->has_focus() && focus_copy_fits_budget(), work_in_flight()});
     const bool drawn_now = draw_picture(
         scheduler_->next(changed, scripted_last, closing,
                          [&] {
