@@ -260,14 +260,16 @@ double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& co
     const double piece_ms =
         options_.frame_budget_ms > 0 ? options_.frame_budget_ms : std::numeric_limits<double>::infinity();
     if (!scheduler_->pieces_begun()) {
-      // The level's spans this view needs come first, a piece's time at a time (the nearest first).
+      RenderSettings s = state_.settings;
+      s.mode = rest.stage_mode();
+      // The level's spans this view needs come first, a piece's time at a time (the nearest first), each with its
+      // per-vertex words where the settings read them (with a region: the groups).
+      renderer.prepare_attributes(s);
       if (!renderer.upload_for(controller_.camera(), double(width) / height, state_.settings.clipping, piece_ms)) {
         stats_.refinement = "uploading the scene's level";
         glFinish();
         return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       }
-      RenderSettings s = state_.settings;
-      s.mode = rest.stage_mode();
       renderer.begin_pieces(controller_.camera(), s, width, height, refine_target_->framebuffer());
       scheduler_->begin_pieces();
     }

@@ -218,9 +218,13 @@ void Renderer::clear_to_base(GLuint fbo, const Camera& camera, const RenderSetti
   draw_shells(ShellHalf::Back, camera, s, width, height);
 }
 
+void Renderer::prepare_attributes(const RenderSettings& s) {
+  lines_->prepare_attributes(s, scalar_name(s), groups_, *indexes_);
+}
+
 void Renderer::start_frame(const Camera& camera, const RenderSettings& s, int width, int height) {
   const double aspect = double(width) / std::max(1, height);
-  lines_->prepare_attributes(s, scalar_name(s), groups_, *indexes_);
+  prepare_attributes(s);
   // The opaque slices first: their colour is the base of the picture, their depth hides lines behind them.
   slices_drawn_ = slices_ && s.slices.any();
   if (slices_drawn_)

@@ -158,6 +158,10 @@ class Renderer {
   // large upload over frames and its event loop never waits for one: returns after about `max_ms`, with the
   // spans whose fill ended by then resident. True once nothing more can be uploaded for that view (all
   // resident, or the budget holds no more).
+  // Makes what `settings` read per vertex (values, groups: LinePass::prepare_attributes) part of every span's upload
+  // from now on; draw() and begin_pieces() do it themselves. A caller that uploads spans ahead of a frame (upload_for)
+  // calls it first: else the frame re-uploads every resident span with those words, all at once.
+  void prepare_attributes(const RenderSettings& settings);
   // may_upload: when given, only the spans it accepts are uploaded (a file whose bytes are still arriving).
   bool upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms,
                   const std::function<bool(std::uint32_t span)>& may_upload = {});
