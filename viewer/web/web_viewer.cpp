@@ -81,6 +81,7 @@ struct Viewer {
   std::vector<bool> span_in;                  // per full-detail span: every byte it reads is in the buffer
   std::uint64_t drawn_uploaded = 0;           // the full-detail renderer's GPU bytes when the last frame was drawn
   bool drawn_mixed = false;                   // the last frame at rest was drawn with a stand-in
+  bool drawn_full = false;                    // the last frame at rest was drawn by the full-detail renderer alone
   std::vector<std::uint64_t> level_segments;  // the file's segments at each level
   // A file fetched by ranges (vw_plan_open): the bytes its buffer holds so far, sorted and disjoint, and those the
   // page was last asked to fetch (held once vw_arrived says they are in).
@@ -112,6 +113,7 @@ void close(Viewer& v) {
   v.span_in.clear();
   v.drawn_uploaded = 0;
   v.drawn_mixed = false;
+  v.drawn_full = false;
 }
 
 // Whether the buffer holds the whole file (fetched whole, or every range fetched).
@@ -445,8 +447,9 @@ EMSCRIPTEN_KEEPALIVE int vw_show_level(int level) {
     if (level <= 0 || static_cast<std::uint32_t>(level) <= v.full_level ||
         static_cast<std::uint32_t>(level) >= v.first_level)
       throw std::runtime_error("not a level between");
-    if (v.piecing == v.interim.get()) v.piecing = nullptr;  // its pieces end with it
-    v.interim.reset();                                      // its GPU memory before the next one's
+    // Its pieces end with it, and so do full detail's where it stands in for spans still coming.
+    if (v.piecing == v.interim.get() || v.piecing == v.full.get()) v.piecing = nullptr;
+    v.interim.reset();  // its GPU memory before the next one's
     v.interim = std::make_unique<vxl::Renderer>(std::vector<const vxl::VxlFile*>{&*v.file}, 0, level);
   });
 }
@@ -673,6 +676,7 @@ EMSCRIPTEN_KEEPALIVE int vw_pending() { return viewer().quick && viewer().full &
 // Uploads a few more full-detail spans for the view: 1 once all it needs are on the GPU (the next frame at
 // rest is drawn at full detail), 0 while more remain, else an error code (vw_error). Where the rest wait for
 // their bytes: -1 when spans were uploaded since the last frame (a frame at rest now shows more), -2 otherwise.
+// -3: all are, and the last frame at rest (drawn, or being drawn in pieces) is full detail already.
 EMSCRIPTEN_KEEPALIVE int vw_upload() {
   int state = 1;
   const int error = guarded([&] {
@@ -680,7 +684,7 @@ EMSCRIPTEN_KEEPALIVE int vw_upload() {
     if (!v.controller || !v.full) throw std::runtime_error("no full-detail renderer to upload for");
     if (!v.quick) return;
     switch (vxl::web::upload_full(v)) {
-      case vxl::web::FullDetail::Ready: state = 1; break;
+      case vxl::web::FullDetail::Ready: state = v.drawn_full ? -3 : 1; break;
       case vxl::web::FullDetail::Uploading: state = 0; break;
       case vxl::web::FullDetail::WaitingForBytes: state = v.full->gpu_bytes() != v.drawn_uploaded ? -1 : -2; break;
     }
@@ -707,6 +711,7 @@ EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
         v.full->draws_in_voxel_pieces(v.settings.mode))
       stand_in = std::exchange(renderer, v.full.get());
     v.drawn_mixed = stand_in != nullptr;
+    v.drawn_full = !moving && renderer == v.full.get() && !stand_in;
     if (v.full) v.drawn_uploaded = v.full->gpu_bytes();
     if (renderer == v.quick.get() || !v.quick) {
       renderer->draw(v.controller->camera(), v.settings, v.width, v.height, 0);

@@ -242,8 +242,10 @@
     function uploadSoon() {
       if (uploading) return;
       uploading = true;
+      const gen = generation;
       setTimeout(function step() {
-        if (moving) { uploading = false; return; }  // the drag's end draws and comes back here
+        // The drag's end draws and comes back here; a file opened since has its own.
+        if (moving || gen !== generation) { uploading = false; return; }
         const r = api.upload();
         if (r > 1) { uploading = false; return fail(api.error()); }
         const info = JSON.parse(api.info());
@@ -252,6 +254,7 @@
         uploading = false;
         if (r === 1) redraw();  // full detail for the view: now, whatever picture is under way
         else if (r === -1) redrawWhenShown();  // more of it, the rest still coming: after the picture under way
+        // -2: the rest waits for its bytes, nothing new; -3: the picture drawn or under way is full detail already
       }, 0);
     }
     // The rest of a file fetched by ranges, then full detail.
@@ -748,6 +751,7 @@
           if (!next.ranges.length) break;
           if (!(await bring(target, next.ranges))) return false;
           window.voxweb.spansFetched.push(...next.spans);
+          if (!next.spans.some((s) => s.in_view)) continue;  // the view does not draw them (yet): nothing to upload
           const now = JSON.parse(api.info());
           say(`${name}: ${now.full_spans_in} of the ${now.full_spans} parts of ` +
               `${info.full_level === 0 ? 'full detail' : 'level ' + info.full_level} in, the nearest the view first`);
