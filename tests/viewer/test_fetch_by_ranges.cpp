@@ -112,7 +112,10 @@ TEST_P(FetchByRanges, TheSpansInAreDrawnWithACoarserLevelInPlaceOfTheRest) {
   const std::vector<const VxlFile*> partial_file{&partial};
   Renderer fine(partial_file, small_spans, 0, nullptr, false), coarse(partial_file, 0, kCoarse);
   const auto fetched = [&](std::uint32_t span) { return in.count(span) > 0; };
-  while (!fine.upload_for(camera, 1.0, {}, std::numeric_limits<double>::infinity(), fetched)) {
+  std::vector<std::uint32_t> view_spans_in;
+  for (const std::uint32_t span : fine.spans_for(camera, 1.0))
+    if (fetched(span)) view_spans_in.push_back(span);
+  while (!fine.upload_spans(view_spans_in, std::numeric_limits<double>::infinity())) {
   }
   for (std::uint32_t span = 0; span < fine.layout().texture_spans().size(); ++span)
     EXPECT_EQ(fine.span_resident(span), fetched(span)) << "span " << span;

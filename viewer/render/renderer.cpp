@@ -129,10 +129,7 @@ std::vector<std::uint32_t> Renderer::spans_for(const Camera& camera, double aspe
   return spans_nearest_first(scene_.layout(), nearest);
 }
 
-bool Renderer::upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms,
-                          const std::function<bool(std::uint32_t span)>& may_upload) {
-  std::vector<std::uint32_t> spans = spans_for(camera, aspect, clipping);
-  if (may_upload) std::erase_if(spans, [&](std::uint32_t span) { return !may_upload(span); });
+bool Renderer::upload_spans(std::span<const std::uint32_t> spans, double max_ms) {
   return !scene_.make_resident(spans, max_ms, false).out_of_time;
 }
 

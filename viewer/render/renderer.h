@@ -9,7 +9,6 @@
 
 #include <array>
 #include <cstdint>
-#include <functional>
 #include <initializer_list>
 #include <memory>
 #include <span>
@@ -153,20 +152,21 @@ class Renderer {
   // The most GPU memory a frame of `camera` with `clipping` can need: the spans its visible voxels lie in,
   // with everything a mode may upload for them (SceneLayout::span_upload_bytes).
   std::uint64_t view_bytes(const Camera& camera, double aspect, const Clipping& clipping = {}) const;
-  // Uploads the spans a frame of `camera` needs that are not resident, the nearest voxels' first, filled on
-  // other threads a few at a time (GpuScene::make_resident without waiting), so that a window can spread a
-  // large upload over frames and its event loop never waits for one: returns after about `max_ms`, with the
-  // spans whose fill ended by then resident. True once nothing more can be uploaded for that view (all
-  // resident, or the budget holds no more).
   // Makes what `settings` read per vertex (values, groups: LinePass::prepare_attributes) part of every span's upload
   // from now on; draw() and begin_pieces() do it themselves. A caller that uploads spans ahead of a frame (upload_for)
   // calls it first: else the frame re-uploads every resident span with those words, all at once.
   void prepare_attributes(const RenderSettings& settings);
-  // may_upload: when given, only the spans it accepts are uploaded (a file whose bytes are still arriving).
-  bool upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms,
-                  const std::function<bool(std::uint32_t span)>& may_upload = {});
-  // The spans a frame of `camera` needs, those of the nearest voxels first (upload_for's order).
+  // The spans a frame of `camera` needs, those of the nearest voxels first.
   std::vector<std::uint32_t> spans_for(const Camera& camera, double aspect, const Clipping& clipping = {}) const;
+  // Uploads those of `spans` that are not resident, in that order, filled on other threads a few at a time
+  // (GpuScene::make_resident without waiting), so that a window can spread a large upload over frames and its event
+  // loop never waits for one: returns after about `max_ms`, with the spans whose fill ended by then resident. True
+  // once nothing more of them can be uploaded (all resident, or the budget holds no more).
+  bool upload_spans(std::span<const std::uint32_t> spans, double max_ms);
+  // upload_spans of the spans a frame of `camera` needs (spans_for).
+  bool upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms) {
+    return upload_spans(spans_for(camera, aspect, clipping), max_ms);
+  }
 
   // The renderer as its transparency modes see it (modes/pass_host.h): its line pass, scene, plan and base.
   // For drawing a mode's pass over this renderer's scene (e.g. an ExactRenderer with a small node buffer).

@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -203,8 +204,10 @@ FullDetail upload_full(Viewer& v) {
     v.full_pending = !v.full->upload_for(camera, aspect, Clipping{}, 0.0);
     return v.full_pending ? FullDetail::Uploading : FullDetail::Ready;
   }
-  const bool done = v.full->upload_for(camera, aspect, Clipping{}, 0.0, [&](std::uint32_t c) { return v.span_in[c]; });
   const std::vector<std::uint32_t> needed = v.full->spans_for(camera, aspect);
+  std::vector<std::uint32_t> in;  // those whose bytes are in
+  std::copy_if(needed.begin(), needed.end(), std::back_inserter(in), [&](std::uint32_t c) { return v.span_in[c]; });
+  const bool done = v.full->upload_spans(in, 0.0);
   v.full_pending =
       !std::all_of(needed.begin(), needed.end(), [&](std::uint32_t c) { return v.full->span_resident(c); });
   return !v.full_pending ? FullDetail::Ready : done ? FullDetail::WaitingForBytes : FullDetail::Uploading;
