@@ -401,14 +401,16 @@ struct VoxelScratch {
 // How many voxlines ahead a streamline's hit bytes are fetched (RegionHits::prefetch).
 constexpr std::size_t kHitsAhead = 16;
 
-// A float a little below (or above) `x`, so that a distance bound kept in float32 stays a bound.
+// A float a little below (or above) a distance x >= 0 (+infinity included), so that a bound kept in float32 stays a
+// bound. The neighbouring float is the next bit pattern (for x >= 0 the rounding never crosses zero), as
+// std::nextafter gives it without its library call: a drag calls these for every voxline it looks at.
 float float_below(double x) {
   const auto f = static_cast<float>(x);
-  return double(f) > x ? std::nextafter(f, -INFINITY) : f;
+  return double(f) > x ? std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) - 1) : f;
 }
 float float_above(double x) {
   const auto f = static_cast<float>(x);
-  return double(f) < x ? std::nextafter(f, INFINITY) : f;
+  return double(f) < x ? std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) + 1) : f;
 }
 
 // The sphere a drag moves, followed through the distances VoxlineBoxes keeps (near_lo, near_hi): how far it moved
@@ -457,9 +459,9 @@ struct DraggedSphere {
       verdict.outside = bit;
     } else if (hi < radius - margin) {
       verdict.inside = bit;
-    } else if (b.nearest != BoxedVoxline::kNoNearest) {  // the point that was nearest, tested as contains() tests it
+    } else if (b.nearest_word != BoxedVoxline::kNoNearest) {  // the point that was nearest, as contains() tests it
       float p[3];
-      packer.decode_word(words[b.first + b.nearest], p);
+      packer.decode_word(b.nearest_word, p);
       const float d2 = sphere->squared_distance(p);
       if (d2 <= sphere->radius_squared()) verdict.inside = bit;
       hi = std::min(hi, std::sqrt(double(d2)));
@@ -483,13 +485,15 @@ struct DraggedSphere {
     }
     if (((verdict.outside | verdict.inside) & bit) == 0) {  // measured again, with contains()'s arithmetic
       float nearest = INFINITY;
-      std::uint32_t nearest_at = BoxedVoxline::kNoNearest;
+      std::uint32_t nearest_word = BoxedVoxline::kNoNearest;
       for (std::uint32_t i = (b.flags & BoxedVoxline::kSyntheticFirst) ? 1 : 0; i < b.own; ++i) {
         float p[3];
-        packer.decode_word(words[b.first + i], p);
-        if (const float d2 = sphere->squared_distance(p); d2 < nearest) nearest = d2, nearest_at = i;
+        const std::uint32_t word = words[b.first + i];
+        packer.decode_word(word, p);
+        if (const float d2 = sphere->squared_distance(p); d2 < nearest)
+          nearest = d2, nearest_word = word & BoxedVoxline::kQuantaBits;
       }
-      b.nearest = std::uint16_t(std::min<std::uint32_t>(nearest_at, BoxedVoxline::kNoNearest));
+      b.nearest_word = nearest_word;
       (nearest <= sphere->radius_squared() ? verdict.inside : verdict.outside) |= bit;
       lo = hi = std::sqrt(double(nearest));
     }
