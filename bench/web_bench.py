@@ -2,13 +2,18 @@
 """The web viewer's times and memory: for each .vxl given, `voxlines share` it, serve the folder over HTTP on
 this machine, open it in headless Chromium (software WebGL2: SwiftShader) and report, per round, the
 milliseconds from navigation to the first picture (drawn at a coarser level of detail for a large file) and to
-full detail, and the browser's peak memory: the resident set of all its processes together, sampled every
-50 ms, against the file's size. The server answers Range requests (as nginx or Apache do; the page then fetches
+full detail, and the browser's peak memory: the proportional set size (PSS) of all its processes together,
+sampled every 100 ms, against the file's size. PSS, not the resident set: Chromium's processes share the
+pages of its binary and the shared memory the page hands the GPU process, which the resident sets of the
+processes each count whole (summed, about twice the memory); PSS counts a shared page once, divided among
+the processes that map it. The server answers Range requests (as nginx or Apache do; the page then fetches
 the first picture's level first), or with --server whole ignores them (as `python3 -m http.server`: the page
 fetches the file whole), or with --server first-range answers one range a request.
 
-Also the resident memory of each kind of Chromium process at the peak (browser, renderer: the page and its
-WebAssembly memory, gpu-process: SwiftShader's copies of the textures), the level drawn at rest, by ranges the
+Also the memory of each kind of Chromium process at the peak (browser, renderer: the page and its
+WebAssembly memory, gpu-process: SwiftShader's copies of the textures), the tab's own peak (the largest renderer
+process: the page's; the others are Chromium's spare ones) against the bytes the page has on the GPU once done
+(what it draws), the level drawn at rest, by ranges the
 bytes fetched, and once the page is done its WebAssembly memory (and malloc's use of it: now and at most) and
 its JavaScript heap. --gpu sets the page's GPU memory budget (?gpu=); --rate sends range answers at that many MB
 a second, as a network would (by ranges, full detail then arrives span by span: the pictures at rest drawn with
@@ -50,8 +55,25 @@ def process_kind(pid):
     return 'browser'
 
 
-def tree_rss_bytes(root):
-    """The resident memory of `root` and every process below it: {kind: bytes} (process_kind)."""
+def process_memory_bytes(pid):
+    """A process's proportional set size (its private pages, and its share of those it shares), or its resident
+    set where the kernel gives no smaps_rollup; None once it has gone."""
+    try:
+        with open(f'/proc/{pid}/smaps_rollup') as f:
+            for line in f:
+                if line.startswith('Pss:'):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        with open(f'/proc/{pid}/statm') as f:
+            return int(f.read().split()[1]) * os.sysconf('SC_PAGE_SIZE')
+    except OSError:
+        return None
+
+
+def tree_memory_bytes(root):
+    """The memory of `root` and every process below it (process_memory_bytes): [(kind, bytes)] (process_kind)."""
     children = {}
     for pid in os.listdir('/proc'):
         if not pid.isdigit():
@@ -62,23 +84,19 @@ def tree_rss_bytes(root):
             children.setdefault(int(fields[1]), []).append(int(pid))
         except OSError:
             continue
-    by_kind, todo = {}, [root]
+    processes, todo = [], [root]
     while todo:
         pid = todo.pop()
         todo += children.get(pid, [])
-        try:
-            with open(f'/proc/{pid}/statm') as f:
-                rss = int(f.read().split()[1]) * os.sysconf('SC_PAGE_SIZE')
-        except OSError:
-            continue
-        kind = process_kind(pid)
-        by_kind[kind] = by_kind.get(kind, 0) + rss
-    return by_kind
+        memory = process_memory_bytes(pid)
+        if memory is not None:
+            processes.append((process_kind(pid), memory))
+    return processes
 
 
 class PeakSampler:
     def __init__(self):
-        self.peak, self._root, self._stop = 0, None, threading.Event()
+        self.peak, self.tab_peak, self._root, self._stop = 0, 0, None, threading.Event()
         self.at_peak = {}  # {kind: bytes} when the total peaked
         self._thread = threading.Thread(target=self._run, daemon=True)
 
@@ -87,8 +105,12 @@ class PeakSampler:
         self._thread.start()
 
     def _run(self):
-        while not self._stop.wait(0.05):
-            by_kind = tree_rss_bytes(self._root)
+        while not self._stop.wait(0.1):
+            processes = tree_memory_bytes(self._root)
+            by_kind = {}
+            for kind, memory in processes:
+                by_kind[kind] = by_kind.get(kind, 0) + memory
+            self.tab_peak = max([self.tab_peak] + [memory for kind, memory in processes if kind == 'renderer'])
             if sum(by_kind.values()) > self.peak:
                 self.peak, self.at_peak = sum(by_kind.values()), by_kind
 
@@ -141,7 +163,7 @@ def main():
                     browser = 'warm' if shared and r > 0 else 'cold'
                     print(f'{os.path.basename(path)} ({size / 2**20:.0f} MiB, server: {args.server}) round {r + 1}, {browser} browser: first picture '
                           f'{report["first_picture_ms"] / 1000:.2f} s (level {report["first_level"]}), full detail {report["full_detail_ms"] / 1000:.2f} s, '
-                          f'browser peak RSS {sampler.peak / 2**20:.0f} MiB = {sampler.peak / size:.2f}x the file '
+                          f'browser peak PSS {sampler.peak / 2**20:.0f} MiB = {sampler.peak / size:.2f}x the file '
                           f'(whole run {time.monotonic() - t0:.1f} s)', flush=True)
                     kinds = ', '.join(f'{k} {v / 2**20:.0f}' for k, v in sorted(sampler.at_peak.items()))
                     fetched = (f'; fetched by ranges {web_server.RangeHandler.bytes_sent / 2**20:.0f} MiB'
@@ -152,6 +174,10 @@ def main():
                         page = (f'; once done, the page\'s WebAssembly memory {memory["wasm"] / 2**20:.0f} MiB (malloc: '
                                 f'{memory["in_use"] / 2**20:.0f} MiB in use, {memory["peak"] / 2**20:.0f} MiB at most), '
                                 f'JavaScript heap {report["heap_bytes"] / 2**20:.0f} MiB')
+                    if memory and memory.get('gpu_bytes'):
+                        page += (f'; the tab at most {sampler.tab_peak / 2**20:.0f} MiB = '
+                                 f'{sampler.tab_peak / memory["gpu_bytes"]:.2f}x the {memory["gpu_bytes"] / 2**20:.0f} MiB '
+                                 f'it draws from (on the GPU once done)')
                     print(f'    at the peak, MiB: {kinds}; drawn at rest: level {report.get("full_level")}{budget}'
                           f'{fetched}{page}', flush=True)
                     spans = report.get('spans_fetched') or []

@@ -296,6 +296,14 @@ void show_file(Viewer& v) {
   v.controller->set_window_height(v.height);
 }
 
+// What the renderers have on the GPU.
+std::uint64_t gpu_bytes(const Viewer& v) {
+  std::uint64_t bytes = 0;
+  for (const Renderer* r : {v.quick.get(), v.interim.get(), v.full.get()})
+    if (r) bytes += r->gpu_bytes();
+  return bytes;
+}
+
 // vw_info's JSON: the file, the renderers, and the modes the page may offer.
 void describe(Viewer& v, nlohmann::json& j) {
   if (v.controller) {  // open
@@ -304,8 +312,7 @@ void describe(Viewer& v, nlohmann::json& j) {
     j["vertices"] = m.vertex_count;
     j["voxels"] = v.file->voxels().size();
     j["bytes"] = v.file->bytes().size();
-    j["gpu_bytes"] = (v.quick ? v.quick->gpu_bytes() : 0) + (v.interim ? v.interim->gpu_bytes() : 0) +
-                     (v.full ? v.full->gpu_bytes() : 0);
+    j["gpu_bytes"] = gpu_bytes(v);
     j["first_level"] = v.quick ? v.quick->layout().level() : v.full_level;
     j["full_level"] = v.full_level;
     for (const RenderModeInfo& m : render_modes())
@@ -522,13 +529,15 @@ EMSCRIPTEN_KEEPALIVE const char* vw_info() {
   return text.c_str();
 }
 
-// The WebAssembly memory's use, for benchmarks (a walk of malloc's heap: not for every step): JSON {"in_use": malloc's
-// bytes in use now, "peak": the most its heap has held, which the memory, never shrinking, keeps}.
+// The memory's use, for benchmarks (a walk of malloc's heap: not for every step): JSON {"in_use": malloc's bytes in
+// use now, "peak": the most its heap has held, which the memory, never shrinking, keeps, "gpu_bytes": what the
+// renderers have on the GPU, which the page draws from}.
 EMSCRIPTEN_KEEPALIVE const char* vw_memory() {
   static std::string text;
   const struct mallinfo heap = mallinfo();
   text = nlohmann::json{{"in_use", static_cast<std::uint64_t>(heap.uordblks)},
-                        {"peak", static_cast<std::uint64_t>(heap.usmblks)}}
+                        {"peak", static_cast<std::uint64_t>(heap.usmblks)},
+                        {"gpu_bytes", vxl::web::gpu_bytes(viewer())}}
              .dump();
   return text.c_str();
 }
