@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 """Opens a page of the web viewer in headless Chromium and writes its picture at full detail as a PNG.
 
-    scripts/web_capture.py URL OUT.png [--timeout S] [--chromium PATH]
+    scripts/web_capture.py URL OUT.png [--timeout S] [--chromium PATH] [--drop PATH]
 
 The page (viewer/web/page) resolves window.voxweb.ready after its first frame (which may be drawn at a
 coarser level of detail) and window.voxweb.complete after its first frame at full detail, or rejects them
 with the viewer's error; this waits for both and saves the canvas. Prints one JSON line: the milliseconds
 from navigation to the first picture ("first_picture_ms") and to full detail ("full_detail_ms"), the page's
 JavaScript heap and what the console said.
+With --drop, the page is given a file as a user drops one on it: PATH (relative to URL) is fetched and dropped on
+the window once the page has loaded.
 Exit 0 with the picture, 1 when the page reported an error, 2 on a browser or usage failure.
 
 Chromium is driven over the DevTools protocol on a pipe (--remote-debugging-pipe: JSON messages ended by a
@@ -131,7 +133,15 @@ FIRST_PICTURE = """new Promise((resolve) => {
 })"""
 
 
-def capture_in(browser, url, out, timeout):
+# Drops the file at DROP (fetched from the page's server) on the window, as a user's drop hands it to the page.
+DROP_FILE = """fetch(DROP).then((r) => r.blob()).then((blob) => {
+  const files = new DataTransfer();
+  files.items.add(new File([blob], DROP.split('/').pop()));
+  window.dispatchEvent(new DragEvent('drop', { dataTransfer: files, cancelable: true }));
+})"""
+
+
+def capture_in(browser, url, out, timeout, drop=None):
     """The page's report (a dict; with 'error' when the page failed) in a new tab of `browser` (a DevTools), its
     picture written to `out`; the tab is closed after."""
     target = browser.call('Target.createTarget', {'url': 'about:blank'})['targetId']
@@ -142,6 +152,12 @@ def capture_in(browser, url, out, timeout):
         browser.events.clear()
         browser.call('Page.navigate', {'url': url}, session=session)
         browser.wait_event('Page.loadEventFired', timeout)
+        if drop:
+            dropped = browser.call('Runtime.evaluate', {'expression': DROP_FILE.replace('DROP', json.dumps(drop)),
+                                                        'awaitPromise': True, 'timeout': timeout * 1000},
+                                   session=session, timeout=timeout)
+            if 'exceptionDetails' in dropped:
+                return {'url': url, 'error': f'the drop of {drop} failed: {dropped["exceptionDetails"].get("text")}'}
         result = browser.call('Runtime.evaluate', {'expression': FIRST_PICTURE, 'awaitPromise': True,
                                                    'returnByValue': True, 'timeout': timeout * 1000},
                               session=session, timeout=timeout)
@@ -183,8 +199,8 @@ class Browser:
             raise
         self.process = self.devtools.process
 
-    def capture(self, url, out, timeout):
-        return capture_in(self.devtools, url, out, timeout)
+    def capture(self, url, out, timeout, drop=None):
+        return capture_in(self.devtools, url, out, timeout, drop)
 
     def close(self):
         """Closes the browser and removes its profile."""
@@ -198,13 +214,13 @@ class Browser:
         self.close()
 
 
-def capture(url, out, timeout, chromium, on_start=None):
+def capture(url, out, timeout, chromium, on_start=None, drop=None):
     """The page's report in a browser of its own (capture_in). on_start(process) is called once the browser runs
     (a benchmark samples its memory)."""
     with Browser(chromium) as browser:
         if on_start:
             on_start(browser.process)
-        return browser.capture(url, out, timeout)
+        return browser.capture(url, out, timeout, drop)
 
 
 def main():
@@ -213,9 +229,10 @@ def main():
     parser.add_argument('out')
     parser.add_argument('--timeout', type=float, default=120, help='seconds to wait for the first picture')
     parser.add_argument('--chromium', default=shutil.which('chromium') or 'chromium')
+    parser.add_argument('--drop', help="a file (relative to URL) dropped on the page once it has loaded")
     args = parser.parse_args()
     try:
-        report = capture(args.url, args.out, args.timeout, args.chromium)
+        report = capture(args.url, args.out, args.timeout, args.chromium, drop=args.drop)
         print(json.dumps(report))
         return 1 if 'error' in report else 0
     except (RuntimeError, TimeoutError, OSError) as e:

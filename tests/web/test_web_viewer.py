@@ -6,7 +6,8 @@ over R, G, B (at least MIN_PSNR dB), not byte for byte. Cases: a synthetic set o
 and float32, in the axis and unsorted modes; a .vxlz shared as it is (fetched whole and unpacked by the page in a worker,
 with the converter's own code built for WebAssembly); with the real fixtures (when
 --real-data holds them), MRtrix's test tracks coloured by their AFD values; the packed file sent gzip-compressed
-(the length the server declares is then not the body's). The files are served by a server that answers Range
+(the length the server declares is then not the body's); the packed file dropped on a page opened without one. The
+files are served by a server that answers Range
 requests (the page then fetches the first picture's level first, many ranges a request), one that answers the
 first range only, one that answers several with the whole file, and one that ignores Range (the page then fetches
 the file whole). Damaged files, which the page
@@ -83,9 +84,11 @@ class ChangingHandler(RangeHandler):
         return super().translate_path('/packed.vxl' if ChangingHandler.requests == 1 else '/float32.vxl')
 
 
-def capture(url, out):
-    """The page's first picture in `out`; returns capture's report (with 'error' when the page refused)."""
-    result = subprocess.run([sys.executable, CAPTURE, url, out, '--timeout', '120'], capture_output=True, text=True)
+def capture(url, out, drop=None):
+    """The page's first picture in `out`; returns capture's report (with 'error' when the page refused). `drop`: a
+    file (relative to `url`) dropped on the page once it has loaded."""
+    result = subprocess.run([sys.executable, CAPTURE, url, out, '--timeout', '120'] + (['--drop', drop] if drop else []),
+                            capture_output=True, text=True)
     if result.returncode == 2:
         raise RuntimeError(f'the browser failed: {result.stdout}{result.stderr}')
     return json.loads(result.stdout.strip().splitlines()[-1])
@@ -235,6 +238,27 @@ def main():
                 shutil.copy(web, keep)
                 shutil.copy(native, keep)
                 failures.append(f'{source} {settings}: PSNR {value:.2f} dB < {MIN_PSNR} (pictures in {keep})')
+
+        # A file dropped on the page (read from the dropped File, not fetched): a page opened without a file (no
+        # share.json), as a recipient's who drops one on it.
+        dropped = path('dropped')
+        shutil.copytree(path('share-packed-vxl'), dropped)
+        os.remove(os.path.join(dropped, 'share.json'))
+        server = Server(dropped, QuietHandler)
+        try:
+            report = capture(f'{server.url}index.html?size={SIZE}#mode=axis', path('web-dropped.png'), drop='packed.vxl')
+        finally:
+            server.close()
+        if 'error' in report:
+            failures.append(f'packed.vxl dropped on the page: {report["error"]}')
+        else:
+            run(options.voxview, path('packed.vxl'), '--render', path('voxview-dropped.png'), '--size', SIZE, '--mode',
+                'axis')
+            value = psnr_rgb(path('web-dropped.png'), path('voxview-dropped.png'))
+            print(f'packed.vxl dropped on the page: PSNR {value:.2f} dB against voxview, first picture after '
+                  f'{report["first_picture_ms"]:.0f} ms')
+            if value < MIN_PSNR:
+                failures.append(f'packed.vxl dropped on the page: PSNR {value:.2f} dB < {MIN_PSNR}')
 
         # Damaged files reaching the page (served as they are, without share, by ranges) are refused with their
         # names: cut short by the first bytes' checks, overwritten by the draw checks of the first level or of

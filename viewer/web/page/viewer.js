@@ -637,16 +637,17 @@
     }
     // One request: the ranges received (null when another file was opened meanwhile). A server that answers a
     // range request with the whole file (status 200, as some do past a number of ranges) gives it all at once.
-    // Hands `response`'s body to `sink` a chunk at a time; false when another file was opened meanwhile. Read into
-    // one buffer of its own where the browser lets it (a byte stream's reader), so that the chunks, copied out at
-    // once, leave nothing for the collector; else chunk by chunk as the browser makes them.
-    async function readBody(response, sink, target) {
+    // Hands `stream` (a response's body, a dropped file's bytes) to `sink` a chunk at a time; false when another
+    // file was opened meanwhile. Read into one buffer of its own where the browser lets it (a byte stream's
+    // reader), so that the chunks, copied out at once, leave nothing for the collector; else chunk by chunk as the
+    // browser makes them.
+    async function readBody(stream, sink, target) {
       let reader, buffer = null;
       try {
-        reader = response.body.getReader({ mode: 'byob' });
+        reader = stream.getReader({ mode: 'byob' });
         buffer = new ArrayBuffer(1 << 20);
       } catch (err) {
-        reader = response.body.getReader();
+        reader = stream.getReader();
       }
       for (;;) {
         const { done, value } = await (buffer ? reader.read(new Uint8Array(buffer)) : reader.read());
@@ -679,7 +680,7 @@
         checkPart(target, r[0], r[1], r[2]);
         sink = rangeSink(target, r[0], r[1], r[2], `${target.url}: a range answer of the wrong length`);
       }
-      if (!(await readBody(response, sink, target))) return null;
+      if (!(await readBody(response.body, sink, target))) return null;
       const got = sink.end();
       for (const [begin, end] of got) target.received += end - begin;
       $('progress').value = Math.min(1, target.received / target.size);
@@ -802,30 +803,42 @@
 
     // Streams the response into the WebAssembly memory as it arrives (one copy of the file in the tab).
     async function fetchWhole(target, response) {
-      const { url, name } = target;
-      if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
-      const declared = Number(response.headers.get('Content-Length'));
+      if (!response.ok) throw new Error(`${target.url}: HTTP ${response.status}`);
+      const whole = await readWhole(target, response.body, Number(response.headers.get('Content-Length')));
+      if (whole) return openBytes(whole.pointer, whole.size, target.name, target);
+    }
+    async function dropFile(file) {
+      const target = { name: file.name, gen: ++generation };
+      bytesComplete = true;
+      fetchRest = restLater = restPromise = null;
+      const whole = await readWhole(target, file.stream(), file.size);
+      if (whole) return openBytes(whole.pointer, whole.size, file.name, target);
+    }
+    // Reads `stream` (a response's body, a dropped file's bytes) whole into memory from Module._malloc: {pointer,
+    // size}, or null when another file was opened meanwhile. Into the memory allocated for the `declared` length
+    // while the bytes fit it; past that (a length that was not the body's, as with a compressed transfer), into
+    // chunks copied together at the end. Read as the ranges are (readBody): a chunk the browser made for each read
+    // would wait for the collector, the file's size of them at its peak.
+    async function readWhole(target, stream, declared) {
+      const { name } = target;
       const chunks = [];
-      // Into the memory allocated for the declared length while the bytes fit it; past that (a length that
-      // was not the body's, as with a compressed transfer), into chunks copied together at the end.
       let received = 0, inMemory = 0, pointer = 0;
       if (declared > 0) pointer = allocate(declared, name);
-      const reader = response.body.getReader();
-      try {
-        for (;;) {
-          const { done, value } = await reader.read();
-          if (!current(target)) throw null;  // another file was opened meanwhile: this one is dropped
-          if (done) break;
+      const sink = {
+        add(value) {
           if (pointer && chunks.length === 0 && inMemory + value.length <= declared) {
             Module.HEAPU8.set(value, pointer + inMemory);
             inMemory += value.length;
           } else {
-            chunks.push(value);
+            chunks.push(value.slice());  // the reader reads into its buffer again
           }
           received += value.length;
           if (received > MAX_FILE_BYTES) allocate(received, name);  // says why it is refused
           if (declared > 0) $('progress').value = Math.min(1, received / declared);
-        }
+        },
+      };
+      try {
+        if (!(await readBody(stream, sink, target))) throw null;
         if (chunks.length > 0 || !pointer) {
           const whole = allocate(received, name);
           if (pointer) Module.HEAPU8.copyWithin(whole, pointer, pointer + inMemory);
@@ -836,22 +849,11 @@
         }
       } catch (err) {
         if (pointer) Module._free(pointer);
-        if (err === null) return;
+        if (err === null) return null;
         throw err;
       }
       $('progress').value = 1;
-      return openBytes(pointer, received, name, target);
-    }
-
-    async function dropFile(file) {
-      const target = { name: file.name, gen: ++generation };
-      bytesComplete = true;
-      fetchRest = restLater = restPromise = null;
-      const bytes = new Uint8Array(await file.arrayBuffer());
-      if (!current(target)) return;
-      const pointer = allocate(bytes.length, file.name);
-      Module.HEAPU8.set(bytes, pointer);
-      return openBytes(pointer, bytes.length, file.name, target);
+      return { pointer, size: received };
     }
 
     async function start() {
