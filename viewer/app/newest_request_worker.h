@@ -22,6 +22,12 @@
 
 namespace vxl::app {
 
+// The worker's nice value: below the window's 0, not so far below that it only runs where the frames leave a core.
+// On 2 cores with llvmpipe, a region dragged through 10M streamlines: at 10 a selection got about a tenth of the
+// cores while a frame drew; at 5 the selections came a third sooner, the frames keeping their budget; at 0 the frames
+// lost it (docs/performance.md, "How far below the window's priority").
+inline constexpr int kWorkerNice = 5;
+
 template <typename Request, typename Result>
 class NewestRequestWorker {
  public:
@@ -67,7 +73,7 @@ class NewestRequestWorker {
   void start(std::uint64_t number, Request request) {
     running_ = BackgroundTask<Done>([this, number, request = std::move(request)] {
 #if defined(__linux__)
-      setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
+      setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kWorkerNice);
 #endif
       Done done;
       done.number = number;
