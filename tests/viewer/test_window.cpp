@@ -550,6 +550,12 @@ TEST_F(Window, AScriptedDragReportsTheSelectionsTimes) {
   EXPECT_GE(j.at("selection_p95_ms").get<double>(), j.at("selection_median_ms").get<double>());
   ASSERT_EQ(j.at("selection_ms").size(), j.at("selections").get<std::size_t>());  // each one's time, listed
   for (const auto& ms : j.at("selection_ms")) EXPECT_GT(ms.get<double>(), 0.0);
+  // The same figures of the selections after the first (the ones the drag's moves asked for).
+  std::vector<double> later;
+  for (std::size_t k = 1; k < j.at("selection_ms").size(); ++k) later.push_back(j.at("selection_ms")[k].get<double>());
+  EXPECT_EQ(j.at("later_selection_p95_ms").get<double>(), *std::max_element(later.begin(), later.end()))
+      << "fewer than 20 selections: the p95 is the slowest";
+  EXPECT_GE(j.at("later_selection_p95_ms").get<double>(), j.at("later_selection_median_ms").get<double>());
   // The first picture does not wait for the command line's selection (its --context-opacity is accepted before the
   // selection's groups exist): each frame says whether its picture shows one; once in, it stays, to the last frame.
   // The frames that took a new selection in are marked: the first to show one is, and none without one is.

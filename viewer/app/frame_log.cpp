@@ -83,6 +83,13 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
   j["selection_median_ms"] = selection_median;
   j["selection_p95_ms"] = selection_p95;
   j["selection_ms"] = selection_ms;  // each selection taken into the picture, in order
+  // The first selection (the regions as the window opens, or as a region first appears) also boxes the voxels it
+  // touches (voxline_boxes.h): with few selections it is their p95. Those after it are the ones a drag's moves ask for.
+  if (selection_ms.size() > 1) {
+    const auto [later_median, later_p95] = median_and_p95({selection_ms.begin() + 1, selection_ms.end()});
+    j["later_selection_median_ms"] = later_median;
+    j["later_selection_p95_ms"] = later_p95;
+  }
   if (drag_end)
     j["drag_end_wait"] = {{"waited", drag_end->waited}, {"ms", drag_end->ms}, {"timed_out", drag_end->timed_out}};
   nlohmann::json list = nlohmann::json::array();

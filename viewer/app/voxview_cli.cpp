@@ -284,7 +284,8 @@ void declare_window(CLI::App& cli, ViewerArguments& a) {
                  "drawn first, at full detail) and time, when the first picture reached "
                  "the screen (first_on_screen_s, since the process started), when it was drawn and the first "
                  "full-detail and exact pictures' times, the moving frames', the refinement pieces' and the "
-                 "selections' median and 95th percentile to this JSON file");
+                 "selections' median and 95th percentile (of all, and of those after the first, which also boxes "
+                 "the voxels its regions touch) to this JSON file");
   cli.add_option("--frames", a.options.frames, "window: quit after this many frames (for scripts and tests)")
       ->check(CLI::PositiveNumber);
   cli.add_flag("--until-refined", a.options.until_refined,
