@@ -1,11 +1,13 @@
 // The interactive `voxview FILE` window, driven by its automation options (--frames, --screenshot) under a
 // virtual X server (xvfb-run; skipped where it is not installed), and the window's voxel-grid overlay,
 // drawn headless.
+#include <algorithm>
 #include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
