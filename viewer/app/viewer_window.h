@@ -119,7 +119,8 @@ class ViewerWindow {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
   // The renderer of the scene's level, or of a coarser one (made on first use, for the frame budget); `whole`: for a
-  // picture drawn whole (focus_first_whole_at), else for the refinement's pieces.
+  // picture drawn whole (focus_first_whole_at), else for the refinement's pieces. Records in drawn_focus_first_
+  // whether it draws the focus first.
   Renderer& renderer_at(std::uint32_t level, bool whole);
   void save_screenshot(const std::string& path, int width, int height);
   // save_screenshot to a stamped name in the current directory; a failure is shown, not thrown.

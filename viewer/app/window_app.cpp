@@ -296,9 +296,9 @@ double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& co
   }
   const bool focus_stage = scheduler_->focus_stage();
   scheduler_->piece_drawn(completes);
-  stats_.refinement = rest.describe(completes ? 0 : renderer.pieces_progress());
-  if (focus_stage && !completes)
-    stats_.refinement = "the focus at full detail: " + std::to_string(int(100 * renderer.pieces_progress())) + " %";
+  stats_.refinement = focus_stage && !completes
+                          ? "the focus at full detail: " + std::to_string(int(100 * renderer.pieces_progress())) + " %"
+                          : rest.describe(completes ? 0 : renderer.pieces_progress());
   glFinish();
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
