@@ -10,6 +10,7 @@
 #include "format/base/error.h"
 #include "format/base/parallel.h"
 #include "format/vxl_file.h"
+#include "format/vxl_levels.h"
 
 namespace vxl {
 namespace {
@@ -127,9 +128,10 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   FileHeader h{};
   std::memcpy(h.magic, kVxlzMagic.data(), 8);
   h.version_major = kVxlzVersionMajor;
-  h.version_minor = c.group_values                          ? kVxlzVersionMinorGroupValues
-                    : c.point_values || c.streamline_values ? kVxlzVersionMinor
-                                                            : 0;
+  h.version_minor = c.pack.predictor == kVxlzPredictorLinearLevelOrder ? kVxlzVersionMinorLevelOrder
+                    : c.group_values                                   ? kVxlzVersionMinorGroupValues
+                    : c.point_values || c.streamline_values            ? kVxlzVersionMinor
+                                                                       : 0;
   h.header_size = sizeof(FileHeader);
   h.file_size = position;
   h.section_table_offset = sizeof(FileHeader);
@@ -153,6 +155,12 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
 
 VxlzFile VxlzFile::open(const std::string& path) {
   VxlzFile f{MappedFile(path)};
+  f.validate();
+  return f;
+}
+
+VxlzFile VxlzFile::open_prefix(MappedFile prefix) {
+  VxlzFile f{std::move(prefix), true};
   f.validate();
   return f;
 }
@@ -190,10 +198,12 @@ void VxlzFile::validate_header_and_table() {
                     std::to_string(kVxlzVersionMajor) + " only" +
                     (h.version_major < kVxlzVersionMajor ? "; pack the .vxl again with this version)" : ")"));
   if (h.header_size != sizeof h) fail_input(p, 12, "header_size must be 64");
-  if (h.file_size != size)
+  if (prefix_ ? h.file_size < size : h.file_size != size)
     fail_input(p, 16,
                "file size is " + std::to_string(size) + " bytes but the header says " + std::to_string(h.file_size) +
                    " (truncated or extended package)");
+  // A prefix's sections are placed in the whole package's size; all but POSD must be in the prefix.
+  const std::uint64_t whole = h.file_size;
   if (h.section_table_offset != sizeof h) fail_input(p, 24, "section table must start at byte 64");
   if (h.section_count == 0 || h.section_count > kVxlzMaxSections) fail_input(p, 32, "section count must be 1..32");
   if (h.flags != 0) fail_input(p, 36, "unknown header flags");
@@ -222,7 +232,11 @@ void VxlzFile::validate_header_and_table() {
       fail_input(p, at + 8,
                  "section " + name + " must start at byte " + std::to_string(expected_offset) +
                      " (right after the previous one)");
-    if (e.size > size - e.offset) fail_input(p, at + 16, "section " + name + " runs past the end of the file");
+    if (e.size > whole - e.offset) fail_input(p, at + 16, "section " + name + " runs past the end of the file");
+    if (e.size > size - std::min(size, e.offset) && id != section_id("POSD"))
+      fail_input(p, size,
+                 "the package's first " + std::to_string(size) + " bytes hold part of section " + name +
+                     ": opening it needs the first " + std::to_string(e.offset + e.size));
     expected_offset += e.size;
     const bool known = std::find(std::begin(kRequired), std::end(kRequired), id) != std::end(kRequired) ||
                        std::find(std::begin(kOptional), std::end(kOptional), id) != std::end(kOptional);
@@ -230,7 +244,7 @@ void VxlzFile::validate_header_and_table() {
       throw Error(ErrorKind::Unsupported, p, at,
                   "required section " + name + " is unknown to this reader (newer writer?)");
   }
-  if (expected_offset != size) fail_input(p, expected_offset, "bytes after the last section");
+  if (expected_offset != whole) fail_input(p, expected_offset, "bytes after the last section");
   for (std::uint32_t id : kRequired)
     if (!find(id)) fail_input(p, 64, "required section " + section_name(id) + " is missing");
 }
@@ -240,7 +254,7 @@ void VxlzFile::validate_checksums() const {
   const std::string& p = file_.path();
   const std::uint8_t* base = file_.data();
   for (const SectionEntry& e : sections_)
-    if (xxh3_64(base + e.offset, e.size) != e.checksum)
+    if (!(prefix_ && std::memcmp(e.id, "POSD", 4) == 0) && xxh3_64(base + e.offset, e.size) != e.checksum)
       fail_input(p, e.offset, "checksum mismatch in section " + std::string(e.id, 4) + " (damaged package)");
 }
 
@@ -259,9 +273,13 @@ void VxlzFile::validate_pack_and_meta() {
   const PackSection& k = pack_;
   if (k.quantization_bits < kVxlzMinBits || k.quantization_bits > kVxlzMaxBits)
     fail_input(p, pack_at, "quantization bits must be 11..16");
-  if (k.predictor != kVxlzPredictorLinear)
+  if (k.predictor != kVxlzPredictorLinear && k.predictor != kVxlzPredictorLinearLevelOrder)
     throw Error(ErrorKind::Unsupported, p, pack_at + 4,
-                "predictor " + std::to_string(k.predictor) + " (this reader knows 1)");
+                "predictor " + std::to_string(k.predictor) + " (this reader knows 1 and 2)");
+  if (k.predictor == kVxlzPredictorLinearLevelOrder ? k.level_count < 2 || k.level_count > kMaxLevels
+                                                    : k.level_count != 0)
+    fail_input(p, pack_at + 100,
+               "PACK level count " + std::to_string(k.level_count) + " (2..8 with predictor 2, else 0)");
   for (int c = 0; c < 3; ++c)
     if (!std::isfinite(k.quant_origin[c])) fail_input(p, pack_at + 8, "quantisation origin is not finite");
   if (!std::isfinite(k.quantum) || !(k.quantum > 0)) fail_input(p, pack_at + 32, "quantum must be finite and positive");
@@ -277,7 +295,7 @@ void VxlzFile::validate_pack_and_meta() {
     fail_input(p, pack_at + 64, "chunk count does not match point count / chunk points");
   if (k.joint_bits < kVxlzMinJointBits || k.joint_bits > kVxlzMaxJointBits)
     fail_input(p, pack_at + 96, "joint symbol bits must be 1..5");
-  if (!all_zero(k.reserved, sizeof k.reserved)) fail_input(p, pack_at + 100, "PACK reserved bytes are not zero");
+  if (!all_zero(k.reserved, sizeof k.reserved)) fail_input(p, pack_at + 104, "PACK reserved bytes are not zero");
 
   const std::uint64_t meta_at = fixed("META", sizeof meta_, &meta_);
   const MetaSection& m = meta_;
@@ -346,8 +364,18 @@ StreamContext VxlzFile::context(std::uint32_t id) const {
   return {file_.path(), section_name(id), e ? e->offset : 0};
 }
 
+std::uint64_t VxlzFile::chunks_present() const {
+  const std::uint64_t n = chunk_count();
+  if (!prefix_) return n;
+  std::uint64_t present = 0;
+  while (present < n && posd_offset_ + chunk_offsets_[2 * present + 2] <= file_.size()) ++present;
+  return present;
+}
+
 ChunkBytes VxlzFile::chunk(std::uint64_t i) const {
   const std::uint64_t* o = chunk_offsets_.data() + 2 * i;
+  if (posd_offset_ + o[2] > file_.size())
+    fail_input(file_.path(), posd_offset_ + o[0], "position chunk " + std::to_string(i) + " has not arrived");
   ChunkBytes c;
   c.symbols = file_.bytes().subspan(posd_offset_ + o[0], o[1] - o[0]);
   c.escapes = file_.bytes().subspan(posd_offset_ + o[1], o[2] - o[1]);

@@ -60,6 +60,11 @@ class VxlzFile {
   // Maps and validates spec §8 steps 1-4. Throws vxl::Error (Input; Unsupported for an unknown major
   // version or required section).
   static VxlzFile open(const std::string& path);
+  // The first bytes of a package still arriving (`prefix`: its bytes so far): validated as open() validates a
+  // whole package, except that the positions (POSD) may be cut short and their checksum is not checked; every
+  // other section must be whole (else Input, "needs the first N bytes"). Chunks past the prefix are not there
+  // (chunks_present).
+  static VxlzFile open_prefix(MappedFile prefix);
 
   const std::string& path() const { return file_.path(); }
   std::uint64_t size() const { return file_.size(); }
@@ -79,13 +84,17 @@ class VxlzFile {
   StreamContext context(std::uint32_t id) const;
 
   std::uint64_t chunk_count() const { return (chunk_offsets_.size() - 1) / 2; }
-  // Chunk i's symbol and escape buffers and where they lie in the file.
+  // The chunks whose bytes are all in the file: all of them, unless it was opened as a prefix.
+  std::uint64_t chunks_present() const;
+  // Chunk i's symbol and escape buffers and where they lie in the file (i < chunks_present()).
   ChunkBytes chunk(std::uint64_t i) const;
+  // Where the first `count` chunks end in the file (count <= chunk_count()).
+  std::uint64_t chunks_end(std::uint64_t count) const { return posd_offset_ + chunk_offsets_[2 * count]; }
   // Points in chunk i (chunk_points, fewer in the last).
   std::uint64_t chunk_point_count(std::uint64_t i) const;
 
  private:
-  explicit VxlzFile(MappedFile file) : file_(std::move(file)) {}
+  explicit VxlzFile(MappedFile file, bool prefix = false) : file_(std::move(file)), prefix_(prefix) {}
   void validate();
   void validate_header_and_table();
   void validate_checksums() const;
@@ -102,6 +111,7 @@ class VxlzFile {
   // 2 chunk_count + 1 offsets inside POSD: chunk i's symbols start at [2i], its escapes at [2i + 1].
   std::vector<std::uint64_t> chunk_offsets_{0};
   std::uint64_t posd_offset_ = 0;
+  bool prefix_ = false;  // the file is the first bytes of a package: POSD may be cut short
 };
 
 }  // namespace vxl

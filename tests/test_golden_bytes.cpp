@@ -3,6 +3,7 @@
 // coordinates, so that a writer and a reader wrong in the same way cannot pass by agreeing with each other.
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -138,6 +139,21 @@ TEST(GoldenBytes, PackWritesThePackage) {
 TEST(GoldenBytes, UnpackWritesTheUnpackedFile) {
   ScratchDir dir;
   const auto r = run_cli("unpack " + q(golden("package.vxlz")) + " " + q(dir.file("unpacked.vxl")) + " --threads 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  expect_same_bytes(dir.file("unpacked.vxl"), golden("unpacked.vxl"));
+}
+
+// A package of version 2.0 (frozen: the points in streamline order, predictor 1) still unpacks, to the very file the
+// package of today (the points level by level) unpacks to: the order the points travel in changes nothing else.
+TEST(GoldenBytes, APackageOfVersion20UnpacksAsTheCurrentOne) {
+  ScratchDir dir;
+  const VxlzFile old_package = VxlzFile::open(golden("package-2.0.vxlz")), now = VxlzFile::open(golden("package.vxlz"));
+  EXPECT_EQ(old_package.pack().predictor, kVxlzPredictorLinear);
+  EXPECT_EQ(now.pack().predictor, kVxlzPredictorLinearLevelOrder);
+  EXPECT_EQ(now.pack().level_count, 2u);
+  // Named as the current one: the unpacked file's provenance names its package.
+  std::filesystem::copy_file(golden("package-2.0.vxlz"), dir.file("package.vxlz"));
+  const auto r = run_cli("unpack " + q(dir.file("package.vxlz")) + " " + q(dir.file("unpacked.vxl")) + " --threads 1");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   expect_same_bytes(dir.file("unpacked.vxl"), golden("unpacked.vxl"));
 }

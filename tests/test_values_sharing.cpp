@@ -63,10 +63,13 @@ Tractogram valued_tractogram(std::uint64_t streamlines = 300) {
   return t;
 }
 
-std::string convert_to(Tractogram t, const std::string& path, PositionEncoding positions = PositionEncoding::Packed) {
+// levels: of the .vxl (a package of a file with levels ships them level by level, which makes it 2.3).
+std::string convert_to(Tractogram t, const std::string& path, PositionEncoding positions = PositionEncoding::Packed,
+                       std::uint32_t levels = kDefaultLevels) {
   ConvertSettings s;
   s.voxel_size = 10.0;
   s.positions = positions;
+  s.levels = levels;
   convert_tractogram(std::move(t), path, s);
   return path;
 }
@@ -99,29 +102,35 @@ ErrorKind kind_of(const std::function<void()>& f) {
 
 TEST(ValuesPackage, UnpackGivesBackTheValueSetsByteForByte) {
   ScratchDir dir;
-  const std::string vxl = convert_to(valued_tractogram(), dir.file("v.vxl"));
-  const VxlFile original = VxlFile::open(vxl);
-  ASSERT_GT(original.meta().synthetic_point_count, 0u) << "the test needs interpolated vertex values";
-  ASSERT_EQ(original.vertex_values().size(), 2u);
-  ASSERT_EQ(original.streamline_values().size(), 3u);
-  for (std::uint32_t bits : {11u, 16u}) {
-    SCOPED_TRACE(bits);
-    PackSettings settings;
-    settings.bits = bits;
-    settings.chunk_points = 1000;  // several chunks
-    const PackSummary packed = pack_vxl(original, dir.file("v.vxlz"), settings);
-    EXPECT_EQ(packed.point_value_sets, 2u);
-    EXPECT_EQ(packed.streamline_value_sets, 3u);
-    EXPECT_EQ(minor_version(dir.file("v.vxlz")), 1) << "a package with value sets is 2.1";
-    const UnpackSummary back = unpack_vxlz(dir.file("v.vxlz"), dir.file("u.vxl"), {});
-    EXPECT_EQ(back.point_value_sets, 2u);
-    EXPECT_EQ(back.streamline_value_sets, 3u);
-    const VerifyResult verified = verify_vxl(dir.file("u.vxl"));
-    EXPECT_TRUE(verified.valid) << verified.problem;
-    const VxlFile copy = VxlFile::open(dir.file("u.vxl"));
-    EXPECT_TRUE(same_bytes(original.vertex_values().payload(), copy.vertex_values().payload()))
-        << "VVAL (names, min/max, every vertex value, padding) must come back exactly";
-    EXPECT_TRUE(same_bytes(original.streamline_values().payload(), copy.streamline_values().payload()));
+  // Without levels the points are shipped in streamline order, with them level by level (package spec §5.1).
+  for (std::uint32_t levels : {1u, kDefaultLevels}) {
+    const std::string vxl = convert_to(valued_tractogram(), dir.file("v.vxl"), PositionEncoding::Packed, levels);
+    const VxlFile original = VxlFile::open(vxl);
+    ASSERT_GT(original.meta().synthetic_point_count, 0u) << "the test needs interpolated vertex values";
+    ASSERT_EQ(original.vertex_values().size(), 2u);
+    ASSERT_EQ(original.streamline_values().size(), 3u);
+    for (std::uint32_t bits : {11u, 16u}) {
+      SCOPED_TRACE(std::to_string(levels) + " levels, " + std::to_string(bits) + " bits");
+      PackSettings settings;
+      settings.bits = bits;
+      settings.chunk_points = 1000;  // several chunks
+      const PackSummary packed = pack_vxl(original, dir.file("v.vxlz"), settings);
+      EXPECT_EQ(packed.point_value_sets, 2u);
+      EXPECT_EQ(packed.streamline_value_sets, 3u);
+      EXPECT_EQ(minor_version(dir.file("v.vxlz")), levels > 1 ? 3 : 1)
+          << "a package with value sets is 2.1, shipped level by level 2.3";
+      UnpackSettings unpacking;
+      unpacking.levels = levels;
+      const UnpackSummary back = unpack_vxlz(dir.file("v.vxlz"), dir.file("u.vxl"), unpacking);
+      EXPECT_EQ(back.point_value_sets, 2u);
+      EXPECT_EQ(back.streamline_value_sets, 3u);
+      const VerifyResult verified = verify_vxl(dir.file("u.vxl"));
+      EXPECT_TRUE(verified.valid) << verified.problem;
+      const VxlFile copy = VxlFile::open(dir.file("u.vxl"));
+      EXPECT_TRUE(same_bytes(original.vertex_values().payload(), copy.vertex_values().payload()))
+          << "VVAL (names, min/max, every vertex value, padding) must come back exactly";
+      EXPECT_TRUE(same_bytes(original.streamline_values().payload(), copy.streamline_values().payload()));
+    }
   }
 }
 
@@ -147,8 +156,11 @@ TEST(ValuesPackage, SectionsAreOptionalAndAPackageWithoutValuesStays20) {
   Tractogram plain = valued_tractogram(50);
   plain.point_values.clear();
   plain.streamline_values.clear();
-  pack_vxl(VxlFile::open(convert_to(std::move(plain), dir.file("p.vxl"))), dir.file("p.vxlz"), {});
+  pack_vxl(VxlFile::open(convert_to(Tractogram(plain), dir.file("p.vxl"), PositionEncoding::Packed, 1)),
+           dir.file("p.vxlz"), {});
   EXPECT_EQ(minor_version(dir.file("p.vxlz")), 0) << "writers write the lowest version that holds what they write";
+  pack_vxl(VxlFile::open(convert_to(Tractogram(plain), dir.file("l.vxl"))), dir.file("l.vxlz"), {});
+  EXPECT_EQ(minor_version(dir.file("l.vxlz")), 3) << "a file with levels is shipped level by level";
   EXPECT_FALSE(VxlzFile::open(dir.file("p.vxlz")).has_section(section_id("PVAL")));
   unpack_vxlz(dir.file("p.vxlz"), dir.file("p2.vxl"), {});
   EXPECT_TRUE(VxlFile::open(dir.file("p2.vxl")).vertex_values().empty());

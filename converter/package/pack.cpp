@@ -14,6 +14,7 @@
 #include "format/vxlz_draco.h"
 #include "format/vxlz_package.h"
 #include "format/vxlz_quantize.h"
+#include "format/vxlz_shipping_order.h"
 #include "format/vxlz_tables.h"
 #include "format/vxlz_values.h"
 
@@ -171,7 +172,10 @@ std::uint32_t pick_joint_bits(bool has_points, SampleFn&& first_chunk_residuals)
 PackSection plan_quantisation(const VxlFile& f, const PackSettings& settings, std::uint64_t n, unsigned threads) {
   PackSection pack{};
   pack.quantization_bits = settings.bits;
-  pack.predictor = kVxlzPredictorLinear;
+  // A file with levels ships the coarsest level's points first, so that a reader can show it before the rest.
+  const std::uint32_t levels = f.meta().level_count;
+  pack.predictor = levels > 1 ? kVxlzPredictorLinearLevelOrder : kVxlzPredictorLinear;
+  pack.level_count = levels > 1 ? levels : 0;
   double hi[3];
   if (!vertex_box(f, threads, pack.quant_origin, hi))
     fail_input(f.path(), f.find_section(section_id("VERT"))->offset, "a vertex coordinate is not finite");
@@ -196,40 +200,40 @@ void encode_positions(const VxlFile& f, const VoxlineIndex& index, unsigned thre
   struct ErrorStats {
     double max = 0, sum_squares = 0;
   };
+  // The points in the order they are shipped (spec §5.1): with levels, the coarsest level's streamlines first.
+  const std::uint32_t levels = pack.predictor == kVxlzPredictorLinearLevelOrder ? pack.level_count : 0;
+  const auto strm = f.streamline_first_voxline();
+  const ShippingOrder order = shipping_order(
+      strm, voxlines, levels > 1 ? streamline_depths(f.meta().streamline_count, levels) : std::vector<std::uint8_t>());
   // Chunk `chunk`'s residuals (spec §5.2) into `residuals`, its quantisation errors into `e`.
   auto chunk_residuals = [&](std::uint64_t chunk, std::vector<std::int32_t>& residuals, ErrorStats& e) {
     const std::uint64_t start = chunk * pack.chunk_points;
     const std::uint64_t count = std::min(pack.chunk_points, n - start);
     residuals.resize(3 * count);
-    std::uint64_t j =
-        std::upper_bound(index.first_point.begin(), index.first_point.end(), start) - index.first_point.begin() - 1;
-    std::uint64_t in_voxline = start - index.first_point[j];
+    ShippedVoxlineCursor at(order, strm, voxlines, start);
     LinearPredictor predictor;
     predictor.reset();
-    // The current voxline's own points, decoded from its voxel's block.
-    std::vector<float> points;
-    auto load_voxline = [&] {
-      points.resize(3 * std::uint64_t(voxlines[j].count_flags & kVoxlineCountMask));
-      f.read_vertices(voxlines[j].voxel, index.first_vertex[j], points.size() / 3, points.data());
-    };
-    if (count > 0) load_voxline();
-    for (std::uint64_t i = 0; i < count; ++i) {
-      if (in_voxline == 0 && index.starts_streamline[j]) predictor.start_streamline();
-      const float* p = points.data() + 3 * in_voxline;
-      std::array<std::int64_t, 3> k;
-      for (int a = 0; a < 3; ++a) {
-        k[a] = quantizer.quantize(p[a], a);
-        residuals[3 * i + a] = static_cast<std::int32_t>(k[a] - predictor.predict(a));
-        const double error = std::abs(double(quantizer.dequantize(k[a], a)) - double(p[a]));
-        e.max = std::max(e.max, error);
-        e.sum_squares += error * error;
+    std::vector<float> points;  // the current voxline's own points, decoded from its voxel's block
+    for (std::uint64_t i = 0; i < count;) {
+      const std::uint64_t j = at.voxline(), from = at.point_in_voxline(), own = at.own();
+      points.resize(3 * own);
+      f.read_vertices(voxlines[j].voxel, index.first_vertex[j], own, points.data());
+      const std::uint64_t run = std::min(own - from, count - i);
+      for (std::uint64_t r = 0; r < run; ++r) {
+        if (from + r == 0 && index.starts_streamline[j]) predictor.start_streamline();
+        const float* p = points.data() + 3 * (from + r);
+        std::array<std::int64_t, 3> k;
+        for (int a = 0; a < 3; ++a) {
+          k[a] = quantizer.quantize(p[a], a);
+          residuals[3 * (i + r) + a] = static_cast<std::int32_t>(k[a] - predictor.predict(a));
+          const double error = std::abs(double(quantizer.dequantize(k[a], a)) - double(p[a]));
+          e.max = std::max(e.max, error);
+          e.sum_squares += error * error;
+        }
+        predictor.push(k);
       }
-      predictor.push(k);
-      if (++in_voxline == (voxlines[j].count_flags & kVoxlineCountMask)) {
-        ++j;
-        in_voxline = 0;
-        if (i + 1 < count) load_voxline();
-      }
+      i += run;
+      at.advance(run);
     }
   };
   std::vector<std::vector<std::int32_t>> residuals(threads);  // one per thread, reused across chunks

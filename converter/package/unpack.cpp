@@ -27,6 +27,7 @@
 #include "format/vxlz_draco.h"
 #include "format/vxlz_package.h"
 #include "format/vxlz_quantize.h"
+#include "format/vxlz_shipping_order.h"
 #include "format/vxlz_tables.h"
 #include "format/vxlz_values.h"
 
@@ -46,8 +47,10 @@ struct Structure {
   // Voxline j's first vertex is voxels[voxel].vertex_first + offset_in_voxel[j] (< 2^32: a voxel's
   // vertex count is).
   std::vector<std::uint32_t> offset_in_voxel;
-  // Chunk c starts at own point chunk_start_point[c] of voxline chunk_start_voxline[c].
-  std::vector<std::uint64_t> chunk_start_voxline, chunk_start_point;
+  // The order the points were shipped in (package spec §5.1), and how many of them the file holds: all, or for
+  // the streamlines of a level alone, the first ones (a level's are shipped first).
+  ShippingOrder order;
+  std::uint64_t shipped_points = 0;
 
   bool connected(std::uint64_t j) const { return !starts_streamline[j + 1]; }
   std::uint64_t first_vertex(std::uint64_t j) const {
@@ -73,17 +76,82 @@ std::vector<VoxlineEntry> read_voxlines(const VxlzFile& f, std::span<const std::
   return voxlines;
 }
 
-Structure rebuild_structure(const VxlzFile& f, std::uint32_t level_count) {
-  const MetaSection& m = f.meta();
+// Each streamline's depth in the package's level order (spec §5.1); empty for streamline order.
+std::vector<std::uint8_t> shipped_depths(const VxlzFile& f) {
+  const PackSection& k = f.pack();
+  return k.predictor == kVxlzPredictorLinearLevelOrder ? streamline_depths(f.meta().streamline_count, k.level_count)
+                                                       : std::vector<std::uint8_t>();
+}
+
+// Keeps the streamlines of depth `min_depth` or more (level `min_depth` of the package's level order) and the voxels
+// they cross, as a file of their own: `m` gets their counts, the grid moved by whole voxels to their bounds (.vxl
+// spec §7 step 5 ties the grid to the bounds), and `coords` the voxels' coordinates in it.
+void keep_level(std::uint32_t min_depth, std::span<const std::uint8_t> depths, MetaSection& m,
+                std::vector<std::array<std::int32_t, 3>>& coords, Structure& s) {
+  std::vector<std::uint64_t> strm{0};
+  std::vector<VoxlineEntry> voxlines;
+  std::vector<std::uint32_t> new_voxel(coords.size(), ~0u);
+  std::uint64_t connecting = 0;  // vertices: each voxline but a streamline's last brings a connecting one
+  for (std::uint64_t st = 0; st + 1 < s.strm.size(); ++st) {
+    if (depths[st] < min_depth) continue;
+    for (std::uint64_t j = s.strm[st]; j < s.strm[st + 1]; ++j) {
+      voxlines.push_back(s.voxlines[j]);
+      new_voxel[s.voxlines[j].voxel] = 0;
+    }
+    connecting += s.strm[st + 1] - s.strm[st] - (s.strm[st + 1] > s.strm[st]);
+    strm.push_back(voxlines.size());
+  }
+  std::vector<std::array<std::int32_t, 3>> kept;
+  std::array<std::int32_t, 3> low{INT32_MAX, INT32_MAX, INT32_MAX}, high{0, 0, 0};
+  for (std::size_t i = 0; i < coords.size(); ++i) {
+    if (new_voxel[i] != 0) continue;
+    new_voxel[i] = static_cast<std::uint32_t>(kept.size());
+    kept.push_back(coords[i]);
+    for (int c = 0; c < 3; ++c) {
+      low[c] = std::min(low[c], coords[i][c]);
+      high[c] = std::max(high[c], coords[i][c]);
+    }
+  }
+  for (VoxlineEntry& v : voxlines) v.voxel = new_voxel[v.voxel];
+  for (auto& xyz : kept)
+    for (int c = 0; c < 3; ++c) xyz[c] -= low[c];
+  for (int c = 0; c < 3 && !kept.empty(); ++c) {
+    m.grid_origin[c] += double(low[c]) * m.voxel_size;
+    m.grid_dims[c] = high[c] - low[c] + 1;
+  }
+  m.streamline_count = strm.size() - 1;
+  m.voxline_count = voxlines.size();
+  m.voxel_count = static_cast<std::uint32_t>(kept.size());
+  std::uint64_t points = 0, synthetic = 0;
+  for (const VoxlineEntry& v : voxlines) {
+    points += v.count_flags & kVoxlineCountMask;
+    synthetic += v.count_flags >> 31;
+  }
+  m.point_count = points - synthetic;
+  m.synthetic_point_count = synthetic;
+  m.vertex_count = points + connecting;
+  m.segment_count = m.vertex_count - voxlines.size();
+  s.strm = std::move(strm);
+  s.voxlines = std::move(voxlines);
+  coords = std::move(kept);
+}
+
+// `m`: META's counts to check the tables against; with min_depth > 0, set to those of the level kept (keep_level).
+Structure rebuild_structure(const VxlzFile& f, std::uint32_t level_count, std::uint32_t min_depth, MetaSection& m) {
   const PackSection& k = f.pack();
   const std::string& p = f.path();
   Structure s;
   s.level_count = level_count;
-  const auto coords =
+  auto coords =
       decode_voxel_coords(f.inflate(section_id("VOXC")), m.voxel_count, m.grid_dims, f.context(section_id("VOXC")));
   s.strm = decode_streamline_voxlines(f.inflate(section_id("STRL")), m.streamline_count, m.voxline_count,
                                       f.context(section_id("STRL")));
   s.voxlines = read_voxlines(f, coords);
+  std::vector<std::uint8_t> depths = shipped_depths(f);
+  if (min_depth > 0) {
+    keep_level(min_depth, depths, m, coords, s);
+    std::erase_if(depths, [&](std::uint8_t d) { return d < min_depth; });
+  }
 
   const std::uint64_t vxlc_at = f.context(section_id("VXLC")).section_offset;
   const std::uint64_t l = m.voxline_count;
@@ -103,8 +171,6 @@ Structure rebuild_structure(const VxlzFile& f, std::uint32_t level_count) {
   std::vector<std::uint64_t> vertex_count(std::uint64_t(m.voxel_count) * levels, 0),
       voxline_count(std::uint64_t(m.voxel_count) * levels, 0);
   s.offset_in_voxel.resize(l);
-  s.chunk_start_voxline.reserve(k.chunk_count);
-  s.chunk_start_point.reserve(k.chunk_count);
   std::uint64_t points = 0, synthetic = 0;
   auto for_each_voxline = [&](auto&& body) {
     for (std::uint64_t st = 0; st < m.streamline_count; ++st) {
@@ -123,12 +189,6 @@ Structure rebuild_structure(const VxlzFile& f, std::uint32_t level_count) {
     s.offset_in_voxel[j] = static_cast<std::uint32_t>(count);  // within its depth, for now
     count += own + s.connected(j);
     voxline_count[std::uint64_t(e.voxel) * levels + depth] += 1;
-    // Chunks start every chunk_points shipped points; record which voxline holds each start.
-    while (s.chunk_start_voxline.size() < k.chunk_count &&
-           s.chunk_start_voxline.size() * k.chunk_points < points + own) {
-      s.chunk_start_voxline.push_back(j);
-      s.chunk_start_point.push_back(s.chunk_start_voxline.size() * k.chunk_points - k.chunk_points - points);
-    }
     points += own;
     synthetic += e.count_flags >> 31;
   });
@@ -171,8 +231,10 @@ Structure rebuild_structure(const VxlzFile& f, std::uint32_t level_count) {
   expect("segments", vertices - l, m.segment_count);
   expect("synthetic points", synthetic, m.synthetic_point_count);
   expect("source points", points - synthetic, m.point_count);
-  expect("shipped points", points, k.point_count);
+  expect("shipped points", points, min_depth > 0 ? points : k.point_count);
   s.order_bytes = layout_orders(s.voxels, s.levels, levels, m.stored_order_count);
+  s.order = shipping_order(s.strm, s.voxlines, depths);
+  s.shipped_points = points;
   return s;
 }
 
@@ -202,17 +264,18 @@ std::string provenance_with_package(const VxlzFile& f) {
 void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, std::span<float> vert,
                   VoxlineEnds& ends) {
   const Quantizer quantizer(f.pack());
-  const std::uint64_t count = f.chunk_point_count(chunk);
   const ChunkBytes bytes = f.chunk(chunk);
-  ResidualChunk residuals(bytes, f.pack().joint_bits, count, f.path());
+  ResidualChunk residuals(bytes, f.pack().joint_bits, f.chunk_point_count(chunk), f.path());
+  // The chunk's points that the file holds: all of them, or for a level alone, those before its end.
+  const std::uint64_t start = chunk * f.pack().chunk_points;
+  const std::uint64_t count = std::min(f.chunk_point_count(chunk), s.shipped_points - start);
 
-  std::uint64_t j = s.chunk_start_voxline[chunk];
-  std::uint64_t in_voxline = s.chunk_start_point[chunk];
+  ShippedVoxlineCursor at(s.order, s.strm, s.voxlines, start);
   LinearPredictor predictor;
   predictor.reset();
   const std::uint64_t max_value = quantizer.max_value();
   for (std::uint64_t i = 0; i < count;) {
-    const std::uint64_t own = s.voxlines[j].count_flags & kVoxlineCountMask;
+    const std::uint64_t j = at.voxline(), in_voxline = at.point_in_voxline(), own = at.own();
     const std::uint64_t run = std::min(own - in_voxline, count - i);
     const std::uint64_t first = s.first_vertex(j);
     if (in_voxline == 0 && s.starts_streamline[j]) predictor.start_streamline();
@@ -227,8 +290,7 @@ void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, st
       if (static_cast<std::uint64_t>(q[0]) > max_value || static_cast<std::uint64_t>(q[1]) > max_value ||
           static_cast<std::uint64_t>(q[2]) > max_value)
         fail_input(f.path(), bytes.symbols_offset,
-                   "position chunk: point " + std::to_string(chunk * f.pack().chunk_points + i + r) +
-                       " decodes outside the quantisation grid");
+                   "position chunk: point " + std::to_string(start + i + r) + " decodes outside the quantisation grid");
       for (int a = 0; a < 3; ++a) dst[a] = quantizer.dequantize(q[a], a);
       predictor.push(q);
     }
@@ -238,12 +300,8 @@ void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, st
       std::memcpy(vert.data() + 3 * (s.first_vertex(j - 1) + previous_own), vert.data() + 3 * first, 12);
     }
     i += run;
-    in_voxline += run;
-    if (in_voxline == own) {
-      ends.set(first + own + s.connected(j) - 1);
-      ++j;
-      in_voxline = 0;
-    }
+    if (in_voxline + run == own) ends.set(first + own + s.connected(j) - 1);
+    at.advance(run);
   }
 }
 
@@ -366,11 +424,16 @@ void measure_streamlines(const Structure& s, std::span<const float> vertices, st
 // voxline ends in `ends`.
 void decode_vertices(const VxlzFile& f, const Structure& s, std::span<float> vertices, VoxlineEnds& ends,
                      unsigned threads, const std::function<void(double)>& progress) {
+  const std::uint64_t chunks = (s.shipped_points + f.pack().chunk_points - 1) / f.pack().chunk_points;
+  if (chunks > f.chunks_present())
+    fail_input(f.path(), std::nullopt,
+               "the positions of the streamlines asked for need " + std::to_string(chunks) + " chunks; " +
+                   std::to_string(f.chunks_present()) + " are there");
   std::atomic<std::uint64_t> done{0};
-  parallel_for(f.chunk_count(), threads, [&](std::uint64_t chunk, unsigned t) {
+  parallel_for(chunks, threads, [&](std::uint64_t chunk, unsigned t) {
     decode_chunk(f, s, chunk, vertices, ends);
     const std::uint64_t d = ++done;
-    if (t == 0) progress(double(d) / double(f.chunk_count()));
+    if (t == 0) progress(double(d) / double(chunks));
   });
 }
 
@@ -425,6 +488,11 @@ void append_tables(VxlStreamWriter& out, const VxlzFile& f, const Structure& s, 
 }  // namespace
 
 UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
+  detail::check_level_count(settings.levels, in_path);
+  return unpack_vxlz(VxlzFile::open(in_path), out_path, settings);
+}
+
+UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const UnpackSettings& settings) {
   using Clock = std::chrono::steady_clock;
   auto seconds_since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   const unsigned threads = resolve_threads(settings.threads);
@@ -435,15 +503,22 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   auto t0 = Clock::now();
   progress("decoding", 0.0);
 
-  detail::check_level_count(settings.levels, in_path);
-  const VxlzFile f = VxlzFile::open(in_path);
+  detail::check_level_count(settings.levels, f.path());
   if (f.meta().order_set == static_cast<std::uint32_t>(OrderSet::Random))
     fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");
-  Structure s = rebuild_structure(f, settings.levels);
-  const std::string provenance = provenance_with_package(f);
-  const PackageExtras extras = read_extras(f, threads);
-
+  const bool level_alone = settings.level > 0;
+  if (level_alone && (f.pack().predictor != kVxlzPredictorLinearLevelOrder || settings.level >= f.pack().level_count))
+    throw Error(ErrorKind::Usage, f.path(), std::nullopt,
+                "level " + std::to_string(settings.level) + " is not shipped apart in this package (" +
+                    (f.pack().level_count > 1 ? std::to_string(f.pack().level_count) + " levels" : "no level order") +
+                    ")");
   MetaSection meta = f.meta();
+  // A level alone is a file of its own, without levels: its counts are set by keep_level.
+  Structure s = rebuild_structure(f, level_alone ? 1 : settings.levels, settings.level, meta);
+  const std::string provenance = provenance_with_package(f);
+  // A level alone is for a first look: the groups and value sets come with the whole.
+  const PackageExtras extras = level_alone ? PackageExtras() : read_extras(f, threads);
+
   meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
   meta.level_count = s.level_count > 1 && meta.voxel_count > 0 ? s.level_count : 0;
   const bool packed = settings.positions == PositionEncoding::Packed;
@@ -508,6 +583,33 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
   summary.point_value_sets = static_cast<std::uint32_t>(extras.point_values.size());
   summary.streamline_value_sets = static_cast<std::uint32_t>(extras.streamline_values.size());
   return summary;
+}
+
+std::vector<ShippedLevel> shipped_levels(const VxlzFile& f) {
+  const PackSection& k = f.pack();
+  if (k.predictor != kVxlzPredictorLinearLevelOrder) return {};
+  const MetaSection& m = f.meta();
+  const std::vector<std::uint64_t> strm = decode_streamline_voxlines(f.inflate(section_id("STRL")), m.streamline_count,
+                                                                     m.voxline_count, f.context(section_id("STRL")));
+  std::vector<VoxlineEntry> voxlines(m.voxline_count);
+  decode_voxline_counts(f.inflate(section_id("VXLC")), voxlines, f.context(section_id("VXLC")));
+  std::vector<std::uint64_t> streamlines(k.level_count, 0), points(k.level_count, 0);
+  for (std::uint64_t st = 0; st < m.streamline_count; ++st) {
+    const std::uint32_t d = streamline_depth(st, k.level_count);
+    streamlines[d] += 1;
+    for (std::uint64_t j = strm[st]; j < strm[st + 1]; ++j) points[d] += voxlines[j].count_flags & kVoxlineCountMask;
+  }
+  std::vector<ShippedLevel> levels;
+  ShippedLevel sum;
+  for (std::uint32_t d = k.level_count; d-- > 0;) {
+    sum.level = d;
+    sum.streamlines += streamlines[d];
+    sum.points += points[d];
+    // Points beyond PACK's count are refused when decoded; here they only ask for every chunk.
+    sum.bytes = f.chunks_end(std::min(k.chunk_count, (sum.points + k.chunk_points - 1) / k.chunk_points));
+    levels.push_back(sum);
+  }
+  return levels;
 }
 
 }  // namespace vxl

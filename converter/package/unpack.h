@@ -9,11 +9,13 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "converter/convert/voxelize.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
 #include "format/vxlz_layout.h"
+#include "format/vxlz_package.h"
 
 namespace vxl {
 
@@ -22,6 +24,10 @@ struct UnpackSettings {
   PositionEncoding positions = PositionEncoding::Packed;  // of the .vxl written (spec §5.4)
   std::uint32_t levels = kDefaultLevels;                  // of the .vxl written (spec §5.12), 1 .. kMaxLevels
   ProgressFn progress;                                    // stages "decoding", "ordering", "writing"; may be empty
+  // > 0: only the streamlines of this level of the package's level order (spec §5.1, predictor 2), as a file of
+  // their own without levels (the first look a viewer gets while the rest arrives); only the chunks that hold them
+  // need be there (VxlzFile::open_prefix). Without groups and value sets.
+  std::uint32_t level = 0;
 };
 
 struct UnpackSummary {
@@ -41,5 +47,15 @@ struct UnpackSummary {
 // nothing at the output path. Throws vxl::Error (Input for a damaged package, naming the file, the byte
 // offset and what was expected; Unsupported for a newer version; Output).
 UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings);
+UnpackSummary unpack_vxlz(const VxlzFile& package, const std::string& out_path, const UnpackSettings& settings);
+
+// A package's levels as it ships them (spec §5.1): for each level d of its level order, from the coarsest, the
+// streamlines and shipped points of depth d or more, and the bytes of the package (a prefix) that hold them. Empty
+// for a package in streamline order. Reads the tables of the exact part only (a prefix will do).
+struct ShippedLevel {
+  std::uint32_t level = 0;
+  std::uint64_t streamlines = 0, points = 0, bytes = 0;
+};
+std::vector<ShippedLevel> shipped_levels(const VxlzFile& package);
 
 }  // namespace vxl

@@ -1,0 +1,154 @@
+// A package of a file with levels ships its points level by level (spec/vxlz-package-v2.md §5.1, predictor 2): the
+// first bytes of the package hold a level whole, and a level unpacked from them alone is the level's streamlines of
+// the whole package, point for point. A prefix that does not hold what is asked for is refused, never read past.
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "converter/convert/convert.h"
+#include "converter/package/pack.h"
+#include "converter/package/unpack.h"
+#include "converter/synth/synth.h"
+#include "format/base/error.h"
+#include "format/base/mapped_file.h"
+#include "format/vxl_file.h"
+#include "format/vxl_levels.h"
+#include "format/vxl_streamlines.h"
+#include "format/vxl_verify.h"
+#include "format/vxlz_package.h"
+#include "tests/test_support.h"
+
+namespace vxl {
+namespace {
+
+using test::ScratchDir;
+using test::slurp;
+
+constexpr std::uint32_t kLevels = 4;
+
+// Each streamline's points, in streamline order.
+std::vector<std::vector<float>> streamlines_of(const std::string& path) {
+  const VxlFile file = VxlFile::open(path);
+  std::vector<std::vector<float>> out;
+  WalkCallbacks callbacks;
+  callbacks.streamline = [&](std::uint64_t, std::span<const float> xyz) { out.emplace_back(xyz.begin(), xyz.end()); };
+  walk_streamlines(file, callbacks);
+  return out;
+}
+
+// The first `n` bytes of the file at `path`, as a package still arriving.
+VxlzFile prefix_of(const std::string& path, std::uint64_t n) {
+  const std::vector<char> bytes = slurp(path);
+  auto* copy = static_cast<std::uint8_t*>(std::malloc(std::max<std::uint64_t>(n, 1)));
+  std::memcpy(copy, bytes.data(), n);
+  return VxlzFile::open_prefix(MappedFile::adopt(path, copy, n));
+}
+
+class LevelOrder : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    SynthSettings synth;
+    synth.streamlines = 3000;
+    synth.seed = 11;
+    ConvertSettings convert;
+    convert.voxel_size = 8.0;
+    convert.levels = kLevels;
+    convert_tractogram(synthesize_tractogram(synth), dir.file("s.vxl"), convert);
+    PackSettings pack;
+    pack.chunk_points = 4000;  // several chunks per level
+    pack_vxl(VxlFile::open(dir.file("s.vxl")), dir.file("s.vxlz"), pack);
+    UnpackSettings whole;
+    whole.positions = PositionEncoding::Float32;  // a level alone packs its voxels' blocks differently
+    unpack_vxlz(dir.file("s.vxlz"), dir.file("whole.vxl"), whole);
+  }
+  ScratchDir dir;
+};
+
+TEST_F(LevelOrder, EachLevelIsAPrefixOfThePackage) {
+  const VxlzFile package = VxlzFile::open(dir.file("s.vxlz"));
+  EXPECT_EQ(package.pack().predictor, kVxlzPredictorLinearLevelOrder);
+  EXPECT_EQ(package.pack().level_count, kLevels);
+  const std::vector<ShippedLevel> levels = shipped_levels(package);
+  ASSERT_EQ(levels.size(), kLevels);
+  std::uint64_t streamlines[kLevels] = {};
+  for (std::uint64_t s = 0; s < package.meta().streamline_count; ++s)
+    for (std::uint32_t d = 0; d <= streamline_depth(s, kLevels); ++d) ++streamlines[d];
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    const ShippedLevel& l = levels[i];
+    EXPECT_EQ(l.level, kLevels - 1 - i) << "coarsest first";
+    EXPECT_EQ(l.streamlines, streamlines[l.level]);
+    if (i > 0) EXPECT_GE(l.bytes, levels[i - 1].bytes) << "nested: each level holds the coarser ones";
+  }
+  EXPECT_EQ(levels.back().points, package.pack().point_count);
+  EXPECT_EQ(levels.back().bytes, package.size()) << "level 0 is everything";
+  EXPECT_LT(levels[0].bytes, package.size() / 2) << "the coarsest level arrives long before the rest";
+}
+
+TEST_F(LevelOrder, ALevelFromItsPrefixAloneIsThatLevelOfTheWholePackage) {
+  const std::vector<std::vector<float>> whole = streamlines_of(dir.file("whole.vxl"));
+  for (const ShippedLevel& l : shipped_levels(VxlzFile::open(dir.file("s.vxlz")))) {
+    if (l.level == 0) continue;
+    SCOPED_TRACE("level " + std::to_string(l.level));
+    UnpackSettings settings;
+    settings.level = l.level;
+    settings.positions = PositionEncoding::Float32;
+    const UnpackSummary s = unpack_vxlz(prefix_of(dir.file("s.vxlz"), l.bytes), dir.file("level.vxl"), settings);
+    EXPECT_EQ(s.streamlines, l.streamlines);
+    const VerifyResult verified = verify_vxl(dir.file("level.vxl"));
+    ASSERT_TRUE(verified.valid) << verified.problem;
+    EXPECT_EQ(VxlFile::open(dir.file("level.vxl")).level_count(), 1u);
+    std::vector<std::vector<float>> expected;
+    for (std::uint64_t st = 0; st < whole.size(); ++st)
+      if (streamline_depth(st, kLevels) >= l.level) expected.push_back(whole[st]);
+    EXPECT_EQ(streamlines_of(dir.file("level.vxl")), expected);
+  }
+}
+
+TEST_F(LevelOrder, APrefixThatDoesNotHoldTheLevelIsRefused) {
+  const std::vector<ShippedLevel> levels = shipped_levels(VxlzFile::open(dir.file("s.vxlz")));
+  UnpackSettings settings;
+  settings.level = levels[0].level;
+  try {
+    unpack_vxlz(prefix_of(dir.file("s.vxlz"), levels[0].bytes - 1), dir.file("level.vxl"), settings);
+    ADD_FAILURE() << "a chunk short of the level was unpacked";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_NE(std::string(e.what()).find("chunks"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("level.vxl"))) << "nothing is left behind";
+  // Short of the exact part: the prefix says how many bytes opening it needs.
+  const VxlzFile package = VxlzFile::open(dir.file("s.vxlz"));
+  const std::uint64_t tables_end = package.chunks_end(0) - 1;
+  try {
+    (void)prefix_of(dir.file("s.vxlz"), tables_end);
+    ADD_FAILURE() << "a prefix without its tables was opened";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_NE(std::string(e.what()).find("needs the first"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(LevelOrder, AFileWithoutLevelsIsShippedInStreamlineOrderAndHasNoLevelAlone) {
+  ConvertSettings convert;
+  convert.voxel_size = 8.0;
+  convert.levels = 1;
+  SynthSettings synth;
+  synth.streamlines = 200;
+  convert_tractogram(synthesize_tractogram(synth), dir.file("flat.vxl"), convert);
+  pack_vxl(VxlFile::open(dir.file("flat.vxl")), dir.file("flat.vxlz"), {});
+  const VxlzFile package = VxlzFile::open(dir.file("flat.vxlz"));
+  EXPECT_EQ(package.pack().predictor, kVxlzPredictorLinear);
+  EXPECT_TRUE(shipped_levels(package).empty());
+  UnpackSettings settings;
+  settings.level = 1;
+  try {
+    unpack_vxlz(package, dir.file("level.vxl"), settings);
+    ADD_FAILURE() << "a level of a package in streamline order was unpacked";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Usage);
+  }
+}
+
+}  // namespace
+}  // namespace vxl
