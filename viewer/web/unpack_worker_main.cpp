@@ -2,16 +2,26 @@
 // (page/unpack_worker.js): a module without threads runs on the thread that calls it, so the page's viewer module
 // would freeze the page for the whole unpack (seconds for a large package); this one runs beside it, and the worker
 // is ended with it, its memory with it. The unpack is the viewer module's (web_package.h): `voxlines unpack`'s code.
+//
+// A package is handed over as it arrives (vu_begin, then its pieces written where vu_begin said, vu_arrived after
+// each): once the first bytes hold a level of detail small enough for a first look (a package of a file with levels
+// ships its coarsest level first), vu_arrived asks for it, vu_unpack_level unpacks it alone, and the page shows it
+// while the rest arrives; vu_unpack then unpacks the whole.
 #include <emscripten/emscripten.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <exception>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "viewer/web/web_package.h"
 
 namespace {
+
+// About the segments voxview's first picture draws (frame_budget.h's kFirstPictureSegments).
+constexpr std::uint64_t kFirstLookPoints = 250'000;
 
 std::optional<vxl::MappedFile>& unpacked() {
   static std::optional<vxl::MappedFile> file;
@@ -23,23 +33,92 @@ std::string& last_error() {
   return error;
 }
 
-}  // namespace
+// The package arriving: its bytes so far, and the first look planned once its tables are in.
+struct Arriving {
+  std::uint8_t* bytes = nullptr;  // malloc'd, the package's declared size
+  std::uint64_t size = 0, received = 0;
+  std::string name;
+  std::optional<vxl::web::FirstLook> look;
+  bool look_asked = false;
+};
 
-extern "C" {
+Arriving& arriving() {
+  static Arriving a;
+  return a;
+}
 
-// Unpacks the package `bytes` (from malloc, `size` bytes, named `name` in errors; freed here) into a .vxl held by
-// the module until the next call: 1, and vu_data / vu_size give it; 0, and vu_error says why.
-EMSCRIPTEN_KEEPALIVE int vu_unpack(std::uint8_t* bytes, double size, const char* name) {
+// Runs `unpack` (which sets unpacked()): 1, or 0 with vu_error saying why.
+template <typename Fn>
+int answer(Fn&& unpack) {
   unpacked().reset();
   last_error().clear();
   try {
-    unpacked().emplace(
-        vxl::web::unpack_package(vxl::MappedFile::adopt(name, bytes, static_cast<std::size_t>(size)), name));
+    unpack();
     return 1;
   } catch (const std::exception& e) {
     last_error() = e.what();
     return 0;
   }
+}
+
+}  // namespace
+
+extern "C" {
+
+// A package of `size` bytes, named `name` in errors, is about to arrive: where to write its bytes (null: no memory).
+EMSCRIPTEN_KEEPALIVE std::uint8_t* vu_begin(double size, const char* name) {
+  Arriving& a = arriving();
+  std::free(a.bytes);
+  a = Arriving();
+  a.size = static_cast<std::uint64_t>(size);
+  a.name = name;
+  a.bytes = static_cast<std::uint8_t*>(std::malloc(a.size > 0 ? a.size : 1));
+  return a.bytes;
+}
+
+// The package is longer than it said (a body whose length was not the one declared): room for `size` bytes, keeping
+// those in; null when there is no memory for them.
+EMSCRIPTEN_KEEPALIVE std::uint8_t* vu_grow(double size) {
+  Arriving& a = arriving();
+  auto* grown = static_cast<std::uint8_t*>(std::realloc(a.bytes, static_cast<std::size_t>(size)));
+  if (grown != nullptr) {
+    a.bytes = grown;
+    a.size = static_cast<std::uint64_t>(size);
+  }
+  return grown;
+}
+
+// The package's first `received` bytes are in: the level of detail to show first when its bytes have just become
+// complete (vu_unpack_level then unpacks it), else 0.
+EMSCRIPTEN_KEEPALIVE int vu_arrived(double received) {
+  Arriving& a = arriving();
+  a.received = static_cast<std::uint64_t>(received);
+  if (!a.look)
+    a.look = vxl::web::plan_first_look({a.bytes, static_cast<std::size_t>(a.received)}, a.name, kFirstLookPoints);
+  if (!a.look || a.look->level == 0 || a.look_asked || a.received < a.look->bytes) return 0;
+  a.look_asked = true;
+  return static_cast<int>(a.look->level);
+}
+
+// Unpacks the level vu_arrived asked for from the bytes in: 1, and vu_data / vu_size give its .vxl; 0, and vu_error
+// says why.
+EMSCRIPTEN_KEEPALIVE int vu_unpack_level() {
+  const Arriving& a = arriving();
+  return answer([&] {
+    unpacked().emplace(
+        vxl::web::unpack_level({a.bytes, static_cast<std::size_t>(a.look->bytes)}, a.look->level, a.name));
+  });
+}
+
+// Unpacks the whole package, once all of it is in (its bytes are let go): 1, and vu_data / vu_size give the .vxl;
+// 0, and vu_error says why.
+EMSCRIPTEN_KEEPALIVE int vu_unpack() {
+  Arriving& a = arriving();
+  std::uint8_t* bytes = std::exchange(a.bytes, nullptr);
+  return answer([&] {
+    unpacked().emplace(
+        vxl::web::unpack_package(vxl::MappedFile::adopt(a.name, bytes, static_cast<std::size_t>(a.received)), a.name));
+  });
 }
 
 EMSCRIPTEN_KEEPALIVE const std::uint8_t* vu_data() { return unpacked() ? unpacked()->data() : nullptr; }

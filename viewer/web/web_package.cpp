@@ -2,11 +2,15 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 
 #include "converter/package/unpack.h"
 #include "format/base/error.h"
+#include "format/vxl_layout.h"
 #include "format/vxlz_layout.h"
+#include "format/vxlz_package.h"
 
 namespace vxl::web {
 namespace {
@@ -21,6 +25,14 @@ struct RemovedAtExit {
 std::string package_path(const std::string& name) {
   const std::string leaf = std::filesystem::path(name).filename().string();
   return leaf.empty() || leaf == "." || leaf == ".." ? "package.vxlz" : leaf;
+}
+
+// A copy of `bytes` in memory of its own (MappedFile::adopt's), named `name` in errors.
+MappedFile copy_of(std::span<const std::uint8_t> bytes, const std::string& name) {
+  auto* copy = static_cast<std::uint8_t*>(std::malloc(std::max<std::size_t>(bytes.size(), 1)));
+  if (copy == nullptr) throw Error(ErrorKind::Unsupported, name, std::nullopt, "no memory to unpack this package in");
+  std::memcpy(copy, bytes.data(), bytes.size());
+  return MappedFile::adopt(name, copy, bytes.size());
 }
 
 }  // namespace
@@ -41,6 +53,46 @@ MappedFile unpack_package(MappedFile package_bytes, const std::string& name) {
   settings.threads = 1;  // this WebAssembly build has no threads
   unpack_vxlz(package.path, unpacked.path, settings);
   std::remove(package.path.c_str());  // before the .vxl is read into memory: the page holds one file at a time
+  return MappedFile(unpacked.path);
+}
+
+std::optional<FirstLook> plan_first_look(std::span<const std::uint8_t> prefix, const std::string& name,
+                                         std::uint64_t max_points) {
+  // The section table says where the positions start: everything before them is what opening the prefix needs.
+  FileHeader h;
+  if (prefix.size() < sizeof h) return std::nullopt;
+  std::memcpy(&h, prefix.data(), sizeof h);
+  if (h.section_count > kVxlzMaxSections) return FirstLook{};
+  const std::uint64_t table_end = sizeof h + std::uint64_t(h.section_count) * sizeof(SectionEntry);
+  if (prefix.size() < table_end) return std::nullopt;
+  std::uint64_t positions = 0;
+  for (std::uint32_t i = 0; i < h.section_count; ++i) {
+    SectionEntry e;
+    std::memcpy(&e, prefix.data() + sizeof h + i * sizeof e, sizeof e);
+    if (std::memcmp(e.id, "POSD", 4) == 0) positions = e.offset;
+  }
+  if (positions == 0) return FirstLook{};
+  if (prefix.size() < positions) return std::nullopt;
+  try {
+    const VxlzFile f = VxlzFile::open_prefix(copy_of(prefix.first(positions), package_path(name)));
+    FirstLook look;
+    for (const ShippedLevel& l : shipped_levels(f))
+      if (l.level > 0 && l.points <= max_points) look = {l.level, l.bytes};
+    return look;
+  } catch (const Error&) {
+    return FirstLook{};
+  }
+}
+
+MappedFile unpack_level(std::span<const std::uint8_t> prefix, std::uint32_t level, const std::string& name) {
+  const RemovedAtExit unpacked{package_path(name) + ".level.vxl"};
+  {
+    const VxlzFile f = VxlzFile::open_prefix(copy_of(prefix, package_path(name)));
+    UnpackSettings settings;
+    settings.threads = 1;  // this WebAssembly build has no threads
+    settings.level = level;
+    unpack_vxlz(f, unpacked.path, settings);
+  }
   return MappedFile(unpacked.path);
 }
 

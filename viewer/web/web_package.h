@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -18,5 +19,21 @@ bool is_package(std::span<const std::uint8_t> bytes);
 // the in-memory file system first and let go then, so that the memory holds it once while it is unpacked; nothing
 // is left in the file system, also when the package is refused (vxl::Error, as unpack_vxlz throws it).
 MappedFile unpack_package(MappedFile package, const std::string& name);
+
+// A package arriving: the level to show before the rest (the finest of its level order, spec §5.1, with at most
+// `max_points` shipped points: about the segments voxview's first picture draws) and the prefix of the package that
+// holds it. Level 0: none (a package in streamline order, or none small enough, or one whose tables are refused:
+// the whole package's unpack then says why).
+struct FirstLook {
+  std::uint32_t level = 0;
+  std::uint64_t bytes = 0;
+};
+// Empty while `prefix` (the package's first bytes) does not hold its tables yet: ask again with more.
+std::optional<FirstLook> plan_first_look(std::span<const std::uint8_t> prefix, const std::string& name,
+                                         std::uint64_t max_points);
+
+// The streamlines of level `level` alone (unpack_vxlz's UnpackSettings::level), from the package's first bytes
+// (`prefix`, copied), as a .vxl held in memory.
+MappedFile unpack_level(std::span<const std::uint8_t> prefix, std::uint32_t level, const std::string& name);
 
 }  // namespace vxl::web

@@ -41,6 +41,7 @@
 #include "format/base/memory_size.h"
 #include "format/vxl_fetch_plan.h"
 #include "format/vxl_file.h"
+#include "format/vxl_levels.h"
 #include "viewer/app/camera_controller.h"
 #include "viewer/app/frame_budget.h"
 #include "viewer/render/camera.h"
@@ -71,6 +72,9 @@ struct Viewer {
     return s;
   }();
   int width = 1, height = 1;
+  // The file is one level of detail of a package alone (the first look while the rest arrives, vw_set
+  // "package-level"): drawn with that level's opacity, so that it looks as bright as the whole will.
+  std::uint32_t package_level = 0;
   std::uint64_t gpu_budget = 0;   // bytes; 0: none (vw_set_gpu_budget)
   std::uint32_t full_level = 0;   // the level drawn at rest: the finest within gpu_budget
   bool full_pending = false;      // the full-detail spans of the last view at rest are not all uploaded yet
@@ -115,6 +119,7 @@ void close(Viewer& v) {
   v.drawn_uploaded = 0;
   v.drawn_mixed = false;
   v.drawn_full = false;
+  v.package_level = 0;
 }
 
 // Whether the buffer holds the whole file (fetched whole, or every range fetched).
@@ -543,7 +548,8 @@ EMSCRIPTEN_KEEPALIVE const char* vw_memory() {
 }
 
 // One setting by name, as voxview's options spell them: mode, color, opacity, fixed-color (hex), background
-// (hex), scalar (a value set's name), colormap, view ("AZ,EL" or a standard view's name), lighting (0/1).
+// (hex), scalar (a value set's name), colormap, view ("AZ,EL" or a standard view's name), lighting (0/1); and the
+// page's package-level (the open file is that level of a package alone, web_package.h's first look; 0: the whole).
 EMSCRIPTEN_KEEPALIVE int vw_set(const char* key_text, const char* value_text) {
   return guarded([&] {
     const std::string key = key_text, value = value_text;
@@ -585,6 +591,10 @@ EMSCRIPTEN_KEEPALIVE int vw_set(const char* key_text, const char* value_text) {
       const auto map = vxl::parse_colormap(value);
       if (!map) throw bad();
       v.settings.colormap = *map;
+    } else if (key == "package-level") {
+      const long level = std::strtol(value.c_str(), nullptr, 10);
+      if (!(level >= 0 && level < static_cast<long>(vxl::kMaxLevels)) || !v.file) throw bad();
+      v.package_level = static_cast<std::uint32_t>(level);
     } else if (key == "lighting") {
       v.settings.lighting = value == "1";
     } else if (key == "view") {
@@ -725,13 +735,15 @@ EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
     v.drawn_mixed = stand_in != nullptr;
     v.drawn_full = !moving && renderer == v.full.get() && !stand_in;
     if (v.full) v.drawn_uploaded = v.full->gpu_bytes();
+    vxl::RenderSettings settings = v.settings;
+    if (v.package_level > 0) settings.opacity = vxl::SceneLayout::level_opacity(settings.opacity, v.package_level);
     if (renderer == v.quick.get() || !v.quick) {
-      renderer->draw(v.controller->camera(), v.settings, v.width, v.height, 0);
+      renderer->draw(v.controller->camera(), settings, v.width, v.height, 0);
       renderer->check_uploaded(false);
       return;
     }
     v.piece_target.ensure(v.width, v.height, GL_RGBA8, 0, true);
-    renderer->begin_pieces(v.controller->camera(), v.settings, v.width, v.height, v.piece_target.fbo, stand_in);
+    renderer->begin_pieces(v.controller->camera(), settings, v.width, v.height, v.piece_target.fbo, stand_in);
     v.piecing = renderer;
     vxl::web::draw_next_piece(v);
   });

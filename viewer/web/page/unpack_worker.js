@@ -1,23 +1,54 @@
-// Unpacks a .vxlz package off the page's thread (unpack_worker_main.cpp, built as voxunpack.js): the page posts
-// {bytes: ArrayBuffer, name}, and gets back {vxl: ArrayBuffer} (the .vxl's bytes) or {error: text}. One package a
-// worker: the page ends the worker once it has the answer, and the module's memory goes with it.
+// Unpacks a .vxlz package off the page's thread (unpack_worker_main.cpp, built as voxunpack.js), as it arrives. The
+// page posts {begin: {size, name}}, then {piece: ArrayBuffer} for each piece of the package in order, then {end:
+// true}; it gets back {level, vxl: ArrayBuffer} when the first pieces hold a level of detail to show while the rest
+// arrives (at most once, before the end), then {vxl: ArrayBuffer} (the whole package's .vxl) or {error: text}. One
+// package a worker: the page ends the worker once it has the answer, and the module's memory goes with it.
 importScripts('voxunpack.js');
 
-onmessage = async (event) => {
-  const { bytes, name } = event.data;
-  try {
-    const unpacker = await createVoxunpack();
-    const pointer = unpacker._malloc(bytes.byteLength) >>> 0;  // addresses past 2 GiB come back negative
+let unpacker = null, pointer = 0, size = 0, received = 0, name = '';
+const ready = createVoxunpack().then((module) => { unpacker = module; });
+let queue = Promise.resolve();  // the messages, one after the other (the module loads first)
+
+// The .vxl the last unpack left in the module, handed over as an ArrayBuffer.
+function unpackedBytes() {
+  const data = unpacker._vu_data() >>> 0;  // addresses past 2 GiB come back negative
+  return unpacker.HEAPU8.slice(data, data + unpacker._vu_size()).buffer;
+}
+function error() { return unpacker.UTF8ToString(unpacker._vu_error() >>> 0); }
+
+function begin(message) {
+  ({ size, name } = message);
+  received = 0;
+  pointer = unpacker.ccall('vu_begin', 'number', ['number', 'string'], [size, name]) >>> 0;
+  if (!pointer) throw new Error(`${name}: no memory to unpack this package in`);
+}
+function piece(bytes) {
+  if (received + bytes.byteLength > size) {  // longer than it said: room for it
+    size = Math.max(2 * size, received + bytes.byteLength);
+    pointer = unpacker._vu_grow(size) >>> 0;
     if (!pointer) throw new Error(`${name}: no memory to unpack this package in`);
-    unpacker.HEAPU8.set(new Uint8Array(bytes), pointer);
-    if (!unpacker.ccall('vu_unpack', 'number', ['number', 'number', 'string'], [pointer, bytes.byteLength, name])) {
-      postMessage({ error: unpacker.UTF8ToString(unpacker._vu_error() >>> 0) });
-      return;
-    }
-    const data = unpacker._vu_data() >>> 0;
-    const vxl = unpacker.HEAPU8.slice(data, data + unpacker._vu_size()).buffer;
-    postMessage({ vxl }, [vxl]);
-  } catch (error) {
-    postMessage({ error: String(error.message || error) });
   }
+  unpacker.HEAPU8.set(new Uint8Array(bytes), pointer + received);
+  received += bytes.byteLength;
+  const level = unpacker._vu_arrived(received);
+  // A first look that cannot be unpacked is left out: the whole package's unpack says what is wrong with it.
+  if (level > 0 && unpacker._vu_unpack_level()) {
+    const vxl = unpackedBytes();
+    postMessage({ level, vxl }, [vxl]);
+  }
+}
+function end() {
+  if (!unpacker._vu_unpack()) return postMessage({ error: error() });
+  const vxl = unpackedBytes();
+  postMessage({ vxl }, [vxl]);
+}
+
+onmessage = (event) => {
+  const message = event.data;
+  queue = queue.then(async () => {
+    await ready;
+    if (message.begin) begin(message.begin);
+    else if (message.piece) piece(message.piece);
+    else if (message.end) end();
+  }).catch((err) => postMessage({ error: String(err.message || err) }));
 };

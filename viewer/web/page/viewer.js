@@ -112,6 +112,9 @@
     // Where the GPU budget draws a coarser level than full detail, fetching stops once that level is in: restLater
     // brings the rest when a setting needs it (fetchRestNow).
     let restLater = null, restPromise = null;
+    // A package's first look (a level of detail alone, openUnpacked) is on the screen, the whole still to come; the
+    // reader has moved the view since the file was opened (the whole then keeps that view).
+    let firstLookShown = false, viewMoved = false;
 
     function set(key, value) {
       if (!bytesComplete && (restLater || restPromise) && needsWholeFileNow(key, String(value))) {
@@ -231,6 +234,7 @@
     }
     // Full detail is on the screen and the whole file in: complete once what is drawn is checked.
     function done() {
+      if (!bytesComplete && !restLater) return;  // a package's first look: the whole is still to come
       checked().then((ok) => {
         if (!ok) return;
         $('progress').value = 1;
@@ -376,25 +380,43 @@
       if (afterWholeFile !== true) redraw();  // after it, only a setting applied (set) asks for a frame
     }
 
-    // A package's bytes (an ArrayBuffer, handed over) unpacked in `worker` (unpack_worker.js), which ends with its
-    // answer: {vxl: ArrayBuffer} or {error: text}. A package opened since ends the one before ({stale: true}).
-    let unpacking = null;  // {worker, answer} of the package being unpacked
-    function unpackInWorker(worker, bytes, name) {
-      if (unpacking) unpacking.answer({ stale: true });
-      return new Promise((resolve) => {
-        const answer = (message) => {
+    // A package unpacked in `worker` (unpack_worker.js) as its bytes arrive: add(Uint8Array) hands each piece over
+    // (copied), end() says all are in and resolves with the answer, {vxl: ArrayBuffer} or {error: text}. Where its
+    // first bytes hold a level of detail to look at while the rest arrives, firstLook(level, vxl) gets it before the
+    // end. A package opened since ends the one before ({stale: true}); so does cancel().
+    let unpacking = null;  // the package being unpacked
+    function unpackInWorker(worker, size, name, firstLook) {
+      if (unpacking) unpacking.cancel();
+      let answer;
+      const whole = new Promise((resolve) => {
+        answer = (message) => {
           worker.terminate();
-          if (unpacking && unpacking.worker === worker) unpacking = null;
+          if (unpacking === self) unpacking = null;
           resolve(message);
         };
-        unpacking = { worker, answer };
-        worker.onmessage = (event) => answer(event.data);
-        worker.onerror = (event) => {
-          event.preventDefault();
-          answer({ error: `${name}: the unpacker could not run (${event.message || 'unpack_worker.js did not load'})` });
-        };
-        worker.postMessage({ bytes, name }, [bytes]);
       });
+      const self = {
+        add(value) {
+          const piece = value.slice().buffer;
+          worker.postMessage({ piece }, [piece]);
+        },
+        end() {
+          worker.postMessage({ end: true });
+          return whole;
+        },
+        cancel() { answer({ stale: true }); },
+      };
+      unpacking = self;
+      worker.onmessage = (event) => {
+        if (event.data.level && !event.data.error) firstLook(event.data.level, event.data.vxl);
+        else answer(event.data);
+      };
+      worker.onerror = (event) => {
+        event.preventDefault();
+        answer({ error: `${name}: the unpacker could not run (${event.message || 'unpack_worker.js did not load'})` });
+      };
+      worker.postMessage({ begin: { size, name } });
+      return self;
     }
     // A worker for the unpacker; null where the browser has none or refuses it (a page opened from the disk).
     function unpackWorker() {
@@ -413,36 +435,67 @@
     // worker (unpack_worker.js), so that the page keeps drawing and taking input; where the browser has no
     // workers, by the viewer itself on this thread, the page saying so before it begins.
     async function openBytes(pointer, size, name, target) {
-      const [w, h] = canvasSize();
       const t0 = performance.now();
       if (isPackage(Module.HEAPU8.subarray(pointer, pointer + 8))) {
         say(`${name}: unpacking the package`);
         const worker = unpackWorker();
         if (worker) {
-          const bytes = Module.HEAPU8.slice(pointer, pointer + size).buffer;
+          const package_ = unpackInWorker(worker, size, name, () => {});
+          package_.add(Module.HEAPU8.subarray(pointer, pointer + size));
           Module._free(pointer);
-          const answer = await unpackInWorker(worker, bytes, name);
-          if (!current(target) || answer.stale) return;
-          if (answer.error !== undefined) return fail(answer.error);
-          mark('unpacked');
-          size = answer.vxl.byteLength;
-          try {
-            pointer = allocate(size, name);
-          } catch (error) {
-            return fail(error.message);
-          }
-          Module.HEAPU8.set(new Uint8Array(answer.vxl), pointer);
-        } else {
-          await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
-          if (!current(target)) return Module._free(pointer);
+          return openUnpacked(await package_.end(), name, target, t0);
         }
+        await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
+        if (!current(target)) return Module._free(pointer);
       }
+      const [w, h] = canvasSize();
       if (api.open(pointer, size, name, w, h, 1) !== 0) return fail(api.error());
       mark('opened');
       shown(name, t0);
     }
+    // A package streamed into the unpacker as it arrives (`first`: its first piece), or null when `first` is not a
+    // package's or the browser has no workers (the package is then read whole and opened by openBytes). Its first look
+    // (a level of detail in its first bytes) is shown while the rest arrives.
+    function streamedPackage(target, first, declared) {
+      if (!isPackage(first)) return null;
+      const worker = unpackWorker();
+      if (!worker) return null;
+      const t0 = performance.now();
+      say(`${target.name}: unpacking the package as it arrives`);
+      return unpackInWorker(worker, Math.max(declared, first.length), target.name, (level, vxl) => {
+        openUnpacked({ vxl }, target.name, target, t0, level);
+      });
+    }
+    // What the unpacker answered (unpackInWorker): the package's .vxl opened, or its error said. level > 0: the first
+    // look, that level of detail alone, drawn with its opacity (package-level) until the whole replaces it in the
+    // view the reader has moved to meanwhile.
+    function openUnpacked(answer, name, target, t0, level = 0) {
+      if (!current(target) || answer.stale) return;
+      if (answer.error !== undefined) return fail(answer.error);
+      if (level === 0 && firstLookShown) mark('whole unpacked');
+      else mark(level > 0 ? 'first look unpacked' : 'unpacked');
+      const size = answer.vxl.byteLength;
+      let pointer;
+      try {
+        pointer = allocate(size, name);
+      } catch (error) {
+        return fail(error.message);
+      }
+      Module.HEAPU8.set(new Uint8Array(answer.vxl), pointer);
+      const camera = level === 0 && firstLookShown && viewMoved ? JSON.parse(api.camera()) : null;
+      const [w, h] = canvasSize();
+      if (api.open(pointer, size, name, w, h, 1) !== 0) return fail(api.error());
+      if (level > 0 && api.set('package-level', String(level)) !== 0) return fail(api.error());
+      if (camera && camera.target)
+        api.setCamera(camera.az, camera.el, camera.distance, camera.target[0], camera.target[1], camera.target[2]);
+      bytesComplete = level === 0;  // a first look waits for the whole for what reads it (unsorted, values, groups)
+      firstLookShown = level > 0;
+      mark(level > 0 ? 'first look opened' : 'opened');
+      if (level > 0) window.voxweb.firstLook = { level, at: performance.now() };
+      shown(name, t0, level);
+    }
     // The file is open and its first picture's renderer made: the panel, then the first frame.
-    function shown(name, t0) {
+    function shown(name, t0, level = 0) {
       opened = true;
       firstFrame = true;  // its first frame starts the rest (afterFirstPicture)
       fullShown = false;
@@ -463,7 +516,10 @@
       $('mode').value = 'axis';
       for (const o of [...$('color').options]) if (o.value === 'scalar' || o.value === 'group') o.remove();
       if (bytesComplete) offerColourings(info);
-      say(`${name}: opened in ${((performance.now() - t0) / 1000).toFixed(2)} s`);
+      const seconds = ((performance.now() - t0) / 1000).toFixed(2);
+      if (level > 0) say(`${name}: level ${level} of the package (${info.streamlines.toLocaleString()} streamlines, ` +
+                         `1/${8 ** level} of them) in ${seconds} s; the rest is arriving`);
+      else say(`${name}: opened in ${seconds} s`);
       applyHash();
     }
 
@@ -804,29 +860,41 @@
     // Streams the response into the WebAssembly memory as it arrives (one copy of the file in the tab).
     async function fetchWhole(target, response) {
       if (!response.ok) throw new Error(`${target.url}: HTTP ${response.status}`);
-      const whole = await readWhole(target, response.body, Number(response.headers.get('Content-Length')));
-      if (whole) return openBytes(whole.pointer, whole.size, target.name, target);
+      return openWhole(target, await readWhole(target, response.body, Number(response.headers.get('Content-Length'))));
     }
     async function dropFile(file) {
       const target = { name: file.name, gen: ++generation };
       bytesComplete = true;
       fetchRest = restLater = restPromise = null;
-      const whole = await readWhole(target, file.stream(), file.size);
-      if (whole) return openBytes(whole.pointer, whole.size, file.name, target);
+      return openWhole(target, await readWhole(target, file.stream(), file.size));
     }
-    // Reads `stream` (a response's body, a dropped file's bytes) whole into memory from Module._malloc: {pointer,
-    // size}, or null when another file was opened meanwhile. Into the memory allocated for the `declared` length
-    // while the bytes fit it; past that (a length that was not the body's, as with a compressed transfer), into
-    // chunks copied together at the end. Read as the ranges are (readBody): a chunk the browser made for each read
-    // would wait for the collector, the file's size of them at its peak.
+    // What readWhole read: a file in memory, or the answer of the unpacker it streamed a package into.
+    async function openWhole(target, whole) {
+      if (!whole) return;
+      if (whole.unpacked) return openUnpacked(await whole.unpacked, target.name, target, whole.t0);
+      return openBytes(whole.pointer, whole.size, target.name, target);
+    }
+    // Reads `stream` (a response's body, a dropped file's bytes) whole: {pointer, size} in memory from Module._malloc,
+    // or for a package (where the browser has workers) {unpacked: the unpacker's answer, t0}, the package handed to
+    // the unpacker as it arrives (streamedPackage); null when another file was opened meanwhile. Into the memory
+    // allocated for the `declared` length while the bytes fit it; past that (a length that was not the body's, as with
+    // a compressed transfer), into chunks copied together at the end. Read as the ranges are (readBody): a chunk the
+    // browser made for each read would wait for the collector, the file's size of them at its peak.
     async function readWhole(target, stream, declared) {
       const { name } = target;
       const chunks = [];
-      let received = 0, inMemory = 0, pointer = 0;
-      if (declared > 0) pointer = allocate(declared, name);
+      let received = 0, inMemory = 0, pointer = 0, package_ = null;
+      const t0 = performance.now();
+      viewMoved = firstLookShown = false;
       const sink = {
         add(value) {
-          if (pointer && chunks.length === 0 && inMemory + value.length <= declared) {
+          if (received === 0) {
+            package_ = streamedPackage(target, value, declared);
+            if (!package_ && declared > 0) pointer = allocate(declared, name);
+          }
+          if (package_) {
+            package_.add(value);
+          } else if (pointer && chunks.length === 0 && inMemory + value.length <= declared) {
             Module.HEAPU8.set(value, pointer + inMemory);
             inMemory += value.length;
           } else {
@@ -839,6 +907,7 @@
       };
       try {
         if (!(await readBody(stream, sink, target))) throw null;
+        if (package_) return { unpacked: package_.end(), t0 };
         if (chunks.length > 0 || !pointer) {
           const whole = allocate(received, name);
           if (pointer) Module.HEAPU8.copyWithin(whole, pointer, pointer + inMemory);
@@ -849,6 +918,7 @@
         }
       } catch (err) {
         if (pointer) Module._free(pointer);
+        if (package_) package_.cancel();
         if (err === null) return null;
         throw err;
       }
@@ -879,7 +949,7 @@
     for (const v of ['axial', 'inferior', 'coronal', 'posterior', 'sagittal', 'right']) {
       const b = document.createElement('button');
       b.textContent = v;
-      b.onclick = () => set('view', v);
+      b.onclick = () => { viewMoved = true; set('view', v); };
       $('views').appendChild(b);
     }
     $('screenshot').onclick = () => {
@@ -899,7 +969,7 @@
     canvas.addEventListener('contextmenu', (e) => e.preventDefault());
     canvas.addEventListener('pointerdown', (e) => {
       canvas.setPointerCapture(e.pointerId);
-      moving = true;
+      moving = viewMoved = true;
       api.drag(e.button === 2 || e.shiftKey ? 2 : 1, e.offsetX * scale(), e.offsetY * scale());
     });
     canvas.addEventListener('pointermove', (e) => {
@@ -908,7 +978,12 @@
       redraw();
     });
     canvas.addEventListener('pointerup', () => { api.drag(0, 0, 0); moving = false; redraw(); });
-    canvas.addEventListener('wheel', (e) => { e.preventDefault(); api.zoom(-Math.sign(e.deltaY)); redraw(); }, { passive: false });
+    canvas.addEventListener('wheel', (e) => {
+      e.preventDefault();
+      viewMoved = true;
+      api.zoom(-Math.sign(e.deltaY));
+      redraw();
+    }, { passive: false });
     window.addEventListener('resize', redraw);
     window.addEventListener('hashchange', applyHash);
 
