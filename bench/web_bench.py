@@ -129,7 +129,7 @@ def main():
     parser.add_argument('--server', choices=sorted(SERVERS), default='ranges')
     parser.add_argument('--gpu', help="the page's GPU memory budget (?gpu=, e.g. 256M)")
     parser.add_argument('--rate', type=float, default=0,
-                        help='MB a second the server sends range answers at (a network; default: at once)')
+                        help='MB a second the server sends range answers and whole data files at (a network; default: at once)')
     parser.add_argument('--voxlines', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), '..',
                                                            'build', 'release', 'converter', 'voxlines'))
     parser.add_argument('--chromium', default=shutil.which('chromium') or 'chromium')
@@ -165,6 +165,10 @@ def main():
                           f'{report["first_picture_ms"] / 1000:.2f} s (level {report["first_level"]}), full detail {report["full_detail_ms"] / 1000:.2f} s, '
                           f'browser peak PSS {sampler.peak / 2**20:.0f} MiB = {sampler.peak / size:.2f}x the file '
                           f'(whole run {time.monotonic() - t0:.1f} s)', flush=True)
+                    look = report.get('first_look')
+                    if look:
+                        print(f'    the first picture is a first look at level {look["level"]} of the package, shown '
+                              f'while the rest arrived; the whole package\'s picture at full detail followed', flush=True)
                     kinds = ', '.join(f'{k} {v / 2**20:.0f}' for k, v in sorted(sampler.at_peak.items()))
                     fetched = (f'; fetched by ranges {web_server.RangeHandler.bytes_sent / 2**20:.0f} MiB'
                                if args.server != 'whole' else '')

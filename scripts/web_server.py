@@ -31,7 +31,8 @@ class RangeHandler(QuietHandler):
     # the bytes of the file those answers held.
     answers = {'one range': 0, 'multipart': 0}
     bytes_sent = 0
-    # Bytes a second the range answers are sent at, as over a network slower than this machine (0: at once).
+    # Bytes a second the range answers and whole data files are sent at, as over a network slower than this machine
+    # (0: at once).
     rate = 0
 
     @classmethod
@@ -45,6 +46,8 @@ class RangeHandler(QuietHandler):
         if not spec or not os.path.isfile(path):
             if os.path.isfile(path) and path.endswith(('.vxl', '.vxlz')):
                 RangeHandler.bytes_sent += os.path.getsize(path)  # the whole file
+                if RangeHandler.rate:
+                    return self.send_whole(path)
             return super().do_GET()
         size = os.path.getsize(path)
         ranges = self.parse_ranges(spec, size)
@@ -84,6 +87,16 @@ class RangeHandler(QuietHandler):
                 self.send_header('Content-Type', f'multipart/byteranges; boundary={boundary}')
         self.send_header('Content-Length', str(len(body)))
         self.send_header('Accept-Ranges', 'bytes')
+        self.end_headers()
+        self.send_body(body)
+
+    def send_whole(self, path):
+        """The whole file (200) at the rate."""
+        with open(path, 'rb') as f:
+            body = f.read()
+        self.send_response(200)
+        self.send_header('Content-Type', 'application/octet-stream')
+        self.send_header('Content-Length', str(len(body)))
         self.end_headers()
         self.send_body(body)
 

@@ -15,8 +15,9 @@ void add_pack_command(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("pack",
                          "Compress a .vxl into a .vxlz package for sharing: tables exact, positions quantised\n"
-                         "(error at most half a quantum of range / (2^bits - 1)) and Draco-coded, value sets exact\n"
-                         "(spec/vxlz-package-v2.md)");
+                         "(error at most half a quantum of range / (2^bits - 1)) and Draco-coded, value sets exact;\n"
+                         "a file with levels of detail ships its coarsest level first, so that a viewer receiving\n"
+                         "the package can show it before the rest (spec/vxlz-package-v2.md)");
   cmd->add_option("input", opt->input, ".vxl file")->required();
   cmd->add_option("output", opt->output, "output .vxlz package (written atomically)")->required();
   cmd->add_option("--bits", opt->settings.bits, "quantisation bits per coordinate over the data's bounding cube")
@@ -34,6 +35,8 @@ void add_pack_command(CLI::App& app) {
         "positions: %u bits over a %.3f mm cube, quantum %.6f mm; error bound %.6f mm, measured max %.6f mm, RMS %.6f "
         "mm\n",
         s.pack.quantization_bits, s.pack.range, s.pack.quantum, s.pack.error_bound, s.pack.max_error, s.pack.rms_error);
+    if (s.pack.level_count > 1)
+      std::printf("points shipped level by level: the coarsest of the %u levels first\n", s.pack.level_count);
     if (s.point_value_sets + s.streamline_value_sets > 0)
       std::printf("values: %u per-point and %u per-streamline set(s), exact\n", s.point_value_sets,
                   s.streamline_value_sets);

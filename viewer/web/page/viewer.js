@@ -482,6 +482,7 @@
         return fail(error.message);
       }
       Module.HEAPU8.set(new Uint8Array(answer.vxl), pointer);
+      answer.vxl = null;  // the copy in the WebAssembly memory is the one kept: this one goes at the next collection
       const camera = level === 0 && firstLookShown && viewMoved ? JSON.parse(api.camera()) : null;
       const [w, h] = canvasSize();
       if (api.open(pointer, size, name, w, h, 1) !== 0) return fail(api.error());
