@@ -159,6 +159,12 @@ VxlzFile VxlzFile::open(const std::string& path) {
   return f;
 }
 
+VxlzFile VxlzFile::open(MappedFile file) {
+  VxlzFile f{std::move(file)};
+  f.validate();
+  return f;
+}
+
 VxlzFile VxlzFile::open_prefix(MappedFile prefix) {
   VxlzFile f{std::move(prefix), true};
   f.validate();

@@ -60,6 +60,8 @@ class VxlzFile {
   // Maps and validates spec §8 steps 1-4. Throws vxl::Error (Input; Unsupported for an unknown major
   // version or required section).
   static VxlzFile open(const std::string& path);
+  // The same, of bytes already in memory (named by file.path() in errors).
+  static VxlzFile open(MappedFile file);
   // The first bytes of a package still arriving (`prefix`: its bytes so far): validated as open() validates a
   // whole package, except that the positions (POSD) may be cut short and their checksum is not checked; every
   // other section must be whole (else Input, "needs the first N bytes"). Chunks past the prefix are not there

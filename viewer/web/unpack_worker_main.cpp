@@ -6,7 +6,8 @@
 // A package is handed over as it arrives (vu_begin, then its pieces written where vu_begin said, vu_arrived after
 // each): once the first bytes hold a level of detail small enough for a first look (a package of a file with levels
 // ships its coarsest level first), vu_arrived asks for it, vu_unpack_level unpacks it alone, and the page shows it
-// while the rest arrives; vu_unpack then unpacks the whole.
+// while the rest arrives; vu_unpack then unpacks the whole. Each .vxl is written into the in-memory file system
+// (vu_unpacked), whose bytes the script hands to the page as they are.
 #include <emscripten/emscripten.h>
 
 #include <cstdint>
@@ -23,9 +24,11 @@ namespace {
 // About the segments voxview's first picture draws (frame_budget.h's kFirstPictureSegments).
 constexpr std::uint64_t kFirstLookPoints = 250'000;
 
-std::optional<vxl::MappedFile>& unpacked() {
-  static std::optional<vxl::MappedFile> file;
-  return file;
+// The .vxl the last unpack wrote into the in-memory file system: the worker's script hands its bytes over as they
+// lie there (no copy in the module's memory) and removes it.
+std::string& unpacked() {
+  static std::string path;
+  return path;
 }
 
 std::string& last_error() {
@@ -50,7 +53,7 @@ Arriving& arriving() {
 // Runs `unpack` (which sets unpacked()): 1, or 0 with vu_error saying why.
 template <typename Fn>
 int answer(Fn&& unpack) {
-  unpacked().reset();
+  unpacked().clear();
   last_error().clear();
   try {
     unpack();
@@ -100,29 +103,29 @@ EMSCRIPTEN_KEEPALIVE int vu_arrived(double received) {
   return static_cast<int>(a.look->level);
 }
 
-// Unpacks the level vu_arrived asked for from the bytes in: 1, and vu_data / vu_size give its .vxl; 0, and vu_error
-// says why.
+// Unpacks the level vu_arrived asked for from the bytes in: 1, and vu_unpacked names its .vxl; 0, and vu_error says
+// why.
 EMSCRIPTEN_KEEPALIVE int vu_unpack_level() {
   const Arriving& a = arriving();
   return answer([&] {
-    unpacked().emplace(
-        vxl::web::unpack_level({a.bytes, static_cast<std::size_t>(a.look->bytes)}, a.look->level, a.name));
+    unpacked() =
+        vxl::web::unpack_level_to_file({a.bytes, static_cast<std::size_t>(a.look->bytes)}, a.look->level, a.name);
   });
 }
 
-// Unpacks the whole package, once all of it is in (its bytes are let go): 1, and vu_data / vu_size give the .vxl;
-// 0, and vu_error says why.
+// Unpacks the whole package, once all of it is in (its bytes are let go): 1, and vu_unpacked names the .vxl; 0, and
+// vu_error says why.
 EMSCRIPTEN_KEEPALIVE int vu_unpack() {
   Arriving& a = arriving();
   std::uint8_t* bytes = std::exchange(a.bytes, nullptr);
   return answer([&] {
-    unpacked().emplace(
-        vxl::web::unpack_package(vxl::MappedFile::adopt(a.name, bytes, static_cast<std::size_t>(a.received)), a.name));
+    unpacked() = vxl::web::unpack_package_to_file(
+        vxl::MappedFile::adopt(vxl::web::package_name(a.name), bytes, static_cast<std::size_t>(a.received)), a.name);
   });
 }
 
-EMSCRIPTEN_KEEPALIVE const std::uint8_t* vu_data() { return unpacked() ? unpacked()->data() : nullptr; }
-EMSCRIPTEN_KEEPALIVE double vu_size() { return unpacked() ? static_cast<double>(unpacked()->size()) : 0.0; }
+// The path of the .vxl the last unpack wrote in the in-memory file system (empty after a failure).
+EMSCRIPTEN_KEEPALIVE const char* vu_unpacked() { return unpacked().c_str(); }
 EMSCRIPTEN_KEEPALIVE const char* vu_error() { return last_error().c_str(); }
 
 }  // extern "C"

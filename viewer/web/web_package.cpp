@@ -21,12 +21,6 @@ struct RemovedAtExit {
   ~RemovedAtExit() { std::remove(path.c_str()); }
 };
 
-// The name the package has in the file system (and so in errors): the page's name for it, less any folder.
-std::string package_path(const std::string& name) {
-  const std::string leaf = std::filesystem::path(name).filename().string();
-  return leaf.empty() || leaf == "." || leaf == ".." ? "package.vxlz" : leaf;
-}
-
 // A copy of `bytes` in memory of its own (MappedFile::adopt's), named `name` in errors.
 MappedFile copy_of(std::span<const std::uint8_t> bytes, const std::string& name) {
   auto* copy = static_cast<std::uint8_t*>(std::malloc(std::max<std::size_t>(bytes.size(), 1)));
@@ -41,18 +35,21 @@ bool is_package(std::span<const std::uint8_t> bytes) {
   return bytes.size() >= kVxlzMagic.size() && std::equal(kVxlzMagic.begin(), kVxlzMagic.end(), bytes.begin());
 }
 
-MappedFile unpack_package(MappedFile package_bytes, const std::string& name) {
-  const RemovedAtExit package{package_path(name)}, unpacked{package.path + ".vxl"};
-  std::FILE* f = std::fopen(package.path.c_str(), "wb");
-  const std::span<const std::uint8_t> bytes = package_bytes.bytes();
-  const bool written = f != nullptr && std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-  if (f == nullptr || std::fclose(f) != 0 || !written)
-    throw Error(ErrorKind::Unsupported, name, std::nullopt, "no memory to unpack this package in");
-  { const MappedFile released = std::move(package_bytes); }  // the file system's copy is the one unpacked
+std::string package_name(const std::string& name) {
+  const std::string leaf = std::filesystem::path(name).filename().string();
+  return leaf.empty() || leaf == "." || leaf == ".." ? "package.vxlz" : leaf;
+}
+
+std::string unpack_package_to_file(MappedFile package_bytes, const std::string& name) {
+  const std::string unpacked = package_name(name) + ".vxl";
   UnpackSettings settings;
   settings.threads = 1;  // this WebAssembly build has no threads
-  unpack_vxlz(package.path, unpacked.path, settings);
-  std::remove(package.path.c_str());  // before the .vxl is read into memory: the page holds one file at a time
+  unpack_vxlz(VxlzFile::open(std::move(package_bytes)), unpacked, settings);
+  return unpacked;
+}
+
+MappedFile unpack_package(MappedFile package, const std::string& name) {
+  const RemovedAtExit unpacked{unpack_package_to_file(std::move(package), name)};
   return MappedFile(unpacked.path);
 }
 
@@ -74,7 +71,7 @@ std::optional<FirstLook> plan_first_look(std::span<const std::uint8_t> prefix, c
   if (positions == 0) return FirstLook{};
   if (prefix.size() < positions) return std::nullopt;
   try {
-    const VxlzFile f = VxlzFile::open_prefix(copy_of(prefix.first(positions), package_path(name)));
+    const VxlzFile f = VxlzFile::open_prefix(copy_of(prefix.first(positions), package_name(name)));
     FirstLook look;
     for (const ShippedLevel& l : shipped_levels(f))
       if (l.level > 0 && l.points <= max_points) look = {l.level, l.bytes};
@@ -84,16 +81,13 @@ std::optional<FirstLook> plan_first_look(std::span<const std::uint8_t> prefix, c
   }
 }
 
-MappedFile unpack_level(std::span<const std::uint8_t> prefix, std::uint32_t level, const std::string& name) {
-  const RemovedAtExit unpacked{package_path(name) + ".level.vxl"};
-  {
-    const VxlzFile f = VxlzFile::open_prefix(copy_of(prefix, package_path(name)));
-    UnpackSettings settings;
-    settings.threads = 1;  // this WebAssembly build has no threads
-    settings.level = level;
-    unpack_vxlz(f, unpacked.path, settings);
-  }
-  return MappedFile(unpacked.path);
+std::string unpack_level_to_file(std::span<const std::uint8_t> prefix, std::uint32_t level, const std::string& name) {
+  const std::string unpacked = package_name(name) + ".level.vxl";
+  UnpackSettings settings;
+  settings.threads = 1;
+  settings.level = level;
+  unpack_vxlz(VxlzFile::open_prefix(copy_of(prefix, package_name(name))), unpacked, settings);
+  return unpacked;
 }
 
 }  // namespace vxl::web

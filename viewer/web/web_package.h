@@ -15,9 +15,15 @@ namespace vxl::web {
 // Whether `bytes` begin as a .vxlz package does (its magic, spec/vxlz-package-v2.md §2.1).
 bool is_package(std::span<const std::uint8_t> bytes);
 
-// Unpacks the package `package` (named `name` in errors) into a .vxl held in memory. The package is copied into
-// the in-memory file system first and let go then, so that the memory holds it once while it is unpacked; nothing
-// is left in the file system, also when the package is refused (vxl::Error, as unpack_vxlz throws it).
+// The name a package named `name` by the page has in errors and in the provenance of the .vxl unpacked from it: its
+// last part ("package.vxlz" when it has none), as `voxlines unpack` names it.
+std::string package_name(const std::string& name);
+
+// Unpacks the package `package` (its bytes, named package_name(name)) into a .vxl in the in-memory file system, and
+// lets the package's bytes go; returns the .vxl's path, which the caller removes. Nothing is left in the file system
+// when the package is refused (vxl::Error, as unpack_vxlz throws it).
+std::string unpack_package_to_file(MappedFile package, const std::string& name);
+// The same, the .vxl read into memory and removed from the file system.
 MappedFile unpack_package(MappedFile package, const std::string& name);
 
 // A package arriving: the level to show before the rest (the finest of its level order, spec §5.1, with at most
@@ -33,7 +39,7 @@ std::optional<FirstLook> plan_first_look(std::span<const std::uint8_t> prefix, c
                                          std::uint64_t max_points);
 
 // The streamlines of level `level` alone (unpack_vxlz's UnpackSettings::level), from the package's first bytes
-// (`prefix`, copied), as a .vxl held in memory.
-MappedFile unpack_level(std::span<const std::uint8_t> prefix, std::uint32_t level, const std::string& name);
+// (`prefix`, copied), as a .vxl in the in-memory file system, as unpack_package_to_file leaves it.
+std::string unpack_level_to_file(std::span<const std::uint8_t> prefix, std::uint32_t level, const std::string& name);
 
 }  // namespace vxl::web

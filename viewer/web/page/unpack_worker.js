@@ -1,7 +1,8 @@
 // Unpacks a .vxlz package off the page's thread (unpack_worker_main.cpp, built as voxunpack.js), as it arrives. The
 // page posts {begin: {size, name}}, then {piece: ArrayBuffer} for each piece of the package in order, then {end:
-// true}; it gets back {level, vxl: ArrayBuffer} when the first pieces hold a level of detail to show while the rest
-// arrives (at most once, before the end), then {vxl: ArrayBuffer} (the whole package's .vxl) or {error: text}. One
+// true}; it gets back {level, vxl: ArrayBuffer, size} when the first pieces hold a level of detail to show while the
+// rest arrives (at most once, before the end), then {vxl: ArrayBuffer, size} (the whole package's .vxl: the first
+// `size` bytes of the buffer) or {error: text}. One
 // package a worker: the page ends the worker once it has the answer, and the module's memory goes with it.
 importScripts('voxunpack.js');
 
@@ -9,10 +10,16 @@ let unpacker = null, pointer = 0, size = 0, received = 0, name = '';
 const ready = createVoxunpack().then((module) => { unpacker = module; });
 let queue = Promise.resolve();  // the messages, one after the other (the module loads first)
 
-// The .vxl the last unpack left in the module, handed over as an ArrayBuffer.
-function unpackedBytes() {
-  const data = unpacker._vu_data() >>> 0;  // addresses past 2 GiB come back negative
-  return unpacker.HEAPU8.slice(data, data + unpacker._vu_size()).buffer;
+// The .vxl the last unpack wrote in the module's in-memory file system: {vxl: its ArrayBuffer, size: its bytes at the
+// start of it}, the file's own storage, handed over as it is (a copy would hold the file twice), and the file removed.
+function unpackedFile() {
+  const path = unpacker.UTF8ToString(unpacker._vu_unpacked() >>> 0);  // addresses past 2 GiB come back negative
+  const node = unpacker.FS.lookupPath(path).node;
+  const contents = node.contents && node.contents.buffer ? node.contents : new Uint8Array(node.contents || 0);
+  const file = { vxl: contents.buffer, size: node.usedBytes };
+  if (contents.byteOffset !== 0) file.vxl = contents.slice(0, file.size).buffer;
+  unpacker.FS.unlink(path);
+  return file;
 }
 function error() { return unpacker.UTF8ToString(unpacker._vu_error() >>> 0); }
 
@@ -33,22 +40,27 @@ function piece(bytes) {
   const level = unpacker._vu_arrived(received);
   // A first look that cannot be unpacked is left out: the whole package's unpack says what is wrong with it.
   if (level > 0 && unpacker._vu_unpack_level()) {
-    const vxl = unpackedBytes();
-    postMessage({ level, vxl }, [vxl]);
+    const file = unpackedFile();
+    postMessage({ level, ...file }, [file.vxl]);
   }
 }
 function end() {
   if (!unpacker._vu_unpack()) return postMessage({ error: error() });
-  const vxl = unpackedBytes();
-  postMessage({ vxl }, [vxl]);
+  const file = unpackedFile();
+  postMessage(file, [file.vxl]);
 }
 
+let failed = false;  // an error was answered: the rest of the package is not looked at
 onmessage = (event) => {
   const message = event.data;
   queue = queue.then(async () => {
     await ready;
+    if (failed) return;
     if (message.begin) begin(message.begin);
     else if (message.piece) piece(message.piece);
     else if (message.end) end();
-  }).catch((err) => postMessage({ error: String(err.message || err) }));
+  }).catch((err) => {
+    failed = true;
+    postMessage({ error: String(err.message || err) });
+  });
 };

@@ -381,9 +381,9 @@
     }
 
     // A package unpacked in `worker` (unpack_worker.js) as its bytes arrive: add(Uint8Array) hands each piece over
-    // (copied), end() says all are in and resolves with the answer, {vxl: ArrayBuffer} or {error: text}. Where its
-    // first bytes hold a level of detail to look at while the rest arrives, firstLook(level, vxl) gets it before the
-    // end. A package opened since ends the one before ({stale: true}); so does cancel().
+    // (copied), end() says all are in and resolves with the answer, {vxl: ArrayBuffer, size} or {error: text}. Where
+    // its first bytes hold a level of detail to look at while the rest arrives, firstLook(level, {vxl, size}) gets it
+    // before the end. A package opened since ends the one before ({stale: true}); so does cancel().
     let unpacking = null;  // the package being unpacked
     function unpackInWorker(worker, size, name, firstLook) {
       if (unpacking) unpacking.cancel();
@@ -408,7 +408,7 @@
       };
       unpacking = self;
       worker.onmessage = (event) => {
-        if (event.data.level && !event.data.error) firstLook(event.data.level, event.data.vxl);
+        if (event.data.level && !event.data.error) firstLook(event.data.level, event.data);
         else answer(event.data);
       };
       worker.onerror = (event) => {
@@ -462,8 +462,8 @@
       if (!worker) return null;
       const t0 = performance.now();
       say(`${target.name}: unpacking the package as it arrives`);
-      return unpackInWorker(worker, Math.max(declared, first.length), target.name, (level, vxl) => {
-        openUnpacked({ vxl }, target.name, target, t0, level);
+      return unpackInWorker(worker, Math.max(declared, first.length), target.name, (level, file) => {
+        openUnpacked(file, target.name, target, t0, level);
       });
     }
     // What the unpacker answered (unpackInWorker): the package's .vxl opened, or its error said. level > 0: the first
@@ -474,14 +474,14 @@
       if (answer.error !== undefined) return fail(answer.error);
       if (level === 0 && firstLookShown) mark('whole unpacked');
       else mark(level > 0 ? 'first look unpacked' : 'unpacked');
-      const size = answer.vxl.byteLength;
+      const size = answer.size !== undefined ? answer.size : answer.vxl.byteLength;
       let pointer;
       try {
         pointer = allocate(size, name);
       } catch (error) {
         return fail(error.message);
       }
-      Module.HEAPU8.set(new Uint8Array(answer.vxl), pointer);
+      Module.HEAPU8.set(new Uint8Array(answer.vxl, 0, size), pointer);
       answer.vxl = null;  // the copy in the WebAssembly memory is the one kept: this one goes at the next collection
       const camera = level === 0 && firstLookShown && viewMoved ? JSON.parse(api.camera()) : null;
       const [w, h] = canvasSize();
