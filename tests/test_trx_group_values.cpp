@@ -319,7 +319,8 @@ TEST(GdatSection, FilesWithoutGroupValuesHaveNoSection) {
 }
 
 // The version a file with GDAT carries (spec §10): every file written has streamline lengths (2.4 with packed
-// positions or levels, 1.5 otherwise), which holds GDAT too; a package with it is 2.2, one without 2.0.
+// positions or levels, 1.5 otherwise), which holds GDAT too; a package with it is 2.2, one without 2.0, and one of a file
+// with levels 2.3 either way (its points shipped level by level).
 TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
   ScratchDir dir;
   test::write_zip(dir.file("a.trx"), trx_members());
@@ -340,7 +341,9 @@ TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
   convert_tractogram(read_trx(dir.file("a.trx")), dir.file("plain.vxl"), plain);
   EXPECT_EQ(version_of(VxlFile::open(dir.file("plain.vxl")).header()), "1.5");
   pack_vxl(VxlFile::open(dir.file("packed.vxl")), dir.file("a.vxlz"), PackSettings{});
-  EXPECT_EQ(package_version_of(dir.file("a.vxlz")), "2.2");
+  EXPECT_EQ(package_version_of(dir.file("a.vxlz")), "2.3");
+  pack_vxl(VxlFile::open(dir.file("plain.vxl")), dir.file("a_plain.vxlz"), PackSettings{});
+  EXPECT_EQ(package_version_of(dir.file("a_plain.vxlz")), "2.2");
 
   auto members = trx_members();
   std::erase_if(members, [](const auto& m) { return m.first.starts_with("dpg/"); });
@@ -350,7 +353,9 @@ TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
   convert_tractogram(read_trx(dir.file("b.trx")), dir.file("b_plain.vxl"), plain);
   EXPECT_EQ(version_of(VxlFile::open(dir.file("b_plain.vxl")).header()), "1.5");
   pack_vxl(VxlFile::open(dir.file("b.vxl")), dir.file("b.vxlz"), PackSettings{});
-  EXPECT_EQ(package_version_of(dir.file("b.vxlz")), "2.0");
+  EXPECT_EQ(package_version_of(dir.file("b.vxlz")), "2.3");
+  pack_vxl(VxlFile::open(dir.file("b_plain.vxl")), dir.file("b_plain.vxlz"), PackSettings{});
+  EXPECT_EQ(package_version_of(dir.file("b_plain.vxlz")), "2.0");
 }
 
 // ---- the real fixture: trx-python's small.trx (groups with repeated indices and dpg rows) ----
