@@ -471,7 +471,11 @@
     // view the reader has moved to meanwhile.
     function openUnpacked(answer, name, target, t0, level = 0) {
       if (!current(target) || answer.stale) return;
-      if (answer.error !== undefined) return fail(answer.error);
+      if (answer.error !== undefined) {
+        // A package refused after its first look: that picture came from bytes the refusal says are damaged.
+        if (firstLookShown) [opened, canvas.style.visibility] = [false, 'hidden'];
+        return fail(answer.error);
+      }
       if (level === 0 && firstLookShown) mark('whole unpacked');
       else mark(level > 0 ? 'first look unpacked' : 'unpacked');
       const size = answer.size !== undefined ? answer.size : answer.vxl.byteLength;
@@ -498,6 +502,7 @@
     // The file is open and its first picture's renderer made: the panel, then the first frame.
     function shown(name, t0, level = 0) {
       opened = true;
+      canvas.style.visibility = '';
       firstFrame = true;  // its first frame starts the rest (afterFirstPicture)
       fullShown = false;
       const info = JSON.parse(api.info());
