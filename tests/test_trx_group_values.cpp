@@ -319,8 +319,8 @@ TEST(GdatSection, FilesWithoutGroupValuesHaveNoSection) {
 }
 
 // The version a file with GDAT carries (spec §10): every file written has streamline lengths (2.4 with packed
-// positions or levels, 1.5 otherwise), which holds GDAT too; a package with it is 2.2, one without 2.0, and one of a file
-// with levels 2.3 either way (its points shipped level by level).
+// positions or levels, 1.5 otherwise), which holds GDAT too; a package with it is 2.2, one without 2.0, and one of a
+// file with levels 2.3 either way (its points shipped level by level).
 TEST(GdatSection, AFileWithGroupValuesCarriesTheVersionThatDefinesThem) {
   ScratchDir dir;
   test::write_zip(dir.file("a.trx"), trx_members());
