@@ -165,10 +165,11 @@ def main():
                           f'{report["first_picture_ms"] / 1000:.2f} s (level {report["first_level"]}), full detail {report["full_detail_ms"] / 1000:.2f} s, '
                           f'browser peak PSS {sampler.peak / 2**20:.0f} MiB = {sampler.peak / size:.2f}x the file '
                           f'(whole run {time.monotonic() - t0:.1f} s)', flush=True)
-                    look = report.get('first_look')
-                    if look:
-                        print(f'    the first picture is a first look at level {look["level"]} of the package, shown '
-                              f'while the rest arrived; the whole package\'s picture at full detail followed', flush=True)
+                    looks = report.get('looks') or []
+                    if looks:
+                        shown = ', '.join(f'level {look["level"]} at {look["at"] / 1000:.2f} s' for look in looks)
+                        print(f'    the package\'s looks before the whole (a level of detail alone, unpacked from the bytes '
+                              f'in): {shown}; then the whole, at full detail', flush=True)
                     kinds = ', '.join(f'{k} {v / 2**20:.0f}' for k, v in sorted(sampler.at_peak.items()))
                     fetched = (f'; fetched by ranges {web_server.RangeHandler.bytes_sent / 2**20:.0f} MiB'
                                if args.server != 'whole' else '')

@@ -6,16 +6,20 @@
 // A package is handed over as it arrives (vu_begin, then its pieces written where vu_begin said, vu_arrived after
 // each): once the first bytes hold a level of detail small enough for a first look (a package of a file with levels
 // ships its coarsest level first), vu_arrived asks for it, vu_unpack_level unpacks it alone, and the page shows it
-// while the rest arrives; vu_unpack then unpacks the whole. Each .vxl is written into the in-memory file system
-// (vu_unpacked), whose bytes the script hands to the page as they are.
+// while the rest arrives, and the finer levels (vu_looks) the page asks for while the rest is still far off; vu_unpack
+// then unpacks the whole. Each .vxl is written into the in-memory file system (vu_unpacked), whose bytes the script
+// hands to the page as they are.
 #include <emscripten/emscripten.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <exception>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "viewer/web/web_package.h"
 
@@ -41,8 +45,8 @@ struct Arriving {
   std::uint8_t* bytes = nullptr;  // malloc'd, the package's declared size
   std::uint64_t size = 0, received = 0;
   std::string name;
-  std::optional<vxl::web::FirstLook> look;
-  bool look_asked = false;
+  std::optional<std::vector<vxl::web::Look>> looks;  // planned once the tables are in (plan_looks)
+  bool first_look_asked = false;
 };
 
 Arriving& arriving() {
@@ -91,25 +95,40 @@ EMSCRIPTEN_KEEPALIVE std::uint8_t* vu_grow(double size) {
   return grown;
 }
 
-// The package's first `received` bytes are in: the level of detail to show first when its bytes have just become
-// complete (vu_unpack_level then unpacks it), else 0.
+// The package's first `received` bytes are in: the level of its first look when its bytes have just become complete
+// (vu_unpack_level then unpacks it), else 0.
 EMSCRIPTEN_KEEPALIVE int vu_arrived(double received) {
   Arriving& a = arriving();
   a.received = static_cast<std::uint64_t>(received);
-  if (!a.look)
-    a.look = vxl::web::plan_first_look({a.bytes, static_cast<std::size_t>(a.received)}, a.name, kFirstLookPoints);
-  if (!a.look || a.look->level == 0 || a.look_asked || a.received < a.look->bytes) return 0;
-  a.look_asked = true;
-  return static_cast<int>(a.look->level);
+  if (!a.looks)
+    a.looks = vxl::web::plan_looks({a.bytes, static_cast<std::size_t>(a.received)}, a.name, kFirstLookPoints);
+  if (!a.looks || a.looks->empty() || a.first_look_asked || a.received < a.looks->front().bytes) return 0;
+  a.first_look_asked = true;
+  return static_cast<int>(a.looks->front().level);
 }
 
-// Unpacks the level vu_arrived asked for from the bytes in: 1, and vu_unpacked names its .vxl; 0, and vu_error says
-// why.
-EMSCRIPTEN_KEEPALIVE int vu_unpack_level() {
+// The looks planned (JSON [[level, bytes], ...], coarsest first; [] for none, or while the tables are not in): the
+// page asks for the finer ones (vu_unpack_level) while the rest of the package is still far off.
+EMSCRIPTEN_KEEPALIVE const char* vu_looks() {
+  static std::string text;
+  text = "[";
+  for (const vxl::web::Look& l : arriving().looks.value_or(std::vector<vxl::web::Look>()))
+    text += (text.size() > 1 ? "," : "") + ("[" + std::to_string(l.level) + "," + std::to_string(l.bytes) + "]");
+  text += "]";
+  return text.c_str();
+}
+
+// Unpacks look `level` (one of vu_looks') from the bytes in: 1, and vu_unpacked names its .vxl; 0, and vu_error says
+// why (also when its bytes are not all in).
+EMSCRIPTEN_KEEPALIVE int vu_unpack_level(int level) {
   const Arriving& a = arriving();
   return answer([&] {
-    unpacked() =
-        vxl::web::unpack_level_to_file({a.bytes, static_cast<std::size_t>(a.look->bytes)}, a.look->level, a.name);
+    const std::vector<vxl::web::Look> none;
+    const auto& looks = a.looks ? *a.looks : none;
+    const auto look = std::find_if(looks.begin(), looks.end(), [&](const auto& l) { return int(l.level) == level; });
+    if (look == looks.end() || look->bytes > a.received)
+      throw std::runtime_error(a.name + ": level " + std::to_string(level) + " of the package is not in yet");
+    unpacked() = vxl::web::unpack_level_to_file({a.bytes, static_cast<std::size_t>(look->bytes)}, look->level, a.name);
   });
 }
 

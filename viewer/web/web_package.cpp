@@ -53,13 +53,13 @@ MappedFile unpack_package(MappedFile package, const std::string& name) {
   return MappedFile(unpacked.path);
 }
 
-std::optional<FirstLook> plan_first_look(std::span<const std::uint8_t> prefix, const std::string& name,
-                                         std::uint64_t max_points) {
+std::optional<std::vector<Look>> plan_looks(std::span<const std::uint8_t> prefix, const std::string& name,
+                                            std::uint64_t max_points) {
   // The section table says where the positions start: everything before them is what opening the prefix needs.
   FileHeader h;
   if (prefix.size() < sizeof h) return std::nullopt;
   std::memcpy(&h, prefix.data(), sizeof h);
-  if (h.section_count > kVxlzMaxSections) return FirstLook{};
+  if (h.section_count > kVxlzMaxSections) return std::vector<Look>();
   const std::uint64_t table_end = sizeof h + std::uint64_t(h.section_count) * sizeof(SectionEntry);
   if (prefix.size() < table_end) return std::nullopt;
   std::uint64_t positions = 0;
@@ -68,16 +68,21 @@ std::optional<FirstLook> plan_first_look(std::span<const std::uint8_t> prefix, c
     std::memcpy(&e, prefix.data() + sizeof h + i * sizeof e, sizeof e);
     if (std::memcmp(e.id, "POSD", 4) == 0) positions = e.offset;
   }
-  if (positions == 0) return FirstLook{};
+  if (positions == 0) return std::vector<Look>();
   if (prefix.size() < positions) return std::nullopt;
   try {
     const VxlzFile f = VxlzFile::open_prefix(copy_of(prefix.first(positions), package_name(name)));
-    FirstLook look;
-    for (const ShippedLevel& l : shipped_levels(f))
-      if (l.level > 0 && l.points <= max_points) look = {l.level, l.bytes};
-    return look;
+    std::vector<Look> looks;
+    for (const ShippedLevel& l : shipped_levels(f)) {  // coarsest first
+      if (l.level == 0) continue;
+      if (l.points <= max_points)
+        looks = {{l.level, l.bytes}};  // the finest still this small looks first
+      else if (!looks.empty())
+        looks.push_back({l.level, l.bytes});  // the finer ones after it
+    }
+    return looks;
   } catch (const Error&) {
-    return FirstLook{};
+    return std::vector<Look>();
   }
 }
 

@@ -7,6 +7,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "format/base/mapped_file.h"
 
@@ -26,17 +27,18 @@ std::string unpack_package_to_file(MappedFile package, const std::string& name);
 // The same, the .vxl read into memory and removed from the file system.
 MappedFile unpack_package(MappedFile package, const std::string& name);
 
-// A package arriving: the level to show before the rest (the finest of its level order, spec §5.1, with at most
-// `max_points` shipped points: about the segments voxview's first picture draws) and the prefix of the package that
-// holds it. Level 0: none (a package in streamline order, or none small enough, or one whose tables are refused:
-// the whole package's unpack then says why).
-struct FirstLook {
+// A package arriving: the levels of detail to look at before the whole (its level order's, spec §5.1), each with the
+// prefix of the package that holds it, coarsest first: the first look is the finest with at most `max_points`
+// shipped points (about the segments voxview's first picture draws), the others each finer one down to level 1, for
+// a page to ask for while the rest is still far off. Empty for a package in streamline order, or with no level small
+// enough, or whose tables are refused (the whole package's unpack then says why).
+struct Look {
   std::uint32_t level = 0;
   std::uint64_t bytes = 0;
 };
-// Empty while `prefix` (the package's first bytes) does not hold its tables yet: ask again with more.
-std::optional<FirstLook> plan_first_look(std::span<const std::uint8_t> prefix, const std::string& name,
-                                         std::uint64_t max_points);
+// nullopt while `prefix` (the package's first bytes) does not hold its tables yet: ask again with more.
+std::optional<std::vector<Look>> plan_looks(std::span<const std::uint8_t> prefix, const std::string& name,
+                                            std::uint64_t max_points);
 
 // The streamlines of level `level` alone (unpack_vxlz's UnpackSettings::level), from the package's first bytes
 // (`prefix`, copied), as a .vxl in the in-memory file system, as unpack_package_to_file leaves it.

@@ -1,12 +1,13 @@
 // Unpacks a .vxlz package off the page's thread (unpack_worker_main.cpp, built as voxunpack.js), as it arrives. The
 // page posts {begin: {size, name}}, then {piece: ArrayBuffer} for each piece of the package in order, then {end:
-// true}; it gets back {level, vxl: ArrayBuffer, size} when the first pieces hold a level of detail to show while the
-// rest arrives (at most once, before the end), then {vxl: ArrayBuffer, size} (the whole package's .vxl: the first
-// `size` bytes of the buffer) or {error: text}. One
+// true}. It gets back {looks: [[level, bytes], ...]} once the package's tables are in (the levels of detail it can
+// look at before the whole, coarsest first, and the bytes each needs), {level, vxl: ArrayBuffer, size} when the first
+// of them is in (the .vxl of that level alone: the first `size` bytes of the buffer), the same for each finer one the
+// page asks for with {look: level} after its bytes, then {vxl, size} (the whole package's .vxl) or {error: text}. One
 // package a worker: the page ends the worker once it has the answer, and the module's memory goes with it.
 importScripts('voxunpack.js');
 
-let unpacker = null, pointer = 0, size = 0, received = 0, name = '';
+let unpacker = null, pointer = 0, size = 0, received = 0, name = '', looksSent = false;
 const ready = createVoxunpack().then((module) => { unpacker = module; });
 let queue = Promise.resolve();  // the messages, one after the other (the module loads first)
 
@@ -38,11 +39,20 @@ function piece(bytes) {
   unpacker.HEAPU8.set(new Uint8Array(bytes), pointer + received);
   received += bytes.byteLength;
   const level = unpacker._vu_arrived(received);
-  // A first look that cannot be unpacked is left out: the whole package's unpack says what is wrong with it.
-  if (level > 0 && unpacker._vu_unpack_level()) {
-    const file = unpackedFile();
-    postMessage({ level, ...file }, [file.vxl]);
+  if (!looksSent) {
+    const looks = JSON.parse(unpacker.UTF8ToString(unpacker._vu_looks() >>> 0));
+    if (looks.length > 0) {
+      postMessage({ looks });
+      looksSent = true;
+    }
   }
+  if (level > 0) look(level);
+}
+// A look that cannot be unpacked is left out: the whole package's unpack says what is wrong with it.
+function look(level) {
+  if (!unpacker._vu_unpack_level(level)) return;
+  const file = unpackedFile();
+  postMessage({ level, ...file }, [file.vxl]);
 }
 function end() {
   if (!unpacker._vu_unpack()) return postMessage({ error: error() });
@@ -58,6 +68,7 @@ onmessage = (event) => {
     if (failed) return;
     if (message.begin) begin(message.begin);
     else if (message.piece) piece(message.piece);
+    else if (message.look) look(message.look);
     else if (message.end) end();
   }).catch((err) => {
     failed = true;

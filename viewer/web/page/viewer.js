@@ -38,6 +38,9 @@
     // pictures at rest shown with some of them in and a coarser level in place of the others.
     spansFetched: [],
     mixedShown: [],  // when each was shown, ms from navigation
+    // A package's looks before the whole ({level, at: ms from navigation}: a level of detail alone), and the first.
+    looks: [],
+    firstLook: null,
     longTasks: () => longTasks.slice(),
   };
 
@@ -395,10 +398,19 @@
           resolve(message);
         };
       });
+      let looks = null, asked = 0;  // the levels the worker can unpack alone ([level, bytes], coarsest first)
       const self = {
         add(value) {
           const piece = value.slice().buffer;
           worker.postMessage({ piece }, [piece]);
+        },
+        // `received` of the package's `declared` bytes are in: while a quarter or more is still to come (a slow
+        // network: the whole is a while off), the finest level whose bytes are in and that is finer than those shown.
+        askFiner(received, declared) {
+          if (!looks || !(declared > 0) || received > 0.75 * declared) return;
+          let finest = 0;
+          for (const [level, bytes] of looks.slice(1)) if (bytes <= received && level < asked) finest = level;
+          if (finest > 0) worker.postMessage({ look: (asked = finest) });
         },
         end() {
           worker.postMessage({ end: true });
@@ -408,7 +420,8 @@
       };
       unpacking = self;
       worker.onmessage = (event) => {
-        if (event.data.level && !event.data.error) firstLook(event.data.level, event.data);
+        if (event.data.looks) [looks, asked] = [event.data.looks, event.data.looks[0][0]];
+        else if (event.data.level && !event.data.error) firstLook(event.data.level, event.data);
         else answer(event.data);
       };
       worker.onerror = (event) => {
@@ -487,7 +500,7 @@
       }
       Module.HEAPU8.set(new Uint8Array(answer.vxl, 0, size), pointer);
       answer.vxl = null;  // the copy in the WebAssembly memory is the one kept: this one goes at the next collection
-      const camera = level === 0 && firstLookShown && viewMoved ? JSON.parse(api.camera()) : null;
+      const camera = firstLookShown && viewMoved ? JSON.parse(api.camera()) : null;
       const [w, h] = canvasSize();
       if (api.open(pointer, size, name, w, h, 1) !== 0) return fail(api.error());
       if (level > 0 && api.set('package-level', String(level)) !== 0) return fail(api.error());
@@ -496,7 +509,10 @@
       bytesComplete = level === 0;  // a first look waits for the whole for what reads it (unsorted, values, groups)
       firstLookShown = level > 0;
       mark(level > 0 ? 'first look opened' : 'opened');
-      if (level > 0) window.voxweb.firstLook = { level, at: performance.now() };
+      if (level > 0) {
+        window.voxweb.looks.push({ level, at: performance.now() });
+        if (!window.voxweb.firstLook) window.voxweb.firstLook = window.voxweb.looks[0];
+      }
       shown(name, t0, level);
     }
     // The file is open and its first picture's renderer made: the panel, then the first frame.
@@ -900,6 +916,7 @@
           }
           if (package_) {
             package_.add(value);
+            package_.askFiner(received + value.length, declared);
           } else if (pointer && chunks.length === 0 && inMemory + value.length <= declared) {
             Module.HEAPU8.set(value, pointer + inMemory);
             inMemory += value.length;
