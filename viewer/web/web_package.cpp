@@ -74,7 +74,7 @@ std::optional<std::vector<Look>> plan_looks(std::span<const std::uint8_t> prefix
     const VxlzFile f = VxlzFile::open_prefix(copy_of(prefix.first(positions), package_name(name)));
     std::vector<Look> looks;
     for (const ShippedLevel& l : shipped_levels(f)) {  // coarsest first
-      if (l.level == 0) continue;
+      if (l.level == 0 || l.points == 0) continue;  // nothing to look at
       if (l.points <= max_points)
         looks = {{l.level, l.bytes}};  // the finest still this small looks first
       else if (!looks.empty())
