@@ -35,7 +35,6 @@ class ShippedVoxlineCursor {
   std::uint64_t point_in_voxline() const { return in_voxline_; }
   // The voxline's own points (count_flags' count).
   std::uint64_t own() const { return voxlines_[voxline_].count_flags & kVoxlineCountMask; }
-  bool starts_streamline() const { return voxline_ == strm_[order_.streamlines[position_]]; }
   // Moves `points` points on (at most to the end of the voxline); past its end, to the next shipped voxline.
   void advance(std::uint64_t points);
 

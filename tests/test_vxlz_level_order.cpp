@@ -17,6 +17,7 @@
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"
 #include "format/vxlz_package.h"
+#include "format/vxlz_streams.h"
 #include "tests/test_support.h"
 
 namespace vxl {
@@ -126,6 +127,36 @@ TEST_F(LevelOrder, APrefixThatDoesNotHoldTheLevelIsRefused) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Input);
     EXPECT_NE(std::string(e.what()).find("needs the first"), std::string::npos) << e.what();
+  }
+}
+
+// A package whose tables claim 2^40 voxlines, all in its first streamline (STRL sums to META's count, checksums
+// valid): the levels' plan refuses it before allocating for them, as the unpack does.
+TEST_F(LevelOrder, AVoxlineCountTheStreamsCannotHoldIsRefusedBeforeAllocating) {
+  const VxlzFile good = VxlzFile::open(dir.file("s.vxlz"));
+  VxlzContent c;
+  c.pack = good.pack();
+  c.meta = good.meta();
+  c.directions.assign(good.directions().begin(), good.directions().end());
+  c.voxel_coords = good.inflate(section_id("VOXC"));
+  c.voxline_voxels = good.inflate(section_id("VXLV"));
+  c.voxline_counts = good.inflate(section_id("VXLC"));
+  for (std::uint64_t i = 0; i < good.chunk_count(); ++i)
+    c.chunks.push_back({std::vector<std::uint8_t>(good.chunk(i).symbols.begin(), good.chunk(i).symbols.end()),
+                        std::vector<std::uint8_t>(good.chunk(i).escapes.begin(), good.chunk(i).escapes.end())});
+  const std::uint64_t huge = std::uint64_t(1) << 40;
+  VarintWriter strl;
+  strl.put(huge);
+  for (std::uint64_t s = 1; s < c.meta.streamline_count; ++s) strl.put(0);
+  c.streamline_voxlines = strl.bytes();
+  c.meta.voxline_count = huge;
+  write_vxlz(dir.file("crafted.vxlz"), c);
+  try {
+    (void)shipped_levels(VxlzFile::open(dir.file("crafted.vxlz")));
+    ADD_FAILURE() << "a plan for 2^40 voxlines was made";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_NE(std::string(e.what()).find("stream too short"), std::string::npos) << e.what();
   }
 }
 

@@ -591,8 +591,13 @@ std::vector<ShippedLevel> shipped_levels(const VxlzFile& f) {
   const MetaSection& m = f.meta();
   const std::vector<std::uint64_t> strm = decode_streamline_voxlines(f.inflate(section_id("STRL")), m.streamline_count,
                                                                      m.voxline_count, f.context(section_id("STRL")));
-  std::vector<VoxlineEntry> voxlines(m.voxline_count);
-  decode_voxline_counts(f.inflate(section_id("VXLC")), voxlines, f.context(section_id("VXLC")));
+  const std::vector<std::uint8_t> counts = f.inflate(section_id("VXLC"));
+  // Every entry takes at least a byte of the stream: refuse a count it cannot hold before allocating.
+  if (m.voxline_count > counts.size())
+    fail_input(f.path(), f.context(section_id("VXLC")).section_offset,
+               "stream too short for META's " + std::to_string(m.voxline_count) + " voxlines");
+  std::vector<VoxlineEntry> voxlines(static_cast<std::size_t>(m.voxline_count));
+  decode_voxline_counts(counts, voxlines, f.context(section_id("VXLC")));
   std::vector<std::uint64_t> streamlines(k.level_count, 0), points(k.level_count, 0);
   for (std::uint64_t st = 0; st < m.streamline_count; ++st) {
     const std::uint32_t d = streamline_depth(st, k.level_count);

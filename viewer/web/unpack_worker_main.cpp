@@ -126,7 +126,7 @@ EMSCRIPTEN_KEEPALIVE int vu_unpack_level(int level) {
     const std::vector<vxl::web::Look> none;
     const auto& looks = a.looks ? *a.looks : none;
     const auto look = std::find_if(looks.begin(), looks.end(), [&](const auto& l) { return int(l.level) == level; });
-    if (look == looks.end() || look->bytes > a.received)
+    if (look == looks.end() || look->bytes > a.received || a.bytes == nullptr)
       throw std::runtime_error(a.name + ": level " + std::to_string(level) + " of the package is not in yet");
     unpacked() = vxl::web::unpack_level_to_file({a.bytes, static_cast<std::size_t>(look->bytes)}, look->level, a.name);
   });
@@ -136,7 +136,8 @@ EMSCRIPTEN_KEEPALIVE int vu_unpack_level(int level) {
 // vu_error says why.
 EMSCRIPTEN_KEEPALIVE int vu_unpack() {
   Arriving& a = arriving();
-  std::uint8_t* bytes = std::exchange(a.bytes, nullptr);
+  std::uint8_t* bytes = std::exchange(a.bytes, nullptr);  // no look after this: their bytes go with the package's
+  a.looks.reset();
   return answer([&] {
     unpacked() = vxl::web::unpack_package_to_file(
         vxl::MappedFile::adopt(vxl::web::package_name(a.name), bytes, static_cast<std::size_t>(a.received)), a.name);

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 
 #include "converter/package/unpack.h"
@@ -74,14 +75,14 @@ std::optional<std::vector<Look>> plan_looks(std::span<const std::uint8_t> prefix
     const VxlzFile f = VxlzFile::open_prefix(copy_of(prefix.first(positions), package_name(name)));
     std::vector<Look> looks;
     for (const ShippedLevel& l : shipped_levels(f)) {  // coarsest first
-      if (l.level == 0 || l.points == 0) continue;  // nothing to look at
+      if (l.level == 0 || l.points == 0) continue;     // nothing to look at
       if (l.points <= max_points)
         looks = {{l.level, l.bytes}};  // the finest still this small looks first
       else if (!looks.empty())
         looks.push_back({l.level, l.bytes});  // the finer ones after it
     }
     return looks;
-  } catch (const Error&) {
+  } catch (const std::exception&) {  // refused, or no memory for its tables: the whole package's unpack says why
     return std::vector<Look>();
   }
 }

@@ -1,13 +1,13 @@
 // Unpacks a .vxlz package off the page's thread (unpack_worker_main.cpp, built as voxunpack.js), as it arrives. The
 // page posts {begin: {size, name}}, then {piece: ArrayBuffer} for each piece of the package in order, then {end:
-// true}. It gets back {looks: [[level, bytes], ...]} once the package's tables are in (the levels of detail it can
+// true} ({begin: {size, name, looks: false}}: no looks, the whole at once). It gets back {looks: [[level, bytes], ...]} once the package's tables are in (the levels of detail it can
 // look at before the whole, coarsest first, and the bytes each needs), {level, vxl: ArrayBuffer, size} when the first
 // of them is in (the .vxl of that level alone: the first `size` bytes of the buffer), the same for each finer one the
 // page asks for with {look: level} after its bytes, then {vxl, size} (the whole package's .vxl) or {error: text}. One
 // package a worker: the page ends the worker once it has the answer, and the module's memory goes with it.
 importScripts('voxunpack.js');
 
-let unpacker = null, pointer = 0, size = 0, received = 0, name = '', looksSent = false;
+let unpacker = null, pointer = 0, size = 0, received = 0, name = '', looksSent = false, looksWanted = true;
 const ready = createVoxunpack().then((module) => { unpacker = module; });
 let queue = Promise.resolve();  // the messages, one after the other (the module loads first)
 
@@ -26,6 +26,7 @@ function error() { return unpacker.UTF8ToString(unpacker._vu_error() >>> 0); }
 
 function begin(message) {
   ({ size, name } = message);
+  looksWanted = message.looks !== false;  // none for a package handed over whole
   received = 0;
   pointer = unpacker.ccall('vu_begin', 'number', ['number', 'string'], [size, name]) >>> 0;
   if (!pointer) throw new Error(`${name}: no memory to unpack this package in`);
@@ -39,6 +40,7 @@ function piece(bytes) {
   unpacker.HEAPU8.set(new Uint8Array(bytes), pointer + received);
   received += bytes.byteLength;
   const level = unpacker._vu_arrived(received);
+  if (!looksWanted) return;
   if (!looksSent) {
     const looks = JSON.parse(unpacker.UTF8ToString(unpacker._vu_looks() >>> 0));
     if (looks.length > 0) {

@@ -428,7 +428,7 @@
         event.preventDefault();
         answer({ error: `${name}: the unpacker could not run (${event.message || 'unpack_worker.js did not load'})` });
       };
-      worker.postMessage({ begin: { size, name } });
+      worker.postMessage({ begin: { size, name, looks: firstLook !== null } });
       return self;
     }
     // A worker for the unpacker; null where the browser has none or refuses it (a page opened from the disk).
@@ -453,7 +453,7 @@
         say(`${name}: unpacking the package`);
         const worker = unpackWorker();
         if (worker) {
-          const package_ = unpackInWorker(worker, size, name, () => {});
+          const package_ = unpackInWorker(worker, size, name, null);  // in memory whole: no looks first
           package_.add(Module.HEAPU8.subarray(pointer, pointer + size));
           Module._free(pointer);
           return openUnpacked(await package_.end(), name, target, t0);
@@ -501,6 +501,8 @@
       Module.HEAPU8.set(new Uint8Array(answer.vxl, 0, size), pointer);
       answer.vxl = null;  // the copy in the WebAssembly memory is the one kept: this one goes at the next collection
       const camera = firstLookShown && viewMoved ? JSON.parse(api.camera()) : null;
+      // What the reader chose in the panel while a look was shown stays chosen.
+      const panel = firstLookShown ? ['mode', 'color', 'opacity'].map((key) => [key, $(key).value]) : [];
       const [w, h] = canvasSize();
       if (api.open(pointer, size, name, w, h, 1) !== 0) return fail(api.error());
       if (level > 0 && api.set('package-level', String(level)) !== 0) return fail(api.error());
@@ -514,6 +516,13 @@
         if (!window.voxweb.firstLook) window.voxweb.firstLook = window.voxweb.looks[0];
       }
       shown(name, t0, level);
+      for (const [key, value] of panel) {
+        const option = key === 'opacity' ? null : [...$(key).options].find((o) => o.value === value);
+        if (key !== 'opacity' && (!option || option.disabled)) continue;
+        $(key).value = value;
+        if (key === 'opacity') $('opacity-value').textContent = value;
+        set(key, value);
+      }
     }
     // The file is open and its first picture's renderer made: the panel, then the first frame.
     function shown(name, t0, level = 0) {
