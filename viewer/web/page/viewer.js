@@ -869,6 +869,7 @@
       const { url } = target;
       say('fetching ' + url);
       bytesComplete = true;
+      firstLookShown = viewMoved = false;
       fetchRest = restLater = restPromise = null;
       const t0 = performance.now();
       let probe;
