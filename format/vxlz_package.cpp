@@ -171,6 +171,21 @@ VxlzFile VxlzFile::open_prefix(MappedFile prefix) {
   return f;
 }
 
+std::optional<std::uint64_t> VxlzFile::positions_offset(std::span<const std::uint8_t> first_bytes) {
+  FileHeader h;
+  if (first_bytes.size() < sizeof h) return std::nullopt;
+  std::memcpy(&h, first_bytes.data(), sizeof h);
+  if (h.section_count > kVxlzMaxSections) return 0;
+  const std::uint64_t table_end = sizeof h + std::uint64_t(h.section_count) * sizeof(SectionEntry);
+  if (first_bytes.size() < table_end) return std::nullopt;
+  for (std::uint32_t i = 0; i < h.section_count; ++i) {
+    SectionEntry e;
+    std::memcpy(&e, first_bytes.data() + sizeof h + i * sizeof e, sizeof e);
+    if (std::memcmp(e.id, "POSD", 4) == 0) return e.offset;
+  }
+  return 0;
+}
+
 const SectionEntry* VxlzFile::find(std::uint32_t id) const {
   for (const SectionEntry& e : sections_) {
     std::uint32_t eid;

@@ -67,6 +67,9 @@ class VxlzFile {
   // other section must be whole (else Input, "needs the first N bytes"). Chunks past the prefix are not there
   // (chunks_present).
   static VxlzFile open_prefix(MappedFile prefix);
+  // Where the positions (POSD) start, read from a package's first bytes (unchecked: open_prefix checks): nullopt while
+  // they do not hold its section table yet, 0 when the table names no POSD. A prefix that reaches it can be opened.
+  static std::optional<std::uint64_t> positions_offset(std::span<const std::uint8_t> first_bytes);
 
   const std::string& path() const { return file_.path(); }
   std::uint64_t size() const { return file_.size(); }

@@ -33,10 +33,11 @@ ShippingOrder shipping_order(std::span<const std::uint64_t> strm, std::span<cons
   return order;
 }
 
-std::vector<std::uint8_t> streamline_depths(std::uint64_t streamline_count, std::uint32_t level_count) {
+std::vector<std::uint8_t> shipped_depths(const PackSection& pack, std::uint64_t streamline_count) {
+  if (pack.predictor != kVxlzPredictorLinearLevelOrder) return {};
   std::vector<std::uint8_t> depths(streamline_count);
   for (std::uint64_t s = 0; s < streamline_count; ++s)
-    depths[s] = static_cast<std::uint8_t>(streamline_depth(s, level_count));
+    depths[s] = static_cast<std::uint8_t>(streamline_depth(s, pack.level_count));
   return depths;
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "format/vxl_layout.h"
+#include "format/vxlz_layout.h"
 
 namespace vxl {
 
@@ -22,8 +23,9 @@ struct ShippingOrder {
 ShippingOrder shipping_order(std::span<const std::uint64_t> strm, std::span<const VoxlineEntry> voxlines,
                              std::span<const std::uint8_t> depths);
 
-// The depth of every streamline for a level order of `level_count` levels (`.vxl` spec §6.5).
-std::vector<std::uint8_t> streamline_depths(std::uint64_t streamline_count, std::uint32_t level_count);
+// Each streamline's depth in the order `pack` names (PACK.predictor, PACK.level_count: `.vxl` spec §6.5's depth for
+// its level order), the key shipping_order sorts by; empty for streamline order.
+std::vector<std::uint8_t> shipped_depths(const PackSection& pack, std::uint64_t streamline_count);
 
 // Walks the shipped points voxline by voxline, from any shipped point: where a chunk starts, which voxline holds
 // the point, and how far into it.

@@ -122,7 +122,7 @@ FIRST_PICTURE = """new Promise((resolve) => {
         levels_shown: window.voxweb.levelsShown || [],
         spans_fetched: window.voxweb.spansFetched || [],
         mixed_shown: window.voxweb.mixedShown || [],
-        first_look: window.voxweb.firstLook || null, looks: window.voxweb.looks || [],
+        looks: window.voxweb.looks || [],
         marks: performance.getEntriesByType('mark').filter((m) => m.startTime <= first)
           .map((m) => [m.name.replace('voxweb:', ''), m.startTime]),
         heap_bytes: performance.memory ? performance.memory.usedJSHeapSize : null,
@@ -181,7 +181,7 @@ def capture_in(browser, url, out, timeout, drop=None):
                    'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'],
                    'full_level': value.get('full_level'), 'mode': value.get('mode'),
                    'levels_shown': value['levels_shown'], 'spans_fetched': value.get('spans_fetched', []),
-                   'mixed_shown': value.get('mixed_shown', []), 'first_look': value.get('first_look'),
+                   'mixed_shown': value.get('mixed_shown', []),
                    'looks': value.get('looks', []),
                    'marks': value.get('marks', []),
                    'heap_bytes': value['heap_bytes'], 'memory': value.get('memory'),

@@ -201,10 +201,8 @@ void encode_positions(const VxlFile& f, const VoxlineIndex& index, unsigned thre
     double max = 0, sum_squares = 0;
   };
   // The points in the order they are shipped (spec §5.1): with levels, the coarsest level's streamlines first.
-  const std::uint32_t levels = pack.predictor == kVxlzPredictorLinearLevelOrder ? pack.level_count : 0;
   const auto strm = f.streamline_first_voxline();
-  const ShippingOrder order = shipping_order(
-      strm, voxlines, levels > 1 ? streamline_depths(f.meta().streamline_count, levels) : std::vector<std::uint8_t>());
+  const ShippingOrder order = shipping_order(strm, voxlines, shipped_depths(pack, f.meta().streamline_count));
   // Chunk `chunk`'s residuals (spec §5.2) into `residuals`, its quantisation errors into `e`.
   auto chunk_residuals = [&](std::uint64_t chunk, std::vector<std::int32_t>& residuals, ErrorStats& e) {
     const std::uint64_t start = chunk * pack.chunk_points;

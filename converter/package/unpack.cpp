@@ -58,6 +58,14 @@ struct Structure {
   }
 };
 
+// Every voxline takes at least a byte of each of its streams (VXLV, VXLC): META's count is refused when `stream` (the
+// inflated section `id`) cannot hold it, before anything is allocated for it.
+void check_stream_holds_voxlines(const VxlzFile& f, std::uint32_t id, const std::vector<std::uint8_t>& stream) {
+  if (f.meta().voxline_count > stream.size())
+    fail_input(f.path(), f.context(id).section_offset,
+               "stream too short for META's " + std::to_string(f.meta().voxline_count) + " voxlines");
+}
+
 // Inflates and decodes the voxline table, the voxel and the count streams side by side.
 std::vector<VoxlineEntry> read_voxlines(const VxlzFile& f, std::span<const std::array<std::int32_t, 3>> coords) {
   const std::uint64_t l = f.meta().voxline_count;
@@ -66,21 +74,12 @@ std::vector<VoxlineEntry> read_voxlines(const VxlzFile& f, std::span<const std::
   std::vector<VoxlineEntry> voxlines;
   auto both = [](auto&& voxel_part, auto&& count_part) { parallel_invoke(true, voxel_part, count_part); };
   both([&] { voxel_stream = f.inflate(vxlv); }, [&] { count_stream = f.inflate(vxlc); });
-  // Every entry takes at least a byte of each stream: refuse a count they cannot hold before allocating.
-  if (l > voxel_stream.size() || l > count_stream.size())
-    fail_input(f.path(), f.context(l > voxel_stream.size() ? vxlv : vxlc).section_offset,
-               "stream too short for META's " + std::to_string(l) + " voxlines");
+  check_stream_holds_voxlines(f, vxlv, voxel_stream);
+  check_stream_holds_voxlines(f, vxlc, count_stream);
   voxlines.resize(l);
   both([&] { decode_voxline_voxels(voxel_stream, coords, voxlines, f.context(vxlv)); },
        [&] { decode_voxline_counts(count_stream, voxlines, f.context(vxlc)); });
   return voxlines;
-}
-
-// Each streamline's depth in the package's level order (spec §5.1); empty for streamline order.
-std::vector<std::uint8_t> shipped_depths(const VxlzFile& f) {
-  const PackSection& k = f.pack();
-  return k.predictor == kVxlzPredictorLinearLevelOrder ? streamline_depths(f.meta().streamline_count, k.level_count)
-                                                       : std::vector<std::uint8_t>();
 }
 
 // Keeps the streamlines of depth `min_depth` or more (level `min_depth` of the package's level order) and the voxels
@@ -147,7 +146,7 @@ Structure rebuild_structure(const VxlzFile& f, std::uint32_t level_count, std::u
   s.strm = decode_streamline_voxlines(f.inflate(section_id("STRL")), m.streamline_count, m.voxline_count,
                                       f.context(section_id("STRL")));
   s.voxlines = read_voxlines(f, coords);
-  std::vector<std::uint8_t> depths = shipped_depths(f);
+  std::vector<std::uint8_t> depths = shipped_depths(k, f.meta().streamline_count);
   if (min_depth > 0) {
     keep_level(min_depth, depths, m, coords, s);
     std::erase_if(depths, [&](std::uint8_t d) { return d < min_depth; });
@@ -592,10 +591,7 @@ std::vector<ShippedLevel> shipped_levels(const VxlzFile& f) {
   const std::vector<std::uint64_t> strm = decode_streamline_voxlines(f.inflate(section_id("STRL")), m.streamline_count,
                                                                      m.voxline_count, f.context(section_id("STRL")));
   const std::vector<std::uint8_t> counts = f.inflate(section_id("VXLC"));
-  // Every entry takes at least a byte of the stream: refuse a count it cannot hold before allocating.
-  if (m.voxline_count > counts.size())
-    fail_input(f.path(), f.context(section_id("VXLC")).section_offset,
-               "stream too short for META's " + std::to_string(m.voxline_count) + " voxlines");
+  check_stream_holds_voxlines(f, section_id("VXLC"), counts);
   std::vector<VoxlineEntry> voxlines(static_cast<std::size_t>(m.voxline_count));
   decode_voxline_counts(counts, voxlines, f.context(section_id("VXLC")));
   std::vector<std::uint64_t> streamlines(k.level_count, 0), points(k.level_count, 0);

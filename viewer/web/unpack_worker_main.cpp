@@ -21,12 +21,10 @@
 #include <utility>
 #include <vector>
 
+#include "viewer/app/frame_budget.h"
 #include "viewer/web/web_package.h"
 
 namespace {
-
-// About the segments voxview's first picture draws (frame_budget.h's kFirstPictureSegments).
-constexpr std::uint64_t kFirstLookPoints = 250'000;
 
 // The .vxl the last unpack wrote into the in-memory file system: the worker's script hands its bytes over as they
 // lie there (no copy in the module's memory) and removes it.
@@ -101,7 +99,8 @@ EMSCRIPTEN_KEEPALIVE int vu_arrived(double received) {
   Arriving& a = arriving();
   a.received = static_cast<std::uint64_t>(received);
   if (!a.looks)
-    a.looks = vxl::web::plan_looks({a.bytes, static_cast<std::size_t>(a.received)}, a.name, kFirstLookPoints);
+    a.looks = vxl::web::plan_looks({a.bytes, static_cast<std::size_t>(a.received)}, a.name,
+                                   vxl::app::kFirstPictureSegments);  // points: about as many segments
   if (!a.looks || a.looks->empty() || a.first_look_asked || a.received < a.looks->front().bytes) return 0;
   a.first_look_asked = true;
   return static_cast<int>(a.looks->front().level);

@@ -9,7 +9,6 @@
 
 #include "converter/package/unpack.h"
 #include "format/base/error.h"
-#include "format/vxl_layout.h"
 #include "format/vxlz_layout.h"
 #include "format/vxlz_package.h"
 
@@ -56,23 +55,12 @@ MappedFile unpack_package(MappedFile package, const std::string& name) {
 
 std::optional<std::vector<Look>> plan_looks(std::span<const std::uint8_t> prefix, const std::string& name,
                                             std::uint64_t max_points) {
-  // The section table says where the positions start: everything before them is what opening the prefix needs.
-  FileHeader h;
-  if (prefix.size() < sizeof h) return std::nullopt;
-  std::memcpy(&h, prefix.data(), sizeof h);
-  if (h.section_count > kVxlzMaxSections) return std::vector<Look>();
-  const std::uint64_t table_end = sizeof h + std::uint64_t(h.section_count) * sizeof(SectionEntry);
-  if (prefix.size() < table_end) return std::nullopt;
-  std::uint64_t positions = 0;
-  for (std::uint32_t i = 0; i < h.section_count; ++i) {
-    SectionEntry e;
-    std::memcpy(&e, prefix.data() + sizeof h + i * sizeof e, sizeof e);
-    if (std::memcmp(e.id, "POSD", 4) == 0) positions = e.offset;
-  }
-  if (positions == 0) return std::vector<Look>();
-  if (prefix.size() < positions) return std::nullopt;
+  // Everything before the positions is what opening the prefix needs.
+  const std::optional<std::uint64_t> positions = VxlzFile::positions_offset(prefix);
+  if (positions && *positions == 0) return std::vector<Look>();  // no positions: nothing to look at
+  if (!positions || prefix.size() < *positions) return std::nullopt;
   try {
-    const VxlzFile f = VxlzFile::open_prefix(copy_of(prefix.first(positions), package_name(name)));
+    const VxlzFile f = VxlzFile::open_prefix(copy_of(prefix.first(*positions), package_name(name)));
     std::vector<Look> looks;
     for (const ShippedLevel& l : shipped_levels(f)) {  // coarsest first
       if (l.level == 0 || l.points == 0) continue;     // nothing to look at

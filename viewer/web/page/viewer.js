@@ -38,9 +38,8 @@
     // pictures at rest shown with some of them in and a coarser level in place of the others.
     spansFetched: [],
     mixedShown: [],  // when each was shown, ms from navigation
-    // A package's looks before the whole ({level, at: ms from navigation}: a level of detail alone), and the first.
+    // A package's looks before the whole ({level, at: ms from navigation}: a level of detail alone), in order.
     looks: [],
-    firstLook: null,
     longTasks: () => longTasks.slice(),
   };
 
@@ -115,9 +114,9 @@
     // Where the GPU budget draws a coarser level than full detail, fetching stops once that level is in: restLater
     // brings the rest when a setting needs it (fetchRestNow).
     let restLater = null, restPromise = null;
-    // A package's first look (a level of detail alone, openUnpacked) is on the screen, the whole still to come; the
-    // reader has moved the view since the file was opened (the whole then keeps that view).
-    let firstLookShown = false, viewMoved = false;
+    // A package's look (a level of detail alone, openUnpacked) is on the screen, the whole still to come; the reader
+    // has moved the view since the file was opened (the next look and the whole then keep that view).
+    let lookShown = false, viewMoved = false;
 
     function set(key, value) {
       if (!bytesComplete && (restLater || restPromise) && needsWholeFileNow(key, String(value))) {
@@ -237,7 +236,7 @@
     }
     // Full detail is on the screen and the whole file in: complete once what is drawn is checked.
     function done() {
-      if (!bytesComplete && !restLater) return;  // a package's first look: the whole is still to come
+      if (!bytesComplete && !restLater) return;  // a package's look: the whole is still to come
       checked().then((ok) => {
         if (!ok) return;
         $('progress').value = 1;
@@ -385,10 +384,10 @@
 
     // A package unpacked in `worker` (unpack_worker.js) as its bytes arrive: add(Uint8Array) hands each piece over
     // (copied), end() says all are in and resolves with the answer, {vxl: ArrayBuffer, size} or {error: text}. Where
-    // its first bytes hold a level of detail to look at while the rest arrives, firstLook(level, {vxl, size}) gets it
-    // before the end. A package opened since ends the one before ({stale: true}); so does cancel().
+    // its first bytes hold a level of detail to look at while the rest arrives, onLook(level, {vxl, size}) gets it
+    // (and each finer one askFiner asks for) before the end; onLook null: no looks. A package opened since ends the one before ({stale: true}); so does cancel().
     let unpacking = null;  // the package being unpacked
-    function unpackInWorker(worker, size, name, firstLook) {
+    function unpackInWorker(worker, size, name, onLook) {
       if (unpacking) unpacking.cancel();
       let answer;
       const whole = new Promise((resolve) => {
@@ -421,14 +420,14 @@
       unpacking = self;
       worker.onmessage = (event) => {
         if (event.data.looks) [looks, asked] = [event.data.looks, event.data.looks[0][0]];
-        else if (event.data.level && !event.data.error) firstLook(event.data.level, event.data);
+        else if (event.data.level && !event.data.error) onLook(event.data.level, event.data);
         else answer(event.data);
       };
       worker.onerror = (event) => {
         event.preventDefault();
         answer({ error: `${name}: the unpacker could not run (${event.message || 'unpack_worker.js did not load'})` });
       };
-      worker.postMessage({ begin: { size, name, looks: firstLook !== null } });
+      worker.postMessage({ begin: { size, name, looks: onLook !== null } });
       return self;
     }
     // A worker for the unpacker; null where the browser has none or refuses it (a page opened from the disk).
@@ -467,8 +466,8 @@
       shown(name, t0);
     }
     // A package streamed into the unpacker as it arrives (`first`: its first piece), or null when `first` is not a
-    // package's or the browser has no workers (the package is then read whole and opened by openBytes). Its first look
-    // (a level of detail in its first bytes) is shown while the rest arrives.
+    // package's or the browser has no workers (the package is then read whole and opened by openBytes). Its looks
+    // (levels of detail alone, from its first bytes) are shown while the rest arrives.
     function streamedPackage(target, first, declared) {
       if (!isPackage(first)) return null;
       const worker = unpackWorker();
@@ -479,18 +478,18 @@
         openUnpacked(file, target.name, target, t0, level);
       });
     }
-    // What the unpacker answered (unpackInWorker): the package's .vxl opened, or its error said. level > 0: the first
-    // look, that level of detail alone, drawn with its opacity (package-level) until the whole replaces it in the
-    // view the reader has moved to meanwhile.
+    // What the unpacker answered (unpackInWorker): the package's .vxl opened, or its error said. level > 0: a look,
+    // that level of detail alone, drawn with its opacity (package-level) until a finer look or the whole replaces it
+    // in the view, and with the panel's choices, the reader has moved to meanwhile.
     function openUnpacked(answer, name, target, t0, level = 0) {
       if (!current(target) || answer.stale) return;
       if (answer.error !== undefined) {
-        // A package refused after its first look: that picture came from bytes the refusal says are damaged.
-        if (firstLookShown) [opened, canvas.style.visibility] = [false, 'hidden'];
+        // A package refused after a look: that picture came from bytes the refusal says are damaged.
+        if (lookShown) [opened, canvas.style.visibility] = [false, 'hidden'];
         return fail(answer.error);
       }
-      if (level === 0 && firstLookShown) mark('whole unpacked');
-      else mark(level > 0 ? 'first look unpacked' : 'unpacked');
+      if (level === 0 && lookShown) mark('whole unpacked');
+      else mark(level > 0 ? 'look unpacked' : 'unpacked');
       const size = answer.size !== undefined ? answer.size : answer.vxl.byteLength;
       let pointer;
       try {
@@ -500,21 +499,18 @@
       }
       Module.HEAPU8.set(new Uint8Array(answer.vxl, 0, size), pointer);
       answer.vxl = null;  // the copy in the WebAssembly memory is the one kept: this one goes at the next collection
-      const camera = firstLookShown && viewMoved ? JSON.parse(api.camera()) : null;
+      const camera = lookShown && viewMoved ? JSON.parse(api.camera()) : null;
       // What the reader chose in the panel while a look was shown stays chosen.
-      const panel = firstLookShown ? ['mode', 'color', 'opacity'].map((key) => [key, $(key).value]) : [];
+      const panel = lookShown ? ['mode', 'color', 'opacity'].map((key) => [key, $(key).value]) : [];
       const [w, h] = canvasSize();
       if (api.open(pointer, size, name, w, h, 1) !== 0) return fail(api.error());
       if (level > 0 && api.set('package-level', String(level)) !== 0) return fail(api.error());
       if (camera && camera.target)
         api.setCamera(camera.az, camera.el, camera.distance, camera.target[0], camera.target[1], camera.target[2]);
-      bytesComplete = level === 0;  // a first look waits for the whole for what reads it (unsorted, values, groups)
-      firstLookShown = level > 0;
-      mark(level > 0 ? 'first look opened' : 'opened');
-      if (level > 0) {
-        window.voxweb.looks.push({ level, at: performance.now() });
-        if (!window.voxweb.firstLook) window.voxweb.firstLook = window.voxweb.looks[0];
-      }
+      bytesComplete = level === 0;  // a look waits for the whole for what reads it (unsorted, values, groups)
+      lookShown = level > 0;
+      mark(level > 0 ? 'look opened' : 'opened');
+      if (level > 0) window.voxweb.looks.push({ level, at: performance.now() });
       shown(name, t0, level);
       for (const [key, value] of panel) {
         const option = key === 'opacity' ? null : [...$(key).options].find((o) => o.value === value);
@@ -869,7 +865,7 @@
       const { url } = target;
       say('fetching ' + url);
       bytesComplete = true;
-      firstLookShown = viewMoved = false;
+      lookShown = viewMoved = false;
       fetchRest = restLater = restPromise = null;
       const t0 = performance.now();
       let probe;
@@ -917,7 +913,7 @@
       const chunks = [];
       let received = 0, inMemory = 0, pointer = 0, package_ = null;
       const t0 = performance.now();
-      viewMoved = firstLookShown = false;
+      viewMoved = lookShown = false;
       const sink = {
         add(value) {
           if (received === 0) {
