@@ -18,6 +18,10 @@ struct ByteRange {
   bool operator==(const ByteRange&) const = default;
 };
 
+// The largest file a reader in 32-bit WebAssembly holds (its memory is 4 GiB at most), with room left for the
+// viewer beside it: the web viewer refuses larger files, and `voxlines share` refuses to share them.
+inline constexpr std::uint64_t kWebMaxFileBytes = (std::uint64_t(1) << 32) - (std::uint64_t(1) << 28);
+
 // Enough of a file's first bytes for the header and the largest section table (spec §3, §4).
 inline constexpr std::uint64_t kSectionTableBytesMax = sizeof(FileHeader) + kVxlMaxSections * sizeof(SectionEntry);
 

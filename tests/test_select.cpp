@@ -37,6 +37,7 @@
 #include "format/base/error.h"
 #include "format/vxl_verify.h"
 #include "tests/address_sanitizer.h"
+#include "tests/hostile_inputs.h"
 #include "tests/hostile_vxl.h"
 #include "tests/mif_test_files.h"
 #include "tests/nifti_test_files.h"
@@ -362,6 +363,42 @@ TEST_F(Selection, RegionsOutsideEverythingOrHoldingEverything) {
 
 // A streamline without points is never selected, as tckedit never writes one: not by an exclude, an inverted
 // query or a length limit of 0, which every streamline with points passes.
+// A level of detail is applied last, after the regions, the lengths and --invert: of what they keep, the streamlines
+// of depth >= level (spec §6.5), about an eighth a level; a level the file has not is refused.
+TEST_F(Selection, ALevelKeepsTheStreamlinesOfThatDepthAmongThoseTheCriteriaKeep) {
+  const VxlFile file = VxlFile::open(dir_->file("packed_4mm.vxl"));
+  const std::uint32_t levels = file.level_count();
+  ASSERT_EQ(levels, kDefaultLevels);
+  auto at_level = [&](std::vector<std::uint64_t> kept, std::uint32_t level) {
+    std::erase_if(kept, [&](std::uint64_t s) { return streamline_depth(s, levels) < level; });
+    return kept;
+  };
+  SelectionCriteria in_sphere;
+  in_sphere.include.push_back(sphere(0, -18, 10, 30));
+  SelectionCriteria inverted = in_sphere;
+  inverted.invert = true;
+  SelectionCriteria lengths;
+  lengths.min_length = 40;
+  for (const SelectionCriteria& base : {SelectionCriteria{}, in_sphere, inverted, lengths}) {
+    const std::vector<std::uint64_t> all = select_streamlines(file, base).streamlines;
+    for (std::uint32_t level = 0; level < levels; ++level) {
+      SelectionCriteria c = base;
+      c.level = level;
+      const std::vector<std::uint64_t> kept = select_streamlines(file, c).streamlines;
+      EXPECT_EQ(kept, at_level(all, level)) << "level " << level;
+      if (level == 1 && base.include.empty() && !base.min_length) {  // about an eighth of 3000
+        EXPECT_GT(kept.size(), all.size() / 8 - 120);
+        EXPECT_LT(kept.size(), all.size() / 8 + 120);
+      }
+    }
+  }
+  SelectionCriteria beyond;
+  beyond.level = levels;
+  const Error error = test::hostile::error_of([&] { select_streamlines(file, beyond); });
+  EXPECT_EQ(error.kind(), ErrorKind::Usage);
+  EXPECT_NE(std::string(error.what()).find("has 5 levels of detail: 0 to 4"), std::string::npos) << error.what();
+}
+
 TEST(SelectionEmptyStreamlines, AreNeverSelected) {
   ScratchDir dir;
   Tractogram t;
@@ -970,6 +1007,26 @@ TEST(SelectionCli, CountJsonAndTheCriteriaInTheTckHeader) {
   const Tractogram back = read_tractogram(dir.file("o.tck"));
   EXPECT_LE(back.streamline_count(), n);
   EXPECT_NE(back.source.header.dump().find("include 0,-18,10,20"), std::string::npos) << back.source.header.dump();
+}
+
+// --level in the CLI: the count is the API's, and the TCK header says how the selection was made.
+TEST(SelectionCli, ALevelOfDetailIsCountedWrittenAndRecorded) {
+  ScratchDir dir;
+  convert_tractogram(synth(800), dir.file("in.vxl"), settings(PositionEncoding::Packed));
+  const std::string in = test::q(dir.file("in.vxl"));
+  SelectionCriteria c;
+  c.level = 1;
+  const std::uint64_t expected = select_streamlines(VxlFile::open(dir.file("in.vxl")), c).streamlines.size();
+  const test::CommandResult count = run_cli("select " + in + " --level 1 --count");
+  ASSERT_EQ(count.exit_code, 0) << count.output;
+  EXPECT_EQ(std::stoull(count.output), expected);
+  ASSERT_EQ(run_cli("select " + in + " " + test::q(dir.file("o.tck")) + " --level 1").exit_code, 0);
+  const Tractogram back = read_tractogram(dir.file("o.tck"));
+  EXPECT_EQ(back.streamline_count(), expected);
+  EXPECT_NE(back.source.header.dump().find("level 1"), std::string::npos) << back.source.header.dump();
+  const test::CommandResult beyond = run_cli("select " + in + " --level 5 --count");
+  EXPECT_EQ(beyond.exit_code, 2);
+  EXPECT_NE(beyond.output.find("--level"), std::string::npos) << beyond.output;
 }
 
 // One table of output formats (converter/export/streamline_outputs.h): select writes every suffix it lists and export

@@ -11,7 +11,10 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/share/share_folder.h"
+#include "format/base/error.h"
+#include "format/vxl_file.h"
 #include "test_support.h"
+#include "tests/hostile_inputs.h"
 
 namespace vxl {
 namespace {
@@ -98,6 +101,63 @@ TEST(Share, ADamagedPackageIsRefusedBeforeItIsShared) {
   EXPECT_NE(r.output.find("checksum"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_EQ(entries_named_part(t.dir), 0);
+}
+
+// --level: the folder holds the streamlines of that level of detail as a .vxl (from a package too, unpacked first,
+// nothing of the unpacking left), as many as select keeps at that level.
+TEST(Share, ALevelOfDetailIsSharedAsAVxlOfItsStreamlines) {
+  SharedTractogram t;
+  const auto count = test::run_cli("select " + test::q(t.vxl) + " --level 1 --count");
+  ASSERT_EQ(count.exit_code, 0) << count.output;
+  const std::uint64_t expected = std::stoull(count.output);
+  ASSERT_GT(expected, 0u);
+  const std::string vxlz = t.dir.file("in.vxlz");
+  ASSERT_EQ(test::run_cli("pack " + test::q(t.vxl) + " " + test::q(vxlz)).exit_code, 0);
+  for (const std::string& in : {t.vxl, vxlz}) {
+    const std::string out = t.dir.file("shared-" + fs::path(in).extension().string().substr(1));
+    const auto r = t.share(in, out, " --level 1");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("level 1 of the input"), std::string::npos) << r.output;
+    EXPECT_EQ(nlohmann::json::parse(test::slurp(out + "/share.json"))["file"], "in.vxl");
+    EXPECT_EQ(VxlFile::open(out + "/in.vxl").meta().streamline_count, expected) << in;
+    EXPECT_EQ(test::run_cli("verify " + test::q(out + "/in.vxl")).exit_code, 0);
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(out)) names.push_back(e.path().filename().string());
+    EXPECT_EQ(names.size(), std::size(kWebViewerFiles) + 3) << in;  // the .vxl, share.json, README.txt
+  }
+  const auto beyond = t.share(vxlz, t.dir.file("beyond"), " --level 5");
+  EXPECT_EQ(beyond.exit_code, 2) << beyond.output;
+  EXPECT_NE(beyond.output.find("in.vxlz has 5 levels of detail"), std::string::npos) << beyond.output;
+  EXPECT_FALSE(fs::exists(t.dir.file("beyond")));
+  EXPECT_EQ(entries_named_part(t.dir), 0);
+}
+
+// The page holds its whole .vxl in WebAssembly's memory: a larger one is refused before anything is copied, naming
+// the level of detail that would fit, or a selection where even the coarsest would not; that level then is shared.
+TEST(Share, AVxlLargerThanTheBrowserHoldsIsRefusedNamingALevelThatFits) {
+  SharedTractogram t;
+  const std::uint64_t size = fs::file_size(t.vxl);
+  ShareSettings settings;
+  settings.web_viewer_dir = t.viewer;
+  const std::string out = t.dir.file("shared");
+  auto refusal = [&](std::uint64_t max_bytes) {
+    settings.max_data_bytes = max_bytes;
+    const Error e = test::hostile::error_of([&] { share_folder(t.vxl, out, settings); });
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_EQ(entries_named_part(t.dir), 0);
+    return std::string(e.what());
+  };
+  std::string why = refusal(size - 1);
+  EXPECT_NE(why.find("in.vxl"), std::string::npos) << why;
+  EXPECT_NE(why.find("--level 1 keeps about 1/8 of the streamlines"), std::string::npos) << why;
+  why = refusal(size / 20);
+  EXPECT_NE(why.find("--level 2 keeps about 1/64"), std::string::npos) << why;
+  why = refusal(8);
+  EXPECT_NE(why.find("voxlines select"), std::string::npos) << why;
+  settings.max_data_bytes = size - 1;
+  settings.level = 1;
+  EXPECT_LT(share_folder(t.vxl, out, settings).data_bytes, size);
 }
 
 TEST(Share, RefusalsLeaveNoFolder) {

@@ -22,6 +22,7 @@ std::vector<std::string> criteria_lines(const std::vector<std::string>& include,
   if (c.min_length) out.push_back("min_dist: " + std::to_string(*c.min_length));
   if (c.max_length) out.push_back("max_dist: " + std::to_string(*c.max_length));
   if (c.invert) out.push_back("voxlines_selection: inverted");
+  if (c.level) out.push_back("voxlines_selection: level " + std::to_string(*c.level));
   return out;
 }
 
@@ -29,6 +30,7 @@ struct SelectOptions {
   std::string input, output;
   std::vector<std::string> include, exclude, ends_in;
   std::optional<double> min_length, max_length;
+  std::optional<std::uint32_t> level;
   bool invert = false, count = false, json = false, verbose = false;
   TckExportSettings tck;
 };
@@ -55,6 +57,7 @@ SelectionCriteria criteria_of(const SelectOptions& opt) {
   criteria.min_length = opt.min_length;
   criteria.max_length = opt.max_length;
   criteria.invert = opt.invert;
+  criteria.level = opt.level;
   return criteria;
 }
 
@@ -97,6 +100,11 @@ void add_select_command(CLI::App& app) {
       ->type_name("MM");
   cmd->add_option("--max-length", opt->max_length, "keep streamlines at most this long (mm)")->type_name("MM");
   cmd->add_flag("--invert", opt->invert, "keep exactly the streamlines the criteria reject (tckedit's -inverse)");
+  cmd->add_option(
+         "--level", opt->level,
+         "of those, keep only the streamlines of this level of detail (1: about an eighth, 2: a 64th...,\n"
+         "spread over the whole tractogram, as voxview draws it coarser): a smaller tractogram alike everywhere")
+      ->type_name("N");
   cmd->add_flag("--count", opt->count, "print only the number of selected streamlines (no output file)");
   cmd->add_flag("--json", opt->json, "print the result as JSON");
   cmd->add_option("--tsf", opt->tck.tsf_path, "with a .tck output: also write one per-point value set as a TSF");

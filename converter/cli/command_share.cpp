@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <string>
 
 #include "converter/cli/commands.h"
 #include "converter/share/share_folder.h"
@@ -42,15 +43,20 @@ void add_share_command(CLI::App& app) {
   cmd->add_flag("--unpack", opt->settings.unpack,
                 "a .vxlz: write it unpacked, as a .vxl (about 8 times larger to host; the page then fetches a large\n"
                 "one by ranges and shows its first picture before the rest is in, where it fetches a .vxlz whole)");
+  cmd->add_option("--level", opt->settings.level,
+                  "share only the streamlines of this level of detail, as a .vxl (1: about an eighth, 2: a 64th...,\n"
+                  "spread over the whole tractogram): for one too large for a browser, which holds at most 3.75 GiB")
+      ->type_name("N");
   cmd->add_option("--threads", opt->settings.threads, "worker threads for --unpack (0: all cores)")->default_val(0);
   cmd->callback([opt] {
     if (opt->settings.web_viewer_dir.empty()) opt->settings.web_viewer_dir = default_web_viewer_dir();
     const ShareSummary s = share_folder(opt->input, opt->output, opt->settings);
+    const std::string how = opt->settings.level ? ", level " + std::to_string(*opt->settings.level) + " of the input"
+                            : s.unpacked        ? ", unpacked from the .vxlz"
+                            : s.package         ? ", unpacked by the page"
+                                                : "";
     std::printf("%s: %llu streamlines in %s (%.1f MiB%s); serve the folder and open index.html\n", opt->output.c_str(),
-                (unsigned long long)s.streamlines, s.data_file.c_str(), double(s.data_bytes) / (1 << 20),
-                s.unpacked  ? ", unpacked from the .vxlz"
-                : s.package ? ", unpacked by the page"
-                            : "");
+                (unsigned long long)s.streamlines, s.data_file.c_str(), double(s.data_bytes) / (1 << 20), how.c_str());
   });
 }
 

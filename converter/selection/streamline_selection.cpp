@@ -19,6 +19,7 @@
 #include "format/base/json_limits.h"
 #include "format/base/parallel.h"
 #include "format/streamline_length.h"
+#include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
 #include "format/vxl_streamlines.h"
 
@@ -603,12 +604,9 @@ void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, s
   for (const HitSearch& search : per_thread) q.points_tested += search.points_tested;
 }
 
-}  // namespace
-
-SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria, const VoxelVoxlines* index,
-                                   SelectionPath path, VoxlineBoxes* boxes) {
-  if (criteria.min_length && criteria.max_length && *criteria.min_length > *criteria.max_length)
-    throw Error(ErrorKind::Usage, "--min-length", std::nullopt, "the minimum length is above the maximum length");
+// Everything select_streamlines decides but the level.
+SelectionResult select_by_regions_and_lengths(const VxlFile& file, const SelectionCriteria& criteria,
+                                              const VoxelVoxlines* index, SelectionPath path, VoxlineBoxes* boxes) {
   const RegionTable table(criteria);
   SelectionResult result;
   const std::uint64_t n = file.meta().streamline_count;
@@ -706,6 +704,28 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
     keep_from(0, n);
   else  // only the streamlines that pass: eight at a time past the others
     for_each_nonzero_chunk(passes.data(), n, [&](std::uint64_t s) { keep_from(s, std::min(n, s + 8)); });
+  return result;
+}
+
+}  // namespace
+
+void check_level(const std::string& path, std::uint32_t level, std::uint32_t levels) {
+  if (level >= levels)
+    throw Error(ErrorKind::Usage, "--level", std::nullopt,
+                path + " has " + std::to_string(levels) + " level" + (levels == 1 ? "" : "s") + " of detail: 0 to " +
+                    std::to_string(levels - 1));
+}
+
+SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria, const VoxelVoxlines* index,
+                                   SelectionPath path, VoxlineBoxes* boxes) {
+  if (criteria.min_length && criteria.max_length && *criteria.min_length > *criteria.max_length)
+    throw Error(ErrorKind::Usage, "--min-length", std::nullopt, "the minimum length is above the maximum length");
+  if (criteria.level) check_level(file.path(), *criteria.level, file.level_count());
+  SelectionResult result = select_by_regions_and_lengths(file, criteria, index, path, boxes);
+  if (criteria.level) {
+    const std::uint32_t levels = file.level_count();
+    std::erase_if(result.streamlines, [&](std::uint64_t s) { return streamline_depth(s, levels) < *criteria.level; });
+  }
   return result;
 }
 

@@ -6,6 +6,9 @@
 //         exclude region contains any of its points, and its length (the sum of its segments' lengths)
 //         passes tckedit's length thresholds (length_limits.h: the limits in float32, widened by the source
 //         header's step_size, the length summed in float32); `invert` keeps exactly the others.
+//   level  (optional, applied last, after `invert`) only those of that level of detail (spec §6.5: depth >= level,
+//         about 1/8^level of them, spread over the whole tractogram): a whole tractogram made smaller alike
+//         everywhere, e.g. to share one too large for a web browser.
 //
 // Points are the source points as the .vxl stores them (synthetic face points are not tested): bit for bit
 // the source's with --positions float32, within the file's packed bound otherwise, so that a streamline
@@ -25,6 +28,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "converter/selection/region.h"
@@ -39,6 +43,7 @@ struct SelectionCriteria {
   std::vector<Region> include, exclude, ends_in;
   std::optional<double> min_length, max_length;  // mm
   bool invert = false;
+  std::optional<std::uint32_t> level;  // below the file's level count (Usage otherwise)
 };
 
 struct SelectionResult {
@@ -62,8 +67,9 @@ inline constexpr std::size_t kMaxRegions = 64;
 // points (tests and the benchmark compare both).
 enum class SelectionPath { Fastest, ScanTable };
 
-// Throws vxl::Error: Usage for more than kMaxRegions regions or min_length > max_length, Input for a .vxl
-// whose tables do not hold together or whose source header tckedit would refuse (length_limits.h). `index`, when given,
+// Throws vxl::Error: Usage for more than kMaxRegions regions, min_length > max_length or a level the file has
+// not, Input for a .vxl whose tables do not hold together or whose source header tckedit would refuse
+// (length_limits.h). `index`, when given,
 // must be VoxelVoxlines::of_file(file)'s: the result is the same with or without it (without it, the file's VXIX is
 // used when it has one), and by either path. `boxes` (the file's, kept by a caller that selects again and again, as
 // the window does while a region moves) lets a packed file's later selections pass over the voxlines they can
@@ -71,5 +77,8 @@ enum class SelectionPath { Fastest, ScanTable };
 SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria,
                                    const VoxelVoxlines* index = nullptr, SelectionPath path = SelectionPath::Fastest,
                                    VoxlineBoxes* boxes = nullptr);
+
+// Throws vxl::Error (Usage, naming `path`) unless `level` is one of the `levels` levels of detail of a file.
+void check_level(const std::string& path, std::uint32_t level, std::uint32_t levels);
 
 }  // namespace vxl

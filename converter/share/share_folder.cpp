@@ -1,6 +1,7 @@
 #include "converter/share/share_folder.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <system_error>
@@ -10,7 +11,10 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/package/unpack.h"
+#include "converter/selection/selection_output.h"
+#include "converter/selection/streamline_selection.h"
 #include "format/base/error.h"
+#include "format/base/memory_size.h"
 #include "format/vxl_file.h"
 #include "format/vxl_layout.h"
 #include "format/vxlz_layout.h"
@@ -32,6 +36,12 @@ std::array<std::uint8_t, 8> magic_of(const std::string& path) {
   if (!in) fail_input(path, std::nullopt, "cannot open it");
   in.read(reinterpret_cast<char*>(magic.data()), magic.size());
   return magic;
+}
+
+void copy_file(const std::string& from, const fs::path& to) {
+  std::error_code ec;
+  fs::copy_file(from, to, ec);
+  if (ec) fail_output(to.string(), "cannot copy the tractogram: " + ec.message());
 }
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -58,6 +68,36 @@ std::string readme(const std::string& title, const std::string& data_file) {
          "and export it back to TCK or TRX.\n";
 }
 
+// A .vxl of `bytes` for the page, which holds its whole file in WebAssembly's memory: refused where that is too
+// small, naming the level of detail that would fit. The .vxl holds level `shared_level` of an input of `levels`
+// levels; each level holds about an eighth of the next finer one's streamlines, and its file shrinks alike.
+void check_fits_the_page(const std::string& in_path, std::uint64_t bytes, std::uint32_t levels,
+                         std::uint32_t shared_level, const ShareSettings& settings) {
+  if (bytes <= settings.max_data_bytes) return;
+  auto size_at = [&](std::uint32_t level) { return double(bytes) / std::pow(8.0, level - shared_level); };
+  std::uint32_t level = shared_level + 1;
+  while (level < levels && size_at(level) > 0.9 * double(settings.max_data_bytes)) ++level;
+  const std::string advice = level < levels ? "share a coarser level of detail: --level " + std::to_string(level) +
+                                                  " keeps about 1/" + std::to_string(1ull << (3 * level)) +
+                                                  " of the streamlines, spread over the whole tractogram (some " +
+                                                  format_memory_size(std::uint64_t(size_at(level))) + ")"
+                                            : "share a part of it (voxlines select IN.vxl OUT.vxl --include ROI ...)";
+  throw Error(ErrorKind::Unsupported, in_path, std::nullopt,
+              "the .vxl to share is " + format_memory_size(bytes) + ", more than the web viewer holds (" +
+                  format_memory_size(settings.max_data_bytes) + " in a browser's WebAssembly memory): " + advice);
+}
+
+// The streamlines of `level` of the .vxl at `in_path`, written to `out_path`; their count.
+std::uint64_t write_level(const VxlFile& file, const std::string& out_path, std::uint32_t level) {
+  SelectionCriteria criteria;
+  criteria.level = level;
+  const SelectionResult selected = select_streamlines(file, criteria);
+  file.release_resident_pages();
+  write_selection(file, StreamlineSubset(file.meta().streamline_count, selected.streamlines), out_path, {},
+                  {"voxlines_selection: level " + std::to_string(level)});
+  return selected.streamlines.size();
+}
+
 // The folder's content, written into `staging`.
 ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, const ShareSettings& settings) {
   ShareSummary summary;
@@ -70,23 +110,37 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
   const auto magic = magic_of(in_path);
   fs::path data = fs::path(in_path).filename();
   const bool package = std::equal(kVxlzMagic.begin(), kVxlzMagic.end(), magic.begin());
-  if (package && settings.unpack) {
+  if (!package) {
+    // Opened first, so that a damaged file is refused here rather than in the recipient's browser.
+    const VxlFile file = VxlFile::open(in_path);
     data.replace_extension(".vxl");
+    if (settings.level) {
+      summary.streamlines = write_level(file, (staging / data).string(), *settings.level);
+      check_fits_the_page(in_path, fs::file_size(staging / data), file.level_count(), *settings.level, settings);
+    } else {
+      summary.streamlines = file.meta().streamline_count;
+      check_fits_the_page(in_path, file.bytes().size(), file.level_count(), 0, settings);
+      copy_file(in_path, staging / data);
+    }
+  } else if (settings.unpack || settings.level) {
     UnpackSettings unpack;
     unpack.threads = settings.threads;
-    summary.streamlines = unpack_vxlz(in_path, (staging / data).string(), unpack).streamlines;
+    if (settings.level) check_level(in_path, *settings.level, unpack.levels);  // the levels of the .vxl unpacked
+    data.replace_extension(".vxl");
+    const fs::path unpacked = settings.level ? staging / ".unpacked.vxl" : staging / data;
+    summary.streamlines = unpack_vxlz(in_path, unpacked.string(), unpack).streamlines;
     summary.unpacked = true;
+    const VxlFile file = VxlFile::open(unpacked.string());
+    if (settings.level) summary.streamlines = write_level(file, (staging / data).string(), *settings.level);
+    check_fits_the_page(in_path, fs::file_size(staging / data), file.level_count(), settings.level.value_or(0),
+                        settings);
+    if (settings.level) fs::remove(unpacked);
   } else {
-    // Opened first, so that a damaged file is refused here rather than in the recipient's browser (a package's
-    // checksums cover every byte of it).
-    summary.streamlines =
-        package ? VxlzFile::open(in_path).meta().streamline_count : VxlFile::open(in_path).meta().streamline_count;
-    summary.package = package;
-    const char* suffix = package ? ".vxlz" : ".vxl";
-    if (data.extension() != suffix) data.replace_extension(suffix);
-    std::error_code ec;
-    fs::copy_file(in_path, staging / data, ec);
-    if (ec) fail_output((staging / data).string(), "cannot copy the tractogram: " + ec.message());
+    // A package's checksums cover every byte of it. The page unpacks it in its own memory, as large as the .vxl.
+    summary.streamlines = VxlzFile::open(in_path).meta().streamline_count;
+    summary.package = true;
+    data.replace_extension(".vxlz");
+    copy_file(in_path, staging / data);
   }
   summary.data_file = data.string();
   summary.data_bytes = fs::file_size(staging / data);

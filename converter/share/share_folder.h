@@ -5,7 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+
+#include "format/vxl_fetch_plan.h"
 
 namespace vxl {
 
@@ -16,6 +19,11 @@ struct ShareSettings {
   // picture before the whole file is in), else copied as it is.
   bool unpack = false;
   unsigned threads = 0;  // for unpacking a .vxlz (0: all cores)
+  // Only the streamlines of this level of detail (about 1/8^level of them, alike everywhere), as a .vxl: a
+  // tractogram too large for a browser's memory made small enough (a .vxlz is unpacked first).
+  std::optional<std::uint32_t> level;
+  // The largest .vxl shared: the web viewer holds its whole file in WebAssembly's memory.
+  std::uint64_t max_data_bytes = kWebMaxFileBytes;
 };
 
 struct ShareSummary {
@@ -32,8 +40,8 @@ inline constexpr const char* kWebViewerFiles[] = {"index.html",       "viewer.js
 
 // Writes the folder `out_dir`, which must not exist: made under a temporary name beside it and renamed
 // when complete, so that a failure or an interruption leaves no partial folder at `out_dir`. Throws
-// vxl::Error: Input for a damaged input, Unsupported when there is no web viewer, Output when the folder
-// cannot be written.
+// vxl::Error: Input for a damaged input, Unsupported when there is no web viewer or the .vxl would be larger than
+// `max_data_bytes` (the message names the --level that would fit), Output when the folder cannot be written.
 ShareSummary share_folder(const std::string& in_path, const std::string& out_dir, const ShareSettings& settings);
 
 }  // namespace vxl

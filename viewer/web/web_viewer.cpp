@@ -524,6 +524,9 @@ EMSCRIPTEN_KEEPALIVE int vw_show() {
 
 EMSCRIPTEN_KEEPALIVE const char* vw_error() { return vxl::web::last_error().c_str(); }
 
+// The largest file the page may hand to vw_open (a double: JavaScript's number, past a 32-bit integer's range).
+EMSCRIPTEN_KEEPALIVE double vw_max_file_bytes() { return double(vxl::kWebMaxFileBytes); }
+
 // What the page shows about the file: counts and the modes it can draw, as JSON ({"error": …} if that fails).
 EMSCRIPTEN_KEEPALIVE const char* vw_info() {
   static std::string text;

@@ -680,7 +680,7 @@
         throw new Error(`${target.url} changed on the server while it was fetched (now ${total} bytes)`);
     }
     // The largest file the WebAssembly memory (32-bit, 4 GiB at most) can hold, with room for the viewer.
-    const MAX_FILE_BYTES = 2 ** 32 - 2 ** 28;
+    const MAX_FILE_BYTES = Module._vw_max_file_bytes();
     function allocate(size, name) {
       if (size > MAX_FILE_BYTES) throw new Error(`${name}: ${size.toLocaleString()} bytes, more than the web viewer can hold (4 GiB less 256 MiB)`);
       const pointer = Module._malloc(Math.max(1, size)) >>> 0;  // an address past 2 GiB comes back negative
