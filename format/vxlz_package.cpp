@@ -1,14 +1,19 @@
 #include "format/vxlz_package.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
+
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "format/base/atomic_output.h"
 #include "format/base/checksum.h"
 #include "format/base/error.h"
 #include "format/base/parallel.h"
+#include "format/base/regular_file.h"
 #include "format/vxl_file.h"
 #include "format/vxl_levels.h"
 
@@ -153,6 +158,15 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   return position;
 }
 
+bool starts_as_vxlz(const std::string& path) {
+  struct stat st {};
+  const int fd = open_regular_file(path, st);  // a FIFO is refused, not waited on
+  std::array<std::uint8_t, 8> magic{};
+  const ssize_t n = ::pread(fd, magic.data(), magic.size(), 0);
+  ::close(fd);
+  return n == ssize_t(magic.size()) && std::memcmp(magic.data(), kVxlzMagic.data(), magic.size()) == 0;
+}
+
 VxlzFile VxlzFile::open(const std::string& path) {
   VxlzFile f{MappedFile(path)};
   f.validate();
@@ -237,6 +251,7 @@ void VxlzFile::validate_header_and_table() {
     if (xxh3_64(head.data(), head.size()) != h.header_checksum)
       fail_input(p, 40, "header checksum mismatch (header or section table damaged)");
   }
+  header_ = h;
   sections_.resize(h.section_count);
   std::memcpy(sections_.data(), base + sizeof h, sections_.size() * sizeof(SectionEntry));
 

@@ -55,6 +55,10 @@ DeflatedTables deflate_tables(const VxlzContent& content, unsigned threads = 0);
 std::uint64_t write_vxlz(const std::string& path, const VxlzContent& content, const DeflatedTables& tables);
 std::uint64_t write_vxlz(const std::string& path, const VxlzContent& content, unsigned threads = 0);
 
+// Whether the file at `path` starts as a package does (its magic), to tell a .vxlz from a .vxl whatever its name.
+// Throws vxl::Error (Input) when it cannot be opened or is not a regular file.
+bool starts_as_vxlz(const std::string& path);
+
 class VxlzFile {
  public:
   // Maps and validates spec §8 steps 1-4. Throws vxl::Error (Input; Unsupported for an unknown major
@@ -73,6 +77,8 @@ class VxlzFile {
 
   const std::string& path() const { return file_.path(); }
   std::uint64_t size() const { return file_.size(); }
+  const FileHeader& header() const { return header_; }
+  std::span<const SectionEntry> sections() const { return sections_; }
   const PackSection& pack() const { return pack_; }
   const MetaSection& meta() const { return meta_; }
   std::span<const DirectionEntry> directions() const { return directions_; }
@@ -109,6 +115,7 @@ class VxlzFile {
   std::span<const std::uint8_t> payload(const SectionEntry& e) const { return file_.bytes().subspan(e.offset, e.size); }
 
   MappedFile file_;
+  FileHeader header_{};
   std::vector<SectionEntry> sections_;
   PackSection pack_{};
   MetaSection meta_{};

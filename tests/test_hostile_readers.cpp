@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "converter/readers/read_tractogram.h"
 #include "converter/readers/read_tsf.h"
 #include "converter/readers/tck_stream.h"
+#include "converter/share/share_folder.h"
 #include "format/base/error.h"
 #include "tests/hostile_inputs.h"
 #include "tests/nifti_test_files.h"
@@ -346,9 +348,13 @@ TEST(NiftiImage, AbsurdTransformsAreExit3) {
 // instead of hanging it.
 TEST(HostileInput, FifoIsRefusedNotWaitedOn) {
   ScratchDir dir;
-  for (const char* name : {"in.tck", "in.trk", "in.trk.gz", "in.trx", "in.tsf", "in.vtk", "in.vtp", "in.vxl"})
+  for (const char* name :
+       {"in.tck", "in.trk", "in.trk.gz", "in.trx", "in.tsf", "in.vtk", "in.vtp", "in.vxl", "in.vxlz"})
     hostile::fifo(dir.file(name));
   vxl::test::write_mrtrix_file(dir.file("ok.tck"), "mrtrix tracks", "Float32LE", "");
+  // share reads its input only once it has a web viewer to copy: a stand-in folder of its files.
+  std::filesystem::create_directories(dir.file("web"));
+  for (const char* name : vxl::kWebViewerFiles) std::ofstream(dir.file("web") + "/" + name) << name;
   const std::string out = dir.file("o.vxl");
   const std::vector<std::string> commands = {
       "convert " + dir.file("in.tck") + " " + out,
@@ -360,7 +366,11 @@ TEST(HostileInput, FifoIsRefusedNotWaitedOn) {
       "convert " + dir.file("in.vtk") + " " + out,
       "convert " + dir.file("in.vtp") + " " + out,
       "info " + dir.file("in.vxl"),
+      "info " + dir.file("in.vxlz"),
+      "unpack " + dir.file("in.vxlz") + " " + out,
       "export " + dir.file("in.vxl") + " " + dir.file("o.tck"),
+      "share " + dir.file("in.vxl") + " " + dir.file("shared") + " --web-viewer " + dir.file("web"),
+      "share " + dir.file("in.vxlz") + " " + dir.file("shared") + " --web-viewer " + dir.file("web"),
   };
   for (const std::string& c : commands) {
     SCOPED_TRACE(c);
@@ -370,6 +380,7 @@ TEST(HostileInput, FifoIsRefusedNotWaitedOn) {
                 r.output.find("not a regular file") != std::string::npos)
         << r.output;
     EXPECT_FALSE(std::filesystem::exists(out));
+    EXPECT_FALSE(std::filesystem::exists(dir.file("shared")));
   }
 }
 

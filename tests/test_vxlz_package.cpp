@@ -21,6 +21,7 @@
 #include "format/base/checksum.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
+#include "format/vxl_levels.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"
 #include "format/vxlz_draco.h"
@@ -702,6 +703,56 @@ TEST(VxlzPackCli, PackUnpackVerify) {
   r = test::run_cli("unpack '" + vxl + "' '" + dir.file("w.vxl") + "'");  // a .vxl is not a package
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("not a .vxlz package"), std::string::npos) << r.output;
+}
+
+// info reads a package from its tables: the .vxl's counts, the quantisation asked for, and, shipped level by level,
+// each level's streamlines (those of depth >= level) and the prefix that holds them; shipped in streamline order
+// (a file without levels), no levels. A damaged package is refused as unpack refuses it.
+TEST(VxlzPackCli, InfoSummarisesAPackage) {
+  ScratchDir dir;
+  const std::string vxl = convert_for_package(test_tractogram(800), dir.file("s.vxl"));
+  ASSERT_EQ(test::run_cli("pack '" + vxl + "' '" + dir.file("s.vxlz") + "' --bits 12").exit_code, 0);
+  const test::CommandResult text = test::run_cli("info '" + dir.file("s.vxlz") + "'");
+  ASSERT_EQ(text.exit_code, 0) << text.output;
+  EXPECT_NE(text.output.find(".vxlz 2.3"), std::string::npos) << text.output;
+  EXPECT_NE(text.output.find("12 bits per axis"), std::string::npos) << text.output;
+  EXPECT_NE(text.output.find("level by level"), std::string::npos) << text.output;
+  const test::CommandResult json = test::run_cli("info --json '" + dir.file("s.vxlz") + "'");
+  ASSERT_EQ(json.exit_code, 0) << json.output;
+  const auto j = nlohmann::json::parse(json.output);
+  const VxlFile f = VxlFile::open(vxl);
+  EXPECT_EQ(j["format"], "vxlz");
+  EXPECT_EQ(j["streamlines"].get<std::uint64_t>(), f.meta().streamline_count);
+  EXPECT_EQ(j["points"].get<std::uint64_t>(), f.meta().point_count);
+  EXPECT_EQ(j["positions"]["quantization_bits"].get<std::uint32_t>(), 12u);
+  EXPECT_GT(j["positions"]["error_bound_mm"].get<double>(), 0);
+  EXPECT_EQ(j["shipping_order"], "level");
+  ASSERT_EQ(j["levels"].size(), f.level_count());
+  std::uint64_t previous_bytes = 0;
+  for (const auto& level : j["levels"]) {  // the coarsest first
+    const std::uint32_t d = level["level"].get<std::uint32_t>();
+    std::uint64_t in_level = 0;
+    for (std::uint64_t s = 0; s < f.meta().streamline_count; ++s) in_level += streamline_depth(s, f.level_count()) >= d;
+    EXPECT_EQ(level["streamlines"].get<std::uint64_t>(), in_level) << d;
+    EXPECT_GE(level["bytes"].get<std::uint64_t>(), previous_bytes) << d;
+    previous_bytes = level["bytes"].get<std::uint64_t>();
+  }
+  EXPECT_EQ(previous_bytes, std::filesystem::file_size(dir.file("s.vxlz")));  // level 0: the whole package
+
+  ConvertSettings one_level;
+  one_level.levels = 1;
+  convert_tractogram(test_tractogram(200), dir.file("flat.vxl"), one_level);
+  ASSERT_EQ(test::run_cli("pack '" + dir.file("flat.vxl") + "' '" + dir.file("flat.vxlz") + "'").exit_code, 0);
+  const auto flat = nlohmann::json::parse(test::run_cli("info --json '" + dir.file("flat.vxlz") + "'").output);
+  EXPECT_EQ(flat["shipping_order"], "streamline");
+  EXPECT_FALSE(flat.contains("levels"));
+
+  std::vector<char> bytes = slurp(dir.file("s.vxlz"));
+  bytes[bytes.size() / 2] ^= 0x10;
+  dump_bytes(dir.file("bad.vxlz"), bytes, bytes.size());
+  const test::CommandResult bad = test::run_cli("info '" + dir.file("bad.vxlz") + "'");
+  EXPECT_EQ(bad.exit_code, 3) << bad.output;
+  EXPECT_NE(bad.output.find("checksum mismatch"), std::string::npos) << bad.output;
 }
 
 TEST(VxlzPackageReal, StrokeAndAfqRoundTrip) {

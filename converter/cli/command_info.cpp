@@ -6,25 +6,14 @@
 #include <nlohmann/json.hpp>
 
 #include "converter/cli/commands.h"
+#include "converter/cli/info_summary.h"
+#include "converter/cli/package_info.h"
 #include "converter/readers/float16.h"
 #include "format/base/json_limits.h"
 #include "format/vxl_file.h"
 
 namespace vxl::cli {
 namespace {
-
-// PROV is any JSON as far as open() is concerned (verify checks only that it parses), so every field is
-// read only when it has the expected type: a damaged provenance must not end `info` with a type error.
-std::string string_field(const nlohmann::json& object, const char* key) {
-  if (!object.is_object()) return "";
-  auto it = object.find(key);
-  return it != object.end() && it->is_string() ? it->get<std::string>() : "";
-}
-std::uint64_t count_field(const nlohmann::json& object, const char* key) {
-  if (!object.is_object()) return 0;
-  auto it = object.find(key);
-  return it != object.end() && it->is_number_unsigned() ? it->get<std::uint64_t>() : 0;
-}
 
 // One row of values per group (GDAT) as JSON numbers: integers exactly, floats as binary64 (NaN: null).
 nlohmann::json row_numbers(const GroupValues& v) {
@@ -61,28 +50,28 @@ void add_info_command(CLI::App& app) {
     bool json = false;
   };
   auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand("info", "Summarise a .vxl file (opens and validates its tables, O(voxels))");
-  cmd->add_option("file", opt->file, ".vxl file")->required();
+  CLI::App* cmd = app.add_subcommand(
+      "info", "Summarise a .vxl file (opens and validates its tables, O(voxels)) or a .vxlz package (checks it whole)");
+  cmd->add_option("file", opt->file, ".vxl file or .vxlz package")->required();
   cmd->add_flag("--json", opt->json, "print JSON instead of text");
   cmd->callback([opt] {
+    if (starts_as_vxlz(opt->file)) {
+      const nlohmann::json j = package_info(VxlzFile::open(opt->file));
+      if (opt->json)
+        std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+      else
+        print_package_info(j);
+      return;
+    }
     VxlFile f = VxlFile::open(opt->file);
     const MetaSection& m = f.meta();
     nlohmann::json j;
     j["file"] = opt->file;
-    j["version"] = std::to_string(f.header().version_major) + "." + std::to_string(f.header().version_minor);
+    add_meta_summary(f.header(), m, j);
     j["bytes"] = f.bytes().size();
-    j["streamlines"] = m.streamline_count;
-    j["points"] = m.point_count;
-    j["voxels"] = m.voxel_count;
     j["segments"] = m.segment_count;
     j["vertices"] = m.vertex_count;
-    j["voxlines"] = m.voxline_count;
     j["synthetic_points"] = m.synthetic_point_count;
-    j["voxel_size"] = m.voxel_size;
-    j["grid_dims"] = {m.grid_dims[0], m.grid_dims[1], m.grid_dims[2]};
-    j["bounds"] = {{"min", {m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]}},
-                   {"max", {m.bounds_max[0], m.bounds_max[1], m.bounds_max[2]}}};
-    j["stored_orders"] = m.stored_order_count;
     // Positions: the encoding and, when packed, the largest error any voxel allows (spec §5.4).
     j["positions"] = position_encoding_name(f.position_encoding());
     if (f.position_encoding() == PositionEncoding::Packed) {
@@ -111,17 +100,7 @@ void add_info_command(CLI::App& app) {
                                            {"components", v.components},
                                            {"values", row_numbers(v)}});
     j["groups"] = groups;
-    auto prov = parse_json(f.provenance_json(), f.path(), f.provenance_offset(), "PROV");
-    if (prov.is_object() && prov.contains("source") && prov["source"].is_object()) {
-      const nlohmann::json& src = prov["source"];
-      j["source"] = {{"name", string_field(src, "name")},
-                     {"format", string_field(src, "format")},
-                     {"bytes", count_field(src, "bytes")}};
-    }
-    // How the voxel size was chosen, when --voxel-size auto chose it.
-    if (prov.is_object() && prov.contains("converter") && prov["converter"].is_object())
-      if (const std::string why = string_field(prov["converter"], "voxel_size_auto"); !why.empty())
-        j["voxel_size_choice"] = why;
+    add_provenance_summary(parse_json(f.provenance_json(), f.path(), f.provenance_offset(), "PROV"), j);
     if (opt->json) {
       // open() has checked every name for UTF-8; replacing invalid bytes is the last line of defence.
       std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
@@ -129,10 +108,7 @@ void add_info_command(CLI::App& app) {
     }
     std::printf("file          %s (.vxl %s, %llu bytes)\n", opt->file.c_str(), j["version"].get<std::string>().c_str(),
                 (unsigned long long)f.bytes().size());
-    if (j.contains("source"))
-      std::printf("source        %s (%s, %llu bytes)\n", j["source"]["name"].get<std::string>().c_str(),
-                  j["source"]["format"].get<std::string>().c_str(),
-                  (unsigned long long)j["source"]["bytes"].get<std::uint64_t>());
+    print_source_line(j);
     std::printf("streamlines   %llu\npoints        %llu\nvoxels        %u (grid %d x %d x %d)\n",
                 (unsigned long long)m.streamline_count, (unsigned long long)m.point_count, m.voxel_count,
                 m.grid_dims[0], m.grid_dims[1], m.grid_dims[2]);

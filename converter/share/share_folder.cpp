@@ -29,15 +29,6 @@ namespace fs = std::filesystem;
   throw Error(ErrorKind::Output, path, std::nullopt, what);
 }
 
-// The first eight bytes of `path`, to tell a .vxl from a .vxlz whatever its name.
-std::array<std::uint8_t, 8> magic_of(const std::string& path) {
-  std::array<std::uint8_t, 8> magic{};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail_input(path, std::nullopt, "cannot open it");
-  in.read(reinterpret_cast<char*>(magic.data()), magic.size());
-  return magic;
-}
-
 void copy_file(const std::string& from, const fs::path& to) {
   std::error_code ec;
   fs::copy_file(from, to, ec);
@@ -107,9 +98,8 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     if (ec)
       fail_output((staging / name).string(), "cannot copy the web viewer's " + std::string(name) + ": " + ec.message());
   }
-  const auto magic = magic_of(in_path);
   fs::path data = fs::path(in_path).filename();
-  const bool package = std::equal(kVxlzMagic.begin(), kVxlzMagic.end(), magic.begin());
+  const bool package = starts_as_vxlz(in_path);
   if (!package) {
     // Opened first, so that a damaged file is refused here rather than in the recipient's browser.
     const VxlFile file = VxlFile::open(in_path);
