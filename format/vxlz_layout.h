@@ -13,12 +13,16 @@ namespace vxl {
 
 inline constexpr std::array<std::uint8_t, 8> kVxlzMagic = {0x89, 'V', 'X', 'Z', '\r', '\n', 0x1A, '\n'};
 inline constexpr std::uint16_t kVxlzVersionMajor = 2;  // 1.0 coded residual triplets with no joint symbols
-// A writer writes minor 3 when the package ships its points level by level (§5.1), else 2 when it holds values
+// A writer writes minor 4 when the package ships its points level by level (§5.1) with a checksum per chunk (CHKS),
+// minor 3 for the level order without them (older writers), else 2 when it holds values
 // per group (§4.8), else 1 when it holds value sets (§4.7), else 0 (§10: the lowest version that holds what it
 // writes).
 inline constexpr std::uint16_t kVxlzVersionMinor = 1;
 inline constexpr std::uint16_t kVxlzVersionMinorGroupValues = 2;
 inline constexpr std::uint16_t kVxlzVersionMinorLevelOrder = 3;
+// §2.2: CHKS, a checksum per position chunk, written with the level order, so that a prefix's chunks are checked
+// before a viewer shows the level they hold.
+inline constexpr std::uint16_t kVxlzVersionMinorChunkChecksums = 4;
 inline constexpr std::uint32_t kVxlzMaxSections = 32;
 inline constexpr std::uint32_t kVxlzMinBits = 11;
 inline constexpr std::uint32_t kVxlzMaxBits = 16;

@@ -26,12 +26,12 @@ std::vector<std::uint8_t> bytes_of(const T& value) {
   return {b, b + sizeof value};
 }
 
-// The sections every package has (spec §2.2), and the optional ones a 2.1 reader knows.
+// The sections every package has (spec §2.2), and the optional ones this reader knows.
 constexpr std::uint32_t kRequired[] = {section_id("PACK"), section_id("META"), section_id("DIRS"),
                                        section_id("VOXC"), section_id("STRL"), section_id("VXLV"),
                                        section_id("VXLC"), section_id("CHNK"), section_id("POSD")};
-constexpr std::uint32_t kOptional[] = {section_id("PROV"), section_id("GRPS"), section_id("PVAL"), section_id("SVAL"),
-                                       section_id("GDAT")};
+constexpr std::uint32_t kOptional[] = {section_id("PROV"), section_id("GRPS"), section_id("PVAL"),
+                                       section_id("SVAL"), section_id("GDAT"), section_id("CHKS")};
 
 }  // namespace
 
@@ -82,17 +82,24 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   std::memset(meta.reserved, 0, sizeof meta.reserved);
   const std::vector<std::uint8_t> pack_bytes = bytes_of(pack), meta_bytes = bytes_of(meta);
   // POSD is the chunks' buffers back to back: written from them, never gathered into one copy.
-  std::vector<std::uint8_t> chunk_sizes;
+  std::vector<std::uint8_t> chunk_sizes, chunk_checksums;
   std::uint64_t posd_size = 0;
   Xxh3_64Stream posd_checksum;
-  for (const EncodedChunk& chunk : c.chunks)
+  auto append_u64 = [](std::vector<std::uint8_t>& to, std::uint64_t n) {
+    to.insert(to.end(), reinterpret_cast<const std::uint8_t*>(&n), reinterpret_cast<const std::uint8_t*>(&n) + 8);
+  };
+  for (const EncodedChunk& chunk : c.chunks) {
+    Xxh3_64Stream chunk_checksum;
     for (const std::vector<std::uint8_t>* buffer : {&chunk.symbols, &chunk.escapes}) {
-      const std::uint64_t n = buffer->size();
-      chunk_sizes.insert(chunk_sizes.end(), reinterpret_cast<const std::uint8_t*>(&n),
-                         reinterpret_cast<const std::uint8_t*>(&n) + 8);
-      posd_size += n;
-      posd_checksum.update(buffer->data(), n);
+      append_u64(chunk_sizes, buffer->size());
+      posd_size += buffer->size();
+      posd_checksum.update(buffer->data(), buffer->size());
+      chunk_checksum.update(buffer->data(), buffer->size());
     }
+    append_u64(chunk_checksums, chunk_checksum.digest());
+  }
+  // With the level order only (spec §2.2): there a prefix is shown before the whole has arrived.
+  const bool level_order = c.pack.predictor == kVxlzPredictorLinearLevelOrder;
 
   std::vector<Section> sections;
   sections.push_back({"PACK", true, pack_bytes});
@@ -113,6 +120,8 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   // Optional (spec §4.8): a reader that skips it loses the rows of values per group only.
   if (d.group_values) sections.push_back({"GDAT", false, *d.group_values});
   sections.push_back({"CHNK", true, chunk_sizes});
+  // Optional: a reader that skips it checks the positions as a whole, once every chunk is in.
+  if (level_order) sections.push_back({"CHKS", false, chunk_checksums});
   sections.push_back({"POSD", true, {}});
 
   // Header, table, then the payloads back to back (spec §2).
@@ -133,10 +142,10 @@ std::uint64_t write_vxlz(const std::string& path, const VxlzContent& c, const De
   FileHeader h{};
   std::memcpy(h.magic, kVxlzMagic.data(), 8);
   h.version_major = kVxlzVersionMajor;
-  h.version_minor = c.pack.predictor == kVxlzPredictorLinearLevelOrder ? kVxlzVersionMinorLevelOrder
-                    : c.group_values                                   ? kVxlzVersionMinorGroupValues
-                    : c.point_values || c.streamline_values            ? kVxlzVersionMinor
-                                                                       : 0;
+  h.version_minor = level_order                             ? kVxlzVersionMinorChunkChecksums
+                    : c.group_values                        ? kVxlzVersionMinorGroupValues
+                    : c.point_values || c.streamline_values ? kVxlzVersionMinor
+                                                            : 0;
   h.header_size = sizeof(FileHeader);
   h.file_size = position;
   h.section_table_offset = sizeof(FileHeader);
@@ -387,6 +396,25 @@ void VxlzFile::validate_chunks() {
   }
   if (chunk_offsets_.back() != posd->size) fail_input(p, chnk->offset, "chunk sizes do not add up to the POSD size");
   posd_offset_ = posd->offset;
+  validate_chunk_checksums();
+}
+
+// CHKS, where the package has it: a checksum per chunk, each present chunk checked (a prefix's too, which POSD's
+// checksum cannot be until the whole has arrived).
+void VxlzFile::validate_chunk_checksums() const {
+  const SectionEntry* chks = find(section_id("CHKS"));
+  if (!chks) return;
+  const std::string& p = file_.path();
+  if (chks->size != 8 * pack_.chunk_count)
+    fail_input(p, chks->offset,
+               "CHKS must hold one 8-byte checksum per chunk (" + std::to_string(pack_.chunk_count) + " chunks)");
+  for (std::uint64_t i = 0, present = chunks_present(); i < present; ++i) {
+    std::uint64_t expected;
+    std::memcpy(&expected, file_.data() + chks->offset + 8 * i, 8);
+    const std::uint64_t begin = posd_offset_ + chunk_offsets_[2 * i], end = posd_offset_ + chunk_offsets_[2 * i + 2];
+    if (xxh3_64(file_.data() + begin, end - begin) != expected)
+      fail_input(p, begin, "checksum mismatch in position chunk " + std::to_string(i) + " (CHKS; damaged package)");
+  }
 }
 
 std::vector<std::uint8_t> VxlzFile::inflate(std::uint32_t id) const {

@@ -69,7 +69,8 @@ class VxlzFile {
   // The first bytes of a package still arriving (`prefix`: its bytes so far): validated as open() validates a
   // whole package, except that the positions (POSD) may be cut short and their checksum is not checked; every
   // other section must be whole (else Input, "needs the first N bytes"). Chunks past the prefix are not there
-  // (chunks_present).
+  // (chunks_present). Those present are checked against their own checksums where the package has them (CHKS,
+  // version 2.4), and only where it has them: has_chunk_checksums().
   static VxlzFile open_prefix(MappedFile prefix);
   // Where the positions (POSD) start, read from a package's first bytes (unchecked: open_prefix checks): nullopt while
   // they do not hold its section table yet, 0 when the table names no POSD. A prefix that reaches it can be opened.
@@ -84,6 +85,7 @@ class VxlzFile {
   std::span<const DirectionEntry> directions() const { return directions_; }
 
   bool has_section(std::uint32_t id) const { return find(id) != nullptr; }
+  bool has_chunk_checksums() const { return has_section(section_id("CHKS")); }
   // A zlib section inflated (spec §8 step 5); empty when an optional section is absent.
   std::vector<std::uint8_t> inflate(std::uint32_t id) const;
   // A section's payload as stored (empty when an optional section is absent).
@@ -111,6 +113,7 @@ class VxlzFile {
   void validate_checksums() const;
   void validate_pack_and_meta();
   void validate_chunks();
+  void validate_chunk_checksums() const;
   const SectionEntry* find(std::uint32_t id) const;
   std::span<const std::uint8_t> payload(const SectionEntry& e) const { return file_.bytes().subspan(e.offset, e.size); }
 

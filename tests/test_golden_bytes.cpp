@@ -143,19 +143,35 @@ TEST(GoldenBytes, UnpackWritesTheUnpackedFile) {
   expect_same_bytes(dir.file("unpacked.vxl"), golden("unpacked.vxl"));
 }
 
-// A package of version 2.0 (frozen: the points in streamline order, predictor 1) still unpacks, to the very file the
-// package of today (the points level by level) unpacks to: the order the points travel in changes nothing else.
-TEST(GoldenBytes, APackageOfVersion20UnpacksAsTheCurrentOne) {
-  ScratchDir dir;
-  const VxlzFile old_package = VxlzFile::open(golden("package-2.0.vxlz")), now = VxlzFile::open(golden("package.vxlz"));
-  EXPECT_EQ(old_package.pack().predictor, kVxlzPredictorLinear);
+// Packages of older versions (frozen) still unpack, to the very file the package of today unpacks to: 2.0 ships the
+// points in streamline order (predictor 1), 2.3 level by level without a checksum per chunk; the order the points
+// travel in and the chunks' checksums change nothing else.
+TEST(GoldenBytes, PackagesOfVersions20And23UnpackAsTheCurrentOne) {
+  const VxlzFile now = VxlzFile::open(golden("package.vxlz"));
+  EXPECT_EQ(now.header().version_minor, kVxlzVersionMinorChunkChecksums);
   EXPECT_EQ(now.pack().predictor, kVxlzPredictorLinearLevelOrder);
   EXPECT_EQ(now.pack().level_count, 2u);
-  // Named as the current one: the unpacked file's provenance names its package.
-  std::filesystem::copy_file(golden("package-2.0.vxlz"), dir.file("package.vxlz"));
-  const auto r = run_cli("unpack " + q(dir.file("package.vxlz")) + " " + q(dir.file("unpacked.vxl")) + " --threads 1");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  expect_same_bytes(dir.file("unpacked.vxl"), golden("unpacked.vxl"));
+  EXPECT_TRUE(now.has_chunk_checksums());
+  struct Older {
+    const char* name;
+    std::uint16_t minor;
+    std::uint32_t predictor;
+  };
+  for (const Older& older : {Older{"package-2.0.vxlz", 0, kVxlzPredictorLinear},
+                             Older{"package-2.3.vxlz", kVxlzVersionMinorLevelOrder, kVxlzPredictorLinearLevelOrder}}) {
+    SCOPED_TRACE(older.name);
+    ScratchDir dir;
+    const VxlzFile package = VxlzFile::open(golden(older.name));
+    EXPECT_EQ(package.header().version_minor, older.minor);
+    EXPECT_EQ(package.pack().predictor, older.predictor);
+    EXPECT_FALSE(package.has_chunk_checksums());
+    // Named as the current one: the unpacked file's provenance names its package.
+    std::filesystem::copy_file(golden(older.name), dir.file("package.vxlz"));
+    const auto r =
+        run_cli("unpack " + q(dir.file("package.vxlz")) + " " + q(dir.file("unpacked.vxl")) + " --threads 1");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    expect_same_bytes(dir.file("unpacked.vxl"), golden("unpacked.vxl"));
+  }
 }
 
 TEST(GoldenBytes, TheFloat32FileDecodesToTheInputBitForBit) {

@@ -117,8 +117,8 @@ TEST(ValuesPackage, UnpackGivesBackTheValueSetsByteForByte) {
       const PackSummary packed = pack_vxl(original, dir.file("v.vxlz"), settings);
       EXPECT_EQ(packed.point_value_sets, 2u);
       EXPECT_EQ(packed.streamline_value_sets, 3u);
-      EXPECT_EQ(minor_version(dir.file("v.vxlz")), levels > 1 ? 3 : 1)
-          << "a package with value sets is 2.1, shipped level by level 2.3";
+      EXPECT_EQ(minor_version(dir.file("v.vxlz")), levels > 1 ? 4 : 1)
+          << "a package with value sets is 2.1, shipped level by level (with a checksum per chunk) 2.4";
       UnpackSettings unpacking;
       unpacking.levels = levels;
       const UnpackSummary back = unpack_vxlz(dir.file("v.vxlz"), dir.file("u.vxl"), unpacking);
@@ -160,7 +160,8 @@ TEST(ValuesPackage, SectionsAreOptionalAndAPackageWithoutValuesStays20) {
            dir.file("p.vxlz"), {});
   EXPECT_EQ(minor_version(dir.file("p.vxlz")), 0) << "writers write the lowest version that holds what they write";
   pack_vxl(VxlFile::open(convert_to(Tractogram(plain), dir.file("l.vxl"))), dir.file("l.vxlz"), {});
-  EXPECT_EQ(minor_version(dir.file("l.vxlz")), 3) << "a file with levels is shipped level by level";
+  EXPECT_EQ(minor_version(dir.file("l.vxlz")), 4)
+      << "a file with levels is shipped level by level, with a checksum per chunk";
   EXPECT_FALSE(VxlzFile::open(dir.file("p.vxlz")).has_section(section_id("PVAL")));
   unpack_vxlz(dir.file("p.vxlz"), dir.file("p2.vxl"), {});
   EXPECT_TRUE(VxlFile::open(dir.file("p2.vxl")).vertex_values().empty());

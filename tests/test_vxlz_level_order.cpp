@@ -19,6 +19,7 @@
 #include "format/vxlz_package.h"
 #include "format/vxlz_streams.h"
 #include "tests/hostile_inputs.h"
+#include "tests/reseal_checksums.h"
 #include "tests/test_support.h"
 
 namespace vxl {
@@ -125,6 +126,63 @@ TEST_F(LevelOrder, APrefixThatDoesNotHoldTheLevelIsRefused) {
   const Error short_of_the_tables = error_of([&] { (void)prefix_of(dir.file("s.vxlz"), tables_end); });
   EXPECT_EQ(short_of_the_tables.kind(), ErrorKind::Input);
   EXPECT_TRUE(test::contains(short_of_the_tables.what(), "needs the first")) << short_of_the_tables.what();
+}
+
+// Each chunk has its own checksum (CHKS, version 2.4): a prefix whose chunks were damaged in transit is refused before
+// its level is unpacked (the positions' checksum covers the whole, which a prefix cannot check); damage past the
+// prefix does not concern it, and the whole package is refused for it. CHKS of the wrong size is refused too.
+TEST_F(LevelOrder, APrefixsChunksAreCheckedAgainstTheirOwnChecksums) {
+  const VxlzFile package = VxlzFile::open(dir.file("s.vxlz"));
+  ASSERT_TRUE(package.has_chunk_checksums());
+  const ShippedLevel coarsest = shipped_levels(package)[0];
+  ASSERT_LT(coarsest.bytes, package.size());
+  std::vector<char> bytes = slurp(dir.file("s.vxlz"));
+  const std::uint64_t in_first_chunk = package.chunk(0).symbols_offset + 5;
+  bytes[in_first_chunk] ^= 0x20;
+  test::hostile::write_file(dir.file("damaged.vxlz"), std::string(bytes.begin(), bytes.end()));
+  UnpackSettings settings;
+  settings.level = coarsest.level;
+  const Error e = error_of(
+      [&] { unpack_vxlz(prefix_of(dir.file("damaged.vxlz"), coarsest.bytes), dir.file("level.vxl"), settings); });
+  EXPECT_EQ(e.kind(), ErrorKind::Input);
+  EXPECT_TRUE(test::contains(e.what(), "checksum mismatch in position chunk 0")) << e.what();
+  EXPECT_FALSE(std::filesystem::exists(dir.file("level.vxl")));
+
+  bytes = slurp(dir.file("s.vxlz"));
+  bytes[bytes.size() - 3] ^= 0x20;  // in the last chunk, past the coarsest level's prefix
+  test::hostile::write_file(dir.file("late.vxlz"), std::string(bytes.begin(), bytes.end()));
+  EXPECT_EQ(unpack_vxlz(prefix_of(dir.file("late.vxlz"), coarsest.bytes), dir.file("level.vxl"), settings).streamlines,
+            coarsest.streamlines);
+  EXPECT_EQ(error_of([&] { (void)VxlzFile::open(dir.file("late.vxlz")); }).kind(), ErrorKind::Input);
+
+  // CHKS one entry short, every checksum resealed: refused for its size.
+  bytes = slurp(dir.file("s.vxlz"));
+  FileHeader h;
+  std::memcpy(&h, bytes.data(), sizeof h);
+  for (std::uint32_t i = 0; i < h.section_count; ++i) {
+    SectionEntry entry;
+    std::memcpy(&entry, bytes.data() + sizeof h + i * sizeof entry, sizeof entry);
+    if (std::memcmp(entry.id, "CHKS", 4) != 0) continue;
+    entry.size -= 8;  // its last 8 bytes given to the next section, POSD, ...
+    std::memcpy(bytes.data() + sizeof h + i * sizeof entry, &entry, sizeof entry);
+    SectionEntry next;
+    std::memcpy(&next, bytes.data() + sizeof h + (i + 1) * sizeof next, sizeof next);
+    next.offset -= 8, next.size += 8;
+    std::memcpy(bytes.data() + sizeof h + (i + 1) * sizeof next, &next, sizeof next);
+    // ... and to chunk 0's symbols in CHNK, whose sizes then still add up to POSD's.
+    SectionEntry chnk;
+    std::memcpy(&chnk, bytes.data() + sizeof h + (i - 1) * sizeof chnk, sizeof chnk);
+    ASSERT_EQ(std::string(chnk.id, 4), "CHNK");
+    std::uint64_t first_size;
+    std::memcpy(&first_size, bytes.data() + chnk.offset, 8);
+    first_size += 8;
+    std::memcpy(bytes.data() + chnk.offset, &first_size, 8);
+  }
+  test::reseal_checksums(bytes.data(), bytes.size());
+  test::hostile::write_file(dir.file("short.vxlz"), std::string(bytes.begin(), bytes.end()));
+  const Error short_table = error_of([&] { (void)VxlzFile::open(dir.file("short.vxlz")); });
+  EXPECT_EQ(short_table.kind(), ErrorKind::Input);
+  EXPECT_TRUE(test::contains(short_table.what(), "CHKS must hold one 8-byte checksum per chunk")) << short_table.what();
 }
 
 // A package whose tables claim 2^40 voxlines, all in its first streamline (STRL sums to META's count, checksums

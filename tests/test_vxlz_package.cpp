@@ -714,7 +714,7 @@ TEST(VxlzPackCli, InfoSummarisesAPackage) {
   ASSERT_EQ(test::run_cli("pack '" + vxl + "' '" + dir.file("s.vxlz") + "' --bits 12").exit_code, 0);
   const test::CommandResult text = test::run_cli("info '" + dir.file("s.vxlz") + "'");
   ASSERT_EQ(text.exit_code, 0) << text.output;
-  EXPECT_NE(text.output.find(".vxlz 2.3"), std::string::npos) << text.output;
+  EXPECT_NE(text.output.find(".vxlz 2.4"), std::string::npos) << text.output;
   EXPECT_NE(text.output.find("12 bits per axis"), std::string::npos) << text.output;
   EXPECT_NE(text.output.find("level by level"), std::string::npos) << text.output;
   const test::CommandResult json = test::run_cli("info --json '" + dir.file("s.vxlz") + "'");
@@ -727,6 +727,7 @@ TEST(VxlzPackCli, InfoSummarisesAPackage) {
   EXPECT_EQ(j["positions"]["quantization_bits"].get<std::uint32_t>(), 12u);
   EXPECT_GT(j["positions"]["error_bound_mm"].get<double>(), 0);
   EXPECT_EQ(j["shipping_order"], "level");
+  EXPECT_TRUE(j["chunks"]["checksums"].get<bool>());
   ASSERT_EQ(j["levels"].size(), f.level_count());
   std::uint64_t previous_bytes = 0;
   for (const auto& level : j["levels"]) {  // the coarsest first
@@ -745,6 +746,7 @@ TEST(VxlzPackCli, InfoSummarisesAPackage) {
   ASSERT_EQ(test::run_cli("pack '" + dir.file("flat.vxl") + "' '" + dir.file("flat.vxlz") + "'").exit_code, 0);
   const auto flat = nlohmann::json::parse(test::run_cli("info --json '" + dir.file("flat.vxlz") + "'").output);
   EXPECT_EQ(flat["shipping_order"], "streamline");
+  EXPECT_FALSE(flat["chunks"]["checksums"].get<bool>());
   EXPECT_FALSE(flat.contains("levels"));
 
   std::vector<char> bytes = slurp(dir.file("s.vxlz"));

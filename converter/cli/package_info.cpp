@@ -24,7 +24,7 @@ nlohmann::json package_info(const VxlzFile& package) {
                     {"error_bound_mm", p.error_bound},
                     {"max_error_mm", p.max_error},
                     {"rms_error_mm", p.rms_error}};
-  j["chunks"] = {{"count", p.chunk_count}, {"points", p.chunk_points}};
+  j["chunks"] = {{"count", p.chunk_count}, {"points", p.chunk_points}, {"checksums", package.has_chunk_checksums()}};
   const bool level_order = p.predictor == kVxlzPredictorLinearLevelOrder;
   j["shipping_order"] = level_order ? "level" : "streamline";
   if (level_order) {
@@ -60,8 +60,9 @@ void print_package_info(const nlohmann::json& j) {
               pos["quantization_bits"].get<std::uint32_t>(), 1000 * pos["quantum_mm"].get<double>(),
               1000 * pos["error_bound_mm"].get<double>(), 1000 * pos["max_error_mm"].get<double>(),
               1000 * pos["rms_error_mm"].get<double>());
-  std::printf("chunks        %llu of %llu points\n", (unsigned long long)j["chunks"]["count"].get<std::uint64_t>(),
-              (unsigned long long)j["chunks"]["points"].get<std::uint64_t>());
+  std::printf("chunks        %llu of %llu points%s\n", (unsigned long long)j["chunks"]["count"].get<std::uint64_t>(),
+              (unsigned long long)j["chunks"]["points"].get<std::uint64_t>(),
+              j["chunks"]["checksums"].get<bool>() ? ", each with its own checksum (a prefix's are checked)" : "");
   if (j["shipping_order"] == "level") {
     std::printf("shipped       level by level, the coarsest first: each level whole in the package's first bytes\n");
     for (const auto& l : j["levels"])
