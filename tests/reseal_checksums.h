@@ -18,6 +18,8 @@ namespace vxl::test {
 // as far as those lie inside the buffer.
 template <typename Byte>
 void reseal_chunk_checksums(Byte* bytes, std::size_t size, const FileHeader& h) {
+  if (h.section_count > kVxlMaxSections || sizeof h + std::uint64_t(h.section_count) * sizeof(SectionEntry) > size)
+    return;
   const SectionEntry *chnk = nullptr, *chks = nullptr, *posd = nullptr;
   SectionEntry entries[kVxlMaxSections];
   for (std::uint32_t i = 0; i < h.section_count; ++i) {

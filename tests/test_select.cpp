@@ -361,8 +361,6 @@ TEST_F(Selection, RegionsOutsideEverythingOrHoldingEverything) {
   EXPECT_EQ(select_streamlines(f, outside).streamlines.size(), source_->streamline_count());
 }
 
-// A streamline without points is never selected, as tckedit never writes one: not by an exclude, an inverted
-// query or a length limit of 0, which every streamline with points passes.
 // A level of detail is applied last, after the regions, the lengths and --invert: of what they keep, the streamlines
 // of depth >= level (spec §6.5), about an eighth a level; a level the file has not is refused.
 TEST_F(Selection, ALevelKeepsTheStreamlinesOfThatDepthAmongThoseTheCriteriaKeep) {
@@ -399,6 +397,8 @@ TEST_F(Selection, ALevelKeepsTheStreamlinesOfThatDepthAmongThoseTheCriteriaKeep)
   EXPECT_NE(std::string(error.what()).find("has 5 levels of detail: 0 to 4"), std::string::npos) << error.what();
 }
 
+// A streamline without points is never selected, as tckedit never writes one: not by an exclude, an inverted
+// query or a length limit of 0, which every streamline with points passes.
 TEST(SelectionEmptyStreamlines, AreNeverSelected) {
   ScratchDir dir;
   Tractogram t;

@@ -47,7 +47,9 @@ void add_share_command(CLI::App& app) {
                   "share only the streamlines of this level of detail, as a .vxl (1: about an eighth, 2: a 64th...,\n"
                   "spread over the whole tractogram): for one too large for a browser, which holds at most 3.75 GiB")
       ->type_name("N");
-  cmd->add_option("--threads", opt->settings.threads, "worker threads for --unpack (0: all cores)")->default_val(0);
+  cmd->add_option("--threads", opt->settings.threads,
+                  "worker threads for unpacking a .vxlz (--unpack, --level; 0: all cores)")
+      ->default_val(0);
   cmd->callback([opt] {
     if (opt->settings.web_viewer_dir.empty()) opt->settings.web_viewer_dir = default_web_viewer_dir();
     const ShareSummary s = share_folder(opt->input, opt->output, opt->settings);

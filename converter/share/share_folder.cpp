@@ -17,6 +17,7 @@
 #include "format/base/memory_size.h"
 #include "format/vxl_file.h"
 #include "format/vxl_layout.h"
+#include "format/vxl_levels.h"
 #include "format/vxlz_layout.h"
 #include "format/vxlz_package.h"
 
@@ -60,33 +61,38 @@ std::string readme(const std::string& title, const std::string& data_file) {
 }
 
 // A .vxl of `bytes` for the page, which holds its whole file in WebAssembly's memory: refused where that is too
-// small, naming the level of detail that would fit. The .vxl holds level `shared_level` of an input of `levels`
-// levels; each level holds about an eighth of the next finer one's streamlines, and its file shrinks alike.
-void check_fits_the_page(const std::string& in_path, std::uint64_t bytes, std::uint32_t levels,
+// small, naming the level of detail that would fit. The .vxl (a package's: unpacked) holds level `shared_level` of an
+// input of `levels` levels; each level holds about an eighth of the next finer one's streamlines, and its file shrinks
+// alike.
+void check_fits_the_page(const std::string& in_path, bool package, std::uint64_t bytes, std::uint32_t levels,
                          std::uint32_t shared_level, const ShareSettings& settings) {
   if (bytes <= settings.max_data_bytes) return;
   auto size_at = [&](std::uint32_t level) { return double(bytes) / std::pow(8.0, level - shared_level); };
   std::uint32_t level = shared_level + 1;
   while (level < levels && size_at(level) > 0.9 * double(settings.max_data_bytes)) ++level;
-  const std::string advice = level < levels ? "share a coarser level of detail: --level " + std::to_string(level) +
-                                                  " keeps about 1/" + std::to_string(1ull << (3 * level)) +
-                                                  " of the streamlines, spread over the whole tractogram (some " +
-                                                  format_memory_size(std::uint64_t(size_at(level))) + ")"
-                                            : "share a part of it (voxlines select IN.vxl OUT.vxl --include ROI ...)";
+  const std::string advice =
+      level < levels
+          ? "share a coarser level of detail: --level " + std::to_string(level) + " keeps about 1/" +
+                std::to_string(1ull << (3 * level)) + " of the streamlines, spread over the whole tractogram (some " +
+                format_memory_size(std::uint64_t(size_at(level))) + ")"
+          : std::string(package ? "unpack it and share a part of it (voxlines unpack, then voxlines select "
+                                : "share a part of it (voxlines select ") +
+                "IN.vxl OUT.vxl --include ROI ...)";
   throw Error(ErrorKind::Unsupported, in_path, std::nullopt,
               "the .vxl to share is " + format_memory_size(bytes) + ", more than the web viewer holds (" +
                   format_memory_size(settings.max_data_bytes) + " in a browser's WebAssembly memory): " + advice);
 }
 
-// The streamlines of `level` of the .vxl at `in_path`, written to `out_path`; their count.
+// The streamlines of `level` of `file` (those of depth >= level, spec §6.5), written to `out_path` as a .vxl; their
+// count. Not a selection's criteria: those would also apply the length limits tckedit takes from the source header.
 std::uint64_t write_level(const VxlFile& file, const std::string& out_path, std::uint32_t level) {
-  SelectionCriteria criteria;
-  criteria.level = level;
-  const SelectionResult selected = select_streamlines(file, criteria);
-  file.release_resident_pages();
-  write_selection(file, StreamlineSubset(file.meta().streamline_count, selected.streamlines), out_path, {},
+  check_level(file.path(), level, file.level_count());
+  std::vector<std::uint64_t> kept;
+  for (std::uint64_t s = 0; s < file.meta().streamline_count; ++s)
+    if (streamline_depth(s, file.level_count()) >= level) kept.push_back(s);
+  write_selection(file, StreamlineSubset(file.meta().streamline_count, kept), out_path, {},
                   {"voxlines_selection: level " + std::to_string(level)});
-  return selected.streamlines.size();
+  return kept.size();
 }
 
 // The folder's content, written into `staging`.
@@ -106,10 +112,10 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     data.replace_extension(".vxl");
     if (settings.level) {
       summary.streamlines = write_level(file, (staging / data).string(), *settings.level);
-      check_fits_the_page(in_path, fs::file_size(staging / data), file.level_count(), *settings.level, settings);
+      check_fits_the_page(in_path, false, fs::file_size(staging / data), file.level_count(), *settings.level, settings);
     } else {
       summary.streamlines = file.meta().streamline_count;
-      check_fits_the_page(in_path, file.bytes().size(), file.level_count(), 0, settings);
+      check_fits_the_page(in_path, false, file.bytes().size(), file.level_count(), 0, settings);
       copy_file(in_path, staging / data);
     }
   } else if (settings.unpack || settings.level) {
@@ -117,14 +123,16 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     unpack.threads = settings.threads;
     if (settings.level) check_level(in_path, *settings.level, unpack.levels);  // the levels of the .vxl unpacked
     data.replace_extension(".vxl");
-    const fs::path unpacked = settings.level ? staging / ".unpacked.vxl" : staging / data;
+    // Not a .vxl's name: the shared file's is the input's with .vxl, whatever the input was called.
+    const fs::path unpacked = settings.level ? staging / "unpacked.tmp" : staging / data;
     summary.streamlines = unpack_vxlz(in_path, unpacked.string(), unpack).streamlines;
     summary.unpacked = true;
     const VxlFile file = VxlFile::open(unpacked.string());
     if (settings.level) summary.streamlines = write_level(file, (staging / data).string(), *settings.level);
-    check_fits_the_page(in_path, fs::file_size(staging / data), file.level_count(), settings.level.value_or(0),
+    check_fits_the_page(in_path, true, fs::file_size(staging / data), file.level_count(), settings.level.value_or(0),
                         settings);
-    if (settings.level) fs::remove(unpacked);
+    std::error_code ec;
+    if (settings.level) fs::remove(unpacked, ec);  // else left in the staging folder, removed with it
   } else {
     // A package's checksums cover every byte of it. The page unpacks it in its own memory, as large as the .vxl.
     summary.streamlines = VxlzFile::open(in_path).meta().streamline_count;
