@@ -39,6 +39,10 @@ std::vector<ByteRange> ranges_of_level(const VxlFile& file, std::uint32_t level,
 std::vector<ByteRange> ranges_of_voxels(const VxlFile& file, std::uint32_t level, std::uint32_t voxel_first,
                                         std::uint32_t voxel_count, std::uint64_t gap);
 
+// Asks the system to read what drawing `level` of `file` reads (ranges_of_level) ahead, in file order: a viewer about
+// to upload a level of a file not in the page cache then waits for one batch of reads, not for a page fault each.
+void read_ahead_level(const VxlFile& file, std::uint32_t level);
+
 // Sorts `ranges` and merges those that overlap or lie less than `gap` bytes apart.
 std::vector<ByteRange> merge_ranges(std::vector<ByteRange> ranges, std::uint64_t gap);
 

@@ -77,6 +77,8 @@ class VxlFile {
   std::span<const std::uint8_t> bytes() const { return file_.bytes(); }
   // MappedFile::release_resident_pages: a pass through the whole file keeps its resident size bounded.
   void release_resident_pages() const { file_.release_resident_pages(); }
+  // MappedFile::will_need: bytes about to be read, asked of the disk at once.
+  void will_need(std::uint64_t offset, std::uint64_t size) const { file_.will_need(offset, size); }
   const FileHeader& header() const { return header_; }
   std::span<const SectionEntry> sections() const { return sections_; }
   const SectionEntry* find_section(std::uint32_t id) const;

@@ -709,6 +709,13 @@ SelectionResult select_by_regions_and_lengths(const VxlFile& file, const Selecti
 
 }  // namespace
 
+void read_ahead_selection_tables(const VxlFile& file) {
+  const bool indexed = file.find_section(section_id("VXIX")) != nullptr;
+  for (const std::uint32_t id :
+       {section_id("VOXT"), section_id("STRM"), indexed ? section_id("VXIX") : section_id("VXLN"), section_id("SLEN")})
+    if (const SectionEntry* e = file.find_section(id)) file.will_need(e->offset, e->size);
+}
+
 void check_level(const std::string& path, std::uint32_t level, std::uint32_t levels) {
   if (level >= levels)
     throw Error(ErrorKind::Usage, "--level", std::nullopt,

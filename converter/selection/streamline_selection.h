@@ -78,6 +78,11 @@ SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria&
                                    const VoxelVoxlines* index = nullptr, SelectionPath path = SelectionPath::Fastest,
                                    VoxlineBoxes* boxes = nullptr);
 
+// Asks the system to read ahead the tables a selection reads whole (VOXT, STRM, the voxel index VXIX or else the
+// voxline table, SLEN): a window's first selection of a file not in the page cache then waits for those reads
+// together, not for a page fault at a time (MappedFile::will_need).
+void read_ahead_selection_tables(const VxlFile& file);
+
 // Throws vxl::Error (Usage, naming `path`) unless `level` is one of the `levels` levels of detail of a file.
 void check_level(const std::string& path, std::uint32_t level, std::uint32_t levels);
 

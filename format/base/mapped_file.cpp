@@ -1,5 +1,6 @@
 #include "format/base/mapped_file.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -49,6 +50,16 @@ MappedFile::~MappedFile() { release(); }
 void MappedFile::release_resident_pages() const {
   // Read-only and private: nothing of ours is lost, the pages come back from the file.
   if (data_ != nullptr && !adopted_) ::madvise(const_cast<std::uint8_t*>(data_), size_, MADV_DONTNEED);
+}
+
+void MappedFile::will_need(std::uint64_t offset, std::uint64_t size) const {
+  if (data_ == nullptr || adopted_ || offset >= size_) return;
+  const std::uint64_t page = static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE));
+  const std::uint64_t end = std::min<std::uint64_t>(size_, offset + size);
+  // In pieces: Linux reads at most its read-ahead window (128 KiB by default) for each call and drops the rest.
+  constexpr std::uint64_t kPiece = 128 << 10;
+  for (std::uint64_t at = offset / page * page; at < end; at += kPiece)
+    ::madvise(const_cast<std::uint8_t*>(data_) + at, std::min(kPiece, end - at), MADV_WILLNEED);  // errors ignored
 }
 
 MappedFile::MappedFile(MappedFile&& other) noexcept

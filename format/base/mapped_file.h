@@ -29,6 +29,11 @@ class MappedFile {
   // read maps them again (a minor fault). A long pass through a large file calls it now and then, so that its
   // resident size stays what it reads between calls, not the whole file.
   void release_resident_pages() const;
+  // Asks the system to read bytes [offset, offset + size) into the page cache ahead of their use (a hint: nothing
+  // happens for bytes in memory already or where the system declines; the reads are queued, not waited for). Reading
+  // many scattered parts of a file that is not in the page cache then waits on the disk once, with the reads queued
+  // together, not once a page fault.
+  void will_need(std::uint64_t offset, std::uint64_t size) const;
 
  private:
   MappedFile() = default;

@@ -2,12 +2,18 @@
 // buffer holding only what ranges_to_open and ranges_of_level name (the rest filled with garbage) opens, passes
 // the draw checks and draws that level exactly as the whole file does; a level whose spans come one at a time, the
 // nearest the view first, draws those in with a coarser level in place of the others.
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <set>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include "converter/synth/synth.h"
 #include "format/base/error.h"
@@ -162,6 +168,45 @@ TEST(FetchPlan, RangesMergeAndTheMissingOnesCoverTheRest) {
   EXPECT_FALSE(ranges_held(std::vector<ByteRange>{{40, 41}}, held)) << "past the last";
   EXPECT_FALSE(ranges_held(std::vector<ByteRange>{{5, 9}}, held)) << "in a gap";
   EXPECT_TRUE(ranges_held({}, held));
+}
+
+// read_ahead_level asks the system for a level's bytes: evicted from the page cache, they are back in it shortly after,
+// without this process reading one of them (mincore: the page cache's view of the file).
+TEST(FetchPlan, ALevelReadAheadBringsItsBytesIntoThePageCache) {
+  ScratchDir dir;
+  SynthSettings synth;
+  synth.streamlines = 20000;
+  ConvertSettings s;
+  s.levels = 4;
+  convert_tractogram(synthesize_tractogram(synth), dir.file("scene.vxl"), s);
+  const VxlFile file = VxlFile::open(dir.file("scene.vxl"));
+  const std::vector<ByteRange> level = ranges_of_level(file, 1, 0);
+  const long page = ::sysconf(_SC_PAGESIZE);
+  auto pages_out = [&] {  // the level's pages not in the page cache
+    std::uint64_t out = 0;
+    for (const ByteRange& r : level) {
+      const std::uint64_t first = r.begin / page * page;
+      std::vector<unsigned char> in((r.end - first + page - 1) / page);
+      EXPECT_EQ(::mincore(const_cast<std::uint8_t*>(file.bytes().data()) + first, r.end - first, in.data()), 0);
+      for (unsigned char c : in) out += (c & 1) == 0;
+    }
+    return out;
+  };
+  {
+    const int fd = ::open(dir.file("scene.vxl").c_str(), O_RDONLY);
+    ASSERT_GE(fd, 0);
+    ::fdatasync(fd);
+    ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
+    ::close(fd);
+  }
+  if (pages_out() == 0) GTEST_SKIP() << "this file system keeps the file in memory: nothing to read ahead";
+  read_ahead_level(file, 1);
+  std::uint64_t out = pages_out();
+  for (int wait = 0; wait < 100 && out > 0; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    out = pages_out();
+  }
+  EXPECT_EQ(out, 0u) << "pages of level 1 still not read after 5 s";
 }
 
 TEST(FetchPlan, TheFirstBytesAreCheckedAsOpenChecksThem) {

@@ -1,5 +1,6 @@
 #include "viewer/app/viewer_session.h"
 
+#include "format/vxl_fetch_plan.h"
 #include "viewer/anatomy/nifti_volume.h"
 #include "viewer/app/scene_source.h"
 #include "viewer/render/scene_layout.h"
@@ -47,6 +48,9 @@ std::uint64_t ViewerSession::span_texels_at(std::uint32_t level) const {
 Renderer& ViewerSession::renderer_at(std::uint32_t level, bool eager) {
   std::unique_ptr<Renderer>& r = renderers_[level];
   if (!r) {
+    // Its level's bytes asked of the disk at once, where the file is not in the page cache: an eager renderer uploads
+    // them now, another as frames need them (the reads then come in the background, not one fault at a time).
+    for (const VxlFile* f : files_) read_ahead_level(*f, level);
     r = std::make_unique<Renderer>(files_, span_texels_at(level), level, gpu_memory_, eager);
     r->share_indexes(indexes_);
     if (image_) r->set_volume(*image_);

@@ -71,6 +71,7 @@ class ViewerWindow {
   // Asks for a new selection when the regions changed and takes the newest finished one into the picture
   // (selection_worker.h); with `wait`, the one the regions ask for now.
   void update_selection(bool wait);
+  void read_ahead_selection_tables_once();
   // Hands the focus and context to every renderer (without a selection: the files' own groups again), and
   // asks for the selection's focus copy (focus first, focus_copy_worker.h).
   void apply_selection(std::optional<SceneSelection> selection);
@@ -172,8 +173,9 @@ class ViewerWindow {
   PanelState state_;
   PanelStats stats_;
   int drag_button_ = -1;
-  bool dragging_region_ = false;   // Ctrl + left drag: the active sphere follows the cursor
-  glm::dvec2 region_cursor_{0.0};  // the cursor at the drag's last move
+  bool selection_tables_asked_ = false;  // read_ahead_selection_tables_once
+  bool dragging_region_ = false;         // Ctrl + left drag: the active sphere follows the cursor
+  glm::dvec2 region_cursor_{0.0};        // the cursor at the drag's last move
   bool screenshot_requested_ = false;
   bool save_view_requested_ = false;
   RenderMode drawn_mode_ =

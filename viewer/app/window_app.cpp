@@ -73,6 +73,8 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
   update_selection(false);
   // Scene-wide facts (bounds, groups, value sets, voxel cubes) are the same at every level.
   Renderer& first = renderer_at(first_level_, true);
+  // The tables the selection reads, asked of the disk once the first level's bytes are in (they go first).
+  if (!regions_.empty()) read_ahead_selection_tables_once();
   grid_.emplace(std::span<const VxlFile* const>(files_));  // the files opened: not a focus copy drawn beside them
   controller_ = CameraController(Camera{}, std::max(1.0, glm::length(first.scene_max() - first.scene_min()) * 0.5));
   stats_.has_image = session_->image() != nullptr;

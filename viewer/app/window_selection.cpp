@@ -27,6 +27,7 @@ void ViewerWindow::update_selection(bool wait) {
       if (selection_) apply_selection(std::nullopt);
     } else {
       try {
+        if (drawn_) read_ahead_selection_tables_once();  // at opening, once the first level is read (the constructor)
         selection_worker_.request(regions_.revision(), regions_.criteria());
         if (!selection_) stats_.selection = "selecting the regions' streamlines ...";
       } catch (const std::exception& e) {  // a region that does not parse: said, and no selection
@@ -52,6 +53,12 @@ void ViewerWindow::update_selection(bool wait) {
   if (s.find_style(SceneGroups::kContext) == nullptr)
     s.style_of(SceneGroups::kContext).opacity = std::min(1.0f, 0.02f / s.opacity);
   apply_selection(std::move(done->result));
+}
+
+void ViewerWindow::read_ahead_selection_tables_once() {
+  if (selection_tables_asked_) return;
+  for (const VxlFile* f : files_) read_ahead_selection_tables(*f);
+  selection_tables_asked_ = true;
 }
 
 void ViewerWindow::apply_selection(std::optional<SceneSelection> selection) {
