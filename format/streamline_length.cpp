@@ -8,13 +8,19 @@
 
 namespace vxl {
 
+double polyline_step(const float* a, const float* b) {
+  const double dx = double(b[0]) - a[0], dy = double(b[1]) - a[1], dz = double(b[2]) - a[2];
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+double polyline_extend(double length, const float* last, const float* xyz, std::size_t n) {
+  for (const float* p = xyz; p != xyz + 3 * n; last = p, p += 3) length += polyline_step(last, p);
+  return length;
+}
+
 double polyline_length(std::span<const float> xyz) {
   double length = 0;
-  for (std::size_t i = 3; i + 2 < xyz.size(); i += 3) {
-    const double dx = double(xyz[i]) - xyz[i - 3], dy = double(xyz[i + 1]) - xyz[i - 2],
-                 dz = double(xyz[i + 2]) - xyz[i - 1];
-    length += std::sqrt(dx * dx + dy * dy + dz * dz);
-  }
+  for (std::size_t i = 3; i + 2 < xyz.size(); i += 3) length += polyline_step(&xyz[i - 3], &xyz[i]);
   return length;
 }
 

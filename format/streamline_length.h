@@ -14,6 +14,11 @@ namespace vxl {
 // The polyline's length in mm: each segment's length from its float32 end points in double, summed in
 // order in double (0 for fewer than two points).
 double polyline_length(std::span<const float> xyz);
+// One step of polyline_length, from point a to point b (3 floats each), and `length` with the steps from `last` to the
+// first of `n` points and on along them added one by one: polyline_length is its steps summed in order, so that a
+// reader with a streamline's points in pieces sums the same steps. Compiled here, with polyline_length.
+double polyline_step(const float* a, const float* b);
+double polyline_extend(double length, const float* last, const float* xyz, std::size_t n);
 
 // The length SLEN stores for those points: polyline_length rounded to float32.
 inline float stored_length_of(std::span<const float> xyz) { return static_cast<float>(polyline_length(xyz)); }

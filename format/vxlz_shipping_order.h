@@ -35,6 +35,8 @@ class ShippedVoxlineCursor {
                        std::span<const VoxlineEntry> voxlines, std::uint64_t point);
   std::uint64_t voxline() const { return voxline_; }
   std::uint64_t point_in_voxline() const { return in_voxline_; }
+  // Where the voxline's streamline is in the order (its index in ShippingOrder::streamlines).
+  std::uint64_t shipped_position() const { return position_; }
   // The voxline's own points (count_flags' count).
   std::uint64_t own() const { return voxlines_[voxline_].count_flags & kVoxlineCountMask; }
   // Moves `points` points on (at most to the end of the voxline); past its end, to the next shipped voxline.

@@ -3,6 +3,7 @@
 // Draco keeps the point order; damaged, truncated and crafted packages are refused with an Error (never
 // a crash: the ASan build runs these too).
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -20,6 +21,7 @@
 #include "converter/synth/synth.h"
 #include "format/base/checksum.h"
 #include "format/base/error.h"
+#include "format/streamline_length.h"
 #include "format/vxl_file.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_streamlines.h"
@@ -264,6 +266,56 @@ TEST(VxlzPackageOptions, ChunkSizeAndThreadsDoNotChangeTheResult) {
   const VxlFile fa = VxlFile::open(dir.file("tiny.vxl")), fb = VxlFile::open(b);
   EXPECT_EQ(fa.all_vertices(), fb.all_vertices());
   EXPECT_EQ(to_vector(fa.order_bytes()), to_vector(fb.order_bytes()));
+}
+
+// The unpacker decodes the chunks side by side, once or twice (its bounds, ends and lengths first, then the positions):
+// a streamline cut by chunks, here by every seventh point, gets the length of its points measured whole, to the bit,
+// and each voxel the bounds of its vertices, as one streamline and one block at a time would measure them.
+TEST(VxlzPackageOptions, StreamlinesCutByChunksGetTheirWholeLengthAndVoxelsTheirBoundsDecodedOnceOrTwice) {
+  ScratchDir dir;
+  const std::string vxl = convert_for_package(test_tractogram(300), dir.file("s.vxl"));
+  PackSettings tiny;
+  tiny.chunk_points = 7;
+  pack_vxl(VxlFile::open(vxl), dir.file("s.vxlz"), tiny);
+  UnpackSettings exact;
+  exact.positions = PositionEncoding::Float32;  // the decoded points themselves, which the lengths and bounds are of
+  exact.threads = 3;
+  unpack_vxlz(dir.file("s.vxlz"), dir.file("u.vxl"), exact);
+  const VxlFile f = VxlFile::open(dir.file("u.vxl"));
+  ASSERT_EQ(f.streamline_lengths().size(), f.meta().streamline_count);
+  std::uint64_t cut = 0;
+  WalkCallbacks cb;
+  cb.streamline = [&](std::uint64_t s, std::span<const float> xyz) {
+    cut += xyz.size() / 3 > 7;  // more points than a chunk holds, in whatever order the streamlines were shipped
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(f.streamline_lengths()[s]),
+              std::bit_cast<std::uint32_t>(stored_length_of(xyz)))
+        << "streamline " << s;
+  };
+  walk_streamlines(f, cb);
+  EXPECT_GT(cut, 250u);
+  // The same lengths and bounds in a packed .vxl, its positions kept as floats for one decode or decoded twice.
+  UnpackSettings packed;
+  packed.threads = 3;
+  unpack_vxlz(dir.file("s.vxlz"), dir.file("kept.vxl"), packed);
+  packed.memory_limit = 1;
+  EXPECT_TRUE(unpack_vxlz(dir.file("s.vxlz"), dir.file("twice.vxl"), packed).decoded_twice);
+  EXPECT_EQ(slurp(dir.file("kept.vxl")), slurp(dir.file("twice.vxl")));
+  const VxlFile twice = VxlFile::open(dir.file("twice.vxl"));
+  EXPECT_EQ(to_vector(twice.streamline_lengths()), to_vector(f.streamline_lengths()));
+  for (std::size_t i = 0; i < f.voxels().size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(twice.voxels()[i].tight_min[c], f.voxels()[i].tight_min[c]);
+      EXPECT_EQ(twice.voxels()[i].tight_max[c], f.voxels()[i].tight_max[c]);
+    }
+  const std::vector<float> all = f.all_vertices();
+  for (const VoxelEntry& v : f.voxels())
+    for (int c = 0; c < 3; ++c) {
+      float lo = INFINITY, hi = -INFINITY;
+      for (std::uint64_t i = v.vertex_first; i < v.vertex_first + v.vertex_count; ++i)
+        lo = std::min(lo, all[3 * i + c]), hi = std::max(hi, all[3 * i + c]);
+      EXPECT_EQ(v.tight_min[c], lo + 0.0f);
+      EXPECT_EQ(v.tight_max[c], hi + 0.0f);
+    }
 }
 
 TEST(VxlzPackageOptions, PackageBytesDoNotDependOnThreads) {
@@ -698,6 +750,16 @@ TEST(VxlzPackCli, PackUnpackVerify) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = test::run_cli("verify '" + dir.file("u.vxl") + "'");
   EXPECT_EQ(r.exit_code, 0) << r.output;
+  // A memory limit the decoded positions do not fit: the package decoded twice, the same bytes; a limit that is not a
+  // size of memory is a usage error.
+  r = test::run_cli("unpack '" + dir.file("s.vxlz") + "' '" + dir.file("twice.vxl") + "' --memory-limit 1K --verbose");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("decoded twice"), std::string::npos) << r.output;
+  EXPECT_EQ(slurp(dir.file("u.vxl")), slurp(dir.file("twice.vxl")));
+  r = test::run_cli("unpack '" + dir.file("s.vxlz") + "' '" + dir.file("x.vxl") + "' --memory-limit lots");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("is not a memory size"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.vxl")));
   r = test::run_cli("pack '" + vxl + "' '" + dir.file("t.vxlz") + "' --bits 9");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = test::run_cli("unpack '" + vxl + "' '" + dir.file("w.vxl") + "'");  // a .vxl is not a package

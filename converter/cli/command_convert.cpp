@@ -81,13 +81,7 @@ void add_memory_limit_option(CLI::App* cmd, std::string& memory_limit) {
              "of the file's size (256 MiB to 6 GiB, at most half of the available memory; raised there where the "
              "data needs more). With --output-dir the limit is per file: --jobs N may use N times SIZE")
       ->type_name("SIZE")
-      ->check(CLI::Validator(
-          [](std::string& s) {
-            return parse_memory_size(s)
-                       ? std::string()
-                       : "'" + s + "' is not a memory size (a number of bytes, or of KiB/MiB/GiB with K/M/G: 512M, 2G)";
-          },
-          ""));
+      ->check(memory_size_validator());
 }
 
 // One conversion (IN OUT.vxl) or a cohort (--output-dir); returns the exit code.

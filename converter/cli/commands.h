@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "format/base/memory_size.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
 
@@ -47,6 +48,17 @@ inline CLI::Option* add_levels_option(CLI::App* cmd, std::uint32_t& levels) {
                    "1 writes full detail only")
       ->check(CLI::Range(1u, kMaxLevels))
       ->default_str(std::to_string(kDefaultLevels));
+}
+
+// A --memory-limit SIZE's check (convert, unpack): bytes, or KiB/MiB/GiB with K/M/G.
+inline CLI::Validator memory_size_validator() {
+  return CLI::Validator(
+      [](std::string& s) {
+        return parse_memory_size(s)
+                   ? std::string()
+                   : "'" + s + "' is not a memory size (a number of bytes, or of KiB/MiB/GiB with K/M/G: 512M, 2G)";
+      },
+      "");
 }
 
 }  // namespace vxl::cli

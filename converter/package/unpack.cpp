@@ -11,12 +11,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "converter/convert/position_packing.h"
 #include "converter/convert/segment_orders.h"
 #include "converter/convert/voxel_table.h"
+#include "converter/package/unpack_positions.h"
+#include "converter/package/unpack_structure.h"
 #include "converter/pipeline/range_orders.h"
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
+#include "format/base/memory_available.h"
 #include "format/base/parallel.h"
 #include "format/streamline_length.h"
 #include "format/voxel_voxlines.h"
@@ -33,30 +35,6 @@
 
 namespace vxl {
 namespace {
-
-// The exact tables of the .vxl, rebuilt from the package's streams (spec §7 steps 2-4), and where each
-// voxline's points go.
-struct Structure {
-  std::vector<std::uint64_t> strm;              // N + 1
-  std::vector<VoxlineEntry> voxlines;           // L
-  std::vector<std::uint8_t> starts_streamline;  // L + 1 (the last entry 1): voxline j is a streamline's first
-  std::vector<VoxelEntry> voxels;               // coord, vertex and segment counts, vertex_first, order layout
-  std::vector<LevelEntry> levels;               // LODS: voxel_count x (level_count - 1)
-  std::uint32_t level_count = 1;
-  std::uint64_t order_bytes = 0;
-  // Voxline j's first vertex is voxels[voxel].vertex_first + offset_in_voxel[j] (< 2^32: a voxel's
-  // vertex count is).
-  std::vector<std::uint32_t> offset_in_voxel;
-  // The order the points were shipped in (package spec §5.1), and how many of them the file holds: all, or for
-  // the streamlines of a level alone, the first ones (a level's are shipped first).
-  ShippingOrder order;
-  std::uint64_t shipped_points = 0;
-
-  bool connected(std::uint64_t j) const { return !starts_streamline[j + 1]; }
-  std::uint64_t first_vertex(std::uint64_t j) const {
-    return voxels[voxlines[j].voxel].vertex_first + offset_in_voxel[j];
-  }
-};
 
 // Every voxline takes at least a byte of each of its streams (VXLV, VXLC): META's count is refused when `stream` (the
 // inflated section `id`) cannot hold it, before anything is allocated for it.
@@ -86,7 +64,7 @@ std::vector<VoxlineEntry> read_voxlines(const VxlzFile& f, std::span<const std::
 // they cross, as a file of their own: `m` gets their counts, the grid moved by whole voxels to their bounds (.vxl
 // spec §7 step 5 ties the grid to the bounds), and `coords` the voxels' coordinates in it.
 void keep_level(std::uint32_t min_depth, std::span<const std::uint8_t> depths, MetaSection& m,
-                std::vector<std::array<std::int32_t, 3>>& coords, Structure& s) {
+                std::vector<std::array<std::int32_t, 3>>& coords, UnpackStructure& s) {
   std::vector<std::uint64_t> strm{0};
   std::vector<VoxlineEntry> voxlines;
   std::vector<std::uint32_t> new_voxel(coords.size(), ~0u);
@@ -136,10 +114,11 @@ void keep_level(std::uint32_t min_depth, std::span<const std::uint8_t> depths, M
 }
 
 // `m`: META's counts to check the tables against; with min_depth > 0, set to those of the level kept (keep_level).
-Structure rebuild_structure(const VxlzFile& f, std::uint32_t level_count, std::uint32_t min_depth, MetaSection& m) {
+UnpackStructure rebuild_structure(const VxlzFile& f, std::uint32_t level_count, std::uint32_t min_depth,
+                                  MetaSection& m) {
   const PackSection& k = f.pack();
   const std::string& p = f.path();
-  Structure s;
+  UnpackStructure s;
   s.level_count = level_count;
   auto coords =
       decode_voxel_coords(f.inflate(section_id("VOXC")), m.voxel_count, m.grid_dims, f.context(section_id("VOXC")));
@@ -257,57 +236,10 @@ std::string provenance_with_package(const VxlzFile& f) {
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-// Decodes chunk c into VERT (spec §5, §6, §7 step 4): own points at their voxline's place, and each
-// voxline's first point also as the connecting vertex of the voxline before it in the same streamline.
-// Marks the last vertex of every voxline that ends in this chunk (for the orders).
-void decode_chunk(const VxlzFile& f, const Structure& s, std::uint64_t chunk, std::span<float> vert,
-                  VoxlineEnds& ends) {
-  const Quantizer quantizer(f.pack());
-  const ChunkBytes bytes = f.chunk(chunk);
-  ResidualChunk residuals(bytes, f.pack().joint_bits, f.chunk_point_count(chunk), f.path());
-  // The chunk's points that the file holds: all of them, or for a level alone, those before its end.
-  const std::uint64_t start = chunk * f.pack().chunk_points;
-  const std::uint64_t count = std::min(f.chunk_point_count(chunk), s.shipped_points - start);
-
-  ShippedVoxlineCursor at(s.order, s.strm, s.voxlines, start);
-  LinearPredictor predictor;
-  predictor.reset();
-  const std::uint64_t max_value = quantizer.max_value();
-  for (std::uint64_t i = 0; i < count;) {
-    const std::uint64_t j = at.voxline(), in_voxline = at.point_in_voxline(), own = at.own();
-    const std::uint64_t run = std::min(own - in_voxline, count - i);
-    const std::uint64_t first = s.first_vertex(j);
-    if (in_voxline == 0 && s.starts_streamline[j]) predictor.start_streamline();
-    float* dst = vert.data() + 3 * (first + in_voxline);
-    for (std::uint64_t r = 0; r < run; ++r, dst += 3) {
-      std::int32_t residual[3];
-      residuals.next(residual);
-      std::array<std::int64_t, 3> q;
-      for (int a = 0; a < 3; ++a) q[a] = predictor.predict(a) + residual[a];
-      // One unsigned comparison per value also catches negatives; checked per point so that a damaged
-      // chunk cannot drive the prediction into overflow.
-      if (static_cast<std::uint64_t>(q[0]) > max_value || static_cast<std::uint64_t>(q[1]) > max_value ||
-          static_cast<std::uint64_t>(q[2]) > max_value)
-        fail_input(f.path(), bytes.symbols_offset,
-                   "position chunk: point " + std::to_string(start + i + r) + " decodes outside the quantisation grid");
-      for (int a = 0; a < 3; ++a) dst[a] = quantizer.dequantize(q[a], a);
-      predictor.push(q);
-    }
-    if (in_voxline == 0 && !s.starts_streamline[j]) {
-      // The previous voxline's connecting vertex is a copy of this first point, bit for bit.
-      const std::uint64_t previous_own = s.voxlines[j - 1].count_flags & kVoxlineCountMask;
-      std::memcpy(vert.data() + 3 * (s.first_vertex(j - 1) + previous_own), vert.data() + 3 * first, 12);
-    }
-    i += run;
-    if (in_voxline + run == own) ends.set(first + own + s.connected(j) - 1);
-    at.advance(run);
-  }
-}
-
 // The value sets as the .vxl lays them out (spec §7 step 8): per vertex, each voxline's own values at
 // its own vertices and, at its connecting vertex, a copy of the next voxline's first value (as the
 // positions); per streamline, as shipped.
-void write_point_values(const Structure& s, const std::vector<NamedValues>& sets, std::span<std::uint8_t> payload,
+void write_point_values(const UnpackStructure& s, const std::vector<NamedValues>& sets, std::span<std::uint8_t> payload,
                         std::uint64_t vertex_count, unsigned threads) {
   std::vector<std::string> names;
   for (const NamedValues& v : sets) names.push_back(v.name);
@@ -399,62 +331,10 @@ void set_bounds_checked(MetaSection& meta, std::span<const VoxelEntry> voxels, c
                    "the positions decode outside their voxels: " + misplaced_voxel(meta, voxels[i], i, c));
 }
 
-// Each streamline's length (SLEN, spec §5.15) from the decoded points, synthetic face points left out: the
-// package's positions are the source of the file written.
-void measure_streamlines(const Structure& s, std::span<const float> vertices, std::span<float> lengths,
-                         unsigned threads) {
-  const std::uint64_t n = lengths.size(), parts = std::min<std::uint64_t>(n, 64ull * threads);
-  parallel_for(parts, threads, [&](std::uint64_t part, unsigned) {
-    std::vector<float> xyz;
-    for (std::uint64_t k = n * part / parts; k < n * (part + 1) / parts; ++k) {
-      xyz.clear();
-      for (std::uint64_t j = s.strm[k]; j < s.strm[k + 1]; ++j) {
-        const std::uint32_t own = s.voxlines[j].count_flags & kVoxlineCountMask;
-        const std::uint32_t from = (s.voxlines[j].count_flags & kVoxlineSyntheticFirst) ? 1 : 0;
-        const float* first = vertices.data() + 3 * s.first_vertex(j);
-        xyz.insert(xyz.end(), first + 3 * from, first + 3 * std::max(own, from));
-      }
-      lengths[k] = stored_length_of(xyz);
-    }
-  });
-}
-
-// Decodes every position chunk into `vertices` (3 floats a vertex, VERT's order), in parallel, and marks the
-// voxline ends in `ends`.
-void decode_vertices(const VxlzFile& f, const Structure& s, std::span<float> vertices, VoxlineEnds& ends,
-                     unsigned threads, const std::function<void(double)>& progress) {
-  const std::uint64_t chunks = (s.shipped_points + f.pack().chunk_points - 1) / f.pack().chunk_points;
-  if (chunks > f.chunks_present())
-    fail_input(f.path(), std::nullopt,
-               "the positions of the streamlines asked for need " + std::to_string(chunks) + " chunks; " +
-                   std::to_string(f.chunks_present()) + " are there");
-  std::atomic<std::uint64_t> done{0};
-  parallel_for(chunks, threads, [&](std::uint64_t chunk, unsigned t) {
-    decode_chunk(f, s, chunk, vertices, ends);
-    const std::uint64_t d = ++done;
-    if (t == 0) progress(double(d) / double(chunks));
-  });
-}
-
-// Each voxel's tight bounds from its decoded vertices (spec §7 step 3) and, packed, its block packed into `packed`
-// (VERT's words). Returns the largest packing bound (0 for float32).
-double bound_and_pack(std::span<VoxelEntry> voxels, std::span<float> vertices, const VoxlineEnds& ends,
-                      std::span<std::uint32_t> packed, unsigned threads) {
-  std::vector<double> repack_bound(threads, 0.0);  // per thread: the largest of its voxels' packing bounds
-  parallel_for(voxels.size(), threads, [&](std::uint64_t i, unsigned t) {
-    VoxelEntry& v = voxels[i];
-    detail::set_tight_bounds({&v, 1}, vertices.data(), 0);
-    if (packed.empty()) return;
-    pack_vertex_blocks({&v, 1}, vertices, ends, packed, 1);
-    repack_bound[t] = std::max(repack_bound[t], packed_error_bound(v));
-  });
-  return *std::max_element(repack_bound.begin(), repack_bound.end());
-}
-
 // The sections after VERT and ORDB (spec §7 steps 6-8): META with its bounds, the directions, the voxel and level
 // tables, the voxline and streamline tables with their voxel index, the lengths, PROV, and what the package carries
 // besides (groups, their values, the value sets).
-void append_tables(VxlStreamWriter& out, const VxlzFile& f, const Structure& s, const MetaSection& meta,
+void append_tables(VxlStreamWriter& out, const VxlzFile& f, const UnpackStructure& s, const MetaSection& meta,
                    std::span<const VoxelEntry> voxels, std::span<const float> lengths, const std::string& provenance,
                    const PackageExtras& extras, unsigned threads) {
   out.append_meta(meta);
@@ -513,14 +393,13 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
                     ")");
   MetaSection meta = f.meta();
   // A level alone is a file of its own, without levels: its counts are set by keep_level.
-  Structure s = rebuild_structure(f, level_alone ? 1 : settings.levels, settings.level, meta);
+  UnpackStructure s = rebuild_structure(f, level_alone ? 1 : settings.levels, settings.level, meta);
   const std::string provenance = provenance_with_package(f);
   // A level alone is for a first look: the groups and value sets come with the whole.
   const PackageExtras extras = level_alone ? PackageExtras() : read_extras(f, threads);
 
   meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
   meta.level_count = s.level_count > 1 && meta.voxel_count > 0 ? s.level_count : 0;
-  const bool packed = settings.positions == PositionEncoding::Packed;
   VxlSectionSizes sizes = section_sizes(meta, s.order_bytes, provenance.size(), extras.groups_bytes.size(),
                                         static_cast<std::uint32_t>(extras.point_values.size()),
                                         static_cast<std::uint32_t>(extras.streamline_values.size()));
@@ -533,22 +412,29 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
   VoxlineEnds ends(meta.vertex_count);
   VoxelRange whole = whole_range(voxels);
   whole.order_threads = threads;
+  const bool packed = settings.positions == PositionEncoding::Packed;
+  const std::uint64_t floats_allowed =
+      settings.memory_limit > 0 ? settings.memory_limit : available_memory().value_or(1ull << 30) / 2;
+  summary.decoded_twice = packed && 12 * meta.vertex_count > floats_allowed;
   const auto place = [&](std::span<std::uint8_t> window) {
-    // Packed positions are decoded as floats first (tight bounds come from them), then packed into VERT.
-    // Left uninitialised: the chunks write every vertex (rebuild_structure checked that the voxlines' points are the
-    // package's), and zeroing them first cost a serial pass over fresh pages (0.3 s for 1M streamlines).
-    std::unique_ptr<float[]> float_blocks =
-        packed ? std::unique_ptr<float[]>(new float[3 * meta.vertex_count]) : nullptr;
-    const std::span<float> vertices =
-        packed ? std::span<float>(float_blocks.get(), 3 * meta.vertex_count)
-               : std::span<float>(reinterpret_cast<float*>(window.data()), window.size() / sizeof(float));
-    decode_vertices(f, s, vertices, ends, threads, [&](double d) { progress("decoding", d); });
-    measure_streamlines(s, vertices, lengths, threads);
-    const std::span<std::uint32_t> words =
-        packed ? std::span<std::uint32_t>(reinterpret_cast<std::uint32_t*>(window.data()), meta.vertex_count)
-               : std::span<std::uint32_t>();
-    summary.repack_error_bound = bound_and_pack(voxels, vertices, ends, words, threads);
-    set_bounds_checked(meta, voxels, f.path());
+    const auto decoding = [&](double from) { return [&, from](double d) { progress("decoding", from + d / 2); }; };
+    const std::span<std::uint32_t> words(reinterpret_cast<std::uint32_t*>(window.data()), window.size() / 4);
+    if (summary.decoded_twice) {
+      scan_positions(f, s, ends, lengths, threads, decoding(0));
+      set_bounds_checked(meta, voxels, f.path());
+      summary.repack_error_bound = write_positions(f, s, ends, settings.positions, window, threads, decoding(0.5));
+    } else if (packed) {
+      // Left uninitialised: the chunks write every vertex (rebuild_structure checked that the voxlines' points are
+      // the package's), and zeroing them first cost a serial pass over fresh pages (0.3 s for 1M streamlines).
+      const auto floats = static_cast<std::size_t>(3 * meta.vertex_count);  // within the memory limit
+      const std::unique_ptr<float[]> kept(new float[floats]);
+      scan_positions(f, s, ends, lengths, threads, decoding(0), kept.get());
+      set_bounds_checked(meta, voxels, f.path());
+      summary.repack_error_bound = pack_kept_positions(s, {kept.get(), floats}, ends, words, threads);
+    } else {  // float32: the decoded positions are VERT's
+      scan_positions(f, s, ends, lengths, threads, decoding(0), reinterpret_cast<float*>(window.data()));
+      set_bounds_checked(meta, voxels, f.path());
+    }
     summary.decode_seconds = seconds_since(t0);
   };
   OrderSetSpec order_set;

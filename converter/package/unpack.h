@@ -28,6 +28,10 @@ struct UnpackSettings {
   // their own without levels (the first look a viewer gets while the rest arrives); only the chunks that hold them
   // need be there (VxlzFile::open_prefix). Without groups and value sets.
   std::uint32_t level = 0;
+  // What the decoded positions may take (0: half of the available memory): a packed .vxl's are kept as floats for one
+  // decode of the chunks where they fit in it (12 bytes a vertex), else the chunks are decoded twice
+  // (unpack_positions.h).
+  std::uint64_t memory_limit = 0;
 };
 
 struct UnpackSummary {
@@ -41,6 +45,7 @@ struct UnpackSummary {
   // decode: the package read, the positions decoded, each voxel's bounds set and its block packed; orders: the
   // orders built and written; write: the tables after them.
   double decode_seconds = 0, orders_seconds = 0, write_seconds = 0;
+  bool decoded_twice = false;  // the positions did not fit UnpackSettings::memory_limit as floats
 };
 
 // Validates the whole package (spec §8) and writes `out_path` atomically: a refused package leaves

@@ -13,6 +13,11 @@
 #include "format/vxlz_package.h"
 
 namespace vxl::web {
+
+// What a package's decoded positions may take (UnpackSettings::memory_limit): the page's memory holds the .vxl
+// beside them, and the tab the page's copy of it. A look's (a level alone) are kept; the whole 1M set's (768 MB),
+// whose .vxl is 781 MB, are decoded twice instead.
+constexpr std::uint64_t kDecodedPositionsBytes = std::uint64_t(256) << 20;
 namespace {
 
 // Removes a file of the in-memory file system when it goes out of scope: its bytes are the page's memory.
@@ -44,6 +49,7 @@ std::string unpack_package_to_file(MappedFile package_bytes, const std::string& 
   const std::string unpacked = package_name(name) + ".vxl";
   UnpackSettings settings;
   settings.threads = 1;  // this WebAssembly build has no threads
+  settings.memory_limit = kDecodedPositionsBytes;
   unpack_vxlz(VxlzFile::open(std::move(package_bytes)), unpacked, settings);
   return unpacked;
 }
@@ -79,6 +85,7 @@ std::string unpack_level_to_file(std::span<const std::uint8_t> prefix, std::uint
   const std::string unpacked = package_name(name) + ".level.vxl";
   UnpackSettings settings;
   settings.threads = 1;
+  settings.memory_limit = kDecodedPositionsBytes;
   settings.level = level;
   unpack_vxlz(VxlzFile::open_prefix(copy_of(prefix, package_name(name))), unpacked, settings);
   return unpacked;

@@ -1,0 +1,38 @@
+// An unpack's positions (spec/vxlz-package-v2.md §7 steps 3-4). A packed .vxl's words depend on each voxel's tight
+// bounds, known only once every chunk is decoded: either the decoded positions are kept as floats until then (12 bytes
+// a vertex, more than the packed .vxl itself: 768 MB beside a 781 MB file for 1M streamlines, 5 GB for 10M), or the
+// chunks are decoded twice, the first time for the bounds (and the voxline ends and the lengths), the second to write
+// the words (about a sixth more time, no memory). A float32 .vxl gets the decoded positions as they are. Chunks are
+// decoded side by side.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+
+#include "converter/convert/voxelize.h"
+#include "converter/package/unpack_structure.h"
+#include "format/vxl_positions.h"
+#include "format/vxlz_package.h"
+
+namespace vxl {
+
+// The first pass: sets the tight bounds of s.voxels (zeros as +0, spec §5.3), marks the last vertex of every voxline
+// in `ends` and writes each streamline's SLEN length (stored_length_of of its points, synthetic face points left out)
+// into `lengths`, which holds one per streamline; with `keep`, also every vertex's decoded position there (3 floats a
+// vertex, VERT's order). `progress` gets the fraction of chunks done. Throws vxl::Error (Input) for a damaged chunk, or
+// where the chunks the streamlines need are not all there.
+void scan_positions(const VxlzFile& f, UnpackStructure& s, VoxlineEnds& ends, std::span<float> lengths,
+                    unsigned threads, const std::function<void(double)>& progress, float* keep = nullptr);
+
+// The packed words of the positions scan_positions kept, once the bounds are set, into `words` (VERT's payload).
+// Returns the largest packing error bound of the voxels.
+double pack_kept_positions(const UnpackStructure& s, std::span<float> kept, const VoxlineEnds& ends,
+                           std::span<std::uint32_t> words, unsigned threads);
+
+// Or the second pass, once the bounds are set: VERT's payload in `vert`, packed words (end bits from `ends`) or float32
+// triplets, decoded again. Returns the largest packing error bound of the voxels (0 for float32).
+double write_positions(const VxlzFile& f, const UnpackStructure& s, const VoxlineEnds& ends, PositionEncoding positions,
+                       std::span<std::uint8_t> vert, unsigned threads, const std::function<void(double)>& progress);
+
+}  // namespace vxl
