@@ -160,6 +160,34 @@ TEST(Share, AVxlLargerThanTheBrowserHoldsIsRefusedNamingALevelThatFits) {
   EXPECT_LT(share_folder(t.vxl, out, settings).data_bytes, size);
 }
 
+// A package is shared as it is, and the page unpacks it: one whose .vxl the page could not hold is refused before
+// anything is copied (its size known from its tables), naming the level that fits; --unpack is refused alike, before it
+// unpacks.
+TEST(Share, APackageWhoseVxlIsLargerThanTheBrowserHoldsIsRefusedBeforeItIsCopied) {
+  SharedTractogram t;
+  const std::string vxlz = t.dir.file("in.vxlz"), out = t.dir.file("shared");
+  ASSERT_EQ(test::run_cli("pack " + test::q(t.vxl) + " " + test::q(vxlz)).exit_code, 0);
+  ShareSettings settings;
+  settings.web_viewer_dir = t.viewer;
+  settings.unpack = true;
+  const std::uint64_t unpacked = share_folder(vxlz, t.dir.file("unpacked"), settings).data_bytes;
+  const std::uint64_t streamlines = VxlFile::open(t.vxl).meta().streamline_count;
+  for (bool unpack : {false, true}) {
+    settings.unpack = unpack;
+    settings.max_data_bytes = unpacked - 1;
+    const Error e = test::hostile::error_of([&] { share_folder(vxlz, out, settings); });
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+    const std::string why = e.what();
+    EXPECT_NE(why.find("in.vxlz"), std::string::npos) << why;
+    EXPECT_NE(why.find("--level 1 keeps about 1/8 of the streamlines"), std::string::npos) << why;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_EQ(entries_named_part(t.dir), 0);
+    settings.max_data_bytes = unpacked;  // the limit is the unpacked .vxl's size, not the package's
+    EXPECT_EQ(share_folder(vxlz, out, settings).streamlines, streamlines);
+    fs::remove_all(out);
+  }
+}
+
 TEST(Share, RefusalsLeaveNoFolder) {
   SharedTractogram t;
   const std::string out = t.dir.file("shared");

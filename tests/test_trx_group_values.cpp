@@ -150,6 +150,9 @@ TEST(TrxGroupValues, SurviveConvertPackUnpackAndExportByteForByte) {
     pack_vxl(a, dir.file("a.vxlz"), PackSettings{});
   }
   unpack_vxlz(dir.file("a.vxlz"), dir.file("b.vxl"), UnpackSettings{});
+  EXPECT_EQ(unpacked_vxl_bytes(VxlzFile::open(dir.file("a.vxlz")), UnpackSettings{}),
+            std::filesystem::file_size(dir.file("b.vxl")))
+      << "the groups' and their values' sizes, known from the package's tables";
   const VxlFile b = VxlFile::open(dir.file("b.vxl"));
   EXPECT_TRUE(verify_vxl(dir.file("b.vxl")).valid);
   EXPECT_EQ(rows_by_member(b.groups(), b.group_values()), expected_rows());

@@ -122,6 +122,9 @@ TEST(ValuesPackage, UnpackGivesBackTheValueSetsByteForByte) {
       UnpackSettings unpacking;
       unpacking.levels = levels;
       const UnpackSummary back = unpack_vxlz(dir.file("v.vxlz"), dir.file("u.vxl"), unpacking);
+      EXPECT_EQ(unpacked_vxl_bytes(VxlzFile::open(dir.file("v.vxlz")), unpacking),
+                std::filesystem::file_size(dir.file("u.vxl")))
+          << "the value sets' sizes, known from their sections' heads";
       EXPECT_EQ(back.point_value_sets, 2u);
       EXPECT_EQ(back.streamline_value_sets, 3u);
       const VerifyResult verified = verify_vxl(dir.file("u.vxl"));

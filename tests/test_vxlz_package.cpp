@@ -318,6 +318,31 @@ TEST(VxlzPackageOptions, StreamlinesCutByChunksGetTheirWholeLengthAndVoxelsTheir
     }
 }
 
+// What a .vxl unpacked from a package will take is known from the package's tables alone (share refuses a package too
+// large for the web page by it): the size of the file unpack writes, for its positions, levels and a level alone.
+TEST(VxlzPackageOptions, TheUnpackedSizeIsKnownBeforeUnpacking) {
+  ScratchDir dir;
+  const std::string vxl = convert_for_package(test_tractogram(800), dir.file("s.vxl"));
+  pack_vxl(VxlFile::open(vxl), dir.file("s.vxlz"), PackSettings{});
+  const VxlzFile package = VxlzFile::open(dir.file("s.vxlz"));
+  ASSERT_GT(package.pack().level_count, 1u);
+  int checked = 0;
+  for (PositionEncoding positions : {PositionEncoding::Packed, PositionEncoding::Float32})
+    for (std::uint32_t levels : {1u, kDefaultLevels})
+      for (std::uint32_t level : {0u, 1u}) {
+        UnpackSettings s;
+        s.positions = positions;
+        s.levels = levels;
+        s.level = level;
+        unpack_vxlz(package, dir.file("u.vxl"), s);
+        EXPECT_EQ(unpacked_vxl_bytes(package, s), std::filesystem::file_size(dir.file("u.vxl")))
+            << vertex_bytes(positions) << " bytes a vertex, " << levels << " levels, level " << level;
+        std::filesystem::remove(dir.file("u.vxl"));
+        ++checked;
+      }
+  EXPECT_EQ(checked, 8);
+}
+
 TEST(VxlzPackageOptions, PackageBytesDoNotDependOnThreads) {
   // The measured errors in PACK are summed in chunk order, whichever thread encoded which chunk.
   ScratchDir dir;
@@ -801,6 +826,12 @@ TEST(VxlzPackCli, InfoSummarisesAPackage) {
     previous_bytes = level["bytes"].get<std::uint64_t>();
   }
   EXPECT_EQ(previous_bytes, std::filesystem::file_size(dir.file("s.vxlz")));  // level 0: the whole package
+  ASSERT_EQ(test::run_cli("unpack '" + dir.file("s.vxlz") + "' '" + dir.file("u.vxl") + "'").exit_code, 0);
+  EXPECT_EQ(j["unpacked_bytes"].get<std::uint64_t>(), std::filesystem::file_size(dir.file("u.vxl")));
+  EXPECT_NE(
+      text.output.find("makes a .vxl of " + std::to_string(std::filesystem::file_size(dir.file("u.vxl"))) + " bytes"),
+      std::string::npos)
+      << text.output;
 
   ConvertSettings one_level;
   one_level.levels = 1;

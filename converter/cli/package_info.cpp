@@ -19,6 +19,7 @@ nlohmann::json package_info(const VxlzFile& package) {
   j["format"] = "vxlz";
   add_meta_summary(package.header(), m, j);
   j["bytes"] = package.size();
+  j["unpacked_bytes"] = unpacked_vxl_bytes(package, UnpackSettings());  // unpack's defaults, as the web page unpacks
   j["positions"] = {{"quantization_bits", p.quantization_bits},
                     {"quantum_mm", p.quantum},
                     {"error_bound_mm", p.error_bound},
@@ -46,9 +47,10 @@ nlohmann::json package_info(const VxlzFile& package) {
 }
 
 void print_package_info(const nlohmann::json& j) {
-  std::printf("file          %s (.vxlz %s, %llu bytes: a package; voxlines unpack makes the .vxl)\n",
+  std::printf("file          %s (.vxlz %s, %llu bytes: a package; voxlines unpack makes a .vxl of %llu bytes)\n",
               j["file"].get<std::string>().c_str(), j["version"].get<std::string>().c_str(),
-              (unsigned long long)j["bytes"].get<std::uint64_t>());
+              (unsigned long long)j["bytes"].get<std::uint64_t>(),
+              (unsigned long long)j["unpacked_bytes"].get<std::uint64_t>());
   print_source_line(j);
   const auto& grid = j["grid_dims"];
   std::printf("streamlines   %llu\npoints        %llu\nvoxels        %u (grid %d x %d x %d), %g mm\n",

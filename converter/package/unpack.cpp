@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <functional>
 #include <memory>
 #include <vector>
 
@@ -20,15 +19,12 @@
 #include "format/base/json_limits.h"
 #include "format/base/memory_available.h"
 #include "format/base/parallel.h"
-#include "format/streamline_length.h"
 #include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
 #include "format/vxl_group_values.h"
 #include "format/vxl_stream_writer.h"
 #include "format/vxl_value_sets.h"
-#include "format/vxlz_draco.h"
 #include "format/vxlz_package.h"
-#include "format/vxlz_quantize.h"
 #include "format/vxlz_shipping_order.h"
 #include "format/vxlz_tables.h"
 #include "format/vxlz_values.h"
@@ -309,6 +305,45 @@ PackageExtras read_extras(const VxlzFile& f, unsigned threads) {
   return extras;
 }
 
+// What the .vxl's sections take besides the structure's (spec §7 steps 6-8): the groups, their values, the value sets.
+struct ExtraSizes {
+  std::uint64_t groups = 0, group_values = 0;
+  std::uint32_t point_sets = 0, streamline_sets = 0;
+};
+
+ExtraSizes sizes_of(const PackageExtras& extras) {
+  return {extras.groups_bytes.size(), extras.group_values_bytes.size(),
+          static_cast<std::uint32_t>(extras.point_values.size()),
+          static_cast<std::uint32_t>(extras.streamline_values.size())};
+}
+
+// The same without the values decoded: a value section's set count is its first word (package spec §4.7).
+ExtraSizes extra_sizes(const VxlzFile& f) {
+  ExtraSizes sizes;
+  std::uint64_t group_count = 0;
+  if (f.has_section(section_id("GRPS"))) {
+    const std::vector<StreamlineGroup> groups =
+        decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count, f.context(section_id("GRPS")));
+    group_count = groups.size();
+    sizes.groups = encode_groups(groups).size();
+  }
+  if (f.has_section(section_id("GDAT"))) sizes.group_values = unpacked_group_values(f, group_count).size();
+  auto set_count = [&](const char(&id)[5]) -> std::uint32_t {
+    if (!f.has_section(section_id(id))) return 0;
+    const std::span<const std::uint8_t> payload = f.section_payload(section_id(id));
+    std::uint32_t count = 0;
+    if (payload.size() >= 4) std::memcpy(&count, payload.data(), 4);
+    if (count < 1 || count > kMaxValueSets)
+      fail_input(f.path(), f.context(section_id(id)).section_offset,
+                 std::string(id) + " says " + std::to_string(count) + " value sets (1 to " +
+                     std::to_string(kMaxValueSets) + ")");
+    return count;
+  };
+  sizes.point_sets = set_count("PVAL");
+  sizes.streamline_sets = set_count("SVAL");
+  return sizes;
+}
+
 // Sets META's bounds from the voxels' tight bounds (package spec §7 step 1), and refuses what a damaged
 // package would make: a grid, or positions decoded outside their voxels, that open() refuses.
 void set_bounds_checked(MetaSection& meta, std::span<const VoxelEntry> voxels, const std::string& path) {
@@ -364,6 +399,33 @@ void append_tables(VxlStreamWriter& out, const VxlzFile& f, const UnpackStructur
   if (!extras.group_values_bytes.empty()) out.append(VxlStreamWriter::kGdat, extras.group_values_bytes);
 }
 
+// Refuses settings the package cannot meet, and rebuilds its tables (`meta`: the .vxl's counts, those of the level
+// alone with settings.level).
+UnpackStructure checked_structure(const VxlzFile& f, const UnpackSettings& settings, MetaSection& meta) {
+  detail::check_level_count(settings.levels, f.path());
+  if (f.meta().order_set == static_cast<std::uint32_t>(OrderSet::Random))
+    fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");
+  const bool level_alone = settings.level > 0;
+  if (level_alone && (f.pack().predictor != kVxlzPredictorLinearLevelOrder || settings.level >= f.pack().level_count))
+    throw Error(ErrorKind::Usage, f.path(), std::nullopt,
+                "level " + std::to_string(settings.level) + " is not shipped apart in this package (" +
+                    (f.pack().level_count > 1 ? std::to_string(f.pack().level_count) + " levels" : "no level order") +
+                    ")");
+  // A level alone is a file of its own, without levels: its counts are set by keep_level.
+  return rebuild_structure(f, level_alone ? 1 : settings.levels, settings.level, meta);
+}
+
+// The .vxl's section sizes (and META's encoding and level count, set in `meta`).
+VxlSectionSizes unpacked_section_sizes(MetaSection& meta, const UnpackStructure& s, const UnpackSettings& settings,
+                                       std::uint64_t provenance_bytes, const ExtraSizes& extra) {
+  meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
+  meta.level_count = s.level_count > 1 && meta.voxel_count > 0 ? s.level_count : 0;
+  VxlSectionSizes sizes =
+      section_sizes(meta, s.order_bytes, provenance_bytes, extra.groups, extra.point_sets, extra.streamline_sets);
+  sizes.group_values = extra.group_values;
+  return sizes;
+}
+
 }  // namespace
 
 UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
@@ -382,28 +444,12 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
   auto t0 = Clock::now();
   progress("decoding", 0.0);
 
-  detail::check_level_count(settings.levels, f.path());
-  if (f.meta().order_set == static_cast<std::uint32_t>(OrderSet::Random))
-    fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");
-  const bool level_alone = settings.level > 0;
-  if (level_alone && (f.pack().predictor != kVxlzPredictorLinearLevelOrder || settings.level >= f.pack().level_count))
-    throw Error(ErrorKind::Usage, f.path(), std::nullopt,
-                "level " + std::to_string(settings.level) + " is not shipped apart in this package (" +
-                    (f.pack().level_count > 1 ? std::to_string(f.pack().level_count) + " levels" : "no level order") +
-                    ")");
   MetaSection meta = f.meta();
-  // A level alone is a file of its own, without levels: its counts are set by keep_level.
-  UnpackStructure s = rebuild_structure(f, level_alone ? 1 : settings.levels, settings.level, meta);
+  UnpackStructure s = checked_structure(f, settings, meta);
   const std::string provenance = provenance_with_package(f);
   // A level alone is for a first look: the groups and value sets come with the whole.
-  const PackageExtras extras = level_alone ? PackageExtras() : read_extras(f, threads);
-
-  meta.position_encoding = static_cast<std::uint32_t>(settings.positions);
-  meta.level_count = s.level_count > 1 && meta.voxel_count > 0 ? s.level_count : 0;
-  VxlSectionSizes sizes = section_sizes(meta, s.order_bytes, provenance.size(), extras.groups_bytes.size(),
-                                        static_cast<std::uint32_t>(extras.point_values.size()),
-                                        static_cast<std::uint32_t>(extras.streamline_values.size()));
-  sizes.group_values = extras.group_values_bytes.size();
+  const PackageExtras extras = settings.level > 0 ? PackageExtras() : read_extras(f, threads);
+  const VxlSectionSizes sizes = unpacked_section_sizes(meta, s, settings, provenance.size(), sizes_of(extras));
   // The same stages as a conversion's last: VERT filled in place, then its orders a chunk of voxels at a time
   // (write_range_orders, one range of every voxel), then the tables. A refused package leaves no file.
   VxlStreamWriter out(out_path, sizes, kSectionDirectStagingBytes);
@@ -468,6 +514,13 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
   summary.point_value_sets = static_cast<std::uint32_t>(extras.point_values.size());
   summary.streamline_value_sets = static_cast<std::uint32_t>(extras.streamline_values.size());
   return summary;
+}
+
+std::uint64_t unpacked_vxl_bytes(const VxlzFile& f, const UnpackSettings& settings) {
+  MetaSection meta = f.meta();
+  const UnpackStructure s = checked_structure(f, settings, meta);
+  const ExtraSizes extra = settings.level > 0 ? ExtraSizes() : extra_sizes(f);
+  return plan_vxl_layout(unpacked_section_sizes(meta, s, settings, provenance_with_package(f).size(), extra)).file_size;
 }
 
 std::vector<ShippedLevel> shipped_levels(const VxlzFile& f) {

@@ -54,6 +54,10 @@ struct UnpackSummary {
 UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings);
 UnpackSummary unpack_vxlz(const VxlzFile& package, const std::string& out_path, const UnpackSettings& settings);
 
+// The size in bytes of the .vxl unpack_vxlz would write with `settings` (its levels, positions, level), from the
+// package's tables alone: no position is decoded, nor a value. Throws what unpack_vxlz throws for damaged tables.
+std::uint64_t unpacked_vxl_bytes(const VxlzFile& package, const UnpackSettings& settings);
+
 // A package's levels as it ships them (spec §5.1): for each level d of its level order, from the coarsest, the
 // streamlines and shipped points of depth d or more, and the bytes of the package (a prefix) that hold them. Empty
 // for a package in streamline order. Reads the tables of the exact part only (a prefix will do).

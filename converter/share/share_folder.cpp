@@ -122,6 +122,10 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     UnpackSettings unpack;
     unpack.threads = settings.threads;
     if (settings.level) check_level(in_path, *settings.level, unpack.levels);  // the levels of the .vxl unpacked
+    // Its size known from its tables: a .vxl too large for the page is refused before it is unpacked.
+    if (!settings.level)
+      check_fits_the_page(in_path, true, unpacked_vxl_bytes(VxlzFile::open(in_path), unpack), unpack.levels, 0,
+                          settings);
     data.replace_extension(".vxl");
     // Not a .vxl's name: the shared file's is the input's with .vxl, whatever the input was called.
     const fs::path unpacked = settings.level ? staging / "unpacked.tmp" : staging / data;
@@ -134,8 +138,12 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     std::error_code ec;
     if (settings.level) fs::remove(unpacked, ec);  // else left in the staging folder, removed with it
   } else {
-    // A package's checksums cover every byte of it. The page unpacks it in its own memory, as large as the .vxl.
-    summary.streamlines = VxlzFile::open(in_path).meta().streamline_count;
+    // A package's checksums cover every byte of it. The page unpacks it in its own memory, as large as the .vxl
+    // (UnpackSettings' defaults): one it cannot hold is refused here, not after the recipient has fetched it.
+    const VxlzFile package_file = VxlzFile::open(in_path);
+    summary.streamlines = package_file.meta().streamline_count;
+    const UnpackSettings as_the_page;
+    check_fits_the_page(in_path, true, unpacked_vxl_bytes(package_file, as_the_page), as_the_page.levels, 0, settings);
     summary.package = true;
     data.replace_extension(".vxlz");
     copy_file(in_path, staging / data);
