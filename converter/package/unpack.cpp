@@ -283,17 +283,23 @@ struct PackageExtras {
   std::vector<NamedValues> point_values, streamline_values;
 };
 
-PackageExtras read_extras(const VxlzFile& f, unsigned threads) {
-  PackageExtras extras;
+// The groups and their values as the .vxl's GRPS and GDAT payloads (empty without the sections). GDAT travels as the
+// .vxl payload (package spec §4.8): checked against the groups, written back as it came.
+void read_groups(const VxlzFile& f, std::vector<std::uint8_t>& groups_bytes,
+                 std::vector<std::uint8_t>& group_values_bytes) {
   std::uint64_t group_count = 0;
   if (f.has_section(section_id("GRPS"))) {
     const std::vector<StreamlineGroup> groups =
         decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count, f.context(section_id("GRPS")));
     group_count = groups.size();
-    extras.groups_bytes = encode_groups(groups);
+    groups_bytes = encode_groups(groups);
   }
-  // GDAT travels as the .vxl payload (package spec §4.8): checked against the groups, written back as it came.
-  if (f.has_section(section_id("GDAT"))) extras.group_values_bytes = unpacked_group_values(f, group_count);
+  if (f.has_section(section_id("GDAT"))) group_values_bytes = unpacked_group_values(f, group_count);
+}
+
+PackageExtras read_extras(const VxlzFile& f, unsigned threads) {
+  PackageExtras extras;
+  read_groups(f, extras.groups_bytes, extras.group_values_bytes);
 
   // Value sets (spec §4.7), checked against PACK's and META's counts before anything is inflated.
   if (f.has_section(section_id("PVAL")))
@@ -320,14 +326,10 @@ ExtraSizes sizes_of(const PackageExtras& extras) {
 // The same without the values decoded: a value section's set count is its first word (package spec §4.7).
 ExtraSizes extra_sizes(const VxlzFile& f) {
   ExtraSizes sizes;
-  std::uint64_t group_count = 0;
-  if (f.has_section(section_id("GRPS"))) {
-    const std::vector<StreamlineGroup> groups =
-        decode_group_stream(f.inflate(section_id("GRPS")), f.meta().streamline_count, f.context(section_id("GRPS")));
-    group_count = groups.size();
-    sizes.groups = encode_groups(groups).size();
-  }
-  if (f.has_section(section_id("GDAT"))) sizes.group_values = unpacked_group_values(f, group_count).size();
+  std::vector<std::uint8_t> groups, group_values;  // small beside the values, which are not decoded
+  read_groups(f, groups, group_values);
+  sizes.groups = groups.size();
+  sizes.group_values = group_values.size();
   auto set_count = [&](const char(&id)[5]) -> std::uint32_t {
     if (!f.has_section(section_id(id))) return 0;
     const std::span<const std::uint8_t> payload = f.section_payload(section_id(id));
