@@ -25,8 +25,8 @@ void add_unpack_command(CLI::App& app) {
                   "what the decoded positions may take (bytes, or K/M/G: 512M, 2G): a packed .vxl's words depend on "
                   "each voxel's bounds, known once every point is decoded, so within SIZE the positions are kept as "
                   "floats until then (12 bytes a vertex: 768 MB for 1M streamlines); past it the package is decoded "
-                  "twice instead, about a sixth slower, without them. The bytes are the same. Without it: half of the "
-                  "available memory")
+                  "twice instead, without them: about a tenth slower, in less than half the memory. The bytes are the "
+                  "same. Without it: half of the available memory")
       ->type_name("SIZE")
       ->check(memory_size_validator());
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
