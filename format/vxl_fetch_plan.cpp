@@ -4,6 +4,7 @@
 #include <cstring>
 #include <iterator>
 
+#include "format/base/memory_available.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_value_sets.h"
 
@@ -55,7 +56,20 @@ std::vector<ByteRange> ranges_of_level(const VxlFile& file, std::uint32_t level,
 
 void read_ahead_level(const VxlFile& file, std::uint32_t level) {
   // Gaps under 64 KiB are read too: one request instead of two costs less than the bytes between them.
-  for (const ByteRange& r : ranges_of_level(file, level, 64 << 10)) file.will_need(r.begin, r.end - r.begin);
+  const std::uint64_t budget = available_memory().value_or(std::uint64_t(1) << 30) / 4;
+  for (const ByteRange& r : ranges_prefix(ranges_of_level(file, level, 64 << 10), budget))
+    file.will_need(r.begin, r.end - r.begin);
+}
+
+std::vector<ByteRange> ranges_prefix(std::span<const ByteRange> ranges, std::uint64_t budget) {
+  std::vector<ByteRange> prefix;
+  for (const ByteRange& r : ranges) {
+    if (budget == 0) break;
+    const std::uint64_t take = std::min(budget, r.end - r.begin);
+    prefix.push_back({r.begin, r.begin + take});
+    budget -= take;
+  }
+  return prefix;
 }
 
 std::vector<ByteRange> ranges_of_voxels(const VxlFile& file, std::uint32_t level, std::uint32_t voxel_first,

@@ -40,8 +40,13 @@ std::vector<ByteRange> ranges_of_voxels(const VxlFile& file, std::uint32_t level
                                         std::uint32_t voxel_count, std::uint64_t gap);
 
 // Asks the system to read what drawing `level` of `file` reads (ranges_of_level) ahead, in file order: a viewer about
-// to upload a level of a file not in the page cache then waits for one batch of reads, not for a page fault each.
+// to upload a level of a file not in the page cache then waits for one batch of reads, not for a page fault each. At
+// most a quarter of the available memory is asked for (the first of the level's ranges): pages read ahead past what
+// memory holds would be dropped before the upload reaches them, and read twice.
 void read_ahead_level(const VxlFile& file, std::uint32_t level);
+
+// The first `budget` bytes of `ranges` (sorted and disjoint), the last range cut where the budget ends.
+std::vector<ByteRange> ranges_prefix(std::span<const ByteRange> ranges, std::uint64_t budget);
 
 // Sorts `ranges` and merges those that overlap or lie less than `gap` bytes apart.
 std::vector<ByteRange> merge_ranges(std::vector<ByteRange> ranges, std::uint64_t gap);

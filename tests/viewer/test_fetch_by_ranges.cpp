@@ -168,6 +168,10 @@ TEST(FetchPlan, RangesMergeAndTheMissingOnesCoverTheRest) {
   EXPECT_FALSE(ranges_held(std::vector<ByteRange>{{40, 41}}, held)) << "past the last";
   EXPECT_FALSE(ranges_held(std::vector<ByteRange>{{5, 9}}, held)) << "in a gap";
   EXPECT_TRUE(ranges_held({}, held));
+  EXPECT_EQ(ranges_prefix(held, 12), (std::vector<ByteRange>{{0, 5}, {10, 17}})) << "cut inside a range";
+  EXPECT_EQ(ranges_prefix(held, 31), held) << "exactly the ranges' 31 bytes";
+  EXPECT_EQ(ranges_prefix(held, 1000), held);
+  EXPECT_TRUE(ranges_prefix(held, 0).empty());
 }
 
 // read_ahead_level asks the system for a level's bytes: evicted from the page cache, they are back in it shortly after,
