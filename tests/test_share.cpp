@@ -2,6 +2,7 @@
 // or a .vxlz as it is or unpacked) and share.json naming it; every refusal leaves no folder and no temporary one beside
 // it. The web viewer here is a stand-in folder (its files' contents do not matter to share); tests/web checks the real
 // one in a browser.
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -10,11 +11,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "converter/package/unpack.h"
 #include "converter/share/share_folder.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
+#include "format/vxl_layout.h"
 #include "test_support.h"
 #include "tests/hostile_inputs.h"
+#include "tests/reseal_checksums.h"
 
 namespace vxl {
 namespace {
@@ -186,6 +190,23 @@ TEST(Share, APackageWhoseVxlIsLargerThanTheBrowserHoldsIsRefusedBeforeItIsCopied
     EXPECT_EQ(share_folder(vxlz, out, settings).streamlines, streamlines);
     fs::remove_all(out);
   }
+  // Refused before it is unpacked: a package whose positions unpack refuses (the last chunk's bytes changed behind
+  // valid checksums) is refused for its size, not for its positions.
+  std::vector<char> bytes = test::slurp(vxlz);
+  FileHeader h;
+  std::memcpy(&h, bytes.data(), sizeof h);
+  for (std::uint32_t i = 0; i < h.section_count; ++i) {
+    SectionEntry e;
+    std::memcpy(&e, bytes.data() + sizeof h + i * sizeof e, sizeof e);
+    if (std::memcmp(e.id, "POSD", 4) == 0) std::memset(bytes.data() + e.offset + e.size - 64, 0xFF, 64);
+  }
+  test::reseal_checksums(bytes.data(), bytes.size());
+  const std::string damaged = t.dir.file("damaged.vxlz");
+  std::ofstream(damaged, std::ios::binary).write(bytes.data(), std::ssize(bytes));
+  ASSERT_EQ(test::hostile::error_of([&] { unpack_vxlz(damaged, t.dir.file("d.vxl"), UnpackSettings()); }).kind(),
+            ErrorKind::Input);
+  settings.max_data_bytes = unpacked - 1;
+  EXPECT_EQ(test::hostile::error_of([&] { share_folder(damaged, out, settings); }).kind(), ErrorKind::Unsupported);
 }
 
 TEST(Share, RefusalsLeaveNoFolder) {

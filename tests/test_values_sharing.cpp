@@ -125,6 +125,14 @@ TEST(ValuesPackage, UnpackGivesBackTheValueSetsByteForByte) {
       EXPECT_EQ(unpacked_vxl_bytes(VxlzFile::open(dir.file("v.vxlz")), unpacking),
                 std::filesystem::file_size(dir.file("u.vxl")))
           << "the value sets' sizes, known from their sections' heads";
+      if (levels > 1) {  // a level alone comes without its value sets
+        UnpackSettings look;
+        look.level = 1;
+        unpack_vxlz(dir.file("v.vxlz"), dir.file("look.vxl"), look);
+        EXPECT_EQ(unpacked_vxl_bytes(VxlzFile::open(dir.file("v.vxlz")), look),
+                  std::filesystem::file_size(dir.file("look.vxl")));
+        std::filesystem::remove(dir.file("look.vxl"));
+      }
       EXPECT_EQ(back.point_value_sets, 2u);
       EXPECT_EQ(back.streamline_value_sets, 3u);
       const VerifyResult verified = verify_vxl(dir.file("u.vxl"));

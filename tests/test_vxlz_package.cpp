@@ -283,6 +283,7 @@ TEST(VxlzPackageOptions, StreamlinesCutByChunksGetTheirWholeLengthAndVoxelsTheir
   unpack_vxlz(dir.file("s.vxlz"), dir.file("u.vxl"), exact);
   const VxlFile f = VxlFile::open(dir.file("u.vxl"));
   ASSERT_EQ(f.streamline_lengths().size(), f.meta().streamline_count);
+  ASSERT_GT(f.meta().synthetic_point_count, 0u) << "voxlines whose first point a length leaves out";
   std::uint64_t cut = 0;
   WalkCallbacks cb;
   cb.streamline = [&](std::uint64_t s, std::span<const float> xyz) {
@@ -307,6 +308,16 @@ TEST(VxlzPackageOptions, StreamlinesCutByChunksGetTheirWholeLengthAndVoxelsTheir
       EXPECT_EQ(twice.voxels()[i].tight_min[c], f.voxels()[i].tight_min[c]);
       EXPECT_EQ(twice.voxels()[i].tight_max[c], f.voxels()[i].tight_max[c]);
     }
+  // A level alone (its streamlines shipped first, cut by the chunks as the whole's are): the same lengths.
+  UnpackSettings level_alone;
+  level_alone.level = 1;
+  level_alone.memory_limit = 1;
+  unpack_vxlz(dir.file("s.vxlz"), dir.file("level.vxl"), level_alone);
+  const VxlFile level = VxlFile::open(dir.file("level.vxl"));
+  std::vector<float> level_lengths;
+  for (std::uint64_t st = 0; st < f.meta().streamline_count; ++st)
+    if (streamline_depth(st, f.level_count()) >= 1) level_lengths.push_back(f.streamline_lengths()[st]);
+  EXPECT_EQ(to_vector(level.streamline_lengths()), level_lengths);
   const std::vector<float> all = f.all_vertices();
   for (const VoxelEntry& v : f.voxels())
     for (int c = 0; c < 3; ++c) {

@@ -6,6 +6,7 @@
 
 #include "converter/cli/info_summary.h"
 #include "converter/package/unpack.h"
+#include "format/base/error.h"
 #include "format/base/json_limits.h"
 #include "format/vxlz_layout.h"
 
@@ -19,7 +20,13 @@ nlohmann::json package_info(const VxlzFile& package) {
   j["format"] = "vxlz";
   add_meta_summary(package.header(), m, j);
   j["bytes"] = package.size();
-  j["unpacked_bytes"] = unpacked_vxl_bytes(package, UnpackSettings());  // unpack's defaults, as the web page unpacks
+  try {
+    j["unpacked_bytes"] = unpacked_vxl_bytes(package, UnpackSettings());  // unpack's defaults, as the web page's
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::Unsupported) throw;  // a damaged package is refused, as unpack refuses it
+    j["unpacked_bytes"] = nullptr;
+    j["unpack_unsupported"] = e.what();
+  }
   j["positions"] = {{"quantization_bits", p.quantization_bits},
                     {"quantum_mm", p.quantum},
                     {"error_bound_mm", p.error_bound},
@@ -47,10 +54,13 @@ nlohmann::json package_info(const VxlzFile& package) {
 }
 
 void print_package_info(const nlohmann::json& j) {
-  std::printf("file          %s (.vxlz %s, %llu bytes: a package; voxlines unpack makes a .vxl of %llu bytes)\n",
-              j["file"].get<std::string>().c_str(), j["version"].get<std::string>().c_str(),
-              (unsigned long long)j["bytes"].get<std::uint64_t>(),
-              (unsigned long long)j["unpacked_bytes"].get<std::uint64_t>());
+  const std::string unpacked =
+      j["unpacked_bytes"].is_null()
+          ? "voxlines unpack cannot make its .vxl: " + j["unpack_unsupported"].get<std::string>()
+          : "voxlines unpack makes a .vxl of " + std::to_string(j["unpacked_bytes"].get<std::uint64_t>()) + " bytes";
+  std::printf("file          %s (.vxlz %s, %llu bytes: a package; %s)\n", j["file"].get<std::string>().c_str(),
+              j["version"].get<std::string>().c_str(), (unsigned long long)j["bytes"].get<std::uint64_t>(),
+              unpacked.c_str());
   print_source_line(j);
   const auto& grid = j["grid_dims"];
   std::printf("streamlines   %llu\npoints        %llu\nvoxels        %u (grid %d x %d x %d), %g mm\n",

@@ -465,22 +465,25 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
       settings.memory_limit > 0 ? settings.memory_limit : available_memory().value_or(1ull << 30) / 2;
   summary.decoded_twice = packed && 12 * meta.vertex_count > floats_allowed;
   const auto place = [&](std::span<std::uint8_t> window) {
-    const auto decoding = [&](double from) { return [&, from](double d) { progress("decoding", from + d / 2); }; };
+    // The stage's progress: a pass's fraction d from `from` on, over `part` of it.
+    const auto decoding = [&](double from, double part) {
+      return [&, from, part](double d) { progress("decoding", from + d * part); };
+    };
     const std::span<std::uint32_t> words(reinterpret_cast<std::uint32_t*>(window.data()), window.size() / 4);
     if (summary.decoded_twice) {
-      scan_positions(f, s, ends, lengths, threads, decoding(0));
+      scan_positions(f, s, ends, lengths, threads, decoding(0, 0.5));
       set_bounds_checked(meta, voxels, f.path());
-      summary.repack_error_bound = write_positions(f, s, ends, settings.positions, window, threads, decoding(0.5));
+      summary.repack_error_bound = write_positions(f, s, ends, settings.positions, window, threads, decoding(0.5, 0.5));
     } else if (packed) {
       // Left uninitialised: the chunks write every vertex (rebuild_structure checked that the voxlines' points are
       // the package's), and zeroing them first cost a serial pass over fresh pages (0.3 s for 1M streamlines).
       const auto floats = static_cast<std::size_t>(3 * meta.vertex_count);  // within the memory limit
       const std::unique_ptr<float[]> kept(new float[floats]);
-      scan_positions(f, s, ends, lengths, threads, decoding(0), kept.get());
+      scan_positions(f, s, ends, lengths, threads, decoding(0, 1), kept.get());
       set_bounds_checked(meta, voxels, f.path());
       summary.repack_error_bound = pack_kept_positions(s, {kept.get(), floats}, ends, words, threads);
     } else {  // float32: the decoded positions are VERT's
-      scan_positions(f, s, ends, lengths, threads, decoding(0), reinterpret_cast<float*>(window.data()));
+      scan_positions(f, s, ends, lengths, threads, decoding(0, 1), reinterpret_cast<float*>(window.data()));
       set_bounds_checked(meta, voxels, f.path());
     }
     summary.decode_seconds = seconds_since(t0);

@@ -55,7 +55,8 @@ UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_pat
 UnpackSummary unpack_vxlz(const VxlzFile& package, const std::string& out_path, const UnpackSettings& settings);
 
 // The size in bytes of the .vxl unpack_vxlz would write with `settings` (its levels, positions, level), from the
-// package's tables alone: no position is decoded, nor a value. Throws what unpack_vxlz throws for damaged tables.
+// package's tables alone: no position is decoded, nor a value (of a value section only its set count is read).
+// Throws what unpack_vxlz throws for damaged or unsupported tables.
 std::uint64_t unpacked_vxl_bytes(const VxlzFile& package, const UnpackSettings& settings);
 
 // A package's levels as it ships them (spec §5.1): for each level d of its level order, from the coarsest, the

@@ -240,6 +240,11 @@ void scan_positions(const VxlzFile& f, UnpackStructure& s, VoxlineEnds& ends, st
   });
   join_cut_streamlines(parts, lengths);
   bounds.store(s.voxels);
+  // Every voxel gets a point where the voxlines' points are the package's (rebuild_structure checks them): a voxel
+  // without one would keep inverted bounds, which no check after this one would see.
+  for (std::size_t i = 0; i < s.voxels.size(); ++i)
+    if (!(s.voxels[i].tight_min[0] <= s.voxels[i].tight_max[0]))
+      fail_input(f.path(), std::nullopt, "voxel " + std::to_string(i) + " gets no decoded point");
 }
 
 double pack_kept_positions(const UnpackStructure& s, std::span<float> kept, const VoxlineEnds& ends,

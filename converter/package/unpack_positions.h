@@ -2,8 +2,9 @@
 // bounds, known only once every chunk is decoded: either the decoded positions are kept as floats until then (12 bytes
 // a vertex, more than the packed .vxl itself: 768 MB beside a 781 MB file for 1M streamlines, 5 GB for 10M), or the
 // chunks are decoded twice, the first time for the bounds (and the voxline ends and the lengths), the second to write
-// the words (about a tenth more time, no memory). A float32 .vxl gets the decoded positions as they are. Chunks are
-// decoded side by side.
+// the words (about a tenth more time; what it holds is small beside the floats: a packer a voxel, and the steps of the
+// few streamlines the chunks cut, 8 bytes a point, until they are joined). A float32 .vxl gets the decoded positions as
+// they are. Chunks are decoded side by side.
 #pragma once
 
 #include <cstdint>

@@ -139,7 +139,8 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     if (settings.level) fs::remove(unpacked, ec);  // else left in the staging folder, removed with it
   } else {
     // A package's checksums cover every byte of it. The page unpacks it in its own memory, as large as the .vxl
-    // (UnpackSettings' defaults): one it cannot hold is refused here, not after the recipient has fetched it.
+    // (UnpackSettings' defaults): a .vxl larger than the page holds is refused here, not after the recipient has
+    // fetched the package.
     const VxlzFile package_file = VxlzFile::open(in_path);
     summary.streamlines = package_file.meta().streamline_count;
     const UnpackSettings as_the_page;
