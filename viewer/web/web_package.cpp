@@ -15,8 +15,8 @@
 namespace vxl::web {
 
 // What a package's decoded positions may take (UnpackSettings::memory_limit): the page's memory holds the .vxl
-// beside them, and the tab the page's copy of it. A look's (a level alone) are kept; the whole 1M set's (768 MB),
-// whose .vxl is 781 MB, are decoded twice instead.
+// beside them, and the tab the page's copy of it. The 1M set's looks (levels alone) keep theirs; its whole (768 MB of
+// floats for a 781 MB .vxl) is decoded twice instead.
 constexpr std::uint64_t kDecodedPositionsBytes = std::uint64_t(256) << 20;
 namespace {
 
