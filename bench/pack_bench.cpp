@@ -40,7 +40,7 @@ using vxl::bench::run_child;
 // previous run's file from the page cache when it replaces it.
 ChildRun median_run(const std::vector<std::string>& args, const std::string& output, int runs) {
   std::vector<double> seconds;
-  ChildRun worst{0, 0, 0};
+  ChildRun worst{0, 0, 0, 0};
   for (int r = 0; r < runs; ++r) {
     std::filesystem::remove(output);
     const ChildRun c = run_child(args);
