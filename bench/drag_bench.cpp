@@ -203,12 +203,13 @@ int main(int argc, char** argv) {
     row("select, through the per-voxel index", indexed_ms);
     row("select, through the index and the voxline boxes kept from the last position", boxed_ms);
     row("focus/context groups and the byte per streamline (before upload)", groups_ms);
-    // The first position alone: the window's first selection, whose boxes are all made then.
+    // The first position alone: the window's first selection, with nothing boxed yet (it reads its voxels without
+    // boxes).
     if (!indexed_ms.empty())
-      std::printf("\nfirst position: through the index %.1f ms, through the index while its boxes are made %.1f ms\n",
+      std::printf("\nfirst position: through the index %.1f ms, with the boxes (nothing boxed yet) %.1f ms\n",
                   indexed_ms.front(), boxed_ms.front());
     else
-      std::printf("\nfirst position, while its boxes are made: %.1f ms\n", boxed_ms.front());
+      std::printf("\nfirst position, with the boxes (nothing boxed yet): %.1f ms\n", boxed_ms.front());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "drag_bench: %s\n", e.what());
     return 1;

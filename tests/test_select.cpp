@@ -277,7 +277,7 @@ TEST_F(Selection, VoxlineBoxesKeptBetweenSelectionsChangeNothing) {
     const std::uint64_t budget = all ? VoxlineBoxes::kDefaultBudgetBytes : all_kept_bytes / 3;
     VoxlineBoxes boxes(f, budget);
     std::array<float, 3> centre = {float(kSynthCentre[0]), float(kSynthCentre[1]), float(kSynthCentre[2])};
-    std::uint64_t kept = 0, cases = 0;
+    std::uint64_t kept = 0, cases = 0, first_boxed_bytes = 0;
     for (int trial = 0; trial < 48; ++trial) {
       for (float& c : centre) c += step(rng);
       SelectionCriteria c;
@@ -293,10 +293,12 @@ TEST_F(Selection, VoxlineBoxesKeptBetweenSelectionsChangeNothing) {
       ASSERT_EQ(boxed.streamlines_per_region, plain.streamlines_per_region) << "trial " << trial;
       EXPECT_LE(boxed.points_tested, plain.points_tested) << "trial " << trial;
       EXPECT_LE(boxes.bytes(), budget) << "trial " << trial;
+      if (trial == 0) first_boxed_bytes = boxes.bytes();
       kept += boxed.streamlines.size();
       ++cases;
     }
     EXPECT_GT(kept, 20 * cases) << "the regions select something to compare";
+    EXPECT_EQ(first_boxed_bytes, 0u) << "the first selection reads its voxels without boxing them";
     if (all) all_kept_bytes = boxes.bytes();
     EXPECT_GT(boxes.bytes(), 0u) << "some voxels boxed";
   }

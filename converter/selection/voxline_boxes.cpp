@@ -19,9 +19,15 @@ VoxlineBoxes::VoxlineBoxes(const VxlFile& file, std::uint64_t budget_bytes)
 std::optional<std::span<BoxedVoxline>> VoxlineBoxes::voxel(std::size_t voxel, const VoxelVoxlines& index) {
   used_[voxel] = true;
   if (boxed_[voxel]) return std::span<BoxedVoxline>(lists_[voxel]);
+  const auto voxlines = static_cast<std::int64_t>(index.of_voxel(voxel).size());
+  if (boxing_left_.fetch_sub(voxlines) <= 0) {  // a voxel larger than the whole allowance is boxed when it comes first
+    boxing_left_ += voxlines;
+    return std::nullopt;
+  }
   const std::uint64_t need = index.of_voxel(voxel).size() * sizeof(BoxedVoxline);
   if (bytes_.fetch_add(need) + need > budget_) {
     bytes_ -= need;
+    boxing_left_ += voxlines;
     return std::nullopt;
   }
   thread_local std::vector<std::uint8_t> ends;
@@ -63,6 +69,11 @@ void VoxlineBoxes::track_region(int region) {
   if (region == tracked_region_) return;
   tracked_region_ = region;
   for (VoxelReference& r : references_) r.known = false;
+}
+
+void VoxlineBoxes::selection_started() {
+  boxing_left_ = selected_before_ ? kBoxedPerSelection : 0;
+  selected_before_ = true;
 }
 
 void VoxlineBoxes::selection_done() {

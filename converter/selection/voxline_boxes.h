@@ -65,7 +65,8 @@ class VoxlineBoxes {
   VoxlineBoxes& operator=(const VoxlineBoxes&) = delete;
 
   // Voxel `voxel`'s voxlines, boxed on first use (placed through `index`, the file's, and its words read once);
-  // nullopt when boxing them would take the boxes past the budget. Threads may ask for different voxels at once.
+  // nullopt when boxing them would take the boxes past the budget or the selection past what it may box
+  // (selection_started). Threads may ask for different voxels at once.
   // Throws what place_voxel_voxlines throws for a damaged file.
   std::optional<std::span<BoxedVoxline>> voxel(std::size_t voxel, const VoxelVoxlines& index);
   // The centre a boxed voxel's distances (near_lo, near_hi) were measured from.
@@ -73,6 +74,12 @@ class VoxlineBoxes {
   // The sphere the distances follow: region `region` of the selection (-1: none). Another region than the last
   // selection's forgets every voxel's distances.
   void track_region(int region);
+  // At the start of each selection: it boxes voxels until they hold kBoxedPerSelection voxlines, and the first
+  // selection none (voxel() gives nullopt past that). Boxing a voxel costs more than reading it once without boxes; it
+  // pays from the next selection on. So the first selection, which the window waits for with nothing boxed, takes the
+  // cheaper way, and each one after it boxes a part, at a bounded cost.
+  void selection_started();
+  static constexpr std::int64_t kBoxedPerSelection = 1 << 18;
   // After each selection: past half the budget, the voxels it did not use are let go.
   void selection_done();
   std::uint64_t bytes() const { return bytes_; }
@@ -85,6 +92,8 @@ class VoxlineBoxes {
   std::vector<VoxelReference> references_;
   int tracked_region_ = -1;
   std::atomic<std::uint64_t> bytes_ = 0;
+  std::atomic<std::int64_t> boxing_left_ = 0;  // voxlines the selection under way may still box
+  bool selected_before_ = false;
 };
 
 }  // namespace vxl
