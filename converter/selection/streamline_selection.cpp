@@ -571,7 +571,10 @@ void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, s
   for (std::size_t r = 0; r < q.table.regions.size() && sphere < 0; ++r)
     if (q.table.regions[r]->shape() == Region::Shape::Sphere && ((q.table.include | q.table.exclude) >> r & 1))
       sphere = int(r);
-  if (boxes) boxes->track_region(sphere), boxes->selection_started();
+  if (boxes) {
+    boxes->track_region(sphere);
+    boxes->selection_started();
+  }
   const DraggedSphere dragged(q.table, sphere);
   std::vector<HitSearch> per_thread(resolve_threads(0), q);
   std::vector<VoxelScratch> scratch(per_thread.size());
