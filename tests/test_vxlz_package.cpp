@@ -337,7 +337,6 @@ TEST(VxlzPackageOptions, TheUnpackedSizeIsKnownBeforeUnpacking) {
   pack_vxl(VxlFile::open(vxl), dir.file("s.vxlz"), PackSettings{});
   const VxlzFile package = VxlzFile::open(dir.file("s.vxlz"));
   ASSERT_GT(package.pack().level_count, 1u);
-  int checked = 0;
   for (PositionEncoding positions : {PositionEncoding::Packed, PositionEncoding::Float32})
     for (std::uint32_t levels : {1u, kDefaultLevels})
       for (std::uint32_t level : {0u, 1u}) {
@@ -349,9 +348,7 @@ TEST(VxlzPackageOptions, TheUnpackedSizeIsKnownBeforeUnpacking) {
         EXPECT_EQ(unpacked_vxl_bytes(package, s), std::filesystem::file_size(dir.file("u.vxl")))
             << vertex_bytes(positions) << " bytes a vertex, " << levels << " levels, level " << level;
         std::filesystem::remove(dir.file("u.vxl"));
-        ++checked;
       }
-  EXPECT_EQ(checked, 8);
 }
 
 TEST(VxlzPackageOptions, PackageBytesDoNotDependOnThreads) {

@@ -470,22 +470,19 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
       return [&, from, part](double d) { progress("decoding", from + d * part); };
     };
     const std::span<std::uint32_t> words(reinterpret_cast<std::uint32_t*>(window.data()), window.size() / 4);
-    if (summary.decoded_twice) {
-      scan_positions(f, s, ends, lengths, threads, decoding(0, 0.5));
-      set_bounds_checked(meta, voxels, f.path());
-      summary.repack_error_bound = write_positions(f, s, ends, settings.positions, window, threads, decoding(0.5, 0.5));
-    } else if (packed) {
-      // Left uninitialised: the chunks write every vertex (rebuild_structure checked that the voxlines' points are
-      // the package's), and zeroing them first cost a serial pass over fresh pages (0.3 s for 1M streamlines).
-      const auto floats = static_cast<std::size_t>(3 * meta.vertex_count);  // within the memory limit
-      const std::unique_ptr<float[]> kept(new float[floats]);
-      scan_positions(f, s, ends, lengths, threads, decoding(0, 1), kept.get());
-      set_bounds_checked(meta, voxels, f.path());
-      summary.repack_error_bound = pack_kept_positions(s, {kept.get(), floats}, ends, words, threads);
-    } else {  // float32: the decoded positions are VERT's
-      scan_positions(f, s, ends, lengths, threads, decoding(0, 1), reinterpret_cast<float*>(window.data()));
-      set_bounds_checked(meta, voxels, f.path());
-    }
+    // Where the first pass keeps the decoded positions: a float32 file's VERT; for a packed one, floats within the
+    // memory limit. Left uninitialised: the chunks write every vertex (rebuild_structure checked that the voxlines'
+    // points are the package's), and zeroing them first cost a serial pass over fresh pages (0.3 s for 1M streamlines).
+    std::unique_ptr<float[]> kept;
+    if (packed && !summary.decoded_twice)
+      kept.reset(new float[3 * words.size()]);  // a packed file's words: one a vertex
+    float* const keep = packed ? kept.get() : reinterpret_cast<float*>(window.data());
+    scan_positions(f, s, ends, lengths, threads, decoding(0, summary.decoded_twice ? 0.5 : 1), keep);
+    set_bounds_checked(meta, voxels, f.path());
+    if (summary.decoded_twice)
+      summary.repack_error_bound = write_positions(f, s, ends, words, threads, decoding(0.5, 0.5));
+    else if (packed)
+      summary.repack_error_bound = pack_kept_positions(s, {kept.get(), 3 * words.size()}, ends, words, threads);
     summary.decode_seconds = seconds_since(t0);
   };
   OrderSetSpec order_set;

@@ -209,6 +209,13 @@ void join_cut_streamlines(std::span<const ChunkLengthParts> chunks, std::span<fl
   finish();
 }
 
+// The largest packing error bound of the voxels, their tight bounds set.
+double largest_packing_bound(std::span<const VoxelEntry> voxels) {
+  double bound = 0;
+  for (const VoxelEntry& v : voxels) bound = std::max(bound, packed_error_bound(v));
+  return bound;
+}
+
 }  // namespace
 
 void scan_positions(const VxlzFile& f, UnpackStructure& s, VoxlineEnds& ends, std::span<float> lengths,
@@ -250,30 +257,18 @@ void scan_positions(const VxlzFile& f, UnpackStructure& s, VoxlineEnds& ends, st
 double pack_kept_positions(const UnpackStructure& s, std::span<float> kept, const VoxlineEnds& ends,
                            std::span<std::uint32_t> words, unsigned threads) {
   pack_vertex_blocks(s.voxels, kept, ends, words, threads);
-  double bound = 0;
-  for (const VoxelEntry& v : s.voxels) bound = std::max(bound, packed_error_bound(v));
-  return bound;
+  return largest_packing_bound(s.voxels);
 }
 
-double write_positions(const VxlzFile& f, const UnpackStructure& s, const VoxlineEnds& ends, PositionEncoding positions,
-                       std::span<std::uint8_t> vert, unsigned threads, const std::function<void(double)>& progress) {
+double write_positions(const VxlzFile& f, const UnpackStructure& s, const VoxlineEnds& ends,
+                       std::span<std::uint32_t> words, unsigned threads, const std::function<void(double)>& progress) {
   const std::uint64_t chunks = chunks_needed(f, s);
-  const bool packed = positions == PositionEncoding::Packed;
   std::vector<VertexPacker> packers;
-  double bound = 0;
-  if (packed) {
-    packers.reserve(s.voxels.size());
-    for (const VoxelEntry& v : s.voxels) {
-      packers.emplace_back(v);
-      bound = std::max(bound, packed_error_bound(v));
-    }
-  }
-  auto* words = reinterpret_cast<std::uint32_t*>(vert.data());
-  auto* floats = reinterpret_cast<float*>(vert.data());
+  packers.reserve(s.voxels.size());
+  for (const VoxelEntry& v : s.voxels) packers.emplace_back(v);
   // n vertices of voxel `voxel` from `vertex` on (3 floats each).
   const auto write = [&](std::uint32_t voxel, std::uint64_t vertex, const float* xyz, std::uint64_t n) {
-    if (!packed) return static_cast<void>(std::memcpy(floats + 3 * vertex, xyz, 12 * n));
-    packers[voxel].words(xyz, n, words + vertex);
+    packers[voxel].words(xyz, n, words.data() + vertex);
     for (std::uint64_t i = vertex; i < vertex + n; ++i)
       if (ends.test(i)) words[i] |= kPackedVoxlineEnd;
   };
@@ -289,7 +284,7 @@ double write_positions(const VxlzFile& f, const UnpackStructure& s, const Voxlin
     const std::uint64_t d = ++done;
     if (t == 0 && progress) progress(double(d) / double(chunks));
   });
-  return bound;
+  return largest_packing_bound(s.voxels);
 }
 
 }  // namespace vxl

@@ -4,7 +4,7 @@
 // chunks are decoded twice, the first time for the bounds (and the voxline ends and the lengths), the second to write
 // the words (about a tenth more time; what it holds is small beside the floats: a packer a voxel, and the steps of the
 // few streamlines the chunks cut, 8 bytes a point, until they are joined). A float32 .vxl gets the decoded positions as
-// they are. Chunks are decoded side by side.
+// they are, decoded once. Chunks are decoded side by side.
 #pragma once
 
 #include <cstdint>
@@ -31,9 +31,9 @@ void scan_positions(const VxlzFile& f, UnpackStructure& s, VoxlineEnds& ends, st
 double pack_kept_positions(const UnpackStructure& s, std::span<float> kept, const VoxlineEnds& ends,
                            std::span<std::uint32_t> words, unsigned threads);
 
-// Or the second pass, once the bounds are set: VERT's payload in `vert`, packed words (end bits from `ends`) or float32
-// triplets, decoded again. Returns the largest packing error bound of the voxels (0 for float32).
-double write_positions(const VxlzFile& f, const UnpackStructure& s, const VoxlineEnds& ends, PositionEncoding positions,
-                       std::span<std::uint8_t> vert, unsigned threads, const std::function<void(double)>& progress);
+// Or the second pass, once the bounds are set: the packed words (end bits from `ends`) decoded again into `words`
+// (VERT's payload). Returns the largest packing error bound of the voxels.
+double write_positions(const VxlzFile& f, const UnpackStructure& s, const VoxlineEnds& ends,
+                       std::span<std::uint32_t> words, unsigned threads, const std::function<void(double)>& progress);
 
 }  // namespace vxl

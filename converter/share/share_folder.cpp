@@ -119,24 +119,25 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
       copy_file(in_path, staging / data);
     }
   } else if (settings.unpack || settings.level) {
+    const VxlzFile package_file = VxlzFile::open(in_path);
     UnpackSettings unpack;
     unpack.threads = settings.threads;
-    if (settings.level) check_level(in_path, *settings.level, unpack.levels);  // the levels of the .vxl unpacked
-    // Its size known from its tables: a .vxl too large for the page is refused before it is unpacked.
-    if (!settings.level)
-      check_fits_the_page(in_path, true, unpacked_vxl_bytes(VxlzFile::open(in_path), unpack), unpack.levels, 0,
-                          settings);
+    if (settings.level)
+      check_level(in_path, *settings.level, unpack.levels);  // the levels of the .vxl unpacked
+    else  // its size known from its tables: a .vxl too large for the page is refused before it is unpacked
+      check_fits_the_page(in_path, true, unpacked_vxl_bytes(package_file, unpack), unpack.levels, 0, settings);
     data.replace_extension(".vxl");
     // Not a .vxl's name: the shared file's is the input's with .vxl, whatever the input was called.
     const fs::path unpacked = settings.level ? staging / "unpacked.tmp" : staging / data;
-    summary.streamlines = unpack_vxlz(in_path, unpacked.string(), unpack).streamlines;
+    summary.streamlines = unpack_vxlz(package_file, unpacked.string(), unpack).streamlines;
     summary.unpacked = true;
-    const VxlFile file = VxlFile::open(unpacked.string());
-    if (settings.level) summary.streamlines = write_level(file, (staging / data).string(), *settings.level);
-    check_fits_the_page(in_path, true, fs::file_size(staging / data), file.level_count(), settings.level.value_or(0),
-                        settings);
-    std::error_code ec;
-    if (settings.level) fs::remove(unpacked, ec);  // else left in the staging folder, removed with it
+    if (settings.level) {
+      const VxlFile file = VxlFile::open(unpacked.string());
+      summary.streamlines = write_level(file, (staging / data).string(), *settings.level);
+      check_fits_the_page(in_path, true, fs::file_size(staging / data), file.level_count(), *settings.level, settings);
+      std::error_code ec;
+      fs::remove(unpacked, ec);  // without --level it is the shared file, in the staging folder
+    }
   } else {
     // A package's checksums cover every byte of it. The page unpacks it in its own memory, as large as the .vxl
     // (UnpackSettings' defaults): a .vxl larger than the page holds is refused here, not after the recipient has
