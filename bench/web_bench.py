@@ -12,8 +12,8 @@ fetches the file whole), or with --server first-range answers one range a reques
 
 Also the memory of each kind of Chromium process at the peak (browser, renderer: the page and its
 WebAssembly memory, gpu-process: SwiftShader's copies of the textures), the tab's own peak (the largest renderer
-process: the page's; the others are Chromium's spare ones) against the bytes the page has on the GPU once done
-(what it draws), the level drawn at rest, by ranges the
+process: the page's; the others are Chromium's spare ones) and its memory once the page is done, against the bytes
+the page has on the GPU once done (what it draws), the level drawn at rest, by ranges the
 bytes fetched, and once the page is done its WebAssembly memory (and malloc's use of it: now and at most) and
 its JavaScript heap. --gpu sets the page's GPU memory budget (?gpu=); --rate sends range answers at that many MB
 a second, as a network would (by ranges, full detail then arrives span by span: the pictures at rest drawn with
@@ -97,6 +97,7 @@ def tree_memory_bytes(root):
 class PeakSampler:
     def __init__(self):
         self.peak, self.tab_peak, self._root, self._stop = 0, 0, None, threading.Event()
+        self.tab_last = 0  # the tab's memory at the last sample with a tab: once the page is done
         self.at_peak = {}  # {kind: bytes} when the total peaked
         self._thread = threading.Thread(target=self._run, daemon=True)
 
@@ -110,7 +111,10 @@ class PeakSampler:
             by_kind = {}
             for kind, memory in processes:
                 by_kind[kind] = by_kind.get(kind, 0) + memory
-            self.tab_peak = max([self.tab_peak] + [memory for kind, memory in processes if kind == 'renderer'])
+            tabs = [memory for kind, memory in processes if kind == 'renderer']
+            if tabs:  # none once the browser has closed
+                self.tab_last = max(tabs)
+                self.tab_peak = max(self.tab_peak, self.tab_last)
             if sum(by_kind.values()) > self.peak:
                 self.peak, self.at_peak = sum(by_kind.values()), by_kind
 
@@ -182,7 +186,8 @@ def main():
                     if memory and memory.get('gpu_bytes'):
                         page += (f'; the tab at most {sampler.tab_peak / 2**20:.0f} MiB = '
                                  f'{sampler.tab_peak / memory["gpu_bytes"]:.2f}x the {memory["gpu_bytes"] / 2**20:.0f} MiB '
-                                 f'it draws from (on the GPU once done)')
+                                 f'it draws from (on the GPU once done), once done {sampler.tab_last / 2**20:.0f} MiB = '
+                                 f'{sampler.tab_last / memory["gpu_bytes"]:.2f}x')
                     print(f'    at the peak, MiB: {kinds}; drawn at rest: level {report.get("full_level")}{budget}'
                           f'{fetched}{page}', flush=True)
                     spans = report.get('spans_fetched') or []

@@ -430,6 +430,16 @@
       worker.postMessage({ begin: { size, name, looks: onLook !== null } });
       return self;
     }
+    // Lets an unpacked file's buffer go now (a transfer detaches it, and a closed channel drops the message it
+    // holds) rather than at the collector's next full collection: a page that makes little JavaScript garbage may not
+    // have one for minutes, and the buffer is as large as the file the page keeps in the WebAssembly memory.
+    function discard(buffer) {
+      if (!(buffer instanceof ArrayBuffer) || buffer.byteLength === 0) return;
+      const channel = new MessageChannel();
+      channel.port1.postMessage(null, [buffer]);
+      channel.port1.close();
+      channel.port2.close();
+    }
     // A worker for the unpacker; null where the browser has none or refuses it (a page opened from the disk).
     function unpackWorker() {
       try {
@@ -482,7 +492,7 @@
     // that level of detail alone, drawn with its opacity (package-level) until a finer look or the whole replaces it
     // in the view, and with the panel's choices, the reader has moved to meanwhile.
     function openUnpacked(answer, name, target, t0, level = 0) {
-      if (!current(target) || answer.stale) return;
+      if (!current(target) || answer.stale) return discard(answer.vxl);
       if (answer.error !== undefined) {
         // A package refused after a look: that picture came from bytes the refusal says are damaged.
         if (lookShown) [opened, canvas.style.visibility] = [false, 'hidden'];
@@ -495,10 +505,12 @@
       try {
         pointer = allocate(size, name);
       } catch (error) {
+        discard(answer.vxl);
         return fail(error.message);
       }
       Module.HEAPU8.set(new Uint8Array(answer.vxl, 0, size), pointer);
-      answer.vxl = null;  // the copy in the WebAssembly memory is the one kept: this one goes at the next collection
+      discard(answer.vxl);  // the copy in the WebAssembly memory is the one kept
+      answer.vxl = null;
       const camera = lookShown && viewMoved ? JSON.parse(api.camera()) : null;
       // What the reader chose in the panel while a look was shown stays chosen.
       const panel = lookShown ? ['mode', 'color', 'opacity'].map((key) => [key, $(key).value]) : [];
