@@ -78,6 +78,9 @@ struct Viewer {
   std::uint64_t gpu_budget = 0;   // bytes; 0: none (vw_set_gpu_budget)
   std::uint32_t full_level = 0;   // the level drawn at rest: the finest within gpu_budget
   bool full_pending = false;      // the full-detail spans of the last view at rest are not all uploaded yet
+  // full_pending as the last vw_draw found it: the picture drawn (or being drawn in pieces) is not full detail's for
+  // its view. Uploads since do not change it: that picture, complete later, still lacks them.
+  bool drawn_pending = false;
   std::uint32_t first_level = 0;  // the first picture's level of detail
   // A file fetched by ranges whose full-detail renderer was made before that level's bytes were all in: its spans
   // are uploaded as their bytes arrive (span_in), the view's nearest first (vw_next_ranges), and a frame at rest
@@ -120,6 +123,7 @@ void close(Viewer& v) {
   v.drawn_mixed = false;
   v.drawn_full = false;
   v.package_level = 0;
+  v.drawn_pending = false;
 }
 
 // Whether the buffer holds the whole file (fetched whole, or every range fetched).
@@ -218,12 +222,22 @@ FullDetail upload_full(Viewer& v) {
   return !v.full_pending ? FullDetail::Ready : done ? FullDetail::WaitingForBytes : FullDetail::Uploading;
 }
 
+// Whether the full-detail spans the view needs are all on the GPU (full_pending says so too). Uploads nothing: a
+// frame that uploaded would wait, in its first call that needs the GPU (a framebuffer's check), for the GPU process to
+// take the upload; vw_upload uploads, a part a call, and the page waits for the GPU between calls.
+bool full_ready_for_view(Viewer& v) {
+  const std::vector<std::uint32_t> needed = v.full->spans_for(v.controller->camera(), double(v.width) / v.height);
+  v.full_pending =
+      !std::all_of(needed.begin(), needed.end(), [&](std::uint32_t c) { return v.full->span_resident(c); });
+  return !v.full_pending;
+}
+
 // The renderer a frame is drawn with: the first picture's while moving or while full detail is not ready for
 // the view (the finest coarser level fetched meanwhile, at rest).
 Renderer* renderer_for(Viewer& v, bool moving) {
   if (!v.quick) return v.full.get();
   if (moving) return v.quick.get();
-  if (!v.full || upload_full(v) != FullDetail::Ready) return v.interim ? v.interim.get() : v.quick.get();
+  if (!v.full || !full_ready_for_view(v)) return v.interim ? v.interim.get() : v.quick.get();
   if (v.piecing == v.interim.get()) v.piecing = nullptr;
   v.interim.reset();  // full detail is on the GPU for this view
   return v.full.get();
@@ -688,15 +702,15 @@ EMSCRIPTEN_KEEPALIVE int vw_refine() {
         v.spans_arriving ? std::min(vxl::GpuScene::driver_limit(),
                                     std::max(kArrivingSpanTexels, vxl::SceneLayout::largest_voxel_texels(files)))
                          : 0;
-    // Made without its spans (eager false): vw_upload and renderer_for upload them a few at a time.
+    // Made without its spans (eager false): vw_upload uploads them a few at a time.
     v.full = std::make_unique<vxl::Renderer>(files, max_texels, v.full_level, nullptr, false);
     v.full_pending = true;
     vxl::web::note_spans_in(v);
   });
 }
 
-// Whether the last frame at rest was drawn before the full-detail spans of its view were all uploaded.
-EMSCRIPTEN_KEEPALIVE int vw_pending() { return viewer().quick && viewer().full && viewer().full_pending ? 1 : 0; }
+// Whether the last frame was drawn before the full-detail spans of its view were all uploaded.
+EMSCRIPTEN_KEEPALIVE int vw_pending() { return viewer().drawn_pending ? 1 : 0; }
 
 // Uploads a few more full-detail spans for the view: 1 once all it needs are on the GPU (the next frame at
 // rest is drawn at full detail), 0 while more remain, else an error code (vw_error). Where the rest wait for
@@ -729,6 +743,7 @@ EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
     v.width = std::max(width, 1);
     v.height = std::max(height, 1);
     vxl::Renderer* renderer = vxl::web::renderer_for(v, moving != 0);
+    v.drawn_pending = v.quick && v.full && v.full_pending;
     v.controller->set_window_height(v.height);
     // At rest with some of full detail's spans in and others still coming: those, with this one standing in.
     vxl::Renderer* stand_in = nullptr;
