@@ -313,6 +313,7 @@
       }
       if (!fullDetail) refine();
       else if (!dirty && fullShown) done();  // drawn at full detail already: no frame more (SwiftShader: seconds)
+      else if (!dirty && api.piecesUnderWay() && !api.pending()) return;  // under way at full detail: done when shown
       else redraw();
     }
     // The whole file is in: what waited for it is offered, and (withLink) what the address asked of it applied.
