@@ -97,7 +97,7 @@ def tree_memory_bytes(root):
 class PeakSampler:
     def __init__(self):
         self.peak, self.tab_peak, self._root, self._stop = 0, 0, None, threading.Event()
-        self.tab_last = 0  # the tab's memory at the last sample with a tab: once the page is done
+        self.tab_done = 0  # the tab's memory once the page is done (sample_done)
         self.at_peak = {}  # {kind: bytes} when the total peaked
         self._thread = threading.Thread(target=self._run, daemon=True)
 
@@ -111,12 +111,13 @@ class PeakSampler:
             by_kind = {}
             for kind, memory in processes:
                 by_kind[kind] = by_kind.get(kind, 0) + memory
-            tabs = [memory for kind, memory in processes if kind == 'renderer']
-            if tabs:  # none once the browser has closed
-                self.tab_last = max(tabs)
-                self.tab_peak = max(self.tab_peak, self.tab_last)
+            self.tab_peak = max([self.tab_peak] + [memory for kind, memory in processes if kind == 'renderer'])
             if sum(by_kind.values()) > self.peak:
                 self.peak, self.at_peak = sum(by_kind.values()), by_kind
+
+    def sample_done(self):
+        """The tab's memory now: the page is done, its tab still open."""
+        self.tab_done = max([0] + [memory for kind, memory in tree_memory_bytes(self._root) if kind == 'renderer'])
 
     def stop(self):
         self._stop.set()
@@ -156,9 +157,10 @@ def main():
                     try:
                         if shared:
                             sampler.start(shared.process)
-                            report = shared.capture(url, picture, 900)
+                            report = shared.capture(url, picture, 900, on_done=sampler.sample_done)
                         else:
-                            report = web_capture.capture(url, picture, 900, args.chromium, on_start=sampler.start)
+                            report = web_capture.capture(url, picture, 900, args.chromium, on_start=sampler.start,
+                                                         on_done=sampler.sample_done)
                     finally:
                         sampler.stop()
                     if 'error' in report:
@@ -186,8 +188,8 @@ def main():
                     if memory and memory.get('gpu_bytes'):
                         page += (f'; the tab at most {sampler.tab_peak / 2**20:.0f} MiB = '
                                  f'{sampler.tab_peak / memory["gpu_bytes"]:.2f}x the {memory["gpu_bytes"] / 2**20:.0f} MiB '
-                                 f'it draws from (on the GPU once done), once done {sampler.tab_last / 2**20:.0f} MiB = '
-                                 f'{sampler.tab_last / memory["gpu_bytes"]:.2f}x')
+                                 f'it draws from (on the GPU once done), once done {sampler.tab_done / 2**20:.0f} MiB = '
+                                 f'{sampler.tab_done / memory["gpu_bytes"]:.2f}x')
                     print(f'    at the peak, MiB: {kinds}; drawn at rest: level {report.get("full_level")}{budget}'
                           f'{fetched}{page}', flush=True)
                     spans = report.get('spans_fetched') or []

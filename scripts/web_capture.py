@@ -142,9 +142,10 @@ DROP_FILE = """fetch(DROP).then((r) => r.blob()).then((blob) => {
 })"""
 
 
-def capture_in(browser, url, out, timeout, drop=None):
+def capture_in(browser, url, out, timeout, drop=None, on_done=None):
     """The page's report (a dict; with 'error' when the page failed) in a new tab of `browser` (a DevTools), its
-    picture written to `out`; the tab is closed after."""
+    picture written to `out`; the tab is closed after, once on_done() (if given) has returned: the page is done, its
+    tab still open (a benchmark samples its memory)."""
     target = browser.call('Target.createTarget', {'url': 'about:blank'})['targetId']
     try:
         session = browser.call('Target.attachToTarget', {'targetId': target, 'flatten': True})['sessionId']
@@ -164,6 +165,8 @@ def capture_in(browser, url, out, timeout, drop=None):
                               session=session, timeout=timeout)
         console = [' '.join(str(a.get('value', a.get('description', ''))) for a in e['params'].get('args', []))
                    for e in browser.events if e.get('method') == 'Runtime.consoleAPICalled']
+        if on_done:
+            on_done()
     finally:
         browser.call('Target.closeTarget', {'targetId': target})
     value = result.get('result', {}).get('value') or {}
@@ -202,8 +205,8 @@ class Browser:
             raise
         self.process = self.devtools.process
 
-    def capture(self, url, out, timeout, drop=None):
-        return capture_in(self.devtools, url, out, timeout, drop)
+    def capture(self, url, out, timeout, drop=None, on_done=None):
+        return capture_in(self.devtools, url, out, timeout, drop, on_done)
 
     def close(self):
         """Closes the browser and removes its profile."""
@@ -217,13 +220,13 @@ class Browser:
         self.close()
 
 
-def capture(url, out, timeout, chromium, on_start=None, drop=None):
+def capture(url, out, timeout, chromium, on_start=None, drop=None, on_done=None):
     """The page's report in a browser of its own (capture_in). on_start(process) is called once the browser runs
     (a benchmark samples its memory)."""
     with Browser(chromium) as browser:
         if on_start:
             on_start(browser.process)
-        return browser.capture(url, out, timeout, drop)
+        return browser.capture(url, out, timeout, drop, on_done)
 
 
 def main():

@@ -431,13 +431,18 @@ GpuScene::Residency GpuScene::make_resident(std::span<const std::uint32_t> neede
     uploaded = true;
   }
   if (!wait) {
-    // The fills that end within the time, finished here (a millisecond's sleep between looks). A span made in
-    // parts gets at least one part, then as many as the time allows; one that fails is dropped.
+    // The fills that end within the time, finished here (a millisecond's sleep between looks). Spans made in parts
+    // get at least one part in all (not one each: a part is a long task on a web page), then as many as the time
+    // allows; one that fails is dropped.
     const auto done = [](const BackgroundTask<>& task) { return !task.valid() || task.ready(); };
+    bool part_made = false;
     const auto parts_left = [&](std::size_t k) {
       try {
-        bool more = fill_next_part(filling_[k]);
-        while (more && elapsed_ms() < max_ms) more = fill_next_part(filling_[k]);
+        bool more = true;
+        while (more && (!part_made || elapsed_ms() < max_ms)) {
+          more = fill_next_part(filling_[k]);
+          part_made = true;
+        }
         return more;
       } catch (...) {
         drop_filling(k);

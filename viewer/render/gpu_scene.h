@@ -72,7 +72,7 @@ class GpuScene {
   // stays out. Waiting (the default), with a time limit, stops once `max_ms` have passed (at least one span
   // is uploaded). Not waiting (`wait` false: a window at rest, whose event loop must not block on an upload),
   // starts the fills of up to kMaxFilling spans on other threads (without threads, a web page: makes their parts
-  // on this thread, at least one, fill_next_part), and returns once those that end within
+  // on this thread, at least one in all, fill_next_part), and returns once those that end within
   // `max_ms` are resident: calling again finishes and starts more. A span still filling is not drawn.
   struct Residency {
     bool complete = true;      // every span of `needed` is resident

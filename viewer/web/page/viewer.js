@@ -520,7 +520,26 @@
     // What the unpacker answered (unpackInWorker): the package's .vxl opened, or its error said. level > 0: a look,
     // that level of detail alone, drawn with its opacity (package-level) until a finer look or the whole replaces it
     // in the view, and with the panel's choices, the reader has moved to meanwhile.
-    function openUnpacked(answer, name, target, t0, level = 0) {
+    // One after another (a look's copy may still be under way when the next arrives).
+    let unpackedOpening = Promise.resolve();
+    function openUnpacked(...args) {
+      unpackedOpening = unpackedOpening.then(() => openUnpackedNow(...args)).catch((err) => fail(String(err.message || err)));
+      return unpackedOpening;
+    }
+    // Copies `bytes` to `pointer` in the WebAssembly memory a slice a task: the 1M set's 745 MiB in one piece held
+    // the page for half a second. False when another file was opened meanwhile.
+    async function copyInSlices(bytes, pointer, target) {
+      const slice = 32 << 20;
+      for (let at = 0; at < bytes.length; at += slice) {
+        if (at > 0) {
+          await new Promise((resolve) => setTimeout(resolve, 0));
+          if (!current(target)) return false;
+        }
+        Module.HEAPU8.set(bytes.subarray(at, Math.min(bytes.length, at + slice)), pointer + at);
+      }
+      return true;
+    }
+    async function openUnpackedNow(answer, name, target, t0, level = 0) {
       if (!current(target) || answer.stale) return discard(answer.vxl);
       if (answer.error !== undefined) {
         // A package refused after a look: that picture came from bytes the refusal says are damaged.
@@ -537,9 +556,10 @@
         discard(answer.vxl);
         return fail(error.message);
       }
-      Module.HEAPU8.set(new Uint8Array(answer.vxl, 0, size), pointer);
+      const copied = await copyInSlices(new Uint8Array(answer.vxl, 0, size), pointer, target);
       discard(answer.vxl);  // the copy in the WebAssembly memory is the one kept
       answer.vxl = null;
+      if (!copied) return Module._free(pointer);
       const camera = lookShown && viewMoved ? JSON.parse(api.camera()) : null;
       // What the reader chose in the panel while a look was shown stays chosen.
       const panel = lookShown ? ['mode', 'color', 'opacity'].map((key) => [key, $(key).value]) : [];
