@@ -75,9 +75,9 @@ struct Viewer {
   // The file is one level of detail of a package alone (the first look while the rest arrives, vw_set
   // "package-level"): drawn with that level's opacity, so that it looks as bright as the whole will.
   std::uint32_t package_level = 0;
-  std::uint64_t gpu_budget = 0;   // bytes; 0: none (vw_set_gpu_budget)
-  std::uint32_t full_level = 0;   // the level drawn at rest: the finest within gpu_budget
-  bool full_pending = false;      // the full-detail spans of the last view at rest are not all uploaded yet
+  std::uint64_t gpu_budget = 0;  // bytes; 0: none (vw_set_gpu_budget)
+  std::uint32_t full_level = 0;  // the level drawn at rest: the finest within gpu_budget
+  bool full_pending = false;     // the full-detail spans of the last view at rest are not all uploaded yet
   // full_pending as the last vw_draw found it: the picture drawn (or being drawn in pieces) is not full detail's for
   // its view. Uploads since do not change it: that picture, complete later, still lacks them.
   bool drawn_pending = false;
