@@ -78,8 +78,9 @@ struct Viewer {
   std::uint64_t gpu_budget = 0;  // bytes; 0: none (vw_set_gpu_budget)
   std::uint32_t full_level = 0;  // the level drawn at rest: the finest within gpu_budget
   bool full_pending = false;     // the full-detail spans of the last view at rest are not all uploaded yet
-  // full_pending as the last vw_draw found it: the picture drawn (or being drawn in pieces) is not full detail's for
-  // its view. Uploads since do not change it: that picture, complete later, still lacks them.
+  // The picture the last vw_draw drew (or is drawing in pieces) is not full detail's for its view: drawn in motion
+  // (from the first level), or at rest before the view's full-detail spans were all uploaded. Uploads since do not
+  // change it: that picture, complete later, still lacks them.
   bool drawn_pending = false;
   std::uint32_t first_level = 0;  // the first picture's level of detail
   // A file fetched by ranges whose full-detail renderer was made before that level's bytes were all in: its spans
@@ -709,7 +710,7 @@ EMSCRIPTEN_KEEPALIVE int vw_refine() {
   });
 }
 
-// Whether the last frame was drawn before the full-detail spans of its view were all uploaded.
+// Whether the last frame lacks full detail (Viewer::drawn_pending).
 EMSCRIPTEN_KEEPALIVE int vw_pending() { return viewer().drawn_pending ? 1 : 0; }
 
 // Uploads a few more full-detail spans for the view: 1 once all it needs are on the GPU (the next frame at
@@ -743,7 +744,7 @@ EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
     v.width = std::max(width, 1);
     v.height = std::max(height, 1);
     vxl::Renderer* renderer = vxl::web::renderer_for(v, moving != 0);
-    v.drawn_pending = v.quick && v.full && v.full_pending;
+    v.drawn_pending = v.quick && v.full && (moving || v.full_pending);
     v.controller->set_window_height(v.height);
     // At rest with some of full detail's spans in and others still coming: those, with this one standing in.
     vxl::Renderer* stand_in = nullptr;

@@ -264,30 +264,36 @@
       });
     }
     // Full detail's upload, a few spans per task so that the page keeps taking input, each once the GPU has taken
-    // the one before (so that no call waits for it); one frame when done.
-    let uploading = false, uploadAsked = false;  // asked for while uploading: once more after it (new bytes since)
+    // the one before (so that no call waits for it); one frame when done, unless one was drawn meanwhile.
+    let uploading = false, uploadAsked = -1;  // the file (generation) that asked while uploading: once more after it
     function uploadSoon() {
       if (uploading) {
-        uploadAsked = true;
+        uploadAsked = generation;
         return;
       }
-      [uploading, uploadAsked] = [true, false];
+      [uploading, uploadAsked] = [true, -1];
       const gen = generation;
+      const end = () => {  // more bytes came, or another file asked, meanwhile: again
+        uploading = false;
+        if (uploadAsked === generation) uploadSoon();
+      };
       setTimeout(function step() {
         // The drag's end draws and comes back here; a file opened since has its own.
-        if (moving || gen !== generation) { uploading = false; return; }
+        if (moving || gen !== generation) return end();
         const r = api.upload();
         if (r > 1) { uploading = false; return fail(api.error()); }
         const info = JSON.parse(api.info());
         if (bytesComplete) $('progress').value = info.full_uploaded / Math.max(1, info.full_bytes);  // else the fetch's
         if (r === 0) return gpuCaughtUp().then(step);
-        // Uploading until the frame is asked for: a picture completed meanwhile, which lacks these, asks for none.
+        const run = piecesRun;
         gpuCaughtUp().then(() => {
+          // A frame drawn meanwhile (or another file) drew what is in: its own shownFrame asks for what it lacks.
+          if (run !== piecesRun || gen !== generation) return end();
           uploading = false;
           if (r === 1) redraw();  // full detail for the view: now, whatever picture is under way
           else if (r === -1) redrawWhenShown();  // more of it, the rest still coming: after the picture under way
           // -2: the rest waits for its bytes, nothing new; -3: the picture drawn or under way is full detail already
-          else if (uploadAsked) uploadSoon();
+          else if (uploadAsked === generation) uploadSoon();
         });
       }, 0);
     }
@@ -523,7 +529,10 @@
     // One after another (a look's copy may still be under way when the next arrives).
     let unpackedOpening = Promise.resolve();
     function openUnpacked(...args) {
-      unpackedOpening = unpackedOpening.then(() => openUnpackedNow(...args)).catch((err) => fail(String(err.message || err)));
+      const target = args[2];
+      unpackedOpening = unpackedOpening.then(() => openUnpackedNow(...args)).catch((err) => {
+        if (current(target)) fail(String(err.message || err));
+      });
       return unpackedOpening;
     }
     // Copies `bytes` to `pointer` in the WebAssembly memory a slice a task: the 1M set's 745 MiB in one piece held
