@@ -75,13 +75,8 @@ struct Viewer {
   // The file is one level of detail of a package alone (the first look while the rest arrives, vw_set
   // "package-level"): drawn with that level's opacity, so that it looks as bright as the whole will.
   std::uint32_t package_level = 0;
-  std::uint64_t gpu_budget = 0;  // bytes; 0: none (vw_set_gpu_budget)
-  std::uint32_t full_level = 0;  // the level drawn at rest: the finest within gpu_budget
-  bool full_pending = false;     // the full-detail spans of the last view at rest are not all uploaded yet
-  // The picture the last vw_draw drew (or is drawing in pieces) is not full detail's for its view: drawn in motion
-  // (from the first level), or at rest before the view's full-detail spans were all uploaded. Uploads since do not
-  // change it: that picture, complete later, still lacks them.
-  bool drawn_pending = false;
+  std::uint64_t gpu_budget = 0;   // bytes; 0: none (vw_set_gpu_budget)
+  std::uint32_t full_level = 0;   // the level drawn at rest: the finest within gpu_budget
   std::uint32_t first_level = 0;  // the first picture's level of detail
   // A file fetched by ranges whose full-detail renderer was made before that level's bytes were all in: its spans
   // are uploaded as their bytes arrive (span_in), the view's nearest first (vw_next_ranges), and a frame at rest
@@ -124,7 +119,6 @@ void close(Viewer& v) {
   v.drawn_mixed = false;
   v.drawn_full = false;
   v.package_level = 0;
-  v.drawn_pending = false;
 }
 
 // Whether the buffer holds the whole file (fetched whole, or every range fetched).
@@ -206,31 +200,24 @@ bool draw_next_piece(Viewer& v) {
 // What upload_full found.
 enum class FullDetail { Ready, Uploading, WaitingForBytes };
 
+// The full-detail spans the view needs, the nearest first.
+std::vector<std::uint32_t> full_spans_for_view(const Viewer& v) {
+  return v.full->spans_for(v.controller->camera(), double(v.width) / v.height);
+}
+
+// Whether those spans are all on the GPU.
+bool all_resident(const Viewer& v, const std::vector<std::uint32_t>& spans) {
+  return std::all_of(spans.begin(), spans.end(), [&](std::uint32_t c) { return v.full->span_resident(c); });
+}
+
 // Uploads a few more of the full-detail spans the view needs (the nearest first) whose bytes are in.
 FullDetail upload_full(Viewer& v) {
-  const Camera& camera = v.controller->camera();
-  const double aspect = double(v.width) / v.height;
-  if (!v.spans_arriving) {
-    v.full_pending = !v.full->upload_for(camera, aspect, Clipping{}, 0.0);
-    return v.full_pending ? FullDetail::Uploading : FullDetail::Ready;
-  }
-  const std::vector<std::uint32_t> needed = v.full->spans_for(camera, aspect);
+  const std::vector<std::uint32_t> needed = full_spans_for_view(v);
+  if (!v.spans_arriving) return v.full->upload_spans(needed, 0.0) ? FullDetail::Ready : FullDetail::Uploading;
   std::vector<std::uint32_t> in;  // those whose bytes are in
   std::copy_if(needed.begin(), needed.end(), std::back_inserter(in), [&](std::uint32_t c) { return v.span_in[c]; });
   const bool done = v.full->upload_spans(in, 0.0);
-  v.full_pending =
-      !std::all_of(needed.begin(), needed.end(), [&](std::uint32_t c) { return v.full->span_resident(c); });
-  return !v.full_pending ? FullDetail::Ready : done ? FullDetail::WaitingForBytes : FullDetail::Uploading;
-}
-
-// Whether the full-detail spans the view needs are all on the GPU (full_pending says so too). Uploads nothing: a
-// frame that uploaded would wait, in its first call that needs the GPU (a framebuffer's check), for the GPU process to
-// take the upload; vw_upload uploads, a part a call, and the page waits for the GPU between calls.
-bool full_ready_for_view(Viewer& v) {
-  const std::vector<std::uint32_t> needed = v.full->spans_for(v.controller->camera(), double(v.width) / v.height);
-  v.full_pending =
-      !std::all_of(needed.begin(), needed.end(), [&](std::uint32_t c) { return v.full->span_resident(c); });
-  return !v.full_pending;
+  return all_resident(v, needed) ? FullDetail::Ready : done ? FullDetail::WaitingForBytes : FullDetail::Uploading;
 }
 
 // The renderer a frame is drawn with: the first picture's while moving or while full detail is not ready for
@@ -238,7 +225,10 @@ bool full_ready_for_view(Viewer& v) {
 Renderer* renderer_for(Viewer& v, bool moving) {
   if (!v.quick) return v.full.get();
   if (moving) return v.quick.get();
-  if (!v.full || !full_ready_for_view(v)) return v.interim ? v.interim.get() : v.quick.get();
+  // Whether full detail is ready; a frame uploads nothing: it would wait, in its first call that needs the GPU (a
+  // framebuffer's check), for the GPU process to take the upload. vw_upload uploads, a part a call, and the page waits
+  // for the GPU between calls.
+  if (!v.full || !all_resident(v, full_spans_for_view(v))) return v.interim ? v.interim.get() : v.quick.get();
   if (v.piecing == v.interim.get()) v.piecing = nullptr;
   v.interim.reset();  // full detail is on the GPU for this view
   return v.full.get();
@@ -705,13 +695,17 @@ EMSCRIPTEN_KEEPALIVE int vw_refine() {
                          : 0;
     // Made without its spans (eager false): vw_upload uploads them a few at a time.
     v.full = std::make_unique<vxl::Renderer>(files, max_texels, v.full_level, nullptr, false);
-    v.full_pending = true;
     vxl::web::note_spans_in(v);
   });
 }
 
-// Whether the last frame lacks full detail (Viewer::drawn_pending).
-EMSCRIPTEN_KEEPALIVE int vw_pending() { return viewer().drawn_pending ? 1 : 0; }
+// Whether the last frame (drawn, or being drawn in pieces) lacks full detail: drawn in motion from the first level, or
+// at rest before the view's full-detail spans were all uploaded. Uploads since do not change it: that picture,
+// complete later, still lacks them.
+EMSCRIPTEN_KEEPALIVE int vw_pending() {
+  const auto& v = viewer();
+  return v.quick && v.full && !v.drawn_full ? 1 : 0;
+}
 
 // Uploads a few more full-detail spans for the view: 1 once all it needs are on the GPU (the next frame at
 // rest is drawn at full detail), 0 while more remain, else an error code (vw_error). Where the rest wait for
@@ -744,7 +738,6 @@ EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
     v.width = std::max(width, 1);
     v.height = std::max(height, 1);
     vxl::Renderer* renderer = vxl::web::renderer_for(v, moving != 0);
-    v.drawn_pending = v.quick && v.full && (moving || v.full_pending);
     v.controller->set_window_height(v.height);
     // At rest with some of full detail's spans in and others still coming: those, with this one standing in.
     vxl::Renderer* stand_in = nullptr;

@@ -246,7 +246,7 @@
     // Resolves once the GPU has done what the page asked of it so far: a fence, looked at between tasks. WebGL hands
     // the GPU process its work to do later, and a call that must wait for it (a framebuffer's check, a pixel read)
     // holds the page's thread until the GPU process has caught up: after full detail's uploads, the next frame's
-    // first call waited 0.2-0.7 s for SwiftShader to copy the textures.
+    // first call took 0.3-0.8 s, waiting for SwiftShader to copy the textures.
     function gpuCaughtUp() {
       const gl = canvas.getContext('webgl2');
       if (!gl || gl.isContextLost()) return Promise.resolve();
@@ -287,13 +287,12 @@
         if (r === 0) return gpuCaughtUp().then(step);
         const run = piecesRun;
         gpuCaughtUp().then(() => {
-          // A frame drawn meanwhile (or another file) drew what is in: its own shownFrame asks for what it lacks.
-          if (run !== piecesRun || gen !== generation) return end();
+          // A frame drawn meanwhile (or another file) drew what is in: its own shownFrame asks for what it lacks. -2:
+          // the rest waits for its bytes, nothing new; -3: the picture drawn or under way is full detail already.
+          if (run !== piecesRun || gen !== generation || r < -1) return end();
           uploading = false;
           if (r === 1) redraw();  // full detail for the view: now, whatever picture is under way
-          else if (r === -1) redrawWhenShown();  // more of it, the rest still coming: after the picture under way
-          // -2: the rest waits for its bytes, nothing new; -3: the picture drawn or under way is full detail already
-          else if (uploadAsked === generation) uploadSoon();
+          else redrawWhenShown();  // -1: more of it, the rest still coming: after the picture under way
         });
       }, 0);
     }
@@ -567,7 +566,6 @@
       }
       const copied = await copyInSlices(new Uint8Array(answer.vxl, 0, size), pointer, target);
       discard(answer.vxl);  // the copy in the WebAssembly memory is the one kept
-      answer.vxl = null;
       if (!copied) return Module._free(pointer);
       const camera = lookShown && viewMoved ? JSON.parse(api.camera()) : null;
       // What the reader chose in the panel while a look was shown stays chosen.
