@@ -184,6 +184,8 @@ def main():
                     if memory and memory.get('peak') is not None and report.get('heap_bytes') is not None:
                         page = (f'; once done, the page\'s WebAssembly memory {memory["wasm"] / 2**20:.0f} MiB (malloc: '
                                 f'{memory["in_use"] / 2**20:.0f} MiB in use, {memory["peak"] / 2**20:.0f} MiB at most), '
+                                + (f'the package\'s unpacker\'s at its end {memory["unpacker"] / 2**20:.0f} MiB, '
+                                   if memory.get('unpacker') else '') +
                                 f'JavaScript heap {report["heap_bytes"] / 2**20:.0f} MiB')
                     if memory and memory.get('gpu_bytes'):
                         page += (f'; the tab at most {sampler.tab_peak / 2**20:.0f} MiB = '

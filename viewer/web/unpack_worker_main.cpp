@@ -7,8 +7,8 @@
 // each): once the first bytes hold a level of detail small enough for a first look (a package of a file with levels
 // ships its coarsest level first), vu_arrived asks for it, vu_unpack_level unpacks it alone, and the page shows it
 // while the rest arrives, and the finer levels (vu_looks) the page asks for while the rest is still far off; vu_unpack
-// then unpacks the whole. Each .vxl is written into the in-memory file system (vu_unpacked), whose bytes the script
-// hands to the page as they are.
+// then unpacks the whole. Each .vxl is written into the module's current folder, whose files are kept in pieces
+// (unpack_pieces_fs.js), and the script hands the pieces to the page as they are (vu_unpacked names the file).
 #include <emscripten/emscripten.h>
 
 #include <algorithm>
@@ -26,7 +26,7 @@
 
 namespace {
 
-// The .vxl the last unpack wrote into the in-memory file system: the worker's script hands its bytes over as they
+// The .vxl the last unpack wrote into the in-memory file system: the worker's script hands its pieces over as they
 // lie there (no copy in the module's memory) and removes it.
 std::string& unpacked() {
   static std::string path;

@@ -1,26 +1,24 @@
 // Unpacks a .vxlz package off the page's thread (unpack_worker_main.cpp, built as voxunpack.js), as it arrives. The
 // page posts {begin: {size, name}}, then {piece: ArrayBuffer} for each piece of the package in order, then {end:
-// true} ({begin: {size, name, looks: false}}: no looks, the whole at once). It gets back {looks: [[level, bytes], ...]} once the package's tables are in (the levels of detail it can
-// look at before the whole, coarsest first, and the bytes each needs), {level, vxl: ArrayBuffer, size} when the first
-// of them is in (the .vxl of that level alone: the first `size` bytes of the buffer), the same for each finer one the
-// page asks for with {look: level} after its bytes, then {vxl, size} (the whole package's .vxl) or {error: text}. One
-// package a worker: the page ends the worker once it has the answer, and the module's memory goes with it.
+// true} ({begin: {size, name, looks: false}}: no looks, the whole at once). It gets back {looks: [[level, bytes],
+// ...]} once the package's tables are in (the levels of detail it can look at before the whole, coarsest first, and
+// the bytes each needs), {level, pieces: [ArrayBuffer, ...], size, memory} when the first of them is in (the .vxl of
+// that level alone: the first `size` bytes of the pieces end to end, so that the page can let each go once it has
+// copied it; memory: the unpacker's), the same for each finer one the page asks for with {look: level} after its
+// bytes, then {pieces, size, memory} (the whole package's .vxl) or {error: text}. One package a worker: the page ends
+// the worker once it has the answer, and the module's memory goes with it.
 importScripts('voxunpack.js');
 
 let unpacker = null, pointer = 0, size = 0, received = 0, name = '', looksSent = false, looksWanted = true;
 const ready = createVoxunpack().then((module) => { unpacker = module; });
 let queue = Promise.resolve();  // the messages, one after the other (the module loads first)
 
-// The .vxl the last unpack wrote in the module's in-memory file system: {vxl: its ArrayBuffer, size: its bytes at the
-// start of it}, the file's own storage, handed over as it is (a copy would hold the file twice), and the file removed.
+// The .vxl the last unpack wrote: {pieces: [ArrayBuffer, ...], size, memory}, its bytes the first `size` of the pieces
+// end to end, taken from the module's file system (unpack_pieces_fs.js) as they are, to be handed over; memory: the
+// module's memory now, the most it has had (it never shrinks), for benchmarks.
 function unpackedFile() {
-  const path = unpacker.UTF8ToString(unpacker._vu_unpacked() >>> 0);  // addresses past 2 GiB come back negative
-  const node = unpacker.FS.lookupPath(path).node;
-  const contents = node.contents && node.contents.buffer ? node.contents : new Uint8Array(node.contents || 0);
-  const file = { vxl: contents.buffer, size: node.usedBytes };
-  if (contents.byteOffset !== 0) file.vxl = contents.slice(0, file.size).buffer;
-  unpacker.FS.unlink(path);
-  return file;
+  const path = unpacker.UTF8ToString(unpacker._vu_unpacked() >>> 0);  // >>> 0: addresses past 2 GiB
+  return { ...unpacker.takePieces(path), memory: unpacker.HEAPU8.length };
 }
 function error() { return unpacker.UTF8ToString(unpacker._vu_error() >>> 0); }
 
@@ -54,12 +52,12 @@ function piece(bytes) {
 function look(level) {
   if (!unpacker._vu_unpack_level(level)) return;
   const file = unpackedFile();
-  postMessage({ level, ...file }, [file.vxl]);
+  postMessage({ level, ...file }, file.pieces);
 }
 function end() {
   if (!unpacker._vu_unpack()) return postMessage({ error: error() });
   const file = unpackedFile();
-  postMessage(file, [file.vxl]);
+  postMessage(file, file.pieces);
 }
 
 let failed = false;  // an error was answered: the rest of the package is not looked at

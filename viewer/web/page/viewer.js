@@ -101,8 +101,9 @@
     }
     window.voxweb.slowCalls = () => slowCalls.slice();
     window.voxweb.mode = () => JSON.parse(api.info()).mode;  // the mode frames are drawn in (for tests)
-    // The WebAssembly memory's size and malloc's use of it (for benchmarks).
-    window.voxweb.memory = () => ({ wasm: Module.HEAPU8.length, ...JSON.parse(api.memory()) });
+    // The WebAssembly memory's size and malloc's use of it, and the most a package's unpacker had (for benchmarks).
+    let unpackerMemory = 0;
+    window.voxweb.memory = () => ({ wasm: Module.HEAPU8.length, unpacker: unpackerMemory, ...JSON.parse(api.memory()) });
     // moving: a drag is under way (frames then come from the first picture's level of detail).
     let opened = false, dirty = false, firstFrame = true, fullDetail = false, moving = false;
     // The last frame shows the view at rest at full detail (a file fetched by ranges: possibly before its tables are in).
@@ -417,9 +418,11 @@
     }
 
     // A package unpacked in `worker` (unpack_worker.js) as its bytes arrive: add(Uint8Array) hands each piece over
-    // (copied), end() says all are in and resolves with the answer, {vxl: ArrayBuffer, size} or {error: text}. Where
-    // its first bytes hold a level of detail to look at while the rest arrives, onLook(level, {vxl, size}) gets it
-    // (and each finer one askFiner asks for) before the end; onLook null: no looks. A package opened since ends the one before ({stale: true}); so does cancel().
+    // (copied), end() says all are in and resolves with the answer, {pieces: [ArrayBuffer, ...], size} (the .vxl: the
+    // first `size` bytes of the pieces end to end) or {error: text}. Where its first bytes hold a level of detail to
+    // look at while the rest arrives, onLook(level, {pieces, size}) gets it (and each finer one askFiner asks for)
+    // before the end; onLook null: no looks. A package opened since ends the one before ({stale: true}); so does
+    // cancel().
     let unpacking = null;  // the package being unpacked
     function unpackInWorker(worker, size, name, onLook) {
       if (unpacking) unpacking.cancel();
@@ -534,21 +537,26 @@
       });
       return unpackedOpening;
     }
-    // Copies `bytes` to `pointer` in the WebAssembly memory a slice a task: the 1M set's 745 MiB in one piece held
-    // the page for half a second. False when another file was opened meanwhile.
-    async function copyInSlices(bytes, pointer, target) {
-      const slice = 32 << 20;
-      for (let at = 0; at < bytes.length; at += slice) {
-        if (at > 0) {
+    // Copies an unpacked .vxl's pieces end to end into the WebAssembly memory at `pointer`, a piece a task (the 1M
+    // set's 745 MiB at once held the page for half a second), letting each go once copied (the tab holds the file
+    // once, not twice). False when another file was opened meanwhile.
+    async function copyPieces(pieces, size, pointer, target) {
+      for (let k = 0, at = 0; k < pieces.length; ++k) {
+        if (k > 0) {
           await new Promise((resolve) => setTimeout(resolve, 0));
           if (!current(target)) return false;
         }
-        Module.HEAPU8.set(bytes.subarray(at, Math.min(bytes.length, at + slice)), pointer + at);
+        const n = Math.min(pieces[k].byteLength, size - at);
+        Module.HEAPU8.set(new Uint8Array(pieces[k], 0, n), pointer + at);
+        discard(pieces[k]);
+        at += n;
       }
       return true;
     }
     async function openUnpackedNow(answer, name, target, t0, level = 0) {
-      if (!current(target) || answer.stale) return discard(answer.vxl);
+      const pieces = answer.pieces || [];
+      unpackerMemory = Math.max(unpackerMemory, answer.memory || 0);
+      if (!current(target) || answer.stale) return pieces.forEach(discard);
       if (answer.error !== undefined) {
         // A package refused after a look: that picture came from bytes the refusal says are damaged.
         if (lookShown) [opened, canvas.style.visibility] = [false, 'hidden'];
@@ -556,17 +564,19 @@
       }
       if (level === 0 && lookShown) mark('whole unpacked');
       else mark(level > 0 ? 'look unpacked' : 'unpacked');
-      const size = answer.size !== undefined ? answer.size : answer.vxl.byteLength;
+      const size = answer.size;
       let pointer;
       try {
         pointer = allocate(size, name);
       } catch (error) {
-        discard(answer.vxl);
+        pieces.forEach(discard);
         return fail(error.message);
       }
-      const copied = await copyInSlices(new Uint8Array(answer.vxl, 0, size), pointer, target);
-      discard(answer.vxl);  // the copy in the WebAssembly memory is the one kept
-      if (!copied) return Module._free(pointer);
+      const copied = await copyPieces(pieces, size, pointer, target);
+      if (!copied) {
+        pieces.forEach(discard);
+        return Module._free(pointer);
+      }
       const camera = lookShown && viewMoved ? JSON.parse(api.camera()) : null;
       // What the reader chose in the panel while a look was shown stays chosen.
       const panel = lookShown ? ['mode', 'color', 'opacity'].map((key) => [key, $(key).value]) : [];
