@@ -214,6 +214,35 @@ TEST_F(Selection, RandomSpheresBoxesAndMasksMatchTheBruteForceReference) {
   EXPECT_GT(nonempty, cases / 3);
 }
 
+// The table of hits keeps a byte a streamline for each 8 regions: with any number of regions (one byte, several),
+// each region's count is what it selects alone, and the streamlines kept are the reference's.
+TEST_F(Selection, EachRegionCountsAsItSelectsAloneWhateverTheNumberOfRegions) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<std::uint64_t> point(0, source_->point_count() - 1);
+  std::uniform_real_distribution<float> radius(5, 30);
+  for (const char* file : {"f32.vxl", "packed_4mm.vxl"}) {
+    const VxlFile f = VxlFile::open(dir_->file(file));
+    for (const std::size_t regions : {1u, 2u, 3u, 5u, 9u, 17u, 33u, 64u}) {
+      SelectionCriteria c;
+      for (std::size_t r = 0; r < regions; ++r) {
+        const float* p = &source_->positions[3 * point(rng)];
+        (r % 2 == 0 ? c.include : c.exclude).push_back(sphere(p[0], p[1], p[2], radius(rng)));
+      }
+      const SelectionResult all = select_streamlines(f, c);
+      ASSERT_EQ(all.streamlines, brute_force(*source_, c)) << file << ", " << regions << " regions";
+      ASSERT_EQ(all.streamlines_per_region.size(), regions);
+      std::vector<Region> in_order = c.include;  // the counts' order: the includes, then the excludes
+      in_order.insert(in_order.end(), c.exclude.begin(), c.exclude.end());
+      for (std::size_t r = 0; r < regions; ++r) {
+        SelectionCriteria alone;
+        alone.include.push_back(in_order[r]);
+        EXPECT_EQ(all.streamlines_per_region[r], select_streamlines(f, alone).streamlines.size())
+            << file << ", region " << r << " of " << regions;
+      }
+    }
+  }
+}
+
 // A packed file's points are tested where they lie in its words, each region's window of quanta first; the scan of
 // the voxline table decodes every point it tests. Both must find the same points in every kind of region, the
 // spheres' surfaces included: spheres centred on points, radii ending on points.
