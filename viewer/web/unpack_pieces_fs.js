@@ -17,7 +17,7 @@ var UnpackPiecesFs = (() => {
       const k = Math.floor((position + done) / PIECE), at = (position + done) % PIECE;
       const n = Math.min(PIECE - at, bytes.length - done);
       if (intoFile) {
-        if (!node.pieces[k]) node.pieces[k] = new Uint8Array(PIECE);
+        if (!node.pieces[k]) node.pieces[k] = newPiece();
         node.pieces[k].set(bytes.subarray(done, done + n), at);
       } else if (node.pieces[k]) {
         bytes.set(node.pieces[k].subarray(at, at + n), done);
@@ -25,6 +25,14 @@ var UnpackPiecesFs = (() => {
         bytes.fill(0, done, done + n);
       }
       done += n;
+    }
+  }
+  // A piece of zeros; where the browser has no memory for it, the write fails with ENOMEM (and the unpack says so).
+  function newPiece() {
+    try {
+      return new Uint8Array(PIECE);
+    } catch (error) {
+      throw new FS.ErrnoError(ENOMEM);
     }
   }
   const asBytes = (buffer, offset, length) => new Uint8Array(buffer.buffer, buffer.byteOffset + offset, length);
@@ -103,7 +111,7 @@ var UnpackPiecesFs = (() => {
       const node = FS.lookupPath(path).node;
       const size = node.usedBytes;
       const pieces = [];
-      for (let k = 0; k * PIECE < size; ++k) pieces.push((node.pieces[k] || new Uint8Array(PIECE)).buffer);
+      for (let k = 0; k * PIECE < size; ++k) pieces.push((node.pieces[k] || newPiece()).buffer);
       node.pieces = [];
       FS.unlink(path);
       return { pieces, size };
