@@ -204,6 +204,14 @@ def main():
             marks = [name for name, _ in report['marks']]
             if source.endswith('.vxlz') and 'unpacked' not in marks and 'look unpacked' not in marks:
                 failures.append(f'{source}: not unpacked in a worker (marks: {report["marks"]})')
+            # The unpacker hands its .vxl over in pieces of 32 MiB, which the page copies end to end: the 50k set's
+            # (33.9 MB) in two, so that the picture compared below is drawn from bytes put together from pieces.
+            if source.endswith('.vxlz'):
+                pieces = (report.get('memory') or {}).get('unpacked_pieces')
+                expected = -(-os.path.getsize(path(source[:-1])) // (32 << 20))  # the .vxl it was packed from
+                if pieces != expected or (source == 's50k.vxlz' and expected < 2):
+                    failures.append(f'{source}: the unpacked .vxl came in {pieces} pieces of 32 MiB, not {expected}'
+                                    ' (the 50k set\'s must take two or more)')
             # Over a slow network the page asks for the finer levels as their bytes come, the whole still far off:
             # the 50k set's package looks at level 2 (its level 1 has more than 250,000 points), then level 1.
             looks = [look['level'] for look in report['looks']]

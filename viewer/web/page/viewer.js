@@ -101,9 +101,11 @@
     }
     window.voxweb.slowCalls = () => slowCalls.slice();
     window.voxweb.mode = () => JSON.parse(api.info()).mode;  // the mode frames are drawn in (for tests)
-    // The WebAssembly memory's size and malloc's use of it, and the most a package's unpacker had (for benchmarks).
-    let unpackerMemory = 0;
-    window.voxweb.memory = () => ({ wasm: Module.HEAPU8.length, unpacker: unpackerMemory, ...JSON.parse(api.memory()) });
+    // The WebAssembly memory's size and malloc's use of it, the most a package's unpacker had, and the pieces the
+    // whole package's .vxl came in (for benchmarks and tests).
+    let unpackerMemory = 0, unpackedPieces = 0;
+    window.voxweb.memory = () => ({ wasm: Module.HEAPU8.length, unpacker: unpackerMemory,
+      unpacked_pieces: unpackedPieces, ...JSON.parse(api.memory()) });
     // moving: a drag is under way (frames then come from the first picture's level of detail).
     let opened = false, dirty = false, firstFrame = true, fullDetail = false, moving = false;
     // The last frame shows the view at rest at full detail (a file fetched by ranges: possibly before its tables are in).
@@ -556,6 +558,7 @@
     async function openUnpackedNow(answer, name, target, t0, level = 0) {
       const pieces = answer.pieces || [];
       unpackerMemory = Math.max(unpackerMemory, answer.memory || 0);
+      if (level === 0) unpackedPieces = pieces.length;
       if (!current(target) || answer.stale) return pieces.forEach(discard);
       if (answer.error !== undefined) {
         // A package refused after a look: that picture came from bytes the refusal says are damaged.
