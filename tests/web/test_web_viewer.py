@@ -5,7 +5,7 @@ headless Chromium (WebGL2 on SwiftShader), against `voxview --render` of the sam
 over R, G, B (at least MIN_PSNR dB), not byte for byte. Cases: a synthetic set of 20,000 streamlines, packed
 and float32, in the axis and unsorted modes; a .vxlz shared as it is (fetched whole and unpacked by the page in a worker,
 with the converter's own code built for WebAssembly, its coarse levels looked at first), and the 50k set's over a slow
-network (the page asks for a finer level as its bytes come); with the real fixtures (when
+network (the page asks for a finer level as its bytes come; its .vxl comes back from the worker in two pieces); with the real fixtures (when
 --real-data holds them), MRtrix's test tracks coloured by their AFD values; the packed file sent gzip-compressed
 (the length the server declares is then not the body's); the packed file dropped on a page opened without one. The
 files are served by a server that answers Range
