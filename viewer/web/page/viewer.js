@@ -539,11 +539,13 @@
       });
       return unpackedOpening;
     }
-    // Copies an unpacked .vxl's pieces end to end into the WebAssembly memory at `pointer`, a piece a task (the 1M
-    // set's 745 MiB at once held the page for half a second), letting each go once copied (the tab holds the file
-    // once, not twice). False when another file was opened meanwhile.
+    // Copies an unpacked .vxl's `size` bytes, its pieces end to end, into the WebAssembly memory at `pointer`, a
+    // piece a task (the 1M set's 745 MiB at once held the page for half a second), letting each go once copied (the
+    // pieces and the copy together hold the file and a piece, not the file twice). False when another file was
+    // opened meanwhile; throws when the pieces hold fewer bytes.
     async function copyPieces(pieces, size, pointer, target) {
-      for (let k = 0, at = 0; k < pieces.length; ++k) {
+      let at = 0;
+      for (let k = 0; k < pieces.length && at < size; ++k) {
         if (k > 0) {
           await new Promise((resolve) => setTimeout(resolve, 0));
           if (!current(target)) return false;
@@ -553,12 +555,11 @@
         discard(pieces[k]);
         at += n;
       }
+      if (at < size) throw new Error(`${target.name}: the unpacker handed over ${at} of the ${size} bytes of its .vxl`);
       return true;
     }
     async function openUnpackedNow(answer, name, target, t0, level = 0) {
       const pieces = answer.pieces || [];
-      unpackerMemory = Math.max(unpackerMemory, answer.memory || 0);
-      if (level === 0) unpackedPieces = pieces.length;
       if (!current(target) || answer.stale) return pieces.forEach(discard);
       if (answer.error !== undefined) {
         // A package refused after a look: that picture came from bytes the refusal says are damaged.
@@ -567,6 +568,8 @@
       }
       if (level === 0 && lookShown) mark('whole unpacked');
       else mark(level > 0 ? 'look unpacked' : 'unpacked');
+      unpackerMemory = Math.max(unpackerMemory, answer.memory || 0);
+      if (level === 0) unpackedPieces = pieces.length;
       const size = answer.size;
       let pointer;
       try {
@@ -575,11 +578,14 @@
         pieces.forEach(discard);
         return fail(error.message);
       }
-      const copied = await copyPieces(pieces, size, pointer, target);
-      if (!copied) {
-        pieces.forEach(discard);
-        return Module._free(pointer);
+      let copied = false;
+      try {
+        copied = await copyPieces(pieces, size, pointer, target);
+      } finally {
+        pieces.forEach(discard);  // those not copied
+        if (!copied) Module._free(pointer);
       }
+      if (!copied) return;
       const camera = lookShown && viewMoved ? JSON.parse(api.camera()) : null;
       // What the reader chose in the panel while a look was shown stays chosen.
       const panel = lookShown ? ['mode', 'color', 'opacity'].map((key) => [key, $(key).value]) : [];
