@@ -14,7 +14,11 @@
 //
 // With --boxes-only, only the window's path (through the index and the boxes) is run: for a profiler.
 //
-// Usage: drag_bench FILE.vxl [--steps N] [--radius MM] [--from X,Y,Z [--by DX,DY,DZ]] [--boxes-only]
+// For a file with levels of detail, also the selection among one level's streamlines alone, through that level's own
+// voxlines (LevelVoxlines, made once, its time printed): what a window drawing its moving frames at that level needs
+// (--level L; by default the coarsest level), checked against the selection through the index at that level.
+//
+// Usage: drag_bench FILE.vxl [--steps N] [--radius MM] [--from X,Y,Z [--by DX,DY,DZ]] [--level L] [--boxes-only]
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -26,8 +30,10 @@
 
 #include "converter/selection/streamline_selection.h"
 #include "converter/selection/voxline_boxes.h"
+#include "format/level_voxlines.h"
 #include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
+#include "format/vxl_levels.h"
 #include "viewer/render/scene_groups.h"
 #include "viewer/render/vertex_attributes.h"
 
@@ -67,13 +73,14 @@ std::vector<std::array<double, 3>> sphere_centres(const vxl::MetaSection& m,
 }
 
 constexpr const char* kUsage =
-    "usage: drag_bench FILE.vxl [--steps N] [--radius MM] [--from X,Y,Z [--by DX,DY,DZ]] [--boxes-only]\n";
+    "usage: drag_bench FILE.vxl [--steps N] [--radius MM] [--from X,Y,Z [--by DX,DY,DZ]] [--level L] [--boxes-only]\n";
 
 struct Arguments {
   int steps = 40;
   double radius = 10;
   std::optional<std::array<double, 3>> from;
   std::array<double, 3> by = {2, 0, 0};
+  std::optional<std::uint32_t> level;  // default: the file's coarsest
   bool boxes_only = false;
 };
 
@@ -95,6 +102,8 @@ std::optional<Arguments> parse_arguments(int argc, char** argv) {
       a.from = triple(argv[++i]);
     else if (option == "--by" && i + 1 < argc)
       a.by = triple(argv[++i]);
+    else if (option == "--level" && i + 1 < argc)
+      a.level = static_cast<std::uint32_t>(std::stoul(argv[++i]));
     else if (option == "--boxes-only")
       a.boxes_only = true;
     else {
@@ -120,7 +129,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (!parsed) return 2;
-  const auto [steps, radius, from, by, boxes_only] = *parsed;
+  const auto [steps, radius, from, by, level_asked, boxes_only] = *parsed;
   try {
     const vxl::VxlFile file = vxl::VxlFile::open(argv[1]);
     const vxl::MetaSection& m = file.meta();
@@ -149,8 +158,19 @@ int main(int argc, char** argv) {
     }
     if (!boxes_only) std::printf("per-vertex attributes of every voxel, once (one thread): %.0f ms\n", ms_since(t0));
 
+    // One level's own voxlines, for the selection among its streamlines alone.
+    const std::uint32_t levels = file.level_count();
+    const std::uint32_t level = level_asked.value_or(levels - 1);
+    std::optional<vxl::LevelVoxlines> level_voxlines;
+    if (!boxes_only && level > 0) {
+      vxl::check_level(argv[1], level, levels);
+      t0 = Clock::now();
+      level_voxlines.emplace(file, level);
+      std::printf("level %u's own voxlines, made once (one thread): %.0f ms\n", level, ms_since(t0));
+    }
+
     const std::vector<std::array<double, 3>> centres = sphere_centres(m, from, by, steps);
-    std::vector<double> scan_ms, indexed_ms, boxed_ms, groups_ms;
+    std::vector<double> scan_ms, indexed_ms, boxed_ms, level_ms, groups_ms;
     vxl::VoxlineBoxes boxes(file);  // the window's selection worker keeps one per file
     std::uint64_t selected_total = 0;
     const std::vector<const vxl::VxlFile*> files = {&file};
@@ -183,6 +203,21 @@ int main(int argc, char** argv) {
                      centre[2]);
         return 1;
       }
+      if (level_voxlines) {
+        vxl::SelectionCriteria at_level = c;
+        at_level.level = level;
+        t0 = Clock::now();
+        const vxl::SelectionResult own =
+            vxl::select_streamlines(file, at_level, &*index, vxl::SelectionPath::Fastest, nullptr, &*level_voxlines);
+        level_ms.push_back(ms_since(t0));
+        std::vector<std::uint64_t> expected = boxed.streamlines;
+        std::erase_if(expected, [&](std::uint64_t st) { return vxl::streamline_depth(st, levels) < level; });
+        if (own.streamlines != expected) {
+          std::fprintf(stderr, "drag_bench: level %u's voxlines and the index disagree at (%g, %g, %g)\n", level,
+                       centre[0], centre[1], centre[2]);
+          return 1;
+        }
+      }
       selected_total += boxed.streamlines.size();
       // What the window does with a new selection: the groups, then one byte per streamline.
       t0 = Clock::now();
@@ -202,6 +237,9 @@ int main(int argc, char** argv) {
     row("select, scanning the voxline table", scan_ms);
     row("select, through the per-voxel index", indexed_ms);
     row("select, through the index and the voxline boxes kept from the last position", boxed_ms);
+    const std::string at_level =
+        "select among level " + std::to_string(level) + "'s streamlines, through its own voxlines";
+    row(at_level.c_str(), level_ms);
     row("focus/context groups and the byte per streamline (before upload)", groups_ms);
     // The first position alone: the window's first selection, with nothing boxed yet (it reads its voxels without
     // boxes).

@@ -7,7 +7,7 @@
 
 namespace vxl {
 
-LevelVoxlines::LevelVoxlines(const VxlFile& file, std::uint32_t level) {
+LevelVoxlines::LevelVoxlines(const VxlFile& file, std::uint32_t level) : level_(level) {
   file.check_streamline_table();
   const auto strm = file.streamline_first_voxline();
   const auto voxlines = file.voxlines();

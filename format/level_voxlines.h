@@ -23,8 +23,10 @@ class LevelVoxlines {
   std::span<const PlacedVoxline> of_voxel(std::size_t voxel) const {
     return {placed_.data() + first_[voxel], placed_.data() + first_[voxel + 1]};
   }
+  std::uint32_t level() const { return level_; }
 
  private:
+  std::uint32_t level_ = 0;
   std::vector<std::uint64_t> first_;  // voxel_count + 1: where each voxel's voxlines start in placed_
   std::vector<PlacedVoxline> placed_;
 };

@@ -35,6 +35,7 @@
 #include "converter/selection/voxline_boxes.h"
 #include "converter/synth/synth.h"
 #include "format/base/error.h"
+#include "format/level_voxlines.h"
 #include "format/vxl_verify.h"
 #include "tests/address_sanitizer.h"
 #include "tests/hostile_inputs.h"
@@ -426,6 +427,59 @@ TEST_F(Selection, ALevelKeepsTheStreamlinesOfThatDepthAmongThoseTheCriteriaKeep)
   const Error error = test::hostile::error_of([&] { select_streamlines(file, beyond); });
   EXPECT_EQ(error.kind(), ErrorKind::Usage);
   EXPECT_NE(std::string(error.what()).find("has 5 levels of detail: 0 to 4"), std::string::npos) << error.what();
+}
+
+// With a level's own voxlines (LevelVoxlines, as a viewer drawing that level holds them), only they are searched:
+// the same streamlines as through the whole index, each region's count that of the level's streamlines alone, and
+// far fewer points tested. Voxlines of another level are refused.
+TEST_F(Selection, ALevelsOwnVoxlinesSelectWhatTheWholeIndexSelectsAtThatLevel) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<std::uint64_t> point(0, source_->point_count() - 1);
+  std::uniform_real_distribution<float> radius(5, 40);
+  auto near_a_point = [&] {
+    const float* p = &source_->positions[3 * point(rng)];
+    return sphere(p[0], p[1], p[2], radius(rng));
+  };
+  for (const char* file : {"f32.vxl", "packed_4mm.vxl"}) {
+    const VxlFile f = VxlFile::open(dir_->file(file));
+    const std::uint32_t levels = f.level_count();
+    ASSERT_EQ(levels, kDefaultLevels);
+    std::uint64_t tested_whole = 0, tested_level = 0;
+    for (std::uint32_t level = 1; level < levels; ++level) {
+      const LevelVoxlines lists(f, level);
+      for (int trial = 0; trial < 12; ++trial) {
+        SelectionCriteria c;
+        c.include.push_back(near_a_point());
+        if (trial % 3 == 1) c.exclude.push_back(near_a_point());
+        if (trial % 4 == 2) c.ends_in.push_back(near_a_point());
+        if (trial % 5 == 3) c.min_length = 50;
+        c.invert = trial % 6 == 4;
+        c.level = level;
+        const SelectionResult whole = select_streamlines(f, c),
+                              own = select_streamlines(f, c, nullptr, SelectionPath::Fastest, nullptr, &lists);
+        ASSERT_EQ(own.streamlines, whole.streamlines) << file << " level " << level << " trial " << trial;
+        std::vector<Region> in_order = c.include;  // the counts' order: includes, ends-in, excludes
+        in_order.insert(in_order.end(), c.ends_in.begin(), c.ends_in.end());
+        in_order.insert(in_order.end(), c.exclude.begin(), c.exclude.end());
+        ASSERT_EQ(own.streamlines_per_region.size(), in_order.size());
+        for (std::size_t r = 0; r < in_order.size(); ++r) {
+          SelectionCriteria alone;
+          (r >= c.include.size() && r < c.include.size() + c.ends_in.size() ? alone.ends_in : alone.include)
+              .push_back(in_order[r]);
+          alone.level = level;
+          EXPECT_EQ(own.streamlines_per_region[r], select_streamlines(f, alone).streamlines.size())
+              << file << " level " << level << " trial " << trial << " region " << r;
+        }
+        tested_whole += whole.points_tested, tested_level += own.points_tested;
+      }
+    }
+    EXPECT_LT(tested_level * 4, tested_whole) << file << ": the level's voxlines alone are tested";
+    SelectionCriteria other;
+    other.include.push_back(sphere(0, 0, 0, 20));
+    other.level = 1;
+    const LevelVoxlines level_two(f, 2);
+    EXPECT_THROW(select_streamlines(f, other, nullptr, SelectionPath::Fastest, nullptr, &level_two), std::logic_error);
+  }
 }
 
 // A streamline without points is never selected, as tckedit never writes one: not by an exclude, an inverted

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <memory>
 #include <new>
+#include <stdexcept>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -18,6 +19,7 @@
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
 #include "format/base/parallel.h"
+#include "format/level_voxlines.h"
 #include "format/streamline_length.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
@@ -541,12 +543,10 @@ void boxed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacker
   if (follow) reference = {dragged.sphere->centre(), true};
 }
 
-// A voxel's voxlines placed in its block and tested: a packed block's points where they lie, a float32 block's
+// A voxel's voxlines placed in its block (`placed`) tested: a packed block's points where they lie, a float32 block's
 // read out.
-void placed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacker* packer, const VoxelVoxlines& index,
-                       VoxelScratch& scratch, RegionHits& hits) {
-  place_voxel_voxlines(search.file, index, voxel, scratch.ends, scratch.placed);
-  const std::vector<PlacedVoxline>& placed = scratch.placed;
+void placed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacker* packer,
+                       std::span<const PlacedVoxline> placed, VoxelScratch& scratch, RegionHits& hits) {
   for (std::size_t k = 0; k < placed.size(); ++k) {
     if (k + kHitsAhead < placed.size()) hits.prefetch(placed[k + kHitsAhead].streamline);
     const PlacedVoxline& p = placed[k];
@@ -558,10 +558,11 @@ void placed_voxel_hits(HitSearch& search, std::uint32_t voxel, const VertexPacke
 }
 
 // Only the voxels the regions may touch, through their lists (VoxelVoxlines): a voxel's list, placed in its
-// block (place_voxel_voxlines, or kept boxed by `boxes` between selections), is all a voxline costs. Voxels are
-// independent here, so they are searched side by side (the first error in voxel order reported).
-void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, std::uint64_t& bytes_read,
-                   VoxlineBoxes* boxes) {
+// block (place_voxel_voxlines, or kept boxed by `boxes` between selections), is all a voxline costs; with `level`,
+// only that level's voxlines, placed already. Voxels are independent here, so they are searched side by side (the
+// first error in voxel order reported).
+void hits_by_index(HitSearch& q, const VoxelVoxlines* index, RegionHits& hits, std::uint64_t& bytes_read,
+                   VoxlineBoxes* boxes, const LevelVoxlines* level) {
   std::vector<std::uint32_t> touched;
   for (std::size_t voxel = 0; voxel < q.voxels.size(); ++voxel)
     if (q.voxel_regions.touching[voxel] != 0) touched.push_back(std::uint32_t(voxel));
@@ -571,6 +572,7 @@ void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, s
   for (std::size_t r = 0; r < q.table.regions.size() && sphere < 0; ++r)
     if (q.table.regions[r]->shape() == Region::Shape::Sphere && ((q.table.include | q.table.exclude) >> r & 1))
       sphere = int(r);
+  if (level) boxes = nullptr;  // a level's few voxlines are placed already
   if (boxes) {
     boxes->track_region(sphere);
     boxes->selection_started();
@@ -586,30 +588,37 @@ void hits_by_index(HitSearch& q, const VoxelVoxlines& index, RegionHits& hits, s
       read_since_release = 0;
       q.file.release_resident_pages();
     }
-    if (!packed) return placed_voxel_hits(per_thread[t], voxel, nullptr, index, scratch[t], hits);
+    // The voxel's voxlines placed in its block: the level's, or its list's (place_voxel_voxlines).
+    const auto placed = [&]() -> std::span<const PlacedVoxline> {
+      if (level) return level->of_voxel(voxel);
+      place_voxel_voxlines(q.file, *index, voxel, scratch[t].ends, scratch[t].placed);
+      return scratch[t].placed;
+    };
+    if (!packed) return placed_voxel_hits(per_thread[t], voxel, nullptr, placed(), scratch[t], hits);
     const VertexPacker packer(q.voxels[voxel]);
     for (Bits b = q.voxel_regions.touching[voxel]; b != 0; b &= b - 1) {
       const int r = std::countr_zero(b);
       scratch[t].windows[std::size_t(r)] = quantum_window(packer, q.table.reach[std::size_t(r)]);
     }
     if (boxes)
-      if (const std::optional<std::span<BoxedVoxline>> list = boxes->voxel(voxel, index))
+      if (const std::optional<std::span<BoxedVoxline>> list = boxes->voxel(voxel, *index))
         return boxed_voxel_hits(per_thread[t], voxel, packer, *boxes, *list, dragged, scratch[t], hits);
-    placed_voxel_hits(per_thread[t], voxel, &packer, index, scratch[t], hits);
+    placed_voxel_hits(per_thread[t], voxel, &packer, placed(), scratch[t], hits);
   });
-  for (std::size_t k = 0; k < touched.size(); ++k) {
+  for (std::size_t k = 0; k < touched.size() && !level; ++k) {
     // The list, and the block's voxline ends: its packed words (float32: order 0), read whole.
     const VoxelEntry& v = q.voxels[touched[k]];
     bytes_read +=
-        index.of_voxel(touched[k]).size_bytes() +
+        index->of_voxel(touched[k]).size_bytes() +
         (packed ? 4ull * v.vertex_count : order_array_bytes(v.segment_count, q.file.order(touched[k], 0).bits));
   }
   for (const HitSearch& search : per_thread) q.points_tested += search.points_tested;
 }
 
-// Everything select_streamlines decides but the level.
+// Everything select_streamlines decides but the level; with `level`, among that level's voxlines alone.
 SelectionResult select_by_regions_and_lengths(const VxlFile& file, const SelectionCriteria& criteria,
-                                              const VoxelVoxlines* index, SelectionPath path, VoxlineBoxes* boxes) {
+                                              const VoxelVoxlines* index, SelectionPath path, VoxlineBoxes* boxes,
+                                              const LevelVoxlines* level) {
   const RegionTable table(criteria);
   SelectionResult result;
   const std::uint64_t n = file.meta().streamline_count;
@@ -631,9 +640,9 @@ SelectionResult select_by_regions_and_lengths(const VxlFile& file, const Selecti
   }
   trust(index && !file.voxel_index_first().empty() ? "VXIX" : "VXLN");
   RegionHits hits(n, table.regions.size());
-  if (index) {
-    if (file.position_encoding() != PositionEncoding::Packed) boxes = nullptr;
-    hits_by_index(search, *index, hits, result.bytes_read, boxes);
+  if (index || level) {
+    if (file.position_encoding() != PositionEncoding::Packed || level) boxes = nullptr;
+    hits_by_index(search, index, hits, result.bytes_read, boxes, level);
     if (boxes) boxes->selection_done();
   } else
     hits_by_scan(search, hits, result.bytes_read);
@@ -727,11 +736,14 @@ void check_level(const std::string& path, std::uint32_t level, std::uint32_t lev
 }
 
 SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria, const VoxelVoxlines* index,
-                                   SelectionPath path, VoxlineBoxes* boxes) {
+                                   SelectionPath path, VoxlineBoxes* boxes, const LevelVoxlines* level_voxlines) {
   if (criteria.min_length && criteria.max_length && *criteria.min_length > *criteria.max_length)
     throw Error(ErrorKind::Usage, "--min-length", std::nullopt, "the minimum length is above the maximum length");
   if (criteria.level) check_level(file.path(), *criteria.level, file.level_count());
-  SelectionResult result = select_by_regions_and_lengths(file, criteria, index, path, boxes);
+  if (level_voxlines && (!criteria.level || level_voxlines->level() != *criteria.level))
+    throw std::logic_error("select_streamlines: the level's voxlines are not those of the criteria's level");
+  SelectionResult result = select_by_regions_and_lengths(file, criteria, index, path, boxes,
+                                                         path == SelectionPath::Fastest ? level_voxlines : nullptr);
   if (criteria.level) {
     const std::uint32_t levels = file.level_count();
     std::erase_if(result.streamlines, [&](std::uint64_t s) { return streamline_depth(s, levels) < *criteria.level; });

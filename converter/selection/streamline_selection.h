@@ -37,6 +37,7 @@
 
 namespace vxl {
 
+class LevelVoxlines;
 class VoxlineBoxes;
 
 struct SelectionCriteria {
@@ -73,10 +74,12 @@ enum class SelectionPath { Fastest, ScanTable };
 // must be VoxelVoxlines::of_file(file)'s: the result is the same with or without it (without it, the file's VXIX is
 // used when it has one), and by either path. `boxes` (the file's, kept by a caller that selects again and again, as
 // the window does while a region moves) lets a packed file's later selections pass over the voxlines they can
-// decide from their boxes; the result is the same without it.
+// decide from their boxes; the result is the same without it. `level_voxlines` (LevelVoxlines of criteria.level,
+// which must be set) searches that level's voxlines alone, about 1/8^level of them: the same streamlines, and
+// streamlines_per_region then counts that level's streamlines only (a viewer drawing that level needs no more).
 SelectionResult select_streamlines(const VxlFile& file, const SelectionCriteria& criteria,
                                    const VoxelVoxlines* index = nullptr, SelectionPath path = SelectionPath::Fastest,
-                                   VoxlineBoxes* boxes = nullptr);
+                                   VoxlineBoxes* boxes = nullptr, const LevelVoxlines* level_voxlines = nullptr);
 
 // Asks the system to read ahead the tables a selection reads whole (VOXT, STRM, the voxel index VXIX or else the
 // voxline table, SLEN): a window's first selection of a file not in the page cache then waits for those reads
