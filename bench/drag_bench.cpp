@@ -114,6 +114,44 @@ std::optional<Arguments> parse_arguments(int argc, char** argv) {
   return a;
 }
 
+// The file's voxel index (its VXIX, or built), its figures printed; nullopt when the file has too many voxlines.
+std::optional<vxl::VoxelVoxlines> open_index(const vxl::VxlFile& file) {
+  const vxl::MetaSection& m = file.meta();
+  const auto t0 = Clock::now();
+  std::optional<vxl::VoxelVoxlines> index = vxl::VoxelVoxlines::of_file(file);
+  const double build_ms = ms_since(t0);
+  if (!index) return index;
+  std::printf("file %s: %llu streamlines, %llu voxlines, %zu voxels\n", file.path().c_str(),
+              static_cast<unsigned long long>(m.streamline_count),
+              static_cast<unsigned long long>(file.voxlines().size()), file.voxels().size());
+  if (index->from_file())
+    std::printf("index: the file's VXIX, mapped in %.3f ms (nothing built)\n", build_ms);
+  else
+    std::printf("index build (a file without VXIX): %.0f ms, %.1f MB (4 bytes a voxline, 8 a voxel)\n", build_ms,
+                index->bytes() / 1e6);
+  return index;
+}
+
+// The per-vertex words of every voxel at full detail, timed: what uploading the whole scene makes once.
+void time_attributes(const vxl::VxlFile& file, const vxl::VoxelVoxlines& index) {
+  const auto t0 = Clock::now();
+  std::vector<std::uint32_t> words;
+  for (std::size_t v = 0; v < file.voxels().size(); ++v) {
+    words.resize(2 * std::size_t(file.voxels()[v].vertex_count));
+    vxl::voxel_attributes(file, v, {{}, 0, &index}, file.voxels()[v].vertex_count, words.data());
+  }
+  std::printf("per-vertex attributes of every voxel, once (one thread): %.0f ms\n", ms_since(t0));
+}
+
+// One level's own voxlines, for the selection among its streamlines alone, timed.
+vxl::LevelVoxlines make_level_voxlines(const vxl::VxlFile& file, std::uint32_t level) {
+  vxl::check_level(file.path(), level, file.level_count());
+  const auto t0 = Clock::now();
+  vxl::LevelVoxlines lists(file, level);
+  std::printf("level %u's own voxlines, made once (one thread): %.0f ms\n", level, ms_since(t0));
+  return lists;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -133,42 +171,18 @@ int main(int argc, char** argv) {
   try {
     const vxl::VxlFile file = vxl::VxlFile::open(argv[1]);
     const vxl::MetaSection& m = file.meta();
-    auto t0 = Clock::now();
-    const std::optional<vxl::VoxelVoxlines> index = vxl::VoxelVoxlines::of_file(file);
-    const double build_ms = ms_since(t0);
+    const std::optional<vxl::VoxelVoxlines> index = open_index(file);
     if (!index) {
       std::fprintf(stderr, "drag_bench: %s has too many voxlines for the index\n", argv[1]);
       return 1;
     }
-    std::printf("file %s: %llu streamlines, %llu voxlines, %zu voxels\n", argv[1],
-                static_cast<unsigned long long>(m.streamline_count),
-                static_cast<unsigned long long>(file.voxlines().size()), file.voxels().size());
-    if (index->from_file())
-      std::printf("index: the file's VXIX, mapped in %.3f ms (nothing built)\n", build_ms);
-    else
-      std::printf("index build (a file without VXIX): %.0f ms, %.1f MB (4 bytes a voxline, 8 a voxel)\n", build_ms,
-                  index->bytes() / 1e6);
-
-    // The per-vertex words of every voxel at full detail: what uploading the whole scene makes once.
-    t0 = Clock::now();
-    std::vector<std::uint32_t> words;
-    for (std::size_t v = 0; v < (boxes_only ? 0 : file.voxels().size()); ++v) {
-      words.resize(2 * std::size_t(file.voxels()[v].vertex_count));
-      vxl::voxel_attributes(file, v, {{}, 0, &*index}, file.voxels()[v].vertex_count, words.data());
-    }
-    if (!boxes_only) std::printf("per-vertex attributes of every voxel, once (one thread): %.0f ms\n", ms_since(t0));
-
-    // One level's own voxlines, for the selection among its streamlines alone.
+    if (!boxes_only) time_attributes(file, *index);
     const std::uint32_t levels = file.level_count();
     const std::uint32_t level = level_asked.value_or(levels - 1);
     std::optional<vxl::LevelVoxlines> level_voxlines;
-    if (!boxes_only && level > 0) {
-      vxl::check_level(argv[1], level, levels);
-      t0 = Clock::now();
-      level_voxlines.emplace(file, level);
-      std::printf("level %u's own voxlines, made once (one thread): %.0f ms\n", level, ms_since(t0));
-    }
+    if (!boxes_only && level > 0) level_voxlines = make_level_voxlines(file, level);
 
+    auto t0 = Clock::now();
     const std::vector<std::array<double, 3>> centres = sphere_centres(m, from, by, steps);
     std::vector<double> scan_ms, indexed_ms, boxed_ms, level_ms, groups_ms;
     vxl::VoxlineBoxes boxes(file);  // the window's selection worker keeps one per file
