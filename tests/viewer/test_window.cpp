@@ -385,6 +385,20 @@ TEST_F(Window, AScriptedDragUnderABudgetEndsWithTheFocusCopyOfItsLastPosition) {
     }
     refined |= f.value("work", std::string("whole")) != "whole";
   }
+  // While the sphere moves, a selection searches only the streamlines of the level the moving frames draw (their
+  // pictures need no more); the one the drag's end waits for searches every streamline, and its focus is what
+  // the last picture, compared below, shows.
+  const auto& searched = j.at("selection_level");
+  ASSERT_EQ(searched.size(), j.at("selections").get<std::size_t>());
+  EXPECT_EQ(searched.back().get<int>(), 0) << j.dump();
+  int moving_level = 0, level_searched = 0;
+  for (const nlohmann::json& f : j.at("frames"))
+    if (f.at("moving").get<bool>()) moving_level = std::max(moving_level, f.at("level").get<int>());
+  for (const auto& level : searched) level_searched = std::max(level_searched, level.get<int>());
+  ASSERT_GT(moving_level, 0) << "the moving frames draw a coarser level: " << j.dump();
+  EXPECT_GT(level_searched, 0) << j.dump();
+  EXPECT_LE(level_searched, moving_level) << j.dump();
+  EXPECT_EQ(j.at("full_selections").get<int>(), std::count(searched.begin(), searched.end(), 0));
   CommandResult r = run_voxview_in_xvfb(shell_quoted(vxl) + args + " --include=" + scene.sphere_at(10) +
                                         " --frames 3 --screenshot " + shell_quoted(still));
   ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -58,7 +58,7 @@ FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint3
 
 void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
                        double frame_budget_ms, const StartupTimes& startup, const std::vector<double>& selection_ms,
-                       const std::optional<DragEndWait>& drag_end) {
+                       const std::vector<std::uint32_t>& selection_levels, const std::optional<DragEndWait>& drag_end) {
   const FrameSummary s = summarize_frames(frames, scene_level);
   nlohmann::json j;
   j["scene_level"] = scene_level;
@@ -89,6 +89,18 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
     const auto [later_median, later_p95] = median_and_p95({selection_ms.begin() + 1, selection_ms.end()});
     j["later_selection_median_ms"] = later_median;
     j["later_selection_p95_ms"] = later_p95;
+  }
+  // The level each searched (0: every streamline; a drag's searched the moving frames' level alone), and the figures
+  // of those that searched every streamline.
+  if (!selection_levels.empty()) {
+    j["selection_level"] = selection_levels;
+    std::vector<double> every;
+    for (std::size_t k = 0; k < selection_ms.size() && k < selection_levels.size(); ++k)
+      if (selection_levels[k] == 0) every.push_back(selection_ms[k]);
+    const auto [every_median, every_p95] = median_and_p95(every);
+    j["full_selections"] = every.size();
+    j["full_selection_median_ms"] = every_median;
+    j["full_selection_p95_ms"] = every_p95;
   }
   if (drag_end)
     j["drag_end_wait"] = {{"waited", drag_end->waited}, {"ms", drag_end->ms}, {"timed_out", drag_end->timed_out}};

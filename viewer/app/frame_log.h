@@ -65,6 +65,7 @@ FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint3
 void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
                        double frame_budget_ms, const StartupTimes& startup = {},
                        const std::vector<double>& selection_ms = {},
+                       const std::vector<std::uint32_t>& selection_levels = {},
                        const std::optional<DragEndWait>& drag_end = std::nullopt);
 
 }  // namespace vxl::app

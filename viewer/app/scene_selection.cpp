@@ -3,13 +3,16 @@
 namespace vxl::app {
 
 SceneSelection select_in_scene(std::span<const VxlFile* const> files, const SelectionCriteria& criteria,
-                               VoxelVoxlinesCache* indexes, std::span<const std::unique_ptr<VoxlineBoxes>> boxes) {
+                               VoxelVoxlinesCache* indexes, std::span<const std::unique_ptr<VoxlineBoxes>> boxes,
+                               std::span<const LevelVoxlines* const> level_voxlines) {
   SceneSelection out;
+  out.level = level_voxlines.empty() ? 0 : criteria.level.value_or(0);
   for (std::size_t i = 0; i < files.size(); ++i) {
     const VxlFile* f = files[i];
     const VoxelVoxlines* index = indexes ? indexes->of(i) : nullptr;
     SelectionResult r =
-        select_streamlines(*f, criteria, index, SelectionPath::Fastest, boxes.empty() ? nullptr : boxes[i].get());
+        select_streamlines(*f, criteria, index, SelectionPath::Fastest, boxes.empty() ? nullptr : boxes[i].get(),
+                           level_voxlines.empty() ? nullptr : level_voxlines[i]);
     out.streamlines_per_region.resize(r.streamlines_per_region.size(), 0);
     for (std::size_t i = 0; i < r.streamlines_per_region.size(); ++i)
       out.streamlines_per_region[i] += r.streamlines_per_region[i];

@@ -68,9 +68,16 @@ class ViewerWindow {
   void toggle_slices();
   void toggle_clip_plane(std::size_t i);
   void move_focus_along(int axis, double mm);
-  // Asks for a new selection when the regions changed and takes the newest finished one into the picture
-  // (selection_worker.h); with `wait`, the one the regions ask for now.
-  void update_selection(bool wait);
+  // Asks for a new selection when the regions changed, or the level it should search did, and takes the newest
+  // finished one into the picture (selection_worker.h); with `wait`, the one the regions ask for now. While a
+  // region is `dragging`, the selection searches only the streamlines of the level the moving frames draw
+  // (selection_level): their pictures need no more; once it stops, every streamline.
+  void update_selection(bool wait, bool dragging);
+  // The level a selection searches: while a region is dragged, the moving frames' (where every file has it); else 0.
+  std::uint32_t selection_level(bool dragging) const;
+  // The selection shown searched one level's streamlines alone: a picture may not be drawn finer, nothing is
+  // refined, and a selection of every streamline is still to come (or on its way).
+  bool level_selection_shown() const { return selection_ && selection_->level > 0; }
   void read_ahead_selection_tables_once();
   // Hands the focus and context to every renderer (without a selection: the files' own groups again), and
   // asks for the selection's focus copy (focus first, focus_copy_worker.h).
@@ -84,7 +91,8 @@ class ViewerWindow {
   // Whether a selection or a focus copy is being made or waits to be taken into the picture: an idle window then
   // looks for it every kWorkPollSeconds instead of sleeping until the next input (FramePacing::next_wait).
   bool work_in_flight() const {
-    return selection_revision_ != regions_.revision() || selection_worker_.busy() || focus_copies_.busy();
+    return selection_revision_ != regions_.revision() || selection_worker_.busy() || focus_copies_.busy() ||
+           level_selection_shown();
   }
   static constexpr double kWorkPollSeconds = 0.02;
   // Whether a picture at `level` draws the focus from its full-detail copy (focus first).
@@ -140,15 +148,18 @@ class ViewerWindow {
   RegionEditor regions_;
   std::optional<SceneSelection> selection_;          // the newest finished; the regions may have moved since
   std::optional<std::uint64_t> selection_revision_;  // the regions' revision last asked for
-  std::optional<std::uint64_t> cleared_revision_;    // all regions removed at this revision: older selections are stale
-  std::uint64_t selection_generation_ = 0;           // counts the selections taken into the picture
-  std::uint64_t framed_generation_ = 0;              // the selection generation of the last frame drawn whole
+  std::uint32_t selection_level_asked_ = 0;          // the level it searched (0: every streamline)
+  std::uint32_t moving_level_ = 0;                 // the level of the last moving frame asked for (first: the first's)
+  std::optional<std::uint64_t> cleared_revision_;  // all regions removed at this revision: older selections are stale
+  std::uint64_t selection_generation_ = 0;         // counts the selections taken into the picture
+  std::uint64_t framed_generation_ = 0;            // the selection generation of the last frame drawn whole
   SelectionWorker selection_worker_;
   // Focus first: copies of the selection for pictures coarser than full detail (none with --level, or
   // when the files hold no coarser level).
   bool focus_first_wanted_ = false;
   FocusCopyWorker focus_copies_;
-  std::vector<double> selection_ms_;  // each selection's run time, for --stats
+  std::vector<double> selection_ms_;             // each selection's run time, for --stats
+  std::vector<std::uint32_t> selection_levels_;  // and the level it searched (0: every streamline)
   // A scripted drag's end waits at most this long for its selection and focus copy (a large selection's copy
   // takes seconds on two cores).
   static constexpr std::chrono::seconds kDragEndWaitLimit{60};

@@ -68,9 +68,10 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
   stats_.detail = describe_scene_detail(detail_, session_->levels_in_files());
   if (!stats_.detail.empty()) std::fprintf(stderr, "voxview: %s\n", stats_.detail.c_str());
   first_level_ = first_picture_level(level_segments(files_), detail_.level);
+  moving_level_ = first_level_;
   // The command line's selection runs on the worker: the first picture does not wait for it (the panel says it is
   // coming), the focus appears when it is ready. Scripted frames without a drag still wait for it, frame by frame.
-  update_selection(false);
+  update_selection(false, o.drag_region_mm && regions_.active());
   // Scene-wide facts (bounds, groups, value sets, voxel cubes) are the same at every level.
   Renderer& first = renderer_at(first_level_, true);
   // The tables the selection reads, asked of the disk once the first level's bytes are in (they go first).
@@ -444,7 +445,7 @@ int ViewerWindow::run() {
     if (dragging) regions_.move_active_by(*options_.drag_region_mm);
     // A script's window (--frames) waits for each selection, so that what it draws does not depend on timing;
     // a scripted drag does not, as a user's drag does not (its end waits above, frame by frame).
-    update_selection(automated && !options_.drag_region_mm);
+    update_selection(automated && !options_.drag_region_mm, dragging || dragging_region_);
     update_focus_copy(automated && !options_.drag_region_mm);
     state_.settings.regions = state_.show_regions ? regions_.shapes() : std::vector<RegionShape>{};
     const PictureKey key{camera, state_.settings, fb_w, fb_h, state_.grid, state_.grid_all, selection_generation_};
@@ -453,13 +454,16 @@ int ViewerWindow::run() {
     const bool scripted_last = closing && frames_done && !options_.until_refined;
     // The picture (and so what the panel should say) changed after the panel was built.
     scheduler_->set_load({session_->has_focus() && focus_copy_fits_budget(), work_in_flight()});
-    const bool drawn_now = draw_picture(
-        scheduler_->next(changed, scripted_last, closing,
-                         [&] {
-                           const double aspect = double(fb_w) / fb_h;
-                           return session_->picture_levels(&camera, aspect, state_.settings.clipping).context_level();
-                         }),
-        key, moving);
+    PictureTask task = scheduler_->next(changed, scripted_last, closing, [&] {
+      const double aspect = double(fb_w) / fb_h;
+      return session_->picture_levels(&camera, aspect, state_.settings.clipping).context_level();
+    });
+    if (task.work == PictureWork::Whole) {
+      if (moving) moving_level_ = task.level;  // the next drag's selections search this level's streamlines
+      // A selection of one level's streamlines holds that level's and the coarser ones', not a finer level's.
+      if (selection_) task.level = std::max(task.level, selection_->level);
+    }
+    const bool drawn_now = draw_picture(task, key, moving);
     pacing.frame_ended(scheduler_->rest().stage() != RestStage::Done, drawn_now);
     idle_at_drag_end = frames_done && !settled && !drawn_now;
     present(fb_w, fb_h);
@@ -485,7 +489,7 @@ int ViewerWindow::run() {
   session_->check_uploaded(true);
   if (options_.stats_json)
     write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms, startup_, selection_ms_,
-                      drag_end_);
+                      selection_levels_, drag_end_);
   return 0;
 }
 

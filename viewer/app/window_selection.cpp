@@ -12,7 +12,14 @@
 
 namespace vxl::app {
 
-void ViewerWindow::update_selection(bool wait) {
+std::uint32_t ViewerWindow::selection_level(bool dragging) const {
+  if (!dragging) return 0;
+  for (const VxlFile* f : files_)
+    if (f->level_count() <= moving_level_) return 0;
+  return moving_level_;
+}
+
+void ViewerWindow::update_selection(bool wait, bool dragging) {
   // The panel's list, every frame: which region is active changes without a new selection.
   stats_.regions.clear();
   for (std::size_t i = 0; i < regions_.regions().size(); ++i) {
@@ -20,15 +27,19 @@ void ViewerWindow::update_selection(bool wait) {
     stats_.regions.push_back(
         {r.role_name(), r.argument(), r.streamlines, r.centre.has_value(), regions_.active() == i, r.radius});
   }
-  if (selection_revision_ != regions_.revision()) {
+  const std::uint32_t level = selection_level(dragging);
+  if (selection_revision_ != regions_.revision() || level != selection_level_asked_) {
     selection_revision_ = regions_.revision();
+    selection_level_asked_ = level;
     if (regions_.empty()) {
       cleared_revision_ = regions_.revision();
       if (selection_) apply_selection(std::nullopt);
     } else {
       try {
         if (drawn_) read_ahead_selection_tables_once();  // at opening, once the first level is read (the constructor)
-        selection_worker_.request(regions_.revision(), regions_.criteria());
+        SelectionCriteria criteria = regions_.criteria();
+        if (level > 0) criteria.level = level;
+        selection_worker_.request(regions_.revision(), std::move(criteria));
         if (!selection_) stats_.selection = "selecting the regions' streamlines ...";
       } catch (const std::exception& e) {  // a region that does not parse: said, and no selection
         set_error(e.what());
@@ -44,10 +55,14 @@ void ViewerWindow::update_selection(bool wait) {
     return;
   }
   selection_ms_.push_back(done->ms);
-  // Counts only for the regions they were computed with: the list may have changed since.
-  if (done->number == regions_.revision()) regions_.set_counts(done->result->streamlines_per_region);
-  stats_.selection = std::to_string(done->result->selected) + " of " + std::to_string(done->result->total) +
-                     " streamlines selected (" + std::to_string(int(done->ms + 0.5)) + " ms)";
+  selection_levels_.push_back(done->result->level);
+  // Counts only for the regions they were computed with (the list may have changed since), and of every streamline.
+  const std::uint32_t searched = done->result->level;
+  if (done->number == regions_.revision() && searched == 0) regions_.set_counts(done->result->streamlines_per_region);
+  stats_.selection = std::to_string(done->result->selected) +
+                     (searched > 0 ? " streamlines of level " + std::to_string(searched) + " selected while moving ("
+                                   : " of " + std::to_string(done->result->total) + " streamlines selected (") +
+                     std::to_string(int(done->ms + 0.5)) + " ms)";
   RenderSettings& s = state_.settings;
   // Regions added in the window to a scene started without: the context faint, as --context-opacity's default.
   if (s.find_style(SceneGroups::kContext) == nullptr)
@@ -69,8 +84,10 @@ void ViewerWindow::apply_selection(std::optional<SceneSelection> selection) {
   // Focus first: the old copy held the old selection; the new one's comes from the worker.
   if (session_->has_focus()) session_->set_focus({}, nullptr);
   focus_copies_.cancel_waiting();
-  // Not while a newer selection runs (a drag): its copy would be stale before it is done.
-  if (selection_ && focus_first_wanted_ && selection_->selected > 0 && !selection_worker_.busy())
+  // Not while a newer selection runs (a drag): its copy would be stale before it is done; nor of one level's
+  // selection, which holds no more than the moving frames draw.
+  if (selection_ && focus_first_wanted_ && selection_->selected > 0 && selection_->level == 0 &&
+      !selection_worker_.busy())
     focus_copies_.request(selection_generation_, selection_->kept);
   const SceneGroups groups = selection_ ? selection_->groups : SceneGroups(files_);
   stats_.groups.clear();
@@ -97,7 +114,7 @@ bool ViewerWindow::drag_end_settled() {
   // busy(): asked for and not yet taken into the picture (a finished one is taken by the next poll). The copy
   // only matters when the last picture, drawn at the scene's level, is coarser than full detail.
   const bool pending = selection_revision_ != regions_.revision() || selection_worker_.busy() ||
-                       (detail_.level > 0 && focus_copies_.busy());
+                       level_selection_shown() || (detail_.level > 0 && focus_copies_.busy());
   const bool timed_out = pending && now - *drag_end_since_ >= kDragEndWaitLimit;
   if (pending && !timed_out) return false;
   drag_end_ = DragEndWait{now != *drag_end_since_,
