@@ -459,7 +459,8 @@ int ViewerWindow::run() {
       return session_->picture_levels(&camera, aspect, state_.settings.clipping).context_level();
     });
     if (task.work == PictureWork::Whole) {
-      if (moving) moving_level_ = task.level;  // the next drag's selections search this level's streamlines
+      // The level a region's drag draws at: its next selections search this level's streamlines.
+      if (moving || dragging_region_) moving_level_ = task.level;
       // A selection of one level's streamlines holds that level's and the coarser ones', not a finer level's.
       if (selection_) task.level = std::max(task.level, selection_->level);
     }
