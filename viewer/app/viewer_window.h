@@ -90,9 +90,11 @@ class ViewerWindow {
   bool drag_end_settled();
   // Whether a selection or a focus copy is being made or waits to be taken into the picture: an idle window then
   // looks for it every kWorkPollSeconds instead of sleeping until the next input (FramePacing::next_wait).
+  // One level's selection shown counts once the user's drag is over (the selection of every streamline is then due);
+  // while the mouse holds a region still there is nothing to look for.
   bool work_in_flight() const {
     return selection_revision_ != regions_.revision() || selection_worker_.busy() || focus_copies_.busy() ||
-           level_selection_shown();
+           (level_selection_shown() && !dragging_region_);
   }
   static constexpr double kWorkPollSeconds = 0.02;
   // Whether a picture at `level` draws the focus from its full-detail copy (focus first).

@@ -383,8 +383,9 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
   }
   if (task.work == PictureWork::Piece) {
     // A selection or a focus copy on its way changes the picture: a refinement of this one would be drawn again,
-    // and it would take the cores that work needs (it runs below the window's priority).
-    if (work_in_flight()) return false;
+    // and it would take the cores that work needs (it runs below the window's priority). One level's selection
+    // holds no finer level's streamlines.
+    if (work_in_flight() || level_selection_shown()) return false;
     bool completes = false;
     const double ms = refine(key.width, key.height, task.level, completes);
     frames_.push_back({task.level, false, ms, seconds_since_start(), task.frame_work, completes});
