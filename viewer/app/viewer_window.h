@@ -73,7 +73,8 @@ class ViewerWindow {
   // region is `dragging`, the selection searches only the streamlines of the level the moving frames draw
   // (selection_level): their pictures need no more; once it stops, every streamline.
   void update_selection(bool wait, bool dragging);
-  // The level a selection searches: while a region is dragged, the moving frames' (where every file has it); else 0.
+  // The level a selection searches: while a region is dragged, the moving frames' (where every file has it and its
+  // voxlines of it are small); else 0.
   std::uint32_t selection_level(bool dragging) const;
   // The selection shown searched one level's streamlines alone: a picture may not be drawn finer, nothing is
   // refined, and a selection of every streamline is still to come (or on its way).

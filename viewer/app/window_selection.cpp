@@ -3,6 +3,7 @@
 // scripted drag's end, and written out on request.
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -12,10 +13,22 @@
 
 namespace vxl::app {
 
+namespace {
+
+// The most a file's voxlines of one level may take (the selection worker keeps them, PlacedVoxline each): a fine
+// level of a large file (level 1 of 10^7 streamlines: 6.5M voxlines, about 160 MB) is selected through the whole
+// index.
+constexpr std::uint64_t kLevelVoxlinesBytes = std::uint64_t(64) << 20;
+
+}  // namespace
+
 std::uint32_t ViewerWindow::selection_level(bool dragging) const {
-  if (!dragging) return 0;
-  for (const VxlFile* f : files_)
+  if (!dragging || moving_level_ == 0) return 0;
+  for (const VxlFile* f : files_) {
     if (f->level_count() <= moving_level_) return 0;
+    const std::uint64_t voxlines = f->meta().voxline_count >> (3 * moving_level_);  // about 1/8 a level
+    if (voxlines * sizeof(PlacedVoxline) > kLevelVoxlinesBytes) return 0;
+  }
   return moving_level_;
 }
 
