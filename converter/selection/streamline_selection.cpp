@@ -580,11 +580,12 @@ void hits_by_index(HitSearch& q, const VoxelVoxlines* index, RegionHits& hits, s
   const DraggedSphere dragged(q.table, sphere);
   std::vector<HitSearch> per_thread(resolve_threads(0), q);
   std::vector<VoxelScratch> scratch(per_thread.size());
-  // A query touching most voxels reads most blocks: their pages are let go as it goes (walk_streamlines does so too).
+  // A query touching most voxels reads most blocks: their pages are let go as it goes (walk_streamlines does so too);
+  // a level's voxlines are a small part of each block.
   std::atomic<std::uint64_t> read_since_release = 0;
   parallel_for_first_error_in_order(touched.size(), unsigned(per_thread.size()), [&](std::uint64_t k, unsigned t) {
     const std::uint32_t voxel = touched[k];
-    if (read_since_release.fetch_add(4ull * q.voxels[voxel].vertex_count) > (64ull << 20)) {
+    if (!level && read_since_release.fetch_add(4ull * q.voxels[voxel].vertex_count) > (64ull << 20)) {
       read_since_release = 0;
       q.file.release_resident_pages();
     }
