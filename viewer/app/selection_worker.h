@@ -44,11 +44,14 @@ class SelectionWorker : public NewestRequestWorker<SelectionCriteria, SceneSelec
   struct LevelLists {
     std::map<std::uint32_t, std::vector<std::unique_ptr<LevelVoxlines>>> made;
     Lists of(const std::vector<const VxlFile*>& files, std::uint32_t level) {
-      auto& lists = made[level];
-      if (lists.empty())
+      auto found = made.find(level);
+      if (found == made.end()) {  // every file's, or none kept (a damaged file throws)
+        std::vector<std::unique_ptr<LevelVoxlines>> lists;
         for (const VxlFile* f : files) lists.push_back(std::make_unique<LevelVoxlines>(*f, level));
+        found = made.emplace(level, std::move(lists)).first;
+      }
       Lists out;
-      for (const auto& l : lists) out.push_back(l.get());
+      for (const auto& l : found->second) out.push_back(l.get());
       return out;
     }
   };
