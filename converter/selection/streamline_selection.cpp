@@ -572,7 +572,6 @@ void hits_by_index(HitSearch& q, const VoxelVoxlines* index, RegionHits& hits, s
   for (std::size_t r = 0; r < q.table.regions.size() && sphere < 0; ++r)
     if (q.table.regions[r]->shape() == Region::Shape::Sphere && ((q.table.include | q.table.exclude) >> r & 1))
       sphere = int(r);
-  if (level) boxes = nullptr;  // a level's few voxlines are placed already
   if (boxes) {
     boxes->track_region(sphere);
     boxes->selection_started();

@@ -1,18 +1,19 @@
 #include "viewer/app/scene_selection.h"
 
+#include "format/level_voxlines.h"
+
 namespace vxl::app {
 
 SceneSelection select_in_scene(std::span<const VxlFile* const> files, const SelectionCriteria& criteria,
-                               VoxelVoxlinesCache* indexes, std::span<const std::unique_ptr<VoxlineBoxes>> boxes,
-                               std::span<const LevelVoxlines* const> level_voxlines) {
+                               VoxelVoxlinesCache* indexes, std::span<const std::unique_ptr<VoxlineBoxes>> boxes) {
   SceneSelection out;
-  out.level = level_voxlines.empty() ? 0 : criteria.level.value_or(0);
+  out.level = criteria.level.value_or(0);
   for (std::size_t i = 0; i < files.size(); ++i) {
     const VxlFile* f = files[i];
     const VoxelVoxlines* index = indexes ? indexes->of(i) : nullptr;
-    SelectionResult r =
-        select_streamlines(*f, criteria, index, SelectionPath::Fastest, boxes.empty() ? nullptr : boxes[i].get(),
-                           level_voxlines.empty() ? nullptr : level_voxlines[i]);
+    const LevelVoxlines* level = indexes && out.level > 0 ? &indexes->level(i, out.level) : nullptr;
+    SelectionResult r = select_streamlines(*f, criteria, index, SelectionPath::Fastest,
+                                           boxes.empty() ? nullptr : boxes[i].get(), level);
     out.streamlines_per_region.resize(r.streamlines_per_region.size(), 0);
     for (std::size_t i = 0; i < r.streamlines_per_region.size(); ++i)
       out.streamlines_per_region[i] += r.streamlines_per_region[i];

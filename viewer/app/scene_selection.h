@@ -11,7 +11,6 @@
 
 #include "converter/selection/streamline_selection.h"
 #include "converter/selection/voxline_boxes.h"
-#include "format/level_voxlines.h"
 #include "viewer/render/scene_groups.h"
 
 namespace vxl::app {
@@ -21,18 +20,17 @@ struct SceneSelection {
   std::vector<std::vector<std::uint64_t>> kept;       // per file, its selected streamlines
   std::vector<std::uint64_t> streamlines_per_region;  // summed over the files (select_streamlines' order)
   std::uint64_t selected = 0, total = 0;
-  // 0, or the level of detail whose streamlines alone were searched (criteria.level with each file's own voxlines of
-  // it): right for pictures at that level or a coarser one, and its counts are that level's.
+  // criteria.level: 0, or the level of detail whose streamlines alone are kept; right for pictures at that level or a
+  // coarser one.
   std::uint32_t level = 0;
 };
 
 // `indexes` (one per file, or null), for selections repeated as regions move: each then reads the voxels
-// its regions touch, not every file's whole voxline table; `boxes` (empty, or one per file) keeps what each
-// selection learned of the voxels it touched for the next (voxline_boxes.h). `level_voxlines` (empty, or one per file,
-// of criteria.level): only that level's streamlines are searched (SceneSelection::level).
+// its regions touch, not every file's whole voxline table, and with criteria.level only that level's voxlines
+// (VoxelVoxlinesCache::level; the counts are then that level's); `boxes` (empty, or one per file) keeps what each
+// selection learned of the voxels it touched for the next (voxline_boxes.h).
 SceneSelection select_in_scene(std::span<const VxlFile* const> files, const SelectionCriteria& criteria,
                                VoxelVoxlinesCache* indexes = nullptr,
-                               std::span<const std::unique_ptr<VoxlineBoxes>> boxes = {},
-                               std::span<const LevelVoxlines* const> level_voxlines = {});
+                               std::span<const std::unique_ptr<VoxlineBoxes>> boxes = {});
 
 }  // namespace vxl::app

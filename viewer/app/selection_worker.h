@@ -6,14 +6,11 @@
 // VoxlineBoxes, the worker's own, carry what one selection learned of its voxels to the next.
 #pragma once
 
-#include <cstdint>
-#include <map>
 #include <memory>
 #include <vector>
 
 #include "converter/selection/streamline_selection.h"
 #include "converter/selection/voxline_boxes.h"
-#include "format/level_voxlines.h"
 #include "viewer/app/newest_request_worker.h"
 #include "viewer/app/scene_selection.h"
 
@@ -21,15 +18,14 @@ namespace vxl::app {
 
 // A request: the regions as of the number it is given (their revision). The files must outlive the worker; they
 // are only read (memory-mapped), so the worker's thread and the window's may read them at once. A request with a
-// level (criteria.level, which every file has) searches that level's streamlines alone, through each file's own
-// voxlines of it (made on the worker's thread the first time, then kept): a picture drawn at that level or a coarser
-// one needs no more, and on 10^7 streamlines the coarsest level's search takes about a millisecond.
+// level (criteria.level, which every file has) searches that level's streamlines alone, through each file's voxlines
+// of it in the shared cache (made once, by the worker or a renderer drawing that level): a picture drawn at that level
+// or a coarser one needs no more, and on 10^7 streamlines the coarsest level's search takes about a millisecond.
 class SelectionWorker : public NewestRequestWorker<SelectionCriteria, SceneSelection> {
  public:
   SelectionWorker(std::vector<const VxlFile*> files, std::shared_ptr<VoxelVoxlinesCache> indexes)
-      : NewestRequestWorker([files, indexes = std::move(indexes), boxes = boxes_of(files),
-                             levels = std::make_shared<LevelLists>()](const SelectionCriteria& c) {
-          return select_in_scene(files, c, indexes.get(), *boxes, c.level ? levels->of(files, *c.level) : Lists());
+      : NewestRequestWorker([files, indexes = std::move(indexes), boxes = boxes_of(files)](const SelectionCriteria& c) {
+          return select_in_scene(files, c, indexes.get(), *boxes);
         }) {}
 
  private:
@@ -39,22 +35,6 @@ class SelectionWorker : public NewestRequestWorker<SelectionCriteria, SceneSelec
     for (const VxlFile* f : files) boxes->push_back(std::make_unique<VoxlineBoxes>(*f));
     return boxes;
   }
-  using Lists = std::vector<const LevelVoxlines*>;
-  // Each file's voxlines of a level, made when first asked for (on the worker's thread), kept for the next.
-  struct LevelLists {
-    std::map<std::uint32_t, std::vector<std::unique_ptr<LevelVoxlines>>> made;
-    Lists of(const std::vector<const VxlFile*>& files, std::uint32_t level) {
-      auto found = made.find(level);
-      if (found == made.end()) {  // every file's, or none kept (a damaged file throws)
-        std::vector<std::unique_ptr<LevelVoxlines>> lists;
-        for (const VxlFile* f : files) lists.push_back(std::make_unique<LevelVoxlines>(*f, level));
-        found = made.emplace(level, std::move(lists)).first;
-      }
-      Lists out;
-      for (const auto& l : found->second) out.push_back(l.get());
-      return out;
-    }
-  };
 };
 
 }  // namespace vxl::app

@@ -15,7 +15,7 @@ namespace vxl::app {
 
 namespace {
 
-// The most a file's voxlines of one level may take (the selection worker keeps them, PlacedVoxline each): a fine
+// The most a file's voxlines of one level may take (the shared cache keeps them, PlacedVoxline each): a fine
 // level of a large file (level 1 of 10^7 streamlines: 6.5M voxlines, about 160 MB) is selected through the whole
 // index.
 constexpr std::uint64_t kLevelVoxlinesBytes = std::uint64_t(64) << 20;
