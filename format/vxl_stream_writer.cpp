@@ -133,6 +133,7 @@ void VxlStreamWriter::close_window(Section section, FileWindow& window) {
   const std::size_t i = entry_[section];
   const std::span<std::uint8_t> bytes = window.bytes();
   checksums_[i]->update(bytes.data(), bytes.size());
+  window.write_back();
   written_[i] += bytes.size();
   window = FileWindow();
 }

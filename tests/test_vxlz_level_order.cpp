@@ -66,6 +66,16 @@ class LevelOrder : public ::testing::Test {
     whole.positions = PositionEncoding::Float32;  // a level alone packs its voxels' blocks differently
     unpack_vxlz(dir.file("s.vxlz"), dir.file("whole.vxl"), whole);
   }
+  // flat.vxlz: `streamlines` synthetic streamlines converted without levels, packed (in streamline order).
+  void pack_flat(std::uint64_t streamlines) {
+    ConvertSettings convert;
+    convert.voxel_size = 8.0;
+    convert.levels = 1;
+    SynthSettings synth;
+    synth.streamlines = streamlines;
+    convert_tractogram(synthesize_tractogram(synth), dir.file("flat.vxl"), convert);
+    pack_vxl(VxlFile::open(dir.file("flat.vxl")), dir.file("flat.vxlz"), {});
+  }
   ScratchDir dir;
 };
 
@@ -212,13 +222,7 @@ TEST_F(LevelOrder, AVoxlineCountTheStreamsCannotHoldIsRefusedBeforeAllocating) {
 }
 
 TEST_F(LevelOrder, AFileWithoutLevelsIsShippedInStreamlineOrderAndHasNoLevelAlone) {
-  ConvertSettings convert;
-  convert.voxel_size = 8.0;
-  convert.levels = 1;
-  SynthSettings synth;
-  synth.streamlines = 200;
-  convert_tractogram(synthesize_tractogram(synth), dir.file("flat.vxl"), convert);
-  pack_vxl(VxlFile::open(dir.file("flat.vxl")), dir.file("flat.vxlz"), {});
+  pack_flat(200);
   const VxlzFile package = VxlzFile::open(dir.file("flat.vxlz"));
   EXPECT_EQ(package.pack().predictor, kVxlzPredictorLinear);
   EXPECT_TRUE(shipped_levels(package).empty());
@@ -226,6 +230,29 @@ TEST_F(LevelOrder, AFileWithoutLevelsIsShippedInStreamlineOrderAndHasNoLevelAlon
   settings.level = 1;
   EXPECT_EQ(error_of([&] { unpack_vxlz(package, dir.file("level.vxl"), settings); }).kind(), ErrorKind::Usage)
       << "a level of a package in streamline order";
+}
+
+// Where VERT is written block by block (an unpack within a tight memory limit, the web page's), each voxel's block of
+// each depth is filled from its first vertex on as the points arrive, in level order and in streamline order: the file
+// is the one VERT held whole gives, byte for byte, whatever the threads.
+TEST_F(LevelOrder, VertexBlocksFilledAsThePointsArriveGiveTheSameFile) {
+  pack_flat(500);
+  for (const char* name : {"s", "flat"}) {
+    SCOPED_TRACE(name);
+    const std::string package = dir.file(std::string(name) + ".vxlz");
+    UnpackSettings held;
+    held.threads = 2;
+    const UnpackSummary whole = unpack_vxlz(package, dir.file("held.vxl"), held);
+    ASSERT_FALSE(whole.vertices_read_back);
+    for (const unsigned threads : {1u, 3u}) {
+      UnpackSettings blocks;
+      blocks.threads = threads;
+      blocks.vertex_blocks = true;
+      EXPECT_TRUE(unpack_vxlz(package, dir.file("blocks.vxl"), blocks).vertices_read_back);
+      EXPECT_EQ(slurp(dir.file("blocks.vxl")), slurp(dir.file("held.vxl"))) << threads << " threads";
+    }
+  }
+  EXPECT_EQ(VxlzFile::open(dir.file("s.vxlz")).pack().level_count, kLevels) << "the first in level order";
 }
 
 }  // namespace

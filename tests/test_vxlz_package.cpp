@@ -10,6 +10,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <optional>
 #include <random>
 
 #include <nlohmann/json.hpp>
@@ -294,12 +295,19 @@ TEST(VxlzPackageOptions, StreamlinesCutByChunksGetTheirWholeLengthAndVoxelsTheir
   };
   walk_streamlines(f, cb);
   EXPECT_GT(cut, 250u);
-  // The same lengths and bounds in a packed .vxl, its positions kept as floats for one decode or decoded twice.
+  // The same lengths and bounds in a packed .vxl, its positions kept as floats for one decode or decoded twice, VERT
+  // held whole or written block by block and read back for the orders: the same bytes.
   UnpackSettings packed;
   packed.threads = 3;
-  unpack_vxlz(dir.file("s.vxlz"), dir.file("kept.vxl"), packed);
+  const UnpackSummary kept = unpack_vxlz(dir.file("s.vxlz"), dir.file("kept.vxl"), packed);
+  EXPECT_FALSE(kept.decoded_twice || kept.vertices_read_back);
+  packed.memory_limit = 8 * f.meta().vertex_count;  // not the floats (12 bytes a vertex), VERT (4) within half
+  const UnpackSummary held = unpack_vxlz(dir.file("s.vxlz"), dir.file("held.vxl"), packed);
+  EXPECT_TRUE(held.decoded_twice && !held.vertices_read_back);
   packed.memory_limit = 1;
-  EXPECT_TRUE(unpack_vxlz(dir.file("s.vxlz"), dir.file("twice.vxl"), packed).decoded_twice);
+  const UnpackSummary read_back = unpack_vxlz(dir.file("s.vxlz"), dir.file("twice.vxl"), packed);
+  EXPECT_TRUE(read_back.decoded_twice && read_back.vertices_read_back);
+  EXPECT_EQ(slurp(dir.file("kept.vxl")), slurp(dir.file("held.vxl")));
   EXPECT_EQ(slurp(dir.file("kept.vxl")), slurp(dir.file("twice.vxl")));
   const VxlFile twice = VxlFile::open(dir.file("twice.vxl"));
   EXPECT_EQ(to_vector(twice.streamline_lengths()), to_vector(f.streamline_lengths()));
@@ -556,16 +564,23 @@ TEST_F(DamagedVxlz, DamageBehindValidChecksumsNeverCrashes) {
     b[pos] = static_cast<char>(b[pos] ^ (pos % 2 ? 0x80 : 0x01));  // the lowest or the highest bit
     test::reseal_checksums(b.data(), b.size());
     dump_bytes(bad, b, b.size());
-    try {
-      unpack_vxlz(bad, out(), {});
-      const VerifyResult r = verify_vxl(out());
-      EXPECT_TRUE(r.valid) << "byte " << pos << ": " << r.problem;
-      std::filesystem::remove(out());
-      ++accepted;
-    } catch (const Error&) {
-      EXPECT_FALSE(std::filesystem::exists(out()));
-      ++refused;
+    // VERT held whole or written block by block: the same outcome, and the same bytes where it is accepted.
+    std::optional<std::vector<char>> unpacked[2];
+    for (const bool blocks : {false, true}) {
+      UnpackSettings settings;
+      settings.vertex_blocks = blocks;
+      try {
+        unpack_vxlz(bad, out(), settings);
+        const VerifyResult r = verify_vxl(out());
+        EXPECT_TRUE(r.valid) << "byte " << pos << ": " << r.problem;
+        unpacked[blocks] = slurp(out());
+        std::filesystem::remove(out());
+      } catch (const Error&) {
+        EXPECT_FALSE(std::filesystem::exists(out()));
+      }
     }
+    EXPECT_EQ(unpacked[0], unpacked[1]) << "byte " << pos;
+    ++(unpacked[0] ? accepted : refused);
   }
   EXPECT_GT(refused, 0u);
   EXPECT_GT(accepted, 0u);

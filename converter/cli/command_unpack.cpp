@@ -25,8 +25,10 @@ void add_unpack_command(CLI::App& app) {
                   "what the decoded positions may take (bytes, or K/M/G: 512M, 2G): a packed .vxl's words depend on "
                   "each voxel's bounds, known once every point is decoded, so within SIZE the positions are kept as "
                   "floats until then (12 bytes a vertex: 768 MB for 1M streamlines); past it the package is decoded "
-                  "twice instead, without them: about a tenth slower, in less than half the memory. The bytes are the "
-                  "same. Without it: half of the available memory")
+                  "twice instead, without them: about a tenth slower, in less than half the memory. The packed words "
+                  "themselves (4 bytes a vertex) are held whole within half of SIZE, else written block by block and "
+                  "read back for the orders: slower again, in less memory still. The bytes are the same. Without it: "
+                  "half of the available memory")
       ->type_name("SIZE")
       ->check(memory_size_validator());
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
@@ -49,8 +51,10 @@ void add_unpack_command(CLI::App& app) {
                   s.streamline_value_sets);
     if (opt->verbose)
       std::printf("stages: decode %.3f s (%s), orders %.3f s, write %.3f s\n", s.decode_seconds,
-                  s.decoded_twice ? "the package decoded twice: its positions as floats would pass the memory limit"
-                                  : "decoded once",
+                  s.vertices_read_back ? "the package decoded twice, the packed words written block by block and read "
+                                         "back for the orders: held whole, they would take more than half the limit"
+                  : s.decoded_twice ? "the package decoded twice: its positions as floats would pass the memory limit"
+                                    : "decoded once",
                   s.orders_seconds, s.write_seconds);
   });
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -14,6 +15,7 @@
 #include "converter/convert/voxel_table.h"
 #include "converter/package/unpack_positions.h"
 #include "converter/package/unpack_structure.h"
+#include "converter/pipeline/conversion_plan.h"
 #include "converter/pipeline/range_orders.h"
 #include "format/base/error.h"
 #include "format/base/json_limits.h"
@@ -31,6 +33,16 @@
 
 namespace vxl {
 namespace {
+
+// A VERT block's staging when VERT is written block by block (write_positions_in_blocks): within a conversion's
+// bounds (16 to 128 KiB), the largest power of two whose stagings for every voxel take at most a sixteenth of the
+// memory allowed. In level order only the blocks of the depth being decoded hold one, a voxel's each (the stagings of
+// 1M streamlines, 980 voxels, within 256 MiB: 16 MiB).
+std::uint64_t vertex_block_staging_bytes(std::uint64_t memory_allowed, std::size_t voxels) {
+  std::uint64_t staging = 128 * 1024;
+  while (staging > 16 * 1024 && staging * std::max<std::size_t>(voxels, 1) > memory_allowed / 16) staging /= 2;
+  return staging;
+}
 
 // Every voxline takes at least a byte of each of its streams (VXLV, VXLC): META's count is refused when `stream` (the
 // inflated section `id`) cannot hold it, before anything is allocated for it.
@@ -401,6 +413,19 @@ void append_tables(VxlStreamWriter& out, const VxlzFile& f, const UnpackStructur
   if (!extras.group_values_bytes.empty()) out.append(VxlStreamWriter::kGdat, extras.group_values_bytes);
 }
 
+// Lets go of what only the positions and the tables after ORDB needed (the orders read the voxel and level tables
+// alone): for 1M streamlines about 120 MB, which the orders' buffers then reuse.
+void let_go_of_voxline_tables(UnpackStructure& s, std::vector<float>& lengths, PackageExtras& extras) {
+  // Assigned new vectors (`= {}` would clear them and keep their memory).
+  s.strm = std::vector<std::uint64_t>();
+  s.voxlines = std::vector<VoxlineEntry>();
+  s.starts_streamline = std::vector<std::uint8_t>();
+  s.offset_in_voxel = std::vector<std::uint32_t>();
+  s.order = ShippingOrder();
+  lengths = std::vector<float>();
+  extras = PackageExtras();
+}
+
 // Refuses settings the package cannot meet, and rebuilds its tables (`meta`: the .vxl's counts, those of the level
 // alone with settings.level).
 UnpackStructure checked_structure(const VxlzFile& f, const UnpackSettings& settings, MetaSection& meta) {
@@ -450,10 +475,13 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
   UnpackStructure s = checked_structure(f, settings, meta);
   const std::string provenance = provenance_with_package(f);
   // A level alone is for a first look: the groups and value sets come with the whole.
-  const PackageExtras extras = settings.level > 0 ? PackageExtras() : read_extras(f, threads);
+  PackageExtras extras = settings.level > 0 ? PackageExtras() : read_extras(f, threads);
+  summary.point_value_sets = static_cast<std::uint32_t>(extras.point_values.size());
+  summary.streamline_value_sets = static_cast<std::uint32_t>(extras.streamline_values.size());
   const VxlSectionSizes sizes = unpacked_section_sizes(meta, s, settings, provenance.size(), sizes_of(extras));
-  // The same stages as a conversion's last: VERT filled in place, then its orders a chunk of voxels at a time
-  // (write_range_orders, one range of every voxel), then the tables. A refused package leaves no file.
+  // The same stages as a conversion's last: VERT filled in place (or block by block), the tables after ORDB, then the
+  // orders a chunk of voxels at a time (write_range_orders, one range of every voxel): the writer takes the sections
+  // in any order, and the tables' memory is let go before the orders take theirs. A refused package leaves no file.
   VxlStreamWriter out(out_path, sizes, kSectionDirectStagingBytes);
   std::vector<VoxelEntry>& voxels = s.voxels;  // their tight bounds set from the decoded vertices
   std::vector<float> lengths(meta.streamline_count);
@@ -461,60 +489,83 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
   VoxelRange whole = whole_range(voxels);
   whole.order_threads = threads;
   const bool packed = settings.positions == PositionEncoding::Packed;
-  const std::uint64_t floats_allowed =
+  const std::uint64_t memory_allowed =
       settings.memory_limit > 0 ? settings.memory_limit : available_memory().value_or(1ull << 30) / 2;
-  summary.decoded_twice = packed && 12 * meta.vertex_count > floats_allowed;
-  const auto place = [&](std::span<std::uint8_t> window) {
-    // The stage's progress: a pass's fraction d from `from` on, over `part` of it.
-    const auto decoding = [&](double from, double part) {
-      return [&, from, part](double d) { progress("decoding", from + d * part); };
-    };
-    const std::span<std::uint32_t> words(reinterpret_cast<std::uint32_t*>(window.data()), window.size() / 4);
-    // Where the first pass keeps the decoded positions: a float32 file's VERT; for a packed one, floats within the
-    // memory limit. Left uninitialised: the chunks write every vertex (rebuild_structure checked that the voxlines'
-    // points are the package's), and zeroing them first cost a serial pass over fresh pages (0.3 s for 1M streamlines).
-    std::unique_ptr<float[]> kept;
-    if (packed && !summary.decoded_twice)
-      kept.reset(new float[3 * words.size()]);  // a packed file's words: one a vertex
-    float* const keep = packed ? kept.get() : reinterpret_cast<float*>(window.data());
-    scan_positions(f, s, ends, lengths, threads, decoding(0, summary.decoded_twice ? 0.5 : 1), keep);
-    set_bounds_checked(meta, voxels, f.path());
-    if (summary.decoded_twice)
-      summary.repack_error_bound = write_positions(f, s, ends, words, threads, decoding(0.5, 0.5));
-    else if (packed)
-      summary.repack_error_bound = pack_kept_positions(s, {kept.get(), 3 * words.size()}, ends, words, threads);
-    summary.decode_seconds = seconds_since(t0);
+  summary.vertices_read_back =
+      packed && settings.level == 0 && (settings.vertex_blocks || sizes.vertices > memory_allowed / 2);
+  summary.decoded_twice = summary.vertices_read_back || (packed && 12 * meta.vertex_count > memory_allowed);
+  // The stage's progress: a pass's fraction d from `from` on, over `part` of it.
+  const auto decoding = [&](double from, double part) {
+    return [&, from, part](double d) { progress("decoding", from + d * part); };
   };
   OrderSetSpec order_set;
   order_set.kind = static_cast<OrderSet>(meta.order_set);
   for (const DirectionEntry& d : f.directions()) order_set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
-  const auto order = [&](std::span<const std::uint8_t> window) {
-    RangeOrderSettings orders;
-    orders.order_set = &order_set;
-    orders.positions = settings.positions;
-    orders.order_chunk_bytes = order_chunk_bytes(voxels, s.order_bytes, threads, 0, s.order_bytes);
-    orders.direct = true;
-    orders.float_ends = &ends;
-    orders.progress = [&](double d) { progress("ordering", d); };
-    summary.orders_seconds =
-        write_range_orders(out, {voxels, s.levels, s.level_count, s.order_bytes}, whole, window, orders);
+  RangeOrderSettings orders;
+  orders.order_set = &order_set;
+  orders.positions = settings.positions;
+  orders.order_chunk_bytes = order_chunk_bytes(voxels, s.order_bytes, threads, 0, s.order_bytes);
+  orders.direct = true;
+  orders.float_ends = &ends;
+  orders.progress = [&](double d) { progress("ordering", d); };
+  const OrderedTable table{voxels, s.levels, s.level_count, s.order_bytes};
+  const auto write_tables = [&] {
+    const auto t = Clock::now();
+    progress("writing", 0.0);
+    append_tables(out, f, s, meta, voxels, lengths, provenance, extras, threads);
+    let_go_of_voxline_tables(s, lengths, extras);
+    summary.write_seconds += seconds_since(t);
   };
-  out.append_in_place(VxlStreamWriter::kVert, meta.vertex_count * vertex_bytes(settings.positions), threads, place,
-                      order);
+  if (summary.vertices_read_back) {
+    scan_positions(f, s, ends, lengths, threads, decoding(0, 0.5));
+    set_bounds_checked(meta, voxels, f.path());
+    summary.repack_error_bound = write_positions_in_blocks(
+        f, s, ends, out, vertex_block_staging_bytes(memory_allowed, voxels.size()), decoding(0.5, 0.5));
+    summary.decode_seconds = seconds_since(t0);
+    write_tables();
+    const OrdersPool pool_sizes = orders_pool(voxels, s.order_bytes, settings.positions, orders.order_chunk_bytes);
+    void* const pool = std::aligned_alloc(DirectRegionWriter::kBlock, pool_sizes.total());
+    if (pool == nullptr) throw std::bad_alloc();
+    const std::unique_ptr<std::uint8_t, void (*)(void*)> pool_owner(static_cast<std::uint8_t*>(pool), std::free);
+    orders.pool = pool_owner.get();
+    orders.pool_chunk_bytes = pool_sizes.chunk_bytes;
+    orders.pool_read_back_bytes = pool_sizes.read_back_bytes;
+    summary.orders_seconds = write_range_orders(out, table, whole, {}, orders);
+  } else {
+    const auto place = [&](std::span<std::uint8_t> window) {
+      const std::span<std::uint32_t> words(reinterpret_cast<std::uint32_t*>(window.data()), window.size() / 4);
+      // Where the first pass keeps the decoded positions: a float32 file's VERT; for a packed one, floats within the
+      // memory limit. Left uninitialised: the chunks write every vertex (rebuild_structure checked that the
+      // voxlines' points are the package's), and zeroing them first cost a serial pass over fresh pages (0.3 s for
+      // 1M streamlines).
+      std::unique_ptr<float[]> kept;
+      if (packed && !summary.decoded_twice)
+        kept.reset(new float[3 * words.size()]);  // a packed file's words: one a vertex
+      float* const keep = packed ? kept.get() : reinterpret_cast<float*>(window.data());
+      scan_positions(f, s, ends, lengths, threads, decoding(0, summary.decoded_twice ? 0.5 : 1), keep);
+      set_bounds_checked(meta, voxels, f.path());
+      if (summary.decoded_twice)
+        summary.repack_error_bound = write_positions(f, s, ends, words, threads, decoding(0.5, 0.5));
+      else if (packed)
+        summary.repack_error_bound = pack_kept_positions(s, {kept.get(), 3 * words.size()}, ends, words, threads);
+      summary.decode_seconds = seconds_since(t0);
+    };
+    const auto order = [&](std::span<const std::uint8_t> window) {
+      write_tables();
+      summary.orders_seconds = write_range_orders(out, table, whole, window, orders);
+    };
+    out.append_in_place(VxlStreamWriter::kVert, sizes.vertices, threads, place, order);
+  }
 
   t0 = Clock::now();
-  progress("writing", 0.0);
-  append_tables(out, f, s, meta, voxels, lengths, provenance, extras, threads);
   out.commit();
-  summary.write_seconds = seconds_since(t0);
+  summary.write_seconds += seconds_since(t0);
   progress("writing", 1.0);
 
   summary.streamlines = meta.streamline_count;
   summary.points = meta.point_count;
   summary.voxels = meta.voxel_count;
   summary.pack = f.pack();
-  summary.point_value_sets = static_cast<std::uint32_t>(extras.point_values.size());
-  summary.streamline_value_sets = static_cast<std::uint32_t>(extras.streamline_values.size());
   return summary;
 }
 

@@ -30,8 +30,11 @@ struct UnpackSettings {
   std::uint32_t level = 0;
   // What the decoded positions may take (0: half of the available memory): a packed .vxl's are kept as floats for one
   // decode of the chunks where they fit in it (12 bytes a vertex), else the chunks are decoded twice
-  // (unpack_positions.h).
+  // (unpack_positions.h). A packed .vxl's whole VERT is held in memory where it takes at most half of it; else (or with
+  // vertex_blocks) it is written block by block as the second decode goes and read back a chunk of voxels at a time for
+  // the orders (write_positions_in_blocks), as a conversion under a tight limit does.
   std::uint64_t memory_limit = 0;
+  bool vertex_blocks = false;
 };
 
 struct UnpackSummary {
@@ -45,7 +48,8 @@ struct UnpackSummary {
   // decode: the package read, the positions decoded, each voxel's bounds set and its block packed; orders: the
   // orders built and written; write: the tables after them.
   double decode_seconds = 0, orders_seconds = 0, write_seconds = 0;
-  bool decoded_twice = false;  // the positions did not fit UnpackSettings::memory_limit as floats
+  bool decoded_twice = false;       // the positions did not fit UnpackSettings::memory_limit as floats
+  bool vertices_read_back = false;  // VERT written block by block and read back for the orders
 };
 
 // Validates the whole package (spec §8) and writes `out_path` atomically: a refused package leaves

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "converter/convert/position_packing.h"
+#include "converter/convert/segment_orders.h"
 #include "format/base/error.h"
 #include "format/base/parallel.h"
 #include "format/streamline_length.h"
@@ -209,6 +210,56 @@ void join_cut_streamlines(std::span<const ChunkLengthParts> chunks, std::span<fl
   finish();
 }
 
+// VERT's (voxel, depth) blocks, each written through a region writer of its own from its first vertex to its end.
+class VertexBlocks {
+ public:
+  VertexBlocks(VxlStreamWriter& out, const UnpackStructure& s, std::uint64_t staging_bytes, const std::string& path)
+      : levels_(s.level_count), path_(path) {
+    blocks_.resize(s.voxels.size() * levels_);
+    for (std::size_t g = 0; g < s.voxels.size(); ++g) {
+      const VoxelEntry& v = s.voxels[g];
+      const std::span<const LevelEntry> row = level_row(s.levels, g, levels_);
+      for (std::uint32_t d = 0; d < levels_; ++d) {  // depth d: [first, end) of the voxel's vertices
+        Block& b = blocks_[g * levels_ + d];
+        b.next = v.vertex_first + depth_first_vertex(row, d);
+        b.end = v.vertex_first + depth_end_vertex(v, row, d);
+        if (b.end > b.next)
+          b.writer = out.region_writer(VxlStreamWriter::kVert, 4 * b.next, 4 * (b.end - b.next), staging_bytes);
+      }
+    }
+  }
+  // Words for vertices [vertex, vertex + n) of voxel `voxel`: the next ones of one of its blocks.
+  void put(std::uint32_t voxel, std::uint64_t vertex, const std::uint32_t* words, std::uint64_t n) {
+    for (std::uint32_t d = 0; d < levels_; ++d) {
+      Block& b = blocks_[std::size_t(voxel) * levels_ + d];
+      if (b.next != vertex || !b.writer) continue;
+      if (n > b.end - b.next) break;
+      b.writer->append({reinterpret_cast<const std::uint8_t*>(words), static_cast<std::size_t>(4 * n)});
+      b.next += n;
+      if (b.next == b.end) b.writer.reset();  // written out: its staging goes
+      return;
+    }
+    fail_input(path_, std::nullopt,
+               "voxel " + std::to_string(voxel) + ": its vertices " + std::to_string(vertex) + ".." +
+                   std::to_string(vertex + n - 1) + " do not come next in the package's points");
+  }
+  void check_complete() const {
+    for (std::size_t k = 0; k < blocks_.size(); ++k)
+      if (blocks_[k].writer)
+        fail_input(path_, std::nullopt,
+                   "voxel " + std::to_string(k / levels_) + " does not get all of its vertices from the package");
+  }
+
+ private:
+  struct Block {
+    std::uint64_t next = 0, end = 0;  // vertices
+    std::unique_ptr<DirectRegionWriter> writer;
+  };
+  std::uint32_t levels_;
+  std::string path_;
+  std::vector<Block> blocks_;  // voxel-major
+};
+
 // The largest packing error bound of the voxels, their tight bounds set.
 double largest_packing_bound(std::span<const VoxelEntry> voxels) {
   double bound = 0;
@@ -217,6 +268,37 @@ double largest_packing_bound(std::span<const VoxelEntry> voxels) {
 }
 
 }  // namespace
+
+double write_positions_in_blocks(const VxlzFile& f, const UnpackStructure& s, const VoxlineEnds& ends,
+                                 VxlStreamWriter& out, std::uint64_t staging_bytes,
+                                 const std::function<void(double)>& progress) {
+  const std::uint64_t chunks = chunks_needed(f, s);
+  std::vector<VertexPacker> packers;
+  packers.reserve(s.voxels.size());
+  for (const VoxelEntry& v : s.voxels) packers.emplace_back(v);
+  VertexBlocks blocks(out, s, staging_bytes, f.path());
+  std::vector<std::uint32_t> words;
+  // n vertices of voxel `voxel` from `vertex` on (3 floats each).
+  const auto write = [&](std::uint32_t voxel, std::uint64_t vertex, const float* xyz, std::uint64_t n) {
+    if (words.size() < n) words.resize(n);
+    packers[voxel].words(xyz, n, words.data());
+    for (std::uint64_t i = 0; i < n; ++i)
+      if (ends.test(vertex + i)) words[i] |= kPackedVoxlineEnd;
+    blocks.put(voxel, vertex, words.data(), n);
+  };
+  std::vector<float> run_xyz;
+  for (std::uint64_t chunk = 0; chunk < chunks; ++chunk) {
+    decode_chunk(f, s, chunk, run_xyz, nullptr,
+                 [&](std::uint64_t, std::uint64_t j, std::uint64_t k, const float* xyz, std::uint64_t n) {
+                   if (k == 0 && !s.starts_streamline[j])  // the connecting vertex that ends the voxline before
+                     write(s.voxlines[j - 1].voxel, s.first_vertex(j - 1) + s.own(j - 1), xyz, 1);
+                   write(s.voxlines[j].voxel, s.first_vertex(j) + k, xyz, n);
+                 });
+    if (progress) progress(double(chunk + 1) / double(chunks));
+  }
+  blocks.check_complete();
+  return largest_packing_bound(s.voxels);
+}
 
 void scan_positions(const VxlzFile& f, UnpackStructure& s, VoxlineEnds& ends, std::span<float> lengths,
                     unsigned threads, const std::function<void(double)>& progress, float* keep) {

@@ -14,6 +14,7 @@
 #include "converter/convert/voxelize.h"
 #include "converter/package/unpack_structure.h"
 #include "format/vxl_positions.h"
+#include "format/vxl_stream_writer.h"
 #include "format/vxlz_package.h"
 
 namespace vxl {
@@ -35,5 +36,15 @@ double pack_kept_positions(const UnpackStructure& s, std::span<float> kept, cons
 // (VERT's payload). Returns the largest packing error bound of the voxels.
 double write_positions(const VxlzFile& f, const UnpackStructure& s, const VoxlineEnds& ends,
                        std::span<std::uint32_t> words, unsigned threads, const std::function<void(double)>& progress);
+
+// Or the second pass without VERT in memory (a packed .vxl's whole unpack): the chunks decoded again in shipping
+// order on this thread, each voxline's words appended to its (voxel, depth) block of `out`'s VERT through a region
+// writer of the block's own (staged `staging_bytes` at a time, the staging let go once the block is complete), which
+// the shipping order fills from its first vertex on (a depth's streamlines in order, spec §5.1; a voxel's block holds
+// each depth's voxlines so, §5.12). VERT is then read back for the orders. Returns the largest packing error bound of
+// the voxels. Throws vxl::Error (Input) where the package's points do not fill a block in order or to its end.
+double write_positions_in_blocks(const VxlzFile& f, const UnpackStructure& s, const VoxlineEnds& ends,
+                                 VxlStreamWriter& out, std::uint64_t staging_bytes,
+                                 const std::function<void(double)>& progress);
 
 }  // namespace vxl

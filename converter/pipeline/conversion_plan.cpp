@@ -50,20 +50,19 @@ std::uint64_t end_bits_bytes(const ConversionCounts& c, std::uint32_t max_vertic
 }
 
 // The most VERT bytes of any run of consecutive voxels whose orders fit in a chunk (read back at once).
-std::uint64_t largest_chunk_vertex_bytes(const ConversionCounts& c, std::uint64_t order_chunk_bytes) {
-  const std::span<const VoxelEntry> voxels = c.voxels;
+std::uint64_t largest_chunk_vertex_bytes(std::span<const VoxelEntry> voxels, std::uint64_t order_bytes,
+                                         PositionEncoding positions, std::uint64_t order_chunk_bytes) {
   std::uint64_t most = 0;
   std::size_t end = 0;  // the end of the longest chunk from `first`: never decreases as `first` grows
   for (std::size_t first = 0; first < voxels.size(); ++first) {
     end = std::max(end, first + 1);
     while (end < voxels.size() &&
-           orders_start(voxels, c.order_bytes, end + 1) - orders_start(voxels, c.order_bytes, first) <=
-               order_chunk_bytes)
+           orders_start(voxels, order_bytes, end + 1) - orders_start(voxels, order_bytes, first) <= order_chunk_bytes)
       ++end;
     const VoxelEntry& last = voxels[end - 1];
     most = std::max(most, last.vertex_first + last.vertex_count - voxels[first].vertex_first);
   }
-  return most * vertex_bytes(c.positions);
+  return most * vertex_bytes(positions);
 }
 
 // The parts of two batches being placed, from what pass 2 counted per point: 24 bytes per voxline (its staged
@@ -86,10 +85,10 @@ std::uint64_t staged_batches_bytes(const ConversionCounts& c) {
 // staging takes at most an eighth of what is left and the pool at most half, and VERT is not held whole in
 // memory (vertices_held_whole).
 void plan_block_staging(const MemoryBudget& budget, const ConversionCounts& counts, ConversionPlan& plan) {
-  plan.pool_chunk_bytes = chunk_buffer_bytes(plan.order_chunk_bytes);
-  plan.pool_read_back_bytes =
-      VxlStreamWriter::read_back_bytes(largest_chunk_vertex_bytes(counts, plan.order_chunk_bytes));
-  const std::uint64_t orders_part = 2 * (plan.pool_chunk_bytes + plan.pool_read_back_bytes);
+  const OrdersPool pool = orders_pool(counts.voxels, counts.order_bytes, counts.positions, plan.order_chunk_bytes);
+  plan.pool_chunk_bytes = pool.chunk_bytes;
+  plan.pool_read_back_bytes = pool.read_back_bytes;
+  const std::uint64_t orders_part = pool.total();
   for (std::uint64_t staging = kBlockStagingBytes; staging >= kMinBlockStagingBytes && plan.block_staging_bytes == 0;
        staging /= 2) {
     const std::uint64_t total = block_staging_total(counts, staging);
@@ -233,6 +232,12 @@ std::uint64_t order_chunk_bytes(std::span<const VoxelEntry> voxels, std::uint64_
 std::uint64_t chunk_buffer_bytes(std::uint64_t order_chunk_bytes) {
   constexpr std::uint64_t block = DirectRegionWriter::kBlock;
   return (order_chunk_bytes + block - 1) / block * block + block;
+}
+
+OrdersPool orders_pool(std::span<const VoxelEntry> voxels, std::uint64_t order_bytes, PositionEncoding positions,
+                       std::uint64_t order_chunk_bytes) {
+  return {chunk_buffer_bytes(order_chunk_bytes), VxlStreamWriter::read_back_bytes(largest_chunk_vertex_bytes(
+                                                     voxels, order_bytes, positions, order_chunk_bytes))};
 }
 
 namespace {

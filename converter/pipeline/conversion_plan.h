@@ -141,4 +141,14 @@ std::uint64_t order_chunk_bytes(std::span<const VoxelEntry> voxels, std::uint64_
 // the orders start where their first byte falls in its block of the file (VxlStreamWriter::append_from_block).
 std::uint64_t chunk_buffer_bytes(std::uint64_t order_chunk_bytes);
 
+// Where VERT is read back for its orders (RangeOrderSettings::pool): two chunks' orders being built and written, of
+// chunk_bytes each, then two chunks' vertices being read, of read_back_bytes each (the largest chunk's, its blocks
+// around it).
+struct OrdersPool {
+  std::uint64_t chunk_bytes = 0, read_back_bytes = 0;
+  std::uint64_t total() const { return 2 * (chunk_bytes + read_back_bytes); }
+};
+OrdersPool orders_pool(std::span<const VoxelEntry> voxels, std::uint64_t order_bytes, PositionEncoding positions,
+                       std::uint64_t order_chunk_bytes);
+
 }  // namespace vxl

@@ -89,8 +89,24 @@ void MappedFile::release() {
   adopted_ = false;
 }
 
+#if defined(__EMSCRIPTEN__)
+constexpr bool kWriteWindowsAreBuffers = true;
+#else
+constexpr bool kWriteWindowsAreBuffers = false;
+#endif
+
 FileWindow::FileWindow(int fd, const std::string& path, std::uint64_t offset, std::uint64_t size, Access access) {
   if (size == 0) return;
+  if (kWriteWindowsAreBuffers && access == Access::Write) {
+    map_ = std::calloc(size, 1);  // what a writer has not written yet reads as zeros, as in a sized output
+    if (map_ == nullptr)
+      throw Error(ErrorKind::Output, path, std::nullopt,
+                  "no memory for " + std::to_string(size) + " bytes of the output");
+    map_size_ = static_cast<std::size_t>(size);
+    bytes_ = {static_cast<std::uint8_t*>(map_), static_cast<std::size_t>(size)};
+    fd_ = fd, offset_ = offset, path_ = path;
+    return;
+  }
   const std::uint64_t page = static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE));
   const std::uint64_t start = offset / page * page;
   const bool write = access == Access::Write;
@@ -117,7 +133,10 @@ FileWindow::~FileWindow() { release(); }
 FileWindow::FileWindow(FileWindow&& other) noexcept
     : map_(std::exchange(other.map_, nullptr)),
       map_size_(std::exchange(other.map_size_, 0)),
-      bytes_(std::exchange(other.bytes_, {})) {}
+      bytes_(std::exchange(other.bytes_, {})),
+      fd_(std::exchange(other.fd_, -1)),
+      offset_(other.offset_),
+      path_(std::move(other.path_)) {}
 
 FileWindow& FileWindow::operator=(FileWindow&& other) noexcept {
   if (this != &other) {
@@ -125,15 +144,34 @@ FileWindow& FileWindow::operator=(FileWindow&& other) noexcept {
     map_ = std::exchange(other.map_, nullptr);
     map_size_ = std::exchange(other.map_size_, 0);
     bytes_ = std::exchange(other.bytes_, {});
+    fd_ = std::exchange(other.fd_, -1);
+    offset_ = other.offset_;
+    path_ = std::move(other.path_);
   }
   return *this;
 }
 
+void FileWindow::write_back() {
+  if (fd_ < 0) return;  // a mapping: its bytes are the file's
+  for (std::size_t done = 0; done < bytes_.size();) {
+    const ssize_t n = ::pwrite(fd_, bytes_.data() + done, bytes_.size() - done, static_cast<off_t>(offset_ + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0)
+      throw Error(ErrorKind::Output, path_, std::nullopt,
+                  std::string("write failed: ") + (n < 0 ? std::strerror(errno) : "nothing written"));
+    done += static_cast<std::size_t>(n);
+  }
+}
+
 void FileWindow::release() {
-  if (map_ != nullptr) ::munmap(map_, map_size_);
+  if (fd_ >= 0)
+    std::free(map_);  // a buffer: written back (write_back) or given up
+  else if (map_ != nullptr)
+    ::munmap(map_, map_size_);
   map_ = nullptr;
   map_size_ = 0;
   bytes_ = {};
+  fd_ = -1;
 }
 
 }  // namespace vxl

@@ -48,7 +48,9 @@ class MappedFile {
 // Read: its pages mapped at once (MAP_POPULATE), so that a reader going through a large file a part at a
 // time reads the page cache in place, without pread's copy, and adds no more than one part to its
 // resident memory. Write (AtomicOutputFile::map_window): shared, what is written stays in the file's page
-// cache after the window is gone.
+// cache after the window is gone. In WebAssembly a window for writing is a buffer of its own, written back
+// where it lies by write_back(): Emscripten's mapping is a copy written back whole when unmapped, from the
+// page boundary below the window, which would overwrite the bytes before it written meanwhile.
 class FileWindow {
  public:
   enum class Access { Read, Write };
@@ -64,11 +66,19 @@ class FileWindow {
   const std::uint8_t* data() const { return bytes_.data(); }
   std::span<std::uint8_t> bytes() const { return bytes_; }  // writable only for Access::Write
 
+  // A window for writing: its bytes in the file now, where they are not already (WebAssembly). Throws vxl::Error
+  // (Output) naming the file.
+  void write_back();
+
  private:
   void release();
   void* map_ = nullptr;
   std::size_t map_size_ = 0;
   std::span<std::uint8_t> bytes_;
+  // WebAssembly's window for writing: where its buffer (map_, malloc'd) goes back.
+  int fd_ = -1;
+  std::uint64_t offset_ = 0;
+  std::string path_;
 };
 
 }  // namespace vxl

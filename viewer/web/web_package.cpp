@@ -50,6 +50,9 @@ std::string unpack_package_to_file(MappedFile package_bytes, const std::string& 
   UnpackSettings settings;
   settings.threads = 1;  // this WebAssembly build has no threads
   settings.memory_limit = kDecodedPositionsBytes;
+  // The .vxl's pieces lie beside the unpacker's memory, which never shrinks: VERT held whole there would sit in the tab
+  // twice once the file is complete (256 MB for 1M streamlines).
+  settings.vertex_blocks = true;
   unpack_vxlz(VxlzFile::open(std::move(package_bytes)), unpacked, settings);
   return unpacked;
 }
