@@ -6,7 +6,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -383,11 +385,11 @@ void set_bounds_checked(MetaSection& meta, std::span<const VoxelEntry> voxels, c
 // The sections after VERT and ORDB (spec §7 steps 6-8): META with its bounds, the directions, the voxel and level
 // tables, the voxline and streamline tables with their voxel index, the lengths, PROV, and what the package carries
 // besides (groups, their values, the value sets).
-void append_tables(VxlStreamWriter& out, const VxlzFile& f, const UnpackStructure& s, const MetaSection& meta,
-                   std::span<const VoxelEntry> voxels, std::span<const float> lengths, const std::string& provenance,
-                   const PackageExtras& extras, unsigned threads) {
+void append_tables(VxlStreamWriter& out, std::span<const DirectionEntry> directions, const UnpackStructure& s,
+                   const MetaSection& meta, std::span<const VoxelEntry> voxels, std::span<const float> lengths,
+                   const std::string& provenance, const PackageExtras& extras, unsigned threads) {
   out.append_meta(meta);
-  out.append_items<DirectionEntry>(VxlStreamWriter::kDirs, f.directions());
+  out.append_items<DirectionEntry>(VxlStreamWriter::kDirs, directions);
   out.append_items<VoxelEntry>(VxlStreamWriter::kVoxt, voxels);
   if (!s.levels.empty()) out.append_items<LevelEntry>(VxlStreamWriter::kLods, s.levels);
   out.append_items<VoxlineEntry>(VxlStreamWriter::kVxln, s.voxlines);
@@ -411,6 +413,16 @@ void append_tables(VxlStreamWriter& out, const VxlzFile& f, const UnpackStructur
     out.append(VxlStreamWriter::kSval, payload);
   }
   if (!extras.group_values_bytes.empty()) out.append(VxlStreamWriter::kGdat, extras.group_values_bytes);
+}
+
+// Lets go of what only the positions needed: the shipping order, and unless the point values are laid out as the
+// positions (write_point_values) each voxline's place and streamline start (for 1M streamlines 37 MB in all), before
+// the tables after ORDB take their memory.
+void let_go_of_decoding_tables(UnpackStructure& s, const PackageExtras& extras) {
+  s.order = ShippingOrder();
+  if (!extras.point_values.empty()) return;
+  s.starts_streamline = std::vector<std::uint8_t>();
+  s.offset_in_voxel = std::vector<std::uint32_t>();
 }
 
 // Lets go of what only the positions and the tables after ORDB needed (the orders read the voxel and level tables
@@ -453,14 +465,9 @@ VxlSectionSizes unpacked_section_sizes(MetaSection& meta, const UnpackStructure&
   return sizes;
 }
 
-}  // namespace
-
-UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
-  detail::check_level_count(settings.levels, in_path);
-  return unpack_vxlz(VxlzFile::open(in_path), out_path, settings);
-}
-
-UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const UnpackSettings& settings) {
+// The unpack; let_go_of_package() is called once the positions are decoded, after which `f` is not read.
+UnpackSummary unpack(const VxlzFile& f, const std::string& out_path, const UnpackSettings& settings,
+                     const std::function<void()>& let_go_of_package) {
   using Clock = std::chrono::steady_clock;
   auto seconds_since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   const unsigned threads = resolve_threads(settings.threads);
@@ -474,6 +481,8 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
   MetaSection meta = f.meta();
   UnpackStructure s = checked_structure(f, settings, meta);
   const std::string provenance = provenance_with_package(f);
+  const std::vector<DirectionEntry> directions(f.directions().begin(), f.directions().end());
+  summary.pack = f.pack();
   // A level alone is for a first look: the groups and value sets come with the whole.
   PackageExtras extras = settings.level > 0 ? PackageExtras() : read_extras(f, threads);
   summary.point_value_sets = static_cast<std::uint32_t>(extras.point_values.size());
@@ -500,7 +509,7 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
   };
   OrderSetSpec order_set;
   order_set.kind = static_cast<OrderSet>(meta.order_set);
-  for (const DirectionEntry& d : f.directions()) order_set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
+  for (const DirectionEntry& d : directions) order_set.directions.push_back({d.xyz[0], d.xyz[1], d.xyz[2]});
   RangeOrderSettings orders;
   orders.order_set = &order_set;
   orders.positions = settings.positions;
@@ -510,9 +519,11 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
   orders.progress = [&](double d) { progress("ordering", d); };
   const OrderedTable table{voxels, s.levels, s.level_count, s.order_bytes};
   const auto write_tables = [&] {
+    let_go_of_package();
+    let_go_of_decoding_tables(s, extras);
     const auto t = Clock::now();
     progress("writing", 0.0);
-    append_tables(out, f, s, meta, voxels, lengths, provenance, extras, threads);
+    append_tables(out, directions, s, meta, voxels, lengths, provenance, extras, threads);
     let_go_of_voxline_tables(s, lengths, extras);
     summary.write_seconds += seconds_since(t);
   };
@@ -565,8 +576,23 @@ UnpackSummary unpack_vxlz(const VxlzFile& f, const std::string& out_path, const 
   summary.streamlines = meta.streamline_count;
   summary.points = meta.point_count;
   summary.voxels = meta.voxel_count;
-  summary.pack = f.pack();
   return summary;
+}
+
+}  // namespace
+
+UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
+  detail::check_level_count(settings.levels, in_path);
+  return unpack_vxlz(VxlzFile::open(in_path), out_path, settings);
+}
+
+UnpackSummary unpack_vxlz(const VxlzFile& package, const std::string& out_path, const UnpackSettings& settings) {
+  return unpack(package, out_path, settings, [] {});
+}
+
+UnpackSummary unpack_vxlz(VxlzFile&& package, const std::string& out_path, const UnpackSettings& settings) {
+  std::optional<VxlzFile> held(std::move(package));
+  return unpack(*held, out_path, settings, [&] { held.reset(); });
 }
 
 std::uint64_t unpacked_vxl_bytes(const VxlzFile& f, const UnpackSettings& settings) {

@@ -57,6 +57,9 @@ struct UnpackSummary {
 // offset and what was expected; Unsupported for a newer version; Output).
 UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings);
 UnpackSummary unpack_vxlz(const VxlzFile& package, const std::string& out_path, const UnpackSettings& settings);
+// The same, the package let go of once its positions are decoded: where it was read into memory (the web page's), its
+// memory goes before the tables and the orders take theirs.
+UnpackSummary unpack_vxlz(VxlzFile&& package, const std::string& out_path, const UnpackSettings& settings);
 
 // The size in bytes of the .vxl unpack_vxlz would write with `settings` (its levels, positions, level), from the
 // package's tables alone: no position is decoded, nor a value (of a value section only its set count is read).
