@@ -253,6 +253,17 @@ TEST_F(LevelOrder, VertexBlocksFilledAsThePointsArriveGiveTheSameFile) {
     }
   }
   EXPECT_EQ(VxlzFile::open(dir.file("s.vxlz")).pack().level_count, kLevels) << "the first in level order";
+  // Fewer levels than a package in level order ships by interleave the coarsest block's streamlines: VERT is then held
+  // whole. As many or more fill each block in order.
+  for (const std::uint32_t levels : {1u, kLevels - 1, kLevels, kLevels + 1}) {
+    SCOPED_TRACE(std::to_string(levels) + " levels");
+    UnpackSettings held, blocks;
+    held.levels = blocks.levels = levels;
+    blocks.vertex_blocks = true;
+    unpack_vxlz(dir.file("s.vxlz"), dir.file("held.vxl"), held);
+    EXPECT_EQ(unpack_vxlz(dir.file("s.vxlz"), dir.file("blocks.vxl"), blocks).vertices_read_back, levels >= kLevels);
+    EXPECT_EQ(slurp(dir.file("blocks.vxl")), slurp(dir.file("held.vxl")));
+  }
 }
 
 }  // namespace

@@ -500,8 +500,13 @@ UnpackSummary unpack(const VxlzFile& f, const std::string& out_path, const Unpac
   const bool packed = settings.positions == PositionEncoding::Packed;
   const std::uint64_t memory_allowed =
       settings.memory_limit > 0 ? settings.memory_limit : available_memory().value_or(1ull << 30) / 2;
-  summary.vertices_read_back =
-      packed && settings.level == 0 && (settings.vertex_blocks || sizes.vertices > memory_allowed / 2);
+  // Block by block where the shipping order fills each (voxel, depth) block from its first vertex on: streamline order
+  // does for any levels, level order for at least the levels it ships by (with fewer, the coarsest block gathers
+  // several shipped depths, whose streamlines then interleave).
+  const bool fills_blocks_in_order =
+      f.pack().predictor != kVxlzPredictorLinearLevelOrder || s.level_count >= f.pack().level_count;
+  summary.vertices_read_back = packed && settings.level == 0 && fills_blocks_in_order &&
+                               (settings.vertex_blocks || sizes.vertices > memory_allowed / 2);
   summary.decoded_twice = summary.vertices_read_back || (packed && 12 * meta.vertex_count > memory_allowed);
   // The stage's progress: a pass's fraction d from `from` on, over `part` of it.
   const auto decoding = [&](double from, double part) {

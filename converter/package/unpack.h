@@ -32,7 +32,9 @@ struct UnpackSettings {
   // decode of the chunks where they fit in it (12 bytes a vertex), else the chunks are decoded twice
   // (unpack_positions.h). A packed .vxl's whole VERT is held in memory where it takes at most half of it; else (or with
   // vertex_blocks) it is written block by block as the second decode goes and read back a chunk of voxels at a time for
-  // the orders (write_positions_in_blocks), as a conversion under a tight limit does.
+  // the orders (write_positions_in_blocks), as a conversion under a tight limit does — where the package's shipping
+  // order fills the blocks in order: streamline order, or level order unpacked with at least the levels it ships by
+  // (`levels` >= PACK.level_count); with fewer, VERT is held whole.
   std::uint64_t memory_limit = 0;
   bool vertex_blocks = false;
 };
