@@ -10,6 +10,7 @@
 #include "converter/package/pack.h"
 #include "converter/package/unpack.h"
 #include "converter/synth/synth.h"
+#include "format/base/direct_region_writer.h"
 #include "format/base/error.h"
 #include "format/base/mapped_file.h"
 #include "format/vxl_file.h"
@@ -67,9 +68,9 @@ class LevelOrder : public ::testing::Test {
     unpack_vxlz(dir.file("s.vxlz"), dir.file("whole.vxl"), whole);
   }
   // flat.vxlz: `streamlines` synthetic streamlines converted without levels, packed (in streamline order).
-  void pack_flat(std::uint64_t streamlines) {
+  void pack_flat(std::uint64_t streamlines, double voxel_size = 8.0) {
     ConvertSettings convert;
-    convert.voxel_size = 8.0;
+    convert.voxel_size = voxel_size;
     convert.levels = 1;
     SynthSettings synth;
     synth.streamlines = streamlines;
@@ -234,9 +235,10 @@ TEST_F(LevelOrder, AFileWithoutLevelsIsShippedInStreamlineOrderAndHasNoLevelAlon
 
 // Where VERT is written block by block (an unpack within a tight memory limit, the web page's), each voxel's block of
 // each depth is filled from its first vertex on as the points arrive, in level order and in streamline order: the file
-// is the one VERT held whole gives, byte for byte, whatever the threads.
+// is the one VERT held whole gives, byte for byte, whatever the threads and the stagings' size (the smallest, one 4 KiB
+// block, under a limit of a byte: blocks are written out part by part).
 TEST_F(LevelOrder, VertexBlocksFilledAsThePointsArriveGiveTheSameFile) {
-  pack_flat(500);
+  pack_flat(2000, 40.0);  // large voxels: blocks of several 4 KiB stagings
   for (const char* name : {"s", "flat"}) {
     SCOPED_TRACE(name);
     const std::string package = dir.file(std::string(name) + ".vxlz");
@@ -244,13 +246,21 @@ TEST_F(LevelOrder, VertexBlocksFilledAsThePointsArriveGiveTheSameFile) {
     held.threads = 2;
     const UnpackSummary whole = unpack_vxlz(package, dir.file("held.vxl"), held);
     ASSERT_FALSE(whole.vertices_read_back);
-    for (const unsigned threads : {1u, 3u}) {
-      UnpackSettings blocks;
-      blocks.threads = threads;
-      blocks.vertex_blocks = true;
-      EXPECT_TRUE(unpack_vxlz(package, dir.file("blocks.vxl"), blocks).vertices_read_back);
-      EXPECT_EQ(slurp(dir.file("blocks.vxl")), slurp(dir.file("held.vxl"))) << threads << " threads";
+    if (std::string(name) == "flat") {
+      const VxlFile f = VxlFile::open(dir.file("held.vxl"));
+      ASSERT_GT(f.meta().vertex_count * 4 / f.voxels().size(), 3 * DirectRegionWriter::kBlock)
+          << "voxels whose blocks a 4 KiB staging writes out in parts";
     }
+    for (const std::uint64_t limit : {std::uint64_t(0), std::uint64_t(1)})
+      for (const unsigned threads : {1u, 3u}) {
+        UnpackSettings blocks;
+        blocks.threads = threads;
+        blocks.vertex_blocks = true;
+        blocks.memory_limit = limit;
+        EXPECT_TRUE(unpack_vxlz(package, dir.file("blocks.vxl"), blocks).vertices_read_back);
+        EXPECT_EQ(slurp(dir.file("blocks.vxl")), slurp(dir.file("held.vxl")))
+            << threads << " threads, memory limit " << limit;
+      }
   }
   EXPECT_EQ(VxlzFile::open(dir.file("s.vxlz")).pack().level_count, kLevels) << "the first in level order";
   // Fewer levels than a package in level order ships by interleave the coarsest block's streamlines: VERT is then held
@@ -264,6 +274,26 @@ TEST_F(LevelOrder, VertexBlocksFilledAsThePointsArriveGiveTheSameFile) {
     EXPECT_EQ(unpack_vxlz(dir.file("s.vxlz"), dir.file("blocks.vxl"), blocks).vertices_read_back, levels >= kLevels);
     EXPECT_EQ(slurp(dir.file("blocks.vxl")), slurp(dir.file("held.vxl")));
   }
+}
+
+// Many small voxels: each open block's staging (a 4 KiB block at least) would take more than a quarter of VERT and more
+// than 16 MiB, so VERT is held whole, and the file is the same.
+TEST_F(LevelOrder, ManySmallVoxelsKeepVertexBlocksHeldWhole) {
+  SynthSettings synth;
+  synth.streamlines = 2000;
+  ConvertSettings convert;
+  convert.voxel_size = 1.0;
+  convert_tractogram(synthesize_tractogram(synth), dir.file("fine.vxl"), convert);
+  pack_vxl(VxlFile::open(dir.file("fine.vxl")), dir.file("fine.vxlz"), {});
+  ASSERT_GT(VxlFile::open(dir.file("fine.vxl")).voxels().size(), 4096u);
+  UnpackSettings held, blocks;
+  blocks.vertex_blocks = true;
+  blocks.memory_limit = 1;
+  unpack_vxlz(dir.file("fine.vxlz"), dir.file("held.vxl"), held);
+  const UnpackSummary s = unpack_vxlz(dir.file("fine.vxlz"), dir.file("blocks.vxl"), blocks);
+  EXPECT_FALSE(s.vertices_read_back);
+  EXPECT_TRUE(s.decoded_twice);
+  EXPECT_EQ(slurp(dir.file("blocks.vxl")), slurp(dir.file("held.vxl")));
 }
 
 }  // namespace

@@ -36,14 +36,18 @@
 namespace vxl {
 namespace {
 
-// A VERT block's staging when VERT is written block by block (write_positions_in_blocks): within a conversion's
-// bounds (16 to 128 KiB), the largest power of two whose stagings for every voxel take at most a sixteenth of the
-// memory allowed. In level order only the blocks of the depth being decoded hold one, a voxel's each (the stagings of
-// 1M streamlines, 980 voxels, within 256 MiB: 16 MiB).
-std::uint64_t vertex_block_staging_bytes(std::uint64_t memory_allowed, std::size_t voxels) {
+// The stagings of VERT's blocks when it is written block by block (write_positions_in_blocks): within a conversion's
+// bounds, 128 KiB down to one 4 KiB block, the largest power of two whose stagings open at once take at most a
+// sixteenth of the memory allowed (the 1M package in level order within 256 MiB: 16 KiB, 15 MiB open at once). 0 where
+// they would take more than a quarter of VERT and more than 16 MiB (many small voxels): holding VERT whole then costs
+// little more.
+std::uint64_t vertex_block_staging_bytes(const UnpackStructure& s, const PackSection& pack, std::uint64_t vert_bytes,
+                                         std::uint64_t memory_allowed) {
   std::uint64_t staging = 128 * 1024;
-  while (staging > 16 * 1024 && staging * std::max<std::size_t>(voxels, 1) > memory_allowed / 16) staging /= 2;
-  return staging;
+  while (staging > DirectRegionWriter::kBlock && open_block_staging_bytes(s, pack, staging) > memory_allowed / 16)
+    staging /= 2;
+  const std::uint64_t open = open_block_staging_bytes(s, pack, staging);
+  return open <= std::max<std::uint64_t>(vert_bytes / 4, 16ull << 20) ? staging : 0;
 }
 
 // Every voxline takes at least a byte of each of its streams (VXLV, VXLC): META's count is refused when `stream` (the
@@ -505,8 +509,11 @@ UnpackSummary unpack(const VxlzFile& f, const std::string& out_path, const Unpac
   // several shipped depths, whose streamlines then interleave).
   const bool fills_blocks_in_order =
       f.pack().predictor != kVxlzPredictorLinearLevelOrder || s.level_count >= f.pack().level_count;
-  summary.vertices_read_back = packed && settings.level == 0 && fills_blocks_in_order &&
-                               (settings.vertex_blocks || sizes.vertices > memory_allowed / 2);
+  const std::uint64_t block_staging = packed && settings.level == 0 && fills_blocks_in_order &&
+                                              (settings.vertex_blocks || sizes.vertices > memory_allowed / 2)
+                                          ? vertex_block_staging_bytes(s, f.pack(), sizes.vertices, memory_allowed)
+                                          : 0;
+  summary.vertices_read_back = block_staging > 0;
   summary.decoded_twice = summary.vertices_read_back || (packed && 12 * meta.vertex_count > memory_allowed);
   // The stage's progress: a pass's fraction d from `from` on, over `part` of it.
   const auto decoding = [&](double from, double part) {
@@ -535,8 +542,7 @@ UnpackSummary unpack(const VxlzFile& f, const std::string& out_path, const Unpac
   if (summary.vertices_read_back) {
     scan_positions(f, s, ends, lengths, threads, decoding(0, 0.5));
     set_bounds_checked(meta, voxels, f.path());
-    summary.repack_error_bound = write_positions_in_blocks(
-        f, s, ends, out, vertex_block_staging_bytes(memory_allowed, voxels.size()), decoding(0.5, 0.5));
+    summary.repack_error_bound = write_positions_in_blocks(f, s, ends, out, block_staging, decoding(0.5, 0.5));
     summary.decode_seconds = seconds_since(t0);
     write_tables();
     const OrdersPool pool_sizes = orders_pool(voxels, s.order_bytes, settings.positions, orders.order_chunk_bytes);

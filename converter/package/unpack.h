@@ -34,7 +34,8 @@ struct UnpackSettings {
   // vertex_blocks) it is written block by block as the second decode goes and read back a chunk of voxels at a time for
   // the orders (write_positions_in_blocks), as a conversion under a tight limit does — where the package's shipping
   // order fills the blocks in order: streamline order, or level order unpacked with at least the levels it ships by
-  // (`levels` >= PACK.level_count); with fewer, VERT is held whole.
+  // (`levels` >= PACK.level_count), and where the blocks' stagings take less than a quarter of VERT; else VERT is held
+  // whole.
   std::uint64_t memory_limit = 0;
   bool vertex_blocks = false;
 };

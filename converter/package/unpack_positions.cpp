@@ -16,6 +16,7 @@
 #include "format/base/parallel.h"
 #include "format/streamline_length.h"
 #include "format/vxlz_draco.h"
+#include "format/vxlz_layout.h"
 #include "format/vxlz_quantize.h"
 
 namespace vxl {
@@ -298,6 +299,23 @@ double write_positions_in_blocks(const VxlzFile& f, const UnpackStructure& s, co
   }
   blocks.check_complete();
   return largest_packing_bound(s.voxels);
+}
+
+std::uint64_t open_block_staging_bytes(const UnpackStructure& s, const PackSection& pack, std::uint64_t staging_bytes) {
+  const std::uint32_t levels = s.level_count;
+  // The shipped depth whose points fill output depth d: in level order the coarsest shipped depth also fills the
+  // output's coarser ones; in streamline order every depth fills at once (one group).
+  const bool level_order = pack.predictor == kVxlzPredictorLinearLevelOrder;
+  const auto group_of = [&](std::uint32_t d) { return level_order ? std::min(d, pack.level_count - 1) : 0u; };
+  std::vector<std::uint64_t> open(levels, 0);  // per group
+  for (std::size_t g = 0; g < s.voxels.size(); ++g) {
+    const VoxelEntry& v = s.voxels[g];
+    const std::span<const LevelEntry> row = level_row(s.levels, g, levels);
+    for (std::uint32_t d = 0; d < levels; ++d)
+      if (const std::uint64_t n = depth_end_vertex(v, row, d) - depth_first_vertex(row, d); n > 0)
+        open[group_of(d)] += DirectRegionWriter::staging_size(4 * n, staging_bytes);
+  }
+  return *std::max_element(open.begin(), open.end());
 }
 
 void scan_positions(const VxlzFile& f, UnpackStructure& s, VoxlineEnds& ends, std::span<float> lengths,

@@ -47,4 +47,10 @@ double write_positions_in_blocks(const VxlzFile& f, const UnpackStructure& s, co
                                  VxlStreamWriter& out, std::uint64_t staging_bytes,
                                  const std::function<void(double)>& progress);
 
+// The most memory the blocks' stagings of write_positions_in_blocks hold at once, with stagings of `staging_bytes`
+// (DirectRegionWriter::staging_size of each open block): in streamline order every block of every voxel is open from
+// its first point to its last; in level order only the blocks one shipped depth fills (`pack`: the package's order and
+// levels; s.level_count at least its levels).
+std::uint64_t open_block_staging_bytes(const UnpackStructure& s, const PackSection& pack, std::uint64_t staging_bytes);
+
 }  // namespace vxl

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 #include <sys/mman.h>
@@ -98,7 +99,8 @@ constexpr bool kWriteWindowsAreBuffers = false;
 FileWindow::FileWindow(int fd, const std::string& path, std::uint64_t offset, std::uint64_t size, Access access) {
   if (size == 0) return;
   if (kWriteWindowsAreBuffers && access == Access::Write) {
-    map_ = std::calloc(size, 1);  // what a writer has not written yet reads as zeros, as in a sized output
+    // What a writer has not written yet reads as zeros, as in a sized output.
+    map_ = size <= std::numeric_limits<std::size_t>::max() ? std::calloc(static_cast<std::size_t>(size), 1) : nullptr;
     if (map_ == nullptr)
       throw Error(ErrorKind::Output, path, std::nullopt,
                   "no memory for " + std::to_string(size) + " bytes of the output");
