@@ -38,7 +38,7 @@ namespace {
 
 // The stagings of VERT's blocks when it is written block by block (write_positions_in_blocks): within a conversion's
 // bounds, 128 KiB down to one 4 KiB block, the largest power of two whose stagings open at once take at most a
-// sixteenth of the memory allowed (the 1M package in level order within 256 MiB: 16 KiB, 15 MiB open at once). 0 where
+// sixteenth of the memory allowed (the 1M package in level order within 256 MiB: 16 KiB, 14 MiB open at once). 0 where
 // they would take more than a quarter of VERT and more than 16 MiB (many small voxels): holding VERT whole then costs
 // little more.
 std::uint64_t vertex_block_staging_bytes(const UnpackStructure& s, const PackSection& pack, std::uint64_t vert_bytes,
@@ -429,15 +429,14 @@ void let_go_of_decoding_tables(UnpackStructure& s, const PackageExtras& extras) 
   s.offset_in_voxel = std::vector<std::uint32_t>();
 }
 
-// Lets go of what only the positions and the tables after ORDB needed (the orders read the voxel and level tables
-// alone): for 1M streamlines about 120 MB, which the orders' buffers then reuse.
+// Then lets go of the rest the tables after ORDB needed (the orders read the voxel and level tables alone): for 1M
+// streamlines about 80 MB, which the orders' buffers then reuse.
 void let_go_of_voxline_tables(UnpackStructure& s, std::vector<float>& lengths, PackageExtras& extras) {
   // Assigned new vectors (`= {}` would clear them and keep their memory).
   s.strm = std::vector<std::uint64_t>();
   s.voxlines = std::vector<VoxlineEntry>();
-  s.starts_streamline = std::vector<std::uint8_t>();
+  s.starts_streamline = std::vector<std::uint8_t>();  // kept until now for point values
   s.offset_in_voxel = std::vector<std::uint32_t>();
-  s.order = ShippingOrder();
   lengths = std::vector<float>();
   extras = PackageExtras();
 }
