@@ -118,6 +118,7 @@ FIRST_PICTURE = """new Promise((resolve) => {
         png: canvas().toDataURL('image/png'), first_picture_ms: first, full_detail_ms: performance.now(),
         first_level: window.voxweb.info ? window.voxweb.info.first_level : null,
         full_level: window.voxweb.info ? window.voxweb.info.full_level : null,
+        level_offset: window.voxweb.info ? window.voxweb.info.level_offset : null,
         mode: window.voxweb.mode ? window.voxweb.mode() : null,
         levels_shown: window.voxweb.levelsShown || [],
         spans_fetched: window.voxweb.spansFetched || [],
@@ -182,7 +183,8 @@ def capture_in(browser, url, out, timeout, drop=None, on_done=None):
     os.replace(out + '.part', out)
     report.update({'first_picture_ms': round(value['first_picture_ms'], 1),
                    'full_detail_ms': round(value['full_detail_ms'], 1), 'first_level': value['first_level'],
-                   'full_level': value.get('full_level'), 'mode': value.get('mode'),
+                   'full_level': value.get('full_level'), 'level_offset': value.get('level_offset'),
+                   'mode': value.get('mode'),
                    'levels_shown': value['levels_shown'], 'spans_fetched': value.get('spans_fetched', []),
                    'mixed_shown': value.get('mixed_shown', []),
                    'looks': value.get('looks', []),

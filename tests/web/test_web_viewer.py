@@ -24,6 +24,7 @@ import gzip
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -144,17 +145,22 @@ def main():
             f.write(package)
 
         # Each case: the file shared, the page's settings (voxview's options of the same names), the server, and
-        # a GPU memory budget (?gpu=, voxview's --gpu-memory) or None. 16M holds level 1 of the 50k set, not full
+        # what the page may hold: None, or a GPU memory budget (gpu=SIZE, voxview's --gpu-memory). 16M holds level 1
+        # of the 50k set, not full
         # detail: the page then draws level 1 at rest, as voxview does (at a low opacity: a coarse level's few lines,
         # their opacity compensated, make the two rasterisers' differences count more than a dense picture's), and
         # fetches only what level 1 reads, unless a setting reads the whole file (unsorted: then it fetches the rest).
+        # Or the page's memory (memory=SIZE): a file larger than it is drawn from a level image of its coarser
+        # levels (6M holds the 50k set's level 1 and the coarser ones, not its 33.9 MB), as voxview --level draws
+        # that level, fetching only what the image holds.
         cases = [('packed.vxl', 'mode=axis', RangeHandler, None), ('packed.vxl', 'mode=unsorted', QuietHandler, None),
                  ('float32.vxl', 'mode=axis', RangeHandler, None),
                  ('float32.vxl', 'mode=unsorted', FirstRangeHandler, None),
                  ('packed.vxlz', 'mode=axis', WholeForSeveralHandler, None),
                  ('s50k.vxl', 'mode=axis', RangeHandler, None),
-                 ('s50k.vxl', 'mode=axis&opacity=0.02', RangeHandler, '16M'),
-                 ('s50k.vxl', 'mode=unsorted&opacity=0.02', RangeHandler, '16M'),
+                 ('s50k.vxl', 'mode=axis&opacity=0.02', RangeHandler, 'gpu=16M'),
+                 ('s50k.vxl', 'mode=unsorted&opacity=0.02', RangeHandler, 'gpu=16M'),
+                 ('s50k.vxl', 'mode=axis&opacity=0.02', RangeHandler, 'memory=6M'),
                  ('s50k.vxlz', 'mode=axis', SlowHandler, None)]
         tracks, afd = (os.path.join(options.real_data, f) for f in ('test_data__tracks.tck', 'test_data__afd.tsf'))
         if os.path.isfile(tracks) and os.path.isfile(afd):
@@ -179,7 +185,9 @@ def main():
         served_by = {RangeHandler: 'ranges', FirstRangeHandler: 'first range only', QuietHandler: 'no ranges',
                      SlowHandler: f'ranges, {SLOW_BYTES_PER_S / 1e6:g} MB/s',
                      GzipHandler: 'gzip, no ranges', WholeForSeveralHandler: 'one range, or the whole file for several'}
-        for source, settings, handler, budget in cases:
+        for source, settings, handler, holds in cases:
+            budget = holds[len('gpu='):] if holds and holds.startswith('gpu=') else None
+            memory = holds[len('memory='):] if holds and holds.startswith('memory=') else None
             folder = path('share-' + source.replace('.', '-'))
             shared = json.load(open(os.path.join(folder, 'share.json')))['file']
             server = Server(folder, handler)
@@ -187,7 +195,7 @@ def main():
             RangeHandler.rate = SLOW_BYTES_PER_S if handler is SlowHandler else 0
             try:
                 web = path(f'web-{source}-{settings}.png')
-                query = f'size={SIZE}' + (f'&gpu={budget}' if budget else '')
+                query = f'size={SIZE}' + (f'&{holds}' if holds else '')
                 report = capture(f'{server.url}index.html?{query}#{settings}', web)
             finally:
                 server.close()
@@ -221,19 +229,23 @@ def main():
             # orders, the voxel tables); the whole file only for a setting that reads it.
             whole = 'unsorted' in settings
             fetched_as_it_should = RangeHandler.bytes_sent >= size if whole else RangeHandler.bytes_sent <= size // 4
-            if budget and not fetched_as_it_should:
-                failures.append(f'{source} {settings}, GPU budget {budget}: {RangeHandler.bytes_sent} of its {size} '
+            if holds and not fetched_as_it_should:
+                failures.append(f'{source} {settings}, {holds}: {RangeHandler.bytes_sent} of its {size} '
                                 'bytes fetched (under a quarter of it, the whole file only for a setting that reads it)')
             wanted_mode = dict(kv.split('=') for kv in settings.split('&')).get('mode')
             if wanted_mode and report.get('mode') != wanted_mode:
                 failures.append(f'{source} {settings}: drawn in {report.get("mode")}, not {wanted_mode}')
             levels = (report['first_level'], report['levels_shown'], report['full_level'])
-            if source == 's50k.vxl' and levels != ((2, [], 1) if budget else (2, [1], 0)):
+            # A level image's levels are its own: its level 0 is the file's level_offset.
+            if memory and (report['level_offset'] != 1 or levels != (1, [], 0)):
+                failures.append(f'{source}, memory {memory}: a level image of level {report["level_offset"]} '
+                                f'(not 1), its levels {levels} (not a first picture at its level 1, then its level 0)')
+            elif source == 's50k.vxl' and not memory and levels != ((2, [], 1) if budget else (2, [1], 0)):
                 failures.append(f's50k.vxl, GPU budget {budget}: first picture at level {levels[0]}, then levels '
                                 f'{levels[1]} drawn before level {levels[2]} at rest')
             # Full detail fetched span by span, those the view needs first, each group the nearest first.
             spans = report['spans_fetched']
-            if handler is RangeHandler and not budget and report['first_level'] > report['full_level'] == 0:
+            if handler is RangeHandler and not holds and report['first_level'] > report['full_level'] == 0:
                 view = [s['distance'] for s in spans if s['in_view']]
                 rest = [s['distance'] for s in spans if not s['in_view']]
                 if (len(spans) < 2 or [s['in_view'] for s in spans] != [True] * len(view) + [False] * len(rest) or
@@ -249,10 +261,10 @@ def main():
                 failures.append(f'{source} {settings}: not fetched one range a request: {answers}')
             native = path(f'voxview-{source}-{settings}.png')
             flags = [x for kv in settings.split('&') for x in ('--' + kv.split('=')[0], kv.split('=')[1])]
-            flags += ['--gpu-memory', budget] if budget else []
+            flags += ['--level', '1'] if memory else ['--gpu-memory', budget] if budget else []
             run(options.voxview, os.path.join(folder, shared), '--render', native, '--size', SIZE, *flags)
             value = psnr_rgb(web, native)
-            served = f' ({served_by[handler]}' + (f', GPU budget {budget})' if budget else ')')
+            served = f' ({served_by[handler]}' + (f', {holds})' if holds else ')')
             print(f'{source}{served} {settings}: PSNR {value:.2f} dB against voxview, first picture after '
                   f'{report["first_picture_ms"]:.0f} ms, full detail after {report["full_detail_ms"]:.0f} ms; '
                   f'range answers {answers}, {RangeHandler.bytes_sent} of {size} bytes; full detail in '
@@ -304,19 +316,29 @@ def main():
                 failures.append(f'{what} in the page: {report}')
             else:
                 print(f'{what} in the page: {report["error"]}')
+            return report.get('error', '')
 
         shutil.copy(path('float32.vxl'), folder)
         expect_refused('a file changed on the server while fetched', 'file=changed.vxl', 'changed on the server',
                        ChangingHandler)
+        refused = {}
         for name in ('damaged.vxl', 'ordb-damaged.vxl', 'vert-damaged.vxl'):
             shutil.copy(path(name), folder)
-            expect_refused(name, f'file={name}', name)
+            refused[name] = expect_refused(name, f'file={name}', name)
+        # The same damage drawn from a level image (11M holds the 20k set's level 0 without its streamline tables, not
+        # the whole file): refused as well, naming the byte of the file it lies in, not the image's.
+        for name in ('ordb-damaged.vxl', 'vert-damaged.vxl'):
+            byte = re.search(r'at byte \d+', refused[name])
+            expect_refused(f'{name} as a level image', f'file={name}&memory=11M',
+                           f'{name}: {byte.group(0)}: ' if byte else 'no byte named without the image')
         shutil.copy(path('damaged.vxlz'), folder)
         expect_refused('damaged.vxlz', 'file=damaged.vxlz', 'damaged.vxlz: at byte')
 
         # A GPU memory budget that is not a size, and one that not even the coarsest level fits: refused, saying so.
         for budget, expected in (('lots', "'lots' is not a size of memory"), ('1K', 'does not fit the GPU memory budget')):
             expect_refused(f'GPU budget {budget}', f'file=packed.vxl&gpu={budget}', expected)
+        # A page memory that not even the coarsest level's image fits: refused, saying so.
+        expect_refused('page memory 4K', 'file=packed.vxl&memory=4K', 'coarsest level of detail')
 
     for f in failures:
         print('FAILED: ' + f)

@@ -26,6 +26,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -41,6 +42,7 @@
 #include "format/base/memory_size.h"
 #include "format/vxl_fetch_plan.h"
 #include "format/vxl_file.h"
+#include "format/vxl_level_image.h"
 #include "format/vxl_levels.h"
 #include "viewer/app/camera_controller.h"
 #include "viewer/app/frame_budget.h"
@@ -72,9 +74,14 @@ struct Viewer {
     return s;
   }();
   int width = 1, height = 1;
-  // The file is one level of detail of a package alone (the first look while the rest arrives, vw_set
-  // "package-level"): drawn with that level's opacity, so that it looks as bright as the whole will.
-  std::uint32_t package_level = 0;
+  // The file's level 0 is level `level_of_whole` of a larger whole (a package's first look while the rest arrives,
+  // vw_set "package-level"; a level image of a file too large for the page, vw_open_image): drawn with that
+  // level's opacity, so that it looks as bright as the whole.
+  std::uint32_t level_of_whole = 0;
+  // A level image (vxl_level_image.h): where its vertex and order bytes lie in the file fetched, and the file's META.
+  bool image = false;
+  std::vector<ImagePlacement> image_data;
+  MetaSection file_meta{};
   std::uint64_t gpu_budget = 0;   // bytes; 0: none (vw_set_gpu_budget)
   std::uint32_t full_level = 0;   // the level drawn at rest: the finest within gpu_budget
   std::uint32_t first_level = 0;  // the first picture's level of detail
@@ -118,7 +125,9 @@ void close(Viewer& v) {
   v.drawn_uploaded = 0;
   v.drawn_mixed = false;
   v.drawn_full = false;
-  v.package_level = 0;
+  v.level_of_whole = 0;
+  v.image = false;
+  v.image_data.clear();
 }
 
 // Whether the buffer holds the whole file (fetched whole, or every range fetched).
@@ -130,6 +139,30 @@ bool complete(const Viewer& v) {
 std::vector<ByteRange>& planned_ranges() {
   static std::vector<ByteRange> ranges;
   return ranges;
+}
+
+// `ranges` of the open file as the page fetches them (JSON [[begin, end], ...]): of a level image, where its bytes lie
+// in the file fetched, merged where less than `gap` apart.
+nlohmann::json ranges_to_fetch(const Viewer& v, std::span<const ByteRange> ranges, std::uint64_t gap) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const ByteRange& r :
+       v.image ? source_ranges(v.image_data, ranges, gap) : std::vector<ByteRange>(ranges.begin(), ranges.end()))
+    j.push_back({r.begin, r.end});
+  return j;
+}
+
+// An error about a level image's bytes, said of the file fetched: the byte the image's came from, else the image's
+// own (a table it rewrote), and the image's voxel numbers named as such.
+std::string said_of_the_file(const Viewer& v, const Error& e) {
+  if (!v.image || !v.file || !e.offset() || e.file() != v.file->path()) return e.what();
+  const std::uint64_t at = *e.offset();
+  const std::string image = "level " + std::to_string(v.level_of_whole) + " image";
+  const auto p = std::partition_point(v.image_data.begin(), v.image_data.end(),
+                                      [&](const ImagePlacement& q) { return q.at + q.size <= at; });
+  if (p != v.image_data.end() && p->at <= at)
+    return e.file() + ": at byte " + std::to_string(p->source + (at - p->at)) + ": " + e.reason() + " (voxels as the " +
+           image + " numbers them)";
+  return e.file() + ": at byte " + std::to_string(at) + " of its " + image + ": " + e.reason();
 }
 
 std::string& last_error() {
@@ -145,7 +178,7 @@ int guarded(Fn&& fn) {
     last_error().clear();
     return 0;
   } catch (const Error& e) {
-    last_error() = e.what();
+    last_error() = said_of_the_file(viewer(), e);
     return static_cast<int>(e.kind());
   } catch (const std::exception& e) {
     last_error() = e.what();
@@ -306,6 +339,13 @@ void show_file(Viewer& v) {
   v.controller->set_window_height(v.height);
 }
 
+// Why a level image cannot draw `what` (it reads the streamline tables, which the image has not).
+Error not_in_image(const Viewer& v, const std::string& what) {
+  return Error(ErrorKind::Unsupported, v.file->path(), std::nullopt,
+               what + " reads the streamline tables, which a file this large leaves out in the page (it draws level " +
+                   std::to_string(v.level_of_whole) + " and coarser, sorted by voxels)");
+}
+
 // What the renderers have on the GPU.
 std::uint64_t gpu_bytes(const Viewer& v) {
   std::uint64_t bytes = 0;
@@ -341,6 +381,13 @@ void describe(Viewer& v, nlohmann::json& j) {
     j["full_spans_in"] =
         v.spans_arriving ? static_cast<std::size_t>(std::count(v.span_in.begin(), v.span_in.end(), true)) : spans;
     j["mixed"] = v.drawn_mixed;
+    // A level image: its level 0 is the file's level_offset, the file's own counts beside the image's.
+    j["image"] = v.image;
+    j["level_offset"] = v.image ? v.level_of_whole : 0;
+    if (v.image) {
+      j["streamlines"] = v.file_meta.streamline_count;
+      j["file_vertices"] = v.file_meta.vertex_count;
+    }
     j["values"] = r.value_set_names();
     nlohmann::json groups = nlohmann::json::array();
     for (std::size_t g = 0; g < r.groups().groups().size(); ++g) {
@@ -357,7 +404,8 @@ void describe(Viewer& v, nlohmann::json& j) {
   }
   nlohmann::json modes = nlohmann::json::array();
   for (const RenderModeInfo& m : render_modes())
-    if (drawable_on_the_web(m.mode)) modes.push_back({{"name", m.name}, {"description", m.description}});
+    if (drawable_on_the_web(m.mode) && !(v.image && m.mode == RenderMode::Unsorted))
+      modes.push_back({{"name", m.name}, {"description", m.description}});
   j["modes"] = modes;
 }
 
@@ -401,18 +449,31 @@ EMSCRIPTEN_KEEPALIVE int vw_open(std::uint8_t* bytes, double size, const char* n
 
 // Fetching by ranges. `first`: the file's first `first_size` bytes (at least vxl::kSectionTableBytesMax, or the
 // whole file if shorter) of `file_size`. What the reader needs to open the file, as JSON [[begin, end], ...]
-// (end exclusive), or {"error": ...}; the page fetches them into a buffer of the file's size, then vw_open.
+// (end exclusive), or {"error": ...}; the page fetches them into a buffer of the file's size, then vw_open. A file
+// larger than `max_bytes` (the most of it the page may hold) is drawn from a level image (vxl_level_image.h): then
+// {"image": [[begin, end], ...], "bytes": N}, the tables the image is made from, which the page fetches into a
+// buffer of N bytes one after another, then vw_open_image.
 EMSCRIPTEN_KEEPALIVE const char* vw_plan_open(const std::uint8_t* first, double first_size, double file_size,
-                                              const char* name) {
+                                              const char* name, double max_bytes) {
   static std::string text;
   nlohmann::json j = nlohmann::json::array();
   std::vector<vxl::ByteRange> ranges;
+  const std::span<const std::uint8_t> first_bytes{first, static_cast<std::size_t>(first_size)};
+  const bool image = file_size > max_bytes;
   const int error = guarded([&] {
-    ranges =
-        vxl::ranges_to_open(name, {first, static_cast<std::size_t>(first_size)}, static_cast<std::uint64_t>(file_size));
+    ranges = image ? vxl::ranges_for_level_image(name, first_bytes, static_cast<std::uint64_t>(file_size))
+                   : vxl::ranges_to_open(name, first_bytes, static_cast<std::uint64_t>(file_size));
   });
   if (error != 0) {
     j = {{"error", vxl::web::last_error()}};
+  } else if (image) {
+    std::uint64_t bytes = 0;
+    nlohmann::json tables = nlohmann::json::array();
+    for (const vxl::ByteRange& r : ranges) {
+      tables.push_back({r.begin, r.end});
+      bytes += r.end - r.begin;
+    }
+    j = {{"image", tables}, {"bytes", bytes}};
   } else {
     const auto held = static_cast<std::uint64_t>(first_size);
     for (const vxl::ByteRange& r : ranges)
@@ -422,6 +483,49 @@ EMSCRIPTEN_KEEPALIVE const char* vw_plan_open(const std::uint8_t* first, double 
   }
   text = j.dump();
   return text.c_str();
+}
+
+// Opens a level image (vw_plan_open's "image"): the finest level of the file, of `file_size` bytes, whose image
+// takes at most `max_bytes`, made from `tables` (from malloc, freed by the viewer, also on failure; the bytes of
+// vw_plan_open's ranges one after another). Its bytes are then fetched as a file's (vw_level_ranges, ...), placed in
+// it as vw_placement says.
+EMSCRIPTEN_KEEPALIVE int vw_open_image(std::uint8_t* tables, double size, const char* name, double file_size,
+                                       double max_bytes, int width, int height) {
+  auto gathered = vxl::MappedFile::adopt(name, tables, static_cast<std::size_t>(size));
+  return guarded([&] {
+    auto& v = viewer();
+    vxl::web::close(v);
+    try {
+      vxl::LevelImage image = vxl::make_level_image(name, gathered.bytes(), static_cast<std::uint64_t>(file_size),
+                                                    static_cast<std::uint64_t>(max_bytes));
+      { const vxl::MappedFile done = std::move(gathered); }  // the tables' bytes, before the image's are fetched
+      vxl::web::open_file(v, std::move(image.bytes), width, height);
+      v.held = std::move(image.written);
+      v.image = true;
+      v.image_data = std::move(image.data);
+      v.file_meta = image.file_meta;
+      v.level_of_whole = image.level;
+    } catch (...) {
+      vxl::web::close(v);
+      throw;
+    }
+  });
+}
+
+// Where the ranges the page fetches go in the open file's buffer (vw_file_pointer): for a level image, JSON [[begin,
+// end, at], ...], the file's bytes [begin, end) to `at` in the image, sorted; [] when the buffer is the file's own.
+EMSCRIPTEN_KEEPALIVE const char* vw_placement() {
+  static std::string text;
+  nlohmann::json j = nlohmann::json::array();
+  for (const vxl::ImagePlacement& p : viewer().image_data) j.push_back({p.source, p.source + p.size, p.at});
+  text = j.dump();
+  return text.c_str();
+}
+
+// The open file's buffer (its address in the WebAssembly memory), which the page fills as ranges arrive.
+EMSCRIPTEN_KEEPALIVE double vw_file_pointer() {
+  const auto& v = viewer();
+  return v.file ? double(reinterpret_cast<std::uintptr_t>(v.file->bytes().data())) : 0;
 }
 
 // The ranges level `level` needs (the first picture's: -1) that the buffer does not hold yet (JSON, as
@@ -436,7 +540,7 @@ EMSCRIPTEN_KEEPALIVE const char* vw_level_ranges(int level, double gap) {
     const std::vector<vxl::ByteRange> wanted =
         vxl::ranges_of_level(*v.file, wanted_level, static_cast<std::uint64_t>(gap));
     v.asked = vxl::ranges_intersection(wanted, vxl::ranges_missing(v.held, v.file->bytes().size()));
-    for (const vxl::ByteRange& r : v.asked) j.push_back({r.begin, r.end});
+    j = vxl::web::ranges_to_fetch(v, v.asked, static_cast<std::uint64_t>(gap));
   }
   text = j.dump();
   return text.c_str();
@@ -451,8 +555,10 @@ EMSCRIPTEN_KEEPALIVE const char* vw_missing_ranges(double piece) {
   if (v.file) {
     const auto step = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(piece));
     v.asked = vxl::ranges_missing(v.held, v.file->bytes().size());
-    for (const vxl::ByteRange& r : v.asked)
-      for (std::uint64_t at = r.begin; at < r.end; at += step) j.push_back({at, std::min(r.end, at + step)});
+    for (const nlohmann::json& r : vxl::web::ranges_to_fetch(v, v.asked, 0)) {
+      const auto begin = r[0].get<std::uint64_t>(), end = r[1].get<std::uint64_t>();
+      for (std::uint64_t at = begin; at < end; at += step) j.push_back({at, std::min(end, at + step)});
+    }
   }
   text = j.dump();
   return text.c_str();
@@ -507,7 +613,7 @@ EMSCRIPTEN_KEEPALIVE const char* vw_next_ranges(double gap, double batch) {
       if (double(bytes) >= batch) break;
     }
     v.asked = vxl::ranges_intersection(vxl::merge_ranges(std::move(wanted), static_cast<std::uint64_t>(gap)), missing);
-    for (const vxl::ByteRange& r : v.asked) ranges.push_back({r.begin, r.end});
+    ranges = vxl::web::ranges_to_fetch(v, v.asked, static_cast<std::uint64_t>(gap));
   }
   text = nlohmann::json{{"ranges", ranges}, {"spans", spans}}.dump();
   return text.c_str();
@@ -570,6 +676,7 @@ EMSCRIPTEN_KEEPALIVE int vw_set(const char* key_text, const char* value_text) {
         throw vxl::Error(vxl::ErrorKind::Unsupported, "", std::nullopt,
                          "the " + value + " mode needs storage buffers or compute shaders, which WebGL2 lacks");
       // It draws in the streamlines' order, from the voxline and streamline tables.
+      if (*mode == vxl::RenderMode::Unsorted && v.image) throw vxl::web::not_in_image(v, "the unsorted mode");
       if (*mode == vxl::RenderMode::Unsorted && !vxl::web::complete(v))
         throw vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt, "the unsorted mode waits for the whole file");
       v.settings.mode = *mode;
@@ -577,6 +684,8 @@ EMSCRIPTEN_KEEPALIVE int vw_set(const char* key_text, const char* value_text) {
       const auto color = vxl::parse_color_mode(value);
       if (!color) throw bad();
       // Values and groups are read per vertex from the voxline and streamline tables.
+      if ((*color == vxl::ColorMode::Scalar || *color == vxl::ColorMode::Group) && v.image)
+        throw vxl::web::not_in_image(v, "colouring by " + value);
       if ((*color == vxl::ColorMode::Scalar || *color == vxl::ColorMode::Group) && !vxl::web::complete(v))
         throw vxl::Error(vxl::ErrorKind::Usage, "", std::nullopt,
                          "colouring by " + value + " waits for the whole file");
@@ -602,7 +711,7 @@ EMSCRIPTEN_KEEPALIVE int vw_set(const char* key_text, const char* value_text) {
     } else if (key == "package-level") {
       const long level = std::strtol(value.c_str(), nullptr, 10);
       if (!(level >= 0 && level < static_cast<long>(vxl::kMaxLevels)) || !v.file) throw bad();
-      v.package_level = static_cast<std::uint32_t>(level);
+      v.level_of_whole = static_cast<std::uint32_t>(level);
     } else if (key == "lighting") {
       v.settings.lighting = value == "1";
     } else if (key == "view") {
@@ -748,7 +857,7 @@ EMSCRIPTEN_KEEPALIVE int vw_draw(int width, int height, int moving) {
     v.drawn_full = !moving && renderer == v.full.get() && !stand_in;
     if (v.full) v.drawn_uploaded = v.full->gpu_bytes();
     vxl::RenderSettings settings = v.settings;
-    if (v.package_level > 0) settings.opacity = vxl::SceneLayout::level_opacity(settings.opacity, v.package_level);
+    if (v.level_of_whole > 0) settings.opacity = vxl::SceneLayout::level_opacity(settings.opacity, v.level_of_whole);
     if (renderer == v.quick.get() || !v.quick) {
       renderer->draw(v.controller->camera(), settings, v.width, v.height, 0);
       renderer->check_uploaded(false);

@@ -26,6 +26,10 @@
   // (navigator.deviceMemory, at most 8 GiB), as voxview takes a quarter where the driver reports none: WebGL
   // reports no GPU memory. 1 GiB where the browser reports nothing either.
   const gpuBudget = params.get('gpu') || `${Math.round((navigator.deviceMemory || 4) * 256)}M`;
+  // The most of a file the page holds (?memory=SIZE: 512M, 2G): a larger file fetched by ranges is drawn from its
+  // coarser levels, as a .vxl of their own that fits (a level image); at most what the WebAssembly memory holds.
+  const memoryParam = /^(\d+(?:\.\d+)?)([KMG]?)$/i.exec(params.get('memory') || '');
+  const memoryLimit = memoryParam ? Number(memoryParam[1]) * 1024 ** ' KMG'.indexOf((memoryParam[2] || ' ').toUpperCase()) : Infinity;
 
   // window.voxweb.ready: resolved after the first frame of a file, rejected on its error; .complete: after the
   // first frame at full detail (the first may be drawn at a coarser level).
@@ -64,7 +68,10 @@
     mark('wasm ready');
     const api = {
       open: Module.cwrap('vw_open', 'number', ['number', 'number', 'string', 'number', 'number', 'number']),
-      planOpen: Module.cwrap('vw_plan_open', 'string', ['number', 'number', 'number', 'string']),
+      planOpen: Module.cwrap('vw_plan_open', 'string', ['number', 'number', 'number', 'string', 'number']),
+      openImage: Module.cwrap('vw_open_image', 'number', ['number', 'number', 'string', 'number', 'number', 'number', 'number']),
+      placement: Module.cwrap('vw_placement', 'string', []),
+      filePointer: Module.cwrap('vw_file_pointer', 'number', []),
       levelRanges: Module.cwrap('vw_level_ranges', 'string', ['number', 'number']),
       showLevel: Module.cwrap('vw_show_level', 'number', ['number']),
       missingRanges: Module.cwrap('vw_missing_ranges', 'string', ['number']),
@@ -359,12 +366,19 @@
       }
       fullDetail = true;
       const info = JSON.parse(api.info());
-      const atRest = info.full_level === 0 ? 'full detail follows'
-        : `level ${info.full_level} follows, the finest whose copy fits the GPU memory budget of ${gpuBudget} (?gpu= sets it)`;
-      say($('status').textContent + `\nfirst picture at level ${info.first_level} (1/${8 ** info.first_level} of the ` +
-          `streamlines); ${atRest}`);
+      const first = info.first_level + info.level_offset;
+      const why = info.full_level > 0 ? `, the finest whose copy fits the GPU memory budget of ${gpuBudget} (?gpu= sets it)`
+        : info.image ? `, the finest the page's memory holds of this file (?memory= sets it)` : '';
+      say($('status').textContent + `\nfirst picture at level ${first} (1/${8 ** first} of the streamlines); ` +
+          `${atRestName(info)} follows${why}`);
       redraw();
       return true;
+    }
+
+    // What is drawn at rest: full detail, or the level the GPU budget or the page's memory allows.
+    function atRestName(info) {
+      const level = info.full_level + info.level_offset;
+      return level === 0 ? 'full detail' : `level ${level}`;
     }
 
     // The view in the address: #az=..&el=..&distance=..&target=x,y,z&mode=..&opacity=..&color=..
@@ -616,8 +630,12 @@
       const info = JSON.parse(api.info());
       window.voxweb.info = info;
       fullDetail = info.full_detail;
-      $('info').textContent = `${info.streamlines.toLocaleString()} streamlines, ` +
-        `${info.vertices.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`;
+      $('info').textContent = info.image
+        ? `${info.streamlines.toLocaleString()} streamlines, drawn from level ${info.level_offset} (about ` +
+          `1/${8 ** info.level_offset} of them; the file is larger than the page holds): ` +
+          `${info.vertices.toLocaleString()} of its ${info.file_vertices.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`
+        : `${info.streamlines.toLocaleString()} streamlines, ` +
+          `${info.vertices.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`;
       $('mode').replaceChildren(...info.modes.map((m) => {
         const o = document.createElement('option');
         o.value = m.name;
@@ -684,8 +702,24 @@
     // never held whole: a page fetching a large file in 32 MiB requests would otherwise hold them until collected).
     // Each sink checks a part's place in the file before writing a byte of it; end() gives the parts written,
     // [[begin, end, the file's size or null], ...].
+    // A level image's buffer takes only some of the file's bytes, each where target.place says ([[begin, end, at],
+    // ...] sorted: the file's bytes [begin, end) to `at`): the others (between ranges merged into one request) are
+    // dropped.
     function copyInto(target, at, bytes) {
-      Module.HEAPU8.set(bytes, target.pointer + at);
+      const place = target.place;
+      if (!place) return Module.HEAPU8.set(bytes, target.pointer + at);
+      const end = at + bytes.length;
+      let lo = 0, hi = place.length;
+      while (lo < hi) {
+        const mid = (lo + hi) >> 1;
+        if (place[mid][1] <= at) lo = mid + 1;
+        else hi = mid;
+      }
+      for (let i = lo; i < place.length && place[i][0] < end; ++i) {
+        const [begin, until, to] = place[i];
+        const from = Math.max(begin, at), stop = Math.min(until, end);
+        if (from < stop) Module.HEAPU8.set(bytes.subarray(from - at, stop - at), target.pointer + to + (from - begin));
+      }
     }
     // The whole file (a 200 answer), or one range ([begin, end) of `total`).
     function rangeSink(target, begin, end, total, wrong) {
@@ -853,13 +887,66 @@
       if (!(await readBody(response.body, sink, target))) return null;
       const got = sink.end();
       for (const [begin, end] of got) target.received += end - begin;
-      $('progress').value = Math.min(1, target.received / target.size);
+      $('progress').value = Math.min(1, target.received / (target.total || target.size));
       return got;
     }
     // Fetches `ranges` and tells the viewer they are in (vw_arrived); false when another file was opened meanwhile.
     async function bring(target, ranges) {
       if (!(await fetchRanges(target, ranges))) return false;
       api.arrived();
+      return true;
+    }
+    // Fetches what the reader needs to open the file (`plan`, vw_plan_open's ranges) into a buffer of the file's size,
+    // and opens it; false when it failed (and said why) or another file was opened meanwhile.
+    async function openFetched(target, first, plan) {
+      const { name, size } = target;
+      target.pointer = allocate(size, name);
+      Module.HEAPU8.set(first, target.pointer);
+      target.received = first.length;
+      let ok;
+      try {
+        ok = await fetchRanges(target, plan);
+      } catch (err) {
+        Module._free(target.pointer);
+        throw err;
+      }
+      if (!ok) return Module._free(target.pointer), false;
+      mark('tables fetched');
+      const [w, h] = canvasSize();
+      // From here the viewer holds the buffer (and frees it).
+      if (api.open(target.pointer, size, name, w, h, 0) !== 0) return fail(api.error()), false;
+      return true;
+    }
+    // A file larger than the page holds: its tables (`plan.image`) fetched one after another into a buffer of
+    // `plan.bytes`, the level image made from them (vw_open_image), and its buffer then filled from the file where
+    // vw_placement says. False as openFetched.
+    async function openImage(target, first, plan, maxBytes) {
+      const { name, size } = target;
+      let at = 0;
+      target.place = plan.image.map(([begin, end]) => [begin, end, (at += end - begin) - (end - begin)]);
+      target.pointer = allocate(plan.bytes, name);
+      target.total = plan.bytes;
+      copyInto(target, 0, first);
+      target.received = first.length;
+      let ok;
+      try {
+        ok = await fetchRanges(target, plan.image.filter((r) => r[1] > first.length)
+          .map((r) => [Math.max(r[0], first.length), r[1]]));
+        // The image's bytes come by ranges too: a server that sent the whole file has sent them past.
+        if (ok && target.whole) throw new Error(`${target.url}: the server sent the whole file to a range request; a file this large needs one that answers ranges`);
+      } catch (err) {
+        Module._free(target.pointer);
+        throw err;
+      }
+      if (!ok) return Module._free(target.pointer), false;
+      mark('tables fetched');
+      const [w, h] = canvasSize();
+      // From here the viewer holds the tables' buffer (and frees it) and the image's.
+      if (api.openImage(target.pointer, plan.bytes, name, size, maxBytes, w, h) !== 0) return fail(api.error()), false;
+      target.pointer = api.filePointer();
+      target.place = JSON.parse(api.placement());
+      target.total = target.place.reduce((n, p) => n + p[1] - p[0], 0);
+      target.received = 0;
       return true;
     }
     // Opens a file by ranges, given the answer to its first request (206, the first bytes); draws the first
@@ -874,24 +961,11 @@
       if (isPackage(first)) return fetchWhole(target, await fetch(target.url));  // unpacked whole, so fetched whole
       const scratch = allocate(first.length, name);
       Module.HEAPU8.set(first, scratch);
-      const plan = JSON.parse(api.planOpen(scratch, first.length, size, name));
+      const maxBytes = Math.min(MAX_FILE_BYTES, memoryLimit);
+      const plan = JSON.parse(api.planOpen(scratch, first.length, size, name, maxBytes));
       Module._free(scratch);
       if (plan.error) return fail(plan.error);
-      target.pointer = allocate(size, name);
-      Module.HEAPU8.set(first, target.pointer);
-      target.received = first.length;
-      let ok;
-      try {
-        ok = await fetchRanges(target, plan);
-      } catch (err) {
-        Module._free(target.pointer);
-        throw err;
-      }
-      if (!ok) return Module._free(target.pointer);
-      mark('tables fetched');
-      const [w, h] = canvasSize();
-      // From here the viewer holds the buffer (and frees it).
-      if (api.open(target.pointer, size, name, w, h, 0) !== 0) return fail(api.error());
+      if (!(await (plan.image ? openImage(target, first, plan, maxBytes) : openFetched(target, first, plan)))) return;
       mark('opened');
       if (!(await bring(target, JSON.parse(api.levelRanges(-1, LEVEL_GAP))))) return;
       mark('first level fetched');
@@ -909,7 +983,8 @@
           if (!(await bring(target, JSON.parse(api.levelRanges(level, LEVEL_GAP))))) return false;
           if (api.showLevel(level) !== 0) throw new Error(`${name}: ${api.error()}`);
           window.voxweb.levelsShown.push(level);
-          say(`${name}: level ${level} (1/${8 ** level} of the streamlines) in; fetching the rest`);
+          const shownLevel = level + info.level_offset;
+          say(`${name}: level ${shownLevel} (1/${8 ** shownLevel} of the streamlines) in; fetching the rest`);
           redraw();
           await new Promise((resolve) => setTimeout(resolve, 0));  // its frame before the next fetch
           if (!current(target)) return false;
@@ -925,7 +1000,7 @@
           if (!next.spans.some((s) => s.in_view)) continue;  // the view does not draw them (yet): nothing to upload
           const now = JSON.parse(api.info());
           say(`${name}: ${now.full_spans_in} of the ${now.full_spans} parts of ` +
-              `${info.full_level === 0 ? 'full detail' : 'level ' + info.full_level} in, the nearest the view first`);
+              `${atRestName(info)} in, the nearest the view first`);
           uploadSoon();
         }
         // Any the renderer did not split into spans (a file fetched whole meanwhile has them all).
