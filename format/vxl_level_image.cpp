@@ -219,6 +219,16 @@ ImagePlan plan_image(const FileVoxels& f, std::uint32_t level, std::uint64_t pro
   return plan;
 }
 
+// The finest level whose image takes at most `max_bytes`, and its plan; the coarsest level's plan where none fits.
+ImagePlan finest_image_within(const FileVoxels& f, std::uint64_t provenance_bytes, std::uint64_t max_bytes,
+                              std::uint32_t& level) {
+  level = 0;
+  ImagePlan plan = plan_image(f, level, provenance_bytes);
+  while (plan.layout.file_size > max_bytes && level + 1 < f.level_count)
+    plan = plan_image(f, ++level, provenance_bytes);
+  return plan;
+}
+
 SectionEntry& entry(VxlLayout& layout, const char (&id)[5]) {
   for (SectionEntry& e : layout.table)
     if (id_of(e) == section_id(id)) return e;
@@ -303,9 +313,7 @@ LevelImage make_level_image(const std::string& path, std::span<const std::uint8_
   const FileVoxels f = read_file_voxels(tables);
   const std::uint64_t provenance_bytes = tables.find("PROV") ? tables.require("PROV").size : 0;
   std::uint32_t level = 0;
-  ImagePlan plan = plan_image(f, level, provenance_bytes);
-  while (plan.layout.file_size > max_bytes && level + 1 < f.level_count)
-    plan = plan_image(f, ++level, provenance_bytes);
+  ImagePlan plan = finest_image_within(f, provenance_bytes, max_bytes, level);
   if (plan.layout.file_size > max_bytes || plan.layout.file_size > std::numeric_limits<std::size_t>::max())
     throw Error(ErrorKind::Unsupported, path, std::nullopt,
                 "its coarsest level of detail (" + std::to_string(level) + ") takes " +
@@ -322,6 +330,20 @@ LevelImage make_level_image(const std::string& path, std::span<const std::uint8_
                                        {orders.offset, orders.offset + orders.size}};
   out.written = ranges_missing(to_come, plan.layout.file_size);
   return out;
+}
+
+std::optional<LevelImageSize> level_image_size(const VxlFile& file, std::uint64_t max_bytes) {
+  FileVoxels f;
+  f.meta = file.meta();
+  f.voxels = file.voxels();
+  f.level_count = file.level_count();
+  if (f.level_count > 1 && !f.voxels.empty())
+    f.levels = {file.levels_of(0).data(), f.voxels.size() * (f.level_count - 1)};
+  f.packing = file.order_packing();
+  std::uint32_t level = 0;
+  const ImagePlan plan = finest_image_within(f, file.provenance_json().size(), max_bytes, level);
+  if (plan.layout.file_size > max_bytes) return std::nullopt;
+  return LevelImageSize{level, plan.layout.file_size};
 }
 
 std::vector<ByteRange> source_ranges(std::span<const ImagePlacement> data, std::span<const ByteRange> image_ranges,

@@ -11,12 +11,14 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "format/base/mapped_file.h"
 #include "format/vxl_fetch_plan.h"
+#include "format/vxl_file.h"
 #include "format/vxl_layout.h"
 
 namespace vxl {
@@ -50,6 +52,14 @@ std::vector<ByteRange> ranges_for_level_image(const std::string& path, std::span
 // then checks the image as any file.
 LevelImage make_level_image(const std::string& path, std::span<const std::uint8_t> gathered, std::uint64_t file_size,
                             std::uint64_t max_bytes);
+
+// The level make_level_image chooses for `file` under `max_bytes`, and its image's size; nullopt where not even the
+// coarsest level's image fits. For a writer that tells whether a reader will draw the file, and from which level.
+struct LevelImageSize {
+  std::uint32_t level = 0;
+  std::uint64_t bytes = 0;
+};
+std::optional<LevelImageSize> level_image_size(const VxlFile& file, std::uint64_t max_bytes);
 
 // Where `image_ranges` (of the image's VERT and ORDB, sorted) lie in the file, merged where less than `gap` bytes lie
 // between two.

@@ -16,6 +16,7 @@
 #include "format/base/error.h"
 #include "format/vxl_file.h"
 #include "format/vxl_layout.h"
+#include "format/vxl_level_image.h"
 #include "test_support.h"
 #include "tests/hostile_inputs.h"
 #include "tests/reseal_checksums.h"
@@ -136,37 +137,50 @@ TEST(Share, ALevelOfDetailIsSharedAsAVxlOfItsStreamlines) {
   EXPECT_EQ(entries_named_part(t.dir), 0);
 }
 
-// The page holds its whole .vxl in WebAssembly's memory: a larger one is refused before anything is copied, naming
-// the level of detail that would fit, or a selection where even the coarsest would not; that level then is shared.
-TEST(Share, AVxlLargerThanTheBrowserHoldsIsRefusedNamingALevelThatFits) {
+// A .vxl larger than the page holds is shared as it is: the page draws it from the finest level whose level image
+// fits (the folder's README says so); refused, before anything is copied, only where not even the coarsest level's
+// fits, naming a selection.
+TEST(Share, AVxlLargerThanTheBrowserHoldsIsSharedForTheLevelsThatFit) {
   SharedTractogram t;
   const std::uint64_t size = fs::file_size(t.vxl);
+  const VxlFile file = VxlFile::open(t.vxl);
   ShareSettings settings;
   settings.web_viewer_dir = t.viewer;
   const std::string out = t.dir.file("shared");
-  auto refusal = [&](std::uint64_t max_bytes) {
+  for (const std::uint64_t max_bytes : {size, size - 1, size / 20}) {
     settings.max_data_bytes = max_bytes;
-    const Error e = test::hostile::error_of([&] { share_folder(t.vxl, out, settings); });
-    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
-    EXPECT_FALSE(fs::exists(out));
-    EXPECT_EQ(entries_named_part(t.dir), 0);
-    return std::string(e.what());
-  };
-  std::string why = refusal(size - 1);
+    const ShareSummary s = share_folder(t.vxl, out, settings);
+    EXPECT_EQ(s.data_bytes, size) << "the file as it is";
+    const std::optional<LevelImageSize> image = level_image_size(file, max_bytes);
+    ASSERT_TRUE(image.has_value());
+    EXPECT_LE(image->bytes, max_bytes);
+    const std::string readme = test::slurp<std::string>(out + "/README.txt");
+    if (max_bytes == size) {
+      EXPECT_FALSE(s.image_level.has_value());
+      EXPECT_EQ(readme.find("larger than a browser holds"), std::string::npos);
+    } else {
+      ASSERT_EQ(s.image_level, image->level);
+      EXPECT_NE(readme.find("its level of detail " + std::to_string(image->level)), std::string::npos) << readme;
+    }
+    if (max_bytes == size / 20) {
+      EXPECT_GE(image->level, 1u) << "level 0 without the streamline tables is not a 20th";
+    }
+    fs::remove_all(out);
+  }
+  settings.max_data_bytes = 8;
+  const Error e = test::hostile::error_of([&] { share_folder(t.vxl, out, settings); });
+  EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+  const std::string why = e.what();
   EXPECT_NE(why.find("in.vxl"), std::string::npos) << why;
-  EXPECT_NE(why.find("--level 1 keeps about 1/8 of the streamlines"), std::string::npos) << why;
-  why = refusal(size / 20);
-  EXPECT_NE(why.find("--level 2 keeps about 1/64"), std::string::npos) << why;
-  why = refusal(8);
+  EXPECT_NE(why.find("not even its coarsest level"), std::string::npos) << why;
   EXPECT_NE(why.find("voxlines select"), std::string::npos) << why;
-  settings.max_data_bytes = size - 1;
-  settings.level = 1;
-  EXPECT_LT(share_folder(t.vxl, out, settings).data_bytes, size);
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(entries_named_part(t.dir), 0);
 }
 
 // A package is shared as it is, and the page unpacks it: one whose .vxl the page could not hold is refused before
-// anything is copied (its size known from its tables), naming the level that fits; --unpack is refused alike, before it
-// unpacks.
+// anything is copied (its size known from its tables), naming --unpack and the level that fits; with --unpack it is
+// shared as a .vxl, which the page draws from the levels that fit.
 TEST(Share, APackageWhoseVxlIsLargerThanTheBrowserHoldsIsRefusedBeforeItIsCopied) {
   SharedTractogram t;
   const std::string vxlz = t.dir.file("in.vxlz"), out = t.dir.file("shared");
@@ -176,20 +190,23 @@ TEST(Share, APackageWhoseVxlIsLargerThanTheBrowserHoldsIsRefusedBeforeItIsCopied
   settings.unpack = true;
   const std::uint64_t unpacked = share_folder(vxlz, t.dir.file("unpacked"), settings).data_bytes;
   const std::uint64_t streamlines = VxlFile::open(t.vxl).meta().streamline_count;
-  for (bool unpack : {false, true}) {
-    settings.unpack = unpack;
-    settings.max_data_bytes = unpacked - 1;
-    const Error e = test::hostile::error_of([&] { share_folder(vxlz, out, settings); });
-    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
-    const std::string why = e.what();
-    EXPECT_NE(why.find("in.vxlz"), std::string::npos) << why;
-    EXPECT_NE(why.find("--level 1 keeps about 1/8 of the streamlines"), std::string::npos) << why;
-    EXPECT_FALSE(fs::exists(out));
-    EXPECT_EQ(entries_named_part(t.dir), 0);
-    settings.max_data_bytes = unpacked;  // the limit is the unpacked .vxl's size, not the package's
-    EXPECT_EQ(share_folder(vxlz, out, settings).streamlines, streamlines);
-    fs::remove_all(out);
-  }
+  settings.max_data_bytes = unpacked - 1;
+  const ShareSummary as_vxl = share_folder(vxlz, out, settings);
+  EXPECT_TRUE(as_vxl.unpacked);
+  EXPECT_EQ(as_vxl.image_level, level_image_size(VxlFile::open(out + "/in.vxl"), unpacked - 1)->level);
+  fs::remove_all(out);
+  settings.unpack = false;
+  const Error e = test::hostile::error_of([&] { share_folder(vxlz, out, settings); });
+  EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+  const std::string why = e.what();
+  EXPECT_NE(why.find("in.vxlz"), std::string::npos) << why;
+  EXPECT_NE(why.find("--unpack"), std::string::npos) << why;
+  EXPECT_NE(why.find("--level 1 keeps about 1/8 of the streamlines"), std::string::npos) << why;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(entries_named_part(t.dir), 0);
+  settings.max_data_bytes = unpacked;  // the limit is the unpacked .vxl's size, not the package's
+  EXPECT_EQ(share_folder(vxlz, out, settings).streamlines, streamlines);
+  fs::remove_all(out);
   // Refused before it is unpacked: a package whose positions unpack refuses (the last chunk's bytes changed behind
   // valid checksums) is refused for its size, not for its positions.
   std::vector<char> bytes = test::slurp(vxlz);

@@ -43,9 +43,11 @@ void add_share_command(CLI::App& app) {
   cmd->add_flag("--unpack", opt->settings.unpack,
                 "a .vxlz: write it unpacked, as a .vxl (about 8 times larger to host; the page then fetches a large\n"
                 "one by ranges and shows its first picture before the rest is in, where it fetches a .vxlz whole)");
-  cmd->add_option("--level", opt->settings.level,
-                  "share only the streamlines of this level of detail, as a .vxl (1: about an eighth, 2: a 64th...,\n"
-                  "spread over the whole tractogram): for one too large for a browser, which holds at most 3.75 GiB")
+  cmd->add_option(
+         "--level", opt->settings.level,
+         "share only the streamlines of this level of detail, as a .vxl (1: about an eighth, 2: a 64th...,\n"
+         "spread over the whole tractogram): a smaller file to host. Without it, a .vxl larger than a browser\n"
+         "holds (3.75 GiB) is drawn from the coarser levels that fit, fetched by ranges")
       ->type_name("N");
   cmd->add_option("--threads", opt->settings.threads,
                   "worker threads for unpacking a .vxlz (--unpack, --level; 0: all cores)")
@@ -59,6 +61,11 @@ void add_share_command(CLI::App& app) {
                                                 : "";
     std::printf("%s: %llu streamlines in %s (%.1f MiB%s); serve the folder and open index.html\n", opt->output.c_str(),
                 (unsigned long long)s.streamlines, s.data_file.c_str(), double(s.data_bytes) / (1 << 20), how.c_str());
+    if (s.image_level)
+      std::printf(
+          "larger than a browser holds: the page draws level %u and coarser (about 1/%llu of the streamlines), fetched "
+          "by ranges: serve it with a server that answers Range requests (most do; python3 -m http.server does not)\n",
+          *s.image_level, 1ull << (3 * *s.image_level));
   });
 }
 

@@ -17,6 +17,7 @@
 #include "format/base/memory_size.h"
 #include "format/vxl_file.h"
 #include "format/vxl_layout.h"
+#include "format/vxl_level_image.h"
 #include "format/vxl_levels.h"
 #include "format/vxlz_layout.h"
 #include "format/vxlz_package.h"
@@ -42,7 +43,14 @@ void write_text(const fs::path& path, const std::string& text) {
   if (!out.flush()) fail_output(path.string(), "cannot write it");
 }
 
-std::string readme(const std::string& title, const std::string& data_file) {
+std::string readme(const std::string& title, const std::string& data_file, std::optional<std::uint32_t> image_level) {
+  const std::string large =
+      image_level ? "The tractogram is larger than a browser holds: the page draws its level of detail " +
+                        std::to_string(*image_level) + " (about 1/" + std::to_string(1ull << (3 * *image_level)) +
+                        " of the streamlines,\nspread over the whole) and the coarser ones, fetching only their bytes. "
+                        "That needs a server that\nanswers HTTP Range requests (most do; python3 -m http.server does "
+                        "not).\n\n"
+                  : std::string();
   return "# " + title +
          "\n\n"
          "A tractogram to look at in a web browser, with correctly ordered transparency (Voxlines).\n\n"
@@ -53,34 +61,48 @@ std::string readme(const std::string& title, const std::string& data_file) {
          "In the page: drag to turn, right-drag (or shift-drag) to pan, the wheel to zoom. \"Copy link to\n"
          "this view\" puts the view in the address, so that whoever opens the link sees what you saw.\n"
          "A large tractogram is drawn in less detail where it would not fit the GPU: index.html?gpu=2G (or\n"
-         "512M...) says how much GPU memory the page may take.\n\n"
-         "The data is " +
-         data_file +
+         "512M...) says how much GPU memory the page may take.\n\n" +
+         large + "The data is " + data_file +
          " (the .vxl format, or a .vxlz package of it); the Voxlines tools (voxlines, voxview) read it\n"
          "and export it back to TCK or TRX.\n";
 }
 
-// A .vxl of `bytes` for the page, which holds its whole file in WebAssembly's memory: refused where that is too
-// small, naming the level of detail that would fit. The .vxl (a package's: unpacked) holds level `shared_level` of an
-// input of `levels` levels; each level holds about an eighth of the next finer one's streamlines, and its file shrinks
-// alike.
-void check_fits_the_page(const std::string& in_path, bool package, std::uint64_t bytes, std::uint32_t levels,
-                         std::uint32_t shared_level, const ShareSettings& settings) {
+// A package's .vxl of `bytes` for the page, which unpacks it whole in WebAssembly's memory: refused where that is
+// too small, naming --unpack (a .vxl larger than the page holds is drawn from its coarser levels) and the level of
+// detail that would fit. The .vxl has `levels` levels; each holds about an eighth of the next finer one's
+// streamlines, and its file shrinks alike.
+void check_package_fits_the_page(const std::string& in_path, std::uint64_t bytes, std::uint32_t levels,
+                                 const ShareSettings& settings) {
   if (bytes <= settings.max_data_bytes) return;
-  auto size_at = [&](std::uint32_t level) { return double(bytes) / std::pow(8.0, level - shared_level); };
-  std::uint32_t level = shared_level + 1;
+  auto size_at = [&](std::uint32_t level) { return double(bytes) / std::pow(8.0, level); };
+  std::uint32_t level = 1;
   while (level < levels && size_at(level) > 0.9 * double(settings.max_data_bytes)) ++level;
-  const std::string advice =
-      level < levels
-          ? "share a coarser level of detail: --level " + std::to_string(level) + " keeps about 1/" +
-                std::to_string(1ull << (3 * level)) + " of the streamlines, spread over the whole tractogram (some " +
-                format_memory_size(std::uint64_t(size_at(level))) + ")"
-          : std::string(package ? "unpack it and share a part of it (voxlines unpack, then voxlines select "
-                                : "share a part of it (voxlines select ") +
-                "IN.vxl OUT.vxl --include ROI ...)";
+  const std::string alone = level < levels ? ", or a coarser level of detail alone: --level " + std::to_string(level) +
+                                                 " keeps about 1/" + std::to_string(1ull << (3 * level)) +
+                                                 " of the streamlines, spread over the whole tractogram (some " +
+                                                 format_memory_size(std::uint64_t(size_at(level))) + ")"
+                                           : std::string();
   throw Error(ErrorKind::Unsupported, in_path, std::nullopt,
               "the .vxl to share is " + format_memory_size(bytes) + ", more than the web viewer holds (" +
-                  format_memory_size(settings.max_data_bytes) + " in a browser's WebAssembly memory): " + advice);
+                  format_memory_size(settings.max_data_bytes) +
+                  " in a browser's WebAssembly memory) to unpack a package: share it unpacked (--unpack: the page "
+                  "then draws the coarser levels of detail that fit, fetched by ranges)" +
+                  alone);
+}
+
+// The level of detail the page draws `file` from (a level image, vxl_level_image.h) where the file is larger than it
+// holds; nullopt where it holds the file. Refused where not even the coarsest level's image fits.
+std::optional<std::uint32_t> page_image_level(const std::string& in_path, const VxlFile& file,
+                                              const ShareSettings& settings) {
+  if (file.bytes().size() <= settings.max_data_bytes) return std::nullopt;
+  if (const auto image = level_image_size(file, settings.max_data_bytes)) return image->level;
+  throw Error(ErrorKind::Unsupported, in_path, std::nullopt,
+              "the .vxl to share is " + format_memory_size(file.bytes().size()) + "; the web viewer holds at most " +
+                  format_memory_size(settings.max_data_bytes) +
+                  " (a browser's WebAssembly memory) and draws a larger file from its coarser levels of detail, but "
+                  "not even its coarsest level (" +
+                  std::to_string(file.level_count() - 1) +
+                  ") fits: share a part of it (voxlines select IN.vxl OUT.vxl --include ROI ...)");
 }
 
 // The streamlines of `level` of `file` (those of depth >= level, spec §6.5), written to `out_path` as a .vxl; their
@@ -112,20 +134,17 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     data.replace_extension(".vxl");
     if (settings.level) {
       summary.streamlines = write_level(file, (staging / data).string(), *settings.level);
-      check_fits_the_page(in_path, false, fs::file_size(staging / data), file.level_count(), *settings.level, settings);
+      summary.image_level = page_image_level(in_path, VxlFile::open((staging / data).string()), settings);
     } else {
       summary.streamlines = file.meta().streamline_count;
-      check_fits_the_page(in_path, false, file.bytes().size(), file.level_count(), 0, settings);
+      summary.image_level = page_image_level(in_path, file, settings);
       copy_file(in_path, staging / data);
     }
   } else if (settings.unpack || settings.level) {
     const VxlzFile package_file = VxlzFile::open(in_path);
     UnpackSettings unpack;
     unpack.threads = settings.threads;
-    if (settings.level)
-      check_level(in_path, *settings.level, unpack.levels);  // the levels of the .vxl unpacked
-    else  // its size known from its tables: a .vxl too large for the page is refused before it is unpacked
-      check_fits_the_page(in_path, true, unpacked_vxl_bytes(package_file, unpack), unpack.levels, 0, settings);
+    if (settings.level) check_level(in_path, *settings.level, unpack.levels);  // the levels of the .vxl unpacked
     data.replace_extension(".vxl");
     // Not a .vxl's name: the shared file's is the input's with .vxl, whatever the input was called.
     const fs::path unpacked = settings.level ? staging / "unpacked.tmp" : staging / data;
@@ -134,10 +153,10 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     if (settings.level) {
       const VxlFile file = VxlFile::open(unpacked.string());
       summary.streamlines = write_level(file, (staging / data).string(), *settings.level);
-      check_fits_the_page(in_path, true, fs::file_size(staging / data), file.level_count(), *settings.level, settings);
       std::error_code ec;
       fs::remove(unpacked, ec);  // without --level it is the shared file, in the staging folder
     }
+    summary.image_level = page_image_level(in_path, VxlFile::open((staging / data).string()), settings);
   } else {
     // A package's checksums cover every byte of it. The page unpacks it in its own memory, as large as the .vxl
     // (UnpackSettings' defaults): a .vxl larger than the page holds is refused here, not after the recipient has
@@ -145,7 +164,7 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     const VxlzFile package_file = VxlzFile::open(in_path);
     summary.streamlines = package_file.meta().streamline_count;
     const UnpackSettings as_the_page;
-    check_fits_the_page(in_path, true, unpacked_vxl_bytes(package_file, as_the_page), as_the_page.levels, 0, settings);
+    check_package_fits_the_page(in_path, unpacked_vxl_bytes(package_file, as_the_page), as_the_page.levels, settings);
     summary.package = true;
     data.replace_extension(".vxlz");
     copy_file(in_path, staging / data);
@@ -156,7 +175,7 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
   write_text(
       staging / "share.json",
       nlohmann::json{{"file", summary.data_file}, {"title", title}, {"voxlines", VOXLINES_VERSION}}.dump(2) + "\n");
-  write_text(staging / "README.txt", readme(title, summary.data_file));
+  write_text(staging / "README.txt", readme(title, summary.data_file, summary.image_level));
   return summary;
 }
 

@@ -22,7 +22,9 @@ struct ShareSettings {
   // Only the streamlines of this level of detail (about 1/8^level of them, alike everywhere), as a .vxl: a
   // tractogram too large for a browser's memory made small enough (a .vxlz is unpacked first).
   std::optional<std::uint32_t> level;
-  // The largest .vxl shared: the web viewer holds its whole file in WebAssembly's memory.
+  // The most of a .vxl the web viewer holds in WebAssembly's memory: a larger one is drawn from the coarser levels of
+  // detail that fit (a level image, format/vxl_level_image.h), fetched by ranges; a package, unpacked whole in the
+  // page, must fit.
   std::uint64_t max_data_bytes = kWebMaxFileBytes;
 };
 
@@ -32,6 +34,8 @@ struct ShareSummary {
   std::uint64_t streamlines = 0;
   bool package = false;   // the folder holds a .vxlz
   bool unpacked = false;  // the input was a .vxlz, unpacked (ShareSettings::unpack)
+  // The shared .vxl is larger than the page holds: it draws this level of detail and the coarser ones (a level image).
+  std::optional<std::uint32_t> image_level;
 };
 
 // The files of the built web viewer that a shared folder holds.
@@ -40,8 +44,9 @@ inline constexpr const char* kWebViewerFiles[] = {"index.html",       "viewer.js
 
 // Writes the folder `out_dir`, which must not exist: made under a temporary name beside it and renamed
 // when complete, so that a failure or an interruption leaves no partial folder at `out_dir`. Throws
-// vxl::Error: Input for a damaged input, Unsupported when there is no web viewer or the .vxl would be larger than
-// `max_data_bytes` (the message names the --level that would fit), Output when the folder cannot be written.
+// vxl::Error: Input for a damaged input, Unsupported when there is no web viewer, a package's .vxl would be larger
+// than `max_data_bytes` (the message names the --level that would fit), or not even a .vxl's coarsest level fits it,
+// Output when the folder cannot be written.
 ShareSummary share_folder(const std::string& in_path, const std::string& out_dir, const ShareSettings& settings);
 
 }  // namespace vxl
