@@ -167,8 +167,13 @@ def main():
                         print(f'{os.path.basename(path)}: {report["error"]}')
                         return 1
                     browser = 'warm' if shared and r > 0 else 'cold'
+                    # A file larger than the page holds is drawn from a level image, whose level 0 is the file's
+                    # level_offset: the levels said are the file's.
+                    offset = report.get('level_offset') or 0
+                    first_level = report['first_level'] + offset
+                    full_level = None if report.get('full_level') is None else report['full_level'] + offset
                     print(f'{os.path.basename(path)} ({size / 2**20:.0f} MiB, server: {args.server}) round {r + 1}, {browser} browser: first picture '
-                          f'{report["first_picture_ms"] / 1000:.2f} s (level {report["first_level"]}), full detail {report["full_detail_ms"] / 1000:.2f} s, '
+                          f'{report["first_picture_ms"] / 1000:.2f} s (level {first_level}), full detail {report["full_detail_ms"] / 1000:.2f} s, '
                           f'browser peak PSS {sampler.peak / 2**20:.0f} MiB = {sampler.peak / size:.2f}x the file '
                           f'(whole run {time.monotonic() - t0:.1f} s)', flush=True)
                     looks = report.get('looks') or []
@@ -192,7 +197,8 @@ def main():
                                  f'{sampler.tab_peak / memory["gpu_bytes"]:.2f}x the {memory["gpu_bytes"] / 2**20:.0f} MiB '
                                  f'it draws from (on the GPU once done), once done {sampler.tab_done / 2**20:.0f} MiB = '
                                  f'{sampler.tab_done / memory["gpu_bytes"]:.2f}x')
-                    print(f'    at the peak, MiB: {kinds}; drawn at rest: level {report.get("full_level")}{budget}'
+                    image = f' (a level image from level {offset}: the file is larger than the page holds)' if offset else ''
+                    print(f'    at the peak, MiB: {kinds}; drawn at rest: level {full_level}{image}{budget}'
                           f'{fetched}{page}', flush=True)
                     spans = report.get('spans_fetched') or []
                     if spans:

@@ -319,16 +319,21 @@ LevelImage make_level_image(const std::string& path, std::span<const std::uint8_
                 "its coarsest level of detail (" + std::to_string(level) + ") takes " +
                     std::to_string(plan.layout.file_size) + " bytes, more than the " + std::to_string(max_bytes) +
                     " this reader holds");
-  auto* image = static_cast<std::uint8_t*>(std::calloc(static_cast<std::size_t>(plan.layout.file_size), 1));
-  if (image == nullptr) throw std::bad_alloc();
-  LevelImage out{
-      MappedFile::adopt(path, image, static_cast<std::size_t>(plan.layout.file_size)), level, f.meta, {}, {}};
-  write_image(tables, f, level, plan, image, out.data);
   const SectionEntry& vert = entry(plan.layout, "VERT");
   const SectionEntry& orders = entry(plan.layout, f.packing == OrderPacking::Bits ? "ORDB" : "ORDR");
   const std::vector<ByteRange> to_come{{vert.offset, vert.offset + vert.size},
                                        {orders.offset, orders.offset + orders.size}};
+  // Not zeroed where the vertices and orders will come: a page never touched takes no memory (a browser's
+  // WebAssembly memory, as a mapping, gets its pages when first written), and the reader fetches only the levels it
+  // draws.
+  auto* image = static_cast<std::uint8_t*>(
+      std::malloc(static_cast<std::size_t>(std::max<std::uint64_t>(1, plan.layout.file_size))));
+  if (image == nullptr) throw std::bad_alloc();
+  LevelImage out{
+      MappedFile::adopt(path, image, static_cast<std::size_t>(plan.layout.file_size)), level, f.meta, {}, {}};
   out.written = ranges_missing(to_come, plan.layout.file_size);
+  for (const ByteRange& r : out.written) std::memset(image + r.begin, 0, r.end - r.begin);
+  write_image(tables, f, level, plan, image, out.data);
   return out;
 }
 

@@ -865,6 +865,7 @@
       }
     }
     async function fetchBatch(target, batch) {
+      if (target.blob) return readParts(target, batch);
       const spec = batch.map((r) => `${r[0]}-${r[1] - 1}`).join(',');
       const response = await fetch(target.url, { headers: { Range: 'bytes=' + spec } });
       if (!current(target)) return null;
@@ -889,6 +890,19 @@
       for (const [begin, end] of got) target.received += end - begin;
       $('progress').value = Math.min(1, target.received / (target.total || target.size));
       return got;
+    }
+    // A dropped file read by parts, as a server's ranges (the ranges read, as fetchBatch gives them; null when another
+    // file was opened meanwhile).
+    async function readParts(target, batch) {
+      for (const [begin, end] of batch) {
+        const bytes = new Uint8Array(await target.blob.slice(begin, end).arrayBuffer());
+        if (!current(target)) return null;
+        if (bytes.length !== end - begin) throw new Error(`${target.name}: changed on the disk while it was read`);
+        copyInto(target, begin, bytes);
+        target.received += bytes.length;
+      }
+      $('progress').value = Math.min(1, target.received / (target.total || target.size));
+      return batch.map(([begin, end]) => [begin, end, target.size]);
     }
     // Fetches `ranges` and tells the viewer they are in (vw_arrived); false when another file was opened meanwhile.
     async function bring(target, ranges) {
@@ -958,7 +972,10 @@
       if (!current(target)) return;
       if (first.length === 0 || first.length > size)
         throw new Error(`${target.url}: a first range answer of ${first.length} bytes for a file of ${size}`);
-      if (isPackage(first)) return fetchWhole(target, await fetch(target.url));  // unpacked whole, so fetched whole
+      if (isPackage(first)) {  // unpacked whole, so fetched whole
+        if (target.blob) throw new Error(`${name}: a package larger than the page can unpack (${size.toLocaleString()} bytes)`);
+        return fetchWhole(target, await fetch(target.url));
+      }
       const scratch = allocate(first.length, name);
       Module.HEAPU8.set(first, scratch);
       const maxBytes = Math.min(MAX_FILE_BYTES, memoryLimit);
@@ -1056,6 +1073,12 @@
       const target = { name: file.name, gen: ++generation };
       bytesComplete = true;
       fetchRest = restLater = restPromise = null;
+      // Larger than the page holds: read by parts, as a server's ranges, and drawn from its coarser levels.
+      if (file.size > Math.min(MAX_FILE_BYTES, memoryLimit)) {
+        Object.assign(target, { blob: file, url: file.name, size: file.size });
+        lookShown = viewMoved = false;
+        return fetchByRanges(target, { arrayBuffer: () => file.slice(0, FIRST_BYTES).arrayBuffer() }, performance.now());
+      }
       return openWhole(target, await readWhole(target, file.stream(), file.size));
     }
     // What readWhole read: a file in memory, or the answer of the unpacker it streamed a package into.
