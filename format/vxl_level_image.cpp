@@ -32,13 +32,18 @@ bool read_whole(std::uint32_t id) {
   return std::find(std::begin(whole), std::end(whole), id) != std::end(whole);
 }
 
+// Enough of the gathered tables for the header and the section table (they come first).
+std::span<const std::uint8_t> head_of(std::span<const std::uint8_t> gathered) {
+  return gathered.first(std::min<std::size_t>(gathered.size(), kSectionTableBytesMax));
+}
+
 // The file's tables, from the bytes of ranges_for_level_image one after another, each checked against its checksum.
 class GatheredTables {
  public:
   GatheredTables(const std::string& path, std::span<const std::uint8_t> gathered, std::uint64_t file_size)
       : path_(path),
-        sections_(VxlFile::read_section_table(path, gathered, file_size)),
-        ranges_(ranges_for_level_image(path, gathered, file_size)),
+        sections_(VxlFile::read_section_table(path, head_of(gathered), file_size)),
+        ranges_(ranges_for_level_image(path, head_of(gathered), file_size)),
         gathered_(gathered) {
     std::uint64_t total = 0;
     for (const ByteRange& r : ranges_) total += r.end - r.begin;
@@ -154,6 +159,9 @@ FileVoxels read_file_voxels(const GatheredTables& t) {
   f.level_count = std::max<std::uint32_t>(1, m.level_count);
   if (t.section("DIRS").size() != std::uint64_t(m.stored_order_count) * sizeof(DirectionEntry))
     fail_input(p, t.require("DIRS").offset, "section DIRS size does not match stored_order_count × 16");
+  // Per-voxel directions exactly with the random order set (spec §5.10), as VxlFile::open requires.
+  if ((m.order_set == static_cast<std::uint32_t>(OrderSet::Random)) != (t.find("VDIR") != nullptr))
+    fail_input(p, meta_at + 100, "a VDIR section exactly when the order set is random");
   if (t.find("VDIR") &&
       t.section("VDIR").size() != std::uint64_t(m.voxel_count) * m.stored_order_count * sizeof(DirectionEntry))
     fail_input(p, t.require("VDIR").offset, "section VDIR size does not match voxel_count × stored_order_count × 16");

@@ -190,6 +190,10 @@ TEST_P(LevelImageTest, DamagedTablesAreRefusedNamingTheirByte) {
   const std::uint64_t order_offset = voxt + file.voxels().size() / 2 * sizeof(VoxelEntry) + 63;
   EXPECT_NE(damaged(order_offset, 0x7F, true).find("voxel orders are not in order"), std::string::npos);
   EXPECT_NE(damaged(lods + 3, 0x7F, true).find("is not a prefix of level 0"), std::string::npos);
+  // The random order set without per-voxel directions: open() refuses it, and so does the image.
+  const std::uint64_t meta = file.find_section(section_id("META"))->offset;
+  EXPECT_NE(damaged(meta + 100, 2, true).find("a VDIR section exactly when the order set is random"),
+            std::string::npos);
   const std::uint64_t vertex_first = voxt + sizeof(VoxelEntry) + 44;
   EXPECT_NE(damaged(vertex_first, 0x01, true).find("not contiguous"), std::string::npos);
 }

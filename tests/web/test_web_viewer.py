@@ -360,6 +360,7 @@ def main():
             expect_refused(f'GPU budget {budget}', f'file=packed.vxl&gpu={budget}', expected)
         # A page memory that not even the coarsest level's image fits: refused, saying so.
         expect_refused('page memory 4K', 'file=packed.vxl&memory=4K', 'coarsest level of detail')
+        expect_refused('page memory lots', 'file=packed.vxl&memory=lots', "'lots' is not a size of memory")
 
     for f in failures:
         print('FAILED: ' + f)

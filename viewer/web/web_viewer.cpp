@@ -154,7 +154,7 @@ nlohmann::json ranges_to_fetch(const Viewer& v, std::span<const ByteRange> range
 // An error about a level image's bytes, said of the file fetched: the byte the image's came from, else the image's
 // own (a table it rewrote), and the image's voxel numbers named as such.
 std::string said_of_the_file(const Viewer& v, const Error& e) {
-  if (!v.image || !v.file || !e.offset() || e.file() != v.file->path()) return e.what();
+  if (!v.image || !e.offset() || e.file().empty()) return e.what();
   const std::uint64_t at = *e.offset();
   const std::string image = "level " + std::to_string(v.level_of_whole) + " image";
   const auto p = std::partition_point(v.image_data.begin(), v.image_data.end(),
@@ -163,6 +163,21 @@ std::string said_of_the_file(const Viewer& v, const Error& e) {
     return e.file() + ": at byte " + std::to_string(p->source + (at - p->at)) + ": " + e.reason() + " (voxels as the " +
            image + " numbers them)";
   return e.file() + ": at byte " + std::to_string(at) + " of its " + image + ": " + e.reason();
+}
+
+// Closes `v` after its file failed to open or show (inside a catch), the error said of the file first: closing
+// forgets the image's placements.
+[[noreturn]] void close_and_rethrow(Viewer& v) {
+  try {
+    throw;
+  } catch (const Error& e) {
+    Error said(e.kind(), "", std::nullopt, said_of_the_file(v, e));
+    close(v);
+    throw said;
+  } catch (...) {
+    close(v);
+    throw;
+  }
 }
 
 std::string& last_error() {
@@ -499,15 +514,14 @@ EMSCRIPTEN_KEEPALIVE int vw_open_image(std::uint8_t* tables, double size, const 
       vxl::LevelImage image = vxl::make_level_image(name, gathered.bytes(), static_cast<std::uint64_t>(file_size),
                                                     static_cast<std::uint64_t>(max_bytes));
       { const vxl::MappedFile done = std::move(gathered); }  // the tables' bytes, before the image's are fetched
-      vxl::web::open_file(v, std::move(image.bytes), width, height);
-      v.held = std::move(image.written);
-      v.image = true;
+      v.image = true;  // before the image opens: its errors are then said of the file
       v.image_data = std::move(image.data);
       v.file_meta = image.file_meta;
       v.level_of_whole = image.level;
+      vxl::web::open_file(v, std::move(image.bytes), width, height);
+      v.held = std::move(image.written);
     } catch (...) {
-      vxl::web::close(v);
-      throw;
+      vxl::web::close_and_rethrow(v);
     }
   });
 }
@@ -517,7 +531,10 @@ EMSCRIPTEN_KEEPALIVE int vw_open_image(std::uint8_t* tables, double size, const 
 EMSCRIPTEN_KEEPALIVE const char* vw_placement() {
   static std::string text;
   nlohmann::json j = nlohmann::json::array();
-  for (const vxl::ImagePlacement& p : viewer().image_data) j.push_back({p.source, p.source + p.size, p.at});
+  if (guarded([&] {
+        for (const vxl::ImagePlacement& p : viewer().image_data) j.push_back({p.source, p.source + p.size, p.at});
+      }) != 0)
+    j = {{"error", vxl::web::last_error()}};
   text = j.dump();
   return text.c_str();
 }
@@ -627,8 +644,7 @@ EMSCRIPTEN_KEEPALIVE int vw_show() {
     try {
       vxl::web::show_file(v);
     } catch (...) {
-      vxl::web::close(v);
-      throw;
+      vxl::web::close_and_rethrow(v);  // the first level's draw checks name the file's byte
     }
   });
 }

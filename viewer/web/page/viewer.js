@@ -26,8 +26,9 @@
   // (navigator.deviceMemory, at most 8 GiB), as voxview takes a quarter where the driver reports none: WebGL
   // reports no GPU memory. 1 GiB where the browser reports nothing either.
   const gpuBudget = params.get('gpu') || `${Math.round((navigator.deviceMemory || 4) * 256)}M`;
-  // The most of a file the page holds (?memory=SIZE: 512M, 2G): a larger file fetched by ranges is drawn from its
-  // coarser levels, as a .vxl of their own that fits (a level image); at most what the WebAssembly memory holds.
+  // The most of a .vxl read by ranges (or dropped) the page holds (?memory=SIZE: 512M, 2G): a larger one is drawn
+  // from its coarser levels, as a .vxl of their own that fits (a level image); at most what the WebAssembly memory
+  // holds.
   const memoryParam = /^(\d+(?:\.\d+)?)([KMG]?)$/i.exec(params.get('memory') || '');
   const memoryLimit = memoryParam ? Number(memoryParam[1]) * 1024 ** ' KMG'.indexOf((memoryParam[2] || ' ').toUpperCase()) : Infinity;
 
@@ -958,7 +959,9 @@
       // From here the viewer holds the tables' buffer (and frees it) and the image's.
       if (api.openImage(target.pointer, plan.bytes, name, size, maxBytes, w, h) !== 0) return fail(api.error()), false;
       target.pointer = api.filePointer();
-      target.place = JSON.parse(api.placement());
+      const placement = JSON.parse(api.placement());
+      if (placement.error) return fail(placement.error), false;
+      target.place = placement;
       target.total = target.place.reduce((n, p) => n + p[1] - p[0], 0);
       target.received = 0;
       return true;
@@ -1211,6 +1214,8 @@
     });
 
     if (api.setGpuBudget(gpuBudget) !== 0) return fail(api.error());
+    if (params.has('memory') && !memoryParam)
+      return fail(`memory: '${params.get('memory')}' is not a size of memory (e.g. 512M, 2G)`);
     start().catch((err) => fail(err.message));
   }, (err) => fail('cannot start the viewer: ' + err));
 })();
