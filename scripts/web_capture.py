@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Opens a page of the web viewer in headless Chromium and writes its picture at full detail as a PNG.
 
-    scripts/web_capture.py URL OUT.png [--timeout S] [--chromium PATH] [--drop PATH]
+    scripts/web_capture.py URL OUT.png [--timeout S] [--chromium PATH] [--drop PATH] [--page PAGE.png [--window WxH]]
 
 The page (viewer/web/page) resolves window.voxweb.ready after its first frame (which may be drawn at a
 coarser level of detail) and window.voxweb.complete after its first frame at full detail, or rejects them
@@ -9,7 +9,8 @@ with the viewer's error; this waits for both and saves the canvas. Prints one JS
 from navigation to the first picture ("first_picture_ms") and to full detail ("full_detail_ms"), the page's
 JavaScript heap and what the console said.
 With --drop, the page is given a file as a user drops one on it: PATH (relative to URL) is fetched and dropped on
-the window once the page has loaded.
+the window once the page has loaded. With --page, the whole page (its panel beside the picture) is written too, as a
+window of --window pixels (default 1100x700) shows it.
 Exit 0 with the picture, 1 when the page reported an error, 2 on a browser or usage failure.
 
 Chromium is driven over the DevTools protocol on a pipe (--remote-debugging-pipe: JSON messages ended by a
@@ -144,13 +145,18 @@ DROP_FILE = """fetch(DROP).then((r) => r.blob()).then((blob) => {
 })"""
 
 
-def capture_in(browser, url, out, timeout, drop=None, on_done=None):
+def capture_in(browser, url, out, timeout, drop=None, on_done=None, page=None):
     """The page's report (a dict; with 'error' when the page failed) in a new tab of `browser` (a DevTools), its
     picture written to `out`; the tab is closed after, once on_done() (if given) has returned: the page is done, its
-    tab still open (a benchmark samples its memory)."""
+    tab still open (a benchmark samples its memory). `page`: (PATH, width, height), the whole page as a window of that
+    size shows it, written to PATH once done."""
     target = browser.call('Target.createTarget', {'url': 'about:blank'})['targetId']
     try:
         session = browser.call('Target.attachToTarget', {'targetId': target, 'flatten': True})['sessionId']
+        if page:
+            browser.call('Emulation.setDeviceMetricsOverride', {'width': page[1], 'height': page[2],
+                                                                'deviceScaleFactor': 1, 'mobile': False},
+                         session=session)
         browser.call('Page.enable', session=session)
         browser.call('Runtime.enable', session=session)
         browser.events.clear()
@@ -167,6 +173,11 @@ def capture_in(browser, url, out, timeout, drop=None, on_done=None):
                               session=session, timeout=timeout)
         console = [' '.join(str(a.get('value', a.get('description', ''))) for a in e['params'].get('args', []))
                    for e in browser.events if e.get('method') == 'Runtime.consoleAPICalled']
+        if page and 'exceptionDetails' not in result and 'error' not in (result.get('result', {}).get('value') or {}):
+            shot = browser.call('Page.captureScreenshot', {'format': 'png'}, session=session, timeout=timeout)
+            with open(page[0] + '.part', 'wb') as f:
+                f.write(base64.b64decode(shot['data']))
+            os.replace(page[0] + '.part', page[0])
         if on_done:
             on_done()
     finally:
@@ -209,8 +220,8 @@ class Browser:
             raise
         self.process = self.devtools.process
 
-    def capture(self, url, out, timeout, drop=None, on_done=None):
-        return capture_in(self.devtools, url, out, timeout, drop, on_done)
+    def capture(self, url, out, timeout, drop=None, on_done=None, page=None):
+        return capture_in(self.devtools, url, out, timeout, drop, on_done, page)
 
     def close(self):
         """Closes the browser and removes its profile."""
@@ -224,13 +235,13 @@ class Browser:
         self.close()
 
 
-def capture(url, out, timeout, chromium, on_start=None, drop=None, on_done=None):
+def capture(url, out, timeout, chromium, on_start=None, drop=None, on_done=None, page=None):
     """The page's report in a browser of its own (capture_in). on_start(process) is called once the browser runs
     (a benchmark samples its memory)."""
     with Browser(chromium) as browser:
         if on_start:
             on_start(browser.process)
-        return browser.capture(url, out, timeout, drop, on_done)
+        return browser.capture(url, out, timeout, drop, on_done, page)
 
 
 def main():
@@ -240,9 +251,15 @@ def main():
     parser.add_argument('--timeout', type=float, default=120, help='seconds to wait for the first picture')
     parser.add_argument('--chromium', default=shutil.which('chromium') or 'chromium')
     parser.add_argument('--drop', help="a file (relative to URL) dropped on the page once it has loaded")
+    parser.add_argument('--page', help='also the whole page, its panel beside the picture, as a PNG')
+    parser.add_argument('--window', default='1100x700', help='the window the whole page is shown in (WxH pixels)')
     args = parser.parse_args()
+    window = args.window.split('x')
+    if len(window) != 2 or not all(w.isdigit() and int(w) > 0 for w in window):
+        parser.error(f'--window {args.window}: not WxH')
+    page = (args.page, int(window[0]), int(window[1])) if args.page else None
     try:
-        report = capture(args.url, args.out, args.timeout, args.chromium, drop=args.drop)
+        report = capture(args.url, args.out, args.timeout, args.chromium, drop=args.drop, page=page)
         print(json.dumps(report))
         return 1 if 'error' in report else 0
     except (RuntimeError, TimeoutError, OSError) as e:
