@@ -19,7 +19,8 @@ struct ByteRange {
 };
 
 // The largest file a reader in 32-bit WebAssembly holds (its memory is 4 GiB at most), with room left for the
-// viewer beside it: the web viewer refuses larger files, and `voxlines share` refuses to share them.
+// viewer beside it: the web viewer draws a larger .vxl from its coarser levels (vxl_level_image.h), and cannot unpack
+// a package into a larger one.
 inline constexpr std::uint64_t kWebMaxFileBytes = (std::uint64_t(1) << 32) - (std::uint64_t(1) << 28);
 
 // Enough of a file's first bytes for the header and the largest section table (spec §3, §4).
