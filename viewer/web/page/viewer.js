@@ -137,7 +137,10 @@
           if (gen === generation && bytesComplete && $(key).value === String(value)) set(key, value);
         });
       }
-      if (api.set(key, String(value)) !== 0) say(api.error(), true);
+      if (api.set(key, String(value)) !== 0) {
+        say(api.error(), true);
+        if (key === 'mode') $('mode').value = JSON.parse(api.info()).mode;  // what it still draws in
+      }
       if (key === 'color' || key === 'scalar' || key === 'colormap') showColouring();
       redraw();
     }
@@ -402,6 +405,8 @@
     // Settings that read the voxline and streamline tables, which a file fetched by ranges brings last: colouring
     // by value or group, and the unsorted mode (it draws in the streamlines' order).
     function needsWholeFile(key, value) {
+      // A level image has no streamline tables to wait for: what reads them is refused at once, saying why.
+      if (window.voxweb.info && window.voxweb.info.image) return false;
       return key === 'color' || key === 'scalar' || key === 'colormap' || (key === 'mode' && value === 'unsorted');
     }
     // What a setting asks of the file now: the voxline and streamline tables, for the unsorted mode and colouring by
@@ -631,9 +636,10 @@
       const info = JSON.parse(api.info());
       window.voxweb.info = info;
       fullDetail = info.full_detail;
+      const drawnFrom = info.level_offset === 0 ? 'drawn without its streamline tables'
+        : `drawn from level ${info.level_offset} (about 1/${8 ** info.level_offset} of them)`;
       $('info').textContent = info.image
-        ? `${info.streamlines.toLocaleString()} streamlines, drawn from level ${info.level_offset} (about ` +
-          `1/${8 ** info.level_offset} of them; the file is larger than the page holds): ` +
+        ? `${info.streamlines.toLocaleString()} streamlines, ${drawnFrom}: the file is larger than the page holds; ` +
           `${info.vertices.toLocaleString()} of its ${info.file_vertices.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`
         : `${info.streamlines.toLocaleString()} streamlines, ` +
           `${info.vertices.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`;
@@ -1049,6 +1055,7 @@
       bytesComplete = true;
       lookShown = viewMoved = false;
       fetchRest = restLater = restPromise = null;
+      window.voxweb.info = null;  // the next file's, once shown
       const t0 = performance.now();
       let probe;
       try {
@@ -1076,6 +1083,7 @@
       const target = { name: file.name, gen: ++generation };
       bytesComplete = true;
       fetchRest = restLater = restPromise = null;
+      window.voxweb.info = null;
       // Larger than the page holds: read by parts, as a server's ranges, and drawn from its coarser levels.
       if (file.size > Math.min(MAX_FILE_BYTES, memoryLimit)) {
         Object.assign(target, { blob: file, url: file.name, size: file.size });
