@@ -63,9 +63,12 @@ void add_share_command(CLI::App& app) {
                 (unsigned long long)s.streamlines, s.data_file.c_str(), double(s.data_bytes) / (1 << 20), how.c_str());
     if (s.image_level)
       std::printf(
-          "larger than a browser holds: the page draws level %u and coarser (about 1/%llu of the streamlines), fetched "
-          "by ranges: serve it with a server that answers Range requests (most do; python3 -m http.server does not)\n",
-          *s.image_level, 1ull << (3 * *s.image_level));
+          "larger than a browser holds: the page draws %s, fetched by ranges: serve it with a server that answers "
+          "Range requests (most do; python3 -m http.server does not)\n",
+          *s.image_level == 0 ? "it without its streamline tables (no unsorted mode, no colouring by value or group)"
+                              : ("level " + std::to_string(*s.image_level) + " and coarser (about 1/" +
+                                 std::to_string(1ull << (3 * *s.image_level)) + " of the streamlines)")
+                                    .c_str());
   });
 }
 

@@ -44,18 +44,26 @@ void write_text(const fs::path& path, const std::string& text) {
 }
 
 std::string readme(const std::string& title, const std::string& data_file, std::optional<std::uint32_t> image_level) {
-  const std::string large =
-      image_level ? "The tractogram is larger than a browser holds: the page draws its level of detail " +
-                        std::to_string(*image_level) + " (about 1/" + std::to_string(1ull << (3 * *image_level)) +
-                        " of the streamlines,\nspread over the whole) and the coarser ones, fetching only their bytes. "
-                        "That needs a server that\nanswers HTTP Range requests (most do; python3 -m http.server does "
-                        "not).\n\n"
-                  : std::string();
+  const std::string drawn =
+      !image_level        ? std::string()
+      : *image_level == 0 ? "all of it but the streamline tables (no unsorted mode, no colouring by value or group)"
+                          : "its level of detail " + std::to_string(*image_level) + " (about 1/" +
+                                std::to_string(1ull << (3 * *image_level)) +
+                                " of the streamlines,\nspread over the whole) and the coarser ones";
+  const std::string large = image_level ? "The tractogram is larger than a browser holds: the page draws " + drawn +
+                                              ", fetching only their bytes by HTTP Range requests.\n\n"
+                                        : std::string();
+  // Python's server sends whole files: the page then reads the tractogram whole, which it cannot for a larger one.
+  const std::string serve =
+      image_level
+          ? "Serve this folder with a static web server that answers HTTP Range requests (nginx, Apache and most\n"
+            "hosting do; python3 -m http.server does not) and open index.html.\n\n"
+          : "Serve this folder with any static web server and open index.html, for example:\n\n"
+            "    python3 -m http.server 8000     (in this folder), then open http://localhost:8000/\n\n";
   return "# " + title +
          "\n\n"
-         "A tractogram to look at in a web browser, with correctly ordered transparency (Voxlines).\n\n"
-         "Serve this folder with any static web server and open index.html, for example:\n\n"
-         "    python3 -m http.server 8000     (in this folder), then open http://localhost:8000/\n\n"
+         "A tractogram to look at in a web browser, with correctly ordered transparency (Voxlines).\n\n" +
+         serve +
          "Opening index.html straight from the disk does not work: browsers do not let a page read files\n"
          "beside it. The folder can be put as it is on institutional web space or GitHub Pages.\n\n"
          "In the page: drag to turn, right-drag (or shift-drag) to pan, the wheel to zoom. \"Copy link to\n"
