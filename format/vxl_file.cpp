@@ -355,6 +355,18 @@ std::string misplaced_voxel(const MetaSection& m, const VoxelEntry& v, std::size
          std::to_string(cell_lo + m.voxel_size) + " mm)";
 }
 
+void check_levels_nested(const VoxelEntry& v, std::span<const LevelEntry> row, std::size_t index,
+                         const std::string& path, std::uint64_t lods_at) {
+  for (std::uint32_t d = 0; d < row.size(); ++d) {
+    const LevelEntry finer = voxel_level(v, row, d), e = row[d];
+    if (e.vertex_count > finer.vertex_count || e.segment_count > finer.segment_count ||
+        (e.vertex_count > 0 ? e.segment_count >= e.vertex_count : e.segment_count != 0))
+      fail_input(path, lods_at + (index * row.size() + d) * sizeof(LevelEntry),
+                 "voxel " + std::to_string(index) + " level " + std::to_string(d + 1) + " is not a prefix of level " +
+                     std::to_string(d) + " with fewer segments than vertices");
+  }
+}
+
 void check_order_set(const MetaSection& m, const std::string& p, std::uint64_t meta_at) {
   if (m.order_set > static_cast<std::uint32_t>(OrderSet::Random))
     fail_input(p, meta_at + 100, "unknown order set " + std::to_string(m.order_set) + " (expected 0, 1 or 2)");
@@ -446,16 +458,8 @@ void VxlFile::validate_voxel_table() {
     if (next_vertex > m.vertex_count) fail_input(p, at + 48, "voxel vertex block runs past vertex_count");
     if (v.order_offset % 4 != 0 || v.order_offset < min_order_offset)
       fail_input(p, at + 56, "order offset not a multiple of 4 or decreasing");
-    // Each level is a prefix of the finer one's vertices, with fewer segments than vertices (spec §5.12).
     const std::span<const LevelEntry> row = levels_of(i);
-    for (std::uint32_t d = 0; d < row.size(); ++d) {
-      const LevelEntry finer = voxel_level(v, row, d), e = row[d];
-      if (e.vertex_count > finer.vertex_count || e.segment_count > finer.segment_count ||
-          (e.vertex_count > 0 ? e.segment_count >= e.vertex_count : e.segment_count != 0))
-        fail_input(p, lods_at + (i * row.size() + d) * sizeof(LevelEntry),
-                   "voxel " + std::to_string(i) + " level " + std::to_string(d + 1) + " is not a prefix of level " +
-                       std::to_string(d) + " with fewer segments than vertices");
-    }
+    check_levels_nested(v, row, i, p, lods_at);
     std::uint64_t bytes = voxel_all_orders_size(v, row, m.stored_order_count, order_packing_);
     if (v.order_offset > orders_.size() || bytes > orders_.size() - v.order_offset)
       fail_input(p, at + 56,

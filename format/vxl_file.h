@@ -57,6 +57,10 @@ void check_grid_geometry(const MetaSection& meta, const std::string& path, std::
 // The order set as spec §5.3 defines them: axis (0) stores 3 directions, axis+diag (1) 7, random (2) any
 // 1..64; another set is unknown. Throws vxl::Error (Input) naming `path` and the field's offset.
 void check_order_set(const MetaSection& meta, const std::string& path, std::uint64_t meta_at);
+// Voxel `index`'s LODS entries (`row`, at `lods_at` in the file): each level a prefix of the finer one's vertices,
+// with fewer segments than vertices (spec §5.12). Throws vxl::Error (Input) naming `path` and the entry's offset.
+void check_levels_nested(const VoxelEntry& v, std::span<const LevelEntry> row, std::size_t index,
+                         const std::string& path, std::uint64_t lods_at);
 // What is wrong, for an error message: voxel `index`'s bounds on `c` and its cell's.
 std::string misplaced_voxel(const MetaSection& meta, const VoxelEntry& v, std::size_t index, int c);
 

@@ -32,6 +32,14 @@ bool read_whole(std::uint32_t id) {
   return std::find(std::begin(whole), std::end(whole), id) != std::end(whole);
 }
 
+// What make_level_image reads of a file with these sections (ranges_for_level_image).
+std::vector<ByteRange> table_ranges(const std::vector<SectionEntry>& sections) {
+  std::vector<ByteRange> ranges{{0, sizeof(FileHeader) + sections.size() * sizeof(SectionEntry)}};
+  for (const SectionEntry& e : sections)
+    if (read_whole(id_of(e))) ranges.push_back({e.offset, e.offset + e.size});
+  return merge_ranges(std::move(ranges), 0);
+}
+
 // Enough of the gathered tables for the header and the section table (they come first).
 std::span<const std::uint8_t> head_of(std::span<const std::uint8_t> gathered) {
   return gathered.first(std::min<std::size_t>(gathered.size(), kSectionTableBytesMax));
@@ -43,7 +51,7 @@ class GatheredTables {
   GatheredTables(const std::string& path, std::span<const std::uint8_t> gathered, std::uint64_t file_size)
       : path_(path),
         sections_(VxlFile::read_section_table(path, head_of(gathered), file_size)),
-        ranges_(ranges_for_level_image(path, head_of(gathered), file_size)),
+        ranges_(table_ranges(sections_)),
         gathered_(gathered) {
     std::uint64_t total = 0;
     for (const ByteRange& r : ranges_) total += r.end - r.begin;
@@ -125,14 +133,7 @@ void check_voxel_runs(const GatheredTables& t, const FileVoxels& f) {
     next_vertex += v.vertex_count;
     if (next_vertex > f.meta.vertex_count) fail_input(t.path(), at + 48, "voxel vertex block runs past vertex_count");
     const std::span<const LevelEntry> row = f.row(i);
-    for (std::uint32_t d = 0; d < row.size(); ++d) {
-      const LevelEntry finer = voxel_level(v, row, d), e = row[d];
-      if (e.vertex_count > finer.vertex_count || e.segment_count > finer.segment_count ||
-          (e.vertex_count > 0 ? e.segment_count >= e.vertex_count : e.segment_count != 0))
-        fail_input(t.path(), t.require("LODS").offset + (i * row.size() + d) * sizeof(LevelEntry),
-                   "voxel " + std::to_string(i) + " level " + std::to_string(d + 1) + " is not a prefix of level " +
-                       std::to_string(d) + " with fewer segments than vertices");
-    }
+    if (!row.empty()) check_levels_nested(v, row, i, t.path(), t.require("LODS").offset);
     const std::uint64_t bytes = voxel_all_orders_size(v, row, f.meta.stored_order_count, f.packing);
     if (v.order_offset % 4 != 0 || v.order_offset < min_order_offset || v.order_offset > f.orders->size ||
         bytes > f.orders->size - v.order_offset)
@@ -308,11 +309,7 @@ void write_image(const GatheredTables& t, const FileVoxels& f, std::uint32_t lev
 
 std::vector<ByteRange> ranges_for_level_image(const std::string& path, std::span<const std::uint8_t> first,
                                               std::uint64_t file_size) {
-  const std::vector<SectionEntry> sections = VxlFile::read_section_table(path, first, file_size);
-  std::vector<ByteRange> ranges{{0, sizeof(FileHeader) + sections.size() * sizeof(SectionEntry)}};
-  for (const SectionEntry& e : sections)
-    if (read_whole(id_of(e))) ranges.push_back({e.offset, e.offset + e.size});
-  return merge_ranges(std::move(ranges), 0);
+  return table_ranges(VxlFile::read_section_table(path, first, file_size));
 }
 
 LevelImage make_level_image(const std::string& path, std::span<const std::uint8_t> gathered, std::uint64_t file_size,

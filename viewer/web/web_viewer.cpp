@@ -141,13 +141,16 @@ std::vector<ByteRange>& planned_ranges() {
   return ranges;
 }
 
-// `ranges` of the open file as the page fetches them (JSON [[begin, end], ...]): of a level image, where its bytes lie
-// in the file fetched, merged where less than `gap` apart.
-nlohmann::json ranges_to_fetch(const Viewer& v, std::span<const ByteRange> ranges, std::uint64_t gap) {
+// `ranges` of the open file as the page fetches them: of a level image, where its bytes lie in the file fetched,
+// merged where less than `gap` apart.
+std::vector<ByteRange> ranges_to_fetch(const Viewer& v, std::span<const ByteRange> ranges, std::uint64_t gap) {
+  return v.image ? source_ranges(v.image_data, ranges, gap) : std::vector<ByteRange>(ranges.begin(), ranges.end());
+}
+
+// JSON [[begin, end], ...] for the page.
+nlohmann::json ranges_json(std::span<const ByteRange> ranges) {
   nlohmann::json j = nlohmann::json::array();
-  for (const ByteRange& r :
-       v.image ? source_ranges(v.image_data, ranges, gap) : std::vector<ByteRange>(ranges.begin(), ranges.end()))
-    j.push_back({r.begin, r.end});
+  for (const ByteRange& r : ranges) j.push_back({r.begin, r.end});
   return j;
 }
 
@@ -557,7 +560,7 @@ EMSCRIPTEN_KEEPALIVE const char* vw_level_ranges(int level, double gap) {
     const std::vector<vxl::ByteRange> wanted =
         vxl::ranges_of_level(*v.file, wanted_level, static_cast<std::uint64_t>(gap));
     v.asked = vxl::ranges_intersection(wanted, vxl::ranges_missing(v.held, v.file->bytes().size()));
-    j = vxl::web::ranges_to_fetch(v, v.asked, static_cast<std::uint64_t>(gap));
+    j = vxl::web::ranges_json(vxl::web::ranges_to_fetch(v, v.asked, static_cast<std::uint64_t>(gap)));
   }
   text = j.dump();
   return text.c_str();
@@ -572,10 +575,8 @@ EMSCRIPTEN_KEEPALIVE const char* vw_missing_ranges(double piece) {
   if (v.file) {
     const auto step = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(piece));
     v.asked = vxl::ranges_missing(v.held, v.file->bytes().size());
-    for (const nlohmann::json& r : vxl::web::ranges_to_fetch(v, v.asked, 0)) {
-      const auto begin = r[0].get<std::uint64_t>(), end = r[1].get<std::uint64_t>();
-      for (std::uint64_t at = begin; at < end; at += step) j.push_back({at, std::min(end, at + step)});
-    }
+    for (const vxl::ByteRange& r : vxl::web::ranges_to_fetch(v, v.asked, 0))
+      for (std::uint64_t at = r.begin; at < r.end; at += step) j.push_back({at, std::min(r.end, at + step)});
   }
   text = j.dump();
   return text.c_str();
@@ -630,7 +631,7 @@ EMSCRIPTEN_KEEPALIVE const char* vw_next_ranges(double gap, double batch) {
       if (double(bytes) >= batch) break;
     }
     v.asked = vxl::ranges_intersection(vxl::merge_ranges(std::move(wanted), static_cast<std::uint64_t>(gap)), missing);
-    ranges = vxl::web::ranges_to_fetch(v, v.asked, static_cast<std::uint64_t>(gap));
+    ranges = vxl::web::ranges_json(vxl::web::ranges_to_fetch(v, v.asked, static_cast<std::uint64_t>(gap)));
   }
   text = nlohmann::json{{"ranges", ranges}, {"spans", spans}}.dump();
   return text.c_str();

@@ -917,6 +917,20 @@
       api.arrived();
       return true;
     }
+    // Fetches `ranges` into the buffer at target.pointer, then runs `check` (which may throw); the buffer is freed when
+    // either throws or another file was opened meanwhile (false).
+    async function fetchOrFree(target, ranges, check = () => {}) {
+      let ok;
+      try {
+        ok = await fetchRanges(target, ranges);
+        if (ok) check();
+      } catch (err) {
+        Module._free(target.pointer);
+        throw err;
+      }
+      if (!ok) Module._free(target.pointer);
+      return ok;
+    }
     // Fetches what the reader needs to open the file (`plan`, vw_plan_open's ranges) into a buffer of the file's size,
     // and opens it; false when it failed (and said why) or another file was opened meanwhile.
     async function openFetched(target, first, plan) {
@@ -924,14 +938,7 @@
       target.pointer = allocate(size, name);
       Module.HEAPU8.set(first, target.pointer);
       target.received = first.length;
-      let ok;
-      try {
-        ok = await fetchRanges(target, plan);
-      } catch (err) {
-        Module._free(target.pointer);
-        throw err;
-      }
-      if (!ok) return Module._free(target.pointer), false;
+      if (!(await fetchOrFree(target, plan))) return false;
       mark('tables fetched');
       const [w, h] = canvasSize();
       // From here the viewer holds the buffer (and frees it).
@@ -949,17 +956,12 @@
       target.total = plan.bytes;
       copyInto(target, 0, first);
       target.received = first.length;
-      let ok;
-      try {
-        ok = await fetchRanges(target, plan.image.filter((r) => r[1] > first.length)
-          .map((r) => [Math.max(r[0], first.length), r[1]]));
-        // The image's bytes come by ranges too: a server that sent the whole file has sent them past.
-        if (ok && target.whole) throw new Error(`${target.url}: the server sent the whole file to a range request; a file this large needs one that answers ranges`);
-      } catch (err) {
-        Module._free(target.pointer);
-        throw err;
-      }
-      if (!ok) return Module._free(target.pointer), false;
+      const tables = plan.image.filter((r) => r[1] > first.length).map((r) => [Math.max(r[0], first.length), r[1]]);
+      // The image's bytes come by ranges too: a server that sent the whole file has sent them past.
+      const byRanges = () => {
+        if (target.whole) throw new Error(`${target.url}: the server sent the whole file to a range request; a file this large needs one that answers ranges`);
+      };
+      if (!(await fetchOrFree(target, tables, byRanges))) return false;
       mark('tables fetched');
       const [w, h] = canvasSize();
       // From here the viewer holds the tables' buffer (and frees it) and the image's.
