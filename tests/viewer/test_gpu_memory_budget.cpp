@@ -7,6 +7,7 @@
 #include "format/base/error.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_metrics.h"
+#include "viewer/render/gl_util.h"
 #include "viewer/render/gpu_memory_pool.h"
 #include "viewer/render/view_queries.h"
 
@@ -101,6 +102,27 @@ class GpuMemoryBudget : public ::testing::Test {
     return s;
   }
   std::uint64_t whole_bytes() const { return SceneLayout(*file_, kTexels, 0).upload_bytes(); }
+  // A budget for the spans the bottom's view needs or the top's, not both.
+  std::uint64_t bottom_or_top_budget() const {
+    Renderer probe({&*file_}, kTexels, 0, std::make_shared<GpuMemoryPool>(0));
+    render_image(probe, view(), near(true), 96, 96);
+    FramePlan bottom_plan, top_plan;
+    probe.plan(view(), 1.0, PlanOrder::Nearest, bottom_plan, near(true).clipping);
+    probe.plan(view(), 1.0, PlanOrder::Nearest, top_plan, near(false).clipping);
+    auto bytes_of = [&](const FramePlan& p) {
+      std::vector<bool> seen(probe.layout().texture_spans().size(), false);
+      std::uint64_t bytes = 0;
+      for (std::int64_t id : p.first) {
+        const std::uint32_t c = probe.layout().span_of_id(id);
+        if (seen[c]) continue;
+        seen[c] = true;
+        const TextureSpan& t = probe.layout().texture_spans()[c];
+        bytes += 4 * t.words() + 4 * t.order_words;
+      }
+      return bytes;
+    };
+    return std::max(bytes_of(bottom_plan), bytes_of(top_plan));
+  }
   ScratchDir dir_;
   std::optional<VxlFile> file_;
 };
@@ -163,25 +185,7 @@ TEST_F(GpuMemoryBudget, EvictedSpansDrawTheSamePictureWhenUploadedAgain) {
   const Image bottom_reference = render_image(reference, view(), near(true), 96, 96);
   ASSERT_GT(lit_pixels(bottom_reference), 100);
 
-  // A budget for the bottom's spans or the top's, not both.
-  Renderer probe({&*file_}, kTexels, 0, std::make_shared<GpuMemoryPool>(0));
-  render_image(probe, view(), near(true), 96, 96);
-  FramePlan bottom_plan, top_plan;
-  probe.plan(view(), 1.0, PlanOrder::Nearest, bottom_plan, near(true).clipping);
-  probe.plan(view(), 1.0, PlanOrder::Nearest, top_plan, near(false).clipping);
-  auto bytes_of = [&](const FramePlan& p) {
-    std::vector<bool> seen(probe.layout().texture_spans().size(), false);
-    std::uint64_t bytes = 0;
-    for (std::int64_t id : p.first) {
-      const std::uint32_t c = probe.layout().span_of_id(id);
-      if (seen[c]) continue;
-      seen[c] = true;
-      const TextureSpan& t = probe.layout().texture_spans()[c];
-      bytes += 4 * t.words() + 4 * t.order_words;
-    }
-    return bytes;
-  };
-  const std::uint64_t budget = std::max(bytes_of(bottom_plan), bytes_of(top_plan));
+  const std::uint64_t budget = bottom_or_top_budget();
   ASSERT_LT(budget, whole_bytes()) << "the test needs views that do not take the whole scene";
 
   const auto pool = std::make_shared<GpuMemoryPool>(budget);
@@ -198,6 +202,49 @@ TEST_F(GpuMemoryBudget, EvictedSpansDrawTheSamePictureWhenUploadedAgain) {
   EXPECT_EQ(compare_images(first, bottom_reference).differing_pixels, 0u) << "and it is the unbudgeted picture";
   EXPECT_LE(pool->peak(), budget);
   EXPECT_GT(lit_pixels(top), 100);
+}
+
+// On llvmpipe a span's buffers are host memory handed to the driver (gl::host_memory_buffers), which the driver
+// neither clears nor copies. They draw what the driver's own buffers draw, also when spans are evicted (their
+// memory given back once the driver is done with it) and uploaded again.
+TEST_F(GpuMemoryBudget, HostMemoryBuffersDrawWhatTheDriversOwnDraw) {
+  const std::string renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  if (renderer.find("llvmpipe") == std::string::npos)
+    GTEST_SKIP() << "host memory buffers are for Mesa's llvmpipe; this context is " << renderer;
+  ASSERT_TRUE(epoxy_has_gl_extension("GL_AMD_pinned_memory")) << "Mesa's llvmpipe offers to take host memory";
+  const std::uint64_t budget = bottom_or_top_budget();
+  struct Pictures {
+    Image bottom, top, bottom_again;
+    std::uint64_t evictions = 0;
+  };
+  auto draw = [&](gl::BufferMemory memory) {
+    gl::set_buffer_memory(memory);
+    const auto pool = std::make_shared<GpuMemoryPool>(budget);
+    Pictures p;
+    {
+      Renderer r({&*file_}, kTexels, 0, pool);
+      p.bottom = render_image(r, view(), near(true), 96, 96);
+      p.top = render_image(r, view(), near(false), 96, 96);
+      p.bottom_again = render_image(r, view(), near(true), 96, 96);
+      r.check_uploaded(true);
+    }
+    p.evictions = pool->evictions();
+    gl::set_buffer_memory(gl::BufferMemory::Auto);
+    return p;
+  };
+  gl::set_buffer_memory(gl::BufferMemory::Auto);
+  EXPECT_TRUE(gl::host_memory_buffers());
+  const Pictures host = draw(gl::BufferMemory::Auto);
+  gl::set_buffer_memory(gl::BufferMemory::Driver);
+  EXPECT_FALSE(gl::host_memory_buffers());
+  const Pictures driver = draw(gl::BufferMemory::Driver);
+  EXPECT_GT(host.evictions, 0u) << "the top's spans made room by evicting the bottom's";
+  EXPECT_EQ(host.evictions, driver.evictions);
+  EXPECT_GT(lit_pixels(host.bottom), 100);
+  EXPECT_GT(lit_pixels(host.top), 100);
+  EXPECT_EQ(compare_images(host.bottom, driver.bottom).differing_pixels, 0u);
+  EXPECT_EQ(compare_images(host.top, driver.top).differing_pixels, 0u);
+  EXPECT_EQ(compare_images(host.bottom_again, driver.bottom_again).differing_pixels, 0u);
 }
 
 // A window spreads a large upload over frames: upload_for fills a few spans at a time on other threads, the

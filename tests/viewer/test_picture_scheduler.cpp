@@ -80,7 +80,7 @@ TEST(PictureScheduler, AFocusCopyLeftOutOfAWholePictureComesFirstAtRest) {
   EXPECT_EQ(s.drawn_level(), kCoarsest);
   t = s.next(false, false, false, view.fn());
   EXPECT_EQ(t.work, PictureWork::Piece);
-  EXPECT_EQ(t.level, kSceneLevel);
+  EXPECT_EQ(t.level, kCoarsest - 1) << "on the way to the view's level";
   EXPECT_EQ(t.frame_work, FrameWork::FullDetailPiece);
   // A picture drawn whole with the copy (or without a focus) has no such stage; a change drops it.
   s.drawn_whole(RenderMode::Axis, kCoarsest, 40, true);
@@ -91,19 +91,30 @@ TEST(PictureScheduler, AFocusCopyLeftOutOfAWholePictureComesFirstAtRest) {
   EXPECT_EQ(s.next(false, false, true, view.fn()).work, PictureWork::None) << "closing: nothing refined";
 }
 
+// Through each level between the picture on screen and the view's, each shown once complete.
 TEST(PictureScheduler, AtRestACoarsePictureIsRefinedAtTheViewsLevelThenToExact) {
   PictureScheduler s = scheduler(true);
   ViewLevel view{0};  // a slab: full detail fits
   s.drawn_whole(RenderMode::Axis, kFirstLevel, 10);
   PictureTask t = s.next(false, false, false, view.fn());
   EXPECT_EQ(t.work, PictureWork::Piece);
-  EXPECT_EQ(t.level, 0u);
+  EXPECT_EQ(t.level, 1u) << "level 1 on the way to 0";
+  EXPECT_EQ(s.level_on_the_way(), 1u);
   EXPECT_EQ(t.frame_work, FrameWork::FullDetailPiece);
   EXPECT_EQ(s.rest().stage_mode(), RenderMode::Axis);
   s.begin_pieces();
   s.piece_drawn(false);
   EXPECT_TRUE(s.pieces_begun());
-  EXPECT_EQ(s.next(false, false, false, view.fn()).level, 0u);
+  EXPECT_EQ(s.next(false, false, false, view.fn()).level, 1u);
+  s.piece_drawn(true);
+  EXPECT_FALSE(s.pieces_begun()) << "the view's level begins its own pieces";
+  EXPECT_EQ(s.drawn_level(), 1u);
+  EXPECT_EQ(s.rest().stage(), RestStage::FullDetail);
+  t = s.next(false, false, false, view.fn());
+  EXPECT_EQ(t.level, 0u);
+  EXPECT_EQ(t.frame_work, FrameWork::FullDetailPiece);
+  EXPECT_EQ(s.level_on_the_way(), std::nullopt) << "the view's level itself";
+  s.begin_pieces();
   s.piece_drawn(true);
   EXPECT_FALSE(s.pieces_begun()) << "the next stage begins its own pieces";
   EXPECT_EQ(s.drawn_level(), 0u);

@@ -12,6 +12,7 @@ TEST(RestRefinement, ACoarsePictureIsRefinedToFullDetailThenExact) {
   EXPECT_EQ(r.stage(), RestStage::FullDetail);
   EXPECT_EQ(r.stage_mode(), RenderMode::Axis);
   EXPECT_EQ(r.describe(0.4), "refining to full detail: 40 %");
+  EXPECT_EQ(r.describe(0.25, 2), "refining to full detail: level 2, 25 %");
   r.stage_complete();
   EXPECT_EQ(r.stage(), RestStage::Exact);
   EXPECT_EQ(r.stage_mode(), RenderMode::Exact);

@@ -239,6 +239,28 @@ TEST_F(Window, TheFirstPictureIsCoarseAndFullDetailFollowsInPieces) {
   EXPECT_EQ(j.at("exact_s"), -1) << "--no-exact-when-still";
 }
 
+// A first picture two levels coarse is refined through the level between: level 1 is drawn in pieces and shown
+// once complete (an eighth of full detail's segments), then full detail follows in its own pieces.
+TEST_F(Window, AtRestEachLevelOnTheWayToFullDetailIsShown) {
+  VXL_REQUIRE_XVFB();
+  make_inputs(50000);
+  const nlohmann::json j = window_stats("--size 320x240 --frames 1 --until-refined --no-exact-when-still");
+  ASSERT_FALSE(j.is_null());
+  const auto& frames = j.at("frames");
+  ASSERT_GE(frames.size(), 3u);
+  EXPECT_EQ(frames[0].at("level"), 2) << "2.7M segments at full detail, 340k at level 1, 42k at level 2";
+  // Each piece draws the level after the last one shown: level 1 until it completes, then level 0.
+  std::vector<int> completed;
+  int expected = 1;
+  for (std::size_t i = 1; i < frames.size(); ++i) {
+    EXPECT_EQ(frames[i].at("work"), "full-detail piece") << i;
+    EXPECT_EQ(frames[i].at("level"), expected) << i;
+    if (frames[i].at("completes").get<bool>()) completed.push_back(expected--);
+  }
+  EXPECT_EQ(completed, (std::vector<int>{1, 0})) << "level 1 shown, then full detail";
+  EXPECT_EQ(j.at("full_detail_s"), frames.back().at("since_start_s"));
+}
+
 // At rest, once full detail is on screen, the axis mode goes on to the exact picture, run by run; it is
 // what headless --mode exact draws (but for a few pixels at voxel faces between runs).
 TEST_F(Window, ExactArrivesWhenTheCameraIsStill) {

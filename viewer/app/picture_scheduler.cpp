@@ -36,7 +36,7 @@ PictureTask PictureScheduler::next(bool changed, bool scripted_last, bool closin
   }
   if (rest_.stage() == RestStage::Done) return task;
   task.work = PictureWork::Piece;
-  task.level = *rest_level_;
+  task.level = rest_.stage() == RestStage::FullDetail ? full_detail_step() : *rest_level_;
   task.frame_work = rest_.stage() == RestStage::Exact ? FrameWork::ExactPiece : FrameWork::FullDetailPiece;
   return task;
 }
@@ -60,9 +60,25 @@ void PictureScheduler::piece_drawn(bool completes) {
     pieces_begun_ = false;
     return;
   }
-  drawn_level_ = *rest_level_;
-  rest_.stage_complete();
   pieces_begun_ = false;
+  if (rest_.stage() == RestStage::FullDetail) {
+    drawn_level_ = full_detail_step();
+    if (drawn_level_ != *rest_level_) return;  // a level on the way: the stage goes on to the next
+  } else {
+    drawn_level_ = *rest_level_;
+  }
+  rest_.stage_complete();
+}
+
+std::optional<std::uint32_t> PictureScheduler::level_on_the_way() const {
+  if (!rest_level_ || focus_left_out_ || rest_.stage() != RestStage::FullDetail) return std::nullopt;
+  const std::uint32_t step = full_detail_step();
+  if (step == *rest_level_) return std::nullopt;
+  return step;
+}
+
+std::uint32_t PictureScheduler::full_detail_step() const {
+  return drawn_level_ > *rest_level_ + 1 ? drawn_level_ - 1 : *rest_level_;
 }
 
 void PictureScheduler::set_exact_when_still(bool on) {

@@ -2,9 +2,10 @@
 // first at a coarse level (so that it comes at once), while the camera moves or a setting changes at the
 // finest level the frame budget allows (frame_budget.h), a script's last frame at the scene's level — and an
 // unchanged one is refined at rest a piece a frame (rest_refinement.h): to the finest level whose visible
-// part fits the GPU memory budget (view_level.h), then to the exact picture; first, where the whole picture left
-// a selection's full-detail focus copy out, to that picture with the copy. Pure logic, testable without
-// GL: the window draws what it says and reports back.
+// part fits the GPU memory budget (view_level.h) — through each level between, each shown once complete, so that
+// a picture eight times denser comes after about an eighth of the time — then to the exact picture; first, where the
+// whole picture left a selection's full-detail focus copy out, to that picture with the copy. Pure logic, testable
+// without GL: the window draws what it says and reports back.
 #pragma once
 
 #include <cstdint>
@@ -70,9 +71,14 @@ class PictureScheduler {
   RestRefinement& rest() { return rest_; }
   // The level of the picture on screen.
   std::uint32_t drawn_level() const { return drawn_level_; }
+  // The level the refinement to full detail is drawing on the way to the view's level; none when it draws that
+  // level itself (or another stage).
+  std::optional<std::uint32_t> level_on_the_way() const;
 
  private:
   std::uint32_t whole_level(bool scripted_last) const;
+  // The level the full-detail stage draws next: one finer than the picture on screen, until the view's level.
+  std::uint32_t full_detail_step() const;
 
   FrameBudget budget_;
   FrameLoad load_;

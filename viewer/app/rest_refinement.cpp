@@ -33,10 +33,12 @@ void RestRefinement::set_exact_when_still(bool on) {
   if (on && stage_ == RestStage::Done && wants_exact()) stage_ = RestStage::Exact;
 }
 
-std::string RestRefinement::describe(double progress) const {
+std::string RestRefinement::describe(double progress, std::optional<std::uint32_t> level_on_the_way) const {
   const std::string percent = std::to_string(static_cast<int>(std::floor(100 * progress))) + " %";
   switch (stage_) {
-    case RestStage::FullDetail: return "refining to full detail: " + percent;
+    case RestStage::FullDetail:
+      return "refining to full detail: " +
+             (level_on_the_way ? "level " + std::to_string(*level_on_the_way) + ", " : std::string()) + percent;
     case RestStage::Exact: return "exact when still: " + percent;
     case RestStage::Done: return exact_shown_ ? "exact (the camera is still)" : "";
   }

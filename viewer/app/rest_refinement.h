@@ -7,6 +7,8 @@
 // logic: which stage comes next; the window draws.
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <string>
 
 #include "viewer/render/render_settings.h"
@@ -39,8 +41,9 @@ class RestRefinement {
   // picture stays) or, once the exact picture is on screen, draws the mode's own picture again.
   void set_exact_when_still(bool on);
 
-  // What the panel says: "refining to full detail: 40 %", "exact when still: 12 %", "exact", "" (full detail).
-  std::string describe(double progress) const;
+  // What the panel says: "refining to full detail: 40 %" (with a level on the way: "refining to full detail:
+  // level 2, 40 %"), "exact when still: 12 %", "exact", "" (full detail).
+  std::string describe(double progress, std::optional<std::uint32_t> level_on_the_way = std::nullopt) const;
 
  private:
   bool wants_exact() const;

@@ -301,7 +301,7 @@ double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& co
   scheduler_->piece_drawn(completes);
   stats_.refinement = focus_stage && !completes
                           ? "the focus at full detail: " + std::to_string(int(100 * renderer.pieces_progress())) + " %"
-                          : rest.describe(completes ? 0 : renderer.pieces_progress());
+                          : rest.describe(completes ? 0 : renderer.pieces_progress(), scheduler_->level_on_the_way());
   glFinish();
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -6,6 +6,11 @@
 #include <utility>
 #include <vector>
 
+#if !VOXLINES_WEBGL
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
+
 namespace vxl::gl {
 namespace {
 
@@ -170,6 +175,29 @@ GLuint make_compute_program(const std::string& cs) {
 #endif
 }
 
+namespace {
+
+BufferMemory buffer_memory = BufferMemory::Auto;
+
+}  // namespace
+
+void set_buffer_memory(BufferMemory memory) { buffer_memory = memory; }
+
+bool host_memory_buffers() {
+#if VOXLINES_WEBGL
+  return false;  // every buffer is a texture the browser copies
+#else
+  // llvmpipe's glBufferData clears a new buffer on the GL thread before the fill writes it (about 40 % of the 1M
+  // set's upload); memory of our own is written once, by the threads that fill it. On a GPU the driver's buffers
+  // are the GPU's, and pinned memory would be read across the bus every frame. Asked of the current context each
+  // time (microseconds, once a buffer): a process may make contexts of other drivers.
+  if (buffer_memory != BufferMemory::Auto) return false;
+  const char* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const std::string renderer = name ? name : "";
+  return renderer.find("llvmpipe") != std::string::npos && epoxy_has_gl_extension("GL_AMD_pinned_memory");
+#endif
+}
+
 #if VOXLINES_WEBGL
 
 void TextureBuffer::create(GLenum internal_format, const void* data, std::size_t bytes) {
@@ -245,12 +273,24 @@ void TextureBuffer::create(GLenum internal_format, const void* data, std::size_t
 }
 
 void* TextureBuffer::create_mapped(std::size_t bytes) {
+  const std::size_t size = std::max<std::size_t>(bytes, 16);
+  if (host_memory_buffers()) {
+    const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+    const std::size_t whole_pages = (size + page - 1) / page * page;
+    void* memory = mmap(nullptr, whole_pages, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (memory == MAP_FAILED)
+      throw std::runtime_error("could not allocate a buffer of " + std::to_string(size) + " bytes");
+    host_memory_ = memory;
+    host_bytes_ = whole_pages;
+    mapped_bytes_ = size;
+    return memory;
+  }
   glGenBuffers(1, &buffer);
   glBindBuffer(GL_TEXTURE_BUFFER, buffer);
-  const auto size = static_cast<GLsizeiptr>(bytes > 16 ? bytes : 16);
-  glBufferData(GL_TEXTURE_BUFFER, size, nullptr, GL_STATIC_DRAW);
+  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(size), nullptr, GL_STATIC_DRAW);
   // Invalidated: the driver need not keep (or copy) what the buffer held.
-  void* memory = glMapBufferRange(GL_TEXTURE_BUFFER, 0, size, GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
+  void* memory = glMapBufferRange(GL_TEXTURE_BUFFER, 0, static_cast<GLsizeiptr>(size),
+                                  GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
   glBindBuffer(GL_TEXTURE_BUFFER, 0);
   if (memory == nullptr) {
     destroy();
@@ -260,12 +300,30 @@ void* TextureBuffer::create_mapped(std::size_t bytes) {
 }
 
 void TextureBuffer::finish_mapped(GLenum internal_format) {
-  glBindBuffer(GL_TEXTURE_BUFFER, buffer);
-  const GLboolean kept = glUnmapBuffer(GL_TEXTURE_BUFFER);
-  if (kept == GL_FALSE) {
-    glBindBuffer(GL_TEXTURE_BUFFER, 0);
-    destroy();
-    throw std::runtime_error("the driver lost a buffer's contents while it was being filled");
+  if (host_memory_ && buffer) return;  // finished already
+  if (host_memory_) {
+    glGenBuffers(1, &buffer);
+    glBindBuffer(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, buffer);
+    glBufferData(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, static_cast<GLsizeiptr>(mapped_bytes_), host_memory_,
+                 GL_STATIC_DRAW);
+    glBindBuffer(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, 0);
+    glBindBuffer(GL_TEXTURE_BUFFER, buffer);
+    GLint64 taken = 0;
+    glGetBufferParameteri64v(GL_TEXTURE_BUFFER, GL_BUFFER_SIZE, &taken);
+    if (taken != static_cast<GLint64>(mapped_bytes_)) {  // the driver refused the memory: it gets a copy instead
+      glGetError();                                      // the refusal's error, answered here
+      glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(mapped_bytes_), host_memory_, GL_STATIC_DRAW);
+      munmap(host_memory_, host_bytes_);
+      host_memory_ = nullptr;
+    }
+  } else {
+    glBindBuffer(GL_TEXTURE_BUFFER, buffer);
+    const GLboolean kept = glUnmapBuffer(GL_TEXTURE_BUFFER);
+    if (kept == GL_FALSE) {
+      glBindBuffer(GL_TEXTURE_BUFFER, 0);
+      destroy();
+      throw std::runtime_error("the driver lost a buffer's contents while it was being filled");
+    }
   }
   glGenTextures(1, &texture);
   glBindTexture(GL_TEXTURE_BUFFER, texture);
@@ -309,6 +367,11 @@ void TextureBuffer::destroy() {
   parts_memory_ = nullptr;  // unmapped with the buffer
   if (texture) glDeleteTextures(1, &texture);
   if (buffer) glDeleteBuffers(1, &buffer);
+  if (host_memory_) {
+    if (buffer) glFinish();  // draws still queued may read the memory
+    munmap(host_memory_, host_bytes_);
+    host_memory_ = nullptr;
+  }
   texture = buffer = 0;
 }
 

@@ -32,6 +32,14 @@ void finish_gpu_work();
 // glMultiDrawArrays; in WebGL2, which has it only as an extension, one draw per range, in order.
 void multi_draw(GLenum mode, const GLint* first, const GLsizei* count, GLsizei ranges);
 
+// Where TextureBuffer::create_mapped's memory comes from. Mesa's llvmpipe keeps its "GPU memory" in this process's
+// memory and takes memory it is handed (GL_AMD_pinned_memory): there, with Auto, a buffer is host memory that the
+// filling threads write once and the driver neither clears nor copies. Elsewhere, and with Driver, it is the
+// driver's buffer, mapped. host_memory_buffers() says which (needs a current context); tests compare the two.
+enum class BufferMemory { Auto, Driver };
+void set_buffer_memory(BufferMemory memory);
+bool host_memory_buffers();
+
 // A buffer object with a buffer texture viewing it (internal format e.g. GL_R32F, GL_R32UI); in WebGL2, which
 // has no buffer textures, a 2D texture of kBufferTextureWidth-texel rows (`buffer` stays 0) that shaders read
 // through FETCH_BUFFER.
@@ -66,6 +74,10 @@ struct TextureBuffer {
   std::vector<std::uint8_t> part_;           // the part being filled
 #else
   std::uint8_t* parts_memory_ = nullptr;  // the buffer, mapped by begin_parts
+  // Host memory (host_memory_buffers()): mapped by create_mapped, handed to the driver by finish_mapped, unmapped
+  // by destroy.
+  void* host_memory_ = nullptr;
+  std::size_t host_bytes_ = 0, mapped_bytes_ = 0;
 #endif
 };
 
