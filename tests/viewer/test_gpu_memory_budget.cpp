@@ -216,11 +216,18 @@ TEST_F(GpuMemoryBudget, HostMemoryBuffersDrawWhatTheDriversOwnDraw) {
   struct Pictures {
     Image bottom, top, bottom_again;
     std::uint64_t evictions = 0;
+    bool host_memory = false;
+  };
+  // The choice is the process's: restored however a draw ends.
+  struct BufferMemoryChoice {
+    explicit BufferMemoryChoice(gl::BufferMemory memory) { gl::set_buffer_memory(memory); }
+    ~BufferMemoryChoice() { gl::set_buffer_memory(gl::BufferMemory::Auto); }
   };
   auto draw = [&](gl::BufferMemory memory) {
-    gl::set_buffer_memory(memory);
+    const BufferMemoryChoice choice(memory);
     const auto pool = std::make_shared<GpuMemoryPool>(budget);
     Pictures p;
+    p.host_memory = gl::host_memory_buffers();
     {
       Renderer r({&*file_}, kTexels, 0, pool);
       p.bottom = render_image(r, view(), near(true), 96, 96);
@@ -229,15 +236,11 @@ TEST_F(GpuMemoryBudget, HostMemoryBuffersDrawWhatTheDriversOwnDraw) {
       r.check_uploaded(true);
     }
     p.evictions = pool->evictions();
-    gl::set_buffer_memory(gl::BufferMemory::Auto);
     return p;
   };
-  gl::set_buffer_memory(gl::BufferMemory::Auto);
-  EXPECT_TRUE(gl::host_memory_buffers());
-  const Pictures host = draw(gl::BufferMemory::Auto);
-  gl::set_buffer_memory(gl::BufferMemory::Driver);
-  EXPECT_FALSE(gl::host_memory_buffers());
-  const Pictures driver = draw(gl::BufferMemory::Driver);
+  const Pictures host = draw(gl::BufferMemory::Auto), driver = draw(gl::BufferMemory::Driver);
+  EXPECT_TRUE(host.host_memory);
+  EXPECT_FALSE(driver.host_memory);
   EXPECT_GT(host.evictions, 0u) << "the top's spans made room by evicting the bottom's";
   EXPECT_EQ(host.evictions, driver.evictions);
   EXPECT_GT(lit_pixels(host.bottom), 100);

@@ -130,6 +130,26 @@ TEST(PictureScheduler, AtRestACoarsePictureIsRefinedAtTheViewsLevelThenToExact) 
   EXPECT_EQ(view.asked, 2) << "a new picture asks again";
 }
 
+// Only levels strictly between the picture's and the view's are drawn on the way, and only once the refinement has
+// chosen the view's level, outside the focus stage.
+TEST(PictureScheduler, OnlyLevelsStrictlyBetweenArePutOnTheWay) {
+  PictureScheduler s = scheduler(true);
+  ViewLevel full{0};
+  s.drawn_whole(RenderMode::Axis, 1, 10);
+  EXPECT_EQ(s.level_on_the_way(), std::nullopt) << "the view's level is not chosen yet";
+  EXPECT_EQ(s.next(false, false, false, full.fn()).level, 0u) << "one level above the view's: straight to it";
+  EXPECT_EQ(s.level_on_the_way(), std::nullopt);
+  // A picture finer than the view's level (a close view's, say, then moved back) is drawn again at the view's.
+  ViewLevel coarse{2};
+  s.drawn_whole(RenderMode::Axis, 1, 10);
+  EXPECT_EQ(s.next(false, false, false, coarse.fn()).level, 2u);
+  EXPECT_EQ(s.level_on_the_way(), std::nullopt);
+  // The focus stage draws the whole picture's level with the copy; the steps come after it.
+  s.drawn_whole(RenderMode::Axis, kCoarsest, 40, true);
+  EXPECT_EQ(s.next(false, false, false, full.fn()).frame_work, FrameWork::FocusPiece);
+  EXPECT_EQ(s.level_on_the_way(), std::nullopt);
+}
+
 TEST(PictureScheduler, APictureAlreadyAtTheViewsLevelSkipsTheFullDetailStage) {
   PictureScheduler without_gl43 = scheduler(false);
   ViewLevel view{kSceneLevel};

@@ -124,7 +124,9 @@ class ViewerWindow {
   // The grid overlay and the annotations (picture_annotations.h) over scene_target_'s picture, when they are on.
   void draw_overlays(const Renderer& renderer, int width, int height);
   // The panel's figures of a complete picture drawn by `renderer`.
-  void show_frame_figures(const Renderer& renderer, std::uint32_t level);
+  // refining: the picture is a piece of the refinement at rest (a level coarser than the scene's is then one on the
+  // way to the view's level, not a moving camera's).
+  void show_frame_figures(const Renderer& renderer, std::uint32_t level, bool refining = false);
   // scene_target_ into the window's back buffer.
   void present(int width, int height) const;
   double seconds_since_start() const {

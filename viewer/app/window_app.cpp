@@ -225,7 +225,7 @@ void ViewerWindow::draw_overlays(const Renderer& renderer, int width, int height
   }
 }
 
-void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t level) {
+void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t level, bool refining) {
   const RenderSettings& s = state_.settings;
   const FrameStats& f = renderer.stats();
   stats_.scalar_range = renderer.scalar_range(s);
@@ -234,13 +234,14 @@ void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t le
   stats_.plan_ms = f.plan_ms;
   stats_.voxels_drawn = f.voxels_drawn;
   stats_.segments_drawn = f.segments_drawn;
-  stats_.frame_level = level > detail_.level ? "level " + std::to_string(level) + " while the camera moves"
+  const std::string coarser = refining ? ", refining at rest" : " while the camera moves";
+  stats_.frame_level = level > detail_.level ? "level " + std::to_string(level) + coarser
                        : level < detail_.level
                            ? "level " + std::to_string(level) + ": the visible part fits the GPU memory budget"
                            : "";
   if (drawn_focus_first_)
-    stats_.frame_level = "focus at full detail, context at level " + std::to_string(level) +
-                         (level > detail_.level ? " while the camera moves" : "");
+    stats_.frame_level =
+        "focus at full detail, context at level " + std::to_string(level) + (level > detail_.level ? coarser : "");
 }
 
 void ViewerWindow::present(int width, int height) const {
@@ -295,7 +296,7 @@ double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& co
   if (completes) {
     std::swap(scene_target_, refine_target_);
     draw_overlays(renderer, width, height);
-    show_frame_figures(renderer, level);
+    show_frame_figures(renderer, level, true);
   }
   const bool focus_stage = scheduler_->focus_stage();
   scheduler_->piece_drawn(completes);

@@ -311,7 +311,7 @@ void TextureBuffer::finish_mapped(GLenum internal_format) {
     GLint64 taken = 0;
     glGetBufferParameteri64v(GL_TEXTURE_BUFFER, GL_BUFFER_SIZE, &taken);
     if (taken != static_cast<GLint64>(mapped_bytes_)) {  // the driver refused the memory: it gets a copy instead
-      glGetError();                                      // the refusal's error, answered here
+      glGetError();                                      // the refusal's GL_INVALID_OPERATION, answered here
       glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(mapped_bytes_), host_memory_, GL_STATIC_DRAW);
       munmap(host_memory_, host_bytes_);
       host_memory_ = nullptr;

@@ -46,9 +46,10 @@ bool host_memory_buffers();
 struct TextureBuffer {
   GLuint buffer = 0, texture = 0;
   void create(GLenum internal_format, const void* data, std::size_t bytes);
-  // The same filled in place: create_mapped makes the buffer `bytes` long (at least 16) and returns its
-  // memory mapped for writing, which any thread may fill; finish_mapped unmaps it and makes the texture.
-  // Throws std::runtime_error when the driver cannot map or loses the contents. (WebGL2 maps nothing: the
+  // The same filled in place: create_mapped returns `bytes` (at least 16) of memory for writing, which any thread
+  // may fill — the driver's buffer, mapped, or host memory (host_memory_buffers()) — and finish_mapped makes the
+  // texture of it (unmapping the driver's buffer, or handing the host memory to the driver). Throws
+  // std::runtime_error when the memory cannot be had or the driver loses the contents. (WebGL2 maps nothing: the
   // memory is the host's, copied to the texture by finish_mapped, which does nothing a second time.)
   void* create_mapped(std::size_t bytes);
   void finish_mapped(GLenum internal_format);

@@ -211,8 +211,8 @@ void GpuScene::begin_upload(std::uint32_t ci) {
   const VxlFile& file = *files_[c.file];
   const std::uint32_t file_first = layout_.files()[c.file].voxel_first;
   GpuTextureSpan& g = spans_[ci];
-  // Filled in place in the GPU's buffers by other threads: voxels fill disjoint ranges of both. The words
-  // fill while this thread has the driver make the order buffer (which a software driver clears first).
+  // Filled in place in the GPU's buffers (on llvmpipe, host memory handed to the driver once filled) by other
+  // threads: voxels fill disjoint ranges of both. The words fill while this thread has the order buffer made.
   Filling f;
   f.span = ci;
   auto* words = static_cast<std::uint32_t*>(g.words.create_mapped(4 * c.words()));
