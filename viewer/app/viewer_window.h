@@ -116,17 +116,17 @@ class ViewerWindow {
   void reset_camera(double aspect);
   double aspect() const;
   void set_error(const std::string& message);
-  // Draws the scene whole at `level` of detail into scene_target_; returns the frame's time in ms.
-  double draw_scene(int width, int height, std::uint32_t level);
+  // Draws the scene whole at `level` of detail into scene_target_; returns the frame's time in ms. moving: the
+  // camera moves (what the panel says of a level coarser than the scene's).
+  double draw_scene(int width, int height, std::uint32_t level, bool moving);
   // Draws the next piece of the refinement at rest (rest_refinement.h) into refine_target_; once the stage's
   // picture is complete it becomes scene_target_'s and `completes` is set. Returns the piece's time in ms.
   double refine(int width, int height, std::uint32_t level, bool& completes);
   // The grid overlay and the annotations (picture_annotations.h) over scene_target_'s picture, when they are on.
   void draw_overlays(const Renderer& renderer, int width, int height);
-  // The panel's figures of a complete picture drawn by `renderer`.
-  // refining: the picture is a piece of the refinement at rest (a level coarser than the scene's is then one on the
-  // way to the view's level, not a moving camera's).
-  void show_frame_figures(const Renderer& renderer, std::uint32_t level, bool refining = false);
+  // The panel's figures of a complete picture drawn by `renderer` at `level`. coarser_why: what the panel adds to
+  // a level coarser than the scene's (" while the camera moves", ", refining at rest").
+  void show_frame_figures(const Renderer& renderer, std::uint32_t level, const std::string& coarser_why);
   // scene_target_ into the window's back buffer.
   void present(int width, int height) const;
   double seconds_since_start() const {

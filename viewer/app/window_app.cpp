@@ -174,7 +174,7 @@ Renderer& ViewerWindow::renderer_at(std::uint32_t level, bool whole) {
   return session_->renderer_at(level, level == first_level_);
 }
 
-double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
+double ViewerWindow::draw_scene(int width, int height, std::uint32_t level, bool moving) {
   Renderer& renderer = renderer_at(level, true);
   RenderSettings& s = state_.settings;
   if (s.mode != drawn_mode_) stats_.error.clear();  // a new choice of mode gets a fresh start
@@ -204,7 +204,8 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level) {
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
   if (ms > 0 && renderer.stats().segments_drawn > 0) segments_per_ms_ = double(renderer.stats().segments_drawn) / ms;
-  show_frame_figures(renderer, level);
+  // At rest a coarser level is the first picture's, or one drawn at once after a change: refined next.
+  show_frame_figures(renderer, level, moving ? " while the camera moves" : ", drawn at once; refining at rest");
   return ms;
 }
 
@@ -225,7 +226,7 @@ void ViewerWindow::draw_overlays(const Renderer& renderer, int width, int height
   }
 }
 
-void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t level, bool refining) {
+void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t level, const std::string& coarser_why) {
   const RenderSettings& s = state_.settings;
   const FrameStats& f = renderer.stats();
   stats_.scalar_range = renderer.scalar_range(s);
@@ -234,14 +235,13 @@ void ViewerWindow::show_frame_figures(const Renderer& renderer, std::uint32_t le
   stats_.plan_ms = f.plan_ms;
   stats_.voxels_drawn = f.voxels_drawn;
   stats_.segments_drawn = f.segments_drawn;
-  const std::string coarser = refining ? ", refining at rest" : " while the camera moves";
-  stats_.frame_level = level > detail_.level ? "level " + std::to_string(level) + coarser
+  stats_.frame_level = level > detail_.level ? "level " + std::to_string(level) + coarser_why
                        : level < detail_.level
                            ? "level " + std::to_string(level) + ": the visible part fits the GPU memory budget"
                            : "";
   if (drawn_focus_first_)
     stats_.frame_level =
-        "focus at full detail, context at level " + std::to_string(level) + (level > detail_.level ? coarser : "");
+        "focus at full detail, context at level " + std::to_string(level) + (level > detail_.level ? coarser_why : "");
 }
 
 void ViewerWindow::present(int width, int height) const {
@@ -296,7 +296,7 @@ double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& co
   if (completes) {
     std::swap(scene_target_, refine_target_);
     draw_overlays(renderer, width, height);
-    show_frame_figures(renderer, level, true);
+    show_frame_figures(renderer, level, ", refining at rest");
   }
   const bool focus_stage = scheduler_->focus_stage();
   scheduler_->piece_drawn(completes);
@@ -371,7 +371,7 @@ void ViewerWindow::build_panel(double aspect) {
 bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, bool moving) {
   if (task.stage_skipped) stats_.refinement = scheduler_->rest().describe(0);
   if (task.work == PictureWork::Whole) {
-    const double ms = draw_scene(key.width, key.height, task.level);
+    const double ms = draw_scene(key.width, key.height, task.level, moving);
     scheduler_->drawn_whole(state_.settings.mode, task.level, ms, focus_first_at(task.level) && !drawn_focus_first_);
     stats_.refinement = scheduler_->rest().describe(0);
     drawn_ = key;
