@@ -187,10 +187,10 @@ bool host_memory_buffers() {
 #if VOXLINES_WEBGL
   return false;  // every buffer is a texture the browser copies
 #else
-  // llvmpipe's glBufferData clears a new buffer on the GL thread before the fill writes it (about 40 % of the 1M
-  // set's upload); memory of our own is written once, by the threads that fill it. On a GPU the driver's buffers
-  // are the GPU's, and pinned memory would be read across the bus every frame. Asked of the current context each
-  // time (microseconds, once a buffer): a process may make contexts of other drivers.
+  // llvmpipe's glBufferData clears a new buffer on the GL thread before the fill writes it (the 1M set uploads in
+  // about half the time without it); memory of our own is written once, by the threads that fill it. On a GPU the
+  // driver's buffers are the GPU's, and pinned memory would be read across the bus every frame. Asked of the current
+  // context each time (microseconds, once a buffer): a process may make contexts of other drivers.
   if (buffer_memory != BufferMemory::Auto) return false;
   const char* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   const std::string renderer = name ? name : "";
