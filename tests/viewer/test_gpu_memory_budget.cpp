@@ -277,5 +277,38 @@ TEST_F(GpuMemoryBudget, UploadsSpreadOverCallsGiveTheSamePicture) {
   EXPECT_EQ(compare_images(a, b).differing_pixels, 0u);
 }
 
+// A buffer texture reads zeros past the driver's limit: a buffer larger than it is refused with the sizes named,
+// made from data or filled through create_mapped, from the driver's buffers and from host memory; one at the
+// limit is made.
+TEST(GpuBufferLimit, ABufferOverTheDriversLimitIsRefused) {
+  gl_context();
+  const std::uint64_t limit = gl::max_buffer_texels();
+  ASSERT_GT(limit, 0u);
+  ASSERT_LE(limit, std::uint64_t(1) << 31) << "one byte a texel below must stay a test-sized buffer";
+  gl::TextureBuffer at_limit;
+  at_limit.create(GL_R8UI, nullptr, limit);
+  EXPECT_NE(at_limit.texture, 0u);
+  at_limit.destroy();
+  gl::TextureBuffer over;
+  try {
+    over.create(GL_R8UI, nullptr, limit + 1);
+    ADD_FAILURE() << "a buffer of limit + 1 texels was made";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(std::to_string(limit + 1) + " texels"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("GL_MAX_TEXTURE_BUFFER_SIZE"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(over.texture, 0u);
+  for (const gl::BufferMemory memory : {gl::BufferMemory::Auto, gl::BufferMemory::Driver}) {
+    gl::set_buffer_memory(memory);
+    gl::TextureBuffer mapped;
+    ASSERT_NE(mapped.create_mapped(limit + 1), nullptr);  // never written
+    EXPECT_THROW(mapped.finish_mapped(GL_R8UI), std::runtime_error);
+    EXPECT_EQ(mapped.texture, 0u);
+    EXPECT_EQ(mapped.buffer, 0u);
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+  }
+  gl::set_buffer_memory(gl::BufferMemory::Auto);
+}
+
 }  // namespace
 }  // namespace vxl

@@ -1,10 +1,16 @@
 // Headless render tests on Mesa llvmpipe (EGL surfaceless, no display): each transparency mode against
 // hand-made scenes whose correct picture is known.
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <random>
+
+#include <glm/gtc/packing.hpp>
 
 #include "converter/synth/synth.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/platform/image_metrics.h"
+#include "viewer/render/exact_resolve.h"
 
 namespace vxl {
 namespace {
@@ -199,7 +205,7 @@ Image exact_with_capacity(Renderer& r, const Camera& camera, std::uint64_t nodes
 // The lists composited on the GPU (a compute pass) and on the CPU (the reference) give the same picture, to the
 // last bit: the same floats, compositing in the same order with every operation rounded on its own. A dense
 // scene (lists far longer than the pass's batch of 16), in one run and in many runs (small node buffers), and
-// lines in one plane seen from above (equal depths, ordered by when they were stored).
+// lines in one plane seen from above (equal depths, ordered by their colours).
 TEST_F(RenderModes, ExactOnTheGpuEqualsTheCpuReference) {
   SynthSettings synth;
   synth.streamlines = 3000;
@@ -221,6 +227,76 @@ TEST_F(RenderModes, ExactOnTheGpuEqualsTheCpuReference) {
   const Image cpu = exact_with_capacity(lines, top_view(), 1u << 20, 64, &passes, ExactResolve::Cpu);
   EXPECT_GT(lit_pixels(gpu), 100);
   EXPECT_EQ(compare_images(gpu, cpu).differing_pixels, 0u);
+}
+
+// A GPU stores one run's fragments in an order its scheduling decides: the picture must not depend on it. The same
+// fragments stored under other node indices and linked in the reverse order composite to the same floats, where
+// many tie in depth with other colours and compositing them in the order stored gives other floats.
+TEST(ExactLists, ThePictureDoesNotDependOnTheOrderTheFragmentsWereStored) {
+  constexpr int kWidth = 16, kHeight = 4, kPixels = kWidth * kHeight;
+  std::mt19937 random(11);
+  struct Fragment {
+    FragmentNode node;
+    int pixel;
+  };
+  std::vector<Fragment> fragments;
+  auto half_in_unit = [&] { return std::uint32_t(random() % 0x3C01u); };  // binary16 bits of [0, 1]
+  for (int p = 0; p < kPixels; ++p)
+    for (int k = 0; k < 2 + p % 12; ++k) {
+      const float depth = 0.5f * float(random() % 3);  // three depths: ties
+      std::uint32_t depth_bits;
+      std::memcpy(&depth_bits, &depth, 4);
+      fragments.push_back(
+          {{half_in_unit() | half_in_unit() << 16, half_in_unit() | half_in_unit() << 16, depth_bits, kListEnd}, p});
+    }
+  struct Stored {
+    std::vector<std::uint32_t> heads;
+    std::vector<FragmentNode> nodes;
+  };
+  // Fragment f under node index slot[f]; each pixel's list linked in the order given.
+  auto store = [&](const std::vector<std::uint32_t>& slot, bool reverse_links) {
+    Stored s{std::vector<std::uint32_t>(kPixels, kListEnd), std::vector<FragmentNode>(fragments.size())};
+    for (std::size_t n = 0; n < fragments.size(); ++n) {
+      const std::size_t f = reverse_links ? fragments.size() - 1 - n : n;
+      const std::uint32_t i = slot[f];
+      s.nodes[i] = fragments[f].node;
+      s.nodes[i][3] = s.heads[fragments[f].pixel];
+      s.heads[fragments[f].pixel] = i;
+    }
+    return s;
+  };
+  auto composite = [&](const Stored& s) {
+    std::vector<float> image(kPixels * 4, 0.25f);
+    composite_lists_on_cpu(s.heads, s.nodes, kWidth, 0, kHeight, image);
+    return image;
+  };
+  // The rule the picture must not follow: at equal depths, the node stored first goes under.
+  auto in_storage_order = [&](const Stored& s) {
+    std::vector<float> image(kPixels, 0.25f);
+    for (int p = 0; p < kPixels; ++p) {
+      std::vector<std::uint32_t> list;
+      for (std::uint32_t i = s.heads[p]; i != kListEnd; i = s.nodes[i][3]) list.push_back(i);
+      std::sort(list.begin(), list.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return s.nodes[a][2] != s.nodes[b][2] ? s.nodes[a][2] > s.nodes[b][2] : a < b;  // depths >= 0: bits order
+      });
+      for (std::uint32_t i : list) {
+        const float red = glm::unpackHalf2x16(s.nodes[i][0]).x, alpha = glm::unpackHalf2x16(s.nodes[i][1]).y;
+        image[p] = red * alpha + image[p] * (1.0f - alpha);
+      }
+    }
+    return image;
+  };
+  std::vector<std::uint32_t> identity(fragments.size()), shuffled(fragments.size());
+  for (std::uint32_t i = 0; i < identity.size(); ++i) identity[i] = shuffled[i] = i;
+  std::shuffle(shuffled.begin(), shuffled.end(), random);
+  const Stored first = store(identity, false), second = store(shuffled, true);
+  std::size_t ties = 0;
+  for (const Fragment& a : fragments)
+    for (const Fragment& b : fragments)
+      ties += &a < &b && a.pixel == b.pixel && a.node[2] == b.node[2] && a.node[0] != b.node[0];
+  EXPECT_GT(ties, 100u) << "fragments of one pixel at one depth, in other colours";
+  EXPECT_NE(in_storage_order(first), in_storage_order(second)) << "where the order stored decides, it shows";
+  EXPECT_EQ(composite(first), composite(second));
 }
 
 TEST_F(RenderModes, ExactInDepthPassesEqualsExactInOnePass) {

@@ -17,6 +17,10 @@ void FrameBudget::record(std::uint32_t level, double ms, FrameLoad load) {
   if (level < kMaxLevels && ms >= 0) measured_ms_[load.index()][level] = ms;
 }
 
+void FrameBudget::record_first_picture(std::uint32_t level, double ms) {
+  if (level < kMaxLevels && ms >= 0) first_picture_ms_[level] = ms;
+}
+
 double FrameBudget::estimate_from_levels(const Costs& costs, std::uint32_t level) {
   if (costs[level] > 0) return costs[level];
   // The nearest measured level, scaled by the segments: 1/8 of them per level.
@@ -59,7 +63,7 @@ double FrameBudget::estimate_ms(std::uint32_t level, FrameLoad load) const {
   // estimate as it is; the next frame measures this one.
   for (const std::size_t other : others)
     if (const double ms = estimate_from_levels(measured_ms_[other], level); ms > 0) return ms;
-  return 0;
+  return estimate_from_levels(first_picture_ms_, level);
 }
 
 std::uint32_t FrameBudget::level_for(bool moving, FrameLoad load) const {

@@ -2,10 +2,10 @@
 // detail (.vxl spec §5.12) whose measured cost fits the budget; at rest, the scene's own level (the finest
 // the GPU memory budget allows, scene_detail.h). Costs are measured per level as frames are drawn; a level
 // not measured yet is estimated from its nearest measured neighbour at 8x per level (the segments it
-// draws). A frame's cost also depends on what else it draws and shares the machine with (FrameLoad): each load
-// is measured apart, and a load not measured at a level is estimated first from another load's cost at that
-// level, scaled by what the two loads cost at a level where both were measured, then from its own nearest
-// measured level. Pure logic: testable without GL.
+// draws), and from the first picture's cost while nothing else is measured. A frame's cost also depends on what else it
+// draws and shares the machine with (FrameLoad): each load is measured apart, and a load not measured at a level is
+// estimated first from another load's cost at that level, scaled by what the two loads cost at a level where both were
+// measured, then from its own nearest measured level. Pure logic: testable without GL.
 #pragma once
 
 #include <array>
@@ -39,6 +39,10 @@ class FrameBudget {
   std::uint32_t level_for(bool moving, FrameLoad load = {}) const;
   // A frame drawn at `level` under `load` took `ms`.
   void record(std::uint32_t level, double ms, FrameLoad load = {});
+  // The first picture took `ms` at `level`. It also paid what a renderer pays once (its shaders built, its
+  // buffers first drawn from: on llvmpipe about as much as the drawing), so it is an estimate only until a frame
+  // is measured: a level it put over the budget is tried again once a measured one puts it within.
+  void record_first_picture(std::uint32_t level, double ms);
   // The estimated frame time at `level` under `load`; 0 when nothing has been measured.
   double estimate_ms(std::uint32_t level, FrameLoad load = {}) const;
 
@@ -52,6 +56,7 @@ class FrameBudget {
   double budget_ms_;
   std::uint32_t scene_level_, coarsest_level_;
   std::array<Costs, FrameLoad::kCount> measured_ms_{};
+  Costs first_picture_ms_{};
 };
 
 // The window's first picture comes before the scene's level is uploaded: the finest level, from the scene's

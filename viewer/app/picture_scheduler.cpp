@@ -43,7 +43,10 @@ PictureTask PictureScheduler::next(bool changed, bool scripted_last, bool closin
 
 void PictureScheduler::drawn_whole(RenderMode mode, std::uint32_t level, double ms, bool focus_left_out) {
   focus_left_out_ = focus_left_out;
-  budget_.record(level, ms, load_);
+  if (drawn_any_)
+    budget_.record(level, ms, load_);
+  else
+    budget_.record_first_picture(level, ms);
   // Full detail for any view only at level 0 (or the level --level forces); otherwise the refinement
   // decides, once at rest, which level this view can have.
   rest_.drawn_whole(mode, level == 0 || (level_forced_ && level == scene_level_));

@@ -116,6 +116,48 @@ EGLDisplay try_platform_display(EGLenum platform, void* native, const char* name
   return dpy;
 }
 
+// The EGL devices in the order they are tried: NVIDIA's (EGL_NV_device_cuda), the other hardware ones, and
+// Mesa's software rasteriser (EGL_MESA_device_software) last.
+struct Devices {
+  std::vector<EGLDeviceEXT> nvidia, hardware, software;
+};
+
+Devices enumerate_devices(const char* client, std::string& errors) {
+  Devices found;
+  if (!has_extension(client, "EGL_EXT_platform_base") || !has_extension(client, "EGL_EXT_platform_device") ||
+      !(has_extension(client, "EGL_EXT_device_enumeration") || has_extension(client, "EGL_EXT_device_base"))) {
+    errors += "; EGL_EXT_platform_device / EGL_EXT_device_enumeration not offered";
+    return found;
+  }
+  EGLint count = 0;
+  std::array<EGLDeviceEXT, 16> devices{};
+  if (eglQueryDevicesEXT(static_cast<EGLint>(devices.size()), devices.data(), &count) != EGL_TRUE) {
+    errors += "; eglQueryDevicesEXT failed (eglGetError " + egl_error_text(eglGetError()) + ")";
+    return found;
+  }
+  if (count <= 0) errors += "; eglQueryDevicesEXT found no device";
+  const bool query = has_extension(client, "EGL_EXT_device_query") || has_extension(client, "EGL_EXT_device_base");
+  for (EGLint i = 0; i < count; ++i) {
+    const char* exts = query ? eglQueryDeviceStringEXT(devices[i], EGL_EXTENSIONS) : nullptr;
+    if (has_extension(exts, "EGL_MESA_device_software"))
+      found.software.push_back(devices[i]);
+    else if (has_extension(exts, "EGL_NV_device_cuda"))
+      found.nvidia.push_back(devices[i]);
+    else
+      found.hardware.push_back(devices[i]);
+  }
+  return found;
+}
+
+// The first of `devices` whose display initialises; EGL_NO_DISPLAY (each failure appended to `errors`) if none.
+EGLDisplay try_devices(const std::vector<EGLDeviceEXT>& devices, std::string& errors) {
+  for (EGLDeviceEXT device : devices) {
+    EGLDisplay dpy = try_platform_display(EGL_PLATFORM_DEVICE_EXT, device, "EGL_PLATFORM_DEVICE_EXT", errors);
+    if (dpy != EGL_NO_DISPLAY) return dpy;
+  }
+  return EGL_NO_DISPLAY;
+}
+
 DisplayChoice open_display(HeadlessGlContext::Platform platform) {
   using P = HeadlessGlContext::Platform;
   const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
@@ -130,6 +172,10 @@ DisplayChoice open_display(HeadlessGlContext::Platform platform) {
 
   const bool platform_base = has_extension(client, "EGL_EXT_platform_base");
   std::string errors;
+  const Devices devices = platform == P::Surfaceless ? Devices{} : enumerate_devices(client, errors);
+  // An NVIDIA GPU before Mesa's surfaceless platform: beside NVIDIA's EGL, Mesa's may answer that platform with
+  // its software rasteriser.
+  if (EGLDisplay dpy = try_devices(devices.nvidia, errors); dpy != EGL_NO_DISPLAY) return {dpy, "device"};
   if (platform == P::Auto || platform == P::Surfaceless) {
     if (platform_base && has_extension(client, "EGL_MESA_platform_surfaceless")) {
       EGLDisplay dpy = try_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY,
@@ -139,23 +185,8 @@ DisplayChoice open_display(HeadlessGlContext::Platform platform) {
       errors += "; EGL_MESA_platform_surfaceless not offered";
     }
   }
-  if (platform == P::Auto || platform == P::Device) {
-    if (platform_base && has_extension(client, "EGL_EXT_platform_device") &&
-        (has_extension(client, "EGL_EXT_device_enumeration") || has_extension(client, "EGL_EXT_device_base"))) {
-      EGLint count = 0;
-      std::array<EGLDeviceEXT, 16> devices{};
-      if (eglQueryDevicesEXT(static_cast<EGLint>(devices.size()), devices.data(), &count) != EGL_TRUE) {
-        errors += "; eglQueryDevicesEXT failed (eglGetError " + egl_error_text(eglGetError()) + ")";
-      } else if (count <= 0) {
-        errors += "; eglQueryDevicesEXT found no device";
-      } else {
-        EGLDisplay dpy = try_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[0], "EGL_PLATFORM_DEVICE_EXT", errors);
-        if (dpy != EGL_NO_DISPLAY) return {dpy, "device"};
-      }
-    } else {
-      errors += "; EGL_EXT_platform_device / EGL_EXT_device_enumeration not offered";
-    }
-  }
+  for (const std::vector<EGLDeviceEXT>* list : {&devices.hardware, &devices.software})
+    if (EGLDisplay dpy = try_devices(*list, errors); dpy != EGL_NO_DISPLAY) return {dpy, "device"};
   if (platform == P::Auto && !platform_base) {
     EGLDisplay dpy = eglGetDisplay(EGL_DEFAULT_DISPLAY);
     if (dpy != EGL_NO_DISPLAY) {

@@ -1,10 +1,13 @@
 #pragma once
 // Headless OpenGL core-profile context through EGL (no window, no X server, no Wayland).
 //
-// Display selection (Options::platform == Auto):
-//   1. EGL_PLATFORM_SURFACELESS_MESA (Mesa; also NVIDIA's EGL),
-//   2. EGL_PLATFORM_DEVICE_EXT with the first enumerated device (EGL_EXT_device_enumeration),
-//   3. eglGetDisplay(EGL_DEFAULT_DISPLAY), only when EGL_EXT_platform_base is missing.
+// Display selection (Options::platform == Auto), the first that initialises:
+//   1. EGL_PLATFORM_DEVICE_EXT with an NVIDIA device (EGL_NV_device_cuda): beside NVIDIA's EGL, Mesa's may
+//      answer the surfaceless platform with its software rasteriser,
+//   2. EGL_PLATFORM_SURFACELESS_MESA (Mesa; also NVIDIA's EGL),
+//   3. EGL_PLATFORM_DEVICE_EXT with each other enumerated device (EGL_EXT_device_enumeration), Mesa's
+//      software device (EGL_MESA_device_software) last,
+//   4. eglGetDisplay(EGL_DEFAULT_DISPLAY), only when EGL_EXT_platform_base is missing.
 // Context: OpenGL core profile, highest of 4.6, 4.5, 4.3, 3.3 (capped by Options::max_version),
 // without a config (EGL_KHR_no_config_context) and without a surface (EGL_KHR_surfaceless_context);
 // each has a fallback (eglChooseConfig / a 1x1 pbuffer) for EGL implementations lacking them.
@@ -32,9 +35,9 @@ std::string to_string(GlVersion v);  // "4.5"
 class HeadlessGlContext {
  public:
   enum class Platform {
-    Auto,         // surfaceless, then device, then default display
+    Auto,         // an NVIDIA device, surfaceless, the other devices, then the default display
     Surfaceless,  // EGL_PLATFORM_SURFACELESS_MESA only
-    Device,       // EGL_PLATFORM_DEVICE_EXT (first device) only
+    Device,       // EGL_PLATFORM_DEVICE_EXT only: each device in Auto's order until one initialises
   };
 
   struct Options {

@@ -73,8 +73,12 @@ ExactRenderer::ExactRenderer(PassHost& host, std::uint64_t node_capacity, ExactR
   clear_program_ = gl::make_compute_program(kClearCompute);
   blit_program_ = gl::make_program(shaders::kFullscreenVertex, kBlitFragment);
   if (resolve == ExactResolve::Gpu || (resolve == ExactResolve::Auto && !software_rasterizer())) {
-    gpu_ = std::make_unique<GpuListResolve>();
-    if (!gpu_->agrees_with_cpu()) gpu_.reset();  // this driver composites otherwise: the CPU does it
+    try {
+      gpu_ = std::make_unique<GpuListResolve>();
+      if (!gpu_->agrees_with_cpu()) gpu_.reset();  // this driver composites otherwise: the CPU does it
+    } catch (const std::exception&) {
+      gpu_.reset();  // a driver that cannot build the compute pass: the CPU composites
+    }
   }
   glGenBuffers(1, &nodes_);
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, nodes_);
@@ -105,6 +109,9 @@ void ExactRenderer::begin(const Camera& camera, const RenderSettings& s, int wid
     glGenTextures(1, &heads_);
     glBindTexture(GL_TEXTURE_2D, heads_);
     glTexStorage2D(GL_TEXTURE_2D, 1, GL_R32UI, width, height);
+    // An integer texture is complete only with NEAREST filters; some drivers check it for image units too.
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glGenTextures(1, &result_);
     glBindTexture(GL_TEXTURE_2D, result_);
     glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
@@ -258,7 +265,9 @@ std::uint64_t ExactRenderer::list_pass(std::size_t first_voxel, std::size_t end_
   const std::span<const std::int32_t> count(plan_.count);
   host_.lines().draw_plan(list_program_, first.subspan(first_voxel, end_voxel - first_voxel),
                           count.subspan(first_voxel, end_voxel - first_voxel));
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT);
+  // The counter is read back below (a buffer update), the lists by the resolve's shader or read-backs.
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_ATOMIC_COUNTER_BARRIER_BIT |
+                  GL_BUFFER_UPDATE_BARRIER_BIT);
 
   // The counter counts every fragment, also those past the capacity that were not stored.
   GLuint stored = 0;

@@ -27,9 +27,14 @@ uniform uint u_stored;
 uniform ivec2 u_rows;  // y0, y1
 const uint kEnd = 0xFFFFFFFFu;
 const int kBatch = 16;
-// Whether fragment (da, ia) is composited before (db, ib): the farther first; at equal depths, the one
-// stored first.
-bool before(float da, uint ia, float db, uint ib) { return da > db || (da == db && ia < ib); }
+// Whether fragment a (depth, colour words, node) is composited before b: the farther first; at equal depths by
+// their colours' words, then their nodes (fragments equal in both are the same fragment).
+bool before(float da, uvec2 ca, uint ia, float db, uvec2 cb, uint ib) {
+  if (da != db) return da > db;
+  if (ca.x != cb.x) return ca.x < cb.x;
+  if (ca.y != cb.y) return ca.y < cb.y;
+  return ia < ib;
+}
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.x, int(gl_GlobalInvocationID.y) + u_rows.x);
   if (p.x >= imageSize(u_heads).x || p.y >= u_rows.y) return;
@@ -38,23 +43,28 @@ void main() {
   // precise: every operation rounded on its own, as the CPU composites (no fused multiply-add).
   precise vec3 color = imageLoad(u_result, p).rgb;
   float depth[kBatch];
+  uvec2 colour[kBatch];
   uint node[kBatch];
   bool started = false;
   float last_depth = 0.0;
+  uvec2 last_colour = uvec2(0u);
   uint last_node = 0u;
   for (;;) {
     int n = 0;
     uint walked = 0u;  // a list cannot hold more than the nodes stored: a corrupt one ends there
     for (uint i = head; i != kEnd && i < u_stored && walked < u_stored; i = nodes[i].w, ++walked) {
-      float d = uintBitsToFloat(nodes[i].z);
-      if (started && !before(last_depth, last_node, d, i)) continue;  // composited already
-      if (n == kBatch && !before(d, i, depth[kBatch - 1], node[kBatch - 1])) continue;
+      uvec4 f = nodes[i];
+      float d = uintBitsToFloat(f.z);
+      if (started && !before(last_depth, last_colour, last_node, d, f.xy, i)) continue;  // composited already
+      if (n == kBatch && !before(d, f.xy, i, depth[kBatch - 1], colour[kBatch - 1], node[kBatch - 1])) continue;
       int j = n < kBatch ? n++ : kBatch - 1;
-      for (; j > 0 && before(d, i, depth[j - 1], node[j - 1]); --j) {
+      for (; j > 0 && before(d, f.xy, i, depth[j - 1], colour[j - 1], node[j - 1]); --j) {
         depth[j] = depth[j - 1];
+        colour[j] = colour[j - 1];
         node[j] = node[j - 1];
       }
       depth[j] = d;
+      colour[j] = f.xy;
       node[j] = i;
     }
     for (int k = 0; k < n; ++k) {
@@ -65,6 +75,7 @@ void main() {
     if (n < kBatch) break;
     started = true;
     last_depth = depth[kBatch - 1];
+    last_colour = colour[kBatch - 1];
     last_node = node[kBatch - 1];
   }
   imageStore(u_result, p, vec4(color, 1.0));
@@ -117,10 +128,15 @@ void composite_lists_on_cpu(std::span<const std::uint32_t> heads, std::span<cons
           list.push_back({depth, i});
         }
         if (list.empty()) continue;
-        // Farthest first; at equal depths the fragment stored first (drawn earlier: an earlier voxel in the
-        // visibility order) goes under, as it does when runs of voxels are composited one after another.
-        std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) {
-          return a.first > b.first || (a.first == b.first && a.second < b.second);
+        // Farthest first; at equal depths by the colours' words: a GPU stores the fragments of one run in an
+        // order of its own, and the picture must not depend on it. (Runs are composited one after another:
+        // a fragment of an earlier run goes under.)
+        std::sort(list.begin(), list.end(), [&](const auto& a, const auto& b) {
+          if (a.first != b.first) return a.first > b.first;
+          const FragmentNode &na = nodes[a.second], &nb = nodes[b.second];
+          if (na[0] != nb[0]) return na[0] < nb[0];
+          if (na[1] != nb[1]) return na[1] < nb[1];
+          return a.second < b.second;
         });
         float* out = image.data() + (std::size_t(y) * width + x) * 4;
         glm::vec3 color(out[0], out[1], out[2]);
@@ -202,6 +218,8 @@ bool GpuListResolve::agrees_with_cpu() const {
   glGenTextures(2, textures);
   glBindTexture(GL_TEXTURE_2D, textures[0]);
   glTexStorage2D(GL_TEXTURE_2D, 1, GL_R32UI, kWidth, kHeight);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);  // an integer texture: complete with NEAREST
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, kWidth, kHeight, GL_RED_INTEGER, GL_UNSIGNED_INT, heads.data());
   glBindTexture(GL_TEXTURE_2D, textures[1]);

@@ -71,7 +71,6 @@ GLuint link(std::initializer_list<GLuint> shaders) {
   return p;
 }
 
-#if VOXLINES_WEBGL
 // The (format, type) that glTexSubImage2D takes for a TextureBuffer's internal format, and its texel size.
 struct PixelLayout {
   GLenum format, type;
@@ -90,6 +89,7 @@ PixelLayout pixel_layout(GLenum internal_format) {
   }
 }
 
+#if VOXLINES_WEBGL
 constexpr std::size_t kUploadBandBytes = 8u << 20;
 
 // Copies `bytes` (whole texels) into the bound rows texture from row `first_row` on: whole rows in bands of at most
@@ -259,7 +259,23 @@ void TextureBuffer::destroy() {
 
 #else
 
+namespace {
+
+// A buffer texture reads zeros past the driver's limit (GL_MAX_TEXTURE_BUFFER_SIZE texels): a larger one is
+// refused, naming the sizes, so that nothing draws from it wrongly.
+void check_within_limit(GLenum internal_format, std::size_t bytes) {
+  const std::uint64_t texels = bytes / pixel_layout(internal_format).texel_bytes, limit = max_buffer_texels();
+  if (texels > limit)
+    throw std::runtime_error("a GPU buffer of " + std::to_string(texels) +
+                             " texels is more than this driver's limit of " + std::to_string(limit) +
+                             " (GL_MAX_TEXTURE_BUFFER_SIZE); a smaller --span-texels keeps "
+                             "each span's buffers within it");
+}
+
+}  // namespace
+
 void TextureBuffer::create(GLenum internal_format, const void* data, std::size_t bytes) {
+  check_within_limit(internal_format, bytes);
   glGenBuffers(1, &buffer);
   glBindBuffer(GL_TEXTURE_BUFFER, buffer);
   // A zero-sized buffer texture is not portable: keep at least one texel.
@@ -285,6 +301,7 @@ void* TextureBuffer::create_mapped(std::size_t bytes) {
     mapped_bytes_ = size;
     return memory;
   }
+  mapped_bytes_ = size;
   glGenBuffers(1, &buffer);
   glBindBuffer(GL_TEXTURE_BUFFER, buffer);
   glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(size), nullptr, GL_STATIC_DRAW);
@@ -301,6 +318,17 @@ void* TextureBuffer::create_mapped(std::size_t bytes) {
 
 void TextureBuffer::finish_mapped(GLenum internal_format) {
   if (host_memory_ && buffer) return;  // finished already
+  try {
+    check_within_limit(internal_format, mapped_bytes_);
+  } catch (...) {
+    if (!host_memory_) {  // the driver's buffer, still mapped
+      glBindBuffer(GL_TEXTURE_BUFFER, buffer);
+      glUnmapBuffer(GL_TEXTURE_BUFFER);
+      glBindBuffer(GL_TEXTURE_BUFFER, 0);
+    }
+    destroy();
+    throw;
+  }
   if (host_memory_) {
     glGenBuffers(1, &buffer);
     glBindBuffer(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, buffer);

@@ -49,7 +49,8 @@ struct TextureBuffer {
   // The same filled in place: create_mapped returns `bytes` (at least 16) of memory for writing, which any thread
   // may fill — the driver's buffer, mapped, or host memory (host_memory_buffers()) — and finish_mapped makes the
   // texture of it (unmapping the driver's buffer, or handing the host memory to the driver). Throws
-  // std::runtime_error when the memory cannot be had or the driver loses the contents. (WebGL2 maps nothing: the
+  // std::runtime_error when the memory cannot be had, the driver loses the contents, or the buffer holds more
+  // texels than the driver's limit (max_buffer_texels; create refuses those too). (WebGL2 maps nothing: the
   // memory is the host's, copied to the texture by finish_mapped, which does nothing a second time.)
   void* create_mapped(std::size_t bytes);
   void finish_mapped(GLenum internal_format);

@@ -139,10 +139,10 @@ void SceneLayout::lay_out(std::span<const VxlFile* const> files, std::uint64_t m
     auto counts = [&](std::uint32_t local) { return file.level(local, fl.level); };
     // The level's K orders as the file stores them, padded to 4 bytes (spec §5.5): whole words.
     auto order_words = [&](const LevelEntry& e) { return level_orders_size(e, slots, file.order_packing()) / 4; };
-    // Both buffers of a span within the limit: its words (4 a texel) and its order words; and its ids
-    // within one draw's.
+    // Both buffers of a span within the limit: its words (4 a texel) and its order words, which the vertex
+    // shader also addresses in bits by a 32-bit uint (2^27 words at most); and its ids within one draw's.
     auto fits = [&](const TextureSpan& c) {
-      return c.words() / 4 <= max_texels && c.order_words <= max_texels &&
+      return c.words() / 4 <= max_texels && c.order_words <= std::min<std::uint64_t>(max_texels, 1ull << 27) &&
              c.virtual_ids() <= std::uint64_t(std::numeric_limits<std::int32_t>::max() / 2);
     };
     auto voxels = file.voxels();
