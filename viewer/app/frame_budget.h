@@ -43,7 +43,7 @@ class FrameBudget {
   // buffers first drawn from: on llvmpipe about as much as the drawing), so it is an estimate only until a frame
   // is measured: a level it put over the budget is tried again once a measured one puts it within.
   void record_first_picture(std::uint32_t level, double ms);
-  // The estimated frame time at `level` under `load`; 0 when nothing has been measured.
+  // The estimated frame time at `level` under `load`; 0 when nothing has been measured nor a first picture drawn.
   double estimate_ms(std::uint32_t level, FrameLoad load = {}) const;
 
  private:

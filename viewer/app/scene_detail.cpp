@@ -20,8 +20,9 @@ constexpr GLenum kAtiTextureFreeMemory = 0x87FC;
 
 std::optional<std::uint64_t> driver_free_bytes() {
   GLint kib[4] = {0, 0, 0, 0};
-  while (glGetError() != GL_NO_ERROR) {
-  }  // an error left by an earlier call must not be taken for this query's
+  // An error left by an earlier call must not be taken for this query's (bounded: a lost context repeats one).
+  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {
+  }
   if (epoxy_has_gl_extension("GL_NVX_gpu_memory_info"))
     glGetIntegerv(kNvxCurrentAvailableKib, kib);
   else if (epoxy_has_gl_extension("GL_ATI_meminfo"))

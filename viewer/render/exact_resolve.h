@@ -4,10 +4,10 @@
 //
 // A fragment node is four words: its colour's red and green, blue and alpha (GLSL packHalf2x16), its window
 // depth (float bits) and the next node of its pixel's list (0xFFFFFFFF ends a list). A pixel's fragments are
-// composited farthest first and, at equal depths, in the order of their colour words (red-green, then
-// blue-alpha, each the smaller first), each as colour * alpha + below * (1 - alpha), every operation rounded on
-// its own. The picture depends on the fragments alone, not on the order a GPU stored them in (which its
-// fragment shaders' scheduling decides).
+// composited farthest first and, at equal depths, in the order of their colour words as unsigned integers
+// (the red-green word, then the blue-alpha one, each the smaller first), each as colour * alpha + below * (1 - alpha),
+// every operation rounded on its own. The picture depends on the fragments alone, not on the order a GPU stored them in
+// (which its fragment shaders' scheduling decides).
 #pragma once
 
 #include <array>

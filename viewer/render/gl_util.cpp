@@ -268,8 +268,8 @@ void check_within_limit(GLenum internal_format, std::size_t bytes) {
   if (texels > limit)
     throw std::runtime_error("a GPU buffer of " + std::to_string(texels) +
                              " texels is more than this driver's limit of " + std::to_string(limit) +
-                             " (GL_MAX_TEXTURE_BUFFER_SIZE); a smaller --span-texels keeps "
-                             "each span's buffers within it");
+                             " (GL_MAX_TEXTURE_BUFFER_SIZE); for a span's buffers, a smaller --span-texels "
+                             "keeps them within it");
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 #include <thread>
+#include <utility>
 
 #include "format/base/error.h"
 #include "format/base/parallel.h"
@@ -383,8 +384,10 @@ void GpuScene::evict(std::uint32_t c) {
     Filling f = std::move(filling_[*k]);
     filling_.erase(filling_.begin() + static_cast<std::ptrdiff_t>(*k));
     f = {};
-    for (gl::TextureBuffer* buffer : {&spans_[c].words, &spans_[c].orders}) try {
-        buffer->finish_mapped(GL_R32UI);
+    for (const auto& [buffer, format] :
+         {std::pair{&spans_[c].words, GLenum(GL_RGBA32UI)}, std::pair{&spans_[c].orders, GLenum(GL_R32UI)}})
+      try {
+        buffer->finish_mapped(format);
       } catch (const std::exception&) {  // contents lost: they are dropped anyway
       }
   } else if (!resident_[c]) {
