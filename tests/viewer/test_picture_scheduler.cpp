@@ -45,6 +45,20 @@ TEST(PictureScheduler, AChangedPictureIsDrawnWholeAtTheFirstThenTheBudgetsLevel)
   EXPECT_EQ(view.asked, 0) << "the view's level is asked only at rest";
 }
 
+// The first picture also builds the shaders and draws from new buffers: its time decides the level only until a
+// whole picture is measured, so that a level it put over the budget is tried again when a measured one fits it.
+TEST(PictureScheduler, TheFirstPicturesTimeDecidesOnlyUntilAPictureIsMeasured) {
+  PictureScheduler s = scheduler(true);
+  ViewLevel view{0};
+  s.drawn_whole(RenderMode::Axis, s.next(true, false, false, view.fn()).level, 150);  // level 2, over the budget
+  PictureTask t = s.next(true, false, false, view.fn());
+  EXPECT_EQ(t.level, kCoarsest) << "nothing measured yet: level 2 as the first picture cost it";
+  s.drawn_whole(RenderMode::Axis, t.level, 5);
+  EXPECT_EQ(s.next(true, false, false, view.fn()).level, kFirstLevel) << "8 x 5 ms fits: level 2 is tried again";
+  s.drawn_whole(RenderMode::Axis, kFirstLevel, 150);
+  EXPECT_EQ(s.next(true, false, false, view.fn()).level, kCoarsest) << "measured over the budget";
+}
+
 // While a selection is made on the other cores, whole pictures are measured and chosen under that load.
 TEST(PictureScheduler, WholePicturesAreMeasuredAndChosenUnderTheirLoad) {
   PictureScheduler s = scheduler(true);
