@@ -1,6 +1,7 @@
 // The GPU memory budget (gpu_memory_pool.h, GpuScene::make_resident): never exceeded, the nearest visible
 // spans first, the least recently used evicted, and an evicted span draws the same picture once uploaded
 // again.
+#include <chrono>
 #include <memory>
 
 #include "converter/synth/synth.h"
@@ -9,6 +10,7 @@
 #include "viewer/platform/image_metrics.h"
 #include "viewer/render/gl_util.h"
 #include "viewer/render/gpu_memory_pool.h"
+#include "viewer/render/upload_tally.h"
 #include "viewer/render/view_queries.h"
 
 namespace vxl {
@@ -275,6 +277,35 @@ TEST_F(GpuMemoryBudget, UploadsSpreadOverCallsGiveTheSamePicture) {
   const Image a = render_image(eager, view(), s, 96, 96), b = render_image(lazy, view(), s, 96, 96);
   EXPECT_EQ(lazy.gpu_bytes(), uploaded) << "the frame found every span it needed";
   EXPECT_EQ(compare_images(a, b).differing_pixels, 0u);
+  // Each pool's tally holds every span it uploaded, however the uploads were spread (nothing was evicted).
+  for (const Renderer* r : {&eager, &lazy}) {
+    const UploadTally& t = r->gpu_memory().uploads();
+    EXPECT_EQ(t.bytes(), r->gpu_bytes());
+    EXPECT_EQ(t.spans(), r->layout().texture_spans().size());
+    EXPECT_GT(t.seconds(), 0.0);
+    EXPECT_DOUBLE_EQ(t.gb_per_s(), double(t.bytes()) / 1e9 / t.seconds());
+  }
+}
+
+// Two spans fill at once: the time both were filling is counted once, and a fill's wait to be looked at not at all
+// (the caller passes when its fill ended).
+TEST(UploadTally, TimeDuringWhichFillsOverlapIsCountedOnce) {
+  using Clock = UploadTally::Clock;
+  const Clock::time_point t0 = Clock::now();
+  const auto at = [&](double s) {
+    return t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  };
+  UploadTally t;
+  EXPECT_EQ(t.gb_per_s(), 0.0) << "nothing uploaded yet";
+  t.add(1'000'000'000, at(0), at(2));
+  t.add(1'000'000'000, at(1), at(3));    // overlaps the first by a second
+  t.add(500'000'000, at(1.5), at(2.5));  // within both
+  EXPECT_NEAR(t.seconds(), 3.0, 1e-9);
+  t.add(1'500'000'000, at(5), at(6));  // after an idle second, which does not count
+  EXPECT_NEAR(t.seconds(), 4.0, 1e-9);
+  EXPECT_EQ(t.bytes(), 4'000'000'000u);
+  EXPECT_EQ(t.spans(), 4u);
+  EXPECT_NEAR(t.gb_per_s(), 1.0, 1e-9);
 }
 
 // A buffer texture reads zeros past the driver's limit: a buffer larger than it is refused with the sizes named,

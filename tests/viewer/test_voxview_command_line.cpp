@@ -1,15 +1,19 @@
 // voxview's command line: a mistyped option gets the nearest one, an unknown view the list of views, and
 // messages about options carry no file name; a picture is written in the format its extension names, through
-// the picture module loaded when it is written (a missing module is an error naming it, and writes nothing).
+// the picture module loaded when it is written (a missing module is an error naming it, and writes nothing); the
+// window's options are refused with --render, and --render's --stats says where the time went.
 #include <sys/resource.h>
 
 #include <filesystem>
 
 #include <epoxy/gl.h>
+#include <nlohmann/json.hpp>
 
 #include "tests/test_support.h"
 #include "viewer/platform/egl_context.h"
 #include "viewer/platform/image_io.h"
+#include "viewer/render/gpu_scene.h"
+#include "viewer/render/scene_layout.h"
 
 namespace vxl {
 namespace {
@@ -130,6 +134,74 @@ TEST(VoxviewCommandLine, AMissingPictureModuleIsAnErrorThatNamesItAndWritesNothi
   // Found where the build put it, the same command writes the picture.
   EXPECT_EQ(test::run_program(VOXVIEW_CLI, args + test::q(dir.file("a.tif"))).exit_code, 0);
   EXPECT_TRUE(std::filesystem::exists(dir.file("a.tif")));
+}
+
+// The window's options would do nothing with --render, which draws its pictures and quits: each is a usage error
+// naming both, before anything is drawn.
+TEST(VoxviewCommandLine, TheWindowsOptionsAreRefusedWithRender) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  const std::string render = test::q(dir.file("a.tck")) + " --size 16x16 --render " + test::q(dir.file("a.png"));
+  const std::vector<std::string> options = {"--frames 3",          "--orbit 5",
+                                            "--frame-budget 50",   "--no-exact-when-still",
+                                            "--drag-region 1,0,0", "--screenshot " + test::q(dir.file("b.png"))};
+  for (const std::string& option : options) {
+    const test::CommandResult r = test::run_program(VOXVIEW_CLI, render + " " + option);
+    EXPECT_EQ(r.exit_code, 2) << option << ": " << r.output;
+    const std::string name = option.substr(0, option.find(' '));
+    EXPECT_NE(r.output.find("--render excludes " + name), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("a.png"))) << option;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("b.png"))) << option;
+  }
+}
+
+// --render with --stats: where the time from the process start to each picture went, and what the GPU was sent.
+TEST(VoxviewCommandLine, RenderWithStatsSaysWhereTheTimeWentAndWhatWasUploaded) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 300").exit_code, 0);
+  ASSERT_EQ(test::run_cli("convert " + test::q(dir.file("a.tck")) + " " + test::q(dir.file("a.vxl"))).exit_code, 0);
+  const test::CommandResult r =
+      test::run_program(VOXVIEW_CLI, test::q(dir.file("a.vxl")) + " --size 64x48 --level 0 --turntable 2 --render " +
+                                         test::q(dir.file("a.png")) + " --stats " + test::q(dir.file("s.json")));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(test::slurp(dir.file("s.json")));
+  EXPECT_EQ(j.at("mode"), "axis");
+  EXPECT_EQ(j.at("size"), nlohmann::json::array({64, 48}));
+  EXPECT_EQ(j.at("level"), 0);
+  EXPECT_FALSE(j.at("gl_renderer").get<std::string>().empty());
+  // Each step after the one before it.
+  const auto& startup = j.at("startup");
+  double before = 0;
+  for (const char* step : {"main_s", "files_open_s", "context_s", "scene_ready_s"}) {
+    EXPECT_GE(startup.at(step).get<double>(), before) << step;
+    before = startup.at(step).get<double>();
+  }
+  const auto& pictures = j.at("pictures");
+  ASSERT_EQ(pictures.size(), 2u) << "one a turntable frame";
+  EXPECT_EQ(j.at("first_picture_written_s"), pictures[0].at("written_s"));
+  for (const auto& p : pictures) {
+    EXPECT_GT(p.at("written_s").get<double>(), before);
+    before = p.at("written_s").get<double>();
+    EXPECT_GT(p.at("draw_ms").get<double>(), 0.0);
+    for (const char* step : {"read_back_ms", "checks_wait_ms", "write_ms"}) EXPECT_GE(p.at(step).get<double>(), 0.0);
+    EXPECT_GT(p.at("segments").get<std::uint64_t>(), 0u);
+  }
+  // The whole file at level 0 was uploaded once: its positions and orders at least, and no more than the layout says
+  // a full copy can take.
+  std::uint64_t least = 0, most = 0;
+  {
+    HeadlessGlContext context;
+    const VxlFile file = VxlFile::open(dir.file("a.vxl"));
+    const SceneLayout layout(file, GpuScene::driver_limit(), 0);
+    for (const TextureSpan& span : layout.texture_spans()) least += 4 * (span.words() + span.order_words);
+    most = layout.upload_bytes();
+  }
+  const auto& upload = j.at("upload");
+  EXPECT_GE(upload.at("bytes").get<std::uint64_t>(), least);
+  EXPECT_LE(upload.at("bytes").get<std::uint64_t>(), most);
+  EXPECT_GE(upload.at("spans").get<std::uint64_t>(), 1u);
+  EXPECT_GT(upload.at("seconds").get<double>(), 0.0);
+  EXPECT_GT(upload.at("gb_per_s").get<double>(), 0.0);
 }
 
 }  // namespace

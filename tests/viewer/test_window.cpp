@@ -209,6 +209,12 @@ TEST_F(Window, MovingFramesDrawACoarserLevelWithinTheFrameBudget) {
   EXPECT_GT(j.at("first_on_screen_s").get<double>(), j.at("first_picture_s").get<double>());
   EXPECT_LT(j.at("first_on_screen_s").get<double>(), frames[1].at("since_start_s").get<double>());
   EXPECT_EQ(startup.at("first_on_screen_s"), j.at("first_on_screen_s"));
+  // The levels drawn were uploaded: their bytes and the time that took.
+  const auto& upload = j.at("upload");
+  EXPECT_GT(upload.at("bytes").get<std::uint64_t>(), 0u);
+  EXPECT_GE(upload.at("spans").get<std::uint64_t>(), 2u) << "full detail and at least one coarser level";
+  EXPECT_GT(upload.at("seconds").get<double>(), 0.0);
+  EXPECT_GT(upload.at("gb_per_s").get<double>(), 0.0);
   EXPECT_EQ(j.at("full_detail_s"), frames[0].at("since_start_s"));
   EXPECT_GT(j.at("moving_p95_ms").get<double>(), 0.0);
   EXPECT_GE(j.at("moving_p95_ms").get<double>(), j.at("moving_median_ms").get<double>());

@@ -56,9 +56,17 @@ FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint3
   return s;
 }
 
+nlohmann::json upload_summary(const UploadTally& uploads) {
+  return {{"bytes", uploads.bytes()},
+          {"spans", uploads.spans()},
+          {"seconds", uploads.seconds()},
+          {"gb_per_s", uploads.gb_per_s()}};
+}
+
 void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
-                       double frame_budget_ms, const StartupTimes& startup, const std::vector<double>& selection_ms,
-                       const std::vector<std::uint32_t>& selection_levels, const std::optional<DragEndWait>& drag_end) {
+                       double frame_budget_ms, const StartupTimes& startup, const UploadTally& uploads,
+                       const std::vector<double>& selection_ms, const std::vector<std::uint32_t>& selection_levels,
+                       const std::optional<DragEndWait>& drag_end) {
   const FrameSummary s = summarize_frames(frames, scene_level);
   nlohmann::json j;
   j["scene_level"] = scene_level;
@@ -69,6 +77,7 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
                   {"window_open_s", startup.window_open_s},
                   {"viewer_ready_s", startup.viewer_ready_s},
                   {"first_on_screen_s", startup.first_on_screen_s}};
+  j["upload"] = upload_summary(uploads);
   j["first_picture_s"] = s.first_picture_s;
   j["full_detail_s"] = s.full_detail_s;
   j["exact_s"] = s.exact_s;
@@ -117,7 +126,11 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
     if (f.new_selection) list.back()["new_selection"] = true;
   }
   j["frames"] = list;
-  const std::string text = j.dump(2) + "\n";
+  write_stats_json(path, j);
+}
+
+void write_stats_json(const std::string& path, const nlohmann::json& stats) {
+  const std::string text = stats.dump(2) + "\n";
   AtomicOutputFile out(path);
   out.write(text.data(), text.size());
   out.commit();

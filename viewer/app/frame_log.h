@@ -11,6 +11,10 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
+#include "viewer/render/upload_tally.h"
+
 namespace vxl::app {
 
 enum class FrameWork {
@@ -59,11 +63,16 @@ struct DragEndWait {
 
 FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint32_t scene_level);
 
-// Writes the summary, the budget and every frame as JSON to `path` (atomically), and the selections' run
-// times (selection_worker.h: how long after a region moved its picture was ready), and for a scripted drag how
-// its end waited. Throws vxl::Error (Output).
+// The upload's figures as --stats writes them: {"bytes", "spans", "seconds", "gb_per_s"}.
+nlohmann::json upload_summary(const UploadTally& uploads);
+// Writes a --stats file (indented JSON) atomically. Throws vxl::Error (Output).
+void write_stats_json(const std::string& path, const nlohmann::json& stats);
+
+// Writes the summary, the budget, what was uploaded to the GPU and every frame as JSON to `path` (atomically),
+// and the selections' run times (selection_worker.h: how long after a region moved its picture was ready), and
+// for a scripted drag how its end waited. Throws vxl::Error (Output).
 void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& frames, std::uint32_t scene_level,
-                       double frame_budget_ms, const StartupTimes& startup = {},
+                       double frame_budget_ms, const StartupTimes& startup = {}, const UploadTally& uploads = {},
                        const std::vector<double>& selection_ms = {},
                        const std::vector<std::uint32_t>& selection_levels = {},
                        const std::optional<DragEndWait>& drag_end = std::nullopt);

@@ -6,11 +6,14 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "format/base/memory_size.h"
 #include "viewer/app/camera_file.h"
 #include "viewer/app/picture_annotations.h"
+#include "viewer/app/process_clock.h"
 #include "viewer/app/region_editor.h"
+#include "viewer/app/render_stats.h"
 #include "viewer/app/scene_selection.h"
 #include "viewer/app/scene_source.h"
 #include "viewer/app/turntable.h"
@@ -55,6 +58,8 @@ Camera initial_camera(std::span<const glm::dvec3> points, const ViewerOptions& o
 
 int run_headless(const ViewerOptions& o) {
   auto t0 = std::chrono::steady_clock::now();
+  RenderStats stats;  // for --stats
+  stats.main_s = seconds_before_main();
   // Made after the files are open, gone after the session's renderers: declared first, made later.
   std::optional<HeadlessGlContext> context;
   ViewerSession session(o);                 // before any GL work: a bad file or image fails fast
@@ -67,7 +72,9 @@ int run_headless(const ViewerOptions& o) {
     std::fprintf(stderr, "voxview: %llu of %llu streamlines selected (the focus; the others are context)\n",
                  (unsigned long long)selection->selected, (unsigned long long)selection->total);
   }
+  stats.files_open_s = seconds_since_process_start();
   context.emplace();
+  stats.context_s = seconds_since_process_start();
   session.choose_detail(o, /*one_renderer=*/true);
   const SceneDetail& detail = session.detail();
   const double aspect = double(o.width) / o.height;
@@ -112,22 +119,42 @@ int run_headless(const ViewerOptions& o) {
   if (o.save_camera)
     write_view(*o.save_camera, SavedView{camera, o.settings, std::array<int, 2>{o.width, o.height}, true, o.include,
                                          o.exclude, o.ends_in, o.show_regions});
+  stats.scene_ready_s = seconds_since_process_start();
+  stats.gl_renderer = context->renderer();
+  stats.mode = render_mode_name(o.settings.mode);
+  stats.width = o.width;
+  stats.height = o.height;
+  stats.level = focus_first ? focus_first->context : level;
   const int frames = std::max(1, o.turntable);
   std::optional<PictureAnnotations> annotations;
   if (PictureAnnotations::wanted(o.settings)) annotations.emplace();
   for (int i = 0; i < frames; ++i) {
     const Camera frame_camera = turntable_camera(camera, i, frames);
+    RenderedPicture& picture = stats.pictures.emplace_back();
+    auto step = std::chrono::steady_clock::now();
+    const auto step_ms = [&step] {  // since the last step, which ends now
+      const auto now = std::chrono::steady_clock::now();
+      return std::chrono::duration<double, std::milli>(now - std::exchange(step, now)).count();
+    };
     renderer->draw(frame_camera, settings, o.width, o.height, target.framebuffer());
     if (annotations) {
       target.bind();
       annotations->draw(frame_camera, o.settings, *renderer, o.width, o.height);
     }
+    glFinish();  // the drawing's time includes the GPU's work
+    picture.draw_ms = step_ms();
     std::vector<std::uint8_t> rgba = target.read_rgba();
+    picture.read_back_ms = step_ms();
     renderer->check_uploaded(true);  // a damaged file's picture is not written
+    picture.checks_wait_ms = step_ms();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::string png = o.turntable ? turntable_frame_path(*o.render_png, i, frames) : *o.render_png;
     write_picture(png, o.width, o.height, rgba);
+    picture.write_ms = step_ms();
+    picture.written_s = seconds_since_process_start();
     const FrameStats& s = renderer->stats();
+    picture.voxels = s.voxels_drawn;
+    picture.segments = s.segments_drawn;
     const std::string levels =
         focus_first ? ", focus at level 0 and context at level " + std::to_string(focus_first->context) : "";
     std::printf("%s: %dx%d %s, %llu voxels and %llu segments drawn%s, %s after %.3f s (%s)\n", png.c_str(), o.width,
@@ -136,6 +163,10 @@ int run_headless(const ViewerOptions& o) {
                 context->renderer().c_str());
   }
   if (o.save_camera) std::printf("view saved to %s\n", o.save_camera->c_str());
+  if (o.stats_json) {
+    stats.uploads = session.uploads();
+    write_render_stats(*o.stats_json, stats);
+  }
   return 0;
 }
 

@@ -42,5 +42,8 @@ const std::chrono::steady_clock::time_point g_start =
 
 std::chrono::steady_clock::time_point process_start() { return g_start; }
 double seconds_before_main() { return g_before_main; }
+double seconds_since_process_start() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - g_start).count();
+}
 
 }  // namespace vxl::app

@@ -10,5 +10,7 @@ std::chrono::steady_clock::time_point process_start();
 // The seconds from the process start to the program's static initialisation, just before main: what loading
 // the program and its shared libraries took (0 where /proc cannot tell).
 double seconds_before_main();
+// The seconds from the process start to now.
+double seconds_since_process_start();
 
 }  // namespace vxl::app

@@ -57,7 +57,7 @@ struct ViewerOptions {
   std::optional<double> orbit_deg;  // window: turn the camera by this azimuth every frame (benchmarks)
   // Window: move the active region by this offset (mm) every frame, a scripted drag (benchmarks).
   std::optional<std::array<double, 3>> drag_region_mm;
-  std::optional<std::string> stats_json;  // window: write each frame's level and time here on quitting
+  std::optional<std::string> stats_json;  // --stats: the window's frames on quitting, or the pictures --render wrote
   // Window automation (tests, scripted screenshots): quit after N frames, saving a screenshot first.
   std::optional<int> frames;
   bool until_refined = false;  // with frames: after them, stay at rest until the refinement is done, then quit

@@ -94,6 +94,8 @@ class ViewerSession {
   // Every renderer's checks of what it uploaded (Renderer::check_uploaded): rethrows a failure; with `wait`,
   // once all have run.
   void check_uploaded(bool wait);
+  // What the renderers have uploaded to the GPU so far (their memory pool's tally; empty before choose_detail).
+  UploadTally uploads() const { return gpu_memory_ ? gpu_memory_->uploads() : UploadTally{}; }
   // The files' per-voxel indexes, shared by the renderers and the selections (built once, on first use).
   const std::shared_ptr<VoxelVoxlinesCache>& indexes() const { return indexes_; }
 

@@ -258,42 +258,53 @@ void declare_loading(CLI::App& cli, ViewerArguments& a) {
       ->check(CLI::Range(0u, kMaxLevels - 1));
 }
 
-// The window's frame budget, refinement and scripting.
+// The window's frame budget, refinement and scripting: refused with --render, which draws one picture and quits
+// (what they ask for would not happen).
 void declare_window(CLI::App& cli, ViewerArguments& a) {
+  CLI::Option* const render = cli.get_option("--render");
   cli.add_option("--frame-budget", a.options.frame_budget_ms,
                  "window: while the camera moves, draw the finest level of detail whose measured frame time fits this "
                  "many milliseconds; at rest, the level --gpu-memory allows (0: always that level)")
       ->default_val(100.0)
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::NonNegativeNumber)
+      ->excludes(render);
   cli.add_flag("--no-exact-when-still{false}", a.options.exact_when_still,
                "window: at rest, stop at the full-detail picture; by default, where OpenGL 4.3 is there, the basic "
-               "and axis modes go on to the exact picture, run by run, dropped at the first movement (key E)");
+               "and axis modes go on to the exact picture, run by run, dropped at the first movement (key E)")
+      ->excludes(render);
   cli.add_option(
-      "--orbit", a.options.orbit_deg,
-      "window: turn the camera by this many degrees of azimuth every frame (a scripted orbit, with --frames, "
-      "for benchmarks); the last frame is drawn at rest (with --until-refined the camera rests after --frames)");
+         "--orbit", a.options.orbit_deg,
+         "window: turn the camera by this many degrees of azimuth every frame (a scripted orbit, with --frames, "
+         "for benchmarks); the last frame is drawn at rest (with --until-refined the camera rests after --frames)")
+      ->excludes(render);
   cli.add_option("--drag-region", a.drag_region,
                  "window: move the active region by DX,DY,DZ mm every frame (a scripted drag, with --frames, for "
                  "benchmarks: --stats then has the selections' times); the picture takes each new selection when it "
                  "is ready, the frames keep their budget; after the frames it draws frames until the last "
                  "position's selection and focus copy are in the picture (at most 60 s; --stats: drag_end_wait)")
       ->delimiter(',')
-      ->expected(3);
+      ->expected(3)
+      ->excludes(render);
   cli.add_option("--stats", a.options.stats_json,
-                 "window: on quitting, write every frame's level of detail (with focus_level 0 where the focus was "
-                 "drawn first, at full detail) and time, when the first picture reached "
-                 "the screen (first_on_screen_s, since the process started), when it was drawn and the first "
-                 "full-detail and exact pictures' times, the moving frames', the refinement pieces' and the "
+                 "write to this JSON file what the GPU was sent (upload: bytes, spans, seconds, gb_per_s) and when "
+                 "(since the process started) the program was loaded (main_s); with --render, when the files were "
+                 "open, the GL context made and the scene ready, and per picture the time to draw it, read it back, "
+                 "wait for the draw checks and write it, and when it was written; in the window, on quitting, every "
+                 "frame's level of detail (with focus_level 0 where the focus was drawn first, at full detail) and "
+                 "time, when the first picture reached the screen (first_on_screen_s), when it was drawn and the "
+                 "first full-detail and exact pictures' times, the moving frames', the refinement pieces' and the "
                  "selections' median and 95th percentile (of all, and of those after the first, which also boxes "
-                 "the voxels its regions touch) to this JSON file");
+                 "the voxels its regions touch)");
   cli.add_option("--frames", a.options.frames, "window: quit after this many frames (for scripts and tests)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->excludes(render);
   cli.add_flag("--until-refined", a.options.until_refined,
                "window, with --frames: after the frames, keep the camera still until the picture is refined (full "
                "detail, then exact unless --no-exact-when-still), then quit")
       ->needs("--frames");
   cli.add_option("--screenshot", a.options.screenshot,
-                 "window: save the last frame to this picture before quitting: " + picture_formats_text());
+                 "window: save the last frame to this picture before quitting: " + picture_formats_text())
+      ->excludes(render);
 }
 
 }  // namespace

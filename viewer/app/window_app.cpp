@@ -491,8 +491,8 @@ int ViewerWindow::run() {
   // What was drawn is checked before the window reports success: a damaged file exits 3, as headless.
   session_->check_uploaded(true);
   if (options_.stats_json)
-    write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms, startup_, selection_ms_,
-                      selection_levels_, drag_end_);
+    write_frame_stats(*options_.stats_json, frames_, detail_.level, options_.frame_budget_ms, startup_,
+                      session_->uploads(), selection_ms_, selection_levels_, drag_end_);
   return 0;
 }
 

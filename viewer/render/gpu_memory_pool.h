@@ -13,6 +13,8 @@
 #include <limits>
 #include <vector>
 
+#include "viewer/render/upload_tally.h"
+
 namespace vxl {
 
 class GpuMemoryPool {
@@ -44,6 +46,9 @@ class GpuMemoryPool {
   std::uint64_t peak() const { return peak_; }            // the most ever resident
   std::uint64_t evictions() const { return evictions_; }  // pieces evicted to make room
   std::uint64_t additions() const { return additions_; }  // pieces added (uploads)
+  // What the scenes sharing the pool copied to the GPU, and how fast (upload_tally.h).
+  const UploadTally& uploads() const { return uploads_; }
+  UploadTally& uploads() { return uploads_; }
 
  private:
   struct Entry {
@@ -54,6 +59,7 @@ class GpuMemoryPool {
   std::uint64_t used_ = 0, peak_ = 0, evictions_ = 0, additions_ = 0, use_ = 0;
   std::vector<Entry> entries_;  // resident pieces (a scene has tens to thousands of them)
   std::vector<Evict> owners_;   // empty function: removed
+  UploadTally uploads_;
 };
 
 }  // namespace vxl

@@ -202,6 +202,7 @@ void GpuScene::begin_upload(std::uint32_t ci) {
   if constexpr (!kThreadsAvailable) {  // made here, part by part: nothing fills on other threads
     Filling f;
     f.span = ci;
+    f.begun = UploadTally::Clock::now();
     begin_parts(f);
     filling_.push_back(std::move(f));
     uploaded_bytes_[ci] = span_bytes(ci);
@@ -216,8 +217,9 @@ void GpuScene::begin_upload(std::uint32_t ci) {
   // threads: voxels fill disjoint ranges of both. The words fill while this thread has the order buffer made.
   Filling f;
   f.span = ci;
+  f.begun = UploadTally::Clock::now();
   auto* words = static_cast<std::uint32_t*>(g.words.create_mapped(4 * c.words()));
-  f.words = BackgroundTask<>([this, &c, &file, file_first, words] {
+  f.words = BackgroundTask<UploadTally::Clock::time_point>([this, &c, &file, file_first, words] {
     std::vector<VoxelScratch> scratch(resolve_threads(0));  // per thread
     const FillWindow<std::uint32_t> window{words, 0, c.words()};
     parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned t) {
@@ -226,15 +228,17 @@ void GpuScene::begin_upload(std::uint32_t ci) {
     });
     // The last words of the tables' texel, which no voxel fills.
     std::fill(words + c.vertex_table_first() + c.vertices / SceneLayout::kGroup, words + c.words(), 0u);
+    return UploadTally::Clock::now();
   });
   try {
     auto* orders = static_cast<std::uint8_t*>(g.orders.create_mapped(4 * c.order_words));
-    f.orders = BackgroundTask<>([this, &c, &file, file_first, orders] {
+    f.orders = BackgroundTask<UploadTally::Clock::time_point>([this, &c, &file, file_first, orders] {
       const FillWindow<std::uint8_t> window{orders, 0, 4 * std::uint64_t(c.order_words)};
       parallel_for(c.voxel_count, 0, [&](std::uint64_t k, unsigned) {
         const std::uint32_t i = c.voxel_first + static_cast<std::uint32_t>(k);
         copy_voxel_orders(file, i, i - file_first, c, window);
       });
+      return UploadTally::Clock::now();
     });
   } catch (...) {
     f.words = {};  // joined: nothing writes to the mapping after this
@@ -253,19 +257,26 @@ void GpuScene::finish_upload(std::size_t k) {
   const std::uint32_t ci = f.span;
   GpuTextureSpan& g = spans_[ci];
   std::exception_ptr error;
-  for (BackgroundTask<>* task : {&f.words, &f.orders}) try {
-      if (task->valid()) task->get();
+  // When the fills ended (made in parts on this thread: now, once the last part is made).
+  UploadTally::Clock::time_point filled = f.begun;
+  for (BackgroundTask<UploadTally::Clock::time_point>* task : {&f.words, &f.orders}) try {
+      if (task->valid()) filled = std::max(filled, task->get());
     } catch (...) {
       if (!error) error = std::current_exception();
     }
   try {
-    if (f.in_parts)
+    if (f.in_parts) {
       while (fill_next_part(f)) {
       }
+      filled = UploadTally::Clock::now();
+    }
+    const auto handing = UploadTally::Clock::now();
     g.words.finish_mapped(GL_RGBA32UI);
     g.orders.finish_mapped(GL_R32UI);
     if (error) std::rethrow_exception(error);
     upload_extras(ci);
+    // The fills' time, and this thread's handing the buffers to the driver; not the wait for this call.
+    pool_->uploads().add(uploaded_bytes_[ci], f.begun, filled + (UploadTally::Clock::now() - handing));
   } catch (...) {
     g.words.destroy();
     g.orders.destroy();
@@ -437,7 +448,9 @@ GpuScene::Residency GpuScene::make_resident(std::span<const std::uint32_t> neede
     // The fills that end within the time, finished here (a millisecond's sleep between looks). Spans made in parts
     // get at least one part in all (not one each: a part is a long task on a web page), then as many as the time
     // allows; one that fails is dropped.
-    const auto done = [](const BackgroundTask<>& task) { return !task.valid() || task.ready(); };
+    const auto done = [](const BackgroundTask<UploadTally::Clock::time_point>& task) {
+      return !task.valid() || task.ready();
+    };
     bool part_made = false;
     const auto parts_left = [&](std::size_t k) {
       try {
@@ -484,7 +497,10 @@ void GpuScene::upload_resident_again() {
       evict(c);
       continue;
     }
+    const auto begun = UploadTally::Clock::now();
     upload_extras(c);
+    const TextureSpan& t = layout_.texture_spans()[c];
+    pool_->uploads().add(bytes - 4 * (t.words() + t.order_words), begun, UploadTally::Clock::now());
     gpu_bytes_ += bytes - uploaded_bytes_[c];
     uploaded_bytes_[c] = bytes;
     pool_->add(owner_, c, bytes, use);

@@ -178,9 +178,11 @@ class GpuScene {
   std::vector<std::int32_t> dataset_count_;
   struct Filling {
     std::uint32_t span = 0;
-    BackgroundTask<> words, orders;  // filling the span's mapped buffers
-    bool in_parts = false;           // made part by part on this thread instead (fill_next_part)
-    bool words_made = false;         // in parts: the words are, the orders come next
+    // Filling the span's mapped buffers; each returns when it ended, for the upload's time (upload_tally.h).
+    BackgroundTask<UploadTally::Clock::time_point> words, orders;
+    UploadTally::Clock::time_point begun;
+    bool in_parts = false;    // made part by part on this thread instead (fill_next_part)
+    bool words_made = false;  // in parts: the words are, the orders come next
   };
   std::vector<Filling> filling_;          // spans being uploaded (begun, not finished)
   std::vector<bool> checked_;             // per span: its draw checks have run or are running
