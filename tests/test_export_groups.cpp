@@ -72,6 +72,14 @@ TEST(ExportGroups, TckExportWarnsNamingTheGroupsLost) {
   const auto r = test::run_cli("export " + q(dir.file("g.vxl")) + " " + q(dir.file("c.tck")));
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("warning: 3 group(s) not written"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("or each with --split-groups DIR"), std::string::npos) << r.output;
+  // `select` has no --group or --split-groups: its warning names only what it has.
+  const auto selected = test::run_cli("select " + q(dir.file("g.vxl")) + " " + q(dir.file("s2.tck")) +
+                                      " --include box:-1000,-1000,-1000,1000,1000,1000");
+  EXPECT_EQ(selected.exit_code, 0) << selected.output;
+  EXPECT_NE(selected.output.find("warning: 3 group(s) not written"), std::string::npos) << selected.output;
+  EXPECT_NE(selected.output.find("(write them to .trx to keep their groups)"), std::string::npos) << selected.output;
+  EXPECT_EQ(selected.output.find("--group"), std::string::npos) << selected.output;
 }
 
 TEST(ExportGroups, VtkWritesEachGroupAsACellArrayReadBackAsValues) {

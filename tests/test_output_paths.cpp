@@ -133,6 +133,30 @@ TEST(OutputPath, EveryConverterWriterRefusesFifosAndDevicesAndFollowsLinks) {
   EXPECT_FALSE(fs::exists(dir.file("v.tck")));
 }
 
+// A file under another format's name passes for that format: synth, pack and unpack name what they write, as
+// convert does, and write nothing under a wrong name (any case of the right one is taken).
+TEST(OutputPath, AnOutputNamedForAnotherFormatIsAUsageError) {
+  ScratchDir dir;
+  const std::string tck = dir.file("in.tck"), vxl = dir.file("in.vxl"), vxlz = dir.file("in.vxlz");
+  ASSERT_EQ(vxl::test::run_cli("synth " + q(dir.file("IN.TCK")) + " --streamlines 5").exit_code, 0);
+  fs::rename(dir.file("IN.TCK"), tck);
+  ASSERT_EQ(vxl::test::run_cli("convert " + q(tck) + " " + q(vxl)).exit_code, 0);
+  ASSERT_EQ(vxl::test::run_cli("pack " + q(vxl) + " " + q(vxlz)).exit_code, 0);
+  const std::vector<std::pair<std::string, std::string>> commands = {{"synth OUT --streamlines 5", "OUT.tck"},
+                                                                     {"pack " + q(vxl) + " OUT", "OUT.vxlz"},
+                                                                     {"unpack " + q(vxlz) + " OUT", "OUT.vxl"},
+                                                                     {"unpack " + q(vxlz) + " OUT", "OUT.vxl"}};
+  const std::vector<std::string> wrong = {"s.vxl", "p.tck", "u.tck", "u.vxlz"};
+  for (std::size_t i = 0; i < commands.size(); ++i) {
+    const std::string out = dir.file(wrong[i]);
+    const auto r = vxl::test::run_cli(with_out(commands[i].first, out));
+    EXPECT_EQ(r.exit_code, 2) << out << ": " << r.output;
+    EXPECT_TRUE(contains(r.output, out)) << r.output;
+    EXPECT_TRUE(contains(r.output, "name the output " + commands[i].second)) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 TEST(OutputPath, MissingFolderOrAFolderAsOutputIsAnOutputError) {
   ScratchDir dir;
   const std::string tck = dir.file("in.tck");

@@ -245,6 +245,11 @@ TEST(Share, RefusalsLeaveNoFolder) {
   EXPECT_EQ(r.exit_code, 4) << r.output;
   EXPECT_NE(r.output.find("VOXLINES_WEB"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out));
+  // --unpack given a .vxl, which is unpacked already: a usage error, not ignored.
+  r = t.share(t.vxl, out, " --unpack");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--unpack unpacks a .vxlz package"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
   // An existing folder is not touched.
   fs::create_directories(out);
   std::ofstream(out + "/mine.txt") << "keep";

@@ -101,13 +101,9 @@ int run_convert(ConvertOptions& o, bool cohort, bool jobs_given) {
                                std::to_string(o.files.size()) + " file names)");
   const std::string& input = o.files[0];
   const std::string& output = o.files[1];
-  // A .vxl under another name would pass for the other format (a TCK reader then fails on it).
-  std::string lower = output;
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (!lower.ends_with(".vxl") && !std::filesystem::is_directory(output))  // a folder: the output rule's (exit 5)
-    throw Error(ErrorKind::Usage, output, std::nullopt,
-                "convert writes a .vxl file: name the output OUT.vxl (to write TCK, TRX or VTK from a .vxl use "
-                "`voxlines export IN.vxl OUT.tck`, or `voxlines select` for some of its streamlines)");
+  require_output_suffix(output, ".vxl",
+                        "convert writes a .vxl file: name the output OUT.vxl (to write TCK, TRX or VTK from a .vxl use "
+                        "`voxlines export IN.vxl OUT.tck`, or `voxlines select` for some of its streamlines)");
   ProgressBar bar;
   o.settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
   bar.update("reading", 0.0);
@@ -153,7 +149,7 @@ void add_convert_command(CLI::App& app, int& exit_code) {
                   "worker threads in all (0: all cores); --jobs N shares them, each file getting threads / N")
       ->default_val(0);
   add_orders_option(cmd, opt->settings.orders);
-  add_positions_option(cmd, opt->settings.positions);
+  add_positions_option(cmd, opt->settings.positions, "the source's coordinates bit for bit");
   add_levels_option(cmd, opt->settings.levels);
   add_memory_limit_option(cmd, opt->memory_limit);
   cmd->add_option("--tsf", opt->tsf,

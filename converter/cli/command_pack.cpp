@@ -25,6 +25,7 @@ void add_pack_command(CLI::App& app) {
       ->check(CLI::Range(kVxlzMinBits, kVxlzMaxBits));
   cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
   cmd->callback([opt] {
+    require_output_suffix(opt->output, ".vxlz", "pack writes a .vxlz package: name the output OUT.vxlz");
     VxlFile f = VxlFile::open(opt->input);
     PackSummary s = pack_vxl(f, opt->output, opt->settings);
     const double per_point = s.points > 0 ? double(s.bytes) / double(s.points) : 0.0;

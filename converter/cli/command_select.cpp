@@ -105,10 +105,13 @@ void add_select_command(CLI::App& app) {
          "of those, keep only the streamlines of this level of detail (1: about an eighth, 2: a 64th...,\n"
          "spread over the whole tractogram, as voxview draws it coarser): a smaller tractogram alike everywhere")
       ->type_name("N");
-  cmd->add_flag("--count", opt->count, "print only the number of selected streamlines (no output file)");
+  CLI::Option* const count =
+      cmd->add_flag("--count", opt->count, "print only the number of selected streamlines (no output file)");
   cmd->add_flag("--json", opt->json, "print the result as JSON");
-  cmd->add_option("--tsf", opt->tck.tsf_path, "with a .tck output: also write one per-point value set as a TSF");
-  cmd->add_option("--value", opt->tck.value, "the per-point value set for --tsf (default: the first)");
+  // With --count nothing is written: what would shape the output is refused rather than ignored.
+  cmd->add_option("--tsf", opt->tck.tsf_path, "with a .tck output: also write one per-point value set as a TSF")
+      ->excludes(count);
+  cmd->add_option("--value", opt->tck.value, "the per-point value set for --tsf (default: the first)")->excludes(count);
   cmd->add_flag("--verbose", opt->verbose, "say what the query touched");
   cmd->callback([opt] {
     if (opt->count == !opt->output.empty())

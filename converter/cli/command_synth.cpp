@@ -20,6 +20,7 @@ void add_synth_command(CLI::App& app) {
       ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
   cmd->add_option("--seed", opt->settings.seed, "random seed")->default_val(1);
   cmd->callback([opt] {
+    require_output_suffix(opt->output, ".tck", "synth writes a TCK file: name the output OUT.tck");
     Tractogram t = synthesize_tractogram(opt->settings);
     TckWriter w(opt->output, t.streamline_count(),
                 {"voxlines_synth: streamlines=" + std::to_string(opt->settings.streamlines) +

@@ -19,7 +19,9 @@ void add_unpack_command(CLI::App& app) {
   cmd->add_option("input", opt->input, ".vxlz package")->required();
   cmd->add_option("output", opt->output, "output .vxl (written atomically)")->required();
   cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
-  add_positions_option(cmd, opt->settings.positions);
+  add_positions_option(cmd, opt->settings.positions,
+                       "the package's positions as decoded: the package quantised them, within the error bound "
+                       "`pack` and `info` print");
   add_levels_option(cmd, opt->settings.levels);
   cmd->add_option("--memory-limit", opt->memory_limit,
                   "what the decoded positions may take (bytes, or K/M/G: 512M, 2G): a packed .vxl's words depend on "
@@ -33,6 +35,7 @@ void add_unpack_command(CLI::App& app) {
       ->check(memory_size_validator());
   cmd->add_flag("--verbose", opt->verbose, "print the time of each stage");
   cmd->callback([opt] {
+    require_output_suffix(opt->output, ".vxl", "unpack writes a .vxl file: name the output OUT.vxl");
     if (!opt->memory_limit.empty()) opt->settings.memory_limit = *parse_memory_size(opt->memory_limit);
     ProgressBar bar;
     opt->settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };

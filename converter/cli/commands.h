@@ -2,11 +2,16 @@
 // the work; errors are thrown as vxl::Error and turned into messages and exit codes by main().
 #pragma once
 
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <map>
 #include <string>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 
+#include "format/base/error.h"
 #include "format/base/memory_size.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
@@ -25,15 +30,27 @@ void add_pack_command(CLI::App& app);
 void add_unpack_command(CLI::App& app);
 void add_share_command(CLI::App& app);
 
-// --positions packed|float32, shared by convert and unpack (spec §5.4).
-inline CLI::Option* add_positions_option(CLI::App* cmd, PositionEncoding& positions) {
+// Refuses (exit 2, naming the file) an output whose name does not end with `suffix`, in any case: a file of one
+// format under another's name passes for that one, and the reader that trusts the name fails on it. A folder is left
+// to the output rule (exit 5). `what`: what the command writes and how to name it.
+inline void require_output_suffix(const std::string& output, std::string_view suffix, const std::string& what) {
+  std::string lower = output;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (!lower.ends_with(suffix) && !std::filesystem::is_directory(output))
+    throw Error(ErrorKind::Usage, output, std::nullopt, what);
+}
+
+// --positions packed|float32, shared by convert and unpack (spec §5.4). `float32_keeps`: what float32 keeps (a
+// source's coordinates bit for bit; a package's, as it decodes them).
+inline CLI::Option* add_positions_option(CLI::App* cmd, PositionEncoding& positions, const std::string& float32_keeps) {
   const std::map<std::string, PositionEncoding> names = {{"packed", PositionEncoding::Packed},
                                                          {"float32", PositionEncoding::Float32}};
   return cmd
       ->add_option("--positions", positions,
                    "how the .vxl stores vertex positions: packed (4 bytes a vertex, 10 bits per axis across each "
                    "voxel's bounds: within 1/2046 of the voxel's extent, about 5 um at 10 mm; `info` prints the "
-                   "bound) or float32 (12 bytes, the source's coordinates bit for bit)")
+                   "bound) or float32 (12 bytes, " +
+                       float32_keeps + ")")
       ->type_name("packed|float32")
       ->default_str("packed")
       ->transform(CLI::CheckedTransformer(names).description(""));

@@ -12,8 +12,11 @@ std::optional<std::string> groups_not_written(const VxlFile& file, const std::st
     lost += (count++ ? ", '" : "'") + g.name + "' (" + std::to_string(members) + " streamlines)";
   }
   if (count == 0) return std::nullopt;
-  return std::to_string(count) + " group(s) not written: " + format + " has no place for them: " + lost +
-         " (export to .trx, or write one group with --group NAME or each with --split-groups DIR)";
+  // Some of the streamlines (a selection, or one group) are written to one file: only .trx keeps their groups.
+  const char* advice = subset
+                           ? " (write them to .trx to keep their groups)"
+                           : " (export to .trx, or write one group with --group NAME or each with --split-groups DIR)";
+  return std::to_string(count) + " group(s) not written: " + format + " has no place for them: " + lost + advice;
 }
 
 std::optional<std::string> group_values_not_written(const VxlFile& file, const std::string& format,

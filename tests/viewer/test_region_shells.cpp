@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "tests/nifti_test_files.h"
 #include "tests/viewer/render_support.h"
 #include "viewer/render/clip_planes.h"
 #include "viewer/render/region_shapes.h"
@@ -203,6 +204,16 @@ TEST_F(RegionShells, VoxviewShowRegions) {
   EXPECT_EQ(alone.exit_code, 2) << alone.output;
   EXPECT_NE(alone.output.find("--show-regions"), std::string::npos) << alone.output;
   EXPECT_FALSE(std::filesystem::exists(dir.file("x.png")));
+  // An image region has no shell: the picture says so rather than leaving it out unremarked.
+  const std::vector<std::int16_t> all(4 * 4 * 4, 1);
+  test::write_nifti_int16(dir.file("m.nii"), {4, 4, 4}, all, {10, 0, 0, -20, 0, 10, 0, -20, 0, 0, 10, -20});
+  const test::CommandResult mask =
+      test::run_program(VOXVIEW_CLI, test::q(dir.file("line.vxl")) + " --render " + test::q(dir.file("m.png")) +
+                                         " --size 32x32 --include " + test::q(dir.file("m.nii")) +
+                                         " --include 0.5,0.5,0,10 --show-regions");
+  EXPECT_EQ(mask.exit_code, 0) << mask.output;
+  EXPECT_NE(mask.output.find("--show-regions draws spheres and boxes: 1 image region(s) not drawn"), std::string::npos)
+      << mask.output;
 }
 
 }  // namespace

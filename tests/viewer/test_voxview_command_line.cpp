@@ -155,6 +155,30 @@ TEST(VoxviewCommandLine, TheWindowsOptionsAreRefusedWithRender) {
   }
 }
 
+// --voxel-size and --memory-limit shape a conversion: with only .vxl and .vxlz inputs, which are converted already,
+// they are usage errors rather than ignored; with a source tractogram among the inputs they apply to it.
+TEST(VoxviewCommandLine, ConversionOptionsWithNothingToConvertAreRefused) {
+  test::ScratchDir dir;
+  const std::string tck = dir.file("a.tck"), vxl = dir.file("a.vxl"), vxlz = dir.file("a.vxlz");
+  ASSERT_EQ(test::run_cli("synth " + test::q(tck) + " --streamlines 20").exit_code, 0);
+  ASSERT_EQ(test::run_cli("convert " + test::q(tck) + " " + test::q(vxl)).exit_code, 0);
+  ASSERT_EQ(test::run_cli("pack " + test::q(vxl) + " " + test::q(vxlz)).exit_code, 0);
+  const std::string render = " --size 16x16 --render " + test::q(dir.file("o.png"));
+  for (const std::string& inputs : {test::q(vxl), test::q(vxlz), test::q(vxl) + " " + test::q(vxlz)})
+    for (const std::string option : {"--voxel-size 3", "--memory-limit 64M"}) {
+      const test::CommandResult r = test::run_program(VOXVIEW_CLI, inputs + " " + option + render);
+      EXPECT_EQ(r.exit_code, 2) << inputs << " " << option << ": " << r.output;
+      EXPECT_NE(r.output.find(option.substr(0, option.find(' ')) + " applies to a source tractogram"),
+                std::string::npos)
+          << r.output;
+      EXPECT_FALSE(std::filesystem::exists(dir.file("o.png")));
+    }
+  const test::CommandResult mixed =
+      test::run_program(VOXVIEW_CLI, test::q(vxl) + " " + test::q(tck) + " --voxel-size 3" + render);
+  EXPECT_EQ(mixed.exit_code, 0) << mixed.output;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("o.png")));
+}
+
 // --render with --stats: where the time from the process start to each picture went, and what the GPU was sent.
 TEST(VoxviewCommandLine, RenderWithStatsSaysWhereTheTimeWentAndWhatWasUploaded) {
   test::ScratchDir dir;

@@ -68,7 +68,11 @@ int run_headless(const ViewerOptions& o) {
   if (o.selecting()) {
     const RegionEditor regions(o);
     selection = select_in_scene(session.files(), regions.criteria());
-    if (o.show_regions) shells = regions.shapes();
+    if (o.show_regions) {
+      shells = regions.shapes();
+      if (const std::size_t masks = regions.regions().size() - shells.size(); masks > 0)
+        std::fprintf(stderr, "voxview: --show-regions draws spheres and boxes: %zu image region(s) not drawn\n", masks);
+    }
     std::fprintf(stderr, "voxview: %llu of %llu streamlines selected (the focus; the others are context)\n",
                  (unsigned long long)selection->selected, (unsigned long long)selection->total);
   }

@@ -61,10 +61,16 @@ SceneSourceOptions scene_source_options(const ViewerOptions& o) {
   return {o.voxel_size, o.tsf, o.verify, o.memory_limit};
 }
 
+bool opens_without_conversion(const std::string& path) {
+  std::string lower = path;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower.ends_with(".vxl") || lower.ends_with(".vxlz");
+}
+
 OpenedScene open_scene(const std::string& path, const SceneSourceOptions& options) {
   std::string lower = path;
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (!options.tsf.empty() && (lower.ends_with(".vxl") || lower.ends_with(".vxlz")))
+  if (!options.tsf.empty() && opens_without_conversion(path))
     throw Error(ErrorKind::Usage, path, std::nullopt,
                 "--tsf adds values to a source tractogram as it is converted; a .vxl keeps the values it was converted "
                 "with (voxlines convert IN.tck OUT.vxl --tsf FILE.tsf)");

@@ -37,6 +37,9 @@ struct SceneSourceOptions {
 };
 SceneSourceOptions scene_source_options(const ViewerOptions& options);
 
+// Whether `path` is opened as it is, a .vxl or a .vxlz (any case), rather than converted as a source tractogram.
+bool opens_without_conversion(const std::string& path);
+
 struct OpenedScene {
   VxlFile file;
   std::optional<SourceConversionReport> conversion;  // for a source tractogram: how it was converted

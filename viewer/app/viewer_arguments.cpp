@@ -8,6 +8,7 @@
 #include "format/base/memory_size.h"
 #include "format/base/output_path.h"
 #include "viewer/app/camera_file.h"
+#include "viewer/app/scene_source.h"
 #include "viewer/app/turntable.h"
 #include "viewer/platform/image_io.h"
 #include "viewer/render/background_color.h"
@@ -252,6 +253,14 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
     if (!limit) usage_error("--memory-limit '" + a.memory_limit + "' is not a memory size (bytes, or K/M/G: 512M, 2G)");
     o.memory_limit = *limit;
   }
+  // What shapes a conversion, where nothing is converted, would change nothing: refused rather than ignored.
+  if (std::all_of(o.inputs.begin(), o.inputs.end(), opens_without_conversion))
+    for (const char* option : {"--voxel-size", "--memory-limit"})
+      if (a.was_given(option))
+        usage_error(std::string(option) +
+                    " applies to a source tractogram as it is converted; every input here is a .vxl or .vxlz, made "
+                    "with the options of its conversion (voxlines convert IN.tck OUT.vxl " +
+                    option + " ...)");
   if (!(o.frame_budget_ms >= 0 && o.frame_budget_ms <= 1e6))
     usage_error("--frame-budget: expected milliseconds in [0, 1e6]");
   if (o.orbit_deg && !(std::abs(*o.orbit_deg) <= 360)) usage_error("--orbit: expected degrees in [-360, 360]");
