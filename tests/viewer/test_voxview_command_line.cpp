@@ -179,6 +179,27 @@ TEST(VoxviewCommandLine, ConversionOptionsWithNothingToConvertAreRefused) {
   EXPECT_TRUE(std::filesystem::exists(dir.file("o.png")));
 }
 
+// A colour option of another colour mode changes nothing in a picture drawn headless: a note says so, and the
+// picture is drawn; with --save-camera it is kept in the saved view, and nothing is said.
+TEST(VoxviewCommandLine, ColourOptionsOfAnotherColourModeAreNotedHeadless) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  const std::string render = test::q(dir.file("a.tck")) + " --size 16x16 --render " + test::q(dir.file("a.png"));
+  const test::CommandResult r = test::run_program(VOXVIEW_CLI, render + " --colormap hot --fixed-color '#ff0000'");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: --colormap goes with --color scalar; this picture is coloured by direction"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("note: --fixed-color goes with --color fixed"), std::string::npos) << r.output;
+  const test::CommandResult fixed = test::run_program(VOXVIEW_CLI, render + " --color fixed --fixed-color '#ff0000'");
+  EXPECT_EQ(fixed.exit_code, 0) << fixed.output;
+  EXPECT_EQ(fixed.output.find("note:"), std::string::npos) << fixed.output;
+  const test::CommandResult saved =
+      test::run_program(VOXVIEW_CLI, render + " --colormap hot --save-camera " + test::q(dir.file("v.json")));
+  EXPECT_EQ(saved.exit_code, 0) << saved.output;
+  EXPECT_EQ(saved.output.find("note:"), std::string::npos) << saved.output;
+}
+
 // --render with --stats: where the time from the process start to each picture went, and what the GPU was sent.
 TEST(VoxviewCommandLine, RenderWithStatsSaysWhereTheTimeWentAndWhatWasUploaded) {
   test::ScratchDir dir;

@@ -60,6 +60,7 @@ int run_headless(const ViewerOptions& o) {
   auto t0 = std::chrono::steady_clock::now();
   RenderStats stats;  // for --stats
   stats.main_s = seconds_before_main();
+  for (const std::string& note : o.notes) std::fprintf(stderr, "voxview: note: %s\n", note.c_str());
   // Made after the files are open, gone after the session's renderers: declared first, made later.
   std::optional<HeadlessGlContext> context;
   ViewerSession session(o);                 // before any GL work: a bad file or image fails fast

@@ -117,6 +117,23 @@ void apply_look(const ViewerArguments& a, bool from_file, RenderSettings& s) {
   }
 }
 
+// Headless without --save-camera, the options of a colour mode other than the picture's change nothing; in the window
+// they preset the panel's choices, and a saved view keeps them. Said, not refused.
+void note_other_colour_modes_options(const ViewerArguments& a, ViewerOptions& o) {
+  if (!o.render_png || o.save_camera) return;
+  const struct {
+    const char* option;
+    ColorMode mode;
+  } options[] = {{"--fixed-color", ColorMode::Fixed},
+                 {"--scalar", ColorMode::Scalar},
+                 {"--colormap", ColorMode::Scalar},
+                 {"--range", ColorMode::Scalar}};
+  for (const auto& [option, mode] : options)
+    if (a.was_given(option) && o.settings.color != mode)
+      o.notes.push_back(std::string(option) + " goes with --color " + color_mode_name(mode) +
+                        "; this picture is coloured by " + color_mode_name(o.settings.color));
+}
+
 // --slab and --clip: clip planes given replace a saved view's.
 void apply_clipping(const ViewerArguments& a, Clipping& c) {
   if (a.was_given("--slab")) {
@@ -239,6 +256,7 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
   std::string size = a.size;
   apply_saved_view(a, o, size);
   apply_look(a, !a.camera_file.empty(), o.settings);
+  note_other_colour_modes_options(a, o);
   apply_clipping(a, o.settings.clipping);
   apply_image(a, o);
   apply_view_and_size(a, size, o);

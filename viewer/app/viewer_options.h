@@ -58,6 +58,8 @@ struct ViewerOptions {
   // Window: move the active region by this offset (mm) every frame, a scripted drag (benchmarks).
   std::optional<std::array<double, 3>> drag_region_mm;
   std::optional<std::string> stats_json;  // --stats: the window's frames on quitting, or the pictures --render wrote
+  // What the options given change nothing in (a colour option of another colour mode, headless): printed as notes.
+  std::vector<std::string> notes;
   // Window automation (tests, scripted screenshots): quit after N frames, saving a screenshot first.
   std::optional<int> frames;
   bool until_refined = false;  // with frames: after them, stay at rest until the refinement is done, then quit
