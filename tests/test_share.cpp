@@ -250,6 +250,10 @@ TEST(Share, RefusalsLeaveNoFolder) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--unpack unpacks a .vxlz package"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out));
+  // Neither a .vxl nor a package: bad input, as without --unpack.
+  r = t.share(t.tck, out, " --unpack");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_FALSE(fs::exists(out));
   // An existing folder is not touched.
   fs::create_directories(out);
   std::ofstream(out + "/mine.txt") << "keep";

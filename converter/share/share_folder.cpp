@@ -136,12 +136,12 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
   }
   fs::path data = fs::path(in_path).filename();
   const bool package = starts_as_vxlz(in_path);
-  if (!package && settings.unpack)
-    throw Error(ErrorKind::Usage, in_path, std::nullopt,
-                "--unpack unpacks a .vxlz package; this is a .vxl, shared as it is (leave --unpack out)");
   if (!package) {
     // Opened first, so that a damaged file is refused here rather than in the recipient's browser.
     const VxlFile file = VxlFile::open(in_path);
+    if (settings.unpack)
+      throw Error(ErrorKind::Usage, in_path, std::nullopt,
+                  "--unpack unpacks a .vxlz package; this is a .vxl, shared as it is (leave --unpack out)");
     data.replace_extension(".vxl");
     if (settings.level) {
       summary.streamlines = write_level(file, (staging / data).string(), *settings.level);

@@ -306,6 +306,15 @@ TEST(UploadTally, TimeDuringWhichFillsOverlapIsCountedOnce) {
   EXPECT_EQ(t.bytes(), 4'000'000'000u);
   EXPECT_EQ(t.spans(), 4u);
   EXPECT_NEAR(t.gb_per_s(), 1.0, 1e-9);
+  // Fills end in either order: one that began earlier may be added after a later one, and its own time still counts.
+  t.add(0, at(8), at(9));
+  t.add(0, at(7), at(8.5));  // began before the one added last: 7 to 8 is its alone
+  EXPECT_NEAR(t.seconds(), 6.0, 1e-9);
+  t.add(0, at(4), at(10));  // spans the gap between the intervals so far and both sides of the last
+  EXPECT_NEAR(t.seconds(), 9.0, 1e-9) << "0-3 and 4-10";
+  t.add(0, at(2), at(2));  // no time
+  EXPECT_NEAR(t.seconds(), 9.0, 1e-9);
+  EXPECT_EQ(t.spans(), 8u);
 }
 
 // A buffer texture reads zeros past the driver's limit: a buffer larger than it is refused with the sizes named,

@@ -129,7 +129,9 @@ void note_other_colour_modes_options(const ViewerArguments& a, ViewerOptions& o)
                  {"--colormap", ColorMode::Scalar},
                  {"--range", ColorMode::Scalar}};
   for (const auto& [option, mode] : options)
-    if (a.was_given(option) && o.settings.color != mode)
+    // The fixed colour is also scalar's, for the points without a value.
+    if (a.was_given(option) && o.settings.color != mode &&
+        !(mode == ColorMode::Fixed && o.settings.color == ColorMode::Scalar))
       o.notes.push_back(std::string(option) + " goes with --color " + color_mode_name(mode) +
                         "; this picture is coloured by " + color_mode_name(o.settings.color));
 }

@@ -301,7 +301,8 @@ void declare_window(CLI::App& cli, ViewerArguments& a) {
   cli.add_flag("--until-refined", a.options.until_refined,
                "window, with --frames: after the frames, keep the camera still until the picture is refined (full "
                "detail, then exact unless --no-exact-when-still), then quit")
-      ->needs("--frames");
+      ->needs("--frames")
+      ->excludes(render);
   cli.add_option("--screenshot", a.options.screenshot,
                  "window: save the last frame to this picture before quitting: " + picture_formats_text())
       ->excludes(render);

@@ -500,7 +500,8 @@ void GpuScene::upload_resident_again() {
     const auto begun = UploadTally::Clock::now();
     upload_extras(c);
     const TextureSpan& t = layout_.texture_spans()[c];
-    pool_->uploads().add(bytes - 4 * (t.words() + t.order_words), begun, UploadTally::Clock::now());
+    if (const std::uint64_t extras = bytes - 4 * (t.words() + t.order_words); extras > 0)
+      pool_->uploads().add(extras, begun, UploadTally::Clock::now());
     gpu_bytes_ += bytes - uploaded_bytes_[c];
     uploaded_bytes_[c] = bytes;
     pool_->add(owner_, c, bytes, use);
