@@ -218,7 +218,12 @@ TEST(VoxviewCommandLine, RenderWithStatsSaysWhereTheTimeWentAndWhatWasUploaded) 
       test::run_program(VOXVIEW_CLI, test::q(dir.file("a.vxl")) + " --size 64x48 --level 0 --turntable 2 --render " +
                                          test::q(dir.file("a.png")) + " --stats " + test::q(dir.file("s.json")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json j = nlohmann::json::parse(test::slurp(dir.file("s.json")));
+  const std::vector<char> text = test::slurp(dir.file("s.json"));
+  const nlohmann::json j = nlohmann::json::parse(text);
+  // The summary first, the pictures' list last.
+  const std::string_view view(text.data(), text.size());
+  EXPECT_LT(view.find("\"upload\""), view.find("\"pictures\"")) << view;
+  EXPECT_LT(view.find("\"first_picture_written_s\""), view.find("\"pictures\"")) << view;
   EXPECT_EQ(j.at("mode"), "axis");
   EXPECT_EQ(j.at("size"), nlohmann::json::array({64, 48}));
   EXPECT_EQ(j.at("level"), 0);

@@ -215,6 +215,11 @@ TEST_F(Window, MovingFramesDrawACoarserLevelWithinTheFrameBudget) {
   EXPECT_GE(upload.at("spans").get<std::uint64_t>(), 2u) << "full detail and at least one coarser level";
   EXPECT_GT(upload.at("seconds").get<double>(), 0.0);
   EXPECT_GT(upload.at("gb_per_s").get<double>(), 0.0);
+  // The summary comes first and the frames' list last, so that the start of the file says the most.
+  const std::string text = vxl::test::slurp<std::string>(dir.file("stats.json"));
+  EXPECT_LT(text.find("\"first_on_screen_s\""), text.find("\"frames\"")) << text;
+  EXPECT_LT(text.find("\"upload\""), text.find("\"frames\"")) << text;
+  EXPECT_LT(text.find("\"moving_p95_ms\""), text.find("\"frames\"")) << text;
   EXPECT_EQ(j.at("full_detail_s"), frames[0].at("since_start_s"));
   EXPECT_GT(j.at("moving_p95_ms").get<double>(), 0.0);
   EXPECT_GE(j.at("moving_p95_ms").get<double>(), j.at("moving_median_ms").get<double>());

@@ -56,7 +56,7 @@ FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint3
   return s;
 }
 
-nlohmann::json upload_summary(const UploadTally& uploads) {
+nlohmann::ordered_json upload_summary(const UploadTally& uploads) {
   return {{"bytes", uploads.bytes()},
           {"spans", uploads.spans()},
           {"seconds", uploads.seconds()},
@@ -68,7 +68,7 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
                        const std::vector<double>& selection_ms, const std::vector<std::uint32_t>& selection_levels,
                        const std::optional<DragEndWait>& drag_end) {
   const FrameSummary s = summarize_frames(frames, scene_level);
-  nlohmann::json j;
+  nlohmann::ordered_json j;
   j["scene_level"] = scene_level;
   j["frame_budget_ms"] = frame_budget_ms;
   // The figure a user sees: the first picture as it reaches the screen, everything before it included.
@@ -113,7 +113,7 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
   }
   if (drag_end)
     j["drag_end_wait"] = {{"waited", drag_end->waited}, {"ms", drag_end->ms}, {"timed_out", drag_end->timed_out}};
-  nlohmann::json list = nlohmann::json::array();
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
   for (const FrameRecord& f : frames) {
     list.push_back({{"level", f.level},
                     {"moving", f.moving},
@@ -129,7 +129,7 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
   write_stats_json(path, j);
 }
 
-void write_stats_json(const std::string& path, const nlohmann::json& stats) {
+void write_stats_json(const std::string& path, const nlohmann::ordered_json& stats) {
   const std::string text = stats.dump(2) + "\n";
   AtomicOutputFile out(path);
   out.write(text.data(), text.size());

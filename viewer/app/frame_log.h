@@ -64,9 +64,10 @@ struct DragEndWait {
 FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint32_t scene_level);
 
 // The upload's figures as --stats writes them: {"bytes", "spans", "seconds", "gb_per_s"}.
-nlohmann::json upload_summary(const UploadTally& uploads);
-// Writes a --stats file (indented JSON) atomically. Throws vxl::Error (Output).
-void write_stats_json(const std::string& path, const nlohmann::json& stats);
+nlohmann::ordered_json upload_summary(const UploadTally& uploads);
+// Writes a --stats file (indented JSON, its keys in the order they were set: the summary first, the long lists last, so
+// that the start of the file says the most) atomically. Throws vxl::Error (Output).
+void write_stats_json(const std::string& path, const nlohmann::ordered_json& stats);
 
 // Writes the summary, the budget, what was uploaded to the GPU and every frame as JSON to `path` (atomically),
 // and the selections' run times (selection_worker.h: how long after a region moved its picture was ready), and

@@ -7,7 +7,7 @@
 namespace vxl::app {
 
 void write_render_stats(const std::string& path, const RenderStats& stats) {
-  nlohmann::json j;
+  nlohmann::ordered_json j;
   j["gl_renderer"] = stats.gl_renderer;
   j["mode"] = stats.mode;
   j["size"] = {stats.width, stats.height};
@@ -18,7 +18,7 @@ void write_render_stats(const std::string& path, const RenderStats& stats) {
                   {"scene_ready_s", stats.scene_ready_s}};
   j["upload"] = upload_summary(stats.uploads);
   j["first_picture_written_s"] = stats.pictures.empty() ? -1.0 : stats.pictures.front().written_s;
-  nlohmann::json list = nlohmann::json::array();
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
   for (const RenderedPicture& p : stats.pictures)
     list.push_back({{"draw_ms", p.draw_ms},
                     {"read_back_ms", p.read_back_ms},
