@@ -2,8 +2,6 @@
 // the work; errors are thrown as vxl::Error and turned into messages and exit codes by main().
 #pragma once
 
-#include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -12,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "format/base/error.h"
+#include "format/base/file_suffix.h"
 #include "format/base/memory_size.h"
 #include "format/vxl_levels.h"
 #include "format/vxl_positions.h"
@@ -34,9 +33,7 @@ void add_share_command(CLI::App& app);
 // format under another's name passes for that one, and the reader that trusts the name fails on it. A folder is left
 // to the output rule (exit 5). `what`: what the command writes and how to name it.
 inline void require_output_suffix(const std::string& output, std::string_view suffix, const std::string& what) {
-  std::string lower = output;
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (!lower.ends_with(suffix) && !std::filesystem::is_directory(output))
+  if (!has_suffix_ignoring_case(output, suffix) && !std::filesystem::is_directory(output))
     throw Error(ErrorKind::Usage, output, std::nullopt, what);
 }
 

@@ -1,5 +1,6 @@
 #include "viewer/app/process_clock.h"
 
+#include <chrono>
 #include <ctime>
 #include <fstream>
 #include <sstream>
@@ -40,7 +41,6 @@ const std::chrono::steady_clock::time_point g_start =
 
 }  // namespace
 
-std::chrono::steady_clock::time_point process_start() { return g_start; }
 double seconds_before_main() { return g_before_main; }
 double seconds_since_process_start() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - g_start).count();

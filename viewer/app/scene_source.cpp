@@ -7,6 +7,7 @@
 #include "converter/convert/temporary_vxl.h"
 #include "converter/package/unpack.h"
 #include "format/base/error.h"
+#include "format/base/file_suffix.h"
 #include "format/base/memory_size.h"
 #include "format/vxl_verify.h"
 #include "viewer/render/renderer.h"
@@ -62,23 +63,19 @@ SceneSourceOptions scene_source_options(const ViewerOptions& o) {
 }
 
 bool opens_without_conversion(const std::string& path) {
-  std::string lower = path;
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower.ends_with(".vxl") || lower.ends_with(".vxlz");
+  return has_suffix_ignoring_case(path, ".vxl") || has_suffix_ignoring_case(path, ".vxlz");
 }
 
 OpenedScene open_scene(const std::string& path, const SceneSourceOptions& options) {
-  std::string lower = path;
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (!options.tsf.empty() && opens_without_conversion(path))
     throw Error(ErrorKind::Usage, path, std::nullopt,
                 "--tsf adds values to a source tractogram as it is converted; a .vxl keeps the values it was converted "
                 "with (voxlines convert IN.tck OUT.vxl --tsf FILE.tsf)");
-  if (lower.ends_with(".vxl")) {
+  if (has_suffix_ignoring_case(path, ".vxl")) {
     if (options.verify) verify_or_refuse(path, path);
     return {VxlFile::open(path), std::nullopt};
   }
-  if (lower.ends_with(".vxlz")) return {open_package(path, options.verify), std::nullopt};
+  if (has_suffix_ignoring_case(path, ".vxlz")) return {open_package(path, options.verify), std::nullopt};
 
   SourceConversion conversion;
   conversion.settings.voxel_size = options.voxel_size;

@@ -49,10 +49,10 @@ bool same_picture(const PictureKey& a, const PictureKey& b);
 class ViewerWindow {
  public:
   // `session`: the scene, its level of detail already chosen (ViewerSession::choose_detail); its renderers
-  // go with the window, before the GL context. `start`: when voxview started, for --stats.
+  // go with the window, before the GL context.
   // `regions`: the selection's regions (region_editor.h), edited in the window.
   ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession> session, RegionEditor regions, GLFWwindow* window,
-               std::chrono::steady_clock::time_point start, StartupTimes startup);
+               StartupTimes startup);
   int run();
 
  private:
@@ -129,9 +129,6 @@ class ViewerWindow {
   void show_frame_figures(const Renderer& renderer, std::uint32_t level, const std::string& coarser_why);
   // scene_target_ into the window's back buffer.
   void present(int width, int height) const;
-  double seconds_since_start() const {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  }
   // The renderer of the scene's level, or of a coarser one (made on first use, for the frame budget); `whole`: for a
   // picture drawn whole (focus_first_whole_at), else for the refinement's pieces. Records in drawn_focus_first_
   // whether it draws the focus first.
@@ -172,7 +169,6 @@ class ViewerWindow {
   std::optional<DragEndWait> drag_end_;                                  // the wait over, for --stats
   const SceneDetail& detail_;  // the level of detail drawn at rest, and the span size
   std::uint32_t first_level_ = 0;
-  std::chrono::steady_clock::time_point start_;
   std::vector<FrameRecord> frames_;            // for --stats
   StartupTimes startup_;                       // for --stats
   std::optional<PictureKey> drawn_;            // what the picture on screen shows (none before the first)

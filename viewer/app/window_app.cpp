@@ -51,7 +51,7 @@ bool same_picture(const PictureKey& a, const PictureKey& b) {
 }
 
 ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession> session, RegionEditor regions,
-                           GLFWwindow* window, std::chrono::steady_clock::time_point start, StartupTimes startup)
+                           GLFWwindow* window, StartupTimes startup)
     : options_(o),
       window_(window),
       session_(std::move(session)),
@@ -61,7 +61,6 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
       focus_first_wanted_(session_->focus_copy_needed(SceneLayout::coarsest_level(session_->files()))),
       focus_copies_(files_),
       detail_(session_->detail()),
-      start_(start),
       startup_(startup),
       controller_(Camera{}, 1.0) {
   if (o.saved_show_regions) state_.show_regions = *o.saved_show_regions;  // as the saved view had them
@@ -128,7 +127,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
   glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* w, int, int) { of(w).events_++; });
   glfwSetWindowRefreshCallback(window_, [](GLFWwindow* w) { of(w).events_++; });
   panel_ = std::make_unique<UiPanel>(window_);
-  startup_.viewer_ready_s = seconds_since_start();
+  startup_.viewer_ready_s = seconds_since_process_start();
 }
 
 double ViewerWindow::aspect() const {
@@ -375,7 +374,7 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
     scheduler_->drawn_whole(state_.settings.mode, task.level, ms, focus_first_at(task.level) && !drawn_focus_first_);
     stats_.refinement = scheduler_->rest().describe(0);
     drawn_ = key;
-    frames_.push_back({task.level, moving, ms, seconds_since_start()});
+    frames_.push_back({task.level, moving, ms, seconds_since_process_start()});
     frames_.back().focus_first = drawn_focus_first_;
     frames_.back().selection = selection_.has_value();
     frames_.back().new_selection = selection_.has_value() && key.selection != framed_generation_;
@@ -389,7 +388,7 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
     if (work_in_flight() || level_selection_shown()) return false;
     bool completes = false;
     const double ms = refine(key.width, key.height, task.level, completes);
-    frames_.push_back({task.level, false, ms, seconds_since_start(), task.frame_work, completes});
+    frames_.push_back({task.level, false, ms, seconds_since_process_start(), task.frame_work, completes});
     frames_.back().focus_first = drawn_focus_first_;
     frames_.back().selection = selection_.has_value();
     return true;
@@ -484,7 +483,7 @@ int ViewerWindow::run() {
     glfwSwapBuffers(window_);
     if (startup_.first_on_screen_s < 0 && !frames_.empty()) {
       glFinish();  // the swap has been carried out, not only queued
-      startup_.first_on_screen_s = seconds_since_start();
+      startup_.first_on_screen_s = seconds_since_process_start();
     }
     if (closing) break;
   }
@@ -497,16 +496,15 @@ int ViewerWindow::run() {
 }
 
 int run_window(const ViewerOptions& o) {
-  const auto start = process_start();
   GlfwLibrary glfw;                                   // first: without a display, fail before any slow conversion
   auto session = std::make_unique<ViewerSession>(o);  // a bad file or image fails before the window opens
   RegionEditor regions(o);                            // parses the regions: a bad one fails there too
   WindowPtr window = open_window(o);
   StartupTimes startup;
   startup.main_s = seconds_before_main();
-  startup.window_open_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  startup.window_open_s = seconds_since_process_start();
   session->choose_detail(o);  // the driver's limits: the window's context is current
-  ViewerWindow viewer(o, std::move(session), std::move(regions), window.get(), start, startup);
+  ViewerWindow viewer(o, std::move(session), std::move(regions), window.get(), startup);
   return viewer.run();
 }
 
