@@ -142,5 +142,19 @@ TEST(FrameLog, RefinementPiecesAndTheFinestLevelReachedAtRest) {
   EXPECT_LT(summarize_frames({frames[0]}, 1).full_detail_s, 0.0) << "only coarser than the scene's level";
 }
 
+// A partial picture (a level's spans in so far, the coarser level for the rest) is a piece, but not full detail, even
+// at the finest level: full detail is the level's complete picture after it.
+TEST(FrameLog, APartialPictureIsNotFullDetail) {
+  using W = FrameWork;
+  const std::vector<FrameRecord> frames = {{1, false, 40, 0.2, W::Whole, true},
+                                           {0, false, 60, 0.5, W::PartialPiece, true},
+                                           {0, false, 30, 0.6, W::FullDetailPiece, false},
+                                           {0, false, 80, 0.9, W::FullDetailPiece, true}};
+  const FrameSummary s = summarize_frames(frames, 0);
+  EXPECT_DOUBLE_EQ(s.full_detail_s, 0.9);
+  EXPECT_EQ(s.pieces, 3u);
+  EXPECT_LT(summarize_frames({frames[0], frames[1]}, 0).full_detail_s, 0.0) << "only the partial picture at level 0";
+}
+
 }  // namespace
 }  // namespace vxl::app

@@ -146,7 +146,7 @@ TEST(VoxviewCommandLine, TheWindowsOptionsAreRefusedWithRender) {
   const std::vector<std::string> options = {"--frames 3",          "--orbit 5",
                                             "--frame-budget 50",   "--no-exact-when-still",
                                             "--drag-region 1,0,0", "--screenshot " + test::q(dir.file("b.png")),
-                                            "--until-refined"};
+                                            "--until-refined",     "--partial-pictures always"};
   for (const std::string& option : options) {
     const test::CommandResult r = test::run_program(VOXVIEW_CLI, render + " " + option);
     EXPECT_EQ(r.exit_code, 2) << option << ": " << r.output;
@@ -155,6 +155,11 @@ TEST(VoxviewCommandLine, TheWindowsOptionsAreRefusedWithRender) {
     EXPECT_FALSE(std::filesystem::exists(dir.file("a.png"))) << option;
     EXPECT_FALSE(std::filesystem::exists(dir.file("b.png"))) << option;
   }
+  // And a window's choice it does not know is a usage error too, naming the choices.
+  const test::CommandResult r =
+      test::run_program(VOXVIEW_CLI, test::q(dir.file("a.tck")) + " --partial-pictures sometimes");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--partial-pictures"), std::string::npos) << r.output;
 }
 
 // --voxel-size and --memory-limit shape a conversion: with only .vxl and .vxlz inputs, which are converted already,

@@ -272,6 +272,39 @@ TEST_F(Window, AtRestEachLevelOnTheWayToFullDetailIsShown) {
   EXPECT_EQ(j.at("full_detail_s"), frames.back().at("since_start_s"));
 }
 
+// While the level refined to is uploading (small spans: a few a frame, the nearest first), a partial picture shows
+// the spans in so far with the level on screen standing in for the others; the complete level follows, and it is the
+// picture drawn without partial pictures. (By default a software renderer draws none: drawing a picture takes far
+// longer than the upload, so one would only delay the complete picture.)
+TEST_F(Window, PartialPicturesShowTheSpansInWhileALevelUploads) {
+  VXL_REQUIRE_XVFB();
+  make_inputs(6000);
+  const std::string args = "--size 200x150 --span-texels 4096 --frames 1 --until-refined --no-exact-when-still";
+  const std::string never_png = dir.file("never.png"), always_png = dir.file("always.png");
+  const nlohmann::json never = window_stats(args + " --partial-pictures never --screenshot " + shell_quoted(never_png));
+  const nlohmann::json always =
+      window_stats(args + " --partial-pictures always --screenshot " + shell_quoted(always_png));
+  ASSERT_FALSE(never.is_null());
+  ASSERT_FALSE(always.is_null());
+  for (const auto& f : never.at("frames")) EXPECT_NE(f.at("work"), "partial piece");
+
+  const auto& frames = always.at("frames");
+  ASSERT_GE(frames.size(), 3u);
+  EXPECT_EQ(frames[0].at("level"), 1) << "a coarse first picture";
+  int partial_shown = 0;
+  for (std::size_t i = 1; i + 1 < frames.size(); ++i) {
+    EXPECT_EQ(frames[i].at("level"), 0) << i;
+    if (frames[i].at("work") != "partial piece") continue;
+    partial_shown += frames[i].at("completes").get<bool>();
+    EXPECT_LT(frames[i].at("since_start_s").get<double>(), always.at("full_detail_s").get<double>()) << i;
+  }
+  EXPECT_GE(partial_shown, 2) << "the level arrives over many frames: several partial pictures";
+  EXPECT_EQ(frames.back().at("work"), "full-detail piece");
+  EXPECT_EQ(frames.back().at("completes"), true);
+  EXPECT_EQ(always.at("full_detail_s"), frames.back().at("since_start_s")) << "a partial picture is not full detail";
+  EXPECT_EQ(compare_images(read_image(never_png), read_image(always_png)).differing_pixels, 0u);
+}
+
 // At rest, once full detail is on screen, the axis mode goes on to the exact picture, run by run; it is
 // what headless --mode exact draws (but for a few pixels at voxel faces between runs).
 TEST_F(Window, ExactArrivesWhenTheCameraIsStill) {

@@ -27,6 +27,7 @@ const char* work_name(FrameWork w) {
     case FrameWork::FullDetailPiece: return "full-detail piece";
     case FrameWork::ExactPiece: return "exact piece";
     case FrameWork::FocusPiece: return "focus piece";
+    case FrameWork::PartialPiece: return "partial piece";
   }
   return "?";
 }
@@ -40,10 +41,10 @@ FrameSummary summarize_frames(const std::vector<FrameRecord>& frames, std::uint3
   // or finer (the window refines a slab or a close view to a finer level than the whole scene's).
   std::uint32_t finest = scene_level;
   for (const FrameRecord& f : frames)
-    if (f.completes && !f.moving) finest = std::min(finest, f.level);
+    if (f.completes && !f.moving && f.work != FrameWork::PartialPiece) finest = std::min(finest, f.level);
   for (const FrameRecord& f : frames) {
     if (s.first_picture_s < 0) s.first_picture_s = f.since_start_s;
-    const bool full_detail = f.completes && !f.moving && f.level == finest;
+    const bool full_detail = f.completes && !f.moving && f.level == finest && f.work != FrameWork::PartialPiece;
     if (s.full_detail_s < 0 && full_detail) s.full_detail_s = f.since_start_s;
     if (s.exact_s < 0 && full_detail && f.work == FrameWork::ExactPiece) s.exact_s = f.since_start_s;
     if (f.moving) moving.push_back(f.ms);

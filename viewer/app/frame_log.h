@@ -22,6 +22,7 @@ enum class FrameWork {
   FullDetailPiece,  // a piece of the full-detail picture at rest
   ExactPiece,       // a piece of the exact picture at rest
   FocusPiece,       // a piece of the picture drawn whole again with the focus's full-detail copy
+  PartialPiece,     // a piece of a partial picture at rest: a level's spans in so far (partial_pictures.h)
 };
 
 struct FrameRecord {

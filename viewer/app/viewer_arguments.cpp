@@ -284,6 +284,9 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
   if (!(o.frame_budget_ms >= 0 && o.frame_budget_ms <= 1e6))
     usage_error("--frame-budget: expected milliseconds in [0, 1e6]");
   if (o.orbit_deg && !(std::abs(*o.orbit_deg) <= 360)) usage_error("--orbit: expected degrees in [-360, 360]");
+  o.partial_pictures = a.partial_pictures == "always"  ? PartialPictures::Always
+                       : a.partial_pictures == "never" ? PartialPictures::Never
+                                                       : PartialPictures::Auto;
   if (!a.drag_region.empty()) {
     if (a.drag_region.size() != 3 ||
         !std::all_of(a.drag_region.begin(), a.drag_region.end(), [](double d) { return std::abs(d) <= 1000; }))

@@ -17,6 +17,7 @@ struct ViewerArguments {
   // What is checked and combined here, as typed; the defaults are the command line's.
   std::string camera_file;  // --camera
   std::string mode = "axis", color = "direction", colormap = "viridis", background = "black";
+  std::string partial_pictures = "auto";  // --partial-pictures: auto, always or never (the parser checks which)
   float opacity = kDefaultLineOpacity, line_width = 1.0f;
   std::string fixed_color, scalar, range;
   std::vector<std::string> groups, clips;

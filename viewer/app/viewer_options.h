@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "viewer/app/partial_pictures.h"
 #include "viewer/render/camera.h"
 #include "viewer/render/render_settings.h"
 
@@ -54,6 +55,8 @@ struct ViewerOptions {
   double frame_budget_ms = 100;
   // Window, at rest: after full detail, draw the exact mode run by run where GL 4.3 is there (rest_refinement.h).
   bool exact_when_still = true;
+  // Window, at rest: while the level refined to is uploading, show the spans in so far (partial_pictures.h).
+  PartialPictures partial_pictures = PartialPictures::Auto;
   std::optional<double> orbit_deg;  // window: turn the camera by this azimuth every frame (benchmarks)
   // Window: move the active region by this offset (mm) every frame, a scripted drag (benchmarks).
   std::optional<std::array<double, 3>> drag_region_mm;

@@ -17,6 +17,7 @@
 #include "viewer/app/focus_copy_worker.h"
 #include "viewer/app/frame_log.h"
 #include "viewer/app/key_bindings.h"
+#include "viewer/app/partial_pictures.h"
 #include "viewer/app/picture_annotations.h"
 #include "viewer/app/picture_scheduler.h"
 #include "viewer/app/region_editor.h"
@@ -119,9 +120,19 @@ class ViewerWindow {
   // Draws the scene whole at `level` of detail into scene_target_; returns the frame's time in ms. moving: the
   // camera moves (what the panel says of a level coarser than the scene's).
   double draw_scene(int width, int height, std::uint32_t level, bool moving);
-  // Draws the next piece of the refinement at rest (rest_refinement.h) into refine_target_; once the stage's
-  // picture is complete it becomes scene_target_'s and `completes` is set. Returns the piece's time in ms.
-  double refine(int width, int height, std::uint32_t level, bool& completes);
+  // Draws the next piece of the refinement at rest (rest_refinement.h) into refine_target_, or uploads more of its
+  // level; once a picture is complete it becomes scene_target_'s. While the level uploads, the picture may be a
+  // partial one (partial_pictures.h), which leaves the stage under way.
+  struct PieceDrawn {
+    double ms = 0;           // the piece's time (or the upload's), GPU work included
+    bool completes = false;  // a picture is complete and on screen
+    bool partial = false;    // the piece is a partial picture's
+  };
+  PieceDrawn refine(int width, int height, std::uint32_t level);
+  // The renderer of the picture on screen, to stand in for the spans of `renderer` (the refinement's level, drawn
+  // in `mode`) that are not in yet; null where a partial picture cannot be drawn: another stage, focus first, a mode
+  // not drawn in pieces of voxels, or a stand-in whose spans for this view are not all resident.
+  Renderer* partial_stand_in(Renderer& renderer, std::uint32_t level, RenderMode mode, double aspect);
   // The grid overlay and the annotations (picture_annotations.h) over scene_target_'s picture, when they are on.
   void draw_overlays(const Renderer& renderer, int width, int height);
   // The panel's figures of a complete picture drawn by `renderer` at `level`. coarser_why: what the panel adds to
@@ -179,6 +190,9 @@ class ViewerWindow {
   // faint layers add up beyond 8-bit rounding and the window shows what --render writes.
   std::optional<OffscreenTarget> scene_target_;
   std::optional<OffscreenTarget> refine_target_;  // the refinement's picture until it is complete
+  PartialPictureRule partial_rule_;               // when to show a level's spans while they upload
+  std::uint64_t partial_bytes_ = 0;  // the pieces under way draw a partial picture of this many uploaded bytes
+  double picture_ms_ = 0;            // the time of the pieces under way so far
   CameraController controller_;
   std::vector<glm::dvec3> framing_points_;  // what the home view fills the window with (scene_framing.h)
   std::unique_ptr<UiPanel> panel_;          // created after our callbacks, which ImGui then chains to

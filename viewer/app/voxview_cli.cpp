@@ -272,6 +272,14 @@ void declare_window(CLI::App& cli, ViewerArguments& a) {
                "window: at rest, stop at the full-detail picture; by default, where OpenGL 4.3 is there, the basic "
                "and axis modes go on to the exact picture, run by run, dropped at the first movement (key E)")
       ->excludes(render);
+  cli.add_option("--partial-pictures", a.partial_pictures,
+                 "window: at rest, while the finer level being refined to uploads (the spans nearest the view first), "
+                 "show the part of it that is in, the picture's level standing in for the rest: auto (once the upload "
+                 "has taken longer than such a picture takes to draw), always, never (keep the picture until the level "
+                 "is complete)")
+      ->check(CLI::IsMember({"auto", "always", "never"}))
+      ->default_val("auto")
+      ->excludes(render);
   cli.add_option(
          "--orbit", a.options.orbit_deg,
          "window: turn the camera by this many degrees of azimuth every frame (a scripted orbit, with --frames, "

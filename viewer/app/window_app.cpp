@@ -62,6 +62,7 @@ ViewerWindow::ViewerWindow(const ViewerOptions& o, std::unique_ptr<ViewerSession
       focus_copies_(files_),
       detail_(session_->detail()),
       startup_(startup),
+      partial_rule_(o.partial_pictures),
       controller_(Camera{}, 1.0) {
   if (o.saved_show_regions) state_.show_regions = *o.saved_show_regions;  // as the saved view had them
   stats_.detail = describe_scene_detail(detail_, session_->levels_in_files());
@@ -201,6 +202,8 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level, bool
   draw_overlays(renderer, width, height);
   glFinish();  // the frame time should include the GPU's work, not only its submission
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  partial_rule_.picture_shown(ms);
+  partial_bytes_ = 0;
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
   if (ms > 0 && renderer.stats().segments_drawn > 0) segments_per_ms_ = double(renderer.stats().segments_drawn) / ms;
   // At rest a coarser level is the first picture's, or one drawn at once after a change: refined next.
@@ -250,14 +253,30 @@ void ViewerWindow::present(int width, int height) const {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& completes) {
+Renderer* ViewerWindow::partial_stand_in(Renderer& renderer, std::uint32_t level, RenderMode mode, double aspect) {
+  // The level on screen, coarser, drawn by the same files' renderer (not the focus first's, which has others).
+  const std::uint32_t shown = scheduler_->drawn_level();
+  if (shown <= level || scheduler_->rest().stage() != RestStage::FullDetail || scheduler_->focus_stage() ||
+      drawn_focus_first_ || focus_first_at(shown) || !renderer.draws_in_voxel_pieces(mode))
+    return nullptr;
+  Renderer& stand_in = session_->renderer_at(shown, false);
+  // Under a GPU memory budget the level's upload may have evicted some of the stand-in's spans this view needs.
+  for (const std::uint32_t span : stand_in.spans_for(controller_.camera(), aspect, state_.settings.clipping))
+    if (!stand_in.span_resident(span)) return nullptr;
+  return &stand_in;
+}
+
+ViewerWindow::PieceDrawn ViewerWindow::refine(int width, int height, std::uint32_t level) {
   const auto t0 = std::chrono::steady_clock::now();
+  const auto elapsed_ms = [&] {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  };
   Renderer& renderer = renderer_at(level, false);
   if (!refine_target_) refine_target_.emplace(width, height);
   if (refine_target_->width() != width || refine_target_->height() != height) refine_target_->resize(width, height);
   RestRefinement& rest = scheduler_->rest();
   const bool exact_stage = rest.stage() == RestStage::Exact;
-  completes = false;
+  PieceDrawn piece;
   try {
     // Each piece fits the frame budget, so that input waits no longer at rest than while moving.
     const double piece_ms =
@@ -268,15 +287,26 @@ double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& co
       // The level's spans this view needs come first, a piece's time at a time (the nearest first), each with its
       // per-vertex words where the settings read them (with a region: the groups).
       renderer.prepare_attributes(s);
-      if (!renderer.upload_for(controller_.camera(), double(width) / height, state_.settings.clipping, piece_ms)) {
-        stats_.refinement = "uploading the scene's level";
-        glFinish();
-        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      const double aspect = double(width) / height;
+      Renderer* stand_in = nullptr;
+      if (!renderer.upload_for(controller_.camera(), aspect, state_.settings.clipping, piece_ms)) {
+        partial_rule_.uploaded(elapsed_ms());
+        stand_in = partial_rule_.wants_picture(renderer.gpu_bytes()) ? partial_stand_in(renderer, level, s.mode, aspect)
+                                                                     : nullptr;
+        if (!stand_in) {
+          stats_.refinement = "uploading the scene's level";
+          glFinish();
+          piece.ms = elapsed_ms();
+          return piece;
+        }
       }
-      renderer.begin_pieces(controller_.camera(), s, width, height, refine_target_->framebuffer());
+      renderer.begin_pieces(controller_.camera(), s, width, height, refine_target_->framebuffer(), stand_in);
       scheduler_->begin_pieces();
+      partial_bytes_ = stand_in ? renderer.gpu_bytes() : 0;
+      picture_ms_ = 0;
     }
-    completes = renderer.draw_piece(piece_ms);
+    piece.partial = partial_bytes_ > 0;
+    piece.completes = renderer.draw_piece(piece_ms);
   } catch (const std::exception& e) {
     rethrow_if_damaged(e);
     // Exact out of node memory, say: keep the picture on screen and stop refining it.
@@ -290,20 +320,38 @@ double ViewerWindow::refine(int width, int height, std::uint32_t level, bool& co
     }
     scheduler_->abandon_pieces();
     stats_.refinement = rest.describe(0);
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    piece.completes = false;
+    piece.ms = elapsed_ms();
+    return piece;
   }
-  if (completes) {
+  if (piece.completes) {
     std::swap(scene_target_, refine_target_);
     draw_overlays(renderer, width, height);
     show_frame_figures(renderer, level, ", refining at rest");
+    if (piece.partial)
+      stats_.frame_level = "level " + std::to_string(level) + " where its spans are in, level " +
+                           std::to_string(scheduler_->drawn_level()) + " elsewhere (the rest is on its way)";
   }
   const bool focus_stage = scheduler_->focus_stage();
-  scheduler_->piece_drawn(completes);
-  stats_.refinement = focus_stage && !completes
-                          ? "the focus at full detail: " + std::to_string(int(100 * renderer.pieces_progress())) + " %"
-                          : rest.describe(completes ? 0 : renderer.pieces_progress(), scheduler_->level_on_the_way());
+  if (piece.partial) {
+    // A partial picture is not the stage's: once shown, the level's upload goes on.
+    if (piece.completes) scheduler_->abandon_pieces();
+  } else {
+    scheduler_->piece_drawn(piece.completes);
+  }
+  stats_.refinement =
+      focus_stage && !piece.completes
+          ? "the focus at full detail: " + std::to_string(int(100 * renderer.pieces_progress())) + " %"
+      : piece.partial && !piece.completes
+          ? "showing the nearest of level " + std::to_string(level) +
+                " in so far: " + std::to_string(int(100 * renderer.pieces_progress())) + " %"
+          : rest.describe(piece.completes ? 0 : renderer.pieces_progress(), scheduler_->level_on_the_way());
   glFinish();
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  piece.ms = elapsed_ms();
+  picture_ms_ += piece.ms;
+  if (piece.completes) partial_rule_.picture_shown(picture_ms_, partial_bytes_);
+  if (piece.completes) partial_bytes_ = 0;
+  return piece;
 }
 
 void ViewerWindow::save_screenshot(const std::string& path, int width, int height) {
@@ -386,9 +434,9 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
     // and it would take the cores that work needs (it runs below the window's priority). One level's selection
     // holds no finer level's streamlines.
     if (work_in_flight() || level_selection_shown()) return false;
-    bool completes = false;
-    const double ms = refine(key.width, key.height, task.level, completes);
-    frames_.push_back({task.level, false, ms, seconds_since_process_start(), task.frame_work, completes});
+    const PieceDrawn piece = refine(key.width, key.height, task.level);
+    frames_.push_back({task.level, false, piece.ms, seconds_since_process_start(),
+                       piece.partial ? FrameWork::PartialPiece : task.frame_work, piece.completes});
     frames_.back().focus_first = drawn_focus_first_;
     frames_.back().selection = selection_.has_value();
     return true;

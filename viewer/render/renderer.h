@@ -82,9 +82,10 @@ class Renderer {
   // draws in the same order for opaque, basic and axis; exact composites runs of voxels as its draw()
   // does, only shorter ones. Modes that blend in no order (unsorted, additive, wboit) are drawn whole by
   // the first piece. A draw() in between abandons the pieces.
-  // stand_in: a renderer of the same files at a coarser level (with no image), for a picture while this one's
-  // spans are still coming (the web viewer fetching a level nearest the view first): the plan's voxels whose span
-  // is not resident are drawn from it, at its level, in their place back to front, and no span is uploaded. Only
+  // stand_in: a renderer of the same files (and image, if any) at a coarser level, for a picture while this one's
+  // spans are still coming (the web viewer fetching a level nearest the view first, the window's partial pictures):
+  // the plan's voxels whose span is not resident are drawn from it, at its level, in their place back to front, and
+  // no span is uploaded (the caller sees that the stand-in's spans for the view are resident). Only
   // for the modes drawn in pieces of voxels (draws_in_voxel_pieces); ignored for the others. It must outlive the
   // pieces (until draw(), the next begin_pieces() or the end of this renderer).
   void begin_pieces(const Camera& camera, const RenderSettings& settings, int width, int height, GLuint fbo,
