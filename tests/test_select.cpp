@@ -1087,7 +1087,7 @@ TEST(SelectionCli, CountJsonAndTheCriteriaInTheTckHeader) {
   ASSERT_EQ(json.exit_code, 0) << json.output;
   EXPECT_EQ(nlohmann::json::parse(json.output)["selected"].get<std::uint64_t>(), n);
   // A count writes nothing: the options of a written TCK are refused with it, not ignored.
-  for (const std::string extra : {" --tsf " + test::q(dir.file("c.tsf")), std::string(" --value v")}) {
+  for (const std::string& extra : {" --tsf " + test::q(dir.file("c.tsf")), std::string(" --value v")}) {
     const test::CommandResult refused = run_cli("select " + in + " --include 0,-18,10,20 --count" + extra);
     EXPECT_EQ(refused.exit_code, 2) << extra << ": " << refused.output;
     EXPECT_NE(refused.output.find("--count excludes " + extra.substr(1, extra.find(' ', 1) - 1)), std::string::npos)

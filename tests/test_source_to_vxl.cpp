@@ -84,6 +84,7 @@ TEST(SourceToVxl, OpenAsVxlStreamsThroughATemporaryFileItRemoves) {
   EXPECT_GE(opened.report.summary.passes, 3u);
   EXPECT_EQ(std::filesystem::path(opened.temporary_path).parent_path(), std::filesystem::path(temporary));
   EXPECT_TRUE(opened.temporary_path.ends_with("-s.tck.vxl")) << opened.temporary_path;
+  EXPECT_EQ(opened.file.path(), tck) << "named by its source in errors and group names, not by the removed file";
   EXPECT_FALSE(std::filesystem::exists(opened.temporary_path));
   EXPECT_TRUE(std::filesystem::is_empty(temporary));
   EXPECT_EQ(mapped_bytes(opened.file), test::slurp(dir.file("whole.vxl")));

@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "format/base/error.h"
+#include "format/base/mapped_file.h"
 
 namespace vxl {
 namespace {
@@ -43,7 +44,9 @@ TemporaryVxl open_through_temporary_vxl(const std::string& name, const std::func
   const std::string path = reserve(name, dir);
   try {
     write(path);
-    VxlFile file = VxlFile::open(path);
+    MappedFile bytes(path);
+    bytes.name_as(name);  // the temporary name means nothing to the user (group names, errors): the source's does
+    VxlFile file = VxlFile::open(std::move(bytes));
     std::filesystem::remove(path);  // the mapping keeps the data
     return {std::move(file), path, on_tmpfs(dir)};
   } catch (...) {

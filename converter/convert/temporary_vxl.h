@@ -17,7 +17,8 @@ struct TemporaryVxl {
 
 // Calls `write` with a fresh path "voxlines-XXXXXX-NAME.vxl" (NAME: the file name of `name`; mkstemps makes the
 // name this call's alone, as an empty file that `write` replaces) in `dir` (empty: the system's temporary
-// folder, $TMPDIR or else /tmp), opens what it wrote and removes it: the mapping keeps the data. The file is
+// folder, $TMPDIR or else /tmp), opens what it wrote, named `name` (VxlFile::path(): in errors, and the scene's group
+// of a file is its file name), and removes it: the mapping keeps the data. The file is
 // removed also when `write` or the opening throws; the exception goes on. Throws vxl::Error (Output) when no
 // temporary file can be made.
 TemporaryVxl open_through_temporary_vxl(const std::string& name, const std::function<void(const std::string&)>& write,

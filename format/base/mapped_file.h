@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 
 namespace vxl {
 
@@ -25,6 +26,9 @@ class MappedFile {
   std::size_t size() const { return size_; }
   std::span<const std::uint8_t> bytes() const { return {data_, size_}; }
   const std::string& path() const { return path_; }
+  // From now on `name` stands for the path (in errors, and where the file is named): for a temporary file removed
+  // once mapped, the file it was made from.
+  void name_as(std::string name) { path_ = std::move(name); }
   // Drops the pages this process has read from its page tables: the file stays in the page cache, and a later
   // read maps them again (a minor fault). A long pass through a large file calls it now and then, so that its
   // resident size stays what it reads between calls, not the whole file.

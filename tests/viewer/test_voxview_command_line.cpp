@@ -198,6 +198,19 @@ TEST(VoxviewCommandLine, ColourOptionsOfAnotherColourModeAreNotedHeadless) {
             std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("note: --fixed-color goes with --color fixed"), std::string::npos) << r.output;
+  // A group's colour is the group mode's; its opacity applies in every mode, so an opacity alone is not noted. (The
+  // TCK, converted on the fly, is the group named after it.)
+  const test::CommandResult group_colour = test::run_program(VOXVIEW_CLI, render + " --group 'a.tck=#00ff00:0.5'");
+  EXPECT_EQ(group_colour.exit_code, 0) << group_colour.output;
+  EXPECT_NE(group_colour.output.find("note: --group a.tck=#00ff00:0.5: its colour goes with --color group; this "
+                                     "picture is coloured by direction (its opacity applies)"),
+            std::string::npos)
+      << group_colour.output;
+  for (const std::string& quiet : {" --group 'a.tck=:0.2'", " --color group --group 'a.tck=#00ff00:0.5'"}) {
+    const test::CommandResult r2 = test::run_program(VOXVIEW_CLI, render + quiet);
+    EXPECT_EQ(r2.exit_code, 0) << quiet << ": " << r2.output;
+    EXPECT_EQ(r2.output.find("note:"), std::string::npos) << quiet << ": " << r2.output;
+  }
   const test::CommandResult fixed = test::run_program(VOXVIEW_CLI, render + " --color fixed --fixed-color '#ff0000'");
   EXPECT_EQ(fixed.exit_code, 0) << fixed.output;
   EXPECT_EQ(fixed.output.find("note:"), std::string::npos) << fixed.output;

@@ -134,6 +134,12 @@ void note_other_colour_modes_options(const ViewerArguments& a, ViewerOptions& o)
         !(mode == ColorMode::Fixed && o.settings.color == ColorMode::Scalar))
       o.notes.push_back(std::string(option) + " goes with --color " + color_mode_name(mode) +
                         "; this picture is coloured by " + color_mode_name(o.settings.color));
+  // A group's opacity applies in every colour mode, its colour only in the group mode.
+  if (o.settings.color == ColorMode::Group) return;
+  for (const std::string& g : a.groups)
+    if (const auto style = parse_group_style(g); style && style->color)
+      o.notes.push_back("--group " + g + ": its colour goes with --color group; this picture is coloured by " +
+                        color_mode_name(o.settings.color) + " (its opacity applies)");
 }
 
 // --slab and --clip: clip planes given replace a saved view's.
