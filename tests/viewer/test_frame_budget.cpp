@@ -154,6 +154,9 @@ TEST(FrameLog, APartialPictureIsNotFullDetail) {
   EXPECT_DOUBLE_EQ(s.full_detail_s, 0.9);
   EXPECT_EQ(s.pieces, 3u);
   EXPECT_LT(summarize_frames({frames[0], frames[1]}, 0).full_detail_s, 0.0) << "only the partial picture at level 0";
+  // Nor is it the finest level reached: with the scene at level 1 and no complete level-0 picture, full detail is
+  // the level-1 picture.
+  EXPECT_DOUBLE_EQ(summarize_frames({frames[0], frames[1], frames[2]}, 1).full_detail_s, 0.2);
 }
 
 }  // namespace

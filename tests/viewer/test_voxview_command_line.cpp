@@ -155,11 +155,13 @@ TEST(VoxviewCommandLine, TheWindowsOptionsAreRefusedWithRender) {
     EXPECT_FALSE(std::filesystem::exists(dir.file("a.png"))) << option;
     EXPECT_FALSE(std::filesystem::exists(dir.file("b.png"))) << option;
   }
-  // And a window's choice it does not know is a usage error too, naming the choices.
-  const test::CommandResult r =
-      test::run_program(VOXVIEW_CLI, test::q(dir.file("a.tck")) + " --partial-pictures sometimes");
+}
+
+// A choice the option does not have is a usage error before anything opens, naming the choices.
+TEST(VoxviewCommandLine, AnUnknownPartialPicturesChoiceIsRefused) {
+  const test::CommandResult r = test::run_program(VOXVIEW_CLI, "missing.vxl --partial-pictures sometimes");
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("--partial-pictures"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--partial-pictures: sometimes not in {auto,always,never}"), std::string::npos) << r.output;
 }
 
 // --voxel-size and --memory-limit shape a conversion: with only .vxl and .vxlz inputs, which are converted already,
@@ -206,7 +208,7 @@ TEST(VoxviewCommandLine, ColourOptionsOfAnotherColourModeAreNotedHeadless) {
                                      "picture is coloured by direction (its opacity applies)"),
             std::string::npos)
       << group_colour.output;
-  for (const std::string& quiet : {" --group 'a.tck=:0.2'", " --color group --group 'a.tck=#00ff00:0.5'"}) {
+  for (const char* quiet : {" --group 'a.tck=:0.2'", " --color group --group 'a.tck=#00ff00:0.5'"}) {
     const test::CommandResult r2 = test::run_program(VOXVIEW_CLI, render + quiet);
     EXPECT_EQ(r2.exit_code, 0) << quiet << ": " << r2.output;
     EXPECT_EQ(r2.output.find("note:"), std::string::npos) << quiet << ": " << r2.output;

@@ -125,6 +125,10 @@ void write_frame_stats(const std::string& path, const std::vector<FrameRecord>& 
     if (f.focus_first) list.back()["focus_level"] = 0;  // focus first: `level` is the context's
     if (f.selection) list.back()["selection"] = true;
     if (f.new_selection) list.back()["new_selection"] = true;
+    if (f.work == FrameWork::PartialPiece) {
+      list.back()["voxels_in"] = f.voxels_in;
+      list.back()["voxels_standing_in"] = f.voxels_standing_in;
+    }
   }
   j["frames"] = list;
   write_stats_json(path, j);

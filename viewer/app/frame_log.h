@@ -35,6 +35,8 @@ struct FrameRecord {
   bool focus_first = false;    // the focus drawn at level 0 from its copy, the context at `level`
   bool selection = false;      // the picture shows a selection of the regions (focus and context)
   bool new_selection = false;  // its selection (or the focus copy) was taken into the picture for this frame
+  // A partial picture's voxels: drawn from the level uploading, and from the level on screen standing in.
+  std::uint64_t voxels_in = 0, voxels_standing_in = 0;
 };
 
 struct FrameSummary {

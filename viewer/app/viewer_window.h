@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -124,15 +125,22 @@ class ViewerWindow {
   // level; once a picture is complete it becomes scene_target_'s. While the level uploads, the picture may be a
   // partial one (partial_pictures.h), which leaves the stage under way.
   struct PieceDrawn {
-    double ms = 0;           // the piece's time (or the upload's), GPU work included
-    bool completes = false;  // a picture is complete and on screen
-    bool partial = false;    // the piece is a partial picture's
+    double ms = 0;                                        // the piece's time (or the upload's), GPU work included
+    bool completes = false;                               // a picture is complete and on screen
+    bool partial = false;                                 // the piece is a partial picture's
+    std::uint64_t voxels_in = 0, voxels_standing_in = 0;  // a partial picture's, drawn from either level
   };
   PieceDrawn refine(int width, int height, std::uint32_t level);
-  // The renderer of the picture on screen, to stand in for the spans of `renderer` (the refinement's level, drawn
-  // in `mode`) that are not in yet; null where a partial picture cannot be drawn: another stage, focus first, a mode
-  // not drawn in pieces of voxels, or a stand-in whose spans for this view are not all resident.
-  Renderer* partial_stand_in(Renderer& renderer, std::uint32_t level, RenderMode mode, double aspect);
+  // Whether to draw a partial picture now (partial_pictures.h) of `renderer`'s `view_spans` (the refinement's level,
+  // drawn in `mode`, uploading): its stand-in, the renderer of the picture on screen, and the view's spans in. No
+  // stand-in where none is wanted yet, or none can be drawn: another stage, focus first, a mode not drawn in pieces of
+  // voxels, or a stand-in whose spans for this view are not all resident.
+  struct PartialPicture {
+    Renderer* stand_in = nullptr;
+    std::uint64_t spans_in = 0;
+  };
+  PartialPicture partial_picture(Renderer& renderer, std::span<const std::uint32_t> view_spans, std::uint32_t level,
+                                 RenderMode mode, double aspect);
   // The grid overlay and the annotations (picture_annotations.h) over scene_target_'s picture, when they are on.
   void draw_overlays(const Renderer& renderer, int width, int height);
   // The panel's figures of a complete picture drawn by `renderer` at `level`. coarser_why: what the panel adds to
@@ -191,8 +199,7 @@ class ViewerWindow {
   std::optional<OffscreenTarget> scene_target_;
   std::optional<OffscreenTarget> refine_target_;  // the refinement's picture until it is complete
   PartialPictureRule partial_rule_;               // when to show a level's spans while they upload
-  std::uint64_t partial_bytes_ = 0;  // the pieces under way draw a partial picture of this many uploaded bytes
-  double picture_ms_ = 0;            // the time of the pieces under way so far
+  std::uint64_t partial_spans_ = 0;  // the pieces under way draw a partial picture of this many of the view's spans
   CameraController controller_;
   std::vector<glm::dvec3> framing_points_;  // what the home view fills the window with (scene_framing.h)
   std::unique_ptr<UiPanel> panel_;          // created after our callbacks, which ImGui then chains to

@@ -275,8 +275,8 @@ void declare_window(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--partial-pictures", a.partial_pictures,
                  "window: at rest, while the finer level being refined to uploads (the spans nearest the view first), "
                  "show the part of it that is in, the picture's level standing in for the rest: auto (once the upload "
-                 "has taken longer than such a picture takes to draw), always, never (keep the picture until the level "
-                 "is complete)")
+                 "has taken as long as such a picture is expected to take to draw), always (whenever spans arrived), "
+                 "never (keep the picture until the level is complete)")
       ->check(CLI::IsMember({"auto", "always", "never"}))
       ->default_val("auto")
       ->excludes(render);

@@ -202,8 +202,8 @@ double ViewerWindow::draw_scene(int width, int height, std::uint32_t level, bool
   draw_overlays(renderer, width, height);
   glFinish();  // the frame time should include the GPU's work, not only its submission
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  partial_rule_.picture_shown(ms);
-  partial_bytes_ = 0;
+  partial_rule_.picture_shown();
+  partial_spans_ = 0;
   stats_.frame_ms = stats_.frame_ms == 0 ? ms : 0.9 * stats_.frame_ms + 0.1 * ms;
   if (ms > 0 && renderer.stats().segments_drawn > 0) segments_per_ms_ = double(renderer.stats().segments_drawn) / ms;
   // At rest a coarser level is the first picture's, or one drawn at once after a change: refined next.
@@ -253,17 +253,33 @@ void ViewerWindow::present(int width, int height) const {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-Renderer* ViewerWindow::partial_stand_in(Renderer& renderer, std::uint32_t level, RenderMode mode, double aspect) {
+ViewerWindow::PartialPicture ViewerWindow::partial_picture(Renderer& renderer,
+                                                           std::span<const std::uint32_t> view_spans,
+                                                           std::uint32_t level, RenderMode mode, double aspect) {
+  PartialPicture partial;
+  std::uint64_t segments_in = 0, segments_all = 0;
+  for (const std::uint32_t span : view_spans) {
+    const std::uint64_t segments = renderer.layout().texture_spans()[span].segments;
+    segments_all += segments;
+    if (!renderer.span_resident(span)) continue;
+    segments_in += segments;
+    ++partial.spans_in;
+  }
+  if (!partial_rule_.spans_arrived(partial.spans_in)) return {};
   // The level on screen, coarser, drawn by the same files' renderer (not the focus first's, which has others).
   const std::uint32_t shown = scheduler_->drawn_level();
   if (shown <= level || scheduler_->rest().stage() != RestStage::FullDetail || scheduler_->focus_stage() ||
       drawn_focus_first_ || focus_first_at(shown) || !renderer.draws_in_voxel_pieces(mode))
-    return nullptr;
+    return {};
   Renderer& stand_in = session_->renderer_at(shown, false);
   // Under a GPU memory budget the level's upload may have evicted some of the stand-in's spans this view needs.
   for (const std::uint32_t span : stand_in.spans_for(controller_.camera(), aspect, state_.settings.clipping))
-    if (!stand_in.span_resident(span)) return nullptr;
-  return &stand_in;
+    if (!stand_in.span_resident(span)) return {};
+  const double rate = segments_per_ms_ > 0 ? segments_per_ms_ : Renderer::kAssumedSegmentsPerMs;
+  const double expected_ms = partial_picture_ms(segments_in, segments_all, stand_in.stats().segments_drawn, rate);
+  if (!partial_rule_.wants_picture(partial.spans_in, expected_ms)) return {};
+  partial.stand_in = &stand_in;
+  return partial;
 }
 
 ViewerWindow::PieceDrawn ViewerWindow::refine(int width, int height, std::uint32_t level) {
@@ -288,25 +304,29 @@ ViewerWindow::PieceDrawn ViewerWindow::refine(int width, int height, std::uint32
       // per-vertex words where the settings read them (with a region: the groups).
       renderer.prepare_attributes(s);
       const double aspect = double(width) / height;
-      Renderer* stand_in = nullptr;
-      if (!renderer.upload_for(controller_.camera(), aspect, state_.settings.clipping, piece_ms)) {
+      const std::vector<std::uint32_t> view_spans =
+          renderer.spans_for(controller_.camera(), aspect, state_.settings.clipping);
+      PartialPicture partial;
+      if (!renderer.upload_spans(view_spans, piece_ms)) {
         partial_rule_.uploaded(elapsed_ms());
-        stand_in = partial_rule_.wants_picture(renderer.gpu_bytes()) ? partial_stand_in(renderer, level, s.mode, aspect)
-                                                                     : nullptr;
-        if (!stand_in) {
+        partial = partial_picture(renderer, view_spans, level, s.mode, aspect);
+        if (!partial.stand_in) {
           stats_.refinement = "uploading the scene's level";
           glFinish();
           piece.ms = elapsed_ms();
           return piece;
         }
       }
-      renderer.begin_pieces(controller_.camera(), s, width, height, refine_target_->framebuffer(), stand_in);
+      renderer.begin_pieces(controller_.camera(), s, width, height, refine_target_->framebuffer(), partial.stand_in);
       scheduler_->begin_pieces();
-      partial_bytes_ = stand_in ? renderer.gpu_bytes() : 0;
-      picture_ms_ = 0;
+      partial_spans_ = partial.spans_in;
     }
-    piece.partial = partial_bytes_ > 0;
+    piece.partial = partial_spans_ > 0;
     piece.completes = renderer.draw_piece(piece_ms);
+    if (piece.partial) {
+      piece.voxels_in = renderer.stats().voxels_drawn;
+      piece.voxels_standing_in = renderer.stats().voxels_waiting;
+    }
   } catch (const std::exception& e) {
     rethrow_if_damaged(e);
     // Exact out of node memory, say: keep the picture on screen and stop refining it.
@@ -342,15 +362,17 @@ ViewerWindow::PieceDrawn ViewerWindow::refine(int width, int height, std::uint32
   stats_.refinement =
       focus_stage && !piece.completes
           ? "the focus at full detail: " + std::to_string(int(100 * renderer.pieces_progress())) + " %"
-      : piece.partial && !piece.completes
-          ? "showing the nearest of level " + std::to_string(level) +
-                " in so far: " + std::to_string(int(100 * renderer.pieces_progress())) + " %"
-          : rest.describe(piece.completes ? 0 : renderer.pieces_progress(), scheduler_->level_on_the_way());
+      : piece.partial ? piece.completes
+                            ? "uploading the scene's level"
+                            : "showing the part of level " + std::to_string(level) +
+                                  " that is in: " + std::to_string(int(100 * renderer.pieces_progress())) + " %"
+                      : rest.describe(piece.completes ? 0 : renderer.pieces_progress(), scheduler_->level_on_the_way());
   glFinish();
   piece.ms = elapsed_ms();
-  picture_ms_ += piece.ms;
-  if (piece.completes) partial_rule_.picture_shown(picture_ms_, partial_bytes_);
-  if (piece.completes) partial_bytes_ = 0;
+  if (piece.completes) {
+    partial_rule_.picture_shown(partial_spans_);
+    partial_spans_ = 0;
+  }
   return piece;
 }
 
@@ -437,6 +459,8 @@ bool ViewerWindow::draw_picture(const PictureTask& task, const PictureKey& key, 
     const PieceDrawn piece = refine(key.width, key.height, task.level);
     frames_.push_back({task.level, false, piece.ms, seconds_since_process_start(),
                        piece.partial ? FrameWork::PartialPiece : task.frame_work, piece.completes});
+    frames_.back().voxels_in = piece.voxels_in;
+    frames_.back().voxels_standing_in = piece.voxels_standing_in;
     frames_.back().focus_first = drawn_focus_first_;
     frames_.back().selection = selection_.has_value();
     return true;
