@@ -272,12 +272,12 @@ ViewerWindow::PartialPicture ViewerWindow::partial_picture(Renderer& renderer,
       drawn_focus_first_ || focus_first_at(shown) || !renderer.draws_in_voxel_pieces(mode))
     return {};
   Renderer& stand_in = session_->renderer_at(shown, false);
-  // Under a GPU memory budget the level's upload may have evicted some of the stand-in's spans this view needs.
-  for (const std::uint32_t span : stand_in.spans_for(controller_.camera(), aspect, state_.settings.clipping))
-    if (!stand_in.span_resident(span)) return {};
   const double rate = segments_per_ms_ > 0 ? segments_per_ms_ : Renderer::kAssumedSegmentsPerMs;
   const double expected_ms = partial_picture_ms(segments_in, segments_all, stand_in.stats().segments_drawn, rate);
   if (!partial_rule_.wants_picture(partial.spans_in, expected_ms)) return {};
+  // Under a GPU memory budget the level's upload may have evicted some of the stand-in's spans this view needs.
+  for (const std::uint32_t span : stand_in.spans_for(controller_.camera(), aspect, state_.settings.clipping))
+    if (!stand_in.span_resident(span)) return {};
   partial.stand_in = &stand_in;
   return partial;
 }
