@@ -252,7 +252,7 @@ TEST_F(GpuMemoryBudget, HostMemoryBuffersDrawWhatTheDriversOwnDraw) {
   EXPECT_EQ(compare_images(host.bottom_again, driver.bottom_again).differing_pixels, 0u);
 }
 
-// A window spreads a large upload over frames: upload_for fills a few spans at a time on other threads, the
+// A window spreads a large upload over frames: upload_spans fills a few spans at a time on other threads, the
 // nearest first, returns after about its time limit with those done resident, and says when the view has all
 // it needs; the picture is then the eager scene's.
 TEST_F(GpuMemoryBudget, UploadsSpreadOverCallsGiveTheSamePicture) {
@@ -264,7 +264,8 @@ TEST_F(GpuMemoryBudget, UploadsSpreadOverCallsGiveTheSamePicture) {
   s.opacity = 0.3f;
   int calls = 1;
   std::uint64_t before = 0;
-  while (!lazy.upload_for(view(), 1.0, s.clipping, 1e-6)) {  // a millionth of a millisecond: hardly any wait
+  const std::vector<std::uint32_t> spans = lazy.spans_for(view(), 1.0, s.clipping);
+  while (!lazy.upload_spans(spans, 1e-6)) {  // a millionth of a millisecond: hardly any wait
     EXPECT_GE(lazy.gpu_bytes(), before) << "call " << calls;
     before = lazy.gpu_bytes();
     ASSERT_LT(++calls, 1000000) << "the uploads never end";

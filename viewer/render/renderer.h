@@ -56,7 +56,7 @@ class Renderer {
   // pool: the GPU memory budget shared with the context's other renderers (gpu_memory_pool.h; none: no
   // budget). A frame draws the visible voxels whose span the budget holds, the nearest first.
   // eager: upload the whole scene when made, if it fits the pool's free room; else spans come as frames (or
-  // upload_for) need them.
+  // upload_spans) need them.
   // file_levels: when not empty, each file's own level instead of `level` (a selection's focus copy at full
   // detail beside the context at a coarser one: viewer_session.h); each group's opacity is then compensated
   // for the level of the files it is drawn from (LinePass::bind).
@@ -154,8 +154,8 @@ class Renderer {
   // with everything a mode may upload for them (SceneLayout::span_upload_bytes).
   std::uint64_t view_bytes(const Camera& camera, double aspect, const Clipping& clipping = {}) const;
   // Makes what `settings` read per vertex (values, groups: LinePass::prepare_attributes) part of every span's upload
-  // from now on; draw() and begin_pieces() do it themselves. A caller that uploads spans ahead of a frame (upload_for)
-  // calls it first: else the frame re-uploads every resident span with those words, all at once.
+  // from now on; draw() and begin_pieces() do it themselves. A caller that uploads spans ahead of a frame
+  // (upload_spans) calls it first: else the frame re-uploads every resident span with those words, all at once.
   void prepare_attributes(const RenderSettings& settings);
   // The spans a frame of `camera` needs, those of the nearest voxels first.
   std::vector<std::uint32_t> spans_for(const Camera& camera, double aspect, const Clipping& clipping = {}) const;
@@ -164,10 +164,6 @@ class Renderer {
   // loop never waits for one: returns after about `max_ms`, with the spans whose fill ended by then resident. True
   // once nothing more of them can be uploaded (all resident, or the budget holds no more).
   bool upload_spans(std::span<const std::uint32_t> spans, double max_ms);
-  // upload_spans of the spans a frame of `camera` needs (spans_for).
-  bool upload_for(const Camera& camera, double aspect, const Clipping& clipping, double max_ms) {
-    return upload_spans(spans_for(camera, aspect, clipping), max_ms);
-  }
 
   // The renderer as its transparency modes see it (modes/pass_host.h): its line pass, scene, plan and base.
   // For drawing a mode's pass over this renderer's scene (e.g. an ExactRenderer with a small node buffer).
