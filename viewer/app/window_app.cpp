@@ -266,10 +266,11 @@ ViewerWindow::PartialPicture ViewerWindow::partial_picture(Renderer& renderer,
     ++partial.spans_in;
   }
   if (!partial_rule_.spans_arrived(partial.spans_in)) return {};
-  // The level on screen, coarser, drawn by the same files' renderer (not the focus first's, which has others).
+  // The level on screen, coarser (not so in the focus stage, which draws that level again), drawn by the same files'
+  // renderer: not focus first's, which has others (and is drawn at any level coarser than 0 once there is a focus).
   const std::uint32_t shown = scheduler_->drawn_level();
-  if (shown <= level || scheduler_->rest().stage() != RestStage::FullDetail || scheduler_->focus_stage() ||
-      drawn_focus_first_ || focus_first_at(shown) || !renderer.draws_in_voxel_pieces(mode))
+  if (shown <= level || scheduler_->rest().stage() != RestStage::FullDetail || focus_first_at(shown) ||
+      !renderer.draws_in_voxel_pieces(mode))
     return {};
   Renderer& stand_in = session_->renderer_at(shown, false);
   const double rate = segments_per_ms_ > 0 ? segments_per_ms_ : Renderer::kAssumedSegmentsPerMs;
