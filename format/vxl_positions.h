@@ -2,7 +2,7 @@
 // (4 bytes: 10 bits per axis of fixed point across the voxel's tight bounds, plus a voxline-end bit).
 //
 // Packed positions are decoded as lo + q * step in binary32, the multiply and the add rounded apart
-// (this file's .cpp is compiled without floating-point contraction), so that every reader — the
+// (the project is compiled without floating-point contraction), so that every reader — the
 // converter building orders, verify checking them, the viewer — sees the same coordinates.
 #pragma once
 

@@ -13,6 +13,7 @@
 #include "format/streamline_length.h"
 #include "format/voxel_voxlines.h"
 #include "format/vxl_file.h"
+#include "format/vxl_positions.h"
 #include "format/vxl_streamlines.h"
 
 namespace vxl {
@@ -188,6 +189,61 @@ void check_voxel_index(const VxlFile& f) {
   }
 }
 
+// Tight bounds (§5.3): the extremes of the voxel's vertices, which frustum and slab culling trust. Float32:
+// every vertex inside them and each bound reached. Packed (§5.4), where only the words are stored: on every
+// axis the words reach the quanta the bounds themselves pack to (0 and, unless the step is 0, 1023).
+// META's bounds (§5.1) are the extremes of all vertices, so of the voxels' tight bounds.
+void check_bounds(const VxlFile& f) {
+  const std::string& p = f.path();
+  const std::uint64_t voxt = f.find_section(section_id("VOXT"))->offset;
+  const std::uint64_t vert = f.find_section(section_id("VERT"))->offset;
+  const bool packed = f.position_encoding() == PositionEncoding::Packed;
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < f.voxels().size(); ++i) {
+    const VoxelEntry& v = f.voxels()[i];
+    float reached_lo[3], reached_hi[3];
+    if (packed) {
+      const VertexPacker packer(v);
+      std::uint32_t want_lo = 0, want_hi = 0;
+      packer.words(v.tight_min, 1, &want_lo);
+      packer.words(v.tight_max, 1, &want_hi);
+      std::uint32_t q_lo[3] = {kPackedAxisMask, kPackedAxisMask, kPackedAxisMask}, q_hi[3] = {0, 0, 0};
+      for (std::uint32_t w : f.packed_vertices().subspan(v.vertex_first, v.vertex_count))
+        for (int c = 0; c < 3; ++c) {
+          q_lo[c] = std::min(q_lo[c], (w >> (10 * c)) & kPackedAxisMask);
+          q_hi[c] = std::max(q_hi[c], (w >> (10 * c)) & kPackedAxisMask);
+        }
+      for (int c = 0; c < 3; ++c) {
+        reached_lo[c] = q_lo[c] == ((want_lo >> (10 * c)) & kPackedAxisMask) ? v.tight_min[c] : NAN;
+        reached_hi[c] = q_hi[c] == ((want_hi >> (10 * c)) & kPackedAxisMask) ? v.tight_max[c] : NAN;
+      }
+    } else {
+      for (int c = 0; c < 3; ++c) reached_lo[c] = reached_hi[c] = NAN;
+      const auto xyz = f.float_vertices().subspan(3 * v.vertex_first, 3 * std::uint64_t(v.vertex_count));
+      for (std::size_t k = 0; k < xyz.size(); ++k) {
+        const int c = static_cast<int>(k % 3);
+        if (!(v.tight_min[c] <= xyz[k] && xyz[k] <= v.tight_max[c]))
+          fail_input(p, vert + 4 * (3 * v.vertex_first + k),
+                     "vertex outside the tight bounds of its voxel " + std::to_string(i));
+        if (xyz[k] == v.tight_min[c]) reached_lo[c] = xyz[k];
+        if (xyz[k] == v.tight_max[c]) reached_hi[c] = xyz[k];
+      }
+    }
+    for (int c = 0; c < 3; ++c) {
+      if (!(reached_lo[c] == v.tight_min[c]) || !(reached_hi[c] == v.tight_max[c]))
+        fail_input(p, voxt + 64 * i + (reached_lo[c] == v.tight_min[c] ? 28 : 16) + 4 * c,
+                   "tight bounds of voxel " + std::to_string(i) + " are not the extremes of its vertices");
+      lo[c] = i == 0 ? v.tight_min[c] : std::min<double>(lo[c], v.tight_min[c]);
+      hi[c] = i == 0 ? v.tight_max[c] : std::max<double>(hi[c], v.tight_max[c]);
+    }
+  }
+  const std::uint64_t meta = f.find_section(section_id("META"))->offset;
+  for (int c = 0; c < 3; ++c)
+    if (f.meta().bounds_min[c] != lo[c] || f.meta().bounds_max[c] != hi[c])
+      fail_input(p, meta + (f.meta().bounds_min[c] != lo[c] ? 104 : 128) + 8 * c,
+                 "META bounds are not the extremes of the voxels' tight bounds");
+}
+
 // SLEN (§5.15): each length against the stored points' length, equal to the bit with float32 positions (they are
 // the source points); with packed positions within what moving each point by the file's bound can change.
 class LengthCheck {
@@ -222,6 +278,8 @@ VerifyResult verify_vxl(const std::string& path) {
     VxlFile f = VxlFile::open(path);
     check_checksums_and_padding(f);
     check_meta_and_dirs(f);
+    check_bounds(f);
+    check_grid_extent(f.meta(), f.voxels(), f.path(), f.find_section(section_id("META"))->offset);
     // The walk marks which vertices start a segment (all but each voxline's last vertex).
     std::vector<std::uint8_t> is_segment_start(f.meta().vertex_count, 0);
     WalkCallbacks cb;

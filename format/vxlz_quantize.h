@@ -27,8 +27,8 @@ class Quantizer {
     return static_cast<std::int32_t>(std::clamp(k, 0.0, double(max_value_)));
   }
 
-  // §6: one binary64 multiply, one binary64 add, one rounding to binary32. (GCC in ISO C++ mode does not
-  // contract this into a fused multiply-add, which would change the last bit.)
+  // §6: one binary64 multiply, one binary64 add, one rounding to binary32. (Never contracted into a fused
+  // multiply-add, which would change the last bit: the project is compiled with -ffp-contract=off.)
   float dequantize(std::int64_t k, int c) const {
     const double scaled = double(k) * quantum_;
     return static_cast<float>(origin_[c] + scaled);

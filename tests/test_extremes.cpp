@@ -106,6 +106,29 @@ TEST(Extremes, VoxelSizesFromAHundredthToTenMetres) {
   EXPECT_TRUE(verify_vxl(dir.file("fine.vxl")).valid);
 }
 
+// A zero on the data's edge is stored as +0 in META's origin and bounds, as in the tight bounds, whichever
+// zero the source lists: packed, where -0 and +0 pack alike, the two files are the same bytes.
+TEST(Extremes, AZeroOnTheDatasEdgeIsStoredAsPlusZero) {
+  ScratchDir dir;
+  auto convert_with = [&](float zero, const std::string& name) {
+    Tractogram t;
+    t.source.path = "zeros";
+    const float points[] = {zero, zero, -3, 3, 3, zero, 1, 2, -1};  // x and y start at 0, z ends at 0
+    t.add_streamline(points, 3);
+    convert_tractogram(std::move(t), dir.file(name), {});
+    return dir.file(name);
+  };
+  const std::string minus = convert_with(-0.0f, "minus.vxl"), plus = convert_with(0.0f, "plus.vxl");
+  const VxlFile f = VxlFile::open(minus);
+  for (double v : {f.meta().grid_origin[0], f.meta().grid_origin[1], f.meta().bounds_min[0], f.meta().bounds_min[1],
+                   f.meta().bounds_max[2]}) {
+    EXPECT_EQ(v, 0.0);
+    EXPECT_FALSE(std::signbit(v));
+  }
+  EXPECT_TRUE(verify_vxl(minus).valid);
+  EXPECT_EQ(test::slurp(minus), test::slurp(plus));
+}
+
 TEST(Extremes, AGridTooLargeIsRefusedWithASuggestionAndNoOverflow) {
   ScratchDir dir;
   Tractogram t;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iterator>
 
 #include "converter/convert/convert.h"
@@ -11,6 +12,7 @@
 #include "format/vxl_file.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"
+#include "tests/reseal_checksums.h"
 #include "tests/test_support.h"
 
 namespace vxl {
@@ -176,6 +178,64 @@ TEST_P(VxlFormat, FailedConversionLeavesNoOutput) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("nan.vxl")));
   for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
     EXPECT_EQ(entry.path().filename(), "small.vxl") << "left behind: " << entry.path();
+}
+
+// Geometry that open() allows within a voxel's margin but verify pins (spec §5.1, §5.3, §6.1): a tight bound
+// that is not its vertices' extreme, META bounds that are not the tight bounds' extremes, a grid one voxel too
+// large. Each is made behind valid checksums, so only the geometry check can catch it.
+TEST_P(VxlFormat, VerifyRefusesBoundsAndAGridThatAreNotTheVerticesExtremes) {
+  ASSERT_TRUE(verify_vxl(path()).valid);
+  const VxlFile f = VxlFile::open(path());
+  const std::uint64_t voxt = f.find_section(section_id("VOXT"))->offset;
+  const std::uint64_t meta = f.find_section(section_id("META"))->offset;
+  struct Damage {
+    std::uint64_t at;
+    std::function<void(char*)> apply;
+    std::string expected;
+    bool tight_bound;  // packed, it moves the decoded vertices
+  };
+  auto add_float = [](float d) {
+    return [d](char* p) {
+      float v;
+      std::memcpy(&v, p, 4);
+      v += d;
+      std::memcpy(p, &v, 4);
+    };
+  };
+  auto add_double = [](double d) {
+    return [d](char* p) {
+      double v;
+      std::memcpy(&v, p, 8);
+      v -= d;
+      std::memcpy(p, &v, 8);
+    };
+  };
+  const std::vector<Damage> damages = {
+      {voxt + 16, add_float(-1.0f), "tight bounds of voxel 0 are not the extremes of its vertices", true},
+      {voxt + 28 + 8, add_float(0.5f), "tight bounds of voxel 0 are not the extremes of its vertices", true},
+      {meta + 104, add_double(0.5), "META bounds are not the extremes of the voxels' tight bounds", false},
+      {meta + 88,
+       [](char* p) {
+         std::int32_t v;
+         std::memcpy(&v, p, 4);
+         ++v;
+         std::memcpy(p, &v, 4);
+       },
+       "their coordinates on x run from 0 to", false},
+  };
+  for (const Damage& d : damages) {
+    SCOPED_TRACE(d.expected);
+    std::vector<char> b = slurp(path());
+    d.apply(b.data() + d.at);
+    ASSERT_TRUE(test::reseal_checksums(b.data(), b.size()));
+    dump(dir.file("bad.vxl"), b, b.size());
+    const VerifyResult r = verify_vxl(dir.file("bad.vxl"));
+    EXPECT_FALSE(r.valid);
+    // With packed positions a moved tight bound moves the decoded vertices instead: the connecting vertices or the
+    // lengths no longer agree, and that is what verify reports.
+    if (GetParam() == PositionEncoding::Packed && d.tight_bound) continue;
+    EXPECT_NE(r.problem.find(d.expected), std::string::npos) << r.problem;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Positions, VxlFormat, ::testing::Values(PositionEncoding::Float32, PositionEncoding::Packed),

@@ -125,11 +125,13 @@ Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std:
                       " mm); use --voxel-size " + format_mm(extent / 1e9) + " or larger");
     }
     m.grid_dims[c] = static_cast<std::int32_t>(cells);
-    m.grid_origin[c] = lo[c];
-    m.bounds_min[c] = lo[c];
-    m.bounds_max[c] = hi[c];
+    // A zero as +0 whichever zero came first (-0 + 0 = +0), as for the tight bounds: the bytes depend on the
+    // points, not on their order.
+    m.grid_origin[c] = lo[c] + 0.0;
+    m.bounds_min[c] = lo[c] + 0.0;
+    m.bounds_max[c] = hi[c] + 0.0;
   }
-  return Grid{{lo[0], lo[1], lo[2]}, s};
+  return Grid{{m.grid_origin[0], m.grid_origin[1], m.grid_origin[2]}, s};
 }
 
 void check_level_count(std::uint32_t levels, const std::string& path) {

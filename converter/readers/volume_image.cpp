@@ -27,7 +27,7 @@ struct ImageFormat {
   const char* extension;
   const char* name;  // nullptr: read; otherwise the format refused
 };
-constexpr ImageFormat kFormats[] = {
+constexpr ImageFormat kImageFormats[] = {
     {".nii", nullptr},
     {".nii.gz", nullptr},
     {".mif", nullptr},
@@ -52,7 +52,7 @@ constexpr ImageFormat kFormats[] = {
 const ImageFormat* format_of(const std::string& path) {
   const std::string name = lower(path);
   const ImageFormat* best = nullptr;
-  for (const ImageFormat& f : kFormats) {
+  for (const ImageFormat& f : kImageFormats) {
     const std::string ext = f.extension;
     if (name.size() > ext.size() && name.ends_with(ext) && (!best || ext.size() > std::string(best->extension).size()))
       best = &f;

@@ -18,7 +18,7 @@
 // library or libm. Random numbers come from our own splitmix64 and an exact integer->double conversion;
 // geometry uses only + - * / and sqrt (IEEE correctly rounded) and our own log, so results are
 // bit-identical on any IEEE-754 platform as long as the compiler does not contract a*b+c into FMA
-// (GCC in ISO mode -std=c++20 does not; for Clang the source turns contraction off itself) and does not
+// (every source is compiled with -ffp-contract=off; the generator's also turn it off themselves) and does not
 // use x87 excess precision (32-bit x86 without SSE2). Two random draws never share one expression
 // (operands of + are unsequenced: GCC and Clang take them in opposite orders).
 //
