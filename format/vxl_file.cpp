@@ -398,20 +398,6 @@ void check_grid_geometry(const MetaSection& m, const std::string& p, std::option
   }
 }
 
-void check_grid_extent(const MetaSection& m, std::span<const VoxelEntry> voxels, const std::string& p,
-                       std::optional<std::uint64_t> meta_at) {
-  if (voxels.empty()) return;
-  std::int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
-  for (const VoxelEntry& v : voxels)
-    for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], v.coord[c]), hi[c] = std::max(hi[c], v.coord[c]);
-  for (int c = 0; c < 3; ++c)
-    if (lo[c] != 0 || hi[c] != m.grid_dims[c] - 1)
-      fail_input(p, meta_at ? std::optional<std::uint64_t>(*meta_at + 88 + 4 * c) : std::nullopt,
-                 "grid_dims or grid_origin do not fit the voxels: their coordinates on " + std::string(1, "xyz"[c]) +
-                     " run from " + std::to_string(lo[c]) + " to " + std::to_string(hi[c]) + ", expected 0 to " +
-                     std::to_string(m.grid_dims[c] - 1));
-}
-
 // VXIX (§5.14), O(voxels): its size from the counts, and voxel lists that start at 0, never shrink and end at
 // the voxline count, so that a list never reads past the entries. The entries themselves are checked by
 // their users (streamline below the count, voxlines within the block), as VXLN's are.

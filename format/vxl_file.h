@@ -54,11 +54,6 @@ bool tight_bounds_in_place(const MetaSection& meta, const VoxelEntry& v, int c);
 // dimensions were changed would be drawn far from its lines, or not at all. Throws vxl::Error (Input)
 // naming `path` and the field's offset from `meta_at`.
 void check_grid_geometry(const MetaSection& meta, const std::string& path, std::optional<std::uint64_t> meta_at);
-// The grid exactly as large as the points make it (spec §6.1): on every axis some voxel has coordinate 0 (the
-// smallest point's) and some grid_dims - 1 (the largest's). check_grid_geometry allows a voxel of slack, which this
-// takes away: verify, and unpack for what it writes. Throws vxl::Error (Input) naming `path` and the field's offset.
-void check_grid_extent(const MetaSection& meta, std::span<const VoxelEntry> voxels, const std::string& path,
-                       std::optional<std::uint64_t> meta_at);
 // The order set as spec §5.3 defines them: axis (0) stores 3 directions, axis+diag (1) 7, random (2) any
 // 1..64; another set is unknown. Throws vxl::Error (Input) naming `path` and the field's offset.
 void check_order_set(const MetaSection& meta, const std::string& path, std::uint64_t meta_at);

@@ -244,6 +244,22 @@ void check_bounds(const VxlFile& f) {
                  "META bounds are not the extremes of the voxels' tight bounds");
 }
 
+// The grid exactly as large as the points make it (spec §6.1): on every axis some voxel has coordinate 0 (the
+// smallest point's) and some grid_dims - 1 (the largest's). open() allows a voxel of slack, which this takes away.
+void check_grid_extent(const VxlFile& f) {
+  if (f.voxels().empty()) return;
+  std::int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  for (const VoxelEntry& v : f.voxels())
+    for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], v.coord[c]), hi[c] = std::max(hi[c], v.coord[c]);
+  const std::uint64_t meta = f.find_section(section_id("META"))->offset;
+  for (int c = 0; c < 3; ++c)
+    if (lo[c] != 0 || hi[c] != f.meta().grid_dims[c] - 1)
+      fail_input(f.path(), meta + 88 + 4 * c,
+                 "grid_dims or grid_origin do not fit the voxels: their coordinates on " + std::string(1, "xyz"[c]) +
+                     " run from " + std::to_string(lo[c]) + " to " + std::to_string(hi[c]) + ", expected 0 to " +
+                     std::to_string(f.meta().grid_dims[c] - 1));
+}
+
 // SLEN (§5.15): each length against the stored points' length, equal to the bit with float32 positions (they are
 // the source points); with packed positions within what moving each point by the file's bound can change.
 class LengthCheck {
@@ -279,7 +295,7 @@ VerifyResult verify_vxl(const std::string& path) {
     check_checksums_and_padding(f);
     check_meta_and_dirs(f);
     check_bounds(f);
-    check_grid_extent(f.meta(), f.voxels(), f.path(), f.find_section(section_id("META"))->offset);
+    check_grid_extent(f);
     // The walk marks which vertices start a segment (all but each voxline's last vertex).
     std::vector<std::uint8_t> is_segment_start(f.meta().vertex_count, 0);
     WalkCallbacks cb;

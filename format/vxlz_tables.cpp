@@ -88,6 +88,7 @@ std::vector<std::array<std::int32_t, 3>> decode_voxel_coords(std::span<const std
   expect_room(in, stream, 3, count);
   std::vector<std::array<std::int32_t, 3>> coords(count);
   std::int64_t previous[3] = {0, 0, 0};
+  std::int32_t lowest[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, highest[3] = {-1, -1, -1};
   for (std::uint32_t i = 0; i < count; ++i) {
     for (int c = 0; c < 3; ++c) {
       const std::int64_t delta = in.get_signed();
@@ -98,6 +99,7 @@ std::vector<std::array<std::int32_t, 3>> decode_voxel_coords(std::span<const std
       if (v < 0 || v >= grid_dims[c]) in.fail("voxel " + std::to_string(i) + " coordinate outside the grid");
       coords[i][c] = static_cast<std::int32_t>(v);
       previous[c] = v;
+      lowest[c] = std::min(lowest[c], coords[i][c]), highest[c] = std::max(highest[c], coords[i][c]);
     }
     if (i > 0) {
       const auto& u = coords[i - 1];
@@ -107,6 +109,12 @@ std::vector<std::array<std::int32_t, 3>> decode_voxel_coords(std::span<const std
     }
   }
   in.expect_end();
+  // The grid as large as the points make it (.vxl spec §6.1): a grid larger than its voxels unpacks to a file verify
+  // refuses.
+  for (int c = 0; c < 3 && count > 0; ++c)
+    if (lowest[c] != 0 || highest[c] != grid_dims[c] - 1)
+      in.fail("voxel coordinates on " + std::string(1, "xyz"[c]) + " run from " + std::to_string(lowest[c]) + " to " +
+              std::to_string(highest[c]) + ", not from 0 to grid_dims - 1 = " + std::to_string(grid_dims[c] - 1));
   return coords;
 }
 

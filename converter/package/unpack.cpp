@@ -377,10 +377,8 @@ void set_bounds_checked(MetaSection& meta, std::span<const VoxelEntry> voxels, c
           i == 0 ? voxels[i].tight_max[c] : std::max<double>(meta.bounds_max[c], voxels[i].tight_max[c]);
     }
   }
-  // A damaged package's grid, or positions it decodes outside their voxels, would make a file open() (or verify)
-  // refuses.
+  // A damaged package's grid, or positions it decodes outside their voxels, would make a file open() refuses.
   check_grid_geometry(meta, path, std::nullopt);
-  check_grid_extent(meta, voxels, path, std::nullopt);
   for (std::size_t i = 0; i < voxels.size(); ++i)
     for (int c = 0; c < 3; ++c)
       if (!tight_bounds_in_place(meta, voxels[i], c))
