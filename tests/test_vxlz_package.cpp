@@ -775,6 +775,28 @@ TEST_F(DamagedVxlz, MetaFieldsThatContradictTheGridAreRefusedOnOpen) {
   }
 }
 
+// A grid one voxel larger than its voxels passes open's rule (a voxel of slack) but not the package's voxels: the
+// unpacked file would be one verify refuses, so unpack refuses the package, naming the axis.
+TEST_F(DamagedVxlz, AGridLargerThanItsVoxelsIsRefusedBeforeDecoding) {
+  for (int c = 0; c < 3; ++c) {
+    VxlzContent crafted = content();
+    ++crafted.meta.grid_dims[c];
+    const std::string path = dir.file("crafted.vxlz");
+    write_vxlz(path, crafted);
+    (void)VxlzFile::open(path);  // within open's slack
+    try {
+      unpack_vxlz(path, out(), {});
+      ADD_FAILURE() << "axis " << c << ": accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
+      EXPECT_NE(std::string(e.what()).find(std::string("voxel coordinates on ") + "xyz"[c] + " run from 0 to"),
+                std::string::npos)
+          << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(out()));
+  }
+}
+
 TEST_F(DamagedVxlz, CliReportsDamageWithExitCode3) {
   std::vector<char> b = slurp(good());
   b[b.size() / 2] ^= 0x10;
