@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "converter/convert/streaming_convert.h"
 #include "converter/readers/read_tractogram.h"
@@ -39,6 +40,30 @@ void expect_same_bytes(const std::string& written, const std::string& golden_pat
   ASSERT_EQ(a.size(), b.size()) << written << " vs " << golden_path << kRegenerate;
   for (std::size_t i = 0; i < a.size(); ++i)
     ASSERT_EQ(a[i], b[i]) << "first difference at byte " << i << " of " << golden_path << kRegenerate;
+}
+
+// The same sections in the same order, each payload the same bytes, except PROV, whose JSON must be the same once
+// `converter.threads` is left out of both: earlier converters recorded their worker threads, which the older
+// golden packages carry in the PROV they ship.
+void expect_same_sections_but_threads(const std::string& written, const std::string& golden_path) {
+  const VxlFile a = VxlFile::open(written), b = VxlFile::open(golden_path);
+  ASSERT_EQ(a.sections().size(), b.sections().size()) << kRegenerate;
+  for (std::size_t i = 0; i < a.sections().size(); ++i) {
+    const SectionEntry &x = a.sections()[i], &y = b.sections()[i];
+    const std::string id(x.id, 4);
+    ASSERT_EQ(id, std::string(y.id, 4)) << kRegenerate;
+    const auto bytes_of = [](const VxlFile& f, const SectionEntry& e) {
+      return std::string(reinterpret_cast<const char*>(f.bytes().data() + e.offset), e.size);
+    };
+    if (id != "PROV") {
+      EXPECT_EQ(bytes_of(a, x), bytes_of(b, y)) << "section " << id << kRegenerate;
+      continue;
+    }
+    nlohmann::json pa = nlohmann::json::parse(bytes_of(a, x)), pb = nlohmann::json::parse(bytes_of(b, y));
+    pa["converter"].erase("threads");
+    pb["converter"].erase("threads");
+    EXPECT_EQ(pa, pb) << kRegenerate;
+  }
 }
 
 struct Streamlines {
@@ -170,7 +195,7 @@ TEST(GoldenBytes, PackagesOfVersions20And23UnpackAsTheCurrentOne) {
     const auto r =
         run_cli("unpack " + q(dir.file("package.vxlz")) + " " + q(dir.file("unpacked.vxl")) + " --threads 1");
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    expect_same_bytes(dir.file("unpacked.vxl"), golden("unpacked.vxl"));
+    expect_same_sections_but_threads(dir.file("unpacked.vxl"), golden("unpacked.vxl"));
   }
 }
 

@@ -539,6 +539,20 @@ TEST(StreamingConvert, CliConvertsWithALimitAndSaysHowItSplitTheWork) {
   EXPECT_NE(test::run_cli("convert --help").output.find("--memory-limit"), std::string::npos);
 }
 
+// The same source and options give the same bytes on any machine: the worker threads (by default the machine's
+// cores) change neither the data nor the provenance.
+TEST(StreamingConvert, TheBytesDoNotDependOnTheThreads) {
+  ScratchDir dir;
+  const std::string tck = dir.file("in.tck");
+  ASSERT_EQ(test::run_cli("synth '" + tck + "' --streamlines 1500").exit_code, 0);
+  for (const char* threads : {"1", "3"})
+    ASSERT_EQ(
+        test::run_cli("convert '" + tck + "' '" + dir.file(std::string(threads) + ".vxl") + "' --threads " + threads)
+            .exit_code,
+        0);
+  EXPECT_TRUE(test::slurp(dir.file("1.vxl")) == test::slurp(dir.file("3.vxl")));
+}
+
 TEST(StreamingConvert, CliRejectsBadSizesAsUsageErrors) {
   ScratchDir dir;
   const std::string tck = dir.file("in.tck"), out = dir.file("out.vxl");

@@ -12,7 +12,7 @@
 
 namespace vxl {
 
-std::string provenance_json(const SourceInfo& src, const ConvertSettings& settings, unsigned threads,
+std::string provenance_json(const SourceInfo& src, const ConvertSettings& settings,
                             const std::string& voxel_size_choice) {
   nlohmann::json j;
   j["source"] = {
@@ -29,8 +29,7 @@ std::string provenance_json(const SourceInfo& src, const ConvertSettings& settin
                     {"voxel_size", settings.voxel_size},
                     {"orders", settings.orders},
                     {"positions", position_encoding_name(settings.positions)},
-                    {"levels", settings.levels},
-                    {"threads", threads}};
+                    {"levels", settings.levels}};
   if (!voxel_size_choice.empty()) j["converter"]["voxel_size_auto"] = voxel_size_choice;
   j["warnings"] = src.warnings;
   if (!src.value_files.empty()) j["value_files"] = src.value_files;

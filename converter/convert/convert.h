@@ -63,9 +63,10 @@ struct ConvertSummary {
 ConvertSummary convert_tractogram(Tractogram&& tractogram, const std::string& out_path,
                                   const ConvertSettings& settings);
 
-// The PROV payload (spec §5.8) for a source converted with these settings and `threads` worker threads;
-// `voxel_size_choice`: why --voxel-size auto chose settings.voxel_size (empty: it was given).
-std::string provenance_json(const SourceInfo& source, const ConvertSettings& settings, unsigned threads,
+// The PROV payload (spec §5.8) for a source converted with these settings; `voxel_size_choice`: why --voxel-size
+// auto chose settings.voxel_size (empty: it was given). Nothing of the machine (threads, memory limit) goes in, so
+// that the same source and options give the same bytes everywhere.
+std::string provenance_json(const SourceInfo& source, const ConvertSettings& settings,
                             const std::string& voxel_size_choice = {});
 
 }  // namespace vxl

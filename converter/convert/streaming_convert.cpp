@@ -172,8 +172,7 @@ ConvertSummary StreamingConversion::run() {
   }
   const std::vector<VoxelRange>& ranges = plan_.ranges;
 
-  const std::string provenance =
-      provenance_json(reader_->source(), job_.settings, job_.threads, job_.voxel_size_choice);
+  const std::string provenance = provenance_json(reader_->source(), job_.settings, job_.voxel_size_choice);
   out_ = std::make_unique<VxlStreamWriter>(job_.out_path, output_sizes(provenance.size()), plan_.direct_staging_bytes);
   for (std::size_t k = 0; k < ranges.size(); ++k) {
     build_range(ranges[k], k, ranges.size());

@@ -140,11 +140,11 @@ void check_level_count(std::uint32_t levels, const std::string& path) {
                 "levels of detail must be 1.." + std::to_string(kMaxLevels) + ", not " + std::to_string(levels));
 }
 
-void fail_too_many_synthetic(const std::string& path, double s, double longest_step2) {
+void fail_too_many_synthetic(const std::string& path, double s, double longest_step2, std::uint64_t synthetic_limit) {
   throw Error(ErrorKind::Unsupported, path, std::nullopt,
               "voxel size " + format_mm(s) + " mm is far below the longest step (" +
-                  format_mm(std::sqrt(longest_step2)) +
-                  " mm): splitting steps at voxel faces would more than double the points; use --voxel-size " +
+                  format_mm(std::sqrt(longest_step2)) + " mm): splitting steps at voxel faces would add more than " +
+                  std::to_string(synthetic_limit) + " points (one per source point, and 4096 more); use --voxel-size " +
                   format_mm(std::sqrt(longest_step2)) + " or larger");
 }
 

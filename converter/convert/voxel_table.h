@@ -124,7 +124,8 @@ void check_level_count(std::uint32_t levels, const std::string& path);  // Usage
 // Sets the grid and bounds of `m` (voxel_size already set) for points inside [lo, hi]; Unsupported when
 // an axis would have 2^31 cells or more.
 Grid set_grid(MetaSection& m, const double lo[3], const double hi[3], const std::string& path);
-[[noreturn]] void fail_too_many_synthetic(const std::string& path, double voxel_size, double longest_step2);
+[[noreturn]] void fail_too_many_synthetic(const std::string& path, double voxel_size, double longest_step2,
+                                          std::uint64_t synthetic_limit);
 
 // Each voxel's tight bounds from its block; `vertices` holds the blocks from vertex `vertex_base` on.
 // A zero bound is stored as +0 whichever zero came first, so that the bounds do not depend on the order

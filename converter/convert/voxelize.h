@@ -18,7 +18,8 @@ namespace vxl {
 using ProgressFn = std::function<void(const char* stage, double fraction)>;
 
 // A conversion is refused (with a suggested voxel size) when splitting long steps would add more than this
-// many points per source point (and 4096 more): a guard against a voxel size far below the step length.
+// many points per source point (and 4096 more, so that a small file of a few long steps converts): a guard
+// against a voxel size far below the step length.
 inline constexpr double kMaxSyntheticPerPoint = 1.0;
 
 // One bit per vertex, set when the vertex is the last of its voxline, so that no segment starts there

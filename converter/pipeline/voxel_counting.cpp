@@ -108,7 +108,7 @@ void StreamingConversion::count_voxels() {
       synthetic += std::exchange(part.synthetic, 0);
     }
     if (synthetic > table_.synthetic_limit)
-      detail::fail_too_many_synthetic(job_.path, table_.meta.voxel_size, scan_.longest_step2);
+      detail::fail_too_many_synthetic(job_.path, table_.meta.voxel_size, scan_.longest_step2, table_.synthetic_limit);
     // Every part's table at its largest (within the limit, by the parts' shares); then the other parts'
     // voxels into the first's index.
     std::uint64_t peak = 0, sinks = 0;
@@ -227,7 +227,7 @@ void StreamingConversion::count_part(const Tractogram& b, std::uint64_t first, s
     detail::voxelize_streamline(table_.grid, pts, b.offsets[k], b.offsets[k + 1] - b.offsets[k], part.sink,
                                 table_.synthetic_limit - std::min(table_.synthetic_limit, synthetic + part.synthetic));
     if (part.sink.too_many_synthetic)
-      detail::fail_too_many_synthetic(job_.path, table_.meta.voxel_size, scan_.longest_step2);
+      detail::fail_too_many_synthetic(job_.path, table_.meta.voxel_size, scan_.longest_step2, table_.synthetic_limit);
     part.synthetic += part.sink.synthetic_xyz.size() / 3;
     if (counting_.recording_runs) {
       if (!part.sink.synthetic_xyz.empty())
