@@ -8,12 +8,14 @@ voxel table, tight and META bounds, grid extent, levels, orders, the voxline wal
 rebuilds every streamline's points from VXLN/STRM/VERT (§5.4, §5.6, §5.7). With --compare SOURCE (a TCK,
 read by nibabel or, for what nibabel refuses such as Float64, by the built-in reader) it also rebuilds every
 vertex the converter must have made from the source (§6.1, §6.3 face points, §5.4 packing) and checks the
-file against them, and PROV's source record (§5.8) against the source file.
+file against them, and PROV's source record (§5.8) against the source file. (Other formats nibabel reads
+are compared by points only, within one float32 spacing: nibabel maps TRK to RAS in float32, §8 in binary64.)
 
 Exit status, for use as a test: 0 valid, 1 invalid, 2 usage error (bad arguments, unreadable file or
 source). The last line printed is one line: "FILE: OK ..." or "FILE: INVALID: byte N: what was expected";
--q prints only that line. Writer rules that §7 does not ask a reader to enforce (−0 written for +0, the
-converter's section order and placement) are reported as notes, not failures.
+-q prints only that line. Writer rules that §7 does not ask a reader to enforce (+0 for a zero bound, the
+section order and placement of §2, PROV's serialisation and converter keys, §5.10's VDIR recipe) are
+reported as notes, not failures.
 
 Deliberately no code from the C++ implementation: where the spec still leaves a choice, the comment says
 "ASSUMED" and what was tried; everything else cites the section that states it.
@@ -99,9 +101,7 @@ def pack_q(x, tmin, tmax):
     step = ((tmax - tmin) / np.float32(1023)).astype(np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (x.astype(np.float64) - tmin.astype(np.float64)) / step
-        # ASSUMED the sum t + 0.5 is rounded in binary64 before the floor (differs from exact rounding
-        # only within 2^−53 of a half; §5.4 writes ⌊t + 0.5⌋ without saying)
-        q = np.floor(t + 0.5)
+        q = np.floor(t + 0.5)                       # "halves rounded up; the addition in binary64"
     return np.where((t <= 0) | (step == 0), 0, np.where(t >= 1023, 1023, q)).astype(np.int64)
 
 
@@ -509,11 +509,14 @@ class VxlFile:
             i = np.nonzero((np.abs(a.astype(np.float64) - b) > tol).any(1))[0]
         need(len(i) == 0, xo + 8 * (nl[i[0]] if len(i) else 0),
              f"voxline {nl[i[0]] if len(i) else 0}: connecting vertex != next voxline's first point")
-        # §6.3 neighbour rule: consecutive voxlines of a streamline are in different, neighbouring voxels
+        # §6.2/§6.3: consecutive voxlines of a streamline are in different voxels, neighbours unless the
+        # next starts with a face point (§6.3 crosses faces at the same t at once, ±1 per face, so two
+        # faces of one axis at one t, possible only with planes that round together, move it by 2)
         c = self.vt["coord"].astype(np.int64)
         dv = np.abs(c[voxel[nl]] - c[voxel[nl + 1]]).max(1) if len(nl) else np.zeros(0)
-        i = np.nonzero((dv == 0) | (dv > 1))[0]
-        need(len(i) == 0, xo + 8 * (nl[i[0]] if len(i) else 0), "consecutive voxlines not in neighbouring voxels")
+        i = np.nonzero((dv == 0) | ((dv > 1) & ~syn[nl + 1]))[0]
+        need(len(i) == 0, xo + 8 * (nl[i[0]] if len(i) else 0),
+             "consecutive voxlines in the same voxel, or a long step (§6.3) not split at the faces")
         # by §6.3's construction a synthetic point follows a crossing, so it never starts a streamline
         i = np.nonzero(syn & firstv)[0]
         need(len(i) == 0, xo + 8 * (i[0] if len(i) else 0), "a streamline's first point is marked synthetic")
@@ -706,6 +709,20 @@ class VxlFile:
         except (UnicodeDecodeError, ValueError) as e:
             fail(off, f"PROV is not valid UTF-8 JSON: {e}")
         need(isinstance(prov, dict), off, "PROV is not a JSON object")
+        # §5.8 writer rules (§7 asks only for valid JSON, so differences are notes): the serialisation,
+        # and the converter keys against what META says the file has
+        if json.dumps(prov, separators=(",", ":"), sort_keys=True, ensure_ascii=False).encode() != \
+                self.data[off:off + size]:
+            self.notes.append("PROV is not serialised as §5.8 says (no whitespace, keys in byte order)")
+        conv = prov.get("converter", {})
+        orders = ["axis", "axis+diag", f"random:{self.K}"][self.order_set]
+        lv = conv.get("levels")
+        want_lc = lv if isinstance(lv, int) and lv >= 2 and self.P > 0 else 0      # §5.1, §10 --levels 1
+        got = (conv.get("voxel_size"), conv.get("orders"), conv.get("positions"), want_lc)
+        have = (self.s, orders, ["float32", "packed"][self.pos_enc], self.lc)
+        if conv.get("name") == "voxlines" and got != have:
+            self.notes.append(f"PROV converter (voxel_size, orders, positions, levels→level_count) {got} "
+                              f"!= META's {have}")
         return prov
 
     def check_values(self):
@@ -855,31 +872,41 @@ def face_points(pts, counts, o, s):
 
 
 def tck_header(path):
+    """§5.8: the lines between `mrtrix tracks` and `END`, `file` included, each split at its first `:`,
+    both sides trimmed, as an object of arrays (a repeated key's values in file order, a line without `:`
+    continuing the previous value), bad UTF-8 → U+FFFD."""
     raw = open(path, "rb").read(1 << 20)
     end = raw.find(b"\nEND\n")
-    need(end > 0, 0, f"{path}: no TCK header END")
-    kv = {}
-    for line in raw[:end].decode("latin-1").splitlines()[1:]:
+    if end < 0:
+        raise Usage(f"{path}: no TCK header END")
+    kv, last = {}, None
+    for line in raw[:end].decode("utf-8", errors="replace").split("\n")[1:]:
         if ":" in line:
             k, v = line.split(":", 1)
-            kv.setdefault(k.strip(), []).append(v.strip())
+            last = kv.setdefault(k.strip(), [])
+            last.append(v.strip())
+        elif last is not None and line.strip():
+            last[-1] += "\n" + line.strip()       # §5.8: a line without ":" continues the previous value
     return kv
 
 
 def check_prov_source(f, prov, src, report):
     """§5.8: PROV names the source by name, format, size, XXH3_128 (32 lowercase hex digits, high 64
     bits first: xxhash's hexdigest), coordinate type in the format's words, and vox_to_ras (null for TCK)."""
-    info = (prov or {}).get("source")
-    off = f.sec("PROV")[0] if "PROV" in f.sections else 0
+    if prov is None:                                # PROV is optional (§4): nothing to check
+        f.notes.append("no PROV: the source record was not checked")
+        return
+    info, off = prov.get("source"), f.sec("PROV")[0]
     need(isinstance(info, dict), off, "PROV has no source object (§5.8)")
     raw = open(src, "rb").read()
     want = {"name": os.path.basename(src), "format": "tck", "bytes": len(raw),
             "xxh3_128": xxhash.xxh3_128(raw).hexdigest(), "vox_to_ras": None,
             "dtype": tck_header(src).get("datatype", [None])[0]}
+    want["header"] = tck_header(src)
     for k, v in want.items():
         need(info.get(k, "(missing)") == v, off, f"PROV source.{k} is {info.get(k, '(missing)')!r}, "
              f"{src} gives {v!r} (§5.8)")
-    report(f"  PROV source matches {src} (name, format, bytes, xxh3_128, dtype, vox_to_ras null)")
+    report(f"  PROV source matches {src} (name, format, bytes, xxh3_128, dtype, vox_to_ras null, header)")
 
 
 def compare(f, src, report):
