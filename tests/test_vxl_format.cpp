@@ -10,6 +10,7 @@
 #include "converter/convert/convert.h"
 #include "format/base/error.h"
 #include "format/vxl_file.h"
+#include "format/vxl_positions.h"
 #include "format/vxl_streamlines.h"
 #include "format/vxl_verify.h"
 #include "tests/reseal_checksums.h"
@@ -206,14 +207,14 @@ TEST_P(VxlFormat, VerifyRefusesBoundsAndAGridThatAreNotTheVerticesExtremes) {
     return [d](char* p) {
       double v;
       std::memcpy(&v, p, 8);
-      v -= d;
+      v += d;
       std::memcpy(p, &v, 8);
     };
   };
   const std::vector<Damage> damages = {
       {voxt + 16, add_float(-1.0f), "tight bounds of voxel 0 are not the extremes of its vertices", true},
       {voxt + 28 + 8, add_float(0.5f), "tight bounds of voxel 0 are not the extremes of its vertices", true},
-      {meta + 104, add_double(0.5), "META bounds are not the extremes of the voxels' tight bounds", false},
+      {meta + 104, add_double(-0.5), "META bounds are not the extremes of the voxels' tight bounds", false},
       {meta + 88,
        [](char* p) {
          std::int32_t v;
@@ -236,6 +237,22 @@ TEST_P(VxlFormat, VerifyRefusesBoundsAndAGridThatAreNotTheVerticesExtremes) {
     if (GetParam() == PositionEncoding::Packed && d.tight_bound) continue;
     EXPECT_NE(r.problem.find(d.expected), std::string::npos) << r.problem;
   }
+  if (GetParam() != PositionEncoding::Packed) return;
+  // Packed, the words themselves must reach the bounds: voxel 0's vertices at quantum 0 on x moved to quantum 1.
+  std::vector<char> b = slurp(path());
+  const std::uint64_t vert = f.find_section(section_id("VERT"))->offset;
+  for (std::uint64_t k = 0; k < f.voxels()[0].vertex_count; ++k) {
+    std::uint32_t w;
+    std::memcpy(&w, b.data() + vert + 4 * k, 4);
+    if ((w & kPackedAxisMask) == 0) w |= 1;
+    std::memcpy(b.data() + vert + 4 * k, &w, 4);
+  }
+  ASSERT_TRUE(test::reseal_checksums(b.data(), b.size()));
+  dump(dir.file("bad.vxl"), b, b.size());
+  const VerifyResult r = verify_vxl(dir.file("bad.vxl"));
+  EXPECT_FALSE(r.valid);
+  EXPECT_NE(r.problem.find("tight bounds of voxel 0 are not the extremes of its vertices"), std::string::npos)
+      << r.problem;
 }
 
 INSTANTIATE_TEST_SUITE_P(Positions, VxlFormat, ::testing::Values(PositionEncoding::Float32, PositionEncoding::Packed),
