@@ -201,7 +201,7 @@ void check_bounds(const VxlFile& f) {
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   for (std::size_t i = 0; i < f.voxels().size(); ++i) {
     const VoxelEntry& v = f.voxels()[i];
-    float reached_lo[3], reached_hi[3];
+    bool reached_lo[3] = {false, false, false}, reached_hi[3] = {false, false, false};
     if (packed) {
       const VertexPacker packer(v);
       std::uint32_t want_lo = 0, want_hi = 0;
@@ -214,24 +214,23 @@ void check_bounds(const VxlFile& f) {
           q_hi[c] = std::max(q_hi[c], (w >> (10 * c)) & kPackedAxisMask);
         }
       for (int c = 0; c < 3; ++c) {
-        reached_lo[c] = q_lo[c] == ((want_lo >> (10 * c)) & kPackedAxisMask) ? v.tight_min[c] : NAN;
-        reached_hi[c] = q_hi[c] == ((want_hi >> (10 * c)) & kPackedAxisMask) ? v.tight_max[c] : NAN;
+        reached_lo[c] = q_lo[c] == ((want_lo >> (10 * c)) & kPackedAxisMask);
+        reached_hi[c] = q_hi[c] == ((want_hi >> (10 * c)) & kPackedAxisMask);
       }
     } else {
-      for (int c = 0; c < 3; ++c) reached_lo[c] = reached_hi[c] = NAN;
       const auto xyz = f.float_vertices().subspan(3 * v.vertex_first, 3 * std::uint64_t(v.vertex_count));
       for (std::size_t k = 0; k < xyz.size(); ++k) {
         const int c = static_cast<int>(k % 3);
         if (!(v.tight_min[c] <= xyz[k] && xyz[k] <= v.tight_max[c]))
           fail_input(p, vert + 4 * (3 * v.vertex_first + k),
                      "vertex outside the tight bounds of its voxel " + std::to_string(i));
-        if (xyz[k] == v.tight_min[c]) reached_lo[c] = xyz[k];
-        if (xyz[k] == v.tight_max[c]) reached_hi[c] = xyz[k];
+        reached_lo[c] = reached_lo[c] || xyz[k] == v.tight_min[c];
+        reached_hi[c] = reached_hi[c] || xyz[k] == v.tight_max[c];
       }
     }
     for (int c = 0; c < 3; ++c) {
-      if (!(reached_lo[c] == v.tight_min[c]) || !(reached_hi[c] == v.tight_max[c]))
-        fail_input(p, voxt + 64 * i + (reached_lo[c] == v.tight_min[c] ? 28 : 16) + 4 * c,
+      if (!reached_lo[c] || !reached_hi[c])
+        fail_input(p, voxt + 64 * i + (reached_lo[c] ? 28 : 16) + 4 * c,
                    "tight bounds of voxel " + std::to_string(i) + " are not the extremes of its vertices");
       lo[c] = i == 0 ? v.tight_min[c] : std::min<double>(lo[c], v.tight_min[c]);
       hi[c] = i == 0 ? v.tight_max[c] : std::max<double>(hi[c], v.tight_max[c]);

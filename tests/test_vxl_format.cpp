@@ -195,34 +195,20 @@ TEST_P(VxlFormat, VerifyRefusesBoundsAndAGridThatAreNotTheVerticesExtremes) {
     std::string expected;
     bool tight_bound;  // packed, it moves the decoded vertices
   };
-  auto add_float = [](float d) {
+  // Adds d to the field of d's type at p.
+  auto add = [](auto d) {
     return [d](char* p) {
-      float v;
-      std::memcpy(&v, p, 4);
+      decltype(d) v;
+      std::memcpy(&v, p, sizeof v);
       v += d;
-      std::memcpy(p, &v, 4);
-    };
-  };
-  auto add_double = [](double d) {
-    return [d](char* p) {
-      double v;
-      std::memcpy(&v, p, 8);
-      v += d;
-      std::memcpy(p, &v, 8);
+      std::memcpy(p, &v, sizeof v);
     };
   };
   const std::vector<Damage> damages = {
-      {voxt + 16, add_float(-1.0f), "tight bounds of voxel 0 are not the extremes of its vertices", true},
-      {voxt + 28 + 8, add_float(0.5f), "tight bounds of voxel 0 are not the extremes of its vertices", true},
-      {meta + 104, add_double(-0.5), "META bounds are not the extremes of the voxels' tight bounds", false},
-      {meta + 88,
-       [](char* p) {
-         std::int32_t v;
-         std::memcpy(&v, p, 4);
-         ++v;
-         std::memcpy(p, &v, 4);
-       },
-       "their coordinates on x run from 0 to", false},
+      {voxt + 16, add(-1.0f), "tight bounds of voxel 0 are not the extremes of its vertices", true},
+      {voxt + 28 + 8, add(0.5f), "tight bounds of voxel 0 are not the extremes of its vertices", true},
+      {meta + 104, add(-0.5), "META bounds are not the extremes of the voxels' tight bounds", false},
+      {meta + 88, add(std::int32_t{1}), "their coordinates on x run from 0 to", false},
   };
   for (const Damage& d : damages) {
     SCOPED_TRACE(d.expected);
