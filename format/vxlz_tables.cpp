@@ -4,6 +4,7 @@
 #include <string>
 
 #include "format/base/error.h"
+#include "format/base/utf8_check.h"
 
 namespace vxl {
 namespace {
@@ -198,6 +199,7 @@ std::vector<StreamlineGroup> decode_group_stream(std::span<const std::uint8_t> s
     std::span<const std::uint8_t> name = in.get_bytes(in.get());
     gc.name.assign(name.begin(), name.end());
     if (gc.name.find('\0') != std::string::npos) in.fail("group name contains a NUL byte");
+    if (!is_valid_utf8(gc.name)) in.fail("group name is not valid UTF-8");
     const std::uint64_t members = in.get();
     expect_room(in, stream, 1, members);
     gc.members.reserve(members);

@@ -5,6 +5,7 @@
 
 #include "format/base/error.h"
 #include "format/base/parallel.h"
+#include "format/base/utf8_check.h"
 #include "format/vxl_value_sets.h"
 
 namespace vxl {
@@ -119,6 +120,9 @@ std::vector<NamedValues> decode_value_section(std::span<const std::uint8_t> payl
     if (!nul) fail(entry_at, "set name is not NUL-terminated");
     if (std::any_of(nul, static_cast<const char*>(e.name) + sizeof e.name, [](char c) { return c != 0; }))
       fail(entry_at, "set name padding is not zero");
+    // The .vxl requires UTF-8 names (its spec §7): a package that does not have them is refused here, not
+    // unpacked into a file that `open` refuses.
+    if (!is_valid_utf8(std::string_view(e.name, nul - e.name))) fail(entry_at, "set name is not valid UTF-8");
     if (e.coding > kValueCodingXorPlanes)
       throw Error(
           ErrorKind::Unsupported, p, at + entry_at + 48,

@@ -533,8 +533,16 @@ class VxlFile:
         self.voxel, self.start, self.m, self.syn, self.sid, self.last, self.firstv = \
             voxel, start, m, syn, sid, last, firstv
         self.end, self.pidx, self.own = end, pidx, own
-        # §6.1 voxel of each source point (exact when positions are float32; else checked in compare)
-        if self.pos_enc == 0:
+
+    def check_converted_point_voxels(self, prov):
+        """§6.1 voxel of each point, where the file alone determines it: float32 positions (packed ones are checked
+        in compare) of a converted file. A file unpacked from a package (PROV has "vxlz") keeps the package's
+        voxels with quantised positions, which may lie up to the package's bound outside them (§8)."""
+        if self.pos_enc != 0:
+            return
+        if isinstance(prov, dict) and "vxlz" in prov:
+            self.notes.append("unpacked from a package: its points' voxels are the package's (§8), not checked")
+        else:
             self.check_point_voxels(self.points)
 
     def check_point_voxels(self, pts):
@@ -695,6 +703,7 @@ class VxlFile:
             self.vdir_recipe = self.check_vdir_recipe()
         slen_err = self.check_slen()
         prov = self.prov = self.check_prov()
+        self.check_converted_point_voxels(prov)
         self.check_values()
         ngroups = self.check_groups()
         self.check_gdat(ngroups)
@@ -994,19 +1003,31 @@ def compare(f, src, report):
     return err
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.error = lambda msg: (print(f"usage error: {msg} (usage: vxl_spec_reader.py FILE.vxl "
-                                  "[--compare SOURCE.tck] [-q])", file=sys.stderr), sys.exit(2))
-    ap.add_argument("file")
-    ap.add_argument("--compare", metavar="SOURCE", help="the source tractogram (TCK for the exact checks)")
+def parse_command_line(description, usage, add_arguments):
+    """A spec reader's command line: a file, --compare FILE, -q, and what `add_arguments` adds. Returns the
+    arguments and the function that prints progress (nothing with -q), or None when a file named is not readable;
+    a malformed command line prints `usage` and exits 2."""
+    ap = argparse.ArgumentParser(description=description)
+    ap.error = lambda msg: (print(f"usage error: {msg} (usage: {usage})", file=sys.stderr), sys.exit(2))
+    add_arguments(ap)
     ap.add_argument("-q", "--quiet", action="store_true", help="print only the one-line verdict")
     a = ap.parse_args()
-    say = (lambda s: None) if a.quiet else print
     for p in [a.file] + ([a.compare] if a.compare else []):
         if not os.path.isfile(p) or not os.access(p, os.R_OK):
             print(f"usage error: {p}: not a readable file", file=sys.stderr)
-            return 2
+            return None
+    return a, ((lambda s: None) if a.quiet else print)
+
+
+def main():
+    def add_arguments(ap):
+        ap.add_argument("file")
+        ap.add_argument("--compare", metavar="SOURCE", help="the source tractogram (TCK for the exact checks)")
+    parsed = parse_command_line(__doc__.split("\n")[0], "vxl_spec_reader.py FILE.vxl [--compare SOURCE.tck] [-q]",
+                                add_arguments)
+    if parsed is None:
+        return 2
+    a, say = parsed
     self_test_depths()
     f = VxlFile(a.file, say)
     try:

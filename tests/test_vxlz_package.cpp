@@ -740,6 +740,31 @@ TEST_F(DamagedVxlz, CraftedPackagesWithValidChecksumsAreRefused) {
   }
 }
 
+// A group or value-set name that is not UTF-8, behind valid checksums: the .vxl requires UTF-8 names (its spec §7
+// step 3), so the package is refused rather than unpacked into a file that `open` would refuse.
+TEST_F(DamagedVxlz, NamesThatAreNotUtf8AreRefused) {
+  {
+    VxlzContent c = content();
+    c.groups = encode_group_stream(std::vector<StreamlineGroup>{{"g\xFF", {1, 4}}});
+    expect_crafted_refused(c, "group name");
+  }
+  // The value-set names lie raw in PVAL and SVAL (spec §4.7): "fa" and "length" as the writer stored them.
+  for (const std::string name : {std::string("fa\0", 3), std::string("length\0", 7)}) {
+    std::vector<char> b = slurp(good());
+    const auto at = std::search(b.begin(), b.end(), name.begin(), name.end());
+    ASSERT_NE(at, b.end()) << name.c_str();
+    at[1] = static_cast<char>(0xC0);  // a lead byte followed by a NUL
+    test::reseal_checksums(b.data(), b.size());
+    dump_bytes(dir.file("names.vxlz"), b, b.size());
+    expect_refused(dir.file("names.vxlz"), name.c_str());
+    try {
+      unpack_vxlz(dir.file("names.vxlz"), out(), {});
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("UTF-8"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // A package's META whose bounds, origin, voxel size or grid dimensions contradict each other, written with
 // valid checksums: refused when the package is opened (so by unpack and info), as the same fields are in a .vxl.
 TEST_F(DamagedVxlz, MetaFieldsThatContradictTheGridAreRefusedOnOpen) {

@@ -14,9 +14,10 @@ Exit 0 every case passes, 1 a case fails, 77 the synthetic cases pass but the re
 import argparse
 import os
 import struct
-import subprocess
 import sys
 import tempfile
+
+from spec_test_support import flip_middle_byte, readers_can_run, run
 
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 READER = os.path.join(REPOSITORY, "scripts", "vxl_spec_reader.py")
@@ -50,10 +51,6 @@ def edge_streamlines():
             [(1.0, 2.0, 3.0), (1.5, 2.5, 3.5), (25.0, 2.5, 3.5)]]
 
 
-def run(command):
-    return subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-
-
 def check(voxlines, source, vxl, options, failures):
     """Converts `source` with `options` and runs the second reader on the result; returns False where the
     converter refuses the source (a malformed fixture: its refusal is tested elsewhere)."""
@@ -76,10 +73,7 @@ def main():
     parser.add_argument("--voxlines", required=True)
     parser.add_argument("--real-data", default="")
     options = parser.parse_args()
-    try:
-        import nibabel, numpy, xxhash  # noqa: F401  (what the reader needs; scripts/setup installs them)
-    except ImportError as e:
-        print(f"{sys.executable} lacks {e.name}: run scripts/setup (python3-nibabel, python3-numpy, python3-xxhash)")
+    if not readers_can_run():
         return 1
     failures = []
     with tempfile.TemporaryDirectory() as scratch:
@@ -93,11 +87,7 @@ def main():
                 failures.append(f"synth_{name}: the converter refused the synthetic tractogram")
         # The reader can refuse: one flipped byte in the middle of a file it accepted must fail a checksum.
         damaged = os.path.join(scratch, "synth_default.vxl")
-        with open(damaged, "r+b") as f:
-            f.seek(os.path.getsize(damaged) // 2)
-            byte = f.read(1)
-            f.seek(-1, os.SEEK_CUR)
-            f.write(bytes([byte[0] ^ 0x10]))
+        flip_middle_byte(damaged)
         refused = run([sys.executable, READER, damaged, "-q"])
         print(f"synth_default.vxl with a flipped byte: {'refused' if refused.returncode == 1 else 'NOT refused'}")
         if refused.returncode != 1:
