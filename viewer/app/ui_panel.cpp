@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#define GLFW_INCLUDE_NONE  // epoxy provides the GL declarations
+#include <GLFW/glfw3.h>
 #include <imgui.h>
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
@@ -343,6 +345,20 @@ void frame_information(const PanelState& state, const PanelStats& stats) {
   if (ImGui::CollapsingHeader("Keys and mouse")) ImGui::TextUnformatted(controls.c_str());
 }
 
+// The window's own key callback, installed before the panel's (one panel per process).
+GLFWkeyfun window_keys = nullptr;
+
+// Tab selects the next region (key_bindings.cpp). ImGui would take it as well, to move the keyboard focus into the
+// panel, which would then keep every key until Escape: so Tab goes to the window's callback alone, and every other
+// key to ImGui's, which passes it on to the window's.
+void keys_for_panel_and_window(GLFWwindow* window, int key, int scancode, int action, int mods) {
+  if (key == GLFW_KEY_TAB) {
+    if (window_keys) window_keys(window, key, scancode, action, mods);
+    return;
+  }
+  ImGui_ImplGlfw_KeyCallback(window, key, scancode, action, mods);
+}
+
 }  // namespace
 
 UiPanel::UiPanel(GLFWwindow* window) {
@@ -351,7 +367,10 @@ UiPanel::UiPanel(GLFWwindow* window) {
   ImGuiIO& io = ImGui::GetIO();
   io.IniFilename = nullptr;  // leave no imgui.ini behind in the user's directory
   ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  window_keys = glfwSetKeyCallback(window, nullptr);
+  glfwSetKeyCallback(window, window_keys);
+  ImGui_ImplGlfw_InitForOpenGL(window, true);  // ImGui's callbacks, each passing the event on to the window's
+  glfwSetKeyCallback(window, keys_for_panel_and_window);
   ImGui_ImplOpenGL3_Init("#version 330 core");
 }
 
