@@ -11,6 +11,7 @@
 
 #include "format/base/error.h"
 #include "format/base/mapped_file.h"
+#include "format/base/output_path.h"
 
 namespace vxl {
 namespace {
@@ -40,7 +41,7 @@ bool on_tmpfs(const std::string& dir) {
 
 TemporaryVxl open_through_temporary_vxl(const std::string& name, const std::function<void(const std::string&)>& write,
                                         const std::string& dir_given) {
-  const std::string dir = dir_given.empty() ? std::filesystem::temp_directory_path().string() : dir_given;
+  const std::string dir = dir_given.empty() ? temporary_folder().string() : dir_given;
   const std::string path = reserve(name, dir);
   try {
     write(path);

@@ -1,6 +1,7 @@
 #include "format/base/output_path.h"
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 
@@ -66,6 +67,16 @@ bool same_output(const std::string& a, const std::string& b) {
   std::error_code ea, eb;
   const fs::path ca = fs::weakly_canonical(ta, ea), cb = fs::weakly_canonical(tb, eb);
   return !ea && !eb ? ca == cb : fs::absolute(ta).lexically_normal() == fs::absolute(tb).lexically_normal();
+}
+
+std::filesystem::path temporary_folder() {
+  const char* tmpdir = std::getenv("TMPDIR");
+  if (!tmpdir || !*tmpdir) return "/tmp";
+  std::error_code ec;
+  if (!std::filesystem::is_directory(tmpdir, ec))
+    throw Error(ErrorKind::Output, std::string("TMPDIR=") + tmpdir, std::nullopt,
+                "names no folder for temporary files: set TMPDIR to an existing folder, or unset it to use /tmp");
+  return tmpdir;
 }
 
 }  // namespace vxl

@@ -10,6 +10,7 @@
 //   - a directory, a FIFO, a device, a socket: refused (exit 5), never replaced.
 #pragma once
 
+#include <filesystem>
 #include <string>
 
 namespace vxl {
@@ -22,5 +23,9 @@ std::string output_target(const std::string& path);
 // resolved, or, for files that exist, the same file under two names (a hard link). Throws what
 // output_target throws.
 bool same_output(const std::string& a, const std::string& b);
+
+// The folder for temporary files: $TMPDIR when it is set, else /tmp. Throws vxl::Error (Output) naming the
+// variable when it names no folder, rather than the library's bare "temp_directory_path" error.
+std::filesystem::path temporary_folder();
 
 }  // namespace vxl

@@ -112,6 +112,21 @@ TEST(VoxviewCommandLine, APictureIsWrittenInTheFormatItsExtensionNames) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("a.bmp")));
 }
 
+// A source or a package opens through a temporary .vxl in $TMPDIR: a TMPDIR that names no folder is an output
+// error (exit 5) that names the variable, before anything is drawn, not an internal error.
+TEST(VoxviewCommandLine, ATmpdirThatNamesNoFolderIsAnOutputErrorNamingIt) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  const std::string missing = dir.file("no-such-folder");
+  const test::CommandResult r =
+      test::run_program("TMPDIR=" + test::q(missing) + " " + VOXVIEW_CLI,
+                        test::q(dir.file("a.tck")) + " --size 16x16 --render " + test::q(dir.file("a.png")));
+  EXPECT_EQ(r.exit_code, 5) << r.output;
+  EXPECT_NE(r.output.find("TMPDIR=" + missing + ": names no folder for temporary files"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.png")));
+}
+
 // PNG and JPEG need no module; TIFF and OpenEXR do, and without it are refused (exit 4) naming it.
 TEST(VoxviewCommandLine, AMissingPictureModuleIsAnErrorThatNamesItAndWritesNothing) {
   test::ScratchDir dir;

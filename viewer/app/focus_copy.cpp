@@ -9,6 +9,7 @@
 
 #include "converter/export/streamline_subset.h"
 #include "converter/selection/selection_output.h"
+#include "format/base/output_path.h"
 
 namespace vxl::app {
 
@@ -17,7 +18,7 @@ namespace {
 // A name of this process's own in the temporary directory.
 std::filesystem::path temporary_vxl() {
   static std::atomic<unsigned> counter{0};
-  return std::filesystem::temp_directory_path() /
+  return temporary_folder() /
          ("voxview-focus-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ".vxl");
 }
 
