@@ -14,6 +14,7 @@
 #include "converter/convert/convert.h"
 #include "converter/convert/segment_orders.h"
 #include "converter/readers/source_formats.h"
+#include "converter/voxel_size_option.h"
 #include "format/base/error.h"
 #include "format/base/memory_size.h"
 
@@ -39,22 +40,6 @@ struct ConvertOptions {
   bool verbose = false;
   std::vector<std::string> tsf;
 };
-
-void add_voxel_size_option(CLI::App* cmd, std::string& voxel_size) {
-  cmd->add_option("--voxel-size", voxel_size,
-                  "voxel edge length in mm, or auto: chosen from the point count, extent and step length so that "
-                  "voxels stay under ~32k vertices (16-bit orders), at most 10 mm; `info` shows the choice")
-      ->type_name("MM|auto")
-      ->default_val("10")
-      ->check([](const std::string& text) -> std::string {
-        if (text == "auto") return {};
-        char* end = nullptr;
-        const double v = std::strtod(text.c_str(), &end);
-        if (end == text.c_str() || *end != '\0' || !(v > 0) || !std::isfinite(v))
-          return "expected a positive number of mm or auto, got '" + text + "'";
-        return {};
-      });
-}
 
 void add_orders_option(CLI::App* cmd, std::string& orders) {
   cmd->add_option("--orders", orders,
@@ -87,8 +72,9 @@ void add_memory_limit_option(CLI::App* cmd, std::string& memory_limit) {
 // One conversion (IN OUT.vxl) or a cohort (--output-dir); returns the exit code.
 int run_convert(ConvertOptions& o, bool cohort, bool jobs_given) {
   if (!o.memory_limit.empty()) o.settings.memory_limit = *parse_memory_size(o.memory_limit);
-  o.settings.voxel_size_auto = o.voxel_size == "auto";
-  if (!o.settings.voxel_size_auto) o.settings.voxel_size = std::strtod(o.voxel_size.c_str(), nullptr);
+  const VoxelSizeArgument voxel_size = parse_voxel_size(o.voxel_size);
+  o.settings.voxel_size = voxel_size.mm;
+  o.settings.voxel_size_auto = voxel_size.automatic;
   if (cohort) {
     CohortOptions c{o.files, o.output_dir, o.jobs, o.settings, o.tsf, o.verbose};
     const int code = run_cohort(c);
@@ -144,7 +130,9 @@ void add_convert_command(CLI::App& app, int& exit_code) {
           ->type_name("N")
           ->default_val(1)
           ->check(CLI::Range(1u, 4096u));
-  add_voxel_size_option(cmd, opt->voxel_size);
+  add_voxel_size_option(*cmd, opt->voxel_size,
+                        "voxel edge length in mm, or auto: chosen from the point count, extent and step length so "
+                        "that voxels stay under ~32k vertices (16-bit orders), at most 10 mm; `info` shows the choice");
   cmd->add_option("--threads", opt->settings.threads,
                   "worker threads in all (0: all cores); --jobs N shares them, each file getting threads / N")
       ->default_val(0);

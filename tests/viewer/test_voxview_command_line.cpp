@@ -112,6 +112,31 @@ TEST(VoxviewCommandLine, APictureIsWrittenInTheFormatItsExtensionNames) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("a.bmp")));
 }
 
+// --voxel-size takes what `voxlines convert` takes (auto too), and a size, slab, frame count or budget out of range
+// is a usage error saying what is expected, not the largest double in full.
+TEST(VoxviewCommandLine, VoxelSizeAutoAndOutOfRangeSizesAsConvertSaysThem) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  const std::string render = test::q(dir.file("a.tck")) + " --size 16x16 --render " + test::q(dir.file("a.png"));
+  const test::CommandResult automatic = test::run_program(VOXVIEW_CLI, render + " --voxel-size auto");
+  EXPECT_EQ(automatic.exit_code, 0) << automatic.output;
+  EXPECT_NE(automatic.output.find("' --voxel-size auto"), std::string::npos)
+      << "the convert hint: " << automatic.output;
+  const char* const refused[][3] = {{"--voxel-size", "0", "expected a positive number of mm or auto, got '0'"},
+                                    {"--voxel-size", "-1", "expected a positive number of mm or auto, got '-1'"},
+                                    {"--slab", "0", "expected a positive number of mm, got '0'"},
+                                    {"--frames", "0", "expected a positive number of frames, got '0'"},
+                                    {"--frame-budget", "-1", "expected a number of milliseconds >= 0, got '-1'"}};
+  for (const auto& [option, value, message] : refused) {
+    const std::string window = test::q(dir.file("a.tck")) + " --size 16x16";
+    const std::string args = std::string(option).rfind("--frame", 0) == 0 ? window : render;
+    const test::CommandResult r = test::run_program(VOXVIEW_CLI, args + " " + option + " " + value);
+    EXPECT_EQ(r.exit_code, 2) << option << " " << value << ": " << r.output;
+    EXPECT_NE(r.output.find(std::string(option) + ": " + message), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("179769"), std::string::npos) << r.output;
+  }
+}
+
 // A source or a package opens through a temporary .vxl in $TMPDIR: a TMPDIR that names no folder is an output
 // error (exit 5) that names the variable, before anything is drawn, not an internal error.
 TEST(VoxviewCommandLine, ATmpdirThatNamesNoFolderIsAnOutputErrorNamingIt) {

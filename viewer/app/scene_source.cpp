@@ -43,7 +43,9 @@ void print_convert_hint(const std::string& path, const SceneSourceOptions& optio
           std::to_string(report.summary.passes) + " passes over the source)";
     if (options.memory_limit > 0) options_text += " --memory-limit " + memory_limit_argument(options.memory_limit);
   }
-  if (options.voxel_size != 10.0) {
+  if (options.voxel_size_auto) {
+    options_text += " --voxel-size auto";
+  } else if (options.voxel_size != 10.0) {
     char size[64];
     std::snprintf(size, sizeof size, " --voxel-size %g", options.voxel_size);
     options_text += size;
@@ -59,7 +61,7 @@ void print_convert_hint(const std::string& path, const SceneSourceOptions& optio
 }  // namespace
 
 SceneSourceOptions scene_source_options(const ViewerOptions& o) {
-  return {o.voxel_size, o.tsf, o.verify, o.memory_limit};
+  return {o.voxel_size, o.voxel_size_auto, o.tsf, o.verify, o.memory_limit};
 }
 
 bool opens_without_conversion(const std::string& path) {
@@ -79,6 +81,7 @@ OpenedScene open_scene(const std::string& path, const SceneSourceOptions& option
 
   SourceConversion conversion;
   conversion.settings.voxel_size = options.voxel_size;
+  conversion.settings.voxel_size_auto = options.voxel_size_auto;
   conversion.settings.memory_limit = options.memory_limit;
   conversion.tsf = options.tsf;
   conversion.warn = [&](const std::string& w) {

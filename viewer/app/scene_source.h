@@ -22,7 +22,8 @@ struct RenderSettings;
 namespace vxl::app {
 
 struct SceneSourceOptions {
-  double voxel_size = 10.0;  // mm, for a source tractogram
+  double voxel_size = 10.0;      // mm, for a source tractogram
+  bool voxel_size_auto = false;  // chosen from the data instead (converter/convert/voxel_size_auto.h)
   // MRtrix track scalar files to attach to a source tractogram (refused for a .vxl / .vxlz, whose values were
   // fixed at conversion).
   std::vector<std::string> tsf;

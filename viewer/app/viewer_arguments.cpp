@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "converter/voxel_size_option.h"
 #include "format/base/error.h"
 #include "format/base/memory_size.h"
 #include "format/base/output_path.h"
@@ -274,6 +275,9 @@ ViewerOptions resolve_viewer_options(const ViewerArguments& a) {
     if (!o.gpu_memory || *o.gpu_memory == 0)
       usage_error("--gpu-memory '" + a.gpu_memory + "' is not a memory size (bytes, or K/M/G: 512M, 2G)");
   }
+  const VoxelSizeArgument voxel_size = parse_voxel_size(a.voxel_size);
+  o.voxel_size = voxel_size.mm;
+  o.voxel_size_auto = voxel_size.automatic;
   if (!a.memory_limit.empty()) {
     const std::optional<std::uint64_t> limit = parse_memory_size(a.memory_limit);
     if (!limit) usage_error("--memory-limit '" + a.memory_limit + "' is not a memory size (bytes, or K/M/G: 512M, 2G)");

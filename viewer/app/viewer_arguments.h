@@ -28,6 +28,7 @@ struct ViewerArguments {
   std::string size = "1024x1024";
   std::string gpu_memory;           // --gpu-memory SIZE
   std::string memory_limit;         // --memory-limit SIZE
+  std::string voxel_size = "10";    // --voxel-size MM|auto
   std::vector<double> drag_region;  // --drag-region DX,DY,DZ
   // With a selection: the focus's opacity (default --opacity) and the context's (0 hides it).
   std::optional<float> focus_opacity;

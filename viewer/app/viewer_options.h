@@ -36,8 +36,9 @@ struct ViewerOptions {
   std::optional<std::string> save_camera;     // write the view here (headless: after rendering)
   bool orthographic = false;
   int width = 1024, height = 1024;
-  bool size_given = false;   // by --size or a saved view: the window keeps it (else it fits the screen)
-  double voxel_size = 10.0;  // for converting a source tractogram
+  bool size_given = false;       // by --size or a saved view: the window keeps it (else it fits the screen)
+  double voxel_size = 10.0;      // for converting a source tractogram
+  bool voxel_size_auto = false;  // --voxel-size auto: chosen from the data, as `voxlines convert` chooses it
   // --memory-limit: a source tractogram is streamed within this many bytes (converter/convert/source_to_vxl.h);
   // 0: only a TCK too big for the available memory is.
   std::uint64_t memory_limit = 0;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "converter/readers/source_formats.h"
+#include "converter/voxel_size_option.h"
 #include "format/vxl_levels.h"
 #include "viewer/app/key_bindings.h"
 #include "viewer/platform/image_io.h"
@@ -37,6 +38,21 @@ std::vector<std::string> cli11_arguments(int argc, const char* const* argv) {
     }
   }
   return args;
+}
+
+// A positive number (or, with `zero`, a non-negative one) of `unit`: CLI's own checks print the largest double in
+// full as the range.
+CLI::Validator number_above_zero(const std::string& unit, bool zero = false) {
+  const std::string expected = zero ? "a number of " + unit + " >= 0" : "a positive number of " + unit;
+  return CLI::Validator(
+      [expected, zero](const std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v < 0 || (v == 0 && !zero))
+          return "expected " + expected + ", got '" + text + "'";
+        return {};
+      },
+      "NUMBER");
 }
 
 // A number from `lo` to `hi`. CLI::Range lets NaN through (every comparison with it is false), and an opacity or a
@@ -214,7 +230,7 @@ void declare_image_and_clipping(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--slab", a.slab,
                  "crop to a slab MM thick, centred on the focus point (the view's centre), perpendicular to the view "
                  "direction (mrview's crop to slab)")
-      ->check(CLI::PositiveNumber);
+      ->check(number_above_zero("mm"));
   cli.add_option(
          "--clip", a.clips,
          "clip plane AXIS,POS in RAS mm, up to 3: x,10 keeps x >= 10, -x,10 keeps x <= 10 (axes x y z, -x -y -z)")
@@ -228,9 +244,9 @@ void declare_loading(CLI::App& cli, ViewerArguments& a) {
                "before drawing, check every .vxl in full (every checksum and padding byte, every order, the streamline "
                "tables; reads the whole file, as 'voxlines verify') and refuse a damaged one (exit 3, naming the first "
                "problem); a .vxlz's unpacked file too (a package's own checksums are always checked)");
-  cli.add_option("--voxel-size", a.options.voxel_size, "voxel size in mm when converting a source tractogram")
-      ->default_val(10.0)
-      ->check(CLI::PositiveNumber);
+  add_voxel_size_option(cli, a.voxel_size,
+                        "voxel size in mm when converting a source tractogram, or auto: chosen from the data as "
+                        "'voxlines convert --voxel-size auto' chooses it");
   cli.add_option("--memory-limit", a.memory_limit,
                  "convert a source tractogram within SIZE of memory (bytes, or K/M/G: 512M, 2G), as 'voxlines convert "
                  "--memory-limit' does. " +
@@ -266,7 +282,7 @@ void declare_window(CLI::App& cli, ViewerArguments& a) {
                  "window: while the camera moves, draw the finest level of detail whose measured frame time fits this "
                  "many milliseconds; at rest, the level --gpu-memory allows (0: always that level)")
       ->default_val(100.0)
-      ->check(CLI::NonNegativeNumber)
+      ->check(number_above_zero("milliseconds", true))
       ->excludes(render);
   cli.add_flag("--no-exact-when-still{false}", a.options.exact_when_still,
                "window: at rest, stop at the full-detail picture; by default, where OpenGL 4.3 is there, the basic "
@@ -304,7 +320,7 @@ void declare_window(CLI::App& cli, ViewerArguments& a) {
                  "selections' median and 95th percentile (of all, and of those after the first, which also boxes "
                  "the voxels its regions touch)");
   cli.add_option("--frames", a.options.frames, "window: quit after this many frames (for scripts and tests)")
-      ->check(CLI::PositiveNumber)
+      ->check(number_above_zero("frames"))
       ->excludes(render);
   cli.add_flag("--until-refined", a.options.until_refined,
                "window, with --frames: after the frames, keep the camera still until the picture is refined (full "
