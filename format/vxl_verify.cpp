@@ -288,9 +288,20 @@ class LengthCheck {
 }  // namespace
 
 VerifyResult verify_vxl(const std::string& path) {
+  try {
+    return verify_vxl(VxlFile::open(path));
+  } catch (const Error& e) {
+    VerifyResult r;
+    r.kind = e.kind();
+    r.problem = e.what();
+    return r;
+  }
+}
+
+VerifyResult verify_vxl(const VxlFile& f) {
+  const std::string& path = f.path();
   VerifyResult r;
   try {
-    VxlFile f = VxlFile::open(path);
     check_checksums_and_padding(f);
     check_meta_and_dirs(f);
     check_bounds(f);
@@ -314,6 +325,7 @@ VerifyResult verify_vxl(const std::string& path) {
     check_value_sets(f, f.streamline_values(), "SVAL");
     r.valid = true;
   } catch (const Error& e) {
+    r.kind = e.kind();
     r.problem = e.what();
   }
   return r;

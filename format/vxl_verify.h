@@ -4,13 +4,21 @@
 
 #include <string>
 
+#include "format/base/error.h"
+#include "format/vxl_file.h"
+
 namespace vxl {
 
 struct VerifyResult {
   bool valid = false;
+  // What kind of problem: Input for a damaged or malformed file; Unsupported for a kind or version this reader
+  // does not handle; Output when a package could not be unpacked to be checked.
+  ErrorKind kind = ErrorKind::Input;
   std::string problem;  // the first problem found, naming the file and byte offset; empty when valid
 };
 
 VerifyResult verify_vxl(const std::string& path);
+// The same checks of a file already open (its errors name f.path()).
+VerifyResult verify_vxl(const VxlFile& f);
 
 }  // namespace vxl

@@ -835,6 +835,28 @@ TEST_F(DamagedVxlz, CliReportsDamageWithExitCode3) {
 
 // The command line and real data ----------------------------------------------------------------
 
+// `verify` of a package checks it in full (its own checks, every chunk decoded, the .vxl it unpacks to), finds a
+// damaged one invalid (exit 1), and a file that is not there is one it cannot read (exit 3), not an invalid one.
+TEST(VxlzPackCli, VerifyChecksAPackageInFull) {
+  ScratchDir dir;
+  const std::string vxl = convert_for_package(test_tractogram(100), dir.file("s.vxl"));
+  ASSERT_EQ(test::run_cli("pack '" + vxl + "' '" + dir.file("s.vxlz") + "'").exit_code, 0);
+  auto r = test::run_cli("verify '" + dir.file("s.vxlz") + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("s.vxlz: valid"), std::string::npos) << r.output;
+  std::vector<char> b = slurp(dir.file("s.vxlz"));
+  b[b.size() / 2] ^= 0x10;
+  dump_bytes(dir.file("bad.vxlz"), b, b.size());
+  r = test::run_cli("verify '" + dir.file("bad.vxlz") + "'");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("bad.vxlz: INVALID: "), std::string::npos) << r.output;
+  r = test::run_cli("verify '" + dir.file("missing.vxl") + "'");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("missing.vxl: cannot be read"), std::string::npos) << r.output;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+    EXPECT_TRUE(e.path().extension() == ".vxl" || e.path().extension() == ".vxlz") << "left behind: " << e.path();
+}
+
 TEST(VxlzPackCli, PackUnpackVerify) {
   ScratchDir dir;
   const std::string vxl = convert_for_package(test_tractogram(100), dir.file("s.vxl"));
