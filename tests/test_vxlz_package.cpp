@@ -835,6 +835,27 @@ TEST_F(DamagedVxlz, CliReportsDamageWithExitCode3) {
 
 // The command line and real data ----------------------------------------------------------------
 
+// Unpacked with no --levels, a package gives back the levels of the file it was packed from (level order: PACK's;
+// streamline order: those its conversion asked for); --levels chooses others.
+TEST(VxlzPackCli, UnpackKeepsThePackagesLevels) {
+  ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth '" + dir.file("s.tck") + "' --streamlines 300").exit_code, 0);
+  const auto unpacked_levels = [&](const std::string& convert_levels, const std::string& unpack_options) {
+    const std::string vxl = dir.file("s.vxl"), vxlz = dir.file("s.vxlz"), out = dir.file("u.vxl");
+    EXPECT_EQ(test::run_cli("convert '" + dir.file("s.tck") + "' '" + vxl + "' --levels " + convert_levels).exit_code,
+              0);
+    EXPECT_EQ(test::run_cli("pack '" + vxl + "' '" + vxlz + "'").exit_code, 0);
+    const auto r = test::run_cli("unpack '" + vxlz + "' '" + out + "'" + unpack_options);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return VxlFile::open(out).meta().level_count;
+  };
+  EXPECT_EQ(unpacked_levels("3", ""), 3u);
+  EXPECT_EQ(unpacked_levels("5", ""), 5u);
+  EXPECT_EQ(unpacked_levels("1", ""), 0u);  // one level: level_count 0
+  EXPECT_EQ(unpacked_levels("3", " --levels 2"), 2u);
+  EXPECT_EQ(unpacked_levels("1", " --levels 4"), 4u);
+}
+
 // `verify` of a package checks it in full (its own checks, every chunk decoded, the .vxl it unpacks to), finds a
 // damaged one invalid (exit 1), and a file that is not there is one it cannot read (exit 3), not an invalid one.
 TEST(VxlzPackCli, VerifyChecksAPackageInFull) {

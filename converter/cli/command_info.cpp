@@ -72,6 +72,7 @@ void add_info_command(CLI::App& app) {
     j["segments"] = m.segment_count;
     j["vertices"] = m.vertex_count;
     j["synthetic_points"] = m.synthetic_point_count;
+    j["levels"] = std::max(m.level_count, 1u);  // of detail: 0 (every streamline) to levels - 1
     // Positions: the encoding and, when packed, the largest error any voxel allows (spec §5.4).
     j["positions"] = position_encoding_name(f.position_encoding());
     if (f.position_encoding() == PositionEncoding::Packed) {
@@ -118,6 +119,12 @@ void add_info_command(CLI::App& app) {
     std::printf("voxel size    %g mm%s\norders        %u stored (x2 by reversal)\n", m.voxel_size,
                 j.contains("voxel_size_choice") ? (" (" + j["voxel_size_choice"].get<std::string>() + ")").c_str() : "",
                 m.stored_order_count);
+    const unsigned levels = j["levels"].get<unsigned>();
+    if (levels > 1)
+      std::printf("levels        %u of detail (0 to %u; level d keeps about 1/8^d of the streamlines)\n", levels,
+                  levels - 1);
+    else
+      std::printf("levels        1 (full detail only)\n");
     if (j.contains("position_error_bound_mm"))
       std::printf("positions     packed (10 bits per axis per voxel; error at most %.3g um)\n",
                   1000 * j["position_error_bound_mm"].get<double>());

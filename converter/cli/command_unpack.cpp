@@ -22,7 +22,11 @@ void add_unpack_command(CLI::App& app) {
   add_positions_option(cmd, opt->settings.positions,
                        "the package's positions as decoded: the package quantised them, within the error bound "
                        "`pack` and `info` print");
-  add_levels_option(cmd, opt->settings.levels);
+  cmd->add_option("--levels", opt->settings.levels,
+                  "levels of detail of the .vxl written (level d keeps a fixed pseudo-random 1/8^d of the "
+                  "streamlines, with its own orders; 1 writes full detail only). Default: the package's own, those "
+                  "of the .vxl it was packed from (5 for a package older than 2.3, which does not record them)")
+      ->check(CLI::Range(1u, kMaxLevels));
   cmd->add_option("--memory-limit", opt->memory_limit,
                   "what the decoded positions may take (bytes, or K/M/G: 512M, 2G): a packed .vxl's words depend on "
                   "each voxel's bounds, known once every point is decoded, so within SIZE the positions are kept as "

@@ -444,7 +444,8 @@ void let_go_of_voxline_tables(UnpackStructure& s, std::vector<float>& lengths, P
 // Refuses settings the package cannot meet, and rebuilds its tables (`meta`: the .vxl's counts, those of the level
 // alone with settings.level).
 UnpackStructure checked_structure(const VxlzFile& f, const UnpackSettings& settings, MetaSection& meta) {
-  detail::check_level_count(settings.levels, f.path());
+  const std::uint32_t levels = settings.levels == 0 ? package_levels(f) : settings.levels;
+  detail::check_level_count(levels, f.path());
   if (f.meta().order_set == static_cast<std::uint32_t>(OrderSet::Random))
     fail_unsupported(f.path(), "per-voxel random order sets are not part of package format 2.0");
   const bool level_alone = settings.level > 0;
@@ -454,7 +455,7 @@ UnpackStructure checked_structure(const VxlzFile& f, const UnpackSettings& setti
                     (f.pack().level_count > 1 ? std::to_string(f.pack().level_count) + " levels" : "no level order") +
                     ")");
   // A level alone is a file of its own, without levels: its counts are set by keep_level.
-  return rebuild_structure(f, level_alone ? 1 : settings.levels, settings.level, meta);
+  return rebuild_structure(f, level_alone ? 1 : levels, settings.level, meta);
 }
 
 // The .vxl's section sizes (and META's encoding and level count, set in `meta`).
@@ -591,8 +592,25 @@ UnpackSummary unpack(const VxlzFile& f, const std::string& out_path, const Unpac
 
 }  // namespace
 
+std::uint32_t package_levels(const VxlzFile& f) {
+  if (f.pack().predictor == kVxlzPredictorLinearLevelOrder) return f.pack().level_count;
+  // Streamline order: written for a file without levels, or by a writer older than 2.3 for any file. Neither
+  // says how many the file had; the levels its conversion asked for (PROV, spec §5.8) do.
+  if (f.has_section(section_id("PROV"))) {
+    const std::vector<std::uint8_t> raw = f.inflate(section_id("PROV"));
+    const nlohmann::json prov =
+        parse_json({reinterpret_cast<const char*>(raw.data()), raw.size()}, f.path(), std::nullopt, "PROV");
+    if (prov.is_object() && prov.contains("converter") && prov["converter"].is_object()) {
+      const nlohmann::json& levels = prov["converter"].value("levels", nlohmann::json());
+      if (levels.is_number_unsigned() && levels.get<std::uint64_t>() >= 1 && levels.get<std::uint64_t>() <= kMaxLevels)
+        return levels.get<std::uint32_t>();
+    }
+  }
+  return kDefaultLevels;
+}
+
 UnpackSummary unpack_vxlz(const std::string& in_path, const std::string& out_path, const UnpackSettings& settings) {
-  detail::check_level_count(settings.levels, in_path);
+  if (settings.levels != 0) detail::check_level_count(settings.levels, in_path);
   return unpack_vxlz(VxlzFile::open(in_path), out_path, settings);
 }
 

@@ -22,8 +22,9 @@ namespace vxl {
 struct UnpackSettings {
   unsigned threads = 0;                                   // 0: all cores
   PositionEncoding positions = PositionEncoding::Packed;  // of the .vxl written (spec §5.4)
-  std::uint32_t levels = kDefaultLevels;                  // of the .vxl written (spec §5.12), 1 .. kMaxLevels
-  ProgressFn progress;                                    // stages "decoding", "ordering", "writing"; may be empty
+  // Levels of detail of the .vxl written (spec §5.12), 1 .. kMaxLevels; 0: the package's own (package_levels).
+  std::uint32_t levels = 0;
+  ProgressFn progress;  // stages "decoding", "ordering", "writing"; may be empty
   // > 0: only the streamlines of this level of the package's level order (spec §5.1, predictor 2), as a file of
   // their own without levels (the first look a viewer gets while the rest arrives); only the chunks that hold them
   // need be there (VxlzFile::open_prefix). Without groups and value sets.
@@ -63,6 +64,11 @@ UnpackSummary unpack_vxlz(const VxlzFile& package, const std::string& out_path, 
 // The same, the package let go of once its positions are decoded: where it was read into memory (the web page's), its
 // memory goes before the tables and the orders take theirs.
 UnpackSummary unpack_vxlz(VxlzFile&& package, const std::string& out_path, const UnpackSettings& settings);
+
+// The levels of detail of the .vxl a package was packed from: PACK.level_count in level order; in streamline order
+// (a file without levels, or any file packed by a writer older than 2.3), the levels its conversion asked for as its
+// PROV records them, else kDefaultLevels.
+std::uint32_t package_levels(const VxlzFile& package);
 
 // The size in bytes of the .vxl unpack_vxlz would write with `settings` (its levels, positions, level), from the
 // package's tables alone: no position is decoded, nor a value (of a value section only its set count is read).
