@@ -137,6 +137,23 @@ TEST(VoxviewCommandLine, VoxelSizeAutoAndOutOfRangeSizesAsConvertSaysThem) {
   }
 }
 
+// --color scalar without values says how to get them: for a source, --tsf; for a .vxl, whose values were fixed when
+// it was converted (voxview refuses --tsf there), converting its source again.
+TEST(VoxviewCommandLine, ColourByValueWithoutValuesSaysHowToAddThem) {
+  test::ScratchDir dir;
+  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  ASSERT_EQ(test::run_cli("convert " + test::q(dir.file("a.tck")) + " " + test::q(dir.file("a.vxl"))).exit_code, 0);
+  const std::string options = " --size 16x16 --color scalar --render " + test::q(dir.file("a.png"));
+  const test::CommandResult source = test::run_program(VOXVIEW_CLI, test::q(dir.file("a.tck")) + options);
+  EXPECT_EQ(source.exit_code, 2) << source.output;
+  EXPECT_NE(source.output.find("(add a TSF with --tsf,"), std::string::npos) << source.output;
+  const test::CommandResult converted = test::run_program(VOXVIEW_CLI, test::q(dir.file("a.vxl")) + options);
+  EXPECT_EQ(converted.exit_code, 2) << converted.output;
+  EXPECT_NE(converted.output.find("voxlines convert SOURCE OUT.vxl --tsf FILE.tsf"), std::string::npos)
+      << converted.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.png")));
+}
+
 // A source or a package opens through a temporary .vxl in $TMPDIR: a TMPDIR that names no folder is an output
 // error (exit 5) that names the variable, before anything is drawn, not an internal error.
 TEST(VoxviewCommandLine, ATmpdirThatNamesNoFolderIsAnOutputErrorNamingIt) {

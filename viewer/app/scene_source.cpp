@@ -126,10 +126,15 @@ void check_color_options(const std::string& path, const Renderer& r, const Rende
   const auto& names = r.value_set_names();
   std::string available;
   for (const std::string& n : names) available += (available.empty() ? "" : ", ") + n;
+  // A .vxl's or a package's values were fixed when it was converted: --tsf cannot add them here.
+  const std::string add_values =
+      opens_without_conversion(path)
+          ? "convert its source again with them: voxlines convert SOURCE OUT.vxl --tsf FILE.tsf, or from a TRK with "
+            "scalars or properties, a TRX with dpv or dps"
+          : "add a TSF with --tsf, or use a TRK with scalars or properties, a TRX with dpv or dps";
   if (s.color == ColorMode::Scalar && names.empty())
     refuse(from_view_file.color, "--color scalar", "color",
-           "no per-point or per-streamline values to colour by (add a TSF with --tsf, or use a TRK with scalars or "
-           "properties, a TRX with dpv or dps)");
+           "no per-point or per-streamline values to colour by (" + add_values + ")");
   if (!s.scalar.empty() && std::find(names.begin(), names.end(), s.scalar) == names.end())
     refuse(from_view_file.scalar, "--scalar", "scalar",
            "no value set '" + s.scalar + "'" + (names.empty() ? " (it has none)" : " (it has: " + available + ")"));
