@@ -232,6 +232,13 @@ def main():
             if holds and not fetched_as_it_should:
                 failures.append(f'{source} {settings}, {holds}: {RangeHandler.bytes_sent} of its {size} '
                                 'bytes fetched (under a quarter of it, the whole file only for a setting that reads it)')
+            # The line under the picture counts the file's points (not its vertices, which add the connecting ones).
+            if not report['image']:
+                points = json.loads(run(options.voxlines, 'info', path(source), '--json'))['points']
+                said = re.sub(r'[\s,.\u00a0\u202f]', '', report.get('info_text') or '')
+                if report.get('points') != points or f'{points}points' not in said:
+                    failures.append(f'{source}: the page says {report.get("info_text")!r} (info.points '
+                                    f'{report.get("points")}), the file has {points} points')
             wanted_mode = dict(kv.split('=') for kv in settings.split('&')).get('mode')
             if wanted_mode and report.get('mode') != wanted_mode:
                 failures.append(f'{source} {settings}: drawn in {report.get("mode")}, not {wanted_mode}')

@@ -377,6 +377,7 @@ void describe(Viewer& v, nlohmann::json& j) {
   if (v.controller) {  // open
     const auto& m = v.file->meta();
     j["streamlines"] = m.streamline_count;
+    j["points"] = m.point_count;
     j["vertices"] = m.vertex_count;
     j["voxels"] = v.file->voxels().size();
     j["bytes"] = v.file->bytes().size();

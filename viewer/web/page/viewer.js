@@ -640,9 +640,9 @@
         : `drawn from level ${info.level_offset} (about 1/${8 ** info.level_offset} of them)`;
       $('info').textContent = info.image
         ? `${info.streamlines.toLocaleString()} streamlines, ${drawnFrom}: the file is larger than the page holds; ` +
-          `${info.vertices.toLocaleString()} of its ${info.file_vertices.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`
+          `${info.vertices.toLocaleString()} of its ${info.file_vertices.toLocaleString()} vertices, ${info.voxels.toLocaleString()} voxels`
         : `${info.streamlines.toLocaleString()} streamlines, ` +
-          `${info.vertices.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`;
+          `${info.points.toLocaleString()} points, ${info.voxels.toLocaleString()} voxels`;
       $('mode').replaceChildren(...info.modes.map((m) => {
         const o = document.createElement('option');
         o.value = m.name;
