@@ -20,8 +20,7 @@ the built program; without it, $VXLZ_DRACO_DUMP, else it is compiled once into /
 
 Exit status: 0 valid (and equal), 1 invalid (or different), 2 usage error. The last line is one line:
 "FILE: OK ..." or "FILE: INVALID: byte N: what was expected" (or "UNSUPPORTED: ..."); -q prints only that.
-Where the spec leaves a choice the code says "ASSUMED"; rules the spec states for writers but §8 does not ask
-a reader to enforce are reported as notes.
+Rules the spec states for writers but §8 does not ask a reader to enforce are reported as notes.
 """
 import argparse
 import hashlib
@@ -88,7 +87,7 @@ def varints(raw, where, base):
     need(i is None, base, f"{where}: inflated byte {starts[i] if i is not None else 0}: varint of more than 10 bytes")
     i = first((lens == 10) & (b[ends] > 1))
     need(i is None, base, f"{where}: inflated byte {starts[i] if i is not None else 0}: varint does not fit 64 bits")
-    # §1: writers write the shortest form; ASSUMED a longer one is still "well-formed" (§8 step 5): a note
+    # §1: writers write the shortest form, readers accept a longer one: a note
     overlong = int(((lens > 1) & (b[ends] == 0)).sum())
     idx = np.arange(len(b)) - np.repeat(starts, lens)
     v = (b & 0x7F).astype(np.uint64) << (7 * idx).astype(np.uint64)
@@ -144,13 +143,13 @@ class Package:
             need(off == p, e + 8, f"{name!r}: offset {off}, expected {p} (payloads back to back from the table)")
             need(size <= len(d) - off, e + 16, f"{name!r}: size {size} runs past the end of the file")
             if sid in KNOWN:
-                if bool(fl & 1) != bool(KNOWN[sid]):   # ASSUMED: §8 does not ask for it; a note (cf. .vxl §7 step 2)
+                if bool(fl & 1) != bool(KNOWN[sid]):   # §2.2: readers do not check it; a note
                     self.notes.append(f"{name}: required flag {fl & 1}, §2.2's table says {KNOWN[sid]}")
             else:
                 need(not fl & 1, e, f"unknown required section {name!r}", "unsupported")
                 self.notes.append(f"unknown optional section {name!r} skipped")
             if not all(0x20 <= c <= 0x7E for c in sid):
-                self.notes.append(f"section id {sid!r} is not printable ASCII (the .vxl rule; §2.2 is silent)")
+                self.notes.append(f"section id {sid!r} is not printable ASCII (the .vxl's rule; §2.2: not checked)")
             self.sec[name], self.entry[name] = (off, size, csum), e
             p = off + size
         need(p == len(d), 16, f"the last payload ends at {p}, the file at {len(d)}")
@@ -226,18 +225,12 @@ class Package:
         g = np.floor((self.mbmax - self.mbmin) / self.s) + 1
         need((np.abs(self.dims - g) <= 1).all(), moff + 88, f"grid_dims {self.dims} not within 1 of {g}")
         need(self.P + self.synth == n, moff + 8, f"point_count {self.P} + synthetic {self.synth} != PACK n = {n}")
-        # ASSUMED (not in §8): META.level_count 0 or 2 … 8, and predictor 2 exactly with that Λ (§5.1)
-        if not (self.mlc == 0 or 2 <= self.mlc <= 8):
-            self.notes.append(f"META.level_count {self.mlc} not 0 or 2 … 8")
-        if (pred == 2) != (self.mlc >= 2) or (pred == 2 and lc != self.mlc):
-            # SPEC: the packages voxlines writes hold META.level_count 0 even in level order (§4.1 says META is
-            # the .vxl's byte for byte except position_encoding); PACK.level_count carries the .vxl's Λ
-            self.notes.append(f"predictor {pred} / PACK.level_count {lc} with META.level_count {self.mlc} (§4.1: "
-                              "META byte for byte but position_encoding; §5.1: level order with the .vxl's Λ)")
+        # §4.1, §8 step 4: the package's META has level_count 0 (PACK.level_count carries Λ)
+        need(self.mlc == 0, moff + 156, f"META.level_count {self.mlc}, expected 0 in a package (§4.1)")
         if not (self.o == self.gorigin).all() and n:
             self.notes.append(f"quant_origin {self.o} != grid_origin {self.gorigin} (§6 says they are equal)")
-        # §4.1: package 2.x holds one direction set; a package that says order_set 2 is refused by the unpacker
-        # (ASSUMED: refused here, after the rest of step 4's META checks; §8 step 4 itself allows 2)
+        # §4.1, §8 step 4: package 2.x holds one direction set; a package that says order_set 2 opens, and the
+        # unpacker refuses it before decoding anything: this reader, which decodes, refuses it here
         need(self.order_set != 2, moff + 100, "order_set 2 (per-voxel directions): not in a 2.x package (§4.1)",
              "unsupported")
         # DIRS
@@ -247,7 +240,7 @@ class Package:
         i = first(dirs["r"] != 0)
         need(i is None, doff + 16 * (i or 0) + 12, f"DIRS entry {i}: reserved not zero")
         ln = np.sqrt((dirs["v"].astype(np.float64) ** 2).sum(1))
-        i = first(np.abs(ln - 1) > 1e-5)          # ASSUMED: "unit vectors" with .vxl §7's ±10^−5
+        i = first(np.abs(ln - 1) > 1e-5)          # §8 step 4: unit vectors within 10^−5
         need(i is None, doff + 16 * (i or 0), f"DIRS entry {i}: not a unit vector (length {ln[i or 0] if len(ln) else 0})")
         self.dirs_raw = dr
         # CHNK / CHKS
@@ -269,7 +262,7 @@ class Package:
                 self.notes.append("CHKS with predictor 1 (§5.3: writers write it exactly with predictor 2)")
         elif pred == 2:
             self.notes.append("level order without CHKS (a 2.3 writer's package)")
-        # version_minor (§2.1, §10): ASSUMED a note, §8 does not list it
+        # version_minor (§2.1): informative for readers, a note
         has = self.sec.__contains__
         want = (4 if has("CHKS") else 3) if pred == 2 else 2 if has("GDAT") else 1 if (has("PVAL") or has("SVAL")) else 0
         if self.minor != want:
@@ -519,7 +512,7 @@ class Package:
         need(not flags & 0x8000, at + 9, f"{where}: Draco metadata flag set")
         cnt = struct.unpack_from("<i", buf, 11)[0]
         need(cnt == count, at + 11, f"{where}: Draco point count {cnt}, expected {count}")
-        if (vmaj, vmin) != (2, 3):     # §1: "version 2.3"; ASSUMED a note (§8 does not ask)
+        if (vmaj, vmin) != (2, 3):     # §5.3: the version is Draco's to accept; a note
             self.notes.append(f"{where}: Draco bitstream {vmaj}.{vmin}, §1 names 2.3")
         r = subprocess.run([self.dump, "-"], input=buf, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
         need(r.returncode == 0, at, f"{where}: Draco refuses it: {r.stderr.decode(errors='replace').strip()}")
@@ -683,7 +676,7 @@ class Package:
             except (UnicodeDecodeError, ValueError) as e:
                 fail(self.sec["PROV"][0], f"PROV is not UTF-8 JSON: {e}")
             need(isinstance(prov, dict), self.sec["PROV"][0], "PROV is not a JSON object (§7 step 6)")
-        # ASSUMED "file name" = the package's name without its directory (what voxlines writes)
+        # §7 step 6: the package's file name without its directory
         prov["vxlz"] = {"package": os.path.basename(self.path), "bits": self.b, "quantum_mm": self.q,
                         "range_mm": self.R, "error_bound_mm": self.eb, "max_error_mm": self.maxe,
                         "rms_error_mm": self.rmse}
@@ -732,10 +725,7 @@ def compare(pkg, path, say):
     except vr.Invalid as e:
         raise Different(f"{path} fails the .vxl reader's checks (.vxl §7): {e}")
     diffs, notes = [], []
-    spec_lc = pkg.mlc if pkg.P else 0
-    if f.lc != spec_lc:
-        notes.append(f"SPEC: the unpacked file has level_count {f.lc}, §7 step 1 ('META as shipped') gives {spec_lc}; "
-                     f"rebuilt with {f.lc} to compare the rest")
+    # §7 step 1: the unpacker chooses Λ; rebuilt with the unpacked file's to compare the rest
     rb = pkg.rebuild(f.lc, f.pos_enc)
 
     def sec(name):
@@ -842,7 +832,7 @@ def main():
     pk = Package(a.package, say, dump)
     try:
         pk.validate()
-        rb = pk.rebuild(pk.mlc, 0)
+        rb = pk.rebuild(pk.plc if pk.pred == 2 else 0, 0)  # §7 step 1: the levels the packed file had
         say(f"{a.package}: vxlz {pk.major}.{pk.minor}, sections " + " ".join(f"{k}:{v[1]}" for k, v in pk.sec.items()))
         say(f"  N={pk.N} P={pk.P} V={pk.V} S={pk.S} L={pk.L} synthetic={pk.synth} voxels={pk.nvox} n={pk.n}")
         say(f"  b={pk.b} predictor={pk.pred} levels={pk.plc} q={pk.q:.6g} R={pk.R:.6g} C={pk.C} chunks={pk.nch} "
