@@ -32,6 +32,16 @@ TEST(MemoryAvailable, TheDefaultLimitFollowsTheSourceWithinHalfOfWhatIsAvailable
 TEST(MemoryAvailable, EnvironmentOverrides) {
   ::setenv("VOXLINES_MEMORY_AVAILABLE", "123M", 1);
   EXPECT_EQ(available_memory(), 123 * MiB);
+  // Set but not a size: a usage error naming the variable, not a silent guess.
+  ::setenv("VOXLINES_MEMORY_AVAILABLE", "abc", 1);
+  try {
+    (void)available_memory();
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Usage);
+    EXPECT_NE(std::string(e.what()).find("VOXLINES_MEMORY_AVAILABLE=abc: is not a memory size"), std::string::npos)
+        << e.what();
+  }
   ::unsetenv("VOXLINES_MEMORY_AVAILABLE");
   // Without it, /proc/meminfo (Linux) gives a figure.
   const auto real = available_memory();

@@ -7,6 +7,7 @@
 
 #include <sys/resource.h>
 
+#include "format/base/error.h"
 #include "format/base/memory_size.h"
 
 namespace vxl {
@@ -47,7 +48,14 @@ std::optional<std::uint64_t> cgroup_headroom() {
 }  // namespace
 
 std::optional<std::uint64_t> available_memory() {
-  if (const char* text = std::getenv("VOXLINES_MEMORY_AVAILABLE")) return parse_memory_size(text);
+  if (const char* text = std::getenv("VOXLINES_MEMORY_AVAILABLE")) {
+    const std::optional<std::uint64_t> given = parse_memory_size(text);
+    // Set but not a size: a mistake to say, not a reason to fall back to a guess silently.
+    if (!given)
+      throw Error(ErrorKind::Usage, std::string("VOXLINES_MEMORY_AVAILABLE=") + text, std::nullopt,
+                  "is not a memory size (bytes, or K/M/G: 512M, 2G)");
+    return given;
+  }
   std::optional<std::uint64_t> available = meminfo("MemAvailable");
   if (const auto headroom = cgroup_headroom()) available = available ? std::min(*available, *headroom) : *headroom;
   return available;
