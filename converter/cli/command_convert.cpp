@@ -87,9 +87,10 @@ int run_convert(ConvertOptions& o, bool cohort, bool jobs_given) {
                                std::to_string(o.files.size()) + " file names)");
   const std::string& input = o.files[0];
   const std::string& output = o.files[1];
-  require_output_suffix(output, ".vxl",
-                        "convert writes a .vxl file: name the output OUT.vxl (to write TCK, TRX or VTK from a .vxl use "
-                        "`voxlines export IN.vxl OUT.tck`, or `voxlines select` for some of its streamlines)");
+  require_output_suffix(
+      output, ".vxl",
+      "convert writes a .vxl file: name the output OUT.vxl (to write TCK, TRK, TRX or VTK from a .vxl use "
+      "`voxlines export IN.vxl OUT.tck`, or `voxlines select` for some of its streamlines)");
   ProgressBar bar;
   o.settings.progress = [&bar](const char* stage, double f) { bar.update(stage, f); };
   bar.update("reading", 0.0);

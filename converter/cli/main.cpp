@@ -30,7 +30,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "voxlines " VOXLINES_VERSION
       " — voxel-chunked tractograms for fast, correct-looking transparency.\n"
-      "Exit codes: 0 ok, 1 verify found the file invalid, 2 usage, 3 bad input, 4 unsupported, 5 output error."};
+      "Exit codes: 0 ok, 1 verify found the file invalid, 2 usage, 3 bad input, 4 unsupported, 5 output error, 6 a\n"
+      "cohort (--output-dir) whose files failed with different kinds of error, 70 an internal error (a bug)."};
   app.set_version_flag("--version", VOXLINES_VERSION);
   app.require_subcommand(1);
   int exit_code = 0;  // set by verify and by a cohort conversion

@@ -72,7 +72,7 @@ std::string readme(const std::string& title, const std::string& data_file, std::
          "512M...) says how much GPU memory the page may take.\n\n" +
          large + "The data is " + data_file +
          " (the .vxl format, or a .vxlz package of it); the Voxlines tools (voxlines, voxview) read it\n"
-         "and export it back to TCK or TRX.\n";
+         "and export it back to TCK, TRK, TRX or VTK (a .vxlz after `voxlines unpack`).\n";
 }
 
 // A package's .vxl of `bytes` for the page, which unpacks it whole in WebAssembly's memory: refused where that is

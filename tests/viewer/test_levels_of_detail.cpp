@@ -184,7 +184,8 @@ TEST_F(LevelsOfDetail, VoxviewDrawsTheFinestLevelItsBudgetAllows) {
   };
   auto r = voxview("--gpu-memory " + std::to_string(full - 1));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("drawing level 1 of 3 (about 1/8 of the streamlines"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("drawing level 1 (of levels 0 to 3; about 1/8 of the streamlines"), std::string::npos)
+      << r.output;
   EXPECT_TRUE(std::filesystem::exists(png));
   std::filesystem::remove(png);
   r = voxview("--gpu-memory " + std::to_string(full));
@@ -192,7 +193,16 @@ TEST_F(LevelsOfDetail, VoxviewDrawsTheFinestLevelItsBudgetAllows) {
   EXPECT_EQ(r.output.find("drawing level"), std::string::npos) << r.output;
   r = voxview("--level 2");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("drawing level 2 of 3 (about 1/64 of the streamlines, opacity compensated) as --level asks"),
+  EXPECT_NE(
+      r.output.find(
+          "drawing level 2 (of levels 0 to 3; about 1/64 of the streamlines, opacity compensated) as --level asks"),
+      std::string::npos)
+      << r.output;
+  std::filesystem::remove(png);
+  r = voxview("--level 5");  // past the coarsest: the coarsest, saying so
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("drawing level 3 (of levels 0 to 3; about 1/512 of the streamlines, opacity compensated): "
+                          "--level 5 is past the coarsest level the files have"),
             std::string::npos)
       << r.output;
   std::filesystem::remove(png);

@@ -67,6 +67,7 @@ SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::o
     d.budget_source = "a quarter of the available memory (the driver reports no GPU memory)";
   }
   d.forced = level.has_value();
+  d.asked = level.value_or(0);
   const std::uint64_t driver = GpuScene::driver_limit();
   auto within_driver = [&](std::uint64_t wanted) {
     return std::min(driver, std::max(wanted, SceneLayout::largest_voxel_texels(files)));
@@ -82,10 +83,12 @@ SceneDetail choose_scene_detail(const std::vector<const VxlFile*>& files, std::o
 
 std::string describe_scene_detail(const SceneDetail& d, std::uint32_t levels_in_files) {
   if (d.level == 0) return "";
-  const std::string what = "drawing level " + std::to_string(d.level) + " of " + std::to_string(levels_in_files - 1) +
-                           " (about 1/" +
+  const std::string what = "drawing level " + std::to_string(d.level) + " (of levels 0 to " +
+                           std::to_string(levels_in_files - 1) + "; about 1/" +
                            std::to_string(static_cast<std::uint64_t>(std::pow(double(kLevelRatio), double(d.level)))) +
                            " of the streamlines, opacity compensated)";
+  if (d.forced && d.asked > d.level)
+    return what + ": --level " + std::to_string(d.asked) + " is past the coarsest level the files have";
   if (d.forced) return what + " as --level asks";
   return what + " to stay within a GPU memory budget of " + format_memory_size(d.budget) + " (" + d.budget_source +
          (d.budget_source == "--gpu-memory" ? ")" : "; --gpu-memory sets it)");

@@ -21,6 +21,7 @@ struct SceneDetail {
   std::uint64_t budget = 0;   // bytes
   std::string budget_source;  // where the budget comes from, for messages
   bool forced = false;        // --level chose the level
+  std::uint32_t asked = 0;    // the level --level asked for (past the coarsest, the coarsest is drawn)
 };
 
 // The span size too: `span_texels` (--span-texels) when given, else the driver's texture-buffer limit when

@@ -202,7 +202,7 @@ void apply_image(const ViewerArguments& a, ViewerOptions& o) {
     o.focus = glm::dvec3(x, y, z);
   }
   if ((a.was_given("--image-range") || a.was_given("--slices")) && !o.image)
-    usage_error("--image-range and --slices need --image FILE.nii[.gz]");
+    usage_error("--image-range and --slices need --image FILE.nii[.gz] or FILE.mif[.gz]");
 }
 
 // --view and the image or window size (--size, else the saved view's, else the default).

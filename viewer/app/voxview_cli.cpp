@@ -83,7 +83,9 @@ std::string voxview_description(const std::string& version) {
          "Opening a .vxl checks its structure (header, section table, section sizes, voxel table, names) in\n"
          "O(voxels) but not its checksums: damaged positions or values are drawn as they are; order entries outside\n"
          "their block and wrong voxline ends are found beside the drawing, which then stops (exit 3). --verify\n"
-         "checks everything first, as 'voxlines verify' does.\n" +
+         "checks everything first, as 'voxlines verify' does.\n"
+         "Exit codes: 0 ok, 2 usage, 3 bad input, 4 unsupported (a format, a size past the driver's limits), 5 output\n"
+         "error, 70 an internal error (a bug).\n" +
          controls_as_paragraph(110);
 }
 
@@ -159,7 +161,8 @@ void declare_picture(CLI::App& cli, ViewerArguments& a) {
 void declare_selection(CLI::App& cli, ViewerArguments& a) {
   cli.add_option("--include", a.options.include,
                  "select the streamlines that pass through this region (as `voxlines select`: X,Y,Z,R, "
-                 "box:X0,Y0,Z0,X1,Y1,Z1, FILE.nii[.gz][:LABEL]); they are drawn as the focus, the others as "
+                 "box:X0,Y0,Z0,X1,Y1,Z1, FILE.nii[.gz][:LABEL], FILE.mif[.gz][:LABEL]); they are drawn as the "
+                 "focus, the others as "
                  "context, in one back-to-front pass (repeatable)")
       ->type_name("ROI")
       ->expected(1)

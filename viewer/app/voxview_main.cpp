@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   using namespace vxl;
   app::ViewerArguments arguments;
   CLI::App cli{app::voxview_description(VOXLINES_VERSION)};
+  cli.set_version_flag("--version", VOXLINES_VERSION);
   app::declare_voxview_options(cli, arguments);
   try {
     app::parse_voxview_command_line(cli, arguments, argc, argv);
