@@ -18,7 +18,7 @@ void add_verify_command(CLI::App& app, int& exit_code) {
       "every check of its spec, every chunk decoded, and the .vxl it unpacks to (written to $TMPDIR, else /tmp, and "
       "removed) as a .vxl.\n"
       "Exit 0 when valid, 1 when invalid (the reason is printed), 3 when the file cannot be read, 4 when it is of a "
-      "version this program does not read.");
+      "version this program does not read, 5 when a package cannot be unpacked to be checked (the temporary folder).");
   cmd->add_option("file", *file, ".vxl or .vxlz file")->required();
   cmd->callback([file, &exit_code] {
     std::error_code ec;

@@ -155,7 +155,7 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     const VxlzFile package_file = VxlzFile::open(in_path);
     UnpackSettings unpack;
     unpack.threads = settings.threads;
-    if (settings.level) check_level(in_path, *settings.level, unpack.levels);  // the levels of the .vxl unpacked
+    if (settings.level) check_level(in_path, *settings.level, package_levels(package_file));  // those unpacked
     data.replace_extension(".vxl");
     // Not a .vxl's name: the shared file's is the input's with .vxl, whatever the input was called.
     const fs::path unpacked = settings.level ? staging / "unpacked.tmp" : staging / data;
@@ -175,7 +175,8 @@ ShareSummary fill_folder(const std::string& in_path, const fs::path& staging, co
     const VxlzFile package_file = VxlzFile::open(in_path);
     summary.streamlines = package_file.meta().streamline_count;
     const UnpackSettings as_the_page;
-    check_package_fits_the_page(in_path, unpacked_vxl_bytes(package_file, as_the_page), as_the_page.levels, settings);
+    check_package_fits_the_page(in_path, unpacked_vxl_bytes(package_file, as_the_page), package_levels(package_file),
+                                settings);
     summary.package = true;
     data.replace_extension(".vxlz");
     copy_file(in_path, staging / data);
