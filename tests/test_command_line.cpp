@@ -42,6 +42,22 @@ TEST(CommandLine, InfoAndVerifyNameTheFormatOfASourceGivenForAVxl) {
   EXPECT_NE(run_cli("info " + q(dir.file("t.trk"))).output.find("TrackVis TRK"), std::string::npos);
 }
 
+// --positions names what it takes, in convert and unpack, instead of CLI11's transformer table.
+TEST(CommandLine, APositionEncodingThatIsNotKnownSaysWhichAre) {
+  ScratchDir dir;
+  ASSERT_EQ(run_cli("synth " + q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  for (const std::string value : {"float64", "0"}) {
+    const test::CommandResult r =
+        run_cli("convert " + q(dir.file("a.tck")) + " " + q(dir.file("a.vxl")) + " --positions " + value);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("--positions: expected packed or float32, got '" + value + "'"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("a.vxl")));
+  }
+  EXPECT_EQ(run_cli("convert " + q(dir.file("a.tck")) + " " + q(dir.file("a.vxl")) + " --positions float32").exit_code,
+            0);
+}
+
 TEST(CommandLine, TyposGetTheNearestName) {
   EXPECT_EQ(nearest_name("convet", {"convert", "info", "verify"}), "convert");
   EXPECT_EQ(nearest_name("--voxelsize", {"--voxel-size", "--verbose"}), "--voxel-size");

@@ -50,7 +50,16 @@ inline CLI::Option* add_positions_option(CLI::App* cmd, PositionEncoding& positi
                        float32_keeps + ")")
       ->type_name("packed|float32")
       ->default_str("packed")
-      ->transform(CLI::CheckedTransformer(names).description(""));
+      // The name to the encoding's number, or a message naming the two (CLI::CheckedTransformer's lists its table,
+      // "{float32->0,packed->1} OR {0,1}", and takes the numbers too).
+      ->transform(CLI::Validator(
+          [names](std::string& name) -> std::string {
+            const auto it = names.find(name);
+            if (it == names.end()) return "expected packed or float32, got '" + name + "'";
+            name = std::to_string(static_cast<int>(it->second));
+            return {};
+          },
+          ""));
 }
 
 // --levels N, shared by convert and unpack (spec §5.12).
