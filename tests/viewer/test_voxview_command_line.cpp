@@ -19,6 +19,12 @@
 namespace vxl {
 namespace {
 
+// A 20-streamline source, a.tck, in `dir`, and the arguments that draw it headless at 16x16 into a.png there.
+std::string small_source_rendered(const test::ScratchDir& dir) {
+  EXPECT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  return test::q(dir.file("a.tck")) + " --size 16x16 --render " + test::q(dir.file("a.png"));
+}
+
 TEST(VoxviewCommandLine, TyposAndUnknownViewsSayWhatIsKnown) {
   const test::CommandResult typo = test::run_program(VOXVIEW_CLI, "x.vxl --render x.png --opacty 0.5");
   EXPECT_EQ(typo.exit_code, 2);
@@ -37,8 +43,7 @@ TEST(VoxviewCommandLine, TyposAndUnknownViewsSayWhatIsKnown) {
 // comparing false) and infinities are usage errors, naming the option, before anything is drawn.
 TEST(VoxviewCommandLine, OpacitiesAndLineWidthsThatAreNoNumberInTheirRangeAreUsageErrors) {
   test::ScratchDir dir;
-  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
-  const std::string render = test::q(dir.file("a.tck")) + " --size 16x16 --render " + test::q(dir.file("a.png"));
+  const std::string render = small_source_rendered(dir);
   const char* const refused[][2] = {
       {"--opacity", "nan"},       {"--opacity", "-nan"},        {"--opacity", "inf"},
       {"--opacity", "2"},         {"--line-width", "nan"},      {"--line-width", "inf"},
@@ -116,8 +121,7 @@ TEST(VoxviewCommandLine, APictureIsWrittenInTheFormatItsExtensionNames) {
 // is a usage error saying what is expected, not the largest double in full.
 TEST(VoxviewCommandLine, VoxelSizeAutoAndOutOfRangeSizesAsConvertSaysThem) {
   test::ScratchDir dir;
-  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
-  const std::string render = test::q(dir.file("a.tck")) + " --size 16x16 --render " + test::q(dir.file("a.png"));
+  const std::string render = small_source_rendered(dir);
   const test::CommandResult automatic = test::run_program(VOXVIEW_CLI, render + " --voxel-size auto");
   EXPECT_EQ(automatic.exit_code, 0) << automatic.output;
   EXPECT_NE(automatic.output.find("' --voxel-size auto"), std::string::npos)
@@ -198,8 +202,7 @@ TEST(VoxviewCommandLine, AMissingPictureModuleIsAnErrorThatNamesItAndWritesNothi
 // naming both, before anything is drawn.
 TEST(VoxviewCommandLine, TheWindowsOptionsAreRefusedWithRender) {
   test::ScratchDir dir;
-  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
-  const std::string render = test::q(dir.file("a.tck")) + " --size 16x16 --render " + test::q(dir.file("a.png"));
+  const std::string render = small_source_rendered(dir);
   const std::vector<std::string> options = {"--frames 3",          "--orbit 5",
                                             "--frame-budget 50",   "--no-exact-when-still",
                                             "--drag-region 1,0,0", "--screenshot " + test::q(dir.file("b.png")),
@@ -249,8 +252,7 @@ TEST(VoxviewCommandLine, ConversionOptionsWithNothingToConvertAreRefused) {
 // picture is drawn; with --save-camera it is kept in the saved view, and nothing is said.
 TEST(VoxviewCommandLine, ColourOptionsOfAnotherColourModeAreNotedHeadless) {
   test::ScratchDir dir;
-  ASSERT_EQ(test::run_cli("synth " + test::q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
-  const std::string render = test::q(dir.file("a.tck")) + " --size 16x16 --render " + test::q(dir.file("a.png"));
+  const std::string render = small_source_rendered(dir);
   const test::CommandResult r = test::run_program(VOXVIEW_CLI, render + " --colormap hot --fixed-color '#ff0000'");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("note: --colormap goes with --color scalar; this picture is coloured by direction"),
