@@ -58,6 +58,23 @@ TEST(CommandLine, APositionEncodingThatIsNotKnownSaysWhichAre) {
             0);
 }
 
+// --threads takes a whole number (0: all cores), in every command that has it, and says so otherwise.
+TEST(CommandLine, AThreadCountThatIsNotAWholeNumberSaysSo) {
+  ScratchDir dir;
+  ASSERT_EQ(run_cli("synth " + q(dir.file("a.tck")) + " --streamlines 20").exit_code, 0);
+  ASSERT_EQ(run_cli("convert " + q(dir.file("a.tck")) + " " + q(dir.file("a.vxl")) + " --threads 1").exit_code, 0);
+  const std::string commands[] = {"convert " + q(dir.file("a.tck")) + " " + q(dir.file("b.vxl")),
+                                  "pack " + q(dir.file("a.vxl")) + " " + q(dir.file("a.vxlz"))};
+  for (const std::string& command : commands)
+    for (const std::string value : {"-1", "x", "1.5"}) {
+      const test::CommandResult r = run_cli(command + " --threads " + value);
+      EXPECT_EQ(r.exit_code, 2) << command << ": " << r.output;
+      EXPECT_NE(r.output.find("--threads: expected a whole number of threads (0: all cores), got '" + value + "'"),
+                std::string::npos)
+          << r.output;
+    }
+}
+
 TEST(CommandLine, TyposGetTheNearestName) {
   EXPECT_EQ(nearest_name("convet", {"convert", "info", "verify"}), "convert");
   EXPECT_EQ(nearest_name("--voxelsize", {"--voxel-size", "--verbose"}), "--voxel-size");

@@ -134,9 +134,8 @@ void add_convert_command(CLI::App& app, int& exit_code) {
   add_voxel_size_option(*cmd, opt->voxel_size,
                         "voxel edge length in mm, or auto: chosen from the point count, extent and step length so "
                         "that voxels stay under ~32k vertices (16-bit orders), at most 10 mm; `info` shows the choice");
-  cmd->add_option("--threads", opt->settings.threads,
-                  "worker threads in all (0: all cores); --jobs N shares them, each file getting threads / N")
-      ->default_val(0);
+  add_threads_option(cmd, opt->settings.threads,
+                     "worker threads in all (0: all cores); --jobs N shares them, each file getting threads / N");
   add_orders_option(cmd, opt->settings.orders);
   add_positions_option(cmd, opt->settings.positions, "the source's coordinates bit for bit");
   add_levels_option(cmd, opt->settings.levels);

@@ -23,7 +23,7 @@ void add_pack_command(CLI::App& app) {
   cmd->add_option("--bits", opt->settings.bits, "quantisation bits per coordinate over the data's bounding cube")
       ->default_val(kVxlzDefaultBits)
       ->check(CLI::Range(kVxlzMinBits, kVxlzMaxBits));
-  cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
+  add_threads_option(cmd, opt->settings.threads, "worker threads (0: all cores)");
   cmd->callback([opt] {
     require_output_suffix(opt->output, ".vxlz", "pack writes a .vxlz package: name the output OUT.vxlz");
     VxlFile f = VxlFile::open(opt->input);

@@ -49,9 +49,8 @@ void add_share_command(CLI::App& app) {
          "spread over the whole tractogram): a smaller file to host. Without it, a .vxl larger than a browser\n"
          "holds (3.75 GiB) is drawn from the coarser levels that fit, fetched by ranges")
       ->type_name("N");
-  cmd->add_option("--threads", opt->settings.threads,
-                  "worker threads for unpacking a .vxlz (--unpack, --level; 0: all cores)")
-      ->default_val(0);
+  add_threads_option(cmd, opt->settings.threads,
+                     "worker threads for unpacking a .vxlz (--unpack, --level; 0: all cores)");
   cmd->callback([opt] {
     if (opt->settings.web_viewer_dir.empty()) opt->settings.web_viewer_dir = default_web_viewer_dir();
     const ShareSummary s = share_folder(opt->input, opt->output, opt->settings);

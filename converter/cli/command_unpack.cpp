@@ -18,7 +18,7 @@ void add_unpack_command(CLI::App& app) {
       "unpack", "Turn a .vxlz package back into a .vxl (orders and bounds recomputed; verify accepts it)");
   cmd->add_option("input", opt->input, ".vxlz package")->required();
   cmd->add_option("output", opt->output, "output .vxl (written atomically)")->required();
-  cmd->add_option("--threads", opt->settings.threads, "worker threads (0: all cores)")->default_val(0);
+  add_threads_option(cmd, opt->settings.threads, "worker threads (0: all cores)");
   add_positions_option(cmd, opt->settings.positions,
                        "the package's positions as decoded: the package quantised them, within the error bound "
                        "`pack` and `info` print");

@@ -2,6 +2,7 @@
 // the work; errors are thrown as vxl::Error and turned into messages and exit codes by main().
 #pragma once
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -60,6 +61,16 @@ inline CLI::Option* add_positions_option(CLI::App* cmd, PositionEncoding& positi
             return {};
           },
           ""));
+}
+
+// --threads N, shared by convert, pack, unpack and share: a whole number, 0 for all cores (CLI11's own message for
+// -1 is "Could not convert").
+inline CLI::Option* add_threads_option(CLI::App* cmd, unsigned& threads, const std::string& help) {
+  return cmd->add_option("--threads", threads, help)->default_val(0)->check([](const std::string& text) -> std::string {
+    const bool digits = !text.empty() && text.size() <= 9 &&
+                        std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+    return digits ? "" : "expected a whole number of threads (0: all cores), got '" + text + "'";
+  });
 }
 
 // --levels N, shared by convert and unpack (spec §5.12).
