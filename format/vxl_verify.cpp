@@ -291,16 +291,12 @@ VerifyResult verify_vxl(const std::string& path) {
   try {
     return verify_vxl(VxlFile::open(path));
   } catch (const Error& e) {
-    VerifyResult r;
-    r.kind = e.kind();
-    r.problem = e.what();
-    return r;
+    return VerifyResult::refused(e);
   }
 }
 
 VerifyResult verify_vxl(const VxlFile& f) {
   const std::string& path = f.path();
-  VerifyResult r;
   try {
     check_checksums_and_padding(f);
     check_meta_and_dirs(f);
@@ -323,12 +319,12 @@ VerifyResult verify_vxl(const VxlFile& f) {
     f.groups();
     check_value_sets(f, f.vertex_values(), "VVAL");
     check_value_sets(f, f.streamline_values(), "SVAL");
-    r.valid = true;
   } catch (const Error& e) {
-    r.kind = e.kind();
-    r.problem = e.what();
+    return VerifyResult::refused(e);
   }
-  return r;
+  VerifyResult valid;
+  valid.valid = true;
+  return valid;
 }
 
 }  // namespace vxl

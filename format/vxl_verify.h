@@ -15,6 +15,9 @@ struct VerifyResult {
   // does not handle; Output when a package could not be unpacked to be checked.
   ErrorKind kind = ErrorKind::Input;
   std::string problem;  // the first problem found, naming the file and byte offset; empty when valid
+
+  // The result of a check that `e` ended.
+  static VerifyResult refused(const Error& e) { return {false, e.kind(), e.what()}; }
 };
 
 VerifyResult verify_vxl(const std::string& path);

@@ -12,10 +12,7 @@ VerifyResult verify_vxlz(const std::string& path) {
         open_through_temporary_vxl(path, [&](const std::string& out) { unpack_vxlz(path, out, UnpackSettings()); });
     return verify_vxl(unpacked.file);
   } catch (const Error& e) {
-    VerifyResult r;
-    r.kind = e.kind();
-    r.problem = e.what();
-    return r;
+    return VerifyResult::refused(e);
   }
 }
 
